@@ -1,0 +1,29 @@
+// Face adjacency of the tets: the neighbour across each tet face, found by sorting face keys
+// (a counting sort on each face's smallest vertex, then small sorts; O(n) for bounded vertex degree,
+// O(n log n) at worst), no hashing.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+
+namespace foxi {
+
+// Face f of tet t is the face opposite its vertex f. neighbour[4t+f] is 4u+g when face g of tet u
+// is the same triangle, kNone on the boundary and on non-manifold faces (shared by 3 or more tets,
+// counted in nonmanifold_faces). Needs tet_count < 2^30.
+struct FaceAdjacency {
+  std::vector<std::uint32_t> neighbour;  // 4 per tet
+  std::size_t interior_faces = 0;        // faces shared by exactly two tets
+  std::size_t boundary_faces = 0;        // faces of exactly one tet
+  std::size_t nonmanifold_faces = 0;     // distinct triangles shared by three or more tets
+};
+
+// Computes the adjacency afresh (uses both cores on large meshes).
+FaceAdjacency compute_face_adjacency(const Mesh& mesh);
+// Cached on the mesh (see invalidate_derived); the reference lives as long as the mesh's cache.
+const FaceAdjacency& face_adjacency(const Mesh& mesh);
+
+}  // namespace foxi

@@ -1,0 +1,29 @@
+// Errors of foxi's readers and writers: they say which file, where in it, and why.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace foxi {
+
+class IoError : public std::runtime_error {
+ public:
+  // line: 1-based line number, 0 when unknown or not meaningful (binary data);
+  // byte_offset: offset of the problem in the file, or kNoOffset.
+  static constexpr std::uint64_t kNoOffset = ~std::uint64_t{0};
+  IoError(std::string file, std::uint64_t line, std::uint64_t byte_offset, std::string reason);
+
+  const std::string& file() const { return file_; }
+  std::uint64_t line() const { return line_; }
+  std::uint64_t byte_offset() const { return byte_offset_; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string file_;
+  std::uint64_t line_;
+  std::uint64_t byte_offset_;
+  std::string reason_;
+};
+
+}  // namespace foxi

@@ -1,0 +1,118 @@
+// The common mesh database: the one structure every foxi library reads and writes.
+//
+// Plain data, structure of arrays, std::uint32_t indices with kNone as "no index". All quantities in
+// SI units (metres, kelvin, ...). Derived data (face adjacency, circumspheres, the Delaunay
+// certificate) is never stored here twice: it is computed on demand by the functions that own it and
+// cached in `derived`, which a copy of the mesh does not share.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace foxi {
+
+inline constexpr std::uint32_t kNone = 0xffffffffu;
+
+// Material properties in SI units; NaN means "not given".
+struct Material {
+  static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
+  std::string name;
+  double thermal_conductivity = kUnset;    // W/(m K)
+  double electrical_conductivity = kUnset; // S/m
+  double relative_permittivity = kUnset;   // 1
+  double youngs_modulus = kUnset;          // Pa
+  double poisson_ratio = kUnset;           // 1
+  double thermal_expansion = kUnset;       // 1/K
+};
+
+// A region (a part, a physical volume group): tets whose tet_region equals `id`.
+struct Region {
+  std::int32_t id = 0;
+  std::string name;                   // may be empty
+  std::uint32_t material = kNone;     // index into Mesh::materials, or kNone
+};
+
+// A named boundary: boundary triangles whose bface_tag equals `tag`.
+struct Boundary {
+  std::int32_t tag = 0;
+  std::string name;                   // may be empty
+};
+
+enum class FieldLocation : std::uint8_t { node, cell };
+
+// A named field on nodes or on cells, with `components` values per entity (1 scalar, 3 vector,
+// 6 symmetric tensor in the order xx yy zz xy yz xz, 9 full tensor row-major; other counts are kept
+// as they are). Several steps (time or load steps) are stored one after the other:
+// values[(step * entity_count + entity) * components + component].
+struct Field {
+  std::string name;
+  FieldLocation location = FieldLocation::node;
+  std::uint32_t components = 1;
+  std::string unit;                   // SI unit symbol, may be empty
+  std::vector<double> step_values;    // time or load value of each step; size = step count (>= 1)
+  std::vector<double> values;
+
+  std::size_t step_count() const { return step_values.empty() ? 1 : step_values.size(); }
+  // Values of one step: entity_count * components doubles.
+  std::span<const double> step(std::size_t s, std::size_t entity_count) const {
+    return std::span<const double>(values).subspan(s * entity_count * components,
+                                                   entity_count * components);
+  }
+};
+
+struct DerivedData;  // defined by the derived-data functions (adjacency.hpp, delaunay.hpp, ...)
+
+// Holds derived data; copying gives an empty cache so that copies never share stale results.
+class DerivedCache {
+ public:
+  DerivedCache() = default;
+  DerivedCache(const DerivedCache&) {}
+  DerivedCache& operator=(const DerivedCache&) { data_.reset(); return *this; }
+  DerivedCache(DerivedCache&&) noexcept = default;
+  DerivedCache& operator=(DerivedCache&&) noexcept = default;
+  ~DerivedCache();
+  void clear() { data_.reset(); }
+  DerivedData& get() const;           // creates the (empty) data on first use
+ private:
+  mutable std::shared_ptr<DerivedData> data_;
+};
+
+struct Mesh {
+  std::vector<double> xyz;                 // 3 per node
+  std::vector<std::uint32_t> tet;          // 4 per tet, positively oriented (see validate.hpp)
+  std::vector<std::int32_t> tet_region;    // 1 per tet (region id), or empty = all region 0
+  std::vector<Region> regions;             // id -> name and material
+  std::vector<Material> materials;
+  std::vector<std::uint32_t> bface;        // 3 per boundary triangle
+  std::vector<std::int32_t> bface_tag;     // 1 per boundary triangle (boundary tag)
+  std::vector<Boundary> boundaries;        // tag -> name
+  std::vector<double> weight;              // 1 per node (regular triangulation), or empty
+  std::vector<Field> fields;
+  DerivedCache derived;                    // see invalidate_derived()
+
+  std::size_t node_count() const { return xyz.size() / 3; }
+  std::size_t tet_count() const { return tet.size() / 4; }
+  std::size_t bface_count() const { return bface.size() / 3; }
+  std::int32_t region_of(std::size_t t) const { return tet_region.empty() ? 0 : tet_region[t]; }
+
+  const Field* find_field(std::string_view name) const;
+  const Region* find_region(std::int32_t id) const;
+  const Boundary* find_boundary(std::int32_t tag) const;
+};
+
+// Drops every cached derived result. Call after changing xyz, tet or weight in place; the functions
+// of foxi that change a mesh call it themselves.
+void invalidate_derived(Mesh& mesh);
+
+// Entity count a field's location refers to (node_count or tet_count).
+std::size_t field_entity_count(const Mesh& mesh, const Field& field);
+
+// Checks the sizes of every array against each other (xyz % 3, tet % 4, tet_region, bface_tag,
+// weight, field value counts). Returns an empty string when consistent, else the first problem.
+std::string check_sizes(const Mesh& mesh);
+
+}  // namespace foxi

@@ -1,0 +1,33 @@
+// Tet shape quality: radius-edge ratio (circumradius / shortest edge; 0.612 for the regular tet) and
+// minimum dihedral angle (degrees; 70.53 for the regular tet), and volumes.
+#pragma once
+
+#include <cstddef>
+#include <span>
+
+#include "foxi/model/mesh.hpp"
+
+namespace foxi {
+
+struct TetQuality {
+  double volume = 0;            // signed, m^3
+  double radius_edge = 0;       // +inf for a flat tet
+  double min_dihedral_deg = 0;  // 0 for a flat tet
+};
+
+TetQuality tet_quality(const double* p0, const double* p1, const double* p2, const double* p3);
+
+struct Stat {
+  double min = 0, max = 0, mean = 0;
+};
+
+struct QualitySummary {
+  std::size_t tets = 0;
+  double total_volume = 0;      // sum of |volume|
+  Stat volume, radius_edge, min_dihedral_deg;
+  std::size_t slivers = 0;      // min dihedral below 5 degrees
+};
+
+QualitySummary summarize_quality(const Mesh& mesh);
+
+}  // namespace foxi

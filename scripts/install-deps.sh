@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs foxi's build and test dependencies from Debian packages (run as root, or with sudo).
+# Installs only what is missing, so a second run costs a few dpkg queries.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config
+  # libraries
+  libcgal-dev libgmp-dev libmpfr-dev libboost-dev libtet1.5-dev libeigen3-dev
+  qtbase5-dev libx11-dev libxext-dev libpng-dev zlib1g-dev libpugixml-dev libfreetype-dev libgif-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev xvfb
+  # outside programs the tests use as oracles
+  gmsh tetgen calculix-ccx python3-meshio python3-numpy
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

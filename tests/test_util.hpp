@@ -1,0 +1,64 @@
+// Helpers for the tests: temporary folders, running outside programs (gmsh, tetgen, the foxi CLI).
+#pragma once
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+namespace foxi::test {
+
+// A fresh empty folder under the system temp folder, removed with everything in it at scope exit.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("foxi-test-" + std::to_string(rd()) + "-" + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+inline std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Runs a shell command; returns its exit status (0 = success). Output goes to `log` if given.
+inline int run(const std::string& command, const std::filesystem::path& log = {}) {
+  std::string cmd = command;
+  if (!log.empty()) cmd += " > '" + log.string() + "' 2>&1";
+  int status = std::system(cmd.c_str());
+  if (status == -1) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+// True if an outside program is on PATH.
+inline bool have_program(const std::string& name) {
+  return run("command -v " + name + " > /dev/null 2>&1") == 0;
+}
+
+inline std::string data_dir() { return FOXI_TEST_DATA_DIR; }
+inline std::string cli_path() { return FOXI_CLI_PATH; }
+
+}  // namespace foxi::test
