@@ -1,1 +1,59 @@
-int main() { return 0; }
+// foxi: the command-line program. Subcommands are plain functions in cmd_*.cpp.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "foxi/model/io_error.hpp"
+
+namespace {
+
+const char* kUsage =
+    "foxi - finite-element pre/post-processor (meshes, fields, Delaunay visibility ordering)\n"
+    "\n"
+    "usage: foxi COMMAND [options]\n"
+    "\n"
+    "commands:\n"
+    "  info MESH      counts, bounding box, regions, boundaries, fields, volume, tet quality,\n"
+    "                 validation; --json for machine-readable output; --check-delaunay\n"
+    "  convert IN OUT convert between mesh formats (format from the extension)\n"
+    "\n"
+    "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"
+    "              .node/.ele/.face (TetGen), .mesh (Medit)\n"
+    "\n"
+    "'foxi COMMAND --help' describes a command.\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::fputs(kUsage, stdout);
+    return args.empty() ? 2 : 0;
+  }
+  if (args[0] == "--version") {
+    std::puts("foxi 0.1.0");
+    return 0;
+  }
+  std::string command = args[0];
+  foxi::cli::Args rest(std::vector<std::string>(args.begin() + 1, args.end()));
+  try {
+    if (command == "info") return foxi::cli::cmd_info(std::move(rest));
+    if (command == "convert") return foxi::cli::cmd_convert(std::move(rest));
+    std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
+    return 2;
+  } catch (const foxi::cli::UsageError& e) {
+    std::fprintf(stderr, "foxi %s: %s\n", command.c_str(), e.what());
+    return 2;
+  } catch (const foxi::IoError& e) {
+    std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "foxi %s: error: out of memory\n", command.c_str());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,77 @@
+#include "cli.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+
+namespace foxi::cli {
+
+bool Args::flag(std::string_view name) {
+  for (auto it = args_.begin(); it != args_.end(); ++it) {
+    if (*it == name) {
+      args_.erase(it);
+      return true;
+    }
+  }
+  return false;
+}
+
+bool Args::has_option(std::string_view name) const {
+  for (const std::string& a : args_) if (a == name) return true;
+  return false;
+}
+
+std::string Args::option(std::string_view name, std::string fallback) {
+  for (auto it = args_.begin(); it != args_.end(); ++it) {
+    if (*it == name) {
+      if (it + 1 == args_.end()) throw UsageError("option " + std::string(name) + " needs a value");
+      std::string value = *(it + 1);
+      args_.erase(it, it + 2);
+      return value;
+    }
+  }
+  return fallback;
+}
+
+std::vector<std::string> Args::positional(std::size_t min, std::size_t max, std::string_view usage) {
+  for (const std::string& a : args_) {
+    if (a.size() > 1 && a[0] == '-' && a[1] == '-') throw UsageError("unknown option " + a + "\nusage: " + std::string(usage));
+  }
+  if (args_.size() < min || args_.size() > max) {
+    throw UsageError("expected " + (min == max ? std::to_string(min) : std::to_string(min) + " to " + std::to_string(max)) +
+                     " arguments, got " + std::to_string(args_.size()) + "\nusage: " + std::string(usage));
+  }
+  return args_;
+}
+
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+  return out;
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+}  // namespace foxi::cli

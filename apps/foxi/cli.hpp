@@ -1,0 +1,42 @@
+// Shared pieces of the foxi command-line program: argument lists, usage errors, JSON text.
+#pragma once
+
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace foxi::cli {
+
+// A mistake in the command line (exit status 2); the message says what was wrong.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// The arguments of one subcommand, with flags taken out as they are asked for.
+class Args {
+ public:
+  explicit Args(std::vector<std::string> args) : args_(std::move(args)) {}
+  // True (and removed) if `flag` is present.
+  bool flag(std::string_view name);
+  // The value after `name` (removed with it), or `fallback` if absent; UsageError if it has none.
+  std::string option(std::string_view name, std::string fallback = {});
+  bool has_option(std::string_view name) const;
+  // The remaining arguments; UsageError if any still starts with "--" (an unknown option) or their
+  // count is not between min and max.
+  std::vector<std::string> positional(std::size_t min, std::size_t max, std::string_view usage);
+
+ private:
+  std::vector<std::string> args_;
+};
+
+// A JSON string literal for `s` (quotes and escapes added).
+std::string json_string(std::string_view s);
+// A JSON number for `v` (null for NaN and infinities, which JSON lacks).
+std::string json_number(double v);
+
+int cmd_info(Args args);
+int cmd_convert(Args args);
+
+}  // namespace foxi::cli

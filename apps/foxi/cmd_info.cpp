@@ -1,0 +1,261 @@
+// foxi info MESH: what is in a mesh file, and whether it is fit to use.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <string>
+
+#include "cli.hpp"
+#include "foxi/model/adjacency.hpp"
+#include "foxi/model/delaunay.hpp"
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/model/quality.hpp"
+#include "foxi/model/validate.hpp"
+
+namespace foxi::cli {
+
+namespace {
+
+const char* kInfoUsage =
+    "foxi info MESH [--json] [--check-delaunay] [--no-quality]\n"
+    "  Prints node, tet and boundary-triangle counts, the bounding box, regions (tets, volume),\n"
+    "  boundaries, fields, total volume, tet quality (radius-edge ratio, minimum dihedral angle),\n"
+    "  face adjacency (boundary and non-manifold faces) and validation problems.\n"
+    "  --json            the same as one JSON object on stdout\n"
+    "  --check-delaunay  also certify that every tet's circumsphere is empty (exact predicates)\n"
+    "  --no-quality      skip the quality statistics\n"
+    "  Exit status: 0 usable mesh, 1 unreadable file or invalid mesh, 2 usage error.";
+
+struct RegionStats {
+  std::size_t tets = 0;
+  double volume = 0;
+};
+
+double tet_volume(const Mesh& m, std::size_t t) {
+  const double* p[4];
+  for (int i = 0; i < 4; ++i) p[i] = &m.xyz[3 * std::size_t(m.tet[4 * t + i])];
+  double a[3], b[3], c[3];
+  for (int k = 0; k < 3; ++k) {
+    a[k] = p[1][k] - p[0][k];
+    b[k] = p[2][k] - p[0][k];
+    c[k] = p[3][k] - p[0][k];
+  }
+  return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+}
+
+const char* location_name(FieldLocation l) { return l == FieldLocation::node ? "node" : "cell"; }
+
+}  // namespace
+
+int cmd_info(Args args) {
+  if (args.flag("--help") || args.flag("-h")) {
+    std::puts(kInfoUsage);
+    return 0;
+  }
+  const bool json = args.flag("--json");
+  const bool check_delaunay = args.flag("--check-delaunay");
+  const bool quality = !args.flag("--no-quality");
+  const std::string path = args.positional(1, 1, kInfoUsage)[0];
+
+  auto t0 = std::chrono::steady_clock::now();
+  const MeshFormat format = format_from_path(path);
+  const Mesh mesh = read_mesh(path);
+  const double read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const ValidationReport report = validate(mesh);
+  const bool indices_ok = report.size_problem.empty() && report.index_out_of_range == 0;
+
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::numeric_limits<double>::infinity();
+    hi[k] = -std::numeric_limits<double>::infinity();
+  }
+  for (std::size_t i = 0; i < mesh.node_count(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      double v = mesh.xyz[3 * i + k];
+      if (std::isfinite(v)) {
+        lo[k] = std::min(lo[k], v);
+        hi[k] = std::max(hi[k], v);
+      }
+    }
+
+  std::map<std::int32_t, RegionStats> regions;
+  double volume = 0;
+  if (indices_ok) {
+    for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+      double v = std::abs(tet_volume(mesh, t));
+      RegionStats& r = regions[mesh.region_of(t)];
+      ++r.tets;
+      r.volume += v;
+      volume += v;
+    }
+  }
+  for (const Region& r : mesh.regions) regions.try_emplace(r.id);
+  std::map<std::int32_t, std::size_t> boundaries;
+  for (std::int32_t tag : mesh.bface_tag) ++boundaries[tag];
+  for (const Boundary& b : mesh.boundaries) boundaries.try_emplace(b.tag, 0);
+
+  QualitySummary q;
+  if (quality && indices_ok) q = summarize_quality(mesh);
+  FaceAdjacency adjacency;
+  bool have_adjacency = indices_ok && report.repeated_vertex == 0;
+  if (have_adjacency) adjacency = compute_face_adjacency(mesh);
+  DelaunayCertificate cert;
+  bool have_cert = check_delaunay && report.ok();
+  if (have_cert) cert = compute_delaunay_certificate(mesh);
+
+  auto region_name = [&](std::int32_t id) {
+    const Region* r = mesh.find_region(id);
+    return r ? r->name : std::string();
+  };
+  auto material_name = [&](std::int32_t id) {
+    const Region* r = mesh.find_region(id);
+    return r && r->material != kNone ? mesh.materials[r->material].name : std::string();
+  };
+  auto boundary_name = [&](std::int32_t tag) {
+    const Boundary* b = mesh.find_boundary(tag);
+    return b ? b->name : std::string();
+  };
+
+  if (json) {
+    std::string o = "{\n";
+    o += "  \"file\": " + json_string(path) + ",\n";
+    o += "  \"format\": " + json_string(format_name(format)) + ",\n";
+    o += "  \"read_seconds\": " + json_number(read_s) + ",\n";
+    o += "  \"nodes\": " + std::to_string(mesh.node_count()) + ",\n";
+    o += "  \"tets\": " + std::to_string(mesh.tet_count()) + ",\n";
+    o += "  \"boundary_triangles\": " + std::to_string(mesh.bface_count()) + ",\n";
+    o += "  \"weighted\": " + std::string(mesh.weight.empty() ? "false" : "true") + ",\n";
+    o += "  \"bounding_box\": {\"min\": [" + json_number(lo[0]) + ", " + json_number(lo[1]) + ", " +
+         json_number(lo[2]) + "], \"max\": [" + json_number(hi[0]) + ", " + json_number(hi[1]) + ", " +
+         json_number(hi[2]) + "]},\n";
+    o += "  \"volume\": " + json_number(volume) + ",\n";
+    o += "  \"regions\": [";
+    bool first = true;
+    for (auto& [id, s] : regions) {
+      o += first ? "\n" : ",\n";
+      first = false;
+      o += "    {\"id\": " + std::to_string(id) + ", \"name\": " + json_string(region_name(id)) +
+           ", \"material\": " + json_string(material_name(id)) + ", \"tets\": " + std::to_string(s.tets) +
+           ", \"volume\": " + json_number(s.volume) + "}";
+    }
+    o += first ? "],\n" : "\n  ],\n";
+    o += "  \"boundaries\": [";
+    first = true;
+    for (auto& [tag, n] : boundaries) {
+      o += first ? "\n" : ",\n";
+      first = false;
+      o += "    {\"tag\": " + std::to_string(tag) + ", \"name\": " + json_string(boundary_name(tag)) +
+           ", \"triangles\": " + std::to_string(n) + "}";
+    }
+    o += first ? "],\n" : "\n  ],\n";
+    o += "  \"fields\": [";
+    first = true;
+    for (const Field& f : mesh.fields) {
+      o += first ? "\n" : ",\n";
+      first = false;
+      o += "    {\"name\": " + json_string(f.name) + ", \"location\": " + json_string(location_name(f.location)) +
+           ", \"components\": " + std::to_string(f.components) + ", \"steps\": " + std::to_string(f.step_count()) +
+           ", \"unit\": " + json_string(f.unit) + "}";
+    }
+    o += first ? "],\n" : "\n  ],\n";
+    if (quality && indices_ok) {
+      auto stat = [](const Stat& s) {
+        return "{\"min\": " + json_number(s.min) + ", \"mean\": " + json_number(s.mean) +
+               ", \"max\": " + json_number(s.max) + "}";
+      };
+      o += "  \"quality\": {\"radius_edge\": " + stat(q.radius_edge) +
+           ", \"min_dihedral_deg\": " + stat(q.min_dihedral_deg) + ", \"volume\": " + stat(q.volume) +
+           ", \"slivers\": " + std::to_string(q.slivers) + "},\n";
+    }
+    if (have_adjacency) {
+      o += "  \"faces\": {\"interior\": " + std::to_string(adjacency.interior_faces) +
+           ", \"boundary\": " + std::to_string(adjacency.boundary_faces) +
+           ", \"nonmanifold\": " + std::to_string(adjacency.nonmanifold_faces) + "},\n";
+    }
+    if (have_cert) {
+      o += "  \"delaunay\": {\"delaunay\": " + std::string(cert.delaunay ? "true" : "false") +
+           ", \"weighted\": " + std::string(cert.weighted ? "true" : "false") +
+           ", \"violating_tets\": " + std::to_string(cert.violating_tet_count) +
+           ", \"degenerate_tets\": " + std::to_string(cert.degenerate_tet_count) +
+           ", \"max_relative_depth\": " + json_number(cert.max_relative_depth) + "},\n";
+    }
+    o += "  \"validation\": {\"ok\": " + std::string(report.ok() ? "true" : "false") +
+         ", \"size_problem\": " + json_string(report.size_problem) +
+         ", \"index_out_of_range\": " + std::to_string(report.index_out_of_range) +
+         ", \"repeated_vertex\": " + std::to_string(report.repeated_vertex) +
+         ", \"nonfinite_nodes\": " + std::to_string(report.nonfinite_nodes) +
+         ", \"zero_volume\": " + std::to_string(report.zero_volume) +
+         ", \"inverted\": " + std::to_string(report.inverted) +
+         ", \"unused_nodes\": " + std::to_string(report.unused_nodes) + ", \"messages\": [";
+    for (std::size_t i = 0; i < report.messages.size(); ++i)
+      o += (i ? ", " : "") + json_string(report.messages[i]);
+    o += "]}\n}\n";
+    std::fputs(o.c_str(), stdout);
+    return report.ok() ? 0 : 1;
+  }
+
+  std::printf("file                %s (%s, read in %.3f s)\n", path.c_str(), format_name(format), read_s);
+  std::printf("nodes               %zu%s\n", mesh.node_count(), mesh.weight.empty() ? "" : " (weighted)");
+  std::printf("tets                %zu\n", mesh.tet_count());
+  std::printf("boundary triangles  %zu\n", mesh.bface_count());
+  if (mesh.node_count() > 0)
+    std::printf("bounding box        [%g, %g, %g] .. [%g, %g, %g]\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+  std::printf("volume              %.10g\n", volume);
+  std::printf("regions             %zu\n", regions.size());
+  for (auto& [id, s] : regions) {
+    std::string name = region_name(id), mat = material_name(id);
+    std::printf("  %6d  %-20s %-14s %10zu tets  volume %.6g\n", id, name.empty() ? "-" : name.c_str(),
+                mat.empty() ? "-" : mat.c_str(), s.tets, s.volume);
+  }
+  std::printf("boundaries          %zu\n", boundaries.size());
+  for (auto& [tag, n] : boundaries) {
+    std::string name = boundary_name(tag);
+    std::printf("  %6d  %-20s %10zu triangles\n", tag, name.empty() ? "-" : name.c_str(), n);
+  }
+  std::printf("fields              %zu\n", mesh.fields.size());
+  for (const Field& f : mesh.fields)
+    std::printf("  %-24s %s, %u component%s, %zu step%s%s%s\n", f.name.c_str(), location_name(f.location),
+                f.components, f.components == 1 ? "" : "s", f.step_count(), f.step_count() == 1 ? "" : "s",
+                f.unit.empty() ? "" : ", ", f.unit.c_str());
+  if (quality && indices_ok && mesh.tet_count() > 0) {
+    std::printf("radius-edge ratio   min %.4g  mean %.4g  max %.4g\n", q.radius_edge.min, q.radius_edge.mean,
+                q.radius_edge.max);
+    std::printf("min dihedral (deg)  min %.4g  mean %.4g  max %.4g  (%zu slivers below 5 deg)\n",
+                q.min_dihedral_deg.min, q.min_dihedral_deg.mean, q.min_dihedral_deg.max, q.slivers);
+  }
+  if (have_adjacency)
+    std::printf("faces               %zu interior, %zu boundary, %zu non-manifold\n", adjacency.interior_faces,
+                adjacency.boundary_faces, adjacency.nonmanifold_faces);
+  if (have_cert) {
+    if (cert.delaunay)
+      std::printf("delaunay            yes: every %s is empty (%zu tets, exact predicates)\n",
+                  cert.weighted ? "orthosphere" : "circumsphere", cert.tets_checked);
+    else
+      std::printf("delaunay            NO: %zu of %zu tets have a vertex inside their %s (deepest %.3g of the "
+                  "radius), %zu degenerate\n",
+                  cert.violating_tet_count, cert.tets_checked, cert.weighted ? "orthosphere" : "circumsphere",
+                  cert.max_relative_depth, cert.degenerate_tet_count);
+  } else if (check_delaunay) {
+    std::printf("delaunay            not checked: the mesh is invalid\n");
+  }
+  if (report.ok() && report.inverted == 0 && report.unused_nodes == 0) {
+    std::printf("validation          ok\n");
+  } else {
+    std::printf("validation          %s\n", report.ok() ? "usable, with warnings" : "INVALID");
+    if (!report.size_problem.empty()) std::printf("  %s\n", report.size_problem.c_str());
+    if (report.index_out_of_range) std::printf("  %zu elements with a node index out of range\n", report.index_out_of_range);
+    if (report.repeated_vertex) std::printf("  %zu elements naming one node twice\n", report.repeated_vertex);
+    if (report.nonfinite_nodes) std::printf("  %zu nodes with NaN or infinite coordinates\n", report.nonfinite_nodes);
+    if (report.zero_volume) std::printf("  %zu tets of zero volume\n", report.zero_volume);
+    if (report.inverted) std::printf("  %zu inverted tets (negative orientation; convert re-orients them)\n", report.inverted);
+    if (report.unused_nodes) std::printf("  %zu nodes used by no tet\n", report.unused_nodes);
+    for (const std::string& m : report.messages) std::printf("  %s\n", m.c_str());
+  }
+  return report.ok() ? 0 : 1;
+}
+
+}  // namespace foxi::cli

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Runs every test on a fresh machine: installs what is missing, builds (Release), runs all tests
+# with CTest; then builds the model tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs
+# them again (readers on broken files must never crash). Set FOXI_SKIP_SANITIZE=1 to skip the second.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+bash scripts/build.sh
+ctest --test-dir build --output-on-failure -j2 --timeout 900
+if [ "${FOXI_SKIP_SANITIZE:-0}" != "1" ]; then
+  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DFOXI_SANITIZE=ON -DFOXI_BUILD_BENCH=OFF \
+    > build-asan.log 2>&1 || { cat build-asan.log; exit 1; }
+  ninja -C build-asan
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    ctest --test-dir build-asan --output-on-failure -j2 --timeout 1800 -R 'model\.|Io|Gmsh|Vtk|Vtu|TetGen|Medit|Bad|Adjacency|Delaunay|Validat|Quality|Cli'
+fi
