@@ -1,7 +1,360 @@
-// Placeholder until the certificate lands.
+// The Delaunay certificate: a global empty-sphere (or, with weights, empty-orthosphere) check.
+//
+// The used vertices go into a uniform grid (a counting sort on cells, x fastest, so one row of cells is
+// one contiguous run of points). For each tet the circumcentre (orthocentre) is computed in double
+// relative to its first vertex, with an a-priori bound on its error (Higham-style: terms bounded by
+// a constant times the unit roundoff times the "permanent", the same expression with absolute values,
+// as in Shewchuk's adaptive predicates). Every vertex in the cells that the sphere's box (enlarged by
+// that bound) overlaps is first tested in double against the sphere enlarged by the bound: a vertex
+// outside is certainly outside the exact sphere. The rest (the tet's own vertices skipped) are decided
+// by CGAL's filtered exact predicates, so cospherical points (on the sphere) are never violations.
 #include "foxi/model/delaunay.hpp"
-#include <stdexcept>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <thread>
+
+#include "derived.hpp"
+
 namespace foxi {
-DelaunayCertificate compute_delaunay_certificate(const Mesh&, const CertificateOptions&) { throw std::logic_error("certificate not built yet"); }
-const DelaunayCertificate& delaunay_certificate(const Mesh&) { throw std::logic_error("certificate not built yet"); }
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = K::Point_3;
+using WPoint = K::Weighted_point_3;
+
+constexpr double kU = 0x1p-53;  // unit roundoff of double
+
+struct GridPoint {
+  double x, y, z;
+  double w;  // weight (0 when unweighted)
+  std::uint32_t id;
+};
+
+// The used, finite vertices sorted into uniform cubic cells.
+struct PointGrid {
+  double lo[3] = {0, 0, 0};
+  double inv_h = 1;
+  std::int64_t dims[3] = {1, 1, 1};
+  std::vector<std::uint32_t> cell_start;  // dims product + 1
+  std::vector<GridPoint> pts;             // in cell order
+  double scale = 0;                       // largest absolute coordinate
+  double wmax = 0;                        // largest weight (0 when unweighted)
+
+  // Monotone in v (rounding is monotone), so a box's cell range holds every point inside the box.
+  std::int64_t cell(double v, int d) const {
+    double f = (v - lo[d]) * inv_h;
+    if (!(f >= 0)) return 0;
+    if (f >= static_cast<double>(dims[d])) return dims[d] - 1;
+    return static_cast<std::int64_t>(f);
+  }
+};
+
+bool finite3(const double* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+
+PointGrid build_grid(const Mesh& mesh, bool weighted) {
+  PointGrid g;
+  const std::size_t nv = mesh.node_count();
+  std::vector<std::uint8_t> used(nv, 0);
+  for (std::uint32_t v : mesh.tet)
+    if (v < nv) used[v] = 1;
+  std::size_t m = 0;
+  double lo[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                  std::numeric_limits<double>::infinity()};
+  double hi[3] = {-lo[0], -lo[1], -lo[2]};
+  for (std::size_t v = 0; v < nv; ++v) {
+    const double* p = &mesh.xyz[3 * v];
+    if (!used[v] || !finite3(p) || (weighted && !std::isfinite(mesh.weight[v]))) {
+      used[v] = 0;
+      continue;
+    }
+    ++m;
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], p[d]);
+      hi[d] = std::max(hi[d], p[d]);
+    }
+    if (weighted) g.wmax = std::max(g.wmax, mesh.weight[v]);
+  }
+  g.cell_start.assign(2, 0);
+  if (m == 0) return g;
+  double emax = 0;
+  for (int d = 0; d < 3; ++d) {
+    g.lo[d] = lo[d];
+    emax = std::max(emax, hi[d] - lo[d]);
+    g.scale = std::max({g.scale, std::abs(lo[d]), std::abs(hi[d])});
+  }
+  if (emax > 0) {
+    // Cubic cells, about one point per cell.
+    double vol = 1;
+    for (int d = 0; d < 3; ++d) vol *= std::max(hi[d] - lo[d], emax * 1e-3);
+    double h = std::cbrt(vol / static_cast<double>(m));
+    for (int d = 0; d < 3; ++d)
+      g.dims[d] =
+          std::clamp<std::int64_t>(static_cast<std::int64_t>(std::ceil((hi[d] - lo[d]) / h)), 1, 4096);
+    g.inv_h = 1 / h;
+  }
+  const std::size_t cells = static_cast<std::size_t>(g.dims[0] * g.dims[1] * g.dims[2]);
+  std::vector<std::uint32_t> cell_of(nv, 0);
+  g.cell_start.assign(cells + 1, 0);
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    const double* p = &mesh.xyz[3 * v];
+    std::size_t c = static_cast<std::size_t>((g.cell(p[2], 2) * g.dims[1] + g.cell(p[1], 1)) * g.dims[0] +
+                                             g.cell(p[0], 0));
+    cell_of[v] = static_cast<std::uint32_t>(c);
+    ++g.cell_start[c + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) g.cell_start[c + 1] += g.cell_start[c];
+  g.pts.resize(m);
+  std::vector<std::uint32_t> fill(g.cell_start.begin(), g.cell_start.end() - 1);
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    const double* p = &mesh.xyz[3 * v];
+    g.pts[fill[cell_of[v]]++] = {p[0], p[1], p[2], weighted ? mesh.weight[v] : 0.0,
+                                 static_cast<std::uint32_t>(v)};
+  }
+  return g;
+}
+
+struct ThreadResult {
+  std::vector<std::uint32_t> violating;
+  std::size_t violating_count = 0;
+  std::size_t degenerate = 0;
+  std::size_t checked = 0;
+  double max_depth = 0;
+};
+
+class Checker {
+ public:
+  Checker(const Mesh& mesh, const PointGrid& grid, bool weighted)
+      : mesh_(mesh), grid_(grid), weighted_(weighted) {}
+
+  void check_tet(std::size_t t, ThreadResult& out) const {
+    const std::size_t nv = mesh_.node_count();
+    std::uint32_t v[4];
+    for (int j = 0; j < 4; ++j) v[j] = mesh_.tet[4 * t + j];
+    for (int j = 0; j < 4; ++j)
+      if (v[j] >= nv || !finite3(&mesh_.xyz[3 * v[j]]) || (weighted_ && !std::isfinite(mesh_.weight[v[j]]))) {
+        ++out.degenerate;
+        return;
+      }
+    const double* a = &mesh_.xyz[3 * v[0]];
+    const double* pb = &mesh_.xyz[3 * v[1]];
+    const double* pc = &mesh_.xyz[3 * v[2]];
+    const double* pd = &mesh_.xyz[3 * v[3]];
+    const double B[3] = {pb[0] - a[0], pb[1] - a[1], pb[2] - a[2]};
+    const double C[3] = {pc[0] - a[0], pc[1] - a[1], pc[2] - a[2]};
+    const double D[3] = {pd[0] - a[0], pd[1] - a[1], pd[2] - a[2]};
+    auto cross = [](const double* p, const double* q, double* r) {
+      r[0] = p[1] * q[2] - p[2] * q[1];
+      r[1] = p[2] * q[0] - p[0] * q[2];
+      r[2] = p[0] * q[1] - p[1] * q[0];
+    };
+    auto cross_abs = [](const double* p, const double* q, double* r) {
+      r[0] = std::abs(p[1] * q[2]) + std::abs(p[2] * q[1]);
+      r[1] = std::abs(p[2] * q[0]) + std::abs(p[0] * q[2]);
+      r[2] = std::abs(p[0] * q[1]) + std::abs(p[1] * q[0]);
+    };
+    double CD[3], DB[3], BC[3], CDa[3], DBa[3], BCa[3];
+    cross(C, D, CD);
+    cross(D, B, DB);
+    cross(B, C, BC);
+    cross_abs(C, D, CDa);
+    cross_abs(D, B, DBa);
+    cross_abs(B, C, BCa);
+    const double den = B[0] * CD[0] + B[1] * CD[1] + B[2] * CD[2];  // 6 x signed volume
+    const double den_perm = std::abs(B[0]) * CDa[0] + std::abs(B[1]) * CDa[1] + std::abs(B[2]) * CDa[2];
+    const double den_err = 32 * kU * den_perm;
+
+    // Orientation: from the double value when its error bound decides it, else exactly.
+    const Point P[4] = {Point(a[0], a[1], a[2]), Point(pb[0], pb[1], pb[2]), Point(pc[0], pc[1], pc[2]),
+                        Point(pd[0], pd[1], pd[2])};
+    int sign = den > den_err ? 1 : den < -den_err ? -1 : 0;
+    if (sign == 0) {
+      CGAL::Orientation o = CGAL::orientation(P[0], P[1], P[2], P[3]);
+      if (o == CGAL::COPLANAR) {
+        ++out.degenerate;
+        return;
+      }
+      sign = o == CGAL::POSITIVE ? 1 : -1;
+    }
+    ++out.checked;
+
+    // Orthocentre relative to a: 2 [B;C;D] x = (lifted B, C, D), lifted B = |B|^2 - (w_b - w_a).
+    double wv[4] = {0, 0, 0, 0};
+    if (weighted_)
+      for (int j = 0; j < 4; ++j) wv[j] = mesh_.weight[v[j]];
+    const double lB = B[0] * B[0] + B[1] * B[1] + B[2] * B[2] - (wv[1] - wv[0]);
+    const double lC = C[0] * C[0] + C[1] * C[1] + C[2] * C[2] - (wv[2] - wv[0]);
+    const double lD = D[0] * D[0] + D[1] * D[1] + D[2] * D[2] - (wv[3] - wv[0]);
+    const double LB = B[0] * B[0] + B[1] * B[1] + B[2] * B[2] + std::abs(wv[1]) + std::abs(wv[0]);
+    const double LC = C[0] * C[0] + C[1] * C[1] + C[2] * C[2] + std::abs(wv[2]) + std::abs(wv[0]);
+    const double LD = D[0] * D[0] + D[1] * D[1] + D[2] * D[2] + std::abs(wv[3]) + std::abs(wv[0]);
+    bool reliable = std::abs(den) > 4 * den_err;
+    double x[3] = {0, 0, 0}, ex = 0;
+    if (reliable) {
+      double ex2 = 0;
+      for (int i = 0; i < 3; ++i) {
+        const double N = lB * CD[i] + lC * DB[i] + lD * BC[i];
+        const double eN = 32 * kU * (LB * CDa[i] + LC * DBa[i] + LD * BCa[i]);
+        x[i] = N / (2 * den);
+        const double e =
+            (eN * std::abs(den) + std::abs(N) * den_err) / (2 * std::abs(den) * (std::abs(den) - den_err)) +
+            4 * kU * std::abs(x[i]);
+        ex2 += e * e;
+      }
+      ex = std::sqrt(ex2) * 1.01;
+      reliable = std::isfinite(ex) && std::isfinite(x[0] + x[1] + x[2]);
+    }
+
+    // Candidates: the cells of the sphere's box (or every point when the centre is unreliable).
+    const double xn = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    const double eq = 4 * kU * grid_.scale;  // bound on the rounding of q - a (vector norm)
+    const double e1 = eq + ex;
+    const double rmax = (xn + ex) * (xn + ex) + grid_.wmax - wv[0];  // largest possible power radius^2
+    double half = e1 + std::sqrt(std::max(0.0, rmax));
+    half = half * (1 + 1e-9) + 8 * kU * (grid_.scale + xn);
+    std::int64_t c0[3] = {0, 0, 0}, c1[3] = {grid_.dims[0] - 1, grid_.dims[1] - 1, grid_.dims[2] - 1};
+    if (reliable && std::isfinite(half)) {
+      for (int d = 0; d < 3; ++d) {
+        const double centre = a[d] + x[d];
+        c0[d] = grid_.cell(centre - half, d);
+        c1[d] = grid_.cell(centre + half, d);
+      }
+    }
+    // Unweighted: outside when |q' - x| > |x| + ex + e1 (squared, with a relative margin).
+    const double t_out = (xn + ex + e1) * (xn + ex + e1) * (1 + 1e-12);
+    const double wa = wv[0];
+
+    const int s2 = sign > 0 ? 2 : 3, s3 = sign > 0 ? 3 : 2;  // positively oriented order
+    bool violated = false;
+    double depth = 0;
+    for (std::int64_t cz = c0[2]; cz <= c1[2]; ++cz)
+      for (std::int64_t cy = c0[1]; cy <= c1[1]; ++cy) {
+        const std::size_t row = static_cast<std::size_t>((cz * grid_.dims[1] + cy) * grid_.dims[0]);
+        const GridPoint* first = grid_.pts.data() + grid_.cell_start[row + static_cast<std::size_t>(c0[0])];
+        const GridPoint* last =
+            grid_.pts.data() + grid_.cell_start[row + static_cast<std::size_t>(c1[0]) + 1];
+        for (const GridPoint* q = first; q < last; ++q) {
+          if (reliable) {
+            const double dx = q->x - a[0] - x[0], dy = q->y - a[1] - x[1], dz = q->z - a[2] - x[2];
+            const double d2 = dx * dx + dy * dy + dz * dz;
+            if (!weighted_) {
+              if (d2 > t_out) continue;
+            } else {
+              const double dl = std::sqrt(d2) - e1;
+              if (dl > 0) {
+                const double lower = dl * dl - q->w - (xn + ex) * (xn + ex) + wa;
+                const double margin = 1e-12 * (d2 + (xn + ex) * (xn + ex) + std::abs(q->w) + std::abs(wa));
+                if (lower > margin) continue;
+              }
+            }
+          }
+          if (q->id == v[0] || q->id == v[1] || q->id == v[2] || q->id == v[3]) continue;
+          const Point pq(q->x, q->y, q->z);
+          CGAL::Oriented_side side;
+          if (!weighted_) {
+            side = CGAL::side_of_oriented_sphere(P[0], P[1], P[s2], P[s3], pq);
+          } else {
+            const WPoint W[4] = {WPoint(P[0], wv[0]), WPoint(P[1], wv[1]), WPoint(P[2], wv[2]),
+                                 WPoint(P[3], wv[3])};
+            side = K().power_side_of_oriented_power_sphere_3_object()(W[0], W[1], W[s2], W[s3],
+                                                                      WPoint(pq, q->w));
+          }
+          if (side == CGAL::ON_POSITIVE_SIDE) {
+            violated = true;
+            if (!weighted_ && reliable && xn > 0) {
+              const double dx = q->x - a[0] - x[0], dy = q->y - a[1] - x[1], dz = q->z - a[2] - x[2];
+              depth = std::max(depth, (xn - std::sqrt(dx * dx + dy * dy + dz * dz)) / xn);
+            }
+          }
+        }
+      }
+    if (violated) {
+      ++out.violating_count;
+      out.violating.push_back(static_cast<std::uint32_t>(t));
+      out.max_depth = std::max(out.max_depth, depth);
+    }
+  }
+
+ private:
+  const Mesh& mesh_;
+  const PointGrid& grid_;
+  bool weighted_;
+};
+
+}  // namespace
+
+DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const CertificateOptions& options) {
+  DelaunayCertificate cert;
+  const bool weighted = !mesh.weight.empty();
+  cert.weighted = weighted;
+  if (weighted && mesh.weight.size() != mesh.node_count()) {
+    // Sizes do not match (see check_sizes): nothing can be certified.
+    cert.degenerate_tet_count = mesh.tet_count();
+    return cert;
+  }
+  const std::size_t n = mesh.tet_count();
+  if (options.progress && !options.progress("delaunay certificate", 0.0)) {
+    cert.cancelled = true;
+    return cert;
+  }
+  const PointGrid grid = build_grid(mesh, weighted);
+  const Checker checker(mesh, grid, weighted);
+
+  const unsigned threads = n >= 20000 ? std::clamp(std::thread::hardware_concurrency(), 1u, 8u) : 1u;
+  constexpr std::size_t kChunk = 4096;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::atomic<std::size_t> next{0}, done{0};
+  std::atomic<bool> cancel{false};
+  std::vector<ThreadResult> results(threads);
+  auto work = [&](unsigned i) {
+    ThreadResult& r = results[i];
+    for (;;) {
+      if (cancel.load(std::memory_order_relaxed)) return;
+      const std::size_t c = next.fetch_add(1);
+      if (c >= chunks) return;
+      const std::size_t end = std::min(n, (c + 1) * kChunk);
+      for (std::size_t t = c * kChunk; t < end; ++t) checker.check_tet(t, r);
+      const std::size_t finished = done.fetch_add(1) + 1;
+      // Only the calling thread reports progress, so the callback never runs on a worker.
+      if (i == 0 && options.progress &&
+          !options.progress("delaunay certificate",
+                            static_cast<double>(finished) / static_cast<double>(chunks)))
+        cancel = true;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work, i);
+  work(0);
+  for (auto& th : pool) th.join();
+
+  for (ThreadResult& r : results) {
+    cert.tets_checked += r.checked + r.degenerate;
+    cert.violating_tet_count += r.violating_count;
+    cert.degenerate_tet_count += r.degenerate;
+    cert.max_relative_depth = std::max(cert.max_relative_depth, r.max_depth);
+    cert.violating_tets.insert(cert.violating_tets.end(), r.violating.begin(), r.violating.end());
+  }
+  std::sort(cert.violating_tets.begin(), cert.violating_tets.end());
+  if (cert.violating_tets.size() > options.max_listed) cert.violating_tets.resize(options.max_listed);
+  cert.cancelled = cancel.load();
+  cert.delaunay = !cert.cancelled && cert.violating_tet_count == 0 && cert.degenerate_tet_count == 0;
+  if (!cert.cancelled && options.progress) options.progress("delaunay certificate", 1.0);
+  return cert;
+}
+
+const DelaunayCertificate& delaunay_certificate(const Mesh& mesh) {
+  DerivedData& d = derived_of(mesh);
+  std::lock_guard<std::mutex> g(d.lock);
+  if (!d.certificate)
+    d.certificate = std::make_unique<DelaunayCertificate>(compute_delaunay_certificate(mesh));
+  return *d.certificate;
+}
+
 }  // namespace foxi
