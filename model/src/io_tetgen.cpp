@@ -198,9 +198,10 @@ class Scanner {
   }
 
  private:
+  // Back to the start of the token read from `at` (for messages that quote it).
   void skip_to_token(std::size_t at) {
     p_ = at;
-    while (p_ < text_.size() && (is_blank(text_[p_]) || is_eol(text_[p_]))) ++p_;
+    skip_to_content();
   }
   [[noreturn]] void bad_number(const char* what, std::errc ec) {
     std::string t = token_at(p_);
@@ -219,6 +220,7 @@ class Scanner {
 // needs at least `tokens` tokens of one character plus a separator.
 template <Span kSpan>
 std::uint64_t declared_count(Scanner& in, const char* what, std::uint64_t tokens) {
+  in.to_field<kSpan>(what);
   std::size_t at = in.pos();
   std::int64_t n = in.integer<kSpan>(what);
   if (n < 0) in.fail_at(at, std::string(what) + " is negative (" + std::to_string(n) + ")");
@@ -232,6 +234,7 @@ std::uint64_t declared_count(Scanner& in, const char* what, std::uint64_t tokens
 
 // A small non-negative header number (attribute and marker counts).
 std::uint64_t header_small(Scanner& in, const char* what) {
+  in.to_field<Span::kLine>(what);
   std::size_t at = in.pos();
   std::int64_t v = in.integer<Span::kLine>(what);
   if (v < 0 || static_cast<std::uint64_t>(v) > in.remaining() + 1) {
@@ -328,6 +331,7 @@ void parse_ele_file(Scanner& in, Mesh& m, std::int64_t offset) {
   }
   std::size_t head = in.pos();
   std::int64_t n_probe = in.integer<L>("tetrahedron count");
+  in.to_field<L>("nodes per tetrahedron");
   std::size_t at_npt = in.pos();
   std::int64_t npt = in.integer<L>("nodes per tetrahedron");
   if (npt != 4 && npt != 10) {
@@ -635,6 +639,7 @@ Mesh parse_medit(std::string_view bytes, const std::string& name) {
                "expected 'MeshVersionFormatted', found '" + io::TextCursor::shorten(w) + "'");
   }
   {
+    in.to_field<A>("format version");
     std::size_t at = in.pos();
     std::int64_t version = in.integer<A>("format version");
     if (version < 1 || version > 4) in.fail_at(at, "unknown format version " + std::to_string(version));
@@ -650,6 +655,7 @@ Mesh parse_medit(std::string_view bytes, const std::string& name) {
     kw_pos = in.pos() - w.size();
     if (iequals(w, "End")) break;  // whatever follows End is not part of the mesh
     if (iequals(w, "Dimension")) {
+      in.to_field<A>("dimension");
       std::size_t at = in.pos();
       std::int64_t dim = in.integer<A>("dimension");
       if (dim != 3) in.fail_at(at, "dimension is " + std::to_string(dim) + ", foxi reads 3-D meshes only");
@@ -697,6 +703,7 @@ Mesh parse_medit(std::string_view bytes, const std::string& name) {
         for (std::uint64_t k = 0; k < n; ++k) {
           in.set_record(kind, k + 1);
           for (std::size_t c = 0; c < per; ++c) {
+            in.to_field<A>("vertex");
             std::size_t at = in.pos();
             std::int64_t v = in.integer<A>("vertex");
             if (v < 1 || v > static_cast<std::int64_t>(kNone))
