@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -15,15 +16,19 @@
 namespace foxi {
 namespace {
 
-// One tet face in its vertex bucket: the two larger vertices of the triangle and the face id 4t+f.
-struct FaceEntry {
-  std::uint32_t mid, max, face;
+// One tet face in its vertex bucket: the two larger vertices of the triangle (middle << 32 | largest,
+// so that one integer comparison orders them) and the face id 4t+f. Packed to 12 bytes.
+struct __attribute__((packed)) FaceEntry {
+  std::uint64_t key;
+  std::uint32_t face;
 };
+static_assert(sizeof(FaceEntry) == 12);
 
-inline bool key_less(const FaceEntry& a, const FaceEntry& b) {
-  return a.mid != b.mid ? a.mid < b.mid : a.max < b.max;
+inline std::uint64_t face_key(std::uint32_t mid, std::uint32_t max) {
+  return (std::uint64_t{mid} << 32) | max;
 }
-inline bool key_equal(const FaceEntry& a, const FaceEntry& b) { return a.mid == b.mid && a.max == b.max; }
+inline bool key_less(const FaceEntry& a, const FaceEntry& b) { return a.key < b.key; }
+inline bool key_equal(const FaceEntry& a, const FaceEntry& b) { return a.key == b.key; }
 
 // Sorts the 4 vertices of a tet with their positions (a 5-comparator network).
 struct SortedTet {
@@ -122,7 +127,9 @@ FaceAdjacency compute_face_adjacency(const Mesh& mesh) {
   }
 
   // Pass 2: scatter the faces into their buckets.
-  std::vector<FaceEntry> entries(4 * n);
+  // Not value-initialised: every entry is written below.
+  std::unique_ptr<FaceEntry[]> entries_storage(new FaceEntry[4 * n]);
+  FaceEntry* const entries = entries_storage.get();
   parallel_for_threads(threads, [&](unsigned i) {
     auto [b, e] = range(i);
     std::uint32_t* c = count.data() + i * buckets;
@@ -130,10 +137,12 @@ FaceAdjacency compute_face_adjacency(const Mesh& mesh) {
       SortedTet s = sort_tet(tet + 4 * t);
       const std::uint32_t base = static_cast<std::uint32_t>(4 * t);
       // The face opposite sorted vertex k consists of the other three, still in order.
-      entries[bucket_start[s.v[0]] + c[s.v[0]]++] = {s.v[2], s.v[3], base + s.pos[1]};  // opp. v1
-      entries[bucket_start[s.v[0]] + c[s.v[0]]++] = {s.v[1], s.v[3], base + s.pos[2]};  // opp. v2
-      entries[bucket_start[s.v[0]] + c[s.v[0]]++] = {s.v[1], s.v[2], base + s.pos[3]};  // opp. v3
-      entries[bucket_start[s.v[1]] + c[s.v[1]]++] = {s.v[2], s.v[3], base + s.pos[0]};  // opp. v0
+      FaceEntry* e0 = entries + bucket_start[s.v[0]] + c[s.v[0]];
+      c[s.v[0]] += 3;
+      e0[0] = {face_key(s.v[2], s.v[3]), base + s.pos[1]};  // opposite v1
+      e0[1] = {face_key(s.v[1], s.v[3]), base + s.pos[2]};  // opposite v2
+      e0[2] = {face_key(s.v[1], s.v[2]), base + s.pos[3]};  // opposite v3
+      entries[bucket_start[s.v[1]] + c[s.v[1]]++] = {face_key(s.v[2], s.v[3]), base + s.pos[0]};  // opp. v0
     }
   });
   count = {};
@@ -153,8 +162,8 @@ FaceAdjacency compute_face_adjacency(const Mesh& mesh) {
   parallel_for_threads(threads, [&](unsigned i) {
     Counts cnt;
     for (std::size_t v = vsplit[i]; v < vsplit[i + 1]; ++v) {
-      FaceEntry* first = entries.data() + bucket_start[v];
-      FaceEntry* last = entries.data() + bucket_start[v + 1];
+      FaceEntry* first = entries + bucket_start[v];
+      FaceEntry* last = entries + bucket_start[v + 1];
       const std::size_t len = static_cast<std::size_t>(last - first);
       if (len == 0) continue;
       if (len <= 24) {  // insertion sort: buckets are small for bounded vertex degree
