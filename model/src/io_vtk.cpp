@@ -45,13 +45,16 @@ constexpr const char* kRegionNames[] = {"region", "gmsh:physical", "CellEntityId
 struct ArrayData {
   VType type = VType::f64;
   std::uint64_t count = 0;  // values (tuples * components)
-  std::string_view bytes;   // count * type_size(type) bytes
-  std::string owned;
-  bool swap = false;  // bytes are in the other byte order
+  std::string_view lent;    // count * type_size(type) bytes in the file, or
+  std::string owned;        // the same, owned (is_owned)
+  bool is_owned = false;
+  bool swap = false;        // bytes are in the other byte order
 
+  // Never a stored view of `owned`: a moved std::string may move its (short) buffer.
+  const char* data() const { return is_owned ? owned.data() : lent.data(); }
   void own(std::string s) {
     owned = std::move(s);
-    bytes = owned;
+    is_owned = true;
   }
 };
 
@@ -60,7 +63,7 @@ ArrayData make_owned_f64(std::vector<double>& v) {
   a.type = VType::f64;
   a.count = v.size();
   a.owned.assign(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
-  a.bytes = a.owned;
+  a.is_owned = true;
   return a;
 }
 ArrayData make_owned_i64(std::vector<std::int64_t>& v) {
@@ -68,7 +71,7 @@ ArrayData make_owned_i64(std::vector<std::int64_t>& v) {
   a.type = VType::i64;
   a.count = v.size();
   a.owned.assign(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(std::int64_t));
-  a.bytes = a.owned;
+  a.is_owned = true;
   return a;
 }
 
@@ -81,7 +84,7 @@ struct Acc {
 
 template <class F>
 decltype(auto) dispatch(const ArrayData& a, F&& f) {
-  const char* p = a.bytes.data();
+  const char* p = a.data();
   switch (a.type) {
     case VType::i8:
       return f(Acc<std::int8_t>{p, a.swap});
@@ -113,7 +116,7 @@ void append_doubles(const ArrayData& a, std::size_t first, std::size_t n, std::v
   out.resize(at + n);
   double* d = out.data() + at;
   if (a.type == VType::f64 && !a.swap) {
-    std::memcpy(d, a.bytes.data() + first * 8, n * 8);
+    std::memcpy(d, a.data() + first * 8, n * 8);
     return;
   }
   dispatch(a, [&](auto acc) {
@@ -146,8 +149,8 @@ ArrayData normalize_ints(ArrayData a, Fail&& fail) {
 
 template <class F>
 decltype(auto) dispatch_int(const ArrayData& a, F&& f) {
-  if (a.type == VType::i32) return f(Acc<std::int32_t>{a.bytes.data(), false});
-  return f(Acc<std::int64_t>{a.bytes.data(), false});
+  if (a.type == VType::i32) return f(Acc<std::int32_t>{a.data(), false});
+  return f(Acc<std::int64_t>{a.data(), false});
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -160,10 +163,12 @@ struct NamedArray {
   std::optional<double> step_value;
   std::string region_names;    // foxi_region_names attribute (region array only)
   std::string boundary_names;  // foxi_boundary_names attribute
+  std::size_t at = 0;          // file offset of its declaration (for errors)
 };
 
 struct Piece {
   std::uint64_t npoints = 0, ncells = 0;
+  std::size_t at = 0, cells_at = 0;  // file offsets of the piece and its cells (for errors)
   ArrayData points;   // 3 * npoints values
   ArrayData conn;     // connectivity
   ArrayData offsets;  // ncells values: end of each cell in conn
@@ -275,11 +280,12 @@ std::map<std::int32_t, std::string> parse_names(std::string_view s) {
 // Builds the mesh from pieces: appends nodes, tets, boundary triangles and arrays.
 class Assembler {
  public:
-  Assembler(const std::string& file) : file_(file) {}
+  Assembler(const std::string& file, std::string_view text) : file_(file), text_(text) {}
 
   void add(Piece& p, std::size_t piece_index) {
+    std::size_t where = p.at;  // offset in the file the next error refers to
     auto fail = [&](const std::string& reason) -> void {
-      throw IoError(file_, 0, IoError::kNoOffset,
+      io::fail_text(file_, text_, where,
                     (piece_count_ > 0 || piece_index > 0 ? "piece " + std::to_string(piece_index + 1) + ": "
                                                          : std::string()) +
                         reason);
@@ -290,6 +296,7 @@ class Assembler {
     append_doubles(p.points, 0, p.points.count, mesh_.xyz);
 
     // Cells.
+    where = p.cells_at;
     if (p.offsets.count != p.ncells || p.types.count != p.ncells)
       fail("offsets and types must have one entry per cell (" + std::to_string(p.ncells) + ")");
     auto int_fail = [&](const char* what) {
@@ -374,6 +381,7 @@ class Assembler {
     std::size_t tets_before = tet_at / 4;
     if (region_index >= 0) {
       NamedArray& ra = p.cell_arrays[static_cast<std::size_t>(region_index)];
+      where = ra.at;
       if (ra.data.count != p.ncells) fail("cell array '" + ra.name + "' size does not match the cell count");
       ArrayData r = normalize_ints(std::move(ra.data), int_fail(ra.name.c_str()));
       if (!have_region_ && tets_before > 0) mesh_.tet_region.assign(tets_before, 0);
@@ -397,10 +405,25 @@ class Assembler {
       mesh_.bface_tag.resize(mesh_.bface_count(), 0);
     }
 
+    // Point arrays.
+    for (NamedArray& na : p.point_arrays) {
+      where = na.at;
+      if (na.data.count != p.npoints * na.components)
+        fail("point array '" + na.name + "' has " + std::to_string(na.data.count) + " values, expected " +
+             std::to_string(p.npoints * na.components));
+      if (na.name == "weight" && na.components == 1) {
+        if (mesh_.weight.size() != node_base) fail("point array 'weight' is missing in a piece");
+        append_doubles(na.data, 0, na.data.count, mesh_.weight);
+        continue;
+      }
+      CollectedArray& ca = collect(na, FieldLocation::node, piece_index);
+      append_doubles(na.data, 0, na.data.count, ca.values);
+    }
     // Other cell arrays become cell fields (tet values only).
     for (std::size_t a = 0; a < p.cell_arrays.size(); ++a) {
       if (static_cast<int>(a) == region_index) continue;
       NamedArray& na = p.cell_arrays[a];
+      where = na.at;
       if (na.data.count != p.ncells * na.components)
         fail("cell array '" + na.name + "' has " + std::to_string(na.data.count) + " values, expected " +
              std::to_string(p.ncells * na.components));
@@ -419,19 +442,6 @@ class Assembler {
           }
         });
       }
-    }
-    // Point arrays.
-    for (NamedArray& na : p.point_arrays) {
-      if (na.data.count != p.npoints * na.components)
-        fail("point array '" + na.name + "' has " + std::to_string(na.data.count) + " values, expected " +
-             std::to_string(p.npoints * na.components));
-      if (na.name == "weight" && na.components == 1) {
-        if (mesh_.weight.size() != node_base) fail("point array 'weight' is missing in a piece");
-        append_doubles(na.data, 0, na.data.count, mesh_.weight);
-        continue;
-      }
-      CollectedArray& ca = collect(na, FieldLocation::node, piece_index);
-      append_doubles(na.data, 0, na.data.count, ca.values);
     }
     ++piece_count_;
   }
@@ -514,7 +524,7 @@ class Assembler {
     auto it = index_.find(key);
     if (it == index_.end()) {
       if (piece_index > 0)
-        throw IoError(file_, 0, IoError::kNoOffset,
+        io::fail_text(file_, text_, na.at,
                       "array '" + na.name + "' of piece " + std::to_string(piece_index + 1) +
                           " is not in the first piece");
       index_[key] = arrays_.size();
@@ -524,13 +534,14 @@ class Assembler {
     }
     CollectedArray& ca = arrays_[it->second];
     if (ca.components != na.components)
-      throw IoError(file_, 0, IoError::kNoOffset,
+      io::fail_text(file_, text_, na.at,
                     "array '" + na.name + "' has different component counts in different pieces");
     ++ca.pieces;
     return ca;
   }
 
   const std::string& file_;
+  std::string_view text_;
   Mesh mesh_;
   bool have_region_ = false;
   std::size_t piece_count_ = 0;
@@ -682,7 +693,7 @@ ArrayData read_binary_block(ByteSource& src, VType type, std::uint64_t expected)
     std::string store;
     std::string_view v = src.take(nbytes, store);
     if (src.raw)
-      a.bytes = v;
+      a.lent = v;
     else
       a.own(std::move(store));
   } else {
@@ -786,6 +797,7 @@ std::pair<std::size_t, std::size_t> content_range(const VtuContext& c, pugi::xml
 NamedArray read_data_array(VtuContext& c, pugi::xml_node da, std::uint64_t tuples,
                            std::uint32_t want_components, const std::string& where) {
   NamedArray out;
+  out.at = static_cast<std::size_t>(da.offset_debug());
   out.name = da.attribute("Name").value();
   const std::string what = where + (out.name.empty() ? "" : " '" + out.name + "'");
   const auto at = static_cast<std::size_t>(da.offset_debug());
@@ -941,11 +953,12 @@ Mesh parse_vtu_impl(std::string_view text, const std::string& file) {
   if (!grid) io::fail_text(file, text, root_at, "no <UnstructuredGrid> element");
   // Upper bound on any count: each value takes at least one byte (or 1/1032 compressed).
   const std::uint64_t bound = c.compressed ? text.size() * kZlibMaxRatio + 1024 : text.size();
-  Assembler asm_(file);
+  Assembler asm_(file, text);
   std::size_t piece_index = 0;
   for (pugi::xml_node pn = grid.child("Piece"); pn; pn = pn.next_sibling("Piece"), ++piece_index) {
     const auto pat = static_cast<std::size_t>(pn.offset_debug());
     Piece p;
+    p.at = p.cells_at = pat;
     p.npoints = attr_u64(c, pn, "NumberOfPoints", kUnknown);
     p.ncells = attr_u64(c, pn, "NumberOfCells", kUnknown);
     if (p.npoints > bound / 3)
@@ -970,6 +983,7 @@ Mesh parse_vtu_impl(std::string_view text, const std::string& file) {
     for (pugi::xml_node da = cells.child("DataArray"); da; da = da.next_sibling("DataArray")) {
       std::string_view n = da.attribute("Name").value();
       if (n == "connectivity") {
+        p.cells_at = static_cast<std::size_t>(da.offset_debug());
         p.conn = read_data_array(c, da, kUnknown, 1, where + " Cells").data;
         got_conn = true;
       } else if (n == "offsets") {
@@ -1216,19 +1230,18 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
   // Emit.
   io::AtomicFile out(path);
   std::string head;
-  head.reserve(enc == VtuEncoding::ascii || enc == VtuEncoding::base64 ? nconn * 8 + nn * 60 : 4096);
+  head.reserve(enc == VtuEncoding::appended_raw ? 4096 : nconn * 8 + nn * 60);
   head += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"";
   head += kHostLittle ? "LittleEndian" : "BigEndian";
   head += "\" header_type=\"UInt64\"";
   if (enc == VtuEncoding::zlib) head += " compressor=\"vtkZLibDataCompressor\"";
   head += ">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" + std::to_string(nn) +
           "\" NumberOfCells=\"" + std::to_string(ncells) + "\">\n";
-  // Appended payloads: raw views (header, data) or compressed buffers.
+  // Appended payloads: views of the arrays (with their byte count as header).
   struct Payload {
     std::uint64_t header;
     const void* data;
     std::size_t bytes;
-    std::string zheader, zdata;
   };
   std::vector<Payload> payloads;
   std::uint64_t offset = 0;
@@ -1261,16 +1274,22 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
       }
       case VtuEncoding::appended_raw: {
         head += " format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
-        payloads.push_back({nbytes, a.data, nbytes, {}, {}});
+        payloads.push_back({nbytes, a.data, nbytes});
         offset += 8 + nbytes;
         break;
       }
       case VtuEncoding::zlib: {
-        head += " format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
-        Payload p{0, nullptr, 0, {}, {}};
-        vtk::zlib_compress_blocks(a.data, nbytes, 32768, 1, p.zheader, p.zdata);
-        offset += p.zheader.size() + p.zdata.size();
-        payloads.push_back(std::move(p));
+        // Inline (base64) like meshio and VTK's binary mode: header and blocks encoded separately.
+        // Not appended: meshio renumbers appended offsets in place and mixes up arrays when a new
+        // offset equals an old one, which happens with compressed appended data.
+        head += " format=\"binary\">\n";
+        std::string zh, zd;
+        vtk::zlib_compress_blocks(a.data, nbytes, 32768, 1, zh, zd);
+        vtk::base64_encode(zh.data(), zh.size(), head);
+        vtk::base64_encode(zd.data(), zd.size(), head);
+        head += "\n";
+        head += indent;
+        head += "</DataArray>\n";
         break;
       }
     }
@@ -1294,17 +1313,12 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
     head += "      </CellData>\n";
   }
   head += "    </Piece>\n  </UnstructuredGrid>\n";
-  if (enc == VtuEncoding::appended_raw || enc == VtuEncoding::zlib) {
+  if (enc == VtuEncoding::appended_raw) {
     head += "  <AppendedData encoding=\"raw\">\n   _";
     out.write(head);
     for (const Payload& p : payloads) {
-      if (enc == VtuEncoding::zlib) {
-        out.write(p.zheader);
-        out.write(p.zdata);
-      } else {
-        out.write(&p.header, 8);
-        if (p.bytes) out.write(p.data, p.bytes);
-      }
+      out.write(&p.header, 8);
+      if (p.bytes) out.write(p.data, p.bytes);
     }
     out.write("\n  </AppendedData>\n</VTKFile>\n");
   } else {
@@ -1362,6 +1376,7 @@ class LegacyReader {
       std::size_t kw_at = tc_.pos();
       std::string k = lower(tc_.token("keyword"));
       if (k == "points") {
+        p.at = kw_at;
         p.npoints = count("point count");
         if (p.npoints > text_.size() / 3)
           tc_.fail_at(kw_at, "declares " + std::to_string(p.npoints) + " points but the file has only " +
@@ -1370,6 +1385,7 @@ class LegacyReader {
         p.points = values(3 * p.npoints, t, "POINTS");
         have_points = true;
       } else if (k == "cells") {
+        p.cells_at = kw_at;
         std::uint64_t n = count("cell count");
         std::uint64_t size = count("cell list size");
         std::size_t save = tc_.pos();
@@ -1451,6 +1467,7 @@ class LegacyReader {
                  k == "texture_coordinates" || k == "color_scalars") {
         if (attrs == nullptr) tc_.fail_at(kw_at, k + " before POINT_DATA or CELL_DATA");
         NamedArray a;
+        a.at = kw_at;
         a.name = percent_decode(tc_.token("array name"));
         std::uint32_t nc = 1;
         VType t = VType::f32;
@@ -1485,7 +1502,9 @@ class LegacyReader {
         std::uint64_t narr = count("array count");
         for (std::uint64_t i = 0; i < narr; ++i) {
           NamedArray a;
+          tc_.skip_space();
           std::size_t name_at = tc_.pos();
+          a.at = name_at;
           a.name = percent_decode(tc_.token("array name"));
           if (lower(a.name) == "metadata") {
             skip_metadata();
@@ -1520,7 +1539,7 @@ class LegacyReader {
       p.offsets.type = VType::i64;
       p.types.type = VType::i32;
     }
-    Assembler a(file_);
+    Assembler a(file_, text_);
     a.add(p, 0);
     return a.finish();
   }
@@ -1575,7 +1594,7 @@ class LegacyReader {
       a.type = t;
       a.count = n;
       a.swap = kHostLittle;
-      a.bytes = text_.substr(at, n * vs);
+      a.lent = text_.substr(at, n * vs);
       tc_.set_pos(at + n * vs);
       return a;
     }
