@@ -45,6 +45,7 @@ struct PointGrid {
   std::vector<GridPoint> pts;             // in cell order
   double scale = 0;                       // largest absolute coordinate
   double wmax = 0;                        // largest weight (0 when unweighted)
+  std::vector<std::uint32_t> cell_of;     // per node: its cell (0 for nodes not in the grid)
 
   // Monotone in v (rounding is monotone), so a box's cell range holds every point inside the box.
   std::int64_t cell(double v, int d) const {
@@ -99,7 +100,8 @@ PointGrid build_grid(const Mesh& mesh, bool weighted) {
     g.inv_h = 1 / h;
   }
   const std::size_t cells = static_cast<std::size_t>(g.dims[0] * g.dims[1] * g.dims[2]);
-  std::vector<std::uint32_t> cell_of(nv, 0);
+  std::vector<std::uint32_t>& cell_of = g.cell_of;
+  cell_of.assign(nv, 0);
   g.cell_start.assign(cells + 1, 0);
   for (std::size_t v = 0; v < nv; ++v) {
     if (!used[v]) continue;
@@ -307,6 +309,21 @@ DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const Certifi
   const PointGrid grid = build_grid(mesh, weighted);
   const Checker checker(mesh, grid, weighted);
 
+  // Visit the tets in the grid order of their first vertex (a counting sort): neighbouring tets
+  // share vertices and candidate cells, so coordinates stay in cache whatever the mesh's numbering.
+  std::vector<std::uint32_t> order(n);
+  {
+    const std::size_t cells = grid.cell_start.size() - 1;
+    std::vector<std::uint32_t> start(cells + 1, 0);
+    auto cell_of_tet = [&](std::size_t t) {
+      const std::uint32_t v = mesh.tet[4 * t];
+      return v < grid.cell_of.size() ? grid.cell_of[v] : 0u;
+    };
+    for (std::size_t t = 0; t < n; ++t) ++start[cell_of_tet(t) + 1];
+    for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+    for (std::size_t t = 0; t < n; ++t) order[start[cell_of_tet(t)]++] = static_cast<std::uint32_t>(t);
+  }
+
   const unsigned threads = n >= 20000 ? std::clamp(std::thread::hardware_concurrency(), 1u, 8u) : 1u;
   constexpr std::size_t kChunk = 4096;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
@@ -320,7 +337,7 @@ DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const Certifi
       const std::size_t c = next.fetch_add(1);
       if (c >= chunks) return;
       const std::size_t end = std::min(n, (c + 1) * kChunk);
-      for (std::size_t t = c * kChunk; t < end; ++t) checker.check_tet(t, r);
+      for (std::size_t k = c * kChunk; k < end; ++k) checker.check_tet(order[k], r);
       const std::size_t finished = done.fetch_add(1) + 1;
       // Only the calling thread reports progress, so the callback never runs on a worker.
       if (i == 0 && options.progress &&

@@ -21,7 +21,9 @@ struct FaceAdjacency {
   std::size_t nonmanifold_faces = 0;     // distinct triangles shared by three or more tets
 };
 
-// Computes the adjacency afresh (uses both cores on large meshes).
+// Computes the adjacency afresh (uses both cores on large meshes: 50k tets and more). Orientation is
+// not checked (two tets on one triangle are paired whatever their orientations). Indices >= node_count
+// are tolerated up to max(node_count, 4 * tet_count); beyond that std::invalid_argument is thrown.
 FaceAdjacency compute_face_adjacency(const Mesh& mesh);
 // Cached on the mesh (see invalidate_derived); the reference lives as long as the mesh's cache.
 const FaceAdjacency& face_adjacency(const Mesh& mesh);

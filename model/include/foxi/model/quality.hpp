@@ -15,6 +15,7 @@ struct TetQuality {
   double min_dihedral_deg = 0;  // 0 for a flat tet
 };
 
+// Each p points to 3 doubles. Exactly zero volume (in double) counts as flat.
 TetQuality tet_quality(const double* p0, const double* p1, const double* p2, const double* p3);
 
 struct Stat {
@@ -28,6 +29,8 @@ struct QualitySummary {
   std::size_t slivers = 0;      // min dihedral below 5 degrees
 };
 
+// Over every tet whose indices are in range (others skipped; see validate()). Volume statistics are
+// signed; a flat tet makes radius_edge.max and .mean +inf.
 QualitySummary summarize_quality(const Mesh& mesh);
 
 }  // namespace foxi

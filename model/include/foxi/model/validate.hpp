@@ -26,9 +26,11 @@ struct ValidationReport {
   }
 };
 
-// Checks without changing anything.
+// Checks without changing anything. Positive orientation means det[p1-p0, p2-p0, p3-p0] > 0 (CGAL's
+// orientation(p0,p1,p2,p3) == POSITIVE). At most 20 messages.
 ValidationReport validate(const Mesh& mesh);
-// Checks and re-orients inverted tets (swapping their last two vertices); the report counts them.
+// Checks and re-orients inverted tets (swapping their last two vertices); the report counts them
+// (as found before the repair). Calls invalidate_derived(mesh) when it changed anything.
 ValidationReport validate_and_repair(Mesh& mesh);
 
 }  // namespace foxi
