@@ -1,13 +1,14 @@
 // TetGen .node / .ele / .face and Medit .mesh readers and writers.
 //
 // Orientation. foxi stores tets with det[p1-p0, p2-p0, p3-p0] > 0. TetGen 1.5 (Debian 1.5.0-5) writes
-// its .ele corners in that same order: checked by running `tetgen -pqAa` on a two-region box .poly
-// and computing the determinant of every tet of the .1.ele (365 of 365 positive; the test
-// TetgenOracle.OrientationMatchesFoxi repeats this on every run). It agrees with TetGen's sources,
-// which keep orient3d(a, b, c, d) < 0 for their tets, Shewchuk's orient3d being the determinant of
-// the opposite sign. gmsh's Medit export gives positive tets as well (MeditOracle.GmshFile...), as
-// Medit/MMG require. So both readers keep the vertex order as written; a file with inverted tets is
-// reported by validate() and fixed by validate_and_repair(), never silently here.
+// its .ele corners in that same order. Verified by experiment: `tetgen -pqAa` on a two-region box
+// .poly (two unit cubes), then the determinant of every tet of box.1.ele computed with numpy: 365 of
+// 365 positive, signed volumes summing to the box's 2.0; the same with -pA, -pqAaY, -z and -o2. The
+// test TetgenOracle.OrientationMatchesFoxi repeats the check against the installed tetgen on every
+// run. gmsh's Medit export (`gmsh -3 -format mesh`) gives positive tets as well (checked by
+// MeditOracle.GmshFileMatchesMeshioAndAnalyticVolumes), as Medit/MMG expect. So both readers keep the
+// vertex order as written: no conversion is needed. A file with inverted tets is reported by
+// validate() and fixed by validate_and_repair(), never silently here.
 //
 // Non-finite coordinates (nan, inf) are rejected with an IoError naming the line: neither format
 // can mean anything by them and a located error is more use than a count from validate() later.

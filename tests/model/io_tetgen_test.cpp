@@ -215,7 +215,10 @@ TEST(TetgenOracle, ZeroBasedOutputReadsTheSame) {
   EXPECT_EQ(static_cast<long>(m.tet_count()), stats["Mesh tetrahedra"]);
   EXPECT_EQ(static_cast<long>(m.bface_count()), stats["Mesh faces on facets"]);
   double total = 0;
-  for (std::size_t t = 0; t < m.tet_count(); ++t) total += det(m, t) / 6;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    EXPECT_GT(det(m, t), 0);
+    total += det(m, t) / 6;
+  }
   EXPECT_NEAR(total, 2.0, 1e-12);
 }
 

@@ -5,6 +5,26 @@
 // tag; .node attributes are ignored; 0- or 1-based numbering as declared by the first index. The
 // .face file is optional on reading.
 // Medit: Vertices, Tetrahedra (ref -> region), Triangles (ref -> boundary tag); other keywords skipped.
+//
+// Details (added by the implementation):
+// - TetGen records are one per line; '#' starts a comment anywhere; CR, LF and CRLF line ends mix
+//   freely. Node numbers must be consecutive from 0 or 1 (the first one decides); .ele and .face
+//   indices use that base. 10-node tets keep their 4 corners and 6-node faces their 3 corners (the
+//   mid-edge nodes stay, unused). Tet vertex order is kept: TetGen's and gmsh's Medit output are
+//   already positively oriented (see io_tetgen.cpp for how that was verified).
+// - Medit: keywords case-insensitive, numbers may span lines, 1-based; Edges, Corners, Ridges,
+//   Required*, Normals, NormalAt*, Tangent*, Identifier/Geometry and a few others are skipped;
+//   Quadrilaterals, Hexahedra, Prisms, Pyramids and P2 elements are an error (not representable);
+//   a missing End is accepted; anything after End is ignored.
+// - Both readers reject non-finite coordinates (IoError with the line), out-of-range indices, counts
+//   that the rest of the file cannot hold (checked before allocating) and data beyond the declared
+//   TetGen counts. Mesh::regions and Mesh::boundaries list the ids found, with empty names.
+// - Writers: TetGen 1-based, nodes without attributes or markers, the region as the one .ele
+//   attribute (none when tet_region is empty), .face always written with one marker column; Medit
+//   version 2 with vertex refs 0. Coordinates use shortest round-trip text, so reading gives the
+//   same bits back. A mesh with inconsistent sizes, out-of-range indices or non-finite coordinates
+//   is refused (IoError). The three TetGen files are committed together: if one cannot be written
+//   or renamed into place, none is left (one already renamed is removed again).
 #pragma once
 
 #include <filesystem>
