@@ -17,6 +17,8 @@
 // - Partitioned 4.1 files ($PartitionedEntities) are rejected; other unknown sections are skipped.
 #include "foxi/model/io_gmsh.hpp"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -132,6 +134,37 @@ class TagMap {
   std::vector<std::uint32_t> table_;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted_;
 };
+
+// Reserves room for n values and, for big arrays, asks the kernel for huge pages: a fresh
+// allocation is first touched while parsing, and 4 KiB page faults cost more than the parsing itself.
+// Reserving only takes address space; pages that are never written are never backed.
+template <class T>
+void reserve_huge(std::vector<T>& v, std::size_t n) {
+  v.reserve(n);
+#if defined(MADV_HUGEPAGE)
+  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
+  const std::size_t bytes = n * sizeof(T);
+  if (bytes < 2 * kHuge) return;
+  const std::uintptr_t b = reinterpret_cast<std::uintptr_t>(v.data());
+  const std::uintptr_t hb = (b + kHuge - 1) & ~(kHuge - 1), he = (b + bytes) & ~(kHuge - 1);
+  if (he > hb) madvise(reinterpret_cast<void*>(hb), he - hb, MADV_HUGEPAGE);
+#endif
+}
+
+// The distinct values of `v`, sorted; linear in v.size() for the few ids a mesh has.
+std::vector<std::int32_t> distinct(const std::vector<std::int32_t>& v) {
+  std::vector<std::int32_t> ids;
+  std::int32_t last = 0;
+  bool have_last = false;
+  for (std::int32_t x : v) {
+    if (have_last && x == last) continue;
+    last = x;
+    have_last = true;
+    auto it = std::lower_bound(ids.begin(), ids.end(), x);
+    if (it == ids.end() || *it != x) ids.insert(it, x);
+  }
+  return ids;
+}
 
 // Number of nodes of the element types foxi reads; -1 for any other type.
 int nodes_of_type(std::int64_t type) {
@@ -431,6 +464,8 @@ class Reader {
   // ---- nodes ----
   void read_nodes22() {
     std::uint64_t n = count("nodes", binary_ ? 28 : 8);
+    reserve_huge(mesh_.xyz, 3 * n);
+    reserve_huge(node_tags_, n);
     mesh_.xyz.resize(3 * n);
     node_tags_.resize(n);
     double* xyz = mesh_.xyz.data();
@@ -473,6 +508,8 @@ class Reader {
       num<std::uint64_t>(cur_, "minimum node tag");
       num<std::uint64_t>(cur_, "maximum node tag");
     }
+    reserve_huge(mesh_.xyz, 3 * n);
+    reserve_huge(node_tags_, n);
     mesh_.xyz.resize(3 * n);
     node_tags_.resize(n);
     std::uint64_t done = 0;
@@ -551,7 +588,7 @@ class Reader {
     if (nn == 4) {
       mesh_.tet.insert(mesh_.tet.end(), v, v + 4);
       mesh_.tet_region.push_back(phys);
-      tet_tags_.push_back(tag);
+      note_tet_tag(tag, mesh_.tet_region.size() - 1);
     } else if (nn == 3) {
       mesh_.bface.insert(mesh_.bface.end(), v, v + 3);
       mesh_.bface_tag.push_back(phys);
@@ -560,7 +597,11 @@ class Reader {
 
   void read_elements22() {
     std::size_t at = cur_.pos();
-    std::uint64_t n = count("elements", binary_ ? 8 : 8);
+    std::uint64_t n = count("elements", 8);
+    reserve_huge(mesh_.tet, 4 * n);
+    reserve_huge(mesh_.tet_region, n);
+    reserve_huge(mesh_.bface, 3 * n);
+    reserve_huge(mesh_.bface_tag, n);
     std::uint32_t v[4];
     if (binary_) {
       cur_.rest_of_line();
@@ -628,6 +669,18 @@ class Reader {
     cur_.expect("$EndElements");
   }
 
+  void note_tet_tag(std::uint64_t tag, std::uint64_t tet) {
+    if (!tet_tag_runs_.empty()) {
+      TagRun& r = tet_tag_runs_.back();
+      if (r.tag0 + r.count == tag && r.first + r.count == tet) [[likely]] {
+        ++r.count;
+        return;
+      }
+    }
+    new_tag_run(tag, tet);
+  }
+  void new_tag_run(std::uint64_t tag, std::uint64_t tet) { tet_tag_runs_.push_back({tag, tet, 1}); }
+
   std::int32_t entity_physical(std::int64_t dim, std::int64_t tag) const {
     if (dim < 0 || dim > 3) return 0;
     auto it = entity_phys_[dim].find(tag);
@@ -644,13 +697,8 @@ class Reader {
     out.resize(out.size() + NN * m);
     reg.resize(reg.size() + m, phys);
     std::uint32_t* o = out.data() + NN * base;
-    std::uint64_t* tt = nullptr;
-    if (NN == 4) {
-      tet_tags_.resize(base + m);
-      tt = tet_tags_.data() + base;
-    }
     for (std::uint64_t i = 0; i < m; ++i, p += rec) {
-      if (NN == 4) tt[i] = io::load<std::uint64_t>(p);
+      if (NN == 4) note_tet_tag(io::load<std::uint64_t>(p), base + i);
       for (int k = 0; k < NN; ++k) {
         std::uint64_t t = io::load<std::uint64_t>(p + 8 + 8 * k);
         std::uint32_t idx = find(t);
@@ -669,14 +717,9 @@ class Reader {
     out.resize(out.size() + NN * m);
     reg.resize(reg.size() + m, phys);
     std::uint32_t* o = out.data() + NN * base;
-    std::uint64_t* tt = nullptr;
-    if (NN == 4) {
-      tet_tags_.resize(base + m);
-      tt = tet_tags_.data() + base;
-    }
     for (std::uint64_t i = 0; i < m; ++i) {
       std::uint64_t tag = num<std::uint64_t>(cur_, "element tag");
-      if (NN == 4) tt[i] = tag;
+      if (NN == 4) note_tet_tag(tag, base + i);
       for (int k = 0; k < NN; ++k) {
         std::size_t nat = here();
         std::uint64_t t = num<std::uint64_t>(cur_, "node tag");
@@ -724,6 +767,11 @@ class Reader {
       num<std::uint64_t>(cur_, "minimum element tag");
       num<std::uint64_t>(cur_, "maximum element tag");
     }
+    // Any element may be a tet or a triangle: reserve for both (address space only).
+    reserve_huge(mesh_.tet, 4 * n);
+    reserve_huge(mesh_.tet_region, n);
+    reserve_huge(mesh_.bface, 3 * n);
+    reserve_huge(mesh_.bface_tag, n);
     std::uint64_t done = 0;
     for (std::uint64_t b = 0; b < blocks; ++b) {
       std::size_t bat = cur_.pos();
@@ -846,7 +894,11 @@ class Reader {
     }
     if (!node && !tet_map_built_) {
       std::uint64_t dup = 0;
-      if (!tet_map_.build(tet_tags_, &dup)) fail_at(at, "element tag " + str(dup) + " appears twice");
+      std::vector<std::uint64_t> tags(mesh_.tet_count());
+      for (const TagRun& r : tet_tag_runs_) {
+        for (std::uint64_t i = 0; i < r.count; ++i) tags[r.first + i] = r.tag0 + i;
+      }
+      if (!tet_map_.build(tags, &dup)) fail_at(at, "element tag " + str(dup) + " appears twice");
       tet_map_built_ = true;
     }
     double* out = s->values.data();
@@ -882,17 +934,11 @@ class Reader {
 
   // ---- assembly ----
   Mesh finish() {
-    std::vector<std::int32_t> ids(mesh_.tet_region);
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    for (std::int32_t id : ids) {
+    for (std::int32_t id : distinct(mesh_.tet_region)) {
       auto it = volume_names_.find(id);
       mesh_.regions.push_back({id, it == volume_names_.end() ? std::string() : it->second, kNone});
     }
-    ids = mesh_.bface_tag;
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    for (std::int32_t id : ids) {
+    for (std::int32_t id : distinct(mesh_.bface_tag)) {
       auto it = surface_names_.find(id);
       mesh_.boundaries.push_back({id, it == surface_names_.end() ? std::string() : it->second});
     }
@@ -923,7 +969,11 @@ class Reader {
   Mesh mesh_;
   std::vector<std::uint64_t> node_tags_;
   TagMap nodes_;
-  std::vector<std::uint64_t> tet_tags_;
+  // Element tags of the tets, as runs of consecutive tags (one run per block in usual files).
+  struct TagRun {
+    std::uint64_t tag0, first, count;
+  };
+  std::vector<TagRun> tet_tag_runs_;
   TagMap tet_map_;
   bool tet_map_built_ = false;
   std::unordered_map<std::int64_t, std::int32_t> entity_phys_[4];
