@@ -48,7 +48,7 @@ struct ArrayData {
   std::string_view lent;    // count * type_size(type) bytes in the file, or
   std::string owned;        // the same, owned (is_owned)
   bool is_owned = false;
-  bool swap = false;        // bytes are in the other byte order
+  bool swap = false;  // bytes are in the other byte order
 
   // Never a stored view of `owned`: a moved std::string may move its (short) buffer.
   const char* data() const { return is_owned ? owned.data() : lent.data(); }
@@ -169,10 +169,10 @@ struct NamedArray {
 struct Piece {
   std::uint64_t npoints = 0, ncells = 0;
   std::size_t at = 0, cells_at = 0;  // file offsets of the piece and its cells (for errors)
-  ArrayData points;   // 3 * npoints values
-  ArrayData conn;     // connectivity
-  ArrayData offsets;  // ncells values: end of each cell in conn
-  ArrayData types;    // ncells values
+  ArrayData points;                  // 3 * npoints values
+  ArrayData conn;                    // connectivity
+  ArrayData offsets;                 // ncells values: end of each cell in conn
+  ArrayData types;                   // ncells values
   std::vector<NamedArray> point_arrays, cell_arrays;
 };
 

@@ -152,12 +152,12 @@ def appended(path, enc, comp, htype, order, bs=20):
         f.write(x.encode())
         f.write(blob if enc == "raw" else blob.encode())
         f.write(b"\n</AppendedData>\n</VTKFile>\n")
-appended(f"{d}/app_raw.vtu", "raw", False, "Uint32", "<")
-appended(f"{d}/app_raw_be.vtu", "raw", False, "Uint64", ">")
-appended(f"{d}/app_b64.vtu", "base64", False, "Uint32", "<")
-appended(f"{d}/app_zraw.vtu", "raw", True, "Uint64", "<")
-appended(f"{d}/app_zraw_be.vtu", "raw", True, "Uint32", ">")
-appended(f"{d}/app_zb64.vtu", "base64", True, "Uint32", "<")
+appended(f"{d}/app_raw.vtu", "raw", False, "UInt32", "<")
+appended(f"{d}/app_raw_be.vtu", "raw", False, "UInt64", ">")
+appended(f"{d}/app_b64.vtu", "base64", False, "UInt32", "<")
+appended(f"{d}/app_zraw.vtu", "raw", True, "UInt64", "<")
+appended(f"{d}/app_zraw_be.vtu", "raw", True, "UInt32", ">")
+appended(f"{d}/app_zb64.vtu", "base64", True, "UInt32", "<")
 
 def out(k, a): print(k + "|" + " ".join(repr(float(x)) for x in np.asarray(a).reshape(-1)))
 out("points", pts); out("points32", pts.astype(np.float32)); out("tets", tets); out("tris", tris)
@@ -318,12 +318,16 @@ void expect_same_mesh(const Mesh& a, const Mesh& b, bool names) {
   ASSERT_EQ(a.regions.size(), b.regions.size());
   for (std::size_t i = 0; i < a.regions.size(); ++i) {
     EXPECT_EQ(a.regions[i].id, b.regions[i].id);
-    if (names) EXPECT_EQ(a.regions[i].name, b.regions[i].name);
+    if (names) {
+      EXPECT_EQ(a.regions[i].name, b.regions[i].name);
+    }
   }
   ASSERT_EQ(a.boundaries.size(), b.boundaries.size());
   for (std::size_t i = 0; i < a.boundaries.size(); ++i) {
     EXPECT_EQ(a.boundaries[i].tag, b.boundaries[i].tag);
-    if (names) EXPECT_EQ(a.boundaries[i].name, b.boundaries[i].name);
+    if (names) {
+      EXPECT_EQ(a.boundaries[i].name, b.boundaries[i].name);
+    }
   }
   ASSERT_EQ(a.fields.size(), b.fields.size());
   for (std::size_t i = 0; i < a.fields.size(); ++i) {
@@ -343,7 +347,8 @@ void expect_same_mesh(const Mesh& a, const Mesh& b, bool names) {
 TEST(VtuWrite, RoundTripEveryEncodingBitForBit) {
   TempDir dir;
   Mesh m = rich_mesh();
-  for (VtuEncoding e : {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
+  for (VtuEncoding e :
+       {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
     SCOPED_TRACE(static_cast<int>(e));
     fs::path p = dir / ("rt" + std::to_string(static_cast<int>(e)) + ".vtu");
     write_vtu(m, p, e);
@@ -422,7 +427,8 @@ TEST(VtuWrite, MeshioReadsFoxiFiles) {
   std::string args;
   const char* names[] = {"ascii.vtu", "base64.vtu", "raw.vtu", "zlib.vtu"};
   int i = 0;
-  for (VtuEncoding e : {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
+  for (VtuEncoding e :
+       {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
     write_vtu(m, dir / names[i], e);
     args += " '" + (dir / names[i]).string() + "'";
     ++i;
@@ -442,9 +448,9 @@ TEST(VtkLegacyRead, GmshWrittenFiles) {
   test::write_text(dir / "box.geo",
                    "SetFactory(\"OpenCASCADE\");\nBox(1) = {0, 0, 0, 1, 2, 0.5};\n"
                    "Mesh.CharacteristicLengthMax = 0.3;\n");
-  ASSERT_EQ(test::run("cd '" + dir.path().string() + "' && gmsh -3 box.geo -format vtk -o a.vtk",
-                      dir / "gmsh.log"),
-            0);
+  ASSERT_EQ(
+      test::run("cd '" + dir.path().string() + "' && gmsh -3 box.geo -format vtk -o a.vtk", dir / "gmsh.log"),
+      0);
   ASSERT_EQ(test::run("cd '" + dir.path().string() + "' && gmsh -3 box.geo -format vtk -bin -o b.vtk",
                       dir / "gmsh2.log"),
             0);
@@ -485,7 +491,8 @@ for p in sys.argv[1:]:
         c[d] = p[3][d] - p[0][d];
       }
       vol += std::abs(a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                      a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+                      a[2] * (b[0] * c[1] - b[1] * c[0])) /
+             6;
     }
     EXPECT_NEAR(vol, 1.0, 1e-9);
   }
@@ -494,7 +501,8 @@ for p in sys.argv[1:]:
 // ------------------------------------------------------------------------------------------------
 // Malformed input.
 
-void expect_io_error(const std::function<void()>& f, const std::string& what, const std::string& reason_part = "") {
+void expect_io_error(const std::function<void()>& f, const std::string& what,
+                     const std::string& reason_part = "") {
   try {
     f();
     ADD_FAILURE() << what << ": no IoError";
@@ -504,7 +512,9 @@ void expect_io_error(const std::function<void()>& f, const std::string& what, co
     EXPECT_TRUE(e.line() != 0 || e.byte_offset() != IoError::kNoOffset ||
                 e.reason().find("piece") != std::string::npos || e.reason().find("cell") != std::string::npos)
         << what << ": " << e.what();
-    if (!reason_part.empty()) EXPECT_NE(e.reason().find(reason_part), std::string::npos) << what << ": " << e.what();
+    if (!reason_part.empty()) {
+      EXPECT_NE(e.reason().find(reason_part), std::string::npos) << what << ": " << e.what();
+    }
   }
 }
 
@@ -556,7 +566,8 @@ std::string small_file(VtuEncoding e, const TempDir& dir) {
 
 TEST(VtkBadInput, TruncationSweepNeverCrashes) {
   TempDir dir;
-  for (VtuEncoding e : {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
+  for (VtuEncoding e :
+       {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
     std::string full = small_file(e, dir);
     ASSERT_NO_THROW(parse_vtu(full, "full.vtu"));
     const std::size_t closing = full.rfind("</VTKFile>");
@@ -583,7 +594,8 @@ TEST(VtkBadInput, TruncationSweepNeverCrashes) {
 TEST(VtkBadInput, ByteFlipsNeverCrash) {
   TempDir dir;
   std::mt19937 rng(11);
-  for (VtuEncoding e : {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
+  for (VtuEncoding e :
+       {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
     std::string full = small_file(e, dir);
     for (int i = 0; i < 300; ++i) {
       std::string s = full;
