@@ -330,6 +330,30 @@ TEST(MeditRead, TruncationSweepNeverCrashes) {
   EXPECT_GT(ok, 0u);
 }
 
+TEST(MeditRead, ByteMutationSweepNeverCrashes) {
+  TempDir dir;
+  write_medit(awkward_mesh(), dir / "a.mesh");
+  const std::string text = test::read_text(dir / "a.mesh");
+  const char subst[] = {'#', '\n', '\r', '-', '9', 'e', '.', ' ', '\0', 'x'};
+  std::size_t failed = 0;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    for (char c : subst) {
+      std::string t = text;
+      t[k] = c;
+      try {
+        Mesh r = parse_medit(t, "mut");
+        ASSERT_TRUE(check_sizes(r).empty());
+        for (std::uint32_t i : r.tet) ASSERT_LT(i, r.node_count());
+        for (std::uint32_t i : r.bface) ASSERT_LT(i, r.node_count());
+        for (double x : r.xyz) ASSERT_TRUE(std::isfinite(x));
+      } catch (const IoError&) {
+        ++failed;
+      }
+    }
+  }
+  EXPECT_GT(failed, 0u);
+}
+
 TEST(MeditWrite, FailedWriteLeavesNothing) {
   TempDir dir;
   fs::create_directories(dir / "a.mesh" / "x");

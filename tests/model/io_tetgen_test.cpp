@@ -521,6 +521,34 @@ TEST(TetgenRead, TruncationSweepNeverCrashes) {
   EXPECT_GT(ok, 0u);
 }
 
+// Every byte replaced by a few troublesome characters: reads or throws IoError, indices in range.
+TEST(TetgenRead, ByteMutationSweepNeverCrashes) {
+  TempDir dir;
+  write_tetgen(awkward_mesh(), dir / "a");
+  std::string files[3] = {test::read_text(dir / "a.node"), test::read_text(dir / "a.ele"),
+                          test::read_text(dir / "a.face")};
+  const char subst[] = {'#', '\n', '\r', '-', '9', 'e', '.', ' ', '\0', 'x'};
+  std::size_t failed = 0;
+  for (int which = 0; which < 3; ++which) {
+    for (std::size_t k = 0; k < files[which].size(); ++k) {
+      for (char c : subst) {
+        std::string f[3] = {files[0], files[1], files[2]};
+        f[which][k] = c;
+        try {
+          Mesh r = parse_tetgen(f[0], f[1], f[2], "mut");
+          ASSERT_TRUE(check_sizes(r).empty());
+          for (std::uint32_t i : r.tet) ASSERT_LT(i, r.node_count());
+          for (std::uint32_t i : r.bface) ASSERT_LT(i, r.node_count());
+          for (double x : r.xyz) ASSERT_TRUE(std::isfinite(x));
+        } catch (const IoError&) {
+          ++failed;
+        }
+      }
+    }
+  }
+  EXPECT_GT(failed, 0u);
+}
+
 TEST(TetgenWrite, FailedWriteLeavesNoFiles) {
   TempDir dir;
   // a.face is a folder holding a file: the last rename fails, and the .node and .ele must go too.
