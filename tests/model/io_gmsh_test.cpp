@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -55,36 +56,47 @@ double tet_volume(const Mesh& m, std::size_t t) {
          6.0;
 }
 
-// Counts and volumes as meshio reports them, one "key value" per line.
-std::map<std::string, double> meshio_summary(const fs::path& file, const TempDir& dir) {
+// Counts and volumes as meshio reports them for each file (one python run: meshio loads slowly),
+// "key value" lines per file, keys prefixed with the file's position.
+std::vector<std::map<std::string, double>> meshio_summary(const std::vector<fs::path>& files,
+                                                          const TempDir& dir) {
   const fs::path script = dir / "summary.py";
   test::write_text(script, R"(import sys, meshio, numpy as np
-m = meshio.read(sys.argv[1])
-print("nodes", len(m.points))
-tets = 0; tris = 0; vol = {}
-for i, block in enumerate(m.cells):
+for f in sys.argv[1:]:
+  m = meshio.read(f)
+  print("file 0")
+  print("nodes", len(m.points))
+  tets = 0; tris = 0; vol = {}
+  for i, block in enumerate(m.cells):
     if block.type == "tetra":
-        tets += len(block.data)
-        phys = m.cell_data["gmsh:physical"][i]
-        p = m.points[block.data]
-        v = np.einsum("ij,ij->i", p[:, 1] - p[:, 0], np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0])) / 6
-        for r in np.unique(phys):
-            vol[int(r)] = vol.get(int(r), 0.0) + float(v[phys == r].sum())
+      tets += len(block.data)
+      phys = m.cell_data["gmsh:physical"][i]
+      p = m.points[block.data]
+      v = np.einsum("ij,ij->i", p[:, 1] - p[:, 0], np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 0])) / 6
+      for r in np.unique(phys):
+        vol[int(r)] = vol.get(int(r), 0.0) + float(v[phys == r].sum())
     if block.type == "triangle":
-        tris += len(block.data)
-print("tets", tets)
-print("triangles", tris)
-for r, v in vol.items():
+      tris += len(block.data)
+  print("tets", tets)
+  print("triangles", tris)
+  for r, v in vol.items():
     print("volume%d" % r, repr(v))
 )");
   const fs::path out = dir / "summary.txt";
-  EXPECT_EQ(test::run(std::string(kPython) + " '" + script.string() + "' '" + file.string() + "'", out), 0)
-      << test::read_text(out);
-  std::map<std::string, double> r;
+  std::string cmd = std::string(kPython) + " '" + script.string() + "'";
+  for (const fs::path& f : files) cmd += " '" + f.string() + "'";
+  EXPECT_EQ(test::run(cmd, out), 0) << test::read_text(out);
+  std::vector<std::map<std::string, double>> r;
   std::istringstream in(test::read_text(out));
   std::string key;
   double value;
-  while (in >> key >> value) r[key] = value;
+  while (in >> key >> value) {
+    if (key == "file")
+      r.emplace_back();
+    else if (!r.empty())
+      r.back()[key] = value;
+  }
+  r.resize(files.size());
   return r;
 }
 
@@ -107,13 +119,23 @@ TEST(GmshRead, GmshGeneratedFilesMatchMeshioAndGeometry) {
                           (dir / "base.msh").string() + "'",
                       dir / "gmsh.log"),
             0);
+  std::vector<fs::path> files;
   for (const Variant& v : kVariants) {
-    SCOPED_TRACE(label(v));
-    const fs::path file = dir / ("two_" + std::to_string(v.version) + (v.binary ? "b" : "a") + ".msh");
+    files.push_back(dir / ("two_" + std::to_string(v.version) + (v.binary ? "b" : "a") + ".msh"));
+  }
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const Variant& v = kVariants[i];
+    const fs::path& file = files[i];
     ASSERT_EQ(test::run("gmsh -nopopup '" + (dir / "base.msh").string() + "' -save -format " + v.gmsh_format +
                             (v.binary ? " -bin" : "") + " -o '" + file.string() + "'",
                         dir / "gmsh.log"),
               0);
+  }
+  const std::vector<std::map<std::string, double>> refs = meshio_summary(files, dir);
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const Variant& v = kVariants[i];
+    const fs::path& file = files[i];
+    SCOPED_TRACE(label(v));
     // The header says which variant gmsh wrote.
     const std::string text = test::read_text(file);
     ASSERT_NE(text.find(std::string(v.version == 22 ? "2.2 " : "4.1 ") + (v.binary ? "1 8" : "0 8")),
@@ -121,7 +143,7 @@ TEST(GmshRead, GmshGeneratedFilesMatchMeshioAndGeometry) {
 
     const Mesh m = read_gmsh(file);
     EXPECT_EQ(check_sizes(m), "");
-    std::map<std::string, double> ref = meshio_summary(file, dir);
+    std::map<std::string, double> ref = refs[i];
     ASSERT_GT(ref["tets"], 100);
     EXPECT_EQ(static_cast<double>(m.node_count()), ref["nodes"]);
     EXPECT_EQ(static_cast<double>(m.tet_count()), ref["tets"]);
@@ -273,28 +295,58 @@ TEST(GmshWrite, GmshLoadsFoxiFiles) {
     count_msh22(test::read_text(out), &nodes, &tets);
     EXPECT_EQ(nodes, m.node_count());
     EXPECT_EQ(tets, m.tet_count());
+
+    // gmsh also loads the fields as views: the temperature (2 steps) with the same extreme values.
+    const fs::path geo = dir / "views.geo";
+    test::write_text(geo,
+                     "Merge \"" + file.string() +
+                         "\";\nPrintf(\"views %g steps %g min %.17g max %.17g\", PostProcessing.NbViews, "
+                         "View[0].NbTimeStep, View[0].Min, View[0].Max);\n");
+    EXPECT_EQ(test::run("gmsh -nopopup '" + geo.string() + "' -parse_and_exit", log), 0);
+    const std::string views = test::read_text(log);
+    const std::size_t at = views.find("views ");
+    ASSERT_NE(at, std::string::npos) << views;
+    std::istringstream in(views.substr(at));
+    std::string w1, w2, w3, w4;
+    double nviews = 0, steps = 0, lo = 0, hi = 0;
+    in >> w1 >> nviews >> w2 >> steps >> w3 >> lo >> w4 >> hi;
+    EXPECT_EQ(nviews, 3);
+    EXPECT_EQ(steps, 2);
+    double want_lo = INFINITY, want_hi = -INFINITY;
+    for (double x : m.fields[0].values) {
+      if (std::isnan(x)) continue;
+      want_lo = std::min(want_lo, x);
+      want_hi = std::max(want_hi, x);
+    }
+    EXPECT_EQ(lo, want_lo);
+    EXPECT_EQ(hi, want_hi);
   }
 }
 
 TEST(GmshRead, MeshioWrittenFieldsMatch) {
   if (!have_meshio()) GTEST_SKIP() << "meshio not available";
   TempDir dir;
+  // Two tets sharing a face; node field x + 2y + 3z, cell vector (i, 10 i, 100 i) for cell i; written
+  // by meshio in 2.2 and 4.1, ASCII and binary (one python run).
+  test::write_text(dir / "write.py", R"(import sys, meshio, numpy as np
+p = np.array([[0,0,0],[1,0,0],[0,1,0],[0,0,1],[1,1,1]], float)
+c = [('tetra', np.array([[0,1,2,3],[1,2,3,4]]))]
+m = meshio.Mesh(p, c, point_data={'lin': p @ [1.0, 2.0, 3.0]},
+  cell_data={'vec': [np.array([[1.0,10,100],[2,20,200]])],
+  'gmsh:physical': [np.array([3, 4])], 'gmsh:geometrical': [np.array([1, 2])]})
+for fmt in ['gmsh22', 'gmsh']:
+  for binary in [False, True]:
+    meshio.write(sys.argv[1] + '/%s_%d.msh' % (fmt, binary), m, file_format=fmt, binary=binary)
+)");
+  ASSERT_EQ(
+      test::run(std::string(kPython) + " '" + (dir / "write.py").string() + "' '" + dir.path().string() + "'",
+                dir / "py.log"),
+      0)
+      << test::read_text(dir / "py.log");
   for (const char* fmt : {"gmsh22", "gmsh"}) {
-    for (bool binary : {false, true}) {
+    for (int binary : {0, 1}) {
       SCOPED_TRACE(std::string(fmt) + (binary ? " binary" : " ascii"));
-      const fs::path file = dir / "meshio.msh";
-      // Two tets sharing a face; node field x + 2y + 3z, cell vector (i, 10 i, 100 i) for cell i.
-      const std::string script =
-          std::string(kPython) + " -c \"import meshio, numpy as np\n" +
-          "p = np.array([[0,0,0],[1,0,0],[0,1,0],[0,0,1],[1,1,1]], float)\n" +
-          "c = [('tetra', np.array([[0,1,2,3],[1,2,3,4]]))]\n" +
-          "m = meshio.Mesh(p, c, point_data={'lin': p @ [1.0, 2.0, 3.0]},\n" +
-          "  cell_data={'vec': [np.array([[1.0,10,100],[2,20,200]])],\n" +
-          "  'gmsh:physical': [np.array([3, 4])], 'gmsh:geometrical': [np.array([1, 2])]})\n" +
-          "meshio.write('" + file.string() + "', m, file_format='" + fmt +
-          "', binary=" + (binary ? "True" : "False") + ")\"";
-      ASSERT_EQ(test::run(script, dir / "py.log"), 0) << test::read_text(dir / "py.log");
-      const Mesh m = read_gmsh(file);
+      const Mesh m = read_gmsh(dir / (std::string(fmt) + "_" + std::to_string(binary) + ".msh"));
       ASSERT_EQ(m.node_count(), 5u);
       ASSERT_EQ(m.tet_count(), 2u);
       // 2.2 carries the physical tag per element; meshio's 4.1 has no $Entities: region 0.
