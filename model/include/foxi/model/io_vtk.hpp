@@ -8,6 +8,22 @@
 // base64), compressed with vtkZLibDataCompressor. Legacy: ASCII and binary (big-endian).
 // Write: region ids as the cell array "region", boundary triangles as triangle cells with tag in the
 // same array, fields as point/cell arrays (one array per step, "name" then "name@step").
+//
+// Details of foxi's choices:
+// - Steps: step k >= 2 of a field is the array "name@k"; on reading, a run "name", "name@2", ...
+//   with equal location and components becomes one field again. Field order on reading: point
+//   arrays first, then cell arrays.
+// - Names, units, step values: .vtu keeps region/boundary names in the attributes
+//   foxi_region_names / foxi_boundary_names ("id=name;..." %-escaped) of the "region" array, and
+//   foxi_unit / foxi_step_value on field arrays; VTK, ParaView and meshio ignore them. Legacy .vtk
+//   keeps none of these (steps read back as step values 0, 1, 2, ...); array names are %-escaped
+//   (spaces as %20), as VTK does. Materials are not stored.
+// - Cell fields hold tet values only; the writers give boundary-triangle cells NaN.
+// - Encodings written: ascii (shortest round-trip decimals), base64 (inline binary), appended_raw,
+//   zlib (inline base64 blocks of 32 KiB, level 1, as meshio writes; all with UInt64 headers).
+//   Connectivity and offsets are Int32 when they fit, else Int64.
+// - NaN or infinite coordinates are read as they are (validate() reports them), not rejected.
+// - Legacy write: version 4.2 layout ("CELLS n size" rows, CELL_TYPES), data as FIELD arrays.
 #pragma once
 
 #include <filesystem>
