@@ -218,7 +218,9 @@ class Checker {
     const double xn = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
     const double eq = 4 * kU * grid_.scale;  // bound on the rounding of q - a (vector norm)
     const double e1 = eq + ex;
-    const double rmax = (xn + ex) * (xn + ex) + grid_.wmax - wv[0];  // largest possible power radius^2
+    // Largest possible power radius^2 (with room for the rounding of the weight terms).
+    const double rmax =
+        (xn + ex) * (xn + ex) + grid_.wmax - wv[0] + 8 * kU * (std::abs(grid_.wmax) + std::abs(wv[0]));
     double half = e1 + std::sqrt(std::max(0.0, rmax));
     half = half * (1 + 1e-9) + 8 * kU * (grid_.scale + xn);
     std::int64_t c0[3] = {0, 0, 0}, c1[3] = {grid_.dims[0] - 1, grid_.dims[1] - 1, grid_.dims[2] - 1};
