@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   try {
     if (command == "info") return foxi::cli::cmd_info(std::move(rest));
     if (command == "convert") return foxi::cli::cmd_convert(std::move(rest));
+    if (command == "order") return foxi::cli::cmd_order(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const foxi::cli::UsageError& e) {

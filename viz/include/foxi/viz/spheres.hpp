@@ -1,0 +1,71 @@
+// Per-mesh precompute of the power ordering (seed paper, section 3): for every tet its circumcentre
+// c and s = |c|^2 - r^2, or for a weighted mesh (vertex weights, a regular triangulation) its
+// orthocentre and s = |c|^2 - R^2 where R^2 may be negative (s keeps its sign; no square root is
+// ever taken). The power of a point p w.r.t. the tet is then s - 2 c.p + |p|^2, so drawing in
+// decreasing key = s - 2 c.p is back to front (Theorem 1).
+//
+// Also found once per mesh: cospherical clusters, maximal sets of face-adjacent tets with the same
+// circumsphere (decided with CGAL's exact insphere test across each shared face), e.g. the 5 or 6
+// tets of one cube of a structured grid. Their keys tie exactly for every view; each is drawn as one
+// unit in the global order and ordered inside by a local MPVO over its own faces (section 3.3).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/progress.hpp"
+
+namespace foxi {
+
+// Sort items carry a tet index, or a cluster index with this bit set.
+inline constexpr std::uint32_t kClusterBit = 0x80000000u;
+
+struct SphereTable {
+  // Centres are stored relative to `origin` (the centre of the mesh's bounding box), and s with them:
+  // s = |c - origin|^2 - r^2, so that keys of a mesh far from the coordinate origin keep their
+  // precision. A view's eye point is taken relative to the same origin.
+  double origin[3] = {0, 0, 0};
+  std::vector<double> c;              // 3 per tet: circumcentre (orthocentre if weighted) - origin
+  std::vector<double> s;              // 1 per tet: |c|^2 - r^2 (|c|^2 - R^2 if weighted), local frame
+  std::vector<std::uint8_t> flat;     // 1 per tet: 1 = zero volume, no sphere (a point sphere at
+                                      // its centroid stands in, so it still gets a place)
+  bool weighted = false;
+  // Conditioning: a centre computed in double whose estimated relative error exceeds 2^-40 is
+  // recomputed with exact rational arithmetic and rounded.
+  std::size_t recomputed_exactly = 0;
+  std::size_t flat_count = 0;
+
+  // Rounding bounds of the keys. For tet t and eye p (local frame), |key error| <= A_t + B_t |p|_1
+  // (orthographic: B_t |d|_1). Most tets are within (bound_a, bound_b); the few that are not (huge
+  // circumspheres of slivers near the hull, badly conditioned centres) are "wide" items, sorted with
+  // their own bound (wide_a, wide_b) so that they do not widen everyone's near-tie window.
+  double bound_a = 0, bound_b = 0;
+  std::vector<std::uint8_t> wide;     // 1 per tet: 1 = a wide item (see above)
+  std::vector<std::uint32_t> wide_items;  // the wide items of the whole mesh (tet or cluster|bit)
+  std::vector<float> wide_a, wide_b;      // their bounds (same order)
+
+  // Cospherical clusters (only those with 2 or more tets). cluster_of[t] = cluster id or kNone.
+  std::vector<std::uint32_t> cluster_of;
+  std::vector<std::uint32_t> cluster_begin;   // CSR over cluster_tets, size = clusters + 1
+  std::vector<std::uint32_t> cluster_tets;
+  // The faces inside each cluster, CSR by cluster: face_tet[2k], face_tet[2k+1] are the two tets
+  // (the first on the positive side of the triangle), face_vertex[3k..3k+2] the triangle's nodes.
+  std::vector<std::uint32_t> cluster_face_begin;
+  std::vector<std::uint32_t> face_tet;
+  std::vector<std::uint32_t> face_vertex;
+  // The sort items of the whole mesh that are not wide, built once: each tet not in a cluster, and
+  // each cluster as (cluster | kClusterBit). A cluster's key is the key of its first tet.
+  std::vector<std::uint32_t> all_items;
+  // Per-tet key bounds, kept for subsets (which must find their own wide items).
+  std::vector<float> key_a, key_b;
+
+  std::size_t tet_count() const { return s.size(); }
+  std::size_t cluster_count() const { return cluster_begin.empty() ? 0 : cluster_begin.size() - 1; }
+};
+
+// Builds the table (both cores). Uses the mesh's cached face adjacency.
+SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress = {});
+
+}  // namespace foxi

@@ -1,0 +1,334 @@
+#include "foxi/viz/spheres.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <thread>
+
+#include "exact.hpp"
+#include "foxi/model/adjacency.hpp"
+
+namespace foxi {
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+// A centre computed in double whose estimated relative error exceeds this is recomputed exactly.
+constexpr double kRecomputeAbove = 0x1p-40;
+
+// Runs f(begin, end) over [0, n) on both cores.
+template <class F>
+void parallel_for(std::size_t n, F f) {
+  if (n < 20000) {
+    f(std::size_t{0}, n);
+    return;
+  }
+  std::size_t half = n / 2;
+  std::thread other([&] { f(half, n); });
+  f(std::size_t{0}, half);
+  other.join();
+}
+
+struct UnionFind {
+  std::vector<std::uint32_t> parent;
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent[x] != x) {
+      parent[x] = parent[parent[x]];
+      x = parent[x];
+    }
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+}  // namespace
+
+SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
+  SphereTable t;
+  const std::size_t n = mesh.tet_count();
+  const bool weighted = !mesh.weight.empty();
+  t.weighted = weighted;
+  t.c.resize(3 * n);
+  t.s.resize(n);
+  t.flat.assign(n, 0);
+  // Relative error estimate of each centre offset, kept until the clusters are found.
+  std::vector<float> rel_err(n, 0.f);
+  const double* X = mesh.xyz.data();
+  const std::uint32_t* T = mesh.tet.data();
+  const double* W = weighted ? mesh.weight.data() : nullptr;
+
+  // The local frame: the centre of the bounding box.
+  if (mesh.node_count() > 0) {
+    double lo[3] = {X[0], X[1], X[2]}, hi[3] = {X[0], X[1], X[2]};
+    for (std::size_t i = 1; i < mesh.node_count(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], X[3 * i + k]);
+        hi[k] = std::max(hi[k], X[3 * i + k]);
+      }
+    for (int k = 0; k < 3; ++k) t.origin[k] = 0.5 * (lo[k] + hi[k]);
+  }
+  const double org[3] = {t.origin[0], t.origin[1], t.origin[2]};
+  t.key_a.resize(n);
+  t.key_b.resize(n);
+
+  std::size_t recomputed[2] = {0, 0}, flats[2] = {0, 0};
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    const int part = begin == 0 ? 0 : 1;
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t* v = T + 4 * i;
+      const double* pa = X + 3 * std::size_t(v[0]);
+      const double* pb = X + 3 * std::size_t(v[1]);
+      const double* pc = X + 3 * std::size_t(v[2]);
+      const double* pd = X + 3 * std::size_t(v[3]);
+      double a[3], b[3], c[3], d[3];
+      for (int k = 0; k < 3; ++k) {
+        a[k] = pa[k] - org[k];
+        b[k] = pb[k] - pa[k];
+        c[k] = pc[k] - pa[k];
+        d[k] = pd[k] - pa[k];
+      }
+      double cd[3] = {c[1] * d[2] - c[2] * d[1], c[2] * d[0] - c[0] * d[2], c[0] * d[1] - c[1] * d[0]};
+      double db[3] = {d[1] * b[2] - d[2] * b[1], d[2] * b[0] - d[0] * b[2], d[0] * b[1] - d[1] * b[0]};
+      double bc[3] = {b[1] * c[2] - b[2] * c[1], b[2] * c[0] - b[0] * c[2], b[0] * c[1] - b[1] * c[0]};
+      double det = b[0] * cd[0] + b[1] * cd[1] + b[2] * cd[2];
+      double lb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+      double lc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+      double ld = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      const double nb = std::sqrt(lb), nc = std::sqrt(lc), nd = std::sqrt(ld);
+      double wb = lb, wc = lc, wd = ld, w0 = 0;
+      if (W != nullptr) {
+        w0 = W[v[0]];
+        wb = lb - W[v[1]] + w0;
+        wc = lc - W[v[2]] + w0;
+        wd = ld - W[v[3]] + w0;
+      }
+      double num[3];
+      for (int k = 0; k < 3; ++k) num[k] = wb * cd[k] + wc * db[k] + wd * bc[k];
+      // Error estimates: a few ulps per operation times the magnitudes that were summed.
+      const double det_err = 16 * kEps * nb * nc * nd;
+      const double num_mag = std::abs(wb) * nc * nd + std::abs(wc) * nd * nb + std::abs(wd) * nb * nc +
+                             (W != nullptr ? (lb + lc + ld + 3 * std::abs(w0)) * (nc * nd + nd * nb + nb * nc) : 0);
+      const double num_norm = std::sqrt(num[0] * num[0] + num[1] * num[1] + num[2] * num[2]);
+      const double num_err = 16 * kEps * num_mag;
+      double rel = std::abs(det) > 0 ? det_err / std::abs(det) + (num_norm > 0 ? num_err / num_norm : 1.0) : 1.0;
+      double* cc = t.c.data() + 3 * i;
+      double& s = t.s[i];
+      if (rel > kRecomputeAbove) {
+        const double* wv = nullptr;
+        double wq[4];
+        if (W != nullptr) {
+          for (int k = 0; k < 4; ++k) wq[k] = W[v[k]];
+          wv = wq;
+        }
+        ++recomputed[part];
+        double cabs[3], sabs;
+        if (exact::centre(pa, pb, pc, pd, wv, cabs, sabs)) {
+          // Into the local frame: c - origin, and s - 2 c.origin + |origin|^2 (rounded, counted below).
+          for (int k = 0; k < 3; ++k) cc[k] = cabs[k] - org[k];
+          s = sabs - 2 * (cabs[0] * org[0] + cabs[1] * org[1] + cabs[2] * org[2]) +
+              (org[0] * org[0] + org[1] * org[1] + org[2] * org[2]);
+        } else {
+          // Flat: a point sphere at the centroid, so the tet still has a place in the order.
+          t.flat[i] = 1;
+          ++flats[part];
+          for (int k = 0; k < 3; ++k) cc[k] = 0.25 * (pa[k] + pb[k] + pc[k] + pd[k]) - org[k];
+          s = cc[0] * cc[0] + cc[1] * cc[1] + cc[2] * cc[2];
+        }
+        rel = 0;
+      } else {
+        const double inv = 0.5 / det;
+        double o[3] = {num[0] * inv, num[1] * inv, num[2] * inv};
+        for (int k = 0; k < 3; ++k) cc[k] = a[k] + o[k];
+        // s = |c|^2 - r^2 = |a|^2 + 2 a.o (+ w0): no cancellation of two large squares.
+        s = a[0] * a[0] + a[1] * a[1] + a[2] * a[2] + 2 * (a[0] * o[0] + a[1] * o[1] + a[2] * o[2]) + w0;
+      }
+      rel_err[i] = static_cast<float>(rel);
+      // Key bounds (see spheres.hpp), generous by a factor of about 2.
+      const double na = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+      const double ncc = std::sqrt(cc[0] * cc[0] + cc[1] * cc[1] + cc[2] * cc[2]);
+      const double no = std::sqrt((cc[0] - a[0]) * (cc[0] - a[0]) + (cc[1] - a[1]) * (cc[1] - a[1]) +
+                                  (cc[2] - a[2]) * (cc[2] - a[2]));
+      const double norg = std::abs(org[0]) + std::abs(org[1]) + std::abs(org[2]);
+      const double err_c = 8 * kEps * (na + ncc) + no * rel + (rel == 0 ? 4 * kEps * (ncc + norg) : 0);
+      const double err_s = 32 * kEps * (na * na + 2 * na * no + std::abs(w0) + std::abs(s)) + 2 * na * no * rel +
+                           (rel == 0 ? 16 * kEps * (std::abs(s) + 2 * (ncc + norg) * norg) : 0);
+      t.key_a[i] = static_cast<float>(2 * (err_s + 8 * kEps * std::abs(s)));
+      t.key_b[i] = static_cast<float>(2 * (2 * err_c + 16 * kEps * ncc));
+    }
+  });
+  t.recomputed_exactly = recomputed[0] + recomputed[1];
+  t.flat_count = flats[0] + flats[1];
+  if (progress && !progress("spheres", 0.5)) return t;
+
+  // Cospherical clusters: across each interior face, is the neighbour's far vertex on this tet's
+  // sphere? A double filter rejects the clear cases; CGAL's exact test decides the rest.
+  const FaceAdjacency& adj = face_adjacency(mesh);
+  std::vector<std::uint8_t> same(4 * n, 0);
+  parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (t.flat[i]) continue;
+      const std::uint32_t* v = T + 4 * i;
+      const double* a = X + 3 * std::size_t(v[0]);
+      const double* cc = t.c.data() + 3 * i;
+      double o[3] = {cc[0] + org[0] - a[0], cc[1] + org[1] - a[1], cc[2] + org[2] - a[2]};
+      const double no = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
+      for (int f = 0; f < 4; ++f) {
+        std::uint32_t nb = adj.neighbour[4 * i + f];
+        if (nb == kNone) continue;
+        std::uint32_t u = nb >> 2;
+        if (u < i || t.flat[u]) continue;  // each face once, from its lower tet
+        std::uint32_t qv = T[4 * std::size_t(u) + (nb & 3)];
+        const double* q = X + 3 * std::size_t(qv);
+        double qa[3] = {q[0] - a[0], q[1] - a[1], q[2] - a[2]};
+        double lqa = qa[0] * qa[0] + qa[1] * qa[1] + qa[2] * qa[2];
+        // power of q w.r.t. the sphere = |q-a|^2 - 2 (q-a).o (- w_q + w_a if weighted)
+        double pw = lqa - 2 * (qa[0] * o[0] + qa[1] * o[1] + qa[2] * o[2]);
+        double mag = lqa + 2 * std::sqrt(lqa) * no;
+        if (W != nullptr) {
+          pw += W[v[0]] - W[qv];
+          mag += std::abs(W[v[0]]) + std::abs(W[qv]);
+        }
+        double bound = 32 * kEps * mag + 4 * std::sqrt(lqa) * no * double(rel_err[i]) +
+                       8 * std::sqrt(lqa) * kEps * (std::abs(org[0]) + std::abs(org[1]) + std::abs(org[2]) + no);
+        if (std::abs(pw) > bound) continue;
+        double w4[4];
+        const double* wv = nullptr;
+        double wq = 0;
+        if (W != nullptr) {
+          for (int k = 0; k < 4; ++k) w4[k] = W[v[k]];
+          wv = w4;
+          wq = W[qv];
+        }
+        if (exact::in_sphere(a, X + 3 * std::size_t(v[1]), X + 3 * std::size_t(v[2]), X + 3 * std::size_t(v[3]), q,
+                             wv, wq) == 0)
+          same[4 * i + f] = 1;
+      }
+    }
+  });
+  if (progress && !progress("clusters", 0.8)) return t;
+
+  UnionFind uf(n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int f = 0; f < 4; ++f)
+      if (same[4 * i + f]) uf.unite(static_cast<std::uint32_t>(i), adj.neighbour[4 * i + f] >> 2);
+  // Number the clusters of two or more tets in order of their smallest tet.
+  std::vector<std::uint32_t> size(n, 0);
+  for (std::size_t i = 0; i < n; ++i) ++size[uf.find(static_cast<std::uint32_t>(i))];
+  t.cluster_of.assign(n, kNone);
+  std::vector<std::uint32_t> id_of_root(n, kNone);
+  std::uint32_t clusters = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t r = uf.find(static_cast<std::uint32_t>(i));
+    if (size[r] < 2) continue;
+    if (id_of_root[r] == kNone) id_of_root[r] = clusters++;
+    t.cluster_of[i] = id_of_root[r];
+  }
+  t.cluster_begin.assign(clusters + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (t.cluster_of[i] != kNone) ++t.cluster_begin[t.cluster_of[i] + 1];
+  for (std::uint32_t k = 0; k < clusters; ++k) t.cluster_begin[k + 1] += t.cluster_begin[k];
+  t.cluster_tets.resize(t.cluster_begin[clusters]);
+  {
+    std::vector<std::uint32_t> fill(t.cluster_begin.begin(), t.cluster_begin.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      if (t.cluster_of[i] != kNone) t.cluster_tets[fill[t.cluster_of[i]]++] = static_cast<std::uint32_t>(i);
+  }
+  // Faces inside clusters, oriented so that the first tet lies on the positive side of the triangle.
+  static const int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  t.cluster_face_begin.assign(clusters + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int f = 0; f < 4; ++f)
+      if (same[4 * i + f]) ++t.cluster_face_begin[t.cluster_of[i] + 1];
+  for (std::uint32_t k = 0; k < clusters; ++k) t.cluster_face_begin[k + 1] += t.cluster_face_begin[k];
+  const std::size_t faces = t.cluster_face_begin[clusters];
+  t.face_tet.resize(2 * faces);
+  t.face_vertex.resize(3 * faces);
+  {
+    std::vector<std::uint32_t> fill(t.cluster_face_begin.begin(), t.cluster_face_begin.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int f = 0; f < 4; ++f) {
+        if (!same[4 * i + f]) continue;
+        std::uint32_t k = fill[t.cluster_of[i]]++;
+        // Face f of a positively oriented tet, listed as kFace[f], has the tet's vertex f on its
+        // negative side; reversed, it puts tet i on the positive side.
+        const std::uint32_t* v = T + 4 * i;
+        t.face_tet[2 * k] = static_cast<std::uint32_t>(i);
+        t.face_tet[2 * k + 1] = adj.neighbour[4 * i + f] >> 2;
+        t.face_vertex[3 * k] = v[kFace[f][0]];
+        t.face_vertex[3 * k + 1] = v[kFace[f][2]];
+        t.face_vertex[3 * k + 2] = v[kFace[f][1]];
+      }
+  }
+  // Wide items: bounds far above the typical (256 x the median), so that a few slivers with huge
+  // spheres do not widen the near-tie window of everyone else.
+  t.wide.assign(n, 0);
+  if (n > 0) {
+    std::vector<float> tmp(t.key_a);
+    std::nth_element(tmp.begin(), tmp.begin() + n / 2, tmp.end());
+    const double cap_a = 256.0 * std::max(double(tmp[n / 2]), 1e-300);
+    tmp = t.key_b;
+    std::nth_element(tmp.begin(), tmp.begin() + n / 2, tmp.end());
+    const double cap_b = 256.0 * std::max(double(tmp[n / 2]), 1e-300);
+    // Wide because of a poorly conditioned centre (not a huge sphere): recompute it exactly, which
+    // shrinks its bound to rounding.
+    for (std::size_t i = 0; i < n; ++i) {
+      if ((t.key_a[i] > cap_a || t.key_b[i] > cap_b) && rel_err[i] > 0 && !t.flat[i]) {
+        const std::uint32_t* v = T + 4 * i;
+        const double* pa = X + 3 * std::size_t(v[0]);
+        double w4[4];
+        const double* wv = nullptr;
+        if (W != nullptr) {
+          for (int k = 0; k < 4; ++k) w4[k] = W[v[k]];
+          wv = w4;
+        }
+        double cabs[3], sabs;
+        if (!exact::centre(pa, X + 3 * std::size_t(v[1]), X + 3 * std::size_t(v[2]), X + 3 * std::size_t(v[3]), wv,
+                           cabs, sabs))
+          continue;
+        ++t.recomputed_exactly;
+        double* cc = t.c.data() + 3 * i;
+        for (int k = 0; k < 3; ++k) cc[k] = cabs[k] - org[k];
+        t.s[i] = sabs - 2 * (cabs[0] * org[0] + cabs[1] * org[1] + cabs[2] * org[2]) +
+                 (org[0] * org[0] + org[1] * org[1] + org[2] * org[2]);
+        const double ncc = std::sqrt(cc[0] * cc[0] + cc[1] * cc[1] + cc[2] * cc[2]);
+        const double norg = std::abs(org[0]) + std::abs(org[1]) + std::abs(org[2]);
+        const double w0 = W != nullptr ? std::abs(W[v[0]]) : 0.0;
+        const double err_c = 8 * kEps * (ncc + norg);
+        const double err_s = 32 * kEps * (std::abs(t.s[i]) + 2 * (ncc + norg) * norg + w0);
+        t.key_a[i] = static_cast<float>(2 * (err_s + 8 * kEps * std::abs(t.s[i])));
+        t.key_b[i] = static_cast<float>(2 * (2 * err_c + 16 * kEps * ncc));
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (t.key_a[i] > cap_a || t.key_b[i] > cap_b) {
+        t.wide[i] = 1;
+      } else {
+        t.bound_a = std::max(t.bound_a, double(t.key_a[i]));
+        t.bound_b = std::max(t.bound_b, double(t.key_b[i]));
+      }
+    }
+  }
+  auto add_item = [&t](std::uint32_t item, std::uint32_t rep) {
+    if (t.wide[rep]) {
+      t.wide_items.push_back(item);
+      t.wide_a.push_back(t.key_a[rep]);
+      t.wide_b.push_back(t.key_b[rep]);
+    } else {
+      t.all_items.push_back(item);
+    }
+  };
+  t.all_items.reserve(n - t.cluster_tets.size() + clusters);
+  for (std::size_t i = 0; i < n; ++i)
+    if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
+  for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
+  if (progress) progress("clusters", 1.0);
+  return t;
+}
+
+}  // namespace foxi

@@ -1,0 +1,540 @@
+#include "foxi/viz/visibility_order.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <thread>
+
+#include "exact.hpp"
+#include "foxi/model/adjacency.hpp"
+
+namespace foxi {
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+// Face f of a positively oriented tet, listed so that the tet's own vertex f is on its negative side.
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+template <class F>
+void parallel_for(std::size_t n, F f) {
+  if (n < 50000) {
+    f(std::size_t{0}, n, 0);
+    return;
+  }
+  std::size_t half = n / 2;
+  std::thread other([&] { f(half, n, 1); });
+  f(std::size_t{0}, half, 0);
+  other.join();
+}
+
+const double* node(const Mesh& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
+
+// +1: the eye is on the positive side of triangle (a, b, c); -1 negative; 0 on its plane.
+int eye_side(const View& view, const double* a, const double* b, const double* c) {
+  if (view.perspective) return exact::orientation(a, b, c, view.eye);
+  const double back[3] = {-view.dir[0], -view.dir[1], -view.dir[2]};
+  return exact::orientation_at_infinity(a, b, c, back);
+}
+
+std::uint32_t rep_tet(const SphereTable& t, std::uint32_t item) {
+  return (item & kClusterBit) ? t.cluster_tets[t.cluster_begin[item & ~kClusterBit]] : item;
+}
+
+void exact_key(const Mesh& m, const SphereTable& table, const View& view, std::uint32_t tet, exact::PowerKey& key) {
+  const std::uint32_t* v = m.tet.data() + 4 * std::size_t(tet);
+  double w[4];
+  const double* wp = nullptr;
+  if (table.weighted) {
+    for (int k = 0; k < 4; ++k) w[k] = m.weight[v[k]];
+    wp = w;
+  }
+  if (table.flat[tet]) {
+    // Flat tets are point spheres at their centroid: give PowerKey a degenerate tet to say so.
+    key.set(node(m, v[0]), node(m, v[1]), node(m, v[2]), node(m, v[3]), nullptr, view.perspective,
+            view.perspective ? view.eye : view.dir);
+    return;
+  }
+  key.set(node(m, v[0]), node(m, v[1]), node(m, v[2]), node(m, v[3]), wp, view.perspective,
+          view.perspective ? view.eye : view.dir);
+}
+
+}  // namespace
+
+// One sort entry: the item's key in drawing order (ascending = drawn first) minus its rounding
+// radius, so that the exact key lies in [lo, lo + 2 radius].
+struct Entry {
+  double lo;
+  float radius;
+  std::uint32_t item;
+  double hi() const { return lo + 2.0 * double(radius); }
+  bool operator<(const Entry& o) const { return lo < o.lo; }
+};
+
+struct ProgressiveOrder::Impl {
+  const Mesh* mesh = nullptr;
+  const SphereTable* table = nullptr;
+  View view;
+  bool front_to_back = false;
+  std::vector<std::uint8_t> in_subset;          // per tet, only when a subset meets clusters
+  std::vector<Entry> sorted;                    // bucketed; each bucket sorted when handed out
+  std::vector<std::uint32_t> bucket_begin;      // size buckets + 1
+  std::size_t next_bucket = 0;
+  std::vector<std::uint32_t> batch;
+  std::size_t handed = 0, total_tets = 0;
+  OrderStats stats;
+  // Scratch for the local MPVO of clusters.
+  std::vector<std::uint32_t> local_tets, local_indeg, local_queue;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
+
+  bool tet_in(std::uint32_t t) const { return in_subset.empty() || in_subset[t]; }
+
+  void prepare(std::span<const std::uint32_t> subset);
+  void fix_ties(std::size_t begin, std::size_t end);
+  void expand(std::uint32_t item, std::vector<std::uint32_t>& out);
+};
+
+void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
+  const SphereTable& t = *table;
+  const std::size_t n = t.tet_count();
+  // The items: all of the mesh (precomputed), or the subset's tets and clusters.
+  std::vector<std::uint32_t> own_items, own_wide;
+  std::vector<float> own_wide_a, own_wide_b;
+  std::span<const std::uint32_t> items, wide_items;
+  std::span<const float> wide_a, wide_b;
+  if (subset.empty()) {
+    items = t.all_items;
+    wide_items = t.wide_items;
+    wide_a = t.wide_a;
+    wide_b = t.wide_b;
+    total_tets = n;
+  } else {
+    if (t.cluster_count() > 0) in_subset.assign(n, 0);
+    std::vector<std::uint8_t> cluster_seen(t.cluster_count(), 0);
+    own_items.reserve(subset.size());
+    for (std::uint32_t tet : subset) {
+      if (!in_subset.empty()) in_subset[tet] = 1;
+      std::uint32_t k = t.cluster_of.empty() ? kNone : t.cluster_of[tet];
+      std::uint32_t item = tet, rep = tet;
+      if (k != kNone) {
+        if (cluster_seen[k]) continue;
+        cluster_seen[k] = 1;
+        item = k | kClusterBit;
+        rep = t.cluster_tets[t.cluster_begin[k]];
+      }
+      if (t.wide[rep]) {
+        own_wide.push_back(item);
+        own_wide_a.push_back(t.key_a[rep]);
+        own_wide_b.push_back(t.key_b[rep]);
+      } else {
+        own_items.push_back(item);
+      }
+    }
+    items = own_items;
+    wide_items = own_wide;
+    wide_a = own_wide_a;
+    wide_b = own_wide_b;
+    total_tets = subset.size();
+  }
+  const std::size_t m_main = items.size(), m = m_main + wide_items.size();
+  stats.items = m;
+  stats.wide_items = wide_items.size();
+  if (m == 0) {
+    bucket_begin.assign(1, 0);
+    return;
+  }
+  auto item_at = [&](std::size_t i) { return i < m_main ? items[i] : wide_items[i - m_main]; };
+
+  // Rounding bounds: |key error| <= a + b |p|_1 (orthographic: b |d|_1), in the local frame.
+  View v = view;
+  for (int k = 0; k < 3; ++k) v.eye[k] -= t.origin[k];
+  const double np = v.perspective ? std::abs(v.eye[0]) + std::abs(v.eye[1]) + std::abs(v.eye[2])
+                                  : std::abs(v.dir[0]) + std::abs(v.dir[1]) + std::abs(v.dir[2]);
+  const double ka = v.perspective ? 1.0 : 0.0;
+  // Rounded up to float, and a little more for the subtraction that places lo.
+  const float bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
+  stats.key_bound = bound;
+
+  // 1. Entries (both cores): key in drawing order, placed at the low end of its interval.
+  sorted.resize(m);
+  const double* C = t.c.data();
+  const double* S = t.s.data();
+  const double sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
+  double lo_part[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  double hi_part[2] = {-lo_part[0], -lo_part[1]};
+  parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
+    double l = lo_part[part], h = hi_part[part];
+    const double px = 2 * v.eye[0], py = 2 * v.eye[1], pz = 2 * v.eye[2];
+    for (std::size_t i = b; i < e; ++i) {
+      std::uint32_t item = item_at(i);
+      std::uint32_t tet = rep_tet(t, item);
+      const double* c = C + 3 * std::size_t(tet);
+      double k = v.perspective ? S[tet] - (c[0] * px + c[1] * py + c[2] * pz)
+                               : c[0] * v.dir[0] + c[1] * v.dir[1] + c[2] * v.dir[2];
+      float r = bound;
+      if (i >= m_main) {
+        std::size_t w = i - m_main;
+        r = std::max(bound, static_cast<float>((ka * wide_a[w] + wide_b[w] * np) * (1 + 1e-6)));
+      }
+      double lo = sign * k - double(r);
+      sorted[i] = Entry{lo, r, item};
+      l = std::min(l, lo);
+      h = std::max(h, lo);
+    }
+    lo_part[part] = l;
+    hi_part[part] = h;
+  });
+  double kmin = std::min(lo_part[0], lo_part[1]), kmax = std::max(hi_part[0], hi_part[1]);
+  stats.key_range = kmax - kmin;
+  // The buckets cover the bulk of the keys, [0.2%, 99.8%] quantiles of a sample, widened: keys
+  // outside (far-flung spheres of slivers at the hull) fall into the first and last buckets.
+  if (m > 4096) {
+    std::vector<double> sample(1024);
+    for (std::size_t i = 0; i < sample.size(); ++i) sample[i] = sorted[i * (m / sample.size())].lo;
+    std::sort(sample.begin(), sample.end());
+    double qlo = sample[2], qhi = sample[sample.size() - 3], widen = 0.05 * (qhi - qlo);
+    kmin = std::max(kmin, qlo - widen);
+    kmax = std::min(kmax, qhi + widen);
+  }
+
+  // 2. The MSD bucket pass: a histogram and a scatter (both cores), by a linear map of lo.
+  int bits = 4;
+  while (bits < 20 && (std::size_t(16) << bits) < m) ++bits;
+  const std::size_t nb = std::size_t(1) << bits;
+  stats.buckets = nb;
+  const double scale = kmax > kmin ? double(nb) / (kmax - kmin) : 0.0;
+  const double last = double(nb - 1);
+  std::vector<std::uint32_t> bucket(m);
+  std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
+  parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
+    std::uint32_t* h = hist[part].data();
+    for (std::size_t i = b; i < e; ++i) {
+      double x = (sorted[i].lo - kmin) * scale;
+      std::uint32_t k = x <= 0 ? 0u : x >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(x);
+      bucket[i] = k;
+      ++h[k];
+    }
+  });
+  bucket_begin.assign(nb + 1, 0);
+  std::vector<std::uint32_t> start0(nb), start1(nb);
+  std::uint32_t acc = 0;
+  for (std::size_t b = 0; b < nb; ++b) {
+    bucket_begin[b] = acc;
+    start0[b] = acc;
+    acc += hist[0][b];
+    start1[b] = acc;
+    acc += hist[1][b];
+  }
+  bucket_begin[nb] = acc;
+  std::vector<Entry> out(m);
+  const std::size_t split = m < 50000 ? m : m / 2;  // as parallel_for splits
+  auto scatter = [&](std::size_t b, std::size_t e, std::vector<std::uint32_t>& pos) {
+    for (std::size_t i = b; i < e; ++i) out[pos[bucket[i]]++] = sorted[i];
+  };
+  if (split == m) {
+    scatter(0, m, start0);
+  } else {
+    std::thread other([&] { scatter(split, m, start1); });
+    scatter(0, split, start0);
+    other.join();
+  }
+  sorted.swap(out);
+}
+
+// Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
+// two entries can be out of order only if their intervals overlap. Sorted by lo, the maximal chains
+// of overlapping intervals are re-sorted by exact comparison (made only for overlapping pairs).
+void ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end) {
+  std::size_t i = begin;
+  while (i + 1 < end) {
+    std::size_t j = i;
+    double reach = sorted[i].hi();
+    while (j + 1 < end && sorted[j + 1].lo <= reach) reach = std::max(reach, sorted[++j].hi());
+    if (j > i) {
+      // Distinct items may still share a sphere (not face-adjacent): exact equality leaves them in
+      // any order, which is then correct (they are incomparable, Theorem 1).
+      struct Run {
+        Entry e;
+        mutable std::unique_ptr<exact::PowerKey> key;
+      };
+      std::vector<Run> run;
+      run.reserve(j - i + 1);
+      for (std::size_t k = i; k <= j; ++k) run.push_back({sorted[k], nullptr});
+      auto exact_of = [&](const Run& r) -> const exact::PowerKey& {
+        if (!r.key) {
+          r.key = std::make_unique<exact::PowerKey>();
+          exact_key(*mesh, *table, view, rep_tet(*table, r.e.item), *r.key);
+        }
+        return *r.key;
+      };
+      const bool ftb = front_to_back;
+      std::stable_sort(run.begin(), run.end(), [&](const Run& x, const Run& y) {
+        if (x.e.hi() < y.e.lo) return true;
+        if (y.e.hi() < x.e.lo) return false;
+        int c = exact_of(x).compare(exact_of(y));
+        return ftb ? c < 0 : c > 0;
+      });
+      for (std::size_t k = i; k <= j; ++k) sorted[k] = run[k - i].e;
+      ++stats.near_tie_runs;
+      stats.near_tie_items += j - i + 1;
+    }
+    i = j + 1;
+  }
+}
+
+// Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
+void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_t>& out) {
+  if (!(item & kClusterBit)) {
+    out.push_back(item);
+    return;
+  }
+  const SphereTable& t = *table;
+  const std::uint32_t k = item & ~kClusterBit;
+  local_tets.clear();
+  for (std::uint32_t i = t.cluster_begin[k]; i < t.cluster_begin[k + 1]; ++i)
+    if (tet_in(t.cluster_tets[i])) local_tets.push_back(t.cluster_tets[i]);
+  if (local_tets.size() == 1) {
+    out.push_back(local_tets[0]);
+    return;
+  }
+  auto local_index = [&](std::uint32_t tet) -> std::uint32_t {
+    for (std::uint32_t i = 0; i < local_tets.size(); ++i)
+      if (local_tets[i] == tet) return i;
+    return kNone;
+  };
+  local_edges.clear();
+  local_indeg.assign(local_tets.size(), 0);
+  for (std::uint32_t f = t.cluster_face_begin[k]; f < t.cluster_face_begin[k + 1]; ++f) {
+    std::uint32_t a = local_index(t.face_tet[2 * f]), b = local_index(t.face_tet[2 * f + 1]);
+    if (a == kNone || b == kNone) continue;
+    const std::uint32_t* fv = t.face_vertex.data() + 3 * std::size_t(f);
+    int side = eye_side(view, node(*mesh, fv[0]), node(*mesh, fv[1]), node(*mesh, fv[2]));
+    if (side == 0) continue;
+    // Tet a lies on the positive side. Eye there: a is in front, so b comes first (back to front).
+    std::uint32_t first = side > 0 ? b : a, second = side > 0 ? a : b;
+    if (front_to_back) std::swap(first, second);
+    local_edges.emplace_back(first, second);
+    ++local_indeg[second];
+  }
+  local_queue.clear();
+  std::vector<std::uint8_t> done(local_tets.size(), 0);
+  std::size_t emitted = 0;
+  for (std::uint32_t i = 0; i < local_tets.size(); ++i)
+    if (local_indeg[i] == 0) local_queue.push_back(i);
+  while (emitted < local_tets.size()) {
+    if (local_queue.empty()) {
+      // A cycle (not possible in a Delaunay cell seen from a generic point): break it.
+      ++stats.cluster_cycles;
+      for (std::uint32_t i = 0; i < local_tets.size(); ++i)
+        if (!done[i]) {
+          local_queue.push_back(i);
+          local_indeg[i] = 0;
+          break;
+        }
+    }
+    std::uint32_t x = local_queue.back();
+    local_queue.pop_back();
+    if (done[x]) continue;
+    done[x] = 1;
+    ++emitted;
+    out.push_back(local_tets[x]);
+    for (auto& e : local_edges)
+      if (e.first == x && !done[e.second] && --local_indeg[e.second] == 0) local_queue.push_back(e.second);
+  }
+}
+
+ProgressiveOrder::ProgressiveOrder(const Mesh& mesh, const SphereTable& table, const View& view,
+                                   std::span<const std::uint32_t> subset, bool front_to_back)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->mesh = &mesh;
+  impl_->table = &table;
+  impl_->view = view;
+  impl_->front_to_back = front_to_back;
+  impl_->prepare(subset);
+}
+
+ProgressiveOrder::~ProgressiveOrder() = default;
+ProgressiveOrder::ProgressiveOrder(ProgressiveOrder&&) noexcept = default;
+ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = default;
+
+std::span<const std::uint32_t> ProgressiveOrder::next() {
+  Impl& d = *impl_;
+  d.batch.clear();
+  const std::size_t nb = d.bucket_begin.size() - 1;
+  while (d.batch.empty() && d.next_bucket < nb) {
+    std::size_t b = d.next_bucket++;
+    std::size_t begin = d.bucket_begin[b], end = d.bucket_begin[b + 1];
+    if (begin == end) continue;
+    std::sort(d.sorted.begin() + begin, d.sorted.begin() + end);
+    double reach = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = begin; i < end; ++i) reach = std::max(reach, d.sorted[i].hi());
+    // A near-tie chain may cross into the following buckets: take them in while it does.
+    while (d.next_bucket < nb) {
+      std::size_t nb_begin = d.bucket_begin[d.next_bucket], nb_end = d.bucket_begin[d.next_bucket + 1];
+      if (nb_begin == nb_end) {
+        ++d.next_bucket;
+        continue;
+      }
+      double next_min = std::min_element(d.sorted.begin() + nb_begin, d.sorted.begin() + nb_end)->lo;
+      if (next_min > reach) break;
+      std::sort(d.sorted.begin() + nb_begin, d.sorted.begin() + nb_end);
+      for (std::size_t i = nb_begin; i < nb_end; ++i) reach = std::max(reach, d.sorted[i].hi());
+      end = nb_end;
+      ++d.next_bucket;
+    }
+    d.fix_ties(begin, end);
+    for (std::size_t i = begin; i < end; ++i) d.expand(d.sorted[i].item, d.batch);
+  }
+  d.handed += d.batch.size();
+  return d.batch;
+}
+
+std::size_t ProgressiveOrder::handed_out() const { return impl_->handed; }
+std::size_t ProgressiveOrder::total() const { return impl_->total_tets; }
+const OrderStats& ProgressiveOrder::stats() const { return impl_->stats; }
+
+std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
+                                            std::span<const std::uint32_t> subset, bool front_to_back,
+                                            OrderStats* stats) {
+  ProgressiveOrder order(mesh, table, view, subset, front_to_back);
+  std::vector<std::uint32_t> out;
+  out.reserve(order.total());
+  for (auto batch = order.next(); !batch.empty(); batch = order.next()) out.insert(out.end(), batch.begin(), batch.end());
+  if (stats) *stats = order.stats();
+  return out;
+}
+
+std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,
+                                      std::span<const std::uint32_t> subset, std::size_t* cycles_broken) {
+  const std::size_t n = mesh.tet_count();
+  std::vector<std::uint32_t> tets;
+  if (subset.empty()) {
+    tets.resize(n);
+    for (std::size_t i = 0; i < n; ++i) tets[i] = static_cast<std::uint32_t>(i);
+  } else {
+    tets.assign(subset.begin(), subset.end());
+  }
+  std::vector<std::uint8_t> member(n, 0);
+  for (std::uint32_t t : tets) member[t] = 1;
+  const double e[3] = {view.eye[0] - table.origin[0], view.eye[1] - table.origin[1], view.eye[2] - table.origin[2]};
+  auto key = [&](std::uint32_t t) {
+    const double* c = table.c.data() + 3 * std::size_t(t);
+    return view.perspective ? table.s[t] - 2 * (c[0] * e[0] + c[1] * e[1] + c[2] * e[2])
+                            : c[0] * view.dir[0] + c[1] * view.dir[1] + c[2] * view.dir[2];
+  };
+  const FaceAdjacency& adj = face_adjacency(mesh);
+  // behind[4t+f]: 1 if the neighbour across face f must be drawn before t (it is behind t).
+  std::vector<std::uint32_t> indeg(n, 0);
+  std::vector<std::uint8_t> edge_out(4 * n, 0);  // 1: t -> neighbour (t drawn first)
+  for (std::uint32_t t : tets) {
+    const std::uint32_t* v = mesh.tet.data() + 4 * std::size_t(t);
+    for (int f = 0; f < 4; ++f) {
+      std::uint32_t nb = adj.neighbour[4 * std::size_t(t) + f];
+      if (nb == kNone || !member[nb >> 2]) continue;
+      std::uint32_t u = nb >> 2;
+      if (u < t) continue;
+      int side = eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]), node(mesh, v[kFace[f][2]]));
+      if (side == 0) continue;
+      // t's own vertex is on the negative side: side < 0 means the eye is on t's side (t in front).
+      if (side < 0) {
+        ++indeg[t];  // u first
+        edge_out[(std::size_t(u) << 2) | (nb & 3)] = 1;
+      } else {
+        ++indeg[u];
+        edge_out[4 * std::size_t(t) + f] = 1;
+      }
+    }
+  }
+  using Ready = std::pair<double, std::uint32_t>;
+  std::priority_queue<Ready> ready;  // largest key (farthest) first
+  for (std::uint32_t t : tets)
+    if (indeg[t] == 0) ready.emplace(key(t), t);
+  // For breaking cycles: all tets by decreasing key.
+  std::vector<std::uint32_t> by_key = tets;
+  std::sort(by_key.begin(), by_key.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) > key(b); });
+  std::size_t scan = 0, cycles = 0;
+  std::vector<std::uint8_t> done(n, 0);
+  std::vector<std::uint32_t> out;
+  out.reserve(tets.size());
+  while (out.size() < tets.size()) {
+    if (ready.empty()) {
+      while (done[by_key[scan]]) ++scan;
+      ready.emplace(key(by_key[scan]), by_key[scan]);
+      ++cycles;
+    }
+    std::uint32_t t = ready.top().second;
+    ready.pop();
+    if (done[t]) continue;
+    done[t] = 1;
+    out.push_back(t);
+    for (int f = 0; f < 4; ++f) {
+      if (!edge_out[4 * std::size_t(t) + f]) continue;
+      std::uint32_t u = adj.neighbour[4 * std::size_t(t) + f] >> 2;
+      if (!done[u] && indeg[u] > 0 && --indeg[u] == 0) ready.emplace(key(u), u);
+    }
+  }
+  if (cycles_broken) *cycles_broken = cycles;
+  return out;
+}
+
+std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view, std::span<const std::uint32_t> subset) {
+  std::vector<std::uint32_t> tets;
+  if (subset.empty()) {
+    tets.resize(mesh.tet_count());
+    for (std::size_t i = 0; i < tets.size(); ++i) tets[i] = static_cast<std::uint32_t>(i);
+  } else {
+    tets.assign(subset.begin(), subset.end());
+  }
+  std::vector<std::pair<double, std::uint32_t>> keyed(tets.size());
+  for (std::size_t i = 0; i < tets.size(); ++i) {
+    const std::uint32_t* v = mesh.tet.data() + 4 * std::size_t(tets[i]);
+    double c[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 3; ++j) c[j] += 0.25 * mesh.xyz[3 * std::size_t(v[k]) + j];
+    double d;
+    if (view.perspective) {
+      d = (c[0] - view.eye[0]) * (c[0] - view.eye[0]) + (c[1] - view.eye[1]) * (c[1] - view.eye[1]) +
+          (c[2] - view.eye[2]) * (c[2] - view.eye[2]);
+    } else {
+      d = c[0] * view.dir[0] + c[1] * view.dir[1] + c[2] * view.dir[2];
+    }
+    keyed[i] = {d, tets[i]};
+  }
+  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (std::size_t i = 0; i < tets.size(); ++i) tets[i] = keyed[i].second;
+  return tets;
+}
+
+ViolationReport count_violations(const Mesh& mesh, const View& view, std::span<const std::uint32_t> order) {
+  const std::size_t n = mesh.tet_count();
+  std::vector<std::uint32_t> pos(n, kNone);
+  for (std::size_t i = 0; i < order.size(); ++i) pos[order[i]] = static_cast<std::uint32_t>(i);
+  const FaceAdjacency& adj = face_adjacency(mesh);
+  ViolationReport r;
+  std::size_t checked[2] = {0, 0}, wrong[2] = {0, 0};
+  parallel_for(order.size(), [&](std::size_t b, std::size_t e, int part) {
+    for (std::size_t i = b; i < e; ++i) {
+      std::uint32_t t = order[i];
+      const std::uint32_t* v = mesh.tet.data() + 4 * std::size_t(t);
+      for (int f = 0; f < 4; ++f) {
+        std::uint32_t nb = adj.neighbour[4 * std::size_t(t) + f];
+        if (nb == kNone) continue;
+        std::uint32_t u = nb >> 2;
+        if (u < t || pos[u] == kNone) continue;
+        int side = eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]), node(mesh, v[kFace[f][2]]));
+        if (side == 0) continue;
+        ++checked[part];
+        // side < 0: the eye is on t's side, t is in front and must come after u.
+        bool ok = side < 0 ? pos[u] < pos[t] : pos[t] < pos[u];
+        if (!ok) ++wrong[part];
+      }
+    }
+  });
+  r.pairs_checked = checked[0] + checked[1];
+  r.violations = wrong[0] + wrong[1];
+  return r;
+}
+
+}  // namespace foxi
