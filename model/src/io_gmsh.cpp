@@ -888,6 +888,13 @@ class Reader {
     }
     const std::size_t entities = node ? mesh_.node_count() : mesh_.tet_count();
     if (s == nullptr) {
+      // Each new step allocates a value for every entity: bound the total by the file's size so that a
+      // small file cannot ask for gigabytes through many tiny blocks.
+      pending_values_ += entities * nc;
+      if (pending_values_ > 16 * data_.size() + (std::uint64_t{1} << 20)) {
+        cur_.fail_at(at, "field data would need " + str(pending_values_) +
+                             " values, far more than this file can hold");
+      }
       f->steps.push_back(
           {it[0], time, std::vector<double>(entities * nc, std::numeric_limits<double>::quiet_NaN())});
       s = &f->steps.back();
@@ -979,6 +986,7 @@ class Reader {
   std::unordered_map<std::int64_t, std::int32_t> entity_phys_[4];
   std::unordered_map<std::int32_t, std::string> volume_names_, surface_names_;
   std::vector<PendingField> fields_;
+  std::uint64_t pending_values_ = 0;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -608,6 +609,41 @@ TEST(GmshRead, TruncationSweep) {
   }
   EXPECT_GT(errors, 1000u);
   EXPECT_GT(meshes, 0u);  // the full files at least
+}
+
+// Random byte corruptions of valid files (fixed seed): IoError or a consistent mesh, never a crash.
+TEST(GmshRead, RandomCorruptionNeverCrashes) {
+  Mesh m = bench::kuhn_grid_mesh(1);
+  Field f{"f", FieldLocation::cell, 3, "", {0.0}, {}};
+  for (std::size_t i = 0; i < 3 * m.tet_count(); ++i) f.values.push_back(0.25 * static_cast<double>(i));
+  m.fields.push_back(f);
+  TempDir dir;
+  std::mt19937 rng(7);
+  std::size_t errors = 0;
+  for (const Variant& v : kVariants) {
+    write_gmsh(m, dir / "a.msh", {v.version, v.binary});
+    const std::string full = test::read_text(dir / "a.msh");
+    for (int trial = 0; trial < 500; ++trial) {
+      std::string bytes = full;
+      const int flips = 1 + static_cast<int>(rng() % 4);
+      for (int k = 0; k < flips; ++k) {
+        const char pool[] = "0123456789 -+.e\n$x";
+        char c = rng() % 2 ? static_cast<char>(rng()) : pool[rng() % (sizeof pool - 1)];
+        bytes[rng() % bytes.size()] = c;
+      }
+      std::unique_ptr<char[]> buf(new char[bytes.size()]);
+      std::memcpy(buf.get(), bytes.data(), bytes.size());
+      try {
+        Mesh r = parse_gmsh(std::string_view(buf.get(), bytes.size()), "mutated.msh");
+        EXPECT_EQ(check_sizes(r), "");
+        for (std::uint32_t x : r.tet) ASSERT_LT(x, r.node_count());
+        for (std::uint32_t x : r.bface) ASSERT_LT(x, r.node_count());
+      } catch (const IoError&) {
+        ++errors;
+      }
+    }
+  }
+  EXPECT_GT(errors, 400u);
 }
 
 TEST(GmshRead, HugeCountsInBinaryAreRejectedBeforeAllocating) {
