@@ -1257,21 +1257,45 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
   // Emit.
   io::AtomicFile out(path);
   std::string head;
-  head.reserve(enc == VtuEncoding::appended_raw ? 4096 : nconn * 8 + nn * 60);
+  head.reserve(enc == VtuEncoding::ascii || enc == VtuEncoding::base64 ? nconn * 8 + nn * 60 : 4096);
   head += "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"";
   head += kHostLittle ? "LittleEndian" : "BigEndian";
   head += "\" header_type=\"UInt64\"";
   if (enc == VtuEncoding::zlib) head += " compressor=\"vtkZLibDataCompressor\"";
   head += ">\n  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"" + std::to_string(nn) +
           "\" NumberOfCells=\"" + std::to_string(ncells) + "\">\n";
-  // Appended payloads: views of the arrays (with their byte count as header).
+  // Appended payloads in document order: a header (byte count, or the zlib block header) and the
+  // data (a view of the array, or its compressed blocks).
   struct Payload {
-    std::uint64_t header;
+    std::string header;
     const void* data;
     std::size_t bytes;
+    std::string zdata;
   };
   std::vector<Payload> payloads;
-  std::uint64_t offset = 0;
+  std::size_t next_payload = 0;
+  // Appended blocks are stored in reverse document order (the last DataArray at offset 0): meshio
+  // renumbers appended offsets in place while it walks the data, and finds a tag by its offset in
+  // document order; with this order an already renumbered tag can never shadow the next one.
+  std::uint64_t offset = 0;  // the total size, counted down
+  if (enc == VtuEncoding::appended_raw || enc == VtuEncoding::zlib) {
+    std::vector<const OutArray*> all{&points, &conn_a, &off_a, &types_a};
+    for (const auto* list : {&point_arrays, &cell_arrays})
+      for (const OutArray& a : *list) all.push_back(&a);
+    for (const OutArray* a : all) {
+      Payload p{{}, a->data, a->count * vtk::type_size(a->type), {}};
+      if (enc == VtuEncoding::zlib) {
+        vtk::zlib_compress_blocks(a->data, p.bytes, 32768, 1, p.header, p.zdata);
+        p.data = p.zdata.data();
+        p.bytes = p.zdata.size();
+      } else {
+        std::uint64_t h = p.bytes;
+        p.header.assign(reinterpret_cast<const char*>(&h), 8);
+      }
+      offset += p.header.size() + p.bytes;
+      payloads.push_back(std::move(p));
+    }
+  }
   auto emit = [&](const OutArray& a, const char* indent) {
     head += indent;
     head += "<DataArray type=\"";
@@ -1299,24 +1323,11 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
         head += "</DataArray>\n";
         break;
       }
-      case VtuEncoding::appended_raw: {
-        head += " format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
-        payloads.push_back({nbytes, a.data, nbytes});
-        offset += 8 + nbytes;
-        break;
-      }
+      case VtuEncoding::appended_raw:
       case VtuEncoding::zlib: {
-        // Inline (base64) like meshio and VTK's binary mode: header and blocks encoded separately.
-        // Not appended: meshio renumbers appended offsets in place and mixes up arrays when a new
-        // offset equals an old one, which happens with compressed appended data.
-        head += " format=\"binary\">\n";
-        std::string zh, zd;
-        vtk::zlib_compress_blocks(a.data, nbytes, 32768, 1, zh, zd);
-        vtk::base64_encode(zh.data(), zh.size(), head);
-        vtk::base64_encode(zd.data(), zd.size(), head);
-        head += "\n";
-        head += indent;
-        head += "</DataArray>\n";
+        const Payload& p = payloads[next_payload++];
+        offset -= p.header.size() + p.bytes;
+        head += " format=\"appended\" offset=\"" + std::to_string(offset) + "\"/>\n";
         break;
       }
     }
@@ -1340,11 +1351,12 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
     head += "      </CellData>\n";
   }
   head += "    </Piece>\n  </UnstructuredGrid>\n";
-  if (enc == VtuEncoding::appended_raw) {
+  if (enc == VtuEncoding::appended_raw || enc == VtuEncoding::zlib) {
     head += "  <AppendedData encoding=\"raw\">\n   _";
     out.write(head);
-    for (const Payload& p : payloads) {
-      out.write(&p.header, 8);
+    for (auto it = payloads.rbegin(); it != payloads.rend(); ++it) {
+      const Payload& p = *it;
+      out.write(p.header);
       if (p.bytes) out.write(p.data, p.bytes);
     }
     out.write("\n  </AppendedData>\n</VTKFile>\n");

@@ -20,8 +20,9 @@
 //   (spaces as %20), as VTK does. Materials are not stored.
 // - Cell fields hold tet values only; the writers give boundary-triangle cells NaN.
 // - Encodings written: ascii (shortest round-trip decimals), base64 (inline binary), appended_raw,
-//   zlib (inline base64 blocks of 32 KiB, level 1, as meshio writes; all with UInt64 headers).
-//   Connectivity and offsets are Int32 when they fit, else Int64.
+//   zlib (appended raw, vtkZLibDataCompressor blocks of 32 KiB, level 1); UInt64 headers. Appended
+//   blocks lie in reverse document order (meshio's offset renumbering needs it). Connectivity and
+//   offsets are Int32 when they fit, else Int64.
 // - NaN or infinite coordinates are read as they are (validate() reports them), not rejected.
 // - Legacy write: version 4.2 layout ("CELLS n size" rows, CELL_TYPES), data as FIELD arrays.
 #pragma once
