@@ -616,19 +616,28 @@ TEST(VtkBadInput, TruncationSweepNeverCrashes) {
 TEST(VtkBadInput, ByteFlipsNeverCrash) {
   TempDir dir;
   std::mt19937 rng(11);
-  for (VtuEncoding e :
-       {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
-    std::string full = small_file(e, dir);
-    for (int i = 0; i < 300; ++i) {
+  auto flip_sweep = [&](const std::string& full, auto&& parse) {
+    for (int i = 0; i < 1000; ++i) {
       std::string s = full;
       for (int k = 0; k < 3; ++k) s[rng() % s.size()] = static_cast<char>(rng());
       try {
-        Mesh r = parse_vtu(s, "flip.vtu");
+        Mesh r = parse(s);
         EXPECT_EQ(check_sizes(r), "");
         for (std::uint32_t v : r.tet) ASSERT_LT(v, r.node_count());
+        for (std::uint32_t v : r.bface) ASSERT_LT(v, r.node_count());
       } catch (const IoError&) {
       }
     }
+  };
+  for (VtuEncoding e :
+       {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib})
+    flip_sweep(small_file(e, dir), [](const std::string& s) { return parse_vtu(s, "flip.vtu"); });
+  Mesh m = bench::kuhn_grid_mesh(1, 0.1, 2);
+  m.fields.push_back({"f", FieldLocation::node, 3, "", {}, std::vector<double>(24, 0.5)});
+  for (bool binary : {false, true}) {
+    write_vtk_legacy(m, dir / "s.vtk", binary);
+    flip_sweep(test::read_text(dir / "s.vtk"),
+               [](const std::string& s) { return parse_vtk_legacy(s, "flip.vtk"); });
   }
 }
 
