@@ -420,7 +420,7 @@ class Reader {
     std::uint64_t n[4];
     if (binary_) {
       cur_.rest_of_line();
-      std::uint64_t mins[4] = {8 + 24 + 8, 8 + 48 + 16, 8 + 48 + 16, 8 + 48 + 16};
+      const std::uint64_t mins[4] = {4 + 24 + 8, 4 + 48 + 16, 4 + 48 + 16, 4 + 48 + 16};
       for (int d = 0; d < 4; ++d) n[d] = bin_count("entities", mins[d]);
       for (int d = 0; d < 4; ++d) {
         for (std::uint64_t i = 0; i < n[d]; ++i) {
@@ -439,7 +439,7 @@ class Reader {
         }
       }
     } else {
-      for (int d = 0; d < 4; ++d) n[d] = count("entities", 12);
+      for (int d = 0; d < 4; ++d) n[d] = count("entities", 10);
       for (int d = 0; d < 4; ++d) {
         for (std::uint64_t i = 0; i < n[d]; ++i) {
           std::size_t at = cur_.pos();
@@ -680,6 +680,34 @@ class Reader {
     new_tag_run(tag, tet);
   }
   void new_tag_run(std::uint64_t tag, std::uint64_t tet) { tet_tag_runs_.push_back({tag, tet, 1}); }
+  void add_tag_run(std::uint64_t tag0, std::uint64_t first, std::uint64_t count) {
+    if (!tet_tag_runs_.empty()) {
+      TagRun& r = tet_tag_runs_.back();
+      if (r.tag0 + r.count == tag0 && r.first + r.count == first) {
+        r.count += count;
+        return;
+      }
+    }
+    tet_tag_runs_.push_back({tag0, first, count});
+  }
+  // A run of consecutive element tags kept in registers inside a block loop.
+  struct LocalRun {
+    std::uint64_t tag0 = 0, first = 0, count = 0;
+    void note(std::uint64_t tag, std::uint64_t tet, Reader& r) {
+      if (count != 0 && tag == tag0 + count) [[likely]] {
+        ++count;
+        return;
+      }
+      flush(r);
+      tag0 = tag;
+      first = tet;
+      count = 1;
+    }
+    void flush(Reader& r) {
+      if (count != 0) r.add_tag_run(tag0, first, count);
+      count = 0;
+    }
+  };
 
   std::int32_t entity_physical(std::int64_t dim, std::int64_t tag) const {
     if (dim < 0 || dim > 3) return 0;
@@ -697,8 +725,9 @@ class Reader {
     out.resize(out.size() + NN * m);
     reg.resize(reg.size() + m, phys);
     std::uint32_t* o = out.data() + NN * base;
+    LocalRun run;
     for (std::uint64_t i = 0; i < m; ++i, p += rec) {
-      if (NN == 4) note_tet_tag(io::load<std::uint64_t>(p), base + i);
+      if (NN == 4) run.note(io::load<std::uint64_t>(p), base + i, *this);
       for (int k = 0; k < NN; ++k) {
         std::uint64_t t = io::load<std::uint64_t>(p + 8 + 8 * k);
         std::uint32_t idx = find(t);
@@ -706,6 +735,7 @@ class Reader {
         o[NN * i + k] = idx;
       }
     }
+    if (NN == 4) run.flush(*this);
     advance(m * rec);
   }
 
@@ -717,9 +747,10 @@ class Reader {
     out.resize(out.size() + NN * m);
     reg.resize(reg.size() + m, phys);
     std::uint32_t* o = out.data() + NN * base;
+    LocalRun run;
     for (std::uint64_t i = 0; i < m; ++i) {
       std::uint64_t tag = num<std::uint64_t>(cur_, "element tag");
-      if (NN == 4) note_tet_tag(tag, base + i);
+      if (NN == 4) run.note(tag, base + i, *this);
       for (int k = 0; k < NN; ++k) {
         std::size_t nat = here();
         std::uint64_t t = num<std::uint64_t>(cur_, "node tag");
@@ -728,6 +759,7 @@ class Reader {
         o[NN * i + k] = idx;
       }
     }
+    if (NN == 4) run.flush(*this);
   }
 
   template <int NN>
