@@ -248,9 +248,13 @@ TEST(VtkLegacyRead, MeshioAsciiAndBinary51And42) {
 
 TEST(VtuRead, MultiplePiecesConcatenate) {
   // Two pieces, local numbering each; the second piece's indices are shifted by the first's nodes.
+  // The first piece's points carry an InformationKey child, as ParaView writes them.
   std::string piece1 =
       "<Piece NumberOfPoints=\"4\" NumberOfCells=\"2\"><Points><DataArray type=\"Float64\" "
-      "NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0 0 0 1</DataArray></Points>"
+      "NumberOfComponents=\"3\" format=\"ascii\" RangeMin=\"0\" RangeMax=\"1\">\n"
+      "<InformationKey name=\"L2_NORM_RANGE\" location=\"vtkDataArray\" length=\"2\">"
+      "<Value index=\"0\">\n0\n</Value><Value index=\"1\">\n1\n</Value></InformationKey>\n"
+      "0 0 0 1 0 0 0 1 0 0 0 1</DataArray></Points>"
       "<Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2 3 0 1 2"
       "</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">4 7</DataArray>"
       "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">10 5</DataArray></Cells>"
