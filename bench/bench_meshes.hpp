@@ -2,9 +2,15 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <random>
+#include <string>
 
+#include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi::bench {
@@ -73,5 +79,37 @@ inline Mesh kuhn_grid_mesh(std::uint32_t n, double jitter = 0.1, std::uint32_t s
     }
   return m;
 }
+
+// TetGen's mesh of a sx x sy x sz box with `tetgen -pq1.414a<max_volume>O0` (no flips or smoothing,
+// so the mesh is Delaunay). The TetGen files are cached in the temp folder under a name made of the
+// parameters, so that repeated runs do not remesh; throws if tetgen fails.
+inline Mesh tetgen_box_mesh(double sx, double sy, double sz, double max_volume) {
+  namespace fs = std::filesystem;
+  char tag[128];
+  std::snprintf(tag, sizeof tag, "foxi-bench-box-%g-%g-%g-%g", sx, sy, sz, max_volume);
+  const fs::path dir = fs::temp_directory_path() / tag;
+  const fs::path base = dir / "box.1";
+  if (!fs::exists(dir / "box.1.ele")) {
+    fs::create_directories(dir);
+    std::string poly = "8 3 0 0\n";
+    for (int i = 0; i < 8; ++i)
+      poly += std::to_string(i + 1) + " " + std::to_string(i & 1 ? sx : 0.0) + " " +
+              std::to_string(i & 2 ? sy : 0.0) + " " + std::to_string(i & 4 ? sz : 0.0) + "\n";
+    poly += "6 0\n1\n4 1 3 7 5\n1\n4 2 4 8 6\n1\n4 1 2 6 5\n1\n4 3 4 8 7\n1\n4 1 2 4 3\n1\n4 5 6 8 7\n0\n0\n";
+    std::FILE* f = std::fopen((dir / "box.poly").c_str(), "w");
+    if (f == nullptr) throw std::runtime_error("cannot write " + (dir / "box.poly").string());
+    std::fputs(poly.c_str(), f);
+    std::fclose(f);
+    char a[64];
+    std::snprintf(a, sizeof a, "%g", max_volume);
+    const std::string cmd = "tetgen -pq1.414a" + std::string(a) + "O0Q '" + (dir / "box.poly").string() + "' > /dev/null 2>&1";
+    if (std::system(cmd.c_str()) != 0) throw std::runtime_error("tetgen failed: " + cmd);
+  }
+  return read_tetgen(base);
+}
+
+// A structured grid of n x n x n unit cubes, each split into 6 tets (the paper's Table 2 meshes):
+// exactly Delaunay, every cube one cospherical cluster.
+inline Mesh cube_grid_mesh(std::uint32_t n) { return kuhn_grid_mesh(n, 0.0); }
 
 }  // namespace foxi::bench

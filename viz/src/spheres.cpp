@@ -321,6 +321,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
       t.wide_b.push_back(t.key_b[rep]);
     } else {
       t.all_items.push_back(item);
+      t.all_rep.push_back(rep);
     }
   };
   t.all_items.reserve(n - t.cluster_tets.size() + clusters);

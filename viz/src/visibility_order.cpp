@@ -33,8 +33,27 @@ void parallel_for(std::size_t n, F f) {
 const double* node(const Mesh& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
 
 // +1: the eye is on the positive side of triangle (a, b, c); -1 negative; 0 on its plane.
+// orient3d(a, b, c, p) in double with Shewchuk's error bound; the exact predicate when in doubt.
+inline int fast_orientation(const double* a, const double* b, const double* c, const double* p) {
+  const double adx = a[0] - p[0], bdx = b[0] - p[0], cdx = c[0] - p[0];
+  const double ady = a[1] - p[1], bdy = b[1] - p[1], cdy = c[1] - p[1];
+  const double adz = a[2] - p[2], bdz = b[2] - p[2], cdz = c[2] - p[2];
+  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
+  const double cdxady = cdx * ady, adxcdy = adx * cdy;
+  const double adxbdy = adx * bdy, bdxady = bdx * ady;
+  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+  const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * std::abs(adz) +
+                           (std::abs(cdxady) + std::abs(adxcdy)) * std::abs(bdz) +
+                           (std::abs(adxbdy) + std::abs(bdxady)) * std::abs(cdz);
+  const double bound = (7.0 * kEps / 2 + 56.0 * kEps * kEps / 4) * permanent;  // o3derrboundA
+  // Shewchuk's orient3d is positive when p is below (a, b, c); ours is det[b-a, c-a, p-a].
+  if (det > bound) return -1;
+  if (-det > bound) return 1;
+  return exact::orientation(a, b, c, p);
+}
+
 int eye_side(const View& view, const double* a, const double* b, const double* c) {
-  if (view.perspective) return exact::orientation(a, b, c, view.eye);
+  if (view.perspective) return fast_orientation(a, b, c, view.eye);
   const double back[3] = {-view.dir[0], -view.dir[1], -view.dir[2]};
   return exact::orientation_at_infinity(a, b, c, back);
 }
@@ -73,6 +92,12 @@ struct Entry {
   bool operator<(const Entry& o) const { return lo < o.lo; }
 };
 
+// Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
+struct Workspace {
+  std::vector<Entry> entries, scratch;
+};
+thread_local Workspace t_workspace;
+
 struct ProgressiveOrder::Impl {
   const Mesh* mesh = nullptr;
   const SphereTable* table = nullptr;
@@ -85,27 +110,48 @@ struct ProgressiveOrder::Impl {
   std::vector<std::uint32_t> batch;
   std::size_t handed = 0, total_tets = 0;
   OrderStats stats;
-  // Scratch for the local MPVO of clusters.
-  std::vector<std::uint32_t> local_tets, local_indeg, local_queue;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
+  // Per-thread scratch: the local MPVO of clusters and the tie counts.
+  struct Scratch {
+    std::vector<std::uint32_t> local_tets, local_indeg, local_queue;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
+    std::vector<std::uint8_t> local_done;
+    std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
+  };
+  Scratch scratch;
+  void add_counts(Scratch& sc) {
+    stats.near_tie_runs += sc.near_tie_runs;
+    stats.near_tie_items += sc.near_tie_items;
+    stats.cluster_cycles += sc.cluster_cycles;
+    sc.near_tie_runs = sc.near_tie_items = sc.cluster_cycles = 0;
+  }
 
   bool tet_in(std::uint32_t t) const { return in_subset.empty() || in_subset[t]; }
 
+  ~Impl() {
+    // Hand the big buffer back for the next view on this thread.
+    if (sorted.capacity() > t_workspace.entries.capacity()) t_workspace.entries.swap(sorted);
+  }
   void prepare(std::span<const std::uint32_t> subset);
-  void fix_ties(std::size_t begin, std::size_t end);
-  void expand(std::uint32_t item, std::vector<std::uint32_t>& out);
+  void fix_ties(std::size_t begin, std::size_t end, Scratch& sc);
+  void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
+  // Hands out buckets [first, last) into out (sorting, tie fix-up, cluster expansion); returns the
+  // next bucket not consumed: a tie chain may take in buckets from `last` up to `limit`. *reach_out
+  // receives the high end of the last entry's chain.
+  std::size_t emit_buckets(std::size_t first, std::size_t last, std::size_t limit, std::vector<std::uint32_t>& out,
+                           Scratch& sc, double* reach_out);
 };
 
 void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   const SphereTable& t = *table;
   const std::size_t n = t.tet_count();
   // The items: all of the mesh (precomputed), or the subset's tets and clusters.
-  std::vector<std::uint32_t> own_items, own_wide;
+  std::vector<std::uint32_t> own_items, own_reps, own_wide;
   std::vector<float> own_wide_a, own_wide_b;
-  std::span<const std::uint32_t> items, wide_items;
+  std::span<const std::uint32_t> items, reps, wide_items;
   std::span<const float> wide_a, wide_b;
   if (subset.empty()) {
     items = t.all_items;
+    reps = t.all_rep;
     wide_items = t.wide_items;
     wide_a = t.wide_a;
     wide_b = t.wide_b;
@@ -130,9 +176,11 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         own_wide_b.push_back(t.key_b[rep]);
       } else {
         own_items.push_back(item);
+        own_reps.push_back(rep);
       }
     }
     items = own_items;
+    reps = own_reps;
     wide_items = own_wide;
     wide_a = own_wide_a;
     wide_b = own_wide_b;
@@ -158,7 +206,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   stats.key_bound = bound;
 
   // 1. Entries (both cores): key in drawing order, placed at the low end of its interval.
-  sorted.resize(m);
+  sorted.swap(t_workspace.entries);
+  if (sorted.size() < m) sorted.resize(m);
   const double* C = t.c.data();
   const double* S = t.s.data();
   const double sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
@@ -169,7 +218,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     const double px = 2 * v.eye[0], py = 2 * v.eye[1], pz = 2 * v.eye[2];
     for (std::size_t i = b; i < e; ++i) {
       std::uint32_t item = item_at(i);
-      std::uint32_t tet = rep_tet(t, item);
+      std::uint32_t tet = i < m_main ? reps[i] : rep_tet(t, item);
       const double* c = C + 3 * std::size_t(tet);
       double k = v.perspective ? S[tet] - (c[0] * px + c[1] * py + c[2] * pz)
                                : c[0] * v.dir[0] + c[1] * v.dir[1] + c[2] * v.dir[2];
@@ -206,16 +255,14 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   stats.buckets = nb;
   const double scale = kmax > kmin ? double(nb) / (kmax - kmin) : 0.0;
   const double last = double(nb - 1);
-  std::vector<std::uint32_t> bucket(m);
+  auto bucket_of = [&](double lo) {
+    double x = (lo - kmin) * scale;
+    return x <= 0 ? 0u : x >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(x);
+  };
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
   parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
     std::uint32_t* h = hist[part].data();
-    for (std::size_t i = b; i < e; ++i) {
-      double x = (sorted[i].lo - kmin) * scale;
-      std::uint32_t k = x <= 0 ? 0u : x >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(x);
-      bucket[i] = k;
-      ++h[k];
-    }
+    for (std::size_t i = b; i < e; ++i) ++h[bucket_of(sorted[i].lo)];
   });
   bucket_begin.assign(nb + 1, 0);
   std::vector<std::uint32_t> start0(nb), start1(nb);
@@ -228,10 +275,11 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     acc += hist[1][b];
   }
   bucket_begin[nb] = acc;
-  std::vector<Entry> out(m);
+  std::vector<Entry>& out = t_workspace.scratch;
+  if (out.size() < m) out.resize(m);
   const std::size_t split = m < 50000 ? m : m / 2;  // as parallel_for splits
   auto scatter = [&](std::size_t b, std::size_t e, std::vector<std::uint32_t>& pos) {
-    for (std::size_t i = b; i < e; ++i) out[pos[bucket[i]]++] = sorted[i];
+    for (std::size_t i = b; i < e; ++i) out[pos[bucket_of(sorted[i].lo)]++] = sorted[i];
   };
   if (split == m) {
     scatter(0, m, start0);
@@ -240,13 +288,13 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     scatter(0, split, start0);
     other.join();
   }
-  sorted.swap(out);
+  sorted.swap(out);  // the scratch buffer keeps the old entries' storage for the next view
 }
 
 // Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
 // two entries can be out of order only if their intervals overlap. Sorted by lo, the maximal chains
 // of overlapping intervals are re-sorted by exact comparison (made only for overlapping pairs).
-void ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end) {
+void ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end, Scratch& sc) {
   std::size_t i = begin;
   while (i + 1 < end) {
     std::size_t j = i;
@@ -277,15 +325,19 @@ void ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end) {
         return ftb ? c < 0 : c > 0;
       });
       for (std::size_t k = i; k <= j; ++k) sorted[k] = run[k - i].e;
-      ++stats.near_tie_runs;
-      stats.near_tie_items += j - i + 1;
+      ++sc.near_tie_runs;
+      sc.near_tie_items += j - i + 1;
     }
     i = j + 1;
   }
 }
 
 // Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
-void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_t>& out) {
+void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc) {
+  auto& local_tets = sc.local_tets;
+  auto& local_indeg = sc.local_indeg;
+  auto& local_queue = sc.local_queue;
+  auto& local_edges = sc.local_edges;
   if (!(item & kClusterBit)) {
     out.push_back(item);
     return;
@@ -319,14 +371,15 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_
     ++local_indeg[second];
   }
   local_queue.clear();
-  std::vector<std::uint8_t> done(local_tets.size(), 0);
+  sc.local_done.assign(local_tets.size(), 0);
+  auto& done = sc.local_done;
   std::size_t emitted = 0;
   for (std::uint32_t i = 0; i < local_tets.size(); ++i)
     if (local_indeg[i] == 0) local_queue.push_back(i);
   while (emitted < local_tets.size()) {
     if (local_queue.empty()) {
       // A cycle (not possible in a Delaunay cell seen from a generic point): break it.
-      ++stats.cluster_cycles;
+      ++sc.cluster_cycles;
       for (std::uint32_t i = 0; i < local_tets.size(); ++i)
         if (!done[i]) {
           local_queue.push_back(i);
@@ -359,34 +412,46 @@ ProgressiveOrder::~ProgressiveOrder() = default;
 ProgressiveOrder::ProgressiveOrder(ProgressiveOrder&&) noexcept = default;
 ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = default;
 
+std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
+                                                 std::vector<std::uint32_t>& out, Scratch& sc, double* reach_out) {
+  const std::size_t nb = limit;
+  std::size_t b = first;
+  double reach = -std::numeric_limits<double>::infinity();
+  while (b < last) {
+    std::size_t begin = bucket_begin[b], end = bucket_begin[b + 1];
+    ++b;
+    if (begin == end) continue;
+    std::sort(sorted.begin() + begin, sorted.begin() + end);
+    reach = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = begin; i < end; ++i) reach = std::max(reach, sorted[i].hi());
+    // A near-tie chain may cross into the following buckets: take them in while it does.
+    while (b < nb) {
+      std::size_t nb_begin = bucket_begin[b], nb_end = bucket_begin[b + 1];
+      if (nb_begin == nb_end) {
+        ++b;
+        continue;
+      }
+      double next_min = std::min_element(sorted.begin() + nb_begin, sorted.begin() + nb_end)->lo;
+      if (next_min > reach) break;
+      std::sort(sorted.begin() + nb_begin, sorted.begin() + nb_end);
+      for (std::size_t i = nb_begin; i < nb_end; ++i) reach = std::max(reach, sorted[i].hi());
+      end = nb_end;
+      ++b;
+    }
+    fix_ties(begin, end, sc);
+    for (std::size_t i = begin; i < end; ++i) expand(sorted[i].item, out, sc);
+  }
+  if (reach_out) *reach_out = reach;
+  return b;
+}
+
 std::span<const std::uint32_t> ProgressiveOrder::next() {
   Impl& d = *impl_;
   d.batch.clear();
   const std::size_t nb = d.bucket_begin.size() - 1;
-  while (d.batch.empty() && d.next_bucket < nb) {
-    std::size_t b = d.next_bucket++;
-    std::size_t begin = d.bucket_begin[b], end = d.bucket_begin[b + 1];
-    if (begin == end) continue;
-    std::sort(d.sorted.begin() + begin, d.sorted.begin() + end);
-    double reach = -std::numeric_limits<double>::infinity();
-    for (std::size_t i = begin; i < end; ++i) reach = std::max(reach, d.sorted[i].hi());
-    // A near-tie chain may cross into the following buckets: take them in while it does.
-    while (d.next_bucket < nb) {
-      std::size_t nb_begin = d.bucket_begin[d.next_bucket], nb_end = d.bucket_begin[d.next_bucket + 1];
-      if (nb_begin == nb_end) {
-        ++d.next_bucket;
-        continue;
-      }
-      double next_min = std::min_element(d.sorted.begin() + nb_begin, d.sorted.begin() + nb_end)->lo;
-      if (next_min > reach) break;
-      std::sort(d.sorted.begin() + nb_begin, d.sorted.begin() + nb_end);
-      for (std::size_t i = nb_begin; i < nb_end; ++i) reach = std::max(reach, d.sorted[i].hi());
-      end = nb_end;
-      ++d.next_bucket;
-    }
-    d.fix_ties(begin, end);
-    for (std::size_t i = begin; i < end; ++i) d.expand(d.sorted[i].item, d.batch);
-  }
+  while (d.batch.empty() && d.next_bucket < nb)
+    d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch, nullptr);
+  d.add_counts(d.scratch);
   d.handed += d.batch.size();
   return d.batch;
 }
@@ -399,10 +464,53 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
                                             std::span<const std::uint32_t> subset, bool front_to_back,
                                             OrderStats* stats) {
   ProgressiveOrder order(mesh, table, view, subset, front_to_back);
+  ProgressiveOrder::Impl& d = *order.impl_;
+  const std::size_t nb = d.bucket_begin.size() - 1;
   std::vector<std::uint32_t> out;
   out.reserve(order.total());
-  for (auto batch = order.next(); !batch.empty(); batch = order.next()) out.insert(out.end(), batch.begin(), batch.end());
-  if (stats) *stats = order.stats();
+  // Both cores: the first half of the buckets here, the second half on another thread. A tie chain
+  // across the split (rare) sends everything back through one thread.
+  std::size_t split = 0;
+  const std::size_t m = d.bucket_begin[nb];
+  if (m >= 100000) {
+    split = static_cast<std::size_t>(std::lower_bound(d.bucket_begin.begin(), d.bucket_begin.end(),
+                                                      static_cast<std::uint32_t>(m / 2)) - d.bucket_begin.begin());
+    if (split >= nb) split = 0;
+  }
+  bool done = false;
+  if (split > 0) {
+    std::vector<std::uint32_t> second;
+    second.reserve(order.total() - order.total() / 2 + 1024);
+    ProgressiveOrder::Impl::Scratch other_scratch;
+    double reach = 0;
+    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch, nullptr); });
+    d.emit_buckets(0, split, split, out, d.scratch, &reach);
+    other.join();
+    // The first entry of the second half must lie beyond every interval of the first half.
+    double second_min = std::numeric_limits<double>::infinity();
+    for (std::size_t b = split; b < nb && d.bucket_begin[b] < d.bucket_begin[nb]; ++b) {
+      if (d.bucket_begin[b] < d.bucket_begin[b + 1]) {
+        second_min = d.sorted[d.bucket_begin[b]].lo;  // sorted by now
+        break;
+      }
+    }
+    if (second_min > reach) {
+      out.insert(out.end(), second.begin(), second.end());
+      d.add_counts(d.scratch);
+      d.add_counts(other_scratch);
+      done = true;
+    } else {
+      out.clear();
+      d.scratch = {};
+    }
+  }
+  if (!done) {
+    d.emit_buckets(0, nb, nb, out, d.scratch, nullptr);
+    d.add_counts(d.scratch);
+  }
+  d.next_bucket = nb;
+  d.handed = out.size();
+  if (stats) *stats = d.stats;
   return out;
 }
 

@@ -58,6 +58,7 @@ struct SphereTable {
   // The sort items of the whole mesh that are not wide, built once: each tet not in a cluster, and
   // each cluster as (cluster | kClusterBit). A cluster's key is the key of its first tet.
   std::vector<std::uint32_t> all_items;
+  std::vector<std::uint32_t> all_rep;     // the tet whose key each item takes (same order)
   // Per-tet key bounds, kept for subsets (which must find their own wide items).
   std::vector<float> key_a, key_b;
 

@@ -54,6 +54,8 @@ class ProgressiveOrder {
   const OrderStats& stats() const;
 
  private:
+  friend std::vector<std::uint32_t> visibility_order(const Mesh&, const SphereTable&, const View&,
+                                                     std::span<const std::uint32_t>, bool, OrderStats*);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

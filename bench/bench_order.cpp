@@ -1,0 +1,174 @@
+// The per-view visibility order (issue 3), with its baselines in the same run.
+//   power_order       whole back-to-front order, ties resolved (foxi::visibility_order)
+//   first_batch       time until the first batch of the progressive order is handed out
+//   precompute        spheres + cospherical clusters (face adjacency computed before, cached)
+//   keys_only         computing the float keys alone: the bandwidth-bound floor
+//   std_sort          std::sort of (float key, uint32 index) pairs (the naive order)
+//   centroid_order    a centroid-depth sort (what VTK's vtkCellCenterDepthSort does)
+// Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-6 (0.97M tets, Delaunay) and a 55^3 cube grid
+// split into 6 tets per cube (1.0M tets, one cospherical cluster per cube); with FOXI_BENCH_LARGE=1
+// also the box at a1e-6 (~3.9M tets). Every iteration takes a new perspective eye point outside the
+// mesh (a fixed sequence), so nothing is reused between views.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <memory>
+#include <random>
+
+#include "bench_meshes.hpp"
+#include "foxi/model/adjacency.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/visibility_order.hpp"
+
+namespace {
+
+using namespace foxi;
+
+struct Case {
+  Mesh mesh;
+  SphereTable table;
+};
+
+Case& get_case(int which) {
+  static std::unique_ptr<Case> cases[3];
+  if (!cases[which]) {
+    auto c = std::make_unique<Case>();
+    if (which == 0) c->mesh = bench::tetgen_box_mesh(2, 1, 1, 4e-6);
+    if (which == 1) c->mesh = bench::cube_grid_mesh(55);
+    if (which == 2) c->mesh = bench::tetgen_box_mesh(2, 1, 1, 1e-6);
+    face_adjacency(c->mesh);
+    c->table = compute_spheres(c->mesh);
+    cases[which] = std::move(c);
+  }
+  return *cases[which];
+}
+
+const char* case_name(int which) { return which == 0 ? "box_972k" : which == 1 ? "grid_1M" : "box_3.9M"; }
+
+View eye_for(std::size_t i) {
+  std::mt19937 rng(static_cast<unsigned>(1000 + i));
+  std::normal_distribution<double> g(0, 1);
+  double d[3] = {g(rng), g(rng), g(rng)};
+  double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  return View::at(1 + 3 * d[0] / len, 0.5 + 3 * d[1] / len, 0.5 + 3 * d[2] / len);
+}
+
+bool skip(benchmark::State& state, int which) {
+  if (which == 2 && std::getenv("FOXI_BENCH_LARGE") == nullptr) {
+    state.SkipWithError("set FOXI_BENCH_LARGE=1 for the 3.9M-tet mesh");
+    return true;
+  }
+  return false;
+}
+
+void per_tet(benchmark::State& state, std::size_t tets) {
+  state.counters["tets"] = double(tets);
+  state.counters["ns_per_tet"] =
+      benchmark::Counter(double(tets), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.SetLabel(case_name(static_cast<int>(state.range(0))));
+}
+
+void BM_power_order(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  if (skip(state, which)) return;
+  Case& c = get_case(which);
+  std::size_t i = 0, runs = 0;
+  for (auto _ : state) {
+    OrderStats stats;
+    auto order = visibility_order(c.mesh, c.table, eye_for(i++), {}, false, &stats);
+    runs += stats.near_tie_runs;
+    benchmark::DoNotOptimize(order.data());
+  }
+  state.counters["near_tie_runs"] = double(runs) / double(std::max<std::size_t>(i, 1));
+  per_tet(state, c.mesh.tet_count());
+}
+
+void BM_first_batch(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  if (skip(state, which)) return;
+  Case& c = get_case(which);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    ProgressiveOrder order(c.mesh, c.table, eye_for(i++));
+    auto batch = order.next();
+    benchmark::DoNotOptimize(batch.data());
+  }
+  state.SetLabel(case_name(which));
+}
+
+void BM_precompute(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  if (skip(state, which)) return;
+  Case& c = get_case(which);
+  for (auto _ : state) {
+    SphereTable t = compute_spheres(c.mesh);
+    benchmark::DoNotOptimize(t.s.data());
+  }
+  per_tet(state, c.mesh.tet_count());
+}
+
+void BM_keys_only(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  if (skip(state, which)) return;
+  Case& c = get_case(which);
+  const std::size_t n = c.mesh.tet_count();
+  std::vector<float> keys(n);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    View v = eye_for(i++);
+    double p[3] = {2 * (v.eye[0] - c.table.origin[0]), 2 * (v.eye[1] - c.table.origin[1]),
+                   2 * (v.eye[2] - c.table.origin[2])};
+    const double* C = c.table.c.data();
+    const double* S = c.table.s.data();
+    for (std::size_t t = 0; t < n; ++t)
+      keys[t] = static_cast<float>(S[t] - (C[3 * t] * p[0] + C[3 * t + 1] * p[1] + C[3 * t + 2] * p[2]));
+    benchmark::DoNotOptimize(keys.data());
+  }
+  per_tet(state, n);
+}
+
+void BM_std_sort(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  if (skip(state, which)) return;
+  Case& c = get_case(which);
+  const std::size_t n = c.mesh.tet_count();
+  std::vector<std::pair<float, std::uint32_t>> pairs(n);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    View v = eye_for(i++);
+    double p[3] = {2 * (v.eye[0] - c.table.origin[0]), 2 * (v.eye[1] - c.table.origin[1]),
+                   2 * (v.eye[2] - c.table.origin[2])};
+    const double* C = c.table.c.data();
+    const double* S = c.table.s.data();
+    for (std::size_t t = 0; t < n; ++t)
+      pairs[t] = {static_cast<float>(S[t] - (C[3 * t] * p[0] + C[3 * t + 1] * p[1] + C[3 * t + 2] * p[2])),
+                  static_cast<std::uint32_t>(t)};
+    std::sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    benchmark::DoNotOptimize(pairs.data());
+  }
+  per_tet(state, n);
+}
+
+void BM_centroid_order(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  if (skip(state, which)) return;
+  Case& c = get_case(which);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    auto order = centroid_order(c.mesh, eye_for(i++));
+    benchmark::DoNotOptimize(order.data());
+  }
+  per_tet(state, c.mesh.tet_count());
+}
+
+}  // namespace
+
+BENCHMARK(BM_power_order)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_first_batch)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_keys_only)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_std_sort)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_centroid_order)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
+BENCHMARK(BM_precompute)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+BENCHMARK_MAIN();
