@@ -191,6 +191,35 @@ TEST(GmshRead, GmshGeneratedFilesMatchMeshioAndGeometry) {
   }
 }
 
+// gmsh can store parametric coordinates after the xyz of nodes on curves and surfaces (4.1): the
+// same mesh (gmsh meshes deterministically) read with and without them must be the same.
+TEST(GmshRead, ParametricNodesMatchPlainFile) {
+  if (!have_gmsh()) GTEST_SKIP() << "gmsh not available";
+  TempDir dir;
+  test::write_text(dir / "two.geo", kTwoBoxes);
+  const std::string geo = "'" + (dir / "two.geo").string() + "'";
+  for (const char* bin : {"", " -bin"}) {
+    SCOPED_TRACE(bin);
+    const std::string plain_file = (dir / "plain.msh").string(), par_file = (dir / "par.msh").string();
+    ASSERT_EQ(test::run("gmsh -3 " + geo + " -format msh41" + bin + " -o '" + plain_file + "'", dir / "log"),
+              0);
+    ASSERT_EQ(test::run("gmsh -3 " + geo + " -save_parametric -format msh41" + bin + " -o '" + par_file + "'",
+                        dir / "log"),
+              0);
+    if (*bin == 0) {
+      const std::string text = test::read_text(par_file);
+      ASSERT_NE(text.find("\n2 1 1 "), std::string::npos) << "gmsh wrote no parametric surface block";
+    }
+    const Mesh plain = read_gmsh(plain_file);
+    ASSERT_GT(plain.tet_count(), 100u);
+    const Mesh m = read_gmsh(par_file);
+    EXPECT_TRUE(m.xyz == plain.xyz);
+    EXPECT_EQ(m.tet, plain.tet);
+    EXPECT_EQ(m.tet_region, plain.tet_region);
+    EXPECT_EQ(m.bface, plain.bface);
+  }
+}
+
 // A small two-region grid with fields: a node scalar with 2 steps (one value NaN = not listed),
 // a 3-component cell vector and a 6-component cell tensor.
 Mesh mesh_with_fields() {
