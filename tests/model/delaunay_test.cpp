@@ -326,6 +326,46 @@ TEST(DelaunayCertificate, DuplicatePointsAreOnSpheresNotInside) {
   expect_matches_brute(m, c, b);
 }
 
+TEST(DelaunayCertificate, NearlyFlatTetDecidedExactly) {
+  // Tet 0 = (0,0,0) (1,0,0) (0,1,0) (1,1,eps): its volume is below the double rounding bound of the
+  // orientation, yet positive; its sphere is centred at (.5,.5,eps/2) with radius ~0.707. A vertex of
+  // a second tet at (.5,.5,.3) lies inside it; with z = .8 instead, outside.
+  for (double z : {0.3, 0.8}) {
+    Mesh m;
+    m.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 1e-17, 0.5, 0.5, z, 3, 0.5, z, 0.5, 3, z, 0.5, 0.5, z + 3};
+    m.tet = {0, 1, 2, 3, 4, 5, 6, 7};
+    DelaunayCertificate c = compute_delaunay_certificate(m);
+    Brute b = brute_force(m);
+    EXPECT_EQ(c.degenerate_tet_count, 0u);
+    const bool tet0 = !c.violating_tets.empty() && c.violating_tets.front() == 0;
+    EXPECT_EQ(tet0, z < 0.5) << "z = " << z;
+    expect_matches_brute(m, c, b);
+  }
+}
+
+TEST(DelaunayCertificate, NearlyFlatSkewTetMatchesBruteForce) {
+  // A parallelogram in a skew plane, its fourth corner lifted by about 1e-15: the double orientation
+  // cannot be trusted (cancellation), the sphere is huge. Whatever the exact predicates say about the
+  // stored doubles (flat or not, which points are inside), the certificate must say the same.
+  for (double lift : {0.0, 1e-15, -1e-15, 1e-13}) {
+    Mesh m;
+    m.xyz = {0.1, 0.2, 0.3, 1.3, 0.4, 0.7, 0.2, 1.1, 0.9, 1.4, 1.3, 1.3 + lift};
+    for (double x : {0.7, 0.5, 0.4, 2.0, 0.6, 0.5, 0.7, 2.1, 0.4, 0.7, 0.5, 2.5}) m.xyz.push_back(x);
+    m.tet = {0, 1, 2, 3, 4, 5, 6, 7};
+    // Positive orientation for both, by the exact predicate.
+    for (std::uint32_t t = 0; t < 2; ++t) {
+      auto p = [&](std::uint32_t j) {
+        const std::uint32_t v = m.tet[4 * t + j];
+        return Point(m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]);
+      };
+      if (CGAL::orientation(p(0), p(1), p(2), p(3)) == CGAL::NEGATIVE)
+        std::swap(m.tet[4 * t + 2], m.tet[4 * t + 3]);
+    }
+    SCOPED_TRACE(lift);
+    expect_matches_brute(m, compute_delaunay_certificate(m), brute_force(m));
+  }
+}
+
 TEST(DelaunayCertificate, DegenerateTetCounted) {
   Mesh m;
   m.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1};
