@@ -344,6 +344,65 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_
   }
   const SphereTable& t = *table;
   const std::uint32_t k = item & ~kClusterBit;
+  const std::uint32_t cb = t.cluster_begin[k], ce = t.cluster_begin[k + 1];
+  if (ce - cb <= 64) {
+    // Small cells (a grid cube: 5 or 6 tets): predecessor bit masks, planes tested in double with a
+    // rounding bound, exact orientation only when in doubt.
+    std::uint64_t pred[64] = {};
+    std::uint64_t emitted = 0;
+    const std::uint32_t size = ce - cb;
+    if (!in_subset.empty())
+      for (std::uint32_t i = 0; i < size; ++i)
+        if (!in_subset[t.cluster_tets[cb + i]]) emitted |= std::uint64_t(1) << i;  // not drawn, no constraints
+    const bool persp = view.perspective;
+    const double* e = view.eye;
+    const double back[3] = {-view.dir[0], -view.dir[1], -view.dir[2]};
+    const double en = persp ? std::abs(e[0]) + std::abs(e[1]) + std::abs(e[2])
+                            : std::abs(back[0]) + std::abs(back[1]) + std::abs(back[2]);
+    for (std::uint32_t f = t.cluster_face_begin[k]; f < t.cluster_face_begin[k + 1]; ++f) {
+      const std::uint32_t a = t.face_local[2 * f], b = t.face_local[2 * f + 1];
+      const double* pl = t.face_plane.data() + 4 * std::size_t(f);
+      double val, bound;
+      if (persp) {
+        val = pl[0] * e[0] + pl[1] * e[1] + pl[2] * e[2] - pl[3];
+        bound = 96 * kEps * double(t.face_scale[f]) * (en + double(t.face_anorm[f]));
+      } else {
+        val = pl[0] * back[0] + pl[1] * back[1] + pl[2] * back[2];
+        bound = 32 * kEps * double(t.face_scale[f]) * en;
+      }
+      int side = val > bound ? 1 : val < -bound ? -1 : 2;
+      if (side == 2) {
+        const std::uint32_t* fv = t.face_vertex.data() + 3 * std::size_t(f);
+        side = eye_side(view, node(*mesh, fv[0]), node(*mesh, fv[1]), node(*mesh, fv[2]));
+      }
+      if (side == 0) continue;
+      // Tet a lies on the positive side. Eye there: a is in front, so b comes first (back to front).
+      std::uint32_t first = side > 0 ? b : a, second = side > 0 ? a : b;
+      if (front_to_back) std::swap(first, second);
+      pred[second] |= std::uint64_t(1) << first;
+    }
+    const std::uint64_t all = size == 64 ? ~std::uint64_t(0) : (std::uint64_t(1) << size) - 1;
+    while (emitted != all) {
+      std::uint32_t pick = 64;
+      for (std::uint32_t i = 0; i < size; ++i)
+        if (!(emitted >> i & 1) && (pred[i] & ~emitted) == 0) {
+          pick = i;
+          break;
+        }
+      if (pick == 64) {
+        // A cycle (not possible in a Delaunay cell seen from a generic point): break it.
+        ++sc.cluster_cycles;
+        for (std::uint32_t i = 0; i < size; ++i)
+          if (!(emitted >> i & 1)) {
+            pick = i;
+            break;
+          }
+      }
+      emitted |= std::uint64_t(1) << pick;
+      out.push_back(t.cluster_tets[cb + pick]);
+    }
+    return;
+  }
   local_tets.clear();
   for (std::uint32_t i = t.cluster_begin[k]; i < t.cluster_begin[k + 1]; ++i)
     if (tet_in(t.cluster_tets[i])) local_tets.push_back(t.cluster_tets[i]);
