@@ -4,9 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "../../bench/bench_meshes.hpp"
+#include "test_util.hpp"
 
 namespace foxi {
 namespace {
@@ -91,6 +96,54 @@ TEST(QualitySummary, GridVolumeAndSlivers) {
   EXPECT_LE(s.min_dihedral_deg.min, s.min_dihedral_deg.mean);
   EXPECT_LE(s.min_dihedral_deg.mean, s.min_dihedral_deg.max);
   EXPECT_GE(s.radius_edge.min, std::sqrt(6.0) / 4 - 1e-12);  // no tet beats the regular one
+}
+
+// Coordinates and tets of a TetGen .node/.ele pair (a tiny local parser: the oracle stays independent).
+Mesh read_node_ele(const std::filesystem::path& base) {
+  auto numbers = [](const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::vector<double> out;
+    std::string line;
+    while (std::getline(in, line)) {
+      line = line.substr(0, line.find('#'));
+      std::istringstream ls(line);
+      double x;
+      while (ls >> x) out.push_back(x);
+    }
+    return out;
+  };
+  Mesh m;
+  std::vector<double> node = numbers(base.string() + ".node");
+  const auto nn = static_cast<std::size_t>(node[0]);
+  const std::size_t stride = 1 + static_cast<std::size_t>(node[1] + node[2] + node[3]);
+  const auto first = static_cast<long>(node[4]);
+  for (std::size_t i = 0; i < nn; ++i)
+    for (std::size_t d = 0; d < 3; ++d) m.xyz.push_back(node[4 + i * stride + 1 + d]);
+  std::vector<double> ele = numbers(base.string() + ".ele");
+  const std::size_t estride = 1 + static_cast<std::size_t>(ele[1] + ele[2]);
+  for (std::size_t t = 0; t < static_cast<std::size_t>(ele[0]); ++t)
+    for (std::size_t j = 0; j < 4; ++j)
+      m.tet.push_back(static_cast<std::uint32_t>(static_cast<long>(ele[3 + t * estride + 1 + j]) - first));
+  return m;
+}
+
+TEST(QualitySummary, TetgenRadiusEdgeBoundAndVolume) {
+  // TetGen's -q1.414 promises radius-edge ratios of at most 1.414; the 2 x 1 x 1 box has volume 2.
+  if (!test::have_program("tetgen")) GTEST_SKIP() << "tetgen not installed";
+  test::TempDir dir;
+  test::write_text(
+      dir / "b.poly",
+      "8 3 0 0\n1 0 0 0\n2 2 0 0\n3 0 1 0\n4 2 1 0\n5 0 0 1\n6 2 0 1\n7 0 1 1\n8 2 1 1\n6 0\n"
+      "1\n4 1 3 7 5\n1\n4 2 4 8 6\n1\n4 1 2 6 5\n1\n4 3 4 8 7\n1\n4 1 2 4 3\n1\n4 5 6 8 7\n0\n0\n");
+  ASSERT_EQ(test::run("tetgen -pq1.414a0.001O0Q '" + (dir / "b.poly").string() + "'", dir / "log"), 0);
+  Mesh m = read_node_ele(dir / "b.1");
+  QualitySummary s = summarize_quality(m);
+  EXPECT_EQ(s.tets, m.tet_count());
+  EXPECT_NEAR(s.total_volume, 2.0, 1e-9);
+  EXPECT_LE(s.radius_edge.max, 1.414 * (1 + 1e-6));
+  EXPECT_GE(s.radius_edge.min, std::sqrt(6.0) / 4 - 1e-12);
+  EXPECT_GT(s.volume.min, 0);  // all positively oriented, none flat
+  EXPECT_GT(s.min_dihedral_deg.max, s.min_dihedral_deg.min);
 }
 
 TEST(QualitySummary, EmptyMesh) {
