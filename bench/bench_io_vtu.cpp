@@ -132,17 +132,14 @@ BENCHMARK_CAPTURE(write_foxi, ascii, VtuEncoding::ascii)
 BENCHMARK_CAPTURE(read_meshio, appended_raw, VtuEncoding::appended_raw)
     ->UseManualTime()
     ->Iterations(2)
-    ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(read_meshio, zlib, VtuEncoding::zlib)
     ->UseManualTime()
     ->Iterations(2)
-    ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(read_meshio, ascii, VtuEncoding::ascii)
     ->UseManualTime()
     ->Iterations(1)
-    ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
