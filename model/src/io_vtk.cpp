@@ -1305,7 +1305,7 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
       Payload p{{}, a->data, a->count * vtk::type_size(a->type), {}};
       if (enc == VtuEncoding::zlib) {
         vtk::zlib_compress_blocks(a->data, p.bytes, 32768, 1, p.header, p.zdata);
-        p.data = p.zdata.data();
+        p.data = nullptr;  // zdata (a pointer into it would not survive moving a short string)
         p.bytes = p.zdata.size();
       } else {
         std::uint64_t h = p.bytes;
@@ -1376,7 +1376,7 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
     for (auto it = payloads.rbegin(); it != payloads.rend(); ++it) {
       const Payload& p = *it;
       out.write(p.header);
-      if (p.bytes) out.write(p.data, p.bytes);
+      if (p.bytes) out.write(p.data != nullptr ? p.data : p.zdata.data(), p.bytes);
     }
     out.write("\n  </AppendedData>\n</VTKFile>\n");
   } else {

@@ -363,6 +363,27 @@ TEST(VtuWrite, RoundTripEveryEncodingBitForBit) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 4);
 }
 
+TEST(VtuWrite, EmptyAndBareMeshesRoundTrip) {
+  TempDir dir;
+  Mesh empty;
+  Mesh bare;  // one tet, no regions, no boundary, no fields
+  bare.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  bare.tet = {0, 1, 2, 3};
+  for (const Mesh* m : {&empty, &bare}) {
+    for (VtuEncoding e :
+         {VtuEncoding::ascii, VtuEncoding::base64, VtuEncoding::appended_raw, VtuEncoding::zlib}) {
+      write_vtu(*m, dir / "m.vtu", e);
+      Mesh r = read_vtu(dir / "m.vtu");
+      expect_same_mesh(*m, r, true);
+      EXPECT_TRUE(r.tet_region.empty());
+    }
+    for (bool binary : {false, true}) {
+      write_vtk_legacy(*m, dir / "m.vtk", binary);
+      expect_same_mesh(*m, read_vtk_legacy(dir / "m.vtk"), true);
+    }
+  }
+}
+
 TEST(VtkLegacyWrite, RoundTripAsciiAndBinaryBitForBit) {
   TempDir dir;
   Mesh m = rich_mesh();
