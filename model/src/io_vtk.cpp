@@ -135,6 +135,7 @@ void append_doubles(const ArrayData& a, std::size_t first, std::size_t n, std::v
   reserve_huge(out, at + n);
   out.resize(at + n);
   double* d = out.data() + at;
+  if (n == 0) return;
   if (a.type == VType::f64 && !a.swap) {
     std::memcpy(d, a.data() + first * 8, n * 8);
     return;
