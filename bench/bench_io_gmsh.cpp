@@ -4,8 +4,8 @@
 // The files are written once to a temporary folder (or to $FOXI_BENCH_DIR, kept, if set) and read
 // from the page cache. gmsh is timed as a whole process running `gmsh -nopopup FILE -parse_and_exit`
 // (open the file, i.e. read the mesh, then exit), as CPU time of the process minus its start-up CPU
-// time, measured on a one-tet file with the same command; the benchmark checks that gmsh's log reports the
-// right node count.
+// time, measured on a one-tet file with the same command; the benchmark checks that gmsh's log
+// reports the right node count.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <sys/time.h>
