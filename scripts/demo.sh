@@ -17,6 +17,9 @@ tetgen -pq1.414a1e-11AO0 -Q "$out/die_on_substrate.poly"
 echo
 "$foxi" info --check-delaunay "$out/die_on_substrate.1.ele"
 echo
+# The visibility order (power of the eye w.r.t. each circumsphere) from 4 random views, verified.
+"$foxi" order "$out/die_on_substrate.1.ele" --views 4 --check
+echo
 "$foxi" convert "$out/die_on_substrate.1.ele" "$out/die_on_substrate.vtu"
 "$foxi" convert "$out/die_on_substrate.1.ele" "$out/die_on_substrate.msh"
 "$foxi" info "$out/die_on_substrate.msh" --json > "$out/die_on_substrate.json"
