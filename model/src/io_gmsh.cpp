@@ -135,21 +135,6 @@ class TagMap {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted_;
 };
 
-// Reserves room for n values and, for big arrays, asks the kernel for huge pages: a fresh
-// allocation is first touched while parsing, and 4 KiB page faults cost more than the parsing itself.
-// Reserving only takes address space; pages that are never written are never backed.
-template <class T>
-void reserve_huge(std::vector<T>& v, std::size_t n) {
-  v.reserve(n);
-#if defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
-  const std::size_t bytes = n * sizeof(T);
-  if (bytes < 2 * kHuge) return;
-  const std::uintptr_t b = reinterpret_cast<std::uintptr_t>(v.data());
-  const std::uintptr_t hb = (b + kHuge - 1) & ~(kHuge - 1), he = (b + bytes) & ~(kHuge - 1);
-  if (he > hb) madvise(reinterpret_cast<void*>(hb), he - hb, MADV_HUGEPAGE);
-#endif
-}
 
 // The distinct values of `v`, sorted; linear in v.size() for the few ids a mesh has.
 std::vector<std::int32_t> distinct(const std::vector<std::int32_t>& v) {
@@ -464,8 +449,8 @@ class Reader {
   // ---- nodes ----
   void read_nodes22() {
     std::uint64_t n = count("nodes", binary_ ? 28 : 8);
-    reserve_huge(mesh_.xyz, 3 * n);
-    reserve_huge(node_tags_, n);
+    io::reserve_huge(mesh_.xyz, 3 * n);
+    io::reserve_huge(node_tags_, n);
     mesh_.xyz.resize(3 * n);
     node_tags_.resize(n);
     double* xyz = mesh_.xyz.data();
@@ -508,8 +493,8 @@ class Reader {
       num<std::uint64_t>(cur_, "minimum node tag");
       num<std::uint64_t>(cur_, "maximum node tag");
     }
-    reserve_huge(mesh_.xyz, 3 * n);
-    reserve_huge(node_tags_, n);
+    io::reserve_huge(mesh_.xyz, 3 * n);
+    io::reserve_huge(node_tags_, n);
     mesh_.xyz.resize(3 * n);
     node_tags_.resize(n);
     std::uint64_t done = 0;
@@ -598,10 +583,10 @@ class Reader {
   void read_elements22() {
     std::size_t at = cur_.pos();
     std::uint64_t n = count("elements", 8);
-    reserve_huge(mesh_.tet, 4 * n);
-    reserve_huge(mesh_.tet_region, n);
-    reserve_huge(mesh_.bface, 3 * n);
-    reserve_huge(mesh_.bface_tag, n);
+    io::reserve_huge(mesh_.tet, 4 * n);
+    io::reserve_huge(mesh_.tet_region, n);
+    io::reserve_huge(mesh_.bface, 3 * n);
+    io::reserve_huge(mesh_.bface_tag, n);
     std::uint32_t v[4];
     if (binary_) {
       cur_.rest_of_line();
@@ -800,10 +785,10 @@ class Reader {
       num<std::uint64_t>(cur_, "maximum element tag");
     }
     // Any element may be a tet or a triangle: reserve for both (address space only).
-    reserve_huge(mesh_.tet, 4 * n);
-    reserve_huge(mesh_.tet_region, n);
-    reserve_huge(mesh_.bface, 3 * n);
-    reserve_huge(mesh_.bface_tag, n);
+    io::reserve_huge(mesh_.tet, 4 * n);
+    io::reserve_huge(mesh_.tet_region, n);
+    io::reserve_huge(mesh_.bface, 3 * n);
+    io::reserve_huge(mesh_.bface_tag, n);
     std::uint64_t done = 0;
     for (std::uint64_t b = 0; b < blocks; ++b) {
       std::size_t bat = cur_.pos();

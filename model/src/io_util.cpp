@@ -41,6 +41,9 @@ std::string read_file(const std::filesystem::path& path) {
     long size = std::ftell(f);
     if (size > 0) {
       std::fseek(f, 0, SEEK_SET);
+      // Huge pages make the zero fill and the copy cheap next to 4 KiB page faults.
+      data.reserve(static_cast<std::size_t>(size));
+      advise_huge(data.data(), static_cast<std::size_t>(size));
       data.resize(static_cast<std::size_t>(size));
       std::size_t got = std::fread(data.data(), 1, data.size(), f);
       data.resize(got);

@@ -42,22 +42,6 @@ constexpr std::uint64_t kZlibMaxRatio = 1032;
 constexpr const char* kRegionNames[] = {"region", "gmsh:physical", "CellEntityIds", "medit:ref",
                                         "tetgen:ref"};
 
-// Reserves room for n values and, for big arrays, asks the kernel for huge pages: the output arrays
-// are fresh allocations, and their 4 KiB page faults cost more than filling them (same helper as in
-// io_gmsh.cpp; a shared one would belong in io_util.hpp).
-template <class T>
-void reserve_huge(std::vector<T>& v, std::size_t n) {
-  if (n <= v.capacity()) return;
-  v.reserve(n);
-#if defined(MADV_HUGEPAGE)
-  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
-  const std::size_t bytes = n * sizeof(T);
-  if (bytes < 2 * kHuge) return;
-  const auto b = reinterpret_cast<std::uintptr_t>(v.data());
-  const std::uintptr_t hb = (b + kHuge - 1) & ~(kHuge - 1), he = (b + bytes) & ~(kHuge - 1);
-  if (he > hb) madvise(reinterpret_cast<void*>(hb), he - hb, MADV_HUGEPAGE);
-#endif
-}
 
 // ------------------------------------------------------------------------------------------------
 // Decoded arrays: bytes of `count` values of `type`, either lent (a view into the file) or owned.
@@ -132,7 +116,7 @@ decltype(auto) dispatch(const ArrayData& a, F&& f) {
 // Appends values [first, first + n) of `a` as doubles to `out`.
 void append_doubles(const ArrayData& a, std::size_t first, std::size_t n, std::vector<double>& out) {
   std::size_t at = out.size();
-  reserve_huge(out, at + n);
+  io::reserve_huge(out, at + n);
   out.resize(at + n);
   double* d = out.data() + at;
   if (n == 0) return;
@@ -354,7 +338,7 @@ class Assembler {
     else
       dispatch_int(types, types_loop);
     std::size_t tet_at = mesh_.tet.size(), tri_at = mesh_.bface.size();
-    reserve_huge(mesh_.tet, tet_at + 4 * ntet);
+    io::reserve_huge(mesh_.tet, tet_at + 4 * ntet);
     mesh_.tet.resize(tet_at + 4 * ntet);
     mesh_.bface.resize(tri_at + 3 * ntri);
     std::uint32_t* td = mesh_.tet.data() + tet_at;
@@ -412,7 +396,7 @@ class Assembler {
       if (ra.data.count != p.ncells) fail("cell array '" + ra.name + "' size does not match the cell count");
       ArrayData r = normalize_ints(std::move(ra.data), int_fail(ra.name.c_str()));
       if (!have_region_ && tets_before > 0) mesh_.tet_region.assign(tets_before, 0);
-      reserve_huge(mesh_.tet_region, mesh_.tet_count());
+      io::reserve_huge(mesh_.tet_region, mesh_.tet_count());
       have_region_ = true;
       dispatch_int(r, [&](auto acc) {
         for (std::size_t i = 0; i < p.ncells; ++i) {
@@ -461,7 +445,7 @@ class Assembler {
         append_doubles(na.data, 0, na.data.count, ca.values);
       } else {
         std::size_t at = ca.values.size();
-        reserve_huge(ca.values, at + ntet * nc);
+        io::reserve_huge(ca.values, at + ntet * nc);
         ca.values.resize(at + ntet * nc);
         double* d = ca.values.data() + at;
         dispatch(na.data, [&](auto acc) {

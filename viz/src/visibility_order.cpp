@@ -115,6 +115,8 @@ struct ProgressiveOrder::Impl {
     std::vector<std::uint32_t> local_tets, local_indeg, local_queue;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
     std::vector<std::uint8_t> local_done;
+    std::vector<Entry> tmp;            // the second-level counting sort
+    std::vector<std::uint32_t> counts;
     std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
   };
   Scratch scratch;
@@ -133,6 +135,9 @@ struct ProgressiveOrder::Impl {
   }
   void prepare(std::span<const std::uint32_t> subset);
   void fix_ties(std::size_t begin, std::size_t end, Scratch& sc);
+  void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc);
+  double bucket_low(std::size_t b) const { return bucket_min + double(b) / bucket_scale; }
+  double bucket_min = 0, bucket_scale = 0;  // the linear map of lo to first-level buckets
   void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
   // Hands out buckets [first, last) into out (sorting, tie fix-up, cluster expansion); returns the
   // next bucket not consumed: a tie chain may take in buckets from `last` up to `limit`. *reach_out
@@ -249,11 +254,15 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   }
 
   // 2. The MSD bucket pass: a histogram and a scatter (both cores), by a linear map of lo.
+  // Few enough buckets that the scatter stays in cache; each is sorted when handed out by a second
+  // counting pass (sort_bucket).
   int bits = 4;
-  while (bits < 20 && (std::size_t(16) << bits) < m) ++bits;
+  while (bits < 16 && (std::size_t(256) << bits) < m) ++bits;
   const std::size_t nb = std::size_t(1) << bits;
   stats.buckets = nb;
   const double scale = kmax > kmin ? double(nb) / (kmax - kmin) : 0.0;
+  bucket_min = kmin;
+  bucket_scale = scale;
   const double last = double(nb - 1);
   auto bucket_of = [&](double lo) {
     double x = (lo - kmin) * scale;
@@ -289,6 +298,42 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     other.join();
   }
   sorted.swap(out);  // the scratch buffer keeps the old entries' storage for the next view
+}
+
+// Sorts one bucket by lo: a counting pass over about n/2 sub-buckets of its own range, then an
+// insertion sort over the nearly sorted result (linear for evenly spread keys).
+void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
+  Entry* a = sorted.data() + begin;
+  const std::size_t n = end - begin;
+  if (n > 48) {
+    double lo = a[0].lo, hi = a[0].lo;
+    for (std::size_t i = 1; i < n; ++i) {
+      lo = std::min(lo, a[i].lo);
+      hi = std::max(hi, a[i].lo);
+    }
+    if (hi > lo) {
+      std::size_t subs = 1;
+      while (subs < n / 2) subs <<= 1;
+      const double sub_scale = double(subs) / (hi - lo) * (1 - 1e-12);
+      sc.counts.assign(subs + 1, 0);
+      if (sc.tmp.size() < n) sc.tmp.resize(n);
+      for (std::size_t i = 0; i < n; ++i)
+        ++sc.counts[std::min(subs - 1, static_cast<std::size_t>((a[i].lo - lo) * sub_scale)) + 1];
+      for (std::size_t k = 1; k <= subs; ++k) sc.counts[k] += sc.counts[k - 1];
+      for (std::size_t i = 0; i < n; ++i)
+        sc.tmp[sc.counts[std::min(subs - 1, static_cast<std::size_t>((a[i].lo - lo) * sub_scale))]++] = a[i];
+      std::copy(sc.tmp.begin(), sc.tmp.begin() + static_cast<std::ptrdiff_t>(n), a);
+    }
+  }
+  for (std::size_t i = 1; i < n; ++i) {
+    Entry x = a[i];
+    std::size_t j = i;
+    while (j > 0 && x.lo < a[j - 1].lo) {
+      a[j] = a[j - 1];
+      --j;
+    }
+    a[j] = x;
+  }
 }
 
 // Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
@@ -480,19 +525,21 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     std::size_t begin = bucket_begin[b], end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    std::sort(sorted.begin() + begin, sorted.begin() + end);
+    sort_bucket(begin, end, sc);
     reach = -std::numeric_limits<double>::infinity();
     for (std::size_t i = begin; i < end; ++i) reach = std::max(reach, sorted[i].hi());
-    // A near-tie chain may cross into the following buckets: take them in while it does.
+    // A near-tie chain may cross into the following buckets: take them in while it does. Bucket b
+    // holds no lo below its lower boundary, so most checks need no scan.
     while (b < nb) {
       std::size_t nb_begin = bucket_begin[b], nb_end = bucket_begin[b + 1];
       if (nb_begin == nb_end) {
         ++b;
         continue;
       }
+      if (b > 0 && bucket_low(b) > reach * (1 + 1e-15) + 1e-300) break;
       double next_min = std::min_element(sorted.begin() + nb_begin, sorted.begin() + nb_end)->lo;
       if (next_min > reach) break;
-      std::sort(sorted.begin() + nb_begin, sorted.begin() + nb_end);
+      sort_bucket(nb_begin, nb_end, sc);
       for (std::size_t i = nb_begin; i < nb_end; ++i) reach = std::max(reach, sorted[i].hi());
       end = nb_end;
       ++b;
