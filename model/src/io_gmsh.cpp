@@ -136,20 +136,6 @@ class TagMap {
 };
 
 
-// The distinct values of `v`, sorted; linear in v.size() for the few ids a mesh has.
-std::vector<std::int32_t> distinct(const std::vector<std::int32_t>& v) {
-  std::vector<std::int32_t> ids;
-  std::int32_t last = 0;
-  bool have_last = false;
-  for (std::int32_t x : v) {
-    if (have_last && x == last) continue;
-    last = x;
-    have_last = true;
-    auto it = std::lower_bound(ids.begin(), ids.end(), x);
-    if (it == ids.end() || *it != x) ids.insert(it, x);
-  }
-  return ids;
-}
 
 // Number of nodes of the element types foxi reads; -1 for any other type.
 int nodes_of_type(std::int64_t type) {
@@ -958,11 +944,11 @@ class Reader {
 
   // ---- assembly ----
   Mesh finish() {
-    for (std::int32_t id : distinct(mesh_.tet_region)) {
+    for (std::int32_t id : io::distinct_ids(mesh_.tet_region)) {
       auto it = volume_names_.find(id);
       mesh_.regions.push_back({id, it == volume_names_.end() ? std::string() : it->second, kNone});
     }
-    for (std::int32_t id : distinct(mesh_.bface_tag)) {
+    for (std::int32_t id : io::distinct_ids(mesh_.bface_tag)) {
       auto it = surface_names_.find(id);
       mesh_.boundaries.push_back({id, it == surface_names_.end() ? std::string() : it->second});
     }

@@ -244,32 +244,10 @@ std::uint64_t header_small(Scanner& in, const char* what) {
   return static_cast<std::uint64_t>(v);
 }
 
-// Distinct values, sorted (few distinct ids in practice: a short list, sorted at the end).
-std::vector<std::int32_t> distinct(const std::vector<std::int32_t>& v) {
-  std::vector<std::int32_t> seen;
-  std::int32_t last = 0;
-  bool have_last = false;
-  for (std::int32_t x : v) {
-    if (have_last && x == last) continue;
-    last = x;
-    have_last = true;
-    if (std::find(seen.begin(), seen.end(), x) == seen.end()) {
-      seen.push_back(x);
-      if (seen.size() > 64) {  // many ids: sort a copy instead
-        std::vector<std::int32_t> all = v;
-        std::sort(all.begin(), all.end());
-        all.erase(std::unique(all.begin(), all.end()), all.end());
-        return all;
-      }
-    }
-  }
-  std::sort(seen.begin(), seen.end());
-  return seen;
-}
 
 void fill_names(Mesh& m) {
-  for (std::int32_t id : distinct(m.tet_region)) m.regions.push_back(Region{id, {}, kNone});
-  for (std::int32_t tag : distinct(m.bface_tag)) m.boundaries.push_back(Boundary{tag, {}});
+  for (std::int32_t id : io::distinct_ids(m.tet_region)) m.regions.push_back(Region{id, {}, kNone});
+  for (std::int32_t tag : io::distinct_ids(m.bface_tag)) m.boundaries.push_back(Boundary{tag, {}});
 }
 
 // ---------------------------------------------------------------------------------------------

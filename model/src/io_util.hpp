@@ -3,6 +3,7 @@
 
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <cstring>
@@ -207,6 +208,29 @@ void reserve_huge(std::vector<T>& v, std::size_t n) {
   if (n <= v.capacity()) return;
   v.reserve(n);
   advise_huge(v.data(), n * sizeof(T));
+}
+
+// The distinct values of `v`, sorted. Linear for the few region ids and boundary tags a mesh has
+// (a short list; runs of equal values skipped); falls back to sorting a copy when there are many.
+inline std::vector<std::int32_t> distinct_ids(const std::vector<std::int32_t>& v) {
+  std::vector<std::int32_t> seen;
+  std::int32_t last = 0;
+  bool have_last = false;
+  for (std::int32_t x : v) {
+    if (have_last && x == last) continue;
+    last = x;
+    have_last = true;
+    auto it = std::lower_bound(seen.begin(), seen.end(), x);
+    if (it != seen.end() && *it == x) continue;
+    seen.insert(it, x);
+    if (seen.size() > 256) {
+      std::vector<std::int32_t> all = v;
+      std::sort(all.begin(), all.end());
+      all.erase(std::unique(all.begin(), all.end()), all.end());
+      return all;
+    }
+  }
+  return seen;
 }
 
 // Reads a little- or big-endian value from unaligned bytes.

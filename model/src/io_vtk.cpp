@@ -503,13 +503,13 @@ class Assembler {
     }
     // Regions and boundaries: one per distinct id.
     if (have_region_) {
-      std::vector<std::int32_t> ids = distinct(mesh_.tet_region);
+      std::vector<std::int32_t> ids = io::distinct_ids(mesh_.tet_region);
       for (std::int32_t id : ids) {
         auto it = region_names_.find(id);
         mesh_.regions.push_back({id, it == region_names_.end() ? std::string() : it->second, kNone});
       }
     }
-    for (std::int32_t tag : distinct(mesh_.bface_tag)) {
+    for (std::int32_t tag : io::distinct_ids(mesh_.bface_tag)) {
       auto it = boundary_names_.find(tag);
       mesh_.boundaries.push_back({tag, it == boundary_names_.end() ? std::string() : it->second});
     }
@@ -517,20 +517,7 @@ class Assembler {
   }
 
  private:
-  static std::vector<std::int32_t> distinct(const std::vector<std::int32_t>& v) {
-    std::vector<std::int32_t> ids;
-    if (v.empty()) return ids;
-    // Ids are few: a small sorted set, fast path for runs of equal values.
-    std::int32_t last = v[0];
-    ids.push_back(last);
-    for (std::int32_t x : v) {
-      if (x == last) continue;
-      last = x;
-      auto it = std::lower_bound(ids.begin(), ids.end(), x);
-      if (it == ids.end() || *it != x) ids.insert(it, x);
-    }
-    return ids;
-  }
+
 
   CollectedArray& collect(NamedArray& na, FieldLocation loc, std::size_t piece_index) {
     auto key = std::make_pair(na.name, loc);

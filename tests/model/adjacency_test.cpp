@@ -249,54 +249,11 @@ TEST(FaceAdjacency, MatchesTetgenNeighboursOnBox) {
   check_against_tetgen(box_poly(2, 1, 1), "-pq1.414a0.0005O0nQ");
 }
 
-// The U-trench PLC of /work/shared/peers/trench.poly (non-convex), with TetGen's mesh optimisation on.
-const char* const kTrenchPoly =
-    R"(# 2x1x1 box with a U-shaped trench [0.5,1.5]x[0,1]x[0.5,1] cut from the top (non-convex)
-# profile in x-z: (0,0)(2,0)(2,1)(1.5,1)(1.5,.5)(.5,.5)(.5,1)(0,1), extruded along y in [0,1]
-16 3 0 0
-1 0 0 0
-2 2 0 0
-3 2 0 1
-4 1.5 0 1
-5 1.5 0 0.5
-6 0.5 0 0.5
-7 0.5 0 1
-8 0 0 1
-9 0 1 0
-10 2 1 0
-11 2 1 1
-12 1.5 1 1
-13 1.5 1 0.5
-14 0.5 1 0.5
-15 0.5 1 1
-16 0 1 1
-10 0
-1
-8 1 2 3 4 5 6 7 8
-1
-8 9 10 11 12 13 14 15 16
-1
-4 1 2 10 9
-1
-4 2 3 11 10
-1
-4 3 4 12 11
-1
-4 4 5 13 12
-1
-4 5 6 14 13
-1
-4 6 7 15 14
-1
-4 7 8 16 15
-1
-4 8 1 9 16
-0
-0
-)";
+// The seed paper's U-trench PLC (non-convex), shipped in examples/.
+std::string trench_poly() { return test::read_text(test::data_dir() + "/../../examples/trench.poly"); }
 
 TEST(FaceAdjacency, MatchesTetgenNeighboursOnTrench) {
-  check_against_tetgen(kTrenchPoly, "-pq1.414a0.001nQ");
+  check_against_tetgen(trench_poly(), "-pq1.414a0.001nQ");
 }
 
 }  // namespace

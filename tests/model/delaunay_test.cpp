@@ -172,51 +172,8 @@ std::string box_poly(double lx, double ly, double lz) {
   return s.str();
 }
 
-// The U-trench PLC of /work/shared/peers/trench.poly (non-convex).
-const char* const kTrenchPoly =
-    R"(# 2x1x1 box with a U-shaped trench [0.5,1.5]x[0,1]x[0.5,1] cut from the top (non-convex)
-# profile in x-z: (0,0)(2,0)(2,1)(1.5,1)(1.5,.5)(.5,.5)(.5,1)(0,1), extruded along y in [0,1]
-16 3 0 0
-1 0 0 0
-2 2 0 0
-3 2 0 1
-4 1.5 0 1
-5 1.5 0 0.5
-6 0.5 0 0.5
-7 0.5 0 1
-8 0 0 1
-9 0 1 0
-10 2 1 0
-11 2 1 1
-12 1.5 1 1
-13 1.5 1 0.5
-14 0.5 1 0.5
-15 0.5 1 1
-16 0 1 1
-10 0
-1
-8 1 2 3 4 5 6 7 8
-1
-8 9 10 11 12 13 14 15 16
-1
-4 1 2 10 9
-1
-4 2 3 11 10
-1
-4 3 4 12 11
-1
-4 4 5 13 12
-1
-4 5 6 14 13
-1
-4 6 7 15 14
-1
-4 7 8 16 15
-1
-4 8 1 9 16
-0
-0
-)";
+// The seed paper's U-trench PLC (non-convex), shipped in examples/.
+std::string trench_poly() { return test::read_text(test::data_dir() + "/../../examples/trench.poly"); }
 
 // Runs tetgen on a PLC; returns false (and the test skips) when tetgen is not installed.
 bool tetgen_mesh(const std::string& poly, const std::string& switches, Mesh& out) {
@@ -243,7 +200,7 @@ TEST(DelaunayCertificate, TetgenBoxWithoutOptimisationIsDelaunay) {
 
 TEST(DelaunayCertificate, OptimisedTrenchViolationsMatchBruteForce) {
   Mesh m;
-  if (!tetgen_mesh(kTrenchPoly, "-pq1.414a0.0005Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.0005Q", m)) GTEST_SKIP() << "no tetgen";
   DelaunayCertificate c = compute_delaunay_certificate(m);
   Brute b = brute_force(m);
   std::printf("trench a0.0005: %zu tets, %zu nodes, %zu violating (brute force %zu)\n", m.tet_count(),
@@ -257,7 +214,7 @@ TEST(DelaunayCertificate, OptimisedTrenchViolationsMatchBruteForce) {
 
 TEST(DelaunayCertificate, TrenchWithoutOptimisationMatchesBruteForce) {
   Mesh m;
-  if (!tetgen_mesh(kTrenchPoly, "-pq1.414a0.002O0Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.002O0Q", m)) GTEST_SKIP() << "no tetgen";
   DelaunayCertificate c = compute_delaunay_certificate(m);
   Brute b = brute_force(m);
   EXPECT_TRUE(b.violating.empty());
@@ -379,7 +336,7 @@ TEST(DelaunayCertificate, DegenerateTetCounted) {
 TEST(DelaunayCertificate, EqualWeightsGiveTheUnweightedResult) {
   // Equal weights shift every power distance by the same amount: regular = Delaunay.
   Mesh m;
-  if (!tetgen_mesh(kTrenchPoly, "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
   DelaunayCertificate plain = compute_delaunay_certificate(m);
   m.weight.assign(m.node_count(), 0.013);
   DelaunayCertificate w = compute_delaunay_certificate(m);
@@ -423,7 +380,7 @@ TEST(DelaunayCertificate, WeightSignConventionAnalytic) {
 
 TEST(DelaunayCertificate, ListTruncatedCountKept) {
   Mesh m;
-  if (!tetgen_mesh(kTrenchPoly, "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
   CertificateOptions opt;
   opt.max_listed = 3;
   DelaunayCertificate all = compute_delaunay_certificate(m);
