@@ -134,10 +134,15 @@ struct ProgressiveOrder::Impl {
     if (sorted.capacity() > t_workspace.entries.capacity()) t_workspace.entries.swap(sorted);
   }
   void prepare(std::span<const std::uint32_t> subset);
-  void fix_ties(std::size_t begin, std::size_t end, Scratch& sc);
-  void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc);
+  // Re-sorts the near-tie chains of [begin, end) exactly; returns the high end of the last chain and
+  // sets *last_chain to where it starts.
+  double fix_ties(std::size_t begin, std::size_t end, Scratch& sc, std::size_t* last_chain);
+  // Sorts [begin, end) by lo; `bucket` is the first-level bucket it is (its key range is known), or
+  // kNone for a range whose bounds must be scanned.
+  void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc, std::size_t bucket);
   double bucket_low(std::size_t b) const { return bucket_min + double(b) / bucket_scale; }
   double bucket_min = 0, bucket_scale = 0;  // the linear map of lo to first-level buckets
+  bool t_cluster_free = false;              // no item is a cluster: copy items straight out
   void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
   // Hands out buckets [first, last) into out (sorting, tie fix-up, cluster expansion); returns the
   // next bucket not consumed: a tie chain may take in buckets from `last` up to `limit`. *reach_out
@@ -192,6 +197,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     total_tets = subset.size();
   }
   const std::size_t m_main = items.size(), m = m_main + wide_items.size();
+  t_cluster_free = t.cluster_count() == 0;
   stats.items = m;
   stats.wide_items = wide_items.size();
   if (m == 0) {
@@ -302,14 +308,23 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
 
 // Sorts one bucket by lo: a counting pass over about n/2 sub-buckets of its own range, then an
 // insertion sort over the nearly sorted result (linear for evenly spread keys).
-void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
+void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc, std::size_t bucket) {
   Entry* a = sorted.data() + begin;
   const std::size_t n = end - begin;
+  const std::size_t nb = bucket_begin.size() - 1;
   if (n > 48) {
-    double lo = a[0].lo, hi = a[0].lo;
-    for (std::size_t i = 1; i < n; ++i) {
-      lo = std::min(lo, a[i].lo);
-      hi = std::max(hi, a[i].lo);
+    double lo, hi;
+    if (bucket != kNone && bucket > 0 && bucket + 1 < nb && bucket_scale > 0) {
+      // Inner buckets: the linear map gives the range (entries just outside it by rounding land in
+      // the end sub-buckets, and the insertion sort puts them right).
+      lo = bucket_low(bucket);
+      hi = bucket_low(bucket + 1);
+    } else {
+      lo = hi = a[0].lo;
+      for (std::size_t i = 1; i < n; ++i) {
+        lo = std::min(lo, a[i].lo);
+        hi = std::max(hi, a[i].lo);
+      }
     }
     if (hi > lo) {
       std::size_t subs = 1;
@@ -317,11 +332,13 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
       const double sub_scale = double(subs) / (hi - lo) * (1 - 1e-12);
       sc.counts.assign(subs + 1, 0);
       if (sc.tmp.size() < n) sc.tmp.resize(n);
-      for (std::size_t i = 0; i < n; ++i)
-        ++sc.counts[std::min(subs - 1, static_cast<std::size_t>((a[i].lo - lo) * sub_scale)) + 1];
+      auto sub = [&](double x) {
+        double f = (x - lo) * sub_scale;
+        return f <= 0 ? std::size_t{0} : std::min(subs - 1, static_cast<std::size_t>(f));
+      };
+      for (std::size_t i = 0; i < n; ++i) ++sc.counts[sub(a[i].lo) + 1];
       for (std::size_t k = 1; k <= subs; ++k) sc.counts[k] += sc.counts[k - 1];
-      for (std::size_t i = 0; i < n; ++i)
-        sc.tmp[sc.counts[std::min(subs - 1, static_cast<std::size_t>((a[i].lo - lo) * sub_scale))]++] = a[i];
+      for (std::size_t i = 0; i < n; ++i) sc.tmp[sc.counts[sub(a[i].lo)]++] = a[i];
       std::copy(sc.tmp.begin(), sc.tmp.begin() + static_cast<std::ptrdiff_t>(n), a);
     }
   }
@@ -339,11 +356,13 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
 // Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
 // two entries can be out of order only if their intervals overlap. Sorted by lo, the maximal chains
 // of overlapping intervals are re-sorted by exact comparison (made only for overlapping pairs).
-void ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end, Scratch& sc) {
+double ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end, Scratch& sc, std::size_t* last_chain) {
   std::size_t i = begin;
-  while (i + 1 < end) {
+  double reach = -std::numeric_limits<double>::infinity();
+  *last_chain = begin;
+  while (i < end) {
     std::size_t j = i;
-    double reach = sorted[i].hi();
+    reach = sorted[i].hi();
     while (j + 1 < end && sorted[j + 1].lo <= reach) reach = std::max(reach, sorted[++j].hi());
     if (j > i) {
       // Distinct items may still share a sphere (not face-adjacent): exact equality leaves them in
@@ -373,8 +392,10 @@ void ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end, Scratc
       ++sc.near_tie_runs;
       sc.near_tie_items += j - i + 1;
     }
+    *last_chain = i;
     i = j + 1;
   }
+  return reach;
 }
 
 // Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
@@ -525,27 +546,38 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     std::size_t begin = bucket_begin[b], end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    sort_bucket(begin, end, sc);
-    reach = -std::numeric_limits<double>::infinity();
-    for (std::size_t i = begin; i < end; ++i) reach = std::max(reach, sorted[i].hi());
+    sort_bucket(begin, end, sc, b - 1);
+    std::size_t chain = begin;
+    reach = fix_ties(begin, end, sc, &chain);
     // A near-tie chain may cross into the following buckets: take them in while it does. Bucket b
-    // holds no lo below its lower boundary, so most checks need no scan.
+    // holds no lo below its lower boundary (up to rounding), so most checks need no scan.
     while (b < nb) {
       std::size_t nb_begin = bucket_begin[b], nb_end = bucket_begin[b + 1];
       if (nb_begin == nb_end) {
         ++b;
         continue;
       }
-      if (b > 0 && bucket_low(b) > reach * (1 + 1e-15) + 1e-300) break;
+      const double margin = 1e-12 * (std::abs(reach) + std::abs(bucket_min) + 1.0 / bucket_scale);
+      if (bucket_scale > 0 && bucket_low(b) > reach + margin) break;
       double next_min = std::min_element(sorted.begin() + nb_begin, sorted.begin() + nb_end)->lo;
       if (next_min > reach) break;
-      sort_bucket(nb_begin, nb_end, sc);
-      for (std::size_t i = nb_begin; i < nb_end; ++i) reach = std::max(reach, sorted[i].hi());
+      sort_bucket(nb_begin, nb_end, sc, b);
       end = nb_end;
       ++b;
+      reach = fix_ties(chain, end, sc, &chain);
     }
-    fix_ties(begin, end, sc);
-    for (std::size_t i = begin; i < end; ++i) expand(sorted[i].item, out, sc);
+    if (t_cluster_free) {
+      const std::size_t at = out.size();
+      out.resize(at + (end - begin));
+      std::uint32_t* o = out.data() + at;
+      for (std::size_t i = begin; i < end; ++i) *o++ = sorted[i].item;
+    } else {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t item = sorted[i].item;
+        if (item & kClusterBit) expand(item, out, sc);
+        else out.push_back(item);
+      }
+    }
   }
   if (reach_out) *reach_out = reach;
   return b;

@@ -1,0 +1,67 @@
+// The camera of the renderer: perspective (an eye point, which may lie inside the mesh) or
+// orthographic (a view direction), with fit-to-bounds and orbit / pan / zoom helpers, and the
+// projection of world points to pixel coordinates used by the rasterizer.
+//
+// Pixel coordinates: x to the right, y down, pixel (i, j) covers [i, i+1) x [j, j+1) and is sampled
+// at its centre (i + 0.5, j + 0.5). Camera coordinates: x along `right`, y along `up` (orthogonalised),
+// z along `forward` (from the eye into the scene); z is the depth.
+#pragma once
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/viz/view.hpp"
+
+namespace foxi {
+
+struct Camera {
+  bool perspective = true;
+  double eye[3] = {0, -1, 0};   // world point; orthographic: only eye - at matters (the direction)
+  double at[3] = {0, 0, 0};     // the point looked at (centre of the image)
+  double up[3] = {0, 0, 1};     // view-up; need not be orthogonal to at - eye, must not be parallel
+  double fov_deg = 30;          // perspective: vertical field of view in degrees, in (0, 180)
+  double ortho_height = 1;      // orthographic: world height shown by the image (> 0)
+};
+
+// Axis-aligned bounds of the nodes used by tets (all nodes if there are no tets). lo > hi if none.
+void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
+
+// A camera looking along `dir` (from the eye into the scene) at the centre of the box [lo, hi], far
+// enough that the box's bounding sphere fills `fill` (0..1] of the smaller image dimension, for an
+// image of width/height `aspect`. Perspective with vertical field of view `fov_deg`, or orthographic.
+// `up` is used as given when not parallel to dir, else another axis is chosen.
+Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
+                  bool perspective = true, double fov_deg = 30, double aspect = 1, double fill = 0.95);
+
+// Turns the eye about `at`: by yaw_deg about the up axis, then by pitch_deg about the right axis.
+// Up is kept (re-orthogonalised). Distance to `at` is unchanged.
+Camera orbit(const Camera& camera, double yaw_deg, double pitch_deg);
+// Moves eye and at together by (dx, dy) fractions of the visible height at `at` (right, up).
+Camera pan(const Camera& camera, double dx, double dy);
+// factor > 1 magnifies: perspective moves the eye toward `at` (distance / factor); orthographic
+// divides ortho_height by factor.
+Camera zoom(const Camera& camera, double factor);
+
+// The per-image projection of a camera. Throws std::invalid_argument for a degenerate camera
+// (eye == at, up parallel to the view direction, fov outside (0, 180), size < 1).
+struct Projector {
+  bool perspective = true;
+  double eye[3] = {0, 0, 0};
+  double right[3] = {1, 0, 0}, up[3] = {0, 1, 0}, forward[3] = {0, 0, 1};  // orthonormal
+  int width = 1, height = 1;
+  double cx = 0.5, cy = 0.5;   // pixel coordinates of the image centre (width/2, height/2)
+  double focal = 1;            // perspective: pixels per unit of x/z (height / 2 / tan(fov / 2))
+  double scale = 1;            // orthographic: pixels per world unit (height / ortho_height)
+
+  Projector(const Camera& camera, int width, int height);
+  // World point -> camera coordinates (x right, y up, z depth along forward from the eye).
+  void to_camera(const double p[3], double c[3]) const;
+  // Camera coordinates -> pixel coordinates; perspective needs c[2] > 0.
+  void camera_to_pixel(const double c[3], double px[2]) const;
+  // World point -> pixel coordinates (x, y) and depth; returns false (px untouched) if the point is
+  // not in front of the eye (perspective, depth <= 0).
+  bool project(const double p[3], double px[2], double* depth = nullptr) const;
+};
+
+// The ordering viewpoint of a camera: perspective -> View::at(eye), orthographic -> View::along(at - eye).
+View view_of(const Camera& camera);
+
+}  // namespace foxi

@@ -1,0 +1,48 @@
+// The picture the painter fills: RGBA8 pixels, an id buffer (the tet each pixel shows, for picking,
+// probing and recolouring) and, in depth-buffer mode only, a float depth buffer.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+
+namespace foxi {
+
+// A pixel: R in bits 0-7, G 8-15, B 16-23, A 24-31.
+constexpr std::uint32_t pack_rgba(std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a = 255) {
+  return (r & 255u) | (g & 255u) << 8 | (b & 255u) << 16 | (a & 255u) << 24;
+}
+
+struct Framebuffer {
+  int width = 0, height = 0;
+  std::vector<std::uint32_t> rgba;   // width * height, row-major, row 0 at the top
+  std::vector<std::uint32_t> id;     // width * height: tet index, or kNone for background
+  std::vector<float> depth;          // width * height in depth-buffer mode, else empty; larger = nearer
+
+  Framebuffer() = default;
+  // A cleared framebuffer; with_depth allocates the depth buffer.
+  Framebuffer(int w, int h, bool with_depth = false, std::uint32_t background = pack_rgba(255, 255, 255)) {
+    resize(w, h, with_depth, background);
+  }
+  void resize(int w, int h, bool with_depth, std::uint32_t background = pack_rgba(255, 255, 255)) {
+    width = w;
+    height = h;
+    rgba.assign(std::size_t(w) * std::size_t(h), background);
+    id.assign(std::size_t(w) * std::size_t(h), kNone);
+    if (with_depth) depth.assign(std::size_t(w) * std::size_t(h), -std::numeric_limits<float>::infinity());
+    else depth.clear();
+  }
+  // Background colour everywhere, no tet, depth at infinity.
+  void clear(std::uint32_t background = pack_rgba(255, 255, 255)) {
+    std::fill(rgba.begin(), rgba.end(), background);
+    std::fill(id.begin(), id.end(), kNone);
+    std::fill(depth.begin(), depth.end(), -std::numeric_limits<float>::infinity());
+  }
+  std::size_t index(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }
+};
+
+}  // namespace foxi

@@ -1,0 +1,80 @@
+// The software painter (seed paper, sections 6-7): tets drawn back to front in a visibility order,
+// each contributing only its FRONT faces (those facing the eye), overwrite the pixels they cover, so
+// no depth buffer is needed. The same rasterizer has a depth-buffer mode (z-test on the interpolated
+// depth, draw order irrelevant) that serves as the test oracle: for a visibility order both give the
+// same picture pixel for pixel.
+//
+// Faces are flat-shaded (Lambert + ambient) in a per-region colour; mesh edges are drawn by
+// darkening a face's own pixels near its edges (never outside them). Rasterization is watertight:
+// vertices are snapped to fixed point (8 subpixel bits), pixels are sampled at their centres with a
+// top-left fill rule, so two faces sharing an edge cover each pixel once and a shared face covers the
+// same pixels from either side. No anti-aliasing. Perspective faces are clipped against a near plane
+// (eyes inside the mesh); tets entirely behind it are skipped. Drawing uses several threads over
+// interleaved bands of rows; each thread draws every tet in order, so the per-pixel order is kept.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/framebuffer.hpp"
+
+namespace foxi {
+
+struct RenderParams {
+  bool depth_buffer = false;     // depth-buffer mode (the framebuffer must have a depth buffer)
+  double shrink = 1;             // each tet scaled about its centroid by this factor, in (0, 1]
+  bool edges = true;             // darken pixels within edge_width of a face's edges
+  double edge_width = 1.0;       // pixels
+  double edge_darkness = 0.65;   // 0 = invisible edges, 1 = black at the edge
+  double ambient = 0.3;          // Lambert: ambient + (1 - ambient) max(0, n . light)
+  double near = 0;               // perspective near-plane distance (world); 0 = automatic (tiny)
+  int threads = 2;               // threads drawing interleaved bands of rows (1 or more)
+};
+
+// The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).
+std::uint32_t region_color(std::int32_t id);
+
+struct RasterStats {
+  std::size_t tets_drawn = 0;       // tets handed to draw() (skipped ones included)
+  std::size_t tets_behind = 0;      // tets entirely behind the near plane
+  std::size_t faces_clipped = 0;    // front faces cut by the near plane
+};
+
+// Per-frame state: the camera's projection of the mesh for one image size. The mesh is lent and must
+// outlive it. Throws std::invalid_argument for a degenerate camera or bad parameters, and for an
+// orthographic camera zoomed in so far that coordinates leave the fixed-point range.
+class TetRasterizer {
+ public:
+  TetRasterizer(const Mesh& mesh, const Camera& camera, int width, int height, const RenderParams& params = {});
+  ~TetRasterizer();
+  TetRasterizer(TetRasterizer&&) noexcept;
+  TetRasterizer& operator=(TetRasterizer&&) noexcept;
+
+  // Draws `tets` in the given order (painter: later overwrites earlier; depth mode: nearest wins)
+  // into fb, which must be width x height (with a depth buffer in depth mode). Can be called again
+  // with the next batch of an order (progressive drawing). Tet indices must be < tet_count.
+  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
+  const RasterStats& stats() const;
+  const Projector& projector() const;
+  double near_plane() const;   // the near-plane distance in use (perspective)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// A convenience: a fresh framebuffer (background white) with `tets` drawn in order.
+Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
+                        std::span<const std::uint32_t> tets, const RenderParams& params = {});
+
+// The pixels covered by one triangle under the rasterizer's fill rule (for tests): vertices in
+// fixed point (pixel coordinate * 256, rounded), either winding; returns y * width + x of every
+// covered pixel of the width x height image, in row order. A zero-area triangle covers nothing.
+std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3], int width, int height);
+
+}  // namespace foxi

@@ -1,0 +1,214 @@
+#include "foxi/viz/camera.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace foxi {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+void cross(const double a[3], const double b[3], double r[3]) {
+  r[0] = a[1] * b[2] - a[2] * b[1];
+  r[1] = a[2] * b[0] - a[0] * b[2];
+  r[2] = a[0] * b[1] - a[1] * b[0];
+}
+double norm(const double a[3]) { return std::sqrt(dot(a, a)); }
+bool normalize(double a[3]) {
+  double n = norm(a);
+  if (!(n > 0) || !std::isfinite(n)) return false;
+  for (int k = 0; k < 3; ++k) a[k] /= n;
+  return true;
+}
+
+// Orthonormal right, up, forward of a camera; false if degenerate.
+bool basis(const Camera& c, double right[3], double up[3], double fwd[3]) {
+  for (int k = 0; k < 3; ++k) fwd[k] = c.at[k] - c.eye[k];
+  if (!normalize(fwd)) return false;
+  cross(fwd, c.up, right);
+  double un = norm(c.up);
+  if (!(norm(right) > 1e-9 * un) || !normalize(right)) return false;
+  cross(right, fwd, up);
+  return normalize(up);
+}
+
+// Rotates v about the unit axis by angle (radians), Rodrigues' formula.
+void rotate(double v[3], const double axis[3], double angle) {
+  double c = std::cos(angle), s = std::sin(angle), kv[3], d = dot(axis, v);
+  cross(axis, v, kv);
+  for (int k = 0; k < 3; ++k) v[k] = v[k] * c + kv[k] * s + axis[k] * d * (1 - c);
+}
+
+}  // namespace
+
+void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::numeric_limits<double>::infinity();
+    hi[k] = -std::numeric_limits<double>::infinity();
+  }
+  auto add = [&](std::size_t n) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], mesh.xyz[3 * n + k]);
+      hi[k] = std::max(hi[k], mesh.xyz[3 * n + k]);
+    }
+  };
+  if (mesh.tet.empty()) {
+    for (std::size_t n = 0; n < mesh.node_count(); ++n) add(n);
+  } else {
+    for (std::uint32_t n : mesh.tet)
+      if (n < mesh.node_count()) add(n);
+  }
+}
+
+Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3], bool perspective,
+                  double fov_deg, double aspect, double fill) {
+  Camera cam;
+  cam.perspective = perspective;
+  cam.fov_deg = fov_deg;
+  double d[3] = {dir[0], dir[1], dir[2]};
+  if (!normalize(d)) throw std::invalid_argument("fit_camera: the view direction is zero");
+  double centre[3], radius = 0;
+  for (int k = 0; k < 3; ++k) {
+    centre[k] = 0.5 * (lo[k] + hi[k]);
+    radius += 0.25 * (hi[k] - lo[k]) * (hi[k] - lo[k]);
+  }
+  radius = std::sqrt(radius);
+  if (!std::isfinite(radius)) throw std::invalid_argument("fit_camera: empty or non-finite bounds");
+  if (radius == 0) radius = 1;
+  if (!(fill > 0) || fill > 1) fill = 0.95;
+  if (!(aspect > 0)) aspect = 1;
+  // Up: as given unless (nearly) parallel to the direction; then the axis least aligned with it.
+  double u[3] = {up[0], up[1], up[2]}, r[3];
+  cross(d, u, r);
+  if (!(norm(r) > 1e-6 * norm(u))) {
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::abs(d[k]) < std::abs(d[axis])) axis = k;
+    u[0] = u[1] = u[2] = 0;
+    u[axis] = 1;
+  }
+  for (int k = 0; k < 3; ++k) {
+    cam.at[k] = centre[k];
+    cam.up[k] = u[k];
+  }
+  // The smaller half-angle of the view (vertical, or horizontal when the image is taller than wide).
+  double half_v = 0.5 * fov_deg * kPi / 180;
+  double half = aspect >= 1 ? half_v : std::atan(std::tan(half_v) * aspect);
+  double dist;
+  if (perspective) {
+    if (!(fov_deg > 0 && fov_deg < 180)) throw std::invalid_argument("fit_camera: fov must be in (0, 180) degrees");
+    // The sphere seen under the angle asin(R / dist) equals fill * half.
+    dist = radius / std::sin(fill * half);
+  } else {
+    dist = 2 * radius;
+    double h = 2 * radius / fill;                      // the smaller image dimension shows h
+    cam.ortho_height = aspect >= 1 ? h : h / aspect;   // height = width / aspect
+  }
+  for (int k = 0; k < 3; ++k) cam.eye[k] = centre[k] - dist * d[k];
+  return cam;
+}
+
+Camera orbit(const Camera& camera, double yaw_deg, double pitch_deg) {
+  Camera c = camera;
+  double r[3], u[3], f[3];
+  if (!basis(c, r, u, f)) throw std::invalid_argument("orbit: degenerate camera");
+  double v[3];
+  for (int k = 0; k < 3; ++k) v[k] = c.eye[k] - c.at[k];
+  double axis_up[3] = {c.up[0], c.up[1], c.up[2]};
+  normalize(axis_up);
+  rotate(v, axis_up, yaw_deg * kPi / 180);
+  rotate(r, axis_up, yaw_deg * kPi / 180);
+  rotate(v, r, pitch_deg * kPi / 180);
+  rotate(u, r, pitch_deg * kPi / 180);
+  for (int k = 0; k < 3; ++k) {
+    c.eye[k] = c.at[k] + v[k];
+    c.up[k] = u[k];
+  }
+  return c;
+}
+
+Camera pan(const Camera& camera, double dx, double dy) {
+  Camera c = camera;
+  double r[3], u[3], f[3];
+  if (!basis(c, r, u, f)) throw std::invalid_argument("pan: degenerate camera");
+  double h;
+  if (c.perspective) {
+    double dist[3] = {c.at[0] - c.eye[0], c.at[1] - c.eye[1], c.at[2] - c.eye[2]};
+    h = 2 * norm(dist) * std::tan(0.5 * c.fov_deg * kPi / 180);
+  } else {
+    h = c.ortho_height;
+  }
+  for (int k = 0; k < 3; ++k) {
+    double m = h * (dx * r[k] + dy * u[k]);
+    c.eye[k] += m;
+    c.at[k] += m;
+  }
+  return c;
+}
+
+Camera zoom(const Camera& camera, double factor) {
+  if (!(factor > 0) || !std::isfinite(factor)) throw std::invalid_argument("zoom: factor must be positive");
+  Camera c = camera;
+  if (c.perspective) {
+    for (int k = 0; k < 3; ++k) c.eye[k] = c.at[k] + (c.eye[k] - c.at[k]) / factor;
+  } else {
+    c.ortho_height /= factor;
+  }
+  return c;
+}
+
+Projector::Projector(const Camera& camera, int w, int h) : perspective(camera.perspective), width(w), height(h) {
+  if (w < 1 || h < 1) throw std::invalid_argument("camera: image size must be at least 1x1");
+  if (!basis(camera, right, up, forward))
+    throw std::invalid_argument("camera: degenerate (eye equals at, or up parallel to the view direction)");
+  for (int k = 0; k < 3; ++k) eye[k] = camera.eye[k];
+  cx = 0.5 * w;
+  cy = 0.5 * h;
+  if (perspective) {
+    if (!(camera.fov_deg > 0 && camera.fov_deg < 180))
+      throw std::invalid_argument("camera: fov must be in (0, 180) degrees, not " + std::to_string(camera.fov_deg));
+    focal = 0.5 * h / std::tan(0.5 * camera.fov_deg * kPi / 180);
+  } else {
+    if (!(camera.ortho_height > 0) || !std::isfinite(camera.ortho_height))
+      throw std::invalid_argument("camera: orthographic height must be positive");
+    scale = h / camera.ortho_height;
+  }
+}
+
+void Projector::to_camera(const double p[3], double c[3]) const {
+  double d[3] = {p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]};
+  c[0] = dot(d, right);
+  c[1] = dot(d, up);
+  c[2] = dot(d, forward);
+}
+
+void Projector::camera_to_pixel(const double c[3], double px[2]) const {
+  if (perspective) {
+    px[0] = cx + focal * c[0] / c[2];
+    px[1] = cy - focal * c[1] / c[2];
+  } else {
+    px[0] = cx + scale * c[0];
+    px[1] = cy - scale * c[1];
+  }
+}
+
+bool Projector::project(const double p[3], double px[2], double* depth) const {
+  double c[3];
+  to_camera(p, c);
+  if (depth != nullptr) *depth = c[2];
+  if (perspective && !(c[2] > 0)) return false;
+  camera_to_pixel(c, px);
+  return true;
+}
+
+View view_of(const Camera& camera) {
+  if (camera.perspective) return View::at(camera.eye[0], camera.eye[1], camera.eye[2]);
+  return View::along(camera.at[0] - camera.eye[0], camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2]);
+}
+
+}  // namespace foxi
