@@ -18,6 +18,7 @@ const char* kUsage =
     "  info MESH      counts, bounding box, regions, boundaries, fields, volume, tet quality,\n"
     "                 validation; --json for machine-readable output; --check-delaunay\n"
     "  convert IN OUT convert between mesh formats (format from the extension)\n"
+    "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png\n"
     "\n"
     "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"
     "              .node/.ele/.face (TetGen), .mesh (Medit)\n"
@@ -42,6 +43,7 @@ int main(int argc, char** argv) {
     if (command == "info") return foxi::cli::cmd_info(std::move(rest));
     if (command == "convert") return foxi::cli::cmd_convert(std::move(rest));
     if (command == "order") return foxi::cli::cmd_order(std::move(rest));
+    if (command == "render") return foxi::cli::cmd_render(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const foxi::cli::UsageError& e) {

@@ -65,8 +65,8 @@ void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]) {
   }
 }
 
-Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3], bool perspective,
-                  double fov_deg, double aspect, double fill) {
+Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
+                  bool perspective, double fov_deg, double aspect, double fill) {
   Camera cam;
   cam.perspective = perspective;
   cam.fov_deg = fov_deg;
@@ -96,18 +96,29 @@ Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], c
     cam.at[k] = centre[k];
     cam.up[k] = u[k];
   }
-  // The smaller half-angle of the view (vertical, or horizontal when the image is taller than wide).
-  double half_v = 0.5 * fov_deg * kPi / 180;
-  double half = aspect >= 1 ? half_v : std::atan(std::tan(half_v) * aspect);
-  double dist;
+  // Fit the 8 corners of the box (camera frame relative to the centre): each needs the eye far
+  // enough that it projects inside `fill` of the half-width and half-height.
+  double rr[3], uu[3];
+  cross(d, u, rr);
+  normalize(rr);
+  cross(rr, d, uu);
+  const double half_v = 0.5 * fov_deg * kPi / 180;
+  double dist = 0, need_h = 0;
+  if (perspective && !(fov_deg > 0 && fov_deg < 180))
+    throw std::invalid_argument("fit_camera: fov must be in (0, 180) degrees");
+  const double tan_v = std::tan(half_v) * fill, tan_h = std::tan(half_v) * aspect * fill;
+  for (int corner = 0; corner < 8; ++corner) {
+    double p[3];
+    for (int k = 0; k < 3; ++k) p[k] = ((corner >> k) & 1 ? hi[k] : lo[k]) - centre[k];
+    const double x = std::abs(dot(p, rr)), y = std::abs(dot(p, uu)), z = dot(p, d);
+    if (perspective) dist = std::max({dist, x / tan_h - z, y / tan_v - z});
+    need_h = std::max({need_h, 2 * y / fill, 2 * x / (aspect * fill)});
+  }
   if (perspective) {
-    if (!(fov_deg > 0 && fov_deg < 180)) throw std::invalid_argument("fit_camera: fov must be in (0, 180) degrees");
-    // The sphere seen under the angle asin(R / dist) equals fill * half.
-    dist = radius / std::sin(fill * half);
+    dist = std::max(dist, 1.05 * radius);  // the eye stays outside the bounding sphere
   } else {
     dist = 2 * radius;
-    double h = 2 * radius / fill;                      // the smaller image dimension shows h
-    cam.ortho_height = aspect >= 1 ? h : h / aspect;   // height = width / aspect
+    cam.ortho_height = need_h > 0 ? need_h : 2 * radius;
   }
   for (int k = 0; k < 3; ++k) cam.eye[k] = centre[k] - dist * d[k];
   return cam;
@@ -162,7 +173,8 @@ Camera zoom(const Camera& camera, double factor) {
   return c;
 }
 
-Projector::Projector(const Camera& camera, int w, int h) : perspective(camera.perspective), width(w), height(h) {
+Projector::Projector(const Camera& camera, int w, int h)
+    : perspective(camera.perspective), width(w), height(h) {
   if (w < 1 || h < 1) throw std::invalid_argument("camera: image size must be at least 1x1");
   if (!basis(camera, right, up, forward))
     throw std::invalid_argument("camera: degenerate (eye equals at, or up parallel to the view direction)");
@@ -171,7 +183,8 @@ Projector::Projector(const Camera& camera, int w, int h) : perspective(camera.pe
   cy = 0.5 * h;
   if (perspective) {
     if (!(camera.fov_deg > 0 && camera.fov_deg < 180))
-      throw std::invalid_argument("camera: fov must be in (0, 180) degrees, not " + std::to_string(camera.fov_deg));
+      throw std::invalid_argument("camera: fov must be in (0, 180) degrees, not " +
+                                  std::to_string(camera.fov_deg));
     focal = 0.5 * h / std::tan(0.5 * camera.fov_deg * kPi / 180);
   } else {
     if (!(camera.ortho_height > 0) || !std::isfinite(camera.ortho_height))
@@ -208,7 +221,8 @@ bool Projector::project(const double p[3], double px[2], double* depth) const {
 
 View view_of(const Camera& camera) {
   if (camera.perspective) return View::at(camera.eye[0], camera.eye[1], camera.eye[2]);
-  return View::along(camera.at[0] - camera.eye[0], camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2]);
+  return View::along(camera.at[0] - camera.eye[0], camera.at[1] - camera.eye[1],
+                     camera.at[2] - camera.eye[2]);
 }
 
 }  // namespace foxi

@@ -14,20 +14,21 @@ namespace foxi {
 
 struct Camera {
   bool perspective = true;
-  double eye[3] = {0, -1, 0};   // world point; orthographic: only eye - at matters (the direction)
-  double at[3] = {0, 0, 0};     // the point looked at (centre of the image)
-  double up[3] = {0, 0, 1};     // view-up; need not be orthogonal to at - eye, must not be parallel
-  double fov_deg = 30;          // perspective: vertical field of view in degrees, in (0, 180)
-  double ortho_height = 1;      // orthographic: world height shown by the image (> 0)
+  double eye[3] = {0, -1, 0};  // world point; orthographic: only eye - at matters (the direction)
+  double at[3] = {0, 0, 0};    // the point looked at (centre of the image)
+  double up[3] = {0, 0, 1};    // view-up; need not be orthogonal to at - eye, must not be parallel
+  double fov_deg = 30;         // perspective: vertical field of view in degrees, in (0, 180)
+  double ortho_height = 1;     // orthographic: world height shown by the image (> 0)
 };
 
 // Axis-aligned bounds of the nodes used by tets (all nodes if there are no tets). lo > hi if none.
 void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
 
 // A camera looking along `dir` (from the eye into the scene) at the centre of the box [lo, hi], far
-// enough that the box's bounding sphere fills `fill` (0..1] of the smaller image dimension, for an
-// image of width/height `aspect`. Perspective with vertical field of view `fov_deg`, or orthographic.
-// `up` is used as given when not parallel to dir, else another axis is chosen.
+// enough that the box's 8 corners project within `fill` (0..1] of the half-width and half-height of
+// an image of width/height `aspect` (and, perspective, the eye outside the box's bounding sphere).
+// Perspective with vertical field of view `fov_deg`, or orthographic. `up` is used as given when not parallel
+// to dir, else another axis is chosen.
 Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
                   bool perspective = true, double fov_deg = 30, double aspect = 1, double fill = 0.95);
 
@@ -47,9 +48,9 @@ struct Projector {
   double eye[3] = {0, 0, 0};
   double right[3] = {1, 0, 0}, up[3] = {0, 1, 0}, forward[3] = {0, 0, 1};  // orthonormal
   int width = 1, height = 1;
-  double cx = 0.5, cy = 0.5;   // pixel coordinates of the image centre (width/2, height/2)
-  double focal = 1;            // perspective: pixels per unit of x/z (height / 2 / tan(fov / 2))
-  double scale = 1;            // orthographic: pixels per world unit (height / ortho_height)
+  double cx = 0.5, cy = 0.5;  // pixel coordinates of the image centre (width/2, height/2)
+  double focal = 1;           // perspective: pixels per unit of x/z (height / 2 / tan(fov / 2))
+  double scale = 1;           // orthographic: pixels per world unit (height / ortho_height)
 
   Projector(const Camera& camera, int width, int height);
   // World point -> camera coordinates (x right, y up, z depth along forward from the eye).

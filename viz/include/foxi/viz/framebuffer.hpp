@@ -19,9 +19,9 @@ constexpr std::uint32_t pack_rgba(std::uint32_t r, std::uint32_t g, std::uint32_
 
 struct Framebuffer {
   int width = 0, height = 0;
-  std::vector<std::uint32_t> rgba;   // width * height, row-major, row 0 at the top
-  std::vector<std::uint32_t> id;     // width * height: tet index, or kNone for background
-  std::vector<float> depth;          // width * height in depth-buffer mode, else empty; larger = nearer
+  std::vector<std::uint32_t> rgba;  // width * height, row-major, row 0 at the top
+  std::vector<std::uint32_t> id;    // width * height: tet index, or kNone for background
+  std::vector<float> depth;         // width * height in depth-buffer mode, else empty; larger = nearer
 
   Framebuffer() = default;
   // A cleared framebuffer; with_depth allocates the depth buffer.
@@ -33,8 +33,10 @@ struct Framebuffer {
     height = h;
     rgba.assign(std::size_t(w) * std::size_t(h), background);
     id.assign(std::size_t(w) * std::size_t(h), kNone);
-    if (with_depth) depth.assign(std::size_t(w) * std::size_t(h), -std::numeric_limits<float>::infinity());
-    else depth.clear();
+    if (with_depth)
+      depth.assign(std::size_t(w) * std::size_t(h), -std::numeric_limits<float>::infinity());
+    else
+      depth.clear();
   }
   // Background colour everywhere, no tet, depth at infinity.
   void clear(std::uint32_t background = pack_rgba(255, 255, 255)) {

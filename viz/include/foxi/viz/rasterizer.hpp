@@ -26,23 +26,23 @@
 namespace foxi {
 
 struct RenderParams {
-  bool depth_buffer = false;     // depth-buffer mode (the framebuffer must have a depth buffer)
-  double shrink = 1;             // each tet scaled about its centroid by this factor, in (0, 1]
-  bool edges = true;             // darken pixels within edge_width of a face's edges
-  double edge_width = 1.0;       // pixels
-  double edge_darkness = 0.65;   // 0 = invisible edges, 1 = black at the edge
-  double ambient = 0.3;          // Lambert: ambient + (1 - ambient) max(0, n . light)
-  double near = 0;               // perspective near-plane distance (world); 0 = automatic (tiny)
-  int threads = 2;               // threads drawing interleaved bands of rows (1 or more)
+  bool depth_buffer = false;    // depth-buffer mode (the framebuffer must have a depth buffer)
+  double shrink = 1;            // each tet scaled about its centroid by this factor, in (0, 1]
+  bool edges = true;            // darken pixels within edge_width of a face's edges
+  double edge_width = 1.0;      // pixels
+  double edge_darkness = 0.65;  // 0 = invisible edges, 1 = black at the edge
+  double ambient = 0.3;         // Lambert: ambient + (1 - ambient) max(0, n . light)
+  double near = 0;              // perspective near-plane distance (world); 0 = automatic (tiny)
+  int threads = 2;              // threads drawing interleaved bands of rows (1 or more)
 };
 
 // The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).
 std::uint32_t region_color(std::int32_t id);
 
 struct RasterStats {
-  std::size_t tets_drawn = 0;       // tets handed to draw() (skipped ones included)
-  std::size_t tets_behind = 0;      // tets entirely behind the near plane
-  std::size_t faces_clipped = 0;    // front faces cut by the near plane
+  std::size_t tets_drawn = 0;     // tets handed to draw() (skipped ones included)
+  std::size_t tets_behind = 0;    // tets entirely behind the near plane
+  std::size_t faces_clipped = 0;  // front faces cut by the near plane
 };
 
 // Per-frame state: the camera's projection of the mesh for one image size. The mesh is lent and must
@@ -50,7 +50,8 @@ struct RasterStats {
 // orthographic camera zoomed in so far that coordinates leave the fixed-point range.
 class TetRasterizer {
  public:
-  TetRasterizer(const Mesh& mesh, const Camera& camera, int width, int height, const RenderParams& params = {});
+  TetRasterizer(const Mesh& mesh, const Camera& camera, int width, int height,
+                const RenderParams& params = {});
   ~TetRasterizer();
   TetRasterizer(TetRasterizer&&) noexcept;
   TetRasterizer& operator=(TetRasterizer&&) noexcept;
@@ -61,7 +62,7 @@ class TetRasterizer {
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
   const RasterStats& stats() const;
   const Projector& projector() const;
-  double near_plane() const;   // the near-plane distance in use (perspective)
+  double near_plane() const;  // the near-plane distance in use (perspective)
 
  private:
   struct Impl;
@@ -75,6 +76,7 @@ Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int h
 // The pixels covered by one triangle under the rasterizer's fill rule (for tests): vertices in
 // fixed point (pixel coordinate * 256, rounded), either winding; returns y * width + x of every
 // covered pixel of the width x height image, in row order. A zero-area triangle covers nothing.
-std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3], int width, int height);
+std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3], int width,
+                                             int height);
 
 }  // namespace foxi

@@ -1,0 +1,497 @@
+// The painter's rasterizer (see rasterizer.hpp). Face setup works in camera coordinates (x right,
+// y up, z depth; a left-handed frame, so cross products there are the mirror of world ones), pixels
+// in fixed point with 8 subpixel bits and 64-bit edge functions.
+#include "foxi/viz/rasterizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+
+namespace foxi {
+
+namespace {
+
+constexpr std::int64_t kOne = 256;       // 8 subpixel bits
+constexpr std::int64_t kHalf = 128;      // pixel centre offset
+constexpr int kBandShift = 4;            // bands of 16 rows, interleaved between threads
+constexpr double kMaxPixel = 1048576.0;  // |pixel coordinate - centre| bound (2^20): 64-bit safe
+
+// Local vertex triples of the 4 faces of a positively oriented tet, ordered so that (b - a) x (c - a)
+// points out of the tet (world frame); face f is opposite vertex f.
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
+  std::int64_t q = a / b;
+  return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+std::int64_t to_fixed(double p) {
+  return static_cast<std::int64_t>(
+      std::llround(std::clamp(p, -4.0 * kMaxPixel, 4.0 * kMaxPixel) * double(kOne)));
+}
+
+// Which rows a thread owns: bands of 16 rows, band b belongs to thread b % count.
+struct Rows {
+  int thread = 0, count = 1;
+  bool owns(int y) const { return count == 1 || ((y >> kBandShift) % count) == thread; }
+  // True if some row in [y0, y1] is owned.
+  bool any(int y0, int y1) const {
+    if (count == 1) return y0 <= y1;
+    if (y0 > y1) return false;
+    int b0 = y0 >> kBandShift, b1 = y1 >> kBandShift;
+    if (b1 - b0 + 1 >= count) return true;
+    for (int b = b0; b <= b1; ++b)
+      if (b % count == thread) return true;
+    return false;
+  }
+};
+
+// Calls fn(x, y) for every pixel whose centre the triangle covers under the top-left rule; the
+// triangle must have positive area: (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) > 0 (clockwise on the
+// screen, y down). Only rows owned by `rows` are visited.
+template <class Fn>
+void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, int height, const Rows& rows,
+                     Fn&& fn) {
+  std::int64_t minx = std::min({X[0], X[1], X[2]}), maxx = std::max({X[0], X[1], X[2]});
+  std::int64_t miny = std::min({Y[0], Y[1], Y[2]}), maxy = std::max({Y[0], Y[1], Y[2]});
+  std::int64_t x0 = std::max<std::int64_t>(0, -floor_div(-(minx - kHalf), kOne));
+  std::int64_t x1 = std::min<std::int64_t>(width - 1, floor_div(maxx - kHalf, kOne));
+  std::int64_t y0 = std::max<std::int64_t>(0, -floor_div(-(miny - kHalf), kOne));
+  std::int64_t y1 = std::min<std::int64_t>(height - 1, floor_div(maxy - kHalf, kOne));
+  if (x0 > x1 || y0 > y1) return;
+  if (!rows.any(int(y0), int(y1))) return;
+  // Edge i goes from vertex i to vertex i+1; E_i(p) = (bx - ax)(py - ay) - (by - ay)(px - ax) >= 0
+  // inside. Top-left edges (dy < 0, or dy == 0 and dx > 0) own their boundary pixels (E == 0);
+  // the others do not (bias -1). A shared edge runs the other way in the neighbour, so exactly one
+  // of the two owns it.
+  std::int64_t dx[3], dy[3], bias[3];
+  for (int i = 0; i < 3; ++i) {
+    int j = i == 2 ? 0 : i + 1;
+    dx[i] = X[j] - X[i];
+    dy[i] = Y[j] - Y[i];
+    bias[i] = (dy[i] < 0 || (dy[i] == 0 && dx[i] > 0)) ? 0 : -1;
+  }
+  const std::int64_t px0 = x0 * kOne + kHalf;
+  for (std::int64_t y = y0; y <= y1; ++y) {
+    if (!rows.owns(int(y))) {
+      y = (((y >> kBandShift) + 1) << kBandShift) - 1;  // skip to the end of this band
+      continue;
+    }
+    const std::int64_t py = y * kOne + kHalf;
+    std::int64_t e[3], step[3];
+    for (int i = 0; i < 3; ++i) {
+      e[i] = dx[i] * (py - Y[i]) - dy[i] * (px0 - X[i]) + bias[i];
+      step[i] = -dy[i] * kOne;
+    }
+    for (std::int64_t x = x0; x <= x1; ++x) {
+      if ((e[0] | e[1] | e[2]) >= 0) fn(int(x), int(y));
+      e[0] += step[0];
+      e[1] += step[1];
+      e[2] += step[2];
+    }
+  }
+}
+
+struct PolyVertex {
+  double c[3] = {0, 0, 0};  // camera coordinates (near-plane cuts only)
+  std::int64_t X = 0, Y = 0;
+  bool mesh_edge = true;  // the edge from this vertex to the next is (part of) a mesh edge
+};
+
+// Everything a face's pixels need.
+struct FaceSetup {
+  std::uint32_t tet = 0;
+  std::uint32_t color = 0;
+  float r = 0, g = 0, b = 0;
+  int lines = 0;
+  double la[4], lb[4], lc[4];     // distance to mesh edge k in pixels = la x + lb y + lc (inside > 0)
+  double da = 0, db = 0, dc = 0;  // depth mode: nearness = da x + db y + dc
+};
+
+constexpr std::uint32_t kPalette[] = {
+    pack_rgba(78, 121, 167),  pack_rgba(242, 142, 43),  pack_rgba(89, 161, 79),   pack_rgba(225, 87, 89),
+    pack_rgba(118, 183, 178), pack_rgba(237, 201, 72),  pack_rgba(176, 122, 161), pack_rgba(255, 157, 167),
+    pack_rgba(156, 117, 95),  pack_rgba(186, 176, 172), pack_rgba(134, 188, 230), pack_rgba(160, 203, 109),
+};
+
+}  // namespace
+
+std::uint32_t region_color(std::int32_t id) {
+  constexpr std::int64_t n = sizeof kPalette / sizeof kPalette[0];
+  return kPalette[((std::int64_t(id) % n) + n) % n];
+}
+
+struct TetRasterizer::Impl {
+  const Mesh* mesh = nullptr;
+  Projector proj;
+  RenderParams params;
+  double near = 0;
+  double light[3] = {0, 0, -1};  // toward the light, camera frame
+  // Per node: camera coordinates, fixed-point pixel coordinates, state (0 in front, 1 behind the
+  // near plane, 2 not finite).
+  std::vector<double> cam;
+  std::vector<std::int64_t> fx, fy;
+  std::vector<std::uint8_t> state;
+  RasterStats stats;
+
+  Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
+      : mesh(&m), proj(c, w, h), params(p) {
+    if (!(params.shrink > 0 && params.shrink <= 1))
+      throw std::invalid_argument("render: shrink must be in (0, 1]");
+    if (params.threads < 1) params.threads = 1;
+    if (params.threads > 64) params.threads = 64;
+    if (!(params.edge_width > 0)) params.edges = false;
+    double l[3] = {-0.3, 0.45, -1};
+    double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+    for (int k = 0; k < 3; ++k) light[k] = l[k] / ln;
+    // Farthest distance from the eye to the mesh's bounding box bounds |x|, |y| of every point.
+    double lo[3], hi[3];
+    mesh_bounds(m, lo, hi);
+    double dmax = 0;
+    if (lo[0] <= hi[0]) {
+      for (int corner = 0; corner < 8; ++corner) {
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+          double v = ((corner >> k) & 1 ? hi[k] : lo[k]) - proj.eye[k];
+          d2 += v * v;
+        }
+        dmax = std::max(dmax, std::sqrt(d2));
+      }
+    }
+    if (!std::isfinite(dmax)) dmax = 0;
+    if (proj.perspective) {
+      // Points at depth >= near project within kMaxPixel of the centre.
+      near = std::max(params.near, dmax * proj.focal / kMaxPixel);
+      if (!(near > 0)) near = 1e-300;
+    } else if (dmax * proj.scale > kMaxPixel) {
+      throw std::invalid_argument("render: orthographic zoom too large for the fixed-point range (" +
+                                  std::to_string(dmax * proj.scale) + " pixels)");
+    }
+    const std::size_t n = m.node_count();
+    for (std::uint32_t nd : m.tet)
+      if (nd >= n) throw std::out_of_range("render: a tet refers to a missing node");
+    cam.resize(3 * n);
+    fx.resize(n);
+    fy.resize(n);
+    state.resize(n);
+    auto work = [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        project_node(&m.xyz[3 * i], &cam[3 * i], fx[i], fy[i], state[i]);
+    };
+    if (n > 20000 && params.threads > 1) {
+      std::thread t(work, n / 2, n);
+      work(0, n / 2);
+      t.join();
+    } else {
+      work(0, n);
+    }
+  }
+
+  void project_camera(const double* c, std::int64_t& X, std::int64_t& Y, std::uint8_t& st) const {
+    if (!(std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]))) {
+      st = 2;
+      return;
+    }
+    if (proj.perspective && !(c[2] >= near)) {
+      st = 1;
+      return;
+    }
+    double px[2];
+    proj.camera_to_pixel(c, px);
+    X = to_fixed(px[0]);
+    Y = to_fixed(px[1]);
+    st = 0;
+  }
+
+  void project_node(const double* p, double* c, std::int64_t& X, std::int64_t& Y, std::uint8_t& st) const {
+    proj.to_camera(p, c);
+    project_camera(c, X, Y, st);
+  }
+
+  // Shading, edge lines and depth plane of a face; `v` = the face's three corners (camera frame)
+  // in outward order; poly = the polygon to draw (positive area), n its size.
+  void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const PolyVertex* poly,
+                  int n) const {
+    fs.tet = tet;
+    double u[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
+    double w[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
+    double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    double len = std::sqrt(nc[0] * nc[0] + nc[1] * nc[1] + nc[2] * nc[2]);
+    // The camera frame is a mirror of the world: the outward normal is -nc there.
+    double lambert = len > 0 ? -(nc[0] * light[0] + nc[1] * light[1] + nc[2] * light[2]) / len : 0;
+    double intensity = params.ambient + (1 - params.ambient) * std::max(0.0, lambert);
+    intensity = std::clamp(intensity, 0.0, 1.0);
+    std::uint32_t base = region_color(mesh->region_of(tet));
+    fs.r = float((base & 255u) * intensity);
+    fs.g = float(((base >> 8) & 255u) * intensity);
+    fs.b = float(((base >> 16) & 255u) * intensity);
+    fs.color = pack_rgba(std::uint32_t(fs.r + 0.5f), std::uint32_t(fs.g + 0.5f), std::uint32_t(fs.b + 0.5f));
+    fs.lines = 0;
+    if (params.edges) {
+      for (int i = 0; i < n; ++i) {
+        if (!poly[i].mesh_edge) continue;
+        const PolyVertex& a = poly[i];
+        const PolyVertex& b = poly[i + 1 == n ? 0 : i + 1];
+        double ex = double(b.X - a.X), ey = double(b.Y - a.Y), el = std::sqrt(ex * ex + ey * ey);
+        if (!(el > 0)) continue;
+        fs.la[fs.lines] = -ey / el;
+        fs.lb[fs.lines] = ex / el;
+        fs.lc[fs.lines] = (-ex * double(a.Y) + ey * double(a.X)) / (double(kOne) * el);
+        ++fs.lines;
+      }
+    }
+    if (params.depth_buffer) {
+      double k = nc[0] * v[0][0] + nc[1] * v[0][1] + nc[2] * v[0][2];
+      if (proj.perspective) {
+        double f = proj.focal;
+        if (k == 0) k = 1e-300;
+        fs.da = nc[0] / (f * k);
+        fs.db = -nc[1] / (f * k);
+        fs.dc = (nc[2] - nc[0] * proj.cx / f + nc[1] * proj.cy / f) / k;
+      } else {
+        double s = proj.scale, nz = nc[2] == 0 ? 1e-300 : nc[2];
+        fs.da = nc[0] / (s * nz);
+        fs.db = -nc[1] / (s * nz);
+        fs.dc = (-nc[0] * proj.cx / s + nc[1] * proj.cy / s - k) / nz;
+      }
+    }
+  }
+
+  void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
+    const std::size_t p = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
+    const double sx = x + 0.5, sy = y + 0.5;
+    if (params.depth_buffer) {
+      float z = float(fs.da * sx + fs.db * sy + fs.dc);
+      if (!(z > fb.depth[p])) return;
+      fb.depth[p] = z;
+    }
+    std::uint32_t col = fs.color;
+    if (fs.lines > 0) {
+      double d = 1e300;
+      for (int k = 0; k < fs.lines; ++k) d = std::min(d, fs.la[k] * sx + fs.lb[k] * sy + fs.lc[k]);
+      if (d < params.edge_width) {
+        float f = float(1 - params.edge_darkness * (1 - std::max(0.0, d) / params.edge_width));
+        col = pack_rgba(std::uint32_t(fs.r * f + 0.5f), std::uint32_t(fs.g * f + 0.5f),
+                        std::uint32_t(fs.b * f + 0.5f));
+      }
+    }
+    fb.rgba[p] = col;
+    fb.id[p] = fs.tet;
+  }
+
+  // Draws a convex polygon (positive area) as a fan from vertex 0.
+  void raster_polygon(Framebuffer& fb, const Rows& rows, const FaceSetup& fs, const PolyVertex* poly,
+                      int n) const {
+    for (int i = 1; i + 1 < n; ++i) {
+      std::int64_t X[3] = {poly[0].X, poly[i].X, poly[i + 1].X}, Y[3] = {poly[0].Y, poly[i].Y, poly[i + 1].Y};
+      std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+      if (area <= 0) continue;
+      raster_triangle(X, Y, fb.width, fb.height, rows, [&](int x, int y) { shade_pixel(fb, fs, x, y); });
+    }
+  }
+
+  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
+    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+    const double* c[4];
+    double local[12];
+    std::int64_t X[4], Y[4];
+    std::uint8_t st[4];
+    if (params.shrink == 1) {
+      for (int k = 0; k < 4; ++k) {
+        std::uint32_t n = tv[k];
+        c[k] = &cam[3 * std::size_t(n)];
+        X[k] = fx[n];
+        Y[k] = fy[n];
+        st[k] = state[n];
+      }
+    } else {
+      double centre[3] = {0, 0, 0};
+      for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 3; ++j) centre[j] += 0.25 * cam[3 * std::size_t(tv[k]) + j];
+      for (int k = 0; k < 4; ++k) {
+        const double* p = &cam[3 * std::size_t(tv[k])];
+        for (int j = 0; j < 3; ++j) local[3 * k + j] = centre[j] + params.shrink * (p[j] - centre[j]);
+        c[k] = &local[3 * k];
+        project_camera(c[k], X[k], Y[k], st[k]);
+      }
+    }
+    if (st[0] == 2 || st[1] == 2 || st[2] == 2 || st[3] == 2) return;
+    const int behind = int(st[0]) + st[1] + st[2] + st[3];
+    if (behind == 4) {
+      if (count) ++stats.tets_behind;
+      return;
+    }
+    if (behind == 0) {
+      // Quick reject: the tet's pixel rows are not this thread's, or it is off screen.
+      std::int64_t miny = std::min({Y[0], Y[1], Y[2], Y[3]}), maxy = std::max({Y[0], Y[1], Y[2], Y[3]});
+      std::int64_t y0 = std::max<std::int64_t>(0, -floor_div(-(miny - kHalf), kOne));
+      std::int64_t y1 = std::min<std::int64_t>(fb.height - 1, floor_div(maxy - kHalf, kOne));
+      if (!rows.any(int(y0), int(y1))) return;
+    }
+    PolyVertex poly[4];
+    FaceSetup fs;
+    for (const auto& face : kFace) {
+      const int a = face[0], b = face[1], d = face[2];
+      if (st[a] + st[b] + st[d] == 0) {
+        // Front iff the projected outward-ordered triangle has negative area (screen y is down and
+        // the camera frame mirrors the world). The neighbour sharing this face computes the same
+        // area with the opposite sign, so exactly one of the two draws it.
+        std::int64_t area = (X[b] - X[a]) * (Y[d] - Y[a]) - (Y[b] - Y[a]) * (X[d] - X[a]);
+        if (area >= 0) continue;
+        const int order[3] = {a, d, b};  // reversed: positive area
+        for (int i = 0; i < 3; ++i) {
+          poly[i].X = X[order[i]];
+          poly[i].Y = Y[order[i]];
+          poly[i].mesh_edge = true;
+        }
+        const double* v[3] = {c[a], c[b], c[d]};
+        setup_face(fs, t, v, poly, 3);
+        raster_polygon(fb, rows, fs, poly, 3);
+        continue;
+      }
+      if (st[a] + st[b] + st[d] == 3) continue;  // entirely behind the near plane
+      // Cut by the near plane. Canonical order (ascending node id) so that both tets sharing the
+      // face compute bit-identical polygons; facing from the exact same double expression.
+      int s[3] = {a, b, d};
+      bool odd = false;
+      auto swap_if = [&](int i, int j) {
+        if (tv[s[i]] > tv[s[j]]) {
+          std::swap(s[i], s[j]);
+          odd = !odd;
+        }
+      };
+      swap_if(0, 1);
+      swap_if(1, 2);
+      swap_if(0, 1);
+      const double *p0 = c[s[0]], *p1 = c[s[1]], *p2 = c[s[2]];
+      double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+      double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+      double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      // World: front iff n_out . (eye - p0) > 0; in the mirrored camera frame n_out = -nc_out and
+      // eye - p0 = -p0, so front iff nc_out . p0 > 0, and nc_out = +-nc by the permutation parity.
+      double side = nc[0] * p0[0] + nc[1] * p0[1] + nc[2] * p0[2];
+      if (odd) side = -side;
+      if (!(side > 0)) continue;
+      if (count) ++stats.faces_clipped;
+      // Sutherland-Hodgman against z >= near; intersections computed from the lower node id.
+      int n = 0;
+      for (int i = 0; i < 3; ++i) {
+        const int pi = s[i], qi = s[i == 2 ? 0 : i + 1];
+        const bool pin = st[pi] == 0, qin = st[qi] == 0;
+        auto cut = [&](PolyVertex& out) {
+          int lo = pi, hi = qi;
+          if (tv[lo] > tv[hi]) std::swap(lo, hi);
+          const double* P = c[lo];
+          const double* Q = c[hi];
+          double tt = (near - P[2]) / (Q[2] - P[2]);
+          out.c[0] = P[0] + tt * (Q[0] - P[0]);
+          out.c[1] = P[1] + tt * (Q[1] - P[1]);
+          out.c[2] = near;
+          std::uint8_t dummy;
+          project_camera(out.c, out.X, out.Y, dummy);
+        };
+        if (pin) {
+          poly[n].X = X[pi];
+          poly[n].Y = Y[pi];
+          poly[n].mesh_edge = true;
+          ++n;
+          if (!qin) {
+            cut(poly[n]);
+            poly[n].mesh_edge = false;
+            ++n;
+          }
+        } else if (qin) {
+          cut(poly[n]);
+          poly[n].mesh_edge = true;
+          ++n;
+        }
+      }
+      std::int64_t area2 = 0;
+      for (int i = 0; i < n; ++i) {
+        const PolyVertex& p = poly[i];
+        const PolyVertex& q = poly[i + 1 == n ? 0 : i + 1];
+        area2 += p.X * q.Y - q.X * p.Y;
+      }
+      if (area2 == 0) continue;
+      if (area2 < 0) {
+        // Reverse; the edge leaving vertex i+1 in the new order is the old edge i -> i+1.
+        PolyVertex r[4];
+        for (int i = 0; i < n; ++i) {
+          r[i] = poly[n - 1 - i];
+          r[i].mesh_edge = poly[(2 * n - 2 - i) % n].mesh_edge;
+        }
+        std::copy(r, r + n, poly);
+      }
+      const double* v[3] = {c[a], c[b], c[d]};
+      setup_face(fs, t, v, poly, n);
+      raster_polygon(fb, rows, fs, poly, n);
+    }
+  }
+
+  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+    if (fb.width != proj.width || fb.height != proj.height)
+      throw std::invalid_argument("render: framebuffer size differs from the rasterizer's");
+    if (fb.rgba.size() != std::size_t(fb.width) * fb.height || fb.id.size() != fb.rgba.size())
+      throw std::invalid_argument("render: framebuffer buffers have the wrong size");
+    if (params.depth_buffer && fb.depth.size() != fb.rgba.size())
+      throw std::invalid_argument("render: depth-buffer mode needs a framebuffer with a depth buffer");
+    const std::size_t tc = mesh->tet_count();
+    for (std::uint32_t t : tets)
+      if (t >= tc) throw std::out_of_range("render: tet index " + std::to_string(t) + " out of range");
+    stats.tets_drawn += tets.size();
+    const int count = std::min(params.threads, std::max(1, fb.height >> kBandShift));
+    auto work = [&](int k) {
+      Rows rows{k, count};
+      for (std::uint32_t t : tets) draw_tet(fb, rows, t, k == 0);
+    };
+    if (count == 1) {
+      work(0);
+      return;
+    }
+    std::vector<std::thread> pool;
+    for (int k = 1; k < count; ++k) pool.emplace_back(work, k);
+    work(0);
+    for (auto& th : pool) th.join();
+  }
+};
+
+TetRasterizer::TetRasterizer(const Mesh& mesh, const Camera& camera, int width, int height,
+                             const RenderParams& params)
+    : impl_(std::make_unique<Impl>(mesh, camera, width, height, params)) {}
+TetRasterizer::~TetRasterizer() = default;
+TetRasterizer::TetRasterizer(TetRasterizer&&) noexcept = default;
+TetRasterizer& TetRasterizer::operator=(TetRasterizer&&) noexcept = default;
+
+void TetRasterizer::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) { impl_->draw(fb, tets); }
+const RasterStats& TetRasterizer::stats() const { return impl_->stats; }
+const Projector& TetRasterizer::projector() const { return impl_->proj; }
+double TetRasterizer::near_plane() const { return impl_->near; }
+
+Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
+                        std::span<const std::uint32_t> tets, const RenderParams& params) {
+  Framebuffer fb(width, height, params.depth_buffer);
+  TetRasterizer r(mesh, camera, width, height, params);
+  r.draw(fb, tets);
+  return fb;
+}
+
+std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3], int width,
+                                             int height) {
+  std::int64_t X[3] = {x[0], x[1], x[2]}, Y[3] = {y[0], y[1], y[2]};
+  std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+  std::vector<std::uint32_t> out;
+  if (area == 0) return out;
+  if (area < 0) {
+    std::swap(X[1], X[2]);
+    std::swap(Y[1], Y[2]);
+  }
+  raster_triangle(X, Y, width, height, Rows{}, [&](int px, int py) {
+    out.push_back(std::uint32_t(py) * std::uint32_t(width) + std::uint32_t(px));
+  });
+  return out;
+}
+
+}  // namespace foxi
