@@ -10,18 +10,17 @@ bash scripts/build.sh
 foxi=build/apps/foxi/foxi
 out=out/demo
 mkdir -p "$out"
-cp examples/die_on_substrate.poly "$out/"
-# -p PLC, -q1.414 radius-edge bound, -a max volume (m^3), -A region attributes, -O0 no flips or
-# smoothing (keeps the mesh Delaunay, see issue 6).
-tetgen -pq1.414a1e-11AO0 -Q "$out/die_on_substrate.poly"
+# TetGen through its library: radius-edge bound 1.414, tets of at most 1e-11 m^3, no flips or
+# smoothing (they break the Delaunay property; see issue 6), then the exact certificate.
+"$foxi" mesh examples/die_on_substrate.poly -o "$out/die_on_substrate.node" --max-volume 1e-11 --check-delaunay
 echo
-"$foxi" info --check-delaunay "$out/die_on_substrate.1.ele"
+"$foxi" info --check-delaunay "$out/die_on_substrate.node"
 echo
 # The visibility order (power of the eye w.r.t. each circumsphere) from 4 random views, verified.
-"$foxi" order "$out/die_on_substrate.1.ele" --views 4 --check
+"$foxi" order "$out/die_on_substrate.node" --views 4 --check
 echo
-"$foxi" convert "$out/die_on_substrate.1.ele" "$out/die_on_substrate.vtu"
-"$foxi" convert "$out/die_on_substrate.1.ele" "$out/die_on_substrate.msh"
+"$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.vtu"
+"$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.msh"
 "$foxi" info "$out/die_on_substrate.msh" --json > "$out/die_on_substrate.json"
 echo
 echo "demo: wrote $out/die_on_substrate.vtu (ParaView), $out/die_on_substrate.msh (Gmsh), $out/die_on_substrate.json"

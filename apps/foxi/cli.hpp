@@ -39,6 +39,7 @@ std::string json_number(double v);
 int cmd_info(Args args);
 int cmd_convert(Args args);
 int cmd_order(Args args);
+int cmd_mesh(Args args);
 int cmd_render(Args args);
 
 }  // namespace foxi::cli

@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
     if (command == "info") return foxi::cli::cmd_info(std::move(rest));
     if (command == "convert") return foxi::cli::cmd_convert(std::move(rest));
     if (command == "order") return foxi::cli::cmd_order(std::move(rest));
+    if (command == "mesh") return foxi::cli::cmd_mesh(std::move(rest));
     if (command == "render") return foxi::cli::cmd_render(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return 2;

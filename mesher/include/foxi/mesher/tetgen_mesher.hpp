@@ -1,0 +1,47 @@
+// Meshing a PLC with TetGen 1.5 through its library (tetgenio / tetrahedralize), into the common
+// mesh database: region seeds become tet regions, facet markers the boundary tags of the boundary
+// and interface triangles.
+//
+// Note (issue 6): TetGen's mesh optimisation (flips and smoothing, on by default in TetGen) breaks
+// the empty-sphere property, so `optimize` is off by default; even then TetGen does not promise a
+// Delaunay mesh at material interfaces. Check with delaunay_certificate() (foxi/model/delaunay.hpp).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/plc.hpp"
+
+namespace foxi {
+
+struct MeshParams {
+  double max_volume = 0;      // global maximum tet volume (m^3); 0: none
+  double radius_edge = 1.414; // radius-edge bound for quality refinement; 0: no quality refinement
+  double min_dihedral = 0;    // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
+  bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
+  bool regions = true;        // region seeds give tet regions (TetGen -A)
+};
+
+struct MeshReport {
+  std::string switches;           // the TetGen switches used
+  std::size_t input_points = 0;
+  std::size_t steiner_points = 0; // points TetGen added
+  double seconds = 0;
+};
+
+// A PLC TetGen rejects (self-intersecting facets, features below its tolerance, an internal error)
+// or a mesh it cannot finish; the message says which.
+class MesherError : public std::runtime_error {
+ public:
+  MesherError(int tetgen_code, const std::string& message)
+      : std::runtime_error(message), code_(tetgen_code) {}
+  int tetgen_code() const { return code_; }
+
+ private:
+  int code_;
+};
+
+Mesh mesh_plc(const Plc& plc, const MeshParams& params = {}, MeshReport* report = nullptr);
+
+}  // namespace foxi

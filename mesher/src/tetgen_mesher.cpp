@@ -1,0 +1,260 @@
+#include "foxi/mesher/tetgen_mesher.hpp"
+
+#define TETLIBRARY
+#include <tetgen.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+namespace foxi {
+
+namespace {
+
+std::string tetgen_message(int code) {
+  switch (code) {
+    case 1: return "TetGen ran out of memory";
+    case 2: return "TetGen met an internal error";
+    case 3: return "the PLC has self-intersecting facets";
+    case 4: return "the PLC has a feature smaller than TetGen's tolerance";
+    case 5: return "the PLC has two facets too close to each other";
+    case 10: return "TetGen rejected the input PLC";
+    default: return "TetGen failed with code " + std::to_string(code);
+  }
+}
+
+bool write_all(int fd, const void* data, std::size_t bytes) {
+  const char* p = static_cast<const char*>(data);
+  while (bytes > 0) {
+    ssize_t n = ::write(fd, p, bytes);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+// The mesh TetGen returns, as it crosses the pipe from the child process.
+struct Result {
+  std::int64_t status = 0;  // 0 = ok, else TetGen's error code
+  std::vector<double> points;
+  std::vector<int> tets, trifaces, trimarkers;
+  std::vector<double> attributes;  // one per tet (first attribute), or empty
+};
+
+// Runs TetGen in a child process: TetGen 1.5's library frees its memory twice when it stops on an
+// error (terminatetetgen() then the mesh destructor), which crashes the caller; in a child the crash
+// becomes an error message.
+Result run_isolated(tetgenio& in, char* switches) {
+  int fds[2];
+  if (::pipe(fds) != 0) throw MesherError(1, std::string("cannot create a pipe: ") + std::strerror(errno));
+  std::fflush(nullptr);
+  pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw MesherError(1, std::string("cannot start TetGen: ") + std::strerror(errno));
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    std::int64_t status = 0;
+    tetgenio out;
+    try {
+      tetrahedralize(switches, &in, &out);
+    } catch (int code) {
+      status = code == 0 ? 2 : code;
+    } catch (...) {
+      status = 1;
+    }
+    bool ok = write_all(fds[1], &status, sizeof status);
+    if (ok && status == 0) {
+      std::int64_t head[5] = {out.numberofpoints, out.numberoftetrahedra, out.numberofcorners,
+                              out.numberoftrifaces, out.numberoftetrahedronattributes};
+      ok = write_all(fds[1], head, sizeof head) &&
+           write_all(fds[1], out.pointlist, sizeof(double) * 3 * std::size_t(out.numberofpoints)) &&
+           write_all(fds[1], out.tetrahedronlist,
+                     sizeof(int) * std::size_t(out.numberofcorners) * std::size_t(out.numberoftetrahedra)) &&
+           write_all(fds[1], out.trifacelist, sizeof(int) * 3 * std::size_t(out.numberoftrifaces));
+      std::vector<int> markers(std::size_t(out.numberoftrifaces), 0);
+      if (out.trifacemarkerlist)
+        std::copy(out.trifacemarkerlist, out.trifacemarkerlist + out.numberoftrifaces, markers.begin());
+      std::vector<double> attr(std::size_t(out.numberoftetrahedra), 0.0);
+      if (out.numberoftetrahedronattributes > 0)
+        for (std::size_t t = 0; t < attr.size(); ++t)
+          attr[t] = out.tetrahedronattributelist[t * std::size_t(out.numberoftetrahedronattributes)];
+      ok = ok && write_all(fds[1], markers.data(), sizeof(int) * markers.size()) &&
+           write_all(fds[1], attr.data(), sizeof(double) * attr.size());
+    }
+    ::close(fds[1]);
+    ::_exit(ok ? 0 : 3);
+  }
+  ::close(fds[1]);
+  std::vector<char> buf;
+  char chunk[1 << 16];
+  for (;;) {
+    ssize_t n = ::read(fds[0], chunk, sizeof chunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    buf.insert(buf.end(), chunk, chunk + n);
+  }
+  ::close(fds[0]);
+  int wstatus = 0;
+  while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
+  }
+  Result r;
+  std::size_t at = 0;
+  auto take = [&](void* dst, std::size_t bytes) {
+    if (buf.size() - at < bytes) return false;
+    std::memcpy(dst, buf.data() + at, bytes);
+    at += bytes;
+    return true;
+  };
+  if (!take(&r.status, sizeof r.status)) {
+    if (WIFSIGNALED(wstatus))
+      throw MesherError(2, "TetGen crashed (signal " + std::to_string(WTERMSIG(wstatus)) + ") on this PLC");
+    throw MesherError(2, "TetGen stopped without a result");
+  }
+  if (r.status != 0) return r;
+  std::int64_t head[5];
+  if (!take(head, sizeof head) || head[2] != 4) throw MesherError(2, "TetGen returned an incomplete or unexpected mesh");
+  r.points.resize(3 * std::size_t(head[0]));
+  r.tets.resize(4 * std::size_t(head[1]));
+  r.trifaces.resize(3 * std::size_t(head[3]));
+  r.trimarkers.resize(std::size_t(head[3]));
+  r.attributes.resize(std::size_t(head[1]));
+  if (!take(r.points.data(), sizeof(double) * r.points.size()) || !take(r.tets.data(), sizeof(int) * r.tets.size()) ||
+      !take(r.trifaces.data(), sizeof(int) * r.trifaces.size()) ||
+      !take(r.trimarkers.data(), sizeof(int) * r.trimarkers.size()) ||
+      !take(r.attributes.data(), sizeof(double) * r.attributes.size()))
+    throw MesherError(2, "TetGen's result was cut short");
+  if (head[4] == 0) r.attributes.clear();
+  return r;
+}
+
+std::string format_number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.12g", v);
+  return buf;
+}
+
+}  // namespace
+
+Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (plc.point_count() < 4) throw MesherError(10, "a PLC needs at least 4 points");
+  if (plc.facet_count() < 4) throw MesherError(10, "a PLC needs at least 4 facets");
+  for (std::uint32_t v : plc.polygon_vertices)
+    if (v >= plc.point_count()) throw MesherError(10, "a facet names point " + std::to_string(v) + " of " + std::to_string(plc.point_count()));
+
+  // tetgenio owns its arrays and frees them with delete[]: fill it with new[] allocations.
+  tetgenio in;
+  in.firstnumber = 0;
+  in.numberofpoints = static_cast<int>(plc.point_count());
+  in.pointlist = new REAL[plc.points.size()];
+  std::copy(plc.points.begin(), plc.points.end(), in.pointlist);
+  in.numberoffacets = static_cast<int>(plc.facet_count());
+  in.facetlist = new tetgenio::facet[plc.facet_count()];
+  in.facetmarkerlist = new int[plc.facet_count()];
+  for (std::size_t f = 0; f < plc.facet_count(); ++f) {
+    tetgenio::facet& fc = in.facetlist[f];
+    tetgenio::init(&fc);
+    const std::uint32_t p0 = plc.facet_polygon_begin[f], p1 = plc.facet_polygon_begin[f + 1];
+    fc.numberofpolygons = static_cast<int>(p1 - p0);
+    fc.polygonlist = new tetgenio::polygon[p1 - p0];
+    for (std::uint32_t p = p0; p < p1; ++p) {
+      tetgenio::polygon& pg = fc.polygonlist[p - p0];
+      tetgenio::init(&pg);
+      const std::uint32_t v0 = plc.polygon_vertex_begin[p], v1 = plc.polygon_vertex_begin[p + 1];
+      pg.numberofvertices = static_cast<int>(v1 - v0);
+      pg.vertexlist = new int[v1 - v0];
+      for (std::uint32_t v = v0; v < v1; ++v) pg.vertexlist[v - v0] = static_cast<int>(plc.polygon_vertices[v]);
+    }
+    const std::uint32_t h0 = plc.facet_hole_begin[f], h1 = plc.facet_hole_begin[f + 1];
+    if (h1 > h0) {
+      fc.numberofholes = static_cast<int>(h1 - h0);
+      fc.holelist = new REAL[3 * (h1 - h0)];
+      std::copy(plc.facet_holes.begin() + 3 * h0, plc.facet_holes.begin() + 3 * h1, fc.holelist);
+    }
+    in.facetmarkerlist[f] = plc.facet_marker[f];
+  }
+  if (!plc.holes.empty()) {
+    in.numberofholes = static_cast<int>(plc.holes.size() / 3);
+    in.holelist = new REAL[plc.holes.size()];
+    std::copy(plc.holes.begin(), plc.holes.end(), in.holelist);
+  }
+  if (!plc.regions.empty()) {
+    in.numberofregions = static_cast<int>(plc.regions.size());
+    in.regionlist = new REAL[5 * plc.regions.size()];
+    for (std::size_t r = 0; r < plc.regions.size(); ++r) {
+      const RegionSeed& s = plc.regions[r];
+      in.regionlist[5 * r] = s.point[0];
+      in.regionlist[5 * r + 1] = s.point[1];
+      in.regionlist[5 * r + 2] = s.point[2];
+      in.regionlist[5 * r + 3] = s.id;
+      in.regionlist[5 * r + 4] = s.max_volume > 0 ? s.max_volume : -1;
+    }
+  }
+
+  // p: PLC (boundary and interface triangles come out with their markers); z: 0-based; Q: quiet; A: regions;
+  // q: quality; a: volume limits; O0: no flips or smoothing.
+  std::string sw = "pzQ";
+  if (params.regions && !plc.regions.empty()) sw += "A";
+  if (params.radius_edge > 0) {
+    sw += "q" + format_number(params.radius_edge);
+    if (params.min_dihedral > 0) sw += "/" + format_number(params.min_dihedral);
+  }
+  bool any_region_volume = false;
+  for (const RegionSeed& s : plc.regions) any_region_volume = any_region_volume || s.max_volume > 0;
+  if (params.max_volume > 0) sw += "a" + format_number(params.max_volume);
+  if (any_region_volume) sw += "a";
+  if (!params.optimize) sw += "O0";
+  std::vector<char> switches(sw.begin(), sw.end());
+  switches.push_back('\0');
+  Result res = run_isolated(in, switches.data());
+  if (res.status != 0) throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
+
+  Mesh m;
+  const std::size_t np = res.points.size() / 3;
+  m.xyz = std::move(res.points);
+  const std::size_t nt = res.tets.size() / 4;
+  m.tet.resize(4 * nt);
+  for (std::size_t i = 0; i < 4 * nt; ++i) {
+    if (res.tets[i] < 0 || std::size_t(res.tets[i]) >= np) throw MesherError(2, "TetGen returned a tet index out of range");
+    m.tet[i] = static_cast<std::uint32_t>(res.tets[i]);
+  }
+  m.tet_region.assign(nt, 0);
+  for (std::size_t t = 0; t < res.attributes.size(); ++t)
+    m.tet_region[t] = static_cast<std::int32_t>(std::lround(res.attributes[t]));
+  const std::size_t nf = res.trifaces.size() / 3;
+  m.bface.resize(3 * nf);
+  for (std::size_t i = 0; i < 3 * nf; ++i) {
+    if (res.trifaces[i] < 0 || std::size_t(res.trifaces[i]) >= np) throw MesherError(2, "TetGen returned a face index out of range");
+    m.bface[i] = static_cast<std::uint32_t>(res.trifaces[i]);
+  }
+  m.bface_tag.assign(res.trimarkers.begin(), res.trimarkers.end());
+  std::vector<std::int32_t> ids(m.tet_region);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  for (std::int32_t id : ids) m.regions.push_back(Region{id, {}, kNone});
+  std::vector<std::int32_t> tags(m.bface_tag);
+  std::sort(tags.begin(), tags.end());
+  tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+  for (std::int32_t tag : tags) m.boundaries.push_back(Boundary{tag, {}});
+  if (report) {
+    report->switches = sw;
+    report->input_points = plc.point_count();
+    report->steiner_points = np > plc.point_count() ? np - plc.point_count() : 0;
+    report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  return m;
+}
+
+}  // namespace foxi
