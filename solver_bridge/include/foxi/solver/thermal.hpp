@@ -1,0 +1,124 @@
+// Steady heat conduction on the common mesh database: linear (P1) tetrahedra, conductivity per
+// region, boundary conditions per boundary tag, volumetric heat per region.
+//
+//   -div(k grad T) = Q in each region,   T = T_fix, -k dT/dn = -q (q into the body),
+//   -k dT/dn = h (T - T_inf) on the tagged boundary triangles; untagged boundaries are insulated.
+//
+// The result goes into Mesh::fields ("temperature" on nodes in K, "heat_flux" = -k grad T on cells
+// in W/m^2, 3 components), replacing fields of those names; the derived quantities an engineer reads
+// first come back in a ThermalReport. The library never prints; errors throw foxi::SolverError.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/progress.hpp"
+
+namespace foxi {
+
+// A problem that cannot be solved as given (missing conductivity, unknown tag, ill-posed boundary
+// conditions, a failed factorization, no convergence); the message names the region or tag.
+struct SolverError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// The progress callback returned false.
+struct SolverCancelled : SolverError {
+  using SolverError::SolverError;
+};
+
+enum class LinearSolverKind : std::uint8_t {
+  automatic,  // direct up to LinearSolverOptions::direct_max_unknowns, else cg_ichol
+  direct,     // sparse LDL^T (Eigen SimplicialLDLT, AMD ordering)
+  cg_ichol,   // conjugate gradients, incomplete Cholesky preconditioner (Eigen, AMD ordering)
+};
+
+// Options of the linear solve shared by foxi's solvers.
+struct LinearSolverOptions {
+  LinearSolverKind kind = LinearSolverKind::automatic;
+  std::size_t direct_max_unknowns = 40000;
+  double relative_tolerance = 1e-10;  // CG stops at |b - A x| <= tol |b|
+  std::size_t max_iterations = 0;     // 0: 10 * unknowns + 100
+  unsigned threads = 0;               // 0: std::thread::hardware_concurrency()
+  ProgressFn progress;                // stages "assemble", "factorize", "solve"; false cancels
+};
+
+struct FixedTemperature {
+  std::int32_t tag = 0;
+  double temperature = 0;  // K
+};
+struct HeatFlux {
+  std::int32_t tag = 0;
+  double flux = 0;  // W/m^2, positive into the body
+};
+struct Convection {
+  std::int32_t tag = 0;
+  double h = 0;        // W/(m^2 K), > 0
+  double ambient = 0;  // K
+};
+struct HeatSource {
+  std::int32_t region = 0;
+  double value = 0;  // W/m^3, or W for the whole region when `total`
+  bool total = false;
+};
+struct RegionConductivity {
+  std::int32_t region = 0;
+  double k = 0;  // W/(m K), > 0
+};
+
+struct ThermalParams {
+  // Overrides the region's material's thermal_conductivity; every region with tets needs one of the two.
+  std::vector<RegionConductivity> conductivity;
+  std::vector<FixedTemperature> fixed;
+  std::vector<HeatFlux> flux;
+  std::vector<Convection> convection;
+  std::vector<HeatSource> sources;
+  LinearSolverOptions solver;
+};
+
+// Heat entering the body through one boundary tag (W): for fixed-temperature tags from the nodal
+// reactions (a node shared by two fixed tags splits its reaction by its lumped area on each), for
+// flux tags q * area, for convection tags the integral of h (T_inf - T).
+struct BoundaryHeat {
+  std::int32_t tag = 0;
+  std::string kind;    // "fixed", "flux", "convection"
+  double area = 0;     // m^2
+  double heat_in = 0;  // W
+};
+
+struct RegionTemperature {
+  std::int32_t region = 0;
+  double volume = 0;           // m^3
+  double conductivity = 0;     // W/(m K)
+  double power = 0;            // W generated in the region
+  double max_temperature = 0;  // K, over the region's nodes
+  std::uint32_t max_node = kNone;
+  double mean_temperature = 0;  // K, volume average of the P1 field
+};
+
+struct ThermalReport {
+  std::vector<BoundaryHeat> boundaries;    // one per tag given a boundary condition, by tag
+  std::vector<RegionTemperature> regions;  // one per region with tets, by id
+  double max_temperature = 0;              // K
+  std::uint32_t max_node = kNone;
+  double total_power = 0;        // W from the sources
+  std::string solver;            // "SimplicialLDLT" or "CG+IncompleteCholesky"
+  std::size_t unknowns = 0;      // free nodes
+  std::size_t nonzeros = 0;      // of the free-free matrix (both triangles)
+  std::size_t iterations = 0;    // CG iterations (0 for the direct solver)
+  double relative_residual = 0;  // |b - A x| / |b| of the free system
+  double assembly_seconds = 0, solve_seconds = 0;
+};
+
+// Solves steady heat conduction on `mesh` (tets positively oriented, see validate.hpp) and stores the
+// fields "temperature" and "heat_flux" in it. Nodes used by no tet get NaN. Throws SolverError when a
+// region has no conductivity, a tag or region in `params` is not in the mesh, a tag has two conditions,
+// no tag fixes a temperature or convects (the temperature would be undetermined), the factorization
+// fails or CG does not converge; SolverCancelled when the progress callback returns false.
+ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params);
+
+}  // namespace foxi

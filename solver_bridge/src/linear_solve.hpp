@@ -1,0 +1,35 @@
+// Internal: the symmetric positive definite solve shared by foxi's solvers (Eigen behind it).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "foxi/solver/thermal.hpp"
+
+namespace foxi::detail {
+
+// A symmetric matrix with both triangles stored, rows sorted (CSR, which is also its CSC).
+struct SymmetricCsr {
+  std::vector<int> start;  // rows + 1
+  std::vector<int> col;
+  std::vector<double> val;
+  std::size_t rows() const { return start.empty() ? 0 : start.size() - 1; }
+};
+
+struct LinearSolveResult {
+  std::string solver;
+  std::size_t iterations = 0;
+  double relative_residual = 0;
+};
+
+// Solves A x = b (A symmetric positive definite) with the solver `options` chooses. Throws
+// SolverError when the factorization fails or CG does not reach the tolerance, SolverCancelled when
+// the progress callback says so.
+LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x,
+                            const LinearSolverOptions& options);
+
+// y = A x on `threads` threads.
+void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned threads);
+
+}  // namespace foxi::detail

@@ -1,0 +1,352 @@
+// Steady heat conduction against analytic 1D solutions on TetGen meshes of a box (x along the slab),
+// and against conservation of energy on the example package.
+#include "foxi/solver/thermal.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "foxi/model/io_tetgen.hpp"
+#include "foxi/model/validate.hpp"
+#include "test_util.hpp"
+
+namespace foxi {
+namespace {
+
+constexpr double kL = 1.0, kW = 0.4;  // slab length (x) and cross-section side (y, z)
+constexpr double kArea = kW * kW;
+
+// A box [0, kL] x [0, kW]^2 as a TetGen PLC. Facet markers: 1 at x = 0, 2 at x = kL, 3 the sides,
+// 4 the interface x = split (only when `split` is in (0, kL); then regions 1 (x < split), 2).
+std::string box_poly(double split) {
+  const bool two = split > 0 && split < kL;
+  std::vector<double> xs = two ? std::vector<double>{0, split, kL} : std::vector<double>{0, kL};
+  std::ostringstream s;
+  s.precision(17);
+  s << 4 * xs.size() << " 3 0 0\n";
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    const double yz[4][2] = {{0, 0}, {kW, 0}, {kW, kW}, {0, kW}};
+    for (int c = 0; c < 4; ++c)
+      s << 4 * i + c + 1 << ' ' << xs[i] << ' ' << yz[c][0] << ' ' << yz[c][1] << '\n';
+  }
+  const std::size_t slabs = xs.size() - 1;
+  s << (2 + 4 * slabs + (two ? 1 : 0)) << " 1\n";
+  auto quad = [&](std::size_t a, std::size_t b, std::size_t c, std::size_t d, int marker) {
+    s << "1 0 " << marker << "\n4 " << a << ' ' << b << ' ' << c << ' ' << d << '\n';
+  };
+  quad(1, 2, 3, 4, 1);
+  const std::size_t last = 4 * slabs;
+  quad(last + 1, last + 2, last + 3, last + 4, 2);
+  if (two) quad(5, 6, 7, 8, 4);
+  for (std::size_t i = 0; i < slabs; ++i)
+    for (std::size_t c = 0; c < 4; ++c) {
+      const std::size_t a = 4 * i + c + 1, b = 4 * i + (c + 1) % 4 + 1;
+      quad(a, b, b + 4, a + 4, 3);
+    }
+  s << "0\n";
+  if (two) {
+    s << "2\n1 " << split / 2 << ' ' << kW / 2 << ' ' << kW / 2 << " 1 0\n";
+    s << "2 " << (split + kL) / 2 << ' ' << kW / 2 << ' ' << kW / 2 << " 2 0\n";
+  } else {
+    s << "1\n1 " << kL / 2 << ' ' << kW / 2 << ' ' << kW / 2 << " 1 0\n";
+  }
+  return s.str();
+}
+
+// Meshes the box with TetGen (quality 1.414, max volume `max_volume`) and reads it back.
+Mesh box_mesh(double max_volume, double split = 0) {
+  test::TempDir dir;
+  test::write_text(dir / "box.poly", box_poly(split));
+  std::ostringstream cmd;
+  cmd << "tetgen -pq1.414AQa" << max_volume << " '" << (dir / "box.poly").string() << "'";
+  if (test::run(cmd.str(), dir / "log") != 0)
+    throw std::runtime_error("tetgen failed: " + test::read_text(dir / "log"));
+  Mesh mesh = read_tetgen(dir / "box.1");
+  validate_and_repair(mesh);
+  return mesh;
+}
+
+double x_of(const Mesh& m, std::size_t v) { return m.xyz[3 * v]; }
+
+const BoundaryHeat& heat_of(const ThermalReport& r, std::int32_t tag) {
+  for (const BoundaryHeat& b : r.boundaries)
+    if (b.tag == tag) return b;
+  throw std::runtime_error("no boundary heat for tag " + std::to_string(tag));
+}
+
+const RegionTemperature& region_of(const ThermalReport& r, std::int32_t id) {
+  for (const RegionTemperature& t : r.regions)
+    if (t.region == id) return t;
+  throw std::runtime_error("no region " + std::to_string(id));
+}
+
+// max over nodes |T - exact(x)|
+template <class F>
+double max_nodal_error(const Mesh& m, F exact) {
+  const Field* t = m.find_field("temperature");
+  EXPECT_NE(t, nullptr);
+  double e = 0;
+  for (std::size_t v = 0; v < m.node_count(); ++v)
+    e = std::max(e, std::abs(t->values[v] - exact(x_of(m, v))));
+  return e;
+}
+
+class ThermalTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!test::have_program("tetgen")) GTEST_SKIP() << "tetgen not installed";
+  }
+};
+
+TEST_F(ThermalTest, SlabBetweenTwoTemperaturesIsLinearAndExact) {
+  Mesh m = box_mesh(0.002);
+  const double k = 2.5, t0 = 300, t1 = 400;
+  ThermalParams p;
+  p.conductivity = {{1, k}};
+  p.fixed = {{1, t0}, {2, t1}};
+  for (LinearSolverKind kind : {LinearSolverKind::direct, LinearSolverKind::cg_ichol}) {
+    p.solver.kind = kind;
+    p.solver.relative_tolerance = 1e-13;
+    const ThermalReport r = solve_thermal(m, p);
+    EXPECT_LT(max_nodal_error(m, [&](double x) { return t0 + (t1 - t0) * x / kL; }), 1e-10 * t1);
+    const double q = k * (t1 - t0) / kL * kArea;  // W, from x = kL to x = 0
+    EXPECT_NEAR(heat_of(r, 2).heat_in, q, 1e-9 * q);
+    EXPECT_NEAR(heat_of(r, 1).heat_in, -q, 1e-9 * q);
+    EXPECT_NEAR(heat_of(r, 1).area, kArea, 1e-12);
+    const Field* flux = m.find_field("heat_flux");
+    ASSERT_NE(flux, nullptr);
+    ASSERT_EQ(flux->values.size(), 3 * m.tet_count());
+    for (std::size_t t = 0; t < m.tet_count(); ++t) {
+      EXPECT_NEAR(flux->values[3 * t], -k * (t1 - t0) / kL, 1e-8);
+      EXPECT_NEAR(flux->values[3 * t + 1], 0, 1e-8);
+    }
+    EXPECT_NEAR(region_of(r, 1).max_temperature, t1, 1e-9);
+    EXPECT_NEAR(region_of(r, 1).mean_temperature, (t0 + t1) / 2, 1e-9);
+    EXPECT_NEAR(r.max_temperature, t1, 1e-9);
+    EXPECT_NEAR(x_of(m, r.max_node), kL, 1e-12);
+    if (kind == LinearSolverKind::cg_ichol) {
+      EXPECT_GT(r.iterations, 0u);
+    }
+  }
+}
+
+// -k T'' = Q, T(0) = T(L) = 0: T = Q x (L - x) / (2k). L2 error of P1 must fall as h^2.
+TEST_F(ThermalTest, HeatGenerationConvergesAtSecondOrder) {
+  const double k = 3, q = 1200;
+  auto exact = [&](double x) { return q * x * (kL - x) / (2 * k); };
+  std::vector<double> hs, errors;
+  std::vector<std::size_t> tets;
+  for (double max_volume : {0.00025, 0.00003125, 0.0000039}) {
+    Mesh m = box_mesh(max_volume);
+    ThermalParams p;
+    p.conductivity = {{1, k}};
+    p.fixed = {{1, 0}, {2, 0}};
+    p.sources = {{1, q * kL * kArea, true}};  // total W
+    const ThermalReport r = solve_thermal(m, p);
+    EXPECT_NEAR(r.total_power, q * kL * kArea, 1e-9 * r.total_power);
+    // Energy balance: what is generated leaves through the two ends, half each by symmetry.
+    EXPECT_NEAR(heat_of(r, 1).heat_in + heat_of(r, 2).heat_in, -r.total_power, 1e-8 * r.total_power);
+    const std::vector<double>& t = m.find_field("temperature")->values;
+    // L2 error by a degree-5 rule would be overkill: the 4-point degree-2 rule on each tet.
+    const double a = 0.5854101966249685, b = 0.1381966011250105;
+    double e2 = 0, vol = 0;
+    for (std::size_t e = 0; e < m.tet_count(); ++e) {
+      const std::uint32_t* v = &m.tet[4 * e];
+      double x[4], tv[4];
+      for (int i = 0; i < 4; ++i) x[i] = x_of(m, v[i]), tv[i] = t[v[i]];
+      const double* p0 = &m.xyz[3 * v[0]];
+      double d[3][3];
+      for (int i = 0; i < 3; ++i)
+        for (int c = 0; c < 3; ++c) d[i][c] = m.xyz[3 * v[i + 1] + c] - p0[c];
+      const double det = d[0][0] * (d[1][1] * d[2][2] - d[1][2] * d[2][1]) -
+                         d[0][1] * (d[1][0] * d[2][2] - d[1][2] * d[2][0]) +
+                         d[0][2] * (d[1][0] * d[2][1] - d[1][1] * d[2][0]);
+      const double volume = det / 6;
+      vol += volume;
+      for (int qp = 0; qp < 4; ++qp) {
+        double xq = 0, tq = 0;
+        for (int i = 0; i < 4; ++i) {
+          const double w = i == qp ? a : b;
+          xq += w * x[i];
+          tq += w * tv[i];
+        }
+        e2 += volume / 4 * (tq - exact(xq)) * (tq - exact(xq));
+      }
+    }
+    hs.push_back(std::cbrt(vol / static_cast<double>(m.tet_count())));
+    errors.push_back(std::sqrt(e2));
+    tets.push_back(m.tet_count());
+  }
+  for (std::size_t i = 1; i < hs.size(); ++i) {
+    const double rate = std::log(errors[i - 1] / errors[i]) / std::log(hs[i - 1] / hs[i]);
+    RecordProperty("rate" + std::to_string(i), std::to_string(rate));
+    std::printf("%zu tets, h %.4g -> %.4g: L2 error %.4g -> %.4g, rate %.3f\n", tets[i], hs[i - 1], hs[i],
+                errors[i - 1], errors[i], rate);
+    EXPECT_GT(rate, 1.8);
+    EXPECT_LT(rate, 2.3);
+  }
+  // And the error is small in absolute terms (max of T is q L^2 / 8k = 50).
+  EXPECT_LT(errors.back() / std::sqrt(kL * kArea), 0.01 * q * kL * kL / (8 * k));
+}
+
+// Two materials in series: the heat is dT / (L1 / (k1 A) + L2 / (k2 A)), the profile piecewise linear.
+TEST_F(ThermalTest, TwoMaterialSlabIsASeriesResistance) {
+  Mesh m = box_mesh(0.002, 0.3);
+  const double k1 = 1.5, k2 = 6, t0 = 250, t1 = 350, l1 = 0.3, l2 = kL - 0.3;
+  // Region 1 takes its conductivity from its material, region 2 from the parameters.
+  m.materials.push_back({"mat", k1});
+  for (Region& r : m.regions)
+    if (r.id == 1) r.material = 0;
+  ThermalParams p;
+  p.conductivity = {{2, k2}};
+  p.fixed = {{1, t0}, {2, t1}};
+  const ThermalReport r = solve_thermal(m, p);
+  const double q = (t1 - t0) / (l1 / (k1 * kArea) + l2 / (k2 * kArea));
+  const double ti = t0 + q * l1 / (k1 * kArea);  // interface temperature
+  auto exact = [&](double x) { return x < l1 ? t0 + (ti - t0) * x / l1 : ti + (t1 - ti) * (x - l1) / l2; };
+  EXPECT_LT(max_nodal_error(m, exact), 1e-10 * t1);
+  EXPECT_NEAR(heat_of(r, 2).heat_in, q, 1e-9 * q);
+  EXPECT_NEAR(heat_of(r, 1).heat_in, -q, 1e-9 * q);
+  EXPECT_NEAR(region_of(r, 1).mean_temperature, (t0 + ti) / 2, 1e-9);
+  EXPECT_NEAR(region_of(r, 2).mean_temperature, (ti + t1) / 2, 1e-9);
+  EXPECT_NEAR(region_of(r, 1).max_temperature, ti, 1e-9);
+  EXPECT_NEAR(region_of(r, 1).volume, l1 * kArea, 1e-12);
+}
+
+// Fixed T0 at x = 0, convection (h, Tinf) at x = L: q = (Tinf - T0) / (L/k + 1/h), linear profile.
+TEST_F(ThermalTest, ConvectionBoundaryMatchesRobinSolution) {
+  Mesh m = box_mesh(0.002);
+  const double k = 4, h = 10, t0 = 300, tinf = 500;
+  ThermalParams p;
+  p.conductivity = {{1, k}};
+  p.fixed = {{1, t0}};
+  p.convection = {{2, h, tinf}};
+  const ThermalReport r = solve_thermal(m, p);
+  const double flux = (tinf - t0) / (kL / k + 1 / h);  // W/m^2 into the body at x = L
+  EXPECT_LT(max_nodal_error(m, [&](double x) { return t0 + flux * x / k; }), 1e-10 * tinf);
+  EXPECT_NEAR(heat_of(r, 2).heat_in, flux * kArea, 1e-9 * flux * kArea);
+  EXPECT_NEAR(heat_of(r, 1).heat_in, -flux * kArea, 1e-9 * flux * kArea);
+}
+
+// Convection only (no fixed temperature) with a source: T at the cooled end is Tinf + P / (h A).
+TEST_F(ThermalTest, ConvectionAloneMakesItWellPosed) {
+  Mesh m = box_mesh(0.002);
+  const double k = 4, h = 25, tinf = 290, q = 5000;
+  ThermalParams p;
+  p.conductivity = {{1, k}};
+  p.convection = {{1, h, tinf}};
+  p.flux = {{2, q}};
+  const ThermalReport r = solve_thermal(m, p);
+  const double t_cool = tinf + q / h;
+  EXPECT_LT(max_nodal_error(m, [&](double x) { return t_cool + q * x / k; }), 1e-9 * t_cool);
+  EXPECT_NEAR(heat_of(r, 1).heat_in, -q * kArea, 1e-9 * q * kArea);
+}
+
+// Fixed T0 at x = 0, heat flux q into the body at x = L: T = T0 + q x / k.
+TEST_F(ThermalTest, FluxBoundaryGivesLinearProfile) {
+  Mesh m = box_mesh(0.002);
+  const double k = 0.8, t0 = 273.15, q = 150;
+  ThermalParams p;
+  p.conductivity = {{1, k}};
+  p.fixed = {{1, t0}};
+  p.flux = {{2, q}};
+  const ThermalReport r = solve_thermal(m, p);
+  EXPECT_LT(max_nodal_error(m, [&](double x) { return t0 + q * x / k; }), 1e-10 * (t0 + q / k));
+  EXPECT_NEAR(heat_of(r, 2).heat_in, q * kArea, 1e-12);
+  EXPECT_NEAR(heat_of(r, 1).heat_in, -q * kArea, 1e-9 * q * kArea);
+  EXPECT_NEAR(heat_of(r, 2).area, kArea, 1e-12);
+}
+
+void expect_error(Mesh& m, const ThermalParams& p, const std::string& words) {
+  try {
+    solve_thermal(m, p);
+    ADD_FAILURE() << "no error; expected one saying '" << words << "'";
+  } catch (const SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(ThermalTest, IllPosedAndIncompleteProblemsGiveClearErrors) {
+  Mesh m = box_mesh(0.01, 0.5);
+  ThermalParams p;
+  p.conductivity = {{1, 1}, {2, 2}};
+  p.flux = {{1, 10}};
+  expect_error(m, p, "ill-posed");  // only a flux: T up to a constant
+  p.fixed = {{2, 300}};
+  ThermalParams missing = p;
+  missing.conductivity = {{1, 1}};
+  expect_error(m, missing, "region 2 has no thermal conductivity");
+  ThermalParams unknown = p;
+  unknown.convection = {{9, 5, 300}};
+  expect_error(m, unknown, "boundary tag 9");
+  ThermalParams twice = p;
+  twice.convection = {{2, 5, 300}};
+  expect_error(m, twice, "more than one boundary condition");
+  ThermalParams bad_h = p;
+  bad_h.convection = {{3, 0, 300}};
+  expect_error(m, bad_h, "must be positive");
+  ThermalParams bad_region = p;
+  bad_region.sources = {{7, 1, true}};
+  expect_error(m, bad_region, "region 7");
+  EXPECT_NO_THROW(solve_thermal(m, p));
+}
+
+TEST_F(ThermalTest, ProgressCanCancel) {
+  Mesh m = box_mesh(0.002);
+  ThermalParams p;
+  p.conductivity = {{1, 1}};
+  p.fixed = {{1, 0}, {2, 1}};
+  int calls = 0;
+  p.solver.progress = [&](std::string_view stage, double f) {
+    ++calls;
+    EXPECT_GE(f, 0.0);
+    EXPECT_LE(f, 1.0);
+    return stage != "solve";
+  };
+  EXPECT_THROW(solve_thermal(m, p), SolverCancelled);
+  EXPECT_GT(calls, 1);
+  EXPECT_EQ(m.find_field("temperature"), nullptr);  // nothing written on cancel
+}
+
+// The example package: die (region 2) dissipating 2 W on an FR-4 substrate (region 1), cooled from
+// below (tag 1, fixed) and by convection on top (tags 3, 6). Direct and CG agree; energy balances;
+// the hottest point is on the die.
+TEST_F(ThermalTest, DieOnSubstrateBalancesEnergyAndSolversAgree) {
+  test::TempDir dir;
+  test::write_text(dir / "pkg.poly",
+                   test::read_text(test::data_dir() + "/../../examples/die_on_substrate.poly"));
+  ASSERT_EQ(test::run("tetgen -pq1.414AQa5e-10 '" + (dir / "pkg.poly").string() + "'", dir / "log"), 0);
+  Mesh m = read_tetgen(dir / "pkg.1");
+  validate_and_repair(m);
+  ThermalParams p;
+  p.conductivity = {{1, 0.3}, {2, 148}};
+  p.fixed = {{1, 300}};
+  p.convection = {{3, 10, 300}, {6, 10, 300}};
+  p.sources = {{2, 2.0, true}};
+  p.solver.kind = LinearSolverKind::direct;
+  const ThermalReport direct = solve_thermal(m, p);
+  const std::vector<double> t_direct = m.find_field("temperature")->values;
+  p.solver.kind = LinearSolverKind::cg_ichol;
+  p.solver.relative_tolerance = 1e-12;
+  const ThermalReport cg = solve_thermal(m, p);
+  const std::vector<double>& t_cg = m.find_field("temperature")->values;
+  double rise = direct.max_temperature - 300, diff = 0;
+  for (std::size_t v = 0; v < t_cg.size(); ++v) diff = std::max(diff, std::abs(t_cg[v] - t_direct[v]));
+  EXPECT_GT(rise, 0.1);
+  EXPECT_LT(diff, 1e-8 * rise);
+  EXPECT_GT(cg.iterations, 0u);
+  double heat = 0;
+  for (const BoundaryHeat& b : direct.boundaries) heat += b.heat_in;
+  EXPECT_NEAR(heat + direct.total_power, 0, 1e-9 * direct.total_power);
+  EXPECT_NEAR(direct.total_power, 2.0, 1e-12);
+  EXPECT_EQ(m.region_of(0) == 1 || m.region_of(0) == 2, true);
+  EXPECT_GT(region_of(direct, 2).max_temperature, region_of(direct, 1).mean_temperature);
+  EXPECT_GE(x_of(m, direct.max_node), 0.003 - 1e-12);
+  EXPECT_LE(x_of(m, direct.max_node), 0.007 + 1e-12);
+  EXPECT_GE(m.xyz[3 * direct.max_node + 2], 0.001 - 1e-12);  // on the die (z >= 1 mm)
+}
+
+}  // namespace
+}  // namespace foxi
