@@ -41,5 +41,6 @@ int cmd_convert(Args args);
 int cmd_order(Args args);
 int cmd_mesh(Args args);
 int cmd_render(Args args);
+int cmd_solve(Args args);
 
 }  // namespace foxi::cli
