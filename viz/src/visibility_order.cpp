@@ -94,7 +94,8 @@ struct Entry {
 
 // Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
 struct Workspace {
-  std::vector<Entry> entries, scratch;
+  std::vector<double> lo;       // pass 1: each item's lo (8 bytes per item)
+  std::vector<Entry> entries;   // the bucketed entries (16 bytes per item)
 };
 thread_local Workspace t_workspace;
 
@@ -216,9 +217,16 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   const float bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
   stats.key_bound = bound;
 
-  // 1. Entries (both cores): key in drawing order, placed at the low end of its interval.
-  sorted.swap(t_workspace.entries);
-  if (sorted.size() < m) sorted.resize(m);
+  // 1. Keys (both cores): each item's key in drawing order, placed at the low end of its interval.
+  // Only lo is stored here (8 bytes); the 16-byte entries are made by the scatter, so a view needs
+  // 24 bytes per item.
+  std::vector<double>& los = t_workspace.lo;
+  if (los.size() < m) los.resize(m);
+  auto radius_of = [&](std::size_t i) {
+    if (i < m_main) return bound;
+    std::size_t w = i - m_main;
+    return std::max(bound, static_cast<float>((ka * wide_a[w] + wide_b[w] * np) * (1 + 1e-6)));
+  };
   const double* C = t.c.data();
   const double* S = t.s.data();
   const double sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
@@ -233,13 +241,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
       const double* c = C + 3 * std::size_t(tet);
       double k = v.perspective ? S[tet] - (c[0] * px + c[1] * py + c[2] * pz)
                                : c[0] * v.dir[0] + c[1] * v.dir[1] + c[2] * v.dir[2];
-      float r = bound;
-      if (i >= m_main) {
-        std::size_t w = i - m_main;
-        r = std::max(bound, static_cast<float>((ka * wide_a[w] + wide_b[w] * np) * (1 + 1e-6)));
-      }
-      double lo = sign * k - double(r);
-      sorted[i] = Entry{lo, r, item};
+      double lo = sign * k - double(i < m_main ? bound : radius_of(i));
+      los[i] = lo;
       l = std::min(l, lo);
       h = std::max(h, lo);
     }
@@ -252,7 +255,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   // outside (far-flung spheres of slivers at the hull) fall into the first and last buckets.
   if (m > 4096) {
     std::vector<double> sample(1024);
-    for (std::size_t i = 0; i < sample.size(); ++i) sample[i] = sorted[i * (m / sample.size())].lo;
+    for (std::size_t i = 0; i < sample.size(); ++i) sample[i] = los[i * (m / sample.size())];
     std::sort(sample.begin(), sample.end());
     double qlo = sample[2], qhi = sample[sample.size() - 3], widen = 0.05 * (qhi - qlo);
     kmin = std::max(kmin, qlo - widen);
@@ -277,7 +280,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
   parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
     std::uint32_t* h = hist[part].data();
-    for (std::size_t i = b; i < e; ++i) ++h[bucket_of(sorted[i].lo)];
+    for (std::size_t i = b; i < e; ++i) ++h[bucket_of(los[i])];
   });
   bucket_begin.assign(nb + 1, 0);
   std::vector<std::uint32_t> start0(nb), start1(nb);
@@ -290,11 +293,15 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     acc += hist[1][b];
   }
   bucket_begin[nb] = acc;
-  std::vector<Entry>& out = t_workspace.scratch;
-  if (out.size() < m) out.resize(m);
+  sorted.swap(t_workspace.entries);
+  if (sorted.size() < m) sorted.resize(m);
+  std::vector<Entry>& out = sorted;
   const std::size_t split = m < 50000 ? m : m / 2;  // as parallel_for splits
   auto scatter = [&](std::size_t b, std::size_t e, std::vector<std::uint32_t>& pos) {
-    for (std::size_t i = b; i < e; ++i) out[pos[bucket_of(sorted[i].lo)]++] = sorted[i];
+    for (std::size_t i = b; i < e; ++i) {
+      const double lo = los[i];
+      out[pos[bucket_of(lo)]++] = Entry{lo, radius_of(i), item_at(i)};
+    }
   };
   if (split == m) {
     scatter(0, m, start0);
@@ -303,7 +310,6 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     scatter(0, split, start0);
     other.join();
   }
-  sorted.swap(out);  // the scratch buffer keeps the old entries' storage for the next view
 }
 
 // Sorts one bucket by lo: a counting pass over about n/2 sub-buckets of its own range, then an
