@@ -66,6 +66,25 @@ TEST(TetgenMesher, DieOnSubstrateRegionsAndBoundariesHaveAnalyticSizes) {
   EXPECT_GT(report.steiner_points, 0u);
 }
 
+TEST(TetgenMesher, ThreeMaterialViaIsDelaunayWithExactVolumes) {
+  Plc plc = read_poly(example("via_in_dielectric.poly"));
+  ASSERT_EQ(plc.regions.size(), 3u);
+  MeshParams params;
+  params.max_volume = 0.0005;
+  Mesh m = mesh_plc(plc, params);
+  std::map<std::int32_t, double> volume, area;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) volume[m.region_of(t)] += tet_volume(m, t);
+  for (std::size_t f = 0; f < m.bface_count(); ++f) area[m.bface_tag[f]] += tri_area(m, f);
+  const double disc = 16.0 / 2 * 0.2 * 0.2 * std::sin(2 * M_PI / 16);  // the 16-gon's area
+  EXPECT_NEAR(volume[1], 0.5, 1e-12);
+  EXPECT_NEAR(volume[3], disc * 0.5, 1e-12);
+  EXPECT_NEAR(volume[2], 0.5 - disc * 0.5, 1e-12);
+  EXPECT_NEAR(area[5], disc, 1e-12);
+  EXPECT_NEAR(area[4], 1 - disc, 1e-12);
+  EXPECT_NEAR(area[6], 16 * 2 * 0.2 * std::sin(M_PI / 16) * 0.5, 1e-12);  // the via wall
+  EXPECT_TRUE(compute_delaunay_certificate(m).delaunay);
+}
+
 TEST(TetgenMesher, SameMeshAsTheTetgenProgram) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
