@@ -117,7 +117,7 @@ struct ProgressiveOrder::Impl {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
     std::vector<std::uint8_t> local_done;
     std::vector<Entry> tmp;            // the second-level counting sort
-    std::vector<std::uint32_t> counts;
+    std::vector<std::uint32_t> counts, subs;
     std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
   };
   Scratch scratch;
@@ -338,14 +338,20 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
       const double sub_scale = double(subs) / (hi - lo) * (1 - 1e-12);
       sc.counts.assign(subs + 1, 0);
       if (sc.tmp.size() < n) sc.tmp.resize(n);
-      auto sub = [&](double x) {
-        double f = (x - lo) * sub_scale;
-        return f <= 0 ? std::size_t{0} : std::min(subs - 1, static_cast<std::size_t>(f));
-      };
-      for (std::size_t i = 0; i < n; ++i) ++sc.counts[sub(a[i].lo) + 1];
-      for (std::size_t k = 1; k <= subs; ++k) sc.counts[k] += sc.counts[k - 1];
-      for (std::size_t i = 0; i < n; ++i) sc.tmp[sc.counts[sub(a[i].lo)]++] = a[i];
-      std::copy(sc.tmp.begin(), sc.tmp.begin() + static_cast<std::ptrdiff_t>(n), a);
+      if (sc.subs.size() < n) sc.subs.resize(n);
+      const double top = double(subs - 1);
+      std::uint32_t* cnt = sc.counts.data();
+      std::uint32_t* sub = sc.subs.data();
+      for (std::size_t i = 0; i < n; ++i) {
+        const double f = (a[i].lo - lo) * sub_scale;
+        const std::uint32_t k = static_cast<std::uint32_t>(std::clamp(f, 0.0, top));
+        sub[i] = k;
+        ++cnt[k + 1];
+      }
+      for (std::size_t k = 1; k <= subs; ++k) cnt[k] += cnt[k - 1];
+      Entry* tmp = sc.tmp.data();
+      for (std::size_t i = 0; i < n; ++i) tmp[cnt[sub[i]]++] = a[i];
+      std::copy(tmp, tmp + n, a);
     }
   }
   for (std::size_t i = 1; i < n; ++i) {
