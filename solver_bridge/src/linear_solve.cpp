@@ -96,7 +96,7 @@ LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b,
 
   result.solver = "CG+IncompleteCholesky";
   report(options, "factorize", 0.0);
-  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> ic;
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> ic;
   {
     SpMat lower = SpMat(A).triangularView<Eigen::Lower>();
     ic.compute(lower);

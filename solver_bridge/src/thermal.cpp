@@ -256,7 +256,8 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
             if (pos == SIZE_MAX)
               throw SolverError("boundary triangle " + std::to_string(f) + " (" +
                                 tag_label(mesh, mesh.bface_tag[f]) + ") is not a face of any tet");
-            kval[pos] += t.a * area / 12 * (i == j ? 2.0 : 1.0);
+            kval[pos] +=
+                params.convection_centroid_rule ? t.a * area / 9 : t.a * area / 12 * (i == j ? 2.0 : 1.0);
           }
         }
         break;

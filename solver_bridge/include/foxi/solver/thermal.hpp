@@ -77,6 +77,10 @@ struct ThermalParams {
   std::vector<HeatFlux> flux;
   std::vector<Convection> convection;
   std::vector<HeatSource> sources;
+  // Convection integrates h T over each triangle exactly (consistent "mass" h A/12 (1 + delta_ij));
+  // true takes h T at the centroid instead (h A/9 for every pair), which is what CalculiX does for
+  // *FILM on C3D4 faces: less accurate, but it reproduces ccx to its output precision.
+  bool convection_centroid_rule = false;
   LinearSolverOptions solver;
 };
 

@@ -1,0 +1,39 @@
+// The bridge to CalculiX (ccx): the same mesh and thermal problem as a CalculiX input deck, and the
+// nodal results of its ASCII .frd file read back, so that foxi's solvers can be checked against an
+// independent code on the same P1 / C3D4 discretisation.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/solver/thermal.hpp"
+
+namespace foxi {
+
+// Writes `mesh` and `params` as a CalculiX steady heat-transfer deck (SI units): *NODE, C3D4
+// elements in one ELSET per region (E<id>, ids shifted to be positive), *CONDUCTIVITY per region
+// (params first, then the region's material), fixed temperatures as *BOUNDARY (per node, the same
+// lumped-area mean that solve_thermal uses where fixed tags meet), heat flux as *DFLUX S<face>,
+// convection as *FILM F<face>, sources as *DFLUX BF on the region's elements, and *NODE FILE NT.
+// Node i of the mesh is CalculiX node i + 1, tet t element t + 1 (tets positively oriented, as
+// C3D4 needs). Throws SolverError for the problems solve_thermal rejects (missing conductivity,
+// unknown tags and regions, a boundary triangle that is no tet face) and IoError when the file
+// cannot be written.
+void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const std::filesystem::path& inp);
+
+// One nodal result block of a CalculiX ASCII .frd file ("NDTEMP", "DISP", ...).
+struct FrdBlock {
+  std::string name;
+  std::uint32_t components = 0;
+  std::vector<std::uint32_t> node;  // CalculiX node numbers, in file order
+  std::vector<double> values;       // components per node
+};
+
+// Reads every nodal result block of an ASCII .frd file (the last step's blocks come last). Throws
+// IoError (file and line) on a malformed or binary file.
+std::vector<FrdBlock> read_frd(const std::filesystem::path& frd);
+
+}  // namespace foxi

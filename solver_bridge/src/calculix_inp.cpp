@@ -1,0 +1,232 @@
+// CalculiX deck writer and .frd reader (see calculix.hpp). Formats: CalculiX 2.20 manual, sections
+// *NODE, *ELEMENT (C3D4: faces 1 = 1-2-3, 2 = 1-4-2, 3 = 2-4-3, 4 = 3-4-1), *BOUNDARY (degree of
+// freedom 11 is the temperature), *DFLUX (S<face> surface flux into the body, BF body flux per
+// volume), *FILM (F<face>, sink temperature, film coefficient); .frd result format (ASCII: " -4"
+// block header, " -1" node records with 12-character values, " -2" continuations, " -3" block end).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "foxi/model/io_error.hpp"
+#include "foxi/solver/calculix.hpp"
+#include "p1_assembly.hpp"
+
+namespace foxi {
+
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* f) const {
+    if (f) std::fclose(f);
+  }
+};
+
+std::string elset_name(std::size_t region_index) { return "R" + std::to_string(region_index + 1); }
+
+}  // namespace
+
+void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const std::filesystem::path& inp) {
+  const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), nf = mesh.bface_count();
+  if (std::string problem = check_sizes(mesh); !problem.empty())
+    throw SolverError("inconsistent mesh: " + problem);
+  // Regions and conductivities, checked as solve_thermal checks them.
+  std::vector<std::int32_t> ids;
+  for (std::size_t t = 0; t < nt; ++t) ids.push_back(mesh.region_of(t));
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  auto index_of = [&](std::int32_t id) -> std::size_t {
+    auto it = std::lower_bound(ids.begin(), ids.end(), id);
+    if (it == ids.end() || *it != id) throw SolverError("region " + std::to_string(id) + " has no tets");
+    return static_cast<std::size_t>(it - ids.begin());
+  };
+  std::vector<double> k(ids.size(), Material::kUnset), q(ids.size(), 0.0), volume(ids.size(), 0.0);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (const Region* r = mesh.find_region(ids[i]); r && r->material < mesh.materials.size())
+      k[i] = mesh.materials[r->material].thermal_conductivity;
+  for (const RegionConductivity& c : params.conductivity) k[index_of(c.region)] = c.k;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (!(k[i] > 0) || !std::isfinite(k[i]))
+      throw SolverError("region " + std::to_string(ids[i]) + " has no valid thermal conductivity");
+  std::array<std::array<double, 3>, 4> g;
+  for (std::size_t t = 0; t < nt; ++t)
+    volume[index_of(mesh.region_of(t))] += detail::p1_gradients(mesh, t, g);
+  for (const HeatSource& s : params.sources) {
+    const std::size_t i = index_of(s.region);
+    q[i] = s.total ? s.value / volume[i] : s.value;
+  }
+
+  // Each boundary triangle as (element, face) of the tet that has it.
+  const detail::NodeTets ntets = detail::node_tets(mesh);
+  auto element_face = [&](std::size_t f) -> std::pair<std::size_t, int> {
+    const std::uint32_t* v = &mesh.bface[3 * f];
+    for (std::size_t k2 = ntets.node_start[v[0]]; k2 < ntets.node_start[v[0] + 1]; ++k2) {
+      const std::size_t t = ntets.item[k2] >> 2;
+      const std::uint32_t* tv = &mesh.tet[4 * t];
+      int missing = -1, found = 0;
+      for (int a = 0; a < 4; ++a) {
+        if (tv[a] == v[0] || tv[a] == v[1] || tv[a] == v[2])
+          ++found;
+        else
+          missing = a;
+      }
+      if (found == 3) {
+        static const int kFaceOpposite[4] = {3, 4, 2, 1};  // C3D4 face opposite local vertex 0..3
+        return {t, kFaceOpposite[missing]};
+      }
+    }
+    throw SolverError("boundary triangle " + std::to_string(f) + " is not a face of any tet");
+  };
+
+  enum Kind { kFixed, kFlux, kFilm };
+  struct Bc {
+    Kind kind;
+    double a, b;
+  };
+  std::map<std::int32_t, Bc> bc;
+  auto add = [&](std::int32_t tag, Bc b) {
+    if (std::find(mesh.bface_tag.begin(), mesh.bface_tag.end(), tag) == mesh.bface_tag.end())
+      throw SolverError("boundary tag " + std::to_string(tag) + " tags no boundary triangle");
+    if (!bc.emplace(tag, b).second)
+      throw SolverError("boundary tag " + std::to_string(tag) + " has more than one boundary condition");
+  };
+  for (const FixedTemperature& f : params.fixed) add(f.tag, {kFixed, f.temperature, 0});
+  for (const HeatFlux& f : params.flux) add(f.tag, {kFlux, f.flux, 0});
+  for (const Convection& c : params.convection) add(c.tag, {kFilm, c.h, c.ambient});
+
+  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(inp.string().c_str(), "w"));
+  if (!file) throw IoError(inp.string(), 0, IoError::kNoOffset, "cannot open for writing");
+  std::FILE* out = file.get();
+  std::fprintf(out,
+               "** foxi: steady heat conduction, %zu nodes, %zu C3D4 elements, SI units\n*NODE, NSET=NALL\n",
+               nn, nt);
+  for (std::size_t v = 0; v < nn; ++v)
+    std::fprintf(out, "%zu, %.17g, %.17g, %.17g\n", v + 1, mesh.xyz[3 * v], mesh.xyz[3 * v + 1],
+                 mesh.xyz[3 * v + 2]);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    std::fprintf(out, "*ELEMENT, TYPE=C3D4, ELSET=%s\n", elset_name(i).c_str());
+    for (std::size_t t = 0; t < nt; ++t) {
+      if (mesh.region_of(t) != ids[i]) continue;
+      const std::uint32_t* tv = &mesh.tet[4 * t];
+      std::fprintf(out, "%zu, %u, %u, %u, %u\n", t + 1, tv[0] + 1, tv[1] + 1, tv[2] + 1, tv[3] + 1);
+    }
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    std::fprintf(out, "*MATERIAL, NAME=M%zu\n*CONDUCTIVITY\n%.17g\n", i + 1, k[i]);
+    std::fprintf(out, "*SOLID SECTION, ELSET=%s, MATERIAL=M%zu\n", elset_name(i).c_str(), i + 1);
+  }
+  std::fprintf(out, "*STEP\n*HEAT TRANSFER, STEADY STATE\n");
+  // Fixed nodes: the lumped-area mean of the fixed tags around each node (as solve_thermal does).
+  std::vector<double> sum(nn, 0.0), weight(nn, 0.0), plain(nn, 0.0);
+  std::vector<std::uint32_t> count(nn, 0);
+  for (std::size_t f = 0; f < nf; ++f) {
+    auto it = bc.find(mesh.bface_tag[f]);
+    if (it == bc.end() || it->second.kind != kFixed) continue;
+    const double area = detail::triangle_area(mesh, f);
+    for (int i = 0; i < 3; ++i) {
+      const std::uint32_t v = mesh.bface[3 * f + i];
+      sum[v] += area / 3 * it->second.a;
+      weight[v] += area / 3;
+      plain[v] += it->second.a;
+      ++count[v];
+    }
+  }
+  bool any_fixed = false;
+  for (std::size_t v = 0; v < nn; ++v) {
+    if (!count[v]) continue;
+    if (!any_fixed) std::fprintf(out, "*BOUNDARY\n");
+    any_fixed = true;
+    std::fprintf(out, "%zu, 11, 11, %.17g\n", v + 1,
+                 weight[v] > 0 ? sum[v] / weight[v] : plain[v] / count[v]);
+  }
+  bool header = false;
+  for (std::size_t f = 0; f < nf; ++f) {
+    auto it = bc.find(mesh.bface_tag[f]);
+    if (it == bc.end() || it->second.kind != kFlux) continue;
+    if (!header) std::fprintf(out, "*DFLUX\n");
+    header = true;
+    const auto [t, face] = element_face(f);
+    std::fprintf(out, "%zu, S%d, %.17g\n", t + 1, face, it->second.a);
+  }
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (q[i] == 0) continue;
+    if (!header) std::fprintf(out, "*DFLUX\n");
+    header = true;
+    std::fprintf(out, "%s, BF, %.17g\n", elset_name(i).c_str(), q[i]);
+  }
+  header = false;
+  for (std::size_t f = 0; f < nf; ++f) {
+    auto it = bc.find(mesh.bface_tag[f]);
+    if (it == bc.end() || it->second.kind != kFilm) continue;
+    if (!header) std::fprintf(out, "*FILM\n");
+    header = true;
+    const auto [t, face] = element_face(f);
+    std::fprintf(out, "%zu, F%d, %.17g, %.17g\n", t + 1, face, it->second.b, it->second.a);
+  }
+  std::fprintf(out, "*NODE FILE\nNT\n*END STEP\n");
+  if (std::ferror(out) || std::fclose(file.release()) != 0)
+    throw IoError(inp.string(), 0, IoError::kNoOffset, "write failed");
+}
+
+std::vector<FrdBlock> read_frd(const std::filesystem::path& frd) {
+  std::ifstream in(frd, std::ios::binary);
+  if (!in) throw IoError(frd.string(), 0, IoError::kNoOffset, "cannot open");
+  std::vector<FrdBlock> blocks;
+  FrdBlock* cur = nullptr;
+  std::string line;
+  std::uint64_t line_no = 0;
+  auto fail = [&](const std::string& why) { throw IoError(frd.string(), line_no, IoError::kNoOffset, why); };
+  auto parse_values = [&](const std::string& s, std::size_t from, std::vector<double>& out) {
+    for (std::size_t p = from; p + 12 <= s.size(); p += 12) {
+      const std::string field = s.substr(p, 12);
+      char* end = nullptr;
+      const double v = std::strtod(field.c_str(), &end);
+      if (end == field.c_str()) fail("expected a number in '" + field + "'");
+      out.push_back(v);
+    }
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.size() >= 3 && line.compare(0, 3, " -4") == 0) {
+      blocks.emplace_back();
+      cur = &blocks.back();
+      std::size_t p = 3;
+      while (p < line.size() && line[p] == ' ') ++p;
+      std::size_t e = p;
+      while (e < line.size() && line[e] != ' ') ++e;
+      cur->name = line.substr(p, e - p);
+    } else if (cur && line.size() >= 3 && line.compare(0, 3, " -1") == 0) {
+      // Long format: node in columns 4-13, values from 14; short format: node in 4-8, values from 9.
+      std::size_t from = (line.size() >= 13 && (line.size() - 13) % 12 == 0) ? 13
+                         : (line.size() >= 8 && (line.size() - 8) % 12 == 0) ? 8
+                                                                             : 0;
+      if (from == 0) fail("a node record of unexpected length " + std::to_string(line.size()));
+      char* end = nullptr;
+      const std::string node = line.substr(3, from - 3);
+      const unsigned long id = std::strtoul(node.c_str(), &end, 10);
+      if (end == node.c_str()) fail("expected a node number");
+      cur->node.push_back(static_cast<std::uint32_t>(id));
+      const std::size_t before = cur->values.size();
+      parse_values(line, from, cur->values);
+      if (cur->node.size() == 1) cur->components = static_cast<std::uint32_t>(cur->values.size() - before);
+    } else if (cur && line.size() >= 3 && line.compare(0, 3, " -2") == 0) {
+      if (cur->node.empty()) fail("a continuation record before any node");
+      const std::size_t before = cur->values.size();
+      parse_values(line, (line.size() - 13) % 12 == 0 ? 13 : 8, cur->values);
+      if (cur->node.size() == 1) cur->components += static_cast<std::uint32_t>(cur->values.size() - before);
+    } else if (line.size() >= 3 && line.compare(0, 3, " -3") == 0) {
+      if (cur && cur->components && cur->values.size() != cur->node.size() * cur->components)
+        fail("block " + cur->name + " has an uneven number of values per node");
+      cur = nullptr;
+    }
+  }
+  return blocks;
+}
+
+}  // namespace foxi
