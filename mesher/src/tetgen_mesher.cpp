@@ -3,6 +3,7 @@
 #define TETLIBRARY
 #include <tetgen.h>
 
+#include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -53,7 +54,7 @@ struct Result {
 // Runs TetGen in a child process: TetGen 1.5's library frees its memory twice when it stops on an
 // error (terminatetetgen() then the mesh destructor), which crashes the caller; in a child the crash
 // becomes an error message.
-Result run_isolated(tetgenio& in, char* switches) {
+Result run_isolated(tetgenio& in, char* switches, const ProgressFn& progress) {
   int fds[2];
   if (::pipe(fds) != 0) throw MesherError(1, std::string("cannot create a pipe: ") + std::strerror(errno));
   std::fflush(nullptr);
@@ -99,7 +100,27 @@ Result run_isolated(tetgenio& in, char* switches) {
   ::close(fds[1]);
   std::vector<char> buf;
   char chunk[1 << 16];
+  const auto start = std::chrono::steady_clock::now();
   for (;;) {
+    if (progress) {
+      // TetGen reports no progress of its own: the callback is asked every 100 ms (fraction -1,
+      // "unknown") so that a user can cancel, which stops the child.
+      pollfd pfd{fds[0], POLLIN, 0};
+      int ready = ::poll(&pfd, 1, 100);
+      if (ready == 0) {
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        (void)elapsed;
+        if (!progress("meshing", -1.0)) {
+          ::kill(pid, SIGKILL);
+          ::close(fds[0]);
+          int ws = 0;
+          while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
+          }
+          throw MesherError(-1, "meshing cancelled");
+        }
+        continue;
+      }
+    }
     ssize_t n = ::read(fds[0], chunk, sizeof chunk);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
@@ -218,7 +239,7 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   if (!params.optimize) sw += "O0";
   std::vector<char> switches(sw.begin(), sw.end());
   switches.push_back('\0');
-  Result res = run_isolated(in, switches.data());
+  Result res = run_isolated(in, switches.data(), params.progress);
   if (res.status != 0) throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
 
   Mesh m;

@@ -107,6 +107,24 @@ TEST(TetgenMesher, SameMeshAsTheTetgenProgram) {
   EXPECT_TRUE(compute_delaunay_certificate(lib).delaunay);
 }
 
+TEST(TetgenMesher, CancelStopsTetgen) {
+  Plc plc = read_poly(example("die_on_substrate.poly"));
+  MeshParams params;
+  params.max_volume = 1e-15;  // tens of millions of tets: long enough to be cancelled first
+  int calls = 0;
+  params.progress = [&](std::string_view stage, double) {
+    EXPECT_EQ(stage, "meshing");
+    return ++calls < 3;
+  };
+  try {
+    mesh_plc(plc, params);
+    FAIL() << "not cancelled";
+  } catch (const MesherError& e) {
+    EXPECT_EQ(e.tetgen_code(), -1);
+    EXPECT_EQ(calls, 3);
+  }
+}
+
 TEST(TetgenMesher, PolyRoundTrip) {
   test::TempDir dir;
   Plc plc = read_poly(example("die_on_substrate.poly"));

@@ -12,6 +12,7 @@
 
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
+#include "foxi/model/progress.hpp"
 
 namespace foxi {
 
@@ -21,6 +22,9 @@ struct MeshParams {
   double min_dihedral = 0;    // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
   bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
   bool regions = true;        // region seeds give tet regions (TetGen -A)
+  // Asked about every 100 ms while TetGen runs (fraction -1: TetGen tells no progress); returning
+  // false stops TetGen and mesh_plc throws MesherError (code -1, "meshing cancelled").
+  ProgressFn progress;
 };
 
 struct MeshReport {
