@@ -98,6 +98,7 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
 struct PolyVertex {
   double c[3] = {0, 0, 0};  // camera coordinates (near-plane cuts only)
   std::int64_t X = 0, Y = 0;
+  double w = 0;           // nearness (1 / depth perspective, -depth orthographic), depth mode
   bool mesh_edge = true;  // the edge from this vertex to the next is (part of) a mesh edge
 };
 
@@ -107,8 +108,10 @@ struct FaceSetup {
   std::uint32_t color = 0;
   float r = 0, g = 0, b = 0;
   int lines = 0;
-  double la[4], lb[4], lc[4];     // distance to mesh edge k in pixels = la x + lb y + lc (inside > 0)
-  double da = 0, db = 0, dc = 0;  // depth mode: nearness = da x + db y + dc
+  double la[4], lb[4], lc[4];  // distance to mesh edge k in pixels = la x + lb y + lc (inside > 0)
+  // Depth mode, per fan triangle: nearness = w0 + da (x - x0) + db (y - y0), interpolated from the
+  // snapped vertices so that faces sharing an edge agree on it exactly (up to rounding).
+  double x0 = 0, y0 = 0, w0 = 0, da = 0, db = 0;
 };
 
 constexpr std::uint32_t kPalette[] = {
@@ -206,12 +209,14 @@ struct TetRasterizer::Impl {
     st = 0;
   }
 
+  double nearness(const double* c) const { return proj.perspective ? 1 / c[2] : -c[2]; }
+
   void project_node(const double* p, double* c, std::int64_t& X, std::int64_t& Y, std::uint8_t& st) const {
     proj.to_camera(p, c);
     project_camera(c, X, Y, st);
   }
 
-  // Shading, edge lines and depth plane of a face; `v` = the face's three corners (camera frame)
+  // Shading and edge lines of a face; `v` = the face's three corners (camera frame)
   // in outward order; poly = the polygon to draw (positive area), n its size.
   void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const PolyVertex* poly,
                   int n) const {
@@ -243,28 +248,13 @@ struct TetRasterizer::Impl {
         ++fs.lines;
       }
     }
-    if (params.depth_buffer) {
-      double k = nc[0] * v[0][0] + nc[1] * v[0][1] + nc[2] * v[0][2];
-      if (proj.perspective) {
-        double f = proj.focal;
-        if (k == 0) k = 1e-300;
-        fs.da = nc[0] / (f * k);
-        fs.db = -nc[1] / (f * k);
-        fs.dc = (nc[2] - nc[0] * proj.cx / f + nc[1] * proj.cy / f) / k;
-      } else {
-        double s = proj.scale, nz = nc[2] == 0 ? 1e-300 : nc[2];
-        fs.da = nc[0] / (s * nz);
-        fs.db = -nc[1] / (s * nz);
-        fs.dc = (-nc[0] * proj.cx / s + nc[1] * proj.cy / s - k) / nz;
-      }
-    }
   }
 
   void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
     const std::size_t p = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
     const double sx = x + 0.5, sy = y + 0.5;
     if (params.depth_buffer) {
-      float z = float(fs.da * sx + fs.db * sy + fs.dc);
+      const double z = fs.w0 + fs.da * (sx - fs.x0) + fs.db * (sy - fs.y0);
       if (!(z > fb.depth[p])) return;
       fb.depth[p] = z;
     }
@@ -283,12 +273,22 @@ struct TetRasterizer::Impl {
   }
 
   // Draws a convex polygon (positive area) as a fan from vertex 0.
-  void raster_polygon(Framebuffer& fb, const Rows& rows, const FaceSetup& fs, const PolyVertex* poly,
-                      int n) const {
+  void raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) const {
     for (int i = 1; i + 1 < n; ++i) {
       std::int64_t X[3] = {poly[0].X, poly[i].X, poly[i + 1].X}, Y[3] = {poly[0].Y, poly[i].Y, poly[i + 1].Y};
       std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
       if (area <= 0) continue;
+      if (params.depth_buffer) {
+        const double inv = double(kOne) * double(kOne) / double(area), s = 1.0 / double(kOne);
+        const double x1 = double(X[1] - X[0]) * s, y1 = double(Y[1] - Y[0]) * s;
+        const double x2 = double(X[2] - X[0]) * s, y2 = double(Y[2] - Y[0]) * s;
+        const double w1 = poly[i].w - poly[0].w, w2 = poly[i + 1].w - poly[0].w;
+        fs.x0 = double(X[0]) * s;
+        fs.y0 = double(Y[0]) * s;
+        fs.w0 = poly[0].w;
+        fs.da = (w1 * y2 - w2 * y1) * inv;
+        fs.db = (x1 * w2 - x2 * w1) * inv;
+      }
       raster_triangle(X, Y, fb.width, fb.height, rows, [&](int x, int y) { shade_pixel(fb, fs, x, y); });
     }
   }
@@ -345,6 +345,7 @@ struct TetRasterizer::Impl {
         for (int i = 0; i < 3; ++i) {
           poly[i].X = X[order[i]];
           poly[i].Y = Y[order[i]];
+          poly[i].w = nearness(c[order[i]]);
           poly[i].mesh_edge = true;
         }
         const double* v[3] = {c[a], c[b], c[d]};
@@ -390,12 +391,14 @@ struct TetRasterizer::Impl {
           out.c[0] = P[0] + tt * (Q[0] - P[0]);
           out.c[1] = P[1] + tt * (Q[1] - P[1]);
           out.c[2] = near;
+          out.w = 1 / near;
           std::uint8_t dummy;
           project_camera(out.c, out.X, out.Y, dummy);
         };
         if (pin) {
           poly[n].X = X[pi];
           poly[n].Y = Y[pi];
+          poly[n].w = nearness(c[pi]);
           poly[n].mesh_edge = true;
           ++n;
           if (!qin) {

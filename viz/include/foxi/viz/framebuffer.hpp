@@ -1,5 +1,6 @@
 // The picture the painter fills: RGBA8 pixels, an id buffer (the tet each pixel shows, for picking,
-// probing and recolouring) and, in depth-buffer mode only, a float depth buffer.
+// probing and recolouring) and, in depth-buffer mode only, a depth buffer (double: it is the test
+// oracle, and float rounding alone flips grazing layers).
 #pragma once
 
 #include <algorithm>
@@ -21,7 +22,7 @@ struct Framebuffer {
   int width = 0, height = 0;
   std::vector<std::uint32_t> rgba;  // width * height, row-major, row 0 at the top
   std::vector<std::uint32_t> id;    // width * height: tet index, or kNone for background
-  std::vector<float> depth;         // width * height in depth-buffer mode, else empty; larger = nearer
+  std::vector<double> depth;        // width * height in depth-buffer mode, else empty; larger = nearer
 
   Framebuffer() = default;
   // A cleared framebuffer; with_depth allocates the depth buffer.
@@ -34,7 +35,7 @@ struct Framebuffer {
     rgba.assign(std::size_t(w) * std::size_t(h), background);
     id.assign(std::size_t(w) * std::size_t(h), kNone);
     if (with_depth)
-      depth.assign(std::size_t(w) * std::size_t(h), -std::numeric_limits<float>::infinity());
+      depth.assign(std::size_t(w) * std::size_t(h), -std::numeric_limits<double>::infinity());
     else
       depth.clear();
   }
@@ -42,7 +43,7 @@ struct Framebuffer {
   void clear(std::uint32_t background = pack_rgba(255, 255, 255)) {
     std::fill(rgba.begin(), rgba.end(), background);
     std::fill(id.begin(), id.end(), kNone);
-    std::fill(depth.begin(), depth.end(), -std::numeric_limits<float>::infinity());
+    std::fill(depth.begin(), depth.end(), -std::numeric_limits<double>::infinity());
   }
   std::size_t index(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }
 };
