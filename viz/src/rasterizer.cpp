@@ -81,17 +81,19 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
       continue;
     }
     const std::int64_t py = y * kOne + kHalf;
-    std::int64_t e[3], step[3];
+    // The covered run of this row, exactly: E_i(x) = e_i + s_i (x - x0) >= 0 for all i.
+    std::int64_t lo = x0, hi = x1;
     for (int i = 0; i < 3; ++i) {
-      e[i] = dx[i] * (py - Y[i]) - dy[i] * (px0 - X[i]) + bias[i];
-      step[i] = -dy[i] * kOne;
+      const std::int64_t e = dx[i] * (py - Y[i]) - dy[i] * (px0 - X[i]) + bias[i], step = -dy[i] * kOne;
+      if (step > 0) {
+        lo = std::max(lo, x0 - floor_div(e, step));  // smallest k with e + step k >= 0 is ceil(-e / step)
+      } else if (step < 0) {
+        hi = std::min(hi, x0 + floor_div(e, -step));  // largest k with e - |step| k >= 0
+      } else if (e < 0) {
+        hi = lo - 1;
+      }
     }
-    for (std::int64_t x = x0; x <= x1; ++x) {
-      if ((e[0] | e[1] | e[2]) >= 0) fn(int(x), int(y));
-      e[0] += step[0];
-      e[1] += step[1];
-      e[2] += step[2];
-    }
+    for (std::int64_t x = lo; x <= hi; ++x) fn(int(x), int(y));
   }
 }
 
