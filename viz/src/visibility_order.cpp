@@ -205,7 +205,6 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     bucket_begin.assign(1, 0);
     return;
   }
-  auto item_at = [&](std::size_t i) { return i < m_main ? items[i] : wide_items[i - m_main]; };
 
   // Rounding bounds: |key error| <= a + b |p|_1 (orthographic: b |d|_1), in the local frame.
   View v = view;
@@ -232,23 +231,44 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   const double sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
   double lo_part[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   double hi_part[2] = {-lo_part[0], -lo_part[1]};
-  parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
+  // Tight loops on raw pointers: the ordinary items (no branch), then the few wide ones.
+  const std::uint32_t* rep_p = reps.data();
+  double* lo_p = los.data();
+  const double px = 2 * v.eye[0], py = 2 * v.eye[1], pz = 2 * v.eye[2];
+  const double dx = v.dir[0], dy = v.dir[1], dz = v.dir[2];
+  const double shift = double(bound);
+  parallel_for(m_main, [&](std::size_t b, std::size_t e, int part) {
     double l = lo_part[part], h = hi_part[part];
-    const double px = 2 * v.eye[0], py = 2 * v.eye[1], pz = 2 * v.eye[2];
-    for (std::size_t i = b; i < e; ++i) {
-      std::uint32_t item = item_at(i);
-      std::uint32_t tet = i < m_main ? reps[i] : rep_tet(t, item);
-      const double* c = C + 3 * std::size_t(tet);
-      double k = v.perspective ? S[tet] - (c[0] * px + c[1] * py + c[2] * pz)
-                               : c[0] * v.dir[0] + c[1] * v.dir[1] + c[2] * v.dir[2];
-      double lo = sign * k - double(i < m_main ? bound : radius_of(i));
-      los[i] = lo;
-      l = std::min(l, lo);
-      h = std::max(h, lo);
+    if (v.perspective) {
+      for (std::size_t i = b; i < e; ++i) {
+        const std::size_t tet = rep_p[i];
+        const double* c = C + 3 * tet;
+        const double lo = sign * (S[tet] - (c[0] * px + c[1] * py + c[2] * pz)) - shift;
+        lo_p[i] = lo;
+        l = std::min(l, lo);
+        h = std::max(h, lo);
+      }
+    } else {
+      for (std::size_t i = b; i < e; ++i) {
+        const double* c = C + 3 * std::size_t(rep_p[i]);
+        const double lo = sign * (c[0] * dx + c[1] * dy + c[2] * dz) - shift;
+        lo_p[i] = lo;
+        l = std::min(l, lo);
+        h = std::max(h, lo);
+      }
     }
     lo_part[part] = l;
     hi_part[part] = h;
   });
+  for (std::size_t i = m_main; i < m; ++i) {
+    const std::uint32_t tet = rep_tet(t, wide_items[i - m_main]);
+    const double* c = C + 3 * std::size_t(tet);
+    const double k = v.perspective ? S[tet] - (c[0] * px + c[1] * py + c[2] * pz) : c[0] * dx + c[1] * dy + c[2] * dz;
+    const double lo = sign * k - double(radius_of(i));
+    lo_p[i] = lo;
+    lo_part[0] = std::min(lo_part[0], lo);
+    hi_part[0] = std::max(hi_part[0], lo);
+  }
   double kmin = std::min(lo_part[0], lo_part[1]), kmax = std::max(hi_part[0], hi_part[1]);
   stats.key_range = kmax - kmin;
   // The buckets cover the bulk of the keys, [0.2%, 99.8%] quantiles of a sample, widened: keys
@@ -280,7 +300,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
   parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
     std::uint32_t* h = hist[part].data();
-    for (std::size_t i = b; i < e; ++i) ++h[bucket_of(los[i])];
+    for (std::size_t i = b; i < e; ++i) ++h[bucket_of(lo_p[i])];
   });
   bucket_begin.assign(nb + 1, 0);
   std::vector<std::uint32_t> start0(nb), start1(nb);
@@ -298,9 +318,17 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   std::vector<Entry>& out = sorted;
   const std::size_t split = m < 50000 ? m : m / 2;  // as parallel_for splits
   auto scatter = [&](std::size_t b, std::size_t e, std::vector<std::uint32_t>& pos) {
-    for (std::size_t i = b; i < e; ++i) {
-      const double lo = los[i];
-      out[pos[bucket_of(lo)]++] = Entry{lo, radius_of(i), item_at(i)};
+    std::uint32_t* ps = pos.data();
+    Entry* o = out.data();
+    const std::uint32_t* it = items.data();
+    const std::size_t main_end = std::min(e, m_main);
+    for (std::size_t i = b; i < main_end; ++i) {
+      const double lo = lo_p[i];
+      o[ps[bucket_of(lo)]++] = Entry{lo, bound, it[i]};
+    }
+    for (std::size_t i = std::max(b, m_main); i < e; ++i) {
+      const double lo = lo_p[i];
+      o[ps[bucket_of(lo)]++] = Entry{lo, radius_of(i), wide_items[i - m_main]};
     }
   };
   if (split == m) {
@@ -372,7 +400,10 @@ double ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end, Scra
   std::size_t i = begin;
   double reach = -std::numeric_limits<double>::infinity();
   *last_chain = begin;
+  const Entry* a = sorted.data();
   while (i < end) {
+    // Fast path: entries whose interval ends before the next one starts (almost all of them).
+    while (i + 1 < end && a[i + 1].lo > a[i].hi()) ++i;
     std::size_t j = i;
     reach = sorted[i].hi();
     while (j + 1 < end && sorted[j + 1].lo <= reach) reach = std::max(reach, sorted[++j].hi());
@@ -579,10 +610,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       reach = fix_ties(chain, end, sc, &chain);
     }
     if (t_cluster_free) {
-      const std::size_t at = out.size();
-      out.resize(at + (end - begin));
-      std::uint32_t* o = out.data() + at;
-      for (std::size_t i = begin; i < end; ++i) *o++ = sorted[i].item;
+      for (std::size_t i = begin; i < end; ++i) out.push_back(sorted[i].item);
     } else {
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t item = sorted[i].item;
