@@ -19,7 +19,7 @@ namespace {
 const char* kSolveUsage =
     "foxi solve MESH --physics thermal [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf]\n"
     "                [--power REGION=W] [--power-density REGION=W/m3] [--k REGION=k]\n"
-    "                [--solver auto|direct|cg] [--tol REL] [-o OUT]\n"
+    "                [--solver auto|direct|amg|ichol] [--tol REL] [-o OUT]\n"
     "  Steady heat conduction with linear tets. Options may be repeated. TAG is a boundary tag\n"
     "  number or name, REGION a region id or name; SI units: T and Tinf in K, q in W/m^2 (into the\n"
     "  body), h in W/(m^2 K), k in W/(m K) (default: the region's material). Boundaries with no\n"
@@ -112,10 +112,12 @@ int cmd_solve(Args args) {
   ThermalParams params;
   if (solver == "direct")
     params.solver.kind = LinearSolverKind::direct;
-  else if (solver == "cg")
+  else if (solver == "amg")
+    params.solver.kind = LinearSolverKind::cg_amg;
+  else if (solver == "ichol")
     params.solver.kind = LinearSolverKind::cg_ichol;
   else if (solver != "auto")
-    throw UsageError("--solver takes auto, direct or cg, not '" + solver + "'");
+    throw UsageError("--solver takes auto, direct, amg or ichol, not '" + solver + "'");
   if (!tol.empty()) params.solver.relative_tolerance = parse_number(tol, "--tol");
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 

@@ -32,15 +32,16 @@ struct SolverCancelled : SolverError {
 };
 
 enum class LinearSolverKind : std::uint8_t {
-  automatic,  // direct up to LinearSolverOptions::direct_max_unknowns, else cg_ichol
+  automatic,  // direct up to LinearSolverOptions::direct_max_unknowns, else cg_amg
   direct,     // sparse LDL^T (Eigen SimplicialLDLT, AMD ordering)
-  cg_ichol,   // conjugate gradients, incomplete Cholesky preconditioner (Eigen, AMD ordering)
+  cg_ichol,   // conjugate gradients, incomplete Cholesky preconditioner (Eigen, mesh node order)
+  cg_amg,     // conjugate gradients, smoothed-aggregation algebraic multigrid V(1,1) preconditioner
 };
 
 // Options of the linear solve shared by foxi's solvers.
 struct LinearSolverOptions {
   LinearSolverKind kind = LinearSolverKind::automatic;
-  std::size_t direct_max_unknowns = 40000;
+  std::size_t direct_max_unknowns = 5000;
   double relative_tolerance = 1e-10;  // CG stops at |b - A x| <= tol |b|
   std::size_t max_iterations = 0;     // 0: 10 * unknowns + 100
   unsigned threads = 0;               // 0: std::thread::hardware_concurrency()
@@ -110,7 +111,7 @@ struct ThermalReport {
   double max_temperature = 0;              // K
   std::uint32_t max_node = kNone;
   double total_power = 0;        // W from the sources
-  std::string solver;            // "SimplicialLDLT" or "CG+IncompleteCholesky"
+  std::string solver;            // "SimplicialLDLT", "CG+IncompleteCholesky", "CG+SmoothedAggregationAMG"
   std::size_t unknowns = 0;      // free nodes
   std::size_t nonzeros = 0;      // of the free-free matrix (both triangles)
   std::size_t iterations = 0;    // CG iterations (0 for the direct solver)
