@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job on a fresh machine: installs what is missing, builds foxi, meshes the example
-# package (a die on a substrate) with TetGen, and shows what foxi makes of it: counts, regions,
-# boundaries, quality, the Delaunay certificate; then converts it to ParaView's and Gmsh's formats.
+# package (a die on a substrate) with TetGen, shows what foxi makes of it (counts, regions,
+# boundaries, quality, the Delaunay certificate, the verified visibility order), solves its steady
+# heat conduction, renders its inside to a PNG, and converts it to ParaView's and Gmsh's formats.
 # Output goes to out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,8 +20,17 @@ echo
 # The visibility order (power of the eye w.r.t. each circumsphere) from 4 random views, verified.
 "$foxi" order "$out/die_on_substrate.node" --views 4 --check
 echo
+# Steady heat: 0.5 W in the die (region 2), the substrate bottom (boundary 1) held at 300 K, the
+# die top (boundary 6) cooled by air (h = 10 W/m^2K at 300 K); conductivities of FR-4 and silicon.
+"$foxi" solve "$out/die_on_substrate.node" --physics thermal --fix 1=300 --power 2=0.5 --k 1=0.3 \
+  --k 2=150 --convect 6=10,300 -o "$out/die_on_substrate_thermal.vtu"
+echo
+# The inside of the mesh: the far 60% of the tets, back to front, each shrunk a little.
+"$foxi" render "$out/die_on_substrate.node" --stop 60% --shrink 0.85 --size 1280x960 -o "$out/die_on_substrate.png"
+echo
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.vtu"
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.msh"
 "$foxi" info "$out/die_on_substrate.msh" --json > "$out/die_on_substrate.json"
 echo
-echo "demo: wrote $out/die_on_substrate.vtu (ParaView), $out/die_on_substrate.msh (Gmsh), $out/die_on_substrate.json"
+echo "demo: wrote $out/die_on_substrate.png (the mesh inside), $out/die_on_substrate_thermal.vtu (temperature and"
+echo "      heat flux, for ParaView), $out/die_on_substrate.vtu and .msh (the mesh), $out/die_on_substrate.json"
