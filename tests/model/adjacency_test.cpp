@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "../../bench/bench_meshes.hpp"
+#include "plc_text.hpp"
 #include "test_util.hpp"
 
 namespace foxi {
@@ -203,17 +204,6 @@ TetgenMesh read_tetgen_with_neigh(const std::filesystem::path& base) {
   return r;
 }
 
-std::string box_poly(double lx, double ly, double lz) {
-  std::ostringstream s;
-  s << "8 3 0 0\n";
-  for (int i = 0; i < 8; ++i)
-    s << i + 1 << ' ' << (i & 1 ? lx : 0) << ' ' << (i & 2 ? ly : 0) << ' ' << (i & 4 ? lz : 0) << '\n';
-  s << "6 0\n";
-  const int f[6][4] = {{1, 3, 7, 5}, {2, 4, 8, 6}, {1, 2, 6, 5}, {3, 4, 8, 7}, {1, 2, 4, 3}, {5, 6, 8, 7}};
-  for (auto& q : f) s << "1\n4 " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << '\n';
-  s << "0\n0\n";
-  return s.str();
-}
 
 void check_against_tetgen(const std::string& poly_text, const std::string& switches) {
   if (!test::have_program("tetgen")) GTEST_SKIP() << "tetgen not installed";
@@ -246,14 +236,12 @@ void check_against_tetgen(const std::string& poly_text, const std::string& switc
 }
 
 TEST(FaceAdjacency, MatchesTetgenNeighboursOnBox) {
-  check_against_tetgen(box_poly(2, 1, 1), "-pq1.414a0.0005O0nQ");
+  check_against_tetgen(test::box_poly(2, 1, 1), "-pq1.414a0.0005O0nQ");
 }
 
-// The seed paper's U-trench PLC (non-convex), shipped in examples/.
-std::string trench_poly() { return test::read_text(test::data_dir() + "/../../examples/trench.poly"); }
 
 TEST(FaceAdjacency, MatchesTetgenNeighboursOnTrench) {
-  check_against_tetgen(trench_poly(), "-pq1.414a0.001nQ");
+  check_against_tetgen(test::trench_poly(), "-pq1.414a0.001nQ");
 }
 
 }  // namespace

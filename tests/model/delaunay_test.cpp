@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "../../bench/bench_meshes.hpp"
+#include "plc_text.hpp"
 #include "test_util.hpp"
 
 namespace foxi {
@@ -160,20 +161,7 @@ Mesh read_node_ele(const std::filesystem::path& base) {
   return m;
 }
 
-std::string box_poly(double lx, double ly, double lz) {
-  std::ostringstream s;
-  s << "8 3 0 0\n";
-  for (int i = 0; i < 8; ++i)
-    s << i + 1 << ' ' << (i & 1 ? lx : 0) << ' ' << (i & 2 ? ly : 0) << ' ' << (i & 4 ? lz : 0) << '\n';
-  s << "6 0\n";
-  const int f[6][4] = {{1, 3, 7, 5}, {2, 4, 8, 6}, {1, 2, 6, 5}, {3, 4, 8, 7}, {1, 2, 4, 3}, {5, 6, 8, 7}};
-  for (auto& q : f) s << "1\n4 " << q[0] << ' ' << q[1] << ' ' << q[2] << ' ' << q[3] << '\n';
-  s << "0\n0\n";
-  return s.str();
-}
 
-// The seed paper's U-trench PLC (non-convex), shipped in examples/.
-std::string trench_poly() { return test::read_text(test::data_dir() + "/../../examples/trench.poly"); }
 
 // Runs tetgen on a PLC; returns false (and the test skips) when tetgen is not installed.
 bool tetgen_mesh(const std::string& poly, const std::string& switches, Mesh& out) {
@@ -188,7 +176,7 @@ bool tetgen_mesh(const std::string& poly, const std::string& switches, Mesh& out
 
 TEST(DelaunayCertificate, TetgenBoxWithoutOptimisationIsDelaunay) {
   Mesh m;
-  if (!tetgen_mesh(box_poly(2, 1, 1), "-pq1.414a0.0004O0Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(test::box_poly(2, 1, 1), "-pq1.414a0.0004O0Q", m)) GTEST_SKIP() << "no tetgen";
   ASSERT_GT(m.tet_count(), 5000u);
   DelaunayCertificate c = compute_delaunay_certificate(m);
   EXPECT_TRUE(c.delaunay);
@@ -200,7 +188,7 @@ TEST(DelaunayCertificate, TetgenBoxWithoutOptimisationIsDelaunay) {
 
 TEST(DelaunayCertificate, OptimisedTrenchViolationsMatchBruteForce) {
   Mesh m;
-  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.0005Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(test::trench_poly(), "-pq1.414a0.0005Q", m)) GTEST_SKIP() << "no tetgen";
   DelaunayCertificate c = compute_delaunay_certificate(m);
   Brute b = brute_force(m);
   std::printf("trench a0.0005: %zu tets, %zu nodes, %zu violating (brute force %zu)\n", m.tet_count(),
@@ -214,7 +202,7 @@ TEST(DelaunayCertificate, OptimisedTrenchViolationsMatchBruteForce) {
 
 TEST(DelaunayCertificate, TrenchWithoutOptimisationMatchesBruteForce) {
   Mesh m;
-  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.002O0Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(test::trench_poly(), "-pq1.414a0.002O0Q", m)) GTEST_SKIP() << "no tetgen";
   DelaunayCertificate c = compute_delaunay_certificate(m);
   Brute b = brute_force(m);
   EXPECT_TRUE(b.violating.empty());
@@ -271,7 +259,7 @@ TEST(DelaunayCertificate, DuplicatePointsAreOnSpheresNotInside) {
   // Two copies of the same Delaunay mesh with their own nodes at identical coordinates: every tet has
   // its twin's four vertices on its sphere and nothing inside.
   Mesh m;
-  if (!tetgen_mesh(box_poly(1, 1, 1), "-pq1.414a0.002O0Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(test::box_poly(1, 1, 1), "-pq1.414a0.002O0Q", m)) GTEST_SKIP() << "no tetgen";
   const auto nn = static_cast<std::uint32_t>(m.node_count());
   const std::size_t nt = m.tet.size();
   m.xyz.insert(m.xyz.end(), m.xyz.begin(), m.xyz.end());
@@ -336,7 +324,7 @@ TEST(DelaunayCertificate, DegenerateTetCounted) {
 TEST(DelaunayCertificate, EqualWeightsGiveTheUnweightedResult) {
   // Equal weights shift every power distance by the same amount: regular = Delaunay.
   Mesh m;
-  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(test::trench_poly(), "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
   DelaunayCertificate plain = compute_delaunay_certificate(m);
   m.weight.assign(m.node_count(), 0.013);
   DelaunayCertificate w = compute_delaunay_certificate(m);
@@ -348,7 +336,7 @@ TEST(DelaunayCertificate, EqualWeightsGiveTheUnweightedResult) {
 
 TEST(DelaunayCertificate, LargeWeightOnOneVertexMatchesBruteForce) {
   Mesh m;
-  if (!tetgen_mesh(box_poly(1, 1, 1), "-pq1.414a0.001O0Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(test::box_poly(1, 1, 1), "-pq1.414a0.001O0Q", m)) GTEST_SKIP() << "no tetgen";
   m.weight.assign(m.node_count(), 0.0);
   // The node nearest the centre gets a power radius of about two mean edge lengths.
   std::uint32_t best = 0;
@@ -380,7 +368,7 @@ TEST(DelaunayCertificate, WeightSignConventionAnalytic) {
 
 TEST(DelaunayCertificate, ListTruncatedCountKept) {
   Mesh m;
-  if (!tetgen_mesh(trench_poly(), "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
+  if (!tetgen_mesh(test::trench_poly(), "-pq1.414a0.002Q", m)) GTEST_SKIP() << "no tetgen";
   CertificateOptions opt;
   opt.max_listed = 3;
   DelaunayCertificate all = compute_delaunay_certificate(m);
