@@ -7,8 +7,9 @@
 //   centroid_order    a centroid-depth sort (what VTK's vtkCellCenterDepthSort does)
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-6 (0.97M tets, Delaunay) and a 55^3 cube grid
 // split into 6 tets per cube (1.0M tets, one cospherical cluster per cube); with FOXI_BENCH_LARGE=1
-// also the box at a1e-6 (~3.9M tets). Every iteration takes a new perspective eye point outside the
-// mesh (a fixed sequence), so nothing is reused between views.
+// also the box at a1e-6 (~3.9M tets), with FOXI_BENCH_LARGE=2 the box at a4e-7 (~9.7M tets) too.
+// Every iteration takes a new perspective eye point outside the mesh (a fixed sequence), so nothing
+// is reused between views.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -31,12 +32,13 @@ struct Case {
 };
 
 Case& get_case(int which) {
-  static std::unique_ptr<Case> cases[3];
+  static std::unique_ptr<Case> cases[4];
   if (!cases[which]) {
     auto c = std::make_unique<Case>();
     if (which == 0) c->mesh = bench::tetgen_box_mesh(2, 1, 1, 4e-6);
     if (which == 1) c->mesh = bench::cube_grid_mesh(55);
     if (which == 2) c->mesh = bench::tetgen_box_mesh(2, 1, 1, 1e-6);
+    if (which == 3) c->mesh = bench::tetgen_box_mesh(2, 1, 1, 4e-7);
     face_adjacency(c->mesh);
     c->table = compute_spheres(c->mesh);
     cases[which] = std::move(c);
@@ -44,7 +46,9 @@ Case& get_case(int which) {
   return *cases[which];
 }
 
-const char* case_name(int which) { return which == 0 ? "box_972k" : which == 1 ? "grid_1M" : "box_3.9M"; }
+const char* case_name(int which) {
+  return which == 0 ? "box_972k" : which == 1 ? "grid_1M" : which == 2 ? "box_3.9M" : "box_9.7M";
+}
 
 View eye_for(std::size_t i) {
   std::mt19937 rng(static_cast<unsigned>(1000 + i));
@@ -55,8 +59,9 @@ View eye_for(std::size_t i) {
 }
 
 bool skip(benchmark::State& state, int which) {
-  if (which == 2 && std::getenv("FOXI_BENCH_LARGE") == nullptr) {
-    state.SkipWithError("set FOXI_BENCH_LARGE=1 for the 3.9M-tet mesh");
+  const char* large = std::getenv("FOXI_BENCH_LARGE");
+  if (which >= 2 && (large == nullptr || std::atoi(large) < which - 1)) {
+    state.SkipWithError("set FOXI_BENCH_LARGE=1 for the 3.9M-tet mesh, 2 for the 9.7M one too");
     return true;
   }
   return false;
@@ -164,11 +169,11 @@ void BM_centroid_order(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_power_order)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_first_batch)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_power_order)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_first_batch)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_keys_only)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_std_sort)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_std_sort)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_centroid_order)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
-BENCHMARK(BM_precompute)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_precompute)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 
 BENCHMARK_MAIN();
