@@ -49,9 +49,9 @@ struct Rows {
   }
 };
 
-// Calls fn(x, y) for every pixel whose centre the triangle covers under the top-left rule; the
-// triangle must have positive area: (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) > 0 (clockwise on the
-// screen, y down). Only rows owned by `rows` are visited.
+// Calls fn(y, x_first, x_last) for every row run of pixels whose centres the triangle covers under the
+// top-left rule; the triangle must have positive area: (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) > 0 (clockwise
+// on the screen, y down). Only rows owned by `rows` are visited.
 template <class Fn>
 void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, int height, const Rows& rows,
                      Fn&& fn) {
@@ -93,7 +93,7 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
         hi = lo - 1;
       }
     }
-    for (std::int64_t x = lo; x <= hi; ++x) fn(int(x), int(y));
+    if (lo <= hi) fn(int(y), int(lo), int(hi));
   }
 }
 
@@ -274,6 +274,64 @@ struct TetRasterizer::Impl {
     fb.id[p] = fs.tet;
   }
 
+  // One row run of a face. Painter mode: constant colour except within reach of an edge line, where
+  // each pixel is shaded by shade_pixel (the intervals are widened by a pixel so that rounding in
+  // solving for them never changes a pixel's colour).
+  void shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+    if (params.depth_buffer) {
+      for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
+      return;
+    }
+    const std::size_t row = std::size_t(y) * std::size_t(fb.width);
+    auto fill = [&](int a, int b) {
+      if (a > b) return;
+      std::fill(fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(a)),
+                fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(b) + 1), fs.color);
+      std::fill(fb.id.begin() + std::ptrdiff_t(row + std::size_t(a)),
+                fb.id.begin() + std::ptrdiff_t(row + std::size_t(b) + 1), fs.tet);
+    };
+    if (fs.lines == 0) {
+      fill(lo, hi);
+      return;
+    }
+    const double sy = y + 0.5, w = params.edge_width;
+    int s[4], e[4], m = 0;
+    for (int k = 0; k < fs.lines; ++k) {
+      // d(x) = la (x + 0.5) + base; dark where d < w.
+      const double la = fs.la[k], base = fs.lb[k] * sy + fs.lc[k];
+      int a, b;
+      if (std::abs(la) < 1e-6) {
+        if (std::min(la * (lo + 0.5), la * (hi + 0.5)) + base >= w + 1e-3) continue;
+        a = lo;
+        b = hi;
+      } else {
+        const double xc = std::clamp((w - base) / la - 0.5, double(lo) - 4, double(hi) + 4);
+        if (la > 0) {
+          a = lo;
+          b = std::min(hi, int(std::floor(xc)) + 1);
+        } else {
+          a = std::max(lo, int(std::ceil(xc)) - 1);
+          b = hi;
+        }
+      }
+      if (a > b) continue;
+      int i = m++;
+      for (; i > 0 && s[i - 1] > a; --i) {
+        s[i] = s[i - 1];
+        e[i] = e[i - 1];
+      }
+      s[i] = a;
+      e[i] = b;
+    }
+    int x = lo;
+    for (int i = 0; i < m; ++i) {
+      fill(x, s[i] - 1);
+      for (int p = std::max(x, s[i]); p <= e[i]; ++p) shade_pixel(fb, fs, p, y);
+      x = std::max(x, e[i] + 1);
+    }
+    fill(x, hi);
+  }
+
   // Draws a convex polygon (positive area) as a fan from vertex 0.
   void raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) const {
     for (int i = 1; i + 1 < n; ++i) {
@@ -291,7 +349,8 @@ struct TetRasterizer::Impl {
         fs.da = (w1 * y2 - w2 * y1) * inv;
         fs.db = (x1 * w2 - x2 * w1) * inv;
       }
-      raster_triangle(X, Y, fb.width, fb.height, rows, [&](int x, int y) { shade_pixel(fb, fs, x, y); });
+      raster_triangle(X, Y, fb.width, fb.height, rows,
+                      [&](int y, int lo, int hi) { shade_row(fb, fs, y, lo, hi); });
     }
   }
 
@@ -493,8 +552,9 @@ std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std:
     std::swap(X[1], X[2]);
     std::swap(Y[1], Y[2]);
   }
-  raster_triangle(X, Y, width, height, Rows{}, [&](int px, int py) {
-    out.push_back(std::uint32_t(py) * std::uint32_t(width) + std::uint32_t(px));
+  raster_triangle(X, Y, width, height, Rows{}, [&](int py, int lo, int hi) {
+    for (int px = lo; px <= hi; ++px)
+      out.push_back(std::uint32_t(py) * std::uint32_t(width) + std::uint32_t(px));
   });
   return out;
 }
