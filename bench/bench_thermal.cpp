@@ -5,6 +5,9 @@
 //   foxi_thermal/ichol     the same with Eigen's incomplete Cholesky as the preconditioner
 //   foxi_thermal/direct    the same with SimplicialLDLT (smaller mesh only: fill-in)
 //   triplet_assembly       the textbook assembly: one serial triplet list, Eigen setFromTriplets
+//   ccx_1M                 CalculiX (Debian's ccx, SPOOLES) on the same mesh and problem, deck written
+//                          by foxi::write_calculix_thermal (wall time of ccx alone; set FOXI_BENCH_CCX=1,
+//                          it takes about half a minute)
 //   eigen_cg_jacobi        Eigen's ConjugateGradient with the diagonal (Jacobi) preconditioner on the
 //                          same system (what scipy's Jacobi-CG does)
 // Mesh: a 57^3 Kuhn grid (1.11M tets, 195k nodes), two regions (k 1 and 10 W/(m K)), fixed 300 K at
@@ -18,9 +21,14 @@
 #include <Eigen/SparseCore>
 #include <array>
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
+#include <random>
+#include <string>
 
 #include "bench_meshes.hpp"
+#include "foxi/solver/calculix.hpp"
 #include "foxi/solver/thermal.hpp"
 
 namespace {
@@ -158,6 +166,28 @@ void eigen_cg_jacobi(benchmark::State& state) {
   state.counters["Tmax"] = x.maxCoeff();
 }
 
+void ccx_1M(benchmark::State& state) {
+  if (std::getenv("FOXI_BENCH_CCX") == nullptr || std::system("command -v ccx > /dev/null 2>&1") != 0) {
+    state.SkipWithError("set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
+    return;
+  }
+  Mesh& m = grid(57);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("foxi-bench-ccx-" + std::to_string(std::random_device{}()));
+  std::filesystem::create_directories(dir);
+  write_calculix_thermal(m, params(LinearSolverKind::automatic), dir / "heat.inp");
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const int rc = std::system(("cd '" + dir.string() + "' && ccx -i heat > ccx.log 2>&1").c_str());
+    const auto t1 = std::chrono::steady_clock::now();
+    if (rc != 0) state.SkipWithError("ccx failed");
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+  }
+  state.counters["tets"] = static_cast<double>(m.tet_count());
+  std::filesystem::remove_all(dir);
+}
+
+BENCHMARK(ccx_1M)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(foxi_thermal, amg_1M, LinearSolverKind::cg_amg, 57u)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()

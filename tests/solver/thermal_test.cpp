@@ -145,7 +145,8 @@ TEST_F(ThermalTest, HeatGenerationConvergesAtSecondOrder) {
     p.conductivity = {{1, k}};
     p.fixed = {{1, 0}, {2, 0}};
     p.sources = {{1, q * kL * kArea, true}};  // total W
-    p.solver.kind = LinearSolverKind::direct;
+    p.solver.kind = LinearSolverKind::cg_amg;
+    p.solver.relative_tolerance = 1e-12;
     const ThermalReport r = solve_thermal(m, p);
     EXPECT_NEAR(r.total_power, q * kL * kArea, 1e-9 * r.total_power);
     // Energy balance: what is generated leaves through the two ends, half each by symmetry.
@@ -180,25 +181,20 @@ TEST_F(ThermalTest, HeatGenerationConvergesAtSecondOrder) {
     hs.push_back(std::cbrt(vol / static_cast<double>(m.tet_count())));
     errors.push_back(std::sqrt(e2));
     tets.push_back(m.tet_count());
-    if (max_volume < 1e-5) {
-      // The finest mesh (about 15k unknowns, several AMG levels): both CG variants agree with LDL^T.
-      EXPECT_EQ(r.solver, "SimplicialLDLT");
-      const std::vector<double> direct = t;
-      for (LinearSolverKind kind : {LinearSolverKind::cg_amg, LinearSolverKind::cg_ichol}) {
-        p.solver.kind = kind;
-        p.solver.relative_tolerance = 1e-12;
-        const ThermalReport rc = solve_thermal(m, p);
-        const std::vector<double>& tc = m.find_field("temperature")->values;
-        double diff = 0;
-        for (std::size_t v = 0; v < tc.size(); ++v) diff = std::max(diff, std::abs(tc[v] - direct[v]));
-        EXPECT_LT(diff, 1e-8 * q * kL * kL / (8 * k)) << rc.solver;
-        EXPECT_LT(rc.relative_residual, 1e-11) << rc.solver;
-        std::printf("%s: %zu iterations\n", rc.solver.c_str(), rc.iterations);
-        if (kind == LinearSolverKind::cg_amg) {
-          EXPECT_LT(rc.iterations, 40u);  // multigrid: iterations nearly independent of the mesh size
-        }
-      }
-    }
+    // The other solvers agree with the one used (AMG, several levels on the finer meshes): LDL^T on
+    // the coarser meshes, incomplete-Cholesky CG on the finest (where LDL^T is slow under ASan).
+    EXPECT_EQ(r.solver, "CG+SmoothedAggregationAMG");
+    EXPECT_LT(r.iterations, 40u);  // multigrid: iterations nearly independent of the mesh size
+    const std::vector<double> first = t;
+    p.solver.kind = max_volume < 1e-5 ? LinearSolverKind::cg_ichol : LinearSolverKind::direct;
+    const ThermalReport rc = solve_thermal(m, p);
+    const std::vector<double>& tc = m.find_field("temperature")->values;
+    double diff = 0;
+    for (std::size_t v = 0; v < tc.size(); ++v) diff = std::max(diff, std::abs(tc[v] - first[v]));
+    EXPECT_LT(diff, 1e-8 * q * kL * kL / (8 * k)) << rc.solver;
+    EXPECT_LT(rc.relative_residual, 1e-11) << rc.solver;
+    std::printf("%zu unknowns: AMG %zu iterations, %s %zu iterations, max difference %.3g K\n", r.unknowns,
+                r.iterations, rc.solver.c_str(), rc.iterations, diff);
   }
   for (std::size_t i = 1; i < hs.size(); ++i) {
     const double rate = std::log(errors[i - 1] / errors[i]) / std::log(hs[i - 1] / hs[i]);
