@@ -1,0 +1,72 @@
+// foxi solve (the command line) on a TetGen slab: the written .vtu holds the exact linear profile,
+// and bad input gives the documented exit statuses and messages.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "foxi/model/mesh_io.hpp"
+#include "test_util.hpp"
+
+namespace foxi {
+namespace {
+
+// The unit cube, facet markers 1 (x = 0), 2 (x = 1), 3 (the rest), region 1.
+const char* kCubePoly =
+    "8 3 0 0\n1 0 0 0\n2 0 1 0\n3 0 1 1\n4 0 0 1\n5 1 0 0\n6 1 1 0\n7 1 1 1\n8 1 0 1\n"
+    "6 1\n1 0 1\n4 1 2 3 4\n1 0 2\n4 5 6 7 8\n1 0 3\n4 1 2 6 5\n1 0 3\n4 2 3 7 6\n"
+    "1 0 3\n4 3 4 8 7\n1 0 3\n4 4 1 5 8\n0\n1\n1 0.5 0.5 0.5 1 0\n";
+
+class SolveCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!test::have_program("tetgen")) GTEST_SKIP() << "tetgen not installed";
+    if (!std::filesystem::exists(test::cli_path())) GTEST_SKIP() << "the foxi program is not built";
+    test::write_text(dir_ / "cube.poly", kCubePoly);
+    ASSERT_EQ(
+        test::run("tetgen -pq1.414AQa0.002 '" + (dir_ / "cube.poly").string() + "'", dir_ / "tetgen.log"), 0);
+  }
+  int foxi(const std::string& args) {
+    return test::run("'" + test::cli_path() + "' " + args, dir_ / "out.log");
+  }
+  std::string mesh() const { return "'" + (dir_ / "cube.1.node").string() + "'"; }
+  test::TempDir dir_;
+};
+
+TEST_F(SolveCliTest, WritesTheExactLinearProfile) {
+  const std::string out = (dir_ / "result.vtu").string();
+  ASSERT_EQ(foxi("solve " + mesh() + " --physics thermal --fix 1=300 --fix 2=400 --k 1=2 -o '" + out + "'"),
+            0)
+      << test::read_text(dir_ / "out.log");
+  const std::string log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("max temperature 400 K"), std::string::npos) << log;
+  const Mesh m = read_mesh(out);
+  const Field* t = m.find_field("temperature");
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->unit, "K");
+  double worst = 0;
+  for (std::size_t v = 0; v < m.node_count(); ++v)
+    worst = std::max(worst, std::abs(t->values[v] - (300 + 100 * m.xyz[3 * v])));
+  EXPECT_LT(worst, 1e-9);
+  const Field* q = m.find_field("heat_flux");
+  ASSERT_NE(q, nullptr);
+  ASSERT_EQ(q->components, 3u);
+  for (std::size_t c = 0; c < m.tet_count(); ++c) EXPECT_NEAR(q->values[3 * c], -200.0, 1e-7);
+}
+
+TEST_F(SolveCliTest, BadInputGivesClearErrors) {
+  EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300"), 1);  // no conductivity
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("region 1 has no thermal conductivity"),
+            std::string::npos);
+  EXPECT_EQ(foxi("solve " + mesh() + " --flux 1=10 --k 1=1"), 1);
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("ill-posed"), std::string::npos);
+  EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=abc --k 1=1"), 2);
+  EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300 --k 1=1 --frobnicate 3"), 2);
+  EXPECT_EQ(foxi("solve " + mesh() + " --physics magic --fix 1=300 --k 1=1"), 2);
+  EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300 --k 1=1 --solver nope"), 2);
+  EXPECT_EQ(foxi("solve --help"), 0);
+}
+
+}  // namespace
+}  // namespace foxi
