@@ -303,6 +303,29 @@ TEST(VisibilityOrder, ProgressiveBatchesConcatenateToTheWholeOrder) {
   for (std::uint32_t i = 0; i < sorted.size(); ++i) ASSERT_EQ(sorted[i], i);
 }
 
+TEST(VisibilityOrder, ProgressiveSortingAheadOnASecondThread) {
+  // 50,000 tets and more: buckets are sorted ahead on a worker thread while batches are taken.
+  if (!test::have_program("tetgen")) GTEST_SKIP();
+  test::TempDir dir;
+  Mesh m = test::random_delaunay(dir, 9000, 43);
+  ASSERT_GE(m.tet_count(), 50000u);
+  SphereTable t = compute_spheres(m);
+  for (const View& v : random_views(m, 6, 77)) {
+    ProgressiveOrder progressive(m, t, v);
+    std::vector<std::uint32_t> all;
+    for (auto b = progressive.next(); !b.empty(); b = progressive.next()) all.insert(all.end(), b.begin(), b.end());
+    EXPECT_EQ(progressive.handed_out(), m.tet_count());
+    EXPECT_EQ(all, visibility_order(m, t, v));
+    EXPECT_EQ(count_violations(m, v, all).violations, 0u);
+  }
+  // Stopping early (a user's stop button): destroying the order stops the worker.
+  for (int k = 0; k < 5; ++k) {
+    ProgressiveOrder progressive(m, t, View::at(0.5, -3, 0.5 + k));
+    auto first = progressive.next();
+    EXPECT_FALSE(first.empty());
+  }
+}
+
 TEST(VisibilityOrder, NonDelaunayMeshIsReportedAndMpvoOrdersIt) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;

@@ -1,8 +1,12 @@
 #include "foxi/viz/visibility_order.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
 #include <limits>
+#include <mutex>
 #include <queue>
 #include <thread>
 
@@ -130,8 +134,23 @@ struct ProgressiveOrder::Impl {
 
   bool tet_in(std::uint32_t t) const { return in_subset.empty() || in_subset[t]; }
 
+  // The progressive path sorts ahead on a second thread (started by the first next()), so that the
+  // caller can draw one batch while the next buckets are being sorted.
+  std::thread worker;
+  std::mutex mu;
+  std::condition_variable cv;
+  std::deque<std::vector<std::uint32_t>> ready;
+  bool worker_done = false;
+  std::atomic<bool> stop{false};
+  void run_worker();
+
   ~Impl() {
-    // Hand the big buffer back for the next view on this thread.
+    if (worker.joinable()) {
+      stop = true;
+      worker.join();
+    }
+    // Hand the big buffer back for the next view on this thread. (A buffer the worker thread made
+    // is the same memory; the thread_local slot is this thread's.)
     if (sorted.capacity() > t_workspace.entries.capacity()) t_workspace.entries.swap(sorted);
   }
   void prepare(std::span<const std::uint32_t> subset);
@@ -623,13 +642,52 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
   return b;
 }
 
+void ProgressiveOrder::Impl::run_worker() {
+  const std::size_t nb = bucket_begin.size() - 1;
+  std::size_t b = next_bucket;
+  bool first = true;
+  std::vector<std::uint32_t> pending;
+  while (b < nb && !stop) {
+    b = emit_buckets(b, b + 1, nb, pending, scratch, nullptr);
+    // The first bucket goes out at once; later ones in pendinges of a few thousand tets.
+    if (!pending.empty() && (first || pending.size() >= 4096 || b >= nb)) {
+      first = false;
+      std::lock_guard<std::mutex> g(mu);
+      ready.push_back(std::move(pending));
+      pending.clear();
+      cv.notify_one();
+    }
+  }
+  std::lock_guard<std::mutex> g(mu);
+  if (!pending.empty()) ready.push_back(std::move(pending));
+  next_bucket = b;
+  worker_done = true;
+  cv.notify_one();
+}
+
 std::span<const std::uint32_t> ProgressiveOrder::next() {
   Impl& d = *impl_;
   d.batch.clear();
   const std::size_t nb = d.bucket_begin.size() - 1;
-  while (d.batch.empty() && d.next_bucket < nb)
-    d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch, nullptr);
-  d.add_counts(d.scratch);
+  if (d.bucket_begin[nb] < 50000) {
+    // Small orders: on this thread, bucket by bucket.
+    while (d.batch.empty() && d.next_bucket < nb)
+      d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch, nullptr);
+    d.add_counts(d.scratch);
+  } else {
+    if (!d.worker.joinable() && !d.worker_done) d.worker = std::thread([&d] { d.run_worker(); });
+    std::unique_lock<std::mutex> lock(d.mu);
+    d.cv.wait(lock, [&d] { return !d.ready.empty() || d.worker_done; });
+    if (!d.ready.empty()) {
+      d.batch.swap(d.ready.front());
+      d.ready.pop_front();
+    }
+    if (d.ready.empty() && d.worker_done) {
+      lock.unlock();
+      if (d.worker.joinable()) d.worker.join();
+      d.add_counts(d.scratch);
+    }
+  }
   d.handed += d.batch.size();
   return d.batch;
 }

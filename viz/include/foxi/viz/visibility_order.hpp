@@ -36,8 +36,11 @@ struct OrderStats {
 };
 
 // Hands out the order of one view progressively: next() returns the next batch of tets (back to
-// front, or front to back if asked), sorting each bucket only when it is handed out, so drawing can
-// begin before the sort ends and stop early. The table and the mesh are lent and must outlive it.
+// front, or front to back if asked). Buckets are sorted in order on a second thread started by the
+// first next() (for orders of 50,000 tets or more), so the caller draws one batch while the next
+// are sorted; the first bucket is handed out as soon as it is sorted. Destroying the object stops
+// the sorting. The table and the mesh are lent and must outlive it; one object is used from one
+// thread.
 class ProgressiveOrder {
  public:
   // subset: tet indices to order (each at most once); empty span = all tets.
