@@ -282,6 +282,34 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
       }
   }
 
+  // Every connected part needs a fixed or convective node, else its temperature is undetermined.
+  {
+    std::vector<std::uint32_t> parent(nn);
+    for (std::size_t v = 0; v < nn; ++v) parent[v] = static_cast<std::uint32_t>(v);
+    auto root = [&](std::uint32_t v) {
+      while (parent[v] != v) v = parent[v] = parent[parent[v]];
+      return v;
+    };
+    for (std::size_t t = 0; t < nt; ++t)
+      for (int a = 1; a < 4; ++a) {
+        const std::uint32_t r0 = root(mesh.tet[4 * t]), r1 = root(mesh.tet[4 * t + a]);
+        if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
+      }
+    std::vector<char> anchored(nn, 0);
+    for (std::size_t v = 0; v < nn; ++v)
+      if (fixed[v]) anchored[root(static_cast<std::uint32_t>(v))] = 1;
+    for (std::size_t f = 0; f < nf; ++f) {
+      auto it = bc.find(mesh.bface_tag[f]);
+      if (it != bc.end() && it->second.kind == BcKind::convection) anchored[root(mesh.bface[3 * f])] = 1;
+    }
+    for (std::size_t t = 0; t < nt; ++t)
+      if (!anchored[root(mesh.tet[4 * t])])
+        throw SolverError("ill-posed thermal problem: the connected part containing tet " +
+                          std::to_string(t) + " (" + region_label(mesh, mesh.region_of(t)) +
+                          ") touches no fixed-temperature or convection boundary, so its temperature is "
+                          "undetermined");
+  }
+
   // Free unknowns and the reduced system.
   std::vector<int> dof(nn, -1);
   int nfree = 0;

@@ -310,6 +310,35 @@ TEST_F(ThermalTest, IllPosedAndIncompleteProblemsGiveClearErrors) {
   EXPECT_NO_THROW(solve_thermal(m, p));
 }
 
+// Two separate boxes (regions 1 and 2, the second shifted away): a condition on the first alone
+// leaves the second floating.
+TEST_F(ThermalTest, FloatingPartIsIllPosed) {
+  Mesh m = box_mesh(0.01);
+  const Mesh second = box_mesh(0.01);
+  const auto offset = static_cast<std::uint32_t>(m.node_count());
+  for (std::size_t v = 0; v < second.node_count(); ++v) {
+    m.xyz.push_back(second.xyz[3 * v] + 2 * kL);
+    m.xyz.push_back(second.xyz[3 * v + 1]);
+    m.xyz.push_back(second.xyz[3 * v + 2]);
+  }
+  if (m.tet_region.empty()) m.tet_region.assign(m.tet_count(), 1);
+  for (std::uint32_t v : second.tet) m.tet.push_back(v + offset);
+  m.tet_region.resize(m.tet_count(), 2);
+  for (std::size_t f = 0; f < second.bface_count(); ++f) {
+    for (int i = 0; i < 3; ++i) m.bface.push_back(second.bface[3 * f + i] + offset);
+    m.bface_tag.push_back(second.bface_tag[f] + 10);
+  }
+  m.regions.push_back({2, "floating", kNone});
+  ThermalParams p;
+  p.conductivity = {{1, 1}, {2, 1}};
+  p.fixed = {{1, 300}, {2, 400}};
+  expect_error(m, p, "region 2 ('floating')");
+  p.convection = {{13, 5, 300}};  // the second box's sides
+  const ThermalReport r = solve_thermal(m, p);
+  EXPECT_NEAR(region_of(r, 2).max_temperature, 300, 1e-9);  // no source: it settles at T_inf
+  EXPECT_NEAR(region_of(r, 2).mean_temperature, 300, 1e-9);
+}
+
 TEST_F(ThermalTest, ProgressCanCancel) {
   Mesh m = box_mesh(0.002);
   ThermalParams p;
