@@ -4,6 +4,7 @@
 //   zbuffer_draw      the same with the depth test (draw order irrelevant; the test oracle)
 //   painter_frame     painter_draw plus computing the visibility order for the view
 //   painter_shrink    painter_draw with every tet shrunk to 0.8 (all faces of all tets visible somewhere)
+//   painter_draw_1thread  painter_draw on one thread (the threading baseline)
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-5 (~100k tets) and a4e-6 (~0.97M tets). The camera
 // is fitted to the box from an oblique direction (the mesh fills about 90% of the image height) and
 // turns by 7 degrees per iteration, so no frame repeats.
@@ -53,11 +54,12 @@ void counters(benchmark::State& state, const Case& c) {
   state.SetLabel(state.range(0) == 0 ? "box_100k" : "box_1M");
 }
 
-void run(benchmark::State& state, bool depth, bool with_order, double shrink) {
+void run(benchmark::State& state, bool depth, bool with_order, double shrink, int threads = 2) {
   Case& c = get_case(int(state.range(0)));
   RenderParams params;
   params.depth_buffer = depth;
   params.shrink = shrink;
+  params.threads = threads;
   Framebuffer fb(kWidth, kHeight, depth);
   std::size_t i = 0;
   std::vector<std::uint32_t> order;
@@ -82,6 +84,7 @@ void BM_painter_draw(benchmark::State& state) { run(state, false, false, 1); }
 void BM_zbuffer_draw(benchmark::State& state) { run(state, true, false, 1); }
 void BM_painter_frame(benchmark::State& state) { run(state, false, true, 1); }
 void BM_painter_shrink(benchmark::State& state) { run(state, false, false, 0.8); }
+void BM_painter_draw_1thread(benchmark::State& state) { run(state, false, false, 1, 1); }
 
 }  // namespace
 
@@ -89,5 +92,6 @@ BENCHMARK(BM_painter_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Use
 BENCHMARK(BM_zbuffer_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_painter_frame)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_painter_shrink)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_painter_draw_1thread)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 BENCHMARK_MAIN();
