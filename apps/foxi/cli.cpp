@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace foxi::cli {
 
@@ -42,6 +43,23 @@ std::vector<std::string> Args::positional(std::size_t min, std::size_t max, std:
                      " arguments, got " + std::to_string(args_.size()) + "\nusage: " + std::string(usage));
   }
   return args_;
+}
+
+std::vector<double> parse_numbers(const std::string& s, const char* what) {
+  std::vector<double> v;
+  std::size_t pos = 0;
+  while (pos <= s.size()) {
+    std::size_t comma = s.find(',', pos);
+    std::string part = s.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    char* end = nullptr;
+    double x = std::strtod(part.c_str(), &end);
+    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(x))
+      throw UsageError(std::string(what) + " takes comma-separated numbers, not '" + s + "'");
+    v.push_back(x);
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  return v;
 }
 
 std::string json_string(std::string_view s) {

@@ -31,22 +31,6 @@ const char* kOrderUsage =
     "                  otherwise; power, mpvo, centroid (the VTK-style baseline) force one\n"
     "  --check         exit status 1 if any view has a violation";
 
-std::vector<double> parse_triple(const std::string& s, const char* what) {
-  std::vector<double> v;
-  std::size_t pos = 0;
-  while (pos <= s.size()) {
-    std::size_t comma = s.find(',', pos);
-    std::string part = s.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-    char* end = nullptr;
-    double x = std::strtod(part.c_str(), &end);
-    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(x))
-      throw UsageError(std::string(what) + " takes comma-separated numbers, not '" + s + "'");
-    v.push_back(x);
-    if (comma == std::string::npos) break;
-    pos = comma + 1;
-  }
-  return v;
-}
 
 }  // namespace
 
@@ -76,11 +60,11 @@ int cmd_order(Args args) {
 
   std::vector<View> views;
   if (!eye_s.empty()) {
-    auto e = parse_triple(eye_s, "--eye");
+    auto e = parse_numbers(eye_s, "--eye");
     if (e.size() != 3) throw UsageError("--eye takes x,y,z");
     views.push_back(View::at(e[0], e[1], e[2]));
   } else if (!dir_s.empty()) {
-    auto d = parse_triple(dir_s, "--dir");
+    auto d = parse_numbers(dir_s, "--dir");
     if (d.size() != 3 || (d[0] == 0 && d[1] == 0 && d[2] == 0)) throw UsageError("--dir takes a nonzero x,y,z");
     views.push_back(View::along(d[0], d[1], d[2]));
   } else {
@@ -115,18 +99,18 @@ int cmd_order(Args args) {
     std::string kind = subset_s.substr(0, subset_s.find(':'));
     std::string rest = subset_s.find(':') == std::string::npos ? "" : subset_s.substr(subset_s.find(':') + 1);
     if (kind == "regions") {
-      auto ids = parse_triple(rest, "--subset regions:");
+      auto ids = parse_numbers(rest, "--subset regions:");
       for (std::size_t t = 0; t < mesh.tet_count(); ++t)
         for (double id : ids)
           if (mesh.region_of(t) == static_cast<std::int32_t>(id)) subset.push_back(static_cast<std::uint32_t>(t));
     } else if (kind == "random") {
-      double f = parse_triple(rest, "--subset random:")[0];
+      double f = parse_numbers(rest, "--subset random:")[0];
       std::mt19937 rng(seed + 7);
       std::uniform_real_distribution<double> u(0, 1);
       for (std::size_t t = 0; t < mesh.tet_count(); ++t)
         if (u(rng) < f) subset.push_back(static_cast<std::uint32_t>(t));
     } else if (kind == "box") {
-      auto b = parse_triple(rest, "--subset box:");
+      auto b = parse_numbers(rest, "--subset box:");
       if (b.size() != 6) throw UsageError("--subset box: takes x0,y0,z0,x1,y1,z1");
       for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
         double c[3] = {0, 0, 0};

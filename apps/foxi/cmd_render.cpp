@@ -37,22 +37,6 @@ const char* kRenderUsage =
     "  Meshes that fail the Delaunay certificate have no guaranteed order: their picture is drawn\n"
     "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.";
 
-std::vector<double> parse_numbers(const std::string& s, const char* what) {
-  std::vector<double> v;
-  std::size_t pos = 0;
-  while (pos <= s.size()) {
-    std::size_t comma = s.find(',', pos);
-    std::string part = s.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-    char* end = nullptr;
-    double x = std::strtod(part.c_str(), &end);
-    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(x))
-      throw UsageError(std::string(what) + " takes comma-separated numbers, not '" + s + "'");
-    v.push_back(x);
-    if (comma == std::string::npos) break;
-    pos = comma + 1;
-  }
-  return v;
-}
 
 void triple(const std::string& s, const char* what, double out[3]) {
   auto v = parse_numbers(s, what);
