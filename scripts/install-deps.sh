@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   # libraries
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libtet1.5-dev libeigen3-dev
-  qtbase5-dev libx11-dev libxext-dev libpng-dev zlib1g-dev libpugixml-dev libfreetype-dev libgif-dev
+  qtbase5-dev libx11-dev libxext-dev libpng-dev zlib1g-dev libpugixml-dev libfreetype-dev libgif-dev libtoml11-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev xvfb
   # outside programs the tests use as oracles

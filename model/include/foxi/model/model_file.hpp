@@ -1,0 +1,67 @@
+// Parametrized structure models: a TOML file of parameters (with units and expressions), materials
+// and parts (boxes, z-axis cylinders, layer stacks, arrays), loaded into plain data in SI units.
+//
+//   units.length = "mm"              # bare numbers in part fields are in this unit
+//   library = "materials.toml"       # optional material library, relative to this file
+//   [parameters]
+//   die_w = "4 mm"                   # strings are expressions with units; bare numbers dimensionless
+//   sub_w = "die_w + 6 mm"
+//   [materials.glue]                 # SI numbers, or expressions with units ("2 W/(m*K)")
+//   thermal_conductivity = 2.0
+//   [[parts]]
+//   name = "die"  material = "silicon"  shape = "box"  origin = [...]  size = ["die_w", 3, 0.5]
+//   shape = "cylinder": center (of the base), radius, height, segments (default 16)
+//   shape = "layers": origin, footprint = [w, d], thicknesses = [...], names = [...], materials = [...]
+//   shape = "array": count = [nx, ny], pitch = [px, py], item = { shape = "box" | "cylinder", ... }
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/units.hpp"
+
+namespace foxi {
+
+// A vertical prism: a convex counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
+// over z in [z0, z1].
+struct Prism {
+  std::vector<double> xy;
+  double z0 = 0, z1 = 0;
+  double area() const;  // of the polygon (m^2)
+};
+
+struct Part {
+  std::string name;
+  std::string material;       // a name in Model::materials
+  std::string shape;          // box, cylinder, layers (one part per layer), array
+  std::vector<Prism> prisms;  // an array part has one prism per item
+  std::uint64_t line = 0;     // of its [[parts]] entry (0: unknown)
+};
+
+struct Parameter {
+  std::string name;
+  std::string expression;  // as written (or as given by --set)
+  Quantity value;
+  bool overridden = false;
+};
+
+struct Model {
+  std::string file;
+  std::string length_unit = "m";
+  double length_scale = 1;            // metres per length unit
+  std::vector<Parameter> parameters;  // sorted by name
+  std::vector<Material> materials;    // those the parts use, in order of first use
+  std::vector<Part> parts;            // layer stacks expanded; region id of parts[i] = i + 1
+};
+
+// Loads a model file. `overrides` are "name=expression" (from --set) and replace parameters of that
+// name. Throws IoError (file, line when known, and a reason naming the entity: parameter, part,
+// material) for TOML syntax errors, unknown parameters, unit mismatches, circular expressions,
+// sizes that are not positive, unknown materials, and unknown shapes or keys.
+Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides = {});
+
+}  // namespace foxi

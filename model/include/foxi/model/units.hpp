@@ -1,0 +1,46 @@
+// Physical quantities with units, and the arithmetic expressions of model files ("die_w + 2 mm",
+// "150 W/(m*K)", "sqrt(area)"): values are SI, dimensions are tracked so that "1 mm + 300 K" is an
+// error instead of a number.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace foxi {
+
+// Exponents of the SI base units metre, kilogram, second, kelvin, ampere.
+using Dims = std::array<std::int8_t, 5>;
+inline constexpr Dims kDimensionless = {0, 0, 0, 0, 0};
+inline constexpr Dims kLength = {1, 0, 0, 0, 0};
+
+struct Quantity {
+  double value = 0;  // SI
+  Dims dims = kDimensionless;
+};
+
+// An error in an expression: what was wrong, with the expression text in the message.
+struct ExpressionError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// "m", "kg K^-1", "m^2", "1" for dimensionless.
+std::string dims_to_string(const Dims& d);
+
+// The SI value of unit `name` ("mm" -> 1e-3 m), or nothing if it is not a unit foxi knows: lengths
+// m cm mm um µm nm in mil; K s kg g W J V A S N Pa kPa MPa GPa Hz ppm (1e-6).
+std::optional<Quantity> unit_quantity(std::string_view name);
+
+// Evaluates `text`: numbers, a number followed by a unit ("8 mm", "2.5um"), names (resolved by
+// `lookup` first, then as units; `lookup` returns nothing for an unknown name), + - * / ^ (integer
+// exponent on dimensioned bases), parentheses, pi, sqrt abs min max sin cos tan exp log (dimensionless
+// arguments except sqrt abs min max). Throws ExpressionError on syntax errors, unknown names ("unknown
+// parameter 'x'") and unit mismatches ("unit mismatch: m + K"); `lookup` may throw its own errors.
+Quantity evaluate_expression(std::string_view text,
+                             const std::function<std::optional<Quantity>(std::string_view)>& lookup);
+
+}  // namespace foxi

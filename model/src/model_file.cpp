@@ -1,0 +1,433 @@
+// Model files: TOML (toml11) -> Model. Parameters are evaluated lazily, so their order in the file
+// does not matter and cycles are found by the "being evaluated" mark.
+#include "foxi/model/model_file.hpp"
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <toml.hpp>
+
+#include "foxi/model/io_error.hpp"
+
+namespace foxi {
+
+double Prism::area() const {
+  double a = 0;
+  const std::size_t n = xy.size() / 2;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    a += xy[2 * i] * xy[2 * j + 1] - xy[2 * j] * xy[2 * i + 1];
+  }
+  return 0.5 * a;
+}
+
+namespace {
+
+using Value = toml::basic_value<toml::discard_comments, std::map, std::vector>;
+using Table = Value::table_type;
+
+// A located error: thrown once with file and line and passed through unchanged by outer handlers.
+struct Located {
+  std::uint64_t line;
+  std::string reason;
+};
+
+std::uint64_t line_of(const Value& v) {
+  const auto loc = v.location();
+  return loc.line();
+}
+
+constexpr Dims kConductivity = {1, 1, -3, -1, 0}, kElectrical = {-3, -1, 3, 0, 2},
+               kModulus = {-1, 1, -2, 0, 0}, kExpansion = {0, 0, 0, -1, 0};
+
+class Loader {
+ public:
+  Loader(std::filesystem::path path, std::span<const std::string> overrides)
+      : path_(std::move(path)), overrides_(overrides) {}
+
+  Model load() {
+    model_.file = path_.string();
+    try {
+      root_ = parse_toml(path_);
+      run();
+    } catch (const Located& e) {
+      throw IoError(model_.file, e.line, IoError::kNoOffset, e.reason);
+    }
+    return std::move(model_);
+  }
+
+ private:
+  Value parse_toml(const std::filesystem::path& p) {
+    try {
+      return toml::parse<toml::discard_comments, std::map, std::vector>(p.string());
+    } catch (const toml::syntax_error& e) {
+      throw IoError(p.string(), e.location().line(), IoError::kNoOffset,
+                    std::string("TOML syntax: ") + e.what());
+    } catch (const std::runtime_error& e) {
+      throw IoError(p.string(), 0, IoError::kNoOffset, e.what());
+    }
+  }
+
+  void run() {
+    if (!root_.is_table()) throw Located{0, "the model is not a TOML table"};
+    for (const auto& [k, v] : root_.as_table())
+      if (k != "units" && k != "library" && k != "parameters" && k != "materials" && k != "parts")
+        throw Located{line_of(v),
+                      "unknown key '" + k + "' (expected units, library, parameters, materials, parts)"};
+    read_units();
+    read_parameters();
+    read_materials();
+    read_parts();
+    for (auto& p : params_) value_of(p.first, {});  // every parameter evaluates, used or not
+    for (auto& [name, e] : params_) model_.parameters.push_back(e.param);
+  }
+
+  void read_units() {
+    const Table& t = root_.as_table();
+    auto it = t.find("units");
+    if (it == t.end()) return;
+    if (!it->second.is_table()) throw Located{line_of(it->second), "'units' must be a table"};
+    for (const auto& [k, v] : it->second.as_table()) {
+      if (k != "length") throw Located{line_of(v), "unknown unit setting 'units." + k + "'"};
+      if (!v.is_string()) throw Located{line_of(v), "units.length must be a string such as \"mm\""};
+      const std::string u = v.as_string().str;
+      auto q = unit_quantity(u);
+      if (!q || q->dims != kLength)
+        throw Located{line_of(v), "units.length: '" + u + "' is not a length unit"};
+      model_.length_unit = u;
+      model_.length_scale = q->value;
+    }
+  }
+
+  struct ParamEntry {
+    Parameter param;
+    std::uint64_t line = 0;
+    int state = 0;  // 0 not evaluated, 1 being evaluated, 2 done
+  };
+
+  void flatten(const std::string& prefix, const Value& v) {
+    for (const auto& [k, x] : v.as_table()) {
+      const std::string name = prefix.empty() ? k : prefix + "." + k;
+      if (x.is_table()) {
+        flatten(name, x);
+        continue;
+      }
+      ParamEntry e;
+      e.param.name = name;
+      e.line = line_of(x);
+      if (x.is_string()) {
+        e.param.expression = x.as_string().str;
+      } else if (x.is_integer()) {
+        e.param.expression = std::to_string(x.as_integer());
+      } else if (x.is_floating()) {
+        e.param.expression = toml::format(x);
+      } else {
+        throw Located{e.line, "parameter '" + name + "': expected a number or an expression string"};
+      }
+      params_[name] = std::move(e);
+    }
+  }
+
+  void read_parameters() {
+    const Table& t = root_.as_table();
+    auto it = t.find("parameters");
+    if (it != t.end()) {
+      if (!it->second.is_table()) throw Located{line_of(it->second), "'parameters' must be a table"};
+      flatten("", it->second);
+    }
+    for (const std::string& o : overrides_) {
+      const auto eq = o.find('=');
+      if (eq == std::string::npos || eq == 0) throw Located{0, "--set '" + o + "': expected name=value"};
+      const std::string name = o.substr(0, eq);
+      auto p = params_.find(name);
+      if (p == params_.end()) throw Located{0, "--set: unknown parameter '" + name + "'"};
+      p->second.param.expression = o.substr(eq + 1);
+      p->second.param.overridden = true;
+    }
+  }
+
+  Quantity value_of(const std::string& name, std::vector<std::string> chain) {
+    ParamEntry& e = params_.at(name);
+    if (e.state == 2) return e.param.value;
+    chain.push_back(name);
+    if (e.state == 1) {
+      std::string path;
+      for (auto& c : chain) path += (path.empty() ? "" : " -> ") + c;
+      throw Located{e.line, "circular expression: parameter " + path};
+    }
+    e.state = 1;
+    try {
+      e.param.value = evaluate(e.param.expression, chain);
+    } catch (const ExpressionError& x) {
+      throw Located{
+          e.param.overridden ? 0 : e.line,
+          "parameter '" + name + "'" + (e.param.overridden ? " (from --set)" : "") + ": " + x.what()};
+    }
+    e.state = 2;
+    return e.param.value;
+  }
+
+  Quantity evaluate(const std::string& text, const std::vector<std::string>& chain) {
+    return evaluate_expression(text, [&](std::string_view n) -> std::optional<Quantity> {
+      auto it = params_.find(std::string(n));
+      if (it == params_.end()) return std::nullopt;
+      return value_of(it->first, chain);
+    });
+  }
+
+  // A quantity from a TOML number or expression string; `entity` names it in errors. Dimensionless
+  // results for a length are taken in units.length.
+  Quantity quantity(const Value& v, const Dims& want, const std::string& entity, double bare_scale) {
+    Quantity q;
+    if (v.is_integer() || v.is_floating()) {
+      q = {v.is_integer() ? static_cast<double>(v.as_integer()) : v.as_floating(), kDimensionless};
+    } else if (v.is_string()) {
+      try {
+        q = evaluate(v.as_string().str, {});
+      } catch (const ExpressionError& x) {
+        throw Located{line_of(v), entity + ": " + x.what()};
+      }
+    } else {
+      throw Located{line_of(v), entity + ": expected a number or an expression string"};
+    }
+    if (q.dims == kDimensionless && want != kDimensionless) q = {q.value * bare_scale, want};
+    if (q.dims != want)
+      throw Located{line_of(v), entity + ": unit mismatch: expected " + dims_to_string(want) + ", got " +
+                                    dims_to_string(q.dims)};
+    return q;
+  }
+
+  void read_material_table(const Value& mats, bool from_library) {
+    if (!mats.is_table()) throw Located{line_of(mats), "'materials' must be a table of tables"};
+    for (const auto& [name, m] : mats.as_table()) {
+      if (!m.is_table()) throw Located{line_of(m), "material '" + name + "' must be a table"};
+      Material mat;
+      mat.name = name;
+      for (const auto& [k, v] : m.as_table()) {
+        const std::string entity = "material '" + name + "' " + k;
+        if (k == "source" || k == "note") continue;
+        double* field = nullptr;
+        Dims d = kDimensionless;
+        if (k == "thermal_conductivity")
+          field = &mat.thermal_conductivity, d = kConductivity;
+        else if (k == "electrical_conductivity")
+          field = &mat.electrical_conductivity, d = kElectrical;
+        else if (k == "relative_permittivity")
+          field = &mat.relative_permittivity;
+        else if (k == "youngs_modulus")
+          field = &mat.youngs_modulus, d = kModulus;
+        else if (k == "poisson_ratio")
+          field = &mat.poisson_ratio;
+        else if (k == "thermal_expansion")
+          field = &mat.thermal_expansion, d = kExpansion;
+        else
+          throw Located{line_of(v), "material '" + name + "': unknown property '" + k + "'"};
+        const double x = quantity(v, d, entity, 1).value;
+        if (!(x >= 0) && k != "thermal_expansion")
+          throw Located{line_of(v), entity + " must not be negative"};
+        *field = x;
+      }
+      if (from_library && materials_.count(name)) continue;  // the model's own definition wins
+      materials_[name] = mat;
+    }
+  }
+
+  void read_materials() {
+    const Table& t = root_.as_table();
+    if (auto it = t.find("materials"); it != t.end()) read_material_table(it->second, false);
+    if (auto it = t.find("library"); it != t.end()) {
+      if (!it->second.is_string()) throw Located{line_of(it->second), "'library' must be a file name"};
+      const std::filesystem::path lib = path_.parent_path() / it->second.as_string().str;
+      Value libroot = parse_toml(lib);
+      try {
+        if (libroot.is_table() && libroot.as_table().count("materials"))
+          read_material_table(libroot.as_table().at("materials"), true);
+      } catch (const Located& e) {
+        throw IoError(lib.string(), e.line, IoError::kNoOffset, e.reason);
+      }
+    }
+  }
+
+  const Value& need(const Value& part, const std::string& key, const std::string& who) {
+    const Table& t = part.as_table();
+    auto it = t.find(key);
+    if (it == t.end()) throw Located{line_of(part), who + ": missing '" + key + "'"};
+    return it->second;
+  }
+  double length(const Value& v, const std::string& entity) {
+    return quantity(v, kLength, entity, model_.length_scale).value;
+  }
+  double positive_length(const Value& v, const std::string& entity) {
+    const double x = length(v, entity);
+    if (!(x > 0))
+      throw Located{line_of(v), entity + " = " + std::to_string(x / model_.length_scale) + " " +
+                                    model_.length_unit + " is not positive (negative or zero size)"};
+    return x;
+  }
+  std::vector<double> lengths(const Value& v, std::size_t n, const std::string& entity, bool positive) {
+    if (!v.is_array() || (n != 0 && v.as_array().size() != n))
+      throw Located{line_of(v), entity + ": expected an array of " +
+                                    (n ? std::to_string(n) : std::string("some")) + " values"};
+    std::vector<double> out;
+    std::size_t i = 0;
+    for (const auto& x : v.as_array()) {
+      const std::string e = entity + "[" + std::to_string(i++) + "]";
+      out.push_back(positive ? positive_length(x, e) : length(x, e));
+    }
+    return out;
+  }
+  long integer(const Value& v, const std::string& entity, long min) {
+    const double x = quantity(v, kDimensionless, entity, 1).value;
+    if (x != std::round(x) || x < static_cast<double>(min) || x > 1e6)
+      throw Located{line_of(v), entity + " must be an integer >= " + std::to_string(min)};
+    return static_cast<long>(x);
+  }
+
+  // box or cylinder at `shift`
+  Prism primitive(const Value& part, const std::string& shape, const std::string& who, double sx, double sy) {
+    Prism p;
+    if (shape == "box") {
+      const auto o = lengths(need(part, "origin", who), 3, who + " origin", false);
+      const auto s = lengths(need(part, "size", who), 3, who + " size", true);
+      const double x0 = o[0] + sx, y0 = o[1] + sy;
+      p.xy = {x0, y0, x0 + s[0], y0, x0 + s[0], y0 + s[1], x0, y0 + s[1]};
+      p.z0 = o[2];
+      p.z1 = o[2] + s[2];
+    } else if (shape == "cylinder") {
+      const auto c = lengths(need(part, "center", who), 3, who + " center", false);
+      const double r = positive_length(need(part, "radius", who), who + " radius");
+      const double h = positive_length(need(part, "height", who), who + " height");
+      long n = 16;
+      if (part.as_table().count("segments"))
+        n = integer(part.as_table().at("segments"), who + " segments", 3);
+      for (long k = 0; k < n; ++k) {
+        const double a = 2 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n);
+        p.xy.push_back(c[0] + sx + r * std::cos(a));
+        p.xy.push_back(c[1] + sy + r * std::sin(a));
+      }
+      p.z0 = c[2];
+      p.z1 = c[2] + h;
+    } else {
+      throw Located{line_of(part),
+                    who + ": unknown shape '" + shape + "' (expected box, cylinder, layers, array)"};
+    }
+    return p;
+  }
+
+  void check_keys(const Value& part, const std::string& who, std::initializer_list<const char*> allowed) {
+    for (const auto& [k, v] : part.as_table()) {
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || k == a;
+      if (!ok) throw Located{line_of(v), who + ": unknown key '" + k + "'"};
+    }
+  }
+
+  std::string material(const Value& v, const std::string& who) {
+    if (!v.is_string()) throw Located{line_of(v), who + ": material must be a name"};
+    const std::string m = v.as_string().str;
+    auto it = materials_.find(m);
+    if (it == materials_.end()) throw Located{line_of(v), who + ": unknown material '" + m + "'"};
+    bool have = false;
+    for (auto& x : model_.materials) have = have || x.name == m;
+    if (!have) model_.materials.push_back(it->second);
+    return m;
+  }
+
+  std::string string_of(const Value& v, const std::string& what) {
+    if (!v.is_string()) throw Located{line_of(v), what + " must be a string"};
+    return v.as_string().str;
+  }
+
+  void read_parts() {
+    const Table& t = root_.as_table();
+    auto it = t.find("parts");
+    if (it == t.end()) throw Located{0, "the model has no [[parts]]"};
+    if (!it->second.is_array())
+      throw Located{line_of(it->second), "'parts' must be an array of tables ([[parts]])"};
+    std::size_t index = 0;
+    for (const Value& pv : it->second.as_array()) {
+      ++index;
+      if (!pv.is_table())
+        throw Located{line_of(pv), "parts entry " + std::to_string(index) + " is not a table"};
+      const std::string name = string_of(need(pv, "name", "parts entry " + std::to_string(index)), "name");
+      const std::string who = "part '" + name + "'";
+      const std::string shape = string_of(need(pv, "shape", who), who + " shape");
+      if (shape == "layers") {
+        check_keys(pv, who, {"name", "shape", "origin", "footprint", "thicknesses", "names", "materials"});
+        const auto o = lengths(need(pv, "origin", who), 3, who + " origin", false);
+        const auto f = lengths(need(pv, "footprint", who), 2, who + " footprint", true);
+        const auto th = lengths(need(pv, "thicknesses", who), 0, who + " thicknesses", true);
+        const Value& names = need(pv, "names", who);
+        const Value& mats = need(pv, "materials", who);
+        if (!names.is_array() || names.as_array().size() != th.size() || !mats.is_array() ||
+            mats.as_array().size() != th.size())
+          throw Located{line_of(pv), who + ": names and materials need one entry per thickness"};
+        double z = o[2];
+        for (std::size_t i = 0; i < th.size(); ++i) {
+          Part part;
+          part.name = string_of(names.as_array()[i], who + " names");
+          part.material = material(mats.as_array()[i], "layer '" + part.name + "' of " + who);
+          part.shape = "layers";
+          part.line = line_of(pv);
+          Prism p;
+          p.xy = {o[0], o[1], o[0] + f[0], o[1], o[0] + f[0], o[1] + f[1], o[0], o[1] + f[1]};
+          p.z0 = z;
+          p.z1 = z + th[i];
+          z = p.z1;
+          part.prisms.push_back(std::move(p));
+          add_part(std::move(part));
+        }
+        continue;
+      }
+      Part part;
+      part.name = name;
+      part.shape = shape;
+      part.line = line_of(pv);
+      part.material = material(need(pv, "material", who), who);
+      if (shape == "array") {
+        check_keys(pv, who, {"name", "shape", "material", "count", "pitch", "item"});
+        const Value& cnt = need(pv, "count", who);
+        const Value& pitch = need(pv, "pitch", who);
+        if (!cnt.is_array() || cnt.as_array().size() != 2)
+          throw Located{line_of(cnt), who + " count: expected [nx, ny]"};
+        const long nx = integer(cnt.as_array()[0], who + " count[0]", 1);
+        const long ny = integer(cnt.as_array()[1], who + " count[1]", 1);
+        const auto pp = lengths(pitch, 2, who + " pitch", true);
+        const Value& item = need(pv, "item", who);
+        if (!item.is_table()) throw Located{line_of(item), who + " item must be a table"};
+        const std::string ishape = string_of(need(item, "shape", who + " item"), who + " item shape");
+        for (long j = 0; j < ny; ++j)
+          for (long i = 0; i < nx; ++i)
+            part.prisms.push_back(primitive(item, ishape, who + " item", static_cast<double>(i) * pp[0],
+                                            static_cast<double>(j) * pp[1]));
+      } else {
+        if (shape == "box") check_keys(pv, who, {"name", "shape", "material", "origin", "size"});
+        if (shape == "cylinder")
+          check_keys(pv, who, {"name", "shape", "material", "center", "radius", "height", "segments"});
+        part.prisms.push_back(primitive(pv, shape, who, 0, 0));
+      }
+      add_part(std::move(part));
+    }
+  }
+
+  void add_part(Part p) {
+    for (const Part& q : model_.parts)
+      if (q.name == p.name) throw Located{p.line, "part '" + p.name + "' is defined twice"};
+    model_.parts.push_back(std::move(p));
+  }
+
+  std::filesystem::path path_;
+  std::span<const std::string> overrides_;
+  Value root_;
+  Model model_;
+  std::map<std::string, ParamEntry> params_;
+  std::map<std::string, Material> materials_;
+};
+
+}  // namespace
+
+Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides) {
+  return Loader(path, overrides).load();
+}
+
+}  // namespace foxi
