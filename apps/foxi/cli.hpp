@@ -45,5 +45,6 @@ int cmd_order(Args args);
 int cmd_mesh(Args args);
 int cmd_render(Args args);
 int cmd_solve(Args args);
+int cmd_model(Args args);
 
 }  // namespace foxi::cli

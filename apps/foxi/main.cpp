@@ -21,6 +21,7 @@ const char* kUsage =
     "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png\n"
     "  solve MESH     steady heat conduction: --fix/--flux/--convect TAG=..., --power REGION=W;\n"
     "                 prints max/mean temperatures, heat per boundary; -o OUT.vtu\n"
+    "  model check|plc MODEL.toml  parametrized structure: report it, or write its PLC (-o OUT.poly)\n"
     "\n"
     "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"
     "              .node/.ele/.face (TetGen), .mesh (Medit)\n"
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
     if (command == "mesh") return foxi::cli::cmd_mesh(std::move(rest));
     if (command == "render") return foxi::cli::cmd_render(std::move(rest));
     if (command == "solve") return foxi::cli::cmd_solve(std::move(rest));
+    if (command == "model") return foxi::cli::cmd_model(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const foxi::cli::UsageError& e) {

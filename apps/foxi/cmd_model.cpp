@@ -1,0 +1,83 @@
+// foxi model check|plc MODEL [--set k=v]...: load a parametrized structure model, report it, write
+// its PLC.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/model/plc.hpp"
+#include "foxi/model/structure.hpp"
+
+namespace foxi::cli {
+
+namespace {
+
+const char* kModelUsage =
+    "foxi model check MODEL.toml [--set NAME=VALUE]...\n"
+    "foxi model plc MODEL.toml [--set NAME=VALUE]... -o OUT.poly\n"
+    "  check: loads the model, builds its PLC and prints parameters, materials, parts with volumes\n"
+    "         and boundary names (or the errors, with file and line)\n"
+    "  plc:   writes the PLC (metres, region id = part number, boundary markers) as a TetGen .poly\n"
+    "  --set NAME=VALUE  overrides a parameter, e.g. --set die_w=8mm";
+
+void print_quantity(const Quantity& q) {
+  std::printf("%.6g %s", q.value, q.dims == kDimensionless ? "" : dims_to_string(q.dims).c_str());
+}
+
+}  // namespace
+
+int cmd_model(Args args) {
+  if (args.flag("--help") || args.flag("-h")) {
+    std::puts(kModelUsage);
+    return 0;
+  }
+  std::vector<std::string> sets;
+  while (args.has_option("--set")) sets.push_back(args.option("--set"));
+  const std::string out = args.option("-o");
+  const auto pos = args.positional(2, 2, kModelUsage);
+  const std::string& action = pos[0];
+  const std::string& file = pos[1];
+  if (action != "check" && action != "plc")
+    throw UsageError("unknown action '" + action + "'\nusage: " + kModelUsage);
+  if (action == "plc" && out.empty()) throw UsageError("give the output file with -o OUT.poly");
+
+  const Model model = load_model(file, sets);
+  const Structure s = build_structure(model);
+  if (action == "plc") {
+    write_poly(s.plc, out);
+    std::printf("%s -> %s: %zu points, %zu facets, %zu parts, %zu boundaries\n", file.c_str(), out.c_str(),
+                s.plc.point_count(), s.plc.facet_count(), model.parts.size(), s.boundary_names.size());
+    return 0;
+  }
+  std::printf("model %s (length unit %s)\n", file.c_str(), model.length_unit.c_str());
+  std::printf("parameters:\n");
+  for (const Parameter& p : model.parameters) {
+    std::printf("  %-16s = ", p.name.c_str());
+    print_quantity(p.value);
+    std::printf("   (%s%s)\n", p.expression.c_str(), p.overridden ? ", from --set" : "");
+  }
+  std::printf("materials:\n");
+  for (const Material& m : model.materials)
+    std::printf("  %-16s k %g W/(m K), sigma %g S/m, eps_r %g, E %g Pa, nu %g, alpha %g 1/K\n",
+                m.name.c_str(), m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity,
+                m.youngs_modulus, m.poisson_ratio, m.thermal_expansion);
+  std::printf("parts (region id, name, shape, material, volume after carving):\n");
+  for (std::size_t i = 0; i < model.parts.size(); ++i) {
+    const Part& p = model.parts[i];
+    std::printf("  %2zu %-16s %-9s %-16s %.6g m^3 (%.6g %s^3)", i + 1, p.name.c_str(), p.shape.c_str(),
+                p.material.c_str(), s.part_volume[i],
+                s.part_volume[i] / (model.length_scale * model.length_scale * model.length_scale),
+                model.length_unit.c_str());
+    if (p.prisms.size() > 1) std::printf(", %zu items", p.prisms.size());
+    std::printf("\n");
+  }
+  std::printf("boundaries (marker, name, area):\n");
+  for (std::size_t b = 0; b < s.boundary_names.size(); ++b)
+    std::printf("  %2zu %-28s %.6g m^2\n", b + 1, s.boundary_names[b].c_str(), s.boundary_area[b]);
+  std::printf("PLC: %zu points, %zu facets, %zu region seeds\n", s.plc.point_count(), s.plc.facet_count(),
+              s.plc.regions.size());
+  return 0;
+}
+
+}  // namespace foxi::cli

@@ -1,0 +1,39 @@
+// A model's parts -> one conforming piecewise linear complex (PLC) for the mesher.
+//
+// Every part is a set of vertical prisms (boxes, layers, faceted z-axis cylinders, arrays of them).
+// The space is cut into z slabs at every prism's top and bottom; in each slab a point belongs to the
+// LAST part (in file order) whose active prism covers it, so a later part carves its volume out of
+// earlier ones. Horizontal facets are emitted where the owner changes across a level, vertical facets
+// where it changes across a footprint edge; shared areas are therefore one set of facets (an inner
+// footprint becomes an inner polygon plus a hole point of the surrounding facet, and a facet of its
+// own). Supported footprint relations between prisms whose z ranges meet: equal, strictly nested, or
+// apart with a gap; partial overlaps and side-by-side contact are rejected with an error naming both
+// parts (general booleans, e.g. CGAL corefinement, are not implemented).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/model/plc.hpp"
+
+namespace foxi {
+
+struct Structure {
+  Plc plc;                                  // metres; region id of parts[i] is i + 1
+  std::vector<double> part_volume;          // 1 per part, after carving (m^3)
+  std::vector<std::string> boundary_names;  // marker m (1-based) is boundary_names[m - 1]
+  std::vector<double> boundary_area;        // 1 per marker (m^2)
+};
+
+// Builds the PLC of `model`. Boundary names: "PART.top", "PART.bottom", "PART.side" for outer faces,
+// "A/B" (A earlier in the file) for the interface of two parts. Throws IoError (the model file, the
+// line of the later part) for unsupported overlaps and for a part carved away entirely.
+Structure build_structure(const Model& model);
+
+// Names a mesh of the structure's PLC: region names and materials from the parts, boundary names
+// from the markers. Regions and boundaries the mesh lacks are added.
+void name_mesh(const Model& model, const Structure& structure, Mesh& mesh);
+
+}  // namespace foxi
