@@ -1,0 +1,306 @@
+// Structure models -> PLC, checked against independent truth: TetGen (the `tetgen` program) meshes
+// each shipped model's PLC, and every region's tet volume and every named boundary's triangle area
+// must equal the analytic volume and area of the parts (boxes, regular n-gon prisms) as written in
+// the model files. Bad input must fail with messages naming the file, the line and the entity.
+#include "foxi/model/structure.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "foxi/model/io_error.hpp"
+#include "foxi/model/io_tetgen.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/model/plc.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+using foxi::test::TempDir;
+
+const std::string kModels = std::string(FOXI_TEST_DATA_DIR) + "/../../models/";
+constexpr double kMm = 1e-3, kMm2 = 1e-6, kMm3 = 1e-9;
+
+// Regular n-gon inscribed in a circle of radius r: area and perimeter.
+double ngon_area(int n, double r) { return 0.5 * n * r * r * std::sin(2 * std::numbers::pi / n); }
+double ngon_perimeter(int n, double r) { return 2.0 * n * r * std::sin(std::numbers::pi / n); }
+
+struct Meshed {
+  std::map<std::string, double> region_volume;  // by part name
+  std::map<std::string, double> boundary_area;  // by boundary name
+};
+
+double tet_volume(const foxi::Mesh& m, std::size_t t) {
+  const double* p[4];
+  for (int i = 0; i < 4; ++i) p[i] = &m.xyz[3 * m.tet[4 * t + i]];
+  double a[3], b[3], c[3];
+  for (int k = 0; k < 3; ++k) a[k] = p[1][k] - p[0][k], b[k] = p[2][k] - p[0][k], c[k] = p[3][k] - p[0][k];
+  return std::abs(a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                  a[2] * (b[0] * c[1] - b[1] * c[0])) /
+         6;
+}
+
+double tri_area(const foxi::Mesh& m, std::size_t f) {
+  const double* p[3];
+  for (int i = 0; i < 3; ++i) p[i] = &m.xyz[3 * m.bface[3 * f + i]];
+  double a[3], b[3];
+  for (int k = 0; k < 3; ++k) a[k] = p[1][k] - p[0][k], b[k] = p[2][k] - p[0][k];
+  const double x = a[1] * b[2] - a[2] * b[1], y = a[2] * b[0] - a[0] * b[2], z = a[0] * b[1] - a[1] * b[0];
+  return 0.5 * std::sqrt(x * x + y * y + z * z);
+}
+
+// Writes the model's PLC, meshes it with the tetgen program, reads the mesh back.
+Meshed mesh_model(const std::string& file, std::vector<std::string> sets, double max_volume) {
+  Meshed out;
+  if (!foxi::test::have_program("tetgen")) {
+    ADD_FAILURE() << "the tetgen program is missing (scripts/install-deps.sh installs it)";
+    return out;
+  }
+  const foxi::Model model = foxi::load_model(file, sets);
+  const foxi::Structure s = foxi::build_structure(model);
+  TempDir dir;
+  foxi::write_poly(s.plc, dir / "m.poly");
+  char vol[64];
+  std::snprintf(vol, sizeof vol, "%.6g", max_volume);
+  const int rc = foxi::test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a" + vol + "AVQ m.poly",
+                                 dir / "log.txt");
+  const std::string log = foxi::test::read_text(dir / "log.txt");
+  EXPECT_EQ(rc, 0) << log;
+  EXPECT_EQ(log.find("ntersect"), std::string::npos) << log;  // "self-intersection", "intersecting"
+  if (rc != 0) return out;
+  foxi::Mesh mesh = foxi::read_tetgen(dir / "m.1");
+  foxi::name_mesh(model, s, mesh);
+  std::map<std::int32_t, std::string> region, boundary;
+  for (const auto& r : mesh.regions) region[r.id] = r.name;
+  for (const auto& b : mesh.boundaries) boundary[b.tag] = b.name;
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const std::int32_t id = mesh.region_of(t);
+    EXPECT_TRUE(region.count(id) && !region[id].empty()) << "tet " << t << " in unnamed region " << id;
+    out.region_volume[region[id]] += tet_volume(mesh, t);
+  }
+  for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
+    const std::int32_t tag = mesh.bface_tag[f];
+    if (tag == 0) continue;
+    out.boundary_area[boundary[tag]] += tri_area(mesh, f);
+  }
+  return out;
+}
+
+void expect_near_rel(double got, double want, const std::string& what) {
+  EXPECT_NEAR(got, want, 1e-9 * std::abs(want)) << what;
+}
+
+void expect_volumes(const Meshed& m, const std::map<std::string, double>& want) {
+  EXPECT_EQ(m.region_volume.size(), want.size());
+  for (const auto& [name, v] : want) {
+    ASSERT_TRUE(m.region_volume.count(name)) << "no tets in region " << name;
+    expect_near_rel(m.region_volume.at(name), v, "volume of " + name);
+  }
+}
+
+void expect_areas(const Meshed& m, const std::map<std::string, double>& want) {
+  EXPECT_EQ(m.boundary_area.size(), want.size());
+  for (const auto& [name, a] : want) {
+    ASSERT_TRUE(m.boundary_area.count(name)) << "no triangles on boundary " << name;
+    expect_near_rel(m.boundary_area.at(name), a, "area of " + name);
+  }
+}
+
+TEST(Structure, DieOnSubstrateMeshesToAnalyticVolumesAndAreas) {
+  const Meshed m = mesh_model(kModels + "die_on_substrate.toml", {}, 1e-9);
+  // substrate 10 x 8 x 1 mm, die 4 x 3 x 0.5 mm on top
+  expect_volumes(m, {{"substrate", 80 * kMm3}, {"die", 6 * kMm3}});
+  expect_areas(m, {{"substrate.bottom", 80 * kMm2},
+                   {"substrate.top", (80 - 12) * kMm2},
+                   {"substrate.side", 2 * (10 + 8) * 1 * kMm2},
+                   {"substrate/die", 12 * kMm2},
+                   {"die.top", 12 * kMm2},
+                   {"die.side", 2 * (4 + 3) * 0.5 * kMm2}});
+}
+
+TEST(Structure, SetChangesVolumesAsTheFormulaSays) {
+  const Meshed m =
+      mesh_model(kModels + "die_on_substrate.toml", {"die_w=6mm", "sub_h=2 mm", "die_h=die_d/6"}, 2e-9);
+  expect_volumes(m, {{"substrate", 10 * 8 * 2 * kMm3}, {"die", 6 * 3 * 0.5 * kMm3}});
+  EXPECT_NEAR(m.boundary_area.at("substrate.top"), (80 - 18) * kMm2, 1e-9 * kMm2);
+  EXPECT_NEAR(m.boundary_area.at("die.side"), 2 * (6 + 3) * 0.5 * kMm2, 1e-9 * kMm2);
+}
+
+TEST(Structure, ViaCarvesItsPrismOutOfTheDielectric) {
+  const Meshed m = mesh_model(kModels + "via_in_dielectric.toml", {}, 1e-11);
+  const double a = ngon_area(16, 0.2) * kMm2, p = ngon_perimeter(16, 0.2) * kMm;
+  expect_volumes(
+      m, {{"substrate", 0.5 * kMm3}, {"dielectric", 0.5 * kMm3 - a * 0.5 * kMm}, {"via", a * 0.5 * kMm}});
+  expect_areas(m, {{"substrate.bottom", 1 * kMm2},
+                   {"substrate.side", 4 * 0.5 * kMm2},
+                   {"dielectric.side", 4 * 0.5 * kMm2},
+                   {"substrate/dielectric", 1 * kMm2 - a},
+                   {"substrate/via", a},
+                   {"dielectric/via", p * 0.5 * kMm},
+                   {"dielectric.top", 1 * kMm2 - a},
+                   {"via.top", a}});
+}
+
+TEST(Structure, ViaSegmentsAndRadiusFromSet) {
+  const Meshed m = mesh_model(kModels + "via_in_dielectric.toml", {"via_n=8", "via_r=0.3mm"}, 1e-11);
+  const double a = ngon_area(8, 0.3) * kMm2;
+  expect_volumes(
+      m, {{"substrate", 0.5 * kMm3}, {"dielectric", 0.5 * kMm3 - a * 0.5 * kMm}, {"via", a * 0.5 * kMm}});
+}
+
+TEST(Structure, FlipChipBumpsCarveTheUnderfill) {
+  const Meshed m = mesh_model(kModels + "flip_chip.toml", {}, 2e-9);
+  // substrate 10 x 10 x 1, underfill 6 x 6 x 0.2 minus 4 bumps (16-gons, r 0.3, h 0.2), die 6 x 6 x 0.5
+  const double a = ngon_area(16, 0.3), p = ngon_perimeter(16, 0.3);
+  expect_volumes(m, {{"substrate", 100 * kMm3},
+                     {"underfill", (36 - 4 * a) * 0.2 * kMm3},
+                     {"bumps", 4 * a * 0.2 * kMm3},
+                     {"die", 36 * 0.5 * kMm3}});
+  expect_areas(m, {{"substrate.bottom", 100 * kMm2},
+                   {"substrate.top", 64 * kMm2},
+                   {"substrate.side", 40 * kMm2},
+                   {"substrate/underfill", (36 - 4 * a) * kMm2},
+                   {"substrate/bumps", 4 * a * kMm2},
+                   {"underfill/bumps", 4 * p * 0.2 * kMm2},
+                   {"underfill.side", 24 * 0.2 * kMm2},
+                   {"underfill/die", (36 - 4 * a) * kMm2},
+                   {"bumps/die", 4 * a * kMm2},
+                   {"die.top", 36 * kMm2},
+                   {"die.side", 24 * 0.5 * kMm2}});
+}
+
+TEST(Structure, ModelsCarryMaterialsFromTheLibrary) {
+  const foxi::Model m = foxi::load_model(kModels + "flip_chip.toml");
+  ASSERT_EQ(m.materials.size(), 4u);
+  for (const auto& mat : m.materials) {
+    EXPECT_GT(mat.thermal_conductivity, 0) << mat.name;
+    EXPECT_GT(mat.youngs_modulus, 1e9) << mat.name;
+    EXPECT_GT(mat.poisson_ratio, 0) << mat.name;
+    EXPECT_LT(mat.poisson_ratio, 0.5) << mat.name;
+  }
+  EXPECT_DOUBLE_EQ(m.length_scale, 1e-3);
+}
+
+// ---- bad input ----
+
+const char* kGood = R"TOML(units.length = "mm"
+[parameters]
+w = "2 mm"
+h = "w / 2"
+[materials.glue]
+thermal_conductivity = "2 W/(m*K)"
+[[parts]]
+name = "base"
+material = "glue"
+shape = "box"
+origin = [0, 0, 0]
+size = ["w", "w", "h"]
+)TOML";
+
+// The 1-based line of the first occurrence of `needle` in `text`.
+std::uint64_t line_of(const std::string& text, const std::string& needle) {
+  const auto at = text.find(needle);
+  EXPECT_NE(at, std::string::npos) << needle;
+  return 1 + static_cast<std::uint64_t>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+}
+
+// Loads (and builds) `text`, which must fail; returns the error.
+foxi::IoError load_error(const std::string& text, std::vector<std::string> sets = {}) {
+  TempDir dir;
+  foxi::test::write_text(dir / "bad.toml", text);
+  try {
+    const foxi::Model m = foxi::load_model(dir / "bad.toml", sets);
+    foxi::build_structure(m);
+  } catch (const foxi::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.toml"), std::string::npos) << e.what();
+    return e;
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return foxi::IoError("", 0, 0, "");
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  s.replace(s.find(from), from.size(), to);
+  return s;
+}
+
+TEST(StructureBadInput, TheGoodModelLoads) {
+  TempDir dir;
+  foxi::test::write_text(dir / "good.toml", kGood);
+  const foxi::Model m = foxi::load_model(dir / "good.toml");
+  const foxi::Structure s = foxi::build_structure(m);
+  EXPECT_NEAR(s.part_volume[0], 2e-3 * 2e-3 * 1e-3, 1e-20);
+  EXPECT_DOUBLE_EQ(m.materials[0].thermal_conductivity, 2.0);
+}
+
+TEST(StructureBadInput, UnknownParameterIsNamed) {
+  const std::string t = replaced(kGood, "\"w\", \"h\"]", "\"w\", \"height\"]");
+  const foxi::IoError e = load_error(t);
+  EXPECT_NE(e.reason().find("unknown parameter 'height'"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("part 'base'"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), line_of(t, "size ="));
+}
+
+TEST(StructureBadInput, UnknownParameterInSetIsNamed) {
+  const foxi::IoError e = load_error(kGood, {"width=3mm"});
+  EXPECT_NE(e.reason().find("'width'"), std::string::npos) << e.what();
+}
+
+TEST(StructureBadInput, UnitMismatchIsNamed) {
+  const std::string t = replaced(kGood, "h = \"w / 2\"", "h = \"w + 300 K\"");
+  const foxi::IoError e = load_error(t);
+  EXPECT_NE(e.reason().find("unit mismatch"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("parameter 'h'"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), line_of(t, "\nh = ") + 1);
+}
+
+TEST(StructureBadInput, TemperatureWhereALengthIsExpected) {
+  const std::string t = replaced(kGood, "h = \"w / 2\"", "h = \"300 K\"");
+  const foxi::IoError e = load_error(t);
+  EXPECT_NE(e.reason().find("unit mismatch"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("part 'base' size"), std::string::npos) << e.what();
+}
+
+TEST(StructureBadInput, CircularExpressionIsNamed) {
+  const std::string t = replaced(kGood, "w = \"2 mm\"", "w = \"2 * h\"");
+  const foxi::IoError e = load_error(t);
+  EXPECT_NE(e.reason().find("circular"), std::string::npos) << e.what();
+  const std::string r = e.reason();
+  EXPECT_TRUE(r.find("h -> w -> h") != std::string::npos || r.find("w -> h -> w") != std::string::npos) << r;
+}
+
+TEST(StructureBadInput, NegativeSizeIsNamed) {
+  const std::string t = replaced(kGood, "h = \"w / 2\"", "h = \"-w / 2\"");
+  const foxi::IoError e = load_error(t);
+  EXPECT_NE(e.reason().find("part 'base' size[2]"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("not positive"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), line_of(t, "size ="));
+}
+
+TEST(StructureBadInput, UnknownMaterialIsNamed) {
+  const std::string t = replaced(kGood, "material = \"glue\"", "material = \"unobtainium\"");
+  const foxi::IoError e = load_error(t);
+  EXPECT_NE(e.reason().find("unknown material 'unobtainium'"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("part 'base'"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), line_of(t, "material = \"unob"));
+}
+
+TEST(StructureBadInput, PartialOverlapNamesBothParts) {
+  const std::string t = std::string(kGood) +
+                        "[[parts]]\nname = \"lid\"\nmaterial = \"glue\"\nshape = \"box\"\n"
+                        "origin = [1, 1, 0.5]\nsize = [2, 2, 1]\n";
+  const foxi::IoError e = load_error(t);
+  EXPECT_NE(e.reason().find("'base' and 'lid'"), std::string::npos) << e.what();
+}
+
+TEST(StructureBadInput, TomlSyntaxErrorHasTheLine) {
+  const std::string t = replaced(kGood, "shape = \"box\"", "shape = \"box");
+  const foxi::IoError e = load_error(t);
+  EXPECT_EQ(e.line(), line_of(t, "shape = \"box"));
+}
+
+}  // namespace
