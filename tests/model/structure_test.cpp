@@ -185,6 +185,61 @@ TEST(Structure, ModelsCarryMaterialsFromTheLibrary) {
   EXPECT_DOUBLE_EQ(m.length_scale, 1e-3);
 }
 
+// Carving and nesting beyond the shipped models: a die buried in mold compound (a box strictly
+// inside a box), a via through two layers into a pad (three levels of nesting), and a disconnected
+// part, each checked against the analytic volumes.
+TEST(Structure, BuriedViaThroughTwoLayersAndDisconnectedParts) {
+  TempDir dir;
+  foxi::test::write_text(dir / "m.toml", R"TOML(units.length = "um"
+[parameters]
+r = "100 um"
+[materials.a]
+thermal_conductivity = 1
+[[parts]]
+name = "mold"
+material = "a"
+shape = "box"
+origin = [0, 0, 0]
+size = [1000, 1000, 600]
+[[parts]]
+name = "die"
+material = "a"
+shape = "box"
+origin = [200, 200, 100]
+size = [600, 600, 300]
+[[parts]]
+name = "pad"
+material = "a"
+shape = "box"
+origin = [350, 350, 150]
+size = [300, 300, 50]
+[[parts]]
+name = "via"
+material = "a"
+shape = "cylinder"
+center = [500, 500, 150]
+radius = "r"
+height = "350 um"
+segments = 12
+[[parts]]
+name = "island"
+material = "a"
+shape = "box"
+origin = [2000, 0, 0]
+size = [100, 200, 300]
+)TOML");
+  const Meshed m = mesh_model((dir / "m.toml").string(), {}, 2e-12);
+  const double um3 = 1e-18, a = ngon_area(12, 100);
+  // via: z 150..500 crosses the pad (150..200), the die (200..400) and the mold (400..500)
+  expect_volumes(m, {{"mold", (1000.0 * 1000 * 600 - 600.0 * 600 * 300 - a * 100) * um3},
+                     {"die", (600.0 * 600 * 300 - 300.0 * 300 * 50 - a * 200) * um3},
+                     {"pad", (300.0 * 300 * 50 - a * 50) * um3},
+                     {"via", a * 350 * um3},
+                     {"island", 100.0 * 200 * 300 * um3}});
+  EXPECT_EQ(m.boundary_area.count("via.top"), 0u);  // the via ends inside the mold
+  EXPECT_EQ(m.boundary_area.count("mold/via"), 1u);
+}
+
 // ---- bad input ----
 
 const char* kGood = R"TOML(units.length = "mm"
