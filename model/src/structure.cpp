@@ -93,10 +93,11 @@ class Builder {
       const auto& below = z > 0 ? active[z - 1] : kEmpty;
       const auto& above = z + 1 < L ? active[z] : kEmpty;
       std::vector<std::size_t> polys = fids(below, above);
+      const Forest forest = make_forest(polys);
       for (std::size_t f : polys) {
         const long lb = label(f, below), la = label(f, above);
         if (lb == la) continue;
-        std::vector<std::size_t> kids = children(f, polys);
+        const std::vector<std::size_t>& kids = forest.children.at(f);
         std::string name = lb < 0   ? m_.parts[la].name + ".bottom"
                            : la < 0 ? m_.parts[lb].name + ".top"
                                     : interface_name(lb, la);
@@ -123,26 +124,19 @@ class Builder {
     std::map<std::size_t, Run> open;  // fid -> run
     for (std::size_t k = 0; k + 1 < L; ++k) {
       std::vector<std::size_t> polys = fids(active[k], {});
+      const Forest forest = make_forest(polys);
       std::map<std::size_t, Run> next;
       for (std::size_t f : polys) {
         const long in = label(f, active[k]);
-        const long par = parent(f, polys);
+        const long par = forest.parent.at(f);
         const long out = par < 0 ? -1 : label(static_cast<std::size_t>(par), active[k]);
-        // region seed and volume of the cell f minus its children
-        if (in >= 0 && (par < 0 || out != in)) {
-          std::vector<std::size_t> kids = children(f, polys);
-          double area = fp_[f].area;
-          for (std::size_t c : kids) area -= fp_[c].area;
-          // only the cell where the owner starts counts; deeper cells of the same owner are counted
-          // by their own footprint minus children
-          s_.part_volume[in] += area * (levels_[k + 1] - levels_[k]);
-          add_seed(f, kids, k, in);
-        } else if (in >= 0) {
-          std::vector<std::size_t> kids = children(f, polys);
-          double area = fp_[f].area;
-          for (std::size_t c : kids) area -= fp_[c].area;
-          s_.part_volume[in] += area * (levels_[k + 1] - levels_[k]);
-        }
+        // the cell "f minus its children" belongs to `in`: its volume, and a region seed where the
+        // owner differs from the surrounding one (else the cell is connected to the surrounding cell)
+        const std::vector<std::size_t>& kids = forest.children.at(f);
+        double area = fp_[f].area;
+        for (std::size_t c : kids) area -= fp_[c].area;
+        if (in >= 0) s_.part_volume[in] += area * (levels_[k + 1] - levels_[k]);
+        if (in >= 0 && in != out) add_seed(f, kids, k, in);
         if (in == out) continue;
         auto it = open.find(f);
         if (it != open.end() && it->second.in == in && it->second.out == out) {
@@ -255,19 +249,24 @@ class Builder {
     return best;
   }
 
-  long parent(std::size_t f, const std::vector<std::size_t>& polys) const {
-    long best = -1;
-    for (std::size_t g : polys)
-      if (contains(g, f) && (best < 0 || fp_[g].area < fp_[static_cast<std::size_t>(best)].area))
-        best = static_cast<long>(g);
-    return best;
-  }
-
-  std::vector<std::size_t> children(std::size_t f, const std::vector<std::size_t>& polys) const {
-    std::vector<std::size_t> out;
-    for (std::size_t g : polys)
-      if (parent(g, polys) == static_cast<long>(f)) out.push_back(g);
-    return out;
+  // The containment forest of a set of footprints: each one's smallest container (-1: none), and
+  // the footprints each one contains directly.
+  struct Forest {
+    std::map<std::size_t, long> parent;
+    std::map<std::size_t, std::vector<std::size_t>> children;
+  };
+  Forest make_forest(const std::vector<std::size_t>& polys) const {
+    Forest forest;
+    for (std::size_t f : polys) {
+      long best = -1;
+      for (std::size_t g : polys)
+        if (contains(g, f) && (best < 0 || fp_[g].area < fp_[static_cast<std::size_t>(best)].area))
+          best = static_cast<long>(g);
+      forest.parent[f] = best;
+      forest.children[f];
+      if (best >= 0) forest.children[static_cast<std::size_t>(best)].push_back(f);
+    }
+    return forest;
   }
 
   std::string interface_name(long a, long b) const {
