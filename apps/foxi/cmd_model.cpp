@@ -21,8 +21,12 @@ const char* kModelUsage =
     "  plc:   writes the PLC (metres, region id = part number, boundary markers) as a TetGen .poly\n"
     "  --set NAME=VALUE  overrides a parameter, e.g. --set die_w=8mm";
 
-void print_quantity(const Quantity& q) {
-  std::printf("%.6g %s", q.value, q.dims == kDimensionless ? "" : dims_to_string(q.dims).c_str());
+// Lengths in the model's unit, everything else in SI.
+void print_quantity(const Quantity& q, const Model& model) {
+  if (q.dims == kLength)
+    std::printf("%.6g %s", q.value / model.length_scale, model.length_unit.c_str());
+  else
+    std::printf("%.6g %s", q.value, q.dims == kDimensionless ? "" : dims_to_string(q.dims).c_str());
 }
 
 }  // namespace
@@ -54,7 +58,7 @@ int cmd_model(Args args) {
   std::printf("parameters:\n");
   for (const Parameter& p : model.parameters) {
     std::printf("  %-16s = ", p.name.c_str());
-    print_quantity(p.value);
+    print_quantity(p.value, model);
     std::printf("   (%s%s)\n", p.expression.c_str(), p.overridden ? ", from --set" : "");
   }
   std::printf("materials:\n");
