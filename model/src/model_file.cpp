@@ -3,6 +3,7 @@
 #include "foxi/model/model_file.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numbers>
 #include <toml.hpp>
@@ -31,6 +32,12 @@ struct Located {
   std::uint64_t line;
   std::string reason;
 };
+
+std::string short_number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
 
 std::uint64_t line_of(const Value& v) {
   const auto loc = v.location();
@@ -260,7 +267,7 @@ class Loader {
   double positive_length(const Value& v, const std::string& entity) {
     const double x = length(v, entity);
     if (!(x > 0))
-      throw Located{line_of(v), entity + " = " + std::to_string(x / model_.length_scale) + " " +
+      throw Located{line_of(v), entity + " = " + short_number(x / model_.length_scale) + " " +
                                     model_.length_unit + " is not positive (negative or zero size)"};
     return x;
   }

@@ -223,8 +223,10 @@ class Builder {
         }
         if (r == -1)
           throw IoError(m_.file, m_.parts[b.part].line, IoError::kNoOffset,
-                        "parts '" + m_.parts[a.part].name + "' and '" + m_.parts[b.part].name +
-                            "' overlap partially or touch side by side; supported: footprints equal, one "
+                        (a.part == b.part
+                             ? "items of part '" + m_.parts[a.part].name + "'"
+                             : "parts '" + m_.parts[a.part].name + "' and '" + m_.parts[b.part].name + "'") +
+                            " overlap partially or touch side by side; supported: footprints equal, one "
                             "strictly inside the other, or apart (general booleans are not implemented)");
       }
   }
