@@ -137,19 +137,41 @@ class TagMap {
 
 
 
-// Number of nodes of the element types foxi reads; -1 for any other type.
+// Number of nodes of the element types foxi reads; -1 for any other type. Second-order tets and
+// triangles are read as their corner nodes (the first 4 or 3; the mid-edge nodes stay in the node
+// list, unused).
 int nodes_of_type(std::int64_t type) {
   switch (type) {
     case 15:
       return 1;  // point
     case 1:
       return 2;  // line
+    case 8:
+      return 3;  // second-order line
     case 2:
       return 3;  // triangle
+    case 9:
+      return 6;  // second-order triangle
     case 4:
       return 4;  // tet
+    case 11:
+      return 10;  // second-order tet
     default:
       return -1;
+  }
+}
+
+// The corners kept: 4 for tets, 3 for triangles, 0 for elements that are skipped.
+int corners_of_type(std::int64_t type) {
+  switch (type) {
+    case 4:
+    case 11:
+      return 4;
+    case 2:
+    case 9:
+      return 3;
+    default:
+      return 0;
   }
 }
 
@@ -163,12 +185,6 @@ std::string type_name(std::int64_t type) {
       return " (6-node prism)";
     case 7:
       return " (5-node pyramid)";
-    case 8:
-      return " (3-node second-order line)";
-    case 9:
-      return " (6-node second-order triangle)";
-    case 11:
-      return " (10-node second-order tetrahedron)";
     default:
       return "";
   }
@@ -573,7 +589,7 @@ class Reader {
     io::reserve_huge(mesh_.tet_region, n);
     io::reserve_huge(mesh_.bface, 3 * n);
     io::reserve_huge(mesh_.bface_tag, n);
-    std::uint32_t v[4];
+    std::uint32_t v[10];
     if (binary_) {
       cur_.rest_of_line();
       std::uint64_t done = 0;
@@ -604,7 +620,7 @@ class Reader {
                              static_cast<std::size_t>(q + 4 * k - data_.data()));
             v[k] = idx;
           }
-          add_element(nn, phys, v, static_cast<std::uint64_t>(io::load<std::int32_t>(p)));
+          add_element(corners_of_type(type), phys, v, static_cast<std::uint64_t>(io::load<std::int32_t>(p)));
         }
         advance(rec * follow);
         done += static_cast<std::uint64_t>(follow);
@@ -633,7 +649,7 @@ class Reader {
           if (idx == kNone) undefined_node(t, nat);
           v[k] = idx;
         }
-        add_element(nn, phys, v, tag);
+        add_element(corners_of_type(type), phys, v, tag);
       }
     }
     (void)at;
@@ -686,54 +702,55 @@ class Reader {
     return it == entity_phys_[dim].end() ? 0 : it->second;
   }
 
-  template <int NN, class Find>
+  template <int NN, int NC, class Find>
   void block41_binary(std::uint64_t m, std::int32_t phys, Find find) {
+    // NN nodes per element in the file, the first NC (4: tet, 3: triangle) kept.
     constexpr std::uint64_t rec = 8 * (1 + NN);
     const char* p = need(m * rec, "element block");
-    std::vector<std::uint32_t>& out = NN == 4 ? mesh_.tet : mesh_.bface;
-    std::vector<std::int32_t>& reg = NN == 4 ? mesh_.tet_region : mesh_.bface_tag;
-    std::size_t base = out.size() / NN;
-    out.resize(out.size() + NN * m);
+    std::vector<std::uint32_t>& out = NC == 4 ? mesh_.tet : mesh_.bface;
+    std::vector<std::int32_t>& reg = NC == 4 ? mesh_.tet_region : mesh_.bface_tag;
+    std::size_t base = out.size() / NC;
+    out.resize(out.size() + NC * m);
     reg.resize(reg.size() + m, phys);
-    std::uint32_t* o = out.data() + NN * base;
+    std::uint32_t* o = out.data() + NC * base;
     LocalRun run;
     for (std::uint64_t i = 0; i < m; ++i, p += rec) {
-      if (NN == 4) run.note(io::load<std::uint64_t>(p), base + i, *this);
+      if (NC == 4) run.note(io::load<std::uint64_t>(p), base + i, *this);
       for (int k = 0; k < NN; ++k) {
         std::uint64_t t = io::load<std::uint64_t>(p + 8 + 8 * k);
         std::uint32_t idx = find(t);
         if (idx == kNone) undefined_node(t, static_cast<std::size_t>(p + 8 + 8 * k - data_.data()));
-        o[NN * i + k] = idx;
+        if (k < NC) o[NC * i + k] = idx;
       }
     }
-    if (NN == 4) run.flush(*this);
+    if (NC == 4) run.flush(*this);
     advance(m * rec);
   }
 
-  template <int NN, class Find>
+  template <int NN, int NC, class Find>
   void block41_ascii(std::uint64_t m, std::int32_t phys, Find find) {
-    std::vector<std::uint32_t>& out = NN == 4 ? mesh_.tet : mesh_.bface;
-    std::vector<std::int32_t>& reg = NN == 4 ? mesh_.tet_region : mesh_.bface_tag;
-    std::size_t base = out.size() / NN;
-    out.resize(out.size() + NN * m);
+    std::vector<std::uint32_t>& out = NC == 4 ? mesh_.tet : mesh_.bface;
+    std::vector<std::int32_t>& reg = NC == 4 ? mesh_.tet_region : mesh_.bface_tag;
+    std::size_t base = out.size() / NC;
+    out.resize(out.size() + NC * m);
     reg.resize(reg.size() + m, phys);
-    std::uint32_t* o = out.data() + NN * base;
+    std::uint32_t* o = out.data() + NC * base;
     LocalRun run;
     for (std::uint64_t i = 0; i < m; ++i) {
       std::uint64_t tag = num<std::uint64_t>(cur_, "element tag");
-      if (NN == 4) run.note(tag, base + i, *this);
+      if (NC == 4) run.note(tag, base + i, *this);
       for (int k = 0; k < NN; ++k) {
         std::size_t nat = here();
         std::uint64_t t = num<std::uint64_t>(cur_, "node tag");
         std::uint32_t idx = find(t);
         if (idx == kNone) undefined_node(t, nat);
-        o[NN * i + k] = idx;
+        if (k < NC) o[NC * i + k] = idx;
       }
     }
-    if (NN == 4) run.flush(*this);
+    if (NC == 4) run.flush(*this);
   }
 
-  template <int NN>
+  template <int NN, int NC>
   void block41(std::uint64_t m, std::int32_t phys) {
     if (nodes_.is_offset()) {
       const std::uint64_t first = nodes_.first(), n = nodes_.size();
@@ -742,15 +759,15 @@ class Reader {
         return i < n ? static_cast<std::uint32_t>(i) : kNone;
       };
       if (binary_)
-        block41_binary<NN>(m, phys, find);
+        block41_binary<NN, NC>(m, phys, find);
       else
-        block41_ascii<NN>(m, phys, find);
+        block41_ascii<NN, NC>(m, phys, find);
     } else {
       auto find = [this](std::uint64_t t) { return nodes_.find(t); };
       if (binary_)
-        block41_binary<NN>(m, phys, find);
+        block41_binary<NN, NC>(m, phys, find);
       else
-        block41_ascii<NN>(m, phys, find);
+        block41_ascii<NN, NC>(m, phys, find);
     }
   }
 
@@ -802,12 +819,18 @@ class Reader {
       }
       if (m > n - done) fail_at(bat, "element blocks hold more elements than the " + str(n) + " declared");
       const std::int32_t phys = entity_physical(dim, etag);
-      switch (nodes_of_type(type)) {
+      switch (type) {
         case 4:
-          block41<4>(m, phys);
+          block41<4, 4>(m, phys);
           break;
-        case 3:
-          block41<3>(m, phys);
+        case 11:
+          block41<10, 4>(m, phys);
+          break;
+        case 2:
+          block41<3, 3>(m, phys);
+          break;
+        case 9:
+          block41<6, 3>(m, phys);
           break;
         default:
           skip_block41(m, nodes_of_type(type));

@@ -220,6 +220,32 @@ TEST(GmshRead, ParametricNodesMatchPlainFile) {
   }
 }
 
+// gmsh's second-order meshes (10-node tets, 6-node triangles) read as their corners: the same tets
+// and triangles as gmsh's first-order mesh of the same geometry, in all four file variants.
+TEST(GmshRead, SecondOrderElementsReadAsCorners) {
+  if (!have_gmsh()) GTEST_SKIP() << "gmsh not available";
+  TempDir dir;
+  test::write_text(dir / "two.geo", kTwoBoxes);
+  const std::string geo = "'" + (dir / "two.geo").string() + "'";
+  const std::string first = (dir / "p1.msh").string();
+  ASSERT_EQ(test::run("gmsh -3 " + geo + " -format msh41 -o '" + first + "'", dir / "log"), 0);
+  const Mesh p1 = read_gmsh(first);
+  for (const char* variant : {"msh41", "msh41 -bin", "msh22", "msh22 -bin"}) {
+    SCOPED_TRACE(variant);
+    const std::string file = (dir / "p2.msh").string();
+    ASSERT_EQ(test::run("gmsh -3 -order 2 " + geo + " -format " + variant + " -o '" + file + "'", dir / "log"), 0);
+    const std::string text = test::read_text(file);
+    const Mesh m = read_gmsh(file);
+    EXPECT_EQ(m.tet_count(), p1.tet_count());
+    EXPECT_EQ(m.bface_count(), p1.bface_count());
+    EXPECT_EQ(m.tet_region, p1.tet_region);
+    EXPECT_GT(m.node_count(), p1.node_count());  // the mid-edge nodes, unused
+    double volume = 0;
+    for (std::size_t t = 0; t < m.tet_count(); ++t) volume += tet_volume(m, t);
+    EXPECT_NEAR(volume, 2.0, 1e-9);  // two unit boxes, flat faces: the corner tets fill them
+  }
+}
+
 // A small two-region grid with fields: a node scalar with 2 steps (one value NaN = not listed),
 // a 3-component cell vector and a 6-component cell tensor.
 Mesh mesh_with_fields() {
@@ -529,7 +555,7 @@ TEST(GmshRead, BadCorpusGivesLocatedErrors) {
       {"huge_count.msh", "declares 1000000000000 nodes but the file has only"},
       {"node_out_of_range.msh", "node 7, which is not defined"},
       {"non_numeric.msh", "expected y coordinate, found 'abc'"},
-      {"unknown_element_type.msh", "unsupported element type 11"},
+      {"unknown_element_type.msh", "unsupported element type 5 (8-node hexahedron)"},
       {"empty.msh", "empty file"},
       {"wrong_endianness_flag.msh", "bad endianness check"},
       {"byte_swapped.msh", "byte-swapped"},

@@ -1,7 +1,9 @@
 // Gmsh .msh 2.2 and 4.1, ASCII and binary.
 //
-// Read: nodes; 4-node tets (type 4) become tets, 3-node triangles (type 2) boundary triangles; points
-// and lines are skipped; any other element type is an error naming it. Physical groups: the first
+// Read: nodes; 4-node tets (type 4) become tets, 3-node triangles (type 2) boundary triangles;
+// second-order 10-node tets (11) and 6-node triangles (9) are read as their corners (the mid-edge
+// nodes stay in the node list, unused); points and lines (15, 1, 8) are skipped; any other element
+// type is an error naming it. Physical groups: the first
 // tag of a tet is its region id, of a triangle its boundary tag ($PhysicalNames give the names).
 // $NodeData / $ElementData become fields (several time steps of one name become one field's steps).
 // Write: files that gmsh itself loads (4.1 with an $Entities section).
