@@ -403,6 +403,9 @@ class Loader {
         const Value& item = need(pv, "item", who);
         if (!item.is_table()) throw Located{line_of(item), who + " item must be a table"};
         const std::string ishape = string_of(need(item, "shape", who + " item"), who + " item shape");
+        if (ishape == "box") check_keys(item, who + " item", {"shape", "origin", "size"});
+        if (ishape == "cylinder")
+          check_keys(item, who + " item", {"shape", "center", "radius", "height", "segments"});
         for (long j = 0; j < ny; ++j)
           for (long i = 0; i < nx; ++i)
             part.prisms.push_back(primitive(item, ishape, who + " item", static_cast<double>(i) * pp[0],

@@ -173,6 +173,24 @@ TEST(Structure, FlipChipBumpsCarveTheUnderfill) {
                    {"die.side", 24 * 0.5 * kMm2}});
 }
 
+TEST(Structure, MultiChipDiesCarveTheMold) {
+  const Meshed m = mesh_model(kModels + "multi_chip.toml", {"die_h=0.6mm"}, 5e-9);
+  // substrate 20 x 12 x 1.2, mold 20 x 12 x 1 minus the dies 6 x 6 and 4 x 4, 0.6 high
+  expect_volumes(m, {{"substrate", 20 * 12 * 1.2 * kMm3},
+                     {"mold", (240 - (36 + 16) * 0.6) * kMm3},
+                     {"die1", 36 * 0.6 * kMm3},
+                     {"die2", 16 * 0.6 * kMm3}});
+  expect_areas(m, {{"substrate.bottom", 240 * kMm2},
+                   {"substrate.side", 2 * (20 + 12) * 1.2 * kMm2},
+                   {"substrate/mold", (240 - 52) * kMm2},
+                   {"substrate/die1", 36 * kMm2},
+                   {"substrate/die2", 16 * kMm2},
+                   {"mold/die1", (36 + 24 * 0.6) * kMm2},
+                   {"mold/die2", (16 + 16 * 0.6) * kMm2},
+                   {"mold.top", 240 * kMm2},
+                   {"mold.side", 2 * (20 + 12) * 1 * kMm2}});
+}
+
 TEST(Structure, ModelsCarryMaterialsFromTheLibrary) {
   const foxi::Model m = foxi::load_model(kModels + "flip_chip.toml");
   ASSERT_EQ(m.materials.size(), 4u);
