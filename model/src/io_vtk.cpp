@@ -312,24 +312,28 @@ class Assembler {
     ArrayData types = p.types.type == VType::u8 ? std::move(p.types)
                                                 : normalize_ints(std::move(p.types), int_fail("types"));
     // Count tets and triangles, check types.
-    std::vector<std::uint8_t> kind(p.ncells);  // 0 skip, 1 tet, 2 triangle
+    // 0 skip, 1 tet, 2 triangle; quadratic tets (24) and triangles (22) are read as their corners
+    // (the first 4 or 3 nodes; the mid-edge points stay, unused).
+    std::vector<std::uint8_t> kind(p.ncells), quadratic(p.ncells, 0);
     std::size_t ntet = 0, ntri = 0;
     auto types_loop = [&](auto t) {
       for (std::size_t i = 0; i < p.ncells; ++i) {
         auto v = static_cast<std::int64_t>(t[i]);
-        if (v == 10) {
+        if (v == 10 || v == 24) {
           kind[i] = 1;
+          quadratic[i] = v == 24;
           ++ntet;
-        } else if (v == 5) {
+        } else if (v == 5 || v == 22) {
           kind[i] = 2;
+          quadratic[i] = v == 22;
           ++ntri;
-        } else if (v >= 1 && v <= 4) {
+        } else if ((v >= 1 && v <= 4) || v == 21) {
           kind[i] = 0;
         } else {
           fail("cell " + std::to_string(i) + " has unsupported cell type " + std::to_string(v) + " (" +
                cell_type_name(v) +
-               "); foxi reads tetra (10), triangle (5), and skips "
-               "vertices and lines");
+               "); foxi reads tetra (10) and quadratic tetra (24), triangle (5) and quadratic triangle "
+               "(22), and skips vertices and lines");
         }
       }
     };
@@ -359,17 +363,19 @@ class Assembler {
           }
           std::uint8_t k = kind[i];
           if (k != 0) {
-            const std::int64_t want = k == 1 ? 4 : 3;
+            const std::int64_t corners = k == 1 ? 4 : 3;
+            const std::int64_t want = quadratic[i] ? (k == 1 ? 10 : 6) : corners;
             if (end - prev != want)
-              fail("cell " + std::to_string(i) + " (" + (k == 1 ? "tetra" : "triangle") + ") has " +
-                   std::to_string(end - prev) + " nodes, expected " + std::to_string(want));
+              fail("cell " + std::to_string(i) + " (" + (quadratic[i] ? "quadratic " : "") +
+                   (k == 1 ? "tetra" : "triangle") + ") has " + std::to_string(end - prev) + " nodes, expected " +
+                   std::to_string(want));
             std::uint32_t* d = k == 1 ? td : fd;
             for (std::int64_t j = 0; j < want; ++j) {
               auto v = static_cast<std::int64_t>(c[static_cast<std::size_t>(prev + j)]);
               if (v < 0 || v >= np)
                 fail("cell " + std::to_string(i) + ": node index " + std::to_string(v) +
                      " out of range (the piece has " + std::to_string(np) + " points)");
-              d[j] = static_cast<std::uint32_t>(v) + base;
+              if (j < corners) d[j] = static_cast<std::uint32_t>(v) + base;
             }
             if (k == 1)
               td += 4;

@@ -246,6 +246,37 @@ TEST(VtkLegacyRead, MeshioAsciiAndBinary51And42) {
     expect_test_mesh(read_vtk_legacy(o.dir / name), o.v, 1e-15, true, name);
 }
 
+// meshio writes quadratic tets (VTK 24) and triangles (22); foxi reads their corners.
+TEST(VtuRead, QuadraticCellsReadAsCorners) {
+  if (!have_meshio()) GTEST_SKIP() << "no meshio";
+  TempDir dir;
+  const std::string script = R"(
+import sys, meshio, numpy as np
+c = np.array([[0,0,0],[2,0,0],[0,3,0],[0,0,4]], dtype=float)
+e = [(0,1),(1,2),(2,0),(0,3),(1,3),(2,3)]  # VTK's mid-edge order
+pts = np.vstack([c] + [0.5 * (c[a] + c[b]) for a, b in e])
+m = meshio.Mesh(pts, [("tetra10", np.array([list(range(10))])), ("triangle6", np.array([[0, 1, 2, 4, 5, 6]]))])
+d = sys.argv[1]
+meshio.write(d + "/q.vtu", m)
+meshio.write(d + "/q.vtk", m, binary=True)
+print("corners|", " ".join(repr(x) for x in c.flatten()))
+)";
+  Values want = run_python(dir, script, "'" + dir.path().string() + "'");
+  ASSERT_EQ(want["corners"].size(), 12u);
+  for (const char* name : {"q.vtu", "q.vtk"}) {
+    SCOPED_TRACE(name);
+    const Mesh m = read_mesh(dir / name);
+    ASSERT_EQ(m.tet_count(), 1u);
+    ASSERT_EQ(m.bface_count(), 1u);
+    EXPECT_EQ(m.node_count(), 10u);  // the mid-edge points stay, unused
+    std::vector<double> corners;
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 3; ++j) corners.push_back(m.xyz[3 * m.tet[k] + j]);
+    EXPECT_EQ(corners, want["corners"]);
+    EXPECT_EQ(std::vector<std::uint32_t>(m.bface.begin(), m.bface.end()), (std::vector<std::uint32_t>{0, 1, 2}));
+  }
+}
+
 TEST(VtuRead, MultiplePiecesConcatenate) {
   // Two pieces, local numbering each; the second piece's indices are shifted by the first's nodes.
   // The first piece's points carry an InformationKey child, as ParaView writes them.

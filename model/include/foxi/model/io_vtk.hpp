@@ -1,6 +1,7 @@
 // VTK: XML unstructured grid (.vtu) and legacy (.vtk).
 //
-// Read: points; cells of type 10 (tetra) become tets, type 5 (triangle) boundary triangles; vertices
+// Read: points; cells of type 10 (tetra) become tets, type 5 (triangle) boundary triangles (quadratic
+// tetra 24 and triangle 22 as their corners, the mid-edge points left unused); vertices
 // and lines are skipped; other cell types are an error. Cell arrays named "region", "gmsh:physical",
 // "CellEntityIds", "medit:ref" or "tetgen:ref" (Int) give tets their region and triangles their
 // boundary tag; every other point or cell array becomes a field. A "weight" point array becomes the
