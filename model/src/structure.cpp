@@ -1,5 +1,19 @@
-// Parts -> PLC by z slabs and footprint forests (see structure.hpp).
+// Parts -> PLC by z slabs and planar arrangements (see structure.hpp).
+//
+// Every part is a set of vertical prisms. The z values of all prism tops and bottoms cut space into
+// slabs. In slab k, the footprint edges of the prisms active there form a planar arrangement A_k
+// (CGAL Arrangement_2, exact constructions, so touching and crossing footprints are split where they
+// meet); every bounded face of A_k is owned by the last part whose prism covers it. At level z, the
+// arrangement of the edges of both neighbouring slabs gives the horizontal facets: a face whose owner
+// below differs from its owner above becomes a facet (outer boundary, inner boundaries with a hole
+// point each). An edge of A_k whose two faces have different owners becomes a vertical facet; its
+// bottom and top edges carry every vertex that the level arrangements put on them, so all facets meet
+// along whole segments (a conforming PLC).
 #include "foxi/model/structure.hpp"
+
+#include <CGAL/Arr_segment_traits_2.h>
+#include <CGAL/Arrangement_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,65 +26,114 @@ namespace foxi {
 
 namespace {
 
-struct Footprint {
-  std::vector<double> xy;  // convex, counter-clockwise
-  double area = 0;
-  double cx = 0, cy = 0;  // vertex centroid (inside: convex)
-  std::size_t n() const { return xy.size() / 2; }
-};
+using K = CGAL::Exact_predicates_exact_constructions_kernel;
+using Traits = CGAL::Arr_segment_traits_2<K>;
+using Arr = CGAL::Arrangement_2<Traits>;
+using Pt = K::Point_2;
 
 struct Item {
   std::size_t part;
-  std::size_t fid;
+  const Prism* prism;
   std::size_t z0, z1;  // level indices
 };
 
-double signed_dist(const Footprint& f, std::size_t e, double x, double y) {
-  const std::size_t n = f.n(), j = (e + 1) % n;
-  const double ax = f.xy[2 * e], ay = f.xy[2 * e + 1], bx = f.xy[2 * j], by = f.xy[2 * j + 1];
-  const double len = std::hypot(bx - ax, by - ay);
-  return ((bx - ax) * (y - ay) - (by - ay) * (x - ax)) / len;
-}
-
-bool strictly_inside_pt(const Footprint& f, double x, double y, double eps) {
-  for (std::size_t e = 0; e < f.n(); ++e)
-    if (signed_dist(f, e, x, y) <= eps) return false;
-  return true;
-}
-
-bool strictly_inside(const Footprint& a, const Footprint& b, double eps) {  // a inside b
-  for (std::size_t i = 0; i < a.n(); ++i)
-    if (!strictly_inside_pt(b, a.xy[2 * i], a.xy[2 * i + 1], eps)) return false;
-  return true;
-}
-
-bool separated(const Footprint& a, const Footprint& b, double eps) {
-  auto axis_of = [&](const Footprint& f, std::size_t e) {
-    // all of the other polygon beyond edge e's line by more than eps
-    const Footprint& o = &f == &a ? b : a;
-    for (std::size_t i = 0; i < o.n(); ++i)
-      if (signed_dist(f, e, o.xy[2 * i], o.xy[2 * i + 1]) > -eps) return false;
-    return true;
-  };
-  for (std::size_t e = 0; e < a.n(); ++e)
-    if (axis_of(a, e)) return true;
-  for (std::size_t e = 0; e < b.n(); ++e)
-    if (axis_of(b, e)) return true;
-  return false;
-}
-
-bool same_polygon(const std::vector<double>& a, const std::vector<double>& b, double eps) {
-  if (a.size() != b.size()) return false;
-  const std::size_t n = a.size() / 2;
-  for (std::size_t s = 0; s < n; ++s) {
-    bool ok = true;
-    for (std::size_t i = 0; i < n && ok; ++i) {
-      const std::size_t j = (i + s) % n;
-      ok = std::abs(a[2 * i] - b[2 * j]) <= eps && std::abs(a[2 * i + 1] - b[2 * j + 1]) <= eps;
-    }
-    if (ok) return true;
+bool inside_polygon(const std::vector<double>& xy, double x, double y) {  // convex, counter-clockwise
+  const std::size_t n = xy.size() / 2;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    const double c =
+        (xy[2 * j] - xy[2 * i]) * (y - xy[2 * i + 1]) - (xy[2 * j + 1] - xy[2 * i + 1]) * (x - xy[2 * i]);
+    if (!(c > 0)) return false;
   }
-  return false;
+  return true;
+}
+
+// A planar arrangement of the footprint edges of some prisms, with a point inside each bounded face.
+struct Plane {
+  Arr arr;
+  std::map<Arr::Face_const_handle, std::pair<double, double>> inner;  // a point inside each bounded face
+  std::map<Arr::Face_const_handle, double> area;                      // of each bounded face
+  std::vector<std::pair<double, double>> vertices;                    // all vertices, sorted
+};
+
+double to_d(const K::FT& v) { return CGAL::to_double(v); }
+
+template <class Circ>
+void ccb_points(Circ c, std::vector<std::pair<double, double>>& out) {
+  Circ e = c;
+  do {
+    out.emplace_back(to_d(e->source()->point().x()), to_d(e->source()->point().y()));
+  } while (++e != c);
+}
+
+double ring_area(const std::vector<std::pair<double, double>>& r) {
+  double a = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const auto& p = r[i];
+    const auto& q = r[(i + 1) % r.size()];
+    a += p.first * q.second - q.first * p.second;
+  }
+  return 0.5 * a;
+}
+
+void build_plane(Plane& pl, const std::vector<const Prism*>& prisms) {
+  std::vector<Traits::X_monotone_curve_2> segs;
+  for (const Prism* p : prisms) {
+    const std::size_t n = p->xy.size() / 2;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t j = (i + 1) % n;
+      segs.emplace_back(Pt(p->xy[2 * i], p->xy[2 * i + 1]), Pt(p->xy[2 * j], p->xy[2 * j + 1]));
+    }
+  }
+  CGAL::insert(pl.arr, segs.begin(), segs.end());
+  for (auto v = pl.arr.vertices_begin(); v != pl.arr.vertices_end(); ++v)
+    pl.vertices.emplace_back(to_d(v->point().x()), to_d(v->point().y()));
+  std::sort(pl.vertices.begin(), pl.vertices.end());
+  for (auto f = pl.arr.faces_begin(); f != pl.arr.faces_end(); ++f) {
+    if (f->is_unbounded()) continue;
+    // rings: the outer boundary and the inner ones, as double polygons
+    std::vector<std::vector<std::pair<double, double>>> rings(1);
+    ccb_points(f->outer_ccb(), rings[0]);
+    double area = ring_area(rings[0]);
+    for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h) {
+      rings.emplace_back();
+      ccb_points(*h, rings.back());
+      area += ring_area(rings.back());  // inner rings run clockwise: negative
+    }
+    pl.area[f] = area;
+    // a point inside: from the middle of the longest outer edge, halfway to the nearest boundary
+    // crossed by the inward normal (the face lies left of its outer boundary)
+    const auto& o = rings[0];
+    std::size_t best = 0;
+    double best_len = -1;
+    for (std::size_t i = 0; i < o.size(); ++i) {
+      const auto& p = o[i];
+      const auto& q = o[(i + 1) % o.size()];
+      const double len = std::hypot(q.first - p.first, q.second - p.second);
+      if (len > best_len) best_len = len, best = i;
+    }
+    const auto& p = o[best];
+    const auto& q = o[(best + 1) % o.size()];
+    const double mx = 0.5 * (p.first + q.first), my = 0.5 * (p.second + q.second);
+    const double nx = -(q.second - p.second) / best_len, ny = (q.first - p.first) / best_len;
+    double tmin = 1e300;
+    for (std::size_t r = 0; r < rings.size(); ++r)
+      for (std::size_t i = 0; i < rings[r].size(); ++i) {
+        if (r == 0 && i == best) continue;
+        const auto& a = rings[r][i];
+        const auto& b = rings[r][(i + 1) % rings[r].size()];
+        // solve m + t n = a + s (b - a)
+        const double dx = b.first - a.first, dy = b.second - a.second;
+        const double den = nx * (-dy) - ny * (-dx);
+        if (den == 0) continue;
+        const double rx = a.first - mx, ry = a.second - my;
+        const double t = (rx * (-dy) - ry * (-dx)) / den;
+        const double s = (nx * ry - ny * rx) / den;
+        if (t > 1e-12 * best_len && s >= -1e-12 && s <= 1 + 1e-12) tmin = std::min(tmin, t);
+      }
+    if (tmin > 1e299) tmin = best_len;  // cannot happen for a closed face; keep a finite point
+    pl.inner[f] = {mx + 0.5 * tmin * nx, my + 0.5 * tmin * ny};
+  }
 }
 
 class Builder {
@@ -79,77 +142,95 @@ class Builder {
 
   Structure build() {
     collect();
-    check_relations();
     const std::size_t L = levels_.size();
-    // slab k is [levels_[k], levels_[k+1]]
     std::vector<std::vector<std::size_t>> active(L ? L - 1 : 0);
     for (std::size_t i = 0; i < items_.size(); ++i)
       for (std::size_t k = items_[i].z0; k < items_[i].z1; ++k) active[k].push_back(i);
     s_.part_volume.assign(m_.parts.size(), 0);
 
-    // horizontal facets at each level
+    // the level arrangements (edges of both neighbouring slabs) and their horizontal facets
+    static const std::vector<std::size_t> kEmpty;
+    std::vector<Plane> level(L);
     for (std::size_t z = 0; z < L; ++z) {
-      static const std::vector<std::size_t> kEmpty;
       const auto& below = z > 0 ? active[z - 1] : kEmpty;
       const auto& above = z + 1 < L ? active[z] : kEmpty;
-      std::vector<std::size_t> polys = fids(below, above);
-      const Forest forest = make_forest(polys);
-      for (std::size_t f : polys) {
-        const long lb = label(f, below), la = label(f, above);
+      std::vector<const Prism*> prisms;
+      for (std::size_t i : below) prisms.push_back(items_[i].prism);
+      for (std::size_t i : above) prisms.push_back(items_[i].prism);
+      Plane& pl = level[z];
+      build_plane(pl, prisms);
+      for (auto f = pl.arr.faces_begin(); f != pl.arr.faces_end(); ++f) {
+        if (f->is_unbounded()) continue;
+        const auto [x, y] = pl.inner.at(f);
+        const long lb = label(x, y, below), la = label(x, y, above);
         if (lb == la) continue;
-        const std::vector<std::size_t>& kids = forest.children.at(f);
-        std::string name = lb < 0   ? m_.parts[la].name + ".bottom"
-                           : la < 0 ? m_.parts[lb].name + ".top"
-                                    : interface_name(lb, la);
+        const std::string name = lb < 0   ? part_name(la) + ".bottom"
+                                 : la < 0 ? part_name(lb) + ".top"
+                                          : interface_name(lb, la);
         const std::int32_t marker = marker_of(name);
-        double area = fp_[f].area;
         s_.plc.facet_polygon_begin.push_back(s_.plc.facet_polygon_begin.back());
-        add_polygon(f, z);
-        for (std::size_t c : kids) {
-          add_polygon(c, z);
-          s_.plc.facet_holes.insert(s_.plc.facet_holes.end(), {fp_[c].cx, fp_[c].cy, levels_[z]});
-          area -= fp_[c].area;
+        add_ccb(f->outer_ccb(), z);
+        for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h) {
+          add_ccb(*h, z);
+          // a hole point: inside the face across this inner boundary
+          Arr::Halfedge_const_handle he = *h;
+          const auto hp = pl.inner.at(he->twin()->face());
+          s_.plc.facet_holes.insert(s_.plc.facet_holes.end(), {hp.first, hp.second, levels_[z]});
         }
         s_.plc.facet_marker.push_back(marker);
         s_.plc.facet_hole_begin.push_back(static_cast<std::uint32_t>(s_.plc.facet_holes.size() / 3));
-        s_.boundary_area[marker - 1] += area;
+        s_.boundary_area[static_cast<std::size_t>(marker - 1)] += pl.area.at(f);
       }
     }
 
-    // walls and region seeds, slab by slab; walls run over consecutive slabs with the same owners
-    struct Run {
-      std::size_t z0;
-      long in, out;
-    };
-    std::map<std::size_t, Run> open;  // fid -> run
+    // the slab arrangements: owners, volumes, region seeds and walls
     for (std::size_t k = 0; k + 1 < L; ++k) {
-      std::vector<std::size_t> polys = fids(active[k], {});
-      const Forest forest = make_forest(polys);
-      std::map<std::size_t, Run> next;
-      for (std::size_t f : polys) {
-        const long in = label(f, active[k]);
-        const long par = forest.parent.at(f);
-        const long out = par < 0 ? -1 : label(static_cast<std::size_t>(par), active[k]);
-        // the cell "f minus its children" belongs to `in`: its volume, and a region seed where the
-        // owner differs from the surrounding one (else the cell is connected to the surrounding cell)
-        const std::vector<std::size_t>& kids = forest.children.at(f);
-        double area = fp_[f].area;
-        for (std::size_t c : kids) area -= fp_[c].area;
-        if (in >= 0) s_.part_volume[in] += area * (levels_[k + 1] - levels_[k]);
-        if (in >= 0 && in != out) add_seed(f, kids, k, in);
-        if (in == out) continue;
-        auto it = open.find(f);
-        if (it != open.end() && it->second.in == in && it->second.out == out) {
-          next[f] = it->second;
-          open.erase(it);
-        } else {
-          next[f] = Run{k, in, out};
+      std::vector<const Prism*> prisms;
+      for (std::size_t i : active[k]) prisms.push_back(items_[i].prism);
+      Plane pl;
+      build_plane(pl, prisms);
+      const double dz = levels_[k + 1] - levels_[k];
+      std::map<Arr::Face_const_handle, long> owner;
+      for (auto f = pl.arr.faces_begin(); f != pl.arr.faces_end(); ++f) {
+        if (f->is_unbounded()) {
+          owner[f] = -1;
+          continue;
         }
+        const auto [x, y] = pl.inner.at(f);
+        const long o = label(x, y, active[k]);
+        owner[f] = o;
+        if (o < 0) continue;
+        s_.part_volume[static_cast<std::size_t>(o)] += pl.area.at(f) * dz;
+        RegionSeed seed;
+        seed.point[0] = x;
+        seed.point[1] = y;
+        seed.point[2] = 0.5 * (levels_[k] + levels_[k + 1]);
+        seed.id = static_cast<std::int32_t>(o + 1);
+        s_.plc.regions.push_back(seed);
       }
-      for (auto& [f, r] : open) emit_walls(f, r.z0, k, r.in, r.out);
-      open = std::move(next);
+      for (auto e = pl.arr.edges_begin(); e != pl.arr.edges_end(); ++e) {
+        const long a = owner.at(e->face()), b = owner.at(e->twin()->face());
+        if (a == b) continue;
+        const std::string name = a < 0   ? part_name(b) + ".side"
+                                 : b < 0 ? part_name(a) + ".side"
+                                         : interface_name(a, b);
+        const std::int32_t marker = marker_of(name);
+        const double px = to_d(e->source()->point().x()), py = to_d(e->source()->point().y());
+        const double qx = to_d(e->target()->point().x()), qy = to_d(e->target()->point().y());
+        // bottom p -> q with the level-k vertices on it, top q -> p with the level-(k+1) ones
+        std::vector<std::uint32_t> poly;
+        for (const auto& v : on_segment(level[k], px, py, qx, qy))
+          poly.push_back(point(v.first, v.second, k));
+        const auto top = on_segment(level[k + 1], qx, qy, px, py);
+        for (const auto& v : top) poly.push_back(point(v.first, v.second, k + 1));
+        s_.plc.facet_polygon_begin.push_back(s_.plc.facet_polygon_begin.back() + 1);
+        s_.plc.polygon_vertices.insert(s_.plc.polygon_vertices.end(), poly.begin(), poly.end());
+        s_.plc.polygon_vertex_begin.push_back(static_cast<std::uint32_t>(s_.plc.polygon_vertices.size()));
+        s_.plc.facet_marker.push_back(marker);
+        s_.plc.facet_hole_begin.push_back(s_.plc.facet_hole_begin.back());
+        s_.boundary_area[static_cast<std::size_t>(marker - 1)] += std::hypot(qx - px, qy - py) * dz;
+      }
     }
-    for (auto& [f, r] : open) emit_walls(f, r.z0, L - 1, r.in, r.out);
 
     for (std::size_t p = 0; p < m_.parts.size(); ++p)
       if (!(s_.part_volume[p] > 0))
@@ -160,18 +241,14 @@ class Builder {
 
  private:
   void collect() {
-    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    double lo = 1e300, hi = -1e300, span = 0;
     for (const Part& p : m_.parts)
       for (const Prism& q : p.prisms) {
-        for (std::size_t i = 0; i < q.xy.size(); ++i) {
-          lo[i % 2] = std::min(lo[i % 2], q.xy[i]);
-          hi[i % 2] = std::max(hi[i % 2], q.xy[i]);
-        }
-        lo[2] = std::min(lo[2], q.z0);
-        hi[2] = std::max(hi[2], q.z1);
+        lo = std::min(lo, q.z0);
+        hi = std::max(hi, q.z1);
+        for (double c : q.xy) span = std::max(span, std::abs(c));
       }
-    const double diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-    eps_ = std::max(1e-9 * diag, 1e-300);
+    eps_ = std::max(1e-9 * std::max(hi - lo, span), 1e-300);
     std::vector<double> zs;
     for (const Part& p : m_.parts)
       for (const Prism& q : p.prisms) zs.insert(zs.end(), {q.z0, q.z1});
@@ -179,101 +256,48 @@ class Builder {
     for (double z : zs)
       if (levels_.empty() || z - levels_.back() > eps_) levels_.push_back(z);
     auto level = [&](double z) {
-      auto it = std::lower_bound(levels_.begin(), levels_.end(), z - eps_);
-      return static_cast<std::size_t>(it - levels_.begin());
+      return static_cast<std::size_t>(std::lower_bound(levels_.begin(), levels_.end(), z - eps_) -
+                                      levels_.begin());
     };
     for (std::size_t pi = 0; pi < m_.parts.size(); ++pi)
-      for (const Prism& q : m_.parts[pi].prisms) {
-        std::size_t fid = fp_.size();
-        for (std::size_t f = 0; f < fp_.size(); ++f)
-          if (same_polygon(fp_[f].xy, q.xy, eps_)) fid = f;
-        if (fid == fp_.size()) {
-          Footprint f;
-          f.xy = q.xy;
-          f.area = q.area();
-          for (std::size_t i = 0; i < f.n(); ++i) f.cx += f.xy[2 * i] / static_cast<double>(f.n());
-          for (std::size_t i = 0; i < f.n(); ++i) f.cy += f.xy[2 * i + 1] / static_cast<double>(f.n());
-          fp_.push_back(std::move(f));
-        }
-        items_.push_back(Item{pi, fid, level(q.z0), level(q.z1)});
-      }
-    contains_.assign(fp_.size() * fp_.size(), 0);
+      for (const Prism& q : m_.parts[pi].prisms) items_.push_back(Item{pi, &q, level(q.z0), level(q.z1)});
   }
 
-  void check_relations() {
-    const std::size_t nf = fp_.size();
-    std::vector<std::int8_t> rel(nf * nf, -2);  // -2 unknown, 0 apart, 1 row contains column, -1 bad
-    for (std::size_t i = 0; i < items_.size(); ++i)
-      for (std::size_t j = i + 1; j < items_.size(); ++j) {
-        const Item &a = items_[i], &b = items_[j];
-        if (a.fid == b.fid || a.z1 < b.z0 || b.z1 < a.z0) continue;
-        std::int8_t& r = rel[a.fid * nf + b.fid];
-        if (r == -2) {
-          if (strictly_inside(fp_[b.fid], fp_[a.fid], eps_)) {
-            contains_[a.fid * nf + b.fid] = 1;
-            r = 1;
-          } else if (strictly_inside(fp_[a.fid], fp_[b.fid], eps_)) {
-            contains_[b.fid * nf + a.fid] = 1;
-            r = 1;
-          } else if (separated(fp_[a.fid], fp_[b.fid], eps_)) {
-            r = 0;
-          } else {
-            r = -1;
-          }
-        }
-        if (r == -1)
-          throw IoError(m_.file, m_.parts[b.part].line, IoError::kNoOffset,
-                        (a.part == b.part
-                             ? "items of part '" + m_.parts[a.part].name + "'"
-                             : "parts '" + m_.parts[a.part].name + "' and '" + m_.parts[b.part].name + "'") +
-                            " overlap partially or touch side by side; supported: footprints equal, one "
-                            "strictly inside the other, or apart (general booleans are not implemented)");
-      }
-  }
-
-  bool contains(std::size_t a, std::size_t b) const { return contains_[a * fp_.size() + b] != 0; }
-
-  std::vector<std::size_t> fids(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b) const {
-    std::vector<std::size_t> out;
-    for (std::size_t i : a) out.push_back(items_[i].fid);
-    for (std::size_t i : b) out.push_back(items_[i].fid);
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-  }
-
-  // the last part among `act` whose footprint is f or contains f; -1 if none
-  long label(std::size_t f, const std::vector<std::size_t>& act) const {
+  // the last part among `act` whose prism covers (x, y); -1 if none
+  long label(double x, double y, const std::vector<std::size_t>& act) const {
     long best = -1;
     for (std::size_t i : act)
-      if (items_[i].fid == f || contains(items_[i].fid, f))
-        best = std::max(best, static_cast<long>(items_[i].part));
+      if (static_cast<long>(items_[i].part) > best && inside_polygon(items_[i].prism->xy, x, y))
+        best = static_cast<long>(items_[i].part);
     return best;
   }
 
-  // The containment forest of a set of footprints: each one's smallest container (-1: none), and
-  // the footprints each one contains directly.
-  struct Forest {
-    std::map<std::size_t, long> parent;
-    std::map<std::size_t, std::vector<std::size_t>> children;
-  };
-  Forest make_forest(const std::vector<std::size_t>& polys) const {
-    Forest forest;
-    for (std::size_t f : polys) {
-      long best = -1;
-      for (std::size_t g : polys)
-        if (contains(g, f) && (best < 0 || fp_[g].area < fp_[static_cast<std::size_t>(best)].area))
-          best = static_cast<long>(g);
-      forest.parent[f] = best;
-      forest.children[f];
-      if (best >= 0) forest.children[static_cast<std::size_t>(best)].push_back(f);
+  // the vertices of `pl` on the segment p -> q, in order from p to q (p and q included)
+  static std::vector<std::pair<double, double>> on_segment(const Plane& pl, double px, double py, double qx,
+                                                           double qy) {
+    const double len2 = (qx - px) * (qx - px) + (qy - py) * (qy - py);
+    const double tol = 1e-9 * std::sqrt(len2);
+    std::vector<std::pair<double, std::pair<double, double>>> hits;
+    const double xlo = std::min(px, qx) - tol, xhi = std::max(px, qx) + tol;
+    auto it = std::lower_bound(pl.vertices.begin(), pl.vertices.end(), std::make_pair(xlo, -1e300));
+    for (; it != pl.vertices.end() && it->first <= xhi; ++it) {
+      const double vx = it->first, vy = it->second;
+      if (vy < std::min(py, qy) - tol || vy > std::max(py, qy) + tol) continue;
+      const double cross = (qx - px) * (vy - py) - (qy - py) * (vx - px);
+      if (std::abs(cross) > tol * std::sqrt(len2)) continue;
+      const double t = ((vx - px) * (qx - px) + (vy - py) * (qy - py)) / len2;
+      hits.push_back({t, {vx, vy}});
     }
-    return forest;
+    std::sort(hits.begin(), hits.end());
+    std::vector<std::pair<double, double>> out;
+    for (auto& h : hits) out.push_back(h.second);
+    return out;
   }
 
+  std::string part_name(long p) const { return m_.parts[static_cast<std::size_t>(p)].name; }
   std::string interface_name(long a, long b) const {
     if (a > b) std::swap(a, b);
-    return m_.parts[static_cast<std::size_t>(a)].name + "/" + m_.parts[static_cast<std::size_t>(b)].name;
+    return part_name(a) + "/" + part_name(b);
   }
 
   std::int32_t marker_of(const std::string& name) {
@@ -284,76 +308,38 @@ class Builder {
     return static_cast<std::int32_t>(s_.boundary_names.size());
   }
 
-  std::uint32_t point(std::size_t f, std::size_t v, std::size_t z) {
-    auto key = std::make_tuple(f, v, z);
+  std::uint32_t point(double x, double y, std::size_t z) {
+    auto key = std::make_tuple(x, y, z);
     auto it = points_.find(key);
     if (it != points_.end()) return it->second;
     const auto id = static_cast<std::uint32_t>(s_.plc.point_count());
-    s_.plc.points.insert(s_.plc.points.end(), {fp_[f].xy[2 * v], fp_[f].xy[2 * v + 1], levels_[z]});
+    s_.plc.points.insert(s_.plc.points.end(), {x, y, levels_[z]});
     points_.emplace(key, id);
     return id;
   }
 
-  void add_polygon(std::size_t f, std::size_t z) {
-    for (std::size_t v = 0; v < fp_[f].n(); ++v) s_.plc.polygon_vertices.push_back(point(f, v, z));
+  template <class Circ>
+  void add_ccb(Circ c, std::size_t z) {
+    Circ e = c;
+    do {
+      s_.plc.polygon_vertices.push_back(
+          point(to_d(e->source()->point().x()), to_d(e->source()->point().y()), z));
+    } while (++e != c);
     s_.plc.polygon_vertex_begin.push_back(static_cast<std::uint32_t>(s_.plc.polygon_vertices.size()));
     ++s_.plc.facet_polygon_begin.back();
-  }
-
-  void emit_walls(std::size_t f, std::size_t z0, std::size_t z1, long in, long out) {
-    const std::string name =
-        out < 0  ? m_.parts[static_cast<std::size_t>(in)].name + ".side"
-        : in < 0 ? m_.parts[static_cast<std::size_t>(out)].name + ".side"  // an empty hole's wall
-                 : interface_name(in, out);
-    const std::int32_t marker = marker_of(name);
-    const Footprint& fp = fp_[f];
-    for (std::size_t e = 0; e < fp.n(); ++e) {
-      const std::size_t j = (e + 1) % fp.n();
-      s_.plc.add_facet({point(f, e, z0), point(f, j, z0), point(f, j, z1), point(f, e, z1)}, marker);
-      s_.boundary_area[marker - 1] +=
-          std::hypot(fp.xy[2 * j] - fp.xy[2 * e], fp.xy[2 * j + 1] - fp.xy[2 * e + 1]) *
-          (levels_[z1] - levels_[z0]);
-    }
-  }
-
-  void add_seed(std::size_t f, const std::vector<std::size_t>& kids, std::size_t k, long part) {
-    const Footprint& fp = fp_[f];
-    auto free = [&](double x, double y) {
-      if (!strictly_inside_pt(fp, x, y, 0)) return false;
-      for (std::size_t c : kids)
-        if (strictly_inside_pt(fp_[c], x, y, -eps_)) return false;
-      return true;
-    };
-    double px = fp.cx, py = fp.cy;
-    bool found = free(px, py);
-    for (double t : {0.02, 0.002, 1e-4})
-      for (std::size_t v = 0; v < fp.n() && !found; ++v) {
-        px = fp.xy[2 * v] + t * (fp.cx - fp.xy[2 * v]);
-        py = fp.xy[2 * v + 1] + t * (fp.cy - fp.xy[2 * v + 1]);
-        found = free(px, py);
-      }
-    RegionSeed seed;
-    seed.point[0] = px;
-    seed.point[1] = py;
-    seed.point[2] = 0.5 * (levels_[k] + levels_[k + 1]);
-    seed.id = static_cast<std::int32_t>(part + 1);
-    s_.plc.regions.push_back(seed);
   }
 
   const Model& m_;
   Structure s_;
   double eps_ = 0;
   std::vector<double> levels_;
-  std::vector<Footprint> fp_;
   std::vector<Item> items_;
-  std::vector<std::uint8_t> contains_;
-  std::map<std::tuple<std::size_t, std::size_t, std::size_t>, std::uint32_t> points_;
+  std::map<std::tuple<double, double, std::size_t>, std::uint32_t> points_;
 };
 
 }  // namespace
 
 Structure build_structure(const Model& model) { return Builder(model).build(); }
-
 void name_mesh(const Model& model, const Structure& structure, Mesh& mesh) {
   mesh.materials.clear();
   for (const Material& m : model.materials) mesh.materials.push_back(m);

@@ -2,13 +2,13 @@
 //
 // Every part is a set of vertical prisms (boxes, layers, faceted z-axis cylinders, arrays of them).
 // The space is cut into z slabs at every prism's top and bottom; in each slab a point belongs to the
-// LAST part (in file order) whose active prism covers it, so a later part carves its volume out of
-// earlier ones. Horizontal facets are emitted where the owner changes across a level, vertical facets
-// where it changes across a footprint edge; shared areas are therefore one set of facets (an inner
-// footprint becomes an inner polygon plus a hole point of the surrounding facet, and a facet of its
-// own). Supported footprint relations between prisms whose z ranges meet: equal, strictly nested, or
-// apart with a gap; partial overlaps and side-by-side contact are rejected with an error naming both
-// parts (general booleans, e.g. CGAL corefinement, are not implemented).
+// LAST part (in file order) whose prism covers it, so a later part carves its volume out of earlier
+// ones, whatever the overlap (nested, partial, crossing) and parts may touch side by side. In each
+// slab the footprint edges form a planar arrangement (CGAL Arrangement_2, exact constructions);
+// horizontal facets are emitted where the owner changes across a level, vertical facets where it
+// changes across an arrangement edge, and each facet carries every vertex that its neighbours put on
+// its boundary, so shared areas are one set of facets. Footprints must be convex polygons (all the
+// shapes of model_file.hpp are). Curved or tilted shapes (spheres, STL surfaces) are not handled.
 #pragma once
 
 #include <string>
