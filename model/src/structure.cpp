@@ -172,10 +172,18 @@ class Builder {
         add_ccb(f->outer_ccb(), z);
         for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h) {
           add_ccb(*h, z);
-          // a hole point: inside the face across this inner boundary
-          Arr::Halfedge_const_handle he = *h;
-          const auto hp = pl.inner.at(he->twin()->face());
-          s_.plc.facet_holes.insert(s_.plc.facet_holes.end(), {hp.first, hp.second, levels_[z]});
+          // hole points: inside each face across this inner boundary (several where the boundary
+          // pinches, e.g. around two footprints that touch at a corner)
+          std::vector<Arr::Face_const_handle> across;
+          auto e = *h;
+          do {
+            const Arr::Face_const_handle t = e->twin()->face();
+            if (t != f && std::find(across.begin(), across.end(), t) == across.end()) across.push_back(t);
+          } while (++e != *h);
+          for (const auto& t : across) {
+            const auto hp = pl.inner.at(t);
+            s_.plc.facet_holes.insert(s_.plc.facet_holes.end(), {hp.first, hp.second, levels_[z]});
+          }
         }
         s_.plc.facet_marker.push_back(marker);
         s_.plc.facet_hole_begin.push_back(static_cast<std::uint32_t>(s_.plc.facet_holes.size() / 3));

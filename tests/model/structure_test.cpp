@@ -323,6 +323,18 @@ TEST(Structure, CrossingBarsAndACylinderOverACorner) {
   expect_near_rel(m.boundary_area.at("a/c"), ngon_perimeter(16, 0.5) / 4 * kMm2, "a/c");
 }
 
+TEST(Structure, PartsTouchingAtACornerOnASubstrate) {
+  // p and q touch only at the corner (2, 2) on the substrate's top, r is sunk 0.5 into it beside p
+  const Meshed m = mesh_text(boxes_model(box("sub", 0, 0, 0, 4, 4, 1) + box("p", 1, 1, 1, 1, 1, 1) +
+                                         box("q", 2, 2, 1, 1, 1, 0.5) + box("r", 2, 1, 0.5, 1, 1, 1)),
+                             1e-10);
+  expect_volumes(m, {{"sub", 15.5 * kMm3}, {"p", 1 * kMm3}, {"q", 0.5 * kMm3}, {"r", 1 * kMm3}});
+  expect_near_rel(m.boundary_area.at("sub.top"), 13 * kMm2, "sub.top");
+  expect_near_rel(m.boundary_area.at("sub/r"), (1 + 4 * 0.5) * kMm2, "sub/r");
+  expect_near_rel(m.boundary_area.at("p/r"), 0.5 * kMm2, "p/r");
+  expect_near_rel(m.boundary_area.at("q/r"), 0.5 * kMm2, "q/r");
+}
+
 // ---- bad input ----
 
 const char* kGood = R"TOML(units.length = "mm"
