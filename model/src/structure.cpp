@@ -1,23 +1,25 @@
-// Parts -> PLC by z slabs and planar arrangements (see structure.hpp).
+// Parts -> PLC by z slabs and planar subdivisions (see structure.hpp).
 //
 // Every part is a set of vertical prisms. The z values of all prism tops and bottoms cut space into
-// slabs. In slab k, the footprint edges of the prisms active there form a planar arrangement A_k
-// (CGAL Arrangement_2, exact constructions, so touching and crossing footprints are split where they
-// meet); every bounded face of A_k is owned by the last part whose prism covers it. At level z, the
-// arrangement of the edges of both neighbouring slabs gives the horizontal facets: a face whose owner
-// below differs from its owner above becomes a facet (outer boundary, inner boundaries with a hole
-// point each). An edge of A_k whose two faces have different owners becomes a vertical facet; its
-// bottom and top edges carry every vertex that the level arrangements put on them, so all facets meet
-// along whole segments (a conforming PLC).
+// slabs. In slab k, the footprint edges of the prisms active there are split where they meet (CGAL's
+// surface sweep, exact constructions) and form a planar subdivision; every bounded face is owned by
+// the last part whose prism covers it. At level z, the subdivision of the edges of both neighbouring
+// slabs gives the horizontal facets: a face whose owner below differs from its owner above becomes a
+// facet (outer boundary, inner boundaries with hole points). An edge of slab k whose two faces have
+// different owners becomes a vertical facet; its bottom and top edges carry every vertex that the
+// level subdivisions put on them, so all facets meet along whole segments (a conforming PLC).
+// (CGAL's Arrangement_2 would give the faces too, but its handles make UBSan report bad downcasts,
+// CGAL issues #5241 and #9140, so the faces are traced here from the swept segments.)
 #include "foxi/model/structure.hpp"
 
-#include <CGAL/Arr_segment_traits_2.h>
-#include <CGAL/Arrangement_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Surface_sweep_2_algorithms.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <numeric>
 #include <tuple>
 
 #include "foxi/model/io_error.hpp"
@@ -28,8 +30,8 @@ namespace {
 
 using K = CGAL::Exact_predicates_exact_constructions_kernel;
 using Traits = CGAL::Arr_segment_traits_2<K>;
-using Arr = CGAL::Arrangement_2<Traits>;
 using Pt = K::Point_2;
+using XY = std::pair<double, double>;
 
 struct Item {
   std::size_t part;
@@ -48,36 +50,49 @@ bool inside_polygon(const std::vector<double>& xy, double x, double y) {  // con
   return true;
 }
 
-// A planar arrangement of the footprint edges of some prisms, with a point inside each bounded face.
+// A planar subdivision by segments: vertices, edges (halfedge 2e runs u -> v, 2e + 1 back; each has
+// its face on the left, -1 for the unbounded face) and bounded faces (rings of halfedges: the outer
+// one counter-clockwise first, then the inner ones), each with a point inside and its area.
 struct Plane {
-  Arr arr;
-  std::map<Arr::Face_const_handle, std::pair<double, double>> inner;  // a point inside each bounded face
-  std::map<Arr::Face_const_handle, double> area;                      // of each bounded face
-  std::vector<std::pair<double, double>> vertices;                    // all vertices, sorted
+  std::vector<XY> vertex;
+  std::vector<XY> sorted_vertex;
+  std::vector<std::uint32_t> he_from;  // source vertex of each halfedge
+  std::vector<long> he_face;
+  struct Face {
+    std::vector<std::vector<std::uint32_t>> rings;  // halfedges
+    double area = 0;
+    XY inner;
+  };
+  std::vector<Face> faces;
+  std::size_t edge_count() const { return he_from.size() / 2; }
+  const XY& from(std::uint32_t h) const { return vertex[he_from[h]]; }
 };
 
-double to_d(const K::FT& v) { return CGAL::to_double(v); }
-
-template <class Circ>
-void ccb_points(Circ c, std::vector<std::pair<double, double>>& out) {
-  Circ e = c;
-  do {
-    out.emplace_back(to_d(e->source()->point().x()), to_d(e->source()->point().y()));
-  } while (++e != c);
-}
-
-double ring_area(const std::vector<std::pair<double, double>>& r) {
+double cycle_area(const Plane& pl, const std::vector<std::uint32_t>& ring) {
   double a = 0;
-  for (std::size_t i = 0; i < r.size(); ++i) {
-    const auto& p = r[i];
-    const auto& q = r[(i + 1) % r.size()];
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    const XY& p = pl.from(ring[i]);
+    const XY& q = pl.from(ring[(i + 1) % ring.size()]);
     a += p.first * q.second - q.first * p.second;
   }
   return 0.5 * a;
 }
 
+bool in_ring(const Plane& pl, const std::vector<std::uint32_t>& ring, double x,
+             double y) {  // crossing number
+  bool in = false;
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    const XY& a = pl.from(ring[i]);
+    const XY& b = pl.from(ring[(i + 1) % ring.size()]);
+    if ((a.second > y) != (b.second > y) &&
+        x < a.first + (y - a.second) * (b.first - a.first) / (b.second - a.second))
+      in = !in;
+  }
+  return in;
+}
+
 void build_plane(Plane& pl, const std::vector<const Prism*>& prisms) {
-  std::vector<Traits::X_monotone_curve_2> segs;
+  std::vector<Traits::Curve_2> segs;
   for (const Prism* p : prisms) {
     const std::size_t n = p->xy.size() / 2;
     for (std::size_t i = 0; i < n; ++i) {
@@ -85,44 +100,117 @@ void build_plane(Plane& pl, const std::vector<const Prism*>& prisms) {
       segs.emplace_back(Pt(p->xy[2 * i], p->xy[2 * i + 1]), Pt(p->xy[2 * j], p->xy[2 * j + 1]));
     }
   }
-  CGAL::insert(pl.arr, segs.begin(), segs.end());
-  for (auto v = pl.arr.vertices_begin(); v != pl.arr.vertices_end(); ++v)
-    pl.vertices.emplace_back(to_d(v->point().x()), to_d(v->point().y()));
-  std::sort(pl.vertices.begin(), pl.vertices.end());
-  for (auto f = pl.arr.faces_begin(); f != pl.arr.faces_end(); ++f) {
-    if (f->is_unbounded()) continue;
-    // rings: the outer boundary and the inner ones, as double polygons
-    std::vector<std::vector<std::pair<double, double>>> rings(1);
-    ccb_points(f->outer_ccb(), rings[0]);
-    double area = ring_area(rings[0]);
-    for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h) {
-      rings.emplace_back();
-      ccb_points(*h, rings.back());
-      area += ring_area(rings.back());  // inner rings run clockwise: negative
+  std::vector<Traits::X_monotone_curve_2> sub;
+  CGAL::compute_subcurves(segs.begin(), segs.end(), std::back_inserter(sub));
+  std::map<Pt, std::uint32_t> ids;
+  auto id = [&](const Pt& p) {
+    auto [it, fresh] = ids.emplace(p, static_cast<std::uint32_t>(pl.vertex.size()));
+    if (fresh) pl.vertex.emplace_back(CGAL::to_double(p.x()), CGAL::to_double(p.y()));
+    return it->second;
+  };
+  std::map<std::pair<std::uint32_t, std::uint32_t>, bool> seen;
+  for (const auto& s : sub) {
+    const std::uint32_t u = id(s.source()), v = id(s.target());
+    if (u == v || !seen.emplace(std::minmax(u, v), true).second) continue;
+    pl.he_from.push_back(u);
+    pl.he_from.push_back(v);
+  }
+  pl.sorted_vertex = pl.vertex;
+  std::sort(pl.sorted_vertex.begin(), pl.sorted_vertex.end());
+  const std::size_t H = pl.he_from.size(), V = pl.vertex.size();
+  auto to = [&](std::size_t h) { return pl.he_from[h ^ 1]; };
+  // outgoing halfedges around each vertex, counter-clockwise
+  std::vector<std::vector<std::uint32_t>> out(V);
+  for (std::size_t h = 0; h < H; ++h) out[pl.he_from[h]].push_back(static_cast<std::uint32_t>(h));
+  auto angle = [&](std::uint32_t h) {
+    const XY& a = pl.vertex[pl.he_from[h]];
+    const XY& b = pl.vertex[to(h)];
+    return std::atan2(b.second - a.second, b.first - a.first);
+  };
+  std::vector<std::uint32_t> pos(H);
+  for (auto& o : out) {
+    std::sort(o.begin(), o.end(), [&](std::uint32_t a, std::uint32_t b) { return angle(a) < angle(b); });
+    for (std::size_t i = 0; i < o.size(); ++i) pos[o[i]] = static_cast<std::uint32_t>(i);
+  }
+  // next halfedge with the same face on the left: at the target, the first one clockwise from the twin
+  auto next = [&](std::uint32_t h) {
+    const std::uint32_t t = h ^ 1u;
+    const auto& o = out[pl.he_from[t]];
+    return o[(pos[t] + o.size() - 1) % o.size()];
+  };
+  // connected components (union-find over vertices)
+  std::vector<std::uint32_t> comp(V);
+  std::iota(comp.begin(), comp.end(), 0u);
+  std::function<std::uint32_t(std::uint32_t)> find = [&](std::uint32_t x) {
+    while (comp[x] != x) x = comp[x] = comp[comp[x]];
+    return x;
+  };
+  for (std::size_t h = 0; h < H; h += 2) comp[find(pl.he_from[h])] = find(pl.he_from[h + 1]);
+  // cycles
+  std::vector<std::vector<std::uint32_t>> cycles;
+  std::vector<long> cycle_of(H, -1);
+  for (std::uint32_t h = 0; h < H; ++h) {
+    if (cycle_of[h] >= 0) continue;
+    std::vector<std::uint32_t> c;
+    std::uint32_t e = h;
+    do {
+      cycle_of[e] = static_cast<long>(cycles.size());
+      c.push_back(e);
+      e = next(e);
+    } while (e != h && c.size() <= H);
+    cycles.push_back(std::move(c));
+  }
+  std::vector<long> face_of_cycle(cycles.size(), -1);
+  std::vector<double> area(cycles.size());
+  for (std::size_t c = 0; c < cycles.size(); ++c) {
+    area[c] = cycle_area(pl, cycles[c]);
+    if (area[c] > 0) {
+      face_of_cycle[c] = static_cast<long>(pl.faces.size());
+      pl.faces.emplace_back();
+      pl.faces.back().rings.push_back(cycles[c]);
     }
-    pl.area[f] = area;
-    // a point inside: from the middle of the longest outer edge, halfway to the nearest boundary
-    // crossed by the inward normal (the face lies left of its outer boundary)
-    const auto& o = rings[0];
+  }
+  // each clockwise cycle bounds a hole of the smallest face (of another component) around it
+  for (std::size_t c = 0; c < cycles.size(); ++c) {
+    if (area[c] > 0) continue;
+    const std::uint32_t v0 = pl.he_from[cycles[c][0]];
+    const XY& p = pl.vertex[v0];
+    long best = -1;
+    for (std::size_t d = 0; d < cycles.size(); ++d) {
+      if (area[d] <= 0 || find(pl.he_from[cycles[d][0]]) == find(v0)) continue;
+      if ((best < 0 || area[d] < area[static_cast<std::size_t>(best)]) &&
+          in_ring(pl, cycles[d], p.first, p.second))
+        best = static_cast<long>(d);
+    }
+    if (best < 0) continue;
+    face_of_cycle[c] = face_of_cycle[static_cast<std::size_t>(best)];
+    pl.faces[static_cast<std::size_t>(face_of_cycle[c])].rings.push_back(cycles[c]);
+  }
+  pl.he_face.resize(H);
+  for (std::size_t h = 0; h < H; ++h) pl.he_face[h] = face_of_cycle[static_cast<std::size_t>(cycle_of[h])];
+  // area and a point inside each face: from the middle of the longest outer edge, halfway to the
+  // nearest boundary crossed by the inward normal (the face lies left of its outer boundary)
+  for (auto& f : pl.faces) {
+    for (const auto& r : f.rings) f.area += cycle_area(pl, r);  // inner rings are negative
+    const auto& o = f.rings[0];
     std::size_t best = 0;
     double best_len = -1;
     for (std::size_t i = 0; i < o.size(); ++i) {
-      const auto& p = o[i];
-      const auto& q = o[(i + 1) % o.size()];
+      const XY& p = pl.from(o[i]);
+      const XY& q = pl.vertex[to(o[i])];
       const double len = std::hypot(q.first - p.first, q.second - p.second);
       if (len > best_len) best_len = len, best = i;
     }
-    const auto& p = o[best];
-    const auto& q = o[(best + 1) % o.size()];
+    const XY& p = pl.from(o[best]);
+    const XY& q = pl.vertex[to(o[best])];
     const double mx = 0.5 * (p.first + q.first), my = 0.5 * (p.second + q.second);
     const double nx = -(q.second - p.second) / best_len, ny = (q.first - p.first) / best_len;
     double tmin = 1e300;
-    for (std::size_t r = 0; r < rings.size(); ++r)
-      for (std::size_t i = 0; i < rings[r].size(); ++i) {
-        if (r == 0 && i == best) continue;
-        const auto& a = rings[r][i];
-        const auto& b = rings[r][(i + 1) % rings[r].size()];
-        // solve m + t n = a + s (b - a)
+    for (const auto& r : f.rings)
+      for (std::uint32_t h : r) {
+        if (h == o[best]) continue;
+        const XY& a = pl.from(h);
+        const XY& b = pl.vertex[to(h)];
         const double dx = b.first - a.first, dy = b.second - a.second;
         const double den = nx * (-dy) - ny * (-dx);
         if (den == 0) continue;
@@ -132,7 +220,7 @@ void build_plane(Plane& pl, const std::vector<const Prism*>& prisms) {
         if (t > 1e-12 * best_len && s >= -1e-12 && s <= 1 + 1e-12) tmin = std::min(tmin, t);
       }
     if (tmin > 1e299) tmin = best_len;  // cannot happen for a closed face; keep a finite point
-    pl.inner[f] = {mx + 0.5 * tmin * nx, my + 0.5 * tmin * ny};
+    f.inner = {mx + 0.5 * tmin * nx, my + 0.5 * tmin * ny};
   }
 }
 
@@ -159,9 +247,9 @@ class Builder {
       for (std::size_t i : above) prisms.push_back(items_[i].prism);
       Plane& pl = level[z];
       build_plane(pl, prisms);
-      for (auto f = pl.arr.faces_begin(); f != pl.arr.faces_end(); ++f) {
-        if (f->is_unbounded()) continue;
-        const auto [x, y] = pl.inner.at(f);
+      for (std::size_t fi = 0; fi < pl.faces.size(); ++fi) {
+        const Plane::Face& f = pl.faces[fi];
+        const auto [x, y] = f.inner;
         const long lb = label(x, y, below), la = label(x, y, above);
         if (lb == la) continue;
         const std::string name = lb < 0   ? part_name(la) + ".bottom"
@@ -169,25 +257,26 @@ class Builder {
                                           : interface_name(lb, la);
         const std::int32_t marker = marker_of(name);
         s_.plc.facet_polygon_begin.push_back(s_.plc.facet_polygon_begin.back());
-        add_ccb(f->outer_ccb(), z);
-        for (auto h = f->inner_ccbs_begin(); h != f->inner_ccbs_end(); ++h) {
-          add_ccb(*h, z);
+        add_ring(pl, f.rings[0], z);
+        for (std::size_t r = 1; r < f.rings.size(); ++r) {
+          add_ring(pl, f.rings[r], z);
           // hole points: inside each face across this inner boundary (several where the boundary
           // pinches, e.g. around two footprints that touch at a corner)
-          std::vector<Arr::Face_const_handle> across;
-          auto e = *h;
-          do {
-            const Arr::Face_const_handle t = e->twin()->face();
-            if (t != f && std::find(across.begin(), across.end(), t) == across.end()) across.push_back(t);
-          } while (++e != *h);
-          for (const auto& t : across) {
-            const auto hp = pl.inner.at(t);
+          std::vector<long> across;
+          for (std::uint32_t h : f.rings[r]) {
+            const long t = pl.he_face[h ^ 1u];
+            if (t >= 0 && t != static_cast<long>(fi) &&
+                std::find(across.begin(), across.end(), t) == across.end())
+              across.push_back(t);
+          }
+          for (long t : across) {
+            const XY hp = pl.faces[static_cast<std::size_t>(t)].inner;
             s_.plc.facet_holes.insert(s_.plc.facet_holes.end(), {hp.first, hp.second, levels_[z]});
           }
         }
         s_.plc.facet_marker.push_back(marker);
         s_.plc.facet_hole_begin.push_back(static_cast<std::uint32_t>(s_.plc.facet_holes.size() / 3));
-        s_.boundary_area[static_cast<std::size_t>(marker - 1)] += pl.area.at(f);
+        s_.boundary_area[static_cast<std::size_t>(marker - 1)] += f.area;
       }
     }
 
@@ -198,17 +287,13 @@ class Builder {
       Plane pl;
       build_plane(pl, prisms);
       const double dz = levels_[k + 1] - levels_[k];
-      std::map<Arr::Face_const_handle, long> owner;
-      for (auto f = pl.arr.faces_begin(); f != pl.arr.faces_end(); ++f) {
-        if (f->is_unbounded()) {
-          owner[f] = -1;
-          continue;
-        }
-        const auto [x, y] = pl.inner.at(f);
+      std::vector<long> owner(pl.faces.size());
+      for (std::size_t fi = 0; fi < pl.faces.size(); ++fi) {
+        const auto [x, y] = pl.faces[fi].inner;
         const long o = label(x, y, active[k]);
-        owner[f] = o;
+        owner[fi] = o;
         if (o < 0) continue;
-        s_.part_volume[static_cast<std::size_t>(o)] += pl.area.at(f) * dz;
+        s_.part_volume[static_cast<std::size_t>(o)] += pl.faces[fi].area * dz;
         RegionSeed seed;
         seed.point[0] = x;
         seed.point[1] = y;
@@ -216,15 +301,16 @@ class Builder {
         seed.id = static_cast<std::int32_t>(o + 1);
         s_.plc.regions.push_back(seed);
       }
-      for (auto e = pl.arr.edges_begin(); e != pl.arr.edges_end(); ++e) {
-        const long a = owner.at(e->face()), b = owner.at(e->twin()->face());
+      auto owner_of = [&](long f) { return f < 0 ? -1L : owner[static_cast<std::size_t>(f)]; };
+      for (std::uint32_t e = 0; e < pl.edge_count(); ++e) {
+        const long a = owner_of(pl.he_face[2 * e]), b = owner_of(pl.he_face[2 * e + 1]);
         if (a == b) continue;
         const std::string name = a < 0   ? part_name(b) + ".side"
                                  : b < 0 ? part_name(a) + ".side"
                                          : interface_name(a, b);
         const std::int32_t marker = marker_of(name);
-        const double px = to_d(e->source()->point().x()), py = to_d(e->source()->point().y());
-        const double qx = to_d(e->target()->point().x()), qy = to_d(e->target()->point().y());
+        const auto [px, py] = pl.from(2 * e);
+        const auto [qx, qy] = pl.from(2 * e + 1);
         // bottom p -> q with the level-k vertices on it, top q -> p with the level-(k+1) ones
         std::vector<std::uint32_t> poly;
         for (const auto& v : on_segment(level[k], px, py, qx, qy))
@@ -287,8 +373,8 @@ class Builder {
     const double tol = 1e-9 * std::sqrt(len2);
     std::vector<std::pair<double, std::pair<double, double>>> hits;
     const double xlo = std::min(px, qx) - tol, xhi = std::max(px, qx) + tol;
-    auto it = std::lower_bound(pl.vertices.begin(), pl.vertices.end(), std::make_pair(xlo, -1e300));
-    for (; it != pl.vertices.end() && it->first <= xhi; ++it) {
+    auto it = std::lower_bound(pl.sorted_vertex.begin(), pl.sorted_vertex.end(), std::make_pair(xlo, -1e300));
+    for (; it != pl.sorted_vertex.end() && it->first <= xhi; ++it) {
       const double vx = it->first, vy = it->second;
       if (vy < std::min(py, qy) - tol || vy > std::max(py, qy) + tol) continue;
       const double cross = (qx - px) * (vy - py) - (qy - py) * (vx - px);
@@ -326,13 +412,9 @@ class Builder {
     return id;
   }
 
-  template <class Circ>
-  void add_ccb(Circ c, std::size_t z) {
-    Circ e = c;
-    do {
-      s_.plc.polygon_vertices.push_back(
-          point(to_d(e->source()->point().x()), to_d(e->source()->point().y()), z));
-    } while (++e != c);
+  void add_ring(const Plane& pl, const std::vector<std::uint32_t>& ring, std::size_t z) {
+    for (std::uint32_t h : ring)
+      s_.plc.polygon_vertices.push_back(point(pl.from(h).first, pl.from(h).second, z));
     s_.plc.polygon_vertex_begin.push_back(static_cast<std::uint32_t>(s_.plc.polygon_vertices.size()));
     ++s_.plc.facet_polygon_begin.back();
   }
