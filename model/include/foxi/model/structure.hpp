@@ -4,7 +4,7 @@
 // The space is cut into z slabs at every prism's top and bottom; in each slab a point belongs to the
 // LAST part (in file order) whose prism covers it, so a later part carves its volume out of earlier
 // ones, whatever the overlap (nested, partial, crossing) and parts may touch side by side. In each
-// slab the footprint edges form a planar arrangement (CGAL Arrangement_2, exact constructions);
+// slab the footprint edges, split where they meet (CGAL surface sweep, exact), form a planar subdivision;
 // horizontal facets are emitted where the owner changes across a level, vertical facets where it
 // changes across an arrangement edge, and each facet carries every vertex that its neighbours put on
 // its boundary, so shared areas are one set of facets. Footprints must be convex polygons (all the
