@@ -54,6 +54,7 @@ double tri_area(const foxi::Mesh& m, std::size_t f) {
 }
 
 // Writes the model's PLC, meshes it with the tetgen program, reads the mesh back.
+// max_volume <= 0: no volume bound and no quality refinement (plain -pA).
 Meshed mesh_model(const std::string& file, std::vector<std::string> sets, double max_volume) {
   Meshed out;
   if (!foxi::test::have_program("tetgen")) {
@@ -66,8 +67,9 @@ Meshed mesh_model(const std::string& file, std::vector<std::string> sets, double
   foxi::write_poly(s.plc, dir / "m.poly");
   char vol[64];
   std::snprintf(vol, sizeof vol, "%.6g", max_volume);
-  const int rc = foxi::test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a" + vol + "AVQ m.poly",
-                                 dir / "log.txt");
+  const std::string switches = max_volume > 0 ? std::string("-pq1.414a") + vol + "AVQ" : std::string("-pAVQ");
+  const int rc =
+      foxi::test::run("cd '" + dir.path().string() + "' && tetgen " + switches + " m.poly", dir / "log.txt");
   const std::string log = foxi::test::read_text(dir / "log.txt");
   EXPECT_EQ(rc, 0) << log;
   EXPECT_EQ(log.find("ntersect"), std::string::npos) << log;  // "self-intersection", "intersecting"
@@ -333,6 +335,17 @@ TEST(Structure, PartsTouchingAtACornerOnASubstrate) {
   expect_near_rel(m.boundary_area.at("sub/r"), (1 + 4 * 0.5) * kMm2, "sub/r");
   expect_near_rel(m.boundary_area.at("p/r"), 0.5 * kMm2, "p/r");
   expect_near_rel(m.boundary_area.at("q/r"), 0.5 * kMm2, "q/r");
+}
+
+TEST(Structure, ThinDieAttachLayer500To1) {
+  // a 20 um die attach under a 4 x 4 mm die on a 10 mm substrate (the 500:1 thin layer)
+  const Meshed m =
+      mesh_text(boxes_model(box("substrate", 0, 0, 0, 10, 10, 1) + box("attach", 3, 3, 1, 4, 4, 0.02) +
+                            box("die", 3, 3, 1.02, 4, 4, 0.5)),
+                0);
+  expect_volumes(m, {{"substrate", 100 * kMm3}, {"attach", 16 * 0.02 * kMm3}, {"die", 8 * kMm3}});
+  expect_near_rel(m.boundary_area.at("attach.side"), 16 * 0.02 * kMm2, "attach.side");
+  expect_near_rel(m.boundary_area.at("attach/die"), 16 * kMm2, "attach/die");
 }
 
 // ---- bad input ----
