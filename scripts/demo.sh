@@ -11,9 +11,13 @@ bash scripts/build.sh
 foxi=build/apps/foxi/foxi
 out=out/demo
 mkdir -p "$out"
+# The parametrized model (TOML: parameters with units, parts, materials) and its PLC.
+"$foxi" model check models/die_on_substrate.toml --set die_w=5mm
+"$foxi" model plc models/die_on_substrate.toml --set die_w=5mm -o "$out/die_on_substrate.poly"
+echo
 # TetGen through its library: radius-edge bound 1.414, tets of at most 1e-11 m^3, no flips or
 # smoothing (they break the Delaunay property; see issue 6), then the exact certificate.
-"$foxi" mesh examples/die_on_substrate.poly -o "$out/die_on_substrate.node" --max-volume 1e-11 --check-delaunay
+"$foxi" mesh "$out/die_on_substrate.poly" -o "$out/die_on_substrate.node" --max-volume 1e-11 --check-delaunay
 echo
 "$foxi" info --check-delaunay "$out/die_on_substrate.node"
 echo
@@ -21,9 +25,9 @@ echo
 "$foxi" order "$out/die_on_substrate.node" --views 4 --check
 echo
 # Steady heat: 0.5 W in the die (region 2), the substrate bottom (boundary 1) held at 300 K, the
-# die top (boundary 6) cooled by air (h = 10 W/m^2K at 300 K); conductivities of FR-4 and silicon.
-"$foxi" solve "$out/die_on_substrate.node" --physics thermal --fix 1=300 --power 2=0.5 --k 1=0.3 \
-  --k 2=150 --convect 6=10,300 -o "$out/die_on_substrate_thermal.vtu"
+# die top (boundary 4) cooled by air (h = 10 W/m^2K at 300 K); FR-4 and silicon (models/materials.toml).
+"$foxi" solve "$out/die_on_substrate.node" --physics thermal --fix 1=300 --power 2=0.5 --k 1=0.4 \
+  --k 2=148 --convect 4=10,300 -o "$out/die_on_substrate_thermal.vtu"
 echo
 # The inside of the mesh: the far 60% of the tets, back to front, each shrunk a little.
 "$foxi" render "$out/die_on_substrate.node" --stop 60% --shrink 0.85 --size 1280x960 -o "$out/die_on_substrate.png"
