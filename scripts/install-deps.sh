@@ -10,7 +10,7 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libtet1.5-dev libeigen3-dev
   qtbase5-dev libx11-dev libxext-dev libpng-dev zlib1g-dev libpugixml-dev libfreetype-dev libgif-dev libtoml11-dev
   # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev xvfb
+  libgtest-dev libgmock-dev libbenchmark-dev xvfb xdotool x11-apps
   # outside programs the tests use as oracles
   gmsh tetgen calculix-ccx python3-meshio python3-numpy
 )

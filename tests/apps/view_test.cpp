@@ -1,0 +1,292 @@
+// foxi-view, the libX11 viewer: its headless script mode (the same state machine as the window)
+// against foxi render, its region of interest through the id buffer, and the real window under Xvfb
+// driven by xdotool, its saved PNG and a screenshot of the window compared with the headless picture.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/viz/png.hpp"
+#include "test_util.hpp"
+#include "viz/mesh_factory.hpp"
+
+namespace foxi {
+namespace {
+
+// foxi-view is built beside the CLI: <build>/apps/foxi/foxi -> <build>/apps/foxi-view/foxi-view.
+std::filesystem::path view_path() {
+  return std::filesystem::path(test::cli_path()).parent_path().parent_path() / "foxi-view" / "foxi-view";
+}
+
+int run_logged(const std::string& cmd, const std::filesystem::path& log, std::string* out = nullptr) {
+  int status = test::run(cmd, log);
+  if (out) *out = test::read_text(log);
+  return status;
+}
+
+std::string q(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+
+std::vector<std::uint32_t> read_ids(const std::filesystem::path& path) {
+  std::string bytes = test::read_text(path);
+  std::vector<std::uint32_t> ids(bytes.size() / 4);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + 4 * i);
+    ids[i] = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 |
+             std::uint32_t(b[3]) << 24;
+  }
+  return ids;
+}
+
+std::vector<std::uint32_t> read_tets(const std::filesystem::path& path) {
+  std::istringstream in(test::read_text(path));
+  std::vector<std::uint32_t> v;
+  std::uint32_t t;
+  while (in >> t) v.push_back(t);
+  return v;
+}
+
+std::size_t differing_pixels(const Framebuffer& a, const Framebuffer& b) {
+  if (a.width != b.width || a.height != b.height) return std::size_t(-1);
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.rgba.size(); ++i) n += (a.rgba[i] & 0xFFFFFFu) != (b.rgba[i] & 0xFFFFFFu);
+  return n;
+}
+
+// A 6 x 5 x 4 grid of cubes, 6 tets each (cospherical clusters), in two regions: left and right half.
+Mesh two_region_grid() {
+  Mesh m = test::grid_mesh(6, 5, 4, 1, 1, 1, 6);
+  m.tet_region.resize(m.tet_count());
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    double x = 0;
+    for (int v = 0; v < 4; ++v) x += m.xyz[3 * std::size_t(m.tet[4 * t + v])];
+    m.tet_region[t] = x < 12 ? 1 : 2;
+  }
+  m.regions = {Region{1, "left", kNone}, Region{2, "right", kNone}};
+  return m;
+}
+
+class ViewTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!std::filesystem::exists(view_path()))
+      GTEST_SKIP() << view_path() << " is not built (FOXI_WITH_X11 off, or no libX11)";
+    mesh_path_ = dir_ / "grid.vtu";
+    write_mesh(two_region_grid(), mesh_path_);
+  }
+  test::TempDir dir_;
+  std::filesystem::path mesh_path_;
+};
+
+const char* kSize = "--size 320x240";
+
+TEST_F(ViewTest, ScriptDrawEqualsFoxiRender) {
+  std::string out;
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --save " + q(dir_ / "h") +
+                           " --script 'd s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("saved " + (dir_ / "h-001.png").string()), std::string::npos) << out;
+  EXPECT_NE(out.find("drawn 720 / 720 tets (100.0%)"), std::string::npos) << out;
+  ASSERT_EQ(
+      run_logged(q(test::cli_path()) + " render " + q(mesh_path_) + " " + kSize + " -o " + q(dir_ / "r.png"),
+                 dir_ / "render.log", &out),
+      0)
+      << out;
+  const Framebuffer view = read_png(dir_ / "h-001.png"), render = read_png(dir_ / "r.png");
+  EXPECT_EQ(differing_pixels(view, render), 0u);
+  // Not a blank picture: both regions' colours show.
+  std::set<std::uint32_t> colours(view.rgba.begin(), view.rgba.end());
+  EXPECT_GT(colours.size(), 10u);
+
+  // An orthographic camera gives the same agreement.
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --dir 1,2,-3 --save " +
+                           q(dir_ / "o") + " --script 'd s'",
+                       dir_ / "view2.log", &out),
+            0)
+      << out;
+  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(mesh_path_) + " " + kSize + " --dir 1,2,-3 -o " +
+                           q(dir_ / "ro.png"),
+                       dir_ / "render2.log", &out),
+            0)
+      << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "o-001.png"), read_png(dir_ / "ro.png")), 0u);
+}
+
+TEST_F(ViewTest, RegionOfInterestDrawsExactlyTheSubsetAndBackRestores) {
+  std::string out;
+  // Draw two batches, save, take them as the region, turn, draw the region, save; back up, draw, save.
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --dump-ids --save " +
+                           q(dir_ / "h") + " --script 'c n n s r orbit:40,10 d s b d s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  const auto roi = read_tets(dir_ / "h-001.tets");
+  ASSERT_GT(roi.size(), 0u);
+  ASSERT_LT(roi.size(), 720u) << "two batches should not be the whole mesh";
+  const std::set<std::uint32_t> subset(roi.begin(), roi.end());
+  ASSERT_EQ(subset.size(), roi.size());
+
+  // The region drawn from the new view: every subset tet once, nothing else, in the id buffer too.
+  auto drawn = read_tets(dir_ / "h-002.tets");
+  std::sort(drawn.begin(), drawn.end());
+  EXPECT_EQ(drawn, std::vector<std::uint32_t>(subset.begin(), subset.end()));
+  std::size_t covered = 0;
+  for (std::uint32_t id : read_ids(dir_ / "h-002.ids")) {
+    if (id == kNone) continue;
+    ++covered;
+    EXPECT_TRUE(subset.count(id)) << "pixel shows tet " << id << " outside the region";
+    if (!subset.count(id)) break;
+  }
+  EXPECT_GT(covered, 0u);
+  EXPECT_NE(out.find("drawn " + std::to_string(roi.size()) + " / " + std::to_string(roi.size()) + " tets"),
+            std::string::npos)
+      << out;
+
+  // Back up: the whole mesh again, from the turned view; equal to foxi render of that camera.
+  auto all = read_tets(dir_ / "h-003.tets");
+  EXPECT_EQ(all.size(), 720u);
+  std::set<std::uint32_t> shown;
+  for (std::uint32_t id : read_ids(dir_ / "h-003.ids"))
+    if (id != kNone) shown.insert(id);
+  EXPECT_TRUE(std::any_of(shown.begin(), shown.end(), [&](std::uint32_t t) { return !subset.count(t); }));
+  const std::string marker = "saved " + (dir_ / "h-003.png").string();
+  const auto at = out.find(marker);
+  ASSERT_NE(at, std::string::npos) << out;
+  const auto open = out.find("(--", at), close = out.find(')', open);
+  const std::string camera = out.substr(open + 1, close - open - 1);
+  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(mesh_path_) + " " + kSize + " " + camera +
+                           " -o " + q(dir_ / "r.png"),
+                       dir_ / "render.log", &out),
+            0)
+      << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "h-003.png"), read_png(dir_ / "r.png")), 0u) << camera;
+}
+
+TEST_F(ViewTest, NonDelaunayMeshIsDrawnWithTheDepthBuffer) {
+  // Two tets on one triangle, each apex inside the other's circumsphere: not Delaunay.
+  Mesh m;
+  m.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.3, 0.3, 0.1, 0.3, 0.3, -0.1};
+  test::push_tet(m, 0, 1, 2, 3);
+  test::push_tet(m, 0, 1, 2, 4);
+  write_mesh(m, dir_ / "nd.vtu");
+  std::string out;
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "nd.vtu") + " " + kSize + " --dir 0.2,0.3,-1 --save " +
+                           q(dir_ / "h") + " --script 'd s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("NOT Delaunay: depth-buffer drawing"), std::string::npos) << out;
+  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(dir_ / "nd.vtu") + " " + kSize +
+                           " --dir 0.2,0.3,-1 -o " + q(dir_ / "r.png"),
+                       dir_ / "render.log", &out),
+            0)
+      << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "h-001.png"), read_png(dir_ / "r.png")), 0u);
+}
+
+TEST_F(ViewTest, BadScriptIsAnError) {
+  EXPECT_EQ(test::run(q(view_path()) + " " + q(mesh_path_) + " --script 'd wobble'", dir_ / "bad.log"), 1);
+  EXPECT_NE(test::read_text(dir_ / "bad.log").find("unknown script command 'wobble'"), std::string::npos);
+  EXPECT_EQ(test::run(q(view_path()) + " " + q(mesh_path_) + " --size 0x3", dir_ / "bad2.log"), 2);
+}
+
+// An XWD screenshot (xwd -id WINDOW) as RGB pixels, for 24/32-bit TrueColor ZPixmap images.
+bool read_xwd(const std::filesystem::path& path, Framebuffer& fb) {
+  const std::string s = test::read_text(path);
+  auto be32 = [&](std::size_t off) {
+    const auto* b = reinterpret_cast<const unsigned char*>(s.data() + off);
+    return std::uint32_t(b[0]) << 24 | std::uint32_t(b[1]) << 16 | std::uint32_t(b[2]) << 8 | b[3];
+  };
+  if (s.size() < 100) return false;
+  const std::uint32_t header = be32(0), format = be32(8), w = be32(16), h = be32(20), order = be32(28);
+  const std::uint32_t bpp = be32(44), bpl = be32(48), rmask = be32(56), gmask = be32(60), bmask = be32(64);
+  const std::uint32_t ncolors = be32(76);
+  if (format != 2 || bpp != 32 || w == 0 || h == 0) return false;
+  const std::size_t data = header + 12 * std::size_t(ncolors);
+  if (s.size() < data + std::size_t(bpl) * h) return false;
+  auto shift = [](std::uint32_t m) {
+    int k = 0;
+    while (m && !(m & 1)) m >>= 1, ++k;
+    return k;
+  };
+  fb.resize(int(w), int(h), false);
+  for (std::uint32_t y = 0; y < h; ++y)
+    for (std::uint32_t x = 0; x < w; ++x) {
+      const auto* b = reinterpret_cast<const unsigned char*>(s.data() + data + std::size_t(y) * bpl + 4 * x);
+      std::uint32_t p =
+          order == 0
+              ? (std::uint32_t(b[3]) << 24 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[1]) << 8 | b[0])
+              : (std::uint32_t(b[0]) << 24 | std::uint32_t(b[1]) << 16 | std::uint32_t(b[2]) << 8 | b[3]);
+      fb.rgba[std::size_t(y) * w + x] =
+          pack_rgba((p & rmask) >> shift(rmask), (p & gmask) >> shift(gmask), (p & bmask) >> shift(bmask));
+    }
+  return true;
+}
+
+// The real window under Xvfb: keys sent with xdotool (d, wait for the draw, s, q). The PNG it saves
+// equals the headless one, and so does a screenshot of the window above its status line.
+TEST_F(ViewTest, WindowUnderXvfbDrivenByXdotool) {
+  if (!test::have_program("xvfb-run") || !test::have_program("xdotool"))
+    GTEST_SKIP() << "xvfb-run or xdotool is missing (scripts/install-deps.sh installs them)";
+  const bool have_xwd = test::have_program("xwd");
+  const std::string driver = R"SH(set -u
+V=$1; M=$2; D=$3
+"$V" "$M" --size 320x240 --save "$D/x" > "$D/window.log" 2>&1 &
+pid=$!
+trap 'kill -9 $pid 2>/dev/null' EXIT
+wait_for() { i=0; while [ $i -lt 100 ]; do [ "$(grep -c "$1" "$D/window.log")" -ge "$2" ] && return 0; kill -0 $pid 2>/dev/null || return 1; sleep 0.1; i=$((i+1)); done; echo "timeout waiting for $1"; return 1; }
+wid=$(timeout 10 xdotool search --sync --name '^foxi-view$' | head -1)
+[ -n "$wid" ] || { echo "no window"; exit 3; }
+wait_for '^done' 1 || exit 4
+xdotool key --window "$wid" d
+wait_for '^done' 2 || exit 5
+xdotool key --window "$wid" s
+wait_for '^saved' 1 || exit 6
+if command -v xwd > /dev/null; then xwd -silent -id "$wid" > "$D/shot.xwd" || exit 8; fi
+xdotool key --window "$wid" q 2>/dev/null
+i=0; while kill -0 $pid 2>/dev/null && [ $i -lt 50 ]; do sleep 0.1; i=$((i+1)); done
+kill -0 $pid 2>/dev/null && { echo "viewer did not quit"; exit 7; }
+exit 0
+)SH";
+  test::write_text(dir_ / "drive.sh", driver);
+  std::string out;
+  const int status =
+      run_logged("timeout -k 5 40 xvfb-run -a -s '-screen 0 640x480x24' sh " + q(dir_ / "drive.sh") + " " +
+                     q(view_path()) + " " + q(mesh_path_) + " " + q(dir_.path()),
+                 dir_ / "xvfb.log", &out);
+  ASSERT_EQ(status, 0) << out << test::read_text(dir_ / "window.log");
+  const std::string log = test::read_text(dir_ / "window.log");
+  EXPECT_NE(log.find("done drawn 720 / 720 tets (100.0%)"), std::string::npos) << log;
+  ASSERT_TRUE(std::filesystem::exists(dir_ / "x-001.png")) << log;
+
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " --size 320x240 --save " + q(dir_ / "h") +
+                           " --script 'd s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  const Framebuffer headless = read_png(dir_ / "h-001.png");
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "x-001.png"), headless), 0u);
+
+  if (!have_xwd) {
+    std::printf("xwd is missing: the screenshot comparison is skipped\n");
+    return;
+  }
+  Framebuffer shot;
+  ASSERT_TRUE(read_xwd(dir_ / "shot.xwd", shot)) << "cannot read the xwd screenshot";
+  ASSERT_EQ(shot.width, 320);
+  ASSERT_GE(shot.height, 240);
+  Framebuffer top(320, 240);
+  for (int y = 0; y < 240; ++y)
+    std::copy_n(shot.rgba.begin() + std::ptrdiff_t(y) * 320, 320, top.rgba.begin() + std::ptrdiff_t(y) * 320);
+  EXPECT_EQ(differing_pixels(top, headless), 0u);
+}
+
+}  // namespace
+}  // namespace foxi
