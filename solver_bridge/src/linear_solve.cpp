@@ -270,13 +270,23 @@ void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned thread
 
 LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x,
                             const LinearSolverOptions& options) {
+  std::vector<std::vector<double>> xs;
+  LinearSolveResult result = solve_spd_many(a, {b}, xs, options);
+  x = std::move(xs[0]);
+  return result;
+}
+
+LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
+                                 std::vector<std::vector<double>>& xs, const LinearSolverOptions& options) {
   const std::size_t n = a.rows();
   const unsigned threads = thread_count(options.threads);
   LinearSolveResult result;
-  x.assign(n, 0.0);
-  double bnorm = 0;
-  for (double v : b) bnorm += v * v;
-  bnorm = std::sqrt(bnorm);
+  xs.assign(bs.size(), std::vector<double>(n, 0.0));
+  auto norm = [](const std::vector<double>& b) {
+    double s = 0;
+    for (double v : b) s += v * v;
+    return std::sqrt(s);
+  };
   LinearSolverKind kind = options.kind;
   if (kind == LinearSolverKind::automatic)
     kind = n <= options.direct_max_unknowns ? LinearSolverKind::direct : LinearSolverKind::cg_amg;
@@ -285,8 +295,6 @@ LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b,
     return result;
   }
   Eigen::Map<const SpMat> A = as_eigen(a);
-  Eigen::Map<const Vec> B(b.data(), static_cast<Eigen::Index>(n));
-  Eigen::Map<Vec> X(x.data(), static_cast<Eigen::Index>(n));
 
   if (kind == LinearSolverKind::direct) {
     result.solver = "SimplicialLDLT";
@@ -296,25 +304,39 @@ LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b,
     if (ldlt.info() != Eigen::Success)
       throw SolverError(
           "sparse LDL^T factorization failed (matrix not positive definite: are the "
-          "conductivities positive and every part connected to a fixed or convective boundary?)");
+          "coefficients positive and every part connected to a fixed boundary?)");
     const Vec d = ldlt.vectorD();
     if (d.minCoeff() <= 0)
       throw SolverError(
-          "sparse LDL^T: the matrix is singular or indefinite (a part with no fixed-temperature "
-          "or convection boundary, or a non-positive conductivity)");
-    report(options, "solve", 0.0);
-    X = ldlt.solve(B);
-    result.relative_residual = bnorm > 0 ? residual_norm(a, b, x, threads) / bnorm : 0.0;
+          "sparse LDL^T: the matrix is singular or indefinite (a part with no fixed boundary, or a "
+          "non-positive coefficient)");
+    for (std::size_t i = 0; i < bs.size(); ++i) {
+      report(options, "solve", static_cast<double>(i) / static_cast<double>(bs.size()));
+      Eigen::Map<const Vec> B(bs[i].data(), static_cast<Eigen::Index>(n));
+      Eigen::Map<Vec> X(xs[i].data(), static_cast<Eigen::Index>(n));
+      X = ldlt.solve(B);
+      const double bnorm = norm(bs[i]);
+      result.relative_residual = std::max(result.relative_residual,
+                                          bnorm > 0 ? residual_norm(a, bs[i], xs[i], threads) / bnorm : 0.0);
+    }
     report(options, "solve", 1.0);
     return result;
   }
 
   report(options, "factorize", 0.0);
+  auto run_all = [&](auto&& precondition) {
+    for (std::size_t i = 0; i < bs.size(); ++i) {
+      LinearSolveResult one;
+      pcg(a, bs[i], xs[i], norm(bs[i]), options, threads, one, precondition);
+      result.iterations += one.iterations;
+      result.relative_residual = std::max(result.relative_residual, one.relative_residual);
+    }
+  };
   if (kind == LinearSolverKind::cg_amg) {
     result.solver = "CG+SmoothedAggregationAMG";
     Amg amg(a);
     report(options, "solve", 0.0);
-    pcg(a, b, x, bnorm, options, threads, result, [&](const Vec& r, Vec& z) { amg.apply(r, z); });
+    run_all([&](const Vec& r, Vec& z) { amg.apply(r, z); });
   } else {
     result.solver = "CG+IncompleteCholesky";
     Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> ic;
@@ -324,7 +346,7 @@ LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b,
     }
     if (ic.info() != Eigen::Success) throw SolverError("incomplete Cholesky factorization failed");
     report(options, "solve", 0.0);
-    pcg(a, b, x, bnorm, options, threads, result, [&](const Vec& r, Vec& z) { z = ic.solve(r); });
+    run_all([&](const Vec& r, Vec& z) { z = ic.solve(r); });
   }
   report(options, "solve", 1.0);
   return result;

@@ -29,6 +29,11 @@ struct LinearSolveResult {
 LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x,
                             const LinearSolverOptions& options);
 
+// The same for several right-hand sides with one factorization or preconditioner; iterations are
+// summed and the relative residual is the largest.
+LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::vector<double>>& b,
+                                 std::vector<std::vector<double>>& x, const LinearSolverOptions& options);
+
 // y = A x on `threads` threads.
 void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned threads);
 

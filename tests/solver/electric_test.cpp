@@ -1,0 +1,361 @@
+// Electrostatics and DC conduction against analytic values: parallel plates and layered dielectrics
+// (exact with P1: the field is piecewise uniform), concentric spheres (gmsh meshes, error falling
+// under refinement), bars in series and parallel (exact), Joule heat, fixed-current terminals, and the
+// ill-posed problems.
+#include "foxi/solver/electric.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "foxi/model/io_gmsh.hpp"
+#include "foxi/model/validate.hpp"
+#include "test_util.hpp"
+
+namespace foxi {
+namespace {
+
+constexpr double kEps0 = 8.8541878128e-12;
+
+// A box [0,lx] x [0,ly] x [0,lz] cut into n[0] x n[1] x n[2] cubes of 6 tets each (Kuhn split).
+// Boundary tags: 1 at x = 0, 2 at x = lx, 3 at y = 0 and y = ly, 4 at z = 0 and z = lz. The region of a
+// tet is region(centroid).
+template <class RegionFn>
+Mesh box(std::array<int, 3> n, std::array<double, 3> l, RegionFn region) {
+  Mesh m;
+  auto id = [&](int i, int j, int k) {
+    return static_cast<std::uint32_t>((k * (n[1] + 1) + j) * (n[0] + 1) + i);
+  };
+  for (int k = 0; k <= n[2]; ++k)
+    for (int j = 0; j <= n[1]; ++j)
+      for (int i = 0; i <= n[0]; ++i) {
+        m.xyz.push_back(l[0] * i / n[0]);
+        m.xyz.push_back(l[1] * j / n[1]);
+        m.xyz.push_back(l[2] * k / n[2]);
+      }
+  // The 6 tets of the Kuhn split of a cube: paths from corner 0 to corner 7 along the axes.
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i)
+        for (const auto& p : perms) {
+          int c[3] = {i, j, k};
+          double centroid[3] = {0, 0, 0};
+          for (int s = 0; s < 4; ++s) {
+            if (s > 0) ++c[p[s - 1]];
+            m.tet.push_back(id(c[0], c[1], c[2]));
+            for (int a = 0; a < 3; ++a) centroid[a] += 0.25 * l[a] * c[a] / n[a];
+          }
+          m.tet_region.push_back(region(centroid[0], centroid[1], centroid[2]));
+        }
+  auto quad = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d, std::int32_t tag) {
+    for (std::uint32_t v : {a, b, c, a, c, d}) m.bface.push_back(v);
+    m.bface_tag.push_back(tag);
+    m.bface_tag.push_back(tag);
+  };
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j) {
+      quad(id(0, j, k), id(0, j + 1, k), id(0, j + 1, k + 1), id(0, j, k + 1), 1);
+      quad(id(n[0], j, k), id(n[0], j + 1, k), id(n[0], j + 1, k + 1), id(n[0], j, k + 1), 2);
+    }
+  for (int k = 0; k < n[2]; ++k)
+    for (int i = 0; i < n[0]; ++i) {
+      quad(id(i, 0, k), id(i + 1, 0, k), id(i + 1, 0, k + 1), id(i, 0, k + 1), 3);
+      quad(id(i, n[1], k), id(i + 1, n[1], k), id(i + 1, n[1], k + 1), id(i, n[1], k + 1), 3);
+    }
+  for (int j = 0; j < n[1]; ++j)
+    for (int i = 0; i < n[0]; ++i) {
+      quad(id(i, j, 0), id(i + 1, j, 0), id(i + 1, j + 1, 0), id(i, j + 1, 0), 4);
+      quad(id(i, j, n[2]), id(i + 1, j, n[2]), id(i + 1, j + 1, n[2]), id(i, j + 1, n[2]), 4);
+    }
+  std::vector<std::int32_t> ids(m.tet_region);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  for (std::int32_t r : ids) m.regions.push_back({r, "r" + std::to_string(r), kNone});
+  validate_and_repair(m);
+  return m;
+}
+
+Mesh box(std::array<int, 3> n, std::array<double, 3> l) {
+  return box(n, l, [](double, double, double) { return 1; });
+}
+
+Electrode electrode(std::string name, std::vector<std::int32_t> tags, double volts = 0) {
+  Electrode e;
+  e.name = std::move(name);
+  e.tags = std::move(tags);
+  e.voltage = volts;
+  return e;
+}
+
+TEST(Electrostatic, ParallelPlatesAreExactWithEnergyAndUniformField) {
+  const double d = 2e-3, w = 10e-3, h = 5e-3, er = 4.5, v = 3;
+  Mesh m = box({6, 5, 4}, {d, w, h});
+  ElectrostaticParams p;
+  p.permittivity = {{1, er}};
+  p.conductors = {electrode("top", {2}, v), electrode("bottom", {1}, 0)};
+  for (LinearSolverKind kind :
+       {LinearSolverKind::direct, LinearSolverKind::cg_amg, LinearSolverKind::cg_ichol}) {
+    p.solver.kind = kind;
+    p.solver.relative_tolerance = 1e-13;
+    const ElectrostaticReport r = solve_electrostatic(m, p);
+    const double c = kEps0 * er * w * h / d;
+    ASSERT_EQ(r.capacitance.size(), 2u);
+    EXPECT_NEAR(r.capacitance[0][0], c, 1e-9 * c);
+    EXPECT_NEAR(r.capacitance[1][1], c, 1e-9 * c);
+    EXPECT_NEAR(r.capacitance[0][1], -c, 1e-9 * c);
+    EXPECT_NEAR(r.energy_capacitance[0], c, 1e-9 * c);
+    EXPECT_NEAR(r.energy, 0.5 * c * v * v, 1e-9 * c * v * v);
+    EXPECT_NEAR(r.conductors[0].charge, c * v, 1e-9 * c * v);
+    EXPECT_NEAR(r.conductors[1].charge, -c * v, 1e-9 * c * v);
+    EXPECT_NEAR(r.conductors[0].area, w * h, 1e-15);
+    const Field* phi = m.find_field("potential");
+    const Field* e = m.find_field("electric_field");
+    ASSERT_TRUE(phi && e);
+    EXPECT_EQ(phi->unit, "V");
+    for (std::size_t n = 0; n < m.node_count(); ++n)
+      EXPECT_NEAR(phi->values[n], v * m.xyz[3 * n] / d, 1e-9 * v);
+    for (std::size_t t = 0; t < m.tet_count(); ++t) {
+      EXPECT_NEAR(e->values[3 * t], -v / d, 1e-8 * v / d);
+      EXPECT_NEAR(e->values[3 * t + 1], 0, 1e-8 * v / d);
+    }
+  }
+}
+
+// Two dielectric layers in series: C = eps0 A / (d1 / er1 + d2 / er2), exact (interface on a node plane).
+TEST(Electrostatic, LayeredDielectricFromMaterials) {
+  const double d = 1e-3, a = 4e-3;
+  Mesh m = box({10, 3, 3}, {d, a, a}, [&](double x, double, double) { return x < 0.3 * d ? 1 : 2; });
+  m.materials = {Material{}, Material{}};
+  m.materials[0].relative_permittivity = 2;
+  m.materials[1].relative_permittivity = 9.8;
+  m.regions[0].material = 0;
+  m.regions[1].material = 1;
+  ElectrostaticParams p;
+  p.conductors = {electrode("a", {1}, 1), electrode("b", {2})};
+  const ElectrostaticReport r = solve_electrostatic(m, p);
+  const double c = kEps0 * a * a / (0.3 * d / 2 + 0.7 * d / 9.8);
+  EXPECT_NEAR(r.capacitance[0][0], c, 1e-9 * c);
+  EXPECT_NEAR(r.energy_capacitance[1], c, 1e-9 * c);
+  p.permittivity = {{2, 2}};  // the parameter overrides the material
+  const ElectrostaticReport r2 = solve_electrostatic(m, p);
+  EXPECT_NEAR(r2.capacitance[0][0], kEps0 * 2 * a * a / d, 1e-9 * c);
+}
+
+// Three conductors (both plates and the y sides): the matrix is symmetric, its diagonal equals the
+// energy capacitance, off-diagonals are negative, and the rows sum to zero: every boundary that is no
+// conductor carries no flux, so the total charge is zero whatever the potentials.
+TEST(Electrostatic, ThreeConductorMatrixIsSymmetric) {
+  Mesh m = box({7, 6, 5}, {1e-3, 1.3e-3, 0.8e-3});
+  ElectrostaticParams p;
+  p.permittivity = {{1, 3}};
+  p.conductors = {electrode("left", {1}), electrode("right", {2}), electrode("sides", {3})};
+  p.conductors[0].voltage = 1;
+  EXPECT_THROW(
+      {
+        try {
+          solve_electrostatic(m, p);
+        } catch (const SolverError& e) {
+          EXPECT_NE(std::string(e.what()).find("touch"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      SolverError);
+  // Tag 3 shares edges with tags 1 and 2: free the side triangles that touch x = 0 or x = lx (tag 5).
+  for (std::size_t f = 0; f < m.bface_count(); ++f) {
+    if (m.bface_tag[f] != 3) continue;
+    for (int i = 0; i < 3; ++i) {
+      const double x = m.xyz[3 * m.bface[3 * f + i]];
+      if (x < 1e-9 || x > 1e-3 - 1e-9) m.bface_tag[f] = 5;
+    }
+  }
+  const ElectrostaticReport r = solve_electrostatic(m, p);
+  EXPECT_LT(r.asymmetry, 1e-9);
+  double big = 0;
+  for (int i = 0; i < 3; ++i) big = std::max(big, r.capacitance[i][i]);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GT(r.capacitance[i][i], 0);
+    EXPECT_NEAR(r.energy_capacitance[i], r.capacitance[i][i], 1e-9 * big);
+    double row = 0;
+    for (int j = 0; j < 3; ++j) {
+      row += r.capacitance[i][j];
+      if (j != i) {
+        EXPECT_LT(r.capacitance[i][j], 0);
+        EXPECT_EQ(r.capacitance[i][j], r.capacitance[j][i]);
+      }
+    }
+    EXPECT_NEAR(row, 0, 1e-9 * big);
+  }
+  // The operating field: 1 V on the left plate, 0 elsewhere; charge = C column 0.
+  EXPECT_NEAR(r.conductors[1].charge, r.capacitance[1][0], 1e-12 * big);
+}
+
+// Spherical shell r1 = 1 < r < r2 = 2 (gmsh, first order): C = 4 pi eps r1 r2 / (r2 - r1).
+TEST(Electrostatic, ConcentricSpheresConverge) {
+  if (!test::have_program("gmsh")) GTEST_SKIP() << "gmsh not installed";
+  const double r1 = 1, r2 = 2, er = 2;
+  const double exact = 4 * std::numbers::pi * kEps0 * er * r1 * r2 / (r2 - r1);
+  test::TempDir dir;
+  test::write_text(dir / "shell.geo",
+                   "SetFactory(\"OpenCASCADE\");\n"
+                   "Sphere(1) = {0,0,0,2};\nSphere(2) = {0,0,0,1};\n"
+                   "BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };\n"
+                   "Physical Volume(1) = {3};\nb() = Boundary{ Volume{3}; };\n"
+                   "Physical Surface(1) = {b(0)};\nPhysical Surface(2) = {b(1)};\n"
+                   "Mesh.CharacteristicLengthMax = 0.25;\n");
+  std::vector<double> errors;
+  for (double scale : {1.6, 1.0, 0.6}) {
+    std::ostringstream cmd;
+    cmd << "gmsh -3 -v 0 -clscale " << scale << " -format msh22 -o '" << (dir / "shell.msh").string() << "' '"
+        << (dir / "shell.geo").string() << "'";
+    ASSERT_EQ(test::run(cmd.str(), dir / "log"), 0) << test::read_text(dir / "log");
+    Mesh m = read_gmsh(dir / "shell.msh");
+    validate_and_repair(m);
+    // Which tag is the inner sphere: the one whose nodes lie at radius 1.
+    std::int32_t inner = 1, outer = 2;
+    {
+      const std::uint32_t v = m.bface[0];
+      const double rad = std::hypot(m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]);
+      if ((rad < 1.5) != (m.bface_tag[0] == 1)) std::swap(inner, outer);
+    }
+    ElectrostaticParams p;
+    p.permittivity = {{1, er}};
+    p.conductors = {electrode("inner", {inner}, 1), electrode("outer", {outer})};
+    const ElectrostaticReport r = solve_electrostatic(m, p);
+    const double err = std::abs(r.capacitance[0][0] - exact) / exact;
+    errors.push_back(err);
+    EXPECT_NEAR(r.energy_capacitance[0], r.capacitance[0][0], 1e-8 * exact);
+    EXPECT_NEAR(r.capacitance[0][1], -r.capacitance[0][0], 1e-8 * exact);
+    std::printf("[ spheres ] clscale %.2f: %zu tets, C = %.6e F (exact %.6e), relative error %.3e\n", scale,
+                m.tet_count(), r.capacitance[0][0], exact, err);
+  }
+  EXPECT_LT(errors[1], errors[0]);
+  EXPECT_LT(errors[2], errors[1]);
+  EXPECT_LT(errors[2], 0.01);
+}
+
+// A bar of length L and section A: R = L / (sigma A), exact; Joule heat V^2 / R = I^2 R.
+TEST(Current, StraightBarResistanceAndJouleHeat) {
+  const double l = 5e-3, a = 0.5e-3, b = 0.2e-3, sigma = 5.8e7, v = 0.01;
+  Mesh m = box({10, 3, 2}, {l, a, b});
+  CurrentParams p;
+  p.conductivity = {{1, sigma}};
+  p.terminals = {electrode("in", {1}, v), electrode("out", {2}, 0)};
+  const CurrentReport r = solve_current(m, p);
+  const double rr = l / (sigma * a * b), i = v / rr;
+  EXPECT_NEAR(r.resistance, rr, 1e-9 * rr);
+  EXPECT_NEAR(r.terminals[0].charge, i, 1e-9 * i);
+  EXPECT_NEAR(r.terminals[1].charge, -i, 1e-9 * i);
+  EXPECT_NEAR(1 / r.conductance[0][0], rr, 1e-9 * rr);
+  EXPECT_NEAR(r.total_power, i * i * rr, 1e-9 * i * i * rr);
+  ASSERT_EQ(r.regions.size(), 1u);
+  EXPECT_NEAR(r.regions[0].power, i * i * rr, 1e-9 * i * i * rr);
+  const Field* j = m.find_field("current_density");
+  const Field* q = m.find_field("joule_heat");
+  ASSERT_TRUE(j && q);
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    EXPECT_NEAR(j->values[3 * t], i / (a * b), 1e-8 * i / (a * b));  // from x = 0 (at v) to x = l
+    EXPECT_NEAR(q->values[t], i * i * rr / (l * a * b), 1e-8 * i * i * rr / (l * a * b));
+  }
+  const std::vector<HeatSource> s = joule_heat_sources(r);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_TRUE(s[0].total);
+  EXPECT_NEAR(s[0].value, i * i * rr, 1e-9 * i * i * rr);
+
+  // A fixed current on the far terminal: V = I R.
+  p.terminals[0].voltage = 0;
+  p.terminals[1].fixed_current = true;
+  p.terminals[1].current = 2.0;
+  const CurrentReport c = solve_current(m, p);
+  EXPECT_NEAR(c.terminals[1].voltage, 2.0 * rr, 1e-9 * 2.0 * rr);
+  EXPECT_NEAR(c.terminals[1].charge, 2.0, 1e-9);
+  EXPECT_NEAR(c.terminals[0].charge, -2.0, 1e-9);
+  EXPECT_NEAR(c.total_power, 4.0 * rr, 1e-9 * 4.0 * rr);
+}
+
+TEST(Current, BarsInSeriesAndInParallel) {
+  const double l = 4e-3, a = 1e-3, s1 = 1e6, s2 = 3.5e7;
+  CurrentParams p;
+  p.conductivity = {{1, s1}, {2, s2}};
+  p.terminals = {electrode("in", {1}, 1), electrode("out", {2}, 0)};
+  {
+    Mesh m = box({8, 2, 2}, {l, a, a}, [&](double x, double, double) { return x < l / 4 ? 1 : 2; });
+    const CurrentReport r = solve_current(m, p);
+    const double r1 = (l / 4) / (s1 * a * a), r2 = (3 * l / 4) / (s2 * a * a), i = 1 / (r1 + r2);
+    EXPECT_NEAR(r.resistance, r1 + r2, 1e-9 * (r1 + r2));
+    EXPECT_NEAR(r.regions[0].power, i * i * r1, 1e-9 * i * i * r1);
+    EXPECT_NEAR(r.regions[1].power, i * i * r2, 1e-9 * i * i * r2);
+  }
+  {
+    Mesh m = box({5, 4, 2}, {l, a, a}, [&](double, double y, double) { return y < a / 4 ? 1 : 2; });
+    const CurrentReport r = solve_current(m, p);
+    const double g = s1 * a * a / 4 / l + s2 * 3 * a * a / 4 / l;
+    EXPECT_NEAR(r.resistance, 1 / g, 1e-9 / g);
+    EXPECT_NEAR(r.regions[0].power, s1 * a * a / 4 / l, 1e-9 * g);
+    EXPECT_NEAR(r.total_power, g, 1e-9 * g);
+  }
+}
+
+template <class Fn>
+void expect_error(Fn fn, const std::string& part) {
+  try {
+    fn();
+    ADD_FAILURE() << "no error; expected one containing '" << part << "'";
+  } catch (const SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+  }
+}
+
+TEST(Electric, IllPosedProblemsAreClearErrors) {
+  Mesh m = box({3, 2, 2}, {1, 1, 1});
+  ElectrostaticParams p;
+  p.permittivity = {{1, 1}};
+  expect_error([&] { solve_electrostatic(m, p); }, "no conductor");
+  p.conductors = {electrode("a", {1}), electrode("b", {9})};
+  expect_error([&] { solve_electrostatic(m, p); }, "tags no boundary triangle");
+  p.conductors = {electrode("a", {1}), electrode("b", {1, 2})};
+  expect_error([&] { solve_electrostatic(m, p); }, "belongs to two conductors");
+  p.conductors = {electrode("a", {1}), electrode("b", {3})};
+  expect_error([&] { solve_electrostatic(m, p); }, "touch");
+  p.conductors = {electrode("a", {1}), electrode("b", {2})};
+  p.permittivity.clear();
+  expect_error([&] { solve_electrostatic(m, p); }, "has no relative permittivity");
+  p.permittivity = {{1, -1}};
+  expect_error([&] { solve_electrostatic(m, p); }, "must be positive");
+  p.permittivity = {{7, 1}};
+  expect_error([&] { solve_electrostatic(m, p); }, "which has no tets");
+
+  // A second, disjoint box that touches no conductor.
+  Mesh two = box({3, 2, 2}, {1, 1, 1});
+  {
+    Mesh other = box({3, 2, 2}, {1, 1, 1});
+    const auto off = static_cast<std::uint32_t>(two.node_count());
+    for (std::size_t i = 0; i < other.xyz.size(); i += 3) {
+      two.xyz.push_back(other.xyz[i] + 5);
+      two.xyz.push_back(other.xyz[i + 1]);
+      two.xyz.push_back(other.xyz[i + 2]);
+    }
+    for (std::uint32_t v : other.tet) two.tet.push_back(v + off);
+    for (std::size_t t = 0; t < other.tet_count(); ++t) two.tet_region.push_back(1);
+    for (std::uint32_t v : other.bface) two.bface.push_back(v + off);
+    for (std::int32_t t : other.bface_tag) two.bface_tag.push_back(t + 10);
+  }
+  p.permittivity = {{1, 1}};
+  expect_error([&] { solve_electrostatic(two, p); }, "touches no conductor");
+
+  CurrentParams c;
+  c.conductivity = {{1, 1}};
+  c.terminals = {electrode("a", {1}), electrode("b", {2})};
+  c.terminals[0].fixed_current = c.terminals[1].fixed_current = true;
+  expect_error([&] { solve_current(m, c); }, "fixed voltage");
+  c.terminals[0].fixed_current = false;
+  expect_error([&] { solve_current(two, c); }, "touches no terminal");
+  c.conductivity.clear();
+  expect_error([&] { solve_current(m, c); }, "has no electrical conductivity");
+}
+
+}  // namespace
+}  // namespace foxi
