@@ -1,5 +1,6 @@
-// foxi solve MESH --physics thermal ...: a finite-element solve on a mesh file, results printed and
-// written as fields.
+// foxi solve MESH --physics thermal|electrostatic|current ...: a finite-element solve on a mesh
+// file, results printed and written as fields.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include "cli.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
+#include "foxi/solver/electric.hpp"
 #include "foxi/solver/thermal.hpp"
 
 namespace foxi::cli {
@@ -26,7 +28,21 @@ const char* kSolveUsage =
     "  condition are insulated; at least one --fix or --convect is needed. --power gives a region's\n"
     "  total heat in W, --power-density in W/m^3. Prints the maximum temperature and where, per-region\n"
     "  maximum and mean, heat through each boundary, and the solver's work; OUT (any mesh format,\n"
-    "  .vtu for ParaView) gets the fields 'temperature' (K, nodes) and 'heat_flux' (W/m^2, cells).";
+    "  .vtu for ParaView) gets the fields 'temperature' (K, nodes) and 'heat_flux' (W/m^2, cells).\n"
+    "\n"
+    "foxi solve MESH --physics electrostatic --conductor TAG[,TAG...]=NAME[:V] ... [--eps REGION=eps_r]\n"
+    "  Electrostatics: each conductor is a set of boundary tags at one potential (V, default 0 V, used\n"
+    "  for the written fields); other boundaries carry no normal field. Prints the capacitance matrix\n"
+    "  (F; C_ij = charge on i with 1 V on j, 0 V on the others), its energy check and the charges.\n"
+    "  eps_r defaults to the region's material. OUT gets 'potential' (V) and 'electric_field' (V/m).\n"
+    "\n"
+    "foxi solve MESH --physics current --terminal TAG[,TAG...]=V ... [--terminal-current TAG[,TAG...]=A]\n"
+    "                [--sigma REGION=S/m]\n"
+    "  DC conduction: terminals at a fixed voltage (V) or a fixed total current into the body (A; at\n"
+    "  least one terminal needs a voltage). Prints the current and voltage of each terminal, the\n"
+    "  resistance (two terminals: (V1 - V2) / I1), the conductance matrix and the Joule heat per region.\n"
+    "  sigma defaults to the region's material. OUT gets 'potential' (V), 'current_density' (A/m^2)\n"
+    "  and 'joule_heat' (W/m^3).";
 
 double parse_number(const std::string& text, const std::string& option) {
   char* end = nullptr;
@@ -88,6 +104,38 @@ std::string region_label(const Mesh& mesh, std::int32_t id) {
   return std::to_string(id) + (r && !r->name.empty() ? " (" + r->name + ")" : "");
 }
 
+std::vector<std::int32_t> boundary_tags(const Mesh& mesh, const std::string& list,
+                                        const std::string& option) {
+  std::vector<std::int32_t> tags;
+  std::size_t at = 0;
+  while (at <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', at), list.size());
+    const std::string key = list.substr(at, comma - at);
+    if (key.empty()) throw UsageError(option + ": empty tag in '" + list + "'");
+    tags.push_back(boundary_tag(mesh, key, option));
+    at = comma + 1;
+  }
+  return tags;
+}
+
+std::string tags_label(const Mesh& mesh, const std::vector<std::int32_t>& tags) {
+  std::string s;
+  for (std::int32_t t : tags) s += (s.empty() ? "" : ",") + boundary_label(mesh, t);
+  return s;
+}
+
+void print_matrix(const char* title, const char* unit, const std::vector<ElectrodeResult>& e,
+                  const std::vector<std::vector<double>>& m) {
+  std::printf("%s (%s):\n  %-16s", title, unit, "");
+  for (const ElectrodeResult& r : e) std::printf(" %14.14s", r.name.c_str());
+  std::printf("\n");
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    std::printf("  %-16.16s", e[i].name.c_str());
+    for (std::size_t j = 0; j < e.size(); ++j) std::printf(" %14.6e", m[i][j]);
+    std::printf("\n");
+  }
+}
+
 }  // namespace
 
 int cmd_solve(Args args) {
@@ -96,8 +144,12 @@ int cmd_solve(Args args) {
     return 0;
   }
   const std::string physics = args.option("--physics", "thermal");
-  if (physics != "thermal")
-    throw UsageError("--physics: only 'thermal' is implemented so far, not '" + physics + "'");
+  if (physics != "thermal" && physics != "electrostatic" && physics != "current")
+    throw UsageError("--physics takes thermal, electrostatic or current, not '" + physics + "'");
+  const std::vector<std::string> conductor = all_options(args, "--conductor"),
+                                 eps = all_options(args, "--eps"), terminal = all_options(args, "--terminal"),
+                                 terminal_current = all_options(args, "--terminal-current"),
+                                 sigma = all_options(args, "--sigma");
   const std::vector<std::string> fix = all_options(args, "--fix"), flux = all_options(args, "--flux"),
                                  convect = all_options(args, "--convect"),
                                  power = all_options(args, "--power"),
@@ -129,6 +181,98 @@ int cmd_solve(Args args) {
     for (const std::string& m : validation.messages) std::fprintf(stderr, "  %s\n", m.c_str());
   }
   auto t1 = std::chrono::steady_clock::now();
+
+  if (physics != "thermal") {
+    if (!fix.empty() || !flux.empty() || !convect.empty() || !power.empty() || !density.empty() ||
+        !cond.empty())
+      throw UsageError(
+          "--fix, --flux, --convect, --power, --power-density and --k are for --physics thermal");
+    LinearSolverOptions so = params.solver;
+    if (physics == "electrostatic") {
+      if (!terminal.empty() || !terminal_current.empty() || !sigma.empty())
+        throw UsageError("--terminal, --terminal-current and --sigma are for --physics current");
+      ElectrostaticParams ep;
+      ep.solver = so;
+      for (const std::string& s : conductor) {
+        auto [k, v] = split_assignment(s, "--conductor");
+        Electrode e;
+        e.tags = boundary_tags(mesh, k, "--conductor");
+        const auto colon = v.rfind(':');
+        e.name = v.substr(0, colon);
+        if (colon != std::string::npos) e.voltage = parse_number(v.substr(colon + 1), "--conductor");
+        ep.conductors.push_back(e);
+      }
+      for (const std::string& s : eps) {
+        auto [k, v] = split_assignment(s, "--eps");
+        ep.permittivity.push_back({region_id(mesh, k, "--eps"), parse_number(v, "--eps")});
+      }
+      const ElectrostaticReport r = solve_electrostatic(mesh, ep);
+      std::printf("%s: %zu nodes, %zu tets; electrostatics, %zu unknowns, %zu conductors\n", files[0].c_str(),
+                  mesh.node_count(), mesh.tet_count(), r.unknowns, r.conductors.size());
+      print_matrix("capacitance matrix", "F", r.conductors, r.capacitance);
+      std::printf("energy check 2W/V^2 (F):");
+      for (std::size_t i = 0; i < r.conductors.size(); ++i) std::printf(" %.6e", r.energy_capacitance[i]);
+      std::printf("\nconductors at their potentials:\n");
+      for (std::size_t i = 0; i < r.conductors.size(); ++i)
+        std::printf("  %-16s tags %-20s area %-10.4g m^2  %.6g V  charge %.6e C\n",
+                    r.conductors[i].name.c_str(), tags_label(mesh, ep.conductors[i].tags).c_str(),
+                    r.conductors[i].area, r.conductors[i].voltage, r.conductors[i].charge);
+      std::printf("stored energy %.6e J\n", r.energy);
+      std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
+                  r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
+      if (!out.empty()) {
+        write_mesh(mesh, out);
+        std::printf("wrote %s (fields potential [V], electric_field [V/m])\n", out.c_str());
+      }
+      return 0;
+    }
+    if (!conductor.empty() || !eps.empty())
+      throw UsageError("--conductor and --eps are for --physics electrostatic");
+    CurrentParams cp;
+    cp.solver = so;
+    auto add_terminal = [&](const std::string& s, const char* option, bool current) {
+      auto [k, v] = split_assignment(s, option);
+      Electrode e;
+      e.tags = boundary_tags(mesh, k, option);
+      e.name = tags_label(mesh, e.tags);
+      e.fixed_current = current;
+      (current ? e.current : e.voltage) = parse_number(v, option);
+      cp.terminals.push_back(e);
+    };
+    for (const std::string& s : terminal) add_terminal(s, "--terminal", false);
+    for (const std::string& s : terminal_current) add_terminal(s, "--terminal-current", true);
+    for (const std::string& s : sigma) {
+      auto [k, v] = split_assignment(s, "--sigma");
+      cp.conductivity.push_back({region_id(mesh, k, "--sigma"), parse_number(v, "--sigma")});
+    }
+    const CurrentReport r = solve_current(mesh, cp);
+    std::printf("%s: %zu nodes, %zu tets; DC conduction, %zu unknowns, %zu terminals\n", files[0].c_str(),
+                mesh.node_count(), mesh.tet_count(), r.unknowns, r.terminals.size());
+    std::printf("terminals (current into the body):\n");
+    for (std::size_t i = 0; i < r.terminals.size(); ++i)
+      std::printf("  %-24s %-8s area %-10.4g m^2  %.6g V  %.6e A\n", r.terminals[i].name.c_str(),
+                  cp.terminals[i].fixed_current ? "current" : "voltage", r.terminals[i].area,
+                  r.terminals[i].voltage, r.terminals[i].charge);
+    std::printf(
+        "resistance %.6e ohm%s\n", r.resistance,
+        r.terminals.size() == 2 ? " (between the two terminals)" : " (1 / G_00, the others grounded)");
+    print_matrix("conductance matrix", "S", r.terminals, r.conductance);
+    std::printf("Joule heat per region:\n");
+    for (const RegionJoule& j : r.regions)
+      std::printf("  %-20s sigma %-10.4g S/m  volume %-10.4g m^3  %.6e W\n",
+                  region_label(mesh, j.region).c_str(), j.conductivity, j.volume, j.power);
+    std::printf("total Joule heat %.6e W\n", r.total_power);
+    std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
+                r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
+    if (!out.empty()) {
+      write_mesh(mesh, out);
+      std::printf("wrote %s (fields potential [V], current_density [A/m^2], joule_heat [W/m^3])\n",
+                  out.c_str());
+    }
+    return 0;
+  }
+  if (!conductor.empty() || !eps.empty() || !terminal.empty() || !terminal_current.empty() || !sigma.empty())
+    throw UsageError("--conductor/--eps are for --physics electrostatic, --terminal/--sigma for current");
 
   for (const std::string& s : fix) {
     auto [k, v] = split_assignment(s, "--fix");

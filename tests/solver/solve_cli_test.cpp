@@ -55,6 +55,34 @@ TEST_F(SolveCliTest, WritesTheExactLinearProfile) {
   for (std::size_t c = 0; c < m.tet_count(); ++c) EXPECT_NEAR(q->values[3 * c], -200.0, 1e-7);
 }
 
+// Plates at x = 0 and 1 around the unit cube: C = eps0 eps_r, R = 1 / sigma, Joule heat V^2 / R.
+TEST_F(SolveCliTest, CapacitanceAndResistanceOfTheCube) {
+  const std::string out = (dir_ / "e.vtu").string();
+  ASSERT_EQ(
+      foxi("solve " + mesh() +
+           " --physics electrostatic --conductor 1=left:1 --conductor 2=right --eps 1=2 -o '" + out + "'"),
+      0)
+      << test::read_text(dir_ / "out.log");
+  std::string log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("1.770838e-11  -1.770838e-11"), std::string::npos) << log;  // 2 * 8.8541878128e-12
+  const Mesh m = read_mesh(out);
+  const Field* phi = m.find_field("potential");
+  ASSERT_NE(phi, nullptr);
+  for (std::size_t v = 0; v < m.node_count(); ++v) EXPECT_NEAR(phi->values[v], 1 - m.xyz[3 * v], 1e-9);
+  ASSERT_NE(m.find_field("electric_field"), nullptr);
+
+  ASSERT_EQ(foxi("solve " + mesh() + " --physics current --terminal 1=2 --terminal 2=0 --sigma 1=4"), 0)
+      << test::read_text(dir_ / "out.log");
+  log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("resistance 2.500000e-01 ohm"), std::string::npos) << log;
+  EXPECT_NE(log.find("total Joule heat 1.600000e+01 W"), std::string::npos) << log;
+  EXPECT_EQ(foxi("solve " + mesh() + " --physics current --terminal-current 1=2 --sigma 1=4"), 1);
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("ill-posed"), std::string::npos);
+  EXPECT_EQ(foxi("solve " + mesh() + " --physics electrostatic --conductor 1=a --conductor 2=b"), 1);
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("no relative permittivity"), std::string::npos);
+  EXPECT_EQ(foxi("solve " + mesh() + " --physics electrostatic --conductor 1=a --fix 2=3 --eps 1=1"), 2);
+}
+
 TEST_F(SolveCliTest, BadInputGivesClearErrors) {
   EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300"), 1);  // no conductivity
   EXPECT_NE(test::read_text(dir_ / "out.log").find("region 1 has no thermal conductivity"),
