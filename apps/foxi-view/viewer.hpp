@@ -62,6 +62,7 @@ class Viewer {
   const std::vector<std::uint32_t>& drawn() const { return drawn_; }
   std::size_t total() const;  // tets in the current draw's order
   bool delaunay() const { return delaunay_; }
+  // Milliseconds spent on the current draw so far (ordering and drawing; time stopped not counted).
   double frame_ms() const { return frame_ms_; }
   // Counts draws started (restart, camera moves, regions); a front end reports each completed draw once.
   std::size_t generation() const { return generation_; }
@@ -93,7 +94,6 @@ class Viewer {
   bool done_ = true, running_ = true, started_ = false;
   double frame_ms_ = 0;
   std::size_t generation_ = 0;
-  std::chrono::steady_clock::time_point t0_;
 };
 
 // The camera foxi render uses for the same options: --dir x,y,z (orthographic), or perspective with

@@ -11,6 +11,7 @@
 #include <sys/shm.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -96,7 +97,9 @@ class Screen {
     ensure(fb.width, fb.height);
     for (int y = 0; y < fb.height; ++y) {
       const std::uint32_t* src = fb.rgba.data() + fb.index(0, y);
-      if (image_->bits_per_pixel == 32) {
+      // The fast path writes host-order words: right when the image is 32-bit and in our byte order.
+      if (image_->bits_per_pixel == 32 &&
+          image_->byte_order == (std::endian::native == std::endian::little ? LSBFirst : MSBFirst)) {
         auto* dst = reinterpret_cast<std::uint32_t*>(image_->data +
                                                      std::size_t(y) * std::size_t(image_->bytes_per_line));
         for (int x = 0; x < fb.width; ++x) {
@@ -196,7 +199,7 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
   auto show = [&] {
     screen.put(win, gc, viewer.framebuffer());
     draw_status();
-    XFlush(dpy);
+    XSync(dpy, False);  // the server has read the shared image before the next batch changes it
   };
   auto report_done = [&] {
     std::printf("done %s\n", viewer.status().c_str());
