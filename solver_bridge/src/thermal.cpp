@@ -13,38 +13,16 @@
 #include <string>
 
 #include "linear_solve.hpp"
-#include "p1_assembly.hpp"
+#include "scalar_p1.hpp"
 
 namespace foxi {
 
 namespace {
 
+using detail::check_finite;
 using detail::parallel_for;
-
-std::string region_label(const Mesh& mesh, std::int32_t id) {
-  std::string s = "region " + std::to_string(id);
-  if (const Region* r = mesh.find_region(id); r && !r->name.empty()) s += " ('" + r->name + "')";
-  return s;
-}
-
-std::string tag_label(const Mesh& mesh, std::int32_t tag) {
-  std::string s = "boundary tag " + std::to_string(tag);
-  if (const Boundary* b = mesh.find_boundary(tag); b && !b->name.empty()) s += " ('" + b->name + "')";
-  return s;
-}
-
-void check_finite(double v, const std::string& what) {
-  if (!std::isfinite(v)) throw SolverError(what + " is not a finite number");
-}
-
-void set_field(Mesh& mesh, Field field) {
-  for (Field& f : mesh.fields)
-    if (f.name == field.name) {
-      f = std::move(field);
-      return;
-    }
-  mesh.fields.push_back(std::move(field));
-}
+using detail::region_label;
+using detail::tag_label;
 
 enum class BcKind : std::uint8_t { none, fixed, flux, convection };
 
@@ -59,55 +37,24 @@ struct TagBc {
 ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();
-  if (std::string problem = check_sizes(mesh); !problem.empty())
-    throw SolverError("inconsistent mesh: " + problem);
+  detail::check_mesh(mesh);
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), nf = mesh.bface_count();
-  if (nt == 0) throw SolverError("the mesh has no tetrahedra");
   const unsigned threads = detail::thread_count(params.solver.threads);
   auto progress = [&](std::string_view stage, double fraction) {
-    if (params.solver.progress && !params.solver.progress(stage, fraction))
-      throw SolverCancelled("solve cancelled during '" + std::string(stage) + "'");
+    detail::report_progress(params.solver, stage, fraction);
   };
   progress("assemble", 0.0);
 
   // Regions with tets, dense indices, conductivity.
-  std::vector<std::int32_t> region_ids;
-  for (std::size_t t = 0; t < nt; ++t) {
-    const std::int32_t r = mesh.region_of(t);
-    if (region_ids.empty() || region_ids.back() != r) region_ids.push_back(r);
-  }
-  std::sort(region_ids.begin(), region_ids.end());
-  region_ids.erase(std::unique(region_ids.begin(), region_ids.end()), region_ids.end());
-  const std::size_t nr = region_ids.size();
-  auto region_index = [&](std::int32_t id) -> std::size_t {
-    auto it = std::lower_bound(region_ids.begin(), region_ids.end(), id);
-    return (it != region_ids.end() && *it == id) ? static_cast<std::size_t>(it - region_ids.begin())
-                                                 : SIZE_MAX;
-  };
-  std::vector<double> region_k(nr, Material::kUnset);
-  for (std::size_t i = 0; i < nr; ++i)
-    if (const Region* r = mesh.find_region(region_ids[i]); r && r->material < mesh.materials.size())
-      region_k[i] = mesh.materials[r->material].thermal_conductivity;
-  for (const RegionConductivity& c : params.conductivity) {
-    const std::size_t i = region_index(c.region);
-    if (i == SIZE_MAX)
-      throw SolverError("conductivity given for " + region_label(mesh, c.region) + ", which has no tets");
-    region_k[i] = c.k;
-  }
-  for (std::size_t i = 0; i < nr; ++i) {
-    if (std::isnan(region_k[i]))
-      throw SolverError(
-          region_label(mesh, region_ids[i]) +
-          " has no thermal conductivity: its material gives none; set it in ThermalParams::conductivity "
-          "(foxi solve --k " +
-          std::to_string(region_ids[i]) + "=K)");
-    if (!(region_k[i] > 0) || !std::isfinite(region_k[i]))
-      throw SolverError("thermal conductivity of " + region_label(mesh, region_ids[i]) +
-                        " must be positive and finite, not " + std::to_string(region_k[i]));
-  }
-  std::vector<std::uint32_t> tet_rix(nt);
-  for (std::size_t t = 0; t < nt; ++t)
-    tet_rix[t] = static_cast<std::uint32_t>(region_index(mesh.region_of(t)));
+  const detail::RegionTable regions = detail::region_table(mesh);
+  const std::size_t nr = regions.size();
+  std::vector<std::pair<std::int32_t, double>> overrides;
+  for (const RegionConductivity& c : params.conductivity) overrides.emplace_back(c.region, c.k);
+  const std::vector<double> region_k = detail::region_coefficients(
+      mesh, regions, [](const Material& m) { return m.thermal_conductivity; }, overrides,
+      "thermal conductivity", "ThermalParams::conductivity (foxi solve --k");
+  const std::vector<std::uint32_t>& tet_rix = regions.tet_rix;
+  auto region_index = [&](std::int32_t id) { return regions.index(id); };
 
   // Boundary conditions by tag.
   std::vector<std::int32_t> tags(mesh.bface_tag.begin(), mesh.bface_tag.end());
@@ -155,27 +102,16 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   }
 
   // Tet volumes, region volumes, source densities.
-  std::vector<double> vol(nt);
   {
-    std::vector<std::vector<double>> part(threads, std::vector<double>(nr, 0.0));
-    parallel_for(nt, threads, [&](std::size_t b, std::size_t e, unsigned th) {
-      std::array<std::array<double, 3>, 4> g;
-      for (std::size_t t = b; t < e; ++t) {
-        vol[t] = detail::p1_gradients(mesh, t, g);
-        part[th][tet_rix[t]] += vol[t];
-      }
-    });
+    std::vector<double> region_volume;
+    (void)detail::tet_volumes(mesh, regions, threads, region_volume);
     rep.regions.resize(nr);
     for (std::size_t i = 0; i < nr; ++i) {
-      rep.regions[i].region = region_ids[i];
+      rep.regions[i].region = regions.ids[i];
       rep.regions[i].conductivity = region_k[i];
-      for (unsigned th = 0; th < threads; ++th) rep.regions[i].volume += part[th][i];
+      rep.regions[i].volume = region_volume[i];
     }
   }
-  for (std::size_t t = 0; t < nt; ++t)
-    if (!(vol[t] > 0))
-      throw SolverError("tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol[t]) +
-                        " (inverted or flat; validate_and_repair() re-orients inverted tets)");
   std::vector<double> region_q(nr, 0.0);  // W/m^3
   std::vector<bool> source_given(nr, false);
   for (const HeatSource& s : params.sources) {
@@ -193,40 +129,24 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   }
 
   // Stiffness (row-wise over the node pattern) and source load.
-  const detail::NodeTets ntets = detail::node_tets(mesh);
-  const detail::CsrPattern pat = detail::node_pattern(mesh, ntets, threads);
-  std::vector<double> kval(pat.col.size(), 0.0);
+  std::vector<double> tet_k(nt);
+  for (std::size_t t = 0; t < nt; ++t) tet_k[t] = region_k[tet_rix[t]];
+  detail::P1Stiffness stiff = detail::assemble_stiffness(mesh, tet_k, threads);
+  const detail::CsrPattern& pat = stiff.pat;
+  std::vector<double>& kval = stiff.val;
   std::vector<double> load(nn, 0.0);
-  parallel_for(nn, threads, [&](std::size_t b, std::size_t e, unsigned) {
+  {
     std::array<std::array<double, 3>, 4> g;
-    for (std::size_t v = b; v < e; ++v) {
-      const std::size_t rs = pat.row_start[v], re = pat.row_start[v + 1];
-      for (std::size_t k = ntets.node_start[v]; k < ntets.node_start[v + 1]; ++k) {
-        const std::size_t t = ntets.item[k] >> 2;
-        const unsigned a = ntets.item[k] & 3u;
-        const double volume = detail::p1_gradients(mesh, t, g);
-        const double kv = region_k[tet_rix[t]] * volume;
-        load[v] += region_q[tet_rix[t]] * volume * 0.25;
-        for (unsigned c = 0; c < 4; ++c) {
-          const std::uint32_t col = mesh.tet[4 * t + c];
-          std::size_t pos = rs;
-          while (pos < re && pat.col[pos] != col) ++pos;
-          kval[pos] += kv * (g[a][0] * g[c][0] + g[a][1] * g[c][1] + g[a][2] * g[c][2]);
-        }
-      }
+    for (std::size_t t = 0; t < nt; ++t) {
+      const double q = region_q[tet_rix[t]];
+      if (q == 0) continue;
+      const double share = q * detail::p1_gradients(mesh, t, g) * 0.25;
+      for (int a = 0; a < 4; ++a) load[mesh.tet[4 * t + a]] += share;
     }
-  });
+  }
   progress("assemble", 0.5);
 
   // Boundary triangles: Robin mass, flux and convection loads, fixed values (lumped-area mean).
-  std::vector<double> fix_sum(nn, 0.0), fix_w(nn, 0.0);
-  std::vector<std::uint32_t> fix_count(nn, 0);
-  struct FixShare {
-    std::uint32_t node;
-    std::uint32_t report;
-    double area;
-  };
-  std::vector<FixShare> fix_share;
   std::vector<double> bface_area(nf, 0.0);
   for (std::size_t f = 0; f < nf; ++f) {
     auto it = bc.find(mesh.bface_tag[f]);
@@ -238,12 +158,6 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
     const std::uint32_t* v = &mesh.bface[3 * f];
     switch (t.kind) {
       case BcKind::fixed:
-        for (int i = 0; i < 3; ++i) {
-          fix_sum[v[i]] += area / 3 * t.a;
-          fix_w[v[i]] += area / 3;
-          ++fix_count[v[i]];
-          fix_share.push_back({v[i], static_cast<std::uint32_t>(t.report), area / 3});
-        }
         break;
       case BcKind::flux:
         for (int i = 0; i < 3; ++i) load[v[i]] += t.a * area / 3;
@@ -266,109 +180,45 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
     }
   }
   // Fixed values; a zero-area neighbourhood falls back to the plain mean of the tags' values.
-  std::vector<double> temp(nn, std::numeric_limits<double>::quiet_NaN());
-  std::vector<char> fixed(nn, 0);
-  if (!params.fixed.empty()) {
-    std::vector<double> plain(nn, 0.0);
-    for (std::size_t f = 0; f < nf; ++f) {
-      auto it = bc.find(mesh.bface_tag[f]);
-      if (it == bc.end() || it->second.kind != BcKind::fixed) continue;
-      for (int i = 0; i < 3; ++i) plain[mesh.bface[3 * f + i]] += it->second.a;
-    }
-    for (std::size_t v = 0; v < nn; ++v)
-      if (fix_count[v] && ntets.node_start[v + 1] > ntets.node_start[v]) {
-        fixed[v] = 1;
-        temp[v] = fix_w[v] > 0 ? fix_sum[v] / fix_w[v] : plain[v] / fix_count[v];
-      }
-  }
+  std::map<std::int32_t, detail::FixedTag> fixed_tags;
+  for (const auto& [tag, t] : bc)
+    if (t.kind == BcKind::fixed) fixed_tags[tag] = {t.a, t.report};
+  const detail::Dirichlet dir = detail::dirichlet_from_tags(mesh, stiff, fixed_tags, rep.boundaries.size());
+  const std::vector<char>& fixed = dir.fixed;
+  std::vector<double> temp = dir.value;
 
   // Every connected part needs a fixed or convective node, else its temperature is undetermined.
   {
-    std::vector<std::uint32_t> parent(nn);
-    for (std::size_t v = 0; v < nn; ++v) parent[v] = static_cast<std::uint32_t>(v);
-    auto root = [&](std::uint32_t v) {
-      while (parent[v] != v) v = parent[v] = parent[parent[v]];
-      return v;
-    };
-    for (std::size_t t = 0; t < nt; ++t)
-      for (int a = 1; a < 4; ++a) {
-        const std::uint32_t r0 = root(mesh.tet[4 * t]), r1 = root(mesh.tet[4 * t + a]);
-        if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
-      }
-    std::vector<char> anchored(nn, 0);
-    for (std::size_t v = 0; v < nn; ++v)
-      if (fixed[v]) anchored[root(static_cast<std::uint32_t>(v))] = 1;
+    std::vector<char> anchored = fixed;
     for (std::size_t f = 0; f < nf; ++f) {
       auto it = bc.find(mesh.bface_tag[f]);
-      if (it != bc.end() && it->second.kind == BcKind::convection) anchored[root(mesh.bface[3 * f])] = 1;
+      if (it != bc.end() && it->second.kind == BcKind::convection) anchored[mesh.bface[3 * f]] = 1;
     }
-    for (std::size_t t = 0; t < nt; ++t)
-      if (!anchored[root(mesh.tet[4 * t])])
-        throw SolverError("ill-posed thermal problem: the connected part containing tet " +
-                          std::to_string(t) + " (" + region_label(mesh, mesh.region_of(t)) +
-                          ") touches no fixed-temperature or convection boundary, so its temperature is "
-                          "undetermined");
+    detail::check_anchored(
+        mesh, anchored, "ill-posed thermal problem",
+        "touches no fixed-temperature or convection boundary, so its temperature is undetermined");
   }
 
   // Free unknowns and the reduced system.
-  std::vector<int> dof(nn, -1);
-  int nfree = 0;
-  for (std::size_t v = 0; v < nn; ++v)
-    if (!fixed[v] && ntets.node_start[v + 1] > ntets.node_start[v]) dof[v] = nfree++;
-  detail::SymmetricCsr sys;
-  sys.start.reserve(static_cast<std::size_t>(nfree) + 1);
-  sys.start.push_back(0);
-  sys.col.reserve(pat.col.size());
-  sys.val.reserve(pat.col.size());
-  std::vector<double> rhs(static_cast<std::size_t>(nfree));
-  for (std::size_t v = 0; v < nn; ++v) {
-    if (dof[v] < 0) continue;
-    double r = load[v];
-    for (std::size_t k = pat.row_start[v]; k < pat.row_start[v + 1]; ++k) {
-      const std::uint32_t c = pat.col[k];
-      if (dof[c] >= 0) {
-        sys.col.push_back(dof[c]);
-        sys.val.push_back(kval[k]);
-      } else if (fixed[c]) {
-        r -= kval[k] * temp[c];
-      }
-    }
-    rhs[static_cast<std::size_t>(dof[v])] = r;
-    sys.start.push_back(static_cast<int>(sys.col.size()));
-  }
-  rep.unknowns = static_cast<std::size_t>(nfree);
-  rep.nonzeros = sys.val.size();
+  const detail::ReducedSystem red = detail::reduce(stiff, fixed);
+  const std::vector<double> rhs = detail::reduced_rhs(stiff, red, load, fixed, temp);
+  rep.unknowns = red.a.rows();
+  rep.nonzeros = red.a.val.size();
   progress("assemble", 1.0);
   const auto t_assembled = clock::now();
 
   std::vector<double> x;
-  const detail::LinearSolveResult lin = detail::solve_spd(sys, rhs, x, params.solver);
+  const detail::LinearSolveResult lin = detail::solve_spd(red.a, rhs, x, params.solver);
   rep.solver = lin.solver;
   rep.iterations = lin.iterations;
   rep.relative_residual = lin.relative_residual;
   const auto t_solved = clock::now();
-  for (std::size_t v = 0; v < nn; ++v)
-    if (dof[v] >= 0) temp[v] = x[static_cast<std::size_t>(dof[v])];
+  detail::scatter(red, x, temp);
 
   // Heat through the boundaries.
-  if (!fix_share.empty()) {
-    std::vector<double> reaction(nn, 0.0), share_w(nn, 0.0);
-    std::vector<std::uint32_t> share_n(nn, 0);
-    for (std::size_t v = 0; v < nn; ++v) {
-      if (!fixed[v]) continue;
-      double s = -load[v];
-      for (std::size_t k = pat.row_start[v]; k < pat.row_start[v + 1]; ++k) s += kval[k] * temp[pat.col[k]];
-      reaction[v] = s;
-    }
-    for (const FixShare& s : fix_share) {
-      share_w[s.node] += s.area;
-      ++share_n[s.node];
-    }
-    for (const FixShare& s : fix_share) {
-      if (!fixed[s.node]) continue;
-      const double w = share_w[s.node] > 0 ? s.area / share_w[s.node] : 1.0 / share_n[s.node];
-      rep.boundaries[s.report].heat_in += w * reaction[s.node];
-    }
+  {
+    const std::vector<double> heat = detail::slot_reactions(stiff, dir, load, temp, rep.boundaries.size());
+    for (std::size_t i = 0; i < heat.size(); ++i) rep.boundaries[i].heat_in += heat[i];
   }
   for (std::size_t f = 0; f < nf; ++f) {
     auto it = bc.find(mesh.bface_tag[f]);
@@ -435,8 +285,8 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   temp_field.components = 1;
   temp_field.unit = "K";
   temp_field.values = std::move(temp);
-  set_field(mesh, std::move(temp_field));
-  set_field(mesh, std::move(flux_field));
+  detail::set_field(mesh, std::move(temp_field));
+  detail::set_field(mesh, std::move(flux_field));
   rep.assembly_seconds = std::chrono::duration<double>(t_assembled - t_start).count();
   rep.solve_seconds = std::chrono::duration<double>(t_solved - t_assembled).count();
   return rep;
