@@ -13,6 +13,7 @@
 
 #include "foxi/model/io_gmsh.hpp"
 #include "foxi/model/validate.hpp"
+#include "foxi/solver/thermal.hpp"
 #include "test_util.hpp"
 
 namespace foxi {
@@ -276,6 +277,27 @@ TEST(Current, StraightBarResistanceAndJouleHeat) {
   EXPECT_NEAR(c.total_power, 4.0 * rr, 1e-9 * 4.0 * rr);
 }
 
+// The Joule heat feeds a thermal run: with both ends held at 300 K the heat leaving through them is I^2 R,
+// and the mid-bar temperature rise of the uniform source q = I^2 R / V is q L^2 / (8 k) (1D parabola).
+TEST(Current, JouleHeatIsAThermalLoad) {
+  const double l = 1e-2, a = 1e-3, sigma = 1e7, v = 0.05, k = 400;
+  Mesh m = box({16, 2, 2}, {l, a, a});
+  CurrentParams p;
+  p.conductivity = {{1, sigma}};
+  p.terminals = {electrode("in", {1}, v), electrode("out", {2}, 0)};
+  const CurrentReport c = solve_current(m, p);
+  const double power = v * v * sigma * a * a / l;
+  ThermalParams t;
+  t.conductivity = {{1, k}};
+  t.fixed = {{1, 300}, {2, 300}};
+  t.sources = joule_heat_sources(c);
+  const ThermalReport r = solve_thermal(m, t);
+  EXPECT_NEAR(r.total_power, power, 1e-9 * power);
+  EXPECT_NEAR(r.boundaries[0].heat_in + r.boundaries[1].heat_in, -power, 1e-9 * power);
+  const double rise = power / (l * a * a) * l * l / (8 * k);
+  EXPECT_NEAR(r.max_temperature - 300, rise, 0.01 * rise);
+}
+
 TEST(Current, BarsInSeriesAndInParallel) {
   const double l = 4e-3, a = 1e-3, s1 = 1e6, s2 = 3.5e7;
   CurrentParams p;
@@ -355,6 +377,11 @@ TEST(Electric, IllPosedProblemsAreClearErrors) {
   expect_error([&] { solve_current(two, c); }, "touches no terminal");
   c.conductivity.clear();
   expect_error([&] { solve_current(m, c); }, "has no electrical conductivity");
+
+  // Cancel from the progress callback.
+  c.conductivity = {{1, 1}};
+  c.solver.progress = [](std::string_view stage, double) { return stage != "solve"; };
+  EXPECT_THROW(solve_current(m, c), SolverCancelled);
 }
 
 }  // namespace
