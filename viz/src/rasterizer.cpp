@@ -4,6 +4,7 @@
 #include "foxi/viz/rasterizer.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -138,9 +139,27 @@ struct TetRasterizer::Impl {
   // Per node: camera coordinates, fixed-point pixel coordinates, state (0 in front, 1 behind the
   // near plane, 2 not finite).
   std::vector<double> cam;
-  std::vector<std::int64_t> fx, fy;
-  std::vector<std::uint8_t> state;
+  // Fixed-point coordinates fit 32 bits (|p| <= 4 kMaxPixel kOne = 2^30); packed with the state so
+  // that a tet's corners cost one cache line each.
+  struct NodeFix {
+    std::int32_t X = 0, Y = 0;
+    std::uint8_t state = 0;
+  };
+  std::vector<NodeFix> fix;
+  // Per draw() call, per tet of the batch (in batch order): its pixel box, filled by both threads
+  // from halves of the batch so that hidden or off-band tets cost each thread a sequential read.
+  struct Box {
+    std::int32_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // x0 > x1: draws nothing; y0 < 0: not known
+  };
+  std::vector<Box> boxes;
   RasterStats stats;
+  // Painter mode draws each batch front to back (tets, faces and fan triangles in reverse order)
+  // and writes only pixels not yet written in this batch: "first write wins" in reverse order is
+  // "last write wins" in the given order, pixel for pixel, and hidden tets cost only a mask test.
+  // One bit per pixel, rows of `mask_words` 64-bit words; a row is touched only by its thread.
+  bool reverse = false;
+  int mask_words = 0;
+  std::vector<std::uint64_t> written;
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
       : mesh(&m), proj(c, w, h), params(p) {
@@ -149,6 +168,8 @@ struct TetRasterizer::Impl {
     if (params.threads < 1) params.threads = 1;
     if (params.threads > 64) params.threads = 64;
     if (!(params.edge_width > 0)) params.edges = false;
+    reverse = !params.depth_buffer;
+    mask_words = (w + 63) / 64;
     double l[3] = {-0.3, 0.45, -1};
     double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
     for (int k = 0; k < 3; ++k) light[k] = l[k] / ln;
@@ -179,12 +200,14 @@ struct TetRasterizer::Impl {
     for (std::uint32_t nd : m.tet)
       if (nd >= n) throw std::out_of_range("render: a tet refers to a missing node");
     cam.resize(3 * n);
-    fx.resize(n);
-    fy.resize(n);
-    state.resize(n);
+    fix.resize(n);
     auto work = [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i)
-        project_node(&m.xyz[3 * i], &cam[3 * i], fx[i], fy[i], state[i]);
+      for (std::size_t i = begin; i < end; ++i) {
+        std::int64_t X = 0, Y = 0;
+        project_node(&m.xyz[3 * i], &cam[3 * i], X, Y, fix[i].state);
+        fix[i].X = std::int32_t(X);
+        fix[i].Y = std::int32_t(Y);
+      }
     };
     if (n > 20000 && params.threads > 1) {
       std::thread t(work, n / 2, n);
@@ -274,14 +297,72 @@ struct TetRasterizer::Impl {
     fb.id[p] = fs.tet;
   }
 
-  // One row run of a face. Painter mode: constant colour except within reach of an edge line, where
-  // each pixel is shaded by shade_pixel (the intervals are widened by a pixel so that rounding in
-  // solving for them never changes a pixel's colour).
-  void shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+  // True if every pixel x in [lo, hi] of row y is already written (lo <= hi, inside the image).
+  bool row_written(int y, int lo, int hi) const {
+    const std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
+    const int w0 = lo >> 6, w1 = hi >> 6;
+    const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
+    if (w0 == w1) return (row[w0] & m0 & m1) == (m0 & m1);
+    if ((row[w0] & m0) != m0) return false;
+    for (int w = w0 + 1; w < w1; ++w)
+      if (row[w] != ~std::uint64_t(0)) return false;
+    return (row[w1] & m1) == m1;
+  }
+
+  // True if every owned pixel of the pixel box b (not empty, y0 >= 0) is already written: nothing
+  // drawn inside it can show.
+  bool box_written(const Rows& rows, const Box& b) const {
+    for (int y = b.y0; y <= b.y1; ++y) {
+      if (!rows.owns(y)) {
+        y = (((y >> kBandShift) + 1) << kBandShift) - 1;
+        continue;
+      }
+      if (!row_written(y, b.x0, b.x1)) return false;
+    }
+    return true;
+  }
+
+  // One row run of a face. Painter mode: only the pixels not yet written (see `written`), then the
+  // whole run is marked written.
+  void shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
     if (params.depth_buffer) {
       for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
       return;
     }
+    std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
+    const int w0 = lo >> 6, w1 = hi >> 6;
+    int x = lo;
+    while (x <= hi) {
+      // The first unwritten pixel at or after x.
+      int w = x >> 6;
+      std::uint64_t free = ~row[w] & (~std::uint64_t(0) << (x & 63));
+      while (free == 0 && w < w1) free = ~row[++w];
+      if (free == 0) break;
+      const int a = (w << 6) + std::countr_zero(free);
+      if (a > hi) break;
+      // The first written pixel after a (or past the run).
+      w = a >> 6;
+      std::uint64_t set = row[w] & (~std::uint64_t(0) << (a & 63));
+      while (set == 0 && w < w1) set = row[++w];
+      const int b = set == 0 ? hi + 1 : std::min(hi + 1, (w << 6) + std::countr_zero(set));
+      shade_span(fb, fs, y, a, b - 1);
+      x = b;
+    }
+    const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
+    if (w0 == w1) {
+      row[w0] |= m0 & m1;
+    } else {
+      row[w0] |= m0;
+      for (int w = w0 + 1; w < w1; ++w) row[w] = ~std::uint64_t(0);
+      row[w1] |= m1;
+    }
+  }
+
+  // Painter mode, one run of pixels [lo, hi] of row y: constant colour except within reach of an
+  // edge line, where each pixel is shaded by shade_pixel (the intervals are widened by a pixel so
+  // that rounding in solving for them never changes a pixel's colour: every pixel gets exactly
+  // shade_pixel's colour, whatever the run).
+  void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
     const std::size_t row = std::size_t(y) * std::size_t(fb.width);
     auto fill = [&](int a, int b) {
       if (a > b) return;
@@ -333,8 +414,9 @@ struct TetRasterizer::Impl {
   }
 
   // Draws a convex polygon (positive area) as a fan from vertex 0.
-  void raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) const {
-    for (int i = 1; i + 1 < n; ++i) {
+  void raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) {
+    for (int q = 1; q + 1 < n; ++q) {
+      const int i = reverse ? n - 1 - q : q;  // painter mode draws the fan back to front too
       std::int64_t X[3] = {poly[0].X, poly[i].X, poly[i + 1].X}, Y[3] = {poly[0].Y, poly[i].Y, poly[i + 1].Y};
       std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
       if (area <= 0) continue;
@@ -354,19 +436,56 @@ struct TetRasterizer::Impl {
     }
   }
 
-  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
+  // The pixel box of tet t (see Box): what draw_tet would draw is inside it, and if it is empty,
+  // draw_tet draws and counts nothing.
+  Box tet_box(std::uint32_t t, int width, int height) const {
     const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
     const double* c[4];
     double local[12];
     std::int64_t X[4], Y[4];
     std::uint8_t st[4];
+    corners(tv, c, local, X, Y, st);
+    Box box;
+    if (st[0] == 2 || st[1] == 2 || st[2] == 2 || st[3] == 2) return box;
+    if (st[0] + st[1] + st[2] + st[3] != 0) {
+      box.y0 = -1;  // cut by the near plane (or behind it): not known
+      box.x0 = box.x1 = 0;
+      return box;
+    }
+    const std::int64_t minx = std::min({X[0], X[1], X[2], X[3]}), maxx = std::max({X[0], X[1], X[2], X[3]});
+    const std::int64_t miny = std::min({Y[0], Y[1], Y[2], Y[3]}), maxy = std::max({Y[0], Y[1], Y[2], Y[3]});
+    const std::int64_t x0 = std::max<std::int64_t>(0, -floor_div(-(minx - kHalf), kOne));
+    const std::int64_t x1 = std::min<std::int64_t>(width - 1, floor_div(maxx - kHalf, kOne));
+    const std::int64_t y0 = std::max<std::int64_t>(0, -floor_div(-(miny - kHalf), kOne));
+    const std::int64_t y1 = std::min<std::int64_t>(height - 1, floor_div(maxy - kHalf, kOne));
+    if (x0 > x1 || y0 > y1) return box;
+    box.x0 = std::int32_t(x0);
+    box.x1 = std::int32_t(x1);
+    box.y0 = std::int32_t(y0);
+    box.y1 = std::int32_t(y1);
+    return box;
+  }
+
+  // Hints the cache about tet t's corners (the batch order jumps around the mesh).
+  void prefetch_tet(std::uint32_t t) const {
+    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+    for (int k = 0; k < 4; ++k) {
+      __builtin_prefetch(&fix[tv[k]]);
+      if (params.shrink != 1) __builtin_prefetch(&cam[3 * std::size_t(tv[k])]);
+    }
+  }
+
+  // A tet's corners: camera coordinates (c, pointing into cam or local), fixed-point pixel
+  // coordinates and states.
+  void corners(const std::uint32_t* tv, const double** c, double* local, std::int64_t* X, std::int64_t* Y,
+               std::uint8_t* st) const {
     if (params.shrink == 1) {
       for (int k = 0; k < 4; ++k) {
         std::uint32_t n = tv[k];
         c[k] = &cam[3 * std::size_t(n)];
-        X[k] = fx[n];
-        Y[k] = fy[n];
-        st[k] = state[n];
+        X[k] = fix[n].X;
+        Y[k] = fix[n].Y;
+        st[k] = fix[n].state;
       }
     } else {
       double centre[3] = {0, 0, 0};
@@ -379,6 +498,15 @@ struct TetRasterizer::Impl {
         project_camera(c[k], X[k], Y[k], st[k]);
       }
     }
+  }
+
+  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
+    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+    const double* c[4];
+    double local[12];
+    std::int64_t X[4], Y[4];
+    std::uint8_t st[4];
+    corners(tv, c, local, X, Y, st);
     if (st[0] == 2 || st[1] == 2 || st[2] == 2 || st[3] == 2) return;
     const int behind = int(st[0]) + st[1] + st[2] + st[3];
     if (behind == 4) {
@@ -394,7 +522,8 @@ struct TetRasterizer::Impl {
     }
     PolyVertex poly[4];
     FaceSetup fs;
-    for (const auto& face : kFace) {
+    for (int fi = 0; fi < 4; ++fi) {
+      const auto& face = kFace[reverse ? 3 - fi : fi];
       const int a = face[0], b = face[1], d = face[2];
       if (st[a] + st[b] + st[d] == 0) {
         // Front iff the projected outward-ordered triangle has negative area (screen y is down and
@@ -507,10 +636,40 @@ struct TetRasterizer::Impl {
       if (t >= tc) throw std::out_of_range("render: tet index " + std::to_string(t) + " out of range");
     stats.tets_drawn += tets.size();
     const int count = std::min(params.threads, std::max(1, fb.height >> kBandShift));
+    if (reverse) written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
+    boxes.resize(tets.size());
+    auto find_boxes = [&](std::size_t begin, std::size_t end) {
+      constexpr std::size_t kAhead = 8;
+      for (std::size_t i = begin; i < end; ++i) {
+        if (i + kAhead < end) prefetch_tet(tets[i + kAhead]);
+        if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 2 * kAhead])]);
+        boxes[i] = tet_box(tets[i], fb.width, fb.height);
+      }
+    };
+    auto draw_one = [&](const Rows& rows, std::size_t i, bool first) {
+      const Box& b = boxes[i];
+      if (b.x0 > b.x1) return;  // draws nothing
+      if (b.y0 >= 0) {
+        if (!rows.any(b.y0, b.y1)) return;
+        if (reverse && box_written(rows, b)) return;  // hidden behind what this batch drew already
+      }
+      draw_tet(fb, rows, tets[i], first);
+    };
     auto work = [&](int k) {
       Rows rows{k, count};
-      for (std::uint32_t t : tets) draw_tet(fb, rows, t, k == 0);
+      if (reverse) {
+        for (std::size_t i = tets.size(); i-- > 0;) draw_one(rows, i, k == 0);
+      } else {
+        for (std::size_t i = 0; i < tets.size(); ++i) draw_one(rows, i, k == 0);
+      }
     };
+    if (count == 1 || tets.size() < 4096) {
+      find_boxes(0, tets.size());
+    } else {
+      std::thread helper(find_boxes, tets.size() / 2, tets.size());
+      find_boxes(0, tets.size() / 2);
+      helper.join();
+    }
     if (count == 1) {
       work(0);
       return;
