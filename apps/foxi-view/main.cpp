@@ -29,7 +29,8 @@ const char* kUsage =
     "     d (draw all)  c (restart, draw nothing)  n (one batch)  f (finish)  r  b  s\n"
     "     orbit:YAW,PITCH (degrees)  zoom:F  pan:DX,DY (fractions of the height)\n"
     "  e.g. --script \"d r orbit:30,0 d s\"; --dump-ids also writes PREFIX-NNN.ids (the id buffer,\n"
-    "  uint32 little-endian) and PREFIX-NNN.tets (the drawn tets, in drawing order).";
+    "  uint32 little-endian) and PREFIX-NNN.tets (the drawn tets, in drawing order).\n"
+    "  Environment: FOXI_VIEW_NO_SHM=1 uses plain XPutImage even where XShm is available.";
 
 struct Usage : std::runtime_error {
   using std::runtime_error::runtime_error;

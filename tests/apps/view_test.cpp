@@ -253,39 +253,50 @@ if command -v xwd > /dev/null; then xwd -silent -id "$wid" > "$D/shot.xwd" || ex
 xdotool key --window "$wid" q 2>/dev/null
 i=0; while kill -0 $pid 2>/dev/null && [ $i -lt 50 ]; do sleep 0.1; i=$((i+1)); done
 kill -0 $pid 2>/dev/null && { echo "viewer did not quit"; exit 7; }
+wait $pid; rc=$?
+[ $rc -eq 0 ] || { echo "viewer exit status $rc"; cat "$D/window.log"; exit 9; }
+trap - EXIT
 exit 0
 )SH";
   test::write_text(dir_ / "drive.sh", driver);
   std::string out;
-  const int status =
-      run_logged("timeout -k 5 40 xvfb-run -a -s '-screen 0 640x480x24' sh " + q(dir_ / "drive.sh") + " " +
-                     q(view_path()) + " " + q(mesh_path_) + " " + q(dir_.path()),
-                 dir_ / "xvfb.log", &out);
-  ASSERT_EQ(status, 0) << out << test::read_text(dir_ / "window.log");
-  const std::string log = test::read_text(dir_ / "window.log");
-  EXPECT_NE(log.find("done drawn 720 / 720 tets (100.0%)"), std::string::npos) << log;
-  ASSERT_TRUE(std::filesystem::exists(dir_ / "x-001.png")) << log;
-
   ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " --size 320x240 --save " + q(dir_ / "h") +
                            " --script 'd s'",
                        dir_ / "view.log", &out),
             0)
       << out;
   const Framebuffer headless = read_png(dir_ / "h-001.png");
-  EXPECT_EQ(differing_pixels(read_png(dir_ / "x-001.png"), headless), 0u);
 
-  if (!have_xwd) {
-    std::printf("xwd is missing: the screenshot comparison is skipped\n");
-    return;
+  // Once with XShm (Xvfb has it), once with plain XPutImage.
+  for (const std::string env : {"", "FOXI_VIEW_NO_SHM=1 "}) {
+    SCOPED_TRACE(env.empty() ? "XShm" : "XPutImage");
+    std::filesystem::remove(dir_ / "x-001.png");
+    std::filesystem::remove(dir_ / "shot.xwd");
+    const int status =
+        run_logged(env + "timeout -k 5 40 xvfb-run -a -s '-screen 0 640x480x24' sh " + q(dir_ / "drive.sh") +
+                       " " + q(view_path()) + " " + q(mesh_path_) + " " + q(dir_.path()),
+                   dir_ / "xvfb.log", &out);
+    ASSERT_EQ(status, 0) << out << test::read_text(dir_ / "window.log");
+    const std::string log = test::read_text(dir_ / "window.log");
+    EXPECT_NE(log.find(env.empty() ? "XShm;" : "XPutImage;"), std::string::npos) << log;
+    EXPECT_NE(log.find("done drawn 720 / 720 tets (100.0%)"), std::string::npos) << log;
+    ASSERT_TRUE(std::filesystem::exists(dir_ / "x-001.png")) << log;
+    EXPECT_EQ(differing_pixels(read_png(dir_ / "x-001.png"), headless), 0u);
+
+    if (!have_xwd) {
+      std::printf("xwd is missing: the screenshot comparison is skipped\n");
+      continue;
+    }
+    Framebuffer shot;
+    ASSERT_TRUE(read_xwd(dir_ / "shot.xwd", shot)) << "cannot read the xwd screenshot";
+    ASSERT_EQ(shot.width, 320);
+    ASSERT_GE(shot.height, 240);
+    Framebuffer top(320, 240);
+    for (int y = 0; y < 240; ++y)
+      std::copy_n(shot.rgba.begin() + std::ptrdiff_t(y) * 320, 320,
+                  top.rgba.begin() + std::ptrdiff_t(y) * 320);
+    EXPECT_EQ(differing_pixels(top, headless), 0u);
   }
-  Framebuffer shot;
-  ASSERT_TRUE(read_xwd(dir_ / "shot.xwd", shot)) << "cannot read the xwd screenshot";
-  ASSERT_EQ(shot.width, 320);
-  ASSERT_GE(shot.height, 240);
-  Framebuffer top(320, 240);
-  for (int y = 0; y < 240; ++y)
-    std::copy_n(shot.rgba.begin() + std::ptrdiff_t(y) * 320, 320, top.rgba.begin() + std::ptrdiff_t(y) * 320);
-  EXPECT_EQ(differing_pixels(top, headless), 0u);
 }
 
 }  // namespace
