@@ -38,6 +38,16 @@ std::int64_t to_fixed(double p) {
 struct Rows {
   int thread = 0, count = 1;
   bool owns(int y) const { return count == 1 || ((y >> kBandShift) % count) == thread; }
+  // The first owned row >= y, and the owned row after the owned row y (one division per band).
+  int first(int y) const {
+    if (count == 1) return y;
+    const int b = y >> kBandShift, r = b % count;
+    return r == thread ? y : (b + (thread - r + count) % count) << kBandShift;
+  }
+  int next(int y) const {
+    ++y;
+    return (count == 1 || (y & ((1 << kBandShift) - 1)) != 0) ? y : first(y);
+  }
   // True if some row in [y0, y1] is owned.
   bool any(int y0, int y1) const {
     if (count == 1) return y0 <= y1;
@@ -76,21 +86,56 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
     bias[i] = (dy[i] < 0 || (dy[i] == 0 && dx[i] > 0)) ? 0 : -1;
   }
   const std::int64_t px0 = x0 * kOne + kHalf;
-  for (std::int64_t y = y0; y <= y1; ++y) {
-    if (!rows.owns(int(y))) {
-      y = (((y >> kBandShift) + 1) << kBandShift) - 1;  // skip to the end of this band
-      continue;
+  // The covered run of a row, exactly: E_i(x) = e_i + s_i (x - x0) >= 0 for all i, with
+  // s_i = -dy_i kOne. For s_i > 0 the run starts at x0 - floor(e_i / s_i) (the smallest k with
+  // e_i + s_i k >= 0 is ceil(-e_i / s_i)), for s_i < 0 it ends at x0 + floor(e_i / |s_i|), for s_i = 0
+  // it is empty if e_i < 0. From row to row e_i grows by dx_i kOne, so the quotient q_i and
+  // remainder r_i of e_i = q_i |s_i| + r_i (0 <= r_i < |s_i|) are carried on exactly without dividing
+  // (recomputed after a skipped band).
+  std::int64_t q[3] = {}, r[3] = {}, e[3] = {}, s[3] = {}, dq[3] = {}, dr[3] = {};
+  for (int i = 0; i < 3; ++i) {
+    s[i] = std::abs(dy[i]) * kOne;
+    if (s[i] != 0) {
+      dq[i] = floor_div(dx[i] * kOne, s[i]);
+      dr[i] = dx[i] * kOne - dq[i] * s[i];
     }
+  }
+  auto start_row = [&](std::int64_t y) {
     const std::int64_t py = y * kOne + kHalf;
-    // The covered run of this row, exactly: E_i(x) = e_i + s_i (x - x0) >= 0 for all i.
+    for (int i = 0; i < 3; ++i) {
+      e[i] = dx[i] * (py - Y[i]) - dy[i] * (px0 - X[i]) + bias[i];
+      if (s[i] != 0) {
+        q[i] = floor_div(e[i], s[i]);
+        r[i] = e[i] - q[i] * s[i];
+      }
+    }
+  };
+  std::int64_t prev = -2;
+  for (std::int64_t y = rows.first(int(y0)); y <= y1; y = rows.next(int(y))) {
+    if (y != prev + 1) {
+      start_row(y);
+    } else {
+      for (int i = 0; i < 3; ++i) {
+        if (s[i] != 0) {
+          q[i] += dq[i];
+          r[i] += dr[i];
+          if (r[i] >= s[i]) {
+            r[i] -= s[i];
+            ++q[i];
+          }
+        } else {
+          e[i] += dx[i] * kOne;
+        }
+      }
+    }
+    prev = y;
     std::int64_t lo = x0, hi = x1;
     for (int i = 0; i < 3; ++i) {
-      const std::int64_t e = dx[i] * (py - Y[i]) - dy[i] * (px0 - X[i]) + bias[i], step = -dy[i] * kOne;
-      if (step > 0) {
-        lo = std::max(lo, x0 - floor_div(e, step));  // smallest k with e + step k >= 0 is ceil(-e / step)
-      } else if (step < 0) {
-        hi = std::min(hi, x0 + floor_div(e, -step));  // largest k with e - |step| k >= 0
-      } else if (e < 0) {
+      if (dy[i] < 0) {
+        lo = std::max(lo, x0 - q[i]);
+      } else if (dy[i] > 0) {
+        hi = std::min(hi, x0 + q[i]);
+      } else if (e[i] < 0) {
         hi = lo - 1;
       }
     }
@@ -312,13 +357,8 @@ struct TetRasterizer::Impl {
   // True if every owned pixel of the pixel box b (not empty, y0 >= 0) is already written: nothing
   // drawn inside it can show.
   bool box_written(const Rows& rows, const Box& b) const {
-    for (int y = b.y0; y <= b.y1; ++y) {
-      if (!rows.owns(y)) {
-        y = (((y >> kBandShift) + 1) << kBandShift) - 1;
-        continue;
-      }
+    for (int y = rows.first(b.y0); y <= b.y1; y = rows.next(y))
       if (!row_written(y, b.x0, b.x1)) return false;
-    }
     return true;
   }
 
@@ -452,8 +492,14 @@ struct TetRasterizer::Impl {
       box.x0 = box.x1 = 0;
       return box;
     }
-    const std::int64_t minx = std::min({X[0], X[1], X[2], X[3]}), maxx = std::max({X[0], X[1], X[2], X[3]});
-    const std::int64_t miny = std::min({Y[0], Y[1], Y[2], Y[3]}), maxy = std::max({Y[0], Y[1], Y[2], Y[3]});
+    return pixel_box(std::min({X[0], X[1], X[2], X[3]}), std::max({X[0], X[1], X[2], X[3]}),
+                     std::min({Y[0], Y[1], Y[2], Y[3]}), std::max({Y[0], Y[1], Y[2], Y[3]}), width, height);
+  }
+
+  // The pixels whose centres lie in the fixed-point box [minx, maxx] x [miny, maxy], in the image.
+  static Box pixel_box(std::int64_t minx, std::int64_t maxx, std::int64_t miny, std::int64_t maxy, int width,
+                       int height) {
+    Box box;
     const std::int64_t x0 = std::max<std::int64_t>(0, -floor_div(-(minx - kHalf), kOne));
     const std::int64_t x1 = std::min<std::int64_t>(width - 1, floor_div(maxx - kHalf, kOne));
     const std::int64_t y0 = std::max<std::int64_t>(0, -floor_div(-(miny - kHalf), kOne));
@@ -531,6 +577,12 @@ struct TetRasterizer::Impl {
         // area with the opposite sign, so exactly one of the two draws it.
         std::int64_t area = (X[b] - X[a]) * (Y[d] - Y[a]) - (Y[b] - Y[a]) * (X[d] - X[a]);
         if (area >= 0) continue;
+        if (reverse) {  // hidden behind what this batch drew already?
+          const Box box =
+              pixel_box(std::min({X[a], X[b], X[d]}), std::max({X[a], X[b], X[d]}),
+                        std::min({Y[a], Y[b], Y[d]}), std::max({Y[a], Y[b], Y[d]}), fb.width, fb.height);
+          if (box.x0 > box.x1 || box_written(rows, box)) continue;
+        }
         const int order[3] = {a, d, b};  // reversed: positive area
         for (int i = 0; i < 3; ++i) {
           poly[i].X = X[order[i]];
