@@ -207,6 +207,9 @@ struct TetRasterizer::Impl {
   bool reverse = false;
   int mask_words = 0;
   std::vector<std::uint64_t> written;
+  // Per band of 16 rows and mask word: 1 once all 16 x 64 pixels (those in the image) are known to
+  // be written, so that a hidden tet costs a few byte tests (set lazily by box_written).
+  std::vector<std::uint8_t> tile_full;
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
       : mesh(&m), proj(c, w, h), params(p) {
@@ -402,9 +405,27 @@ struct TetRasterizer::Impl {
 
   // True if every owned pixel of the pixel box b (not empty, y0 >= 0) is already written: nothing
   // drawn inside it can show.
-  bool box_written(const Rows& rows, const Box& b) const {
-    for (int y = rows.first(b.y0); y <= b.y1; y = rows.next(y))
-      if (!row_written(y, b.x0, b.x1)) return false;
+  bool box_written(const Rows& rows, const Box& b, int height) {
+    const int w0 = b.x0 >> 6, w1 = b.x1 >> 6;
+    for (int y = rows.first(b.y0); y <= b.y1;) {
+      const int band = y >> kBandShift, band_end = std::min(((band + 1) << kBandShift) - 1, height - 1);
+      const int last = std::min(b.y1, band_end);
+      std::uint8_t* tiles = &tile_full[std::size_t(band) * std::size_t(mask_words)];
+      for (int w = w0; w <= w1; ++w) {
+        if (tiles[w]) continue;
+        bool full = true;
+        for (int r = band << kBandShift; r <= band_end && full; ++r)
+          full = written[std::size_t(r) * std::size_t(mask_words) + std::size_t(w)] == ~std::uint64_t(0);
+        if (full) {
+          tiles[w] = 1;
+          continue;
+        }
+        const int lo = std::max(b.x0, w << 6), hi = std::min(b.x1, (w << 6) + 63);
+        for (int r = y; r <= last; ++r)
+          if (!row_written(r, lo, hi)) return false;
+      }
+      y = rows.first(band_end + 1);
+    }
     return true;
   }
 
@@ -627,7 +648,7 @@ struct TetRasterizer::Impl {
           const Box box =
               pixel_box(std::min({X[a], X[b], X[d]}), std::max({X[a], X[b], X[d]}),
                         std::min({Y[a], Y[b], Y[d]}), std::max({Y[a], Y[b], Y[d]}), fb.width, fb.height);
-          if (box.x0 > box.x1 || box_written(rows, box)) continue;
+          if (box.x0 > box.x1 || box_written(rows, box, fb.height)) continue;
         }
         const int order[3] = {a, d, b};  // reversed: positive area
         for (int i = 0; i < 3; ++i) {
@@ -734,7 +755,10 @@ struct TetRasterizer::Impl {
       if (t >= tc) throw std::out_of_range("render: tet index " + std::to_string(t) + " out of range");
     stats.tets_drawn += tets.size();
     const int count = std::min(params.threads, std::max(1, fb.height >> kBandShift));
-    if (reverse) written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
+    if (reverse) {
+      written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
+      tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
+    }
     boxes.resize(tets.size());
     auto find_boxes = [&](std::size_t begin, std::size_t end) {
       constexpr std::size_t kAhead = 8;
@@ -749,7 +773,7 @@ struct TetRasterizer::Impl {
       if (b.x0 > b.x1) return;  // draws nothing
       if (b.y0 >= 0) {
         if (!rows.any(b.y0, b.y1)) return;
-        if (reverse && box_written(rows, b)) return;  // hidden behind what this batch drew already
+        if (reverse && box_written(rows, b, fb.height)) return;  // hidden behind what this batch drew already
       }
       draw_tet(fb, rows, tets[i], first);
     };
