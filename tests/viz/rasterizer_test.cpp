@@ -454,6 +454,43 @@ TEST(Rasterizer, ThreadsDoNotChangeThePicture) {
   }
 }
 
+// Painter mode is "later overwrites earlier" for ANY order, not only visibility orders (it draws each
+// batch front to back into a written-pixel mask, which must not change that): a shuffled order with
+// repeats, in one batch or several, equals overlaying the tets' single-tet pictures one by one.
+TEST(Rasterizer, PainterIsLastWriteWinsForAnyOrder) {
+  Mesh m = test::grid_mesh(3, 3, 3, 1, 1, 1, 5);
+  std::mt19937 rng(61);
+  std::vector<std::uint32_t> order(m.tet_count());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = std::uint32_t(i);
+  for (int i = 0; i < 40; ++i) order.push_back(std::uint32_t(rng() % m.tet_count()));
+  std::shuffle(order.begin(), order.end(), rng);
+  for (const Camera& cam : random_cameras(m, 6, 67)) {
+    for (double shrink : {1.0, 0.7}) {
+      RenderParams p;
+      p.shrink = shrink;
+      Framebuffer expect(kW, kH);
+      for (std::uint32_t t : order) {
+        const Framebuffer one = render_tets(m, cam, kW, kH, std::span<const std::uint32_t>(&t, 1), p);
+        for (std::size_t i = 0; i < one.id.size(); ++i) {
+          if (one.id[i] == kNone) continue;
+          expect.rgba[i] = one.rgba[i];
+          expect.id[i] = one.id[i];
+        }
+      }
+      const Framebuffer whole = render_tets(m, cam, kW, kH, order, p);
+      EXPECT_EQ(whole.rgba, expect.rgba);
+      EXPECT_EQ(whole.id, expect.id);
+      TetRasterizer r(m, cam, kW, kH, p);
+      Framebuffer batches(kW, kH);
+      for (std::size_t s = 0; s < order.size(); s += 37)
+        r.draw(batches,
+               std::span<const std::uint32_t>(order).subspan(s, std::min<std::size_t>(37, order.size() - s)));
+      EXPECT_EQ(batches.rgba, expect.rgba);
+      EXPECT_EQ(batches.id, expect.id);
+    }
+  }
+}
+
 // Edges are drawn inside the faces: turning them off changes colours but never which tet a pixel shows.
 TEST(Rasterizer, EdgesStayInsideFaces) {
   Mesh m = test::grid_mesh(4, 4, 4, 1, 1, 1, 5);
