@@ -121,10 +121,9 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
         if (s[i] != 0) {
           q[i] += dq[i];
           r[i] += dr[i];
-          if (r[i] >= s[i]) {
-            r[i] -= s[i];
-            ++q[i];
-          }
+          const std::int64_t carry = -std::int64_t(r[i] >= s[i]);  // branch-free: 0 or -1
+          r[i] -= s[i] & carry;
+          q[i] -= carry;
         } else {
           e[i] += dx[i] * kOne;
         }
