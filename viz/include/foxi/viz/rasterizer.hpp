@@ -11,6 +11,9 @@
 // same pixels from either side. No anti-aliasing. Perspective faces are clipped against a near plane
 // (eyes inside the mesh); tets entirely behind it are skipped. Drawing uses several threads over
 // interleaved bands of rows; each thread draws every tet in order, so the per-pixel order is kept.
+// The painter walks each draw() batch front to back (reverse order) and writes only pixels not yet
+// written in that batch, which is pixel for pixel the same picture as drawing back to front, but
+// tets hidden behind what is already drawn cost only a test of a written-pixel mask.
 #pragma once
 
 #include <cstddef>
