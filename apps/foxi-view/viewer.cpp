@@ -51,48 +51,28 @@ constexpr std::size_t kMpvoChunk = 4096;
 Camera default_camera(const Mesh& mesh, int width, int height, const std::string& eye_s,
                       const std::string& at_s, const std::string& up_s, const std::string& fov_s,
                       const std::string& dir_s) {
-  // The same rules as foxi render (apps/foxi/cmd_render.cpp), so both give the same picture.
+  // The same rules as foxi render (camera_from_options), so both give the same picture.
   if (!dir_s.empty() && (!eye_s.empty() || !fov_s.empty()))
     throw std::invalid_argument("--dir (orthographic) cannot be combined with --eye or --fov");
   double lo[3], hi[3];
   mesh_bounds(mesh, lo, hi);
   const double aspect = double(width) / height;
-  double up[3] = {0, 0, 1};
+  double up[3], at[3], eye[3], dir[3];
   if (!up_s.empty()) triple(up_s, "--up", up);
-  Camera camera;
+  if (!at_s.empty()) triple(at_s, "--at", at);
+  if (!eye_s.empty()) triple(eye_s, "--eye", eye);
   if (!dir_s.empty()) {
-    double d[3];
-    triple(dir_s, "--dir", d);
-    if (d[0] == 0 && d[1] == 0 && d[2] == 0) throw std::invalid_argument("--dir takes a nonzero x,y,z");
-    camera = fit_camera(lo, hi, d, up, false, 30, aspect);
-    if (!at_s.empty()) {
-      double at[3];
-      triple(at_s, "--at", at);
-      for (int k = 0; k < 3; ++k) {
-        camera.eye[k] += at[k] - camera.at[k];
-        camera.at[k] = at[k];
-      }
-    }
-    return camera;
+    triple(dir_s, "--dir", dir);
+    if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) throw std::invalid_argument("--dir takes a nonzero x,y,z");
   }
-  double fov = 30;
+  double fov = 0;
   if (!fov_s.empty()) {
     char* end = nullptr;
     fov = std::strtod(fov_s.c_str(), &end);
     if (*end != 0 || !(fov > 0 && fov < 180)) throw std::invalid_argument("--fov takes degrees in (0, 180)");
   }
-  const double oblique[3] = {-1.0, 1.6, -0.9};  // from front-right, above (as foxi render)
-  camera = fit_camera(lo, hi, oblique, up, true, fov, aspect);
-  if (!at_s.empty()) triple(at_s, "--at", camera.at);
-  if (!eye_s.empty()) {
-    triple(eye_s, "--eye", camera.eye);
-  } else if (!at_s.empty()) {
-    double d0[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
-    Camera fitted = fit_camera(lo, hi, oblique, up, true, fov, aspect);
-    for (int k = 0; k < 3; ++k) camera.eye[k] = camera.at[k] + (fitted.eye[k] - d0[k]);
-  }
-  for (int k = 0; k < 3; ++k) camera.up[k] = up[k];
-  return camera;
+  return camera_from_options(lo, hi, aspect, eye_s.empty() ? nullptr : eye, at_s.empty() ? nullptr : at,
+                             up_s.empty() ? nullptr : up, fov, dir_s.empty() ? nullptr : dir);
 }
 
 Viewer::Viewer(const Mesh& mesh, const Camera& camera, int width, int height, const RenderParams& params)

@@ -132,41 +132,22 @@ int cmd_render(Args args) {
         }
   }
   const double aspect = double(width) / height;
-  double up[3] = {0, 0, 1};
+  double up[3], at[3], eye[3], dir[3];
   if (!up_s.empty()) triple(up_s, "--up", up);
-  Camera camera;
+  if (!at_s.empty()) triple(at_s, "--at", at);
+  if (!eye_s.empty()) triple(eye_s, "--eye", eye);
   if (!dir_s.empty()) {
-    double d[3];
-    triple(dir_s, "--dir", d);
-    if (d[0] == 0 && d[1] == 0 && d[2] == 0) throw UsageError("--dir takes a nonzero x,y,z");
-    camera = fit_camera(lo, hi, d, up, false, 30, aspect);
-    if (!at_s.empty()) {
-      double at[3];
-      triple(at_s, "--at", at);
-      for (int k = 0; k < 3; ++k) {
-        camera.eye[k] += at[k] - camera.at[k];
-        camera.at[k] = at[k];
-      }
-    }
-  } else {
-    double fov = 30;
-    if (!fov_s.empty()) {
-      char* end = nullptr;
-      fov = std::strtod(fov_s.c_str(), &end);
-      if (*end != 0 || !(fov > 0 && fov < 180)) throw UsageError("--fov takes degrees in (0, 180)");
-    }
-    const double oblique[3] = {-1.0, 1.6, -0.9};  // from front-right, above
-    camera = fit_camera(lo, hi, oblique, up, true, fov, aspect);
-    if (!at_s.empty()) triple(at_s, "--at", camera.at);
-    if (!eye_s.empty()) {
-      triple(eye_s, "--eye", camera.eye);
-    } else if (!at_s.empty()) {
-      double d0[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
-      Camera fitted = fit_camera(lo, hi, oblique, up, true, fov, aspect);
-      for (int k = 0; k < 3; ++k) camera.eye[k] = camera.at[k] + (fitted.eye[k] - d0[k]);
-    }
-    for (int k = 0; k < 3; ++k) camera.up[k] = up[k];
+    triple(dir_s, "--dir", dir);
+    if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) throw UsageError("--dir takes a nonzero x,y,z");
   }
+  double fov = 0;
+  if (!fov_s.empty()) {
+    char* end = nullptr;
+    fov = std::strtod(fov_s.c_str(), &end);
+    if (*end != 0 || !(fov > 0 && fov < 180)) throw UsageError("--fov takes degrees in (0, 180)");
+  }
+  const Camera camera = camera_from_options(lo, hi, aspect, eye_s.empty() ? nullptr : eye, at_s.empty() ? nullptr : at,
+                                            up_s.empty() ? nullptr : up, fov, dir_s.empty() ? nullptr : dir);
 
   auto t0 = std::chrono::steady_clock::now();
   const DelaunayCertificate& cert = delaunay_certificate(mesh);

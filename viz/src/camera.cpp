@@ -225,4 +225,34 @@ View view_of(const Camera& camera) {
                      camera.at[2] - camera.eye[2]);
 }
 
+Camera camera_from_options(const double lo[3], const double hi[3], double aspect, const double* eye,
+                           const double* at, const double* up_given, double fov_deg, const double* dir) {
+  const double up[3] = {up_given ? up_given[0] : 0.0, up_given ? up_given[1] : 0.0, up_given ? up_given[2] : 1.0};
+  Camera camera;
+  if (dir != nullptr) {
+    camera = fit_camera(lo, hi, dir, up, false, 30, aspect);
+    if (at != nullptr) {
+      for (int k = 0; k < 3; ++k) {
+        camera.eye[k] += at[k] - camera.at[k];
+        camera.at[k] = at[k];
+      }
+    }
+    return camera;
+  }
+  const double fov = fov_deg > 0 ? fov_deg : 30;
+  const double oblique[3] = {-1.0, 1.6, -0.9};  // from front-right, above
+  camera = fit_camera(lo, hi, oblique, up, true, fov, aspect);
+  const double centre[3] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+  const double fitted_eye[3] = {camera.eye[0], camera.eye[1], camera.eye[2]};
+  if (at != nullptr)
+    for (int k = 0; k < 3; ++k) camera.at[k] = at[k];
+  if (eye != nullptr) {
+    for (int k = 0; k < 3; ++k) camera.eye[k] = eye[k];
+  } else if (at != nullptr) {
+    for (int k = 0; k < 3; ++k) camera.eye[k] = camera.at[k] + (fitted_eye[k] - centre[k]);
+  }
+  for (int k = 0; k < 3; ++k) camera.up[k] = up[k];
+  return camera;
+}
+
 }  // namespace foxi

@@ -32,6 +32,14 @@ void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
 Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
                   bool perspective = true, double fov_deg = 30, double aspect = 1, double fill = 0.95);
 
+// The camera the front ends (foxi render, foxi-view) build from partly given options, so that they
+// agree: any of eye, at, up, dir may be null (not given); fov_deg <= 0 means 30 degrees; up defaults
+// to +z. With dir: orthographic, fitted along dir, then moved to `at`. Otherwise perspective, fitted
+// from an oblique direction (front-right, above); `at` replaces the target and `eye` the eye; with
+// `at` but no `eye` the fitted eye's offset from the box centre is kept.
+Camera camera_from_options(const double lo[3], const double hi[3], double aspect, const double* eye,
+                           const double* at, const double* up, double fov_deg, const double* dir);
+
 // Turns the eye about `at`: by yaw_deg about the up axis, then by pitch_deg about the right axis.
 // Up is kept (re-orthogonalised). Distance to `at` is unchanged.
 Camera orbit(const Camera& camera, double yaw_deg, double pitch_deg);
