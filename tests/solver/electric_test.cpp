@@ -228,7 +228,7 @@ TEST(Electrostatic, ConcentricSpheresConverge) {
     const ElectrostaticReport r = solve_electrostatic(m, p);
     const double err = std::abs(r.capacitance[0][0] - exact) / exact;
     errors.push_back(err);
-    sizes.push_back(std::cbrt(4.0 / 3 * std::numbers::pi * (r2 * r2 * r2 - r1 * r1 * r1) / m.tet_count()));
+    sizes.push_back(std::cbrt(4.0 / 3 * std::numbers::pi * (r2 * r2 * r2 - r1 * r1 * r1) / double(m.tet_count())));
     EXPECT_NEAR(r.energy_capacitance[0], r.capacitance[0][0], 1e-8 * exact);
     EXPECT_NEAR(r.capacitance[0][1], -r.capacitance[0][0], 1e-8 * exact);
     std::printf("[ spheres ] clscale %.2f: %zu tets, C = %.6e F (exact %.6e), relative error %.3e\n", scale,
