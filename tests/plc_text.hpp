@@ -1,7 +1,10 @@
 // PLCs as TetGen .poly text, for the tests that run the tetgen program.
 #pragma once
 
+#include <filesystem>
+#include <fstream>
 #include <sstream>
+#include <vector>
 #include <string>
 
 #include "test_util.hpp"
@@ -23,5 +26,22 @@ inline std::string box_poly(double lx, double ly, double lz) {
 
 // The seed paper's U-trench PLC (non-convex), shipped in examples/.
 inline std::string trench_poly() { return read_text(data_dir() + "/../../examples/trench.poly"); }
+
+// The whitespace-separated numbers of a TetGen output file (.node, .ele, .neigh), '#' comments
+// skipped: a tiny reader of its own, so that tests can use TetGen's files as an oracle independent of
+// foxi's TetGen reader.
+inline std::vector<double> read_numbers(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::vector<double> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    auto hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    std::istringstream ls(line);
+    double x;
+    while (ls >> x) out.push_back(x);
+  }
+  return out;
+}
 
 }  // namespace foxi::test

@@ -156,20 +156,6 @@ TEST(FaceAdjacency, RejectsAbsurdIndex) {
 
 // --- TetGen oracle ---------------------------------------------------------------------------------
 
-// Reads whitespace-separated numbers of a TetGen file, skipping '#' comments.
-std::vector<double> read_numbers(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::vector<double> out;
-  std::string line;
-  while (std::getline(in, line)) {
-    auto hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    std::istringstream ls(line);
-    double x;
-    while (ls >> x) out.push_back(x);
-  }
-  return out;
-}
 
 struct TetgenMesh {
   Mesh mesh;
@@ -178,14 +164,14 @@ struct TetgenMesh {
 
 TetgenMesh read_tetgen_with_neigh(const std::filesystem::path& base) {
   TetgenMesh r;
-  std::vector<double> node = read_numbers(base.string() + ".node");
+  std::vector<double> node = test::read_numbers(base.string() + ".node");
   const std::size_t nn = static_cast<std::size_t>(node[0]), dim = static_cast<std::size_t>(node[1]);
   const std::size_t nattr = static_cast<std::size_t>(node[2]), nmark = static_cast<std::size_t>(node[3]);
   const std::size_t stride = 1 + dim + nattr + nmark;
   const long node_base = static_cast<long>(node[4]);
   for (std::size_t i = 0; i < nn; ++i)
     for (std::size_t d = 0; d < 3; ++d) r.mesh.xyz.push_back(node[4 + i * stride + 1 + d]);
-  std::vector<double> ele = read_numbers(base.string() + ".ele");
+  std::vector<double> ele = test::read_numbers(base.string() + ".ele");
   const std::size_t ne = static_cast<std::size_t>(ele[0]), npt = static_cast<std::size_t>(ele[1]);
   const std::size_t eattr = static_cast<std::size_t>(ele[2]);
   const std::size_t estride = 1 + npt + eattr;
@@ -194,7 +180,7 @@ TetgenMesh read_tetgen_with_neigh(const std::filesystem::path& base) {
     for (std::size_t j = 0; j < 4; ++j)
       r.mesh.tet.push_back(
           static_cast<std::uint32_t>(static_cast<long>(ele[3 + t * estride + 1 + j]) - node_base));
-  std::vector<double> nb = read_numbers(base.string() + ".neigh");
+  std::vector<double> nb = test::read_numbers(base.string() + ".neigh");
   EXPECT_EQ(static_cast<std::size_t>(nb[0]), ne);
   for (std::size_t t = 0; t < ne; ++t)
     for (std::size_t j = 0; j < 4; ++j) {

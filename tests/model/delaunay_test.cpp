@@ -129,29 +129,16 @@ void expect_matches_brute(const Mesh& m, const DelaunayCertificate& c, const Bru
 }
 
 // --- TetGen meshes ----------------------------------------------------------------------------------
-std::vector<double> read_numbers(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::vector<double> out;
-  std::string line;
-  while (std::getline(in, line)) {
-    auto hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    std::istringstream ls(line);
-    double x;
-    while (ls >> x) out.push_back(x);
-  }
-  return out;
-}
 
 Mesh read_node_ele(const std::filesystem::path& base) {
   Mesh m;
-  std::vector<double> node = read_numbers(base.string() + ".node");
+  std::vector<double> node = test::read_numbers(base.string() + ".node");
   const auto nn = static_cast<std::size_t>(node[0]);
   const std::size_t stride = 1 + static_cast<std::size_t>(node[1] + node[2] + node[3]);
   const long node_base = static_cast<long>(node[4]);
   for (std::size_t i = 0; i < nn; ++i)
     for (std::size_t d = 0; d < 3; ++d) m.xyz.push_back(node[4 + i * stride + 1 + d]);
-  std::vector<double> ele = read_numbers(base.string() + ".ele");
+  std::vector<double> ele = test::read_numbers(base.string() + ".ele");
   const auto ne = static_cast<std::size_t>(ele[0]);
   const std::size_t estride = 1 + static_cast<std::size_t>(ele[1] + ele[2]);
   for (std::size_t t = 0; t < ne; ++t)
