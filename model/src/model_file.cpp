@@ -9,6 +9,7 @@
 #include <toml.hpp>
 
 #include "foxi/model/io_error.hpp"
+#include "model_conditions.hpp"
 
 namespace foxi {
 
@@ -78,15 +79,18 @@ class Loader {
   void run() {
     if (!root_.is_table()) throw Located{0, "the model is not a TOML table"};
     for (const auto& [k, v] : root_.as_table())
-      if (k != "units" && k != "library" && k != "parameters" && k != "materials" && k != "parts")
-        throw Located{line_of(v),
-                      "unknown key '" + k + "' (expected units, library, parameters, materials, parts)"};
+      if (k != "units" && k != "library" && k != "parameters" && k != "materials" && k != "parts" &&
+          !is_conditions_key(k))
+        throw Located{line_of(v), "unknown key '" + k +
+                                      "' (expected units, library, parameters, materials, parts, surfaces, "
+                                      "conditions, loads, mesh)"};
     read_units();
     read_parameters();
     read_materials();
     read_parts();
     for (auto& p : params_) value_of(p.first, {});  // every parameter evaluates, used or not
     for (auto& [name, e] : params_) model_.parameters.push_back(e.param);
+    read_model_conditions(root_, model_);
   }
 
   void read_units() {

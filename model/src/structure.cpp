@@ -23,6 +23,7 @@
 #include <tuple>
 
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/surfaces.hpp"
 
 namespace foxi {
 
@@ -429,7 +430,12 @@ class Builder {
 
 }  // namespace
 
-Structure build_structure(const Model& model) { return Builder(model).build(); }
+Structure build_structure(const Model& model) {
+  Structure s = Builder(model).build();
+  tag_selected_surfaces(model, s);
+  check_conditions(model, s);
+  return s;
+}
 void name_mesh(const Model& model, const Structure& structure, Mesh& mesh) {
   mesh.materials.clear();
   for (const Material& m : model.materials) mesh.materials.push_back(m);

@@ -13,6 +13,7 @@
 //   shape = "cylinder": center (of the base), radius, height, segments (default 16)
 //   shape = "layers": origin, footprint = [w, d], thicknesses = [...], names = [...], materials = [...]
 //   shape = "array": count = [nx, ny], pitch = [px, py], item = { shape = "box" | "cylinder", ... }
+//   [surfaces.NAME], [[conditions]], [[loads]], [mesh]: see conditions.hpp
 #pragma once
 
 #include <cstdint>
@@ -21,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/model/conditions.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/units.hpp"
 
@@ -56,12 +58,18 @@ struct Model {
   std::vector<Parameter> parameters;  // sorted by name
   std::vector<Material> materials;    // those the parts use, in order of first use
   std::vector<Part> parts;            // layer stacks expanded; region id of parts[i] = i + 1
+  std::vector<SurfaceSelector> surfaces;       // [surfaces], in name order
+  std::vector<BoundaryCondition> conditions;   // [[conditions]], in file order
+  std::vector<Load> loads;                     // [[loads]], in file order
+  ModelMeshControls mesh;                      // [mesh]
 };
 
 // Loads a model file. `overrides` are "name=expression" (from --set) and replace parameters of that
 // name. Throws IoError (file, line when known, and a reason naming the entity: parameter, part,
 // material) for TOML syntax errors, unknown parameters, unit mismatches, circular expressions,
-// sizes that are not positive, unknown materials, and unknown shapes or keys.
+// sizes that are not positive, unknown materials, and unknown shapes or keys; for conditions and
+// loads: unknown types, units that do not fit the type, surfaces that name no part face, interface or
+// [surfaces] entry, unknown parts.
 Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides = {});
 
 }  // namespace foxi

@@ -29,7 +29,8 @@ struct Structure {
 
 // Builds the PLC of `model`. Boundary names: "PART.top", "PART.bottom", "PART.side" for outer faces,
 // "A/B" (A earlier in the file) for the interface of two parts. Throws IoError (the model file, the
-// line of the later part) for unsupported overlaps and for a part carved away entirely.
+// line of the later part) for unsupported overlaps and for a part carved away entirely. Then the
+// model's [surfaces] get their own markers and its conditions are checked (surfaces.hpp).
 Structure build_structure(const Model& model);
 
 // Names a mesh of the structure's PLC: region names and materials from the parts, boundary names

@@ -1,0 +1,25 @@
+// What a solve of a model needs: material properties per physics and at least one condition that
+// makes the problem well posed, checked before any meshing.
+#pragma once
+
+#include "foxi/model/model_file.hpp"
+
+namespace foxi {
+
+enum class Physics : std::uint8_t { thermal, electrostatic, current, thermal_stress };
+
+// "thermal", "electrostatic", "current", "thermal_stress".
+const char* physics_name(Physics physics);
+
+// True if `c` belongs to `physics` (temperature/heat_flux/convection: thermal; voltage: electrostatic
+// and current; current: current; displacement/sliding: thermal_stress).
+bool condition_applies(ConditionKind c, Physics physics);
+
+// Throws IoError (the model file, the line of the part, naming the part, its material and the
+// property) when a part's material lacks a property `physics` needs (thermal_conductivity;
+// relative_permittivity; electrical_conductivity; youngs_modulus, poisson_ratio and
+// thermal_expansion), and (line 0) when the model has no condition that fixes the solution (a
+// temperature or convection; a voltage; a voltage; a displacement).
+void check_physics(const Model& model, Physics physics);
+
+}  // namespace foxi

@@ -1,0 +1,70 @@
+// Material properties and conditions each physics needs (physics.hpp).
+#include "foxi/model/physics.hpp"
+
+#include <cmath>
+
+#include "foxi/model/io_error.hpp"
+
+namespace foxi {
+
+const char* physics_name(Physics physics) {
+  switch (physics) {
+    case Physics::thermal: return "thermal";
+    case Physics::electrostatic: return "electrostatic";
+    case Physics::current: return "current";
+    case Physics::thermal_stress: return "thermal_stress";
+  }
+  return "?";
+}
+
+bool condition_applies(ConditionKind c, Physics physics) {
+  switch (c) {
+    case ConditionKind::temperature:
+    case ConditionKind::heat_flux:
+    case ConditionKind::convection: return physics == Physics::thermal;
+    case ConditionKind::voltage: return physics == Physics::electrostatic || physics == Physics::current;
+    case ConditionKind::current: return physics == Physics::current;
+    case ConditionKind::displacement:
+    case ConditionKind::sliding: return physics == Physics::thermal_stress;
+  }
+  return false;
+}
+
+void check_physics(const Model& model, Physics physics) {
+  struct Need {
+    const char* property;
+    double Material::*field;
+  };
+  std::vector<Need> needs;
+  switch (physics) {
+    case Physics::thermal: needs = {{"thermal_conductivity", &Material::thermal_conductivity}}; break;
+    case Physics::electrostatic: needs = {{"relative_permittivity", &Material::relative_permittivity}}; break;
+    case Physics::current: needs = {{"electrical_conductivity", &Material::electrical_conductivity}}; break;
+    case Physics::thermal_stress:
+      needs = {{"youngs_modulus", &Material::youngs_modulus},
+               {"poisson_ratio", &Material::poisson_ratio},
+               {"thermal_expansion", &Material::thermal_expansion}};
+      break;
+  }
+  for (const Part& part : model.parts)
+    for (const Material& m : model.materials)
+      if (m.name == part.material)
+        for (const Need& n : needs)
+          if (std::isnan(m.*n.field) || (physics != Physics::thermal_stress && !(m.*n.field > 0)))
+            throw IoError(model.file, part.line, IoError::kNoOffset,
+                          "part '" + part.name + "': material '" + m.name + "' has no " + n.property +
+                              ", which --physics " + physics_name(physics) + " needs");
+  bool fixes = false;
+  for (const BoundaryCondition& c : model.conditions)
+    fixes = fixes || (condition_applies(c.kind, physics) && c.kind != ConditionKind::heat_flux &&
+                      c.kind != ConditionKind::current && c.kind != ConditionKind::sliding);
+  if (!fixes)
+    throw IoError(model.file, 0, IoError::kNoOffset,
+                  std::string("no [[conditions]] fix the ") + physics_name(physics) + " solution (give " +
+                      (physics == Physics::thermal          ? "a temperature or a convection"
+                       : physics == Physics::thermal_stress ? "a displacement"
+                                                            : "a voltage or ground") +
+                      " condition)");
+}
+
+}  // namespace foxi
