@@ -5,7 +5,10 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "model_run.hpp"
+#include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
+#include "foxi/model/physics.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/structure.hpp"
 
@@ -16,8 +19,8 @@ namespace {
 const char* kModelUsage =
     "foxi model check MODEL.toml [--set NAME=VALUE]...\n"
     "foxi model plc MODEL.toml [--set NAME=VALUE]... -o OUT.poly\n"
-    "  check: loads the model, builds its PLC and prints parameters, materials, parts with volumes\n"
-    "         and boundary names (or the errors, with file and line)\n"
+    "  check: loads the model, builds its PLC and prints parameters, materials, parts with volumes,\n"
+    "         boundary names, conditions, loads and mesh controls (or the errors, with file and line)\n"
     "  plc:   writes the PLC (metres, region id = part number, boundary markers) as a TetGen .poly\n"
     "  --set NAME=VALUE  overrides a parameter, e.g. --set die_w=8mm";
 
@@ -79,6 +82,19 @@ int cmd_model(Args args) {
   std::printf("boundaries (marker, name, area):\n");
   for (std::size_t b = 0; b < s.boundary_names.size(); ++b)
     std::printf("  %2zu %-28s %.6g m^2\n", b + 1, s.boundary_names[b].c_str(), s.boundary_area[b]);
+  print_model_conditions(model);
+  // which solves the model is ready for (foxi solve MODEL --physics NAME), or why not
+  for (Physics ph : {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress}) {
+    bool has = false;
+    for (const BoundaryCondition& c : model.conditions) has = has || condition_applies(c.kind, ph);
+    if (!has) continue;
+    try {
+      check_physics(model, ph);
+      std::printf("physics %s: ready\n", physics_name(ph));
+    } catch (const IoError& e) {
+      std::printf("physics %s: not ready: %s\n", physics_name(ph), e.what());
+    }
+  }
   std::printf("PLC: %zu points, %zu facets, %zu region seeds\n", s.plc.point_count(), s.plc.facet_count(),
               s.plc.regions.size());
   return 0;

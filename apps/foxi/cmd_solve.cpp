@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "model_run.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/solver/electric.hpp"
+#include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermal.hpp"
 
 namespace foxi::cli {
@@ -19,6 +21,10 @@ namespace foxi::cli {
 namespace {
 
 const char* kSolveUsage =
+    "foxi solve MODEL.toml --physics thermal|electrostatic|current [--set NAME=VALUE]... [options below]\n"
+    "  Meshes the model (TetGen, its [mesh] controls) and solves with its [[conditions]] and [[loads]];\n"
+    "  the options below add to them, boundaries and regions named as in 'foxi model check'.\n"
+    "\n"
     "foxi solve MESH --physics thermal [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf]\n"
     "                [--power REGION=W] [--power-density REGION=W/m3] [--k REGION=k]\n"
     "                [--solver auto|direct|amg|ichol] [--tol REL] [-o OUT]\n"
@@ -159,6 +165,7 @@ int cmd_solve(Args args) {
   const std::string tol = args.option("--tol", "");
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
+  const std::vector<std::string> sets = all_options(args, "--set");
   const auto files = args.positional(1, 1, kSolveUsage);
 
   ThermalParams params;
@@ -174,7 +181,11 @@ int cmd_solve(Args args) {
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 
   auto t0 = std::chrono::steady_clock::now();
-  Mesh mesh = read_mesh(files[0]);
+  const bool from_model = is_model_path(files[0]);
+  MeshedModel model_run;
+  if (from_model) model_run = mesh_model_for_solve(files[0], sets, physics);
+  if (!from_model && !sets.empty()) throw UsageError("--set is for model files (MODEL.toml)");
+  Mesh mesh = from_model ? std::move(model_run.mesh) : read_mesh(files[0]);
   const ValidationReport validation = validate_and_repair(mesh);
   if (!validation.ok()) {
     std::fprintf(stderr, "foxi solve: warning: %s has problems:\n", files[0].c_str());
@@ -193,6 +204,7 @@ int cmd_solve(Args args) {
         throw UsageError("--terminal, --terminal-current and --sigma are for --physics current");
       ElectrostaticParams ep;
       ep.solver = so;
+      if (from_model) ep.conductors = electrostatic_params_from_model(model_run.model, mesh).conductors;
       for (const std::string& s : conductor) {
         auto [k, v] = split_assignment(s, "--conductor");
         Electrode e;
@@ -230,6 +242,7 @@ int cmd_solve(Args args) {
       throw UsageError("--conductor and --eps are for --physics electrostatic");
     CurrentParams cp;
     cp.solver = so;
+    if (from_model) cp.terminals = current_params_from_model(model_run.model, mesh).terminals;
     auto add_terminal = [&](const std::string& s, const char* option, bool current) {
       auto [k, v] = split_assignment(s, option);
       Electrode e;
@@ -274,6 +287,11 @@ int cmd_solve(Args args) {
   if (!conductor.empty() || !eps.empty() || !terminal.empty() || !terminal_current.empty() || !sigma.empty())
     throw UsageError("--conductor/--eps are for --physics electrostatic, --terminal/--sigma for current");
 
+  if (from_model) {
+    ThermalParams mp = thermal_params_from_model(model_run.model, mesh);
+    params.fixed = mp.fixed, params.flux = mp.flux, params.convection = mp.convection;
+    params.sources = mp.sources;
+  }
   for (const std::string& s : fix) {
     auto [k, v] = split_assignment(s, "--fix");
     params.fixed.push_back({boundary_tag(mesh, k, "--fix"), parse_number(v, "--fix")});

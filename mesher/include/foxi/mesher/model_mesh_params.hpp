@@ -1,0 +1,25 @@
+// A model's mesh controls ([mesh], foxi/model/conditions.hpp) as TetGen parameters, until the mesher
+// takes a size field: TetGen bounds tet volumes, so an edge length a becomes the volume of the
+// regular tet of edge a, a^3 / (6 sqrt 2).
+#pragma once
+
+#include "foxi/mesher/tetgen_mesher.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/model/plc.hpp"
+
+namespace foxi {
+
+// Volume of the regular tetrahedron with edge `edge`.
+double regular_tet_volume(double edge);
+
+// MeshParams with max_volume from model.mesh.max_size (or `default_size` when the model gives none;
+// 0: no limit) and radius_edge from model.mesh.quality (when given); the region seeds in `plc` of
+// parts with their own size get that part's volume bound. Refinement boxes are not applied here (TetGen
+// has no box sizes); the result's count of ignored boxes is `ignored_refine_boxes`.
+struct ModelMeshParams {
+  MeshParams params;
+  std::size_t ignored_refine_boxes = 0;
+};
+ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double default_size = 0);
+
+}  // namespace foxi

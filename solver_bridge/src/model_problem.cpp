@@ -1,0 +1,70 @@
+// Model conditions and loads -> solver parameters (model_problem.hpp).
+#include "foxi/solver/model_problem.hpp"
+
+namespace foxi {
+
+std::vector<std::int32_t> surface_tags(const BoundaryCondition& c, const Mesh& mesh) {
+  std::vector<std::int32_t> tags;
+  for (const std::string& s : c.surfaces) {
+    const Boundary* found = nullptr;
+    for (const Boundary& b : mesh.boundaries)
+      if (b.name == s) found = &b;
+    if (found == nullptr)
+      throw SolverError(std::string(condition_kind_name(c.kind)) + " condition (line " + std::to_string(c.line) +
+                        "): the mesh has no boundary named '" + s + "'");
+    tags.push_back(found->tag);
+  }
+  return tags;
+}
+
+ThermalParams thermal_params_from_model(const Model& model, const Mesh& mesh) {
+  ThermalParams p;
+  for (const BoundaryCondition& c : model.conditions) {
+    if (c.kind != ConditionKind::temperature && c.kind != ConditionKind::heat_flux &&
+        c.kind != ConditionKind::convection)
+      continue;
+    for (std::int32_t tag : surface_tags(c, mesh)) {
+      if (c.kind == ConditionKind::temperature) p.fixed.push_back({tag, c.value});
+      if (c.kind == ConditionKind::heat_flux) p.flux.push_back({tag, c.value});
+      if (c.kind == ConditionKind::convection) p.convection.push_back({tag, c.h, c.ambient});
+    }
+  }
+  for (const Load& l : model.loads) {
+    if (l.kind != LoadKind::power) continue;
+    for (std::size_t i = 0; i < model.parts.size(); ++i)
+      if (model.parts[i].name == l.part) p.sources.push_back({static_cast<std::int32_t>(i + 1), l.value, l.total});
+  }
+  return p;
+}
+
+namespace {
+
+std::vector<Electrode> electrodes(const Model& model, const Mesh& mesh, bool with_current) {
+  std::vector<Electrode> out;
+  for (const BoundaryCondition& c : model.conditions) {
+    if (c.kind != ConditionKind::voltage && !(with_current && c.kind == ConditionKind::current)) continue;
+    Electrode e;
+    e.name = c.name;
+    e.tags = surface_tags(c, mesh);
+    e.fixed_current = c.kind == ConditionKind::current;
+    (e.fixed_current ? e.current : e.voltage) = c.value;
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+}  // namespace
+
+ElectrostaticParams electrostatic_params_from_model(const Model& model, const Mesh& mesh) {
+  ElectrostaticParams p;
+  p.conductors = electrodes(model, mesh, false);
+  return p;
+}
+
+CurrentParams current_params_from_model(const Model& model, const Mesh& mesh) {
+  CurrentParams p;
+  p.terminals = electrodes(model, mesh, true);
+  return p;
+}
+
+}  // namespace foxi
