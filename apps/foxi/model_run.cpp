@@ -89,9 +89,11 @@ void print_model_conditions(const Model& model) {
   std::printf("mesh controls: max size %s", mc.max_size > 0 ? "" : "none");
   if (mc.max_size > 0) std::printf("%g %s", mc.max_size / s, u);
   if (mc.quality >= 0)
-    std::printf(", radius-edge bound %g\n", mc.quality);
+    std::printf(", radius-edge bound %g", mc.quality);
   else
-    std::printf(", radius-edge bound the mesher's default\n");
+    std::printf(", radius-edge bound the mesher's default");
+  if (mc.min_dihedral > 0) std::printf(", min dihedral %g deg", mc.min_dihedral);
+  std::printf("\n");
   for (const PartSize& p : mc.part_sizes)
     std::printf("  part %-16s max size %g %s\n", p.part.c_str(), p.max_size / s, u);
   for (const RefineBox& b : mc.refine)

@@ -13,6 +13,7 @@ ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double defa
   const double size = mc.max_size > 0 ? mc.max_size : default_size;
   if (size > 0) out.params.max_volume = regular_tet_volume(size);
   if (mc.quality >= 0) out.params.radius_edge = mc.quality;
+  out.params.min_dihedral = mc.min_dihedral;
   for (const PartSize& ps : mc.part_sizes)
     for (std::size_t i = 0; i < model.parts.size(); ++i)
       if (model.parts[i].name == ps.part)

@@ -309,13 +309,18 @@ class ConditionReader {
 
   void read_mesh(const Value& v) {
     if (!v.is_table()) fail(v, "'mesh' must be a table ([mesh])");
-    allow_keys(v, "[mesh]", {"max_size", "quality", "parts", "refine"});
+    allow_keys(v, "[mesh]", {"max_size", "quality", "min_dihedral", "parts", "refine"});
     ModelMeshControls& mc = m_.mesh;
     if (const Value* s = find(v, "max_size")) mc.max_size = positive_length(*s, "mesh max_size");
     if (const Value* q = find(v, "quality")) {
       mc.quality = quantity(*q, kDimensionless, "mesh quality", 1);
       if (!(mc.quality == 0 || mc.quality >= 1))
         fail(*q, "mesh quality (a radius-edge bound) must be 0 (off) or at least 1");
+    }
+    if (const Value* d = find(v, "min_dihedral")) {
+      mc.min_dihedral = quantity(*d, kDimensionless, "mesh min_dihedral", 1);
+      if (!(mc.min_dihedral >= 0 && mc.min_dihedral < 30))
+        fail(*d, "mesh min_dihedral must be between 0 and 30 degrees (larger bounds do not terminate)");
     }
     if (const Value* p = find(v, "parts")) {
       if (!p->is_table()) fail(*p, "mesh parts must be a table { PART = max_size, ... }");

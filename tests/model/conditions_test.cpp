@@ -97,6 +97,7 @@ value = "-100 degC"
 [mesh]
 max_size = "0.5 mm"
 quality = 1.2
+min_dihedral = 8
 parts = { cube = "100 um" }
 [[mesh.refine]]
 min = [0, 0, 2]
@@ -175,6 +176,7 @@ TEST(ModelConditions, ValuesInSiWithCelsiusOffsets) {
   EXPECT_TRUE(m.loads[2].part.empty());
   EXPECT_DOUBLE_EQ(m.mesh.max_size, 5e-4);
   EXPECT_DOUBLE_EQ(m.mesh.quality, 1.2);
+  EXPECT_DOUBLE_EQ(m.mesh.min_dihedral, 8);
   ASSERT_EQ(m.mesh.part_sizes.size(), 1u);
   EXPECT_EQ(m.mesh.part_sizes[0].part, "cube");
   EXPECT_DOUBLE_EQ(m.mesh.part_sizes[0].max_size, 1e-4);

@@ -23,6 +23,7 @@
 //   [mesh]
 //   max_size = "0.5 mm"          # global maximum element edge length
 //   quality = 1.414              # radius-edge bound (0: no quality refinement)
+//   min_dihedral = 10            # degrees: no slivers (flat tets make the FEM matrix ill-conditioned)
 //   parts = { die = "0.1 mm" }   # per-part maximum edge length
 //   [[mesh.refine]]
 //   min = [x, y, z]  max = [x, y, z]  max_size = "0.05 mm"
@@ -96,6 +97,7 @@ struct RefineBox {
 struct ModelMeshControls {
   double max_size = 0;   // m, edge length; 0: none
   double quality = -1;   // radius-edge bound; negative: the mesher's default
+  double min_dihedral = 0;  // degrees; 0: the mesher's default
   std::vector<PartSize> part_sizes;
   std::vector<RefineBox> refine;
 };

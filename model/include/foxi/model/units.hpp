@@ -32,7 +32,8 @@ struct ExpressionError : std::runtime_error {
 std::string dims_to_string(const Dims& d);
 
 // The SI value of unit `name` ("mm" -> 1e-3 m), or nothing if it is not a unit foxi knows: lengths
-// m cm mm um µm nm in mil; K s kg g W J V A S N Pa kPa MPa GPa Hz ppm (1e-6).
+// m cm mm um µm nm in mil; K s kg g W mW kW J V mV kV A mA uA S N Pa kPa MPa GPa Hz ppm (1e-6).
+// Absolute temperatures in degC are read by the boundary conditions (conditions.hpp), not here.
 std::optional<Quantity> unit_quantity(std::string_view name);
 
 // Evaluates `text`: numbers, a number followed by a unit ("8 mm", "2.5um"), names (resolved by
