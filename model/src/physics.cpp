@@ -58,6 +58,14 @@ void check_physics(const Model& model, Physics physics) {
   for (const BoundaryCondition& c : model.conditions)
     fixes = fixes || (condition_applies(c.kind, physics) && c.kind != ConditionKind::heat_flux &&
                       c.kind != ConditionKind::current && c.kind != ConditionKind::sliding);
+  std::size_t electrodes = 0;
+  for (const BoundaryCondition& c : model.conditions)
+    electrodes += (physics == Physics::electrostatic || physics == Physics::current) &&
+                  condition_applies(c.kind, physics);
+  if (fixes && electrodes == 1)
+    throw IoError(model.file, 0, IoError::kNoOffset,
+                  std::string("--physics ") + physics_name(physics) +
+                      " needs two electrodes (voltage, ground or current conditions); the model has one");
   if (!fixes)
     throw IoError(model.file, 0, IoError::kNoOffset,
                   std::string("no [[conditions]] fix the ") + physics_name(physics) + " solution (give " +
