@@ -1,10 +1,12 @@
 // foxi model check|plc MODEL [--set k=v]...: load a parametrized structure model, report it, write
 // its PLC.
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
+#include "model_picture.hpp"
 #include "model_run.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
@@ -19,9 +21,14 @@ namespace {
 const char* kModelUsage =
     "foxi model check MODEL.toml [--set NAME=VALUE]...\n"
     "foxi model plc MODEL.toml [--set NAME=VALUE]... -o OUT.poly\n"
+    "foxi model show MODEL.toml [--set NAME=VALUE]... [--size WxH] [--view exploded|cut|whole] -o OUT.png\n"
     "  check: loads the model, builds its PLC and prints parameters, materials, parts with volumes,\n"
     "         boundary names, conditions, loads and mesh controls (or the errors, with file and line)\n"
     "  plc:   writes the PLC (metres, region id = part number, boundary markers) as a TetGen .poly\n"
+    "  show:  meshes the model coarsely (TetGen, its quality bounds, no sizes) and draws it with the\n"
+    "         painter, each part in its material's colour, seen from the front, above, right; --view\n"
+    "         exploded (default: part i lifted by i gaps, so every part shows whole), cut (the back\n"
+    "         half, tets beyond the middle of y) or whole; prints the colour legend\n"
     "  --set NAME=VALUE  overrides a parameter, e.g. --set die_w=8mm";
 
 // Lengths in the model's unit, everything else in SI.
@@ -42,12 +49,39 @@ int cmd_model(Args args) {
   std::vector<std::string> sets;
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
   const std::string out = args.option("-o");
+  const std::string size = args.option("--size", "1280x960");
+  const std::string view = args.option("--view", "exploded");
   const auto pos = args.positional(2, 2, kModelUsage);
   const std::string& action = pos[0];
   const std::string& file = pos[1];
-  if (action != "check" && action != "plc")
+  if (action != "check" && action != "plc" && action != "show")
     throw UsageError("unknown action '" + action + "'\nusage: " + kModelUsage);
   if (action == "plc" && out.empty()) throw UsageError("give the output file with -o OUT.poly");
+  if (action == "show") {
+    if (out.empty()) throw UsageError("give the output file with -o OUT.png");
+    ModelPictureParams pp;
+    if (view == "cut")
+      pp.view = ModelView::cut;
+    else if (view == "whole")
+      pp.view = ModelView::whole;
+    else if (view != "exploded")
+      throw UsageError("--view takes exploded, cut or whole, not '" + view + "'");
+    const auto wh = parse_numbers(size.substr(0, size.find('x')) + "," + size.substr(size.find('x') + 1), "--size");
+    if (size.find('x') == std::string::npos || wh.size() != 2 || !(wh[0] >= 16 && wh[0] <= 8192) ||
+        !(wh[1] >= 16 && wh[1] <= 8192) || wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]))
+      throw UsageError("--size takes WxH, 16 to 8192 pixels each, not '" + size + "'");
+    pp.width = static_cast<int>(wh[0]);
+    pp.height = static_cast<int>(wh[1]);
+    const MeshedModel m = mesh_model(file, sets, std::nullopt, true);
+    const ModelPicture pic = render_model_picture(m, out, pp);
+    std::printf("%s: %zu parts, coarse mesh %zu nodes, %zu tets (TetGen %s); drew %zu tets (%s) -> %s\n",
+                file.c_str(), m.model.parts.size(), m.mesh.node_count(), m.mesh.tet_count(),
+                m.report.switches.c_str(), pic.tets_drawn,
+                pic.delaunay ? "painter, power order" : "not Delaunay: MPVO order, depth buffer", out.c_str());
+    std::printf("colours (part, material, RGB):\n");
+    print_legend(m, pic);
+    return 0;
+  }
 
   const Model model = load_model(file, sets);
   const Structure s = build_structure(model);

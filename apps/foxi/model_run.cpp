@@ -18,12 +18,12 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
   if (physics) check_physics(m.model, *physics);
   m.structure = build_structure(m.model);
   Plc plc = m.structure.plc;
-  MeshParams params;
-  if (!coarse) {
-    const ModelMeshParams mp = mesh_params_from_model(m.model, plc);
-    params = mp.params;
-    m.ignored_refine_boxes = mp.ignored_refine_boxes;
-  }
+  Model controls = m.model;  // coarse: the quality bounds only
+  if (coarse) controls.mesh = {.max_size = 0, .quality = m.model.mesh.quality,
+                               .min_dihedral = m.model.mesh.min_dihedral, .part_sizes = {}, .refine = {}};
+  const ModelMeshParams mp = mesh_params_from_model(controls, plc);
+  const MeshParams params = mp.params;
+  m.ignored_refine_boxes = mp.ignored_refine_boxes;
   m.mesh = mesh_plc(plc, params, &m.report);
   name_mesh(m.model, m.structure, m.mesh);
   return m;

@@ -26,7 +26,7 @@ struct MeshedModel {
 };
 
 // Loads `file` with the --set overrides, checks what `physics` needs (before meshing), builds the
-// PLC and meshes it with the model's [mesh] controls; `coarse` ignores them (quality bound only).
+// PLC and meshes it with the model's [mesh] controls; `coarse` keeps only its quality bounds.
 // Errors: IoError from the model, MesherError from TetGen.
 MeshedModel mesh_model(const std::string& file, std::span<const std::string> sets,
                        std::optional<Physics> physics, bool coarse = false);

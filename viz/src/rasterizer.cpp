@@ -347,7 +347,10 @@ struct TetRasterizer::Impl {
     double lambert = len > 0 ? -(nc[0] * light[0] + nc[1] * light[1] + nc[2] * light[2]) / len : 0;
     double intensity = params.ambient + (1 - params.ambient) * std::max(0.0, lambert);
     intensity = std::clamp(intensity, 0.0, 1.0);
-    std::uint32_t base = region_color(mesh->region_of(tet));
+    const std::int32_t region = mesh->region_of(tet);
+    std::uint32_t base = region >= 0 && std::size_t(region) < params.region_colors.size()
+                             ? params.region_colors[std::size_t(region)]
+                             : region_color(region);
     fs.r = float((base & 255u) * intensity);
     fs.g = float(((base >> 8) & 255u) * intensity);
     fs.b = float(((base >> 16) & 255u) * intensity);

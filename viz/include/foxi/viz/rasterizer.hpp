@@ -37,6 +37,9 @@ struct RenderParams {
   double ambient = 0.3;         // Lambert: ambient + (1 - ambient) max(0, n . light)
   double near = 0;              // perspective near-plane distance (world); 0 = automatic (tiny)
   int threads = 2;              // threads drawing interleaved bands of rows (1 or more)
+  // Colour of region id r (opaque RGBA, pack_rgba) at region_colors[r] where r is in range; other
+  // regions take region_color(r).
+  std::vector<std::uint32_t> region_colors;
 };
 
 // The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).

@@ -1,0 +1,119 @@
+// Model pictures: material colours, a cut-away view, the painter (model_picture.hpp).
+#include "model_picture.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+
+#include "foxi/model/delaunay.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/png.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/visibility_order.hpp"
+
+namespace foxi::cli {
+
+std::uint32_t material_color(const std::string& name, std::size_t index) {
+  struct Known {
+    const char* name;
+    std::uint32_t rgba;
+  };
+  static const Known kKnown[] = {
+      {"copper", pack_rgba(200, 117, 51)},        {"silicon", pack_rgba(96, 110, 160)},
+      {"polysilicon", pack_rgba(150, 100, 170)},  {"sac305", pack_rgba(175, 180, 185)},
+      {"fr4", pack_rgba(70, 140, 70)},            {"mold_compound", pack_rgba(80, 80, 85)},
+      {"underfill", pack_rgba(225, 190, 110)},    {"sio2", pack_rgba(150, 215, 230)},
+      {"aluminium", pack_rgba(210, 210, 215)},    {"alumina", pack_rgba(240, 235, 215)},
+  };
+  for (const Known& k : kKnown)
+    if (name == k.name) return k.rgba;
+  return region_color(static_cast<std::int32_t>(index));
+}
+
+namespace {
+
+// The mesh with every region's nodes copied and lifted by (region index - 1) * gap in z.
+Mesh exploded_mesh(const Mesh& mesh, double gap) {
+  Mesh out;
+  out.regions = mesh.regions;
+  std::map<std::pair<std::uint32_t, std::int32_t>, std::uint32_t> copy;
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const std::int32_t r = mesh.region_of(t);
+    for (int v = 0; v < 4; ++v) {
+      const std::uint32_t n = mesh.tet[4 * t + v];
+      auto [it, fresh] = copy.emplace(std::make_pair(n, r), static_cast<std::uint32_t>(out.xyz.size() / 3));
+      if (fresh) {
+        const double* p = &mesh.xyz[3 * std::size_t{n}];
+        out.xyz.insert(out.xyz.end(), {p[0], p[1], p[2] + gap * std::max(0, r - 1)});
+      }
+      out.tet.push_back(it->second);
+    }
+    out.tet_region.push_back(r);
+  }
+  return out;
+}
+
+}  // namespace
+
+ModelPicture render_model_picture(const MeshedModel& m, const std::string& path, const ModelPictureParams& p) {
+  double lo[3], hi[3];
+  mesh_bounds(m.mesh, lo, hi);
+  const double size = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  const Mesh exploded =
+      p.view == ModelView::exploded ? exploded_mesh(m.mesh, 0.12 * size) : Mesh{};
+  const Mesh& mesh = p.view == ModelView::exploded ? exploded : m.mesh;
+  ModelPicture out;
+  RenderParams rp;
+  rp.region_colors.assign(m.model.parts.size() + 1, pack_rgba(128, 128, 128));
+  for (std::size_t i = 0; i < m.model.parts.size(); ++i) {
+    std::size_t index = 0;
+    for (std::size_t k = 0; k < m.model.materials.size(); ++k)
+      if (m.model.materials[k].name == m.model.parts[i].material) index = k;
+    out.part_color.push_back(material_color(m.model.parts[i].material, index));
+    rp.region_colors[i + 1] = out.part_color.back();
+  }
+  rp.edge_darkness = 0.35;  // the parts' colours first, the mesh second
+
+  mesh_bounds(mesh, lo, hi);
+  std::vector<std::uint32_t> subset;
+  if (p.view == ModelView::cut) {
+    const double mid = 0.5 * (lo[1] + hi[1]);
+    for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+      double cy = 0;
+      for (int v = 0; v < 4; ++v) cy += mesh.xyz[3 * std::size_t{mesh.tet[4 * t + v]} + 1];
+      if (cy >= 4 * mid) subset.push_back(static_cast<std::uint32_t>(t));
+    }
+  }
+  // flat structures (packages) fill the picture better seen from lower down
+  const double dir[3] = {-0.55, 1, -0.55}, up[3] = {0, 0, 1};
+  const Camera camera = fit_camera(lo, hi, dir, up, true, 30, double(p.width) / p.height, 0.95);
+  const DelaunayCertificate& cert = delaunay_certificate(mesh);
+  const SphereTable table = compute_spheres(mesh);
+  const View view = view_of(camera);
+  std::vector<std::uint32_t> order;
+  if (cert.delaunay) {
+    order = visibility_order(mesh, table, view, subset);
+  } else {
+    std::size_t cycles = 0;
+    order = mpvo_order(mesh, table, view, subset, &cycles);
+  }
+  out.delaunay = cert.delaunay;
+  rp.depth_buffer = !cert.delaunay;
+  Framebuffer fb(p.width, p.height, rp.depth_buffer);
+  TetRasterizer raster(mesh, camera, p.width, p.height, rp);
+  raster.draw(fb, order);
+  write_png(path, fb);
+  out.tets_drawn = order.size();
+  return out;
+}
+
+void print_legend(const MeshedModel& m, const ModelPicture& picture) {
+  for (std::size_t i = 0; i < m.model.parts.size(); ++i) {
+    const std::uint32_t c = picture.part_color[i];
+    std::printf("  %-16s %-16s #%02x%02x%02x\n", m.model.parts[i].name.c_str(), m.model.parts[i].material.c_str(),
+                c & 255u, (c >> 8) & 255u, (c >> 16) & 255u);
+  }
+}
+
+}  // namespace foxi::cli

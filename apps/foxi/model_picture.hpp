@@ -1,0 +1,43 @@
+// Pictures of models for foxi model show and foxi demo: the mesh of a model cut open and drawn by
+// the painter (viz), each part in its material's colour.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "model_run.hpp"
+
+namespace foxi::cli {
+
+// RGBA (pack_rgba) of a material: familiar colours for the library's materials (copper, silicon,
+// solder, FR-4, ...), else entry `index` of a fixed palette.
+std::uint32_t material_color(const std::string& name, std::size_t index);
+
+enum class ModelView : std::uint8_t {
+  exploded,  // each part lifted in z by its index times a gap: every part shows whole
+  cut,       // only tets with centroids at y >= the middle: the inside shows (jagged at the cut)
+  whole,     // the mesh as it is
+};
+
+struct ModelPictureParams {
+  int width = 1280, height = 960;
+  ModelView view = ModelView::exploded;
+};
+
+struct ModelPicture {
+  std::size_t tets_drawn = 0;
+  bool delaunay = false;  // painter in the power order; otherwise MPVO order with the depth buffer
+  std::vector<std::uint32_t> part_color;  // 1 per part
+};
+
+// Renders `m.mesh` seen obliquely from the front (-y), above and to the right, to the PNG `path`:
+// by the painter in the power order when the drawn mesh is Delaunay (cut, whole), else in MPVO order
+// with the depth buffer (an exploded mesh is not one Delaunay mesh).
+ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
+                                  const ModelPictureParams& params = {});
+
+// Prints "  PART  material  colour #rrggbb" lines, the picture's legend.
+void print_legend(const MeshedModel& m, const ModelPicture& picture);
+
+}  // namespace foxi::cli
