@@ -46,5 +46,6 @@ int cmd_mesh(Args args);
 int cmd_render(Args args);
 int cmd_solve(Args args);
 int cmd_model(Args args);
+int cmd_demo(Args args);
 
 }  // namespace foxi::cli

@@ -15,13 +15,15 @@ const char* kUsage =
     "usage: foxi COMMAND [options]\n"
     "\n"
     "commands:\n"
-    "  model check|plc MODEL.toml  parametrized structure: report it, or write its PLC (-o OUT.poly)\n"
+    "  model check|plc|show MODEL.toml  parametrized structure: report it, write its PLC (-o OUT.poly)\n"
+    "                 or a picture of its parts (-o OUT.png)\n"
+    "  demo [MODEL]   one model end to end: mesh, certificate, steady heat, pictures (-o DIR)\n"
     "  mesh PLC.poly  tetrahedral mesh of a TetGen .poly (-o OUT, --max-volume, --check-delaunay)\n"
     "  info MESH      counts, bounding box, regions, boundaries, fields, volume, tet quality,\n"
     "                 validation; --json for machine-readable output; --check-delaunay\n"
     "  convert IN OUT convert between mesh formats (format from the extension)\n"
     "  order MESH     visibility order for views (--eye, --dir, --views N), with violation counts\n"
-    "  solve MESH     --physics thermal: temperatures, heat per boundary; electrostatic: the\n"
+    "  solve MESH|MODEL.toml  --physics thermal: temperatures, heat per boundary; electrostatic: the\n"
     "                 capacitance matrix; current: resistance, Joule heat; -o OUT.vtu\n"
     "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png\n"
     "\n"
@@ -52,6 +54,7 @@ int main(int argc, char** argv) {
     if (command == "render") return foxi::cli::cmd_render(std::move(rest));
     if (command == "solve") return foxi::cli::cmd_solve(std::move(rest));
     if (command == "model") return foxi::cli::cmd_model(std::move(rest));
+    if (command == "demo") return foxi::cli::cmd_demo(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return 2;
   } catch (const foxi::cli::UsageError& e) {

@@ -98,6 +98,10 @@ ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
     std::size_t cycles = 0;
     order = mpvo_order(mesh, table, view, subset, &cycles);
   }
+  if (p.view == ModelView::interior) {
+    order.resize(order.size() * 6 / 10);
+    rp.shrink = 0.85;
+  }
   out.delaunay = cert.delaunay;
   rp.depth_buffer = !cert.delaunay;
   Framebuffer fb(p.width, p.height, rp.depth_buffer);
