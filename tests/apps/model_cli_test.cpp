@@ -2,9 +2,12 @@
 // program), --set, and errors that name the file and the entity.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <regex>
 #include <string>
 
 #include "foxi/model/plc.hpp"
+#include "foxi/viz/png.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -55,6 +58,86 @@ TEST(ModelCli, ErrorsAndUsage) {
   EXPECT_EQ(foxi_cli("model check '" + (dir / "missing.toml").string() + "'", dir / "e4.txt"), 1);
   EXPECT_NE(test::read_text(dir / "e4.txt").find("missing.toml"), std::string::npos)
       << test::read_text(dir / "e4.txt");
+}
+
+// foxi solve MODEL.toml: the model's conditions and loads drive the solve; the heat put into the
+// die leaves through the boundaries, the fixed board temperature is what the model says (45 degC).
+TEST(ModelCli, SolveModelUsesItsConditionsAndLoads) {
+  TempDir dir;
+  ASSERT_EQ(foxi_cli("solve '" + kModels + "flip_chip.toml' --physics thermal --set die_h=0.6mm", dir / "out.txt"), 0)
+      << test::read_text(dir / "out.txt");
+  const std::string out = test::read_text(dir / "out.txt");
+  for (const char* s : {"substrate.bottom", "fixed", "die.top", "convection", "total source power 3 W"})
+    EXPECT_NE(out.find(s), std::string::npos) << s << " missing in:\n" << out;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("energy balance \\(sources \\+ boundary heat\\) (\\S+) W"))) << out;
+  EXPECT_LT(std::abs(std::stod(m[1])), 1e-6 * 3) << out;
+  // the hottest point is above the board's 318.15 K
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("max temperature (\\S+) K"))) << out;
+  EXPECT_GT(std::stod(m[1]), 318.15);
+  ASSERT_EQ(foxi_cli("solve '" + kModels + "via_in_dielectric.toml' --physics current", dir / "cur.txt"), 0)
+      << test::read_text(dir / "cur.txt");
+  EXPECT_NE(test::read_text(dir / "cur.txt").find("resistance"), std::string::npos);
+}
+
+TEST(ModelCli, SolveModelErrorsBeforeMeshing) {
+  TempDir dir;
+  // die_on_substrate has no electrodes
+  EXPECT_EQ(foxi_cli("solve '" + kModels + "die_on_substrate.toml' --physics current", dir / "e1.txt"), 1);
+  EXPECT_NE(test::read_text(dir / "e1.txt").find("no [[conditions]] fix the current solution"), std::string::npos)
+      << test::read_text(dir / "e1.txt");
+  std::filesystem::copy(kModels + "materials.toml", dir / "materials.toml");
+  test::write_text(dir / "bad.toml", test::read_text(kModels + "die_on_substrate.toml") +
+                                          "\n[[conditions]]\ntype = \"heat_flux\"\nsurface = \"die.bottom\"\n"
+                                          "value = \"1 W/m^2\"\n");
+  EXPECT_EQ(foxi_cli("solve '" + (dir / "bad.toml").string() + "' --physics thermal", dir / "e2.txt"), 1);
+  const std::string e2 = test::read_text(dir / "e2.txt");
+  EXPECT_NE(e2.find("bad.toml:"), std::string::npos) << e2;
+  EXPECT_NE(e2.find("surface 'die.bottom' does not exist"), std::string::npos) << e2;
+  EXPECT_EQ(e2.find("nodes"), std::string::npos) << "meshed before the error:\n" << e2;
+  EXPECT_EQ(foxi_cli("solve '" + kModels + "die_on_substrate.toml' --set nothing=1", dir / "e3.txt"), 1);
+}
+
+// Every part of the exploded picture shows: some pixel has the part's colour (up to shading).
+TEST(ModelCli, ShowDrawsEveryPartInItsColour) {
+  TempDir dir;
+  ASSERT_EQ(foxi_cli("model show '" + kModels + "flip_chip.toml' --size 640x480 -o '" + (dir / "f.png").string() + "'",
+                     dir / "out.txt"),
+            0)
+      << test::read_text(dir / "out.txt");
+  const std::string out = test::read_text(dir / "out.txt");
+  const foxi::Framebuffer fb = foxi::read_png(dir / "f.png");
+  ASSERT_EQ(fb.width, 640);
+  ASSERT_EQ(fb.height, 480);
+  std::size_t parts = 0;
+  const std::regex legend("\\n  (\\S+) +(\\S+) +#([0-9a-f]{6})");
+  for (auto it = std::sregex_iterator(out.begin(), out.end(), legend); it != std::sregex_iterator(); ++it) {
+    ++parts;
+    const unsigned c = static_cast<unsigned>(std::stoul((*it)[3].str(), nullptr, 16));
+    const double want[3] = {double(c >> 16), double((c >> 8) & 255u), double(c & 255u)};
+    std::size_t hits = 0;
+    for (std::uint32_t px : fb.rgba) {
+      const double got[3] = {double(px & 255u), double((px >> 8) & 255u), double((px >> 16) & 255u)};
+      const double k = (got[0] + got[1] + got[2]) / (want[0] + want[1] + want[2]);
+      bool same = k > 0.25;
+      for (int i = 0; i < 3; ++i) same = same && std::abs(got[i] - k * want[i]) <= 2.5;
+      hits += same;
+    }
+    EXPECT_GT(hits, 50u) << (*it)[1] << " (" << (*it)[2] << ") not in the picture";
+  }
+  EXPECT_EQ(parts, 4u) << out;
+  EXPECT_EQ(foxi_cli("model show '" + kModels + "flip_chip.toml'", dir / "e.txt"), 2);  // no -o
+}
+
+TEST(ModelCli, DemoRunsAModelEndToEnd) {
+  TempDir dir;
+  ASSERT_EQ(foxi_cli("demo '" + kModels + "trench.toml' -o '" + (dir / "d").string() + "'", dir / "out.txt"), 0)
+      << test::read_text(dir / "out.txt");
+  const std::string out = test::read_text(dir / "out.txt");
+  for (const char* s : {"1. model", "2. mesh", "3. certificate", "4. steady heat", "5. picture"})
+    EXPECT_NE(out.find(s), std::string::npos) << s << " missing in:\n" << out;
+  for (const char* f : {"trench.vtu", "trench.png", "trench_parts.png"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "d" / f)) << f;
 }
 
 }  // namespace
