@@ -24,10 +24,10 @@ echo
 # The visibility order (power of the eye w.r.t. each circumsphere) from 4 random views, verified.
 "$foxi" order "$out/die_on_substrate.node" --views 4 --check
 echo
-# Steady heat: 0.5 W in the die (region 2), the substrate bottom (boundary 1) held at 300 K, the
-# die top (boundary 4) cooled by air (h = 10 W/m^2K at 300 K); FR-4 and silicon (models/materials.toml).
-"$foxi" solve "$out/die_on_substrate.node" --physics thermal --fix 1=300 --power 2=0.5 --k 1=0.4 \
-  --k 2=148 --convect 4=10,300 -o "$out/die_on_substrate_thermal.vtu"
+# Steady heat with the model's own conditions and loads: 0.5 W in the die, the substrate bottom
+# held at 300 K, the free faces cooled by air (h = 10 W/m^2K at 300 K); FR-4 and silicon
+# (models/materials.toml). foxi solve meshes the model itself ([mesh] in the model file).
+"$foxi" solve models/die_on_substrate.toml --physics thermal --set die_w=5mm -o "$out/die_on_substrate_thermal.vtu"
 echo
 # The inside of the mesh: the far 60% of the tets, back to front, each shrunk a little.
 "$foxi" render "$out/die_on_substrate.node" --stop 60% --shrink 0.85 --size 1280x960 -o "$out/die_on_substrate.png"
@@ -36,5 +36,11 @@ echo
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.msh"
 "$foxi" info "$out/die_on_substrate.msh" --json > "$out/die_on_substrate.json"
 echo
+# Another example end to end in one command (the flip chip: mesh, certificate, heat, pictures).
+"$foxi" demo -o "$out"
+"$foxi" model show models/power_module.toml --view exploded -o "$out/power_module_parts.png" --set solder_h=0.5mm \
+  --set cu_h=0.5mm --set ceramic_h=0.6mm
+echo
+echo "demo: wrote $out/flip_chip.png and $out/flip_chip_parts.png (foxi demo), $out/power_module_parts.png,"
 echo "demo: wrote $out/die_on_substrate.png (the mesh inside), $out/die_on_substrate_thermal.vtu (temperature and"
 echo "      heat flux, for ParaView), $out/die_on_substrate.vtu and .msh (the mesh), $out/die_on_substrate.json"
