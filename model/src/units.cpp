@@ -190,6 +190,9 @@ class Parser {
         auto uq = unit_quantity(u);
         if (!uq) {
           p_ = at;
+          if (u == "degC")  // an offset unit: only a whole absolute temperature may end with it
+            fail("degC is an absolute temperature with an offset: write it only at the end of a "
+                 "condition's temperature (\"25 degC\"); in expressions use K");
           fail("unknown unit '" + std::string(u) + "'");
         }
         Quantity unit = *uq;

@@ -282,6 +282,14 @@ TEST(ModelConditionsBadInput, CelsiusWrittenAsKelvin) {
   EXPECT_NE(e.reason().find("-20 degC"), std::string::npos) << e.what();
 }
 
+TEST(ModelConditionsBadInput, CelsiusInAParameterIsExplained) {
+  const std::string t = replaced(kModel, "t_amb = \"25\"", "t_amb = \"25 degC\"");
+  const foxi::IoError e = build_error(t);
+  EXPECT_NE(e.reason().find("parameter 't_amb'"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("degC is an absolute temperature"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), line_of(t, "t_amb = "));
+}
+
 TEST(ModelConditionsBadInput, TwoThermalConditionsOnOneSurface) {
   const std::string t = replaced(kModel, "surface = \"island.top\"", "surface = \"cube.top\"");
   const foxi::IoError e = build_error(t);
