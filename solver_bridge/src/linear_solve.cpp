@@ -1,5 +1,6 @@
 #include "linear_solve.hpp"
 
+#include <Eigen/Dense>
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
@@ -83,22 +84,27 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
   result.relative_residual = residual_norm(a, b, x, threads) / bnorm;
 }
 
-// Smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) for scalar diffusion: aggregates
-// of strongly connected nodes, piecewise-constant tentative prolongation smoothed by one damped Jacobi
-// step, Galerkin coarse operators, symmetric Gauss-Seidel V(1,1) cycles, LDL^T on the coarsest level.
-// One V-cycle is a symmetric positive definite preconditioner for CG.
+// Smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996): aggregates of strongly
+// connected nodes, a tentative prolongation that interpolates the near-null space exactly on each
+// aggregate (constants for scalar diffusion; for elasticity the 6 rigid-body modes, orthonormalised per
+// aggregate by a QR whose R factors become the coarse level's near-null space), smoothed by one damped
+// Jacobi step, Galerkin coarse operators, symmetric Gauss-Seidel V(1,1) cycles, LDL^T on the coarsest
+// level. One V-cycle is a symmetric positive definite preconditioner for CG.
 class Amg {
  public:
-  explicit Amg(const SymmetricCsr& a) {
+  Amg(const SymmetricCsr& a, const NearNullSpace* near_null) {
     RMat fine = Eigen::Map<const RMat>(
         static_cast<Eigen::Index>(a.rows()), static_cast<Eigen::Index>(a.rows()),
         static_cast<Eigen::Index>(a.val.size()), a.start.data(), a.col.data(), a.val.data());
     levels_.push_back({std::move(fine), {}, {}, {}});
+    NearNullSpace ns;
+    if (near_null) ns = *near_null;
     while (levels_.back().a.rows() > kCoarsest && levels_.size() < 12) {
       Level& l = levels_.back();
       l.diag = l.a.diagonal();
-      RMat p = prolongation(l.a, l.diag);
-      if (p.cols() == 0 || p.cols() >= l.a.rows() * 9 / 10) break;  // no longer coarsening
+      RMat tentative = near_null ? block_tentative(l.a, ns) : scalar_tentative(l.a);
+      if (tentative.cols() == 0 || tentative.cols() >= l.a.rows() * 9 / 10) break;  // no longer coarsening
+      RMat p = smooth(l.a, l.diag, tentative);
       RMat r = p.transpose();
       RMat ap = product(l.a, p);
       RMat coarse = product(r, ap);
@@ -148,25 +154,15 @@ class Amg {
     return c;
   }
 
-  static RMat prolongation(const RMat& a, const Vec& diag) {
-    const Eigen::Index n = a.rows();
-    // Strong: |a_ij| at least theta times the largest off-diagonal magnitude of row i (relative to the
-    // row, so that the wide stencils of coarse levels still have strong connections).
-    const double theta = 0.25;
-    const int* start = a.outerIndexPtr();
-    const int* col = a.innerIndexPtr();
-    const double* val = a.valuePtr();
-    std::vector<double> row_max(static_cast<std::size_t>(n), 0.0);
-    for (Eigen::Index i = 0; i < n; ++i)
-      for (int k = start[i]; k < start[i + 1]; ++k)
-        if (col[k] != i) row_max[i] = std::max(row_max[i], std::abs(val[k]));
-    auto strong = [&](Eigen::Index i, int k) {
-      return col[k] != i && std::abs(val[k]) >= theta * row_max[i] && row_max[i] > 0;
-    };
-    std::vector<int> agg(static_cast<std::size_t>(n), -1);
-    int count = 0;
+  // Aggregates of the graph (start, col) under the predicate strong(i, k) for edge k of node i, whose
+  // strength is weight[k]: per node its aggregate; `count` gets the number of aggregates.
+  template <class Strong>
+  static std::vector<int> aggregate(std::size_t n, const int* start, const int* col, const double* weight,
+                                    Strong&& strong, int& count) {
+    std::vector<int> agg(n, -1);
+    count = 0;
     // Pass 1: a node whose strong neighbours are all free starts an aggregate with them.
-    for (Eigen::Index i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < n; ++i) {
       if (agg[i] >= 0) continue;
       bool free = true;
       int neighbours = 0;
@@ -183,25 +179,141 @@ class Amg {
     }
     // Pass 2: the rest join the aggregate of their strongest aggregated neighbour.
     std::vector<int> joined = agg;
-    for (Eigen::Index i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < n; ++i) {
       if (agg[i] >= 0) continue;
       double best = 0;
       for (int k = start[i]; k < start[i + 1]; ++k)
-        if (strong(i, k) && agg[col[k]] >= 0 && std::abs(val[k]) > best) {
-          best = std::abs(val[k]);
+        if (strong(i, k) && agg[col[k]] >= 0 && std::abs(weight[k]) > best) {
+          best = std::abs(weight[k]);
           joined[i] = agg[col[k]];
         }
     }
     agg = std::move(joined);
     // Pass 3: what is still alone becomes an aggregate of its own.
-    for (Eigen::Index i = 0; i < n; ++i)
+    for (std::size_t i = 0; i < n; ++i)
       if (agg[i] < 0) agg[i] = count++;
-    // Tentative P (constants on aggregates), smoothed: P = (I - w D^-1 A) P_tent, w = 4 / (3 rho(D^-1 A)).
+    return agg;
+  }
+
+  // Scalar problems: aggregates of unknowns, constants on each.
+  static RMat scalar_tentative(const RMat& a) {
+    const Eigen::Index n = a.rows();
+    // Strong: |a_ij| at least theta times the largest off-diagonal magnitude of row i (relative to the
+    // row, so that the wide stencils of coarse levels still have strong connections).
+    const double theta = 0.25;
+    const int* start = a.outerIndexPtr();
+    const int* col = a.innerIndexPtr();
+    const double* val = a.valuePtr();
+    std::vector<double> row_max(static_cast<std::size_t>(n), 0.0);
+    for (Eigen::Index i = 0; i < n; ++i)
+      for (int k = start[i]; k < start[i + 1]; ++k)
+        if (col[k] != i) row_max[i] = std::max(row_max[i], std::abs(val[k]));
+    auto strong = [&](std::size_t i, int k) {
+      return col[k] != static_cast<int>(i) && std::abs(val[k]) >= theta * row_max[i] && row_max[i] > 0;
+    };
+    int count = 0;
+    const std::vector<int> agg = aggregate(static_cast<std::size_t>(n), start, col, val, strong, count);
     std::vector<Eigen::Triplet<double>> t;
     t.reserve(static_cast<std::size_t>(n));
     for (Eigen::Index i = 0; i < n; ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
     RMat tentative(n, count);
     tentative.setFromTriplets(t.begin(), t.end());
+    return tentative;
+  }
+
+  // Systems of several unknowns per node: aggregates of nodes (strength from the Frobenius norms of
+  // the node blocks, ||A_IJ|| >= theta sqrt(||A_II|| ||A_JJ||)), the near-null space orthonormalised
+  // per aggregate; `ns` becomes the coarse level's near-null space (one coarse node per aggregate).
+  static RMat block_tentative(const RMat& a, NearNullSpace& ns) {
+    const std::size_t n = static_cast<std::size_t>(a.rows()), nodes = ns.nodes, k = ns.vectors;
+    const int* start = a.outerIndexPtr();
+    const int* col = a.innerIndexPtr();
+    const double* val = a.valuePtr();
+    // Unknowns of each node.
+    std::vector<int> node_start(nodes + 1, 0), node_dof(n);
+    for (std::size_t i = 0; i < n; ++i) ++node_start[ns.node[i] + 1];
+    for (std::size_t v = 0; v < nodes; ++v) node_start[v + 1] += node_start[v];
+    {
+      std::vector<int> fill(node_start.begin(), node_start.end() - 1);
+      for (std::size_t i = 0; i < n; ++i) node_dof[static_cast<std::size_t>(fill[ns.node[i]]++)] = static_cast<int>(i);
+    }
+    // The node graph with block norms.
+    std::vector<int> gstart(nodes + 1, 0), gcol;
+    std::vector<double> gval, acc(nodes, 0.0), self(nodes, 0.0);
+    std::vector<std::uint32_t> mark(nodes, UINT32_MAX), touched;
+    gcol.reserve(a.nonZeros() / 6);
+    gval.reserve(a.nonZeros() / 6);
+    for (std::size_t v = 0; v < nodes; ++v) {
+      touched.clear();
+      for (int d = node_start[v]; d < node_start[v + 1]; ++d) {
+        const int i = node_dof[static_cast<std::size_t>(d)];
+        for (int q = start[i]; q < start[i + 1]; ++q) {
+          const std::uint32_t w = ns.node[static_cast<std::size_t>(col[q])];
+          if (mark[w] != v) {
+            mark[w] = static_cast<std::uint32_t>(v);
+            acc[w] = 0;
+            touched.push_back(w);
+          }
+          acc[w] += val[q] * val[q];
+        }
+      }
+      std::sort(touched.begin(), touched.end());
+      for (std::uint32_t w : touched) {
+        gcol.push_back(static_cast<int>(w));
+        gval.push_back(std::sqrt(acc[w]));
+        if (w == v) self[v] = std::sqrt(acc[w]);
+      }
+      gstart[v + 1] = static_cast<int>(gcol.size());
+    }
+    const double theta = 0.08;
+    auto strong = [&](std::size_t v, int q) {
+      const auto w = static_cast<std::size_t>(gcol[static_cast<std::size_t>(q)]);
+      return w != v && gval[static_cast<std::size_t>(q)] >= theta * std::sqrt(self[v] * self[w]);
+    };
+    int count = 0;
+    const std::vector<int> agg = aggregate(nodes, gstart.data(), gcol.data(), gval.data(), strong, count);
+    // Unknowns of each aggregate, their near-null space block, its QR.
+    std::vector<int> agg_start(static_cast<std::size_t>(count) + 1, 0), agg_dof(n);
+    for (std::size_t i = 0; i < n; ++i) ++agg_start[static_cast<std::size_t>(agg[ns.node[i]]) + 1];
+    for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) agg_start[g + 1] += agg_start[g];
+    {
+      std::vector<int> fill(agg_start.begin(), agg_start.end() - 1);
+      for (std::size_t i = 0; i < n; ++i)
+        agg_dof[static_cast<std::size_t>(fill[static_cast<std::size_t>(agg[ns.node[i]])]++)] = static_cast<int>(i);
+    }
+    NearNullSpace coarse;
+    coarse.vectors = k;
+    coarse.nodes = static_cast<std::size_t>(count);
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(n * k);
+    int columns = 0;
+    for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) {
+      const auto m = static_cast<Eigen::Index>(agg_start[g + 1] - agg_start[g]);
+      const Eigen::Index r = std::min<Eigen::Index>(m, static_cast<Eigen::Index>(k));
+      Eigen::MatrixXd b(m, static_cast<Eigen::Index>(k));
+      for (Eigen::Index i = 0; i < m; ++i) {
+        const auto dof = static_cast<std::size_t>(agg_dof[static_cast<std::size_t>(agg_start[g] + i)]);
+        for (std::size_t c = 0; c < k; ++c) b(i, static_cast<Eigen::Index>(c)) = ns.values[dof * k + c];
+      }
+      Eigen::HouseholderQR<Eigen::MatrixXd> qr(b);
+      const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(m, r);
+      const Eigen::MatrixXd rf = qr.matrixQR().topRows(r).triangularView<Eigen::Upper>();
+      for (Eigen::Index c = 0; c < r; ++c) {
+        for (Eigen::Index i = 0; i < m; ++i)
+          t.emplace_back(agg_dof[static_cast<std::size_t>(agg_start[g] + i)], columns + static_cast<int>(c), q(i, c));
+        coarse.node.push_back(static_cast<std::uint32_t>(g));
+        for (std::size_t c2 = 0; c2 < k; ++c2) coarse.values.push_back(rf(c, static_cast<Eigen::Index>(c2)));
+      }
+      columns += static_cast<int>(r);
+    }
+    RMat tentative(a.rows(), columns);
+    tentative.setFromTriplets(t.begin(), t.end());
+    ns = std::move(coarse);
+    return tentative;
+  }
+
+  // P = (I - w D^-1 A) P_tent, w = 4 / (3 rho(D^-1 A)).
+  static RMat smooth(const RMat& a, const Vec& diag, const RMat& tentative) {
     const double omega = 4.0 / (3.0 * spectral_radius(a, diag));
     RMat ap = product(a, tentative);
     Vec scale = -omega * diag.cwiseInverse();
@@ -269,15 +381,16 @@ void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned thread
 }
 
 LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x,
-                            const LinearSolverOptions& options) {
+                            const LinearSolverOptions& options, const NearNullSpace* near_null) {
   std::vector<std::vector<double>> xs;
-  LinearSolveResult result = solve_spd_many(a, {b}, xs, options);
+  LinearSolveResult result = solve_spd_many(a, {b}, xs, options, near_null);
   x = std::move(xs[0]);
   return result;
 }
 
 LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
-                                 std::vector<std::vector<double>>& xs, const LinearSolverOptions& options) {
+                                 std::vector<std::vector<double>>& xs, const LinearSolverOptions& options,
+                                 const NearNullSpace* near_null) {
   const std::size_t n = a.rows();
   const unsigned threads = thread_count(options.threads);
   LinearSolveResult result;
@@ -333,8 +446,9 @@ LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::v
     }
   };
   if (kind == LinearSolverKind::cg_amg) {
-    result.solver = "CG+SmoothedAggregationAMG";
-    Amg amg(a);
+    result.solver = near_null ? "CG+SmoothedAggregationAMG(rigid-body modes)" : "CG+SmoothedAggregationAMG";
+    Amg amg(a, near_null);
+    result.levels = amg.level_count();
     report(options, "solve", 0.0);
     run_all([&](const Vec& r, Vec& z) { amg.apply(r, z); });
   } else {
