@@ -251,6 +251,26 @@ TEST_F(ThermoelasticTest, RigidMotionIsReportedNotSolved) {
   EXPECT_EQ(message(), "");
 }
 
+// The progress callback sees the stages in order and can cancel the solve.
+TEST_F(ThermoelasticTest, ReportsProgressAndCancels) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.004);
+  ThermoelasticParams p = one_material(kDt);
+  p.sliding = {{1}, {3}, {5}};
+  p.solver.kind = LinearSolverKind::cg_amg;
+  std::vector<std::string> stages;
+  p.solver.progress = [&](std::string_view stage, double) {
+    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+    return true;
+  };
+  const ThermoelasticReport r = solve_thermoelastic(m, p);
+  EXPECT_EQ(stages.front(), "assemble");
+  EXPECT_EQ(stages.back(), "solve");
+  EXPECT_GT(r.iterations, 0u);
+  EXPECT_LT(r.relative_residual, 1e-12);
+  p.solver.progress = [](std::string_view stage, double) { return stage != "factorize"; };
+  EXPECT_THROW(solve_thermoelastic(m, p), SolverCancelled);
+}
+
 TEST_F(ThermoelasticTest, BadInputGivesClearErrors) {
   Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.01);
   ThermoelasticParams p = one_material(kDt);
