@@ -313,6 +313,7 @@ class Amg {
     for (std::size_t g = 0; g < static_cast<std::size_t>(count); ++g) {
       const auto m = static_cast<Eigen::Index>(agg_start[g + 1] - agg_start[g]);
       const Eigen::Index r = std::min<Eigen::Index>(m, static_cast<Eigen::Index>(k));
+      if (r == 0) continue;  // a node with every unknown constrained
       Eigen::MatrixXd b(m, static_cast<Eigen::Index>(k));
       for (Eigen::Index i = 0; i < m; ++i) {
         const auto dof = static_cast<std::size_t>(agg_dof[static_cast<std::size_t>(agg_start[g] + i)]);
