@@ -27,6 +27,7 @@
 #include <random>
 #include <string>
 
+#include "bench_ccx.hpp"
 #include "bench_meshes.hpp"
 #include "foxi/solver/calculix.hpp"
 #include "foxi/solver/thermal.hpp"
@@ -167,24 +168,11 @@ void eigen_cg_jacobi(benchmark::State& state) {
 }
 
 void ccx_1M(benchmark::State& state) {
-  if (std::getenv("FOXI_BENCH_CCX") == nullptr || std::system("command -v ccx > /dev/null 2>&1") != 0) {
-    state.SkipWithError("set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
-    return;
-  }
   Mesh& m = grid(57);
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("foxi-bench-ccx-" + std::to_string(std::random_device{}()));
-  std::filesystem::create_directories(dir);
-  write_calculix_thermal(m, params(LinearSolverKind::automatic), dir / "heat.inp");
-  for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const int rc = std::system(("cd '" + dir.string() + "' && ccx -i heat > ccx.log 2>&1").c_str());
-    const auto t1 = std::chrono::steady_clock::now();
-    if (rc != 0) state.SkipWithError("ccx failed");
-    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
-  }
+  bench::time_ccx(
+      state, "heat", [&](const std::filesystem::path& inp) { write_calculix_thermal(m, params(LinearSolverKind::automatic), inp); },
+      std::getenv("FOXI_BENCH_CCX") != nullptr, "set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
   state.counters["tets"] = static_cast<double>(m.tet_count());
-  std::filesystem::remove_all(dir);
 }
 
 BENCHMARK(ccx_1M)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);

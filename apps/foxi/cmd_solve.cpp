@@ -10,6 +10,7 @@
 
 #include "cli.hpp"
 #include "model_run.hpp"
+#include "solve_options.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/solver/electric.hpp"
@@ -48,7 +49,11 @@ const char* kSolveUsage =
     "  least one terminal needs a voltage). Prints the current and voltage of each terminal, the\n"
     "  resistance (two terminals: (V1 - V2) / I1), the conductance matrix and the Joule heat per region.\n"
     "  sigma defaults to the region's material. OUT gets 'potential' (V), 'current_density' (A/m^2)\n"
-    "  and 'joule_heat' (W/m^3).";
+    "  and 'joule_heat' (W/m^3).\n"
+    "\n"
+    "foxi solve MESH --physics thermoelastic ... : thermal stress, see 'foxi solve --physics thermoelastic --help'.";
+
+}  // namespace
 
 double parse_number(const std::string& text, const std::string& option) {
   char* end = nullptr;
@@ -130,6 +135,24 @@ std::string tags_label(const Mesh& mesh, const std::vector<std::int32_t>& tags) 
   return s;
 }
 
+LinearSolverOptions parse_solver_options(Args& args) {
+  LinearSolverOptions options;
+  const std::string solver = args.option("--solver", "auto");
+  const std::string tol = args.option("--tol", "");
+  if (solver == "direct")
+    options.kind = LinearSolverKind::direct;
+  else if (solver == "amg")
+    options.kind = LinearSolverKind::cg_amg;
+  else if (solver == "ichol")
+    options.kind = LinearSolverKind::cg_ichol;
+  else if (solver != "auto")
+    throw UsageError("--solver takes auto, direct, amg or ichol, not '" + solver + "'");
+  if (!tol.empty()) options.relative_tolerance = parse_number(tol, "--tol");
+  return options;
+}
+
+namespace {
+
 void print_matrix(const char* title, const char* unit, const std::vector<ElectrodeResult>& e,
                   const std::vector<std::vector<double>>& m) {
   std::printf("%s (%s):\n  %-16s", title, unit, "");
@@ -145,13 +168,14 @@ void print_matrix(const char* title, const char* unit, const std::vector<Electro
 }  // namespace
 
 int cmd_solve(Args args) {
+  const std::string physics = args.option("--physics", "thermal");
+  if (physics == "thermoelastic") return cmd_solve_thermoelastic(std::move(args));
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kSolveUsage);
     return 0;
   }
-  const std::string physics = args.option("--physics", "thermal");
   if (physics != "thermal" && physics != "electrostatic" && physics != "current")
-    throw UsageError("--physics takes thermal, electrostatic or current, not '" + physics + "'");
+    throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics + "'");
   const std::vector<std::string> conductor = all_options(args, "--conductor"),
                                  eps = all_options(args, "--eps"), terminal = all_options(args, "--terminal"),
                                  terminal_current = all_options(args, "--terminal-current"),
@@ -161,23 +185,14 @@ int cmd_solve(Args args) {
                                  power = all_options(args, "--power"),
                                  density = all_options(args, "--power-density"),
                                  cond = all_options(args, "--k");
-  const std::string solver = args.option("--solver", "auto");
-  const std::string tol = args.option("--tol", "");
+  const LinearSolverOptions solver_options = parse_solver_options(args);
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
   const std::vector<std::string> sets = all_options(args, "--set");
   const auto files = args.positional(1, 1, kSolveUsage);
 
   ThermalParams params;
-  if (solver == "direct")
-    params.solver.kind = LinearSolverKind::direct;
-  else if (solver == "amg")
-    params.solver.kind = LinearSolverKind::cg_amg;
-  else if (solver == "ichol")
-    params.solver.kind = LinearSolverKind::cg_ichol;
-  else if (solver != "auto")
-    throw UsageError("--solver takes auto, direct, amg or ichol, not '" + solver + "'");
-  if (!tol.empty()) params.solver.relative_tolerance = parse_number(tol, "--tol");
+  params.solver = solver_options;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 
   auto t0 = std::chrono::steady_clock::now();

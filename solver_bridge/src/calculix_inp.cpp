@@ -12,9 +12,11 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "foxi/model/io_error.hpp"
 #include "foxi/solver/calculix.hpp"
+#include "elastic_setup.hpp"
 #include "p1_assembly.hpp"
 
 namespace foxi {
@@ -28,6 +30,41 @@ struct FileCloser {
 };
 
 std::string elset_name(std::size_t region_index) { return "R" + std::to_string(region_index + 1); }
+
+// A deck being written: IoError naming the file when it cannot be opened or written.
+class DeckFile {
+ public:
+  explicit DeckFile(const std::filesystem::path& path) : path_(path), file_(std::fopen(path.string().c_str(), "w")) {
+    if (!file_) throw IoError(path_.string(), 0, IoError::kNoOffset, "cannot open for writing");
+  }
+  std::FILE* get() const { return file_.get(); }
+  void close() {
+    if (std::ferror(file_.get()) || std::fclose(file_.release()) != 0)
+      throw IoError(path_.string(), 0, IoError::kNoOffset, "write failed");
+  }
+
+ private:
+  std::filesystem::path path_;
+  std::unique_ptr<std::FILE, FileCloser> file_;
+};
+
+// *NODE (node i is CalculiX node i + 1, set NALL) and one C3D4 *ELEMENT block per region of `ids`
+// (elset R<index + 1>, tet t is element t + 1). Coordinates with 14 significant digits: ccx reads at
+// most 20 characters per field and rejects "-5.8690046200254745E-05".
+void write_nodes_and_elements(std::FILE* out, const Mesh& mesh, const std::vector<std::int32_t>& ids) {
+  std::fprintf(out, "*NODE, NSET=NALL\n");
+  for (std::size_t v = 0; v < mesh.node_count(); ++v)
+    std::fprintf(out, "%zu, %.14g, %.14g, %.14g\n", v + 1, mesh.xyz[3 * v], mesh.xyz[3 * v + 1],
+                 mesh.xyz[3 * v + 2]);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    std::fprintf(out, "*ELEMENT, TYPE=C3D4, ELSET=%s\n", elset_name(i).c_str());
+    for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+      if (mesh.region_of(t) != ids[i]) continue;
+      const std::uint32_t* tv = &mesh.tet[4 * t];
+      std::fprintf(out, "%zu, %u, %u, %u, %u\n", t + 1, tv[0] + 1, tv[1] + 1, tv[2] + 1, tv[3] + 1);
+    }
+  }
+}
 
 }  // namespace
 
@@ -99,23 +136,10 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
   for (const HeatFlux& f : params.flux) add(f.tag, {kFlux, f.flux, 0});
   for (const Convection& c : params.convection) add(c.tag, {kFilm, c.h, c.ambient});
 
-  std::unique_ptr<std::FILE, FileCloser> file(std::fopen(inp.string().c_str(), "w"));
-  if (!file) throw IoError(inp.string(), 0, IoError::kNoOffset, "cannot open for writing");
+  DeckFile file(inp);
   std::FILE* out = file.get();
-  std::fprintf(out,
-               "** foxi: steady heat conduction, %zu nodes, %zu C3D4 elements, SI units\n*NODE, NSET=NALL\n",
-               nn, nt);
-  for (std::size_t v = 0; v < nn; ++v)
-    std::fprintf(out, "%zu, %.17g, %.17g, %.17g\n", v + 1, mesh.xyz[3 * v], mesh.xyz[3 * v + 1],
-                 mesh.xyz[3 * v + 2]);
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    std::fprintf(out, "*ELEMENT, TYPE=C3D4, ELSET=%s\n", elset_name(i).c_str());
-    for (std::size_t t = 0; t < nt; ++t) {
-      if (mesh.region_of(t) != ids[i]) continue;
-      const std::uint32_t* tv = &mesh.tet[4 * t];
-      std::fprintf(out, "%zu, %u, %u, %u, %u\n", t + 1, tv[0] + 1, tv[1] + 1, tv[2] + 1, tv[3] + 1);
-    }
-  }
+  std::fprintf(out, "** foxi: steady heat conduction, %zu nodes, %zu C3D4 elements, SI units\n", nn, nt);
+  write_nodes_and_elements(out, mesh, ids);
   for (std::size_t i = 0; i < ids.size(); ++i) {
     std::fprintf(out, "*MATERIAL, NAME=M%zu\n*CONDUCTIVITY\n%.17g\n", i + 1, k[i]);
     std::fprintf(out, "*SOLID SECTION, ELSET=%s, MATERIAL=M%zu\n", elset_name(i).c_str(), i + 1);
@@ -169,8 +193,85 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
     std::fprintf(out, "%zu, F%d, %.17g, %.17g\n", t + 1, face, it->second.b, it->second.a);
   }
   std::fprintf(out, "*NODE FILE\nNT\n*END STEP\n");
-  if (std::ferror(out) || std::fclose(file.release()) != 0)
-    throw IoError(inp.string(), 0, IoError::kNoOffset, "write failed");
+  file.close();
+}
+
+void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,
+                                  const std::filesystem::path& inp) {
+  if (std::string problem = check_sizes(mesh); !problem.empty())
+    throw SolverError("inconsistent mesh: " + problem);
+  const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
+  const detail::ElasticMaterials mat = detail::elastic_materials(mesh, params);
+  (void)detail::tet_temperature_change(mesh, params);  // checks the temperature field
+  std::vector<char> used(nn, 0);
+  for (std::uint32_t v : mesh.tet) used[v] = 1;
+  const detail::NodeFrames fr = detail::displacement_frames(mesh, params, used);
+
+  DeckFile file(inp);
+  std::FILE* out = file.get();
+  std::fprintf(out, "** foxi: linear thermoelasticity, %zu nodes, %zu C3D4 elements, SI units\n", nn, nt);
+  write_nodes_and_elements(out, mesh, mat.regions.ids);
+  for (std::size_t i = 0; i < mat.regions.size(); ++i) {
+    std::fprintf(out, "*MATERIAL, NAME=M%zu\n*ELASTIC\n%.14g, %.14g\n*EXPANSION\n%.14g\n", i + 1, mat.young[i],
+                 mat.poisson[i], mat.expansion[i]);
+    std::fprintf(out, "*SOLID SECTION, ELSET=%s, MATERIAL=M%zu\n", elset_name(i).c_str(), i + 1);
+  }
+  // Values with 14 significant digits: ccx reads at most 20 characters per field.
+  // Constraints: frame axes along a coordinate axis as *BOUNDARY, others (sliding planes of other
+  // orientations) as homogeneous *EQUATIONs whose dependent term is the largest free component.
+  std::string boundary, equation;
+  char line[256];
+  for (std::size_t v = 0; v < nn; ++v) {
+    bool taken[3] = {false, false, false};
+    std::vector<int> general;
+    for (int a = 0; a < fr.m[v]; ++a) {
+      const double* q = &fr.r[9 * v + 3 * a];
+      int axis = -1;
+      for (int c = 0; c < 3; ++c)
+        if (std::abs(q[c]) == 1 && q[(c + 1) % 3] == 0 && q[(c + 2) % 3] == 0) axis = c;
+      if (axis < 0) {
+        general.push_back(a);
+        continue;
+      }
+      taken[axis] = true;
+      std::snprintf(line, sizeof line, "%zu, %d, %d, %.14g\n", v + 1, axis + 1, axis + 1, q[axis] * fr.g[3 * v + a]);
+      boundary += line;
+    }
+    for (int a : general) {
+      const double* q = &fr.r[9 * v + 3 * a];
+      if (fr.g[3 * v + a] != 0)
+        throw SolverError("CalculiX deck: node " + std::to_string(v) +
+                          " has a non-zero displacement prescribed along a direction that is no coordinate axis");
+      int dep = -1;
+      for (int c = 0; c < 3; ++c)
+        if (!taken[c] && std::abs(q[c]) > 1e-3 && (dep < 0 || std::abs(q[c]) > std::abs(q[dep]))) dep = c;
+      if (dep < 0) throw SolverError("CalculiX deck: no free component for the constraint at node " + std::to_string(v));
+      taken[dep] = true;
+      int terms = 0;
+      std::string row;
+      for (int k = 0; k < 3; ++k) {
+        const int c = (dep + k) % 3;
+        if (q[c] == 0) continue;
+        std::snprintf(line, sizeof line, "%s%zu, %d, %.14g", terms ? ", " : "", v + 1, c + 1, q[c]);
+        row += line;
+        ++terms;
+      }
+      equation += std::to_string(terms) + "\n" + row + "\n";
+    }
+  }
+  if (!boundary.empty()) std::fprintf(out, "*BOUNDARY\n%s", boundary.c_str());
+  if (!equation.empty()) std::fprintf(out, "*EQUATION\n%s", equation.c_str());
+  // Thermal strain alpha (T - T_initial): the reference temperature is the initial condition.
+  const double tref = params.temperature.empty() ? 0.0 : params.reference_temperature;
+  std::fprintf(out, "*INITIAL CONDITIONS, TYPE=TEMPERATURE\nNALL, %.14g\n*STEP\n*STATIC\n*TEMPERATURE\n", tref);
+  if (params.temperature.empty()) {
+    std::fprintf(out, "NALL, %.14g\n", tref + params.delta_t);
+  } else {
+    for (std::size_t v = 0; v < nn; ++v)
+      if (used[v]) std::fprintf(out, "%zu, %.14g\n", v + 1, params.temperature[v]);
+  }
+  std::fprintf(out, "*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n");
+  file.close();
 }
 
 std::vector<FrdBlock> read_frd(const std::filesystem::path& frd) {

@@ -52,9 +52,7 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   if (ne == 0)
     throw SolverError("ill-posed " + problem + ": no " + kind +
                       " is given, so the potential is undetermined; name at least one");
-  std::vector<std::int32_t> tags(mesh.bface_tag.begin(), mesh.bface_tag.end());
-  std::sort(tags.begin(), tags.end());
-  tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+  const std::vector<std::int32_t> tags = boundary_tag_list(mesh);
   std::map<std::int32_t, FixedTag> fixed_tags;
   for (std::size_t e = 0; e < ne; ++e) {
     const Electrode& el = electrodes[e];

@@ -21,18 +21,32 @@ struct LinearSolveResult {
   std::string solver;
   std::size_t iterations = 0;
   double relative_residual = 0;
+  std::size_t levels = 0;  // AMG levels (0 for the other solvers)
+};
+
+// The near-null space of the operator for smoothed-aggregation AMG (Vanek, Mandel, Brezina 1996):
+// `vectors` vectors given per unknown (values[unknown * vectors + k]) and the node of each unknown;
+// the unknowns of one node are always aggregated together. For 3D elasticity: the 6 rigid-body modes
+// with 3 (or fewer, where constrained) unknowns per node. Without one, AMG aggregates single unknowns
+// and interpolates constants (right for diffusion).
+struct NearNullSpace {
+  std::vector<std::uint32_t> node;  // per unknown, < nodes
+  std::size_t nodes = 0;
+  std::size_t vectors = 0;
+  std::vector<double> values;  // unknowns * vectors
 };
 
 // Solves A x = b (A symmetric positive definite) with the solver `options` chooses. Throws
 // SolverError when the factorization fails or CG does not reach the tolerance, SolverCancelled when
 // the progress callback says so.
 LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x,
-                            const LinearSolverOptions& options);
+                            const LinearSolverOptions& options, const NearNullSpace* near_null = nullptr);
 
 // The same for several right-hand sides with one factorization or preconditioner; iterations are
 // summed and the relative residual is the largest.
 LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::vector<double>>& b,
-                                 std::vector<std::vector<double>>& x, const LinearSolverOptions& options);
+                                 std::vector<std::vector<double>>& x, const LinearSolverOptions& options,
+                                 const NearNullSpace* near_null = nullptr);
 
 // y = A x on `threads` threads.
 void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned threads);

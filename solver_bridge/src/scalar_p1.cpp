@@ -66,6 +66,16 @@ std::vector<double> region_coefficients(const Mesh& mesh, const RegionTable& reg
                                         const std::function<double(const Material&)>& from_material,
                                         const std::vector<std::pair<std::int32_t, double>>& overrides,
                                         const std::string& what, const std::string& hint) {
+  return region_values(
+      mesh, regions, from_material, overrides, what, hint,
+      [](double v) { return v > 0 && std::isfinite(v); }, "positive and finite");
+}
+
+std::vector<double> region_values(const Mesh& mesh, const RegionTable& regions,
+                                  const std::function<double(const Material&)>& from_material,
+                                  const std::vector<std::pair<std::int32_t, double>>& overrides,
+                                  const std::string& what, const std::string& hint,
+                                  const std::function<bool(double)>& valid, const std::string& requirement) {
   const std::size_t nr = regions.size();
   std::vector<double> c(nr, Material::kUnset);
   for (std::size_t i = 0; i < nr; ++i)
@@ -82,9 +92,9 @@ std::vector<double> region_coefficients(const Mesh& mesh, const RegionTable& reg
       throw SolverError(region_label(mesh, regions.ids[i]) + " has no " + what +
                         ": its material gives none; set it in " + hint + " " +
                         std::to_string(regions.ids[i]) + "=VALUE)");
-    if (!(c[i] > 0) || !std::isfinite(c[i]))
-      throw SolverError(what + " of " + region_label(mesh, regions.ids[i]) +
-                        " must be positive and finite, not " + std::to_string(c[i]));
+    if (!valid(c[i]))
+      throw SolverError(what + " of " + region_label(mesh, regions.ids[i]) + " must be " + requirement +
+                        ", not " + std::to_string(c[i]));
   }
   return c;
 }
@@ -169,8 +179,7 @@ Dirichlet dirichlet_from_tags(const Mesh& mesh, const P1Stiffness& k,
   return d;
 }
 
-void check_anchored(const Mesh& mesh, const std::vector<char>& anchored_node, const std::string& problem,
-                    const std::string& what) {
+std::vector<std::uint32_t> node_components(const Mesh& mesh) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   std::vector<std::uint32_t> parent(nn);
   for (std::size_t v = 0; v < nn; ++v) parent[v] = static_cast<std::uint32_t>(v);
@@ -183,11 +192,26 @@ void check_anchored(const Mesh& mesh, const std::vector<char>& anchored_node, co
       const std::uint32_t r0 = root(mesh.tet[4 * t]), r1 = root(mesh.tet[4 * t + a]);
       if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
     }
+  for (std::size_t v = 0; v < nn; ++v) parent[v] = root(static_cast<std::uint32_t>(v));
+  return parent;
+}
+
+std::vector<std::int32_t> boundary_tag_list(const Mesh& mesh) {
+  std::vector<std::int32_t> tags(mesh.bface_tag.begin(), mesh.bface_tag.end());
+  std::sort(tags.begin(), tags.end());
+  tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+  return tags;
+}
+
+void check_anchored(const Mesh& mesh, const std::vector<char>& anchored_node, const std::string& problem,
+                    const std::string& what) {
+  const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
+  const std::vector<std::uint32_t> part = node_components(mesh);
   std::vector<char> anchored(nn, 0);
   for (std::size_t v = 0; v < nn; ++v)
-    if (anchored_node[v]) anchored[root(static_cast<std::uint32_t>(v))] = 1;
+    if (anchored_node[v]) anchored[part[v]] = 1;
   for (std::size_t t = 0; t < nt; ++t)
-    if (!anchored[root(mesh.tet[4 * t])])
+    if (!anchored[part[mesh.tet[4 * t]]])
       throw SolverError(problem + ": the connected part containing tet " + std::to_string(t) + " (" +
                         region_label(mesh, mesh.region_of(t)) + ") " + what);
 }

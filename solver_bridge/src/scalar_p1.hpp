@@ -43,6 +43,13 @@ std::vector<double> region_coefficients(const Mesh& mesh, const RegionTable& reg
                                         const std::function<double(const Material&)>& from_material,
                                         const std::vector<std::pair<std::int32_t, double>>& overrides,
                                         const std::string& what, const std::string& hint);
+// The same with another condition than "positive": `valid` says whether a value is acceptable and
+// `requirement` how ("in (-1, 0.5)").
+std::vector<double> region_values(const Mesh& mesh, const RegionTable& regions,
+                                  const std::function<double(const Material&)>& from_material,
+                                  const std::vector<std::pair<std::int32_t, double>>& overrides,
+                                  const std::string& what, const std::string& hint,
+                                  const std::function<bool(double)>& valid, const std::string& requirement);
 
 // Tet volumes (and their sum per region); SolverError on a non-positive one.
 std::vector<double> tet_volumes(const Mesh& mesh, const RegionTable& regions, unsigned threads,
@@ -77,6 +84,12 @@ struct Dirichlet {
 };
 Dirichlet dirichlet_from_tags(const Mesh& mesh, const P1Stiffness& k,
                               const std::map<std::int32_t, FixedTag>& tags, std::size_t slots);
+
+// Per node, the smallest node of its connected part (parts joined through tets); unused nodes are
+// their own part.
+std::vector<std::uint32_t> node_components(const Mesh& mesh);
+// The distinct boundary tags of the mesh's triangles, sorted.
+std::vector<std::int32_t> boundary_tag_list(const Mesh& mesh);
 
 // Throws SolverError("<problem>: the connected part containing tet T (region R) <what>") when a
 // connected part of the mesh has no node with anchored[node] set.

@@ -57,9 +57,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   auto region_index = [&](std::int32_t id) { return regions.index(id); };
 
   // Boundary conditions by tag.
-  std::vector<std::int32_t> tags(mesh.bface_tag.begin(), mesh.bface_tag.end());
-  std::sort(tags.begin(), tags.end());
-  tags.erase(std::unique(tags.begin(), tags.end()), tags.end());
+  const std::vector<std::int32_t> tags = detail::boundary_tag_list(mesh);
   std::map<std::int32_t, TagBc> bc;
   ThermalReport rep;
   auto add_bc = [&](std::int32_t tag, BcKind kind, double a, double b, const char* kind_name) {

@@ -11,6 +11,8 @@
 #include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "foxi/solver/thermoelastic.hpp"
+#include "layered_box.hpp"
 #include "test_util.hpp"
 
 namespace foxi {
@@ -89,6 +91,102 @@ TEST_F(CalculixTest, PackageTemperaturesAgreeWithCcx) {
   EXPECT_LT(same_rule, 1e-5);
   EXPECT_LT(exact_rule, 1e-3);
   EXPECT_GT(r.max_temperature - 300, 10.0);  // a problem with a real temperature rise
+}
+
+// The nodal block `name` of ccx's .frd per mesh node (NaN where ccx gave none), `components` each.
+std::vector<double> frd_nodal(const std::filesystem::path& frd, const std::string& name, std::uint32_t components,
+                              std::size_t nodes) {
+  std::vector<double> out(components * nodes, std::nan(""));
+  for (const FrdBlock& b : read_frd(frd)) {
+    if (b.name != name) continue;
+    EXPECT_GE(b.components, components);
+    for (std::size_t i = 0; i < b.node.size(); ++i)
+      if (b.node[i] >= 1 && b.node[i] <= nodes)
+        for (std::uint32_t c = 0; c < components; ++c)
+          out[(b.node[i] - 1) * components + c] = b.values[i * b.components + c];
+  }
+  return out;
+}
+
+// Runs foxi and ccx on the same thermal-stress problem; returns the largest differences of the nodal
+// displacements (relative to the largest |u|) and of the nodal stresses (relative to the largest von
+// Mises stress). ccx writes C3D4 stresses at the nodes as the mean over the elements around each
+// node, so foxi's constant tet stresses are averaged the same way.
+std::pair<double, double> thermal_stress_difference(const test::TempDir& dir, Mesh& m,
+                                                     const ThermoelasticParams& p) {
+  const ThermoelasticReport r = solve_thermoelastic(m, p);
+  write_calculix_thermoelastic(m, p, dir / "stress.inp");
+  const int rc = test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i stress", dir / "ccx.log");
+  EXPECT_EQ(rc, 0) << test::read_text(dir / "ccx.log");
+  const std::size_t nn = m.node_count();
+  const std::vector<double> u_ccx = frd_nodal(dir / "stress.frd", "DISP", 3, nn);
+  const std::vector<double> s_ccx = frd_nodal(dir / "stress.frd", "STRESS", 6, nn);
+  const std::vector<double>& u = m.find_field("displacement")->values;
+  const std::vector<double>& s = m.find_field("stress")->values;
+  std::vector<double> s_node(6 * nn, 0.0), count(nn, 0.0);
+  for (std::size_t t = 0; t < m.tet_count(); ++t)
+    for (int a = 0; a < 4; ++a) {
+      const std::uint32_t v = m.tet[4 * t + a];
+      count[v] += 1;
+      for (int c = 0; c < 6; ++c) s_node[6 * v + c] += s[6 * t + c];
+    }
+  double u_worst = 0, s_worst = 0;
+  for (std::size_t v = 0; v < nn; ++v) {
+    for (int c = 0; c < 3; ++c)  // a missing value (NaN) counts as a total mismatch
+      u_worst = std::max(u_worst, std::isnan(u_ccx[3 * v + c])
+                                      ? HUGE_VAL
+                                      : std::abs(u[3 * v + c] - u_ccx[3 * v + c]) / r.max_displacement);
+    for (int c = 0; c < 6; ++c)
+      s_worst = std::max(s_worst, std::isnan(s_ccx[6 * v + c])
+                                      ? HUGE_VAL
+                                      : std::abs(s_node[6 * v + c] / count[v] - s_ccx[6 * v + c]) / r.max_von_mises);
+  }
+  std::printf("%zu nodes, max |u| %.4g m, max von Mises %.4g Pa; relative difference to ccx: u %.3g, stress %.3g\n",
+              nn, r.max_displacement, r.max_von_mises, u_worst, s_worst);
+  return {u_worst, s_worst};
+}
+
+ThermoelasticParams two_layer_params(const Mesh& m) {
+  ThermoelasticParams p;
+  p.materials = {{1, 130e9, 0.28, 2.6e-6}, {2, 117e9, 0.34, 16.5e-6}};
+  p.reference_temperature = 293.15;
+  p.temperature.resize(m.node_count());
+  for (std::size_t v = 0; v < m.node_count(); ++v)
+    p.temperature[v] = 350 + 2e4 * m.xyz[3 * v] - 3e4 * m.xyz[3 * v + 2];
+  p.solver.kind = LinearSolverKind::direct;
+  return p;
+}
+
+// Thermal stress on the same C3D4 mesh: a two-layer box (E, nu, alpha per layer), its bottom fixed,
+// x = 0 sliding, a nodal temperature field varying in x and z: displacements and nodal stresses agree
+// with ccx to its 6 printed digits.
+TEST_F(CalculixTest, ThermalStressAgreesWithCcx) {
+  test::TempDir dir;
+  Mesh m = test::layered_box_mesh(2e-3, 1e-3, {0, 0.4e-3, 1e-3}, 4e-12);
+  ThermoelasticParams p = two_layer_params(m);
+  p.fixed = {{5}};
+  p.sliding = {{1}};
+  const auto [du, ds] = thermal_stress_difference(dir, m, p);
+  EXPECT_LT(du, 1e-5);
+  EXPECT_LT(ds, 1e-5);
+}
+
+// The same box turned off the axes, held only by three sliding planes: ccx gets them as *EQUATIONs.
+TEST_F(CalculixTest, SlidingPlanesOffTheAxesAgreeWithCcx) {
+  test::TempDir dir;
+  Mesh m = test::layered_box_mesh(2e-3, 1e-3, {0, 0.4e-3, 1e-3}, 4e-12);
+  ThermoelasticParams p = two_layer_params(m);
+  const double c = std::cos(0.5), s = std::sin(0.5);
+  for (std::size_t v = 0; v < m.node_count(); ++v) {  // a turn of 0.5 rad about z, then about x
+    double* x = &m.xyz[3 * v];
+    const double x0 = c * x[0] - s * x[1], y0 = s * x[0] + c * x[1];
+    const double y1 = c * y0 - s * x[2], z1 = s * y0 + c * x[2];
+    x[0] = x0, x[1] = y1, x[2] = z1;
+  }
+  p.sliding = {{1}, {3}, {5}};
+  const auto [du, ds] = thermal_stress_difference(dir, m, p);
+  EXPECT_LT(du, 1e-5);
+  EXPECT_LT(ds, 1e-5);
 }
 
 TEST(FrdReader, RejectsMalformedFiles) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "foxi/model/mesh_io.hpp"
+#include "layered_box.hpp"
 #include "test_util.hpp"
 
 namespace foxi {
@@ -94,6 +95,60 @@ TEST_F(SolveCliTest, BadInputGivesClearErrors) {
   EXPECT_EQ(foxi("solve " + mesh() + " --physics magic --fix 1=300 --k 1=1"), 2);
   EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300 --k 1=1 --solver nope"), 2);
   EXPECT_EQ(foxi("solve --help"), 0);
+}
+
+// Thermal stress from the command line on a 1 x 0.6 x 0.4 box (tags 1..6: x = 0, x = 1, y = 0,
+// y = 0.6, z = 0, z = 0.4): sliding on the three planes through the origin, a uniform dT gives the
+// exact free expansion u = alpha dT x in the written .vtu, and so does the temperature written by a
+// thermal run (both ends at 350 K: uniform) read back with --temperature and --tref 300.
+TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) {
+  test::write_text(dir_ / "box.poly", test::layered_box_poly(1.0, 0.6, {0, 0.4}));
+  ASSERT_EQ(test::run("tetgen -pq1.414AQa0.002 '" + (dir_ / "box.poly").string() + "'", dir_ / "tetgen.log"), 0);
+  const std::string box = "'" + (dir_ / "box.1.node").string() + "'";
+  const std::string material = " --E 1=70e9 --nu 1=0.3 --alpha 1=2e-5 --slide 1 --slide 3 --slide 5";
+  const std::string out = (dir_ / "stress.vtu").string();
+  ASSERT_EQ(foxi("solve " + box + " --physics thermoelastic --dT 50" + material + " -o '" + out + "'"), 0)
+      << test::read_text(dir_ / "out.log");
+  std::string log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("max von Mises stress"), std::string::npos) << log;
+  EXPECT_NE(log.find("max displacement 0.00123288"), std::string::npos) << log;  // 1e-3 |(1, 0.6, 0.4)|
+  Mesh m = read_mesh(out);
+  auto expansion_error = [](const Mesh& r) {
+    const Field* u = r.find_field("displacement");
+    EXPECT_NE(u, nullptr);
+    if (!u) return HUGE_VAL;
+    EXPECT_EQ(u->unit, "m");
+    double worst = 0;
+    for (std::size_t i = 0; i < 3 * r.node_count(); ++i)
+      worst = std::max(worst, std::abs(u->values[i] - 1e-3 * r.xyz[i]));
+    return worst;
+  };
+  EXPECT_LT(expansion_error(m), 1e-12);
+  const Field* s = m.find_field("stress");
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s->components, 6u);
+  EXPECT_EQ(s->location, FieldLocation::cell);
+  ASSERT_NE(m.find_field("von_mises"), nullptr);
+  ASSERT_NE(m.find_field("principal_stress"), nullptr);
+
+  const std::string temperature = (dir_ / "temperature.vtu").string();
+  ASSERT_EQ(foxi("solve " + box + " --physics thermal --fix 1=350 --fix 2=350 --k 1=1 -o '" + temperature + "'"), 0);
+  ASSERT_EQ(foxi("solve " + box + " --physics thermoelastic --temperature '" + temperature + "' --tref 300" +
+                 material + " -o '" + out + "'"),
+            0)
+      << test::read_text(dir_ / "out.log");
+  EXPECT_LT(expansion_error(read_mesh(out)), 1e-12);
+
+  // Bad input: no load (2), an unknown component (2), a body free to move (1, the modes named).
+  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic" + material), 2);
+  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic --dT 1 --fix 1=uw" + material), 2);
+  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic --dT 1 --slide 5 --E 1=1e9 --nu 1=0.3 --alpha 1=1e-5"), 1);
+  log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("3 rigid-body modes left"), std::string::npos) << log;
+  EXPECT_EQ(foxi("solve " + mesh() + " --physics thermoelastic --dT 1 --slide 3 --E 1=1e9 --nu 1=0.3 --alpha 1=1e-5"), 1);
+  log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("not planar"), std::string::npos) << log;
+  EXPECT_EQ(foxi("solve --physics thermoelastic --help"), 0);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The bridge to CalculiX (ccx): the same mesh and thermal problem as a CalculiX input deck, and the
+// The bridge to CalculiX (ccx): the same mesh and thermal or thermal-stress problem as a CalculiX input deck, and the
 // nodal results of its ASCII .frd file read back, so that foxi's solvers can be checked against an
 // independent code on the same P1 / C3D4 discretisation.
 #pragma once
@@ -10,6 +10,7 @@
 
 #include "foxi/model/mesh.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "foxi/solver/thermoelastic.hpp"
 
 namespace foxi {
 
@@ -23,6 +24,17 @@ namespace foxi {
 // unknown tags and regions, a boundary triangle that is no tet face) and IoError when the file
 // cannot be written.
 void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const std::filesystem::path& inp);
+
+// Writes `mesh` and `params` as a CalculiX linear static thermal-stress deck (SI units): *NODE, C3D4
+// elements per region, *ELASTIC and *EXPANSION per region (params first, then the material), the
+// constraints of solve_thermoelastic node by node (components along a coordinate axis as *BOUNDARY,
+// sliding normals of other orientations as homogeneous *EQUATION), the reference temperature as
+// *INITIAL CONDITIONS and the temperature (reference + delta_t, or the nodal field) as *TEMPERATURE,
+// *NODE FILE U and *EL FILE S. Throws SolverError for what solve_thermoelastic rejects (except the
+// rigid-body check) and for a non-zero displacement along a direction that is no coordinate axis;
+// IoError when the file cannot be written.
+void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,
+                                  const std::filesystem::path& inp);
 
 // One nodal result block of a CalculiX ASCII .frd file ("NDTEMP", "DISP", ...).
 struct FrdBlock {

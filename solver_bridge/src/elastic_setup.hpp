@@ -1,0 +1,51 @@
+// Internal pieces of the thermoelastic solver shared with the CalculiX deck writer: materials per
+// region, the temperature change per tet, and the displacement constraints as per-node frames.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "foxi/solver/thermoelastic.hpp"
+#include "scalar_p1.hpp"
+
+namespace foxi::detail {
+
+using Vec3 = std::array<double, 3>;
+inline double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+inline Vec3 point(const Mesh& mesh, std::size_t v) {
+  return {mesh.xyz[3 * v], mesh.xyz[3 * v + 1], mesh.xyz[3 * v + 2]};
+}
+
+// E, nu, alpha per region with tets (params first, then the region's material); SolverError naming
+// the region when one is missing or invalid.
+struct ElasticMaterials {
+  RegionTable regions;
+  std::vector<double> young, poisson, expansion;  // per region index
+};
+ElasticMaterials elastic_materials(const Mesh& mesh, const ThermoelasticParams& params);
+
+// dT per tet: params.delta_t, or the mean of (temperature - reference) over its 4 nodes. SolverError
+// on a field of the wrong size or a non-finite value on a used node.
+std::vector<double> tet_temperature_change(const Mesh& mesh, const ThermoelasticParams& params);
+
+// Per node: m constrained directions (the first m rows of the orthonormal frame r, rows = local axes
+// in global coordinates) and their prescribed values g (local components 0..m-1). m = 0: free node,
+// r and g unused.
+struct NodeFrames {
+  std::vector<std::uint8_t> m;
+  std::vector<double> r;  // 9 per node, row-major
+  std::vector<double> g;  // 3 per node
+};
+
+// The frames of the nodes with `used` set, from params.fixed (fixed components; the lumped-area mean
+// of the values where fixed tags meet) and params.sliding (the tag's plane normal, value 0), Gram-
+// Schmidt orthonormalised per node. SolverError on an unknown tag, a tag with two conditions, a sliding
+// tag that is not planar, contradictory constraints at a node.
+NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& params, const std::vector<char>& used);
+
+}  // namespace foxi::detail

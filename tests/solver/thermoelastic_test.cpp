@@ -1,0 +1,312 @@
+// Linear thermoelasticity against analytic solutions on TetGen meshes of boxes: free expansion on
+// symmetry planes (also rotated, for sliding planes of any orientation), a bar held along its axis, a
+// fully constrained block (P1 reproduces these linear fields exactly), and Timoshenko's bimetal strip
+// (a beam-theory curvature, to a few percent); the well-posedness check and bad input.
+#include "foxi/solver/thermoelastic.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <string>
+
+#include "layered_box.hpp"
+
+namespace foxi {
+namespace {
+
+constexpr double kE = 70e9, kNu = 0.3, kAlpha = 2e-5, kDt = 80;
+
+class ThermoelasticTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!test::have_program("tetgen")) GTEST_SKIP() << "tetgen not installed";
+  }
+};
+
+ThermoelasticParams one_material(double dt) {
+  ThermoelasticParams p;
+  p.materials = {{1, kE, kNu, kAlpha}};
+  p.delta_t = dt;
+  p.solver.relative_tolerance = 1e-12;
+  return p;
+}
+
+// max over nodes |u - exact(x)| / scale
+template <class F>
+double max_displacement_error(const Mesh& m, F exact, double scale) {
+  const Field* u = m.find_field("displacement");
+  EXPECT_NE(u, nullptr);
+  double e = 0;
+  for (std::size_t v = 0; v < m.node_count(); ++v) {
+    const Eigen::Vector3d want = exact(Eigen::Vector3d(m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]));
+    for (int c = 0; c < 3; ++c) e = std::max(e, std::abs(u->values[3 * v + c] - want[c]) / scale);
+  }
+  return e;
+}
+
+// max over tets |stress - want| / scale (6 components)
+double max_stress_error(const Mesh& m, const double want[6], double scale) {
+  const Field* s = m.find_field("stress");
+  EXPECT_NE(s, nullptr);
+  double e = 0;
+  for (std::size_t t = 0; t < m.tet_count(); ++t)
+    for (int c = 0; c < 6; ++c) e = std::max(e, std::abs(s->values[6 * t + c] - want[c]) / scale);
+  return e;
+}
+
+// Sliding on the three planes x = 0, y = 0, z = 0 holds the block against rigid motion without
+// stress (the symmetric form of a 3-2-1 support): u = alpha dT x, zero stress, with every solver.
+TEST_F(ThermoelasticTest, FreeExpansionOnSymmetryPlanesIsStressFree) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.002);
+  ThermoelasticParams p = one_material(kDt);
+  p.sliding = {{1}, {3}, {5}};
+  for (LinearSolverKind kind : {LinearSolverKind::direct, LinearSolverKind::cg_ichol, LinearSolverKind::cg_amg}) {
+    p.solver.kind = kind;
+    const ThermoelasticReport r = solve_thermoelastic(m, p);
+    EXPECT_LT(max_displacement_error(m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); },
+                                     kAlpha * kDt),
+              1e-8)
+        << r.solver;
+    const double zero[6] = {0, 0, 0, 0, 0, 0};
+    EXPECT_LT(max_stress_error(m, zero, kE * kAlpha * kDt), 1e-7) << r.solver;
+    EXPECT_LT(r.max_von_mises, 1e-7 * kE * kAlpha * kDt);
+    EXPECT_NEAR(r.max_displacement, kAlpha * kDt * std::sqrt(1.0 + 0.36 + 0.16), 1e-9);
+  }
+}
+
+// The same block turned by an arbitrary rotation and shifted: the sliding planes are no longer
+// axis-aligned, the answer is the rotated one (u = alpha dT (x - corner), zero stress).
+TEST_F(ThermoelasticTest, SlidingPlanesOfAnyOrientation) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.004);
+  const Eigen::Matrix3d rot = (Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()) *
+                               Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitX()))
+                                  .toRotationMatrix();
+  const Eigen::Vector3d shift(0.3, -2.0, 5.0);
+  for (std::size_t v = 0; v < m.node_count(); ++v) {
+    Eigen::Map<Eigen::Vector3d> x(&m.xyz[3 * v]);
+    x = rot * x + shift;
+  }
+  ThermoelasticParams p = one_material(kDt);
+  p.sliding = {{1}, {3}, {5}};
+  p.solver.kind = LinearSolverKind::cg_amg;
+  solve_thermoelastic(m, p);
+  EXPECT_LT(max_displacement_error(
+                m, [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * (x - shift)); },
+                kAlpha * kDt),
+            1e-8);
+  const double zero[6] = {0, 0, 0, 0, 0, 0};
+  EXPECT_LT(max_stress_error(m, zero, kE * kAlpha * kDt), 1e-7);
+}
+
+// A bar along z held at both ends along its axis (sliding ends), free sides (symmetry planes x = 0
+// and y = 0 hold it against rigid motion): sigma_zz = -E alpha dT, the rest zero;
+// u = alpha (1 + nu) dT (x, y, 0).
+TEST_F(ThermoelasticTest, BarHeldAtBothEnds) {
+  Mesh m = test::layered_box_mesh(0.2, 0.2, {0, 1.0}, 0.0005);
+  ThermoelasticParams p = one_material(kDt);
+  p.sliding = {{1}, {3}, {5}, {6}};
+  const ThermoelasticReport r = solve_thermoelastic(m, p);
+  const double s = kE * kAlpha * kDt;
+  const double want[6] = {0, 0, -s, 0, 0, 0};
+  EXPECT_LT(max_stress_error(m, want, s), 1e-8);
+  const double lateral = kAlpha * (1 + kNu) * kDt;
+  EXPECT_LT(max_displacement_error(
+                m, [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(lateral * x[0], lateral * x[1], 0); },
+                kAlpha * kDt),
+            1e-8);
+  EXPECT_NEAR(r.max_von_mises, s, 1e-8 * s);
+  ASSERT_EQ(r.regions.size(), 1u);
+  EXPECT_NEAR(r.regions[0].max_von_mises, s, 1e-8 * s);
+  const Field* pr = m.find_field("principal_stress");
+  ASSERT_NE(pr, nullptr);
+  EXPECT_NEAR(pr->values[0], 0, 1e-7 * s);
+  EXPECT_NEAR(pr->values[2], -s, 1e-7 * s);
+}
+
+// Every face fixed: u = 0, hydrostatic sigma = -E alpha dT / (1 - 2 nu).
+TEST_F(ThermoelasticTest, FullyConstrainedBlock) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.004);
+  ThermoelasticParams p = one_material(kDt);
+  for (std::int32_t tag = 1; tag <= 6; ++tag) p.fixed.push_back({tag});
+  const ThermoelasticReport r = solve_thermoelastic(m, p);
+  EXPECT_EQ(r.unknowns, 3 * (m.node_count() - r.constrained_nodes));
+  const double s = kE * kAlpha * kDt / (1 - 2 * kNu);
+  const double want[6] = {-s, -s, -s, 0, 0, 0};
+  EXPECT_LT(max_stress_error(m, want, s), 1e-12);
+  EXPECT_LT(r.max_von_mises, 1e-9 * s);
+}
+
+// Timoshenko (1925), bi-metal thermostats: curvature of a free bimaterial strip,
+// kappa = 6 (a2 - a1) dT (1 + m)^2 / (h (3 (1 + m)^2 + (1 + m n)(m^2 + 1 / (m n)))),
+// m = h1 / h2, n = E1 / E2, h = h1 + h2 (beam theory, nu = 0). Half the strip (x = 0 a symmetry plane,
+// y = 0 too) with uz held on the x = 0 face; the curvature is fitted to the bottom centre line away
+// from the ends. Linear tets are too stiff in bending (about 15% on ~3 tets through the thickness,
+// falling as h^2), so the check is on two meshes: the error must fall, and the Richardson
+// extrapolation (h ~ tets^(-1/3)) must be within 3%. Also per-region and interface maxima.
+struct StripCurvature {
+  double fitted = 0, timoshenko = 0;
+  std::size_t tets = 0;
+  ThermoelasticReport report;
+};
+
+StripCurvature bimaterial_strip(double max_volume) {
+  const double half_length = 10e-3, width = 1e-3, h1 = 0.5e-3, h2 = 0.5e-3;
+  Mesh m = test::layered_box_mesh(half_length, width, {0, h1, h1 + h2}, max_volume);
+  const double e1 = 200e9, e2 = 70e9, a1 = 1e-6, a2 = 23e-6, dt = 100;
+  ThermoelasticParams p;
+  p.materials = {{1, e1, 0.0, a1}, {2, e2, 0.0, a2}};
+  p.delta_t = dt;
+  FixedDisplacement clamp;
+  clamp.tag = 1;
+  clamp.fix[1] = false;
+  p.fixed = {clamp};
+  p.sliding = {{3}};
+  p.solver.kind = LinearSolverKind::cg_amg;
+  StripCurvature out;
+  out.report = solve_thermoelastic(m, p);
+  out.tets = m.tet_count();
+  const double mm = h1 / h2, n = e1 / e2, h = h1 + h2;
+  out.timoshenko = 6 * (a2 - a1) * dt * (1 + mm) * (1 + mm) /
+                   (h * (3 * (1 + mm) * (1 + mm) + (1 + mm * n) * (mm * mm + 1 / (mm * n))));
+  // Least squares uz = c0 + c1 x + kappa/2 x^2 over bottom nodes with 0.3 L < x < 0.9 L.
+  const Field* u = m.find_field("displacement");
+  EXPECT_NE(u, nullptr);
+  Eigen::MatrixXd a(0, 3);
+  Eigen::VectorXd b(0);
+  for (std::size_t v = 0; v < m.node_count(); ++v) {
+    const double x = m.xyz[3 * v], z = m.xyz[3 * v + 2];
+    if (z > 1e-12 || x < 0.3 * half_length || x > 0.9 * half_length) continue;
+    a.conservativeResize(a.rows() + 1, 3);
+    b.conservativeResize(b.rows() + 1);
+    a.row(a.rows() - 1) << 1, x, x * x / 2;
+    b[b.rows() - 1] = u->values[3 * v + 2];
+  }
+  EXPECT_GT(a.rows(), 10);
+  out.fitted = -a.colPivHouseholderQr().solve(b)[2];  // the high-alpha layer on top bends the ends down
+  const ThermoelasticReport& r = out.report;
+  EXPECT_EQ(r.regions.size(), 2u);
+  EXPECT_EQ(r.interfaces.size(), 1u);
+  if (r.interfaces.size() == 1 && r.regions.size() == 2) {
+    EXPECT_EQ(r.interfaces[0].region_a, 1);
+    EXPECT_EQ(r.interfaces[0].region_b, 2);
+    EXPECT_NEAR(r.interfaces[0].area, half_length * width, 1e-9 * half_length * width);
+    EXPECT_GT(r.interfaces[0].max_von_mises, 0.5 * r.max_von_mises);
+    EXPECT_EQ(std::max(r.regions[0].max_von_mises, r.regions[1].max_von_mises), r.max_von_mises);
+  }
+  std::printf("%zu tets, %zu unknowns: curvature %.5g 1/m, Timoshenko %.5g 1/m (%+.2f%%), %s, %zu levels, %zu it\n",
+              out.tets, r.unknowns, out.fitted, out.timoshenko, 100 * (out.fitted / out.timoshenko - 1),
+              r.solver.c_str(), r.amg_levels, r.iterations);
+  return out;
+}
+
+TEST_F(ThermoelasticTest, BimaterialStripBendsAsTimoshenkoSays) {
+  const StripCurvature coarse = bimaterial_strip(4e-12), fine = bimaterial_strip(2e-12);
+  const double kappa = coarse.timoshenko;
+  EXPECT_LT(std::abs(fine.fitted - kappa), std::abs(coarse.fitted - kappa));
+  EXPECT_NEAR(fine.fitted, kappa, 0.2 * kappa);
+  const double ratio = std::pow(static_cast<double>(fine.tets) / static_cast<double>(coarse.tets), 2.0 / 3.0);
+  const double extrapolated = (ratio * fine.fitted - coarse.fitted) / (ratio - 1);
+  std::printf("Richardson extrapolation %.5g 1/m (%+.2f%%)\n", extrapolated, 100 * (extrapolated / kappa - 1));
+  EXPECT_NEAR(extrapolated, kappa, 0.03 * kappa);
+  EXPECT_GT(fine.report.amg_levels, 1u);  // AMG with the rigid-body modes: few iterations
+  EXPECT_LT(fine.report.iterations, 60u);
+}
+
+// A nodal temperature field equal to T_ref + dT everywhere gives the uniform-dT answer; a field of the
+// wrong size is rejected.
+TEST_F(ThermoelasticTest, NodalTemperatureFieldEqualsUniformChange) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.004);
+  ThermoelasticParams p = one_material(0);
+  p.sliding = {{1}, {3}, {5}};
+  p.reference_temperature = 300;
+  p.temperature.assign(m.node_count(), 300 + kDt);
+  solve_thermoelastic(m, p);
+  EXPECT_LT(max_displacement_error(m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); },
+                                   kAlpha * kDt),
+            1e-8);
+  p.temperature.pop_back();
+  EXPECT_THROW(solve_thermoelastic(m, p), SolverError);
+}
+
+TEST_F(ThermoelasticTest, RigidMotionIsReportedNotSolved) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.01);
+  ThermoelasticParams p = one_material(kDt);
+  auto message = [&] {
+    try {
+      solve_thermoelastic(m, p);
+    } catch (const SolverError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message().find("6 rigid-body modes left"), std::string::npos) << message();
+  p.sliding = {{5}};  // slides on the bottom: x, y translation and rotation about z remain
+  const std::string three = message();
+  EXPECT_NE(three.find("3 rigid-body modes left"), std::string::npos) << three;
+  EXPECT_NE(three.find("rotation about (0, 0, 1)"), std::string::npos) << three;
+  p.sliding = {{5}, {1}};  // y translation remains
+  EXPECT_NE(message().find("1 rigid-body mode left (translation along (0, 1, 0))"), std::string::npos) << message();
+  p.sliding = {{5}, {1}, {3}};
+  EXPECT_EQ(message(), "");
+}
+
+// The progress callback sees the stages in order and can cancel the solve.
+TEST_F(ThermoelasticTest, ReportsProgressAndCancels) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.004);
+  ThermoelasticParams p = one_material(kDt);
+  p.sliding = {{1}, {3}, {5}};
+  p.solver.kind = LinearSolverKind::cg_amg;
+  std::vector<std::string> stages;
+  p.solver.progress = [&](std::string_view stage, double) {
+    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+    return true;
+  };
+  const ThermoelasticReport r = solve_thermoelastic(m, p);
+  EXPECT_EQ(stages.front(), "assemble");
+  EXPECT_EQ(stages.back(), "solve");
+  EXPECT_GT(r.iterations, 0u);
+  EXPECT_LT(r.relative_residual, 1e-12);
+  p.solver.progress = [](std::string_view stage, double) { return stage != "factorize"; };
+  EXPECT_THROW(solve_thermoelastic(m, p), SolverCancelled);
+}
+
+TEST_F(ThermoelasticTest, BadInputGivesClearErrors) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.01);
+  ThermoelasticParams p = one_material(kDt);
+  p.sliding = {{1}, {3}, {5}};
+  ThermoelasticParams q = p;
+  q.materials[0].poisson_ratio = 0.5;
+  EXPECT_THROW(solve_thermoelastic(m, q), SolverError);
+  q = p;
+  q.materials.clear();  // no material in a TetGen mesh
+  EXPECT_THROW(solve_thermoelastic(m, q), SolverError);
+  q = p;
+  q.sliding.push_back({42});
+  EXPECT_THROW(solve_thermoelastic(m, q), SolverError);
+  q = p;
+  q.fixed.push_back({1});  // two conditions on tag 1
+  EXPECT_THROW(solve_thermoelastic(m, q), SolverError);
+  q = p;
+  FixedDisplacement pull;
+  pull.tag = 2;
+  pull.value[0] = 1e-3;
+  q.sliding = {{1}, {3}, {5}};
+  q.fixed = {pull};
+  q.sliding.push_back({4});  // y = ly slides, x = lx fixed: no contradiction
+  EXPECT_NO_THROW(solve_thermoelastic(m, q));
+  FixedDisplacement shear;  // y = 0 fixed with ux = 1e-3 meets x = 0 sliding (ux = 0) on an edge
+  shear.tag = 3;
+  shear.value[0] = 1e-3;
+  q.sliding = {{1}, {5}};
+  q.fixed = {shear};
+  try {
+    solve_thermoelastic(m, q);
+    ADD_FAILURE() << "contradictory constraints accepted";
+  } catch (const SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find("contradictory"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace foxi
