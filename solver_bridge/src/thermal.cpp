@@ -32,6 +32,90 @@ struct TagBc {
   std::size_t report = 0;
 };
 
+const char* probe_name(ThermalProbeKind kind) {
+  switch (kind) {
+    case ThermalProbeKind::region_max:
+      return "maximum temperature";
+    case ThermalProbeKind::region_mean:
+      return "mean temperature";
+    case ThermalProbeKind::boundary_mean:
+      return "mean surface temperature";
+    case ThermalProbeKind::ambient:
+      return "ambient temperature";
+  }
+  return "temperature";
+}
+
+bool is_region_probe(ThermalProbeKind kind) {
+  return kind == ThermalProbeKind::region_max || kind == ThermalProbeKind::region_mean;
+}
+
+// Throws SolverError when the probe names a region without tets, a tag on no boundary triangle, or
+// the ambient of a tag that does not convect.
+void check_probe(const Mesh& mesh, const ThermalProbe& probe, const detail::RegionTable& regions,
+                 const std::vector<std::int32_t>& tags, const std::map<std::int32_t, TagBc>& bc) {
+  const std::string what = std::string("thermal resistance: the ") + probe_name(probe.kind) + " of ";
+  if (is_region_probe(probe.kind)) {
+    if (regions.index(probe.id) == SIZE_MAX)
+      throw SolverError(what + region_label(mesh, probe.id) + ", which has no tets");
+    return;
+  }
+  if (!std::binary_search(tags.begin(), tags.end(), probe.id))
+    throw SolverError(what + tag_label(mesh, probe.id) + ", which tags no boundary triangle");
+  if (probe.kind == ThermalProbeKind::ambient) {
+    auto it = bc.find(probe.id);
+    if (it == bc.end() || it->second.kind != BcKind::convection)
+      throw SolverError(what + tag_label(mesh, probe.id) + ": it has no convection condition");
+  }
+}
+
+// The probe's temperature from the solved nodal temperatures and the region table of the report.
+double probe_temperature(const Mesh& mesh, const ThermalProbe& probe, const ThermalReport& rep,
+                         const std::vector<double>& temp, const std::map<std::int32_t, TagBc>& bc) {
+  if (is_region_probe(probe.kind)) {
+    for (const RegionTemperature& r : rep.regions)
+      if (r.region == probe.id)
+        return probe.kind == ThermalProbeKind::region_max ? r.max_temperature : r.mean_temperature;
+  }
+  if (probe.kind == ThermalProbeKind::ambient) return bc.at(probe.id).b;
+  double sum = 0, area = 0;
+  for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
+    if (mesh.bface_tag[f] != probe.id) continue;
+    const std::uint32_t* v = &mesh.bface[3 * f];
+    const double a = detail::triangle_area(mesh, f);
+    sum += a * (temp[v[0]] + temp[v[1]] + temp[v[2]]) / 3;
+    area += a;
+  }
+  if (area > 0) return sum / area;
+  // Degenerate (zero-area) triangles only: the plain mean of their nodes.
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < mesh.bface_count(); ++f)
+    if (mesh.bface_tag[f] == probe.id)
+      for (int i = 0; i < 3; ++i, ++n) sum += temp[mesh.bface[3 * f + i]];
+  return sum / static_cast<double>(n);
+}
+
+ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceSpec& spec,
+                                      const ThermalReport& rep, const std::vector<double>& temp,
+                                      const std::map<std::int32_t, TagBc>& bc) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  ThermalResistance r;
+  r.spec = spec;
+  r.junction_temperature = probe_temperature(mesh, spec.junction, rep, temp, bc);
+  r.reference_temperature = probe_temperature(mesh, spec.reference, rep, temp, bc);
+  r.delta_t = r.junction_temperature - r.reference_temperature;
+  r.power = rep.total_power;
+  for (const BoundaryHeat& b : rep.boundaries)
+    if (b.kind == "flux") r.power += b.heat_in;
+  r.theta = r.power != 0 ? r.delta_t / r.power : nan;
+  // An insulated reference boundary takes no heat; a region reference has no boundary heat at all.
+  r.reference_heat_out = is_region_probe(spec.reference.kind) ? nan : 0.0;
+  for (const BoundaryHeat& b : rep.boundaries)
+    if (!is_region_probe(spec.reference.kind) && b.tag == spec.reference.id) r.reference_heat_out = -b.heat_in;
+  r.path_theta = r.reference_heat_out != 0 ? r.delta_t / r.reference_heat_out : nan;
+  return r;
+}
+
 }  // namespace
 
 ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
@@ -93,6 +177,10 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
         "ill-posed thermal problem: no boundary has a fixed temperature or convection, so the "
         "temperature is determined only up to a constant (and a net heat input has no way out); "
         "fix a temperature or add convection on at least one boundary tag");
+  for (const ThermalResistanceSpec& spec : params.resistances) {
+    check_probe(mesh, spec.junction, regions, tags, bc);
+    check_probe(mesh, spec.reference, regions, tags, bc);
+  }
   for (auto& [tag, t] : bc) {
     t.report = rep.boundaries.size();
     BoundaryHeat h;
@@ -278,6 +366,8 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
       rep.max_temperature = r.max_temperature;
       rep.max_node = r.max_node;
     }
+  for (const ThermalResistanceSpec& spec : params.resistances)
+    rep.resistances.push_back(evaluate_resistance(mesh, spec, rep, temp, bc));
 
   Field temp_field;
   temp_field.name = "temperature";
