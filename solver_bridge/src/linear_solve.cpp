@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <thread>
 
+#include "amg.hpp"
 #include "p1_assembly.hpp"
 
 namespace foxi::detail {
@@ -83,175 +83,6 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
   result.relative_residual = residual_norm(a, b, x, threads) / bnorm;
 }
 
-// Smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) for scalar diffusion: aggregates
-// of strongly connected nodes, piecewise-constant tentative prolongation smoothed by one damped Jacobi
-// step, Galerkin coarse operators, symmetric Gauss-Seidel V(1,1) cycles, LDL^T on the coarsest level.
-// One V-cycle is a symmetric positive definite preconditioner for CG.
-class Amg {
- public:
-  explicit Amg(const SymmetricCsr& a) {
-    RMat fine = Eigen::Map<const RMat>(
-        static_cast<Eigen::Index>(a.rows()), static_cast<Eigen::Index>(a.rows()),
-        static_cast<Eigen::Index>(a.val.size()), a.start.data(), a.col.data(), a.val.data());
-    levels_.push_back({std::move(fine), {}, {}, {}});
-    while (levels_.back().a.rows() > kCoarsest && levels_.size() < 12) {
-      Level& l = levels_.back();
-      l.diag = l.a.diagonal();
-      RMat p = prolongation(l.a, l.diag);
-      if (p.cols() == 0 || p.cols() >= l.a.rows() * 9 / 10) break;  // no longer coarsening
-      RMat r = p.transpose();
-      RMat ap = product(l.a, p);
-      RMat coarse = product(r, ap);
-      l.p = std::move(p);
-      l.r = std::move(r);
-      levels_.push_back({std::move(coarse), {}, {}, {}});
-    }
-    levels_.back().diag = levels_.back().a.diagonal();
-    coarse_.compute(Eigen::SparseMatrix<double>(levels_.back().a));
-    if (coarse_.info() != Eigen::Success)
-      throw SolverError("AMG: the coarsest system could not be factorized");
-  }
-
-  void apply(const Vec& r, Vec& z) const { cycle(0, r, z); }
-  std::size_t level_count() const { return levels_.size(); }
-
- private:
-  using RMat = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
-  static constexpr Eigen::Index kCoarsest = 2000;
-  struct Level {
-    RMat a, p, r;
-    Vec diag;
-  };
-  std::vector<Level> levels_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> coarse_;
-
-  // a * b with the rows of a split between two threads (Eigen's sparse product is serial).
-  static RMat product(const RMat& a, const RMat& b) {
-    const Eigen::Index n = a.rows(), h = n / 2;
-    if (n < 20000 || std::thread::hardware_concurrency() < 2) return RMat(a * b);
-    RMat top, bottom;
-    std::thread first([&] { top = a.topRows(h) * b; });
-    bottom = a.bottomRows(n - h) * b;
-    first.join();
-    top.makeCompressed();
-    bottom.makeCompressed();
-    RMat c(n, b.cols());
-    const Eigen::Index nt = top.nonZeros(), nb = bottom.nonZeros();
-    c.resizeNonZeros(nt + nb);
-    std::copy_n(top.innerIndexPtr(), nt, c.innerIndexPtr());
-    std::copy_n(bottom.innerIndexPtr(), nb, c.innerIndexPtr() + nt);
-    std::copy_n(top.valuePtr(), nt, c.valuePtr());
-    std::copy_n(bottom.valuePtr(), nb, c.valuePtr() + nt);
-    std::copy_n(top.outerIndexPtr(), h + 1, c.outerIndexPtr());
-    for (Eigen::Index i = 1; i <= n - h; ++i)
-      c.outerIndexPtr()[h + i] = static_cast<int>(nt) + bottom.outerIndexPtr()[i];
-    return c;
-  }
-
-  static RMat prolongation(const RMat& a, const Vec& diag) {
-    const Eigen::Index n = a.rows();
-    // Strong: |a_ij| at least theta times the largest off-diagonal magnitude of row i (relative to the
-    // row, so that the wide stencils of coarse levels still have strong connections).
-    const double theta = 0.25;
-    const int* start = a.outerIndexPtr();
-    const int* col = a.innerIndexPtr();
-    const double* val = a.valuePtr();
-    std::vector<double> row_max(static_cast<std::size_t>(n), 0.0);
-    for (Eigen::Index i = 0; i < n; ++i)
-      for (int k = start[i]; k < start[i + 1]; ++k)
-        if (col[k] != i) row_max[i] = std::max(row_max[i], std::abs(val[k]));
-    auto strong = [&](Eigen::Index i, int k) {
-      return col[k] != i && std::abs(val[k]) >= theta * row_max[i] && row_max[i] > 0;
-    };
-    std::vector<int> agg(static_cast<std::size_t>(n), -1);
-    int count = 0;
-    // Pass 1: a node whose strong neighbours are all free starts an aggregate with them.
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (agg[i] >= 0) continue;
-      bool free = true;
-      int neighbours = 0;
-      for (int k = start[i]; k < start[i + 1] && free; ++k)
-        if (strong(i, k)) {
-          ++neighbours;
-          free = agg[col[k]] < 0;
-        }
-      if (!free || neighbours == 0) continue;
-      agg[i] = count;
-      for (int k = start[i]; k < start[i + 1]; ++k)
-        if (strong(i, k)) agg[col[k]] = count;
-      ++count;
-    }
-    // Pass 2: the rest join the aggregate of their strongest aggregated neighbour.
-    std::vector<int> joined = agg;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      if (agg[i] >= 0) continue;
-      double best = 0;
-      for (int k = start[i]; k < start[i + 1]; ++k)
-        if (strong(i, k) && agg[col[k]] >= 0 && std::abs(val[k]) > best) {
-          best = std::abs(val[k]);
-          joined[i] = agg[col[k]];
-        }
-    }
-    agg = std::move(joined);
-    // Pass 3: what is still alone becomes an aggregate of its own.
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (agg[i] < 0) agg[i] = count++;
-    // Tentative P (constants on aggregates), smoothed: P = (I - w D^-1 A) P_tent, w = 4 / (3 rho(D^-1 A)).
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<std::size_t>(n));
-    for (Eigen::Index i = 0; i < n; ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
-    RMat tentative(n, count);
-    tentative.setFromTriplets(t.begin(), t.end());
-    const double omega = 4.0 / (3.0 * spectral_radius(a, diag));
-    RMat ap = product(a, tentative);
-    Vec scale = -omega * diag.cwiseInverse();
-    RMat p = tentative + RMat(scale.asDiagonal() * ap);
-    p.prune(0.0);
-    return p;
-  }
-
-  // rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%).
-  static double spectral_radius(const RMat& a, const Vec& diag) {
-    Vec v = Vec::LinSpaced(a.rows(), 1.0, 2.0);
-    double rho = 1;
-    for (int it = 0; it < 10; ++it) {
-      Vec w = (a * v).cwiseQuotient(diag);
-      rho = w.norm() / v.norm();
-      v = w / w.norm();
-    }
-    return 1.05 * rho;
-  }
-
-  // Gauss-Seidel sweep on level l, forward or backward.
-  static void gauss_seidel(const Level& l, const Vec& b, Vec& x, bool forward) {
-    const Eigen::Index n = l.a.rows();
-    const int* start = l.a.outerIndexPtr();
-    const int* col = l.a.innerIndexPtr();
-    const double* val = l.a.valuePtr();
-    for (Eigen::Index s = 0; s < n; ++s) {
-      const Eigen::Index i = forward ? s : n - 1 - s;
-      double sum = b[i];
-      for (int k = start[i]; k < start[i + 1]; ++k) sum -= val[k] * x[col[k]];
-      x[i] += sum / l.diag[i];
-    }
-  }
-
-  void cycle(std::size_t level, const Vec& b, Vec& x) const {
-    const Level& l = levels_[level];
-    if (level + 1 == levels_.size()) {
-      x = coarse_.solve(b);
-      return;
-    }
-    x.setZero(b.size());
-    gauss_seidel(l, b, x, true);
-    const Vec residual = b - l.a * x;
-    const Vec coarse_b = l.r * residual;
-    Vec coarse_x(coarse_b.size());
-    cycle(level + 1, coarse_b, coarse_x);
-    x += l.p * coarse_x;
-    gauss_seidel(l, b, x, false);
-  }
-};
 }  // namespace
 
 void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned threads) {
@@ -334,9 +165,9 @@ LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::v
   };
   if (kind == LinearSolverKind::cg_amg) {
     result.solver = "CG+SmoothedAggregationAMG";
-    Amg amg(a);
+    AmgPreconditioner amg(a, threads);
     report(options, "solve", 0.0);
-    run_all([&](const Vec& r, Vec& z) { amg.apply(r, z); });
+    run_all([&](const Vec& r, Vec& z) { amg.apply(r.data(), z.data()); });
   } else {
     result.solver = "CG+IncompleteCholesky";
     Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> ic;

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "../../bench/bench_meshes.hpp"
 #include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/validate.hpp"
 #include "test_util.hpp"
@@ -467,6 +468,28 @@ TEST_F(ThermalTest, FloatingPartIsIllPosed) {
   const ThermalReport r = solve_thermal(m, p);
   EXPECT_NEAR(region_of(r, 2).max_temperature, 300, 1e-9);  // no source: it settles at T_inf
   EXPECT_NEAR(region_of(r, 2).mean_temperature, 300, 1e-9);
+}
+
+// A jittered Kuhn grid with more unknowns than the AMG keeps on one thread (20,000 rows): the hybrid
+// Gauss-Seidel smoother (each thread its own block of rows) must converge like the serial one, to the
+// exact linear profile between two fixed ends (exact for P1, so what is left is solver error).
+TEST(ThermalAmg, ThreadedHierarchyReachesTheExactLinearProfile) {
+  Mesh m = bench::kuhn_grid_mesh(28, 0.15, 7);
+  ThermalParams p;
+  p.conductivity = {{1, 2.0}, {2, 2.0}};
+  p.fixed = {{1, 300}, {2, 500}};
+  p.solver.kind = LinearSolverKind::cg_amg;
+  p.solver.relative_tolerance = 1e-12;
+  for (unsigned threads : {1u, 2u, 3u}) {
+    p.solver.threads = threads;
+    const ThermalReport r = solve_thermal(m, p);
+    ASSERT_GT(r.unknowns, 20000u);
+    std::printf("[ amg ] %u threads: %zu unknowns, %zu iterations\n", threads, r.unknowns, r.iterations);
+    EXPECT_LT(r.iterations, 30u) << threads << " threads";
+    EXPECT_LT(r.relative_residual, 1e-12);
+    EXPECT_LT(max_nodal_error(m, [](double x) { return 300 + 200 * x; }), 1e-8) << threads << " threads";
+    EXPECT_NEAR(heat_of(r, 2).heat_in, 2.0 * 200, 1e-7);  // k dT/L over the unit square
+  }
 }
 
 TEST_F(ThermalTest, ProgressCanCancel) {
