@@ -12,11 +12,13 @@
 //                          same system (what scipy's Jacobi-CG does)
 //   foxi_thermal/amg_6M    the 6M-tet figure (goal: <= 6 s assembly + solve, <= 3 GB peak): a 100^3
 //                          Kuhn grid (6.0M tets, 1.03M nodes); counters peak_MB (VmHWM of the process
-//                          while solving, mesh included) and solver_MB (what the solve adds)
+//                          while solving, mesh included), solver_MB (what the solve adds) and
+//                          process_cpu_s (CPU seconds of all threads per run)
 // Mesh: a 57^3 Kuhn grid (1.11M tets, 195k nodes), two regions (k 1 and 10 W/(m K)), fixed 300 K at
 // z = 0, convection (h 100, 300 K) at z = 1, 1 kW in the upper region; with n = 30 (162k tets) for
 // the direct solver.
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/IterativeLinearSolvers>
@@ -57,6 +59,14 @@ double proc_status_kb(const char* key) {
   return 0;
 }
 
+// CPU seconds of the whole process (all threads) so far.
+double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 // Resets the process's peak resident size (VmHWM) to its current size (Linux >= 4.0).
 void reset_peak_rss() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
@@ -81,12 +91,15 @@ void foxi_thermal(benchmark::State& state, LinearSolverKind kind, std::uint32_t 
   m.fields.shrink_to_fit();
   reset_peak_rss();
   const double rss_before = proc_status_kb("VmRSS:");
+  const double cpu_before = process_cpu_seconds();
   for (auto _ : state) {
     r = solve_thermal(m, p);
     assembly += r.assembly_seconds;
     solve += r.solve_seconds;
   }
   const double peak = proc_status_kb("VmHWM:");
+  // CPU of all threads per run: on a busy machine a steadier figure than the wall time.
+  state.counters["process_cpu_s"] = (process_cpu_seconds() - cpu_before) / static_cast<double>(state.iterations());
   // Process peak while solving (mesh and benchmark included) and what the solve added to it.
   state.counters["peak_MB"] = peak / 1024;
   state.counters["solver_MB"] = (peak - rss_before) / 1024;

@@ -220,6 +220,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   std::vector<double> tet_k(nt);
   for (std::size_t t = 0; t < nt; ++t) tet_k[t] = region_k[tet_rix[t]];
   detail::P1Stiffness stiff = detail::assemble_stiffness(mesh, tet_k, threads);
+  std::vector<double>().swap(tet_k);  // not needed again; the solve needs the memory
   const detail::CsrPattern& pat = stiff.pat;
   std::vector<double>& kval = stiff.val;
   std::vector<double> load(nn, 0.0);
@@ -288,8 +289,8 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   }
 
   // Free unknowns and the reduced system.
-  const detail::ReducedSystem red = detail::reduce(stiff, fixed);
-  const std::vector<double> rhs = detail::reduced_rhs(stiff, red, load, fixed, temp);
+  const detail::ReducedSystem red = detail::reduce(stiff, fixed, threads);
+  const std::vector<double> rhs = detail::reduced_rhs(stiff, red, load, fixed, temp, threads);
   rep.unknowns = red.a.rows();
   rep.nonzeros = red.a.val.size();
   progress("assemble", 1.0);
