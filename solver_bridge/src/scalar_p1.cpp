@@ -119,18 +119,16 @@ P1Stiffness assemble_stiffness(const Mesh& mesh, const std::vector<double>& tet_
   k.val.assign(k.pat.col.size(), 0.0);
   parallel_for(mesh.node_count(), threads, [&](std::size_t b, std::size_t e, unsigned) {
     std::array<std::array<double, 3>, 4> g;
+    // Position of each column of the current row in val (a dense map, set row by row: O(1) lookups).
+    std::vector<std::size_t> slot(mesh.node_count());
     for (std::size_t v = b; v < e; ++v) {
-      const std::size_t rs = k.pat.row_start[v], re = k.pat.row_start[v + 1];
+      for (std::size_t pos = k.pat.row_start[v]; pos < k.pat.row_start[v + 1]; ++pos) slot[k.pat.col[pos]] = pos;
       for (std::size_t i = k.ntets.node_start[v]; i < k.ntets.node_start[v + 1]; ++i) {
         const std::size_t t = k.ntets.item[i] >> 2;
         const unsigned a = k.ntets.item[i] & 3u;
         const double cv = tet_coefficient[t] * p1_gradients(mesh, t, g);
-        for (unsigned c = 0; c < 4; ++c) {
-          const std::uint32_t col = mesh.tet[4 * t + c];
-          std::size_t pos = rs;
-          while (pos < re && k.pat.col[pos] != col) ++pos;
-          k.val[pos] += cv * (g[a][0] * g[c][0] + g[a][1] * g[c][1] + g[a][2] * g[c][2]);
-        }
+        for (unsigned c = 0; c < 4; ++c)
+          k.val[slot[mesh.tet[4 * t + c]]] += cv * (g[a][0] * g[c][0] + g[a][1] * g[c][1] + g[a][2] * g[c][2]);
       }
     }
   });
