@@ -27,7 +27,8 @@ const char* kSolveUsage =
     "  body), h in W/(m^2 K), k in W/(m K) (default: the region's material). Boundaries with no\n"
     "  condition are insulated; at least one --fix or --convect is needed. --power gives a region's\n"
     "  total heat in W, --power-density in W/m^3. Prints the maximum temperature and where, per-region\n"
-    "  maximum and mean, heat through each boundary, and the solver's work; OUT (any mesh format,\n"
+    "  maximum and mean, heat through each boundary and its mean surface temperature, the energy\n"
+    "  balance (sources + boundary heat, ~0), and the solver's work; OUT (any mesh format,\n"
     "  .vtu for ParaView) gets the fields 'temperature' (K, nodes) and 'heat_flux' (W/m^2, cells).\n"
     "  --theta prints a thermal resistance theta = (T_junction - T_reference) / P in K/W, P the total\n"
     "  power (sources + heat-flux boundaries), as JEDEC's theta_JC / theta_JA, and dT over the heat\n"
@@ -352,20 +353,25 @@ int cmd_solve(Args args) {
   const double* p = &mesh.xyz[3 * std::size_t{r.max_node}];
   std::printf("max temperature %.6g K (%.6g C) at node %u (%.6g, %.6g, %.6g)\n", r.max_temperature,
               r.max_temperature - 273.15, r.max_node, p[0], p[1], p[2]);
-  std::printf("regions:\n");
+  std::printf("%-24s %12s %12s %12s %10s %12s %12s\n", "regions", "k W/(m K)", "power W", "max T K",
+              "max T C", "mean T K", "volume m^3");
   for (const RegionTemperature& t : r.regions)
-    std::printf("  %-20s k %-10.4g W/(m K)  power %-10.4g W  max %.6g K  mean %.6g K  volume %.4g m^3\n",
-                region_label(mesh, t.region).c_str(), t.conductivity, t.power, t.max_temperature,
-                t.mean_temperature, t.volume);
-  std::printf("boundaries (heat into the body):\n");
-  double net = r.total_power;
+    std::printf("  %-22s %12.4g %12.4g %12.6g %10.4g %12.6g %12.4g\n", region_label(mesh, t.region).c_str(),
+                t.conductivity, t.power, t.max_temperature, t.max_temperature - 273.15, t.mean_temperature,
+                t.volume);
+  std::printf("%-24s %-10s %12s %14s %12s\n", "boundaries", "condition", "area m^2", "heat in W", "mean T K");
+  double boundary_heat = 0;
   for (const BoundaryHeat& b : r.boundaries) {
-    std::printf("  %-20s %-10s area %-10.4g m^2  heat %.6g W\n", boundary_label(mesh, b.tag).c_str(),
-                b.kind.c_str(), b.area, b.heat_in);
-    net += b.heat_in;
+    std::printf("  %-22s %-10s %12.4g %14.6g %12.6g\n", boundary_label(mesh, b.tag).c_str(), b.kind.c_str(),
+                b.area, b.heat_in, b.mean_temperature);
+    boundary_heat += b.heat_in;
   }
-  std::printf("total source power %.6g W; energy balance (sources + boundary heat) %.3g W\n", r.total_power,
-              net);
+  const double imbalance = r.total_power + boundary_heat;
+  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W", r.total_power,
+              boundary_heat, imbalance);
+  const double scale = std::max(std::abs(r.total_power), std::abs(boundary_heat));
+  if (scale > 0) std::printf(" (%.2g of the heat flow)", std::abs(imbalance) / scale);
+  std::printf("\n");
   for (const ThermalResistance& t : r.resistances) {
     auto side = [&](const ThermalProbe& probe) {
       switch (probe.kind) {

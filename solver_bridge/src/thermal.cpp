@@ -69,6 +69,23 @@ void check_probe(const Mesh& mesh, const ThermalProbe& probe, const detail::Regi
   }
 }
 
+// Area mean of the P1 temperature over the triangles of `tag` (the plain mean of their nodes when
+// they all have zero area).
+double boundary_mean_temperature(const Mesh& mesh, std::int32_t tag, const std::vector<double>& temp) {
+  double sum = 0, area = 0, plain = 0;
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
+    if (mesh.bface_tag[f] != tag) continue;
+    const std::uint32_t* v = &mesh.bface[3 * f];
+    const double a = detail::triangle_area(mesh, f), t = temp[v[0]] + temp[v[1]] + temp[v[2]];
+    sum += a * t / 3;
+    area += a;
+    plain += t;
+    n += 3;
+  }
+  return area > 0 ? sum / area : plain / static_cast<double>(n);
+}
+
 // The probe's temperature from the solved nodal temperatures and the region table of the report.
 double probe_temperature(const Mesh& mesh, const ThermalProbe& probe, const ThermalReport& rep,
                          const std::vector<double>& temp, const std::map<std::int32_t, TagBc>& bc) {
@@ -78,21 +95,7 @@ double probe_temperature(const Mesh& mesh, const ThermalProbe& probe, const Ther
         return probe.kind == ThermalProbeKind::region_max ? r.max_temperature : r.mean_temperature;
   }
   if (probe.kind == ThermalProbeKind::ambient) return bc.at(probe.id).b;
-  double sum = 0, area = 0;
-  for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
-    if (mesh.bface_tag[f] != probe.id) continue;
-    const std::uint32_t* v = &mesh.bface[3 * f];
-    const double a = detail::triangle_area(mesh, f);
-    sum += a * (temp[v[0]] + temp[v[1]] + temp[v[2]]) / 3;
-    area += a;
-  }
-  if (area > 0) return sum / area;
-  // Degenerate (zero-area) triangles only: the plain mean of their nodes.
-  std::size_t n = 0;
-  for (std::size_t f = 0; f < mesh.bface_count(); ++f)
-    if (mesh.bface_tag[f] == probe.id)
-      for (int i = 0; i < 3; ++i, ++n) sum += temp[mesh.bface[3 * f + i]];
-  return sum / static_cast<double>(n);
+  return boundary_mean_temperature(mesh, probe.id, temp);
 }
 
 ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceSpec& spec,
@@ -367,6 +370,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
       rep.max_temperature = r.max_temperature;
       rep.max_node = r.max_node;
     }
+  for (BoundaryHeat& b : rep.boundaries) b.mean_temperature = boundary_mean_temperature(mesh, b.tag, temp);
   for (const ThermalResistanceSpec& spec : params.resistances)
     rep.resistances.push_back(evaluate_resistance(mesh, spec, rep, temp, bc));
 

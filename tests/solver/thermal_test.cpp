@@ -248,6 +248,9 @@ TEST_F(ThermalTest, ConvectionBoundaryMatchesRobinSolution) {
   EXPECT_LT(max_nodal_error(m, [&](double x) { return t0 + flux * x / k; }), 1e-10 * tinf);
   EXPECT_NEAR(heat_of(r, 2).heat_in, flux * kArea, 1e-9 * flux * kArea);
   EXPECT_NEAR(heat_of(r, 1).heat_in, -flux * kArea, 1e-9 * flux * kArea);
+  // The cooled surface sits between the wall and the air: T(L) = T0 + flux L / k.
+  EXPECT_NEAR(heat_of(r, 2).mean_temperature, t0 + flux * kL / k, 1e-9 * tinf);
+  EXPECT_NEAR(heat_of(r, 1).mean_temperature, t0, 1e-12 * t0);
 }
 
 // Convection only (no fixed temperature) with a source: T at the cooled end is Tinf + P / (h A).

@@ -114,6 +114,7 @@ struct BoundaryHeat {
   std::string kind;    // "fixed", "flux", "convection"
   double area = 0;     // m^2
   double heat_in = 0;  // W
+  double mean_temperature = 0;  // K, area mean of the surface temperature (a case temperature)
 };
 
 struct RegionTemperature {
