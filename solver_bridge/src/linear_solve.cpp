@@ -18,6 +18,8 @@ void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned thread
 namespace {
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+// Vector lengths below which the CG updates stay on one thread.
+constexpr std::size_t kVectorSerialBelow = 50000;
 using Vec = Eigen::VectorXd;
 
 Eigen::Map<const SpMat> as_eigen(const SymmetricCsr& a) {
@@ -41,19 +43,40 @@ double residual_norm(const SymmetricCsr& a, const std::vector<double>& b, const 
 }
 
 // Preconditioned conjugate gradients from x = 0; precondition(r, z) sets z = M^-1 r.
+// Sum of f(i) over [0, n) on threads; the slices' sums are added in slice order, so the result is
+// the same on every run with the same thread count.
+template <class F>
+double parallel_sum(std::size_t n, unsigned threads, F&& f) {
+  std::vector<double> part(threads, 0.0);
+  parallel_for(
+      n, threads,
+      [&](std::size_t b, std::size_t e, unsigned t) {
+        double s = 0;
+        for (std::size_t i = b; i < e; ++i) s += f(i);
+        part[t] = s;
+      },
+      kVectorSerialBelow);
+  double s = 0;
+  for (double v : part) s += v;
+  return s;
+}
+
+// Preconditioned conjugate gradients from x = 0; precondition(r, z) sets z = M^-1 r. The vector
+// updates run on threads, fused so that each iteration reads every vector as few times as it can.
 template <class Precondition>
 void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x, double bnorm,
          const LinearSolverOptions& options, unsigned threads, LinearSolveResult& result,
          Precondition&& precondition) {
   const std::size_t n = a.rows();
   if (bnorm == 0) return;
-  Eigen::Map<Vec> X(x.data(), static_cast<Eigen::Index>(n));
   const double tol = options.relative_tolerance * bnorm;
   const std::size_t max_it = options.max_iterations ? options.max_iterations : 10 * n + 100;
   Vec r = Eigen::Map<const Vec>(b.data(), static_cast<Eigen::Index>(n)), z(static_cast<Eigen::Index>(n));
   precondition(r, z);
   Vec p = z, q(static_cast<Eigen::Index>(n));
-  double rz = r.dot(z);
+  double* xd = x.data();
+  double *rd = r.data(), *zd = z.data(), *pd = p.data(), *qd = q.data();
+  double rz = parallel_sum(n, threads, [&](std::size_t i) { return rd[i] * zd[i]; });
   const double log_goal = std::log(std::max(1e-300, options.relative_tolerance));
   std::size_t it = 0;
   double rnorm = bnorm;
@@ -61,21 +84,29 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
     if (it == max_it)
       throw SolverError("conjugate gradients did not converge in " + std::to_string(max_it) +
                         " iterations (relative residual " + std::to_string(rnorm / bnorm) + ")");
-    multiply(a, p.data(), q.data(), threads);
-    const double pq = p.dot(q);
+    multiply(a, pd, qd, threads);
+    const double pq = parallel_sum(n, threads, [&](std::size_t i) { return pd[i] * qd[i]; });
     if (!(pq > 0))
       throw SolverError(
           "conjugate gradients broke down: the matrix is not positive definite (a part with "
           "no fixed-temperature or convection boundary?)");
     const double alpha = rz / pq;
-    X += alpha * p;
-    r -= alpha * q;
-    rnorm = r.norm();
+    rnorm = std::sqrt(parallel_sum(n, threads, [&](std::size_t i) {
+      xd[i] += alpha * pd[i];
+      rd[i] -= alpha * qd[i];
+      return rd[i] * rd[i];
+    }));
     ++it;
     if (rnorm <= tol) break;
     precondition(r, z);
-    const double rz_new = r.dot(z);
-    p = z + (rz_new / rz) * p;
+    const double rz_new = parallel_sum(n, threads, [&](std::size_t i) { return rd[i] * zd[i]; });
+    const double beta = rz_new / rz;
+    parallel_for(
+        n, threads,
+        [&](std::size_t lo, std::size_t hi, unsigned) {
+          for (std::size_t i = lo; i < hi; ++i) pd[i] = zd[i] + beta * pd[i];
+        },
+        kVectorSerialBelow);
     rz = rz_new;
     if (it % 10 == 0) report(options, "solve", std::clamp(std::log(rnorm / bnorm) / log_goal, 0.0, 1.0));
   }
