@@ -146,24 +146,39 @@ void spmv(const View& a, const double* x, double* y, unsigned threads) {
       kSerialRows);
 }
 
-// rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%).
+// rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%). Each iteration is one
+// pass on threads: w = D^-1 A v and |w|^2 by slices (added in slice order: deterministic); no
+// normalisation is needed in 10 steps of a factor of a few.
 double spectral_radius(const View& a, const std::vector<double>& inv_diag, unsigned threads) {
   const std::size_t n = a.rows;
-  std::vector<double> v(n), w(n);
-  for (std::size_t i = 0; i < n; ++i) v[i] = 1.0 + (n > 1 ? static_cast<double>(i) / static_cast<double>(n - 1) : 0.0);
+  std::vector<double> v(n), w(n), part(threads);
+  double vv = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    v[i] = 1.0 + (n > 1 ? static_cast<double>(i) / static_cast<double>(n - 1) : 0.0);
+    vv += v[i] * v[i];
+  }
   double rho = 1;
   for (int it = 0; it < 10; ++it) {
-    spmv(a, v.data(), w.data(), threads);
-    double wn = 0, vn = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      w[i] *= inv_diag[i];
-      wn += w[i] * w[i];
-      vn += v[i] * v[i];
-    }
-    wn = std::sqrt(wn);
-    rho = wn / std::sqrt(vn);
-    if (wn == 0) break;
-    for (std::size_t i = 0; i < n; ++i) v[i] = w[i] / wn;
+    std::fill(part.begin(), part.end(), 0.0);
+    parallel_for(
+        n, threads,
+        [&](std::size_t lo, std::size_t hi, unsigned th) {
+          double ww = 0;
+          for (std::size_t i = lo; i < hi; ++i) {
+            double sum = 0;
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k) sum += a.val[k] * v[static_cast<std::size_t>(a.col[k])];
+            w[i] = sum * inv_diag[i];
+            ww += w[i] * w[i];
+          }
+          part[th] = ww;
+        },
+        kSerialRows);
+    double ww = 0;
+    for (double p : part) ww += p;
+    rho = std::sqrt(ww / vv);
+    if (ww == 0 || !std::isfinite(ww)) break;
+    v.swap(w);
+    vv = ww;
   }
   return 1.05 * rho;
 }
