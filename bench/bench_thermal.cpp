@@ -105,7 +105,8 @@ void foxi_thermal(benchmark::State& state, LinearSolverKind kind, std::uint32_t 
   }
   const double peak = proc_status_kb("VmHWM:");
   // CPU of all threads per run: on a busy machine a steadier figure than the wall time.
-  state.counters["process_cpu_s"] = (process_cpu_seconds() - cpu_before) / static_cast<double>(state.iterations());
+  state.counters["process_cpu_s"] =
+      (process_cpu_seconds() - cpu_before) / static_cast<double>(state.iterations());
   // Process peak while solving (mesh and benchmark included) and what the solve added to it.
   state.counters["peak_MB"] = peak / 1024;
   state.counters["solver_MB"] = (peak - rss_before) / 1024;

@@ -367,8 +367,8 @@ int cmd_solve(Args args) {
     boundary_heat += b.heat_in;
   }
   const double imbalance = r.total_power + boundary_heat;
-  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W", r.total_power,
-              boundary_heat, imbalance);
+  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W",
+              r.total_power, boundary_heat, imbalance);
   const double scale = std::max(std::abs(r.total_power), std::abs(boundary_heat));
   if (scale > 0) std::printf(" (%.2g of the heat flow)", std::abs(imbalance) / scale);
   std::printf("\n");

@@ -108,7 +108,8 @@ Csr multiply(const View& a, const Csr& b, unsigned threads) {
     for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
       const double av = a.val[k];
       const auto j = static_cast<std::size_t>(a.col[k]);
-      for (int l = b.start[j]; l < b.start[j + 1]; ++l) emit(b.col[static_cast<std::size_t>(l)], av * b.val[static_cast<std::size_t>(l)]);
+      for (int l = b.start[j]; l < b.start[j + 1]; ++l)
+        emit(b.col[static_cast<std::size_t>(l)], av * b.val[static_cast<std::size_t>(l)]);
     }
   });
 }
@@ -166,7 +167,8 @@ double spectral_radius(const View& a, const std::vector<double>& inv_diag, unsig
           double ww = 0;
           for (std::size_t i = lo; i < hi; ++i) {
             double sum = 0;
-            for (int k = a.start[i]; k < a.start[i + 1]; ++k) sum += a.val[k] * v[static_cast<std::size_t>(a.col[k])];
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+              sum += a.val[k] * v[static_cast<std::size_t>(a.col[k])];
             w[i] = sum * inv_diag[i];
             ww += w[i] * w[i];
           }
@@ -194,7 +196,8 @@ std::vector<int> aggregate(const View& a, int& count) {
     for (int k = a.start[i]; k < a.start[i + 1]; ++k)
       if (static_cast<std::size_t>(a.col[k]) != i) row_max[i] = std::max(row_max[i], std::abs(a.val[k]));
   auto strong = [&](std::size_t i, int k) {
-    return static_cast<std::size_t>(a.col[k]) != i && std::abs(a.val[k]) >= theta * row_max[i] && row_max[i] > 0;
+    return static_cast<std::size_t>(a.col[k]) != i && std::abs(a.val[k]) >= theta * row_max[i] &&
+           row_max[i] > 0;
   };
   std::vector<int> agg(n, -1);
   count = 0;
@@ -251,7 +254,8 @@ struct AmgPreconditioner::Impl {
   void cycle(std::size_t level, const double* b, double* x);
 };
 
-AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads) : impl_(std::make_unique<Impl>()) {
+AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.threads = std::max(1u, threads);
   m.levels.emplace_back();
@@ -277,7 +281,8 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads) : 
     l.p = build_rows(n, nc, m.threads, [&](std::size_t i, auto&& emit) {
       emit(agg[i], 1.0);
       const double s = -omega * l.inv_diag[i];
-      for (int k = av.start[i]; k < av.start[i + 1]; ++k) emit(agg[static_cast<std::size_t>(av.col[k])], s * av.val[k]);
+      for (int k = av.start[i]; k < av.start[i + 1]; ++k)
+        emit(agg[static_cast<std::size_t>(av.col[k])], s * av.val[k]);
     });
     l.r = transpose(l.p);
     Csr coarse;
@@ -287,11 +292,11 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads) : 
     }
     Impl::Level next;
     next.own = std::move(coarse);
-    next.a = view(next.own);
     next.b.resize(nc);
     next.x.resize(nc);
     m.levels.push_back(std::move(next));
-    m.levels.back().a = view(m.levels.back().own);  // the move kept the arrays; refresh anyway
+    // The view is taken in place: moving a Level keeps its arrays, so it stays valid as levels grows.
+    m.levels.back().a = view(m.levels.back().own);
   }
   // The coarsest level by sparse LDL^T.
   const Impl::Level& last = m.levels.back();
@@ -304,7 +309,8 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads) : 
   Eigen::SparseMatrix<double> c(nl, nl);
   c.setFromTriplets(t.begin(), t.end());
   m.coarse.compute(c);
-  if (m.coarse.info() != Eigen::Success) throw SolverError("AMG: the coarsest system could not be factorized");
+  if (m.coarse.info() != Eigen::Success)
+    throw SolverError("AMG: the coarsest system could not be factorized");
   m.coarse_b.resize(nl);
   m.coarse_x.resize(nl);
 }
@@ -365,7 +371,8 @@ void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* 
         for (std::size_t i = lo; i < hi; ++i) {
           double s = 0;
           for (int k = l.p.start[i]; k < l.p.start[i + 1]; ++k)
-            s += l.p.val[static_cast<std::size_t>(k)] * next.x[static_cast<std::size_t>(l.p.col[static_cast<std::size_t>(k)])];
+            s += l.p.val[static_cast<std::size_t>(k)] *
+                 next.x[static_cast<std::size_t>(l.p.col[static_cast<std::size_t>(k)])];
           x[i] += s;
           l.scratch[i] = x[i];
         }

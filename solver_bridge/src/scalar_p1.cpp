@@ -122,13 +122,15 @@ P1Stiffness assemble_stiffness(const Mesh& mesh, const std::vector<double>& tet_
     // Position of each column of the current row in val (a dense map, set row by row: O(1) lookups).
     std::vector<std::size_t> slot(mesh.node_count());
     for (std::size_t v = b; v < e; ++v) {
-      for (std::size_t pos = k.pat.row_start[v]; pos < k.pat.row_start[v + 1]; ++pos) slot[k.pat.col[pos]] = pos;
+      for (std::size_t pos = k.pat.row_start[v]; pos < k.pat.row_start[v + 1]; ++pos)
+        slot[k.pat.col[pos]] = pos;
       for (std::size_t i = k.ntets.node_start[v]; i < k.ntets.node_start[v + 1]; ++i) {
         const std::size_t t = k.ntets.item[i] >> 2;
         const unsigned a = k.ntets.item[i] & 3u;
         const double cv = tet_coefficient[t] * p1_gradients(mesh, t, g);
         for (unsigned c = 0; c < 4; ++c)
-          k.val[slot[mesh.tet[4 * t + c]]] += cv * (g[a][0] * g[c][0] + g[a][1] * g[c][1] + g[a][2] * g[c][2]);
+          k.val[slot[mesh.tet[4 * t + c]]] +=
+              cv * (g[a][0] * g[c][0] + g[a][1] * g[c][1] + g[a][2] * g[c][2]);
       }
     }
   });
@@ -207,7 +209,8 @@ ReducedSystem reduce(const P1Stiffness& k, const std::vector<char>& fixed, unsig
   parallel_for(nf, threads, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t i = b; i < e; ++i) {
       int n = 0;
-      for (std::size_t j = k.pat.row_start[node[i]]; j < k.pat.row_start[node[i] + 1]; ++j) n += r.dof[k.pat.col[j]] >= 0;
+      for (std::size_t j = k.pat.row_start[node[i]]; j < k.pat.row_start[node[i] + 1]; ++j)
+        n += r.dof[k.pat.col[j]] >= 0;
       r.a.start[i + 1] = n;
     }
   });

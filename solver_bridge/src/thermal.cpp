@@ -114,7 +114,8 @@ ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceS
   // An insulated reference boundary takes no heat; a region reference has no boundary heat at all.
   r.reference_heat_out = is_region_probe(spec.reference.kind) ? nan : 0.0;
   for (const BoundaryHeat& b : rep.boundaries)
-    if (!is_region_probe(spec.reference.kind) && b.tag == spec.reference.id) r.reference_heat_out = -b.heat_in;
+    if (!is_region_probe(spec.reference.kind) && b.tag == spec.reference.id)
+      r.reference_heat_out = -b.heat_in;
   r.path_theta = r.reference_heat_out != 0 ? r.delta_t / r.reference_heat_out : nan;
   return r;
 }

@@ -263,11 +263,11 @@ TEST(Electrostatic, CoaxialCapacitorConverges) {
       << "Cylinder(2) = {0,0,0, 0,0," << height << ", " << a << "};\n";
   test::write_text(dir / "coax.geo",
                    geo.str() +
-                   "BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };\n"
-                   "Physical Volume(1) = {3};\nb() = Boundary{ Volume{3}; };\n"
-                   "For i In {0:#b()-1}\n  Physical Surface(i+1) = {b(i)};\nEndFor\n");
+                       "BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };\n"
+                       "Physical Volume(1) = {3};\nb() = Boundary{ Volume{3}; };\n"
+                       "For i In {0:#b()-1}\n  Physical Surface(i+1) = {b(i)};\nEndFor\n");
   std::vector<double> errors, sizes;  // against the faceted geometry
-  double exact_error = 0;                // of the last (finest) mesh against the circles
+  double exact_error = 0;             // of the last (finest) mesh against the circles
   for (double lc : {0.4, 0.28, 0.2, 0.14}) {
     std::ostringstream cmd;
     cmd << "gmsh -3 -v 0 -clmax " << lc << " -format msh22 -o '" << (dir / "coax.msh").string() << "' '"
@@ -323,7 +323,10 @@ TEST(Electrostatic, CoaxialCapacitorConverges) {
   for (std::size_t i = 1; i < errors.size(); ++i) EXPECT_LT(errors[i], errors[i - 1]);
   const std::size_t last = errors.size() - 1;
   const double rate = std::log(errors[0] / errors[last]) / std::log(sizes[0] / sizes[last]);
-  std::printf("[ coax ] observed order %.2f (against the faceted geometry) in h = (volume / tets)^(1/3) over %zu meshes\n", rate, errors.size());
+  std::printf(
+      "[ coax ] observed order %.2f (against the faceted geometry) in h = (volume / tets)^(1/3) over %zu "
+      "meshes\n",
+      rate, errors.size());
   EXPECT_GT(rate, 1.5);
   EXPECT_LT(exact_error, 0.01);
 }

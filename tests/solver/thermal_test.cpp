@@ -282,7 +282,6 @@ TEST_F(ThermalTest, FluxBoundaryGivesLinearProfile) {
   EXPECT_NEAR(heat_of(r, 2).area, kArea, 1e-12);
 }
 
-
 void expect_error(Mesh& m, const ThermalParams& p, const std::string& words) {
   try {
     solve_thermal(m, p);
@@ -303,16 +302,19 @@ Mesh parallel_box_mesh(double max_volume, double split) {
   s << "12 3 0 0\n";
   for (int ix = 0; ix < 2; ++ix)
     for (int iy = 0; iy < 3; ++iy)
-      for (int iz = 0; iz < 2; ++iz) s << id(ix, iy, iz) << ' ' << ix * kL << ' ' << ys[iy] << ' ' << iz * kW << '\n';
+      for (int iz = 0; iz < 2; ++iz)
+        s << id(ix, iy, iz) << ' ' << ix * kL << ' ' << ys[iy] << ' ' << iz * kW << '\n';
   s << "11 1\n";
   auto quad = [&](int a, int b, int c, int d, int marker) {
     s << "1 0 " << marker << "\n4 " << a << ' ' << b << ' ' << c << ' ' << d << '\n';
   };
   for (int ix = 0; ix < 2; ++ix)
-    for (int iy = 0; iy < 2; ++iy) quad(id(ix, iy, 0), id(ix, iy + 1, 0), id(ix, iy + 1, 1), id(ix, iy, 1), 1 + ix);
+    for (int iy = 0; iy < 2; ++iy)
+      quad(id(ix, iy, 0), id(ix, iy + 1, 0), id(ix, iy + 1, 1), id(ix, iy, 1), 1 + ix);
   for (int iy = 0; iy < 3; iy += 2) quad(id(0, iy, 0), id(1, iy, 0), id(1, iy, 1), id(0, iy, 1), 3);
   for (int iz = 0; iz < 2; ++iz)
-    for (int iy = 0; iy < 2; ++iy) quad(id(0, iy, iz), id(1, iy, iz), id(1, iy + 1, iz), id(0, iy + 1, iz), 3);
+    for (int iy = 0; iy < 2; ++iy)
+      quad(id(0, iy, iz), id(1, iy, iz), id(1, iy + 1, iz), id(0, iy + 1, iz), 3);
   quad(id(0, 1, 0), id(1, 1, 0), id(1, 1, 1), id(0, 1, 1), 4);
   s << "0\n2\n";
   s << "1 " << kL / 2 << ' ' << split / 2 << ' ' << kW / 2 << " 1 0\n";
@@ -363,7 +365,8 @@ TEST_F(ThermalTest, SeriesThermalResistancesAdd) {
   p.convection = {{1, h, tinf}};
   p.flux = {{2, q}};
   using K = ThermalProbeKind;
-  p.resistances = {theta_spec(K::region_max, 2, K::ambient, 1), theta_spec(K::region_max, 2, K::boundary_mean, 1),
+  p.resistances = {theta_spec(K::region_max, 2, K::ambient, 1),
+                   theta_spec(K::region_max, 2, K::boundary_mean, 1),
                    theta_spec(K::region_max, 1, K::boundary_mean, 1)};
   const ThermalReport r = solve_thermal(m, p);
   const double film = 1 / (h * kArea), r1 = l1 / (k1 * kArea), r2 = l2 / (k2 * kArea);
