@@ -486,7 +486,7 @@ TEST(ThermalAmg, ThreadedHierarchyReachesTheExactLinearProfile) {
   p.fixed = {{1, 300}, {2, 500}};
   p.solver.kind = LinearSolverKind::cg_amg;
   p.solver.relative_tolerance = 1e-12;
-  for (unsigned threads : {1u, 2u, 3u}) {
+  for (unsigned threads : {2u, 3u}) {  // one thread: the smaller meshes above
     p.solver.threads = threads;
     const ThermalReport r = solve_thermal(m, p);
     ASSERT_GT(r.unknowns, 20000u);
