@@ -28,14 +28,21 @@ const char* kSolveUsage =
     "\n"
     "foxi solve MESH --physics thermal [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf]\n"
     "                [--power REGION=W] [--power-density REGION=W/m3] [--k REGION=k]\n"
-    "                [--solver auto|direct|amg|ichol] [--tol REL] [-o OUT]\n"
+    "                [--theta JUNCTION:REFERENCE] [--solver auto|direct|amg|ichol] [--tol REL] [-o OUT]\n"
     "  Steady heat conduction with linear tets. Options may be repeated. TAG is a boundary tag\n"
     "  number or name, REGION a region id or name; SI units: T and Tinf in K, q in W/m^2 (into the\n"
     "  body), h in W/(m^2 K), k in W/(m K) (default: the region's material). Boundaries with no\n"
     "  condition are insulated; at least one --fix or --convect is needed. --power gives a region's\n"
     "  total heat in W, --power-density in W/m^3. Prints the maximum temperature and where, per-region\n"
-    "  maximum and mean, heat through each boundary, and the solver's work; OUT (any mesh format,\n"
+    "  maximum and mean, heat through each boundary and its mean surface temperature, the energy\n"
+    "  balance (sources + boundary heat, ~0), and the solver's work; OUT (any mesh format,\n"
     "  .vtu for ParaView) gets the fields 'temperature' (K, nodes) and 'heat_flux' (W/m^2, cells).\n"
+    "  --theta prints a thermal resistance theta = (T_junction - T_reference) / P in K/W, P the total\n"
+    "  power (sources + heat-flux boundaries), as JEDEC's theta_JC / theta_JA, and dT over the heat\n"
+    "  leaving through the reference boundary (the path's own resistance). Each side is NAME or\n"
+    "  KIND=NAME: max=REGION (the region's hottest node; a bare JUNCTION), mean=REGION (volume mean),\n"
+    "  surface=TAG (area-mean surface temperature; a bare REFERENCE), ambient=TAG (Tinf of a\n"
+    "  --convect tag). E.g. --theta die:bottom (theta_JC), --theta die:ambient=top (theta_JA).\n"
     "\n"
     "foxi solve MESH --physics electrostatic --conductor TAG[,TAG...]=NAME[:V] ... [--eps REGION=eps_r]\n"
     "  Electrostatics: each conductor is a set of boundary tags at one potential (V, default 0 V, used\n"
@@ -97,6 +104,32 @@ std::int32_t region_id(const Mesh& mesh, const std::string& key, const std::stri
   for (const Region& r : mesh.regions)
     if (r.name == key) return r.id;
   throw UsageError(option + ": no region named '" + key + "'");
+}
+
+// One side of --theta: NAME or KIND=NAME (see kSolveUsage); a bare NAME is `bare`.
+ThermalProbe theta_probe(const Mesh& mesh, const std::string& text, ThermalProbeKind bare) {
+  const auto eq = text.find('=');
+  ThermalProbe probe{bare, 0};
+  std::string name = text;
+  if (eq != std::string::npos) {
+    const std::string kind = text.substr(0, eq);
+    name = text.substr(eq + 1);
+    if (kind == "max")
+      probe.kind = ThermalProbeKind::region_max;
+    else if (kind == "mean")
+      probe.kind = ThermalProbeKind::region_mean;
+    else if (kind == "surface")
+      probe.kind = ThermalProbeKind::boundary_mean;
+    else if (kind == "ambient")
+      probe.kind = ThermalProbeKind::ambient;
+    else
+      throw UsageError("--theta: '" + kind + "' is not max, mean, surface or ambient (in '" + text + "')");
+  }
+  if (name.empty()) throw UsageError("--theta: empty name in '" + text + "'");
+  const bool region =
+      probe.kind == ThermalProbeKind::region_max || probe.kind == ThermalProbeKind::region_mean;
+  probe.id = region ? region_id(mesh, name, "--theta") : boundary_tag(mesh, name, "--theta");
+  return probe;
 }
 
 std::vector<std::string> all_options(Args& args, const char* name) {
@@ -184,7 +217,7 @@ int cmd_solve(Args args) {
                                  convect = all_options(args, "--convect"),
                                  power = all_options(args, "--power"),
                                  density = all_options(args, "--power-density"),
-                                 cond = all_options(args, "--k");
+                                 cond = all_options(args, "--k"), theta = all_options(args, "--theta");
   const LinearSolverOptions solver_options = parse_solver_options(args);
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
@@ -210,9 +243,10 @@ int cmd_solve(Args args) {
 
   if (physics != "thermal") {
     if (!fix.empty() || !flux.empty() || !convect.empty() || !power.empty() || !density.empty() ||
-        !cond.empty())
+        !cond.empty() || !theta.empty())
       throw UsageError(
-          "--fix, --flux, --convect, --power, --power-density and --k are for --physics thermal");
+          "--fix, --flux, --convect, --power, --power-density, --k and --theta are for --physics "
+          "thermal");
     LinearSolverOptions so = params.solver;
     if (physics == "electrostatic") {
       if (!terminal.empty() || !terminal_current.empty() || !sigma.empty())
@@ -336,6 +370,13 @@ int cmd_solve(Args args) {
     auto [k, v] = split_assignment(s, "--k");
     params.conductivity.push_back({region_id(mesh, k, "--k"), parse_number(v, "--k")});
   }
+  for (const std::string& s : theta) {
+    const auto colon = s.find(':');
+    if (colon == std::string::npos || s.find(':', colon + 1) != std::string::npos)
+      throw UsageError("--theta takes JUNCTION:REFERENCE, not '" + s + "'");
+    params.resistances.push_back({theta_probe(mesh, s.substr(0, colon), ThermalProbeKind::region_max),
+                                  theta_probe(mesh, s.substr(colon + 1), ThermalProbeKind::boundary_mean)});
+  }
 
   const ThermalReport r = solve_thermal(mesh, params);
   auto t2 = std::chrono::steady_clock::now();
@@ -345,20 +386,47 @@ int cmd_solve(Args args) {
   const double* p = &mesh.xyz[3 * std::size_t{r.max_node}];
   std::printf("max temperature %.6g K (%.6g C) at node %u (%.6g, %.6g, %.6g)\n", r.max_temperature,
               r.max_temperature - 273.15, r.max_node, p[0], p[1], p[2]);
-  std::printf("regions:\n");
+  std::printf("%-24s %12s %12s %12s %10s %12s %12s\n", "regions", "k W/(m K)", "power W", "max T K",
+              "max T C", "mean T K", "volume m^3");
   for (const RegionTemperature& t : r.regions)
-    std::printf("  %-20s k %-10.4g W/(m K)  power %-10.4g W  max %.6g K  mean %.6g K  volume %.4g m^3\n",
-                region_label(mesh, t.region).c_str(), t.conductivity, t.power, t.max_temperature,
-                t.mean_temperature, t.volume);
-  std::printf("boundaries (heat into the body):\n");
-  double net = r.total_power;
+    std::printf("  %-22s %12.4g %12.4g %12.6g %10.4g %12.6g %12.4g\n", region_label(mesh, t.region).c_str(),
+                t.conductivity, t.power, t.max_temperature, t.max_temperature - 273.15, t.mean_temperature,
+                t.volume);
+  std::printf("%-24s %-10s %12s %14s %12s\n", "boundaries", "condition", "area m^2", "heat in W", "mean T K");
+  double boundary_heat = 0;
   for (const BoundaryHeat& b : r.boundaries) {
-    std::printf("  %-20s %-10s area %-10.4g m^2  heat %.6g W\n", boundary_label(mesh, b.tag).c_str(),
-                b.kind.c_str(), b.area, b.heat_in);
-    net += b.heat_in;
+    std::printf("  %-22s %-10s %12.4g %14.6g %12.6g\n", boundary_label(mesh, b.tag).c_str(), b.kind.c_str(),
+                b.area, b.heat_in, b.mean_temperature);
+    boundary_heat += b.heat_in;
   }
-  std::printf("total source power %.6g W; energy balance (sources + boundary heat) %.3g W\n", r.total_power,
-              net);
+  const double imbalance = r.total_power + boundary_heat;
+  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W",
+              r.total_power, boundary_heat, imbalance);
+  const double scale = std::max(std::abs(r.total_power), std::abs(boundary_heat));
+  if (scale > 0) std::printf(" (%.2g of the heat flow)", std::abs(imbalance) / scale);
+  std::printf("\n");
+  for (const ThermalResistance& t : r.resistances) {
+    auto side = [&](const ThermalProbe& probe) {
+      switch (probe.kind) {
+        case ThermalProbeKind::region_max:
+          return "max of region " + region_label(mesh, probe.id);
+        case ThermalProbeKind::region_mean:
+          return "mean of region " + region_label(mesh, probe.id);
+        case ThermalProbeKind::boundary_mean:
+          return "surface mean of boundary " + boundary_label(mesh, probe.id);
+        case ThermalProbeKind::ambient:
+          return "ambient of boundary " + boundary_label(mesh, probe.id);
+      }
+      return std::string();
+    };
+    std::printf("thermal resistance %s %.6g K -> %s %.6g K: dT %.6g K, P %.6g W, theta %.6g K/W; ",
+                side(t.spec.junction).c_str(), t.junction_temperature, side(t.spec.reference).c_str(),
+                t.reference_temperature, t.delta_t, t.power, t.theta);
+    if (std::isnan(t.reference_heat_out))
+      std::printf("no boundary heat at a region reference\n");
+    else
+      std::printf("heat out there %.6g W, dT/heat %.6g K/W\n", t.reference_heat_out, t.path_theta);
+  }
   std::printf(
       "solver %s, %zu nonzeros, %zu iterations, relative residual %.3g; read %.3f s, assemble %.3f s, "
       "solve %.3f s\n",

@@ -23,12 +23,9 @@ const char* kUsage =
     "                 validation; --json for machine-readable output; --check-delaunay\n"
     "  convert IN OUT convert between mesh formats (format from the extension)\n"
     "  order MESH     visibility order for views (--eye, --dir, --views N), with violation counts\n"
-    "  solve MESH|MODEL.toml  --physics thermal: temperatures, heat per boundary; electrostatic: the
-"
-    "                 capacitance matrix; current: resistance, Joule heat; thermoelastic:
-"
-    "                 thermal stress, max von Mises and where; -o OUT.vtu
-"
+    "  solve MESH|MODEL.toml  --physics thermal: temperatures, heat per boundary; electrostatic: the\n"
+    "                 capacitance matrix; current: resistance, Joule heat; thermoelastic:\n"
+    "                 thermal stress, max von Mises and where; -o OUT.vtu\n"
     "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png\n"
     "\n"
     "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"

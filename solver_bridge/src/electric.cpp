@@ -73,6 +73,7 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   std::vector<double> tet_c(nt);
   for (std::size_t t = 0; t < nt; ++t) tet_c[t] = s.coefficient[s.regions.tet_rix[t]];
   const P1Stiffness k = assemble_stiffness(mesh, tet_c, threads);
+  std::vector<double>().swap(tet_c);
   report_progress(options, "assemble", 0.5);
   // The value of each tag is its electrode's index; a node whose tags belong to two electrodes
   // would be averaged between them: refuse it.
@@ -92,14 +93,14 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   }
   check_anchored(mesh, d.fixed, "ill-posed " + problem,
                  "touches no " + kind + ", so its potential is undetermined");
-  const ReducedSystem r = reduce(k, d.fixed);
+  const ReducedSystem r = reduce(k, d.fixed, threads);
   s.unknowns = r.a.rows();
   std::vector<std::vector<double>> rhs(ne);
   std::vector<std::vector<double>> fixed_u(ne, std::vector<double>(nn, 0.0));
   for (std::size_t e = 0; e < ne; ++e) {
     for (std::size_t v = 0; v < nn; ++v)
       if (d.fixed[v]) fixed_u[e][v] = d.value[v] == static_cast<double>(e) ? 1.0 : 0.0;
-    rhs[e] = reduced_rhs(k, r, {}, d.fixed, fixed_u[e]);
+    rhs[e] = reduced_rhs(k, r, {}, d.fixed, fixed_u[e], threads);
   }
   report_progress(options, "assemble", 1.0);
   const auto t1 = clock::now();

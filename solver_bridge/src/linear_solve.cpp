@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <thread>
 
+#include "amg.hpp"
 #include "p1_assembly.hpp"
 
 namespace foxi::detail {
@@ -19,6 +19,8 @@ void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned thread
 namespace {
 
 using SpMat = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+// Vector lengths below which the CG updates stay on one thread.
+constexpr std::size_t kVectorSerialBelow = 50000;
 using Vec = Eigen::VectorXd;
 
 Eigen::Map<const SpMat> as_eigen(const SymmetricCsr& a) {
@@ -42,19 +44,40 @@ double residual_norm(const SymmetricCsr& a, const std::vector<double>& b, const 
 }
 
 // Preconditioned conjugate gradients from x = 0; precondition(r, z) sets z = M^-1 r.
+// Sum of f(i) over [0, n) on threads; the slices' sums are added in slice order, so the result is
+// the same on every run with the same thread count.
+template <class F>
+double parallel_sum(std::size_t n, unsigned threads, F&& f) {
+  std::vector<double> part(threads, 0.0);
+  parallel_for(
+      n, threads,
+      [&](std::size_t b, std::size_t e, unsigned t) {
+        double s = 0;
+        for (std::size_t i = b; i < e; ++i) s += f(i);
+        part[t] = s;
+      },
+      kVectorSerialBelow);
+  double s = 0;
+  for (double v : part) s += v;
+  return s;
+}
+
+// Preconditioned conjugate gradients from x = 0; precondition(r, z) sets z = M^-1 r. The vector
+// updates run on threads, fused so that each iteration reads every vector as few times as it can.
 template <class Precondition>
 void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x, double bnorm,
          const LinearSolverOptions& options, unsigned threads, LinearSolveResult& result,
          Precondition&& precondition) {
   const std::size_t n = a.rows();
   if (bnorm == 0) return;
-  Eigen::Map<Vec> X(x.data(), static_cast<Eigen::Index>(n));
   const double tol = options.relative_tolerance * bnorm;
   const std::size_t max_it = options.max_iterations ? options.max_iterations : 10 * n + 100;
   Vec r = Eigen::Map<const Vec>(b.data(), static_cast<Eigen::Index>(n)), z(static_cast<Eigen::Index>(n));
   precondition(r, z);
   Vec p = z, q(static_cast<Eigen::Index>(n));
-  double rz = r.dot(z);
+  double* xd = x.data();
+  double *rd = r.data(), *zd = z.data(), *pd = p.data(), *qd = q.data();
+  double rz = parallel_sum(n, threads, [&](std::size_t i) { return rd[i] * zd[i]; });
   const double log_goal = std::log(std::max(1e-300, options.relative_tolerance));
   std::size_t it = 0;
   double rnorm = bnorm;
@@ -62,21 +85,29 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
     if (it == max_it)
       throw SolverError("conjugate gradients did not converge in " + std::to_string(max_it) +
                         " iterations (relative residual " + std::to_string(rnorm / bnorm) + ")");
-    multiply(a, p.data(), q.data(), threads);
-    const double pq = p.dot(q);
+    multiply(a, pd, qd, threads);
+    const double pq = parallel_sum(n, threads, [&](std::size_t i) { return pd[i] * qd[i]; });
     if (!(pq > 0))
       throw SolverError(
           "conjugate gradients broke down: the matrix is not positive definite (a part with "
           "no fixed-temperature or convection boundary?)");
     const double alpha = rz / pq;
-    X += alpha * p;
-    r -= alpha * q;
-    rnorm = r.norm();
+    rnorm = std::sqrt(parallel_sum(n, threads, [&](std::size_t i) {
+      xd[i] += alpha * pd[i];
+      rd[i] -= alpha * qd[i];
+      return rd[i] * rd[i];
+    }));
     ++it;
     if (rnorm <= tol) break;
     precondition(r, z);
-    const double rz_new = r.dot(z);
-    p = z + (rz_new / rz) * p;
+    const double rz_new = parallel_sum(n, threads, [&](std::size_t i) { return rd[i] * zd[i]; });
+    const double beta = rz_new / rz;
+    parallel_for(
+        n, threads,
+        [&](std::size_t lo, std::size_t hi, unsigned) {
+          for (std::size_t i = lo; i < hi; ++i) pd[i] = zd[i] + beta * pd[i];
+        },
+        kVectorSerialBelow);
     rz = rz_new;
     if (it % 10 == 0) report(options, "solve", std::clamp(std::log(rnorm / bnorm) / log_goal, 0.0, 1.0));
   }
@@ -84,34 +115,32 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
   result.relative_residual = residual_norm(a, b, x, threads) / bnorm;
 }
 
-// Aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996): aggregates of strongly connected
-// nodes, a tentative prolongation that interpolates the near-null space exactly on each aggregate
-// (constants for scalar diffusion; for elasticity the 6 rigid-body modes, orthonormalised per
-// aggregate by a QR whose R factors become the coarse level's near-null space), smoothed by one damped
-// Jacobi step for scalar problems (smoothed aggregation), Galerkin coarse operators, symmetric
-// (hybrid) Gauss-Seidel V(1,1) cycles, LDL^T on the coarsest level. One V-cycle is a symmetric
-// positive definite preconditioner for CG.
-class Amg {
+// Aggregation algebraic multigrid for systems with several unknowns per node (elasticity): aggregates
+// of strongly connected nodes, a tentative prolongation that interpolates the near-null space (the 6
+// rigid-body modes) exactly on each aggregate, orthonormalised per aggregate by a QR whose R factors
+// become the coarse level's near-null space; Galerkin coarse operators, symmetric (hybrid)
+// Gauss-Seidel V(1,1) cycles, LDL^T on the coarsest level. Scalar problems use the smoothed-aggregation
+// AMG on plain arrays in amg.cpp. TODO: move this block variant onto amg.cpp's CSR machinery too.
+class BlockAmg {
  public:
-  Amg(const SymmetricCsr& a, const NearNullSpace* near_null) {
+  BlockAmg(const SymmetricCsr& a, const NearNullSpace& near_null) {
     RMat fine = Eigen::Map<const RMat>(
         static_cast<Eigen::Index>(a.rows()), static_cast<Eigen::Index>(a.rows()),
         static_cast<Eigen::Index>(a.val.size()), a.start.data(), a.col.data(), a.val.data());
     levels_.push_back({std::move(fine), {}, {}, {}, 1, {}});
-    NearNullSpace ns;
-    if (near_null) ns = *near_null;
+    NearNullSpace ns = near_null;
     // Block problems: coarse levels are nearly dense (6 unknowns per aggregate, wide stencils), so
     // coarsen further and factorize the coarsest level densely.
-    const Eigen::Index coarsest = near_null ? kCoarsestBlock : kCoarsest;
+    const Eigen::Index coarsest = kCoarsestBlock;
     while (levels_.back().a.rows() > coarsest && levels_.size() < 12) {
       Level& l = levels_.back();
       l.diag = l.a.diagonal();
-      RMat tentative = near_null ? block_tentative(l.a, ns) : scalar_tentative(l.a);
+      RMat tentative = block_tentative(l.a, ns);
       if (tentative.cols() == 0 || tentative.cols() >= l.a.rows() * 9 / 10) break;  // no longer coarsening
       // Block problems keep the tentative prolongation (plain aggregation): smoothing it made the
       // coarse operators 3.5 times denser and the setup 4 times slower for 35% fewer CG iterations
       // (250k tets), a net loss.
-      RMat p = near_null ? std::move(tentative) : smooth(l.a, l.diag, tentative);
+      RMat p = std::move(tentative);
       RMat r = p.transpose();
       RMat ap = product(l.a, p);
       RMat coarse = product(r, ap);
@@ -121,7 +150,7 @@ class Amg {
     }
     levels_.back().diag = levels_.back().a.diagonal();
     for (Level& l : levels_) prepare_smoother(l);
-    if (near_null && levels_.back().a.rows() <= 3 * kCoarsestBlock) {
+    if (levels_.back().a.rows() <= 3 * kCoarsestBlock) {
       dense_coarse_.compute(Eigen::MatrixXd(levels_.back().a));
       if (dense_coarse_.info() != Eigen::Success)
         throw SolverError("AMG: the coarsest system could not be factorized");
@@ -137,7 +166,7 @@ class Amg {
 
  private:
   using RMat = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
-  static constexpr Eigen::Index kCoarsest = 2000, kCoarsestBlock = 600;
+  static constexpr Eigen::Index kCoarsestBlock = 600;
   struct Level {
     RMat a, p, r;
     Vec diag;
@@ -214,32 +243,6 @@ class Amg {
     for (std::size_t i = 0; i < n; ++i)
       if (agg[i] < 0) agg[i] = count++;
     return agg;
-  }
-
-  // Scalar problems: aggregates of unknowns, constants on each.
-  static RMat scalar_tentative(const RMat& a) {
-    const Eigen::Index n = a.rows();
-    // Strong: |a_ij| at least theta times the largest off-diagonal magnitude of row i (relative to the
-    // row, so that the wide stencils of coarse levels still have strong connections).
-    const double theta = 0.25;
-    const int* start = a.outerIndexPtr();
-    const int* col = a.innerIndexPtr();
-    const double* val = a.valuePtr();
-    std::vector<double> row_max(static_cast<std::size_t>(n), 0.0);
-    for (Eigen::Index i = 0; i < n; ++i)
-      for (int k = start[i]; k < start[i + 1]; ++k)
-        if (col[k] != i) row_max[i] = std::max(row_max[i], std::abs(val[k]));
-    auto strong = [&](std::size_t i, int k) {
-      return col[k] != static_cast<int>(i) && std::abs(val[k]) >= theta * row_max[i] && row_max[i] > 0;
-    };
-    int count = 0;
-    const std::vector<int> agg = aggregate(static_cast<std::size_t>(n), start, col, val, strong, count);
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<std::size_t>(n));
-    for (Eigen::Index i = 0; i < n; ++i) t.emplace_back(static_cast<int>(i), agg[i], 1.0);
-    RMat tentative(n, count);
-    tentative.setFromTriplets(t.begin(), t.end());
-    return tentative;
   }
 
   // Systems of several unknowns per node: aggregates of nodes (strength from the Frobenius norms of
@@ -334,28 +337,6 @@ class Amg {
     tentative.setFromTriplets(t.begin(), t.end());
     ns = std::move(coarse);
     return tentative;
-  }
-
-  // P = (I - w D^-1 A) P_tent, w = 4 / (3 rho(D^-1 A)).
-  static RMat smooth(const RMat& a, const Vec& diag, const RMat& tentative) {
-    const double omega = 4.0 / (3.0 * spectral_radius(a, diag));
-    RMat ap = product(a, tentative);
-    Vec scale = -omega * diag.cwiseInverse();
-    RMat p = tentative + RMat(scale.asDiagonal() * ap);
-    p.prune(0.0);
-    return p;
-  }
-
-  // rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%).
-  static double spectral_radius(const RMat& a, const Vec& diag) {
-    Vec v = Vec::LinSpaced(a.rows(), 1.0, 2.0);
-    double rho = 1;
-    for (int it = 0; it < 10; ++it) {
-      Vec w = (a * v).cwiseQuotient(diag);
-      rho = w.norm() / v.norm();
-      v = w / w.norm();
-    }
-    return 1.05 * rho;
   }
 
   static void prepare_smoother(Level& l) {
@@ -515,11 +496,19 @@ LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::v
     }
   };
   if (kind == LinearSolverKind::cg_amg) {
-    result.solver = near_null ? "CG+AggregationAMG(rigid-body modes)" : "CG+SmoothedAggregationAMG";
-    Amg amg(a, near_null);
-    result.levels = amg.level_count();
-    report(options, "solve", 0.0);
-    run_all([&](const Vec& r, Vec& z) { amg.apply(r, z); });
+    if (near_null) {
+      result.solver = "CG+AggregationAMG(rigid-body modes)";
+      BlockAmg amg(a, *near_null);
+      result.levels = amg.level_count();
+      report(options, "solve", 0.0);
+      run_all([&](const Vec& r, Vec& z) { amg.apply(r, z); });
+    } else {
+      result.solver = "CG+SmoothedAggregationAMG";
+      AmgPreconditioner amg(a, threads);
+      result.levels = amg.level_count();
+      report(options, "solve", 0.0);
+      run_all([&](const Vec& r, Vec& z) { amg.apply(r.data(), z.data()); });
+    }
   } else {
     result.solver = "CG+IncompleteCholesky";
     Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> ic;

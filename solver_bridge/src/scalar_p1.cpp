@@ -129,21 +129,22 @@ P1Stiffness assemble_stiffness(const Mesh& mesh, const std::vector<double>& tet_
   k.val.assign(k.pat.col.size(), 0.0);
   parallel_for(mesh.node_count(), threads, [&](std::size_t b, std::size_t e, unsigned) {
     std::array<std::array<double, 3>, 4> g;
+    // Position of each column of the current row in val (a dense map, set row by row: O(1) lookups).
+    std::vector<std::size_t> slot(mesh.node_count());
     for (std::size_t v = b; v < e; ++v) {
-      const std::size_t rs = k.pat.row_start[v], re = k.pat.row_start[v + 1];
+      for (std::size_t pos = k.pat.row_start[v]; pos < k.pat.row_start[v + 1]; ++pos)
+        slot[k.pat.col[pos]] = pos;
       for (std::size_t i = k.ntets.node_start[v]; i < k.ntets.node_start[v + 1]; ++i) {
         const std::size_t t = k.ntets.item[i] >> 2;
         const unsigned a = k.ntets.item[i] & 3u;
         const double cv = tet_coefficient[t] * p1_gradients(mesh, t, g);
-        for (unsigned c = 0; c < 4; ++c) {
-          const std::uint32_t col = mesh.tet[4 * t + c];
-          std::size_t pos = rs;
-          while (pos < re && k.pat.col[pos] != col) ++pos;
-          k.val[pos] += cv * (g[a][0] * g[c][0] + g[a][1] * g[c][1] + g[a][2] * g[c][2]);
-        }
+        for (unsigned c = 0; c < 4; ++c)
+          k.val[slot[mesh.tet[4 * t + c]]] +=
+              cv * (g[a][0] * g[c][0] + g[a][1] * g[c][1] + g[a][2] * g[c][2]);
       }
     }
   });
+  std::vector<std::uint32_t>().swap(k.ntets.item);
   return k;
 }
 
@@ -216,39 +217,62 @@ void check_anchored(const Mesh& mesh, const std::vector<char>& anchored_node, co
                         region_label(mesh, mesh.region_of(t)) + ") " + what);
 }
 
-ReducedSystem reduce(const P1Stiffness& k, const std::vector<char>& fixed) {
+ReducedSystem reduce(const P1Stiffness& k, const std::vector<char>& fixed, unsigned threads) {
   const std::size_t nn = k.pat.rows();
   ReducedSystem r;
   r.dof.assign(nn, -1);
   int nfree = 0;
   for (std::size_t v = 0; v < nn; ++v)
     if (!fixed[v] && k.has_tets(v)) r.dof[v] = nfree++;
-  r.a.start.reserve(static_cast<std::size_t>(nfree) + 1);
-  r.a.start.push_back(0);
-  r.a.col.reserve(k.pat.col.size());
-  r.a.val.reserve(k.pat.col.size());
-  for (std::size_t v = 0; v < nn; ++v) {
-    if (r.dof[v] < 0) continue;
-    for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i)
-      if (const int c = r.dof[k.pat.col[i]]; c >= 0) {
-        r.a.col.push_back(c);
-        r.a.val.push_back(k.val[i]);
-      }
-    r.a.start.push_back(static_cast<int>(r.a.col.size()));
+  const auto nf = static_cast<std::size_t>(nfree);
+  std::vector<std::size_t> node(nf);  // the node of each free row
+  for (std::size_t v = 0; v < nn; ++v)
+    if (r.dof[v] >= 0) node[static_cast<std::size_t>(r.dof[v])] = v;
+  // Two passes over the rows on threads: the length of each reduced row, then its entries in place.
+  r.a.start.assign(nf + 1, 0);
+  parallel_for(nf, threads, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t i = b; i < e; ++i) {
+      int n = 0;
+      for (std::size_t j = k.pat.row_start[node[i]]; j < k.pat.row_start[node[i] + 1]; ++j)
+        n += r.dof[k.pat.col[j]] >= 0;
+      r.a.start[i + 1] = n;
+    }
+  });
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < nf; ++i) {
+    total += static_cast<std::size_t>(r.a.start[i + 1]);
+    if (total > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+      throw SolverError("the system has more than 2^31 nonzeros");
+    r.a.start[i + 1] = static_cast<int>(total);
   }
+  r.a.col.resize(total);
+  r.a.val.resize(total);
+  parallel_for(nf, threads, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t i = b; i < e; ++i) {
+      auto at = static_cast<std::size_t>(r.a.start[i]);
+      for (std::size_t j = k.pat.row_start[node[i]]; j < k.pat.row_start[node[i] + 1]; ++j)
+        if (const int c = r.dof[k.pat.col[j]]; c >= 0) {
+          r.a.col[at] = c;
+          r.a.val[at++] = k.val[j];
+        }
+    }
+  });
   return r;
 }
 
 std::vector<double> reduced_rhs(const P1Stiffness& k, const ReducedSystem& r, const std::vector<double>& load,
-                                const std::vector<char>& fixed, const std::vector<double>& u_fixed) {
+                                const std::vector<char>& fixed, const std::vector<double>& u_fixed,
+                                unsigned threads) {
   std::vector<double> rhs(r.a.rows());
-  for (std::size_t v = 0; v < r.dof.size(); ++v) {
-    if (r.dof[v] < 0) continue;
-    double s = load.empty() ? 0.0 : load[v];
-    for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i)
-      if (fixed[k.pat.col[i]]) s -= k.val[i] * u_fixed[k.pat.col[i]];
-    rhs[static_cast<std::size_t>(r.dof[v])] = s;
-  }
+  parallel_for(r.dof.size(), threads, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t v = b; v < e; ++v) {
+      if (r.dof[v] < 0) continue;
+      double s = load.empty() ? 0.0 : load[v];
+      for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i)
+        if (fixed[k.pat.col[i]]) s -= k.val[i] * u_fixed[k.pat.col[i]];
+      rhs[static_cast<std::size_t>(r.dof[v])] = s;
+    }
+  });
   return rhs;
 }
 

@@ -56,6 +56,8 @@ std::vector<double> tet_volumes(const Mesh& mesh, const RegionTable& regions, un
                                 std::vector<double>& region_volume);
 
 // The matrix of sum_t c_t int grad(phi_i) . grad(phi_j) on the node pattern (rows split over threads).
+// Of the node-to-tet map only node_start is kept after assembly (ntets.item is released: it is as
+// large as the tets, and a big solve needs that memory for the multigrid hierarchy).
 struct P1Stiffness {
   NodeTets ntets;
   CsrPattern pat;
@@ -96,15 +98,16 @@ std::vector<std::int32_t> boundary_tag_list(const Mesh& mesh);
 void check_anchored(const Mesh& mesh, const std::vector<char>& anchored, const std::string& problem,
                     const std::string& what);
 
-// The system on the free nodes (nodes with tets that are not fixed).
+// The system on the free nodes (nodes with tets that are not fixed), rows split over `threads`.
 struct ReducedSystem {
   std::vector<int> dof;  // per node, -1 when fixed or without tets
   SymmetricCsr a;
 };
-ReducedSystem reduce(const P1Stiffness& k, const std::vector<char>& fixed);
+ReducedSystem reduce(const P1Stiffness& k, const std::vector<char>& fixed, unsigned threads = 1);
 // Right-hand side load - K_free,fixed u_fixed.
 std::vector<double> reduced_rhs(const P1Stiffness& k, const ReducedSystem& r, const std::vector<double>& load,
-                                const std::vector<char>& fixed, const std::vector<double>& u_fixed);
+                                const std::vector<char>& fixed, const std::vector<double>& u_fixed,
+                                unsigned threads = 1);
 // Writes the free values x into u.
 void scatter(const ReducedSystem& r, const std::vector<double>& x, std::vector<double>& u);
 // (K u - load) at the fixed nodes (0 elsewhere), summed into the slots by lumped-area shares.

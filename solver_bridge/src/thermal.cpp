@@ -32,6 +32,94 @@ struct TagBc {
   std::size_t report = 0;
 };
 
+const char* probe_name(ThermalProbeKind kind) {
+  switch (kind) {
+    case ThermalProbeKind::region_max:
+      return "maximum temperature";
+    case ThermalProbeKind::region_mean:
+      return "mean temperature";
+    case ThermalProbeKind::boundary_mean:
+      return "mean surface temperature";
+    case ThermalProbeKind::ambient:
+      return "ambient temperature";
+  }
+  return "temperature";
+}
+
+bool is_region_probe(ThermalProbeKind kind) {
+  return kind == ThermalProbeKind::region_max || kind == ThermalProbeKind::region_mean;
+}
+
+// Throws SolverError when the probe names a region without tets, a tag on no boundary triangle, or
+// the ambient of a tag that does not convect.
+void check_probe(const Mesh& mesh, const ThermalProbe& probe, const detail::RegionTable& regions,
+                 const std::vector<std::int32_t>& tags, const std::map<std::int32_t, TagBc>& bc) {
+  const std::string what = std::string("thermal resistance: the ") + probe_name(probe.kind) + " of ";
+  if (is_region_probe(probe.kind)) {
+    if (regions.index(probe.id) == SIZE_MAX)
+      throw SolverError(what + region_label(mesh, probe.id) + ", which has no tets");
+    return;
+  }
+  if (!std::binary_search(tags.begin(), tags.end(), probe.id))
+    throw SolverError(what + tag_label(mesh, probe.id) + ", which tags no boundary triangle");
+  if (probe.kind == ThermalProbeKind::ambient) {
+    auto it = bc.find(probe.id);
+    if (it == bc.end() || it->second.kind != BcKind::convection)
+      throw SolverError(what + tag_label(mesh, probe.id) + ": it has no convection condition");
+  }
+}
+
+// Area mean of the P1 temperature over the triangles of `tag` (the plain mean of their nodes when
+// they all have zero area).
+double boundary_mean_temperature(const Mesh& mesh, std::int32_t tag, const std::vector<double>& temp) {
+  double sum = 0, area = 0, plain = 0;
+  std::size_t n = 0;
+  for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
+    if (mesh.bface_tag[f] != tag) continue;
+    const std::uint32_t* v = &mesh.bface[3 * f];
+    const double a = detail::triangle_area(mesh, f), t = temp[v[0]] + temp[v[1]] + temp[v[2]];
+    sum += a * t / 3;
+    area += a;
+    plain += t;
+    n += 3;
+  }
+  return area > 0 ? sum / area : plain / static_cast<double>(n);
+}
+
+// The probe's temperature from the solved nodal temperatures and the region table of the report.
+double probe_temperature(const Mesh& mesh, const ThermalProbe& probe, const ThermalReport& rep,
+                         const std::vector<double>& temp, const std::map<std::int32_t, TagBc>& bc) {
+  if (is_region_probe(probe.kind)) {
+    for (const RegionTemperature& r : rep.regions)
+      if (r.region == probe.id)
+        return probe.kind == ThermalProbeKind::region_max ? r.max_temperature : r.mean_temperature;
+  }
+  if (probe.kind == ThermalProbeKind::ambient) return bc.at(probe.id).b;
+  return boundary_mean_temperature(mesh, probe.id, temp);
+}
+
+ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceSpec& spec,
+                                      const ThermalReport& rep, const std::vector<double>& temp,
+                                      const std::map<std::int32_t, TagBc>& bc) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  ThermalResistance r;
+  r.spec = spec;
+  r.junction_temperature = probe_temperature(mesh, spec.junction, rep, temp, bc);
+  r.reference_temperature = probe_temperature(mesh, spec.reference, rep, temp, bc);
+  r.delta_t = r.junction_temperature - r.reference_temperature;
+  r.power = rep.total_power;
+  for (const BoundaryHeat& b : rep.boundaries)
+    if (b.kind == "flux") r.power += b.heat_in;
+  r.theta = r.power != 0 ? r.delta_t / r.power : nan;
+  // An insulated reference boundary takes no heat; a region reference has no boundary heat at all.
+  r.reference_heat_out = is_region_probe(spec.reference.kind) ? nan : 0.0;
+  for (const BoundaryHeat& b : rep.boundaries)
+    if (!is_region_probe(spec.reference.kind) && b.tag == spec.reference.id)
+      r.reference_heat_out = -b.heat_in;
+  r.path_theta = r.reference_heat_out != 0 ? r.delta_t / r.reference_heat_out : nan;
+  return r;
+}
+
 }  // namespace
 
 ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
@@ -91,6 +179,10 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
         "ill-posed thermal problem: no boundary has a fixed temperature or convection, so the "
         "temperature is determined only up to a constant (and a net heat input has no way out); "
         "fix a temperature or add convection on at least one boundary tag");
+  for (const ThermalResistanceSpec& spec : params.resistances) {
+    check_probe(mesh, spec.junction, regions, tags, bc);
+    check_probe(mesh, spec.reference, regions, tags, bc);
+  }
   for (auto& [tag, t] : bc) {
     t.report = rep.boundaries.size();
     BoundaryHeat h;
@@ -130,6 +222,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   std::vector<double> tet_k(nt);
   for (std::size_t t = 0; t < nt; ++t) tet_k[t] = region_k[tet_rix[t]];
   detail::P1Stiffness stiff = detail::assemble_stiffness(mesh, tet_k, threads);
+  std::vector<double>().swap(tet_k);  // not needed again; the solve needs the memory
   const detail::CsrPattern& pat = stiff.pat;
   std::vector<double>& kval = stiff.val;
   std::vector<double> load(nn, 0.0);
@@ -198,8 +291,8 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   }
 
   // Free unknowns and the reduced system.
-  const detail::ReducedSystem red = detail::reduce(stiff, fixed);
-  const std::vector<double> rhs = detail::reduced_rhs(stiff, red, load, fixed, temp);
+  const detail::ReducedSystem red = detail::reduce(stiff, fixed, threads);
+  const std::vector<double> rhs = detail::reduced_rhs(stiff, red, load, fixed, temp, threads);
   rep.unknowns = red.a.rows();
   rep.nonzeros = red.a.val.size();
   progress("assemble", 1.0);
@@ -276,6 +369,9 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
       rep.max_temperature = r.max_temperature;
       rep.max_node = r.max_node;
     }
+  for (BoundaryHeat& b : rep.boundaries) b.mean_temperature = boundary_mean_temperature(mesh, b.tag, temp);
+  for (const ThermalResistanceSpec& spec : params.resistances)
+    rep.resistances.push_back(evaluate_resistance(mesh, spec, rep, temp, bc));
 
   Field temp_field;
   temp_field.name = "temperature";

@@ -84,6 +84,25 @@ TEST_F(SolveCliTest, CapacitanceAndResistanceOfTheCube) {
   EXPECT_EQ(foxi("solve " + mesh() + " --physics electrostatic --conductor 1=a --fix 2=3 --eps 1=1"), 2);
 }
 
+// The unit cube held at 300 K at x = 0, 100 W/m^2 into x = 1, k = 2: theta = L / (k A) = 0.5 K/W from
+// the hottest node to boundary 1, and with a 5 W/(m^2 K) film on x = 0 instead, theta_JA adds 1 / (h A).
+TEST_F(SolveCliTest, ThetaIsTheSlabResistance) {
+  ASSERT_EQ(foxi("solve " + mesh() + " --fix 1=300 --flux 2=100 --k 1=2 --theta 1:1"), 0)
+      << test::read_text(dir_ / "out.log");
+  std::string log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("dT 50 K, P 100 W, theta 0.5 K/W; heat out there 100 W, dT/heat 0.5 K/W"),
+            std::string::npos)
+      << log;
+  ASSERT_EQ(foxi("solve " + mesh() + " --convect 1=5,300 --flux 2=100 --k 1=2 --theta max=1:ambient=1"), 0)
+      << test::read_text(dir_ / "out.log");
+  log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("theta 0.7 K/W"), std::string::npos) << log;
+  EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300 --flux 2=100 --k 1=2 --theta 1:ambient=1"), 1);
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("no convection condition"), std::string::npos);
+  EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300 --k 1=2 --theta 1"), 2);
+  EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300 --k 1=2 --theta hottest=1:1"), 2);
+}
+
 TEST_F(SolveCliTest, BadInputGivesClearErrors) {
   EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300"), 1);  // no conductivity
   EXPECT_NE(test::read_text(dir_ / "out.log").find("region 1 has no thermal conductivity"),

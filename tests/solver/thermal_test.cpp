@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "../../bench/bench_meshes.hpp"
 #include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/validate.hpp"
 #include "test_util.hpp"
@@ -55,10 +56,10 @@ std::string box_poly(double split) {
   return s.str();
 }
 
-// Meshes the box with TetGen (quality 1.414, max volume `max_volume`) and reads it back.
-Mesh box_mesh(double max_volume, double split = 0) {
+// Meshes a PLC with TetGen (quality 1.414, max volume `max_volume`) and reads it back.
+Mesh tetgen_mesh(const std::string& poly, double max_volume) {
   test::TempDir dir;
-  test::write_text(dir / "box.poly", box_poly(split));
+  test::write_text(dir / "box.poly", poly);
   std::ostringstream cmd;
   cmd << "tetgen -pq1.414AQa" << max_volume << " '" << (dir / "box.poly").string() << "'";
   if (test::run(cmd.str(), dir / "log") != 0)
@@ -67,6 +68,8 @@ Mesh box_mesh(double max_volume, double split = 0) {
   validate_and_repair(mesh);
   return mesh;
 }
+
+Mesh box_mesh(double max_volume, double split = 0) { return tetgen_mesh(box_poly(split), max_volume); }
 
 double x_of(const Mesh& m, std::size_t v) { return m.xyz[3 * v]; }
 
@@ -245,6 +248,9 @@ TEST_F(ThermalTest, ConvectionBoundaryMatchesRobinSolution) {
   EXPECT_LT(max_nodal_error(m, [&](double x) { return t0 + flux * x / k; }), 1e-10 * tinf);
   EXPECT_NEAR(heat_of(r, 2).heat_in, flux * kArea, 1e-9 * flux * kArea);
   EXPECT_NEAR(heat_of(r, 1).heat_in, -flux * kArea, 1e-9 * flux * kArea);
+  // The cooled surface sits between the wall and the air: T(L) = T0 + flux L / k.
+  EXPECT_NEAR(heat_of(r, 2).mean_temperature, t0 + flux * kL / k, 1e-9 * tinf);
+  EXPECT_NEAR(heat_of(r, 1).mean_temperature, t0, 1e-12 * t0);
 }
 
 // Convection only (no fixed temperature) with a source: T at the cooled end is Tinf + P / (h A).
@@ -283,6 +289,137 @@ void expect_error(Mesh& m, const ThermalParams& p, const std::string& words) {
   } catch (const SolverError& e) {
     EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
   }
+}
+
+// The box split along y at `split` into regions 1 (y < split) and 2, both spanning x = 0 .. kL: two
+// conductors in parallel. Facet markers as box_poly: 1 at x = 0, 2 at x = kL, 3 the sides, 4 the
+// interface.
+Mesh parallel_box_mesh(double max_volume, double split) {
+  const double ys[3] = {0, split, kW};
+  auto id = [](int ix, int iy, int iz) { return 1 + 6 * ix + 2 * iy + iz; };
+  std::ostringstream s;
+  s.precision(17);
+  s << "12 3 0 0\n";
+  for (int ix = 0; ix < 2; ++ix)
+    for (int iy = 0; iy < 3; ++iy)
+      for (int iz = 0; iz < 2; ++iz)
+        s << id(ix, iy, iz) << ' ' << ix * kL << ' ' << ys[iy] << ' ' << iz * kW << '\n';
+  s << "11 1\n";
+  auto quad = [&](int a, int b, int c, int d, int marker) {
+    s << "1 0 " << marker << "\n4 " << a << ' ' << b << ' ' << c << ' ' << d << '\n';
+  };
+  for (int ix = 0; ix < 2; ++ix)
+    for (int iy = 0; iy < 2; ++iy)
+      quad(id(ix, iy, 0), id(ix, iy + 1, 0), id(ix, iy + 1, 1), id(ix, iy, 1), 1 + ix);
+  for (int iy = 0; iy < 3; iy += 2) quad(id(0, iy, 0), id(1, iy, 0), id(1, iy, 1), id(0, iy, 1), 3);
+  for (int iz = 0; iz < 2; ++iz)
+    for (int iy = 0; iy < 2; ++iy)
+      quad(id(0, iy, iz), id(1, iy, iz), id(1, iy + 1, iz), id(0, iy + 1, iz), 3);
+  quad(id(0, 1, 0), id(1, 1, 0), id(1, 1, 1), id(0, 1, 1), 4);
+  s << "0\n2\n";
+  s << "1 " << kL / 2 << ' ' << split / 2 << ' ' << kW / 2 << " 1 0\n";
+  s << "2 " << kL / 2 << ' ' << (split + kW) / 2 << ' ' << kW / 2 << " 2 0\n";
+  return tetgen_mesh(s.str(), max_volume);
+}
+
+ThermalResistanceSpec theta_spec(ThermalProbeKind junction, std::int32_t j, ThermalProbeKind reference,
+                                 std::int32_t r) {
+  return {{junction, j}, {reference, r}};
+}
+
+// Fixed T0 at x = 0, flux q into x = L: the hottest point (x = L) is T0 + q L / k and the power q A,
+// so junction-to-end theta = L / (k A), the conductance of a slab; the volume mean sits half-way.
+TEST_F(ThermalTest, SlabThermalResistanceIsLengthOverConductance) {
+  Mesh m = box_mesh(0.002);
+  const double k = 2.5, t0 = 300, q = 400;
+  ThermalParams p;
+  p.conductivity = {{1, k}};
+  p.fixed = {{1, t0}};
+  p.flux = {{2, q}};
+  using K = ThermalProbeKind;
+  p.resistances = {theta_spec(K::region_max, 1, K::boundary_mean, 1),
+                   theta_spec(K::boundary_mean, 2, K::boundary_mean, 1),
+                   theta_spec(K::region_mean, 1, K::boundary_mean, 1)};
+  const ThermalReport r = solve_thermal(m, p);
+  ASSERT_EQ(r.resistances.size(), 3u);
+  const double theta = kL / (k * kArea);
+  for (int i = 0; i < 2; ++i) {
+    const ThermalResistance& t = r.resistances[static_cast<std::size_t>(i)];
+    EXPECT_NEAR(t.power, q * kArea, 1e-12 * q);
+    EXPECT_NEAR(t.junction_temperature, t0 + q * kL / k, 1e-9 * t0);
+    EXPECT_NEAR(t.reference_temperature, t0, 1e-12 * t0);
+    EXPECT_NEAR(t.theta, theta, 1e-9 * theta);
+    EXPECT_NEAR(t.reference_heat_out, q * kArea, 1e-9 * q * kArea);  // all the heat leaves at x = 0
+    EXPECT_NEAR(t.path_theta, theta, 1e-9 * theta);
+  }
+  EXPECT_NEAR(r.resistances[2].theta, theta / 2, 1e-9 * theta);
+}
+
+// Two materials in series between a heat flux and a convective end: the resistances add,
+// theta_JA = 1 / (h A) + L1 / (k1 A) + L2 / (k2 A), and to the cooled surface without the film term.
+TEST_F(ThermalTest, SeriesThermalResistancesAdd) {
+  Mesh m = box_mesh(0.002, 0.3);
+  const double k1 = 1.5, k2 = 6, h = 20, tinf = 290, q = 300, l1 = 0.3, l2 = kL - 0.3;
+  ThermalParams p;
+  p.conductivity = {{1, k1}, {2, k2}};
+  p.convection = {{1, h, tinf}};
+  p.flux = {{2, q}};
+  using K = ThermalProbeKind;
+  p.resistances = {theta_spec(K::region_max, 2, K::ambient, 1),
+                   theta_spec(K::region_max, 2, K::boundary_mean, 1),
+                   theta_spec(K::region_max, 1, K::boundary_mean, 1)};
+  const ThermalReport r = solve_thermal(m, p);
+  const double film = 1 / (h * kArea), r1 = l1 / (k1 * kArea), r2 = l2 / (k2 * kArea);
+  const double expected[3] = {film + r1 + r2, r1 + r2, r1};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(r.resistances[i].theta, expected[i], 1e-9 * expected[i]) << i;
+    EXPECT_NEAR(r.resistances[i].path_theta, expected[i], 1e-9 * expected[i]) << i;
+  }
+  EXPECT_NEAR(r.resistances[0].reference_temperature, tinf, 1e-12);
+}
+
+// Two materials side by side between two fixed temperatures: no power at all, so theta is undefined,
+// and the path resistance is the parallel combination 1 / (k1 A1 / L + k2 A2 / L).
+TEST_F(ThermalTest, ParallelThermalResistancesCombine) {
+  const double split = 0.1, k1 = 2, k2 = 7, t0 = 300, t1 = 350;
+  Mesh m = parallel_box_mesh(0.002, split);
+  ThermalParams p;
+  p.conductivity = {{1, k1}, {2, k2}};
+  p.fixed = {{1, t0}, {2, t1}};
+  using K = ThermalProbeKind;
+  p.resistances = {theta_spec(K::boundary_mean, 2, K::boundary_mean, 1)};
+  const ThermalReport r = solve_thermal(m, p);
+  const double expected = 1 / (k1 * split * kW / kL + k2 * (kW - split) * kW / kL);
+  const ThermalResistance& t = r.resistances[0];
+  EXPECT_NEAR(t.delta_t, t1 - t0, 1e-9);
+  EXPECT_EQ(t.power, 0.0);
+  EXPECT_TRUE(std::isnan(t.theta));
+  EXPECT_NEAR(t.path_theta, expected, 1e-9 * expected);
+  EXPECT_NEAR(region_of(r, 1).volume, split * kW * kL, 1e-12);
+}
+
+TEST_F(ThermalTest, ThermalResistanceProbesAreChecked) {
+  Mesh m = box_mesh(0.01);
+  ThermalParams p;
+  p.conductivity = {{1, 1}};
+  p.fixed = {{1, 300}};
+  p.flux = {{2, 10}};
+  using K = ThermalProbeKind;
+  ThermalParams ambient = p;
+  ambient.resistances = {theta_spec(K::region_max, 1, K::ambient, 1)};
+  expect_error(m, ambient, "boundary tag 1: it has no convection condition");
+  ThermalParams region = p;
+  region.resistances = {theta_spec(K::region_max, 5, K::boundary_mean, 1)};
+  expect_error(m, region, "maximum temperature of region 5, which has no tets");
+  ThermalParams tag = p;
+  tag.resistances = {theta_spec(K::region_max, 1, K::boundary_mean, 8)};
+  expect_error(m, tag, "boundary tag 8, which tags no boundary triangle");
+  // An insulated reference takes no heat: the path resistance is undefined, theta is not.
+  p.resistances = {theta_spec(K::region_max, 1, K::boundary_mean, 3)};
+  const ThermalReport r = solve_thermal(m, p);
+  EXPECT_EQ(r.resistances[0].reference_heat_out, 0.0);
+  EXPECT_TRUE(std::isnan(r.resistances[0].path_theta));
+  EXPECT_GT(r.resistances[0].theta, 0.0);
 }
 
 TEST_F(ThermalTest, IllPosedAndIncompleteProblemsGiveClearErrors) {
@@ -337,6 +474,28 @@ TEST_F(ThermalTest, FloatingPartIsIllPosed) {
   const ThermalReport r = solve_thermal(m, p);
   EXPECT_NEAR(region_of(r, 2).max_temperature, 300, 1e-9);  // no source: it settles at T_inf
   EXPECT_NEAR(region_of(r, 2).mean_temperature, 300, 1e-9);
+}
+
+// A jittered Kuhn grid with more unknowns than the AMG keeps on one thread (20,000 rows): the hybrid
+// Gauss-Seidel smoother (each thread its own block of rows) must converge like the serial one, to the
+// exact linear profile between two fixed ends (exact for P1, so what is left is solver error).
+TEST(ThermalAmg, ThreadedHierarchyReachesTheExactLinearProfile) {
+  Mesh m = bench::kuhn_grid_mesh(28, 0.15, 7);
+  ThermalParams p;
+  p.conductivity = {{1, 2.0}, {2, 2.0}};
+  p.fixed = {{1, 300}, {2, 500}};
+  p.solver.kind = LinearSolverKind::cg_amg;
+  p.solver.relative_tolerance = 1e-12;
+  for (unsigned threads : {2u, 3u}) {  // one thread: the smaller meshes above
+    p.solver.threads = threads;
+    const ThermalReport r = solve_thermal(m, p);
+    ASSERT_GT(r.unknowns, 20000u);
+    std::printf("[ amg ] %u threads: %zu unknowns, %zu iterations\n", threads, r.unknowns, r.iterations);
+    EXPECT_LT(r.iterations, 30u) << threads << " threads";
+    EXPECT_LT(r.relative_residual, 1e-12);
+    EXPECT_LT(max_nodal_error(m, [](double x) { return 300 + 200 * x; }), 1e-8) << threads << " threads";
+    EXPECT_NEAR(heat_of(r, 2).heat_in, 2.0 * 200, 1e-7);  // k dT/L over the unit square
+  }
 }
 
 TEST_F(ThermalTest, ProgressCanCancel) {

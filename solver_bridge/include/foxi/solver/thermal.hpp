@@ -71,6 +71,25 @@ struct RegionConductivity {
   double k = 0;  // W/(m K), > 0
 };
 
+// One side of a thermal resistance: a temperature read off the solution.
+enum class ThermalProbeKind : std::uint8_t {
+  region_max,     // the largest nodal temperature of a region (JEDEC's junction: the hottest point)
+  region_mean,    // the volume mean of a region
+  boundary_mean,  // the area mean of a boundary tag's surface temperature (a case or board temperature)
+  ambient,        // T_inf of a convection boundary tag (JEDEC's theta_JA reference)
+};
+struct ThermalProbe {
+  ThermalProbeKind kind = ThermalProbeKind::region_max;
+  std::int32_t id = 0;  // region id for region_*, boundary tag otherwise
+};
+
+// A thermal resistance to report, e.g. theta_JC = junction {region_max, die} to reference
+// {boundary_mean, case}, or theta_JA = ... to {ambient, convective tag}.
+struct ThermalResistanceSpec {
+  ThermalProbe junction;
+  ThermalProbe reference{ThermalProbeKind::boundary_mean, 0};
+};
+
 struct ThermalParams {
   // Overrides the region's material's thermal_conductivity; every region with tets needs one of the two.
   std::vector<RegionConductivity> conductivity;
@@ -82,6 +101,8 @@ struct ThermalParams {
   // true takes h T at the centroid instead (h A/9 for every pair), which is what CalculiX does for
   // *FILM on C3D4 faces: less accurate, but it reproduces ccx to its output precision.
   bool convection_centroid_rule = false;
+  // Thermal resistances to evaluate after the solve (ThermalReport::resistances, same order).
+  std::vector<ThermalResistanceSpec> resistances;
   LinearSolverOptions solver;
 };
 
@@ -93,6 +114,7 @@ struct BoundaryHeat {
   std::string kind;    // "fixed", "flux", "convection"
   double area = 0;     // m^2
   double heat_in = 0;  // W
+  double mean_temperature = 0;  // K, area mean of the surface temperature (a case temperature)
 };
 
 struct RegionTemperature {
@@ -105,12 +127,29 @@ struct RegionTemperature {
   double mean_temperature = 0;  // K, volume average of the P1 field
 };
 
+// theta = (T_junction - T_reference) / P with P the total power put into the body (sources plus the
+// heat entering through heat-flux boundaries), as JEDEC JESD51 defines theta_JX. `path_theta` divides
+// by the heat leaving through the reference boundary instead: the resistance of that path alone, which
+// equals theta when all the heat leaves there, and is the one defined between two fixed-temperature
+// boundaries with no power at all. A quantity whose divisor is zero is NaN.
+struct ThermalResistance {
+  ThermalResistanceSpec spec;
+  double junction_temperature = 0;   // K
+  double reference_temperature = 0;  // K
+  double delta_t = 0;                // K, junction - reference
+  double power = 0;                  // W, P above
+  double theta = 0;                  // K/W, delta_t / power
+  double reference_heat_out = 0;     // W leaving through the reference boundary
+  double path_theta = 0;             // K/W, delta_t / reference_heat_out
+};
+
 struct ThermalReport {
   std::vector<BoundaryHeat> boundaries;    // one per tag given a boundary condition, by tag
   std::vector<RegionTemperature> regions;  // one per region with tets, by id
   double max_temperature = 0;              // K
   std::uint32_t max_node = kNone;
   double total_power = 0;        // W from the sources
+  std::vector<ThermalResistance> resistances;  // one per ThermalParams::resistances
   std::string solver;            // "SimplicialLDLT", "CG+IncompleteCholesky", "CG+SmoothedAggregationAMG"
   std::size_t unknowns = 0;      // free nodes
   std::size_t nonzeros = 0;      // of the free-free matrix (both triangles)
@@ -121,7 +160,8 @@ struct ThermalReport {
 
 // Solves steady heat conduction on `mesh` (tets positively oriented, see validate.hpp) and stores the
 // fields "temperature" and "heat_flux" in it. Nodes used by no tet get NaN. Throws SolverError when a
-// region has no conductivity, a tag or region in `params` is not in the mesh, a tag has two conditions,
+// region has no conductivity, a tag or region in `params` (resistances included; an ambient probe
+// needs a convection tag) is not in the mesh, a tag has two conditions,
 // no tag fixes a temperature or convects (the temperature would be undetermined), the factorization
 // fails or CG does not converge; SolverCancelled when the progress callback returns false.
 ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params);

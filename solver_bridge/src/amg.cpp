@@ -1,0 +1,384 @@
+#include "amg.hpp"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <vector>
+
+#include "p1_assembly.hpp"
+
+namespace foxi::detail {
+
+namespace {
+
+// Rows below which a level's loops stay on one thread (the thread start costs more).
+constexpr std::size_t kSerialRows = 20000;
+// Levels stop coarsening at this size; the coarsest is factorized.
+constexpr std::size_t kCoarsest = 2000;
+
+// A sparse matrix by rows; columns within a row in no particular order.
+struct Csr {
+  std::size_t rows = 0, cols = 0;
+  std::vector<int> start;  // rows + 1
+  std::vector<int> col;
+  std::vector<double> val;
+};
+
+// The arrays of a level's matrix: the caller's fine matrix or a Csr of the hierarchy.
+struct View {
+  std::size_t rows = 0;
+  const int* start = nullptr;
+  const int* col = nullptr;
+  const double* val = nullptr;
+};
+
+View view(const Csr& m) { return {m.rows, m.start.data(), m.col.data(), m.val.data()}; }
+
+int checked_nonzeros(std::size_t n) {
+  if (n > static_cast<std::size_t>(INT_MAX))
+    throw SolverError("AMG: a coarse matrix would have more than 2^31 nonzeros");
+  return static_cast<int>(n);
+}
+
+// Builds a Csr of `rows` rows on `threads` threads in two passes over the same row function:
+// row(i, emit) calls emit(column, value) for the products of row i (repeated columns are summed).
+// The first pass counts the distinct columns of each row, the second fills them in place.
+template <class Row>
+Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row) {
+  Csr out;
+  out.rows = rows;
+  out.cols = cols;
+  out.start.assign(rows + 1, 0);
+  std::vector<std::vector<int>> marks(threads);
+  parallel_for(
+      rows, threads,
+      [&](std::size_t b, std::size_t e, unsigned th) {
+        std::vector<int>& mark = marks[th];
+        mark.assign(cols, -1);
+        for (std::size_t i = b; i < e; ++i) {
+          int count = 0;
+          const int id = static_cast<int>(i);
+          row(i, [&](int c, double) {
+            if (mark[static_cast<std::size_t>(c)] != id) {
+              mark[static_cast<std::size_t>(c)] = id;
+              ++count;
+            }
+          });
+          out.start[i + 1] = count;
+        }
+      },
+      kSerialRows);
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < rows; ++i) {
+    total += static_cast<std::size_t>(out.start[i + 1]);
+    out.start[i + 1] = checked_nonzeros(total);
+  }
+  out.col.resize(total);
+  out.val.resize(total);
+  parallel_for(
+      rows, threads,
+      [&](std::size_t b, std::size_t e, unsigned th) {
+        // Positions only grow along a thread's rows, so a mark below the row's start is stale.
+        std::vector<int>& mark = marks[th];
+        std::fill(mark.begin(), mark.end(), -1);
+        for (std::size_t i = b; i < e; ++i) {
+          const int first = out.start[i];
+          int next = first;
+          row(i, [&](int c, double v) {
+            int& m = mark[static_cast<std::size_t>(c)];
+            if (m < first) {
+              m = next++;
+              out.col[static_cast<std::size_t>(m)] = c;
+              out.val[static_cast<std::size_t>(m)] = v;
+            } else {
+              out.val[static_cast<std::size_t>(m)] += v;
+            }
+          });
+        }
+      },
+      kSerialRows);
+  return out;
+}
+
+// a * b.
+Csr multiply(const View& a, const Csr& b, unsigned threads) {
+  return build_rows(a.rows, b.cols, threads, [&](std::size_t i, auto&& emit) {
+    for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+      const double av = a.val[k];
+      const auto j = static_cast<std::size_t>(a.col[k]);
+      for (int l = b.start[j]; l < b.start[j + 1]; ++l)
+        emit(b.col[static_cast<std::size_t>(l)], av * b.val[static_cast<std::size_t>(l)]);
+    }
+  });
+}
+
+Csr transpose(const Csr& m) {
+  Csr t;
+  t.rows = m.cols;
+  t.cols = m.rows;
+  t.start.assign(t.rows + 1, 0);
+  for (int c : m.col) ++t.start[static_cast<std::size_t>(c) + 1];
+  for (std::size_t i = 0; i < t.rows; ++i) t.start[i + 1] += t.start[i];
+  t.col.resize(m.col.size());
+  t.val.resize(m.val.size());
+  std::vector<int> fill(t.start.begin(), t.start.end() - 1);
+  for (std::size_t i = 0; i < m.rows; ++i)
+    for (int k = m.start[i]; k < m.start[i + 1]; ++k) {
+      const int at = fill[static_cast<std::size_t>(m.col[static_cast<std::size_t>(k)])]++;
+      t.col[static_cast<std::size_t>(at)] = static_cast<int>(i);
+      t.val[static_cast<std::size_t>(at)] = m.val[static_cast<std::size_t>(k)];
+    }
+  return t;
+}
+
+// y = a x (rows split over threads).
+void spmv(const View& a, const double* x, double* y, unsigned threads) {
+  parallel_for(
+      a.rows, threads,
+      [&](std::size_t b, std::size_t e, unsigned) {
+        for (std::size_t i = b; i < e; ++i) {
+          double s = 0;
+          for (int k = a.start[i]; k < a.start[i + 1]; ++k) s += a.val[k] * x[a.col[k]];
+          y[i] = s;
+        }
+      },
+      kSerialRows);
+}
+
+// rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%). Each iteration is one
+// pass on threads: w = D^-1 A v and |w|^2 by slices (added in slice order: deterministic); no
+// normalisation is needed in 10 steps of a factor of a few.
+double spectral_radius(const View& a, const std::vector<double>& inv_diag, unsigned threads) {
+  const std::size_t n = a.rows;
+  std::vector<double> v(n), w(n), part(threads);
+  double vv = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    v[i] = 1.0 + (n > 1 ? static_cast<double>(i) / static_cast<double>(n - 1) : 0.0);
+    vv += v[i] * v[i];
+  }
+  double rho = 1;
+  for (int it = 0; it < 10; ++it) {
+    std::fill(part.begin(), part.end(), 0.0);
+    parallel_for(
+        n, threads,
+        [&](std::size_t lo, std::size_t hi, unsigned th) {
+          double ww = 0;
+          for (std::size_t i = lo; i < hi; ++i) {
+            double sum = 0;
+            for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+              sum += a.val[k] * v[static_cast<std::size_t>(a.col[k])];
+            w[i] = sum * inv_diag[i];
+            ww += w[i] * w[i];
+          }
+          part[th] = ww;
+        },
+        kSerialRows);
+    double ww = 0;
+    for (double p : part) ww += p;
+    rho = std::sqrt(ww / vv);
+    if (ww == 0 || !std::isfinite(ww)) break;
+    v.swap(w);
+    vv = ww;
+  }
+  return 1.05 * rho;
+}
+
+// Aggregates of strongly connected rows; returns the aggregate of each row and their count in `count`.
+std::vector<int> aggregate(const View& a, int& count) {
+  const std::size_t n = a.rows;
+  // Strong: |a_ij| at least theta times the largest off-diagonal magnitude of row i (relative to the
+  // row, so that the wide stencils of coarse levels still have strong connections).
+  const double theta = 0.25;
+  std::vector<double> row_max(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+      if (static_cast<std::size_t>(a.col[k]) != i) row_max[i] = std::max(row_max[i], std::abs(a.val[k]));
+  auto strong = [&](std::size_t i, int k) {
+    return static_cast<std::size_t>(a.col[k]) != i && std::abs(a.val[k]) >= theta * row_max[i] &&
+           row_max[i] > 0;
+  };
+  std::vector<int> agg(n, -1);
+  count = 0;
+  // Pass 1: a node whose strong neighbours are all free starts an aggregate with them.
+  for (std::size_t i = 0; i < n; ++i) {
+    if (agg[i] >= 0) continue;
+    bool free = true;
+    int neighbours = 0;
+    for (int k = a.start[i]; k < a.start[i + 1] && free; ++k)
+      if (strong(i, k)) {
+        ++neighbours;
+        free = agg[static_cast<std::size_t>(a.col[k])] < 0;
+      }
+    if (!free || neighbours == 0) continue;
+    agg[i] = count;
+    for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+      if (strong(i, k)) agg[static_cast<std::size_t>(a.col[k])] = count;
+    ++count;
+  }
+  // Pass 2: the rest join the aggregate of their strongest aggregated neighbour.
+  std::vector<int> joined = agg;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (agg[i] >= 0) continue;
+    double best = 0;
+    for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+      if (strong(i, k) && agg[static_cast<std::size_t>(a.col[k])] >= 0 && std::abs(a.val[k]) > best) {
+        best = std::abs(a.val[k]);
+        joined[i] = agg[static_cast<std::size_t>(a.col[k])];
+      }
+  }
+  // Pass 3: what is still alone becomes an aggregate of its own.
+  for (std::size_t i = 0; i < n; ++i)
+    if (joined[i] < 0) joined[i] = count++;
+  return joined;
+}
+
+}  // namespace
+
+struct AmgPreconditioner::Impl {
+  struct Level {
+    Csr own;  // the matrix of a coarse level (empty on the fine level, which is the caller's)
+    View a;
+    std::vector<double> inv_diag;
+    Csr p, r;                     // prolongation to this level from the next, and its transpose
+    std::vector<double> b, x;     // right-hand side and solution (coarse levels)
+    std::vector<double> scratch;  // the residual, then the values before the backward sweep
+  };
+  std::vector<Level> levels;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> coarse;
+  Eigen::VectorXd coarse_b, coarse_x;
+  unsigned threads = 1;
+
+  void smooth(const Level& l, const double* b, double* x, bool forward) const;
+  void cycle(std::size_t level, const double* b, double* x);
+};
+
+AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.threads = std::max(1u, threads);
+  m.levels.emplace_back();
+  m.levels[0].a = {a.rows(), a.start.data(), a.col.data(), a.val.data()};
+  for (;;) {
+    Impl::Level& l = m.levels.back();
+    const std::size_t n = l.a.rows;
+    l.inv_diag.assign(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int k = l.a.start[i]; k < l.a.start[i + 1]; ++k)
+        if (static_cast<std::size_t>(l.a.col[k]) == i) l.inv_diag[i] += l.a.val[k];
+    for (double& d : l.inv_diag) d = 1.0 / d;
+    l.scratch.resize(n);
+    if (n <= kCoarsest || m.levels.size() >= 12) break;
+    int count = 0;
+    const std::vector<int> agg = aggregate(l.a, count);
+    const auto nc = static_cast<std::size_t>(count);
+    if (nc == 0 || nc >= n * 9 / 10) break;  // no longer coarsening
+    // P = (I - w D^-1 A) P_tent with P_tent the constants on the aggregates, w = 4 / (3 rho(D^-1 A)):
+    // row i of P is e_agg(i) - (w / a_ii) sum_k a_ik e_agg(k).
+    const double omega = 4.0 / (3.0 * spectral_radius(l.a, l.inv_diag, m.threads));
+    const View& av = l.a;
+    l.p = build_rows(n, nc, m.threads, [&](std::size_t i, auto&& emit) {
+      emit(agg[i], 1.0);
+      const double s = -omega * l.inv_diag[i];
+      for (int k = av.start[i]; k < av.start[i + 1]; ++k)
+        emit(agg[static_cast<std::size_t>(av.col[k])], s * av.val[k]);
+    });
+    l.r = transpose(l.p);
+    Csr coarse;
+    {
+      const Csr ap = multiply(l.a, l.p, m.threads);
+      coarse = multiply(view(l.r), ap, m.threads);
+    }
+    Impl::Level next;
+    next.own = std::move(coarse);
+    next.b.resize(nc);
+    next.x.resize(nc);
+    m.levels.push_back(std::move(next));
+    // The view is taken in place: moving a Level keeps its arrays, so it stays valid as levels grows.
+    m.levels.back().a = view(m.levels.back().own);
+  }
+  // The coarsest level by sparse LDL^T.
+  const Impl::Level& last = m.levels.back();
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(static_cast<std::size_t>(last.a.start[last.a.rows]));
+  for (std::size_t i = 0; i < last.a.rows; ++i)
+    for (int k = last.a.start[i]; k < last.a.start[i + 1]; ++k)
+      t.emplace_back(static_cast<int>(i), last.a.col[k], last.a.val[k]);
+  const auto nl = static_cast<Eigen::Index>(last.a.rows);
+  Eigen::SparseMatrix<double> c(nl, nl);
+  c.setFromTriplets(t.begin(), t.end());
+  m.coarse.compute(c);
+  if (m.coarse.info() != Eigen::Success)
+    throw SolverError("AMG: the coarsest system could not be factorized");
+  m.coarse_b.resize(nl);
+  m.coarse_x.resize(nl);
+}
+
+AmgPreconditioner::~AmgPreconditioner() = default;
+
+std::size_t AmgPreconditioner::level_count() const { return impl_->levels.size(); }
+
+void AmgPreconditioner::apply(const double* r, double* z) { impl_->cycle(0, r, z); }
+
+// One hybrid Gauss-Seidel sweep: each thread's block of rows in order (forward) or in reverse, values
+// of the other blocks taken from l.scratch (the values before the sweep; the forward sweep starts
+// from x = 0, so there they are zero and skipped).
+void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x, bool forward) const {
+  const View& a = l.a;
+  const double* before = l.scratch.data();
+  parallel_for(
+      a.rows, threads,
+      [&](std::size_t lo, std::size_t hi, unsigned) {
+        const auto first = static_cast<int>(lo), end = static_cast<int>(hi);
+        for (std::size_t s = lo; s < hi; ++s) {
+          const std::size_t i = forward ? s : hi - 1 - (s - lo);
+          double sum = b[i];
+          for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+            const int c = a.col[k];
+            if (c >= first && c < end)
+              sum -= a.val[k] * x[c];
+            else if (!forward)
+              sum -= a.val[k] * before[c];
+          }
+          x[i] += sum * l.inv_diag[i];
+        }
+      },
+      kSerialRows);
+}
+
+void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* x) {
+  Level& l = levels[level];
+  const std::size_t n = l.a.rows;
+  if (level + 1 == levels.size()) {
+    coarse_b = Eigen::Map<const Eigen::VectorXd>(b, static_cast<Eigen::Index>(n));
+    coarse_x = coarse.solve(coarse_b);
+    std::copy_n(coarse_x.data(), n, x);
+    return;
+  }
+  std::fill_n(x, n, 0.0);
+  smooth(l, b, x, true);
+  // Residual, restricted to the next level.
+  spmv(l.a, x, l.scratch.data(), threads);
+  for (std::size_t i = 0; i < n; ++i) l.scratch[i] = b[i] - l.scratch[i];
+  Level& next = levels[level + 1];
+  spmv(view(l.r), l.scratch.data(), next.b.data(), threads);
+  cycle(level + 1, next.b.data(), next.x.data());
+  // Coarse correction, then the backward sweep from a copy of x for the other blocks' values.
+  parallel_for(
+      n, threads,
+      [&](std::size_t lo, std::size_t hi, unsigned) {
+        for (std::size_t i = lo; i < hi; ++i) {
+          double s = 0;
+          for (int k = l.p.start[i]; k < l.p.start[i + 1]; ++k)
+            s += l.p.val[static_cast<std::size_t>(k)] *
+                 next.x[static_cast<std::size_t>(l.p.col[static_cast<std::size_t>(k)])];
+          x[i] += s;
+          l.scratch[i] = x[i];
+        }
+      },
+      kSerialRows);
+  smooth(l, b, x, false);
+}
+
+}  // namespace foxi::detail

@@ -1,0 +1,41 @@
+// Internal: smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) as the
+// preconditioner of CG for scalar diffusion matrices: aggregates of strongly connected nodes,
+// piecewise-constant tentative prolongation smoothed by one damped Jacobi step, Galerkin coarse
+// operators, symmetric Gauss-Seidel V(1,1) cycles, LDL^T on the coarsest level.
+//
+// Plain CSR arrays throughout (no sparse-matrix library in the setup): the fine matrix is used in
+// place, the products P^T (A P) run row-parallel in two passes (count, then fill) so that nothing is
+// built twice, and the work vectors of the cycle are allocated once. The smoother is "hybrid"
+// Gauss-Seidel: each thread sweeps its own contiguous block of rows and takes the values of the other
+// blocks from before the sweep, the backward sweep mirroring the forward one, so one cycle stays a
+// symmetric positive definite operator (and is plain symmetric Gauss-Seidel on one thread).
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "linear_solve.hpp"
+
+namespace foxi::detail {
+
+class AmgPreconditioner {
+ public:
+  // Builds the hierarchy of `a` (referenced, not copied: it must outlive this object) on `threads`
+  // threads. Throws SolverError when the coarsest matrix cannot be factorized or a coarse matrix
+  // would exceed 2^31 nonzeros.
+  AmgPreconditioner(const SymmetricCsr& a, unsigned threads);
+  ~AmgPreconditioner();
+  AmgPreconditioner(const AmgPreconditioner&) = delete;
+  AmgPreconditioner& operator=(const AmgPreconditioner&) = delete;
+
+  // z = M^-1 r by one V(1,1) cycle from zero; r and z have a.rows() entries. Uses the object's work
+  // vectors: one call at a time.
+  void apply(const double* r, double* z);
+  std::size_t level_count() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace foxi::detail
