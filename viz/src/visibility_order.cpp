@@ -86,20 +86,26 @@ void exact_key(const Mesh& m, const SphereTable& table, const View& view, std::u
 
 }  // namespace
 
-// One sort entry: the item's key in drawing order (ascending = drawn first) minus its rounding
-// radius, so that the exact key lies in [lo, lo + 2 radius].
+// An entry of a near-tie run: the item's key in drawing order (ascending = drawn first) minus its
+// rounding radius, so that the exact key lies in [lo, lo + 2 radius].
 struct Entry {
   double lo;
   float radius;
   std::uint32_t item;
   double hi() const { return lo + 2.0 * double(radius); }
-  bool operator<(const Entry& o) const { return lo < o.lo; }
 };
+
+// A sort entry: the item's quantised key q (high 32 bits) and the item (low 32 bits). q is a
+// monotone function of lo, so sorting the packed integers sorts by lo up to ties of q; entries whose
+// q differ by more than the view's window are in the right order (their intervals are disjoint).
+using Packed = std::uint64_t;
+inline std::uint32_t q_of(Packed p) { return static_cast<std::uint32_t>(p >> 32); }
+inline std::uint32_t item_of(Packed p) { return static_cast<std::uint32_t>(p); }
 
 // Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
 struct Workspace {
-  std::vector<double> lo;       // pass 1: each item's lo (8 bytes per item)
-  std::vector<Entry> entries;   // the bucketed entries (16 bytes per item)
+  std::vector<Packed> keyed;    // pass 1: the items with their q, in input order (8 bytes per item)
+  std::vector<Packed> entries;  // the bucketed entries (8 bytes per item)
 };
 thread_local Workspace t_workspace;
 
@@ -109,19 +115,20 @@ struct ProgressiveOrder::Impl {
   View view;
   bool front_to_back = false;
   std::vector<std::uint8_t> in_subset;          // per tet, only when a subset meets clusters
-  std::vector<Entry> sorted;                    // bucketed; each bucket sorted when handed out
+  std::vector<Packed> sorted;                   // bucketed; each bucket sorted when handed out
   std::vector<std::uint32_t> bucket_begin;      // size buckets + 1
   std::size_t next_bucket = 0;
   std::vector<std::uint32_t> batch;
   std::size_t handed = 0, total_tets = 0;
   OrderStats stats;
-  // Per-thread scratch: the local MPVO of clusters and the tie counts.
+  // Per-thread scratch: the local MPVO of clusters, the bucket sort, the near-tie runs, tie counts.
   struct Scratch {
     std::vector<std::uint32_t> local_tets, local_indeg, local_queue;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
     std::vector<std::uint8_t> local_done;
-    std::vector<Entry> tmp;            // the second-level counting sort
-    std::vector<std::uint32_t> counts, subs;
+    std::vector<Packed> tmp;           // the second-level counting sort
+    std::vector<std::uint32_t> counts;
+    std::vector<Entry> run;
     std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
   };
   Scratch scratch;
@@ -133,6 +140,44 @@ struct ProgressiveOrder::Impl {
   }
 
   bool tet_in(std::uint32_t t) const { return in_subset.empty() || in_subset[t]; }
+
+  // The view's keys in the table's local frame: key = s - c.(2 eye) (perspective) or c.dir, drawn
+  // in increasing sign * key; an item's lo is sign * key - its radius.
+  bool perspective = true;
+  double eye2[3] = {0, 0, 0}, dir[3] = {0, 0, 0};
+  double sign = -1, ka = 1, np = 0;
+  float bound = 0;                          // the radius of ordinary items
+  double lo_of(std::uint32_t tet, float radius) const {
+    const double* c = table->c.data() + 3 * std::size_t(tet);
+    const double k = perspective ? table->s[tet] - (c[0] * eye2[0] + c[1] * eye2[1] + c[2] * eye2[2])
+                                 : c[0] * dir[0] + c[1] * dir[1] + c[2] * dir[2];
+    return sign * k - double(radius);
+  }
+  float radius_of(std::uint32_t rep) const {
+    if (!table->wide[rep]) return bound;
+    return std::max(bound, static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) *
+                                              (1 + 1e-6)));
+  }
+  // q = floor((lo - q_min) q_scale) clamped to 32 bits: monotone in lo (NaN goes to 0).
+  double q_min = 0, q_scale = 0;
+  std::uint32_t quantise(double lo) const {
+    const double x = (lo - q_min) * q_scale;
+    return x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+  }
+  // Neighbours in q order are "joined" (possibly out of order, resolved in double and exactly) if
+  // their q differ by at most q_window, or both lie in one zone: the q range of everything whose
+  // interval may overlap a wide item's (merged, sorted).
+  std::uint64_t q_window = 0;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> zones;
+  bool joined(Packed a, Packed b) const {
+    const std::uint32_t qa = q_of(a), qb = q_of(b);
+    if (std::uint64_t(qb) - qa <= q_window) return true;
+    if (zones.empty()) return false;
+    auto z = std::lower_bound(zones.begin(), zones.end(), qa,
+                              [](const std::pair<std::uint32_t, std::uint32_t>& r, std::uint32_t q) { return r.second < q; });
+    return z != zones.end() && z->first <= qa && qb <= z->second;
+  }
+  int bucket_shift = 32;                    // first-level bucket of an entry: q >> bucket_shift
 
   // The progressive path sorts ahead on a second thread (started by the first next()), so that the
   // caller can draw one batch while the next buckets are being sorted.
@@ -154,21 +199,17 @@ struct ProgressiveOrder::Impl {
     if (sorted.capacity() > t_workspace.entries.capacity()) t_workspace.entries.swap(sorted);
   }
   void prepare(std::span<const std::uint32_t> subset);
-  // Re-sorts the near-tie chains of [begin, end) exactly; returns the high end of the last chain and
-  // sets *last_chain to where it starts.
-  double fix_ties(std::size_t begin, std::size_t end, Scratch& sc, std::size_t* last_chain);
-  // Sorts [begin, end) by lo; `bucket` is the first-level bucket it is (its key range is known), or
-  // kNone for a range whose bounds must be scanned.
-  void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc, std::size_t bucket);
-  double bucket_low(std::size_t b) const { return bucket_min + double(b) / bucket_scale; }
-  double bucket_min = 0, bucket_scale = 0;  // the linear map of lo to first-level buckets
+  // Sorts one first-level bucket [begin, end) by packed value.
+  void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc);
+  // Puts every maximal run of joined neighbours in [begin, end) in exact order.
+  void resolve_runs(std::size_t begin, std::size_t end, Scratch& sc);
+  void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
   void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
   // Hands out buckets [first, last) into out (sorting, tie fix-up, cluster expansion); returns the
-  // next bucket not consumed: a tie chain may take in buckets from `last` up to `limit`. *reach_out
-  // receives the high end of the last entry's chain.
+  // next bucket not consumed: a run of joined entries may take in buckets from `last` up to `limit`.
   std::size_t emit_buckets(std::size_t first, std::size_t last, std::size_t limit, std::vector<std::uint32_t>& out,
-                           Scratch& sc, double* reach_out);
+                           Scratch& sc);
 };
 
 void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
@@ -226,101 +267,124 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   }
 
   // Rounding bounds: |key error| <= a + b |p|_1 (orthographic: b |d|_1), in the local frame.
-  View v = view;
-  for (int k = 0; k < 3; ++k) v.eye[k] -= t.origin[k];
-  const double np = v.perspective ? std::abs(v.eye[0]) + std::abs(v.eye[1]) + std::abs(v.eye[2])
-                                  : std::abs(v.dir[0]) + std::abs(v.dir[1]) + std::abs(v.dir[2]);
-  const double ka = v.perspective ? 1.0 : 0.0;
+  perspective = view.perspective;
+  for (int k = 0; k < 3; ++k) {
+    eye2[k] = 2 * (view.eye[k] - t.origin[k]);
+    dir[k] = view.dir[k];
+  }
+  np = perspective ? 0.5 * (std::abs(eye2[0]) + std::abs(eye2[1]) + std::abs(eye2[2]))
+                   : std::abs(dir[0]) + std::abs(dir[1]) + std::abs(dir[2]);
+  ka = perspective ? 1.0 : 0.0;
+  sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
   // Rounded up to float, and a little more for the subtraction that places lo.
-  const float bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
+  bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
   stats.key_bound = bound;
 
-  // 1. Keys (both cores): each item's key in drawing order, placed at the low end of its interval.
-  // Only lo is stored here (8 bytes); the 16-byte entries are made by the scatter, so a view needs
-  // 24 bytes per item.
-  std::vector<double>& los = t_workspace.lo;
-  if (los.size() < m) los.resize(m);
-  auto radius_of = [&](std::size_t i) {
-    if (i < m_main) return bound;
-    std::size_t w = i - m_main;
-    return std::max(bound, static_cast<float>((ka * wide_a[w] + wide_b[w] * np) * (1 + 1e-6)));
+  // 1. The quantisation of lo to 32 bits, over the bulk of a sample of the keys ([0.1%, 99.9%]
+  // quantiles widened by an eighth each side): keys outside (far-flung spheres of slivers at the
+  // hull) are clamped to the end values and sorted in double as runs of ties.
+  auto item_lo = [&](std::size_t i) {
+    if (i < m_main) return lo_of(reps[i], bound);
+    const std::uint32_t rep = rep_tet(t, wide_items[i - m_main]);
+    return lo_of(rep, radius_of(rep));
   };
-  const double* C = t.c.data();
-  const double* S = t.s.data();
-  const double sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
+  {
+    const std::size_t samples = std::min<std::size_t>(m, 2048);
+    std::vector<double> sample(samples);
+    for (std::size_t k = 0; k < samples; ++k) sample[k] = item_lo(k * m / samples);
+    std::sort(sample.begin(), sample.end());
+    double kmin = sample.front(), kmax = sample.back();
+    if (samples < m) {
+      const double qlo = sample[2], qhi = sample[samples - 3], widen = (qhi - qlo) / 8;
+      kmin = qlo - widen;
+      kmax = qhi + widen;
+    }
+    q_min = kmin;
+    q_scale = kmax > kmin ? 4294967296.0 / (kmax - kmin) : 0.0;
+    // Joined neighbours: q apart by at most 2 radius q_scale plus the rounding of the map and floor.
+    const double w = 2.0 * double(bound) * q_scale * (1 + 1e-9) + 2;
+    q_window = w < 8e9 ? static_cast<std::uint64_t>(w) : std::uint64_t(1) << 33;
+  }
+
+  // 2. Keys, q and the first-level histogram in one pass (both cores). Few enough buckets that the
+  // scatter stays in cache; each is sorted when handed out (sort_bucket).
+  int bits = 4;
+  while (bits < 16 && (std::size_t(256) << bits) < m) ++bits;
+  const std::size_t nb = std::size_t(1) << bits;
+  const int shift = 32 - bits;
+  bucket_shift = shift;
+  stats.buckets = nb;
+  std::vector<Packed>& keyed = t_workspace.keyed;
+  if (keyed.size() < m) keyed.resize(m);
+  std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
   double lo_part[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   double hi_part[2] = {-lo_part[0], -lo_part[1]};
-  // Tight loops on raw pointers: the ordinary items (no branch), then the few wide ones.
+  // Tight loops on raw pointers: the ordinary items (no branch on the kind of view inside).
   const std::uint32_t* rep_p = reps.data();
-  double* lo_p = los.data();
-  const double px = 2 * v.eye[0], py = 2 * v.eye[1], pz = 2 * v.eye[2];
-  const double dx = v.dir[0], dy = v.dir[1], dz = v.dir[2];
-  const double shift = double(bound);
+  const std::uint32_t* item_p = items.data();
+  Packed* keyed_p = keyed.data();
+  const double* C = t.c.data();
+  const double* S = t.s.data();
+  const double px = eye2[0], py = eye2[1], pz = eye2[2];
+  const double dx = dir[0], dy = dir[1], dz = dir[2];
+  const double shift_lo = double(bound), sgn = sign, qmin = q_min, qscale = q_scale;
   parallel_for(m_main, [&](std::size_t b, std::size_t e, int part) {
     double l = lo_part[part], h = hi_part[part];
-    if (v.perspective) {
+    std::uint32_t* hp = hist[part].data();
+    auto put = [&](std::size_t i, double lo) {
+      const double x = (lo - qmin) * qscale;
+      const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+      keyed_p[i] = (Packed(q) << 32) | item_p[i];
+      ++hp[q >> shift];
+      l = std::min(l, lo);
+      h = std::max(h, lo);
+    };
+    if (perspective) {
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t tet = rep_p[i];
         const double* c = C + 3 * tet;
-        const double lo = sign * (S[tet] - (c[0] * px + c[1] * py + c[2] * pz)) - shift;
-        lo_p[i] = lo;
-        l = std::min(l, lo);
-        h = std::max(h, lo);
+        put(i, sgn * (S[tet] - (c[0] * px + c[1] * py + c[2] * pz)) - shift_lo);
       }
     } else {
       for (std::size_t i = b; i < e; ++i) {
         const double* c = C + 3 * std::size_t(rep_p[i]);
-        const double lo = sign * (c[0] * dx + c[1] * dy + c[2] * dz) - shift;
-        lo_p[i] = lo;
-        l = std::min(l, lo);
-        h = std::max(h, lo);
+        put(i, sgn * (c[0] * dx + c[1] * dy + c[2] * dz) - shift_lo);
       }
     }
     lo_part[part] = l;
     hi_part[part] = h;
   });
+  // The wide items (few) go with the second part, and each makes a zone of joined q values.
+  const std::size_t split = m_main < 50000 ? m : m_main / 2;  // as parallel_for splits
+  const int wide_part = split == m ? 0 : 1;
+  zones.clear();
   for (std::size_t i = m_main; i < m; ++i) {
-    const std::uint32_t tet = rep_tet(t, wide_items[i - m_main]);
-    const double* c = C + 3 * std::size_t(tet);
-    const double k = v.perspective ? S[tet] - (c[0] * px + c[1] * py + c[2] * pz) : c[0] * dx + c[1] * dy + c[2] * dz;
-    const double lo = sign * k - double(radius_of(i));
-    lo_p[i] = lo;
+    const std::uint32_t rep = rep_tet(t, wide_items[i - m_main]);
+    const float r = radius_of(rep);
+    const double lo = lo_of(rep, r);
+    const std::uint32_t q = quantise(lo);
+    keyed_p[i] = (Packed(q) << 32) | wide_items[i - m_main];
+    ++hist[wide_part][q >> shift];
     lo_part[0] = std::min(lo_part[0], lo);
     hi_part[0] = std::max(hi_part[0], lo);
+    // Whatever overlaps [lo, lo + 2r] has its lo in [lo - 2 bound, lo + 2r] (ordinary items), or
+    // its own zone meets this one (wide items).
+    const std::uint64_t za = quantise(lo - 2.0 * double(bound)), zb = quantise(lo + 2.0 * double(r));
+    zones.emplace_back(static_cast<std::uint32_t>(za > q_window ? za - q_window : 0),
+                       static_cast<std::uint32_t>(std::min<std::uint64_t>(zb + q_window, 0xFFFFFFFFu)));
   }
-  double kmin = std::min(lo_part[0], lo_part[1]), kmax = std::max(hi_part[0], hi_part[1]);
-  stats.key_range = kmax - kmin;
-  // The buckets cover the bulk of the keys, [0.2%, 99.8%] quantiles of a sample, widened: keys
-  // outside (far-flung spheres of slivers at the hull) fall into the first and last buckets.
-  if (m > 4096) {
-    std::vector<double> sample(1024);
-    for (std::size_t i = 0; i < sample.size(); ++i) sample[i] = los[i * (m / sample.size())];
-    std::sort(sample.begin(), sample.end());
-    double qlo = sample[2], qhi = sample[sample.size() - 3], widen = 0.05 * (qhi - qlo);
-    kmin = std::max(kmin, qlo - widen);
-    kmax = std::min(kmax, qhi + widen);
+  if (!zones.empty()) {
+    std::sort(zones.begin(), zones.end());
+    std::size_t k = 0;
+    for (std::size_t z = 1; z < zones.size(); ++z) {
+      if (zones[z].first <= zones[k].second) zones[k].second = std::max(zones[k].second, zones[z].second);
+      else zones[++k] = zones[z];
+    }
+    zones.resize(k + 1);
   }
+  stats.key_range = std::max(hi_part[0], hi_part[1]) - std::min(lo_part[0], lo_part[1]);
 
-  // 2. The MSD bucket pass: a histogram and a scatter (both cores), by a linear map of lo.
-  // Few enough buckets that the scatter stays in cache; each is sorted when handed out by a second
-  // counting pass (sort_bucket).
-  int bits = 4;
-  while (bits < 16 && (std::size_t(256) << bits) < m) ++bits;
-  const std::size_t nb = std::size_t(1) << bits;
-  stats.buckets = nb;
-  const double scale = kmax > kmin ? double(nb) / (kmax - kmin) : 0.0;
-  bucket_min = kmin;
-  bucket_scale = scale;
-  const double last = double(nb - 1);
-  auto bucket_of = [&](double lo) {
-    double x = (lo - kmin) * scale;
-    return x <= 0 ? 0u : x >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(x);
-  };
-  std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
-  parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
-    std::uint32_t* h = hist[part].data();
-    for (std::size_t i = b; i < e; ++i) ++h[bucket_of(lo_p[i])];
-  });
+  // 3. The scatter by first-level bucket (both cores, each into its own slots of every bucket).
   bucket_begin.assign(nb + 1, 0);
   std::vector<std::uint32_t> start0(nb), start1(nb);
   std::uint32_t acc = 0;
@@ -334,20 +398,12 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   bucket_begin[nb] = acc;
   sorted.swap(t_workspace.entries);
   if (sorted.size() < m) sorted.resize(m);
-  std::vector<Entry>& out = sorted;
-  const std::size_t split = m < 50000 ? m : m / 2;  // as parallel_for splits
+  Packed* out = sorted.data();
   auto scatter = [&](std::size_t b, std::size_t e, std::vector<std::uint32_t>& pos) {
     std::uint32_t* ps = pos.data();
-    Entry* o = out.data();
-    const std::uint32_t* it = items.data();
-    const std::size_t main_end = std::min(e, m_main);
-    for (std::size_t i = b; i < main_end; ++i) {
-      const double lo = lo_p[i];
-      o[ps[bucket_of(lo)]++] = Entry{lo, bound, it[i]};
-    }
-    for (std::size_t i = std::max(b, m_main); i < e; ++i) {
-      const double lo = lo_p[i];
-      o[ps[bucket_of(lo)]++] = Entry{lo, radius_of(i), wide_items[i - m_main]};
+    for (std::size_t i = b; i < e; ++i) {
+      const Packed p = keyed_p[i];
+      out[ps[q_of(p) >> shift]++] = p;
     }
   };
   if (split == m) {
@@ -359,105 +415,119 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   }
 }
 
-// Sorts one bucket by lo: a counting pass over about n/2 sub-buckets of its own range, then an
-// insertion sort over the nearly sorted result (linear for evenly spread keys).
-void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc, std::size_t bucket) {
-  Entry* a = sorted.data() + begin;
+// Sorts one first-level bucket [begin, end) by packed value: a counting pass over about n/2 sub-buckets of the q bits below
+// the first level's, then each sub-bucket on its own (insertion sort if small).
+void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
+  Packed* a = sorted.data() + begin;
   const std::size_t n = end - begin;
-  const std::size_t nb = bucket_begin.size() - 1;
-  if (n > 48) {
-    double lo, hi;
-    if (bucket != kNone && bucket > 0 && bucket + 1 < nb && bucket_scale > 0) {
-      // Inner buckets: the linear map gives the range (entries just outside it by rounding land in
-      // the end sub-buckets, and the insertion sort puts them right).
-      lo = bucket_low(bucket);
-      hi = bucket_low(bucket + 1);
-    } else {
-      lo = hi = a[0].lo;
-      for (std::size_t i = 1; i < n; ++i) {
-        lo = std::min(lo, a[i].lo);
-        hi = std::max(hi, a[i].lo);
-      }
+  auto insertion = [](Packed* x, std::size_t len) {
+    for (std::size_t i = 1; i < len; ++i) {
+      const Packed v = x[i];
+      std::size_t j = i;
+      for (; j > 0 && v < x[j - 1]; --j) x[j] = x[j - 1];
+      x[j] = v;
     }
-    if (hi > lo) {
-      std::size_t subs = 1;
-      while (subs < n / 2) subs <<= 1;
-      const double sub_scale = double(subs) / (hi - lo) * (1 - 1e-12);
-      sc.counts.assign(subs + 1, 0);
-      if (sc.tmp.size() < n) sc.tmp.resize(n);
-      if (sc.subs.size() < n) sc.subs.resize(n);
-      const double top = double(subs - 1);
-      std::uint32_t* cnt = sc.counts.data();
-      std::uint32_t* sub = sc.subs.data();
-      for (std::size_t i = 0; i < n; ++i) {
-        const double f = (a[i].lo - lo) * sub_scale;
-        const std::uint32_t k = static_cast<std::uint32_t>(std::clamp(f, 0.0, top));
-        sub[i] = k;
-        ++cnt[k + 1];
-      }
-      for (std::size_t k = 1; k <= subs; ++k) cnt[k] += cnt[k - 1];
-      Entry* tmp = sc.tmp.data();
-      for (std::size_t i = 0; i < n; ++i) tmp[cnt[sub[i]]++] = a[i];
-      std::copy(tmp, tmp + n, a);
-    }
+  };
+  if (n <= 32) {
+    insertion(a, n);
+    return;
   }
-  for (std::size_t i = 1; i < n; ++i) {
-    Entry x = a[i];
-    std::size_t j = i;
-    while (j > 0 && x.lo < a[j - 1].lo) {
-      a[j] = a[j - 1];
-      --j;
-    }
-    a[j] = x;
+  int sub_bits = 1;
+  while ((std::size_t(2) << sub_bits) < n && sub_bits < bucket_shift) ++sub_bits;
+  const int sub_shift = bucket_shift - sub_bits;
+  const std::uint32_t mask = (std::uint32_t(1) << sub_bits) - 1;
+  const std::size_t subs = std::size_t(1) << sub_bits;
+  sc.counts.assign(subs + 1, 0);
+  if (sc.tmp.size() < n) sc.tmp.resize(n);
+  std::uint32_t* cnt = sc.counts.data();
+  Packed* tmp = sc.tmp.data();
+  for (std::size_t i = 0; i < n; ++i) ++cnt[((q_of(a[i]) >> sub_shift) & mask) + 1];
+  for (std::size_t k = 1; k <= subs; ++k) cnt[k] += cnt[k - 1];
+  for (std::size_t i = 0; i < n; ++i) tmp[cnt[(q_of(a[i]) >> sub_shift) & mask]++] = a[i];
+  // cnt[k] is now the end of sub-bucket k.
+  std::size_t b = 0;
+  for (std::size_t k = 0; k < subs; ++k) {
+    const std::size_t e = cnt[k];
+    if (e - b > 16) std::sort(tmp + b, tmp + e);
+    else if (e - b > 1) insertion(tmp + b, e - b);
+    b = e;
   }
+  std::copy(tmp, tmp + n, a);
 }
 
 // Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
-// two entries can be out of order only if their intervals overlap. Sorted by lo, the maximal chains
-// of overlapping intervals are re-sorted by exact comparison (made only for overlapping pairs).
-double ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end, Scratch& sc, std::size_t* last_chain) {
+// two entries can be out of order only if their intervals overlap, and then they are joined in q
+// order. Each maximal run of joined neighbours is re-sorted by lo (recomputed in double), and
+// within it the chains of overlapping intervals by exact comparison (made only for overlapping pairs).
+void ProgressiveOrder::Impl::resolve_runs(std::size_t begin, std::size_t end, Scratch& sc) {
+  const Packed* a = sorted.data();
+  const std::uint64_t w = q_window;
+  const bool plain = zones.empty();
   std::size_t i = begin;
-  double reach = -std::numeric_limits<double>::infinity();
-  *last_chain = begin;
-  const Entry* a = sorted.data();
-  while (i < end) {
-    // Fast path: entries whose interval ends before the next one starts (almost all of them).
-    while (i + 1 < end && a[i + 1].lo > a[i].hi()) ++i;
+  while (i + 1 < end) {
+    // Fast path: neighbours far apart in q (almost all of them).
+    if (plain ? std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w : !joined(a[i], a[i + 1])) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j + 1 < end && joined(a[j], a[j + 1])) ++j;
+    resolve_run(i, j + 1, sc);
+    i = j + 1;
+  }
+}
+
+void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scratch& sc) {
+  std::vector<Entry>& run = sc.run;
+  run.clear();
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::uint32_t item = item_of(sorted[k]);
+    const std::uint32_t rep = rep_tet(*table, item);
+    const float r = radius_of(rep);
+    run.push_back({lo_of(rep, r), r, item});
+  }
+  // By (lo, item): the same order whatever order the run came in.
+  std::sort(run.begin(), run.end(), [](const Entry& x, const Entry& y) {
+    return x.lo < y.lo || (x.lo == y.lo && x.item < y.item);
+  });
+  std::size_t i = 0;
+  const std::size_t n = run.size();
+  while (i < n) {
+    double reach = run[i].hi();
     std::size_t j = i;
-    reach = sorted[i].hi();
-    while (j + 1 < end && sorted[j + 1].lo <= reach) reach = std::max(reach, sorted[++j].hi());
+    while (j + 1 < n && run[j + 1].lo <= reach) reach = std::max(reach, run[++j].hi());
     if (j > i) {
       // Distinct items may still share a sphere (not face-adjacent): exact equality leaves them in
       // any order, which is then correct (they are incomparable, Theorem 1).
-      struct Run {
+      struct Exact {
         Entry e;
         mutable std::unique_ptr<exact::PowerKey> key;
       };
-      std::vector<Run> run;
-      run.reserve(j - i + 1);
-      for (std::size_t k = i; k <= j; ++k) run.push_back({sorted[k], nullptr});
-      auto exact_of = [&](const Run& r) -> const exact::PowerKey& {
-        if (!r.key) {
-          r.key = std::make_unique<exact::PowerKey>();
-          exact_key(*mesh, *table, view, rep_tet(*table, r.e.item), *r.key);
+      std::vector<Exact> chain;
+      chain.reserve(j - i + 1);
+      for (std::size_t k = i; k <= j; ++k) chain.push_back({run[k], nullptr});
+      auto exact_of = [&](const Exact& x) -> const exact::PowerKey& {
+        if (!x.key) {
+          x.key = std::make_unique<exact::PowerKey>();
+          exact_key(*mesh, *table, view, rep_tet(*table, x.e.item), *x.key);
         }
-        return *r.key;
+        return *x.key;
       };
       const bool ftb = front_to_back;
-      std::stable_sort(run.begin(), run.end(), [&](const Run& x, const Run& y) {
+      std::stable_sort(chain.begin(), chain.end(), [&](const Exact& x, const Exact& y) {
         if (x.e.hi() < y.e.lo) return true;
         if (y.e.hi() < x.e.lo) return false;
         int c = exact_of(x).compare(exact_of(y));
         return ftb ? c < 0 : c > 0;
       });
-      for (std::size_t k = i; k <= j; ++k) sorted[k] = run[k - i].e;
+      for (std::size_t k = i; k <= j; ++k) run[k] = chain[k - i].e;
       ++sc.near_tie_runs;
       sc.near_tie_items += j - i + 1;
     }
-    *last_chain = i;
     i = j + 1;
   }
-  return reach;
+  // The items in their order; the q values stay where they were (ascending).
+  for (std::size_t k = begin; k < end; ++k) sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | run[k - begin].item;
 }
 
 // Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
@@ -490,15 +560,15 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_
     for (std::uint32_t f = t.cluster_face_begin[k]; f < t.cluster_face_begin[k + 1]; ++f) {
       const std::uint32_t a = t.face_local[2 * f], b = t.face_local[2 * f + 1];
       const double* pl = t.face_plane.data() + 4 * std::size_t(f);
-      double val, bound;
+      double val, err;
       if (persp) {
         val = pl[0] * e[0] + pl[1] * e[1] + pl[2] * e[2] - pl[3];
-        bound = 96 * kEps * double(t.face_scale[f]) * (en + double(t.face_anorm[f]));
+        err = 96 * kEps * double(t.face_scale[f]) * (en + double(t.face_anorm[f]));
       } else {
         val = pl[0] * back[0] + pl[1] * back[1] + pl[2] * back[2];
-        bound = 32 * kEps * double(t.face_scale[f]) * en;
+        err = 32 * kEps * double(t.face_scale[f]) * en;
       }
-      int side = val > bound ? 1 : val < -bound ? -1 : 2;
+      int side = val > err ? 1 : val < -err ? -1 : 2;
       if (side == 2) {
         const std::uint32_t* fv = t.face_vertex.data() + 3 * std::size_t(f);
         side = eye_side(view, node(*mesh, fv[0]), node(*mesh, fv[1]), node(*mesh, fv[2]));
@@ -600,45 +670,40 @@ ProgressiveOrder::ProgressiveOrder(ProgressiveOrder&&) noexcept = default;
 ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = default;
 
 std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
-                                                 std::vector<std::uint32_t>& out, Scratch& sc, double* reach_out) {
-  const std::size_t nb = limit;
+                                                 std::vector<std::uint32_t>& out, Scratch& sc) {
   std::size_t b = first;
-  double reach = -std::numeric_limits<double>::infinity();
   while (b < last) {
-    std::size_t begin = bucket_begin[b], end = bucket_begin[b + 1];
+    const std::size_t begin = bucket_begin[b];
+    std::size_t end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    sort_bucket(begin, end, sc, b - 1);
-    std::size_t chain = begin;
-    reach = fix_ties(begin, end, sc, &chain);
-    // A near-tie chain may cross into the following buckets: take them in while it does. Bucket b
-    // holds no lo below its lower boundary (up to rounding), so most checks need no scan.
-    while (b < nb) {
-      std::size_t nb_begin = bucket_begin[b], nb_end = bucket_begin[b + 1];
+    sort_bucket(begin, end, sc);
+    // A run of joined entries may cross into the following buckets: take them in while it may.
+    // Bucket b holds no q below b << bucket_shift, so most checks need not look into it.
+    while (b < limit) {
+      const std::size_t nb_begin = bucket_begin[b], nb_end = bucket_begin[b + 1];
       if (nb_begin == nb_end) {
         ++b;
         continue;
       }
-      const double margin = 1e-12 * (std::abs(reach) + std::abs(bucket_min) + 1.0 / bucket_scale);
-      if (bucket_scale > 0 && bucket_low(b) > reach + margin) break;
-      double next_min = std::min_element(sorted.begin() + nb_begin, sorted.begin() + nb_end)->lo;
-      if (next_min > reach) break;
-      sort_bucket(nb_begin, nb_end, sc, b);
+      const Packed bucket_low = Packed(b) << (32 + bucket_shift);
+      if (!joined(sorted[end - 1], bucket_low)) break;
+      sort_bucket(nb_begin, nb_end, sc);
+      if (!joined(sorted[end - 1], sorted[nb_begin])) break;  // sorted now, handed out next
       end = nb_end;
       ++b;
-      reach = fix_ties(chain, end, sc, &chain);
     }
+    resolve_runs(begin, end, sc);
     if (t_cluster_free) {
-      for (std::size_t i = begin; i < end; ++i) out.push_back(sorted[i].item);
+      for (std::size_t i = begin; i < end; ++i) out.push_back(item_of(sorted[i]));
     } else {
       for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t item = sorted[i].item;
+        const std::uint32_t item = item_of(sorted[i]);
         if (item & kClusterBit) expand(item, out, sc);
         else out.push_back(item);
       }
     }
   }
-  if (reach_out) *reach_out = reach;
   return b;
 }
 
@@ -648,7 +713,7 @@ void ProgressiveOrder::Impl::run_worker() {
   bool first = true;
   std::vector<std::uint32_t> pending;
   while (b < nb && !stop) {
-    b = emit_buckets(b, b + 1, nb, pending, scratch, nullptr);
+    b = emit_buckets(b, b + 1, nb, pending, scratch);
     // The first bucket goes out at once; later ones in pendinges of a few thousand tets.
     if (!pending.empty() && (first || pending.size() >= 4096 || b >= nb)) {
       first = false;
@@ -672,7 +737,7 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
   if (d.bucket_begin[nb] < 50000) {
     // Small orders: on this thread, bucket by bucket.
     while (d.batch.empty() && d.next_bucket < nb)
-      d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch, nullptr);
+      d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch);
     d.add_counts(d.scratch);
   } else {
     if (!d.worker.joinable() && !d.worker_done) d.worker = std::thread([&d] { d.run_worker(); });
@@ -718,19 +783,12 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
     std::vector<std::uint32_t> second;
     second.reserve(order.total() - order.total() / 2 + 1024);
     ProgressiveOrder::Impl::Scratch other_scratch;
-    double reach = 0;
-    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch, nullptr); });
-    d.emit_buckets(0, split, split, out, d.scratch, &reach);
+    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch); });
+    d.emit_buckets(0, split, split, out, d.scratch);
     other.join();
-    // The first entry of the second half must lie beyond every interval of the first half.
-    double second_min = std::numeric_limits<double>::infinity();
-    for (std::size_t b = split; b < nb && d.bucket_begin[b] < d.bucket_begin[nb]; ++b) {
-      if (d.bucket_begin[b] < d.bucket_begin[b + 1]) {
-        second_min = d.sorted[d.bucket_begin[b]].lo;  // sorted by now
-        break;
-      }
-    }
-    if (second_min > reach) {
+    // The halves are independent unless the last entry of the first joins the first of the second.
+    const std::size_t at = d.bucket_begin[split];
+    if (at == 0 || at == m || !d.joined(d.sorted[at - 1], d.sorted[at])) {
       out.insert(out.end(), second.begin(), second.end());
       d.add_counts(d.scratch);
       d.add_counts(other_scratch);
@@ -741,7 +799,7 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
     }
   }
   if (!done) {
-    d.emit_buckets(0, nb, nb, out, d.scratch, nullptr);
+    d.emit_buckets(0, nb, nb, out, d.scratch);
     d.add_counts(d.scratch);
   }
   d.next_bucket = nb;
