@@ -201,8 +201,24 @@ struct ProgressiveOrder::Impl {
   void prepare(std::span<const std::uint32_t> subset);
   // Sorts one first-level bucket [begin, end) by packed value.
   void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc);
-  // Puts every maximal run of joined neighbours in [begin, end) in exact order.
-  void resolve_runs(std::size_t begin, std::size_t end, Scratch& sc);
+  // Calls put(item) for the items of [begin, end) in order, after putting each maximal run of joined
+  // neighbours in exact order (resolve_run).
+  template <class Put>
+  void scan_runs(std::size_t begin, std::size_t end, Scratch& sc, Put put) {
+    const Packed* a = sorted.data();
+    const std::uint64_t w = q_window;
+    const bool plain = zones.empty();
+    for (std::size_t i = begin; i < end; ++i) {
+      // Fast path: neighbours far apart in q (almost all of them).
+      if (i + 1 < end && (plain ? std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) <= w : joined(a[i], a[i + 1]))) {
+        std::size_t j = i + 1;
+        while (j + 1 < end && joined(a[j], a[j + 1])) ++j;
+        resolve_run(i, j + 1, sc);
+        for (; i < j; ++i) put(item_of(a[i]));
+      }
+      put(item_of(a[i]));
+    }
+  }
   void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
   void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
@@ -317,43 +333,39 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   std::vector<Packed>& keyed = t_workspace.keyed;
   if (keyed.size() < m) keyed.resize(m);
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
-  double lo_part[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  double hi_part[2] = {-lo_part[0], -lo_part[1]};
-  // Tight loops on raw pointers: the ordinary items (no branch on the kind of view inside).
+  // Tight loops over the ordinary items, on locals (the stores to the histogram could alias anything
+  // reached through a reference).
   const std::uint32_t* rep_p = reps.data();
   const std::uint32_t* item_p = items.data();
   Packed* keyed_p = keyed.data();
   const double* C = t.c.data();
   const double* S = t.s.data();
-  const double px = eye2[0], py = eye2[1], pz = eye2[2];
-  const double dx = dir[0], dy = dir[1], dz = dir[2];
+  const double p0 = perspective ? eye2[0] : dir[0], p1 = perspective ? eye2[1] : dir[1],
+               p2 = perspective ? eye2[2] : dir[2];
   const double shift_lo = double(bound), sgn = sign, qmin = q_min, qscale = q_scale;
-  parallel_for(m_main, [&](std::size_t b, std::size_t e, int part) {
-    double l = lo_part[part], h = hi_part[part];
+  const bool persp_view = perspective;
+  auto key_pass = [=, &hist](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
-    auto put = [&](std::size_t i, double lo) {
+    auto put = [=](std::size_t i, double lo) {
       const double x = (lo - qmin) * qscale;
       const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
       keyed_p[i] = (Packed(q) << 32) | item_p[i];
       ++hp[q >> shift];
-      l = std::min(l, lo);
-      h = std::max(h, lo);
     };
-    if (perspective) {
+    if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t tet = rep_p[i];
         const double* c = C + 3 * tet;
-        put(i, sgn * (S[tet] - (c[0] * px + c[1] * py + c[2] * pz)) - shift_lo);
+        put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo);
       }
     } else {
       for (std::size_t i = b; i < e; ++i) {
         const double* c = C + 3 * std::size_t(rep_p[i]);
-        put(i, sgn * (c[0] * dx + c[1] * dy + c[2] * dz) - shift_lo);
+        put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo);
       }
     }
-    lo_part[part] = l;
-    hi_part[part] = h;
-  });
+  };
+  parallel_for(m_main, key_pass);
   // The wide items (few) go with the second part, and each makes a zone of joined q values.
   const std::size_t split = m_main < 50000 ? m : m_main / 2;  // as parallel_for splits
   const int wide_part = split == m ? 0 : 1;
@@ -365,8 +377,6 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     const std::uint32_t q = quantise(lo);
     keyed_p[i] = (Packed(q) << 32) | wide_items[i - m_main];
     ++hist[wide_part][q >> shift];
-    lo_part[0] = std::min(lo_part[0], lo);
-    hi_part[0] = std::max(hi_part[0], lo);
     // Whatever overlaps [lo, lo + 2r] has its lo in [lo - 2 bound, lo + 2r] (ordinary items), or
     // its own zone meets this one (wide items).
     const std::uint64_t za = quantise(lo - 2.0 * double(bound)), zb = quantise(lo + 2.0 * double(r));
@@ -382,7 +392,6 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     }
     zones.resize(k + 1);
   }
-  stats.key_range = std::max(hi_part[0], hi_part[1]) - std::min(lo_part[0], lo_part[1]);
 
   // 3. The scatter by first-level bucket (both cores, each into its own slots of every bucket).
   bucket_begin.assign(nb + 1, 0);
@@ -413,6 +422,19 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     scatter(0, split, start0);
     other.join();
   }
+  // The key range: q is monotone in lo, so the extremes lie in the first and last non-empty buckets.
+  std::size_t first = 0, last = nb - 1;
+  while (bucket_begin[first + 1] == 0) ++first;
+  while (bucket_begin[last] == m) --last;
+  double kmin = std::numeric_limits<double>::infinity(), kmax = -kmin;
+  for (std::size_t b : {first, last})
+    for (std::size_t i = bucket_begin[b]; i < bucket_begin[b + 1]; ++i) {
+      const std::uint32_t rep = rep_tet(t, item_of(sorted[i]));
+      const double lo = lo_of(rep, radius_of(rep));
+      kmin = std::min(kmin, lo);
+      kmax = std::max(kmax, lo);
+    }
+  stats.key_range = kmax - kmin;
 }
 
 // Sorts one first-level bucket [begin, end) by packed value: a counting pass over about n/2 sub-buckets of the q bits below
@@ -442,41 +464,32 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
   std::uint32_t* cnt = sc.counts.data();
   Packed* tmp = sc.tmp.data();
   for (std::size_t i = 0; i < n; ++i) ++cnt[((q_of(a[i]) >> sub_shift) & mask) + 1];
-  for (std::size_t k = 1; k <= subs; ++k) cnt[k] += cnt[k - 1];
+  std::uint32_t most = 0;
+  for (std::size_t k = 1; k <= subs; ++k) {
+    most = std::max(most, cnt[k]);
+    cnt[k] += cnt[k - 1];
+  }
   for (std::size_t i = 0; i < n; ++i) tmp[cnt[(q_of(a[i]) >> sub_shift) & mask]++] = a[i];
-  // cnt[k] is now the end of sub-bucket k.
-  std::size_t b = 0;
-  for (std::size_t k = 0; k < subs; ++k) {
-    const std::size_t e = cnt[k];
-    if (e - b > 16) std::sort(tmp + b, tmp + e);
-    else if (e - b > 1) insertion(tmp + b, e - b);
-    b = e;
+  if (most <= 16) {
+    // Evenly spread keys: one insertion pass (nothing moves across sub-buckets).
+    insertion(tmp, n);
+  } else {
+    // cnt[k] is now the end of sub-bucket k.
+    std::size_t b = 0;
+    for (std::size_t k = 0; k < subs; ++k) {
+      const std::size_t e = cnt[k];
+      if (e - b > 16) std::sort(tmp + b, tmp + e);
+      else if (e - b > 1) insertion(tmp + b, e - b);
+      b = e;
+    }
   }
   std::copy(tmp, tmp + n, a);
 }
 
 // Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
 // two entries can be out of order only if their intervals overlap, and then they are joined in q
-// order. Each maximal run of joined neighbours is re-sorted by lo (recomputed in double), and
-// within it the chains of overlapping intervals by exact comparison (made only for overlapping pairs).
-void ProgressiveOrder::Impl::resolve_runs(std::size_t begin, std::size_t end, Scratch& sc) {
-  const Packed* a = sorted.data();
-  const std::uint64_t w = q_window;
-  const bool plain = zones.empty();
-  std::size_t i = begin;
-  while (i + 1 < end) {
-    // Fast path: neighbours far apart in q (almost all of them).
-    if (plain ? std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w : !joined(a[i], a[i + 1])) {
-      ++i;
-      continue;
-    }
-    std::size_t j = i + 1;
-    while (j + 1 < end && joined(a[j], a[j + 1])) ++j;
-    resolve_run(i, j + 1, sc);
-    i = j + 1;
-  }
-}
-
+// order. A maximal run of joined neighbours is re-sorted by lo (recomputed in double), and within it
+// the chains of overlapping intervals by exact comparison (made only for overlapping pairs).
 void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scratch& sc) {
   std::vector<Entry>& run = sc.run;
   run.clear();
@@ -693,15 +706,16 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       end = nb_end;
       ++b;
     }
-    resolve_runs(begin, end, sc);
     if (t_cluster_free) {
-      for (std::size_t i = begin; i < end; ++i) out.push_back(item_of(sorted[i]));
+      const std::size_t at = out.size();
+      out.resize(at + (end - begin));
+      std::uint32_t* o = out.data() + at;
+      scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t item = item_of(sorted[i]);
+      scan_runs(begin, end, sc, [&](std::uint32_t item) {
         if (item & kClusterBit) expand(item, out, sc);
         else out.push_back(item);
-      }
+      });
     }
   }
   return b;
