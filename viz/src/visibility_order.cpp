@@ -437,8 +437,9 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   stats.key_range = kmax - kmin;
 }
 
-// Sorts one first-level bucket [begin, end) by packed value: a counting pass over about n/2 sub-buckets of the q bits below
-// the first level's, then each sub-bucket on its own (insertion sort if small).
+// Sorts one first-level bucket [begin, end) by packed value: a counting pass over 2n to 4n
+// sub-buckets of the q bits below the first level's (mostly empty or single, so that the insertion
+// pass that follows mispredicts little), then the insertion pass.
 void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
   Packed* a = sorted.data() + begin;
   const std::size_t n = end - begin;
@@ -455,7 +456,7 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
     return;
   }
   int sub_bits = 1;
-  while ((std::size_t(2) << sub_bits) < n && sub_bits < bucket_shift) ++sub_bits;
+  while ((std::size_t(1) << sub_bits) < 2 * n && sub_bits < bucket_shift) ++sub_bits;
   const int sub_shift = bucket_shift - sub_bits;
   const std::uint32_t mask = (std::uint32_t(1) << sub_bits) - 1;
   const std::size_t subs = std::size_t(1) << sub_bits;
@@ -464,26 +465,27 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
   std::uint32_t* cnt = sc.counts.data();
   Packed* tmp = sc.tmp.data();
   for (std::size_t i = 0; i < n; ++i) ++cnt[((q_of(a[i]) >> sub_shift) & mask) + 1];
-  std::uint32_t most = 0;
+  std::uint32_t acc = 0;  // the running sum in a register, not through memory
   for (std::size_t k = 1; k <= subs; ++k) {
-    most = std::max(most, cnt[k]);
-    cnt[k] += cnt[k - 1];
+    acc += cnt[k];
+    cnt[k] = acc;
   }
   for (std::size_t i = 0; i < n; ++i) tmp[cnt[(q_of(a[i]) >> sub_shift) & mask]++] = a[i];
-  if (most <= 16) {
-    // Evenly spread keys: one insertion pass (nothing moves across sub-buckets).
-    insertion(tmp, n);
-  } else {
-    // cnt[k] is now the end of sub-bucket k.
-    std::size_t b = 0;
-    for (std::size_t k = 0; k < subs; ++k) {
-      const std::size_t e = cnt[k];
-      if (e - b > 16) std::sort(tmp + b, tmp + e);
-      else if (e - b > 1) insertion(tmp + b, e - b);
-      b = e;
+  // Back into place by one insertion pass (nothing moves across sub-buckets), with a budget of
+  // moves: keys crowded into a few sub-buckets go to std::sort instead.
+  std::size_t budget = 4 * n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Packed v = tmp[i];
+    std::size_t j = i;
+    for (; j > 0 && v < a[j - 1]; --j) a[j] = a[j - 1];
+    a[j] = v;
+    budget -= std::min(budget, i - j);
+    if (budget == 0) {
+      std::copy(tmp + i + 1, tmp + n, a + i + 1);
+      std::sort(a, a + n);
+      break;
     }
   }
-  std::copy(tmp, tmp + n, a);
 }
 
 // Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
