@@ -322,10 +322,11 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     q_window = w < 8e9 ? static_cast<std::uint64_t>(w) : std::uint64_t(1) << 33;
   }
 
-  // 2. Keys, q and the first-level histogram in one pass (both cores). Few enough buckets that the
-  // scatter stays in cache; each is sorted when handed out (sort_bucket).
+  // 2. Keys, q and the first-level histogram in one pass (both cores). About 1000 entries a bucket:
+  // few enough buckets that the scatter's write fronts stay in cache, and each bucket sorted when
+  // handed out (sort_bucket) stays in L1/L2 (measured against 256 to 2048 a bucket).
   int bits = 4;
-  while (bits < 16 && (std::size_t(256) << bits) < m) ++bits;
+  while (bits < 16 && (std::size_t(1024) << bits) < m) ++bits;
   const std::size_t nb = std::size_t(1) << bits;
   const int shift = 32 - bits;
   bucket_shift = shift;
