@@ -137,6 +137,7 @@ struct ProgressiveOrder::Impl {
     stats.near_tie_items += sc.near_tie_items;
     stats.cluster_cycles += sc.cluster_cycles;
     sc.near_tie_runs = sc.near_tie_items = sc.cluster_cycles = 0;
+    stats.key_range = key_range_found;
   }
 
   bool tet_in(std::uint32_t t) const { return in_subset.empty() || in_subset[t]; }
@@ -178,6 +179,14 @@ struct ProgressiveOrder::Impl {
     return z != zones.end() && z->first <= qa && qb <= z->second;
   }
   int bucket_shift = 32;                    // first-level bucket of an entry: q >> bucket_shift
+  // The entries in input order (pass 1) and what the scatter of them into `sorted` needs.
+  std::vector<Packed> keyed;
+  std::vector<std::uint32_t> scatter_start[2];  // per bucket, the next slot of each part
+  std::size_t scatter_split = 0;                // part 0 is keyed[0, split), part 1 the rest
+  std::size_t head_buckets = 0;                 // buckets a progressive order places first
+  bool scattered = false;
+  double key_range_found = 0;                   // set by the scatter, published by add_counts
+  void scatter(std::size_t from, std::size_t to);
 
   // The progressive path sorts ahead on a second thread (started by the first next()), so that the
   // caller can draw one batch while the next buckets are being sorted.
@@ -197,6 +206,7 @@ struct ProgressiveOrder::Impl {
     // Hand the big buffer back for the next view on this thread. (A buffer the worker thread made
     // is the same memory; the thread_local slot is this thread's.)
     if (sorted.capacity() > t_workspace.entries.capacity()) t_workspace.entries.swap(sorted);
+    if (keyed.capacity() > t_workspace.keyed.capacity()) t_workspace.keyed.swap(keyed);
   }
   void prepare(std::span<const std::uint32_t> subset);
   // Sorts one first-level bucket [begin, end) by packed value.
@@ -304,12 +314,14 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     const std::uint32_t rep = rep_tet(t, wide_items[i - m_main]);
     return lo_of(rep, radius_of(rep));
   };
+  double head_lo = 0;
   {
     const std::size_t samples = std::min<std::size_t>(m, 2048);
     std::vector<double> sample(samples);
     for (std::size_t k = 0; k < samples; ++k) sample[k] = item_lo(k * m / samples);
     std::sort(sample.begin(), sample.end());
     double kmin = sample.front(), kmax = sample.back();
+    head_lo = sample[samples / 512];
     if (samples < m) {
       const double qlo = sample[2], qhi = sample[samples - 3], widen = (qhi - qlo) / 8;
       kmin = qlo - widen;
@@ -331,7 +343,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   const int shift = 32 - bits;
   bucket_shift = shift;
   stats.buckets = nb;
-  std::vector<Packed>& keyed = t_workspace.keyed;
+  keyed.swap(t_workspace.keyed);
   if (keyed.size() < m) keyed.resize(m);
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
   // Tight loops over the ordinary items, on locals (the stores to the histogram could alias anything
@@ -406,23 +418,47 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     acc += hist[1][b];
   }
   bucket_begin[nb] = acc;
+  scatter_start[0].swap(start0);
+  scatter_start[1].swap(start1);
+  scatter_split = split;
   sorted.swap(t_workspace.entries);
   if (sorted.size() < m) sorted.resize(m);
+  // The head: the buckets up to the one of the sample's 0.2% quantile, which a progressive order
+  // places by a scan of their own and hands out before the whole scatter.
+  head_buckets = m >= 50000 ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb) : 0;
+}
+
+// Places the entries of buckets [from, to) of keyed into sorted (both cores), each part into its
+// own slots of every bucket: the same layout whatever ranges the buckets are placed in.
+void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
+  const std::size_t m = bucket_begin.back(), nb = bucket_begin.size() - 1;
+  const Packed* keyed_p = keyed.data();
   Packed* out = sorted.data();
-  auto scatter = [&](std::size_t b, std::size_t e, std::vector<std::uint32_t>& pos) {
-    std::uint32_t* ps = pos.data();
-    for (std::size_t i = b; i < e; ++i) {
-      const Packed p = keyed_p[i];
-      out[ps[q_of(p) >> shift]++] = p;
+  const int shift = bucket_shift;
+  auto run = [=](std::size_t b, std::size_t e, std::uint32_t* ps) {
+    if (from == 0 && to == nb) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Packed p = keyed_p[i];
+        out[ps[q_of(p) >> shift]++] = p;
+      }
+    } else {
+      for (std::size_t i = b; i < e; ++i) {
+        const Packed p = keyed_p[i];
+        const std::size_t k = q_of(p) >> shift;
+        if (k >= from && k < to) out[ps[k]++] = p;
+      }
     }
   };
+  const std::size_t split = scatter_split;
   if (split == m) {
-    scatter(0, m, start0);
+    run(0, m, scatter_start[0].data());
   } else {
-    std::thread other([&] { scatter(split, m, start1); });
-    scatter(0, split, start0);
+    std::thread other([&] { run(split, m, scatter_start[1].data()); });
+    run(0, split, scatter_start[0].data());
     other.join();
   }
+  if (to < nb) return;
+  const SphereTable& t = *table;
   // The key range: q is monotone in lo, so the extremes lie in the first and last non-empty buckets.
   std::size_t first = 0, last = nb - 1;
   while (bucket_begin[first + 1] == 0) ++first;
@@ -435,7 +471,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
       kmin = std::min(kmin, lo);
       kmax = std::max(kmax, lo);
     }
-  stats.key_range = kmax - kmin;
+  key_range_found = kmax - kmin;
 }
 
 // Sorts one first-level bucket [begin, end) by packed value: a counting pass over 2n to 4n
@@ -729,16 +765,41 @@ void ProgressiveOrder::Impl::run_worker() {
   std::size_t b = next_bucket;
   bool first = true;
   std::vector<std::uint32_t> pending;
+  auto hand_out = [&] {
+    first = false;
+    std::lock_guard<std::mutex> g(mu);
+    ready.push_back(std::move(pending));
+    pending.clear();
+    cv.notify_one();
+  };
+  if (!scattered) {
+    // The head buckets first: placed, sorted and handed out before the rest is scattered, unless a
+    // run of joined entries may go on past them.
+    const std::size_t head = head_buckets;
+    if (head > 0 && head < nb) {
+      scatter(0, head);
+      const std::size_t counts[3] = {scratch.near_tie_runs, scratch.near_tie_items, scratch.cluster_cycles};
+      b = emit_buckets(0, head, head, pending, scratch);
+      const std::size_t at = bucket_begin[head];
+      if (at > 0 && joined(sorted[at - 1], Packed(head) << (32 + bucket_shift))) {
+        pending.clear();
+        b = 0;
+        scratch.near_tie_runs = counts[0];
+        scratch.near_tie_items = counts[1];
+        scratch.cluster_cycles = counts[2];
+      } else if (!pending.empty()) {
+        hand_out();
+      }
+      scatter(head, nb);
+    } else {
+      scatter(0, nb);
+    }
+    scattered = true;
+  }
   while (b < nb && !stop) {
     b = emit_buckets(b, b + 1, nb, pending, scratch);
-    // The first bucket goes out at once; later ones in pendinges of a few thousand tets.
-    if (!pending.empty() && (first || pending.size() >= 4096 || b >= nb)) {
-      first = false;
-      std::lock_guard<std::mutex> g(mu);
-      ready.push_back(std::move(pending));
-      pending.clear();
-      cv.notify_one();
-    }
+    // The first bucket goes out at once; later ones in batches of a few thousand tets.
+    if (!pending.empty() && (first || pending.size() >= 4096 || b >= nb)) hand_out();
   }
   std::lock_guard<std::mutex> g(mu);
   if (!pending.empty()) ready.push_back(std::move(pending));
@@ -753,6 +814,10 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
   const std::size_t nb = d.bucket_begin.size() - 1;
   if (d.bucket_begin[nb] < 50000) {
     // Small orders: on this thread, bucket by bucket.
+    if (!d.scattered) {
+      d.scatter(0, nb);
+      d.scattered = true;
+    }
     while (d.batch.empty() && d.next_bucket < nb)
       d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch);
     d.add_counts(d.scratch);
@@ -784,6 +849,8 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
   ProgressiveOrder order(mesh, table, view, subset, front_to_back);
   ProgressiveOrder::Impl& d = *order.impl_;
   const std::size_t nb = d.bucket_begin.size() - 1;
+  d.scatter(0, nb);
+  d.scattered = true;
   std::vector<std::uint32_t> out;
   out.reserve(order.total());
   // Both cores: the first half of the buckets here, the second half on another thread. A tie chain
