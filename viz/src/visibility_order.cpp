@@ -234,8 +234,9 @@ struct ProgressiveOrder::Impl {
   void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
   // Hands out buckets [first, last) into out (sorting, tie fix-up, cluster expansion); returns the
   // next bucket not consumed: a run of joined entries may take in buckets from `last` up to `limit`.
+  // With no clusters, `direct` (if given) receives the tets at their entries' places instead.
   std::size_t emit_buckets(std::size_t first, std::size_t last, std::size_t limit, std::vector<std::uint32_t>& out,
-                           Scratch& sc);
+                           Scratch& sc, std::uint32_t* direct = nullptr);
 };
 
 void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
@@ -349,7 +350,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   // Tight loops over the ordinary items, on locals (the stores to the histogram could alias anything
   // reached through a reference).
   const std::uint32_t* rep_p = reps.data();
-  const std::uint32_t* item_p = items.data();
+  const std::uint32_t* item_p = t_cluster_free ? rep_p : items.data();  // items are their reps then
   Packed* keyed_p = keyed.data();
   const double* C = t.c.data();
   const double* S = t.s.data();
@@ -722,7 +723,7 @@ ProgressiveOrder::ProgressiveOrder(ProgressiveOrder&&) noexcept = default;
 ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = default;
 
 std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
-                                                 std::vector<std::uint32_t>& out, Scratch& sc) {
+                                                 std::vector<std::uint32_t>& out, Scratch& sc, std::uint32_t* direct) {
   std::size_t b = first;
   while (b < last) {
     const std::size_t begin = bucket_begin[b];
@@ -746,9 +747,12 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       ++b;
     }
     if (t_cluster_free) {
-      const std::size_t at = out.size();
-      out.resize(at + (end - begin));
-      std::uint32_t* o = out.data() + at;
+      std::uint32_t* o = direct + begin;
+      if (direct == nullptr) {
+        const std::size_t at = out.size();
+        out.resize(at + (end - begin));
+        o = out.data() + at;
+      }
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
       scan_runs(begin, end, sc, [&](std::uint32_t item) {
@@ -862,13 +866,19 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
                                                       static_cast<std::uint32_t>(m / 2)) - d.bucket_begin.begin());
     if (split >= nb) split = 0;
   }
+  // With no clusters, the tets go straight to their final places (those of their entries).
+  std::uint32_t* direct = nullptr;
+  if (d.t_cluster_free) {
+    out.resize(m);
+    direct = out.data();
+  }
   bool done = false;
   if (split > 0) {
     std::vector<std::uint32_t> second;
-    second.reserve(order.total() - order.total() / 2 + 1024);
+    if (!direct) second.reserve(order.total() - order.total() / 2 + 1024);
     ProgressiveOrder::Impl::Scratch other_scratch;
-    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch); });
-    d.emit_buckets(0, split, split, out, d.scratch);
+    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch, direct); });
+    d.emit_buckets(0, split, split, out, d.scratch, direct);
     other.join();
     // The halves are independent unless the last entry of the first joins the first of the second.
     const std::size_t at = d.bucket_begin[split];
@@ -878,12 +888,12 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
       d.add_counts(other_scratch);
       done = true;
     } else {
-      out.clear();
+      if (!direct) out.clear();
       d.scratch = {};
     }
   }
   if (!done) {
-    d.emit_buckets(0, nb, nb, out, d.scratch);
+    d.emit_buckets(0, nb, nb, out, d.scratch, direct);
     d.add_counts(d.scratch);
   }
   d.next_bucket = nb;
