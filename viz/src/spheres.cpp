@@ -1,6 +1,7 @@
 #include "foxi/viz/spheres.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -17,16 +18,22 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 // A centre computed in double whose estimated relative error exceeds this is recomputed exactly.
 constexpr double kRecomputeAbove = 0x1p-40;
 
-// Runs f(begin, end) over [0, n) on both cores.
+// Runs f(begin, end, part) over [0, n) on both cores (part 0 or 1: the thread), in chunks taken
+// in turn, so that the costly exact recomputations, bunched in some part of the mesh, do not leave
+// one core idle.
 template <class F>
 void parallel_for(std::size_t n, F f) {
   if (n < 20000) {
-    f(std::size_t{0}, n);
+    f(std::size_t{0}, n, 0);
     return;
   }
-  std::size_t half = n / 2;
-  std::thread other([&] { f(half, n); });
-  f(std::size_t{0}, half);
+  const std::size_t chunk = std::max<std::size_t>(4096, n / 256);
+  std::atomic<std::size_t> next{0};
+  auto work = [&](int part) {
+    for (std::size_t b = next.fetch_add(chunk); b < n; b = next.fetch_add(chunk)) f(b, std::min(n, b + chunk), part);
+  };
+  std::thread other([&] { work(1); });
+  work(0);
   other.join();
 }
 
@@ -78,8 +85,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   t.key_b.resize(n);
 
   std::size_t recomputed[2] = {0, 0}, flats[2] = {0, 0};
-  parallel_for(n, [&](std::size_t begin, std::size_t end) {
-    const int part = begin == 0 ? 0 : 1;
+  parallel_for(n, [&](std::size_t begin, std::size_t end, int part) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t* v = T + 4 * i;
       const double* pa = X + 3 * std::size_t(v[0]);
@@ -170,7 +176,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   // sphere? A double filter rejects the clear cases; CGAL's exact test decides the rest.
   const FaceAdjacency& adj = face_adjacency(mesh);
   std::vector<std::uint8_t> same(4 * n, 0);
-  parallel_for(n, [&](std::size_t begin, std::size_t end) {
+  parallel_for(n, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t i = begin; i < end; ++i) {
       if (t.flat[i]) continue;
       const std::uint32_t* v = T + 4 * i;
@@ -213,21 +219,24 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   });
   if (progress && !progress("clusters", 0.8)) return t;
 
-  UnionFind uf(n);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int f = 0; f < 4; ++f)
-      if (same[4 * i + f]) uf.unite(static_cast<std::uint32_t>(i), adj.neighbour[4 * i + f] >> 2);
-  // Number the clusters of two or more tets in order of their smallest tet.
-  std::vector<std::uint32_t> size(n, 0);
-  for (std::size_t i = 0; i < n; ++i) ++size[uf.find(static_cast<std::uint32_t>(i))];
   t.cluster_of.assign(n, kNone);
-  std::vector<std::uint32_t> id_of_root(n, kNone);
   std::uint32_t clusters = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint32_t r = uf.find(static_cast<std::uint32_t>(i));
-    if (size[r] < 2) continue;
-    if (id_of_root[r] == kNone) id_of_root[r] = clusters++;
-    t.cluster_of[i] = id_of_root[r];
+  // Most unstructured meshes have no or few cospherical faces: no union-find over all tets then.
+  if (std::find(same.begin(), same.end(), std::uint8_t(1)) != same.end()) {
+    UnionFind uf(n);
+    for (std::size_t i = 0; i < n; ++i)
+      for (int f = 0; f < 4; ++f)
+        if (same[4 * i + f]) uf.unite(static_cast<std::uint32_t>(i), adj.neighbour[4 * i + f] >> 2);
+    // Number the clusters of two or more tets in order of their smallest tet.
+    std::vector<std::uint32_t> size(n, 0);
+    for (std::size_t i = 0; i < n; ++i) ++size[uf.find(static_cast<std::uint32_t>(i))];
+    std::vector<std::uint32_t> id_of_root(n, kNone);
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint32_t r = uf.find(static_cast<std::uint32_t>(i));
+      if (size[r] < 2) continue;
+      if (id_of_root[r] == kNone) id_of_root[r] = clusters++;
+      t.cluster_of[i] = id_of_root[r];
+    }
   }
   t.cluster_begin.assign(clusters + 1, 0);
   for (std::size_t i = 0; i < n; ++i)
@@ -269,12 +278,18 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   // spheres do not widen the near-tie window of everyone else.
   t.wide.assign(n, 0);
   if (n > 0) {
-    std::vector<float> tmp(t.key_a);
-    std::nth_element(tmp.begin(), tmp.begin() + n / 2, tmp.end());
-    const double cap_a = 256.0 * std::max(double(tmp[n / 2]), 1e-300);
-    tmp = t.key_b;
-    std::nth_element(tmp.begin(), tmp.begin() + n / 2, tmp.end());
-    const double cap_b = 256.0 * std::max(double(tmp[n / 2]), 1e-300);
+    // The medians of a strided sample (under 2^17 bounds): the cap is a heuristic (any cap is
+    // correct, bounds are kept per item), and a sample needs no copy of all n.
+    const std::size_t stride = std::max<std::size_t>(1, n / 65536);
+    std::vector<float> tmp;
+    auto median = [&](const std::vector<float>& v) {
+      tmp.clear();
+      for (std::size_t i = 0; i < n; i += stride) tmp.push_back(v[i]);
+      std::nth_element(tmp.begin(), tmp.begin() + tmp.size() / 2, tmp.end());
+      return double(tmp[tmp.size() / 2]);
+    };
+    const double cap_a = 256.0 * std::max(median(t.key_a), 1e-300);
+    const double cap_b = 256.0 * std::max(median(t.key_b), 1e-300);
     // Wide because of a poorly conditioned centre (not a huge sphere): recompute it exactly, which
     // shrinks its bound to rounding.
     for (std::size_t i = 0; i < n; ++i) {

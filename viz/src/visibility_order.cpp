@@ -86,20 +86,26 @@ void exact_key(const Mesh& m, const SphereTable& table, const View& view, std::u
 
 }  // namespace
 
-// One sort entry: the item's key in drawing order (ascending = drawn first) minus its rounding
-// radius, so that the exact key lies in [lo, lo + 2 radius].
+// An entry of a near-tie run: the item's key in drawing order (ascending = drawn first) minus its
+// rounding radius, so that the exact key lies in [lo, lo + 2 radius].
 struct Entry {
   double lo;
   float radius;
   std::uint32_t item;
   double hi() const { return lo + 2.0 * double(radius); }
-  bool operator<(const Entry& o) const { return lo < o.lo; }
 };
+
+// A sort entry: the item's quantised key q (high 32 bits) and the item (low 32 bits). q is a
+// monotone function of lo, so sorting the packed integers sorts by lo up to ties of q; entries whose
+// q differ by more than the view's window are in the right order (their intervals are disjoint).
+using Packed = std::uint64_t;
+inline std::uint32_t q_of(Packed p) { return static_cast<std::uint32_t>(p >> 32); }
+inline std::uint32_t item_of(Packed p) { return static_cast<std::uint32_t>(p); }
 
 // Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
 struct Workspace {
-  std::vector<double> lo;       // pass 1: each item's lo (8 bytes per item)
-  std::vector<Entry> entries;   // the bucketed entries (16 bytes per item)
+  std::vector<Packed> keyed;    // pass 1: the items with their q, in input order (8 bytes per item)
+  std::vector<Packed> entries;  // the bucketed entries (8 bytes per item)
 };
 thread_local Workspace t_workspace;
 
@@ -109,19 +115,20 @@ struct ProgressiveOrder::Impl {
   View view;
   bool front_to_back = false;
   std::vector<std::uint8_t> in_subset;          // per tet, only when a subset meets clusters
-  std::vector<Entry> sorted;                    // bucketed; each bucket sorted when handed out
+  std::vector<Packed> sorted;                   // bucketed; each bucket sorted when handed out
   std::vector<std::uint32_t> bucket_begin;      // size buckets + 1
   std::size_t next_bucket = 0;
   std::vector<std::uint32_t> batch;
   std::size_t handed = 0, total_tets = 0;
   OrderStats stats;
-  // Per-thread scratch: the local MPVO of clusters and the tie counts.
+  // Per-thread scratch: the local MPVO of clusters, the bucket sort, the near-tie runs, tie counts.
   struct Scratch {
     std::vector<std::uint32_t> local_tets, local_indeg, local_queue;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
     std::vector<std::uint8_t> local_done;
-    std::vector<Entry> tmp;            // the second-level counting sort
-    std::vector<std::uint32_t> counts, subs;
+    std::vector<Packed> tmp;           // the second-level counting sort
+    std::vector<std::uint32_t> counts;
+    std::vector<Entry> run;
     std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
   };
   Scratch scratch;
@@ -130,9 +137,56 @@ struct ProgressiveOrder::Impl {
     stats.near_tie_items += sc.near_tie_items;
     stats.cluster_cycles += sc.cluster_cycles;
     sc.near_tie_runs = sc.near_tie_items = sc.cluster_cycles = 0;
+    stats.key_range = key_range_found;
   }
 
   bool tet_in(std::uint32_t t) const { return in_subset.empty() || in_subset[t]; }
+
+  // The view's keys in the table's local frame: key = s - c.(2 eye) (perspective) or c.dir, drawn
+  // in increasing sign * key; an item's lo is sign * key - its radius.
+  bool perspective = true;
+  double eye2[3] = {0, 0, 0}, dir[3] = {0, 0, 0};
+  double sign = -1, ka = 1, np = 0;
+  float bound = 0;                          // the radius of ordinary items
+  double lo_of(std::uint32_t tet, float radius) const {
+    const double* c = table->c.data() + 3 * std::size_t(tet);
+    const double k = perspective ? table->s[tet] - (c[0] * eye2[0] + c[1] * eye2[1] + c[2] * eye2[2])
+                                 : c[0] * dir[0] + c[1] * dir[1] + c[2] * dir[2];
+    return sign * k - double(radius);
+  }
+  float radius_of(std::uint32_t rep) const {
+    if (!table->wide[rep]) return bound;
+    return std::max(bound, static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) *
+                                              (1 + 1e-6)));
+  }
+  // q = floor((lo - q_min) q_scale) clamped to 32 bits: monotone in lo (NaN goes to 0).
+  double q_min = 0, q_scale = 0;
+  std::uint32_t quantise(double lo) const {
+    const double x = (lo - q_min) * q_scale;
+    return x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+  }
+  // Neighbours in q order are "joined" (possibly out of order, resolved in double and exactly) if
+  // their q differ by at most q_window, or both lie in one zone: the q range of everything whose
+  // interval may overlap a wide item's (merged, sorted).
+  std::uint64_t q_window = 0;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> zones;
+  bool joined(Packed a, Packed b) const {
+    const std::uint32_t qa = q_of(a), qb = q_of(b);
+    if (std::uint64_t(qb) - qa <= q_window) return true;
+    if (zones.empty()) return false;
+    auto z = std::lower_bound(zones.begin(), zones.end(), qa,
+                              [](const std::pair<std::uint32_t, std::uint32_t>& r, std::uint32_t q) { return r.second < q; });
+    return z != zones.end() && z->first <= qa && qb <= z->second;
+  }
+  int bucket_shift = 32;                    // first-level bucket of an entry: q >> bucket_shift
+  // The entries in input order (pass 1) and what the scatter of them into `sorted` needs.
+  std::vector<Packed> keyed;
+  std::vector<std::uint32_t> scatter_start[2];  // per bucket, the next slot of each part
+  std::size_t scatter_split = 0;                // part 0 is keyed[0, split), part 1 the rest
+  std::size_t head_buckets = 0;                 // buckets a progressive order places first
+  bool scattered = false;
+  double key_range_found = 0;                   // set by the scatter, published by add_counts
+  void scatter(std::size_t from, std::size_t to);
 
   // The progressive path sorts ahead on a second thread (started by the first next()), so that the
   // caller can draw one batch while the next buckets are being sorted.
@@ -152,23 +206,37 @@ struct ProgressiveOrder::Impl {
     // Hand the big buffer back for the next view on this thread. (A buffer the worker thread made
     // is the same memory; the thread_local slot is this thread's.)
     if (sorted.capacity() > t_workspace.entries.capacity()) t_workspace.entries.swap(sorted);
+    if (keyed.capacity() > t_workspace.keyed.capacity()) t_workspace.keyed.swap(keyed);
   }
   void prepare(std::span<const std::uint32_t> subset);
-  // Re-sorts the near-tie chains of [begin, end) exactly; returns the high end of the last chain and
-  // sets *last_chain to where it starts.
-  double fix_ties(std::size_t begin, std::size_t end, Scratch& sc, std::size_t* last_chain);
-  // Sorts [begin, end) by lo; `bucket` is the first-level bucket it is (its key range is known), or
-  // kNone for a range whose bounds must be scanned.
-  void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc, std::size_t bucket);
-  double bucket_low(std::size_t b) const { return bucket_min + double(b) / bucket_scale; }
-  double bucket_min = 0, bucket_scale = 0;  // the linear map of lo to first-level buckets
+  // Sorts one first-level bucket [begin, end) by packed value.
+  void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc);
+  // Calls put(item) for the items of [begin, end) in order, after putting each maximal run of joined
+  // neighbours in exact order (resolve_run).
+  template <class Put>
+  void scan_runs(std::size_t begin, std::size_t end, Scratch& sc, Put put) {
+    const Packed* a = sorted.data();
+    const std::uint64_t w = q_window;
+    const bool plain = zones.empty();
+    for (std::size_t i = begin; i < end; ++i) {
+      // Fast path: neighbours far apart in q (almost all of them).
+      if (i + 1 < end && (plain ? std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) <= w : joined(a[i], a[i + 1]))) {
+        std::size_t j = i + 1;
+        while (j + 1 < end && joined(a[j], a[j + 1])) ++j;
+        resolve_run(i, j + 1, sc);
+        for (; i < j; ++i) put(item_of(a[i]));
+      }
+      put(item_of(a[i]));
+    }
+  }
+  void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
   void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
   // Hands out buckets [first, last) into out (sorting, tie fix-up, cluster expansion); returns the
-  // next bucket not consumed: a tie chain may take in buckets from `last` up to `limit`. *reach_out
-  // receives the high end of the last entry's chain.
+  // next bucket not consumed: a run of joined entries may take in buckets from `last` up to `limit`.
+  // With no clusters, `direct` (if given) receives the tets at their entries' places instead.
   std::size_t emit_buckets(std::size_t first, std::size_t last, std::size_t limit, std::vector<std::uint32_t>& out,
-                           Scratch& sc, double* reach_out);
+                           Scratch& sc, std::uint32_t* direct = nullptr);
 };
 
 void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
@@ -226,101 +294,120 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   }
 
   // Rounding bounds: |key error| <= a + b |p|_1 (orthographic: b |d|_1), in the local frame.
-  View v = view;
-  for (int k = 0; k < 3; ++k) v.eye[k] -= t.origin[k];
-  const double np = v.perspective ? std::abs(v.eye[0]) + std::abs(v.eye[1]) + std::abs(v.eye[2])
-                                  : std::abs(v.dir[0]) + std::abs(v.dir[1]) + std::abs(v.dir[2]);
-  const double ka = v.perspective ? 1.0 : 0.0;
+  perspective = view.perspective;
+  for (int k = 0; k < 3; ++k) {
+    eye2[k] = 2 * (view.eye[k] - t.origin[k]);
+    dir[k] = view.dir[k];
+  }
+  np = perspective ? 0.5 * (std::abs(eye2[0]) + std::abs(eye2[1]) + std::abs(eye2[2]))
+                   : std::abs(dir[0]) + std::abs(dir[1]) + std::abs(dir[2]);
+  ka = perspective ? 1.0 : 0.0;
+  sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
   // Rounded up to float, and a little more for the subtraction that places lo.
-  const float bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
+  bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
   stats.key_bound = bound;
 
-  // 1. Keys (both cores): each item's key in drawing order, placed at the low end of its interval.
-  // Only lo is stored here (8 bytes); the 16-byte entries are made by the scatter, so a view needs
-  // 24 bytes per item.
-  std::vector<double>& los = t_workspace.lo;
-  if (los.size() < m) los.resize(m);
-  auto radius_of = [&](std::size_t i) {
-    if (i < m_main) return bound;
-    std::size_t w = i - m_main;
-    return std::max(bound, static_cast<float>((ka * wide_a[w] + wide_b[w] * np) * (1 + 1e-6)));
+  // 1. The quantisation of lo to 32 bits, over the bulk of a sample of the keys ([0.1%, 99.9%]
+  // quantiles widened by an eighth each side): keys outside (far-flung spheres of slivers at the
+  // hull) are clamped to the end values and sorted in double as runs of ties.
+  auto item_lo = [&](std::size_t i) {
+    if (i < m_main) return lo_of(reps[i], bound);
+    const std::uint32_t rep = rep_tet(t, wide_items[i - m_main]);
+    return lo_of(rep, radius_of(rep));
   };
+  double head_lo = 0;
+  {
+    const std::size_t samples = std::min<std::size_t>(m, 2048);
+    std::vector<double> sample(samples);
+    for (std::size_t k = 0; k < samples; ++k) sample[k] = item_lo(k * m / samples);
+    std::sort(sample.begin(), sample.end());
+    double kmin = sample.front(), kmax = sample.back();
+    head_lo = sample[samples / 512];
+    if (samples < m) {
+      const double qlo = sample[2], qhi = sample[samples - 3], widen = (qhi - qlo) / 8;
+      kmin = qlo - widen;
+      kmax = qhi + widen;
+    }
+    q_min = kmin;
+    q_scale = kmax > kmin ? 4294967296.0 / (kmax - kmin) : 0.0;
+    // Joined neighbours: q apart by at most 2 radius q_scale plus the rounding of the map and floor.
+    const double w = 2.0 * double(bound) * q_scale * (1 + 1e-9) + 2;
+    q_window = w < 8e9 ? static_cast<std::uint64_t>(w) : std::uint64_t(1) << 33;
+  }
+
+  // 2. Keys, q and the first-level histogram in one pass (both cores). About 1000 entries a bucket:
+  // few enough buckets that the scatter's write fronts stay in cache, and each bucket sorted when
+  // handed out (sort_bucket) stays in L1/L2 (measured against 256 to 2048 a bucket).
+  int bits = 4;
+  while (bits < 16 && (std::size_t(1024) << bits) < m) ++bits;
+  const std::size_t nb = std::size_t(1) << bits;
+  const int shift = 32 - bits;
+  bucket_shift = shift;
+  stats.buckets = nb;
+  keyed.swap(t_workspace.keyed);
+  if (keyed.size() < m) keyed.resize(m);
+  std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
+  // Tight loops over the ordinary items, on locals (the stores to the histogram could alias anything
+  // reached through a reference).
+  const std::uint32_t* rep_p = reps.data();
+  const std::uint32_t* item_p = t_cluster_free ? rep_p : items.data();  // items are their reps then
+  Packed* keyed_p = keyed.data();
   const double* C = t.c.data();
   const double* S = t.s.data();
-  const double sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
-  double lo_part[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
-  double hi_part[2] = {-lo_part[0], -lo_part[1]};
-  // Tight loops on raw pointers: the ordinary items (no branch), then the few wide ones.
-  const std::uint32_t* rep_p = reps.data();
-  double* lo_p = los.data();
-  const double px = 2 * v.eye[0], py = 2 * v.eye[1], pz = 2 * v.eye[2];
-  const double dx = v.dir[0], dy = v.dir[1], dz = v.dir[2];
-  const double shift = double(bound);
-  parallel_for(m_main, [&](std::size_t b, std::size_t e, int part) {
-    double l = lo_part[part], h = hi_part[part];
-    if (v.perspective) {
+  const double p0 = perspective ? eye2[0] : dir[0], p1 = perspective ? eye2[1] : dir[1],
+               p2 = perspective ? eye2[2] : dir[2];
+  const double shift_lo = double(bound), sgn = sign, qmin = q_min, qscale = q_scale;
+  const bool persp_view = perspective;
+  auto key_pass = [=, &hist](std::size_t b, std::size_t e, int part) {
+    std::uint32_t* hp = hist[part].data();
+    auto put = [=](std::size_t i, double lo) {
+      const double x = (lo - qmin) * qscale;
+      const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+      keyed_p[i] = (Packed(q) << 32) | item_p[i];
+      ++hp[q >> shift];
+    };
+    if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t tet = rep_p[i];
         const double* c = C + 3 * tet;
-        const double lo = sign * (S[tet] - (c[0] * px + c[1] * py + c[2] * pz)) - shift;
-        lo_p[i] = lo;
-        l = std::min(l, lo);
-        h = std::max(h, lo);
+        put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo);
       }
     } else {
       for (std::size_t i = b; i < e; ++i) {
         const double* c = C + 3 * std::size_t(rep_p[i]);
-        const double lo = sign * (c[0] * dx + c[1] * dy + c[2] * dz) - shift;
-        lo_p[i] = lo;
-        l = std::min(l, lo);
-        h = std::max(h, lo);
+        put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo);
       }
     }
-    lo_part[part] = l;
-    hi_part[part] = h;
-  });
+  };
+  parallel_for(m_main, key_pass);
+  // The wide items (few) go with the second part, and each makes a zone of joined q values.
+  const std::size_t split = m_main < 50000 ? m : m_main / 2;  // as parallel_for splits
+  const int wide_part = split == m ? 0 : 1;
+  zones.clear();
   for (std::size_t i = m_main; i < m; ++i) {
-    const std::uint32_t tet = rep_tet(t, wide_items[i - m_main]);
-    const double* c = C + 3 * std::size_t(tet);
-    const double k = v.perspective ? S[tet] - (c[0] * px + c[1] * py + c[2] * pz) : c[0] * dx + c[1] * dy + c[2] * dz;
-    const double lo = sign * k - double(radius_of(i));
-    lo_p[i] = lo;
-    lo_part[0] = std::min(lo_part[0], lo);
-    hi_part[0] = std::max(hi_part[0], lo);
+    const std::uint32_t rep = rep_tet(t, wide_items[i - m_main]);
+    const float r = radius_of(rep);
+    const double lo = lo_of(rep, r);
+    const std::uint32_t q = quantise(lo);
+    keyed_p[i] = (Packed(q) << 32) | wide_items[i - m_main];
+    ++hist[wide_part][q >> shift];
+    // Whatever overlaps [lo, lo + 2r] has its lo in [lo - 2 bound, lo + 2r] (ordinary items), or
+    // its own zone meets this one (wide items).
+    const std::uint64_t za = quantise(lo - 2.0 * double(bound)), zb = quantise(lo + 2.0 * double(r));
+    zones.emplace_back(static_cast<std::uint32_t>(za > q_window ? za - q_window : 0),
+                       static_cast<std::uint32_t>(std::min<std::uint64_t>(zb + q_window, 0xFFFFFFFFu)));
   }
-  double kmin = std::min(lo_part[0], lo_part[1]), kmax = std::max(hi_part[0], hi_part[1]);
-  stats.key_range = kmax - kmin;
-  // The buckets cover the bulk of the keys, [0.2%, 99.8%] quantiles of a sample, widened: keys
-  // outside (far-flung spheres of slivers at the hull) fall into the first and last buckets.
-  if (m > 4096) {
-    std::vector<double> sample(1024);
-    for (std::size_t i = 0; i < sample.size(); ++i) sample[i] = los[i * (m / sample.size())];
-    std::sort(sample.begin(), sample.end());
-    double qlo = sample[2], qhi = sample[sample.size() - 3], widen = 0.05 * (qhi - qlo);
-    kmin = std::max(kmin, qlo - widen);
-    kmax = std::min(kmax, qhi + widen);
+  if (!zones.empty()) {
+    std::sort(zones.begin(), zones.end());
+    std::size_t k = 0;
+    for (std::size_t z = 1; z < zones.size(); ++z) {
+      if (zones[z].first <= zones[k].second) zones[k].second = std::max(zones[k].second, zones[z].second);
+      else zones[++k] = zones[z];
+    }
+    zones.resize(k + 1);
   }
 
-  // 2. The MSD bucket pass: a histogram and a scatter (both cores), by a linear map of lo.
-  // Few enough buckets that the scatter stays in cache; each is sorted when handed out by a second
-  // counting pass (sort_bucket).
-  int bits = 4;
-  while (bits < 16 && (std::size_t(256) << bits) < m) ++bits;
-  const std::size_t nb = std::size_t(1) << bits;
-  stats.buckets = nb;
-  const double scale = kmax > kmin ? double(nb) / (kmax - kmin) : 0.0;
-  bucket_min = kmin;
-  bucket_scale = scale;
-  const double last = double(nb - 1);
-  auto bucket_of = [&](double lo) {
-    double x = (lo - kmin) * scale;
-    return x <= 0 ? 0u : x >= last ? static_cast<std::uint32_t>(last) : static_cast<std::uint32_t>(x);
-  };
-  std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
-  parallel_for(m, [&](std::size_t b, std::size_t e, int part) {
-    std::uint32_t* h = hist[part].data();
-    for (std::size_t i = b; i < e; ++i) ++h[bucket_of(lo_p[i])];
-  });
+  // 3. The scatter by first-level bucket (both cores, each into its own slots of every bucket).
   bucket_begin.assign(nb + 1, 0);
   std::vector<std::uint32_t> start0(nb), start1(nb);
   std::uint32_t acc = 0;
@@ -332,132 +419,168 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     acc += hist[1][b];
   }
   bucket_begin[nb] = acc;
+  scatter_start[0].swap(start0);
+  scatter_start[1].swap(start1);
+  scatter_split = split;
   sorted.swap(t_workspace.entries);
   if (sorted.size() < m) sorted.resize(m);
-  std::vector<Entry>& out = sorted;
-  const std::size_t split = m < 50000 ? m : m / 2;  // as parallel_for splits
-  auto scatter = [&](std::size_t b, std::size_t e, std::vector<std::uint32_t>& pos) {
-    std::uint32_t* ps = pos.data();
-    Entry* o = out.data();
-    const std::uint32_t* it = items.data();
-    const std::size_t main_end = std::min(e, m_main);
-    for (std::size_t i = b; i < main_end; ++i) {
-      const double lo = lo_p[i];
-      o[ps[bucket_of(lo)]++] = Entry{lo, bound, it[i]};
-    }
-    for (std::size_t i = std::max(b, m_main); i < e; ++i) {
-      const double lo = lo_p[i];
-      o[ps[bucket_of(lo)]++] = Entry{lo, radius_of(i), wide_items[i - m_main]};
-    }
-  };
-  if (split == m) {
-    scatter(0, m, start0);
-  } else {
-    std::thread other([&] { scatter(split, m, start1); });
-    scatter(0, split, start0);
-    other.join();
-  }
+  // The head: the buckets up to the one of the sample's 0.2% quantile, which a progressive order
+  // places by a scan of their own and hands out before the whole scatter.
+  head_buckets = m >= 50000 ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb) : 0;
 }
 
-// Sorts one bucket by lo: a counting pass over about n/2 sub-buckets of its own range, then an
-// insertion sort over the nearly sorted result (linear for evenly spread keys).
-void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc, std::size_t bucket) {
-  Entry* a = sorted.data() + begin;
-  const std::size_t n = end - begin;
-  const std::size_t nb = bucket_begin.size() - 1;
-  if (n > 48) {
-    double lo, hi;
-    if (bucket != kNone && bucket > 0 && bucket + 1 < nb && bucket_scale > 0) {
-      // Inner buckets: the linear map gives the range (entries just outside it by rounding land in
-      // the end sub-buckets, and the insertion sort puts them right).
-      lo = bucket_low(bucket);
-      hi = bucket_low(bucket + 1);
+// Places the entries of buckets [from, to) of keyed into sorted (both cores), each part into its
+// own slots of every bucket: the same layout whatever ranges the buckets are placed in.
+void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
+  const std::size_t m = bucket_begin.back(), nb = bucket_begin.size() - 1;
+  const Packed* keyed_p = keyed.data();
+  Packed* out = sorted.data();
+  const int shift = bucket_shift;
+  auto run = [=](std::size_t b, std::size_t e, std::uint32_t* ps) {
+    if (from == 0 && to == nb) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Packed p = keyed_p[i];
+        out[ps[q_of(p) >> shift]++] = p;
+      }
     } else {
-      lo = hi = a[0].lo;
-      for (std::size_t i = 1; i < n; ++i) {
-        lo = std::min(lo, a[i].lo);
-        hi = std::max(hi, a[i].lo);
+      for (std::size_t i = b; i < e; ++i) {
+        const Packed p = keyed_p[i];
+        const std::size_t k = q_of(p) >> shift;
+        if (k >= from && k < to) out[ps[k]++] = p;
       }
     }
-    if (hi > lo) {
-      std::size_t subs = 1;
-      while (subs < n / 2) subs <<= 1;
-      const double sub_scale = double(subs) / (hi - lo) * (1 - 1e-12);
-      sc.counts.assign(subs + 1, 0);
-      if (sc.tmp.size() < n) sc.tmp.resize(n);
-      if (sc.subs.size() < n) sc.subs.resize(n);
-      const double top = double(subs - 1);
-      std::uint32_t* cnt = sc.counts.data();
-      std::uint32_t* sub = sc.subs.data();
-      for (std::size_t i = 0; i < n; ++i) {
-        const double f = (a[i].lo - lo) * sub_scale;
-        const std::uint32_t k = static_cast<std::uint32_t>(std::clamp(f, 0.0, top));
-        sub[i] = k;
-        ++cnt[k + 1];
-      }
-      for (std::size_t k = 1; k <= subs; ++k) cnt[k] += cnt[k - 1];
-      Entry* tmp = sc.tmp.data();
-      for (std::size_t i = 0; i < n; ++i) tmp[cnt[sub[i]]++] = a[i];
-      std::copy(tmp, tmp + n, a);
-    }
+  };
+  const std::size_t split = scatter_split;
+  if (split == m) {
+    run(0, m, scatter_start[0].data());
+  } else {
+    std::thread other([&] { run(split, m, scatter_start[1].data()); });
+    run(0, split, scatter_start[0].data());
+    other.join();
   }
-  for (std::size_t i = 1; i < n; ++i) {
-    Entry x = a[i];
-    std::size_t j = i;
-    while (j > 0 && x.lo < a[j - 1].lo) {
-      a[j] = a[j - 1];
-      --j;
+  if (to < nb) return;
+  const SphereTable& t = *table;
+  // The key range: q is monotone in lo, so the extremes lie in the first and last non-empty buckets.
+  std::size_t first = 0, last = nb - 1;
+  while (bucket_begin[first + 1] == 0) ++first;
+  while (bucket_begin[last] == m) --last;
+  double kmin = std::numeric_limits<double>::infinity(), kmax = -kmin;
+  for (std::size_t b : {first, last})
+    for (std::size_t i = bucket_begin[b]; i < bucket_begin[b + 1]; ++i) {
+      const std::uint32_t rep = rep_tet(t, item_of(sorted[i]));
+      const double lo = lo_of(rep, radius_of(rep));
+      kmin = std::min(kmin, lo);
+      kmax = std::max(kmax, lo);
     }
-    a[j] = x;
+  key_range_found = kmax - kmin;
+}
+
+// Sorts one first-level bucket [begin, end) by packed value: a counting pass over 2n to 4n
+// sub-buckets of the q bits below the first level's (mostly empty or single, so that the insertion
+// pass that follows mispredicts little), then the insertion pass.
+void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
+  Packed* a = sorted.data() + begin;
+  const std::size_t n = end - begin;
+  auto insertion = [](Packed* x, std::size_t len) {
+    for (std::size_t i = 1; i < len; ++i) {
+      const Packed v = x[i];
+      std::size_t j = i;
+      for (; j > 0 && v < x[j - 1]; --j) x[j] = x[j - 1];
+      x[j] = v;
+    }
+  };
+  if (n <= 32) {
+    insertion(a, n);
+    return;
+  }
+  int sub_bits = 1;
+  while ((std::size_t(1) << sub_bits) < 2 * n && sub_bits < bucket_shift) ++sub_bits;
+  const int sub_shift = bucket_shift - sub_bits;
+  const std::uint32_t mask = (std::uint32_t(1) << sub_bits) - 1;
+  const std::size_t subs = std::size_t(1) << sub_bits;
+  sc.counts.assign(subs + 1, 0);
+  if (sc.tmp.size() < n) sc.tmp.resize(n);
+  std::uint32_t* cnt = sc.counts.data();
+  Packed* tmp = sc.tmp.data();
+  for (std::size_t i = 0; i < n; ++i) ++cnt[((q_of(a[i]) >> sub_shift) & mask) + 1];
+  std::uint32_t acc = 0;  // the running sum in a register, not through memory
+  for (std::size_t k = 1; k <= subs; ++k) {
+    acc += cnt[k];
+    cnt[k] = acc;
+  }
+  for (std::size_t i = 0; i < n; ++i) tmp[cnt[(q_of(a[i]) >> sub_shift) & mask]++] = a[i];
+  // Back into place by one insertion pass (nothing moves across sub-buckets), with a budget of
+  // moves: keys crowded into a few sub-buckets go to std::sort instead.
+  std::size_t budget = 4 * n;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Packed v = tmp[i];
+    std::size_t j = i;
+    for (; j > 0 && v < a[j - 1]; --j) a[j] = a[j - 1];
+    a[j] = v;
+    budget -= std::min(budget, i - j);
+    if (budget == 0) {
+      std::copy(tmp + i + 1, tmp + n, a + i + 1);
+      std::sort(a, a + n);
+      break;
+    }
   }
 }
 
 // Every entry stands for an interval [lo, lo + 2 radius] holding its exact key (drawing order);
-// two entries can be out of order only if their intervals overlap. Sorted by lo, the maximal chains
-// of overlapping intervals are re-sorted by exact comparison (made only for overlapping pairs).
-double ProgressiveOrder::Impl::fix_ties(std::size_t begin, std::size_t end, Scratch& sc, std::size_t* last_chain) {
-  std::size_t i = begin;
-  double reach = -std::numeric_limits<double>::infinity();
-  *last_chain = begin;
-  const Entry* a = sorted.data();
-  while (i < end) {
-    // Fast path: entries whose interval ends before the next one starts (almost all of them).
-    while (i + 1 < end && a[i + 1].lo > a[i].hi()) ++i;
+// two entries can be out of order only if their intervals overlap, and then they are joined in q
+// order. A maximal run of joined neighbours is re-sorted by lo (recomputed in double), and within it
+// the chains of overlapping intervals by exact comparison (made only for overlapping pairs).
+void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scratch& sc) {
+  std::vector<Entry>& run = sc.run;
+  run.clear();
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::uint32_t item = item_of(sorted[k]);
+    const std::uint32_t rep = rep_tet(*table, item);
+    const float r = radius_of(rep);
+    run.push_back({lo_of(rep, r), r, item});
+  }
+  // By (lo, item): the same order whatever order the run came in.
+  std::sort(run.begin(), run.end(), [](const Entry& x, const Entry& y) {
+    return x.lo < y.lo || (x.lo == y.lo && x.item < y.item);
+  });
+  std::size_t i = 0;
+  const std::size_t n = run.size();
+  while (i < n) {
+    double reach = run[i].hi();
     std::size_t j = i;
-    reach = sorted[i].hi();
-    while (j + 1 < end && sorted[j + 1].lo <= reach) reach = std::max(reach, sorted[++j].hi());
+    while (j + 1 < n && run[j + 1].lo <= reach) reach = std::max(reach, run[++j].hi());
     if (j > i) {
       // Distinct items may still share a sphere (not face-adjacent): exact equality leaves them in
       // any order, which is then correct (they are incomparable, Theorem 1).
-      struct Run {
+      struct Exact {
         Entry e;
         mutable std::unique_ptr<exact::PowerKey> key;
       };
-      std::vector<Run> run;
-      run.reserve(j - i + 1);
-      for (std::size_t k = i; k <= j; ++k) run.push_back({sorted[k], nullptr});
-      auto exact_of = [&](const Run& r) -> const exact::PowerKey& {
-        if (!r.key) {
-          r.key = std::make_unique<exact::PowerKey>();
-          exact_key(*mesh, *table, view, rep_tet(*table, r.e.item), *r.key);
+      std::vector<Exact> chain;
+      chain.reserve(j - i + 1);
+      for (std::size_t k = i; k <= j; ++k) chain.push_back({run[k], nullptr});
+      auto exact_of = [&](const Exact& x) -> const exact::PowerKey& {
+        if (!x.key) {
+          x.key = std::make_unique<exact::PowerKey>();
+          exact_key(*mesh, *table, view, rep_tet(*table, x.e.item), *x.key);
         }
-        return *r.key;
+        return *x.key;
       };
       const bool ftb = front_to_back;
-      std::stable_sort(run.begin(), run.end(), [&](const Run& x, const Run& y) {
+      std::stable_sort(chain.begin(), chain.end(), [&](const Exact& x, const Exact& y) {
         if (x.e.hi() < y.e.lo) return true;
         if (y.e.hi() < x.e.lo) return false;
         int c = exact_of(x).compare(exact_of(y));
         return ftb ? c < 0 : c > 0;
       });
-      for (std::size_t k = i; k <= j; ++k) sorted[k] = run[k - i].e;
+      for (std::size_t k = i; k <= j; ++k) run[k] = chain[k - i].e;
       ++sc.near_tie_runs;
       sc.near_tie_items += j - i + 1;
     }
-    *last_chain = i;
     i = j + 1;
   }
-  return reach;
+  // The items in their order; the q values stay where they were (ascending).
+  for (std::size_t k = begin; k < end; ++k) sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | run[k - begin].item;
 }
 
 // Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
@@ -490,15 +613,15 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_
     for (std::uint32_t f = t.cluster_face_begin[k]; f < t.cluster_face_begin[k + 1]; ++f) {
       const std::uint32_t a = t.face_local[2 * f], b = t.face_local[2 * f + 1];
       const double* pl = t.face_plane.data() + 4 * std::size_t(f);
-      double val, bound;
+      double val, err;
       if (persp) {
         val = pl[0] * e[0] + pl[1] * e[1] + pl[2] * e[2] - pl[3];
-        bound = 96 * kEps * double(t.face_scale[f]) * (en + double(t.face_anorm[f]));
+        err = 96 * kEps * double(t.face_scale[f]) * (en + double(t.face_anorm[f]));
       } else {
         val = pl[0] * back[0] + pl[1] * back[1] + pl[2] * back[2];
-        bound = 32 * kEps * double(t.face_scale[f]) * en;
+        err = 32 * kEps * double(t.face_scale[f]) * en;
       }
-      int side = val > bound ? 1 : val < -bound ? -1 : 2;
+      int side = val > err ? 1 : val < -err ? -1 : 2;
       if (side == 2) {
         const std::uint32_t* fv = t.face_vertex.data() + 3 * std::size_t(f);
         side = eye_side(view, node(*mesh, fv[0]), node(*mesh, fv[1]), node(*mesh, fv[2]));
@@ -600,45 +723,44 @@ ProgressiveOrder::ProgressiveOrder(ProgressiveOrder&&) noexcept = default;
 ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = default;
 
 std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
-                                                 std::vector<std::uint32_t>& out, Scratch& sc, double* reach_out) {
-  const std::size_t nb = limit;
+                                                 std::vector<std::uint32_t>& out, Scratch& sc, std::uint32_t* direct) {
   std::size_t b = first;
-  double reach = -std::numeric_limits<double>::infinity();
   while (b < last) {
-    std::size_t begin = bucket_begin[b], end = bucket_begin[b + 1];
+    const std::size_t begin = bucket_begin[b];
+    std::size_t end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    sort_bucket(begin, end, sc, b - 1);
-    std::size_t chain = begin;
-    reach = fix_ties(begin, end, sc, &chain);
-    // A near-tie chain may cross into the following buckets: take them in while it does. Bucket b
-    // holds no lo below its lower boundary (up to rounding), so most checks need no scan.
-    while (b < nb) {
-      std::size_t nb_begin = bucket_begin[b], nb_end = bucket_begin[b + 1];
+    sort_bucket(begin, end, sc);
+    // A run of joined entries may cross into the following buckets: take them in while it may.
+    // Bucket b holds no q below b << bucket_shift, so most checks need not look into it.
+    while (b < limit) {
+      const std::size_t nb_begin = bucket_begin[b], nb_end = bucket_begin[b + 1];
       if (nb_begin == nb_end) {
         ++b;
         continue;
       }
-      const double margin = 1e-12 * (std::abs(reach) + std::abs(bucket_min) + 1.0 / bucket_scale);
-      if (bucket_scale > 0 && bucket_low(b) > reach + margin) break;
-      double next_min = std::min_element(sorted.begin() + nb_begin, sorted.begin() + nb_end)->lo;
-      if (next_min > reach) break;
-      sort_bucket(nb_begin, nb_end, sc, b);
+      const Packed bucket_low = Packed(b) << (32 + bucket_shift);
+      if (!joined(sorted[end - 1], bucket_low)) break;
+      sort_bucket(nb_begin, nb_end, sc);
+      if (!joined(sorted[end - 1], sorted[nb_begin])) break;  // sorted now, handed out next
       end = nb_end;
       ++b;
-      reach = fix_ties(chain, end, sc, &chain);
     }
     if (t_cluster_free) {
-      for (std::size_t i = begin; i < end; ++i) out.push_back(sorted[i].item);
+      std::uint32_t* o = direct + begin;
+      if (direct == nullptr) {
+        const std::size_t at = out.size();
+        out.resize(at + (end - begin));
+        o = out.data() + at;
+      }
+      scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
-      for (std::size_t i = begin; i < end; ++i) {
-        const std::uint32_t item = sorted[i].item;
+      scan_runs(begin, end, sc, [&](std::uint32_t item) {
         if (item & kClusterBit) expand(item, out, sc);
         else out.push_back(item);
-      }
+      });
     }
   }
-  if (reach_out) *reach_out = reach;
   return b;
 }
 
@@ -647,16 +769,41 @@ void ProgressiveOrder::Impl::run_worker() {
   std::size_t b = next_bucket;
   bool first = true;
   std::vector<std::uint32_t> pending;
-  while (b < nb && !stop) {
-    b = emit_buckets(b, b + 1, nb, pending, scratch, nullptr);
-    // The first bucket goes out at once; later ones in pendinges of a few thousand tets.
-    if (!pending.empty() && (first || pending.size() >= 4096 || b >= nb)) {
-      first = false;
-      std::lock_guard<std::mutex> g(mu);
-      ready.push_back(std::move(pending));
-      pending.clear();
-      cv.notify_one();
+  auto hand_out = [&] {
+    first = false;
+    std::lock_guard<std::mutex> g(mu);
+    ready.push_back(std::move(pending));
+    pending.clear();
+    cv.notify_one();
+  };
+  if (!scattered) {
+    // The head buckets first: placed, sorted and handed out before the rest is scattered, unless a
+    // run of joined entries may go on past them.
+    const std::size_t head = head_buckets;
+    if (head > 0 && head < nb) {
+      scatter(0, head);
+      const std::size_t counts[3] = {scratch.near_tie_runs, scratch.near_tie_items, scratch.cluster_cycles};
+      b = emit_buckets(0, head, head, pending, scratch);
+      const std::size_t at = bucket_begin[head];
+      if (at > 0 && joined(sorted[at - 1], Packed(head) << (32 + bucket_shift))) {
+        pending.clear();
+        b = 0;
+        scratch.near_tie_runs = counts[0];
+        scratch.near_tie_items = counts[1];
+        scratch.cluster_cycles = counts[2];
+      } else if (!pending.empty()) {
+        hand_out();
+      }
+      scatter(head, nb);
+    } else {
+      scatter(0, nb);
     }
+    scattered = true;
+  }
+  while (b < nb && !stop) {
+    b = emit_buckets(b, b + 1, nb, pending, scratch);
+    // The first bucket goes out at once; later ones in batches of a few thousand tets.
+    if (!pending.empty() && (first || pending.size() >= 4096 || b >= nb)) hand_out();
   }
   std::lock_guard<std::mutex> g(mu);
   if (!pending.empty()) ready.push_back(std::move(pending));
@@ -671,8 +818,12 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
   const std::size_t nb = d.bucket_begin.size() - 1;
   if (d.bucket_begin[nb] < 50000) {
     // Small orders: on this thread, bucket by bucket.
+    if (!d.scattered) {
+      d.scatter(0, nb);
+      d.scattered = true;
+    }
     while (d.batch.empty() && d.next_bucket < nb)
-      d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch, nullptr);
+      d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch);
     d.add_counts(d.scratch);
   } else {
     if (!d.worker.joinable() && !d.worker_done) d.worker = std::thread([&d] { d.run_worker(); });
@@ -702,6 +853,8 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
   ProgressiveOrder order(mesh, table, view, subset, front_to_back);
   ProgressiveOrder::Impl& d = *order.impl_;
   const std::size_t nb = d.bucket_begin.size() - 1;
+  d.scatter(0, nb);
+  d.scattered = true;
   std::vector<std::uint32_t> out;
   out.reserve(order.total());
   // Both cores: the first half of the buckets here, the second half on another thread. A tie chain
@@ -713,35 +866,34 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
                                                       static_cast<std::uint32_t>(m / 2)) - d.bucket_begin.begin());
     if (split >= nb) split = 0;
   }
+  // With no clusters, the tets go straight to their final places (those of their entries).
+  std::uint32_t* direct = nullptr;
+  if (d.t_cluster_free) {
+    out.resize(m);
+    direct = out.data();
+  }
   bool done = false;
   if (split > 0) {
     std::vector<std::uint32_t> second;
-    second.reserve(order.total() - order.total() / 2 + 1024);
+    if (!direct) second.reserve(order.total() - order.total() / 2 + 1024);
     ProgressiveOrder::Impl::Scratch other_scratch;
-    double reach = 0;
-    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch, nullptr); });
-    d.emit_buckets(0, split, split, out, d.scratch, &reach);
+    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch, direct); });
+    d.emit_buckets(0, split, split, out, d.scratch, direct);
     other.join();
-    // The first entry of the second half must lie beyond every interval of the first half.
-    double second_min = std::numeric_limits<double>::infinity();
-    for (std::size_t b = split; b < nb && d.bucket_begin[b] < d.bucket_begin[nb]; ++b) {
-      if (d.bucket_begin[b] < d.bucket_begin[b + 1]) {
-        second_min = d.sorted[d.bucket_begin[b]].lo;  // sorted by now
-        break;
-      }
-    }
-    if (second_min > reach) {
+    // The halves are independent unless the last entry of the first joins the first of the second.
+    const std::size_t at = d.bucket_begin[split];
+    if (at == 0 || at == m || !d.joined(d.sorted[at - 1], d.sorted[at])) {
       out.insert(out.end(), second.begin(), second.end());
       d.add_counts(d.scratch);
       d.add_counts(other_scratch);
       done = true;
     } else {
-      out.clear();
+      if (!direct) out.clear();
       d.scratch = {};
     }
   }
   if (!done) {
-    d.emit_buckets(0, nb, nb, out, d.scratch, nullptr);
+    d.emit_buckets(0, nb, nb, out, d.scratch, direct);
     d.add_counts(d.scratch);
   }
   d.next_bucket = nb;

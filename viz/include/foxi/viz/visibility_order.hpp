@@ -2,9 +2,11 @@
 // decreasing power of the viewpoint w.r.t. each tet's circumsphere, for any subset of the mesh
 // (non-convex, disconnected), with no adjacency graph. Orthographic views order by decreasing c.d.
 //
-// Exactness: keys are computed in double and sorted in a progressive MSD bucket sort; every run of
-// keys closer than the rounding bound is re-sorted with exact rational comparisons of the powers;
-// cospherical clusters are single items expanded by a local MPVO. For a Delaunay (or regular) mesh
+// Exactness: keys are computed in double, mapped monotonically to 32-bit integers and sorted in a
+// progressive MSD radix sort; every run of keys whose integers are closer than the rounding bound is
+// re-sorted in double, and chains of overlapping intervals in it with exact rational comparisons of
+// the powers; cospherical clusters are single items expanded by a local MPVO. Extra memory per view:
+// 16 bytes per item (besides the output). For a Delaunay (or regular) mesh
 // the result is a visibility order: no face-adjacent pair is drawn in the wrong order.
 //
 // Non-Delaunay meshes (see delaunay.hpp) have no such guarantee; use mpvo_order() for them, which
