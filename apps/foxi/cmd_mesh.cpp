@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "foxi/mesher/conforming.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
@@ -54,7 +55,11 @@ int cmd_mesh(Args args) {
   MeshReport report;
   Mesh mesh;
   try {
-    mesh = mesh_plc(plc, params, &report);
+    ConformingReport cr;
+    mesh = mesh_conforming(plc, params, {}, &cr);
+    report = cr.tetgen;
+    std::printf("conforming: %zu first-mesh points, %zu violations, added %zu in %zu iterations, delaunay %d\n",
+                cr.first_mesh_points, cr.first_mesh_violations, cr.added_points, cr.iterations, int(cr.delaunay));
   } catch (const MesherError& e) {
     std::fprintf(stderr, "foxi mesh: error: %s: %s\n", in.c_str(), e.what());
     return 1;
