@@ -82,7 +82,7 @@ TEST_P(Corpus, RefinementMakesTheO0MeshDelaunay) {
 
 INSTANTIATE_TEST_SUITE_P(Cdt, Corpus,
                          ::testing::Values(Case{"tilted_facets_q1414.poly", 1.414}, Case{"floating_triangles_p.poly", 0},
-                                           Case{"floating_facets_p.poly", 0}),
+                                           Case{"floating_facets_p.poly", 0}, Case{"floating_facets_q1414.poly", 1.414}),
                          [](const ::testing::TestParamInfo<Case>& p) {
                            std::string n = p.param.file;
                            return n.substr(0, n.find('.'));
