@@ -107,7 +107,9 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
       // "unknown") so that a user can cancel, which stops the child.
       pollfd pfd{fds[0], POLLIN, 0};
       int ready = ::poll(&pfd, 1, 100);
-      if (ready == 0) {
+      // A signal (the app's Ctrl-C handler) interrupts poll: ask the callback now rather than
+      // blocking in read() until TetGen ends.
+      if (ready == 0 || (ready < 0 && errno == EINTR)) {
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         (void)elapsed;
         if (!progress("meshing", -1.0)) {
