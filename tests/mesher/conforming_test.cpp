@@ -39,6 +39,7 @@ std::map<std::int32_t, double> areas(const Mesh& m) {
 struct Case {
   const char* file;
   double radius_edge;
+  double max_volume = 0;
 };
 
 class Corpus : public ::testing::TestWithParam<Case> {};
@@ -47,6 +48,7 @@ TEST_P(Corpus, RefinementMakesTheO0MeshDelaunay) {
   const Plc plc = read_poly(corpus(GetParam().file));
   MeshParams params;
   params.radius_edge = GetParam().radius_edge;
+  params.max_volume = GetParam().max_volume;
   const Mesh plain = mesh_plc(plc, params);
   const DelaunayCertificate before = compute_delaunay_certificate(plain);
   ASSERT_FALSE(before.delaunay) << "the corpus case no longer fails with TetGen -O0";
@@ -82,7 +84,8 @@ TEST_P(Corpus, RefinementMakesTheO0MeshDelaunay) {
 
 INSTANTIATE_TEST_SUITE_P(Cdt, Corpus,
                          ::testing::Values(Case{"tilted_facets_q1414.poly", 1.414}, Case{"floating_triangles_p.poly", 0},
-                                           Case{"floating_facets_p.poly", 0}, Case{"floating_facets_q1414.poly", 1.414}),
+                                           Case{"floating_facets_p.poly", 0}, Case{"floating_facets_q1414.poly", 1.414},
+                                           Case{"floating_facets_q1414_a0002.poly", 1.414, 0.002}),
                          [](const ::testing::TestParamInfo<Case>& p) {
                            std::string n = p.param.file;
                            return n.substr(0, n.find('.'));
