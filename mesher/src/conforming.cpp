@@ -60,7 +60,8 @@ struct PointGrid {
   std::size_t coord(double v, int axis) const {
     const double k = std::floor((v - lo[std::size_t(axis)]) / cell);
     if (!(k > 0)) return 0;
-    return std::min(std::size_t(k), dim[std::size_t(axis)] - 1);
+    const std::size_t last = dim[std::size_t(axis)] - 1;
+    return k >= double(last) ? last : std::size_t(k);  // no out-of-range conversion for huge balls
   }
 
   PointGrid(const std::vector<double>& xyz, const std::vector<std::uint32_t>& vertices) {
