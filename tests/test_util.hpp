@@ -60,5 +60,11 @@ inline bool have_program(const std::string& name) {
 
 inline std::string data_dir() { return FOXI_TEST_DATA_DIR; }
 inline std::string cli_path() { return FOXI_CLI_PATH; }
+inline std::string models_dir() { return data_dir() + "/../../models/"; }
+
+// Runs the foxi program with `args` (already quoted as needed); output to `log`.
+inline int run_cli(const std::string& args, const std::filesystem::path& log) {
+  return run("'" + cli_path() + "' " + args, log);
+}
 
 }  // namespace foxi::test

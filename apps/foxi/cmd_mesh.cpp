@@ -1,35 +1,86 @@
-// foxi mesh PLC.poly -o OUT: a tetrahedral mesh of a piecewise linear complex, through TetGen.
+// foxi mesh MODEL.toml|PLC.poly -o OUT: a conforming Delaunay tetrahedral mesh of a model or a PLC,
+// through TetGen and the conforming refinement, with size controls and a quality report.
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
+#include <cmath>
+#include <optional>
 #include <cstdio>
 #include <string>
 
 #include "cli.hpp"
+#include "foxi/mesher/conforming.hpp"
+#include "foxi/mesher/quality_report.hpp"
+#include "foxi/mesher/size_field.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/model/model_file.hpp"
 #include "foxi/model/plc.hpp"
-#include "foxi/model/quality.hpp"
+#include "foxi/model/structure.hpp"
+#include "foxi/model/units.hpp"
 
 namespace foxi::cli {
 
 namespace {
 
 const char* kMeshUsage =
-    "foxi mesh PLC.poly -o OUT [--max-volume V] [--radius-edge Q] [--min-dihedral DEG] [--optimize]\n"
-    "                   [--check-delaunay]\n"
-    "  Meshes a TetGen .poly (points, facets with boundary markers, holes, region seeds) into tets\n"
-    "  and writes OUT in any mesh format foxi knows (.vtu .msh .vtk .node .mesh).\n"
-    "  --max-volume V    largest tet volume (in the PLC's units cubed); regions may set their own\n"
-    "  --radius-edge Q   radius-edge quality bound (default 1.414; 0 turns quality refinement off)\n"
-    "  --min-dihedral D  minimum dihedral angle bound in degrees\n"
-    "  --optimize        TetGen's flips and smoothing: better angles, but the mesh stops being Delaunay\n"
-    "  --check-delaunay  certify the result (exact empty-circumsphere test) and report it";
+    "foxi mesh MODEL.toml|PLC.poly -o OUT [--set NAME=VALUE]... [--max-size H] [--quality Q]\n"
+    "          [--min-dihedral DEG] [--max-volume V] [--region-size REGION=H]... [--refine-box X0,Y0,Z0,X1,Y1,Z1=H]...\n"
+    "          [--refine-from RESULT.vtu [--field NAME] --target-error E] [--no-conform] [--optimize]\n"
+    "  Meshes a model (parts -> PLC) or a TetGen .poly into tets with TetGen (no optimisation), then\n"
+    "  splits encroached boundary/interface triangles until every tet is Delaunay (exact certificate),\n"
+    "  and prints a quality report. OUT in any mesh format foxi knows (.vtu .msh .vtk .node .mesh).\n"
+    "  Lengths H take a unit (\"0.2 mm\"); a bare number is in the model's length unit (metres for .poly).\n"
+    "  --set NAME=VALUE   overrides a model parameter\n"
+    "  --max-size H       target edge length everywhere (TetGen -a with the regular tet's volume)\n"
+    "  --quality Q        radius-edge bound (default 1.414; 0: no quality refinement)\n"
+    "  --min-dihedral D   TetGen's dihedral bound in degrees (not guaranteed without optimisation)\n"
+    "  --max-volume V     largest tet volume in m^3 (or the .poly's units cubed)\n"
+    "  --region-size R=H  target edge length in region R (its id; a model's part i has id i+1)\n"
+    "  --refine-box B=H   target edge length H inside the box X0,Y0,Z0,X1,Y1,Z1 (lengths as above)\n"
+    "  --refine-from F    remesh from a solved mesh F: elements shrink where the Zienkiewicz-Zhu\n"
+    "                     error of its field (--field, default the first node field) is large, for a\n"
+    "                     relative gradient error --target-error E (e.g. 0.05)\n"
+    "  --no-conform       TetGen's mesh as it is (may not be Delaunay)\n"
+    "  --optimize         TetGen's flips and smoothing (implies --no-conform: the mesh stops being Delaunay)\n"
+    "  Ctrl-C cancels (nothing is written).";
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_sigint(int) { g_interrupted = true; }
 
 double number(const std::string& s, const char* what) {
   char* end = nullptr;
   double v = std::strtod(s.c_str(), &end);
   if (s.empty() || end != s.c_str() + s.size() || !(v >= 0)) throw UsageError(std::string(what) + " takes a number >= 0, not '" + s + "'");
   return v;
+}
+
+// A length: "0.2 mm", or a bare number in `unit_scale` metres.
+double length(const std::string& s, double unit_scale, const char* what) {
+  Quantity q;
+  try {
+    q = evaluate_expression(s, [](std::string_view) { return std::optional<Quantity>(); });
+  } catch (const ExpressionError& e) {
+    throw UsageError(std::string(what) + ": " + e.what());
+  }
+  if (q.dims == kDimensionless) q.value *= unit_scale;
+  else if (q.dims != kLength) throw UsageError(std::string(what) + " takes a length, not '" + s + "'");
+  if (!(q.value > 0) || !std::isfinite(q.value)) throw UsageError(std::string(what) + " must be > 0, not '" + s + "'");
+  return q.value;
+}
+
+// "LHS=RHS" split at the last '='.
+std::pair<std::string, std::string> split_eq(const std::string& s, const char* what) {
+  const auto eq = s.rfind('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == s.size()) throw UsageError(std::string(what) + " takes A=B, not '" + s + "'");
+  return {s.substr(0, eq), s.substr(eq + 1)};
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace
@@ -39,41 +90,133 @@ int cmd_mesh(Args args) {
     std::puts(kMeshUsage);
     return 0;
   }
+  std::vector<std::string> sets, region_sizes, boxes;
+  while (args.has_option("--set")) sets.push_back(args.option("--set"));
+  while (args.has_option("--region-size")) region_sizes.push_back(args.option("--region-size"));
+  while (args.has_option("--refine-box")) boxes.push_back(args.option("--refine-box"));
+  const std::string max_size = args.option("--max-size");
   MeshParams params;
   params.max_volume = number(args.option("--max-volume", "0"), "--max-volume");
-  params.radius_edge = number(args.option("--radius-edge", "1.414"), "--radius-edge");
+  params.radius_edge = number(args.option("--quality", args.option("--radius-edge", "1.414")), "--quality");
   params.min_dihedral = number(args.option("--min-dihedral", "0"), "--min-dihedral");
   params.optimize = args.flag("--optimize");
-  const bool check = args.flag("--check-delaunay");
+  const bool conform = !args.flag("--no-conform") && !params.optimize;
+  args.flag("--check-delaunay");  // the certificate is always part of the report now
+  const std::string refine_from = args.option("--refine-from");
+  const std::string field_name = args.option("--field");
+  const std::string target_error = args.option("--target-error");
   const std::string out = args.option("-o");
   if (out.empty()) throw UsageError("give the output file with -o OUT\nusage: " + std::string(kMeshUsage));
   const std::string in = args.positional(1, 1, kMeshUsage)[0];
+  if (!refine_from.empty() && target_error.empty()) throw UsageError("--refine-from needs --target-error E");
   format_from_path(out);  // an unknown output format fails before any meshing
 
-  const Plc plc = read_poly(in);
-  MeshReport report;
+  // The PLC, from a model or a .poly.
+  const bool is_model = ends_with(in, ".toml");
+  Model model;
+  Structure structure;
+  Plc plc;
+  double unit_scale = 1;
+  if (is_model) {
+    model = load_model(in, sets);
+    structure = build_structure(model);
+    plc = structure.plc;
+    unit_scale = model.length_scale;
+  } else {
+    if (!sets.empty()) throw UsageError("--set needs a model file (.toml), not a .poly");
+    plc = read_poly(in);
+  }
+
+  SizeControls controls;
+  if (!max_size.empty()) {
+    controls.max_size = length(max_size, unit_scale, "--max-size");
+    const double v = regular_tet_volume(controls.max_size);
+    params.max_volume = params.max_volume > 0 ? std::min(params.max_volume, v) : v;
+  }
+  for (const std::string& r : region_sizes) {
+    const auto [id, h] = split_eq(r, "--region-size");
+    controls.region_ids.push_back(static_cast<std::int32_t>(number(id, "--region-size")));
+    controls.region_sizes.push_back(length(h, unit_scale, "--region-size"));
+  }
+  for (const std::string& b : boxes) {
+    const auto [corners, h] = split_eq(b, "--refine-box");
+    const std::vector<double> c = parse_numbers(corners, "--refine-box");
+    if (c.size() != 6) throw UsageError("--refine-box takes X0,Y0,Z0,X1,Y1,Z1=H, not '" + b + "'");
+    RefinementBox box;
+    for (int k = 0; k < 3; ++k) {
+      box.lo[k] = std::min(c[std::size_t(k)], c[std::size_t(k) + 3]) * unit_scale;
+      box.hi[k] = std::max(c[std::size_t(k)], c[std::size_t(k) + 3]) * unit_scale;
+    }
+    box.size = length(h, unit_scale, "--refine-box");
+    controls.boxes.push_back(box);
+  }
+
+  // Progress on stderr for long runs; Ctrl-C makes the callback say stop.
+  g_interrupted = false;
+  struct sigaction sa{}, old{};
+  sa.sa_handler = on_sigint;
+  sigemptyset(&sa.sa_mask);
+  ::sigaction(SIGINT, &sa, &old);
+  const auto t0 = std::chrono::steady_clock::now();
+  double last_print = 0;
+  const bool tty = ::isatty(2);
+  params.progress = [&](std::string_view stage, double fraction) {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (tty && s - last_print >= 1) {
+      last_print = s;
+      if (fraction >= 0)
+        std::fprintf(stderr, "\r%.*s %3.0f%% %5.0f s   ", int(stage.size()), stage.data(), 100 * fraction, s);
+      else
+        std::fprintf(stderr, "\r%.*s %5.0f s   ", int(stage.size()), stage.data(), s);
+    }
+    return !g_interrupted.load();
+  };
+
   Mesh mesh;
+  ConformingReport report;
+  SizeField field;
+  int status = 0;
   try {
-    mesh = mesh_plc(plc, params, &report);
+    plc = with_region_sizes(plc, controls);
+    if (!refine_from.empty()) {
+      const Mesh solved = read_mesh(refine_from);
+      const Field* f = nullptr;
+      for (const Field& cand : solved.fields)
+        if (cand.location == FieldLocation::node && (field_name.empty() ? true : cand.name == field_name)) {
+          f = &cand;
+          break;
+        }
+      if (!f) throw UsageError(refine_from + " has no node field" + (field_name.empty() ? "" : " named '" + field_name + "'"));
+      const ErrorIndicator e = zz_error_indicator(solved, *f);
+      field = size_field_from_error(solved, *f, number(target_error, "--target-error"), 0, controls.max_size);
+      std::printf("refine from %s: field '%s', relative gradient error %.3g (Zienkiewicz-Zhu), target %s\n",
+                  refine_from.c_str(), f->name.c_str(), e.relative_error(), target_error.c_str());
+    } else if (!controls.boxes.empty()) {
+      field = box_size_field(plc, params, controls);
+    }
+    if (!field.empty()) params.size_field = &field;
+    if (conform) {
+      mesh = mesh_conforming(plc, params, {}, &report);
+    } else {
+      mesh = mesh_plc(plc, params, &report.tetgen);
+      report.first_mesh_points = mesh.node_count();
+      report.seconds = report.tetgen.seconds;
+      const DelaunayCertificate cert = compute_delaunay_certificate(mesh);
+      report.delaunay = cert.delaunay;
+      report.first_mesh_violations = cert.violating_tet_count;
+      report.violations.push_back(cert.violating_tet_count);
+    }
+    if (is_model) name_mesh(model, structure, mesh);
   } catch (const MesherError& e) {
-    std::fprintf(stderr, "foxi mesh: error: %s: %s\n", in.c_str(), e.what());
-    return 1;
+    std::fprintf(stderr, "%sfoxi mesh: error: %s: %s\n", tty ? "\n" : "", in.c_str(), e.what());
+    status = 1;
   }
+  ::sigaction(SIGINT, &old, nullptr);
+  if (tty && last_print > 0) std::fputc('\n', stderr);
+  if (status != 0) return status;
   write_mesh(mesh, out);
-  const QualitySummary q = summarize_quality(mesh);
-  std::printf("%s -> %s: %zu nodes (%zu Steiner points), %zu tets, %zu boundary triangles, %zu regions in %.3f s\n",
-              in.c_str(), out.c_str(), mesh.node_count(), report.steiner_points, mesh.tet_count(), mesh.bface_count(),
-              mesh.regions.size(), report.seconds);
-  std::printf("TetGen switches %s; radius-edge max %.4g, min dihedral %.3g deg, %zu slivers below 5 deg\n",
-              report.switches.c_str(), q.radius_edge.max, q.min_dihedral_deg.min, q.slivers);
-  if (check) {
-    const DelaunayCertificate cert = compute_delaunay_certificate(mesh);
-    if (cert.delaunay)
-      std::printf("delaunay: yes, every circumsphere is empty (%zu tets)\n", cert.tets_checked);
-    else
-      std::printf("delaunay: NO, %zu of %zu tets have a vertex inside their circumsphere (deepest %.3g of the radius)\n",
-                  cert.violating_tet_count, cert.tets_checked, cert.max_relative_depth);
-  }
+  std::printf("%s -> %s (TetGen switches %s)\n", in.c_str(), out.c_str(), report.tetgen.switches.c_str());
+  std::printf("%s\n", format_quality_report(mesh_quality_report(mesh, report)).c_str());
   return 0;
 }
 

@@ -54,7 +54,7 @@ struct Result {
 // Runs TetGen in a child process: TetGen 1.5's library frees its memory twice when it stops on an
 // error (terminatetetgen() then the mesh destructor), which crashes the caller; in a child the crash
 // becomes an error message.
-Result run_isolated(tetgenio& in, char* switches, const ProgressFn& progress) {
+Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const ProgressFn& progress) {
   int fds[2];
   if (::pipe(fds) != 0) throw MesherError(1, std::string("cannot create a pipe: ") + std::strerror(errno));
   std::fflush(nullptr);
@@ -69,7 +69,7 @@ Result run_isolated(tetgenio& in, char* switches, const ProgressFn& progress) {
     std::int64_t status = 0;
     tetgenio out;
     try {
-      tetrahedralize(switches, &in, &out);
+      tetrahedralize(switches, &in, &out, nullptr, background);
     } catch (int code) {
       status = code == 0 ? 2 : code;
     } catch (...) {
@@ -107,7 +107,9 @@ Result run_isolated(tetgenio& in, char* switches, const ProgressFn& progress) {
       // "unknown") so that a user can cancel, which stops the child.
       pollfd pfd{fds[0], POLLIN, 0};
       int ready = ::poll(&pfd, 1, 100);
-      if (ready == 0) {
+      // A signal (the app's Ctrl-C handler) interrupts poll: ask the callback now rather than
+      // blocking in read() until TetGen ends.
+      if (ready == 0 || (ready < 0 && errno == EINTR)) {
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         (void)elapsed;
         if (!progress("meshing", -1.0)) {
@@ -237,9 +239,31 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   if (params.max_volume > 0) sw += "a" + format_number(params.max_volume);
   if (any_region_volume) sw += "a";
   if (!params.optimize) sw += "O0";
+  tetgenio background;
+  const bool sized = params.size_field && !params.size_field->empty();
+  if (sized) {
+    const SizeField& sf = *params.size_field;
+    const std::size_t nb = sf.xyz.size() / 3;
+    if (sf.size.size() != nb || sf.tet.size() % 4 != 0 || sf.tet.empty())
+      throw MesherError(10, "the size field's background mesh is inconsistent");
+    for (std::uint32_t v : sf.tet)
+      if (v >= nb) throw MesherError(10, "the size field's background mesh has a node index out of range");
+    background.firstnumber = 0;
+    background.numberofpoints = static_cast<int>(nb);
+    background.pointlist = new REAL[sf.xyz.size()];
+    std::copy(sf.xyz.begin(), sf.xyz.end(), background.pointlist);
+    background.numberofpointmtrs = 1;
+    background.pointmtrlist = new REAL[nb];
+    std::copy(sf.size.begin(), sf.size.end(), background.pointmtrlist);
+    background.numberoftetrahedra = static_cast<int>(sf.tet.size() / 4);
+    background.numberofcorners = 4;
+    background.tetrahedronlist = new int[sf.tet.size()];
+    for (std::size_t i = 0; i < sf.tet.size(); ++i) background.tetrahedronlist[i] = static_cast<int>(sf.tet[i]);
+    sw += "m";
+  }
   std::vector<char> switches(sw.begin(), sw.end());
   switches.push_back('\0');
-  Result res = run_isolated(in, switches.data(), params.progress);
+  Result res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress);
   if (res.status != 0) throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
 
   Mesh m;

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "foxi/mesher/size_field.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/progress.hpp"
@@ -22,6 +23,9 @@ struct MeshParams {
   double min_dihedral = 0;    // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
   bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
   bool regions = true;        // region seeds give tet regions (TetGen -A)
+  // A sizing function (TetGen -m with a background mesh, size_field.hpp); null or empty: none. It must
+  // outlive the call.
+  const SizeField* size_field = nullptr;
   // Asked about every 100 ms while TetGen runs (fraction -1: TetGen tells no progress); returning
   // false stops TetGen and mesh_plc throws MesherError (code -1, "meshing cancelled").
   ProgressFn progress;

@@ -1,0 +1,61 @@
+// Conforming Delaunay meshing (issue 6, item 2): TetGen without optimisation (-O0) gives a
+// constrained Delaunay mesh, which is not always Delaunay where a boundary or interface triangle
+// separates a tet from a vertex inside its circumsphere. mesh_conforming() certifies TetGen's mesh
+// (exact global check, delaunay.hpp), and for every violation splits the constraint triangles that
+// the offending vertex encroaches (the vertex lies strictly inside the triangle's diametral sphere):
+// it adds the triangle's circumcentre to its facet, or, when that centre would fall outside the
+// triangle next to a PLC segment or encroach that segment, the subsegment's midpoint to the segment
+// (Ruppert/Shewchuk's rule). The points go into the PLC (as one-vertex polygons of the facet, or as
+// a new vertex of every polygon along the segment) and TetGen meshes the refined PLC again, until the
+// certificate passes, the point budget is spent or the iterations run out.
+//
+// Sliver policy: Delaunay refinement bounds the radius-edge ratio, not the dihedral angles, so the
+// result may hold slivers (four nearly cospherical vertices). They are Delaunay and ordered
+// correctly by the viewer; they are counted in the quality report (quality_report.hpp) and left in
+// place, because flipping or smoothing them away would break the Delaunay property. A sliver-free
+// mesh needs the weighted (regular) path through CGAL with sliver exudation.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "foxi/mesher/tetgen_mesher.hpp"
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/plc.hpp"
+
+namespace foxi {
+
+struct ConformingParams {
+  std::size_t max_iterations = 12;  // TetGen runs after the first
+  double max_added_fraction = 0.15; // stop once the points added exceed this fraction of the
+                                    // first (-O0) mesh's point count ...
+  std::size_t min_added_budget = 100; // ... or this many, whichever is more (small meshes)
+};
+
+struct ConformingReport {
+  MeshReport tetgen;                       // the last TetGen run
+  std::size_t first_mesh_points = 0;       // points of the first -O0 mesh
+  std::size_t first_mesh_violations = 0;   // its non-Delaunay tets
+  std::size_t added_points = 0;            // Steiner points added to the PLC for conformity
+  std::size_t iterations = 0;              // TetGen re-runs after the first
+  std::vector<std::size_t> violations;     // non-Delaunay tets after each TetGen run
+  bool delaunay = false;                   // the final mesh passed the exact certificate
+  double seconds = 0;                      // all TetGen runs, certificates and splits
+  double certificate_seconds = 0;          // of which the certificates
+};
+
+// Meshes `plc` with TetGen (params.optimize is forced off) and refines until the exact Delaunay
+// certificate passes. Returns the last mesh even when it is not certified (report->delaunay says);
+// throws MesherError like mesh_plc, and MesherError(-1) when params.progress cancels (stage
+// "conforming refinement" between runs, fraction = iteration / max_iterations). `refined_plc`, if
+// given, receives the PLC with the added points.
+Mesh mesh_conforming(const Plc& plc, const MeshParams& params = {}, const ConformingParams& conforming = {},
+                     ConformingReport* report = nullptr, Plc* refined_plc = nullptr);
+
+// The split points for one mesh of `plc`: for every tet in `violating_tets`, every constraint
+// triangle (mesh.bface) encroached by a vertex inside that tet's circumsphere is split; `plc` gets
+// the points. Returns the number of points added (0: nothing found to split). Exposed for tests.
+std::size_t split_encroached_constraints(const Mesh& mesh, const std::vector<std::uint32_t>& violating_tets,
+                                         Plc& plc);
+
+}  // namespace foxi

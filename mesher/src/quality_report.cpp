@@ -1,0 +1,85 @@
+#include "foxi/mesher/quality_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace foxi {
+
+MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& conforming,
+                                      const QualityReportParams& params) {
+  MeshQualityReport r;
+  r.nodes = mesh.node_count();
+  r.tets = mesh.tet_count();
+  r.boundary_triangles = mesh.bface_count();
+  r.shape = summarize_quality(mesh);
+  r.sliver_angle_deg = params.sliver_angle_deg;
+  std::map<std::int32_t, RegionSize> regions;
+  const std::size_t nv = mesh.node_count();
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const std::uint32_t* v = &mesh.tet[4 * t];
+    if (v[0] >= nv || v[1] >= nv || v[2] >= nv || v[3] >= nv) continue;
+    const TetQuality q =
+        tet_quality(&mesh.xyz[3 * v[0]], &mesh.xyz[3 * v[1]], &mesh.xyz[3 * v[2]], &mesh.xyz[3 * v[3]]);
+    if (q.min_dihedral_deg < params.sliver_angle_deg) ++r.slivers;
+    const double bin = std::floor(q.min_dihedral_deg / 5);
+    const std::size_t last = r.min_dihedral_histogram.size() - 1;
+    r.min_dihedral_histogram[bin > 0 ? std::min(std::size_t(bin), last) : 0]++;
+    RegionSize& rs = regions[mesh.region_of(t)];
+    ++rs.tets;
+    rs.volume += std::abs(q.volume);
+  }
+  for (auto& [id, rs] : regions) {
+    rs.id = id;
+    for (const Region& reg : mesh.regions)
+      if (reg.id == id) rs.name = reg.name;
+    r.regions.push_back(rs);
+  }
+  r.tetgen_steiner_points = conforming.tetgen.steiner_points;  // the added points were TetGen's input
+  r.conforming_points = conforming.added_points;
+  r.conforming_overhead =
+      conforming.first_mesh_points ? double(conforming.added_points) / double(conforming.first_mesh_points) : 0;
+  r.iterations = conforming.iterations;
+  r.first_mesh_violations = conforming.first_mesh_violations;
+  r.delaunay = conforming.delaunay;
+  r.violating_tets = conforming.violations.empty() ? 0 : conforming.violations.back();
+  r.mesh_seconds = conforming.seconds;
+  r.certificate_seconds = conforming.certificate_seconds;
+  return r;
+}
+
+std::string format_quality_report(const MeshQualityReport& r) {
+  std::string s;
+  char line[512];
+  auto put = [&](const char* fmt, auto... args) {
+    std::snprintf(line, sizeof line, fmt, args...);
+    if (!s.empty()) s += '\n';
+    s += line;
+  };
+  put("mesh: %zu nodes, %zu tets, %zu boundary triangles", r.nodes, r.tets, r.boundary_triangles);
+  put("radius-edge ratio: min %.3g, mean %.3g, max %.3g (regular tet 0.612)", r.shape.radius_edge.min,
+      r.shape.radius_edge.mean, r.shape.radius_edge.max);
+  put("min dihedral angle: min %.3g, mean %.3g deg; %zu slivers below %g deg (kept: Delaunay refinement does not "
+      "remove slivers, flips or smoothing would break the Delaunay property)",
+      r.shape.min_dihedral_deg.min, r.shape.min_dihedral_deg.mean, r.slivers, r.sliver_angle_deg);
+  std::string hist = "min dihedral histogram (5 deg bins from 0):";
+  for (std::size_t c : r.min_dihedral_histogram) hist += " " + std::to_string(c);
+  put("%s", hist.c_str());
+  put("tet volume: min %.4g, max %.4g m^3, total %.6g m^3", r.shape.volume.min, r.shape.volume.max,
+      r.shape.total_volume);
+  for (const RegionSize& rs : r.regions)
+    put("  region %d%s%s: %zu tets, %.6g m^3", rs.id, rs.name.empty() ? "" : " ", rs.name.c_str(), rs.tets, rs.volume);
+  put("Steiner points: %zu by TetGen, %zu for conformity (%.2f%% of the first -O0 mesh's points) in %zu iterations",
+      r.tetgen_steiner_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
+  if (r.delaunay)
+    put("delaunay: yes, every circumsphere is empty (exact; the first -O0 mesh had %zu non-Delaunay tets)",
+        r.first_mesh_violations);
+  else
+    put("delaunay: NO, %zu tets have a vertex inside their circumsphere (the first -O0 mesh had %zu)",
+        r.violating_tets, r.first_mesh_violations);
+  put("time: %.3f s meshing and refinement, of which %.3f s certificates", r.mesh_seconds, r.certificate_seconds);
+  return s;
+}
+
+}  // namespace foxi
