@@ -3,6 +3,8 @@
 // in fixed point with 8 subpixel bits and 64-bit edge functions.
 #include "foxi/viz/rasterizer.hpp"
 
+#include "foxi/model/adjacency.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -209,6 +211,20 @@ struct TetRasterizer::Impl {
   // Per band of 16 rows and mask word: 1 once all 16 x 64 pixels (those in the image) are known to
   // be written, so that a hidden tet costs a few byte tests (set lazily by box_written).
   std::vector<std::uint8_t> tile_full;
+  // Whether painter drawing tests and sets the mask (off while undraw repaints neighbours' faces).
+  bool use_mask = false;
+  // Undoable mode (params.undoable): the tets drawn so far in order, each tet's position in it
+  // (kNone if not drawn), and the undraw stack of saved pixels: per tet with an unshared back face,
+  // where its pixels start in saved_rgba / saved_id (the runs of those faces, in raster order).
+  const FaceAdjacency* adjacency = nullptr;
+  std::vector<std::uint32_t> history;
+  std::vector<std::uint32_t> drawn_at;
+  struct Save {
+    std::uint32_t at = 0;    // position in history
+    std::size_t offset = 0;  // first saved pixel
+  };
+  std::vector<Save> saves;
+  std::vector<std::uint32_t> saved_rgba, saved_id;
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
       : mesh(&m), proj(c, w, h), params(p) {
@@ -218,6 +234,12 @@ struct TetRasterizer::Impl {
     if (params.threads > 64) params.threads = 64;
     if (!(params.edge_width > 0)) params.edges = false;
     reverse = !params.depth_buffer;
+    use_mask = reverse;
+    if (params.undoable) {
+      if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
+      adjacency = &face_adjacency(m);
+      drawn_at.assign(m.tet_count(), kNone);
+    }
     mask_words = (w + 63) / 64;
     double l[3] = {-0.3, 0.45, -1};
     double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
@@ -435,6 +457,10 @@ struct TetRasterizer::Impl {
       for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
       return;
     }
+    if (!use_mask) {
+      shade_span(fb, fs, y, lo, hi);
+      return;
+    }
     std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
     const int w0 = lo >> 6, w1 = hi >> 6;
     int x = lo;
@@ -612,14 +638,137 @@ struct TetRasterizer::Impl {
     }
   }
 
-  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
-    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
-    const double* c[4];
-    double local[12];
-    std::int64_t X[4], Y[4];
-    std::uint8_t st[4];
-    corners(tv, c, local, X, Y, st);
-    if (st[0] == 2 || st[1] == 2 || st[2] == 2 || st[3] == 2) return;
+  // A tet's corners as `corners` gives them (c may point into local).
+  struct TetCorners {
+    const std::uint32_t* tv = nullptr;
+    const double* c[4] = {};
+    double local[12] = {};
+    std::int64_t X[4] = {}, Y[4] = {};
+    std::uint8_t st[4] = {};
+  };
+  // Loads tet t's corners into k; false if one of them is not finite (the tet draws nothing).
+  bool load_corners(std::uint32_t t, TetCorners& k) const {
+    k.tv = &mesh->tet[4 * std::size_t(t)];
+    corners(k.tv, k.c, k.local, k.X, k.Y, k.st);
+    return k.st[0] != 2 && k.st[1] != 2 && k.st[2] != 2 && k.st[3] != 2;
+  }
+
+  // The polygon of face f of tet t (corners from `corners`) as drawn when it faces the eye: front
+  // (back = false) for t itself, back (back = true) the same face seen from the other side, which is
+  // exactly the polygon the neighbour across it draws as its front face (same vertices, same
+  // orientation, same pixels under the fill rule). Returns its vertex count (3, or 4 when the near
+  // plane cuts it) with positive area, or 0 when the face is not of the asked side or covers nothing.
+  // *clipped is set when the near plane cuts a face of the asked side.
+  int face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped) const {
+    const std::uint32_t* tv = k.tv;
+    const double* const* c = k.c;
+    const std::int64_t *X = k.X, *Y = k.Y;
+    const std::uint8_t* st = k.st;
+    *clipped = false;
+    const auto& face = kFace[f];
+    const int a = face[0], b = face[1], d = face[2];
+    if (st[a] + st[b] + st[d] == 0) {
+      // Front iff the projected outward-ordered triangle has negative area (screen y is down and
+      // the camera frame mirrors the world). The neighbour sharing this face computes the same
+      // area with the opposite sign, so exactly one of the two draws it.
+      const std::int64_t area = (X[b] - X[a]) * (Y[d] - Y[a]) - (Y[b] - Y[a]) * (X[d] - X[a]);
+      if (back ? area <= 0 : area >= 0) return 0;
+      const int front_order[3] = {a, d, b}, back_order[3] = {a, b, d};  // positive area
+      const int* order = back ? back_order : front_order;
+      for (int i = 0; i < 3; ++i) {
+        poly[i].X = X[order[i]];
+        poly[i].Y = Y[order[i]];
+        poly[i].w = nearness(c[order[i]]);
+        poly[i].mesh_edge = true;
+      }
+      return 3;
+    }
+    if (st[a] + st[b] + st[d] == 3) return 0;  // entirely behind the near plane
+    // Cut by the near plane. Canonical order (ascending node id) so that both tets sharing the
+    // face compute bit-identical polygons; facing from the exact same double expression.
+    int s[3] = {a, b, d};
+    bool odd = false;
+    auto swap_if = [&](int i, int j) {
+      if (tv[s[i]] > tv[s[j]]) {
+        std::swap(s[i], s[j]);
+        odd = !odd;
+      }
+    };
+    swap_if(0, 1);
+    swap_if(1, 2);
+    swap_if(0, 1);
+    const double *p0 = c[s[0]], *p1 = c[s[1]], *p2 = c[s[2]];
+    double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    // World: front iff n_out . (eye - p0) > 0; in the mirrored camera frame n_out = -nc_out and
+    // eye - p0 = -p0, so front iff nc_out . p0 > 0, and nc_out = +-nc by the permutation parity.
+    // The neighbour's parity is the opposite one, so its side is exactly -side.
+    double side = nc[0] * p0[0] + nc[1] * p0[1] + nc[2] * p0[2];
+    if (odd != back) side = -side;
+    if (!(side > 0)) return 0;
+    *clipped = true;
+    // Sutherland-Hodgman against z >= near; intersections computed from the lower node id.
+    int n = 0;
+    for (int i = 0; i < 3; ++i) {
+      const int pi = s[i], qi = s[i == 2 ? 0 : i + 1];
+      const bool pin = st[pi] == 0, qin = st[qi] == 0;
+      auto cut = [&](PolyVertex& out) {
+        int lo = pi, hi = qi;
+        if (tv[lo] > tv[hi]) std::swap(lo, hi);
+        const double* P = c[lo];
+        const double* Q = c[hi];
+        double tt = (near - P[2]) / (Q[2] - P[2]);
+        out.c[0] = P[0] + tt * (Q[0] - P[0]);
+        out.c[1] = P[1] + tt * (Q[1] - P[1]);
+        out.c[2] = near;
+        out.w = 1 / near;
+        std::uint8_t dummy;
+        project_camera(out.c, out.X, out.Y, dummy);
+      };
+      if (pin) {
+        poly[n].X = X[pi];
+        poly[n].Y = Y[pi];
+        poly[n].w = nearness(c[pi]);
+        poly[n].mesh_edge = true;
+        ++n;
+        if (!qin) {
+          cut(poly[n]);
+          poly[n].mesh_edge = false;
+          ++n;
+        }
+      } else if (qin) {
+        cut(poly[n]);
+        poly[n].mesh_edge = true;
+        ++n;
+      }
+    }
+    std::int64_t area2 = 0;
+    for (int i = 0; i < n; ++i) {
+      const PolyVertex& p = poly[i];
+      const PolyVertex& q = poly[i + 1 == n ? 0 : i + 1];
+      area2 += p.X * q.Y - q.X * p.Y;
+    }
+    if (area2 == 0) return 0;
+    if (area2 < 0) {
+      // Reverse; the edge leaving vertex i+1 in the new order is the old edge i -> i+1.
+      PolyVertex r[4];
+      for (int i = 0; i < n; ++i) {
+        r[i] = poly[n - 1 - i];
+        r[i].mesh_edge = poly[(2 * n - 2 - i) % n].mesh_edge;
+      }
+      std::copy(r, r + n, poly);
+    }
+    return n;
+  }
+
+  // Draws tet t's front faces (only face `only_face` when it is 0..3) into the rows of `rows`.
+  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count, int only_face = -1) {
+    TetCorners k;
+    if (!load_corners(t, k)) return;
+    const double* const* c = k.c;
+    const std::int64_t* Y = k.Y;
+    const std::uint8_t* st = k.st;
     const int behind = int(st[0]) + st[1] + st[2] + st[3];
     if (behind == 4) {
       if (count) ++stats.tets_behind;
@@ -635,126 +784,76 @@ struct TetRasterizer::Impl {
     PolyVertex poly[4];
     FaceSetup fs;
     for (int fi = 0; fi < 4; ++fi) {
-      const auto& face = kFace[reverse ? 3 - fi : fi];
-      const int a = face[0], b = face[1], d = face[2];
-      if (st[a] + st[b] + st[d] == 0) {
-        // Front iff the projected outward-ordered triangle has negative area (screen y is down and
-        // the camera frame mirrors the world). The neighbour sharing this face computes the same
-        // area with the opposite sign, so exactly one of the two draws it.
-        std::int64_t area = (X[b] - X[a]) * (Y[d] - Y[a]) - (Y[b] - Y[a]) * (X[d] - X[a]);
-        if (area >= 0) continue;
-        if (reverse) {  // hidden behind what this batch drew already?
-          const Box box =
-              pixel_box(std::min({X[a], X[b], X[d]}), std::max({X[a], X[b], X[d]}),
-                        std::min({Y[a], Y[b], Y[d]}), std::max({Y[a], Y[b], Y[d]}), fb.width, fb.height);
-          if (box.x0 > box.x1 || box_written(rows, box, fb.height)) continue;
-        }
-        const int order[3] = {a, d, b};  // reversed: positive area
-        for (int i = 0; i < 3; ++i) {
-          poly[i].X = X[order[i]];
-          poly[i].Y = Y[order[i]];
-          poly[i].w = nearness(c[order[i]]);
-          poly[i].mesh_edge = true;
-        }
-        const double* v[3] = {c[a], c[b], c[d]};
-        setup_face(fs, t, v, poly, 3);
-        raster_polygon(fb, rows, fs, poly, 3);
-        continue;
+      const int f = reverse ? 3 - fi : fi;
+      if (only_face >= 0 && f != only_face) continue;
+      bool clipped = false;
+      const int n = face_polygon(k, f, false, poly, &clipped);
+      if (clipped && count) ++stats.faces_clipped;
+      if (n == 0) continue;
+      if (use_mask && !clipped) {  // hidden behind what this batch drew already?
+        const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
+                                  std::max({poly[0].X, poly[1].X, poly[2].X}),
+                                  std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
+                                  std::max({poly[0].Y, poly[1].Y, poly[2].Y}), fb.width, fb.height);
+        if (box.x0 > box.x1 || box_written(rows, box, fb.height)) continue;
       }
-      if (st[a] + st[b] + st[d] == 3) continue;  // entirely behind the near plane
-      // Cut by the near plane. Canonical order (ascending node id) so that both tets sharing the
-      // face compute bit-identical polygons; facing from the exact same double expression.
-      int s[3] = {a, b, d};
-      bool odd = false;
-      auto swap_if = [&](int i, int j) {
-        if (tv[s[i]] > tv[s[j]]) {
-          std::swap(s[i], s[j]);
-          odd = !odd;
-        }
-      };
-      swap_if(0, 1);
-      swap_if(1, 2);
-      swap_if(0, 1);
-      const double *p0 = c[s[0]], *p1 = c[s[1]], *p2 = c[s[2]];
-      double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-      double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-      double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-      // World: front iff n_out . (eye - p0) > 0; in the mirrored camera frame n_out = -nc_out and
-      // eye - p0 = -p0, so front iff nc_out . p0 > 0, and nc_out = +-nc by the permutation parity.
-      double side = nc[0] * p0[0] + nc[1] * p0[1] + nc[2] * p0[2];
-      if (odd) side = -side;
-      if (!(side > 0)) continue;
-      if (count) ++stats.faces_clipped;
-      // Sutherland-Hodgman against z >= near; intersections computed from the lower node id.
-      int n = 0;
-      for (int i = 0; i < 3; ++i) {
-        const int pi = s[i], qi = s[i == 2 ? 0 : i + 1];
-        const bool pin = st[pi] == 0, qin = st[qi] == 0;
-        auto cut = [&](PolyVertex& out) {
-          int lo = pi, hi = qi;
-          if (tv[lo] > tv[hi]) std::swap(lo, hi);
-          const double* P = c[lo];
-          const double* Q = c[hi];
-          double tt = (near - P[2]) / (Q[2] - P[2]);
-          out.c[0] = P[0] + tt * (Q[0] - P[0]);
-          out.c[1] = P[1] + tt * (Q[1] - P[1]);
-          out.c[2] = near;
-          out.w = 1 / near;
-          std::uint8_t dummy;
-          project_camera(out.c, out.X, out.Y, dummy);
-        };
-        if (pin) {
-          poly[n].X = X[pi];
-          poly[n].Y = Y[pi];
-          poly[n].w = nearness(c[pi]);
-          poly[n].mesh_edge = true;
-          ++n;
-          if (!qin) {
-            cut(poly[n]);
-            poly[n].mesh_edge = false;
-            ++n;
-          }
-        } else if (qin) {
-          cut(poly[n]);
-          poly[n].mesh_edge = true;
-          ++n;
-        }
-      }
-      std::int64_t area2 = 0;
-      for (int i = 0; i < n; ++i) {
-        const PolyVertex& p = poly[i];
-        const PolyVertex& q = poly[i + 1 == n ? 0 : i + 1];
-        area2 += p.X * q.Y - q.X * p.Y;
-      }
-      if (area2 == 0) continue;
-      if (area2 < 0) {
-        // Reverse; the edge leaving vertex i+1 in the new order is the old edge i -> i+1.
-        PolyVertex r[4];
-        for (int i = 0; i < n; ++i) {
-          r[i] = poly[n - 1 - i];
-          r[i].mesh_edge = poly[(2 * n - 2 - i) % n].mesh_edge;
-        }
-        std::copy(r, r + n, poly);
-      }
-      const double* v[3] = {c[a], c[b], c[d]};
+      const auto& face = kFace[f];
+      const double* v[3] = {c[face[0]], c[face[1]], c[face[2]]};
       setup_face(fs, t, v, poly, n);
       raster_polygon(fb, rows, fs, poly, n);
     }
   }
 
-  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+  void check_framebuffer(const Framebuffer& fb) const {
     if (fb.width != proj.width || fb.height != proj.height)
       throw std::invalid_argument("render: framebuffer size differs from the rasterizer's");
     if (fb.rgba.size() != std::size_t(fb.width) * fb.height || fb.id.size() != fb.rgba.size())
       throw std::invalid_argument("render: framebuffer buffers have the wrong size");
     if (params.depth_buffer && fb.depth.size() != fb.rgba.size())
       throw std::invalid_argument("render: depth-buffer mode needs a framebuffer with a depth buffer");
+  }
+
+  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+    check_framebuffer(fb);
     const std::size_t tc = mesh->tet_count();
     for (std::uint32_t t : tets)
       if (t >= tc) throw std::out_of_range("render: tet index " + std::to_string(t) + " out of range");
     stats.tets_drawn += tets.size();
-    const int count = std::min(params.threads, std::max(1, fb.height >> kBandShift));
-    if (reverse) {
+    if (!params.undoable) {
+      draw_batch(fb, tets);
+      return;
+    }
+    // Undoable: cut the batch before every tet that has a back face no earlier tet shares, so that
+    // the framebuffer holds exactly the picture of the tets before it when its save is taken.
+    const std::size_t start = history.size();
+    for (std::size_t i = 0; i < tets.size(); ++i) {
+      if (drawn_at[tets[i]] != kNone) {
+        for (std::size_t k = 0; k < i; ++k) drawn_at[tets[k]] = kNone;
+        throw std::invalid_argument("render: undoable drawing draws each tet once (tet " +
+                                    std::to_string(tets[i]) + " again)");
+      }
+      drawn_at[tets[i]] = std::uint32_t(start + i);
+    }
+    history.insert(history.end(), tets.begin(), tets.end());
+    std::size_t segment = 0;
+    for (std::size_t i = 0; i < tets.size(); ++i) {
+      const std::uint32_t t = tets[i];
+      if (has_unshared_back_face(t)) {
+        draw_batch(fb, tets.subspan(segment, i - segment));
+        segment = i;
+        save_pixels(fb, t);
+      }
+    }
+    draw_batch(fb, tets.subspan(segment));
+  }
+
+  // Painter or depth-buffer drawing of a batch (see draw); the written-pixel mask is all zero before
+  // and after, cleared only on the rows the batch could touch (short batches cost what they draw).
+  void draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+    if (tets.empty()) return;
+    // Threads pay for themselves only on long batches.
+    const int count = tets.size() < 256 ? 1 : std::min(params.threads, std::max(1, fb.height >> kBandShift));
+    if (reverse && written.empty()) {
       written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
       tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
     }
@@ -772,7 +871,7 @@ struct TetRasterizer::Impl {
       if (b.x0 > b.x1) return;  // draws nothing
       if (b.y0 >= 0) {
         if (!rows.any(b.y0, b.y1)) return;
-        if (reverse && box_written(rows, b, fb.height)) return;  // hidden behind what this batch drew already
+        if (use_mask && box_written(rows, b, fb.height)) return;  // hidden behind what this batch drew already
       }
       draw_tet(fb, rows, tets[i], first);
     };
@@ -793,12 +892,134 @@ struct TetRasterizer::Impl {
     }
     if (count == 1) {
       work(0);
-      return;
+    } else {
+      std::vector<std::thread> pool;
+      for (int k = 1; k < count; ++k) pool.emplace_back(work, k);
+      work(0);
+      for (auto& th : pool) th.join();
     }
-    std::vector<std::thread> pool;
-    for (int k = 1; k < count; ++k) pool.emplace_back(work, k);
-    work(0);
-    for (auto& th : pool) th.join();
+    if (reverse) clear_mask(tets.size());
+  }
+
+  // Zeroes the written-pixel mask on the rows the batch's boxes span (all rows if a box is unknown).
+  void clear_mask(std::size_t n) {
+    int y0 = proj.height, y1 = -1;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Box& b = boxes[i];
+      if (b.x0 > b.x1) continue;
+      if (b.y0 < 0) {
+        y0 = 0;
+        y1 = proj.height - 1;
+        break;
+      }
+      y0 = std::min(y0, b.y0);
+      y1 = std::max(y1, b.y1);
+    }
+    if (y0 > y1) return;
+    const std::size_t words = std::size_t(mask_words);
+    std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
+              written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
+    std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
+              tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
+  }
+
+  // --- Undraw (seed paper, section 6.2) ---
+  // A back face of a drawn tet is shared when the tet across it was drawn before it (with unshrunk
+  // tets only): in the picture of the tets before t, its pixels show that neighbour's front face.
+  std::uint32_t earlier_neighbour(std::uint32_t t, int f) const {
+    if (params.shrink != 1) return kNone;
+    const std::uint32_t nb = adjacency->neighbour[4 * std::size_t(t) + std::size_t(f)];
+    if (nb == kNone || drawn_at[nb >> 2] >= drawn_at[t]) return kNone;
+    return nb;
+  }
+
+  // Calls fn(y, lo, hi) for the pixel runs of a polygon (positive area), in a fixed order.
+  template <class Fn>
+  void for_each_run(const PolyVertex* poly, int n, Fn&& fn) const {
+    for (int q = 1; q + 1 < n; ++q) {
+      std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X}, Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
+      std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+      if (area <= 0) continue;
+      raster_triangle(X, Y, proj.width, proj.height, Rows{}, fn);
+    }
+  }
+
+  // Calls fn(f, poly, n) for each back face of drawn tet t that covers pixels.
+  template <class Fn>
+  void for_each_back_face(std::uint32_t t, Fn&& fn) const {
+    TetCorners k;
+    if (!load_corners(t, k)) return;
+    PolyVertex poly[4];
+    for (int f = 0; f < 4; ++f) {
+      bool clipped = false;
+      const int n = face_polygon(k, f, true, poly, &clipped);
+      if (n > 0) fn(f, poly, n);
+    }
+  }
+
+  bool has_unshared_back_face(std::uint32_t t) const {
+    bool any = false;
+    for_each_back_face(t, [&](int f, const PolyVertex*, int) { any = any || earlier_neighbour(t, f) == kNone; });
+    return any;
+  }
+
+  // Saves the pixels of t's unshared back faces (colour and id) before t is drawn.
+  void save_pixels(const Framebuffer& fb, std::uint32_t t) {
+    saves.push_back(Save{drawn_at[t], saved_rgba.size()});
+    for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
+      if (earlier_neighbour(t, f) != kNone) return;
+      for_each_run(poly, n, [&](int y, int lo, int hi) {
+        const std::size_t row = std::size_t(y) * std::size_t(fb.width);
+        saved_rgba.insert(saved_rgba.end(), fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(lo)),
+                          fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(hi) + 1));
+        saved_id.insert(saved_id.end(), fb.id.begin() + std::ptrdiff_t(row + std::size_t(lo)),
+                        fb.id.begin() + std::ptrdiff_t(row + std::size_t(hi) + 1));
+      });
+    });
+  }
+
+  void undraw(Framebuffer& fb, std::size_t count) {
+    if (!params.undoable) throw std::logic_error("render: undraw needs RenderParams::undoable");
+    check_framebuffer(fb);
+    if (count > history.size()) throw std::out_of_range("render: undraw of more tets than are drawn");
+    use_mask = false;  // the neighbours' faces overwrite
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::uint32_t t = history.back();
+      const std::uint32_t at = std::uint32_t(history.size() - 1);
+      const bool saved = !saves.empty() && saves.back().at == at;
+      std::size_t cursor = saved ? saves.back().offset : 0;
+      for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
+        const std::uint32_t nb = earlier_neighbour(t, f);
+        if (nb != kNone) {  // the neighbour's front face, as the neighbour drew it
+          draw_tet(fb, Rows{}, nb >> 2, false, int(nb & 3));
+          return;
+        }
+        for_each_run(poly, n, [&](int y, int lo, int hi) {
+          const std::size_t row = std::size_t(y) * std::size_t(fb.width), len = std::size_t(hi - lo + 1);
+          std::copy_n(saved_rgba.begin() + std::ptrdiff_t(cursor), len,
+                      fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(lo)));
+          std::copy_n(saved_id.begin() + std::ptrdiff_t(cursor), len,
+                      fb.id.begin() + std::ptrdiff_t(row + std::size_t(lo)));
+          cursor += len;
+        });
+      });
+      if (saved) {
+        saved_rgba.resize(saves.back().offset);
+        saved_id.resize(saves.back().offset);
+        saves.pop_back();
+      }
+      drawn_at[t] = kNone;
+      history.pop_back();
+    }
+    use_mask = reverse;
+  }
+
+  void forget() {
+    for (std::uint32_t t : history) drawn_at[t] = kNone;
+    history.clear();
+    saves.clear();
+    saved_rgba.clear();
+    saved_id.clear();
   }
 };
 
@@ -813,6 +1034,16 @@ void TetRasterizer::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
 const RasterStats& TetRasterizer::stats() const { return impl_->stats; }
 const Projector& TetRasterizer::projector() const { return impl_->proj; }
 double TetRasterizer::near_plane() const { return impl_->near; }
+void TetRasterizer::undraw(Framebuffer& fb, std::size_t count) { impl_->undraw(fb, count); }
+std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_->history; }
+std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_rgba.size(); }
+std::size_t TetRasterizer::undo_bytes() const {
+  const Impl& m = *impl_;
+  return (m.saved_rgba.capacity() + m.saved_id.capacity() + m.history.capacity() + m.drawn_at.capacity()) *
+             sizeof(std::uint32_t) +
+         m.saves.capacity() * sizeof(Impl::Save);
+}
+void TetRasterizer::forget_drawn() { impl_->forget(); }
 
 Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
                         std::span<const std::uint32_t> tets, const RenderParams& params) {

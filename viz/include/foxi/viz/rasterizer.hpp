@@ -37,6 +37,7 @@ struct RenderParams {
   double ambient = 0.3;         // Lambert: ambient + (1 - ambient) max(0, n . light)
   double near = 0;              // perspective near-plane distance (world); 0 = automatic (tiny)
   int threads = 2;              // threads drawing interleaved bands of rows (1 or more)
+  bool undoable = false;        // painter only: record what undraw() needs (see TetRasterizer::undraw)
 };
 
 // The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).
@@ -63,6 +64,23 @@ class TetRasterizer {
   // into fb, which must be width x height (with a depth buffer in depth mode). Can be called again
   // with the next batch of an order (progressive drawing). Tet indices must be < tet_count.
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
+
+  // Undoable mode (RenderParams::undoable; the seed paper's undrawing, section 6.2). draw() keeps the
+  // tets drawn so far (each tet at most once, else std::invalid_argument) and, just before drawing a
+  // tet with a back face not shared with an earlier-drawn tet (mesh boundary, subset boundary,
+  // shrunk tets), saves the pixels that face covers. undraw(fb, k) takes back the last k drawn tets,
+  // front to back: each tet's back faces are repainted as the earlier neighbour's front face, or
+  // restored from its saved pixels. For a visibility order, fb (colours and ids) is then pixel for
+  // pixel the picture of the remaining tets drawn from scratch; fb must not be changed in between.
+  // Cost is proportional to the undrawn tets' pixels, not to the mesh. Throws std::logic_error if
+  // not undoable, std::out_of_range if k exceeds the tets drawn.
+  void undraw(Framebuffer& fb, std::size_t count);
+  std::span<const std::uint32_t> drawn_tets() const;  // undoable: the tets drawn, in order
+  std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
+  std::size_t undo_bytes() const;                     // undoable: memory held for undraw (bytes)
+  // Undoable: forgets the tets drawn (call after clearing fb to start a new picture).
+  void forget_drawn();
+
   const RasterStats& stats() const;
   const Projector& projector() const;
   double near_plane() const;  // the near-plane distance in use (perspective)
