@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/depth_stop.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
@@ -21,7 +23,7 @@ namespace {
 
 const char* kRenderUsage =
     "foxi render MESH [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z] [--size WxH]\n"
-    "                 [--stop P%] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges] -o OUT.png\n"
+    "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges] -o OUT.png\n"
     "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
     "  faces flat-shaded in its region's colour with the mesh edges darkened (no depth buffer).\n"
     "  --eye/--at/--up/--fov  a perspective camera (the eye may be inside the mesh); missing parts\n"
@@ -30,6 +32,10 @@ const char* kRenderUsage =
     "  --dir x,y,z     an orthographic view along this direction, fitted to the mesh\n"
     "  --size WxH      image size in pixels (default 1280x960)\n"
     "  --stop P%       draw only the first P percent of the back-to-front order (the far part)\n"
+    "  --depth d       stop at the first tet whose power distance from the eye, sqrt(|eye-c|^2-r^2)\n"
+    "                  for its circumsphere (c, r), is below d (world units; the order decreases in\n"
+    "                  it); orthographic: the circumcentre's distance in front of the plane through\n"
+    "                  --at across the view. With --stop, whichever stops first\n"
     "  --zbuffer       draw with a depth buffer instead (the oracle; order irrelevant)\n"
     "  --shrink f      scale each tet about its centroid by f in (0, 1] (e.g. 0.8)\n"
     "  --regions a,b   draw only the tets of these region ids\n"
@@ -58,6 +64,7 @@ int cmd_render(Args args) {
   const std::string eye_s = args.option("--eye"), at_s = args.option("--at"), up_s = args.option("--up");
   const std::string fov_s = args.option("--fov"), dir_s = args.option("--dir");
   const std::string size_s = args.option("--size", "1280x960"), stop_s = args.option("--stop");
+  const std::string depth_s = args.option("--depth");
   const std::string shrink_s = args.option("--shrink", "1"), regions_s = args.option("--regions");
   std::string out = args.option("-o");
   if (out.empty()) out = args.option("--output");
@@ -90,6 +97,12 @@ int cmd_render(Args args) {
     if (s.empty() || *end != 0 || !(p >= 0 && p <= 100))
       throw UsageError("--stop takes a percentage 0..100, e.g. 40%");
     stop = p / 100;
+  }
+  double depth_stop = -std::numeric_limits<double>::infinity();
+  if (!depth_s.empty()) {
+    char* end = nullptr;
+    depth_stop = std::strtod(depth_s.c_str(), &end);
+    if (*end != 0 || !std::isfinite(depth_stop)) throw UsageError("--depth takes a distance, e.g. 0.5");
   }
   RenderParams params;
   params.edges = !no_edges;
@@ -164,8 +177,8 @@ int cmd_render(Args args) {
   else
     order = mpvo_order(mesh, table, view, subset, &cycles);
   const double order_ms = ms_since(t0);
-  const std::size_t count =
-      std::min(order.size(), std::size_t(std::floor(stop * double(order.size()) + 1e-9)));
+  std::size_t count = std::min(order.size(), std::size_t(std::floor(stop * double(order.size()) + 1e-9)));
+  if (!depth_s.empty()) count = std::min(count, count_deeper(table, camera, order, depth_stop));
 
   params.depth_buffer = zbuffer || !cert.delaunay;
   t0 = std::chrono::steady_clock::now();
@@ -194,6 +207,8 @@ int cmd_render(Args args) {
               count, order.size(), order.empty() ? 0.0 : 100.0 * double(count) / double(order.size()),
               params.depth_buffer ? "depth-buffer" : "painter", draw_ms, width, height,
               100.0 * double(covered) / double(fb.id.size()));
+  if (!depth_s.empty() && count > 0)
+    std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop, tet_depth(table, camera, order[count - 1]));
   if (raster.stats().tets_behind > 0) std::printf(", %zu tets behind the eye", raster.stats().tets_behind);
   std::printf("\nwrote       %s\n", out.c_str());
   return 0;
