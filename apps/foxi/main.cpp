@@ -24,6 +24,7 @@ const char* kUsage =
     "  solve MESH     --physics thermal: temperatures, heat per boundary; electrostatic: the\n"
     "                 capacitance matrix; current: resistance, Joule heat; -o OUT.vtu\n"
     "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png\n"
+    "  movie MESH     draw/undraw back and forth, or turn the view: -o OUT.gif|.apng|.mp4|frames\n"
     "\n"
     "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"
     "              .node/.ele/.face (TetGen), .mesh (Medit)\n"
@@ -50,6 +51,7 @@ int main(int argc, char** argv) {
     if (command == "order") return foxi::cli::cmd_order(std::move(rest));
     if (command == "mesh") return foxi::cli::cmd_mesh(std::move(rest));
     if (command == "render") return foxi::cli::cmd_render(std::move(rest));
+    if (command == "movie") return foxi::cli::cmd_movie(std::move(rest));
     if (command == "solve") return foxi::cli::cmd_solve(std::move(rest));
     if (command == "model") return foxi::cli::cmd_model(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
