@@ -39,6 +39,12 @@ void check_frame(const std::filesystem::path& path, const AnimationParams& p, co
                              std::to_string(p.width) + "x" + std::to_string(p.height));
 }
 
+void move_into_place(const std::filesystem::path& tmp, const std::filesystem::path& path) {
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw std::runtime_error(path.string() + ": " + ec.message());
+}
+
 void put32(std::string& s, std::uint32_t v) {
   s += char(v >> 24);
   s += char(v >> 16 & 255);
@@ -142,9 +148,7 @@ class ApngWriter final : public AnimationWriter {
     chunk("acTL", actl);
     out_.close();
     if (!out_) throw std::runtime_error(path_.string() + ": write failed");
-    std::error_code ec;
-    std::filesystem::rename(tmp_, path_, ec);
-    if (ec) throw std::runtime_error(path_.string() + ": " + ec.message());
+    move_into_place(tmp_, path_);
     finished_ = true;
   }
   int frames() const override { return frames_; }
@@ -286,9 +290,7 @@ class GifWriter final : public AnimationWriter {
     const int closed = EGifCloseFile(gif_, &err);
     gif_ = nullptr;
     if (closed == GIF_ERROR) fail(err);
-    std::error_code ec;
-    std::filesystem::rename(tmp_, path_, ec);
-    if (ec) throw std::runtime_error(path_.string() + ": " + ec.message());
+    move_into_place(tmp_, path_);
     finished_ = true;
   }
   int frames() const override { return frames_; }
