@@ -224,7 +224,22 @@ struct TetRasterizer::Impl {
     std::size_t offset = 0;  // first saved pixel
   };
   std::vector<Save> saves;
-  std::vector<std::uint32_t> saved_rgba, saved_id;
+  std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;  // y * width + x, colour, id
+  // Per draw() call: where its saves and saved pixels begin (a call's saves are freed together).
+  struct SaveRegion {
+    std::size_t first_save = 0, first_pixel = 0;
+  };
+  std::vector<SaveRegion> regions;
+  // Undoable drawing walks a batch front to back like the painter (see `written`, here "done"), so
+  // the value a tet's save needs, what was drawn before it, comes later in the walk: each saved
+  // pixel is a request (slot: its index, per pixel, kNone if none), answered by the next tet that
+  // covers the pixel, or at the end of the batch by what was there before the batch (fb, or
+  // `before` where the batch overwrote it). `shown`: pixels the batch has given their final value.
+  bool recording = false;
+  std::vector<std::uint64_t> shown;
+  std::vector<std::uint32_t> slot, before_rgba, before_id;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> aliases;  // (request, later request it equals)
+  std::vector<std::uint8_t> need_save;  // per batch tet
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
       : mesh(&m), proj(c, w, h), params(p) {
@@ -234,13 +249,18 @@ struct TetRasterizer::Impl {
     if (params.threads > 64) params.threads = 64;
     if (!(params.edge_width > 0)) params.edges = false;
     reverse = !params.depth_buffer;
+    mask_words = (w + 63) / 64;
     use_mask = reverse;
     if (params.undoable) {
       if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
       adjacency = &face_adjacency(m);
       drawn_at.assign(m.tet_count(), kNone);
+      const std::size_t pixels = std::size_t(w) * std::size_t(h);
+      shown.assign(std::size_t(mask_words) * std::size_t(h), 0);
+      slot.assign(pixels, kNone);
+      before_rgba.assign(pixels, 0);
+      before_id.assign(pixels, 0);
     }
-    mask_words = (w + 63) / 64;
     double l[3] = {-0.3, 0.45, -1};
     double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
     for (int k = 0; k < 3; ++k) light[k] = l[k] / ln;
@@ -392,12 +412,18 @@ struct TetRasterizer::Impl {
 
   void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
     const std::size_t p = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
-    const double sx = x + 0.5, sy = y + 0.5;
     if (params.depth_buffer) {
-      const double z = fs.w0 + fs.da * (sx - fs.x0) + fs.db * (sy - fs.y0);
+      const double z = fs.w0 + fs.da * (x + 0.5 - fs.x0) + fs.db * (y + 0.5 - fs.y0);
       if (!(z > fb.depth[p])) return;
       fb.depth[p] = z;
     }
+    fb.rgba[p] = face_color(fs, x, y);
+    fb.id[p] = fs.tet;
+  }
+
+  // The colour of a face at pixel (x, y): flat, darkened near its edges.
+  std::uint32_t face_color(const FaceSetup& fs, int x, int y) const {
+    const double sx = x + 0.5, sy = y + 0.5;
     std::uint32_t col = fs.color;
     if (fs.lines > 0) {
       double d = 1e300;
@@ -408,8 +434,7 @@ struct TetRasterizer::Impl {
                         std::uint32_t(fs.b * f + 0.5f));
       }
     }
-    fb.rgba[p] = col;
-    fb.id[p] = fs.tet;
+    return col;
   }
 
   // True if every pixel x in [lo, hi] of row y is already written (lo <= hi, inside the image).
@@ -477,7 +502,10 @@ struct TetRasterizer::Impl {
       std::uint64_t set = row[w] & (~std::uint64_t(0) << (a & 63));
       while (set == 0 && w < w1) set = row[++w];
       const int b = set == 0 ? hi + 1 : std::min(hi + 1, (w << 6) + std::countr_zero(set));
-      shade_span(fb, fs, y, a, b - 1);
+      if (recording)
+        record_span(fb, fs, y, a, b - 1);
+      else
+        shade_span(fb, fs, y, a, b - 1);
       x = b;
     }
     const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
@@ -487,6 +515,37 @@ struct TetRasterizer::Impl {
       row[w0] |= m0;
       for (int w = w0 + 1; w < w1; ++w) row[w] = ~std::uint64_t(0);
       row[w1] |= m1;
+    }
+  }
+
+  // Undoable drawing, a run of pixels not done in this batch: those not yet shown get the face
+  // (their previous contents kept in `before`), the others hold undraw requests of tets drawn later
+  // (nearer) whose unshared back faces cover them: this face is what lay behind, their saved value.
+  void record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
+    const std::size_t row = std::size_t(y) * std::size_t(fb.width);
+    std::uint64_t* shown_row = &shown[std::size_t(y) * std::size_t(mask_words)];
+    auto is_shown = [&](int x) { return (shown_row[x >> 6] >> (x & 63)) & 1; };
+    for (int x = lo; x <= hi;) {
+      int e = x;
+      const bool was_shown = is_shown(x);
+      while (e + 1 <= hi && is_shown(e + 1) == was_shown) ++e;
+      if (!was_shown) {
+        std::copy_n(fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
+                    before_rgba.begin() + std::ptrdiff_t(row + std::size_t(x)));
+        std::copy_n(fb.id.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
+                    before_id.begin() + std::ptrdiff_t(row + std::size_t(x)));
+        shade_span(fb, fs, y, x, e);
+        for (int k = x; k <= e; ++k) shown_row[k >> 6] |= std::uint64_t(1) << (k & 63);
+      } else {
+        for (int k = x; k <= e; ++k) {
+          std::uint32_t& request = slot[row + std::size_t(k)];
+          if (request == kNone) continue;  // cannot happen: shown and not done means a request
+          saved_rgba[request] = face_color(fs, k, y);
+          saved_id[request] = fs.tet;
+          request = kNone;
+        }
+      }
+      x = e + 1;
     }
   }
 
@@ -823,8 +882,8 @@ struct TetRasterizer::Impl {
       draw_batch(fb, tets);
       return;
     }
-    // Undoable: cut the batch before every tet that has a back face no earlier tet shares, so that
-    // the framebuffer holds exactly the picture of the tets before it when its save is taken.
+    // Undoable: positions first (a back face is shared with a tet drawn earlier), then one
+    // front-to-back walk that answers the saves' requests (see `recording`).
     const std::size_t start = history.size();
     for (std::size_t i = 0; i < tets.size(); ++i) {
       if (drawn_at[tets[i]] != kNone) {
@@ -835,16 +894,44 @@ struct TetRasterizer::Impl {
       drawn_at[tets[i]] = std::uint32_t(start + i);
     }
     history.insert(history.end(), tets.begin(), tets.end());
-    std::size_t segment = 0;
-    for (std::size_t i = 0; i < tets.size(); ++i) {
-      const std::uint32_t t = tets[i];
-      if (has_unshared_back_face(t)) {
-        draw_batch(fb, tets.subspan(segment, i - segment));
-        segment = i;
-        save_pixels(fb, t);
-      }
+    need_save.resize(tets.size());
+    for (std::size_t i = 0; i < tets.size(); ++i) need_save[i] = has_unshared_back_face(tets[i]);
+    regions.push_back(SaveRegion{saves.size(), saved_pixel.size()});
+    recording = true;
+    try {
+      draw_batch(fb, tets);
+    } catch (...) {
+      recording = false;
+      clear_mask(tets.size());
+      throw;
     }
-    draw_batch(fb, tets.subspan(segment));
+    recording = false;
+    answer_requests(fb, regions.back());
+    clear_mask(tets.size());
+    // Saves were made front to back: put this call's in drawing order.
+    std::reverse(saves.begin() + std::ptrdiff_t(regions.back().first_save), saves.end());
+    if (saves.size() == regions.back().first_save) regions.pop_back();
+  }
+
+  // End of an undoable batch: requests no tet answered get what was there before the batch; a
+  // request replaced at its pixel by a later one (a back face covering a pixel its tet's front
+  // faces miss, after snapping) takes that one's answer.
+  void answer_requests(const Framebuffer& fb, const SaveRegion& region) {
+    for (std::size_t k = region.first_pixel; k < saved_pixel.size(); ++k) {
+      const std::uint32_t p = saved_pixel[k];
+      if (slot[p] != k) continue;
+      const bool was_shown = (shown[std::size_t(p / std::uint32_t(fb.width)) * std::size_t(mask_words) +
+                                   ((p % std::uint32_t(fb.width)) >> 6)] >>
+                              ((p % std::uint32_t(fb.width)) & 63)) & 1;
+      saved_rgba[k] = was_shown ? before_rgba[p] : fb.rgba[p];
+      saved_id[k] = was_shown ? before_id[p] : fb.id[p];
+      slot[p] = kNone;
+    }
+    for (std::size_t k = aliases.size(); k-- > 0;) {
+      saved_rgba[aliases[k].first] = saved_rgba[aliases[k].second];
+      saved_id[aliases[k].first] = saved_id[aliases[k].second];
+    }
+    aliases.clear();
   }
 
   // Painter or depth-buffer drawing of a batch (see draw); the written-pixel mask is all zero before
@@ -852,7 +939,8 @@ struct TetRasterizer::Impl {
   void draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets) {
     if (tets.empty()) return;
     // Threads pay for themselves only on long batches.
-    const int count = tets.size() < 256 ? 1 : std::min(params.threads, std::max(1, fb.height >> kBandShift));
+    const int count =
+        tets.size() < 256 || recording ? 1 : std::min(params.threads, std::max(1, fb.height >> kBandShift));
     if (reverse && written.empty()) {
       written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
       tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
@@ -869,11 +957,14 @@ struct TetRasterizer::Impl {
     auto draw_one = [&](const Rows& rows, std::size_t i, bool first) {
       const Box& b = boxes[i];
       if (b.x0 > b.x1) return;  // draws nothing
+      const bool files_save = recording && need_save[i];
       if (b.y0 >= 0) {
         if (!rows.any(b.y0, b.y1)) return;
-        if (use_mask && box_written(rows, b, fb.height)) return;  // hidden behind what this batch drew already
+        // Hidden behind what this batch drew already (a tet with a save still files its requests).
+        if (use_mask && !files_save && box_written(rows, b, fb.height)) return;
       }
       draw_tet(fb, rows, tets[i], first);
+      if (files_save) request_saves(fb, tets[i]);
     };
     auto work = [&](int k) {
       Rows rows{k, count};
@@ -898,7 +989,7 @@ struct TetRasterizer::Impl {
       work(0);
       for (auto& th : pool) th.join();
     }
-    if (reverse) clear_mask(tets.size());
+    if (reverse && !recording) clear_mask(tets.size());
   }
 
   // Zeroes the written-pixel mask on the rows the batch's boxes span (all rows if a box is unknown).
@@ -921,6 +1012,9 @@ struct TetRasterizer::Impl {
               written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
     std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
               tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
+    if (!shown.empty())
+      std::fill(shown.begin() + std::ptrdiff_t(std::size_t(y0) * words),
+                shown.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
   }
 
   // --- Undraw (seed paper, section 6.2) ---
@@ -963,61 +1057,106 @@ struct TetRasterizer::Impl {
     return any;
   }
 
-  // Saves the pixels of t's unshared back faces (colour and id) before t is drawn.
-  void save_pixels(const Framebuffer& fb, std::uint32_t t) {
-    saves.push_back(Save{drawn_at[t], saved_rgba.size()});
+  // Files t's save: a request for each pixel of its unshared back faces (just after t's front faces
+  // were walked, which answered the requests of nearer tets on the same pixels).
+  void request_saves(const Framebuffer& fb, std::uint32_t t) {
+    saves.push_back(Save{drawn_at[t], saved_pixel.size()});
     for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
       if (earlier_neighbour(t, f) != kNone) return;
       for_each_run(poly, n, [&](int y, int lo, int hi) {
         const std::size_t row = std::size_t(y) * std::size_t(fb.width);
-        saved_rgba.insert(saved_rgba.end(), fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(lo)),
-                          fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(hi) + 1));
-        saved_id.insert(saved_id.end(), fb.id.begin() + std::ptrdiff_t(row + std::size_t(lo)),
-                        fb.id.begin() + std::ptrdiff_t(row + std::size_t(hi) + 1));
+        std::uint64_t* done = &written[std::size_t(y) * std::size_t(mask_words)];
+        for (int x = lo; x <= hi; ++x) {
+          const std::uint32_t k = std::uint32_t(saved_pixel.size()), p = std::uint32_t(row + std::size_t(x));
+          if (slot[p] != kNone) aliases.emplace_back(slot[p], k);
+          slot[p] = k;
+          saved_pixel.push_back(p);
+          done[x >> 6] &= ~(std::uint64_t(1) << (x & 63));  // to be walked again
+          tile_full[std::size_t(y >> kBandShift) * std::size_t(mask_words) + std::size_t(x >> 6)] = 0;
+        }
       });
     });
+    saved_rgba.resize(saved_pixel.size());
+    saved_id.resize(saved_pixel.size());
   }
 
+  // Takes back the last `count` tets. Sequentially (front to back) each tet's back-face pixels are
+  // repainted; the last write to a pixel is by the farthest undrawn tet covering it, so the tets are
+  // walked back to front instead and each pixel is written once, first write wins (the mask).
   void undraw(Framebuffer& fb, std::size_t count) {
     if (!params.undoable) throw std::logic_error("render: undraw needs RenderParams::undoable");
     check_framebuffer(fb);
     if (count > history.size()) throw std::out_of_range("render: undraw of more tets than are drawn");
-    use_mask = false;  // the neighbours' faces overwrite
-    for (std::size_t k = 0; k < count; ++k) {
-      const std::uint32_t t = history.back();
-      const std::uint32_t at = std::uint32_t(history.size() - 1);
-      const bool saved = !saves.empty() && saves.back().at == at;
-      std::size_t cursor = saved ? saves.back().offset : 0;
-      for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
-        const std::uint32_t nb = earlier_neighbour(t, f);
-        if (nb != kNone) {  // the neighbour's front face, as the neighbour drew it
-          draw_tet(fb, Rows{}, nb >> 2, false, int(nb & 3));
-          return;
-        }
-        for_each_run(poly, n, [&](int y, int lo, int hi) {
-          const std::size_t row = std::size_t(y) * std::size_t(fb.width), len = std::size_t(hi - lo + 1);
-          std::copy_n(saved_rgba.begin() + std::ptrdiff_t(cursor), len,
-                      fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(lo)));
-          std::copy_n(saved_id.begin() + std::ptrdiff_t(cursor), len,
-                      fb.id.begin() + std::ptrdiff_t(row + std::size_t(lo)));
-          cursor += len;
-        });
-      });
-      if (saved) {
-        saved_rgba.resize(saves.back().offset);
-        saved_id.resize(saves.back().offset);
-        saves.pop_back();
-      }
-      drawn_at[t] = kNone;
-      history.pop_back();
+    if (count == 0) return;
+    if (written.empty()) {
+      written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
+      tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
     }
-    use_mask = reverse;
+    const std::size_t first = history.size() - count;
+    std::size_t save = std::size_t(
+        std::lower_bound(saves.begin(), saves.end(), first, [](const Save& s, std::size_t at) { return s.at < at; }) -
+        saves.begin());
+    const std::size_t first_save = save;
+    boxes.resize(count);
+    const Rows all{};
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t t = history[first + i];
+      const bool saved = save < saves.size() && saves[save].at == first + i;
+      Box& b = boxes[i];
+      b = tet_box(t, fb.width, fb.height);
+      if (b.x0 > b.x1 || (b.y0 >= 0 && box_written(all, b, fb.height))) {
+        if (saved) ++save;
+        continue;
+      }
+      if (saved) {
+        // The save's requests, in this call's region: up to the next save's, or the end.
+        const std::size_t from = saves[save].offset;
+        const std::size_t to = save_end(save);
+        for (std::size_t k = from; k < to; ++k) {
+          const std::uint32_t p = saved_pixel[k];
+          const std::uint32_t x = p % std::uint32_t(fb.width), y = p / std::uint32_t(fb.width);
+          std::uint64_t& word = written[std::size_t(y) * std::size_t(mask_words) + (x >> 6)];
+          const std::uint64_t bit = std::uint64_t(1) << (x & 63);
+          if (word & bit) continue;
+          word |= bit;
+          fb.rgba[p] = saved_rgba[k];
+          fb.id[p] = saved_id[k];
+        }
+        ++save;
+      }
+      for_each_back_face(t, [&](int f, const PolyVertex*, int) {
+        const std::uint32_t nb = earlier_neighbour(t, f);
+        if (nb != kNone) draw_tet(fb, all, nb >> 2, false, int(nb & 3));  // as the neighbour drew it
+      });
+    }
+    clear_mask(count);
+    for (std::size_t i = history.size(); i-- > first;) drawn_at[history[i]] = kNone;
+    history.resize(first);
+    saves.resize(first_save);
+    while (!regions.empty() && regions.back().first_save >= saves.size()) {
+      saved_pixel.resize(regions.back().first_pixel);
+      regions.pop_back();
+    }
+    saved_rgba.resize(saved_pixel.size());
+    saved_id.resize(saved_pixel.size());
+  }
+
+  // Where save s's pixels end: saves of one draw() call were filed front to back, so in drawing
+  // order a save's pixels run up to those of the save before it in the same call.
+  std::size_t save_end(std::size_t s) const {
+    std::size_t r = regions.size();
+    while (r > 0 && regions[r - 1].first_save > s) --r;
+    const SaveRegion& region = regions[r - 1];
+    const std::size_t region_end = r < regions.size() ? regions[r].first_pixel : saved_pixel.size();
+    return s > region.first_save ? saves[s - 1].offset : region_end;
   }
 
   void forget() {
     for (std::uint32_t t : history) drawn_at[t] = kNone;
     history.clear();
     saves.clear();
+    regions.clear();
+    saved_pixel.clear();
     saved_rgba.clear();
     saved_id.clear();
   }
@@ -1039,9 +1178,11 @@ std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_-
 std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_rgba.size(); }
 std::size_t TetRasterizer::undo_bytes() const {
   const Impl& m = *impl_;
-  return (m.saved_rgba.capacity() + m.saved_id.capacity() + m.history.capacity() + m.drawn_at.capacity()) *
+  return (m.saved_pixel.capacity() + m.saved_rgba.capacity() + m.saved_id.capacity() + m.history.capacity() +
+          m.drawn_at.capacity() + m.slot.capacity() + m.before_rgba.capacity() + m.before_id.capacity()) *
              sizeof(std::uint32_t) +
-         m.saves.capacity() * sizeof(Impl::Save);
+         (m.shown.capacity() + m.written.capacity()) * sizeof(std::uint64_t) + m.saves.capacity() * sizeof(Impl::Save) +
+         m.regions.capacity() * sizeof(Impl::SaveRegion);
 }
 void TetRasterizer::forget_drawn() { impl_->forget(); }
 
