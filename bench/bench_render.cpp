@@ -8,8 +8,9 @@
 //   painter_draw_undoable painter_draw recording what undraw needs (saved pixels of unshared back
 //                     faces); counter undo_MB = memory held for undraw after the whole mesh is drawn
 //   undraw_front10    (after an untimed undoable draw of all tets) undraw the front 10% of the order
-//                     in 10 frames of 1%, each frame copied out as a display would (issue 4 target:
-//                     at most a fifth of painter_draw); counters ms_per_frame, undrawn_per_s, undo_MB
+//                     in 10 frames of 1%, each frame copied out as a display would; counters
+//                     ms_per_frame (issue 4 target: at most a fifth of painter_draw, the cost of
+//                     redrawing that frame from scratch), tets_per_s (tets undrawn), undo_MB
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-5 (~100k tets) and a4e-6 (~0.97M tets). The camera
 // is fitted to the box from an oblique direction (the mesh fills about 90% of the image height) and
 // turns by 7 degrees per iteration, so no frame repeats.
