@@ -221,24 +221,32 @@ struct TetRasterizer::Impl {
   std::vector<std::uint32_t> drawn_at;
   struct Save {
     std::uint32_t at = 0;    // position in history
-    std::size_t offset = 0;  // first saved pixel
+    std::size_t offset = 0;  // first saved pixel (in its lane)
   };
-  std::vector<Save> saves;
-  std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;  // y * width + x, colour, id
   // Per draw() call: where its saves and saved pixels begin (a call's saves are freed together).
   struct SaveRegion {
     std::size_t first_save = 0, first_pixel = 0;
   };
-  std::vector<SaveRegion> regions;
+  // The saved pixels live in lanes, one per thread of the band partition (lane k holds the pixels of
+  // the rows Rows{k, lane_count} owns, see lane_of), so that threads record and restore them
+  // independently. A tet's save is filed in each lane whose rows it touches.
+  struct Lane {
+    std::vector<Save> saves;                                        // in drawing order
+    std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;  // y * width + x, colour, id
+    std::vector<SaveRegion> regions;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> aliases;  // (request, later request it equals)
+  };
+  std::vector<Lane> lanes;
+  int lane_count = 1;
+  int lane_of(int y) const { return (y >> kBandShift) % lane_count; }
   // Undoable drawing walks a batch front to back like the painter (see `written`, here "done"), so
   // the value a tet's save needs, what was drawn before it, comes later in the walk: each saved
-  // pixel is a request (slot: its index, per pixel, kNone if none), answered by the next tet that
-  // covers the pixel, or at the end of the batch by what was there before the batch (fb, or
+  // pixel is a request (slot: its index in its lane, per pixel, kNone if none), answered by the next
+  // tet that covers the pixel, or at the end of the batch by what was there before the batch (fb, or
   // `before` where the batch overwrote it). `shown`: pixels the batch has given their final value.
   bool recording = false;
   std::vector<std::uint64_t> shown;
   std::vector<std::uint32_t> slot, before_rgba, before_id;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> aliases;  // (request, later request it equals)
   std::vector<std::uint8_t> need_save;  // per batch tet
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
@@ -260,6 +268,8 @@ struct TetRasterizer::Impl {
       slot.assign(pixels, kNone);
       before_rgba.assign(pixels, 0);
       before_id.assign(pixels, 0);
+      lane_count = std::min(params.threads, std::max(1, h >> kBandShift));
+      lanes.resize(std::size_t(lane_count));
     }
     double l[3] = {-0.3, 0.45, -1};
     double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
@@ -537,11 +547,12 @@ struct TetRasterizer::Impl {
         shade_span(fb, fs, y, x, e);
         for (int k = x; k <= e; ++k) shown_row[k >> 6] |= std::uint64_t(1) << (k & 63);
       } else {
+        Lane& lane = lanes[std::size_t(lane_of(y))];
         for (int k = x; k <= e; ++k) {
           std::uint32_t& request = slot[row + std::size_t(k)];
           if (request == kNone) continue;  // cannot happen: shown and not done means a request
-          saved_rgba[request] = face_color(fs, k, y);
-          saved_id[request] = fs.tet;
+          lane.saved_rgba[request] = face_color(fs, k, y);
+          lane.saved_id[request] = fs.tet;
           request = kNone;
         }
       }
@@ -894,9 +905,7 @@ struct TetRasterizer::Impl {
       drawn_at[tets[i]] = std::uint32_t(start + i);
     }
     history.insert(history.end(), tets.begin(), tets.end());
-    need_save.resize(tets.size());
-    for (std::size_t i = 0; i < tets.size(); ++i) need_save[i] = has_unshared_back_face(tets[i]);
-    regions.push_back(SaveRegion{saves.size(), saved_pixel.size()});
+    for (Lane& lane : lanes) lane.regions.push_back(SaveRegion{lane.saves.size(), lane.saved_pixel.size()});
     recording = true;
     try {
       draw_batch(fb, tets);
@@ -906,41 +915,46 @@ struct TetRasterizer::Impl {
       throw;
     }
     recording = false;
-    answer_requests(fb, regions.back());
     clear_mask(tets.size());
-    // Saves were made front to back: put this call's in drawing order.
-    std::reverse(saves.begin() + std::ptrdiff_t(regions.back().first_save), saves.end());
-    if (saves.size() == regions.back().first_save) regions.pop_back();
+    for (Lane& lane : lanes)
+      if (lane.saves.size() == lane.regions.back().first_save) lane.regions.pop_back();
   }
 
-  // End of an undoable batch: requests no tet answered get what was there before the batch; a
-  // request replaced at its pixel by a later one (a back face covering a pixel its tet's front
-  // faces miss, after snapping) takes that one's answer.
-  void answer_requests(const Framebuffer& fb, const SaveRegion& region) {
-    for (std::size_t k = region.first_pixel; k < saved_pixel.size(); ++k) {
-      const std::uint32_t p = saved_pixel[k];
-      if (slot[p] != k) continue;
+  // End of an undoable batch, in lane k (by its thread): requests no tet answered get what was there
+  // before the batch; a request replaced at its pixel by a later one (a back face covering a pixel
+  // its tet's front faces miss, after snapping) takes that one's answer. The lane's saves, filed
+  // front to back, are then put in drawing order.
+  void answer_requests(const Framebuffer& fb, int k) {
+    Lane& lane = lanes[std::size_t(k)];
+    const SaveRegion& region = lane.regions.back();
+    for (std::size_t i = region.first_pixel; i < lane.saved_pixel.size(); ++i) {
+      const std::uint32_t p = lane.saved_pixel[i];
+      if (slot[p] != i) continue;
       const bool was_shown = (shown[std::size_t(p / std::uint32_t(fb.width)) * std::size_t(mask_words) +
                                    ((p % std::uint32_t(fb.width)) >> 6)] >>
                               ((p % std::uint32_t(fb.width)) & 63)) & 1;
-      saved_rgba[k] = was_shown ? before_rgba[p] : fb.rgba[p];
-      saved_id[k] = was_shown ? before_id[p] : fb.id[p];
+      lane.saved_rgba[i] = was_shown ? before_rgba[p] : fb.rgba[p];
+      lane.saved_id[i] = was_shown ? before_id[p] : fb.id[p];
       slot[p] = kNone;
     }
-    for (std::size_t k = aliases.size(); k-- > 0;) {
-      saved_rgba[aliases[k].first] = saved_rgba[aliases[k].second];
-      saved_id[aliases[k].first] = saved_id[aliases[k].second];
+    for (std::size_t i = lane.aliases.size(); i-- > 0;) {
+      lane.saved_rgba[lane.aliases[i].first] = lane.saved_rgba[lane.aliases[i].second];
+      lane.saved_id[lane.aliases[i].first] = lane.saved_id[lane.aliases[i].second];
     }
-    aliases.clear();
+    lane.aliases.clear();
+    std::reverse(lane.saves.begin() + std::ptrdiff_t(region.first_save), lane.saves.end());
   }
 
   // Painter or depth-buffer drawing of a batch (see draw); the written-pixel mask is all zero before
   // and after, cleared only on the rows the batch could touch (short batches cost what they draw).
   void draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets) {
     if (tets.empty()) return;
-    // Threads pay for themselves only on long batches.
-    const int count =
-        tets.size() < 256 || recording ? 1 : std::min(params.threads, std::max(1, fb.height >> kBandShift));
+    // Threads pay for themselves only on long batches. Undoable drawing always uses its lanes'
+    // partition (saved pixels are kept per lane), on one thread for short batches.
+    const int count = recording       ? lane_count
+                      : tets.size() < 256 ? 1
+                                          : std::min(params.threads, std::max(1, fb.height >> kBandShift));
+    const bool spawn = count > 1 && tets.size() >= 256;
     if (reverse && written.empty()) {
       written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
       tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
@@ -952,6 +966,7 @@ struct TetRasterizer::Impl {
         if (i + kAhead < end) prefetch_tet(tets[i + kAhead]);
         if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 2 * kAhead])]);
         boxes[i] = tet_box(tets[i], fb.width, fb.height);
+        if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i]);
       }
     };
     auto draw_one = [&](const Rows& rows, std::size_t i, bool first) {
@@ -964,7 +979,7 @@ struct TetRasterizer::Impl {
         if (use_mask && !files_save && box_written(rows, b, fb.height)) return;
       }
       draw_tet(fb, rows, tets[i], first);
-      if (files_save) request_saves(fb, tets[i]);
+      if (files_save) request_saves(fb, rows, tets[i]);
     };
     auto work = [&](int k) {
       Rows rows{k, count};
@@ -973,16 +988,18 @@ struct TetRasterizer::Impl {
       } else {
         for (std::size_t i = 0; i < tets.size(); ++i) draw_one(rows, i, k == 0);
       }
+      if (recording) answer_requests(fb, k);
     };
-    if (count == 1 || tets.size() < 4096) {
+    if (recording) need_save.resize(tets.size());
+    if (!spawn || tets.size() < 4096) {
       find_boxes(0, tets.size());
     } else {
       std::thread helper(find_boxes, tets.size() / 2, tets.size());
       find_boxes(0, tets.size() / 2);
       helper.join();
     }
-    if (count == 1) {
-      work(0);
+    if (!spawn) {
+      for (int k = 0; k < count; ++k) work(k);
     } else {
       std::vector<std::thread> pool;
       for (int k = 1; k < count; ++k) pool.emplace_back(work, k);
@@ -1027,14 +1044,15 @@ struct TetRasterizer::Impl {
     return nb;
   }
 
-  // Calls fn(y, lo, hi) for the pixel runs of a polygon (positive area), in a fixed order.
+  // Calls fn(y, lo, hi) for the pixel runs of a polygon (positive area) in the rows of `rows`, in a
+  // fixed order.
   template <class Fn>
-  void for_each_run(const PolyVertex* poly, int n, Fn&& fn) const {
+  void for_each_run(const PolyVertex* poly, int n, const Rows& rows, Fn&& fn) const {
     for (int q = 1; q + 1 < n; ++q) {
       std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X}, Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
       std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
       if (area <= 0) continue;
-      raster_triangle(X, Y, proj.width, proj.height, Rows{}, fn);
+      raster_triangle(X, Y, proj.width, proj.height, rows, fn);
     }
   }
 
@@ -1051,24 +1069,43 @@ struct TetRasterizer::Impl {
     }
   }
 
+  // Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
+  // for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
+  // its projected area (as face_polygon does) without building its polygon.
   bool has_unshared_back_face(std::uint32_t t) const {
-    bool any = false;
-    for_each_back_face(t, [&](int f, const PolyVertex*, int) { any = any || earlier_neighbour(t, f) == kNone; });
-    return any;
+    TetCorners k;
+    if (!load_corners(t, k)) return false;
+    const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
+    for (int f = 0; f < 4; ++f) {
+      bool back;
+      if (unclipped) {
+        const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
+        back = (k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) > 0;
+      } else {
+        PolyVertex poly[4];
+        bool clipped = false;
+        back = face_polygon(k, f, true, poly, &clipped) > 0;
+      }
+      if (back && earlier_neighbour(t, f) == kNone) return true;
+    }
+    return false;
   }
 
-  // Files t's save: a request for each pixel of its unshared back faces (just after t's front faces
-  // were walked, which answered the requests of nearer tets on the same pixels).
-  void request_saves(const Framebuffer& fb, std::uint32_t t) {
-    saves.push_back(Save{drawn_at[t], saved_pixel.size()});
+  // Files t's save in the lane of `rows`: a request for each pixel of its unshared back faces in
+  // those rows (just after t's front faces were walked, which answered the requests of nearer tets
+  // on the same pixels).
+  void request_saves(const Framebuffer& fb, const Rows& rows, std::uint32_t t) {
+    Lane& lane = lanes[std::size_t(rows.thread)];
+    std::vector<std::uint32_t>& saved_pixel = lane.saved_pixel;
+    lane.saves.push_back(Save{drawn_at[t], saved_pixel.size()});
     for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
       if (earlier_neighbour(t, f) != kNone) return;
-      for_each_run(poly, n, [&](int y, int lo, int hi) {
+      for_each_run(poly, n, rows, [&](int y, int lo, int hi) {
         const std::size_t row = std::size_t(y) * std::size_t(fb.width);
         std::uint64_t* done = &written[std::size_t(y) * std::size_t(mask_words)];
         for (int x = lo; x <= hi; ++x) {
           const std::uint32_t k = std::uint32_t(saved_pixel.size()), p = std::uint32_t(row + std::size_t(x));
-          if (slot[p] != kNone) aliases.emplace_back(slot[p], k);
+          if (slot[p] != kNone) lane.aliases.emplace_back(slot[p], k);
           slot[p] = k;
           saved_pixel.push_back(p);
           done[x >> 6] &= ~(std::uint64_t(1) << (x & 63));  // to be walked again
@@ -1076,13 +1113,14 @@ struct TetRasterizer::Impl {
         }
       });
     });
-    saved_rgba.resize(saved_pixel.size());
-    saved_id.resize(saved_pixel.size());
+    lane.saved_rgba.resize(saved_pixel.size());
+    lane.saved_id.resize(saved_pixel.size());
   }
 
   // Takes back the last `count` tets. Sequentially (front to back) each tet's back-face pixels are
   // repainted; the last write to a pixel is by the farthest undrawn tet covering it, so the tets are
-  // walked back to front instead and each pixel is written once, first write wins (the mask).
+  // walked back to front instead and each pixel is written once, first write wins (the mask). Each
+  // lane's thread does its own rows.
   void undraw(Framebuffer& fb, std::size_t count) {
     if (!params.undoable) throw std::logic_error("render: undraw needs RenderParams::undoable");
     check_framebuffer(fb);
@@ -1093,72 +1131,104 @@ struct TetRasterizer::Impl {
       tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
     }
     const std::size_t first = history.size() - count;
-    std::size_t save = std::size_t(
-        std::lower_bound(saves.begin(), saves.end(), first, [](const Save& s, std::size_t at) { return s.at < at; }) -
-        saves.begin());
-    const std::size_t first_save = save;
+    auto first_save = [&](const Lane& lane) {
+      return std::size_t(std::lower_bound(lane.saves.begin(), lane.saves.end(), first,
+                                          [](const Save& s, std::size_t at) { return s.at < at; }) -
+                         lane.saves.begin());
+    };
     boxes.resize(count);
-    const Rows all{};
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::uint32_t t = history[first + i];
-      const bool saved = save < saves.size() && saves[save].at == first + i;
-      Box& b = boxes[i];
-      b = tet_box(t, fb.width, fb.height);
-      if (b.x0 > b.x1 || (b.y0 >= 0 && box_written(all, b, fb.height))) {
-        if (saved) ++save;
-        continue;
-      }
-      if (saved) {
-        // The save's requests, in this call's region: up to the next save's, or the end.
-        const std::size_t from = saves[save].offset;
-        const std::size_t to = save_end(save);
-        for (std::size_t k = from; k < to; ++k) {
-          const std::uint32_t p = saved_pixel[k];
-          const std::uint32_t x = p % std::uint32_t(fb.width), y = p / std::uint32_t(fb.width);
-          std::uint64_t& word = written[std::size_t(y) * std::size_t(mask_words) + (x >> 6)];
-          const std::uint64_t bit = std::uint64_t(1) << (x & 63);
-          if (word & bit) continue;
-          word |= bit;
-          fb.rgba[p] = saved_rgba[k];
-          fb.id[p] = saved_id[k];
+    auto find_boxes = [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) boxes[i] = tet_box(history[first + i], fb.width, fb.height);
+    };
+    auto work = [&](int k) {
+      const Rows rows{k, lane_count};
+      Lane& lane = lanes[std::size_t(k)];
+      std::size_t save = first_save(lane);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t t = history[first + i];
+        const bool saved = save < lane.saves.size() && lane.saves[save].at == first + i;
+        const std::size_t s = saved ? save++ : 0;
+        const Box& b = boxes[i];
+        if (b.x0 > b.x1) continue;
+        if (b.y0 >= 0 && (!rows.any(b.y0, b.y1) || box_written(rows, b, fb.height))) continue;
+        if (saved) {
+          const std::size_t to = save_end(lane, s);
+          for (std::size_t j = lane.saves[s].offset; j < to; ++j) {
+            const std::uint32_t p = lane.saved_pixel[j];
+            const std::uint32_t x = p % std::uint32_t(fb.width), y = p / std::uint32_t(fb.width);
+            std::uint64_t& word = written[std::size_t(y) * std::size_t(mask_words) + (x >> 6)];
+            const std::uint64_t bit = std::uint64_t(1) << (x & 63);
+            if (word & bit) continue;
+            word |= bit;
+            fb.rgba[p] = lane.saved_rgba[j];
+            fb.id[p] = lane.saved_id[j];
+          }
         }
-        ++save;
+        for_each_back_face(t, [&](int f, const PolyVertex*, int) {
+          const std::uint32_t nb = earlier_neighbour(t, f);
+          if (nb != kNone) draw_tet(fb, rows, nb >> 2, false, int(nb & 3));  // as the neighbour drew it
+        });
       }
-      for_each_back_face(t, [&](int f, const PolyVertex*, int) {
-        const std::uint32_t nb = earlier_neighbour(t, f);
-        if (nb != kNone) draw_tet(fb, all, nb >> 2, false, int(nb & 3));  // as the neighbour drew it
-      });
+    };
+    const bool spawn = lane_count > 1 && count >= 256;
+    if (!spawn) {
+      find_boxes(0, count);
+      for (int k = 0; k < lane_count; ++k) work(k);
+    } else {
+      std::thread helper(find_boxes, count / 2, count);
+      find_boxes(0, count / 2);
+      helper.join();
+      std::vector<std::thread> pool;
+      for (int k = 1; k < lane_count; ++k) pool.emplace_back(work, k);
+      work(0);
+      for (auto& th : pool) th.join();
     }
     clear_mask(count);
     for (std::size_t i = history.size(); i-- > first;) drawn_at[history[i]] = kNone;
     history.resize(first);
-    saves.resize(first_save);
-    while (!regions.empty() && regions.back().first_save >= saves.size()) {
-      saved_pixel.resize(regions.back().first_pixel);
-      regions.pop_back();
+    for (Lane& lane : lanes) {
+      lane.saves.resize(first_save(lane));
+      while (!lane.regions.empty() && lane.regions.back().first_save >= lane.saves.size()) {
+        lane.saved_pixel.resize(lane.regions.back().first_pixel);
+        lane.regions.pop_back();
+      }
+      lane.saved_rgba.resize(lane.saved_pixel.size());
+      lane.saved_id.resize(lane.saved_pixel.size());
     }
-    saved_rgba.resize(saved_pixel.size());
-    saved_id.resize(saved_pixel.size());
   }
 
-  // Where save s's pixels end: saves of one draw() call were filed front to back, so in drawing
-  // order a save's pixels run up to those of the save before it in the same call.
-  std::size_t save_end(std::size_t s) const {
-    std::size_t r = regions.size();
-    while (r > 0 && regions[r - 1].first_save > s) --r;
-    const SaveRegion& region = regions[r - 1];
-    const std::size_t region_end = r < regions.size() ? regions[r].first_pixel : saved_pixel.size();
-    return s > region.first_save ? saves[s - 1].offset : region_end;
+  // Where save s of a lane's pixels end: saves of one draw() call were filed front to back, so in
+  // drawing order a save's pixels run up to those of the save before it in the same call.
+  static std::size_t save_end(const Lane& lane, std::size_t s) {
+    std::size_t r = lane.regions.size();
+    while (r > 0 && lane.regions[r - 1].first_save > s) --r;
+    const SaveRegion& region = lane.regions[r - 1];
+    const std::size_t region_end = r < lane.regions.size() ? lane.regions[r].first_pixel : lane.saved_pixel.size();
+    return s > region.first_save ? lane.saves[s - 1].offset : region_end;
   }
 
   void forget() {
     for (std::uint32_t t : history) drawn_at[t] = kNone;
     history.clear();
-    saves.clear();
-    regions.clear();
-    saved_pixel.clear();
-    saved_rgba.clear();
-    saved_id.clear();
+    for (Lane& lane : lanes) lane = Lane{};
+  }
+
+  std::size_t saved_pixels() const {
+    std::size_t n = 0;
+    for (const Lane& lane : lanes) n += lane.saved_rgba.size();
+    return n;
+  }
+
+  std::size_t undo_bytes() const {
+    std::size_t bytes = (history.capacity() + drawn_at.capacity() + slot.capacity() + before_rgba.capacity() +
+                         before_id.capacity()) *
+                            sizeof(std::uint32_t) +
+                        (shown.capacity() + written.capacity()) * sizeof(std::uint64_t);
+    for (const Lane& lane : lanes)
+      bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
+                   sizeof(std::uint32_t) +
+               lane.saves.capacity() * sizeof(Save) + lane.regions.capacity() * sizeof(SaveRegion);
+    return bytes;
   }
 };
 
@@ -1175,15 +1245,8 @@ const Projector& TetRasterizer::projector() const { return impl_->proj; }
 double TetRasterizer::near_plane() const { return impl_->near; }
 void TetRasterizer::undraw(Framebuffer& fb, std::size_t count) { impl_->undraw(fb, count); }
 std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_->history; }
-std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_rgba.size(); }
-std::size_t TetRasterizer::undo_bytes() const {
-  const Impl& m = *impl_;
-  return (m.saved_pixel.capacity() + m.saved_rgba.capacity() + m.saved_id.capacity() + m.history.capacity() +
-          m.drawn_at.capacity() + m.slot.capacity() + m.before_rgba.capacity() + m.before_id.capacity()) *
-             sizeof(std::uint32_t) +
-         (m.shown.capacity() + m.written.capacity()) * sizeof(std::uint64_t) + m.saves.capacity() * sizeof(Impl::Save) +
-         m.regions.capacity() * sizeof(Impl::SaveRegion);
-}
+std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_pixels(); }
+std::size_t TetRasterizer::undo_bytes() const { return impl_->undo_bytes(); }
 void TetRasterizer::forget_drawn() { impl_->forget(); }
 
 Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
