@@ -965,6 +965,14 @@ struct TetRasterizer::Impl {
       for (std::size_t i = begin; i < end; ++i) {
         if (i + kAhead < end) prefetch_tet(tets[i + kAhead]);
         if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 2 * kAhead])]);
+        if (recording) {  // has_unshared_back_face reads the tet's neighbours and their positions
+          if (i + 2 * kAhead < end) __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
+          if (i + kAhead < end) {
+            const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(tets[i + kAhead])];
+            for (int f = 0; f < 4; ++f)
+              if (nb[f] != kNone) __builtin_prefetch(&drawn_at[nb[f] >> 2]);
+          }
+        }
         boxes[i] = tet_box(tets[i], fb.width, fb.height);
         if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i]);
       }
