@@ -534,18 +534,20 @@ struct TetRasterizer::Impl {
   void record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
     const std::size_t row = std::size_t(y) * std::size_t(fb.width);
     std::uint64_t* shown_row = &shown[std::size_t(y) * std::size_t(mask_words)];
-    auto is_shown = [&](int x) { return (shown_row[x >> 6] >> (x & 63)) & 1; };
     for (int x = lo; x <= hi;) {
-      int e = x;
-      const bool was_shown = is_shown(x);
-      while (e + 1 <= hi && is_shown(e + 1) == was_shown) ++e;
+      // The run of pixels from x with x's shown bit, within x's mask word (a word of bits at a time).
+      const std::uint64_t bits = shown_row[x >> 6] >> (x & 63);
+      const bool was_shown = bits & 1;
+      const std::uint64_t change = was_shown ? ~bits : bits;
+      const int left = 64 - (x & 63);
+      const int e = std::min(hi, x + (change == 0 ? left : std::min(left, std::countr_zero(change))) - 1);
       if (!was_shown) {
         std::copy_n(fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
                     before_rgba.begin() + std::ptrdiff_t(row + std::size_t(x)));
         std::copy_n(fb.id.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
                     before_id.begin() + std::ptrdiff_t(row + std::size_t(x)));
         shade_span(fb, fs, y, x, e);
-        for (int k = x; k <= e; ++k) shown_row[k >> 6] |= std::uint64_t(1) << (k & 63);
+        shown_row[x >> 6] |= (~std::uint64_t(0) >> (63 - (e - x))) << (x & 63);  // [x, e] in one word
       } else {
         Lane& lane = lanes[std::size_t(lane_of(y))];
         for (int k = x; k <= e; ++k) {
