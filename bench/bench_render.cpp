@@ -10,7 +10,9 @@
 //   undraw_front10    (after an untimed undoable draw of all tets) undraw the front 10% of the order
 //                     in 10 frames of 1%, each frame copied out as a display would; counters
 //                     ms_per_frame (issue 4 target: at most a fifth of painter_draw, the cost of
-//                     redrawing that frame from scratch), tets_per_s (tets undrawn), undo_MB
+//                     redrawing that frame from scratch), tets_per_s (tets undrawn), undo_MB,
+//                     px_per_frame (pixels a frame changes, counted untimed: the work a frame must do)
+// Times are process CPU time (all threads) and real time.
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-5 (~100k tets) and a4e-6 (~0.97M tets). The camera
 // is fitted to the box from an oblique direction (the mesh fills about 90% of the image height) and
 // turns by 7 degrees per iteration, so no frame repeats.
@@ -93,8 +95,8 @@ void run_undo(benchmark::State& state, bool undraw) {
   Case& c = get_case(int(state.range(0)));
   RenderParams params;
   params.undoable = true;
-  Framebuffer fb(kWidth, kHeight), shown(kWidth, kHeight);
-  std::size_t i = 0, undo_bytes = 0;
+  Framebuffer fb(kWidth, kHeight), shown(kWidth, kHeight), before(kWidth, kHeight);
+  std::size_t i = 0, undo_bytes = 0, changed = 0;
   double undraw_ms = 0;
   std::vector<std::uint32_t> order;
   constexpr int kFrames = 10;
@@ -108,13 +110,23 @@ void run_undo(benchmark::State& state, bool undraw) {
       r->draw(fb, order);
       undo_bytes = r->undo_bytes();
       const std::size_t step = order.size() / 100;
+      before.id = fb.id;
+      before.rgba = fb.rgba;
       state.ResumeTiming();
-      const auto t0 = std::chrono::steady_clock::now();
+      auto t0 = std::chrono::steady_clock::now();
+      double frame_ms = 0;
       for (int f = 0; f < kFrames; ++f) {
         r->undraw(fb, step);
         std::copy(fb.rgba.begin(), fb.rgba.end(), shown.rgba.begin());  // the frame shown
+        frame_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        state.PauseTiming();  // how many pixels the frame changed (colour or id)
+        for (std::size_t p = 0; p < fb.id.size(); ++p) changed += fb.id[p] != before.id[p] || fb.rgba[p] != before.rgba[p];
+        before.id = fb.id;
+        before.rgba = fb.rgba;
+        state.ResumeTiming();
+        t0 = std::chrono::steady_clock::now();
       }
-      undraw_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      undraw_ms += frame_ms;
       benchmark::DoNotOptimize(shown.rgba.data());
       state.PauseTiming();
       r.reset();  // freeing the saved pixels is not part of undrawing
@@ -134,6 +146,7 @@ void run_undo(benchmark::State& state, bool undraw) {
     state.counters["tets"] = undrawn;
     state.counters["tets_per_s"] = benchmark::Counter(undrawn, benchmark::Counter::kIsIterationInvariantRate);
     state.counters["ms_per_frame"] = undraw_ms / double(state.iterations() * kFrames);
+    state.counters["px_per_frame"] = double(changed) / double(state.iterations() * kFrames);
   }
 }
 
