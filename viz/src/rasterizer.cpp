@@ -434,17 +434,22 @@ struct TetRasterizer::Impl {
   // The colour of a face at pixel (x, y): flat, darkened near its edges.
   std::uint32_t face_color(const FaceSetup& fs, int x, int y) const {
     const double sx = x + 0.5, sy = y + 0.5;
-    std::uint32_t col = fs.color;
-    if (fs.lines > 0) {
-      double d = 1e300;
-      for (int k = 0; k < fs.lines; ++k) d = std::min(d, fs.la[k] * sx + fs.lb[k] * sy + fs.lc[k]);
-      if (d < params.edge_width) {
-        float f = float(1 - params.edge_darkness * (1 - std::max(0.0, d) / params.edge_width));
-        col = pack_rgba(std::uint32_t(fs.r * f + 0.5f), std::uint32_t(fs.g * f + 0.5f),
-                        std::uint32_t(fs.b * f + 0.5f));
-      }
-    }
-    return col;
+    double d = 1e300;
+    for (int k = 0; k < fs.lines; ++k) d = std::min(d, edge_distance(fs, k, sx, sy));
+    return darkened(fs, d);
+  }
+
+  // Distance in pixels from pixel centre (sx, sy) to the face's edge line k (one expression, so that
+  // every caller gets the same bits).
+  static double edge_distance(const FaceSetup& fs, int k, double sx, double sy) {
+    return fs.la[k] * sx + fs.lb[k] * sy + fs.lc[k];
+  }
+
+  // The face's colour at distance d from its nearest edge line.
+  std::uint32_t darkened(const FaceSetup& fs, double d) const {
+    if (!(d < params.edge_width)) return fs.color;
+    float f = float(1 - params.edge_darkness * (1 - std::max(0.0, d) / params.edge_width));
+    return pack_rgba(std::uint32_t(fs.r * f + 0.5f), std::uint32_t(fs.g * f + 0.5f), std::uint32_t(fs.b * f + 0.5f));
   }
 
   // True if every pixel x in [lo, hi] of row y is already written (lo <= hi, inside the image).
@@ -580,7 +585,7 @@ struct TetRasterizer::Impl {
       return;
     }
     const double sy = y + 0.5, w = params.edge_width;
-    int s[4], e[4], m = 0;
+    int s[4], e[4], line[4], m = 0;
     for (int k = 0; k < fs.lines; ++k) {
       // d(x) = la (x + 0.5) + base; dark where d < w.
       const double la = fs.la[k], base = fs.lb[k] * sy + fs.lc[k];
@@ -604,14 +609,25 @@ struct TetRasterizer::Impl {
       for (; i > 0 && s[i - 1] > a; --i) {
         s[i] = s[i - 1];
         e[i] = e[i - 1];
+        line[i] = line[i - 1];
       }
       s[i] = a;
       e[i] = b;
+      line[i] = k;
     }
+    // A pixel outside line k's interval is at least edge_width from it, so the lines whose
+    // intervals hold the pixel give face_color's nearest-line distance whenever it darkens.
     int x = lo;
     for (int i = 0; i < m; ++i) {
       fill(x, s[i] - 1);
-      for (int p = std::max(x, s[i]); p <= e[i]; ++p) shade_pixel(fb, fs, p, y);
+      for (int p = std::max(x, s[i]); p <= e[i]; ++p) {
+        const double sx = p + 0.5;
+        double d = 1e300;
+        for (int j = i; j < m && s[j] <= p; ++j)
+          if (p <= e[j]) d = std::min(d, edge_distance(fs, line[j], sx, sy));
+        fb.rgba[row + std::size_t(p)] = darkened(fs, d);
+        fb.id[row + std::size_t(p)] = fs.tet;
+      }
       x = std::max(x, e[i] + 1);
     }
     fill(x, hi);
