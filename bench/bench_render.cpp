@@ -5,11 +5,21 @@
 //   painter_frame     painter_draw plus computing the visibility order for the view
 //   painter_shrink    painter_draw with every tet shrunk to 0.8 (all faces of all tets visible somewhere)
 //   painter_draw_1thread  painter_draw on one thread (the threading baseline)
+//   painter_draw_undoable painter_draw recording what undraw needs (saved pixels of unshared back
+//                     faces); counter undo_MB = memory held for undraw after the whole mesh is drawn
+//   undraw_front10    (after an untimed undoable draw of all tets) undraw the front 10% of the order
+//                     in 10 frames of 1%, each frame copied out as a display would; counters
+//                     ms_per_frame (issue 4 target: at most a fifth of painter_draw, the cost of
+//                     redrawing that frame from scratch), tets_per_s (tets undrawn), undo_MB,
+//                     px_per_frame (pixels a frame changes, counted untimed: the work a frame must do)
+// Times are process CPU time (all threads) and real time.
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-5 (~100k tets) and a4e-6 (~0.97M tets). The camera
 // is fitted to the box from an oblique direction (the mesh fills about 90% of the image height) and
 // turns by 7 degrees per iteration, so no frame repeats.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <memory>
 
 #include "bench_meshes.hpp"
@@ -80,7 +90,69 @@ void run(benchmark::State& state, bool depth, bool with_order, double shrink, in
   counters(state, c);
 }
 
+// The whole order drawn undoably (timed or not), then (undraw) the front 10% undrawn in 10 frames.
+void run_undo(benchmark::State& state, bool undraw) {
+  Case& c = get_case(int(state.range(0)));
+  RenderParams params;
+  params.undoable = true;
+  Framebuffer fb(kWidth, kHeight), shown(kWidth, kHeight), before(kWidth, kHeight);
+  std::size_t i = 0, undo_bytes = 0, changed = 0;
+  double undraw_ms = 0;
+  std::vector<std::uint32_t> order;
+  constexpr int kFrames = 10;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const Camera cam = orbit(c.camera, 7.0 * double(i++), 0);
+    order = visibility_order(c.mesh, c.table, view_of(cam));
+    fb.clear();
+    if (undraw) {
+      auto r = std::make_unique<TetRasterizer>(c.mesh, cam, kWidth, kHeight, params);
+      r->draw(fb, order);
+      undo_bytes = r->undo_bytes();
+      const std::size_t step = order.size() / 100;
+      before.id = fb.id;
+      before.rgba = fb.rgba;
+      state.ResumeTiming();
+      auto t0 = std::chrono::steady_clock::now();
+      double frame_ms = 0;
+      for (int f = 0; f < kFrames; ++f) {
+        r->undraw(fb, step);
+        std::copy(fb.rgba.begin(), fb.rgba.end(), shown.rgba.begin());  // the frame shown
+        frame_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        state.PauseTiming();  // how many pixels the frame changed (colour or id)
+        for (std::size_t p = 0; p < fb.id.size(); ++p) changed += fb.id[p] != before.id[p] || fb.rgba[p] != before.rgba[p];
+        before.id = fb.id;
+        before.rgba = fb.rgba;
+        state.ResumeTiming();
+        t0 = std::chrono::steady_clock::now();
+      }
+      undraw_ms += frame_ms;
+      benchmark::DoNotOptimize(shown.rgba.data());
+      state.PauseTiming();
+      r.reset();  // freeing the saved pixels is not part of undrawing
+      state.ResumeTiming();
+    } else {
+      state.ResumeTiming();
+      TetRasterizer r(c.mesh, cam, kWidth, kHeight, params);
+      r.draw(fb, order);
+      undo_bytes = r.undo_bytes();
+      benchmark::DoNotOptimize(fb.rgba.data());
+    }
+  }
+  counters(state, c);
+  state.counters["undo_MB"] = double(undo_bytes) / 1e6;
+  if (undraw) {
+    const double undrawn = double(kFrames * (order.size() / 100));
+    state.counters["tets"] = undrawn;
+    state.counters["tets_per_s"] = benchmark::Counter(undrawn, benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["ms_per_frame"] = undraw_ms / double(state.iterations() * kFrames);
+    state.counters["px_per_frame"] = double(changed) / double(state.iterations() * kFrames);
+  }
+}
+
 void BM_painter_draw(benchmark::State& state) { run(state, false, false, 1); }
+void BM_painter_draw_undoable(benchmark::State& state) { run_undo(state, false); }
+void BM_undraw_front10(benchmark::State& state) { run_undo(state, true); }
 void BM_zbuffer_draw(benchmark::State& state) { run(state, true, false, 1); }
 void BM_painter_frame(benchmark::State& state) { run(state, false, true, 1); }
 void BM_painter_shrink(benchmark::State& state) { run(state, false, false, 0.8); }
@@ -88,10 +160,12 @@ void BM_painter_draw_1thread(benchmark::State& state) { run(state, false, false,
 
 }  // namespace
 
-BENCHMARK(BM_painter_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_zbuffer_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_painter_frame)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_painter_shrink)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_painter_draw_1thread)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_painter_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_zbuffer_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_painter_frame)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_painter_shrink)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_painter_draw_1thread)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_painter_draw_undoable)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_undraw_front10)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 BENCHMARK_MAIN();

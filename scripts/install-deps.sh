@@ -13,6 +13,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev xvfb xdotool x11-apps
   # outside programs the tests use as oracles
   gmsh tetgen calculix-ccx python3-meshio python3-numpy
+  # optional: foxi movie writes MP4 through it, and the movie tests decode APNG/GIF/MP4 with it
+  ffmpeg
 )
 
 missing=()

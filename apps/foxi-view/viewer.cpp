@@ -81,6 +81,7 @@ Viewer::Viewer(const Mesh& mesh, const Camera& camera, int width, int height, co
   delaunay_ = delaunay_certificate(mesh).delaunay;
   table_ = compute_spheres(mesh);
   params_.depth_buffer = !delaunay_;
+  params_.undoable = delaunay_;  // the painter can undraw
   fb_.resize(width_, height_, params_.depth_buffer);
 }
 
@@ -106,7 +107,9 @@ void Viewer::begin_draw() {
     mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
   fb_.resize(width_, height_, params_.depth_buffer);
   drawn_.clear();
+  handed_.clear();
   done_ = false;
+  undrawing_ = false;
   started_ = true;
   ++generation_;
   frame_ms_ = ms_since(t0);  // ordering set-up (MPVO: the whole order) counts
@@ -115,11 +118,22 @@ void Viewer::begin_draw() {
 void Viewer::restart() { begin_draw(); }
 
 bool Viewer::step() {
-  if (done_) return false;
   const auto t0 = std::chrono::steady_clock::now();
+  if (undrawing_) {
+    const std::size_t n = undraw(std::max<std::size_t>(1, total() / 64));
+    step_ms_ = ms_since(t0);
+    frame_ms_ += step_ms_;
+    return n > 0;
+  }
+  if (done_) return false;
   std::span<const std::uint32_t> batch;
-  if (order_) {
+  if (drawn_.size() < handed_.size()) {  // drawing on after an undraw: the order is known
+    const std::size_t n = std::min(handed_.size() - drawn_.size(), std::max<std::size_t>(1, total() / 64));
+    batch = std::span<const std::uint32_t>(handed_).subspan(drawn_.size(), n);
+  } else if (order_) {
     batch = order_->next();
+    handed_.insert(handed_.end(), batch.begin(), batch.end());
+    batch = std::span<const std::uint32_t>(handed_).last(batch.size());
   } else {
     std::size_t n = std::min(mpvo_.size() - mpvo_pos_, std::max(kMpvoChunk, mpvo_.size() / 64));
     batch = std::span<const std::uint32_t>(mpvo_).subspan(mpvo_pos_, n);
@@ -127,17 +141,34 @@ bool Viewer::step() {
   }
   if (batch.empty()) {
     done_ = true;
-    frame_ms_ += ms_since(t0);
+    step_ms_ = ms_since(t0);
+    frame_ms_ += step_ms_;
     return false;
   }
   raster_->draw(fb_, batch);
   drawn_.insert(drawn_.end(), batch.begin(), batch.end());
-  frame_ms_ += ms_since(t0);
+  step_ms_ = ms_since(t0);
+  frame_ms_ += step_ms_;
   if (drawn_.size() >= total()) {
     done_ = true;
     order_.reset();  // stops its sorting thread
   }
   return true;
+}
+
+bool Viewer::set_undrawing(bool on) {
+  if (on && !params_.undoable) return false;
+  undrawing_ = on;
+  return true;
+}
+
+std::size_t Viewer::undraw(std::size_t count) {
+  if (!params_.undoable || !raster_) return 0;
+  const std::size_t n = std::min(count, drawn_.size());
+  raster_->undraw(fb_, n);
+  drawn_.resize(drawn_.size() - n);
+  if (n > 0) done_ = false;
+  return n;
 }
 
 void Viewer::finish() {
@@ -190,9 +221,10 @@ void Viewer::resize(int width, int height) {
 std::string Viewer::status() const {
   char buf[256];
   const std::size_t n = drawn_.size(), t = total();
-  std::snprintf(buf, sizeof buf, "%s %zu / %zu tets (%.1f%%), %.1f ms%s, region %zu%s",
-                done_ ? "drawn" : "drawing", n, t, t ? 100.0 * double(n) / double(t) : 0.0, frame_ms_,
-                started_ && !done_ && !running_ ? " [stopped]" : "", stack_.size(),
+  const char* state = undrawing_ ? (n == 0 ? "undrawn" : "undrawing") : done_ ? "drawn" : "drawing";
+  std::snprintf(buf, sizeof buf, "%s %zu / %zu tets (%.1f%%), %.1f ms, %.2f ms/frame%s, region %zu%s", state, n,
+                t, t ? 100.0 * double(n) / double(t) : 0.0, frame_ms_, step_ms_,
+                started_ && !running_ && (undrawing_ ? n > 0 : !done_) ? " [stopped]" : "", stack_.size(),
                 delaunay_ ? "" : "  NOT Delaunay: depth-buffer drawing");
   return buf;
 }
@@ -261,7 +293,18 @@ void run_script(Viewer& viewer, const std::string& script, const std::string& pr
     } else if (cmd == "n") {
       viewer.step();
     } else if (cmd == "f") {
+      viewer.set_undrawing(false);
       viewer.finish();
+    } else if (name == "u") {
+      if (!viewer.set_undrawing(true)) throw std::invalid_argument("script: 'u' needs the painter (a Delaunay mesh)");
+      if (arg.empty()) {
+        while (viewer.step()) {
+        }
+      } else {
+        const double k = args(1)[0];
+        if (!(k >= 0 && k == std::floor(k))) throw std::invalid_argument("u:N takes a whole number of tets");
+        viewer.undraw(std::size_t(k));
+      }
     } else if (cmd == "r") {
       if (!viewer.push_region()) throw std::invalid_argument("script: 'r' with no tets drawn");
     } else if (cmd == "b") {
@@ -280,7 +323,7 @@ void run_script(Viewer& viewer, const std::string& script, const std::string& pr
       viewer.pan(v[0], v[1]);
     } else {
       throw std::invalid_argument("unknown script command '" + cmd +
-                                  "' (d c n f r b s orbit:Y,P zoom:F pan:X,Y)");
+                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y)");
     }
   }
 }

@@ -32,15 +32,23 @@ class Viewer {
 
   // 'd': a new draw of the displayed set from the back, for the current camera (picture cleared).
   void restart();
-  // Draws the next batch of the order; returns false (nothing drawn) when the draw is complete.
+  // Draws the next batch of the order (undrawing: takes back the front-most chunk, 1/64 of the
+  // displayed set); returns false (nothing changed) when there is nothing left to do that way.
   bool step();
   // Draws all remaining batches.
   void finish();
   bool done() const { return done_; }
 
   // Space: the front end keeps stepping while running.
-  bool running() const { return running_ && !done_; }
+  bool running() const { return running_ && (undrawing_ ? !drawn_.empty() : !done_); }
   void set_running(bool on) { running_ = on; }
+  // 'u': undraw (front to back, the seed paper's undraw: each frame equals drawing fewer tets from
+  // scratch) or, set to false, draw on again from where the undraw stopped. Returns false (nothing
+  // changes) for meshes drawn with the depth buffer, which cannot undraw.
+  bool set_undrawing(bool on);
+  bool undrawing() const { return undrawing_; }
+  // Undraws up to `count` tets at once (the script's u:N); returns how many.
+  std::size_t undraw(std::size_t count);
 
   // 'r': the tets drawn so far become the displayed set (pushed on the stack), redrawn from the back.
   // Returns false (nothing changes) when no tet has been drawn.
@@ -64,10 +72,13 @@ class Viewer {
   bool delaunay() const { return delaunay_; }
   // Milliseconds spent on the current draw so far (ordering and drawing; time stopped not counted).
   double frame_ms() const { return frame_ms_; }
+  // Milliseconds of the last step (one frame of the progressive draw or undraw).
+  double step_ms() const { return step_ms_; }
   // Counts draws started (restart, camera moves, regions); a front end reports each completed draw once.
   std::size_t generation() const { return generation_; }
   const Mesh& mesh() const { return mesh_; }
-  // "drawn 1234 / 5000 tets (24.7%), 12.3 ms, region 1, ..." for the status line.
+  // "drawn 1234 / 5000 tets (24.7%), 12.3 ms, 0.8 ms/frame, region 1, ..." for the status line
+  // (first word drawing, drawn, undrawing or undrawn).
   std::string status() const;
   // The camera as foxi render options (--eye/--at/--up/--fov or --dir), exact (%.17g).
   std::string camera_options() const;
@@ -90,9 +101,10 @@ class Viewer {
   std::size_t mpvo_pos_ = 0;
   std::unique_ptr<TetRasterizer> raster_;
   Framebuffer fb_;
-  std::vector<std::uint32_t> drawn_;
-  bool done_ = true, running_ = true, started_ = false;
-  double frame_ms_ = 0;
+  std::vector<std::uint32_t> drawn_;    // the prefix of handed_ on the screen
+  std::vector<std::uint32_t> handed_;   // the order as far as it has been handed out
+  bool done_ = true, running_ = true, started_ = false, undrawing_ = false;
+  double frame_ms_ = 0, step_ms_ = 0;
   std::size_t generation_ = 0;
 };
 

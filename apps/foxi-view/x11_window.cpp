@@ -181,7 +181,8 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
   Screen& screen = *screen_holder;
 
   std::printf(
-      "foxi-view: %zu tets, %s, %s; keys: d draw, space stop/continue, n step, r region, b back, s save, "
+      "foxi-view: %zu tets, %s, %s; keys: d draw, space stop/continue, n step, u undraw/draw on, r region, "
+      "b back, s save, "
       "q quit; mouse: left orbit, right/wheel zoom, middle pan\n",
       viewer.mesh().tet_count(),
       viewer.delaunay() ? "Delaunay (painter, no depth buffer)" : "NOT Delaunay (depth-buffer drawing)",
@@ -210,6 +211,7 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
   viewer.restart();
   bool quit = false, mapped = false;
   std::size_t reported = 0;  // the generation whose completion was last reported
+  bool was_done = false, was_undrawn = false;
   int button = 0, last_x = 0, last_y = 0;
   while (!quit) {
     bool changed = false;
@@ -286,6 +288,9 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
               viewer.restart();
               viewer.set_running(true);
               break;
+            case XK_u:
+              if (viewer.set_undrawing(!viewer.undrawing())) viewer.set_running(true);
+              break;
             case XK_space:
               viewer.set_running(!viewer.running());
               break;
@@ -321,11 +326,21 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
       viewer.step();
       changed = true;
     }
-    if (viewer.done() && reported != viewer.generation()) {
+    // "done" once per completed draw (again after an undraw and a draw on), "undrawn" once per
+    // complete undraw.
+    if (viewer.done() && (reported != viewer.generation() || !was_done)) {
       reported = viewer.generation();
       report_done();
       changed = true;
     }
+    was_done = viewer.done();
+    const bool undrawn = viewer.undrawing() && viewer.drawn().empty();
+    if (undrawn && !was_undrawn) {
+      std::printf("undrawn %s\n", viewer.status().c_str());
+      std::fflush(stdout);
+      changed = true;
+    }
+    was_undrawn = undrawn;
     if (changed && mapped) show();
     if (!viewer.running() || !mapped) {
       // Idle: sleep until the next event.

@@ -44,6 +44,7 @@ int cmd_convert(Args args);
 int cmd_order(Args args);
 int cmd_mesh(Args args);
 int cmd_render(Args args);
+int cmd_movie(Args args);
 int cmd_solve(Args args);
 int cmd_model(Args args);
 int cmd_demo(Args args);

@@ -3,13 +3,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
+#include "render_options.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/depth_stop.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
@@ -19,30 +22,21 @@ namespace foxi::cli {
 
 namespace {
 
-const char* kRenderUsage =
+const std::string kRenderUsage = std::string(
     "foxi render MESH [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z] [--size WxH]\n"
-    "                 [--stop P%] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges] -o OUT.png\n"
+    "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges] -o OUT.png\n"
     "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
-    "  faces flat-shaded in its region's colour with the mesh edges darkened (no depth buffer).\n"
-    "  --eye/--at/--up/--fov  a perspective camera (the eye may be inside the mesh); missing parts\n"
-    "                  are fitted: --at defaults to the centre of the bounding box, the eye to an\n"
-    "                  oblique view of the whole mesh, --up to +z, --fov to 30 degrees\n"
-    "  --dir x,y,z     an orthographic view along this direction, fitted to the mesh\n"
-    "  --size WxH      image size in pixels (default 1280x960)\n"
+    "  faces flat-shaded in its region's colour with the mesh edges darkened (no depth buffer).\n") +
+    kPictureOptionsHelp +
+    "  (--size defaults to 1280x960)\n"
     "  --stop P%       draw only the first P percent of the back-to-front order (the far part)\n"
+    "  --depth d       stop at the first tet whose power distance from the eye, sqrt(|eye-c|^2-r^2)\n"
+    "                  for its circumsphere (c, r), is below d (world units; the order decreases in\n"
+    "                  it); orthographic: the circumcentre's distance in front of the plane through\n"
+    "                  --at across the view. With --stop, whichever stops first\n"
     "  --zbuffer       draw with a depth buffer instead (the oracle; order irrelevant)\n"
-    "  --shrink f      scale each tet about its centroid by f in (0, 1] (e.g. 0.8)\n"
-    "  --regions a,b   draw only the tets of these region ids\n"
-    "  --no-edges      no mesh edges\n"
     "  Meshes that fail the Delaunay certificate have no guaranteed order: their picture is drawn\n"
     "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.";
-
-
-void triple(const std::string& s, const char* what, double out[3]) {
-  auto v = parse_numbers(s, what);
-  if (v.size() != 3) throw UsageError(std::string(what) + " takes x,y,z");
-  for (int k = 0; k < 3; ++k) out[k] = v[k];
-}
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -52,35 +46,17 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 
 int cmd_render(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
-    std::puts(kRenderUsage);
+    std::puts(kRenderUsage.c_str());
     return 0;
   }
-  const std::string eye_s = args.option("--eye"), at_s = args.option("--at"), up_s = args.option("--up");
-  const std::string fov_s = args.option("--fov"), dir_s = args.option("--dir");
-  const std::string size_s = args.option("--size", "1280x960"), stop_s = args.option("--stop");
-  const std::string shrink_s = args.option("--shrink", "1"), regions_s = args.option("--regions");
+  const std::string stop_s = args.option("--stop"), depth_s = args.option("--depth");
   std::string out = args.option("-o");
   if (out.empty()) out = args.option("--output");
-  const bool zbuffer = args.flag("--zbuffer"), no_edges = args.flag("--no-edges");
+  const bool zbuffer = args.flag("--zbuffer");
+  PictureOptions options = take_picture_options(args, "1280x960");
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
-  if (out.empty())
-    throw UsageError("give the output file with -o OUT.png\nusage: " + std::string(kRenderUsage));
-  if (!dir_s.empty() && (!eye_s.empty() || !fov_s.empty()))
-    throw UsageError("--dir (orthographic) cannot be combined with --eye or --fov");
-
-  int width = 0, height = 0;
-  {
-    std::size_t x = size_s.find('x');
-    char* e1 = nullptr;
-    char* e2 = nullptr;
-    std::string w = size_s.substr(0, x), h = x == std::string::npos ? "" : size_s.substr(x + 1);
-    long lw = std::strtol(w.c_str(), &e1, 10), lh = std::strtol(h.c_str(), &e2, 10);
-    if (x == std::string::npos || w.empty() || h.empty() || *e1 != 0 || *e2 != 0 || lw < 1 || lh < 1 ||
-        lw > 16384 || lh > 16384)
-      throw UsageError("--size takes WxH with 1 <= W, H <= 16384, not '" + size_s + "'");
-    width = int(lw);
-    height = int(lh);
-  }
+  if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
+  const int width = options.width, height = options.height;
   double stop = 1;
   if (!stop_s.empty()) {
     std::string s = stop_s;
@@ -91,63 +67,19 @@ int cmd_render(Args args) {
       throw UsageError("--stop takes a percentage 0..100, e.g. 40%");
     stop = p / 100;
   }
-  RenderParams params;
-  params.edges = !no_edges;
-  {
+  double depth_stop = -std::numeric_limits<double>::infinity();
+  if (!depth_s.empty()) {
     char* end = nullptr;
-    params.shrink = std::strtod(shrink_s.c_str(), &end);
-    if (*end != 0 || !(params.shrink > 0 && params.shrink <= 1))
-      throw UsageError("--shrink takes a factor in (0, 1]");
+    depth_stop = std::strtod(depth_s.c_str(), &end);
+    if (*end != 0 || !std::isfinite(depth_stop)) throw UsageError("--depth takes a distance, e.g. 0.5");
   }
+  RenderParams params = options.params;
 
   const Mesh mesh = read_mesh(path);
   if (mesh.tet_count() == 0) throw UsageError(path + " has no tets");
-  std::vector<std::uint32_t> subset;
-  if (!regions_s.empty()) {
-    auto ids = parse_numbers(regions_s, "--regions");
-    for (std::size_t t = 0; t < mesh.tet_count(); ++t)
-      for (double id : ids)
-        if (mesh.region_of(t) == static_cast<std::int32_t>(id)) {
-          subset.push_back(static_cast<std::uint32_t>(t));
-          break;
-        }
-    if (subset.empty()) throw UsageError("--regions " + regions_s + " selects no tets");
-  }
-
-  // The camera: given parts, the rest fitted to the bounds of what is drawn.
-  double lo[3], hi[3];
-  if (subset.empty()) {
-    mesh_bounds(mesh, lo, hi);
-  } else {
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = 1e300;
-      hi[k] = -1e300;
-    }
-    for (std::uint32_t t : subset)
-      for (int v = 0; v < 4; ++v)
-        for (int k = 0; k < 3; ++k) {
-          double x = mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + v]) + k];
-          lo[k] = std::min(lo[k], x);
-          hi[k] = std::max(hi[k], x);
-        }
-  }
-  const double aspect = double(width) / height;
-  double up[3], at[3], eye[3], dir[3];
-  if (!up_s.empty()) triple(up_s, "--up", up);
-  if (!at_s.empty()) triple(at_s, "--at", at);
-  if (!eye_s.empty()) triple(eye_s, "--eye", eye);
-  if (!dir_s.empty()) {
-    triple(dir_s, "--dir", dir);
-    if (dir[0] == 0 && dir[1] == 0 && dir[2] == 0) throw UsageError("--dir takes a nonzero x,y,z");
-  }
-  double fov = 0;
-  if (!fov_s.empty()) {
-    char* end = nullptr;
-    fov = std::strtod(fov_s.c_str(), &end);
-    if (*end != 0 || !(fov > 0 && fov < 180)) throw UsageError("--fov takes degrees in (0, 180)");
-  }
-  const Camera camera = camera_from_options(lo, hi, aspect, eye_s.empty() ? nullptr : eye, at_s.empty() ? nullptr : at,
-                                            up_s.empty() ? nullptr : up, fov, dir_s.empty() ? nullptr : dir);
+  const Picture picture = resolve_picture(options, mesh);
+  const std::vector<std::uint32_t>& subset = picture.subset;
+  const Camera& camera = picture.camera;
 
   auto t0 = std::chrono::steady_clock::now();
   const DelaunayCertificate& cert = delaunay_certificate(mesh);
@@ -164,8 +96,8 @@ int cmd_render(Args args) {
   else
     order = mpvo_order(mesh, table, view, subset, &cycles);
   const double order_ms = ms_since(t0);
-  const std::size_t count =
-      std::min(order.size(), std::size_t(std::floor(stop * double(order.size()) + 1e-9)));
+  std::size_t count = std::min(order.size(), std::size_t(std::floor(stop * double(order.size()) + 1e-9)));
+  if (!depth_s.empty()) count = std::min(count, count_deeper(table, camera, order, depth_stop));
 
   params.depth_buffer = zbuffer || !cert.delaunay;
   t0 = std::chrono::steady_clock::now();
@@ -194,6 +126,8 @@ int cmd_render(Args args) {
               count, order.size(), order.empty() ? 0.0 : 100.0 * double(count) / double(order.size()),
               params.depth_buffer ? "depth-buffer" : "painter", draw_ms, width, height,
               100.0 * double(covered) / double(fb.id.size()));
+  if (!depth_s.empty() && count > 0)
+    std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop, tet_depth(table, camera, order[count - 1]));
   if (raster.stats().tets_behind > 0) std::printf(", %zu tets behind the eye", raster.stats().tets_behind);
   std::printf("\nwrote       %s\n", out.c_str());
   return 0;

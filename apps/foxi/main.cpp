@@ -28,6 +28,7 @@ const char* kUsage =
     "                 capacitance matrix; current: resistance, Joule heat; thermoelastic:\n"
     "                 thermal stress, max von Mises and where; -o OUT.vtu\n"
     "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png\n"
+    "  movie MESH     draw/undraw back and forth, or turn the view: -o OUT.gif|.apng|.mp4|frames\n"
     "\n"
     "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"
     "              .node/.ele/.face (TetGen), .mesh (Medit)\n"
@@ -54,6 +55,7 @@ int main(int argc, char** argv) {
     if (command == "order") return foxi::cli::cmd_order(std::move(rest));
     if (command == "mesh") return foxi::cli::cmd_mesh(std::move(rest));
     if (command == "render") return foxi::cli::cmd_render(std::move(rest));
+    if (command == "movie") return foxi::cli::cmd_movie(std::move(rest));
     if (command == "solve") return foxi::cli::cmd_solve(std::move(rest));
     if (command == "model") return foxi::cli::cmd_model(std::move(rest));
     if (command == "demo") return foxi::cli::cmd_demo(std::move(rest));

@@ -119,6 +119,42 @@ TEST_F(ViewTest, ScriptDrawEqualsFoxiRender) {
   EXPECT_EQ(differing_pixels(read_png(dir_ / "o-001.png"), read_png(dir_ / "ro.png")), 0u);
 }
 
+// Undraw in the viewer's state machine: draw all, undraw 360 of the 720 tets, and the picture (and
+// the tets left) equal foxi render --stop 50% (another program, drawing them afresh); undraw all is
+// blank; drawing on after the undraw gives the whole picture again; a region taken after an undraw
+// is exactly the tets left.
+TEST_F(ViewTest, UndrawEqualsRenderingFewerTets) {
+  std::string out;
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --dump-ids --save " + q(dir_ / "u") +
+                           " --script 'd s u:360 s u s f s u:100 r s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("undrawing 360 / 720 tets (50.0%)"), std::string::npos) << out;
+  EXPECT_NE(out.find("undrawn 0 / 720 tets"), std::string::npos) << out;
+  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(mesh_path_) + " " + kSize + " --stop 50% -o " +
+                           q(dir_ / "half.png"),
+                       dir_ / "render.log", &out),
+            0)
+      << out;
+  const auto all = read_tets(dir_ / "u-001.tets");
+  ASSERT_EQ(all.size(), 720u);
+  const auto half = read_tets(dir_ / "u-002.tets");
+  EXPECT_EQ(half, std::vector<std::uint32_t>(all.begin(), all.begin() + 360));
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "u-002.png"), read_png(dir_ / "half.png")), 0u);
+  const auto blank_ids = read_ids(dir_ / "u-003.ids");
+  EXPECT_TRUE(std::all_of(blank_ids.begin(), blank_ids.end(), [](std::uint32_t id) { return id == kNone; }));
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "u-003.png"), Framebuffer(320, 240)), 0u);
+  EXPECT_EQ(read_tets(dir_ / "u-004.tets"), all);
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "u-004.png"), read_png(dir_ / "u-001.png")), 0u);
+  EXPECT_EQ(read_ids(dir_ / "u-004.ids"), read_ids(dir_ / "u-001.ids"));
+  // The region after undrawing 100: the first 620 tets of the order, nothing drawn yet.
+  const std::string log = test::read_text(dir_ / "view.log");
+  EXPECT_NE(log.find("drawing 0 / 620 tets"), std::string::npos) << log;
+  EXPECT_NE(log.find("region 1"), std::string::npos) << log;
+  EXPECT_NE(run_logged(q(view_path()) + " " + q(mesh_path_) + " --script 'u:x'", dir_ / "bad.log", &out), 0);
+}
+
 TEST_F(ViewTest, RegionOfInterestDrawsExactlyTheSubsetAndBackRestores) {
   std::string out;
   // Draw two batches, save, take them as the region, turn, draw the region, save; back up, draw, save.
@@ -230,7 +266,8 @@ bool read_xwd(const std::filesystem::path& path, Framebuffer& fb) {
   return true;
 }
 
-// The real window under Xvfb: keys sent with xdotool (d, wait for the draw, s, q). The PNG it saves
+// The real window under Xvfb: keys sent with xdotool (d, wait for the draw, s, u undraw all, s,
+// u draw on, s, q). The PNG it saves
 // equals the headless one, and so does a screenshot of the window above its status line.
 TEST_F(ViewTest, WindowUnderXvfbDrivenByXdotool) {
   if (!test::have_program("xvfb-run") || !test::have_program("xdotool"))
@@ -249,6 +286,14 @@ xdotool key --window "$wid" d
 wait_for '^done' 2 || exit 5
 xdotool key --window "$wid" s
 wait_for '^saved' 1 || exit 6
+xdotool key --window "$wid" u
+wait_for '^undrawn' 1 || exit 10
+xdotool key --window "$wid" s
+wait_for '^saved' 2 || exit 11
+xdotool key --window "$wid" u
+wait_for '^done' 3 || exit 12
+xdotool key --window "$wid" s
+wait_for '^saved' 3 || exit 13
 if command -v xwd > /dev/null; then xwd -silent -id "$wid" > "$D/shot.xwd" || exit 8; fi
 xdotool key --window "$wid" q 2>/dev/null
 i=0; while kill -0 $pid 2>/dev/null && [ $i -lt 50 ]; do sleep 0.1; i=$((i+1)); done
@@ -270,7 +315,7 @@ exit 0
   // Once with XShm (Xvfb has it), once with plain XPutImage.
   for (const std::string env : {"", "FOXI_VIEW_NO_SHM=1 "}) {
     SCOPED_TRACE(env.empty() ? "XShm" : "XPutImage");
-    std::filesystem::remove(dir_ / "x-001.png");
+    for (const char* name : {"x-001.png", "x-002.png", "x-003.png"}) std::filesystem::remove(dir_ / name);
     std::filesystem::remove(dir_ / "shot.xwd");
     const int status =
         run_logged(env + "timeout -k 5 40 xvfb-run -a -s '-screen 0 640x480x24' sh " + q(dir_ / "drive.sh") +
@@ -282,6 +327,10 @@ exit 0
     EXPECT_NE(log.find("done drawn 720 / 720 tets (100.0%)"), std::string::npos) << log;
     ASSERT_TRUE(std::filesystem::exists(dir_ / "x-001.png")) << log;
     EXPECT_EQ(differing_pixels(read_png(dir_ / "x-001.png"), headless), 0u);
+    // Key u undrew everything (blank), u again drew it all on.
+    EXPECT_NE(log.find("undrawn 0 / 720 tets"), std::string::npos) << log;
+    EXPECT_EQ(differing_pixels(read_png(dir_ / "x-002.png"), Framebuffer(320, 240)), 0u);
+    EXPECT_EQ(differing_pixels(read_png(dir_ / "x-003.png"), headless), 0u);
 
     if (!have_xwd) {
       std::printf("xwd is missing: the screenshot comparison is skipped\n");

@@ -68,6 +68,16 @@ inline Mesh grid_mesh(int nx, int ny, int nz, double hx, double hy, double hz, i
   return m;
 }
 
+// Three regions (materials 1, 2, 3) by the x of each tet's centroid: below x1, below x2, beyond.
+inline void regions_along_x(Mesh& m, double x1, double x2) {
+  m.tet_region.assign(m.tet_count(), 0);
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    double cx = 0;
+    for (int k = 0; k < 4; ++k) cx += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * t + k])];
+    m.tet_region[t] = cx < x1 ? 1 : cx < x2 ? 2 : 3;
+  }
+}
+
 // TetGen's Delaunay tetrahedralization of `n` random points in the box [0,sx]x[0,sy]x[0,sz]
 // (`tetgen` on a .node file, no PLC: the convex hull is meshed).
 inline Mesh random_delaunay(const TempDir& dir, int n, unsigned seed, double sx = 1, double sy = 1, double sz = 1) {

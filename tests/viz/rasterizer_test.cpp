@@ -17,6 +17,7 @@
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/visibility_order.hpp"
 #include "mesh_factory.hpp"
+#include "random_cameras.hpp"
 #include "test_util.hpp"
 
 namespace foxi {
@@ -24,32 +25,8 @@ namespace {
 
 constexpr int kW = 160, kH = 120;
 
-// Random cameras around and inside the mesh: perspective eyes outside (looking at the centre),
-// perspective eyes inside the bounding box (looking in a random direction), orthographic directions.
 std::vector<Camera> random_cameras(const Mesh& m, int n, unsigned seed) {
-  double lo[3], hi[3];
-  mesh_bounds(m, lo, hi);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(0, 1);
-  std::normal_distribution<double> g(0, 1);
-  std::vector<Camera> cams;
-  for (int i = 0; i < n; ++i) {
-    double d[3] = {g(rng), g(rng), g(rng)}, up[3] = {g(rng), g(rng), g(rng)};
-    if (i % 3 == 2) {
-      cams.push_back(fit_camera(lo, hi, d, up, false, 30, double(kW) / kH, 0.9));
-      continue;
-    }
-    Camera c = fit_camera(lo, hi, d, up, true, 20 + 40 * u(rng), double(kW) / kH, 0.9);
-    if (i % 3 == 1) {  // eye inside the box
-      for (int k = 0; k < 3; ++k) {
-        c.eye[k] = lo[k] + (0.1 + 0.8 * u(rng)) * (hi[k] - lo[k]);
-        c.at[k] = c.eye[k] + d[k];
-      }
-      c.fov_deg = 70;
-    }
-    cams.push_back(c);
-  }
-  return cams;
+  return test::random_cameras(m, n, seed, double(kW) / kH);
 }
 
 // Distance in pixels from (x, y) to the segment a-b.
@@ -253,13 +230,8 @@ TEST(Rasterizer, PainterEqualsDepthBufferOnGrids) {
 TEST(Rasterizer, PainterEqualsDepthBufferOnNonConvexSubsetsAndRegions) {
   test::TempDir dir;
   Mesh m = test::random_delaunay(dir, 1000, 21, 2, 1, 1);
-  m.tet_region.assign(m.tet_count(), 0);
-  // Regions by position (multi-material), then a random 40% of the tets (non-convex, holes).
-  for (std::size_t t = 0; t < m.tet_count(); ++t) {
-    double cx = 0;
-    for (int k = 0; k < 4; ++k) cx += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * t + k])];
-    m.tet_region[t] = cx < 0.7 ? 1 : cx < 1.3 ? 2 : 3;
-  }
+  // Regions by position (multi-material).
+  test::regions_along_x(m, 0.7, 1.3);
   std::mt19937 rng(4);
   std::vector<std::uint32_t> subset;
   for (std::uint32_t t = 0; t < m.tet_count(); ++t)

@@ -3,6 +3,8 @@
 // in fixed point with 8 subpixel bits and 64-bit edge functions.
 #include "foxi/viz/rasterizer.hpp"
 
+#include "foxi/model/adjacency.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -209,6 +211,43 @@ struct TetRasterizer::Impl {
   // Per band of 16 rows and mask word: 1 once all 16 x 64 pixels (those in the image) are known to
   // be written, so that a hidden tet costs a few byte tests (set lazily by box_written).
   std::vector<std::uint8_t> tile_full;
+  // Whether painter drawing tests and sets the mask (off while undraw repaints neighbours' faces).
+  bool use_mask = false;
+  // Undoable mode (params.undoable): the tets drawn so far in order, each tet's position in it
+  // (kNone if not drawn), and the undraw stack of saved pixels: per tet with an unshared back face,
+  // where its pixels start in saved_rgba / saved_id (the runs of those faces, in raster order).
+  const FaceAdjacency* adjacency = nullptr;
+  std::vector<std::uint32_t> history;
+  std::vector<std::uint32_t> drawn_at;
+  struct Save {
+    std::uint32_t at = 0;    // position in history
+    std::size_t offset = 0;  // first saved pixel (in its lane)
+  };
+  // Per draw() call: where its saves and saved pixels begin (a call's saves are freed together).
+  struct SaveRegion {
+    std::size_t first_save = 0, first_pixel = 0;
+  };
+  // The saved pixels live in lanes, one per thread of the band partition (lane k holds the pixels of
+  // the rows Rows{k, lane_count} owns, see lane_of), so that threads record and restore them
+  // independently. A tet's save is filed in each lane whose rows it touches.
+  struct Lane {
+    std::vector<Save> saves;                                        // in drawing order
+    std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;  // y * width + x, colour, id
+    std::vector<SaveRegion> regions;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> aliases;  // (request, later request it equals)
+  };
+  std::vector<Lane> lanes;
+  int lane_count = 1;
+  int lane_of(int y) const { return (y >> kBandShift) % lane_count; }
+  // Undoable drawing walks a batch front to back like the painter (see `written`, here "done"), so
+  // the value a tet's save needs, what was drawn before it, comes later in the walk: each saved
+  // pixel is a request (slot: its index in its lane, per pixel, kNone if none), answered by the next
+  // tet that covers the pixel, or at the end of the batch by what was there before the batch (fb, or
+  // `before` where the batch overwrote it). `shown`: pixels the batch has given their final value.
+  bool recording = false;
+  std::vector<std::uint64_t> shown;
+  std::vector<std::uint32_t> slot, before_rgba, before_id;
+  std::vector<std::uint8_t> need_save;  // per batch tet
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
       : mesh(&m), proj(c, w, h), params(p) {
@@ -219,6 +258,19 @@ struct TetRasterizer::Impl {
     if (!(params.edge_width > 0)) params.edges = false;
     reverse = !params.depth_buffer;
     mask_words = (w + 63) / 64;
+    use_mask = reverse;
+    if (params.undoable) {
+      if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
+      adjacency = &face_adjacency(m);
+      drawn_at.assign(m.tet_count(), kNone);
+      const std::size_t pixels = std::size_t(w) * std::size_t(h);
+      shown.assign(std::size_t(mask_words) * std::size_t(h), 0);
+      slot.assign(pixels, kNone);
+      before_rgba.assign(pixels, 0);
+      before_id.assign(pixels, 0);
+      lane_count = std::min(params.threads, std::max(1, h >> kBandShift));
+      lanes.resize(std::size_t(lane_count));
+    }
     double l[3] = {-0.3, 0.45, -1};
     double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
     for (int k = 0; k < 3; ++k) light[k] = l[k] / ln;
@@ -373,24 +425,34 @@ struct TetRasterizer::Impl {
 
   void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
     const std::size_t p = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
-    const double sx = x + 0.5, sy = y + 0.5;
     if (params.depth_buffer) {
-      const double z = fs.w0 + fs.da * (sx - fs.x0) + fs.db * (sy - fs.y0);
+      const double z = fs.w0 + fs.da * (x + 0.5 - fs.x0) + fs.db * (y + 0.5 - fs.y0);
       if (!(z > fb.depth[p])) return;
       fb.depth[p] = z;
     }
-    std::uint32_t col = fs.color;
-    if (fs.lines > 0) {
-      double d = 1e300;
-      for (int k = 0; k < fs.lines; ++k) d = std::min(d, fs.la[k] * sx + fs.lb[k] * sy + fs.lc[k]);
-      if (d < params.edge_width) {
-        float f = float(1 - params.edge_darkness * (1 - std::max(0.0, d) / params.edge_width));
-        col = pack_rgba(std::uint32_t(fs.r * f + 0.5f), std::uint32_t(fs.g * f + 0.5f),
-                        std::uint32_t(fs.b * f + 0.5f));
-      }
-    }
-    fb.rgba[p] = col;
+    fb.rgba[p] = face_color(fs, x, y);
     fb.id[p] = fs.tet;
+  }
+
+  // The colour of a face at pixel (x, y): flat, darkened near its edges.
+  std::uint32_t face_color(const FaceSetup& fs, int x, int y) const {
+    const double sx = x + 0.5, sy = y + 0.5;
+    double d = 1e300;
+    for (int k = 0; k < fs.lines; ++k) d = std::min(d, edge_distance(fs, k, sx, sy));
+    return darkened(fs, d);
+  }
+
+  // Distance in pixels from pixel centre (sx, sy) to the face's edge line k (one expression, so that
+  // every caller gets the same bits).
+  static double edge_distance(const FaceSetup& fs, int k, double sx, double sy) {
+    return fs.la[k] * sx + fs.lb[k] * sy + fs.lc[k];
+  }
+
+  // The face's colour at distance d from its nearest edge line.
+  std::uint32_t darkened(const FaceSetup& fs, double d) const {
+    if (!(d < params.edge_width)) return fs.color;
+    float f = float(1 - params.edge_darkness * (1 - std::max(0.0, d) / params.edge_width));
+    return pack_rgba(std::uint32_t(fs.r * f + 0.5f), std::uint32_t(fs.g * f + 0.5f), std::uint32_t(fs.b * f + 0.5f));
   }
 
   // True if every pixel x in [lo, hi] of row y is already written (lo <= hi, inside the image).
@@ -438,6 +500,10 @@ struct TetRasterizer::Impl {
       for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
       return;
     }
+    if (!use_mask) {
+      shade_span(fb, fs, y, lo, hi);
+      return;
+    }
     std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
     const int w0 = lo >> 6, w1 = hi >> 6;
     int x = lo;
@@ -454,7 +520,10 @@ struct TetRasterizer::Impl {
       std::uint64_t set = row[w] & (~std::uint64_t(0) << (a & 63));
       while (set == 0 && w < w1) set = row[++w];
       const int b = set == 0 ? hi + 1 : std::min(hi + 1, (w << 6) + std::countr_zero(set));
-      shade_span(fb, fs, y, a, b - 1);
+      if (recording)
+        record_span(fb, fs, y, a, b - 1);
+      else
+        shade_span(fb, fs, y, a, b - 1);
       x = b;
     }
     const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
@@ -464,6 +533,40 @@ struct TetRasterizer::Impl {
       row[w0] |= m0;
       for (int w = w0 + 1; w < w1; ++w) row[w] = ~std::uint64_t(0);
       row[w1] |= m1;
+    }
+  }
+
+  // Undoable drawing, a run of pixels not done in this batch: those not yet shown get the face
+  // (their previous contents kept in `before`), the others hold undraw requests of tets drawn later
+  // (nearer) whose unshared back faces cover them: this face is what lay behind, their saved value.
+  void record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
+    const std::size_t row = std::size_t(y) * std::size_t(fb.width);
+    std::uint64_t* shown_row = &shown[std::size_t(y) * std::size_t(mask_words)];
+    for (int x = lo; x <= hi;) {
+      // The run of pixels from x with x's shown bit, within x's mask word (a word of bits at a time).
+      const std::uint64_t bits = shown_row[x >> 6] >> (x & 63);
+      const bool was_shown = bits & 1;
+      const std::uint64_t change = was_shown ? ~bits : bits;
+      const int left = 64 - (x & 63);
+      const int e = std::min(hi, x + (change == 0 ? left : std::min(left, std::countr_zero(change))) - 1);
+      if (!was_shown) {
+        std::copy_n(fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
+                    before_rgba.begin() + std::ptrdiff_t(row + std::size_t(x)));
+        std::copy_n(fb.id.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
+                    before_id.begin() + std::ptrdiff_t(row + std::size_t(x)));
+        shade_span(fb, fs, y, x, e);
+        shown_row[x >> 6] |= (~std::uint64_t(0) >> (63 - (e - x))) << (x & 63);  // [x, e] in one word
+      } else {
+        Lane& lane = lanes[std::size_t(lane_of(y))];
+        for (int k = x; k <= e; ++k) {
+          std::uint32_t& request = slot[row + std::size_t(k)];
+          if (request == kNone) continue;  // cannot happen: shown and not done means a request
+          lane.saved_rgba[request] = face_color(fs, k, y);
+          lane.saved_id[request] = fs.tet;
+          request = kNone;
+        }
+      }
+      x = e + 1;
     }
   }
 
@@ -485,7 +588,7 @@ struct TetRasterizer::Impl {
       return;
     }
     const double sy = y + 0.5, w = params.edge_width;
-    int s[4], e[4], m = 0;
+    int s[4], e[4], line[4], m = 0;
     for (int k = 0; k < fs.lines; ++k) {
       // d(x) = la (x + 0.5) + base; dark where d < w.
       const double la = fs.la[k], base = fs.lb[k] * sy + fs.lc[k];
@@ -509,14 +612,25 @@ struct TetRasterizer::Impl {
       for (; i > 0 && s[i - 1] > a; --i) {
         s[i] = s[i - 1];
         e[i] = e[i - 1];
+        line[i] = line[i - 1];
       }
       s[i] = a;
       e[i] = b;
+      line[i] = k;
     }
+    // A pixel outside line k's interval is at least edge_width from it, so the lines whose
+    // intervals hold the pixel give face_color's nearest-line distance whenever it darkens.
     int x = lo;
     for (int i = 0; i < m; ++i) {
       fill(x, s[i] - 1);
-      for (int p = std::max(x, s[i]); p <= e[i]; ++p) shade_pixel(fb, fs, p, y);
+      for (int p = std::max(x, s[i]); p <= e[i]; ++p) {
+        const double sx = p + 0.5;
+        double d = 1e300;
+        for (int j = i; j < m && s[j] <= p; ++j)
+          if (p <= e[j]) d = std::min(d, edge_distance(fs, line[j], sx, sy));
+        fb.rgba[row + std::size_t(p)] = darkened(fs, d);
+        fb.id[row + std::size_t(p)] = fs.tet;
+      }
       x = std::max(x, e[i] + 1);
     }
     fill(x, hi);
@@ -615,14 +729,137 @@ struct TetRasterizer::Impl {
     }
   }
 
-  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
-    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
-    const double* c[4];
-    double local[12];
-    std::int64_t X[4], Y[4];
-    std::uint8_t st[4];
-    corners(tv, c, local, X, Y, st);
-    if (st[0] == 2 || st[1] == 2 || st[2] == 2 || st[3] == 2) return;
+  // A tet's corners as `corners` gives them (c may point into local).
+  struct TetCorners {
+    const std::uint32_t* tv = nullptr;
+    const double* c[4] = {};
+    double local[12] = {};
+    std::int64_t X[4] = {}, Y[4] = {};
+    std::uint8_t st[4] = {};
+  };
+  // Loads tet t's corners into k; false if one of them is not finite (the tet draws nothing).
+  bool load_corners(std::uint32_t t, TetCorners& k) const {
+    k.tv = &mesh->tet[4 * std::size_t(t)];
+    corners(k.tv, k.c, k.local, k.X, k.Y, k.st);
+    return k.st[0] != 2 && k.st[1] != 2 && k.st[2] != 2 && k.st[3] != 2;
+  }
+
+  // The polygon of face f of tet t (corners from `corners`) as drawn when it faces the eye: front
+  // (back = false) for t itself, back (back = true) the same face seen from the other side, which is
+  // exactly the polygon the neighbour across it draws as its front face (same vertices, same
+  // orientation, same pixels under the fill rule). Returns its vertex count (3, or 4 when the near
+  // plane cuts it) with positive area, or 0 when the face is not of the asked side or covers nothing.
+  // *clipped is set when the near plane cuts a face of the asked side.
+  int face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped) const {
+    const std::uint32_t* tv = k.tv;
+    const double* const* c = k.c;
+    const std::int64_t *X = k.X, *Y = k.Y;
+    const std::uint8_t* st = k.st;
+    *clipped = false;
+    const auto& face = kFace[f];
+    const int a = face[0], b = face[1], d = face[2];
+    if (st[a] + st[b] + st[d] == 0) {
+      // Front iff the projected outward-ordered triangle has negative area (screen y is down and
+      // the camera frame mirrors the world). The neighbour sharing this face computes the same
+      // area with the opposite sign, so exactly one of the two draws it.
+      const std::int64_t area = (X[b] - X[a]) * (Y[d] - Y[a]) - (Y[b] - Y[a]) * (X[d] - X[a]);
+      if (back ? area <= 0 : area >= 0) return 0;
+      const int front_order[3] = {a, d, b}, back_order[3] = {a, b, d};  // positive area
+      const int* order = back ? back_order : front_order;
+      for (int i = 0; i < 3; ++i) {
+        poly[i].X = X[order[i]];
+        poly[i].Y = Y[order[i]];
+        poly[i].w = nearness(c[order[i]]);
+        poly[i].mesh_edge = true;
+      }
+      return 3;
+    }
+    if (st[a] + st[b] + st[d] == 3) return 0;  // entirely behind the near plane
+    // Cut by the near plane. Canonical order (ascending node id) so that both tets sharing the
+    // face compute bit-identical polygons; facing from the exact same double expression.
+    int s[3] = {a, b, d};
+    bool odd = false;
+    auto swap_if = [&](int i, int j) {
+      if (tv[s[i]] > tv[s[j]]) {
+        std::swap(s[i], s[j]);
+        odd = !odd;
+      }
+    };
+    swap_if(0, 1);
+    swap_if(1, 2);
+    swap_if(0, 1);
+    const double *p0 = c[s[0]], *p1 = c[s[1]], *p2 = c[s[2]];
+    double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    // World: front iff n_out . (eye - p0) > 0; in the mirrored camera frame n_out = -nc_out and
+    // eye - p0 = -p0, so front iff nc_out . p0 > 0, and nc_out = +-nc by the permutation parity.
+    // The neighbour's parity is the opposite one, so its side is exactly -side.
+    double side = nc[0] * p0[0] + nc[1] * p0[1] + nc[2] * p0[2];
+    if (odd != back) side = -side;
+    if (!(side > 0)) return 0;
+    *clipped = true;
+    // Sutherland-Hodgman against z >= near; intersections computed from the lower node id.
+    int n = 0;
+    for (int i = 0; i < 3; ++i) {
+      const int pi = s[i], qi = s[i == 2 ? 0 : i + 1];
+      const bool pin = st[pi] == 0, qin = st[qi] == 0;
+      auto cut = [&](PolyVertex& out) {
+        int lo = pi, hi = qi;
+        if (tv[lo] > tv[hi]) std::swap(lo, hi);
+        const double* P = c[lo];
+        const double* Q = c[hi];
+        double tt = (near - P[2]) / (Q[2] - P[2]);
+        out.c[0] = P[0] + tt * (Q[0] - P[0]);
+        out.c[1] = P[1] + tt * (Q[1] - P[1]);
+        out.c[2] = near;
+        out.w = 1 / near;
+        std::uint8_t dummy;
+        project_camera(out.c, out.X, out.Y, dummy);
+      };
+      if (pin) {
+        poly[n].X = X[pi];
+        poly[n].Y = Y[pi];
+        poly[n].w = nearness(c[pi]);
+        poly[n].mesh_edge = true;
+        ++n;
+        if (!qin) {
+          cut(poly[n]);
+          poly[n].mesh_edge = false;
+          ++n;
+        }
+      } else if (qin) {
+        cut(poly[n]);
+        poly[n].mesh_edge = true;
+        ++n;
+      }
+    }
+    std::int64_t area2 = 0;
+    for (int i = 0; i < n; ++i) {
+      const PolyVertex& p = poly[i];
+      const PolyVertex& q = poly[i + 1 == n ? 0 : i + 1];
+      area2 += p.X * q.Y - q.X * p.Y;
+    }
+    if (area2 == 0) return 0;
+    if (area2 < 0) {
+      // Reverse; the edge leaving vertex i+1 in the new order is the old edge i -> i+1.
+      PolyVertex r[4];
+      for (int i = 0; i < n; ++i) {
+        r[i] = poly[n - 1 - i];
+        r[i].mesh_edge = poly[(2 * n - 2 - i) % n].mesh_edge;
+      }
+      std::copy(r, r + n, poly);
+    }
+    return n;
+  }
+
+  // Draws tet t's front faces (only face `only_face` when it is 0..3) into the rows of `rows`.
+  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count, int only_face = -1) {
+    TetCorners k;
+    if (!load_corners(t, k)) return;
+    const double* const* c = k.c;
+    const std::int64_t* Y = k.Y;
+    const std::uint8_t* st = k.st;
     const int behind = int(st[0]) + st[1] + st[2] + st[3];
     if (behind == 4) {
       if (count) ++stats.tets_behind;
@@ -638,126 +875,108 @@ struct TetRasterizer::Impl {
     PolyVertex poly[4];
     FaceSetup fs;
     for (int fi = 0; fi < 4; ++fi) {
-      const auto& face = kFace[reverse ? 3 - fi : fi];
-      const int a = face[0], b = face[1], d = face[2];
-      if (st[a] + st[b] + st[d] == 0) {
-        // Front iff the projected outward-ordered triangle has negative area (screen y is down and
-        // the camera frame mirrors the world). The neighbour sharing this face computes the same
-        // area with the opposite sign, so exactly one of the two draws it.
-        std::int64_t area = (X[b] - X[a]) * (Y[d] - Y[a]) - (Y[b] - Y[a]) * (X[d] - X[a]);
-        if (area >= 0) continue;
-        if (reverse) {  // hidden behind what this batch drew already?
-          const Box box =
-              pixel_box(std::min({X[a], X[b], X[d]}), std::max({X[a], X[b], X[d]}),
-                        std::min({Y[a], Y[b], Y[d]}), std::max({Y[a], Y[b], Y[d]}), fb.width, fb.height);
-          if (box.x0 > box.x1 || box_written(rows, box, fb.height)) continue;
-        }
-        const int order[3] = {a, d, b};  // reversed: positive area
-        for (int i = 0; i < 3; ++i) {
-          poly[i].X = X[order[i]];
-          poly[i].Y = Y[order[i]];
-          poly[i].w = nearness(c[order[i]]);
-          poly[i].mesh_edge = true;
-        }
-        const double* v[3] = {c[a], c[b], c[d]};
-        setup_face(fs, t, v, poly, 3);
-        raster_polygon(fb, rows, fs, poly, 3);
-        continue;
+      const int f = reverse ? 3 - fi : fi;
+      if (only_face >= 0 && f != only_face) continue;
+      bool clipped = false;
+      const int n = face_polygon(k, f, false, poly, &clipped);
+      if (clipped && count) ++stats.faces_clipped;
+      if (n == 0) continue;
+      if (use_mask && !clipped) {  // hidden behind what this batch drew already?
+        const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
+                                  std::max({poly[0].X, poly[1].X, poly[2].X}),
+                                  std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
+                                  std::max({poly[0].Y, poly[1].Y, poly[2].Y}), fb.width, fb.height);
+        if (box.x0 > box.x1 || box_written(rows, box, fb.height)) continue;
       }
-      if (st[a] + st[b] + st[d] == 3) continue;  // entirely behind the near plane
-      // Cut by the near plane. Canonical order (ascending node id) so that both tets sharing the
-      // face compute bit-identical polygons; facing from the exact same double expression.
-      int s[3] = {a, b, d};
-      bool odd = false;
-      auto swap_if = [&](int i, int j) {
-        if (tv[s[i]] > tv[s[j]]) {
-          std::swap(s[i], s[j]);
-          odd = !odd;
-        }
-      };
-      swap_if(0, 1);
-      swap_if(1, 2);
-      swap_if(0, 1);
-      const double *p0 = c[s[0]], *p1 = c[s[1]], *p2 = c[s[2]];
-      double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-      double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-      double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-      // World: front iff n_out . (eye - p0) > 0; in the mirrored camera frame n_out = -nc_out and
-      // eye - p0 = -p0, so front iff nc_out . p0 > 0, and nc_out = +-nc by the permutation parity.
-      double side = nc[0] * p0[0] + nc[1] * p0[1] + nc[2] * p0[2];
-      if (odd) side = -side;
-      if (!(side > 0)) continue;
-      if (count) ++stats.faces_clipped;
-      // Sutherland-Hodgman against z >= near; intersections computed from the lower node id.
-      int n = 0;
-      for (int i = 0; i < 3; ++i) {
-        const int pi = s[i], qi = s[i == 2 ? 0 : i + 1];
-        const bool pin = st[pi] == 0, qin = st[qi] == 0;
-        auto cut = [&](PolyVertex& out) {
-          int lo = pi, hi = qi;
-          if (tv[lo] > tv[hi]) std::swap(lo, hi);
-          const double* P = c[lo];
-          const double* Q = c[hi];
-          double tt = (near - P[2]) / (Q[2] - P[2]);
-          out.c[0] = P[0] + tt * (Q[0] - P[0]);
-          out.c[1] = P[1] + tt * (Q[1] - P[1]);
-          out.c[2] = near;
-          out.w = 1 / near;
-          std::uint8_t dummy;
-          project_camera(out.c, out.X, out.Y, dummy);
-        };
-        if (pin) {
-          poly[n].X = X[pi];
-          poly[n].Y = Y[pi];
-          poly[n].w = nearness(c[pi]);
-          poly[n].mesh_edge = true;
-          ++n;
-          if (!qin) {
-            cut(poly[n]);
-            poly[n].mesh_edge = false;
-            ++n;
-          }
-        } else if (qin) {
-          cut(poly[n]);
-          poly[n].mesh_edge = true;
-          ++n;
-        }
-      }
-      std::int64_t area2 = 0;
-      for (int i = 0; i < n; ++i) {
-        const PolyVertex& p = poly[i];
-        const PolyVertex& q = poly[i + 1 == n ? 0 : i + 1];
-        area2 += p.X * q.Y - q.X * p.Y;
-      }
-      if (area2 == 0) continue;
-      if (area2 < 0) {
-        // Reverse; the edge leaving vertex i+1 in the new order is the old edge i -> i+1.
-        PolyVertex r[4];
-        for (int i = 0; i < n; ++i) {
-          r[i] = poly[n - 1 - i];
-          r[i].mesh_edge = poly[(2 * n - 2 - i) % n].mesh_edge;
-        }
-        std::copy(r, r + n, poly);
-      }
-      const double* v[3] = {c[a], c[b], c[d]};
+      const auto& face = kFace[f];
+      const double* v[3] = {c[face[0]], c[face[1]], c[face[2]]};
       setup_face(fs, t, v, poly, n);
       raster_polygon(fb, rows, fs, poly, n);
     }
   }
 
-  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+  void check_framebuffer(const Framebuffer& fb) const {
     if (fb.width != proj.width || fb.height != proj.height)
       throw std::invalid_argument("render: framebuffer size differs from the rasterizer's");
     if (fb.rgba.size() != std::size_t(fb.width) * fb.height || fb.id.size() != fb.rgba.size())
       throw std::invalid_argument("render: framebuffer buffers have the wrong size");
     if (params.depth_buffer && fb.depth.size() != fb.rgba.size())
       throw std::invalid_argument("render: depth-buffer mode needs a framebuffer with a depth buffer");
+  }
+
+  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+    check_framebuffer(fb);
     const std::size_t tc = mesh->tet_count();
     for (std::uint32_t t : tets)
       if (t >= tc) throw std::out_of_range("render: tet index " + std::to_string(t) + " out of range");
     stats.tets_drawn += tets.size();
-    const int count = std::min(params.threads, std::max(1, fb.height >> kBandShift));
-    if (reverse) {
+    if (!params.undoable) {
+      draw_batch(fb, tets);
+      return;
+    }
+    // Undoable: positions first (a back face is shared with a tet drawn earlier), then one
+    // front-to-back walk that answers the saves' requests (see `recording`).
+    const std::size_t start = history.size();
+    for (std::size_t i = 0; i < tets.size(); ++i) {
+      if (drawn_at[tets[i]] != kNone) {
+        for (std::size_t k = 0; k < i; ++k) drawn_at[tets[k]] = kNone;
+        throw std::invalid_argument("render: undoable drawing draws each tet once (tet " +
+                                    std::to_string(tets[i]) + " again)");
+      }
+      drawn_at[tets[i]] = std::uint32_t(start + i);
+    }
+    history.insert(history.end(), tets.begin(), tets.end());
+    for (Lane& lane : lanes) lane.regions.push_back(SaveRegion{lane.saves.size(), lane.saved_pixel.size()});
+    recording = true;
+    try {
+      draw_batch(fb, tets);
+    } catch (...) {
+      recording = false;
+      clear_mask(tets.size());
+      throw;
+    }
+    recording = false;
+    clear_mask(tets.size());
+    for (Lane& lane : lanes)
+      if (lane.saves.size() == lane.regions.back().first_save) lane.regions.pop_back();
+  }
+
+  // End of an undoable batch, in lane k (by its thread): requests no tet answered get what was there
+  // before the batch; a request replaced at its pixel by a later one (a back face covering a pixel
+  // its tet's front faces miss, after snapping) takes that one's answer. The lane's saves, filed
+  // front to back, are then put in drawing order.
+  void answer_requests(const Framebuffer& fb, int k) {
+    Lane& lane = lanes[std::size_t(k)];
+    const SaveRegion& region = lane.regions.back();
+    for (std::size_t i = region.first_pixel; i < lane.saved_pixel.size(); ++i) {
+      const std::uint32_t p = lane.saved_pixel[i];
+      if (slot[p] != i) continue;
+      const bool was_shown = (shown[std::size_t(p / std::uint32_t(fb.width)) * std::size_t(mask_words) +
+                                   ((p % std::uint32_t(fb.width)) >> 6)] >>
+                              ((p % std::uint32_t(fb.width)) & 63)) & 1;
+      lane.saved_rgba[i] = was_shown ? before_rgba[p] : fb.rgba[p];
+      lane.saved_id[i] = was_shown ? before_id[p] : fb.id[p];
+      slot[p] = kNone;
+    }
+    for (std::size_t i = lane.aliases.size(); i-- > 0;) {
+      lane.saved_rgba[lane.aliases[i].first] = lane.saved_rgba[lane.aliases[i].second];
+      lane.saved_id[lane.aliases[i].first] = lane.saved_id[lane.aliases[i].second];
+    }
+    lane.aliases.clear();
+    std::reverse(lane.saves.begin() + std::ptrdiff_t(region.first_save), lane.saves.end());
+  }
+
+  // Painter or depth-buffer drawing of a batch (see draw); the written-pixel mask is all zero before
+  // and after, cleared only on the rows the batch could touch (short batches cost what they draw).
+  void draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+    if (tets.empty()) return;
+    // Threads pay for themselves only on long batches. Undoable drawing always uses its lanes'
+    // partition (saved pixels are kept per lane), on one thread for short batches.
+    const int count = recording       ? lane_count
+                      : tets.size() < 256 ? 1
+                                          : std::min(params.threads, std::max(1, fb.height >> kBandShift));
+    const bool spawn = count > 1 && tets.size() >= 256;
+    if (reverse && written.empty()) {
       written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
       tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
     }
@@ -767,17 +986,29 @@ struct TetRasterizer::Impl {
       for (std::size_t i = begin; i < end; ++i) {
         if (i + kAhead < end) prefetch_tet(tets[i + kAhead]);
         if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 2 * kAhead])]);
+        if (recording) {  // has_unshared_back_face reads the tet's neighbours and their positions
+          if (i + 2 * kAhead < end) __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
+          if (i + kAhead < end) {
+            const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(tets[i + kAhead])];
+            for (int f = 0; f < 4; ++f)
+              if (nb[f] != kNone) __builtin_prefetch(&drawn_at[nb[f] >> 2]);
+          }
+        }
         boxes[i] = tet_box(tets[i], fb.width, fb.height);
+        if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i]);
       }
     };
     auto draw_one = [&](const Rows& rows, std::size_t i, bool first) {
       const Box& b = boxes[i];
       if (b.x0 > b.x1) return;  // draws nothing
+      const bool files_save = recording && need_save[i];
       if (b.y0 >= 0) {
         if (!rows.any(b.y0, b.y1)) return;
-        if (reverse && box_written(rows, b, fb.height)) return;  // hidden behind what this batch drew already
+        // Hidden behind what this batch drew already (a tet with a save still files its requests).
+        if (use_mask && !files_save && box_written(rows, b, fb.height)) return;
       }
       draw_tet(fb, rows, tets[i], first);
+      if (files_save) request_saves(fb, rows, tets[i]);
     };
     auto work = [&](int k) {
       Rows rows{k, count};
@@ -786,22 +1017,247 @@ struct TetRasterizer::Impl {
       } else {
         for (std::size_t i = 0; i < tets.size(); ++i) draw_one(rows, i, k == 0);
       }
+      if (recording) answer_requests(fb, k);
     };
-    if (count == 1 || tets.size() < 4096) {
+    if (recording) need_save.resize(tets.size());
+    if (!spawn || tets.size() < 4096) {
       find_boxes(0, tets.size());
     } else {
       std::thread helper(find_boxes, tets.size() / 2, tets.size());
       find_boxes(0, tets.size() / 2);
       helper.join();
     }
-    if (count == 1) {
+    if (!spawn) {
+      for (int k = 0; k < count; ++k) work(k);
+    } else {
+      std::vector<std::thread> pool;
+      for (int k = 1; k < count; ++k) pool.emplace_back(work, k);
       work(0);
-      return;
+      for (auto& th : pool) th.join();
     }
-    std::vector<std::thread> pool;
-    for (int k = 1; k < count; ++k) pool.emplace_back(work, k);
-    work(0);
-    for (auto& th : pool) th.join();
+    if (reverse && !recording) clear_mask(tets.size());
+  }
+
+  // Zeroes the written-pixel mask on the rows the batch's boxes span (all rows if a box is unknown).
+  void clear_mask(std::size_t n) {
+    int y0 = proj.height, y1 = -1;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Box& b = boxes[i];
+      if (b.x0 > b.x1) continue;
+      if (b.y0 < 0) {
+        y0 = 0;
+        y1 = proj.height - 1;
+        break;
+      }
+      y0 = std::min(y0, b.y0);
+      y1 = std::max(y1, b.y1);
+    }
+    if (y0 > y1) return;
+    const std::size_t words = std::size_t(mask_words);
+    std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
+              written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
+    std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
+              tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
+    if (!shown.empty())
+      std::fill(shown.begin() + std::ptrdiff_t(std::size_t(y0) * words),
+                shown.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
+  }
+
+  // --- Undraw (seed paper, section 6.2) ---
+  // A back face of a drawn tet is shared when the tet across it was drawn before it (with unshrunk
+  // tets only): in the picture of the tets before t, its pixels show that neighbour's front face.
+  std::uint32_t earlier_neighbour(std::uint32_t t, int f) const {
+    if (params.shrink != 1) return kNone;
+    const std::uint32_t nb = adjacency->neighbour[4 * std::size_t(t) + std::size_t(f)];
+    if (nb == kNone || drawn_at[nb >> 2] >= drawn_at[t]) return kNone;
+    return nb;
+  }
+
+  // Calls fn(y, lo, hi) for the pixel runs of a polygon (positive area) in the rows of `rows`, in a
+  // fixed order.
+  template <class Fn>
+  void for_each_run(const PolyVertex* poly, int n, const Rows& rows, Fn&& fn) const {
+    for (int q = 1; q + 1 < n; ++q) {
+      std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X}, Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
+      std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+      if (area <= 0) continue;
+      raster_triangle(X, Y, proj.width, proj.height, rows, fn);
+    }
+  }
+
+  // Calls fn(f, poly, n) for each back face of drawn tet t that covers pixels.
+  template <class Fn>
+  void for_each_back_face(std::uint32_t t, Fn&& fn) const {
+    TetCorners k;
+    if (!load_corners(t, k)) return;
+    PolyVertex poly[4];
+    for (int f = 0; f < 4; ++f) {
+      bool clipped = false;
+      const int n = face_polygon(k, f, true, poly, &clipped);
+      if (n > 0) fn(f, poly, n);
+    }
+  }
+
+  // Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
+  // for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
+  // its projected area (as face_polygon does) without building its polygon.
+  bool has_unshared_back_face(std::uint32_t t) const {
+    TetCorners k;
+    if (!load_corners(t, k)) return false;
+    const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
+    for (int f = 0; f < 4; ++f) {
+      bool back;
+      if (unclipped) {
+        const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
+        back = (k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) > 0;
+      } else {
+        PolyVertex poly[4];
+        bool clipped = false;
+        back = face_polygon(k, f, true, poly, &clipped) > 0;
+      }
+      if (back && earlier_neighbour(t, f) == kNone) return true;
+    }
+    return false;
+  }
+
+  // Files t's save in the lane of `rows`: a request for each pixel of its unshared back faces in
+  // those rows (just after t's front faces were walked, which answered the requests of nearer tets
+  // on the same pixels).
+  void request_saves(const Framebuffer& fb, const Rows& rows, std::uint32_t t) {
+    Lane& lane = lanes[std::size_t(rows.thread)];
+    std::vector<std::uint32_t>& saved_pixel = lane.saved_pixel;
+    lane.saves.push_back(Save{drawn_at[t], saved_pixel.size()});
+    for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
+      if (earlier_neighbour(t, f) != kNone) return;
+      for_each_run(poly, n, rows, [&](int y, int lo, int hi) {
+        const std::size_t row = std::size_t(y) * std::size_t(fb.width);
+        std::uint64_t* done = &written[std::size_t(y) * std::size_t(mask_words)];
+        for (int x = lo; x <= hi; ++x) {
+          const std::uint32_t k = std::uint32_t(saved_pixel.size()), p = std::uint32_t(row + std::size_t(x));
+          if (slot[p] != kNone) lane.aliases.emplace_back(slot[p], k);
+          slot[p] = k;
+          saved_pixel.push_back(p);
+          done[x >> 6] &= ~(std::uint64_t(1) << (x & 63));  // to be walked again
+          tile_full[std::size_t(y >> kBandShift) * std::size_t(mask_words) + std::size_t(x >> 6)] = 0;
+        }
+      });
+    });
+    lane.saved_rgba.resize(saved_pixel.size());
+    lane.saved_id.resize(saved_pixel.size());
+  }
+
+  // Takes back the last `count` tets. Sequentially (front to back) each tet's back-face pixels are
+  // repainted; the last write to a pixel is by the farthest undrawn tet covering it, so the tets are
+  // walked back to front instead and each pixel is written once, first write wins (the mask). Each
+  // lane's thread does its own rows.
+  void undraw(Framebuffer& fb, std::size_t count) {
+    if (!params.undoable) throw std::logic_error("render: undraw needs RenderParams::undoable");
+    check_framebuffer(fb);
+    if (count > history.size()) throw std::out_of_range("render: undraw of more tets than are drawn");
+    if (count == 0) return;
+    if (written.empty()) {
+      written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
+      tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
+    }
+    const std::size_t first = history.size() - count;
+    auto first_save = [&](const Lane& lane) {
+      return std::size_t(std::lower_bound(lane.saves.begin(), lane.saves.end(), first,
+                                          [](const Save& s, std::size_t at) { return s.at < at; }) -
+                         lane.saves.begin());
+    };
+    boxes.resize(count);
+    auto find_boxes = [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) boxes[i] = tet_box(history[first + i], fb.width, fb.height);
+    };
+    auto work = [&](int k) {
+      const Rows rows{k, lane_count};
+      Lane& lane = lanes[std::size_t(k)];
+      std::size_t save = first_save(lane);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t t = history[first + i];
+        const bool saved = save < lane.saves.size() && lane.saves[save].at == first + i;
+        const std::size_t s = saved ? save++ : 0;
+        const Box& b = boxes[i];
+        if (b.x0 > b.x1) continue;
+        if (b.y0 >= 0 && (!rows.any(b.y0, b.y1) || box_written(rows, b, fb.height))) continue;
+        if (saved) {
+          const std::size_t to = save_end(lane, s);
+          for (std::size_t j = lane.saves[s].offset; j < to; ++j) {
+            const std::uint32_t p = lane.saved_pixel[j];
+            const std::uint32_t x = p % std::uint32_t(fb.width), y = p / std::uint32_t(fb.width);
+            std::uint64_t& word = written[std::size_t(y) * std::size_t(mask_words) + (x >> 6)];
+            const std::uint64_t bit = std::uint64_t(1) << (x & 63);
+            if (word & bit) continue;
+            word |= bit;
+            fb.rgba[p] = lane.saved_rgba[j];
+            fb.id[p] = lane.saved_id[j];
+          }
+        }
+        for_each_back_face(t, [&](int f, const PolyVertex*, int) {
+          const std::uint32_t nb = earlier_neighbour(t, f);
+          if (nb != kNone) draw_tet(fb, rows, nb >> 2, false, int(nb & 3));  // as the neighbour drew it
+        });
+      }
+    };
+    const bool spawn = lane_count > 1 && count >= 256;
+    if (!spawn) {
+      find_boxes(0, count);
+      for (int k = 0; k < lane_count; ++k) work(k);
+    } else {
+      std::thread helper(find_boxes, count / 2, count);
+      find_boxes(0, count / 2);
+      helper.join();
+      std::vector<std::thread> pool;
+      for (int k = 1; k < lane_count; ++k) pool.emplace_back(work, k);
+      work(0);
+      for (auto& th : pool) th.join();
+    }
+    clear_mask(count);
+    for (std::size_t i = history.size(); i-- > first;) drawn_at[history[i]] = kNone;
+    history.resize(first);
+    for (Lane& lane : lanes) {
+      lane.saves.resize(first_save(lane));
+      while (!lane.regions.empty() && lane.regions.back().first_save >= lane.saves.size()) {
+        lane.saved_pixel.resize(lane.regions.back().first_pixel);
+        lane.regions.pop_back();
+      }
+      lane.saved_rgba.resize(lane.saved_pixel.size());
+      lane.saved_id.resize(lane.saved_pixel.size());
+    }
+  }
+
+  // Where save s of a lane's pixels end: saves of one draw() call were filed front to back, so in
+  // drawing order a save's pixels run up to those of the save before it in the same call.
+  static std::size_t save_end(const Lane& lane, std::size_t s) {
+    std::size_t r = lane.regions.size();
+    while (r > 0 && lane.regions[r - 1].first_save > s) --r;
+    const SaveRegion& region = lane.regions[r - 1];
+    const std::size_t region_end = r < lane.regions.size() ? lane.regions[r].first_pixel : lane.saved_pixel.size();
+    return s > region.first_save ? lane.saves[s - 1].offset : region_end;
+  }
+
+  void forget() {
+    for (std::uint32_t t : history) drawn_at[t] = kNone;
+    history.clear();
+    for (Lane& lane : lanes) lane = Lane{};
+  }
+
+  std::size_t saved_pixels() const {
+    std::size_t n = 0;
+    for (const Lane& lane : lanes) n += lane.saved_rgba.size();
+    return n;
+  }
+
+  std::size_t undo_bytes() const {
+    std::size_t bytes = (history.capacity() + drawn_at.capacity() + slot.capacity() + before_rgba.capacity() +
+                         before_id.capacity()) *
+                            sizeof(std::uint32_t) +
+                        (shown.capacity() + written.capacity()) * sizeof(std::uint64_t);
+    for (const Lane& lane : lanes)
+      bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
+                   sizeof(std::uint32_t) +
+               lane.saves.capacity() * sizeof(Save) + lane.regions.capacity() * sizeof(SaveRegion);
+    return bytes;
   }
 };
 
@@ -816,6 +1272,11 @@ void TetRasterizer::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
 const RasterStats& TetRasterizer::stats() const { return impl_->stats; }
 const Projector& TetRasterizer::projector() const { return impl_->proj; }
 double TetRasterizer::near_plane() const { return impl_->near; }
+void TetRasterizer::undraw(Framebuffer& fb, std::size_t count) { impl_->undraw(fb, count); }
+std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_->history; }
+std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_pixels(); }
+std::size_t TetRasterizer::undo_bytes() const { return impl_->undo_bytes(); }
+void TetRasterizer::forget_drawn() { impl_->forget(); }
 
 Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
                         std::span<const std::uint32_t> tets, const RenderParams& params) {

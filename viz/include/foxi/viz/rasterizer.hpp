@@ -40,6 +40,7 @@ struct RenderParams {
   // Colour of region id r (opaque RGBA, pack_rgba) at region_colors[r] where r is in range; other
   // regions take region_color(r).
   std::vector<std::uint32_t> region_colors;
+  bool undoable = false;        // painter only: record what undraw() needs (see TetRasterizer::undraw)
 };
 
 // The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).
@@ -66,6 +67,27 @@ class TetRasterizer {
   // into fb, which must be width x height (with a depth buffer in depth mode). Can be called again
   // with the next batch of an order (progressive drawing). Tet indices must be < tet_count.
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
+
+  // Undoable mode (RenderParams::undoable; the seed paper's undrawing, section 6.2). draw() keeps the
+  // tets drawn so far (each tet at most once, else std::invalid_argument) and saves, for each tet
+  // with a back face not shared with an earlier-drawn tet (mesh boundary, subset boundary, shrunk
+  // tets), the pixels that face covers as they were just before the tet was drawn. It walks each
+  // batch front to back like the painter (on one thread), the saved values being filled in by the
+  // farther tets met later in the walk. undraw(fb, k) takes back the last k drawn tets: each tet's
+  // back faces are repainted as the earlier neighbour's front face, or restored from its saved
+  // pixels; the k tets are walked back to front writing each pixel once (the farthest undrawn tet
+  // over a pixel decides it). For a visibility order, fb (colours and ids) is then pixel for pixel
+  // the picture of the remaining tets drawn from scratch; fb must not be changed in between. Cost
+  // is proportional to the undrawn tets' pixels, not to the mesh. Throws std::logic_error if not
+  // undoable, std::out_of_range if k exceeds the tets drawn.
+  void undraw(Framebuffer& fb, std::size_t count);
+  std::span<const std::uint32_t> drawn_tets() const;  // undoable: the tets drawn, in order
+  std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
+  std::size_t undo_bytes() const;  // undoable: memory held for undraw (bytes; saved pixels 12 each,
+                                   // 4 per tet, per-image buffers of 20 bytes a pixel)
+  // Undoable: forgets the tets drawn (call after clearing fb to start a new picture).
+  void forget_drawn();
+
   const RasterStats& stats() const;
   const Projector& projector() const;
   double near_plane() const;  // the near-plane distance in use (perspective)

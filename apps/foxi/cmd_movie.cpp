@@ -1,0 +1,215 @@
+// foxi movie MESH: the painter's movies (seed paper, section 6.1): back-and-forth (draw back to
+// front, undraw front to back) or a rotating view, as numbered PNG frames, an animated PNG, a GIF,
+// or an MP4 (through the ffmpeg program, when it is installed).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "cli.hpp"
+#include "foxi/model/delaunay.hpp"
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/viz/animation.hpp"
+#include "foxi/viz/movie.hpp"
+#include "foxi/viz/png.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "render_options.hpp"
+
+namespace foxi::cli {
+
+namespace {
+
+const std::string kMovieUsage = std::string(
+    "foxi movie MESH [camera and picture options] [--mode backforth|rotate] [--frames N]\n"
+    "                [--cycles C] [--from P%] [--to P%] [--turn deg] [--fps F]\n"
+    "                -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png\n"
+    "  A movie of the painter. backforth (the default): the tets drawn back to front in the\n"
+    "  visibility order from --from to --to percent of the order (default 0% to 100%), then\n"
+    "  undrawn front to back (the seed paper's undraw: back faces repainted as the neighbour's\n"
+    "  front face, or restored from saved pixels), N frames per cycle, looping seamlessly.\n"
+    "  rotate: the camera turned --turn degrees (default 360) about its up axis through --at over\n"
+    "  N frames, each frame the first --to percent of its own order.\n") +
+    kPictureOptionsHelp +
+    "  (--size defaults to 640x480)\n"
+    "  --frames N      frames per cycle (default 48), --cycles C cycles (default 1)\n"
+    "  --fps F         frames per second of the animated file (default 12)\n"
+    "  -o              .gif (giflib, 256 colours per frame), .apng (animated PNG), .mp4 (needs the\n"
+    "                  ffmpeg program), or a name with a printf number, e.g. out/frame_%04d.png:\n"
+    "                  numbered PNG frames (the folder is created)\n"
+    "  Meshes that fail the Delaunay certificate have no visibility order and are refused.";
+
+double percent(const std::string& s, const char* what, double fallback) {
+  if (s.empty()) return fallback;
+  std::string v = s;
+  if (v.back() == '%') v.pop_back();
+  char* end = nullptr;
+  const double p = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != 0 || !(p >= 0 && p <= 100))
+    throw UsageError(std::string(what) + " takes a percentage 0..100, e.g. 40%");
+  return p / 100;
+}
+
+long whole(const std::string& s, const char* what, long fallback, long lo, long hi) {
+  if (s.empty()) return fallback;
+  char* end = nullptr;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  if (*end != 0 || v < lo || v > hi)
+    throw UsageError(std::string(what) + " takes a whole number in " + std::to_string(lo) + ".." + std::to_string(hi));
+  return v;
+}
+
+// True if `pattern` holds exactly one printf integer conversion (%d or %0Nd) and no other '%'.
+bool frame_pattern(const std::string& pattern) {
+  int conversions = 0;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') continue;
+    std::size_t j = i + 1;
+    if (j < pattern.size() && pattern[j] == '0') ++j;
+    while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9') ++j;
+    if (j >= pattern.size() || pattern[j] != 'd' || j - i > 4) return false;
+    ++conversions;
+    i = j;
+  }
+  return conversions == 1;
+}
+
+std::string frame_name(const std::string& pattern, std::size_t k) {
+  char buf[4096];
+  std::snprintf(buf, sizeof buf, pattern.c_str(), int(k));  // checked by frame_pattern
+  return buf;
+}
+
+std::string quoted(const std::filesystem::path& p) {
+  std::string s = "'";
+  for (char c : p.string()) s += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return s + "'";
+}
+
+bool have_ffmpeg() { return std::system("command -v ffmpeg > /dev/null 2>&1") == 0; }
+
+}  // namespace
+
+int cmd_movie(Args args) {
+  if (args.flag("--help") || args.flag("-h")) {
+    std::puts(kMovieUsage.c_str());
+    return 0;
+  }
+  const std::string mode = args.option("--mode", "backforth");
+  const std::string frames_s = args.option("--frames"), cycles_s = args.option("--cycles");
+  const std::string from_s = args.option("--from"), to_s = args.option("--to"), turn_s = args.option("--turn");
+  const std::string fps_s = args.option("--fps", "12");
+  std::string out = args.option("-o");
+  if (out.empty()) out = args.option("--output");
+  PictureOptions options = take_picture_options(args, "640x480");
+  const std::string path = args.positional(1, 1, kMovieUsage)[0];
+  if (out.empty()) throw UsageError("give the output with -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png");
+  if (mode != "backforth" && mode != "rotate") throw UsageError("--mode takes backforth or rotate");
+  MovieParams mp;
+  mp.rotate = mode == "rotate";
+  mp.frames = int(whole(frames_s, "--frames", 48, 2, 100000));
+  mp.cycles = int(whole(cycles_s, "--cycles", 1, 1, 1000));
+  mp.from = percent(from_s, "--from", 0);
+  mp.to = percent(to_s, "--to", 1);
+  if (mp.from > mp.to) throw UsageError("--from must not exceed --to");
+  if (!turn_s.empty()) {
+    char* end = nullptr;
+    mp.turn_deg = std::strtod(turn_s.c_str(), &end);
+    if (*end != 0 || !std::isfinite(mp.turn_deg)) throw UsageError("--turn takes degrees");
+  }
+  char* fps_end = nullptr;
+  const double fps = std::strtod(fps_s.c_str(), &fps_end);
+  if (*fps_end != 0 || !(fps > 0 && fps <= 100)) throw UsageError("--fps takes a rate in (0, 100]");
+  mp.render = options.params;
+
+  enum class Kind { frames, gif, apng, mp4 } kind;
+  const std::string ext = std::filesystem::path(out).extension().string();
+  if (out.find('%') != std::string::npos) {
+    if (!frame_pattern(out)) throw UsageError("-o " + out + ": a frame name needs one %d or %0Nd and no other %");
+    kind = Kind::frames;
+  } else if (ext == ".gif") {
+    kind = Kind::gif;
+  } else if (ext == ".apng") {
+    kind = Kind::apng;
+  } else if (ext == ".mp4") {
+    kind = Kind::mp4;
+    if (!have_ffmpeg())
+      throw UsageError("-o " + out + ": MP4 needs the ffmpeg program, which is not installed (write .gif, .apng or frames)");
+  } else {
+    throw UsageError("-o " + out + ": give .gif, .apng, .mp4 or a numbered frame name like dir/frame_%04d.png");
+  }
+
+  const Mesh mesh = read_mesh(path);
+  if (mesh.tet_count() == 0) throw UsageError(path + " has no tets");
+  const Picture picture = resolve_picture(options, mesh);
+  if (!delaunay_certificate(mesh).delaunay)
+    throw std::runtime_error(path + " fails the Delaunay certificate: it has no visibility order to make a "
+                             "movie with (foxi render --zbuffer draws it)");
+  const SphereTable table = compute_spheres(mesh);
+
+  AnimationParams ap;
+  ap.width = options.width;
+  ap.height = options.height;
+  ap.fps = fps;
+  std::unique_ptr<AnimationWriter> writer;
+  std::filesystem::path frame_dir;  // mp4: PNG frames for ffmpeg, removed afterwards
+  std::string pattern = out;
+  if (kind == Kind::gif) writer = open_gif(out, ap);
+  if (kind == Kind::apng) writer = open_apng(out, ap);
+  if (kind == Kind::mp4) {
+    frame_dir = std::filesystem::path(out + ".frames.tmp");
+    std::filesystem::create_directories(frame_dir);
+    pattern = (frame_dir / "frame_%06d.png").string();
+  }
+  if (kind == Kind::frames) {
+    const std::filesystem::path parent = std::filesystem::path(frame_name(pattern, 0)).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+  }
+  struct RemoveDir {
+    std::filesystem::path dir;
+    ~RemoveDir() {
+      std::error_code ec;
+      if (!dir.empty()) std::filesystem::remove_all(dir, ec);
+    }
+  } cleanup{frame_dir};
+
+  std::size_t index = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const MovieStats stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
+                                      [&](const Framebuffer& fb) {
+                                        if (writer)
+                                          writer->add(fb);
+                                        else
+                                          write_png(frame_name(pattern, index), fb);
+                                        ++index;
+                                      });
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (writer) writer->finish();
+  if (kind == Kind::mp4) {
+    const std::filesystem::path tmp = out + ".tmp.mp4";
+    const std::string cmd = "ffmpeg -y -loglevel error -framerate " + std::to_string(fps) + " -i " +
+                            quoted(frame_dir / "frame_%06d.png") +
+                            " -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -pix_fmt yuv420p -c:v libx264 " + quoted(tmp) +
+                            " < /dev/null";
+    if (std::system(cmd.c_str()) != 0) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw std::runtime_error(out + ": ffmpeg failed to encode the frames");
+    }
+    std::filesystem::rename(tmp, out);
+  }
+  std::printf("mesh        %s: %zu tets, %zu shown\n", path.c_str(), mesh.tet_count(),
+              picture.subset.empty() ? mesh.tet_count() : picture.subset.size());
+  std::printf("movie       %s, %zu frames of %dx%d, %.1f ms per frame (frames written included)\n", mode.c_str(),
+              stats.frames, options.width, options.height, ms / double(std::max<std::size_t>(1, stats.frames)));
+  std::printf("painter     %zu tets drawn, %zu undrawn, undraw memory at most %.1f MB\n", stats.tets_drawn,
+              stats.tets_undrawn, double(stats.max_undo_bytes) / 1e6);
+  std::printf("wrote       %s\n", out.c_str());
+  return 0;
+}
+
+}  // namespace foxi::cli

@@ -1,0 +1,40 @@
+// The picture options foxi render and foxi movie share: camera (--eye --at --up --fov | --dir),
+// --size, --shrink, --regions, --no-edges. Parsed before the mesh is read (usage errors first),
+// resolved against the mesh after.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "foxi/model/mesh.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/rasterizer.hpp"
+
+namespace foxi::cli {
+
+// Help text lines for these options.
+extern const char* const kPictureOptionsHelp;
+
+struct PictureOptions {
+  int width = 0, height = 0;
+  RenderParams params;  // edges, shrink
+  bool has_eye = false, has_at = false, has_up = false, has_dir = false;
+  double eye[3] = {0, 0, 0}, at[3] = {0, 0, 0}, up[3] = {0, 0, 1}, dir[3] = {0, 0, 1};
+  double fov = 0;  // 0: default
+  std::string regions;
+};
+
+// Takes the options out of args; UsageError for malformed ones.
+PictureOptions take_picture_options(Args& args, const char* default_size);
+
+struct Picture {
+  std::vector<std::uint32_t> subset;  // empty: all tets
+  Camera camera;
+};
+
+// The selected tets (UsageError if --regions selects none) and the camera fitted to them.
+Picture resolve_picture(const PictureOptions& options, const Mesh& mesh);
+
+}  // namespace foxi::cli

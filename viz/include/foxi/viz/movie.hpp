@@ -1,0 +1,54 @@
+// Movies of the painter (seed paper, section 6.1): back-and-forth (draw the tets back to front, then
+// undraw them front to back, over and over, with intermediate frames) and a rotating view (the
+// camera turned about its up axis through `at`, the order recomputed per frame). Frames are handed
+// to a callback; writing them (PNG frames, APNG, GIF, MP4) is the caller's business (animation.hpp).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <span>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/progress.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/spheres.hpp"
+
+namespace foxi {
+
+struct MovieParams {
+  bool rotate = false;  // false: back-and-forth; true: rotating view
+  int frames = 48;      // frames per cycle (>= 2); back-and-forth: half drawing, half undrawing
+  int cycles = 1;       // cycles (>= 1)
+  double from = 0;      // back-and-forth: fraction of the order drawn at the low turning point
+  double to = 1;        // fraction drawn at the high turning point (rotate: drawn in every frame)
+  double turn_deg = 360;  // rotate: total yaw over one cycle
+  RenderParams render;    // painter settings (undoable is set for back-and-forth)
+};
+
+struct MovieStats {
+  std::size_t frames = 0;
+  std::size_t tets_drawn = 0;    // tets drawn over the whole movie (redraws counted again)
+  std::size_t tets_undrawn = 0;
+  std::size_t max_undo_bytes = 0;  // largest memory held for undraw
+};
+
+// Thrown when the progress callback returns false.
+struct MovieCancelled : std::runtime_error {
+  MovieCancelled() : std::runtime_error("movie cancelled") {}
+};
+
+// Calls frame(fb) for each frame, in order. Back-and-forth frame k of a cycle of F frames shows the
+// first round(n (from + (to - from) k / h)) tets of the order for k <= h = F / 2, then undraws
+// back (the undrawn picture equals drawing that prefix afresh, see TetRasterizer::undraw): a cycle
+// starts and ends at `from`, so it loops seamlessly. Rotate frame k turns the camera by
+// turn_deg k / F. subset: tets to show (empty = all). Meshes without a visibility-order guarantee
+// should not be given (the painter's picture would be wrong; the caller checks the certificate).
+// Throws std::invalid_argument for bad parameters, MovieCancelled when progress returns false.
+MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& camera, int width, int height,
+                      std::span<const std::uint32_t> subset, const MovieParams& params,
+                      const std::function<void(const Framebuffer&)>& frame, const ProgressFn& progress = {});
+
+}  // namespace foxi
