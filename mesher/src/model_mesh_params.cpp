@@ -1,11 +1,10 @@
 // [mesh] controls -> TetGen volume bounds (model_mesh_params.hpp).
 #include "foxi/mesher/model_mesh_params.hpp"
 
-#include <cmath>
+#include "foxi/mesher/size_field.hpp"
+
 
 namespace foxi {
-
-double regular_tet_volume(double edge) { return edge * edge * edge / (6 * std::sqrt(2.0)); }
 
 ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double default_size) {
   ModelMeshParams out;

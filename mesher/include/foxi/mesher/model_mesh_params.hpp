@@ -3,14 +3,12 @@
 // regular tet of edge a, a^3 / (6 sqrt 2).
 #pragma once
 
+#include "foxi/mesher/size_field.hpp"  // regular_tet_volume
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/plc.hpp"
 
 namespace foxi {
-
-// Volume of the regular tetrahedron with edge `edge`.
-double regular_tet_volume(double edge);
 
 // MeshParams with max_volume from model.mesh.max_size (or `default_size` when the model gives none;
 // 0: no limit), radius_edge from model.mesh.quality (when given) and min_dihedral; the region seeds in `plc` of
