@@ -326,25 +326,6 @@ TEST(VisibilityOrder, ProgressiveSortingAheadOnASecondThread) {
   }
 }
 
-TEST(VisibilityOrder, ProgressiveGridWithExactTiesAcrossBuckets) {
-  // Over 50,000 clusters (the worker path, head buckets handed out before the scatter), eyes on the
-  // grid's mirror planes: mirror-image cells tie exactly (runs resolved exactly, also where they
-  // meet bucket boundaries); the batches must still make the whole order, with no violation.
-  Mesh m = test::grid_mesh(48, 48, 22, 1, 1, 1, 5);
-  SphereTable t = compute_spheres(m);
-  ASSERT_GE(t.cluster_count(), 50000u);
-  const View views[] = {View::at(24, -30, 11), View::at(24, 24, 60), View::at(70, 80, 11)};
-  for (const View& v : views) {
-    ProgressiveOrder progressive(m, t, v);
-    std::vector<std::uint32_t> all;
-    for (auto b = progressive.next(); !b.empty(); b = progressive.next()) all.insert(all.end(), b.begin(), b.end());
-    OrderStats stats;
-    EXPECT_EQ(all, visibility_order(m, t, v, {}, false, &stats));
-    EXPECT_GT(stats.near_tie_runs, 0u);
-    EXPECT_EQ(count_violations(m, v, all).violations, 0u);
-  }
-}
-
 TEST(VisibilityOrder, NonDelaunayMeshIsReportedAndMpvoOrdersIt) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
