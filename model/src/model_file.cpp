@@ -2,6 +2,7 @@
 // does not matter and cycles are found by the "being evaluated" mark.
 #include "foxi/model/model_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -37,6 +38,51 @@ std::string short_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
+}
+
+double orient(const double* a, const double* b, const double* c) {
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+// Whether closed segments ab and cd share a point (touching counts).
+bool segments_meet(const double* a, const double* b, const double* c, const double* d) {
+  const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+  auto on = [](const double* p, const double* q, const double* r) {  // r on segment pq, collinear
+    return std::min(p[0], q[0]) <= r[0] && r[0] <= std::max(p[0], q[0]) && std::min(p[1], q[1]) <= r[1] &&
+           r[1] <= std::max(p[1], q[1]);
+  };
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
+  return (o1 == 0 && on(a, b, c)) || (o2 == 0 && on(a, b, d)) || (o3 == 0 && on(c, d, a)) ||
+         (o4 == 0 && on(c, d, b));
+}
+
+// Why a closed outline (2 doubles per vertex) is not a simple polygon, or "" when it is one: repeated
+// points, edges that cross or touch other than at their shared vertex, edges that fold back.
+std::string polygon_problem(const std::vector<double>& xy) {
+  const std::size_t n = xy.size() / 2;
+  const double* v = xy.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n, k = (i + 2) % n;
+    if (v[2 * i] == v[2 * j] && v[2 * i + 1] == v[2 * j + 1])
+      return "point " + std::to_string(j) + " repeats point " + std::to_string(i);
+    // consecutive edges fold back on each other: collinear with the turn point not between them
+    const double* a = v + 2 * i;
+    const double* b = v + 2 * j;
+    const double* c = v + 2 * k;
+    if (n > 3 && orient(a, b, c) == 0 && (c[0] - b[0]) * (a[0] - b[0]) + (c[1] - b[1]) * (a[1] - b[1]) > 0)
+      return "edges " + std::to_string(i) + " and " + std::to_string(j) + " fold back on each other";
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours through the closing edge
+      if (segments_meet(v + 2 * i, v + 2 * ((i + 1) % n), v + 2 * j, v + 2 * ((j + 1) % n)))
+        return "the outline is not a simple polygon: edge " + std::to_string(i) + " meets edge " +
+               std::to_string(j);
+    }
+  double area = 0;
+  for (std::size_t i = 0; i < n; ++i) area += orient(v, v + 2 * i, v + 2 * ((i + 1) % n));
+  if (area == 0) return "the outline has no area";
+  return "";
 }
 
 std::uint64_t line_of(const Value& v) {
@@ -314,9 +360,28 @@ class Loader {
       }
       p.z0 = c[2];
       p.z1 = c[2] + h;
+    } else if (shape == "extrusion") {
+      const Value& pts = need(part, "points", who);
+      if (!pts.is_array() || pts.as_array().size() < 3)
+        throw Located{line_of(pts), who + " points: expected an array of at least 3 [x, y] points"};
+      std::size_t i = 0;
+      for (const Value& q : pts.as_array()) {
+        const auto xy = lengths(q, 2, who + " points[" + std::to_string(i++) + "]", false);
+        p.xy.push_back(xy[0] + sx);
+        p.xy.push_back(xy[1] + sy);
+      }
+      p.z0 = length(need(part, "z", who), who + " z");
+      p.z1 = p.z0 + positive_length(need(part, "height", who), who + " height");
+      if (const std::string why = polygon_problem(p.xy); !why.empty())
+        throw Located{line_of(pts), who + " points: " + why};
+      if (p.area() < 0)  // clockwise as written: the builders take counter-clockwise outlines
+        for (std::size_t a = 0, b = p.xy.size() / 2 - 1; a < b; ++a, --b) {
+          std::swap(p.xy[2 * a], p.xy[2 * b]);
+          std::swap(p.xy[2 * a + 1], p.xy[2 * b + 1]);
+        }
     } else {
-      throw Located{line_of(part),
-                    who + ": unknown shape '" + shape + "' (expected box, cylinder, layers, array)"};
+      throw Located{line_of(part), who + ": unknown shape '" + shape +
+                                       "' (expected box, cylinder, extrusion, ball, stl, layers, array)"};
     }
     return p;
   }
@@ -406,6 +471,7 @@ class Loader {
         if (ishape == "box") check_keys(item, who + " item", {"shape", "origin", "size"});
         if (ishape == "cylinder")
           check_keys(item, who + " item", {"shape", "center", "radius", "height", "segments"});
+        if (ishape == "extrusion") check_keys(item, who + " item", {"shape", "points", "z", "height"});
         for (long j = 0; j < ny; ++j)
           for (long i = 0; i < nx; ++i)
             part.prisms.push_back(primitive(item, ishape, who + " item", static_cast<double>(i) * pp[0],
@@ -414,6 +480,8 @@ class Loader {
         if (shape == "box") check_keys(pv, who, {"name", "shape", "material", "origin", "size"});
         if (shape == "cylinder")
           check_keys(pv, who, {"name", "shape", "material", "center", "radius", "height", "segments"});
+        if (shape == "extrusion")
+          check_keys(pv, who, {"name", "shape", "material", "points", "z", "height"});
         part.prisms.push_back(primitive(pv, shape, who, 0, 0));
       }
       add_part(std::move(part));

@@ -39,15 +39,23 @@ struct Item {
   std::size_t z0, z1;  // level indices
 };
 
-bool inside_polygon(const std::vector<double>& xy, double x, double y) {  // convex, counter-clockwise
-  const std::size_t n = xy.size() / 2;
+// Whether (x, y) is inside the closed polygon of vertices at(0) .. at(n - 1) (either orientation,
+// convex or not), by the crossing number. Only called with points well inside a face of a
+// subdivision, so points on the outline do not occur.
+template <class At>
+bool inside_ring(std::size_t n, At at, double x, double y) {
+  bool in = false;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t j = (i + 1) % n;
-    const double c =
-        (xy[2 * j] - xy[2 * i]) * (y - xy[2 * i + 1]) - (xy[2 * j + 1] - xy[2 * i + 1]) * (x - xy[2 * i]);
-    if (!(c > 0)) return false;
+    const XY a = at(i), b = at((i + 1) % n);
+    if ((a.second > y) != (b.second > y) &&
+        x < a.first + (y - a.second) * (b.first - a.first) / (b.second - a.second))
+      in = !in;
   }
-  return true;
+  return in;
+}
+
+bool inside_polygon(const std::vector<double>& xy, double x, double y) {  // 2 doubles per vertex
+  return inside_ring(xy.size() / 2, [&](std::size_t i) { return XY{xy[2 * i], xy[2 * i + 1]}; }, x, y);
 }
 
 // A planar subdivision by segments: vertices, edges (halfedge 2e runs u -> v, 2e + 1 back; each has
@@ -78,17 +86,8 @@ double cycle_area(const Plane& pl, const std::vector<std::uint32_t>& ring) {
   return 0.5 * a;
 }
 
-bool in_ring(const Plane& pl, const std::vector<std::uint32_t>& ring, double x,
-             double y) {  // crossing number
-  bool in = false;
-  for (std::size_t i = 0; i < ring.size(); ++i) {
-    const XY& a = pl.from(ring[i]);
-    const XY& b = pl.from(ring[(i + 1) % ring.size()]);
-    if ((a.second > y) != (b.second > y) &&
-        x < a.first + (y - a.second) * (b.first - a.first) / (b.second - a.second))
-      in = !in;
-  }
-  return in;
+bool in_ring(const Plane& pl, const std::vector<std::uint32_t>& ring, double x, double y) {
+  return inside_ring(ring.size(), [&](std::size_t i) { return pl.from(ring[i]); }, x, y);
 }
 
 void build_plane(Plane& pl, const std::vector<const Prism*>& prisms) {

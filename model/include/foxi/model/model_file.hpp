@@ -11,8 +11,10 @@
 //   [[parts]]
 //   name = "die"  material = "silicon"  shape = "box"  origin = [...]  size = ["die_w", 3, 0.5]
 //   shape = "cylinder": center (of the base), radius, height, segments (default 16)
+//   shape = "extrusion": points = [[x, y], ...] (a simple polygon, convex or not, either orientation),
+//     z (of the base), height
 //   shape = "layers": origin, footprint = [w, d], thicknesses = [...], names = [...], materials = [...]
-//   shape = "array": count = [nx, ny], pitch = [px, py], item = { shape = "box" | "cylinder", ... }
+//   shape = "array": count = [nx, ny], pitch = [px, py], item = { shape = "box" | "cylinder" | ..., ... }
 #pragma once
 
 #include <cstdint>
@@ -26,7 +28,7 @@
 
 namespace foxi {
 
-// A vertical prism: a convex counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
+// A vertical prism: a simple (convex or not) counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
 // over z in [z0, z1].
 struct Prism {
   std::vector<double> xy;

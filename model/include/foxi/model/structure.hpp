@@ -7,8 +7,7 @@
 // slab the footprint edges, split where they meet (CGAL surface sweep, exact), form a planar subdivision;
 // horizontal facets are emitted where the owner changes across a level, vertical facets where it
 // changes across an arrangement edge, and each facet carries every vertex that its neighbours put on
-// its boundary, so shared areas are one set of facets. Footprints must be convex polygons (all the
-// shapes of model_file.hpp are). Curved or tilted shapes (spheres, STL surfaces) are not handled.
+// its boundary, so shared areas are one set of facets. Footprints are simple polygons, convex or not.
 #pragma once
 
 #include <string>
