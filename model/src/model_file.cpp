@@ -336,9 +336,45 @@ class Loader {
     return static_cast<long>(x);
   }
 
-  // box or cylinder at `shift`
-  Prism primitive(const Value& part, const std::string& shape, const std::string& who, double sx, double sy) {
-    Prism p;
+  // A ball or an STL surface shifted by (sx, sy), appended to out.surface.
+  void surface_primitive(Part& out, const Value& part, const std::string& shape, const std::string& who,
+                         double sx, double sy) {
+    const Table& t = part.as_table();
+    if (shape == "stl") {
+      const Value& f = need(part, "file", who);
+      const std::filesystem::path file = path_.parent_path() / string_of(f, who + " file");
+      auto cached = stl_.find(file.string());
+      if (cached == stl_.end()) cached = stl_.emplace(file.string(), read_stl(file, model_.length_scale)).first;
+      out.surface.append(cached->second, sx, sy, 0);
+      out.source = file.string();
+      return;
+    }
+    Ball b;
+    const auto c = lengths(need(part, "center", who), 3, who + " center", false);
+    b.center[0] = c[0] + sx;
+    b.center[1] = c[1] + sy;
+    b.center[2] = c[2];
+    b.radius = positive_length(need(part, "radius", who), who + " radius");
+    b.z0 = c[2] - b.radius;
+    b.z1 = c[2] + b.radius;
+    if (auto it = t.find("z_range"); it != t.end()) {
+      const auto z = lengths(it->second, 2, who + " z_range", false);
+      if (!(z[0] < z[1]) || z[1] <= b.z0 || z[0] >= b.z1)
+        throw Located{line_of(it->second), who + " z_range: expected [z0, z1] with z0 < z1 cutting the sphere"};
+      b.z0 = std::max(b.z0, z[0]);
+      b.z1 = std::min(b.z1, z[1]);
+    }
+    b.tolerance = 0.01 * b.radius;
+    if (auto it = t.find("tolerance"); it != t.end()) b.tolerance = positive_length(it->second, who + " tolerance");
+    out.surface.append(ball_surface(b));
+  }
+
+  // A box, cylinder or extrusion shifted by (sx, sy) appended to out.prisms, or a ball or STL
+  // surface appended to out.surface.
+  void primitive(Part& out, const Value& part, const std::string& shape, const std::string& who, double sx,
+                 double sy) {
+    if (shape == "ball" || shape == "stl") return surface_primitive(out, part, shape, who, sx, sy);
+    Prism& p = out.prisms.emplace_back();
     if (shape == "box") {
       const auto o = lengths(need(part, "origin", who), 3, who + " origin", false);
       const auto s = lengths(need(part, "size", who), 3, who + " size", true);
@@ -383,7 +419,6 @@ class Loader {
       throw Located{line_of(part), who + ": unknown shape '" + shape +
                                        "' (expected box, cylinder, extrusion, ball, stl, layers, array)"};
     }
-    return p;
   }
 
   void check_keys(const Value& part, const std::string& who, std::initializer_list<const char*> allowed) {
@@ -472,17 +507,23 @@ class Loader {
         if (ishape == "cylinder")
           check_keys(item, who + " item", {"shape", "center", "radius", "height", "segments"});
         if (ishape == "extrusion") check_keys(item, who + " item", {"shape", "points", "z", "height"});
+        if (ishape == "ball")
+          check_keys(item, who + " item", {"shape", "center", "radius", "z_range", "tolerance"});
+        if (ishape == "stl") check_keys(item, who + " item", {"shape", "file"});
         for (long j = 0; j < ny; ++j)
           for (long i = 0; i < nx; ++i)
-            part.prisms.push_back(primitive(item, ishape, who + " item", static_cast<double>(i) * pp[0],
-                                            static_cast<double>(j) * pp[1]));
+            primitive(part, item, ishape, who + " item", static_cast<double>(i) * pp[0],
+                      static_cast<double>(j) * pp[1]);
       } else {
         if (shape == "box") check_keys(pv, who, {"name", "shape", "material", "origin", "size"});
         if (shape == "cylinder")
           check_keys(pv, who, {"name", "shape", "material", "center", "radius", "height", "segments"});
         if (shape == "extrusion")
           check_keys(pv, who, {"name", "shape", "material", "points", "z", "height"});
-        part.prisms.push_back(primitive(pv, shape, who, 0, 0));
+        if (shape == "ball")
+          check_keys(pv, who, {"name", "shape", "material", "center", "radius", "z_range", "tolerance"});
+        if (shape == "stl") check_keys(pv, who, {"name", "shape", "material", "file"});
+        primitive(part, pv, shape, who, 0, 0);
       }
       add_part(std::move(part));
     }
@@ -500,6 +541,7 @@ class Loader {
   Model model_;
   std::map<std::string, ParamEntry> params_;
   std::map<std::string, Material> materials_;
+  std::map<std::string, TriSurface> stl_;  // by file, read once
 };
 
 }  // namespace

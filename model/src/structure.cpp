@@ -23,6 +23,7 @@
 #include <tuple>
 
 #include "foxi/model/io_error.hpp"
+#include "structure_solids.hpp"
 
 namespace foxi {
 
@@ -393,13 +394,7 @@ class Builder {
     return part_name(a) + "/" + part_name(b);
   }
 
-  std::int32_t marker_of(const std::string& name) {
-    for (std::size_t i = 0; i < s_.boundary_names.size(); ++i)
-      if (s_.boundary_names[i] == name) return static_cast<std::int32_t>(i + 1);
-    s_.boundary_names.push_back(name);
-    s_.boundary_area.push_back(0);
-    return static_cast<std::int32_t>(s_.boundary_names.size());
-  }
+  std::int32_t marker_of(const std::string& name) { return boundary_marker(s_, name); }
 
   std::uint32_t point(double x, double y, std::size_t z) {
     auto key = std::make_tuple(x, y, z);
@@ -428,7 +423,19 @@ class Builder {
 
 }  // namespace
 
-Structure build_structure(const Model& model) { return Builder(model).build(); }
+std::int32_t boundary_marker(Structure& s, const std::string& name) {
+  for (std::size_t i = 0; i < s.boundary_names.size(); ++i)
+    if (s.boundary_names[i] == name) return static_cast<std::int32_t>(i + 1);
+  s.boundary_names.push_back(name);
+  s.boundary_area.push_back(0);
+  return static_cast<std::int32_t>(s.boundary_names.size());
+}
+
+Structure build_structure(const Model& model) {
+  for (const Part& p : model.parts)
+    if (!p.surface.tri.empty()) return build_structure_from_solids(model);
+  return Builder(model).build();
+}
 void name_mesh(const Model& model, const Structure& structure, Mesh& mesh) {
   mesh.materials.clear();
   for (const Material& m : model.materials) mesh.materials.push_back(m);

@@ -5,9 +5,15 @@
 // fail with the file, the line and the part's name.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <numbers>
 #include <string>
 
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/surface.hpp"
 #include "structure_mesh.hpp"
 #include "test_util.hpp"
 
@@ -78,6 +84,139 @@ TEST(StructureShapes, SelfIntersectingOutlineIsRejectedWithThePart) {
   EXPECT_NE(e.reason().find("part 'bow' points"), std::string::npos) << e.what();
   EXPECT_NE(e.reason().find("not a simple polygon"), std::string::npos) << e.what();
   EXPECT_EQ(e.line(), 8u);  // the points line
+}
+
+// ---- balls ----
+
+std::string ball(const std::string& name, double cx, double cy, double cz, double r, double z0, double z1,
+                 double tol) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "[[parts]]\nname = \"%s\"\nmaterial = \"a\"\nshape = \"ball\"\ncenter = [%.17g, %.17g, %.17g]\n"
+                "radius = %.17g\nz_range = [%.17g, %.17g]\ntolerance = %.17g\n",
+                name.c_str(), cx, cy, cz, r, z0, z1, tol);
+  return buf;
+}
+
+// The faceting of the same ball in metres (the model is in mm).
+foxi::BallFaceting faceting_mm(double cz, double r, double z0, double z1, double tol) {
+  foxi::Ball b;
+  b.center[2] = cz * 1e-3;
+  b.radius = r * 1e-3;
+  b.z0 = z0 * 1e-3;
+  b.z1 = z1 * 1e-3;
+  b.tolerance = tol * 1e-3;
+  return foxi::ball_faceting(b);
+}
+
+// Volume of the faceted ball as a stack of frusta of regular n-gon pyramids: h/3 (A + B + sqrt(A B)).
+double frusta_volume(const foxi::BallFaceting& f) {
+  double v = 0;
+  for (std::size_t k = 0; k + 1 < f.ring_z.size(); ++k) {
+    const double a = ngon_area(static_cast<int>(f.around), f.ring_radius[k]);
+    const double b = ngon_area(static_cast<int>(f.around), f.ring_radius[k + 1]);
+    v += (f.ring_z[k] - f.ring_z[k + 1]) / 3 * (a + b + std::sqrt(a * b));
+  }
+  return v;
+}
+
+// The sphere between two planes: pi * integral of r^2 - (z - c)^2 dz.
+double segment_volume(double cz, double r, double z0, double z1) {
+  auto prim = [&](double z) { return r * r * z - std::pow(z - cz, 3) / 3; };
+  return std::numbers::pi * (prim(z1) - prim(z0));
+}
+
+TEST(StructureShapes, BallFacetingStaysWithinTheTolerance) {
+  // every ring vertex on the sphere, every chord's sagitta (around and along meridians) <= tol / 2
+  const double r = 0.5e-3, tol = 3e-6;
+  foxi::Ball b;
+  b.radius = r;
+  b.z0 = -0.3e-3;
+  b.z1 = 0.45e-3;
+  b.tolerance = tol;
+  const foxi::BallFaceting f = foxi::ball_faceting(b);
+  EXPECT_EQ(f.around % 4, 0u);
+  EXPECT_LE(r * (1 - std::cos(std::numbers::pi / f.around)), tol / 2);
+  EXPECT_DOUBLE_EQ(f.ring_z.front(), b.z1);
+  EXPECT_DOUBLE_EQ(f.ring_z.back(), b.z0);
+  for (std::size_t k = 0; k < f.ring_z.size(); ++k) {
+    EXPECT_NEAR(std::hypot(f.ring_radius[k], f.ring_z[k]), r, 1e-15) << k;
+    if (k == 0) continue;
+    const double chord = std::hypot(f.ring_radius[k] - f.ring_radius[k - 1], f.ring_z[k] - f.ring_z[k - 1]);
+    EXPECT_LE(r - std::sqrt(r * r - chord * chord / 4), tol / 2 * (1 + 1e-12)) << k;
+  }
+  // the surface: closed (every edge twice, once each way) with the frusta volume (divergence theorem)
+  const foxi::TriSurface s = foxi::ball_surface(b);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  double vol = 0;
+  for (std::size_t t = 0; t < s.triangle_count(); ++t) {
+    const std::uint32_t* c = &s.tri[3 * t];
+    for (int i = 0; i < 3; ++i) ++edges[{c[i], c[(i + 1) % 3]}];
+    const double* p = &s.xyz[3 * c[0]];
+    const double* q = &s.xyz[3 * c[1]];
+    const double* w = &s.xyz[3 * c[2]];
+    vol += (p[0] * (q[1] * w[2] - q[2] * w[1]) - p[1] * (q[0] * w[2] - q[2] * w[0]) +
+            p[2] * (q[0] * w[1] - q[1] * w[0])) / 6;
+  }
+  for (const auto& [e, k] : edges) {
+    EXPECT_EQ(k, 1);
+    EXPECT_EQ(edges.count({e.second, e.first}), 1u);
+  }
+  EXPECT_NEAR(vol, frusta_volume(f), 1e-12 * vol);
+  EXPECT_GT(vol, 0);
+}
+
+TEST(StructureShapes, SolderBallBetweenTwoPads) {
+  // pads [0,2]^2 x [0,0.2] and [0,2]^2 x [1,1.2] mm, a ball r 0.5 centred at (1, 1, 0.6) cut by both
+  const double cz = 0.6, r = 0.5, z0 = 0.2, z1 = 1.0, tol = 0.005;
+  const Meshed m = mesh_text(boxes_model(box("low", 0, 0, 0, 2, 2, 0.2) + box("high", 0, 0, 1, 2, 2, 0.2) +
+                                         ball("ball", 1, 1, cz, r, z0, z1, tol)),
+                             0);
+  const foxi::BallFaceting f = faceting_mm(cz, r, z0, z1, tol);
+  const double vf = frusta_volume(f);
+  expect_volumes(m, {{"low", 0.8 * kMm3}, {"high", 0.8 * kMm3}, {"ball", vf}});
+  // the faceted ball is inscribed: smaller than the sphere segment by at most tolerance x area
+  const double va = segment_volume(cz, r, z0, z1) * kMm3;
+  EXPECT_GT(va, vf);
+  EXPECT_LT(va - vf, tol * kMm * 4 * std::numbers::pi * r * r * kMm2);
+  const double a_low = ngon_area(static_cast<int>(f.around), f.ring_radius.back());
+  const double a_high = ngon_area(static_cast<int>(f.around), f.ring_radius.front());
+  expect_near_rel(m.boundary_area.at("low/ball"), a_low, "low/ball");
+  expect_near_rel(m.boundary_area.at("high/ball"), a_high, "high/ball");
+  expect_near_rel(m.boundary_area.at("low.top"), 4 * kMm2 - a_low, "low.top");
+  expect_near_rel(m.boundary_area.at("high.bottom"), 4 * kMm2 - a_high, "high.bottom");
+  expect_near_rel(m.boundary_area.at("low.bottom"), 4 * kMm2, "low.bottom");
+  EXPECT_EQ(m.boundary_area.count("ball.top"), 0u);
+  EXPECT_EQ(m.boundary_area.count("ball.bottom"), 0u);
+  EXPECT_EQ(m.boundary_area.size(), 9u);  // + low.side, high.side, high.top, ball.side
+}
+
+TEST(StructureShapes, BallCarvesHalfItsVolumeOutOfABox) {
+  // a whole ball centred on the face x = 2 of a 2 mm cube: the faceting is symmetric about x = 2,
+  // so the cube loses exactly half the faceted volume and half the faceted surface is the interface
+  const double r = 0.6, tol = 0.01;
+  const Meshed m =
+      mesh_text(boxes_model(box("cube", 0, 0, 0, 2, 2, 2) + ball("ball", 2, 1, 1, r, 0, 2, tol)), 0);
+  const double vf = frusta_volume(faceting_mm(1, r, 0.4, 1.6, tol));
+  expect_volumes(m, {{"cube", 8 * kMm3 - vf / 2}, {"ball", vf}});
+  foxi::Ball b;
+  b.radius = r * kMm;
+  b.z0 = -r * kMm;
+  b.z1 = r * kMm;
+  b.tolerance = tol * kMm;
+  const foxi::TriSurface s = foxi::ball_surface(b);
+  double area = 0;
+  for (std::size_t t = 0; t < s.triangle_count(); ++t) {
+    const double* p = &s.xyz[3 * s.tri[3 * t]];
+    const double* q = &s.xyz[3 * s.tri[3 * t + 1]];
+    const double* w = &s.xyz[3 * s.tri[3 * t + 2]];
+    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, v[3] = {w[0] - p[0], w[1] - p[1], w[2] - p[2]};
+    area += 0.5 * std::sqrt(std::pow(u[1] * v[2] - u[2] * v[1], 2) + std::pow(u[2] * v[0] - u[0] * v[2], 2) +
+                            std::pow(u[0] * v[1] - u[1] * v[0], 2));
+  }
+  expect_near_rel(m.boundary_area.at("cube/ball"), area / 2, "cube/ball");
+  expect_near_rel(m.boundary_area.at("ball.side"), area / 2, "ball.side");
+  expect_near_rel(m.boundary_area.at("cube.top"), 4 * kMm2, "cube.top");
 }
 
 }  // namespace
