@@ -5,12 +5,14 @@
 // fail with the file, the line and the part's name.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/surface.hpp"
@@ -217,6 +219,131 @@ TEST(StructureShapes, BallCarvesHalfItsVolumeOutOfABox) {
   expect_near_rel(m.boundary_area.at("cube/ball"), area / 2, "cube/ball");
   expect_near_rel(m.boundary_area.at("ball.side"), area / 2, "ball.side");
   expect_near_rel(m.boundary_area.at("cube.top"), 4 * kMm2, "cube.top");
+}
+
+// ---- STL surfaces ----
+
+using Tri = std::array<std::array<double, 3>, 3>;
+
+// The 12 outward triangles of the box [x0, x1] x [y0, y1] x [z0, z1].
+std::vector<Tri> cube(double x0, double y0, double z0, double x1, double y1, double z1) {
+  const double X[2] = {x0, x1}, Y[2] = {y0, y1}, Z[2] = {z0, z1};
+  auto c = [&](int i, int j, int k) { return std::array<double, 3>{X[i], Y[j], Z[k]}; };
+  std::vector<Tri> t;
+  auto quad = [&](std::array<double, 3> a, std::array<double, 3> b, std::array<double, 3> d,
+                  std::array<double, 3> e) {  // counter-clockwise seen from outside
+    t.push_back({a, b, d});
+    t.push_back({a, d, e});
+  };
+  quad(c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), c(1, 0, 0));  // bottom
+  quad(c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1));  // top
+  quad(c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1));  // y = y0
+  quad(c(0, 1, 0), c(0, 1, 1), c(1, 1, 1), c(1, 1, 0));  // y = y1
+  quad(c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0));  // x = x0
+  quad(c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), c(1, 0, 1));  // x = x1
+  return t;
+}
+
+// The 4 outward triangles of the tetrahedron o, o + a x, o + a y, o + a z.
+std::vector<Tri> tetra(double x, double y, double z, double a) {
+  const std::array<double, 3> o{x, y, z}, px{x + a, y, z}, py{x, y + a, z}, pz{x, y, z + a};
+  return {{o, py, px}, {o, px, pz}, {o, pz, py}, {px, py, pz}};
+}
+
+void write_ascii_stl(const std::filesystem::path& path, const std::vector<Tri>& tris) {
+  std::string text = "solid test\n";
+  char buf[128];
+  for (const Tri& t : tris) {
+    text += "  facet normal 0 0 0\n    outer loop\n";
+    for (const auto& v : t) {
+      std::snprintf(buf, sizeof buf, "      vertex %.17g %.17g %.17g\n", v[0], v[1], v[2]);
+      text += buf;
+    }
+    text += "    endloop\n  endfacet\n";
+  }
+  foxi::test::write_text(path, text + "endsolid test\n");
+}
+
+void write_binary_stl(const std::filesystem::path& path, const std::vector<Tri>& tris) {
+  std::string data(80, ' ');
+  const auto n = static_cast<std::uint32_t>(tris.size());
+  data.append(reinterpret_cast<const char*>(&n), 4);
+  for (const Tri& t : tris) {
+    float f[12] = {};
+    for (std::size_t v = 0; v < 3; ++v)
+      for (std::size_t i = 0; i < 3; ++i) f[3 + 3 * v + i] = static_cast<float>(t[v][i]);
+    data.append(reinterpret_cast<const char*>(f), sizeof f);
+    data.append(2, '\0');
+  }
+  std::ofstream(path, std::ios::binary).write(data.data(), static_cast<std::streamsize>(data.size()));
+}
+
+std::string stl_part(const std::string& name, const std::string& file) {
+  return "[[parts]]\nname = \"" + name + "\"\nmaterial = \"a\"\nshape = \"stl\"\nfile = \"" + file + "\"\n";
+}
+
+TEST(StructureShapes, StlCubeCarvesABaseAndAnStlTetrahedronSitsOnItsEdge) {
+  // base [0,3]^2 x [0,1]; a binary STL cube [1,2]^2 x [0.5,1.5] sunk half into it; an ASCII STL
+  // tetrahedron (legs 1 from (2.5, 2.5, 1)) standing on the base's top, overhanging its edges x = 3
+  // and y = 3: its foot inside the base is the triangle of legs 1 less two corners of legs 0.5.
+  TempDir dir;
+  write_binary_stl(dir / "cube.stl", cube(1, 1, 0.5, 2, 2, 1.5));
+  write_ascii_stl(dir / "tet.stl", tetra(2.5, 2.5, 1, 1));
+  foxi::test::write_text(dir / "m.toml", boxes_model(box("base", 0, 0, 0, 3, 3, 1) + stl_part("cube", "cube.stl") +
+                                                     stl_part("tet", "tet.stl")));
+  const Meshed m = foxi::test::mesh_model((dir / "m.toml").string(), {}, 0);
+  expect_volumes(m, {{"base", 8.5 * kMm3}, {"cube", 1 * kMm3}, {"tet", kMm3 / 6}});
+  expect_near_rel(m.boundary_area.at("base/cube"), 3 * kMm2, "base/cube");
+  expect_near_rel(m.boundary_area.at("cube.top"), 1 * kMm2, "cube.top");
+  expect_near_rel(m.boundary_area.at("cube.side"), 2 * kMm2, "cube.side");
+  expect_near_rel(m.boundary_area.at("base/tet"), 0.25 * kMm2, "base/tet");
+  expect_near_rel(m.boundary_area.at("tet.bottom"), 0.25 * kMm2, "tet.bottom");
+  expect_near_rel(m.boundary_area.at("base.top"), (9 - 1 - 0.25) * kMm2, "base.top");
+}
+
+// The build error of a model with one STL part of these triangles (ASCII).
+foxi::IoError stl_error(const std::vector<Tri>& tris) {
+  TempDir dir;
+  write_ascii_stl(dir / "s.stl", tris);
+  const std::string text = boxes_model(box("base", 0, 0, 0, 3, 3, 1) + stl_part("blob", "s.stl"));
+  foxi::test::write_text(dir / "bad.toml", text);
+  try {
+    foxi::build_structure(foxi::load_model(dir / "bad.toml"));
+  } catch (const foxi::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.toml"), std::string::npos) << e.what();
+    EXPECT_NE(e.reason().find("part 'blob'"), std::string::npos) << e.what();
+    EXPECT_NE(e.reason().find("s.stl"), std::string::npos) << e.what();
+    EXPECT_EQ(e.line(), 10u);  // [[parts]] of blob
+    return e;
+  }
+  ADD_FAILURE() << "no error";
+  return foxi::IoError("", 0, 0, "");
+}
+
+TEST(StructureShapes, SelfIntersectingStlIsRejectedWithThePart) {
+  std::vector<Tri> t = tetra(0, 0, 0, 1);
+  for (const Tri& x : tetra(0.2, 0.2, 0.2, 1)) t.push_back(x);  // a second tetrahedron through the first
+  const foxi::IoError e = stl_error(t);
+  EXPECT_NE(e.reason().find("intersects itself"), std::string::npos) << e.what();
+}
+
+TEST(StructureShapes, OpenOrInconsistentStlIsRejectedWithThePart) {
+  std::vector<Tri> open = cube(0, 0, 0, 1, 1, 1);
+  open.pop_back();
+  EXPECT_NE(stl_error(open).reason().find("not closed"), std::string::npos);
+  std::vector<Tri> flipped = cube(0, 0, 0, 1, 1, 1);
+  std::swap(flipped[3][0], flipped[3][1]);
+  EXPECT_NE(stl_error(flipped).reason().find("consistently oriented"), std::string::npos);
+}
+
+TEST(StructureShapes, InsideOutStlIsTurnedAround) {
+  std::vector<Tri> t = tetra(4, 0, 0, 1);
+  for (Tri& x : t) std::swap(x[0], x[1]);
+  TempDir dir;
+  write_ascii_stl(dir / "t.stl", t);
+  foxi::test::write_text(dir / "m.toml", boxes_model(box("base", 0, 0, 0, 3, 3, 1) + stl_part("t", "t.stl")));
+  const foxi::Structure s = foxi::build_structure(foxi::load_model(dir / "m.toml"));
+  EXPECT_NEAR(s.part_volume[1], kMm3 / 6, 1e-15 * kMm3);
 }
 
 }  // namespace
