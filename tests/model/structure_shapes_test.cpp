@@ -221,6 +221,45 @@ TEST(StructureShapes, BallCarvesHalfItsVolumeOutOfABox) {
   expect_near_rel(m.boundary_area.at("cube.top"), 4 * kMm2, "cube.top");
 }
 
+// Side area of the faceted ball: `around` planar trapezoids per ring step, parallel sides
+// 2 rho sin(pi / n), height sqrt(dz^2 + (d rho cos(pi / n))^2).
+double frusta_side_area(const foxi::BallFaceting& f) {
+  const double n = f.around, s = std::sin(std::numbers::pi / n), c = std::cos(std::numbers::pi / n);
+  double a = 0;
+  for (std::size_t k = 0; k + 1 < f.ring_z.size(); ++k) {
+    const double dz = f.ring_z[k] - f.ring_z[k + 1], dr = f.ring_radius[k] - f.ring_radius[k + 1];
+    a += n * (f.ring_radius[k] + f.ring_radius[k + 1]) * s * std::sqrt(dz * dz + dr * dr * c * c);
+  }
+  return a;
+}
+
+TEST(StructureShapes, BallGridArrayModelMeshesWithItsRegionsAndBoundaries) {
+  // models/bga.toml: board 8 x 8 x 0.8, package 6 x 6 x 0.4 at z 1.4, 9 balls r 0.38 centred at
+  // z 1.1 between them, a 6 x 6 x 0.6 mold cap carved by a 3 x 3 x 0.3 die; coarse balls for speed
+  const Meshed m = foxi::test::mesh_model(foxi::test::kModels + "bga.toml", {"ball_tol=0.02mm"}, 0);
+  const foxi::BallFaceting f = faceting_mm(1.1, 0.38, 0.8, 1.4, 0.02);
+  const double vb = frusta_volume(f), end = ngon_area(static_cast<int>(f.around), f.ring_radius.front());
+  EXPECT_NEAR(f.ring_radius.front(), f.ring_radius.back(), 1e-12 * f.ring_radius.back());  // symmetric
+  expect_volumes(m, {{"board", 51.2 * kMm3},
+                     {"package", 14.4 * kMm3},
+                     {"balls", 9 * vb},
+                     {"mold", (21.6 - 2.7) * kMm3},
+                     {"die", 2.7 * kMm3}});
+  expect_areas(m, {{"board.bottom", 64 * kMm2},
+                   {"board.side", 4 * 8 * 0.8 * kMm2},
+                   {"board.top", 64 * kMm2 - 9 * end},
+                   {"board/balls", 9 * end},
+                   {"balls.side", 9 * frusta_side_area(f)},
+                   {"package/balls", 9 * end},
+                   {"package.bottom", 36 * kMm2 - 9 * end},
+                   {"package.side", 4 * 6 * 0.4 * kMm2},
+                   {"package/mold", 27 * kMm2},
+                   {"package/die", 9 * kMm2},
+                   {"mold/die", (9 + 4 * 3 * 0.3) * kMm2},
+                   {"mold.side", 4 * 6 * 0.6 * kMm2},
+                   {"mold.top", 36 * kMm2}});
+}
+
 // ---- STL surfaces ----
 
 using Tri = std::array<std::array<double, 3>, 3>;
