@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <numbers>
@@ -40,6 +41,18 @@ foxi::IoError build_error(const std::string& text) {
   }
   ADD_FAILURE() << "no error for:\n" << text;
   return foxi::IoError("", 0, 0, "");
+}
+
+// det(a, b, c) / 6: the signed volume of the tetrahedron (origin, a, b, c).
+double origin_tet_volume(const double* a, const double* b, const double* c) {
+  return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+}
+
+double triangle_area(const double* a, const double* b, const double* c) {
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  return 0.5 * std::sqrt(std::pow(u[1] * v[2] - u[2] * v[1], 2) + std::pow(u[2] * v[0] - u[0] * v[2], 2) +
+                         std::pow(u[0] * v[1] - u[1] * v[0], 2));
 }
 
 TEST(StructureShapes, UShapedExtrusionAroundABoxAndAClockwiseL) {
@@ -157,8 +170,7 @@ TEST(StructureShapes, BallFacetingStaysWithinTheTolerance) {
     const double* p = &s.xyz[3 * c[0]];
     const double* q = &s.xyz[3 * c[1]];
     const double* w = &s.xyz[3 * c[2]];
-    vol += (p[0] * (q[1] * w[2] - q[2] * w[1]) - p[1] * (q[0] * w[2] - q[2] * w[0]) +
-            p[2] * (q[0] * w[1] - q[1] * w[0])) / 6;
+    vol += origin_tet_volume(p, q, w);
   }
   for (const auto& [e, k] : edges) {
     EXPECT_EQ(k, 1);
@@ -212,9 +224,7 @@ TEST(StructureShapes, BallCarvesHalfItsVolumeOutOfABox) {
     const double* p = &s.xyz[3 * s.tri[3 * t]];
     const double* q = &s.xyz[3 * s.tri[3 * t + 1]];
     const double* w = &s.xyz[3 * s.tri[3 * t + 2]];
-    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, v[3] = {w[0] - p[0], w[1] - p[1], w[2] - p[2]};
-    area += 0.5 * std::sqrt(std::pow(u[1] * v[2] - u[2] * v[1], 2) + std::pow(u[2] * v[0] - u[0] * v[2], 2) +
-                            std::pow(u[0] * v[1] - u[1] * v[0], 2));
+    area += triangle_area(p, q, w);
   }
   expect_near_rel(m.boundary_area.at("cube/ball"), area / 2, "cube/ball");
   expect_near_rel(m.boundary_area.at("ball.side"), area / 2, "ball.side");
@@ -383,6 +393,44 @@ TEST(StructureShapes, InsideOutStlIsTurnedAround) {
   foxi::test::write_text(dir / "m.toml", boxes_model(box("base", 0, 0, 0, 3, 3, 1) + stl_part("t", "t.stl")));
   const foxi::Structure s = foxi::build_structure(foxi::load_model(dir / "m.toml"));
   EXPECT_NEAR(s.part_volume[1], kMm3 / 6, 1e-15 * kMm3);
+}
+
+TEST(StructureShapes, GmshSphereStlCarvesACube) {
+  // gmsh writes the STL (a foreign file); the expected volume and area are summed here from its
+  // "vertex" lines, independently of foxi's reader (divergence theorem: sum of det(a, b, c) / 6)
+  if (!foxi::test::have_program("gmsh")) GTEST_SKIP() << "gmsh is missing";
+  TempDir dir;
+  foxi::test::write_text(dir / "s.geo",
+                         "SetFactory(\"OpenCASCADE\");\nSphere(1) = {2, 2, 2, 1};\nMesh.MeshSizeMax = 0.4;\n");
+  ASSERT_EQ(foxi::test::run("cd '" + dir.path().string() + "' && gmsh -2 s.geo -format stl -o s.stl",
+                            dir / "gmsh.log"),
+            0)
+      << foxi::test::read_text(dir / "gmsh.log");
+  const std::string stl = foxi::test::read_text(dir / "s.stl");
+  std::vector<double> c;
+  for (std::size_t at = stl.find("vertex"); at != std::string::npos; at = stl.find("vertex", at + 6)) {
+    const char* p = stl.c_str() + at + 6;
+    char* e = nullptr;
+    for (int i = 0; i < 3; ++i, p = e) c.push_back(std::strtod(p, &e));
+  }
+  ASSERT_EQ(c.size() % 9, 0u);
+  double vol = 0, area = 0;
+  for (std::size_t t = 0; t < c.size(); t += 9) {
+    const double* a = &c[t];
+    const double* b = &c[t + 3];
+    const double* d = &c[t + 6];
+    vol += origin_tet_volume(a, b, d);
+    area += triangle_area(a, b, d);
+  }
+  vol = std::abs(vol);
+  EXPECT_NEAR(vol, 4 * std::numbers::pi / 3, 0.25);  // a sphere of radius 1, coarsely faceted (size 0.4)
+  foxi::test::write_text(dir / "m.toml", boxes_model(box("cube", 0, 0, 0, 4, 4, 4) + stl_part("ball", "s.stl")));
+  const Meshed m = foxi::test::mesh_model((dir / "m.toml").string(), {}, 0);
+  expect_volumes(m, {{"cube", (64 - vol) * kMm3}, {"ball", vol * kMm3}});
+  expect_areas(m, {{"cube.top", 16 * kMm2},
+                   {"cube.bottom", 16 * kMm2},
+                   {"cube.side", 64 * kMm2},
+                   {"cube/ball", area * kMm2}});
 }
 
 }  // namespace
