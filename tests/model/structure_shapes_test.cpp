@@ -270,6 +270,25 @@ TEST(StructureShapes, BallGridArrayModelMeshesWithItsRegionsAndBoundaries) {
                    {"mold.top", 36 * kMm2}});
 }
 
+TEST(StructureShapes, OverlappingBallsOfAnArrayAreRejectedWithThePart) {
+  // pitch 0.5 < diameter 0.8: the items of one part intersect each other
+  const std::string text = boxes_model(
+      box("base", 0, 0, 0, 3, 3, 1) +
+      "[[parts]]\nname = \"balls\"\nmaterial = \"a\"\nshape = \"array\"\ncount = [2, 1]\npitch = [0.5, 1]\n"
+      "item = { shape = \"ball\", center = [1, 1, 1.2], radius = 0.4, z_range = [1, 2] }\n");
+  const foxi::IoError e = build_error(text);
+  EXPECT_NE(e.reason().find("part 'balls'"), std::string::npos) << e.what();
+  EXPECT_NE(e.reason().find("intersects itself"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), 10u);
+}
+
+TEST(StructureShapes, BoxSwallowedByALaterBallIsAnError) {
+  const foxi::IoError e =
+      build_error(boxes_model(box("chip", 0, 0, 0, 0.2, 0.2, 0.2) + ball("blob", 0.1, 0.1, 0.1, 1, -1, 1, 0.05)));
+  EXPECT_NE(e.reason().find("'chip' is carved away entirely"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), 4u);
+}
+
 // ---- STL surfaces ----
 
 using Tri = std::array<std::array<double, 3>, 3>;
