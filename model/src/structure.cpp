@@ -431,9 +431,9 @@ std::int32_t boundary_marker(Structure& s, const std::string& name) {
   return static_cast<std::int32_t>(s.boundary_names.size());
 }
 
-Structure build_structure(const Model& model) {
+Structure build_structure(const Model& model, const ProgressFn& progress) {
   for (const Part& p : model.parts)
-    if (!p.surface.tri.empty()) return build_structure_from_solids(model);
+    if (!p.surface.tri.empty()) return build_structure_from_solids(model, progress);
   return Builder(model).build();
 }
 void name_mesh(const Model& model, const Structure& structure, Mesh& mesh) {

@@ -94,16 +94,20 @@ double ray_hit(const V3& o, const V3& d, const std::vector<std::array<V3, 3>>& t
 
 class SolidBuilder {
  public:
-  explicit SolidBuilder(const Model& m) : m_(m) {}
+  SolidBuilder(const Model& m, const ProgressFn& progress) : m_(m), progress_(progress) {}
 
   Structure build() {
     const std::size_t n = m_.parts.size();
     solid_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) solid_[i] = closed_surface(i);
+    for (std::size_t i = 0; i < n; ++i) {
+      report("surfaces", i, n);
+      solid_[i] = closed_surface(i);
+    }
     std::vector<CGAL::Bbox_3> box(n);
     for (std::size_t i = 0; i < n; ++i) box[i] = PMP::bbox(solid_[i]);
     // 2. carve: part i minus the later parts that may overlap it
     for (std::size_t i = 0; i < n; ++i) {
+      report("carve", i, n);
       for (std::size_t j = i + 1; j < n; ++j) {
         if (!CGAL::do_overlap(box[i], box[j]) || solid_[i].is_empty()) continue;
         SMesh later = solid_[j];  // corefinement refines both operands; keep part j's own surface
@@ -125,7 +129,10 @@ class SolidBuilder {
       for (std::size_t j = i + 1; j < n; ++j)
         if (CGAL::do_overlap(box[i], box[j])) pairs.emplace_back(i, j);
     for (int round = 0;; ++round) {
-      for (auto [i, j] : pairs) PMP::corefine(solid_[i], solid_[j]);
+      for (std::size_t k = 0; k < pairs.size(); ++k) {
+        report("conform", k, pairs.size());
+        PMP::corefine(solid_[pairs[k].first], solid_[pairs[k].second]);
+      }
       if (emit(pairs)) break;
       if (round == 3)
         throw IoError(m_.file, 0, IoError::kNoOffset,
@@ -134,6 +141,7 @@ class SolidBuilder {
     // 4. volumes and seeds
     s_.part_volume.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
+      report("seeds", i, n);
       s_.part_volume[i] = CGAL::to_double(PMP::volume(solid_[i]));
       seeds(i);
     }
@@ -141,6 +149,11 @@ class SolidBuilder {
   }
 
  private:
+  void report(const char* stage, std::size_t done, std::size_t total) const {
+    if (progress_ && !progress_(stage, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1))))
+      throw StructureCancelled();
+  }
+
   [[noreturn]] void fail(std::size_t part, const std::string& reason) const {
     throw IoError(m_.file, m_.parts[part].line, IoError::kNoOffset, reason);
   }
@@ -290,6 +303,7 @@ class SolidBuilder {
   }
 
   const Model& m_;
+  const ProgressFn& progress_;
   Structure s_;
   std::vector<SMesh> solid_;
   std::map<P3, std::uint32_t> ids_;
@@ -297,6 +311,8 @@ class SolidBuilder {
 
 }  // namespace
 
-Structure build_structure_from_solids(const Model& model) { return SolidBuilder(model).build(); }
+Structure build_structure_from_solids(const Model& model, const ProgressFn& progress) {
+  return SolidBuilder(model, progress).build();
+}
 
 }  // namespace foxi

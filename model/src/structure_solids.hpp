@@ -12,7 +12,7 @@
 
 namespace foxi {
 
-Structure build_structure_from_solids(const Model& model);
+Structure build_structure_from_solids(const Model& model, const ProgressFn& progress);
 
 // The 1-based marker of the boundary `name` in s.boundary_names, appended (area 0) if new.
 std::int32_t boundary_marker(Structure& s, const std::string& name);

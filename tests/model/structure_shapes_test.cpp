@@ -289,6 +289,22 @@ TEST(StructureShapes, BoxSwallowedByALaterBallIsAnError) {
   EXPECT_EQ(e.line(), 4u);
 }
 
+TEST(StructureShapes, ProgressReportsStagesAndCancels) {
+  TempDir dir;
+  foxi::test::write_text(dir / "m.toml", boxes_model(box("cube", 0, 0, 0, 2, 2, 2) + ball("ball", 2, 1, 1, 0.6, 0, 2, 0.05)));
+  const foxi::Model model = foxi::load_model(dir / "m.toml");
+  std::vector<std::string> stages;
+  foxi::build_structure(model, [&](std::string_view stage, double f) {
+    EXPECT_GE(f, 0);
+    EXPECT_LE(f, 1);
+    if (stages.empty() || stages.back() != stage) stages.emplace_back(stage);
+    return true;
+  });
+  EXPECT_EQ(stages, (std::vector<std::string>{"surfaces", "carve", "conform", "seeds"}));
+  EXPECT_THROW(foxi::build_structure(model, [](std::string_view stage, double) { return stage != "conform"; }),
+               foxi::StructureCancelled);
+}
+
 // ---- STL surfaces ----
 
 using Tri = std::array<std::array<double, 3>, 3>;

@@ -35,6 +35,8 @@ using foxi::test::mesh_model;
 using foxi::test::mesh_text;
 using foxi::test::ngon_area;
 using foxi::test::ngon_perimeter;
+using foxi::test::tet_volume;
+using foxi::test::tri_area;
 
 TEST(Structure, DieOnSubstrateMeshesToAnalyticVolumesAndAreas) {
   const Meshed m = mesh_model(kModels + "die_on_substrate.toml", {}, 1e-9);

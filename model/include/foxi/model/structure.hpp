@@ -18,12 +18,14 @@
 // "P.bottom", all others "P.side"; region seeds are points strictly inside every connected piece.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/plc.hpp"
+#include "foxi/model/progress.hpp"
 
 namespace foxi {
 
@@ -39,7 +41,12 @@ struct Structure {
 // line of the part, its name) for a part carved away entirely, a part surface that is not closed,
 // not consistently oriented or intersects itself (also two items of one array that overlap), and a
 // carving that leaves a non-manifold solid.
-Structure build_structure(const Model& model);
+// `progress` (may be empty) is called by the triangle-surface path with the stages "surfaces",
+// "carve", "conform" and "seeds"; returning false cancels with StructureCancelled.
+struct StructureCancelled : std::runtime_error {
+  StructureCancelled() : std::runtime_error("building the structure was cancelled") {}
+};
+Structure build_structure(const Model& model, const ProgressFn& progress = {});
 
 // Names a mesh of the structure's PLC: region names and materials from the parts, boundary names
 // from the markers. Regions and boundaries the mesh lacks are added.
