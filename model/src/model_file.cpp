@@ -344,7 +344,8 @@ class Loader {
       const Value& f = need(part, "file", who);
       const std::filesystem::path file = path_.parent_path() / string_of(f, who + " file");
       auto cached = stl_.find(file.string());
-      if (cached == stl_.end()) cached = stl_.emplace(file.string(), read_stl(file, model_.length_scale)).first;
+      if (cached == stl_.end())
+        cached = stl_.emplace(file.string(), read_stl(file, model_.length_scale)).first;
       out.surface.append(cached->second, sx, sy, 0);
       out.source = file.string();
       return;
@@ -360,12 +361,14 @@ class Loader {
     if (auto it = t.find("z_range"); it != t.end()) {
       const auto z = lengths(it->second, 2, who + " z_range", false);
       if (!(z[0] < z[1]) || z[1] <= b.z0 || z[0] >= b.z1)
-        throw Located{line_of(it->second), who + " z_range: expected [z0, z1] with z0 < z1 cutting the sphere"};
+        throw Located{line_of(it->second),
+                      who + " z_range: expected [z0, z1] with z0 < z1 cutting the sphere"};
       b.z0 = std::max(b.z0, z[0]);
       b.z1 = std::min(b.z1, z[1]);
     }
     b.tolerance = 0.01 * b.radius;
-    if (auto it = t.find("tolerance"); it != t.end()) b.tolerance = positive_length(it->second, who + " tolerance");
+    if (auto it = t.find("tolerance"); it != t.end())
+      b.tolerance = positive_length(it->second, who + " tolerance");
     out.surface.append(ball_surface(b));
   }
 
@@ -518,8 +521,7 @@ class Loader {
         if (shape == "box") check_keys(pv, who, {"name", "shape", "material", "origin", "size"});
         if (shape == "cylinder")
           check_keys(pv, who, {"name", "shape", "material", "center", "radius", "height", "segments"});
-        if (shape == "extrusion")
-          check_keys(pv, who, {"name", "shape", "material", "points", "z", "height"});
+        if (shape == "extrusion") check_keys(pv, who, {"name", "shape", "material", "points", "z", "height"});
         if (shape == "ball")
           check_keys(pv, who, {"name", "shape", "material", "center", "radius", "z_range", "tolerance"});
         if (shape == "stl") check_keys(pv, who, {"name", "shape", "material", "file"});

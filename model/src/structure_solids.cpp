@@ -66,7 +66,8 @@ std::vector<std::array<P3, 3>> triangles_of(const SMesh& m) {
   for (auto f : m.faces()) {
     std::array<P3, 3> t;
     int i = 0;
-    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) t[static_cast<std::size_t>(i++ % 3)] = m.point(v);
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+      t[static_cast<std::size_t>(i++ % 3)] = m.point(v);
     out.push_back(t);
   }
   return out;
@@ -117,10 +118,13 @@ class SolidBuilder {
         } catch (const std::exception& e) {
           fail(i, "carving by part '" + m_.parts[j].name + "' failed: " + e.what());
         }
-        if (!ok) fail(i, "carving by part '" + m_.parts[j].name + "' leaves a non-manifold solid (parts that "
-                         "touch along an edge or at a point inside it)");
+        if (!ok)
+          fail(i, "carving by part '" + m_.parts[j].name +
+                      "' leaves a non-manifold solid (parts that "
+                      "touch along an edge or at a point inside it)");
       }
-      if (solid_[i].is_empty()) fail(i, "part '" + m_.parts[i].name + "' is carved away entirely by later parts");
+      if (solid_[i].is_empty())
+        fail(i, "part '" + m_.parts[i].name + "' is carved away entirely by later parts");
       box[i] = PMP::bbox(solid_[i]);
     }
     // 3. conforming interfaces
@@ -150,7 +154,8 @@ class SolidBuilder {
 
  private:
   void report(const char* stage, std::size_t done, std::size_t total) const {
-    if (progress_ && !progress_(stage, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1))))
+    if (progress_ &&
+        !progress_(stage, static_cast<double>(done) / static_cast<double>(std::max<std::size_t>(total, 1))))
       throw StructureCancelled();
   }
 
@@ -179,14 +184,16 @@ class SolidBuilder {
     }
     const TriSurface& s = part.surface;
     const std::size_t base = pts.size();
-    for (std::size_t v = 0; v < s.vertex_count(); ++v) pts.emplace_back(s.xyz[3 * v], s.xyz[3 * v + 1], s.xyz[3 * v + 2]);
+    for (std::size_t v = 0; v < s.vertex_count(); ++v)
+      pts.emplace_back(s.xyz[3 * v], s.xyz[3 * v + 1], s.xyz[3 * v + 2]);
     for (std::size_t t = 0; t < s.triangle_count(); ++t)
       polys.push_back({base + s.tri[3 * t], base + s.tri[3 * t + 1], base + s.tri[3 * t + 2]});
     const std::string who =
         "part '" + part.name + "'" + (part.source.empty() ? std::string() : " (" + part.source + ")");
     if (!PMP::is_polygon_soup_a_polygon_mesh(polys))
-      fail(pi, who + ": the surface is not a consistently oriented manifold (an edge with more than two "
-                     "triangles, or neighbours that disagree on their orientation)");
+      fail(pi, who +
+                   ": the surface is not a consistently oriented manifold (an edge with more than two "
+                   "triangles, or neighbours that disagree on their orientation)");
     SMesh mesh;
     PMP::polygon_soup_to_polygon_mesh(pts, polys, mesh);
     if (!CGAL::is_closed(mesh)) fail(pi, who + ": the surface is not closed (it has border edges)");
@@ -230,7 +237,8 @@ class SolidBuilder {
         const CGAL::Bbox_3 cb = c.bbox();
         long other = -1;
         for (std::size_t j : near[i])
-          if (CGAL::do_overlap(cb, box[j]) && (*side[j])(c) == CGAL::ON_BOUNDARY) other = static_cast<long>(j);
+          if (CGAL::do_overlap(cb, box[j]) && (*side[j])(c) == CGAL::ON_BOUNDARY)
+            other = static_cast<long>(j);
         if (other >= 0 && static_cast<std::size_t>(other) < i) continue;  // the earlier part emits it
         std::string name;
         if (other >= 0) {
@@ -298,7 +306,8 @@ class SolidBuilder {
         s_.plc.regions.push_back(r);
         found = true;
       }
-      if (!found) fail(pi, "no point strictly inside part '" + m_.parts[pi].name + "' was found for its region");
+      if (!found)
+        fail(pi, "no point strictly inside part '" + m_.parts[pi].name + "' was found for its region");
     }
   }
 

@@ -22,7 +22,8 @@ void TriSurface::append(const TriSurface& other, double dx, double dy, double dz
 }
 
 BallFaceting ball_faceting(const Ball& b) {
-  if (!(b.radius > 0) || !(b.tolerance > 0)) throw std::invalid_argument("ball radius and tolerance must be positive");
+  if (!(b.radius > 0) || !(b.tolerance > 0))
+    throw std::invalid_argument("ball radius and tolerance must be positive");
   const double r = b.radius, cz = b.center[2];
   const double z1 = std::min(b.z1, cz + r), z0 = std::max(b.z0, cz - r);
   if (!(z0 < z1)) throw std::invalid_argument("the ball's z range misses the sphere");
@@ -65,10 +66,13 @@ TriSurface ball_surface(const Ball& b) {
     }
     for (std::uint32_t j = 0; j < n; ++j) {
       const double a = 2 * std::numbers::pi * static_cast<double>(j) / static_cast<double>(n);
-      add(b.center[0] + f.ring_radius[k] * std::cos(a), b.center[1] + f.ring_radius[k] * std::sin(a), f.ring_z[k]);
+      add(b.center[0] + f.ring_radius[k] * std::cos(a), b.center[1] + f.ring_radius[k] * std::sin(a),
+          f.ring_z[k]);
     }
   }
-  auto at = [&](std::size_t k, std::uint32_t j) { return f.ring_radius[k] == 0 ? first[k] : first[k] + j % n; };
+  auto at = [&](std::size_t k, std::uint32_t j) {
+    return f.ring_radius[k] == 0 ? first[k] : first[k] + j % n;
+  };
   // sides: ring k (above) and k + 1 (below); counter-clockwise from outside is
   // below j -> below j+1 -> above j+1 -> above j (azimuth grows to the right)
   for (std::size_t k = 0; k + 1 < f.ring_z.size(); ++k)
@@ -100,7 +104,8 @@ class SoupBuilder {
   bool add(const std::array<std::array<double, 3>, 3>& corner) {
     std::uint32_t id[3];
     for (int i = 0; i < 3; ++i) {
-      auto [it, fresh] = ids_.emplace(corner[static_cast<std::size_t>(i)], static_cast<std::uint32_t>(ids_.size()));
+      auto [it, fresh] =
+          ids_.emplace(corner[static_cast<std::size_t>(i)], static_cast<std::uint32_t>(ids_.size()));
       if (fresh)
         for (double c : corner[static_cast<std::size_t>(i)]) s_.xyz.push_back(c * scale_);
       id[i] = it->second;
@@ -176,7 +181,8 @@ TriSurface read_binary_stl(const std::string& file, std::string_view data, doubl
         c[v][i] = static_cast<double>(x);
       }
     if (!soup.add(c))
-      io::fail_binary(file, at, "triangle " + std::to_string(t) + " has two equal vertices (a degenerate triangle)");
+      io::fail_binary(file, at,
+                      "triangle " + std::to_string(t) + " has two equal vertices (a degenerate triangle)");
   }
   return soup.take();
 }
@@ -198,8 +204,8 @@ TriSurface read_stl(const std::filesystem::path& path, double scale) {
   if (data.size() >= 84)
     io::fail_binary(file, 80,
                     "binary STL: the header says " + std::to_string(count) + " triangles (" +
-                        std::to_string(84 + 50 * static_cast<std::uint64_t>(count)) + " bytes), the file has " +
-                        std::to_string(data.size()) + " bytes");
+                        std::to_string(84 + 50 * static_cast<std::uint64_t>(count)) +
+                        " bytes), the file has " + std::to_string(data.size()) + " bytes");
   throw IoError(file, 1, 0, "not an STL file: neither 'solid' (ASCII) nor a binary header and count");
 }
 

@@ -46,7 +46,8 @@ foxi::IoError build_error(const std::string& text) {
 // det(a, b, c) / 6: the signed volume of the tetrahedron (origin, a, b, c).
 double origin_tet_volume(const double* a, const double* b, const double* c) {
   return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+          a[2] * (b[0] * c[1] - b[1] * c[0])) /
+         6;
 }
 
 double triangle_area(const double* a, const double* b, const double* c) {
@@ -106,10 +107,11 @@ TEST(StructureShapes, SelfIntersectingOutlineIsRejectedWithThePart) {
 std::string ball(const std::string& name, double cx, double cy, double cz, double r, double z0, double z1,
                  double tol) {
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "[[parts]]\nname = \"%s\"\nmaterial = \"a\"\nshape = \"ball\"\ncenter = [%.17g, %.17g, %.17g]\n"
-                "radius = %.17g\nz_range = [%.17g, %.17g]\ntolerance = %.17g\n",
-                name.c_str(), cx, cy, cz, r, z0, z1, tol);
+  std::snprintf(
+      buf, sizeof buf,
+      "[[parts]]\nname = \"%s\"\nmaterial = \"a\"\nshape = \"ball\"\ncenter = [%.17g, %.17g, %.17g]\n"
+      "radius = %.17g\nz_range = [%.17g, %.17g]\ntolerance = %.17g\n",
+      name.c_str(), cx, cy, cz, r, z0, z1, tol);
   return buf;
 }
 
@@ -283,15 +285,16 @@ TEST(StructureShapes, OverlappingBallsOfAnArrayAreRejectedWithThePart) {
 }
 
 TEST(StructureShapes, BoxSwallowedByALaterBallIsAnError) {
-  const foxi::IoError e =
-      build_error(boxes_model(box("chip", 0, 0, 0, 0.2, 0.2, 0.2) + ball("blob", 0.1, 0.1, 0.1, 1, -1, 1, 0.05)));
+  const foxi::IoError e = build_error(
+      boxes_model(box("chip", 0, 0, 0, 0.2, 0.2, 0.2) + ball("blob", 0.1, 0.1, 0.1, 1, -1, 1, 0.05)));
   EXPECT_NE(e.reason().find("'chip' is carved away entirely"), std::string::npos) << e.what();
   EXPECT_EQ(e.line(), 4u);
 }
 
 TEST(StructureShapes, ProgressReportsStagesAndCancels) {
   TempDir dir;
-  foxi::test::write_text(dir / "m.toml", boxes_model(box("cube", 0, 0, 0, 2, 2, 2) + ball("ball", 2, 1, 1, 0.6, 0, 2, 0.05)));
+  foxi::test::write_text(dir / "m.toml",
+                         boxes_model(box("cube", 0, 0, 0, 2, 2, 2) + ball("ball", 2, 1, 1, 0.6, 0, 2, 0.05)));
   const foxi::Model model = foxi::load_model(dir / "m.toml");
   std::vector<std::string> stages;
   foxi::build_structure(model, [&](std::string_view stage, double f) {
@@ -301,8 +304,9 @@ TEST(StructureShapes, ProgressReportsStagesAndCancels) {
     return true;
   });
   EXPECT_EQ(stages, (std::vector<std::string>{"surfaces", "carve", "conform", "seeds"}));
-  EXPECT_THROW(foxi::build_structure(model, [](std::string_view stage, double) { return stage != "conform"; }),
-               foxi::StructureCancelled);
+  EXPECT_THROW(
+      foxi::build_structure(model, [](std::string_view stage, double) { return stage != "conform"; }),
+      foxi::StructureCancelled);
 }
 
 // ---- STL surfaces ----
@@ -373,8 +377,9 @@ TEST(StructureShapes, StlCubeCarvesABaseAndAnStlTetrahedronSitsOnItsEdge) {
   TempDir dir;
   write_binary_stl(dir / "cube.stl", cube(1, 1, 0.5, 2, 2, 1.5));
   write_ascii_stl(dir / "tet.stl", tetra(2.5, 2.5, 1, 1));
-  foxi::test::write_text(dir / "m.toml", boxes_model(box("base", 0, 0, 0, 3, 3, 1) + stl_part("cube", "cube.stl") +
-                                                     stl_part("tet", "tet.stl")));
+  foxi::test::write_text(
+      dir / "m.toml",
+      boxes_model(box("base", 0, 0, 0, 3, 3, 1) + stl_part("cube", "cube.stl") + stl_part("tet", "tet.stl")));
   const Meshed m = foxi::test::mesh_model((dir / "m.toml").string(), {}, 0);
   expect_volumes(m, {{"base", 8.5 * kMm3}, {"cube", 1 * kMm3}, {"tet", kMm3 / 6}});
   expect_near_rel(m.boundary_area.at("base/cube"), 3 * kMm2, "base/cube");
@@ -435,8 +440,8 @@ TEST(StructureShapes, GmshSphereStlCarvesACube) {
   // "vertex" lines, independently of foxi's reader (divergence theorem: sum of det(a, b, c) / 6)
   if (!foxi::test::have_program("gmsh")) GTEST_SKIP() << "gmsh is missing";
   TempDir dir;
-  foxi::test::write_text(dir / "s.geo",
-                         "SetFactory(\"OpenCASCADE\");\nSphere(1) = {2, 2, 2, 1};\nMesh.MeshSizeMax = 0.4;\n");
+  foxi::test::write_text(
+      dir / "s.geo", "SetFactory(\"OpenCASCADE\");\nSphere(1) = {2, 2, 2, 1};\nMesh.MeshSizeMax = 0.4;\n");
   ASSERT_EQ(foxi::test::run("cd '" + dir.path().string() + "' && gmsh -2 s.geo -format stl -o s.stl",
                             dir / "gmsh.log"),
             0)
@@ -459,7 +464,8 @@ TEST(StructureShapes, GmshSphereStlCarvesACube) {
   }
   vol = std::abs(vol);
   EXPECT_NEAR(vol, 4 * std::numbers::pi / 3, 0.25);  // a sphere of radius 1, coarsely faceted (size 0.4)
-  foxi::test::write_text(dir / "m.toml", boxes_model(box("cube", 0, 0, 0, 4, 4, 4) + stl_part("ball", "s.stl")));
+  foxi::test::write_text(dir / "m.toml",
+                         boxes_model(box("cube", 0, 0, 0, 4, 4, 4) + stl_part("ball", "s.stl")));
   const Meshed m = foxi::test::mesh_model((dir / "m.toml").string(), {}, 0);
   expect_volumes(m, {{"cube", (64 - vol) * kMm3}, {"ball", vol * kMm3}});
   expect_areas(m, {{"cube.top", 16 * kMm2},

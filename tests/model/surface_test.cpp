@@ -51,7 +51,8 @@ endsolid t
 
 foxi::IoError stl_error(const std::string& data) {
   TempDir dir;
-  std::ofstream(dir / "bad.stl", std::ios::binary).write(data.data(), static_cast<std::streamsize>(data.size()));
+  std::ofstream(dir / "bad.stl", std::ios::binary)
+      .write(data.data(), static_cast<std::streamsize>(data.size()));
   try {
     foxi::read_stl(dir / "bad.stl");
   } catch (const foxi::IoError& e) {
@@ -75,7 +76,8 @@ std::string binary_of(const foxi::TriSurface& s) {
   for (std::size_t t = 0; t < s.triangle_count(); ++t) {
     float f[12] = {};
     for (std::size_t v = 0; v < 3; ++v)
-      for (std::size_t i = 0; i < 3; ++i) f[3 + 3 * v + i] = static_cast<float>(s.xyz[3 * s.tri[3 * t + v] + i]);
+      for (std::size_t i = 0; i < 3; ++i)
+        f[3 + 3 * v + i] = static_cast<float>(s.xyz[3 * s.tri[3 * t + v] + i]);
     data.append(reinterpret_cast<const char*>(f), sizeof f);
     data.append(2, '\0');
   }
@@ -97,12 +99,17 @@ TEST(Stl, AsciiAndBinaryGiveTheSameMergedSurface) {
 }
 
 TEST(Stl, BadAsciiNamesTheLine) {
-  const foxi::IoError e = stl_error(replaced(kTetra, "vertex 1 0 0\n  vertex 0 0 1", "vertex 1 0 0\n  vertex 0 x 1"));
+  const foxi::IoError e =
+      stl_error(replaced(kTetra, "vertex 1 0 0\n  vertex 0 0 1", "vertex 1 0 0\n  vertex 0 x 1"));
   EXPECT_EQ(e.line(), 13u);
   EXPECT_NE(e.reason().find("vertex coordinate"), std::string::npos) << e.what();
-  EXPECT_EQ(stl_error(replaced(kTetra, " endloop\nendfacet\nfacet normal -1", " endloop\nfacet normal -1")).line(), 15u);
-  EXPECT_EQ(stl_error(replaced(kTetra, "  vertex 0 1 0\n  vertex 1 0 0\n", "  vertex 0 1 0\n  vertex 0 1 0\n")).line(),
-            2u);  // the degenerate facet starts on line 2
+  EXPECT_EQ(
+      stl_error(replaced(kTetra, " endloop\nendfacet\nfacet normal -1", " endloop\nfacet normal -1")).line(),
+      15u);
+  EXPECT_EQ(
+      stl_error(replaced(kTetra, "  vertex 0 1 0\n  vertex 1 0 0\n", "  vertex 0 1 0\n  vertex 0 1 0\n"))
+          .line(),
+      2u);  // the degenerate facet starts on line 2
   const foxi::IoError end = stl_error(replaced(kTetra, "endsolid t\n", ""));
   EXPECT_NE(end.reason().find("end of file"), std::string::npos) << end.what();
   EXPECT_EQ(stl_error("solid empty\nendsolid empty\n").reason().find("no facets") != std::string::npos, true);
