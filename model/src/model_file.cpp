@@ -2,6 +2,7 @@
 // does not matter and cycles are found by the "being evaluated" mark.
 #include "foxi/model/model_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -38,6 +39,51 @@ std::string short_number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
   return buf;
+}
+
+double orient(const double* a, const double* b, const double* c) {
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+// Whether closed segments ab and cd share a point (touching counts).
+bool segments_meet(const double* a, const double* b, const double* c, const double* d) {
+  const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+  auto on = [](const double* p, const double* q, const double* r) {  // r on segment pq, collinear
+    return std::min(p[0], q[0]) <= r[0] && r[0] <= std::max(p[0], q[0]) && std::min(p[1], q[1]) <= r[1] &&
+           r[1] <= std::max(p[1], q[1]);
+  };
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
+  return (o1 == 0 && on(a, b, c)) || (o2 == 0 && on(a, b, d)) || (o3 == 0 && on(c, d, a)) ||
+         (o4 == 0 && on(c, d, b));
+}
+
+// Why a closed outline (2 doubles per vertex) is not a simple polygon, or "" when it is one: repeated
+// points, edges that cross or touch other than at their shared vertex, edges that fold back.
+std::string polygon_problem(const std::vector<double>& xy) {
+  const std::size_t n = xy.size() / 2;
+  const double* v = xy.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n, k = (i + 2) % n;
+    if (v[2 * i] == v[2 * j] && v[2 * i + 1] == v[2 * j + 1])
+      return "point " + std::to_string(j) + " repeats point " + std::to_string(i);
+    // consecutive edges fold back on each other: collinear with the turn point not between them
+    const double* a = v + 2 * i;
+    const double* b = v + 2 * j;
+    const double* c = v + 2 * k;
+    if (n > 3 && orient(a, b, c) == 0 && (c[0] - b[0]) * (a[0] - b[0]) + (c[1] - b[1]) * (a[1] - b[1]) > 0)
+      return "edges " + std::to_string(i) + " and " + std::to_string(j) + " fold back on each other";
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbours through the closing edge
+      if (segments_meet(v + 2 * i, v + 2 * ((i + 1) % n), v + 2 * j, v + 2 * ((j + 1) % n)))
+        return "the outline is not a simple polygon: edge " + std::to_string(i) + " meets edge " +
+               std::to_string(j);
+    }
+  double area = 0;
+  for (std::size_t i = 0; i < n; ++i) area += orient(v, v + 2 * i, v + 2 * ((i + 1) % n));
+  if (area == 0) return "the outline has no area";
+  return "";
 }
 
 std::uint64_t line_of(const Value& v) {
@@ -294,9 +340,48 @@ class Loader {
     return static_cast<long>(x);
   }
 
-  // box or cylinder at `shift`
-  Prism primitive(const Value& part, const std::string& shape, const std::string& who, double sx, double sy) {
-    Prism p;
+  // A ball or an STL surface shifted by (sx, sy), appended to out.surface.
+  void surface_primitive(Part& out, const Value& part, const std::string& shape, const std::string& who,
+                         double sx, double sy) {
+    const Table& t = part.as_table();
+    if (shape == "stl") {
+      const Value& f = need(part, "file", who);
+      const std::filesystem::path file = path_.parent_path() / string_of(f, who + " file");
+      auto cached = stl_.find(file.string());
+      if (cached == stl_.end())
+        cached = stl_.emplace(file.string(), read_stl(file, model_.length_scale)).first;
+      out.surface.append(cached->second, sx, sy, 0);
+      out.source = file.string();
+      return;
+    }
+    Ball b;
+    const auto c = lengths(need(part, "center", who), 3, who + " center", false);
+    b.center[0] = c[0] + sx;
+    b.center[1] = c[1] + sy;
+    b.center[2] = c[2];
+    b.radius = positive_length(need(part, "radius", who), who + " radius");
+    b.z0 = c[2] - b.radius;
+    b.z1 = c[2] + b.radius;
+    if (auto it = t.find("z_range"); it != t.end()) {
+      const auto z = lengths(it->second, 2, who + " z_range", false);
+      if (!(z[0] < z[1]) || z[1] <= b.z0 || z[0] >= b.z1)
+        throw Located{line_of(it->second),
+                      who + " z_range: expected [z0, z1] with z0 < z1 cutting the sphere"};
+      b.z0 = std::max(b.z0, z[0]);
+      b.z1 = std::min(b.z1, z[1]);
+    }
+    b.tolerance = 0.01 * b.radius;
+    if (auto it = t.find("tolerance"); it != t.end())
+      b.tolerance = positive_length(it->second, who + " tolerance");
+    out.surface.append(ball_surface(b));
+  }
+
+  // A box, cylinder or extrusion shifted by (sx, sy) appended to out.prisms, or a ball or STL
+  // surface appended to out.surface.
+  void primitive(Part& out, const Value& part, const std::string& shape, const std::string& who, double sx,
+                 double sy) {
+    if (shape == "ball" || shape == "stl") return surface_primitive(out, part, shape, who, sx, sy);
+    Prism& p = out.prisms.emplace_back();
     if (shape == "box") {
       const auto o = lengths(need(part, "origin", who), 3, who + " origin", false);
       const auto s = lengths(need(part, "size", who), 3, who + " size", true);
@@ -318,11 +403,29 @@ class Loader {
       }
       p.z0 = c[2];
       p.z1 = c[2] + h;
+    } else if (shape == "extrusion") {
+      const Value& pts = need(part, "points", who);
+      if (!pts.is_array() || pts.as_array().size() < 3)
+        throw Located{line_of(pts), who + " points: expected an array of at least 3 [x, y] points"};
+      std::size_t i = 0;
+      for (const Value& q : pts.as_array()) {
+        const auto xy = lengths(q, 2, who + " points[" + std::to_string(i++) + "]", false);
+        p.xy.push_back(xy[0] + sx);
+        p.xy.push_back(xy[1] + sy);
+      }
+      p.z0 = length(need(part, "z", who), who + " z");
+      p.z1 = p.z0 + positive_length(need(part, "height", who), who + " height");
+      if (const std::string why = polygon_problem(p.xy); !why.empty())
+        throw Located{line_of(pts), who + " points: " + why};
+      if (p.area() < 0)  // clockwise as written: the builders take counter-clockwise outlines
+        for (std::size_t a = 0, b = p.xy.size() / 2 - 1; a < b; ++a, --b) {
+          std::swap(p.xy[2 * a], p.xy[2 * b]);
+          std::swap(p.xy[2 * a + 1], p.xy[2 * b + 1]);
+        }
     } else {
-      throw Located{line_of(part),
-                    who + ": unknown shape '" + shape + "' (expected box, cylinder, layers, array)"};
+      throw Located{line_of(part), who + ": unknown shape '" + shape +
+                                       "' (expected box, cylinder, extrusion, ball, stl, layers, array)"};
     }
-    return p;
   }
 
   void check_keys(const Value& part, const std::string& who, std::initializer_list<const char*> allowed) {
@@ -410,15 +513,23 @@ class Loader {
         if (ishape == "box") check_keys(item, who + " item", {"shape", "origin", "size"});
         if (ishape == "cylinder")
           check_keys(item, who + " item", {"shape", "center", "radius", "height", "segments"});
+        if (ishape == "extrusion") check_keys(item, who + " item", {"shape", "points", "z", "height"});
+        if (ishape == "ball")
+          check_keys(item, who + " item", {"shape", "center", "radius", "z_range", "tolerance"});
+        if (ishape == "stl") check_keys(item, who + " item", {"shape", "file"});
         for (long j = 0; j < ny; ++j)
           for (long i = 0; i < nx; ++i)
-            part.prisms.push_back(primitive(item, ishape, who + " item", static_cast<double>(i) * pp[0],
-                                            static_cast<double>(j) * pp[1]));
+            primitive(part, item, ishape, who + " item", static_cast<double>(i) * pp[0],
+                      static_cast<double>(j) * pp[1]);
       } else {
         if (shape == "box") check_keys(pv, who, {"name", "shape", "material", "origin", "size"});
         if (shape == "cylinder")
           check_keys(pv, who, {"name", "shape", "material", "center", "radius", "height", "segments"});
-        part.prisms.push_back(primitive(pv, shape, who, 0, 0));
+        if (shape == "extrusion") check_keys(pv, who, {"name", "shape", "material", "points", "z", "height"});
+        if (shape == "ball")
+          check_keys(pv, who, {"name", "shape", "material", "center", "radius", "z_range", "tolerance"});
+        if (shape == "stl") check_keys(pv, who, {"name", "shape", "material", "file"});
+        primitive(part, pv, shape, who, 0, 0);
       }
       add_part(std::move(part));
     }
@@ -436,6 +547,7 @@ class Loader {
   Model model_;
   std::map<std::string, ParamEntry> params_;
   std::map<std::string, Material> materials_;
+  std::map<std::string, TriSurface> stl_;  // by file, read once
 };
 
 }  // namespace

@@ -24,6 +24,7 @@
 
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/surfaces.hpp"
+#include "structure_solids.hpp"
 
 namespace foxi {
 
@@ -40,15 +41,23 @@ struct Item {
   std::size_t z0, z1;  // level indices
 };
 
-bool inside_polygon(const std::vector<double>& xy, double x, double y) {  // convex, counter-clockwise
-  const std::size_t n = xy.size() / 2;
+// Whether (x, y) is inside the closed polygon of vertices at(0) .. at(n - 1) (either orientation,
+// convex or not), by the crossing number. Only called with points well inside a face of a
+// subdivision, so points on the outline do not occur.
+template <class At>
+bool inside_ring(std::size_t n, At at, double x, double y) {
+  bool in = false;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t j = (i + 1) % n;
-    const double c =
-        (xy[2 * j] - xy[2 * i]) * (y - xy[2 * i + 1]) - (xy[2 * j + 1] - xy[2 * i + 1]) * (x - xy[2 * i]);
-    if (!(c > 0)) return false;
+    const XY a = at(i), b = at((i + 1) % n);
+    if ((a.second > y) != (b.second > y) &&
+        x < a.first + (y - a.second) * (b.first - a.first) / (b.second - a.second))
+      in = !in;
   }
-  return true;
+  return in;
+}
+
+bool inside_polygon(const std::vector<double>& xy, double x, double y) {  // 2 doubles per vertex
+  return inside_ring(xy.size() / 2, [&](std::size_t i) { return XY{xy[2 * i], xy[2 * i + 1]}; }, x, y);
 }
 
 // A planar subdivision by segments: vertices, edges (halfedge 2e runs u -> v, 2e + 1 back; each has
@@ -79,17 +88,8 @@ double cycle_area(const Plane& pl, const std::vector<std::uint32_t>& ring) {
   return 0.5 * a;
 }
 
-bool in_ring(const Plane& pl, const std::vector<std::uint32_t>& ring, double x,
-             double y) {  // crossing number
-  bool in = false;
-  for (std::size_t i = 0; i < ring.size(); ++i) {
-    const XY& a = pl.from(ring[i]);
-    const XY& b = pl.from(ring[(i + 1) % ring.size()]);
-    if ((a.second > y) != (b.second > y) &&
-        x < a.first + (y - a.second) * (b.first - a.first) / (b.second - a.second))
-      in = !in;
-  }
-  return in;
+bool in_ring(const Plane& pl, const std::vector<std::uint32_t>& ring, double x, double y) {
+  return inside_ring(ring.size(), [&](std::size_t i) { return pl.from(ring[i]); }, x, y);
 }
 
 void build_plane(Plane& pl, const std::vector<const Prism*>& prisms) {
@@ -395,13 +395,7 @@ class Builder {
     return part_name(a) + "/" + part_name(b);
   }
 
-  std::int32_t marker_of(const std::string& name) {
-    for (std::size_t i = 0; i < s_.boundary_names.size(); ++i)
-      if (s_.boundary_names[i] == name) return static_cast<std::int32_t>(i + 1);
-    s_.boundary_names.push_back(name);
-    s_.boundary_area.push_back(0);
-    return static_cast<std::int32_t>(s_.boundary_names.size());
-  }
+  std::int32_t marker_of(const std::string& name) { return boundary_marker(s_, name); }
 
   std::uint32_t point(double x, double y, std::size_t z) {
     auto key = std::make_tuple(x, y, z);
@@ -430,8 +424,18 @@ class Builder {
 
 }  // namespace
 
-Structure build_structure(const Model& model) {
-  Structure s = Builder(model).build();
+std::int32_t boundary_marker(Structure& s, const std::string& name) {
+  for (std::size_t i = 0; i < s.boundary_names.size(); ++i)
+    if (s.boundary_names[i] == name) return static_cast<std::int32_t>(i + 1);
+  s.boundary_names.push_back(name);
+  s.boundary_area.push_back(0);
+  return static_cast<std::int32_t>(s.boundary_names.size());
+}
+
+Structure build_structure(const Model& model, const ProgressFn& progress) {
+  bool solids = false;
+  for (const Part& p : model.parts) solids = solids || !p.surface.tri.empty();
+  Structure s = solids ? build_structure_from_solids(model, progress) : Builder(model).build();
   tag_selected_surfaces(model, s);
   check_conditions(model, s);
   return s;

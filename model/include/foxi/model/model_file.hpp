@@ -11,8 +11,15 @@
 //   [[parts]]
 //   name = "die"  material = "silicon"  shape = "box"  origin = [...]  size = ["die_w", 3, 0.5]
 //   shape = "cylinder": center (of the base), radius, height, segments (default 16)
+//   shape = "extrusion": points = [[x, y], ...] (a simple polygon, convex or not, either orientation),
+//     z (of the base), height
+//   shape = "ball": center, radius, z_range = [z0, z1] (optional: the planes that cut the sphere, e.g.
+//     the pads of a solder ball), tolerance (optional, default radius / 100: the largest distance of a
+//     facet from the sphere; see surface.hpp for the faceting)
+//   shape = "stl": file (ASCII or binary STL, relative to this file, coordinates in units.length; a
+//     closed, consistently oriented surface without self-intersections)
 //   shape = "layers": origin, footprint = [w, d], thicknesses = [...], names = [...], materials = [...]
-//   shape = "array": count = [nx, ny], pitch = [px, py], item = { shape = "box" | "cylinder", ... }
+//   shape = "array": count = [nx, ny], pitch = [px, py], item = { shape = "box" | "cylinder" | ..., ... }
 //   [surfaces.NAME], [[conditions]], [[loads]], [mesh]: see conditions.hpp
 #pragma once
 
@@ -24,11 +31,12 @@
 
 #include "foxi/model/conditions.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/surface.hpp"
 #include "foxi/model/units.hpp"
 
 namespace foxi {
 
-// A vertical prism: a convex counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
+// A vertical prism: a simple (convex or not) counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
 // over z in [z0, z1].
 struct Prism {
   std::vector<double> xy;
@@ -39,8 +47,10 @@ struct Prism {
 struct Part {
   std::string name;
   std::string material;       // a name in Model::materials
-  std::string shape;          // box, cylinder, layers (one part per layer), array
+  std::string shape;          // box, cylinder, extrusion, ball, stl, layers (one part per layer), array
   std::vector<Prism> prisms;  // an array part has one prism per item
+  TriSurface surface;         // balls and STL surfaces (an array: one closed component per item)
+  std::string source;         // the STL file of an stl part
   std::uint64_t line = 0;     // of its [[parts]] entry (0: unknown)
 };
 
