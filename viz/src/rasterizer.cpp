@@ -704,6 +704,17 @@ struct TetRasterizer::Impl {
     }
   }
 
+  // Undoable: hints the cache about tet t's neighbours' positions in the drawing (and their nodes,
+  // `nodes`), read by earlier_neighbour and undraw; t's adjacency row should be prefetched earlier.
+  void prefetch_neighbours(std::uint32_t t, bool nodes) const {
+    const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(t)];
+    for (int f = 0; f < 4; ++f) {
+      if (nb[f] == kNone) continue;
+      __builtin_prefetch(&drawn_at[nb[f] >> 2]);
+      if (nodes) __builtin_prefetch(&mesh->tet[4 * std::size_t(nb[f] >> 2)]);
+    }
+  }
+
   // A tet's corners: camera coordinates (c, pointing into cam or local), fixed-point pixel
   // coordinates and states.
   void corners(const std::uint32_t* tv, const double** c, double* local, std::int64_t* X, std::int64_t* Y,
@@ -988,11 +999,7 @@ struct TetRasterizer::Impl {
         if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 2 * kAhead])]);
         if (recording) {  // has_unshared_back_face reads the tet's neighbours and their positions
           if (i + 2 * kAhead < end) __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
-          if (i + kAhead < end) {
-            const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(tets[i + kAhead])];
-            for (int f = 0; f < 4; ++f)
-              if (nb[f] != kNone) __builtin_prefetch(&drawn_at[nb[f] >> 2]);
-          }
+          if (i + kAhead < end) prefetch_neighbours(tets[i + kAhead], false);
         }
         boxes[i] = tet_box(tets[i], fb.width, fb.height);
         if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i]);
@@ -1173,7 +1180,11 @@ struct TetRasterizer::Impl {
       const Rows rows{k, lane_count};
       Lane& lane = lanes[std::size_t(k)];
       std::size_t save = first_save(lane);
+      constexpr std::size_t kAhead = 8;
       for (std::size_t i = 0; i < count; ++i) {
+        if (i + 2 * kAhead < count)
+          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(history[first + i + 2 * kAhead])]);
+        if (i + kAhead < count) prefetch_neighbours(history[first + i + kAhead], true);
         const std::uint32_t t = history[first + i];
         const bool saved = save < lane.saves.size() && lane.saves[save].at == first + i;
         const std::size_t s = saved ? save++ : 0;
