@@ -15,15 +15,20 @@ namespace foxi::cli {
 namespace {
 
 const char* kMeshUsage =
-    "foxi mesh PLC.poly -o OUT [--max-volume V] [--radius-edge Q] [--min-dihedral DEG] [--optimize]\n"
-    "                   [--check-delaunay]\n"
+    "foxi mesh PLC.poly -o OUT [--mesher tetgen|cgal] [--max-volume V] [--radius-edge Q] [--min-dihedral DEG]\n"
+    "                   [--optimize] [--perturb] [--check-delaunay]\n"
     "  Meshes a TetGen .poly (points, facets with boundary markers, holes, region seeds) into tets\n"
     "  and writes OUT in any mesh format foxi knows (.vtu .msh .vtk .node .mesh).\n"
     "  --max-volume V    largest tet volume (in the PLC's units cubed); regions may set their own\n"
     "  --radius-edge Q   radius-edge quality bound (default 1.414; 0 turns quality refinement off)\n"
     "  --min-dihedral D  minimum dihedral angle bound in degrees\n"
     "  --optimize        TetGen's flips and smoothing: better angles, but the mesh stops being Delaunay\n"
-    "  --check-delaunay  certify the result (exact empty-circumsphere test) and report it";
+    "  --check-delaunay  certify the result (exact empty-circumsphere test) and report it\n"
+    "  --mesher cgal     CGAL Mesh_3 instead of TetGen: protected facet edges, sliver exudation; the mesh\n"
+    "                    is part of a regular triangulation, its vertex weights are written (point data\n"
+    "                    'weight' in .vtu) and always certified (orthospheres). --max-volume becomes the\n"
+    "                    circumradius of a regular tet of that volume; --radius-edge defaults to 2;\n"
+    "                    --perturb adds sliver perturbation; Ctrl-C cancels";
 
 double number(const std::string& s, const char* what) {
   char* end = nullptr;
@@ -34,11 +39,16 @@ double number(const std::string& s, const char* what) {
 
 }  // namespace
 
+int mesh_with_cgal(Args& args);  // cmd_mesh_cgal.cpp
+
 int cmd_mesh(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kMeshUsage);
     return 0;
   }
+  const std::string mesher = args.option("--mesher", "tetgen");
+  if (mesher == "cgal") return mesh_with_cgal(args);
+  if (mesher != "tetgen") throw UsageError("--mesher takes tetgen or cgal, not '" + mesher + "'");
   MeshParams params;
   params.max_volume = number(args.option("--max-volume", "0"), "--max-volume");
   params.radius_edge = number(args.option("--radius-edge", "1.414"), "--radius-edge");
