@@ -64,7 +64,7 @@ struct CellSize {
   }
 };
 
-// The PLC surface grouped into the domain's input polyhedra: one per facet and pair of cells.
+// The PLC surface grouped into the domain's input polyhedra: one per facet marker and pair of cells.
 struct Patches {
   std::vector<Polyhedron> polyhedra;
   std::vector<std::pair<int, int>> subdomains;  // (behind the normals, in front of them), Mesh_3's order
@@ -73,39 +73,53 @@ struct Patches {
 
 Patches make_patches(const Plc& plc, const detail::PlcSurface& s) {
   namespace PMP = CGAL::Polygon_mesh_processing;
-  std::map<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
+  // Triangles of one marker with the same cells on their sides: facets of one patch are oriented alike
+  // (their normals point into the same cell), so the group is a consistently oriented surface.
+  std::map<std::tuple<std::int32_t, std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
   for (std::uint32_t t = 0; t < s.tri_facet.size(); ++t) {
     const std::uint32_t front = s.side_cell[2 * t], back = s.side_cell[2 * t + 1];
-    if (front != back) groups[{s.tri_facet[t], back, front}].push_back(t);
+    if (front == back) continue;
+    const std::int32_t marker = plc.facet_marker[s.tri_facet[t]];
+    // Facets of a patch may face either way: orient every triangle from the lower cell index to the higher.
+    if (front < back)
+      groups[{marker, front, back}].push_back(t | 0x80000000u);  // flipped
+    else
+      groups[{marker, back, front}].push_back(t);
   }
   Patches out;
   for (const auto& [key, tris] : groups) {
-    const auto [facet, back, front] = key;
+    const auto [marker, back, front] = key;
     std::vector<K::Point_3> pts;
     std::vector<std::vector<std::size_t>> polys;
     std::unordered_map<std::uint32_t, std::size_t> local;
-    for (std::uint32_t t : tris) {
+    for (std::uint32_t tf : tris) {
+      const std::uint32_t t = tf & 0x7fffffffu;
       std::vector<std::size_t> poly;
       for (int i = 0; i < 3; ++i) {
-        const std::uint32_t v = s.tri[3 * t + i];
+        const std::uint32_t v = s.tri[3 * t + ((tf & 0x80000000u) ? 2 - i : i)];
         const auto [it, fresh] = local.emplace(v, pts.size());
         if (fresh) pts.emplace_back(s.points[3 * v], s.points[3 * v + 1], s.points[3 * v + 2]);
         poly.push_back(it->second);
       }
       polys.push_back(std::move(poly));
     }
-    const K::Vector_3 normal = CGAL::normal(pts[polys[0][0]], pts[polys[0][1]], pts[polys[0][2]]);
-    if (!PMP::is_polygon_soup_a_polygon_mesh(polys)) PMP::orient_polygon_soup(pts, polys);  // splits pinched vertices
+    if (!PMP::is_polygon_soup_a_polygon_mesh(polys)) {
+      const auto before = polys;
+      PMP::orient_polygon_soup(pts, polys);  // splits non-manifold vertices; must not flip a triangle
+      if (polys.size() != before.size()) throw MesherError(10, "the facets of marker " + std::to_string(marker) + " overlap");
+      for (std::size_t i = 0; i < polys.size(); ++i) {
+        const auto& a = before[i];
+        const auto& b = polys[i];
+        const bool same = (pts[a[0]] == pts[b[0]] && pts[a[1]] == pts[b[1]]) || (pts[a[0]] == pts[b[1]] && pts[a[1]] == pts[b[2]]) ||
+                          (pts[a[0]] == pts[b[2]] && pts[a[1]] == pts[b[0]]);
+        if (!same) throw MesherError(10, "the facets of marker " + std::to_string(marker) + " meet in a non-manifold way");
+      }
+    }
     Polyhedron poly;
     PMP::polygon_soup_to_polygon_mesh(pts, polys, poly);
-    for (auto f : faces(poly)) {
-      const auto h = halfedge(f, poly);
-      const K::Vector_3 n = CGAL::normal(source(h, poly)->point(), target(h, poly)->point(), target(next(h, poly), poly)->point());
-      if (n * normal < 0) throw MesherError(10, "facet " + std::to_string(facet + 1) + " could not be oriented (pinched)");
-    }
     out.polyhedra.push_back(std::move(poly));
     out.subdomains.emplace_back(static_cast<int>(back), static_cast<int>(front));
-    out.marker.push_back(plc.facet_marker[facet]);
+    out.marker.push_back(marker);
   }
   if (out.polyhedra.empty()) throw MesherError(10, "the PLC encloses no volume (no facet has different cells on its sides)");
   return out;
@@ -176,7 +190,11 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
                              const CgalMeshParams& params) {
   namespace P = CGAL::parameters;
   Domain domain(patches.polyhedra.begin(), patches.polyhedra.end(), patches.subdomains.begin(), patches.subdomains.end());
-  domain.detect_features();  // planar patches: their borders, i.e. every facet edge, become protected features
+  // Protected features: the borders of the patches (where markers or materials change) and edges where
+  // the facets turn by more than feature_angle. Faceted cylinders are not cut at every facet edge:
+  // protecting balls placed alike along both long edges of a narrow planar facet make cocircular
+  // rectangles there, and so flat tets that exudation cannot remove.
+  domain.detect_features(params.feature_angle);
 
   CellSize cell_size{&domain, sizes.max_size, std::vector<double>(s.cell_count, sizes.max_size)};
   for (const RegionSeed& seed : plc.regions)
@@ -187,6 +205,7 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
   // part takes facets that cut across its corners (the dual edge meets a patch, the facet does not lie in it).
   Criteria criteria(P::edge_size = sizes.edge_size, P::facet_angle = params.facet_angle, P::facet_size = sizes.facet_size,
                     P::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH_WITH_ADJACENCY_CHECK,
+                    P::facet_distance = sizes.facet_distance,
                     P::cell_radius_edge_ratio = params.radius_edge, P::cell_size = cell_size);
   C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, P::no_perturb(), P::no_exude());
   if (params.perturb)
@@ -216,8 +235,9 @@ Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport*
   const auto t0 = std::chrono::steady_clock::now();
   if (!(params.max_size >= 0 && params.facet_size >= 0 && params.edge_size >= 0 && params.radius_edge >= 0 &&
         params.facet_angle >= 0 && params.facet_angle <= 30 && params.optimiser_seconds >= 0 && params.sliver_bound >= 0 &&
-        params.sliver_bound < 70))
-    throw MesherError(10, "CGAL mesh parameters out of range (sizes >= 0, facet angle in [0, 30], sliver bound in [0, 70) degrees)");
+        params.sliver_bound < 70 &&
+        params.facet_distance >= 0 && params.feature_angle >= 0 && params.feature_angle <= 180))
+    throw MesherError(10, "CGAL mesh parameters out of range (sizes >= 0, facet angle in [0, 30], sliver bound in [0, 70), feature angle in [0, 180] degrees)");
   const detail::PlcSurface s = detail::plc_surface(plc);
   const Patches patches = make_patches(plc, s);
 
@@ -231,6 +251,7 @@ Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport*
   rep.max_size = params.max_size > 0 ? params.max_size : diag / 20;
   rep.facet_size = params.facet_size > 0 ? params.facet_size : rep.max_size;
   rep.edge_size = params.edge_size > 0 ? params.edge_size : rep.facet_size;
+  rep.facet_distance = params.facet_distance > 0 ? params.facet_distance : rep.facet_size / 20;
   rep.input_points = plc.point_count();
   rep.facet_triangles = s.tri_facet.size();
   rep.patches = patches.polyhedra.size();

@@ -32,8 +32,8 @@ std::string source_file(const std::string& name) { return test::data_dir() + "/.
 std::map<std::int32_t, double> region_volumes(const Mesh& m) {
   std::map<std::int32_t, double> v;
   for (std::size_t t = 0; t < m.tet_count(); ++t) {
-    const std::uint32_t* v = &m.tet[4 * t];
-    const double vol = tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume;
+    const std::uint32_t* n = &m.tet[4 * t];
+    const double vol = tet_quality(&m.xyz[3 * n[0]], &m.xyz[3 * n[1]], &m.xyz[3 * n[2]], &m.xyz[3 * n[3]]).volume;
     EXPECT_GT(vol, 0) << "tet " << t << " is not positively oriented";
     v[m.region_of(t)] += vol;
   }
@@ -208,24 +208,29 @@ TEST(CgalMesher, CylinderViaThroughALayerHasAnalyticVolumes) {
   CgalMeshParams params;
   params.max_size = 0.12;
   const Mesh m = mesh_plc_cgal(plc, params);
-  const double via = 0.5 * 8 * 0.2 * 0.2 * std::sin(std::numbers::pi / 8);  // 16-gon prism, r 0.2, height 0.5
+  const double via = 0.5 * 8 * 0.2 * 0.2 * std::sin(std::numbers::pi / 8);     // 16-gon prism, r 0.2, height 0.5
+  const double wall = 16 * 2 * 0.2 * std::sin(std::numbers::pi / 16) * 0.5;   // its side area
   const auto vol = region_volumes(m);
   ASSERT_EQ(vol.size(), 3u);
+  // Box-shaped parts with sharp, protected edges are exact. The faceted via is resampled: its 22.5 degree
+  // wall edges are not protected, so its rim is one smooth curve whose protecting balls do not fall
+  // on the 16-gon's corners (chords cut them; faceting tolerance, a few percent at this size).
   EXPECT_NEAR(vol.at(1), 0.5, 1e-9);
-  EXPECT_NEAR(vol.at(2), 0.5 - via, 1e-9);
-  EXPECT_NEAR(vol.at(3), via, 1e-9);
+  EXPECT_NEAR(vol.at(2) + vol.at(3), 0.5, 1e-9);
+  EXPECT_NEAR(vol.at(3), via, 0.05 * via);
   const auto area = tag_areas(m);
   EXPECT_EQ(area.size(), 8u);
-  EXPECT_NEAR(area.at(1), 1.0, 1e-9);                                // bottom
-  EXPECT_NEAR(area.at(6), 16 * 2 * 0.2 * std::sin(std::numbers::pi / 16) * 0.5, 1e-9);  // via wall
-  EXPECT_NEAR(area.at(8), 2 * via, 1e-9);                            // via top = its footprint
+  EXPECT_NEAR(area.at(1), 1.0, 1e-9);             // bottom
+  EXPECT_NEAR(area.at(7) + area.at(8), 1.0, 1e-9);  // the top: dielectric and via
+  EXPECT_NEAR(area.at(8), 2 * via, 0.06 * 2 * via); // via top = its footprint
+  EXPECT_NEAR(area.at(6), wall, 0.05 * wall);
   expect_certified(m, 30);
 
   MeshParams tp;
   tp.max_volume = 1.5 / static_cast<double>(m.tet_count());
   const Mesh t = mesh_plc(plc, tp);
-  std::printf("via: CGAL %zu tets, min dihedral %.2f deg; TetGen -O0 %zu tets, min dihedral %.2f deg\n", m.tet_count(),
-              min_dihedral(m), t.tet_count(), min_dihedral(t));
+  std::printf("via: CGAL %zu tets, min dihedral %.2f deg, via volume error %.2e; TetGen -O0 %zu tets, min dihedral %.2f deg\n",
+              m.tet_count(), min_dihedral(m), vol.at(3) / via - 1, t.tet_count(), min_dihedral(t));
   EXPECT_GT(min_dihedral(m), min_dihedral(t));
 }
 
@@ -242,6 +247,12 @@ TEST(CgalMesher, WeightsSurviveAVtuFileAndStillCertify) {
   ASSERT_EQ(r.weight.size(), m.weight.size());
   EXPECT_TRUE(std::equal(r.weight.begin(), r.weight.end(), m.weight.begin()));
   EXPECT_TRUE(compute_delaunay_certificate(r).delaunay);
+  // For the record: what the weights are worth (the same tets, certified as if unweighted).
+  Mesh bare = m;
+  bare.weight.clear();
+  const DelaunayCertificate c = compute_delaunay_certificate(bare);
+  std::printf("unit box without its weights: %zu of %zu tets have a vertex inside their circumsphere\n", c.violating_tet_count,
+              c.tets_checked);
 }
 
 TEST(CgalMesher, BadPlcsAndCancelGiveMesherErrors) {

@@ -1,6 +1,7 @@
 // Meshing a PLC with CGAL's Mesh_3 (issue 6, item 3): the PLC's facets become the patches of a
-// polyhedral-complex domain (one per facet and pair of cells on its sides, so multiple materials and
-// interfaces are kept), every facet edge is protected as a sharp feature (boxes stay boxes), then
+// polyhedral-complex domain (one per facet marker and pair of cells on its sides, so multiple materials
+// and interfaces are kept), patch borders and sharp facet edges are protected features (boxes stay
+// boxes; a faceted cylinder's wall is resampled within facet_distance), then
 // Delaunay refinement with facet/cell size and radius-edge criteria, then sliver exudation (and
 // optionally perturbation).
 //
@@ -31,6 +32,12 @@ struct CgalMeshParams {
   double max_size = 0;
   double facet_size = 0;       // largest surface Delaunay ball radius; 0: max_size
   double edge_size = 0;        // largest protecting ball along facet edges; 0: facet_size
+  // Largest distance of a boundary triangle's circumcentre from the PLC surface: it bounds how far a
+  // curved-looking surface (a faceted cylinder) is cut inside; 0: facet_size / 20.
+  double facet_distance = 0;
+  // Facet edges that are not patch borders are protected features where the facets turn by more than
+  // this (degrees between normals); 60 keeps boxes sharp and lets faceted cylinders be resampled.
+  double feature_angle = 60;
   double facet_angle = 25;     // lower bound of boundary triangle angles (degrees, at most 30)
   double radius_edge = 2;      // circumradius / shortest edge bound of tets (>= 2 guarantees termination)
   bool exude = true;           // sliver exudation (weight pumping: keeps the triangulation regular)
@@ -51,7 +58,7 @@ struct CgalMeshReport {
   std::size_t patches = 0;          // surface patches of the domain
   std::size_t cells = 0;            // meshed cells (regions of space) of the PLC
   double max_size = 0;              // the size bounds used
-  double facet_size = 0, edge_size = 0;
+  double facet_size = 0, edge_size = 0, facet_distance = 0;
   double seconds = 0;
 };
 
