@@ -30,6 +30,7 @@ const char* kMeshUsage =
     "foxi mesh MODEL.toml|PLC.poly -o OUT [--set NAME=VALUE]... [--max-size H] [--quality Q]\n"
     "          [--min-dihedral DEG] [--max-volume V] [--region-size REGION=H]... [--refine-box X0,Y0,Z0,X1,Y1,Z1=H]...\n"
     "          [--refine-from RESULT.vtu [--field NAME] --target-error E] [--no-conform] [--optimize]\n"
+    "          [--mesher tetgen|cgal] [--perturb]\n"
     "  Meshes a model (parts -> PLC) or a TetGen .poly into tets with TetGen (no optimisation), then\n"
     "  splits encroached boundary/interface triangles until every tet is Delaunay (exact certificate),\n"
     "  and prints a quality report. OUT in any mesh format foxi knows (.vtu .msh .vtk .node .mesh).\n"
@@ -46,6 +47,11 @@ const char* kMeshUsage =
     "                     relative gradient error --target-error E (e.g. 0.05)\n"
     "  --no-conform       TetGen's mesh as it is (may not be Delaunay)\n"
     "  --optimize         TetGen's flips and smoothing (implies --no-conform: the mesh stops being Delaunay)\n"
+    "  --mesher cgal      CGAL Mesh_3 instead of TetGen (PLC.poly input): protected facet edges, sliver\n"
+    "                     exudation; the mesh is part of a regular triangulation, its vertex weights are\n"
+    "                     written (point data 'weight' in .vtu) and always certified (orthospheres).\n"
+    "                     --max-volume becomes the circumradius of a regular tet of that volume;\n"
+    "                     --radius-edge defaults to 2; --perturb adds sliver perturbation\n"
     "  Ctrl-C cancels (nothing is written).";
 
 std::atomic<bool> g_interrupted{false};
@@ -85,11 +91,16 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 }  // namespace
 
+int mesh_with_cgal(Args& args);  // cmd_mesh_cgal.cpp
+
 int cmd_mesh(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kMeshUsage);
     return 0;
   }
+  const std::string mesher = args.option("--mesher", "tetgen");
+  if (mesher == "cgal") return mesh_with_cgal(args);
+  if (mesher != "tetgen") throw UsageError("--mesher takes tetgen or cgal, not '" + mesher + "'");
   std::vector<std::string> sets, region_sizes, boxes;
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
   while (args.has_option("--region-size")) region_sizes.push_back(args.option("--region-size"));

@@ -1,0 +1,100 @@
+// foxi mesh PLC.poly --mesher cgal -o OUT: the CGAL Mesh_3 path of `foxi mesh` (options in cmd_mesh.cpp's
+// usage text): meshes, writes, and prints counts, time, dihedral angles and the weighted certificate.
+#include <csignal>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "cli.hpp"
+#include "foxi/mesher/cgal_mesher.hpp"
+#include "foxi/model/delaunay.hpp"
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/model/plc.hpp"
+#include "foxi/model/quality.hpp"
+
+namespace foxi::cli {
+
+namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_interrupt(int) { g_interrupted = 1; }
+
+double non_negative(const std::string& s, const char* what) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || !(v >= 0) || !std::isfinite(v))
+    throw UsageError(std::string(what) + " takes a number >= 0, not '" + s + "'");
+  return v;
+}
+
+// The largest dihedral angle of a tet (degrees), from its face normals.
+double max_dihedral_deg(const Mesh& m, std::size_t t) {
+  static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  double n[4][3];
+  for (int f = 0; f < 4; ++f) {
+    const double* a = &m.xyz[3 * m.tet[4 * t + face[f][0]]];
+    const double* b = &m.xyz[3 * m.tet[4 * t + face[f][1]]];
+    const double* c = &m.xyz[3 * m.tet[4 * t + face[f][2]]];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[f][0] = u[1] * w[2] - u[2] * w[1];
+    n[f][1] = u[2] * w[0] - u[0] * w[2];
+    n[f][2] = u[0] * w[1] - u[1] * w[0];
+    const double len = std::sqrt(n[f][0] * n[f][0] + n[f][1] * n[f][1] + n[f][2] * n[f][2]);
+    for (double& x : n[f]) x /= len;
+  }
+  double worst = 0;  // the dihedral angle at the edge of faces f and g is pi minus the angle of their outward normals
+  for (int f = 0; f < 4; ++f)
+    for (int g = f + 1; g < 4; ++g) {
+      const double d = n[f][0] * n[g][0] + n[f][1] * n[g][1] + n[f][2] * n[g][2];
+      worst = std::max(worst, 180.0 - std::acos(std::clamp(d, -1.0, 1.0)) * 180.0 / M_PI);
+    }
+  return worst;
+}
+
+}  // namespace
+
+int mesh_with_cgal(Args& args) {
+  CgalMeshParams params;
+  const double max_volume = non_negative(args.option("--max-volume", "0"), "--max-volume");
+  // The circumradius of the regular tet of that volume: CGAL bounds tet sizes by circumradius.
+  if (max_volume > 0) params.max_size = std::cbrt(6 * std::sqrt(2.0) * max_volume) * std::sqrt(6.0) / 4;
+  params.radius_edge = non_negative(args.option("--radius-edge", "2"), "--radius-edge");
+  params.perturb = args.flag("--perturb");
+  args.flag("--check-delaunay");  // the CGAL path always certifies
+  const std::string out = args.option("-o");
+  if (out.empty()) throw UsageError("give the output file with -o OUT (see foxi mesh --help)");
+  const std::string in = args.positional(1, 1, "foxi mesh PLC.poly --mesher cgal -o OUT")[0];
+  format_from_path(out);  // an unknown output format fails before any meshing
+
+  const Plc plc = read_poly(in);
+  g_interrupted = 0;
+  auto* previous = std::signal(SIGINT, on_interrupt);
+  params.progress = [](std::string_view, double) { return g_interrupted == 0; };
+  CgalMeshReport report;
+  Mesh mesh;
+  try {
+    mesh = mesh_plc_cgal(plc, params, &report);
+  } catch (const MesherError& e) {
+    std::signal(SIGINT, previous);
+    std::fprintf(stderr, "foxi mesh: error: %s: %s\n", in.c_str(), e.what());
+    return 1;
+  }
+  std::signal(SIGINT, previous);
+  write_mesh(mesh, out);
+  const QualitySummary q = summarize_quality(mesh);
+  double max_dihedral = 0;
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) max_dihedral = std::max(max_dihedral, max_dihedral_deg(mesh, t));
+  std::printf("%s -> %s: %zu nodes, %zu tets, %zu boundary triangles, %zu regions in %.3f s (CGAL Mesh_3)\n", in.c_str(),
+              out.c_str(), mesh.node_count(), mesh.tet_count(), mesh.bface_count(), mesh.regions.size(), report.seconds);
+  std::printf("sizes: cell %.4g, facet %.4g, edge %.4g; radius-edge max %.4g, dihedral min %.3g max %.4g deg, %zu slivers below 5 deg\n",
+              report.max_size, report.facet_size, report.edge_size, q.radius_edge.max, q.min_dihedral_deg.min, max_dihedral, q.slivers);
+  const DelaunayCertificate cert = compute_delaunay_certificate(mesh);
+  if (cert.delaunay)
+    std::printf("regular (weighted Delaunay): yes, every orthosphere is empty (%zu tets); weights written\n", cert.tets_checked);
+  else
+    std::printf("regular (weighted Delaunay): NO, %zu of %zu tets violated, %zu degenerate\n", cert.violating_tet_count,
+                cert.tets_checked, cert.degenerate_tet_count);
+  return cert.delaunay ? 0 : 1;
+}
+
+}  // namespace foxi::cli

@@ -1,0 +1,300 @@
+// The CGAL Mesh_3 path. Mesh_3 translation units are heavy (minutes of compile time, GBs of memory):
+// all Mesh_3 code of foxi stays in this one file.
+#include "foxi/mesher/cgal_mesher.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Mesh_complex_3_in_triangulation_3.h>
+#include <CGAL/Mesh_criteria_3.h>
+#include <CGAL/Mesh_polyhedron_3.h>
+#include <CGAL/Mesh_triangulation_3.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polyhedral_complex_mesh_domain_3.h>
+#include <CGAL/make_mesh_3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <tuple>
+#include <unordered_map>
+
+#include "child_process.hpp"
+#include "plc_surface.hpp"
+
+namespace foxi {
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Polyhedron = CGAL::Mesh_polyhedron_3<K>::type;
+using ComplexDomain = CGAL::Polyhedral_complex_mesh_domain_3<K>;
+
+// The domain, telling which input polyhedron a surface patch index comes from (feature detection
+// renumbers the patches).
+class Domain : public ComplexDomain {
+ public:
+  template <class... Args>
+  explicit Domain(Args&&... args) : ComplexDomain(std::forward<Args>(args)...) {}
+  std::size_t polyhedron_of_patch(Surface_patch_index patch) const {
+    return patch_id_to_polyhedron_id.at(static_cast<std::size_t>(patch));
+  }
+};
+
+using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
+using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
+using Criteria = CGAL::Mesh_criteria_3<Tr>;
+
+// Circumradius of the regular tet of volume v: edge a = (6 sqrt2 v)^(1/3), R = a sqrt6 / 4.
+double regular_tet_circumradius(double v) { return std::cbrt(6 * std::sqrt(2.0) * v) * std::sqrt(6.0) / 4; }
+
+// Cell size bound: the global one, lowered in subdomains whose region seed sets a max volume.
+struct CellSize {
+  using FT = K::FT;
+  using Point_3 = K::Point_3;
+  using Index = Domain::Index;
+  const Domain* domain = nullptr;
+  double global = 0;
+  std::vector<double> per_subdomain;  // by subdomain index
+  FT operator()(const Point_3&, int dim, const Index& index) const {
+    if (dim != 3) return global;
+    const auto sd = static_cast<std::size_t>(domain->subdomain_index(index));
+    return sd < per_subdomain.size() ? per_subdomain[sd] : global;
+  }
+};
+
+// The PLC surface grouped into the domain's input polyhedra: one per facet marker and pair of cells.
+struct Patches {
+  std::vector<Polyhedron> polyhedra;
+  std::vector<std::pair<int, int>> subdomains;  // (behind the normals, in front of them), Mesh_3's order
+  std::vector<std::int32_t> marker;             // the facet marker of each polyhedron
+};
+
+Patches make_patches(const Plc& plc, const detail::PlcSurface& s) {
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  // Triangles of one marker with the same cells on their sides: facets of one patch are oriented alike
+  // (their normals point into the same cell), so the group is a consistently oriented surface.
+  std::map<std::tuple<std::int32_t, std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
+  for (std::uint32_t t = 0; t < s.tri_facet.size(); ++t) {
+    const std::uint32_t front = s.side_cell[2 * t], back = s.side_cell[2 * t + 1];
+    if (front == back) continue;
+    const std::int32_t marker = plc.facet_marker[s.tri_facet[t]];
+    // Facets of a patch may face either way: orient every triangle from the lower cell index to the higher.
+    if (front < back)
+      groups[{marker, front, back}].push_back(t | 0x80000000u);  // flipped
+    else
+      groups[{marker, back, front}].push_back(t);
+  }
+  Patches out;
+  for (const auto& [key, tris] : groups) {
+    const auto [marker, back, front] = key;
+    std::vector<K::Point_3> pts;
+    std::vector<std::vector<std::size_t>> polys;
+    std::unordered_map<std::uint32_t, std::size_t> local;
+    for (std::uint32_t tf : tris) {
+      const std::uint32_t t = tf & 0x7fffffffu;
+      std::vector<std::size_t> poly;
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t v = s.tri[3 * t + ((tf & 0x80000000u) ? 2 - i : i)];
+        const auto [it, fresh] = local.emplace(v, pts.size());
+        if (fresh) pts.emplace_back(s.points[3 * v], s.points[3 * v + 1], s.points[3 * v + 2]);
+        poly.push_back(it->second);
+      }
+      polys.push_back(std::move(poly));
+    }
+    if (!PMP::is_polygon_soup_a_polygon_mesh(polys)) {
+      const auto before = polys;
+      PMP::orient_polygon_soup(pts, polys);  // splits non-manifold vertices; must not flip a triangle
+      if (polys.size() != before.size()) throw MesherError(10, "the facets of marker " + std::to_string(marker) + " overlap");
+      for (std::size_t i = 0; i < polys.size(); ++i) {
+        const auto& a = before[i];
+        const auto& b = polys[i];
+        const bool same = (pts[a[0]] == pts[b[0]] && pts[a[1]] == pts[b[1]]) || (pts[a[0]] == pts[b[1]] && pts[a[1]] == pts[b[2]]) ||
+                          (pts[a[0]] == pts[b[2]] && pts[a[1]] == pts[b[0]]);
+        if (!same) throw MesherError(10, "the facets of marker " + std::to_string(marker) + " meet in a non-manifold way");
+      }
+    }
+    Polyhedron poly;
+    PMP::polygon_soup_to_polygon_mesh(pts, polys, poly);
+    out.polyhedra.push_back(std::move(poly));
+    out.subdomains.emplace_back(static_cast<int>(back), static_cast<int>(front));
+    out.marker.push_back(marker);
+  }
+  if (out.polyhedra.empty()) throw MesherError(10, "the PLC encloses no volume (no facet has different cells on its sides)");
+  return out;
+}
+
+// The meshed tets, crossing the pipe from the child process.
+struct Result {
+  std::vector<double> xyz, weight;
+  std::vector<std::uint32_t> tet, bface;
+  std::vector<std::int32_t> tet_region, bface_tag;
+};
+
+template <class T>
+void put(std::vector<char>& out, const std::vector<T>& v) {
+  const std::uint64_t n = v.size();
+  const char* p = reinterpret_cast<const char*>(&n);
+  out.insert(out.end(), p, p + sizeof n);
+  p = reinterpret_cast<const char*>(v.data());
+  out.insert(out.end(), p, p + sizeof(T) * v.size());
+}
+
+template <class T>
+void get(const std::vector<char>& in, std::size_t& at, std::vector<T>& v) {
+  std::uint64_t n = 0;
+  if (in.size() - at < sizeof n) throw MesherError(2, "CGAL's result was cut short");
+  std::memcpy(&n, in.data() + at, sizeof n);
+  at += sizeof n;
+  if (n > (in.size() - at) / sizeof(T)) throw MesherError(2, "CGAL's result was cut short");
+  v.resize(n);
+  std::memcpy(v.data(), in.data() + at, sizeof(T) * n);
+  at += sizeof(T) * n;
+}
+
+Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& patches, const std::vector<std::int32_t>& cell_region) {
+  Result r;
+  std::unordered_map<Tr::Vertex_handle, std::uint32_t, CGAL::Handle_hash_function> index;
+  auto node = [&](Tr::Vertex_handle v) {
+    const auto [it, fresh] = index.emplace(v, static_cast<std::uint32_t>(r.weight.size()));
+    if (fresh) {
+      const auto& wp = v->point();
+      r.xyz.insert(r.xyz.end(), {wp.x(), wp.y(), wp.z()});
+      r.weight.push_back(wp.weight());
+    }
+    return it->second;
+  };
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+    // CGAL's cells are positively oriented, as foxi's tets.
+    for (int i = 0; i < 4; ++i) r.tet.push_back(node(c->vertex(i)));
+    const auto sd = static_cast<std::size_t>(c3t3.subdomain_index(c));
+    r.tet_region.push_back(sd < cell_region.size() ? cell_region[sd] : 0);
+  }
+  for (auto f = c3t3.facets_in_complex_begin(); f != c3t3.facets_in_complex_end(); ++f) {
+    std::uint32_t v[3];
+    bool in_mesh = true;
+    for (int k = 0; k < 3; ++k) {
+      const auto it = index.find(f->first->vertex((f->second + 1 + k) % 4));
+      in_mesh = in_mesh && it != index.end();
+      v[k] = in_mesh ? it->second : 0;
+    }
+    if (!in_mesh) continue;
+    r.bface.insert(r.bface.end(), v, v + 3);
+    r.bface_tag.push_back(patches.marker.at(domain.polyhedron_of_patch(c3t3.surface_patch_index(*f))));
+  }
+  return r;
+}
+
+std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s, const Plc& plc, const CgalMeshReport& sizes,
+                             const CgalMeshParams& params) {
+  namespace P = CGAL::parameters;
+  Domain domain(patches.polyhedra.begin(), patches.polyhedra.end(), patches.subdomains.begin(), patches.subdomains.end());
+  // Protected features: the borders of the patches (where markers or materials change) and edges where
+  // the facets turn by more than feature_angle. Faceted cylinders are not cut at every facet edge:
+  // protecting balls placed alike along both long edges of a narrow planar facet make cocircular
+  // rectangles there, and so flat tets that exudation cannot remove.
+  domain.detect_features(params.feature_angle);
+
+  CellSize cell_size{&domain, sizes.max_size, std::vector<double>(s.cell_count, sizes.max_size)};
+  for (const RegionSeed& seed : plc.regions)
+    if (seed.max_volume > 0)
+      for (std::size_t c = 1; c < s.cell_count; ++c)
+        if (s.cell_region[c] == seed.id) cell_size.per_subdomain[c] = std::min(cell_size.per_subdomain[c], regular_tet_circumradius(seed.max_volume));
+  // Facets keep their vertices on one patch (or its bounding features): without it a coarse mesh of a thin
+  // part takes facets that cut across its corners (the dual edge meets a patch, the facet does not lie in it).
+  Criteria criteria(P::edge_size = sizes.edge_size, P::facet_angle = params.facet_angle, P::facet_size = sizes.facet_size,
+                    P::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH_WITH_ADJACENCY_CHECK,
+                    P::facet_distance = sizes.facet_distance,
+                    P::cell_radius_edge_ratio = params.radius_edge, P::cell_size = cell_size);
+  C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, P::no_perturb(), P::no_exude());
+  if (params.perturb)
+    CGAL::perturb_mesh_3(c3t3, domain, P::time_limit = params.optimiser_seconds, P::sliver_bound = params.sliver_bound);
+  if (params.exude) CGAL::exude_mesh_3(c3t3, P::time_limit = params.optimiser_seconds, P::sliver_bound = params.sliver_bound);
+
+  const Result r = export_complex(c3t3, domain, patches, s.cell_region);
+  std::vector<char> out;
+  put(out, r.xyz);
+  put(out, r.weight);
+  put(out, r.tet);
+  put(out, r.tet_region);
+  put(out, r.bface);
+  put(out, r.bface_tag);
+  return out;
+}
+
+std::vector<std::int32_t> distinct(std::vector<std::int32_t> v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+}  // namespace
+
+Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!(params.max_size >= 0 && params.facet_size >= 0 && params.edge_size >= 0 && params.radius_edge >= 0 &&
+        params.facet_angle >= 0 && params.facet_angle <= 30 && params.optimiser_seconds >= 0 && params.sliver_bound >= 0 &&
+        params.sliver_bound < 70 &&
+        params.facet_distance >= 0 && params.feature_angle >= 0 && params.feature_angle <= 180))
+    throw MesherError(10, "CGAL mesh parameters out of range (sizes >= 0, facet angle in [0, 30], sliver bound in [0, 70), feature angle in [0, 180] degrees)");
+  const detail::PlcSurface s = detail::plc_surface(plc);
+  const Patches patches = make_patches(plc, s);
+
+  CgalMeshReport rep;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    lo[i % 3] = std::min(lo[i % 3], s.points[i]);
+    hi[i % 3] = std::max(hi[i % 3], s.points[i]);
+  }
+  const double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  rep.max_size = params.max_size > 0 ? params.max_size : diag / 20;
+  rep.facet_size = params.facet_size > 0 ? params.facet_size : rep.max_size;
+  rep.edge_size = params.edge_size > 0 ? params.edge_size : rep.facet_size;
+  rep.facet_distance = params.facet_distance > 0 ? params.facet_distance : rep.facet_size / 20;
+  rep.input_points = plc.point_count();
+  rep.facet_triangles = s.tri_facet.size();
+  rep.patches = patches.polyhedra.size();
+  rep.cells = s.cell_count - 1;
+
+  const std::vector<char> bytes = detail::run_in_child(
+      [&] {
+        try {
+          return run_mesh_3(patches, s, plc, rep, params);
+        } catch (const MesherError&) {
+          throw;
+        } catch (const std::exception& e) {
+          throw MesherError(2, std::string("CGAL Mesh_3 failed: ") + e.what());
+        }
+      },
+      params.progress, "meshing (CGAL)", "CGAL Mesh_3");
+  Result r;
+  std::size_t at = 0;
+  get(bytes, at, r.xyz);
+  get(bytes, at, r.weight);
+  get(bytes, at, r.tet);
+  get(bytes, at, r.tet_region);
+  get(bytes, at, r.bface);
+  get(bytes, at, r.bface_tag);
+  const std::size_t nn = r.weight.size();
+  if (r.xyz.size() != 3 * nn || r.tet.size() != 4 * r.tet_region.size() || r.bface.size() != 3 * r.bface_tag.size())
+    throw MesherError(2, "CGAL's result is inconsistent");
+  for (std::uint32_t v : r.tet)
+    if (v >= nn) throw MesherError(2, "CGAL returned a tet index out of range");
+  if (r.tet.empty()) throw MesherError(2, "CGAL Mesh_3 returned no tets (sizes too large for the PLC?)");
+
+  Mesh m;
+  m.xyz = std::move(r.xyz);
+  m.weight = std::move(r.weight);
+  m.tet = std::move(r.tet);
+  m.tet_region = std::move(r.tet_region);
+  m.bface = std::move(r.bface);
+  m.bface_tag = std::move(r.bface_tag);
+  for (std::int32_t id : distinct(m.tet_region)) m.regions.push_back(Region{id, {}, kNone});
+  for (std::int32_t tag : distinct(m.bface_tag)) m.boundaries.push_back(Boundary{tag, {}});
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (report) *report = rep;
+  return m;
+}
+
+}  // namespace foxi

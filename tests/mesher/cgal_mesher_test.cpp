@@ -1,0 +1,283 @@
+// Meshing PLCs through CGAL's Mesh_3: region volumes and boundary areas against analytic values and
+// the model builder's own part volumes, the weighted Delaunay certificate (exact, global), the
+// visibility order from many views (exact orientation tests), weights through a .vtu file, and the
+// minimum dihedral angle against TetGen's -O0 mesh of the same PLC.
+#include "foxi/mesher/cgal_mesher.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+
+#include "foxi/mesher/tetgen_mesher.hpp"
+#include "foxi/model/delaunay.hpp"
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/model/plc.hpp"
+#include "foxi/model/quality.hpp"
+#include "foxi/model/structure.hpp"
+#include "foxi/model/validate.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/visibility_order.hpp"
+#include "test_util.hpp"
+
+namespace foxi {
+namespace {
+
+std::string source_file(const std::string& name) { return test::data_dir() + "/../../" + name; }
+
+std::map<std::int32_t, double> region_volumes(const Mesh& m) {
+  std::map<std::int32_t, double> v;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    const std::uint32_t* n = &m.tet[4 * t];
+    const double vol = tet_quality(&m.xyz[3 * n[0]], &m.xyz[3 * n[1]], &m.xyz[3 * n[2]], &m.xyz[3 * n[3]]).volume;
+    EXPECT_GT(vol, 0) << "tet " << t << " is not positively oriented";
+    v[m.region_of(t)] += vol;
+  }
+  return v;
+}
+
+std::map<std::int32_t, double> tag_areas(const Mesh& m) {
+  std::map<std::int32_t, double> area;
+  for (std::size_t f = 0; f < m.bface_count(); ++f) {
+    const double* p = &m.xyz[3 * m.bface[3 * f]];
+    const double* q = &m.xyz[3 * m.bface[3 * f + 1]];
+    const double* r = &m.xyz[3 * m.bface[3 * f + 2]];
+    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    area[m.bface_tag[f]] += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  }
+  return area;
+}
+
+// A box [lo, hi]^3 as 6 facets with markers first_marker .. first_marker + 5 (bottom, top, -y, +x, +y, -x).
+void add_box(Plc& plc, const double lo[3], const double hi[3], std::int32_t first_marker) {
+  const auto base = static_cast<std::uint32_t>(plc.point_count());
+  for (int k = 0; k < 8; ++k) {
+    plc.points.push_back((k & 1) ^ ((k >> 1) & 1) ? hi[0] : lo[0]);
+    plc.points.push_back(k & 2 ? hi[1] : lo[1]);
+    plc.points.push_back(k & 4 ? hi[2] : lo[2]);
+  }
+  // Points 0..3 go round the bottom (x, y) = (lo,lo) (hi,lo) (hi,hi) (lo,hi); 4..7 the same on top.
+  plc.add_facet({base, base + 1, base + 2, base + 3}, first_marker);
+  plc.add_facet({base + 4, base + 5, base + 6, base + 7}, first_marker + 1);
+  plc.add_facet({base, base + 1, base + 5, base + 4}, first_marker + 2);
+  plc.add_facet({base + 1, base + 2, base + 6, base + 5}, first_marker + 3);
+  plc.add_facet({base + 2, base + 3, base + 7, base + 6}, first_marker + 4);
+  plc.add_facet({base + 3, base, base + 4, base + 7}, first_marker + 5);
+}
+
+Plc unit_box() {
+  Plc plc;
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+  add_box(plc, lo, hi, 1);
+  plc.regions.push_back(RegionSeed{{0.5, 0.5, 0.5}, 7, 0});
+  return plc;
+}
+
+// Eyes on a sphere twice the mesh's size around its centre and at its centre, and orthographic
+// directions, spread on the sphere by the golden angle.
+std::vector<View> views_around(const Mesh& m, int n) {
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (std::size_t i = 0; i < m.xyz.size(); ++i) {
+    lo[i % 3] = std::min(lo[i % 3], m.xyz[i]);
+    hi[i % 3] = std::max(hi[i % 3], m.xyz[i]);
+  }
+  const double c[3] = {(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2};
+  const double r = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  std::vector<View> views{View::at(c[0] + 1e-3 * r, c[1] + 2e-3 * r, c[2] + 3e-3 * r)};
+  for (int i = 1; i < n; ++i) {
+    const double z = 1 - 2 * (i + 0.5) / n, s = std::sqrt(1 - z * z), phi = i * 2.399963229728653;
+    const double d[3] = {s * std::cos(phi), s * std::sin(phi), z};
+    views.push_back(i % 2 ? View::along(d[0], d[1], d[2]) : View::at(c[0] + r * d[0], c[1] + r * d[1], c[2] + r * d[2]));
+  }
+  return views;
+}
+
+// The properties every CGAL mesh must have: valid, weighted, certified regular, and ordered without a
+// single face pair in the wrong order from many views.
+void expect_certified(const Mesh& m, int views) {
+  EXPECT_TRUE(validate(m).ok());
+  ASSERT_EQ(m.weight.size(), m.node_count());
+  const DelaunayCertificate cert = compute_delaunay_certificate(m);
+  EXPECT_TRUE(cert.weighted);
+  EXPECT_TRUE(cert.delaunay) << cert.violating_tet_count << " tets violate the weighted certificate, "
+                             << cert.degenerate_tet_count << " degenerate";
+  const SphereTable table = compute_spheres(m);
+  std::size_t checked = 0;
+  for (const View& v : views_around(m, views)) {
+    const auto order = visibility_order(m, table, v);
+    ASSERT_EQ(order.size(), m.tet_count());
+    const ViolationReport r = count_violations(m, v, order);
+    EXPECT_EQ(r.violations, 0u);
+    checked += r.pairs_checked;
+  }
+  EXPECT_GT(checked, m.tet_count());  // the views really compared face pairs
+}
+
+double min_dihedral(const Mesh& m) { return summarize_quality(m).min_dihedral_deg.min; }
+
+TEST(CgalMesher, UnitBoxKeepsItsCornersTagsAndIsCertified) {
+  const Plc plc = unit_box();
+  CgalMeshParams params;
+  params.max_size = 0.15;
+  CgalMeshReport report;
+  const Mesh m = mesh_plc_cgal(plc, params, &report);
+  EXPECT_GT(m.tet_count(), 200u);
+  EXPECT_EQ(report.cells, 1u);
+  EXPECT_EQ(report.patches, 6u);
+  const auto vol = region_volumes(m);
+  ASSERT_EQ(vol.size(), 1u);
+  EXPECT_NEAR(vol.at(7), 1.0, 1e-9);  // protected edges: the box is not rounded
+  const auto area = tag_areas(m);
+  ASSERT_EQ(area.size(), 6u);
+  for (std::int32_t tag = 1; tag <= 6; ++tag) EXPECT_NEAR(area.at(tag), 1.0, 1e-9) << "tag " << tag;
+  // Every corner of the box is a mesh vertex.
+  for (std::size_t k = 0; k < 8; ++k) {
+    bool found = false;
+    for (std::size_t i = 0; i < m.node_count() && !found; ++i)
+      found = m.xyz[3 * i] == plc.points[3 * k] && m.xyz[3 * i + 1] == plc.points[3 * k + 1] && m.xyz[3 * i + 2] == plc.points[3 * k + 2];
+    EXPECT_TRUE(found) << "corner " << k;
+  }
+  expect_certified(m, 40);
+}
+
+TEST(CgalMesher, NestedShellsAndVolumeHolesFindTheirCells) {
+  // A box floating inside a box, touching nothing: the outer region's boundary has two shells.
+  Plc plc;
+  const double lo[3] = {0, 0, 0}, hi[3] = {2, 2, 2}, ilo[3] = {0.5, 0.5, 0.5}, ihi[3] = {1.5, 1.5, 1.5};
+  add_box(plc, lo, hi, 1);
+  add_box(plc, ilo, ihi, 7);
+  plc.regions.push_back(RegionSeed{{0.25, 0.25, 0.25}, 1, 0});
+  plc.regions.push_back(RegionSeed{{1, 1, 1}, 2, 0});
+  CgalMeshParams params;
+  params.max_size = 0.3;
+  const Mesh m = mesh_plc_cgal(plc, params);
+  auto vol = region_volumes(m);
+  ASSERT_EQ(vol.size(), 2u);
+  EXPECT_NEAR(vol.at(1), 7.0, 1e-9);
+  EXPECT_NEAR(vol.at(2), 1.0, 1e-9);
+  auto area = tag_areas(m);
+  for (std::int32_t tag = 7; tag <= 12; ++tag) EXPECT_NEAR(area.at(tag), 1.0, 1e-9);  // the interface
+  expect_certified(m, 10);
+
+  // The inner box as a volume hole: not meshed, and the outer region keeps its 7 units.
+  plc.regions.pop_back();
+  plc.holes = {1, 1, 1};
+  const Mesh h = mesh_plc_cgal(plc, params);
+  vol = region_volumes(h);
+  ASSERT_EQ(vol.size(), 1u);
+  EXPECT_NEAR(vol.at(1), 7.0, 1e-9);
+  area = tag_areas(h);
+  for (std::int32_t tag = 7; tag <= 12; ++tag) EXPECT_NEAR(area.at(tag), 1.0, 1e-9);  // now a boundary
+}
+
+TEST(CgalMesher, DieOnSubstrateModelMatchesThePartVolumesAndBeatsTetgenAngles) {
+  const Model model = load_model(source_file("models/die_on_substrate.toml"));
+  const Structure st = build_structure(model);
+  CgalMeshParams params;
+  CgalMeshReport report;
+  Mesh m = mesh_plc_cgal(st.plc, params, &report);
+  const auto vol = region_volumes(m);
+  ASSERT_EQ(vol.size(), st.part_volume.size());
+  for (std::size_t p = 0; p < st.part_volume.size(); ++p)
+    EXPECT_NEAR(vol.at(static_cast<std::int32_t>(p + 1)), st.part_volume[p], 1e-9 * st.part_volume[p]) << "part " << p;
+  const auto area = tag_areas(m);
+  ASSERT_EQ(area.size(), st.boundary_area.size());  // every named surface is covered
+  for (std::size_t b = 0; b < st.boundary_area.size(); ++b)
+    EXPECT_NEAR(area.at(static_cast<std::int32_t>(b + 1)), st.boundary_area[b], 1e-8 * st.boundary_area[b]) << st.boundary_names[b];
+  expect_certified(m, 30);
+
+  // TetGen -O0 (no flips or smoothing) with a similar tet count: CGAL's exuded mesh has better angles.
+  MeshParams tp;
+  double total = 0;
+  for (double v : st.part_volume) total += v;
+  tp.max_volume = 1.5 * total / static_cast<double>(m.tet_count());
+  const Mesh t = mesh_plc(st.plc, tp);
+  const double cgal_min = min_dihedral(m), tetgen_min = min_dihedral(t);
+  std::printf("die on substrate: CGAL %zu tets, min dihedral %.2f deg; TetGen -O0 %zu tets, min dihedral %.2f deg\n", m.tet_count(),
+              cgal_min, t.tet_count(), tetgen_min);
+  EXPECT_GT(cgal_min, tetgen_min);
+}
+
+TEST(CgalMesher, CylinderViaThroughALayerHasAnalyticVolumes) {
+  const Plc plc = read_poly(source_file("examples/via_in_dielectric.poly"));
+  CgalMeshParams params;
+  params.max_size = 0.12;
+  const Mesh m = mesh_plc_cgal(plc, params);
+  const double via = 0.5 * 8 * 0.2 * 0.2 * std::sin(std::numbers::pi / 8);     // 16-gon prism, r 0.2, height 0.5
+  const double wall = 16 * 2 * 0.2 * std::sin(std::numbers::pi / 16) * 0.5;   // its side area
+  const auto vol = region_volumes(m);
+  ASSERT_EQ(vol.size(), 3u);
+  // Box-shaped parts with sharp, protected edges are exact. The faceted via is resampled: its 22.5 degree
+  // wall edges are not protected, so its rim is one smooth curve whose protecting balls do not fall
+  // on the 16-gon's corners (chords cut them; faceting tolerance, a few percent at this size).
+  EXPECT_NEAR(vol.at(1), 0.5, 1e-9);
+  EXPECT_NEAR(vol.at(2) + vol.at(3), 0.5, 1e-9);
+  EXPECT_NEAR(vol.at(3), via, 0.05 * via);
+  const auto area = tag_areas(m);
+  EXPECT_EQ(area.size(), 8u);
+  EXPECT_NEAR(area.at(1), 1.0, 1e-9);             // bottom
+  EXPECT_NEAR(area.at(7) + area.at(8), 1.0, 1e-9);  // the top: dielectric and via
+  EXPECT_NEAR(area.at(8), 2 * via, 0.06 * 2 * via); // via top = its footprint
+  EXPECT_NEAR(area.at(6), wall, 0.05 * wall);
+  expect_certified(m, 30);
+
+  MeshParams tp;
+  tp.max_volume = 1.5 / static_cast<double>(m.tet_count());
+  const Mesh t = mesh_plc(plc, tp);
+  std::printf("via: CGAL %zu tets, min dihedral %.2f deg, via volume error %.2e; TetGen -O0 %zu tets, min dihedral %.2f deg\n",
+              m.tet_count(), min_dihedral(m), vol.at(3) / via - 1, t.tet_count(), min_dihedral(t));
+  EXPECT_GT(min_dihedral(m), min_dihedral(t));
+}
+
+TEST(CgalMesher, WeightsSurviveAVtuFileAndStillCertify) {
+  CgalMeshParams params;
+  params.max_size = 0.2;
+  const Mesh m = mesh_plc_cgal(unit_box(), params);
+  std::size_t weighted = 0;
+  for (double w : m.weight) weighted += w != 0;
+  EXPECT_GT(weighted, 0u);  // protecting balls and exudation give non-zero weights
+  test::TempDir dir;
+  write_mesh(m, dir / "box.vtu");
+  const Mesh r = read_mesh(dir / "box.vtu");
+  ASSERT_EQ(r.weight.size(), m.weight.size());
+  EXPECT_TRUE(std::equal(r.weight.begin(), r.weight.end(), m.weight.begin()));
+  EXPECT_TRUE(compute_delaunay_certificate(r).delaunay);
+  // For the record: what the weights are worth (the same tets, certified as if unweighted).
+  Mesh bare = m;
+  bare.weight.clear();
+  const DelaunayCertificate c = compute_delaunay_certificate(bare);
+  std::printf("unit box without its weights: %zu of %zu tets have a vertex inside their circumsphere\n", c.violating_tet_count,
+              c.tets_checked);
+}
+
+TEST(CgalMesher, BadPlcsAndCancelGiveMesherErrors) {
+  Plc outside = unit_box();
+  outside.regions[0].point[0] = 3;
+  try {
+    mesh_plc_cgal(outside);
+    FAIL() << "a seed outside the PLC was accepted";
+  } catch (const MesherError& e) {
+    EXPECT_NE(std::string(e.what()).find("outside every closed surface"), std::string::npos) << e.what();
+  }
+  Plc crossing = unit_box();
+  crossing.add_facet({0, 2, 1, 3}, 9);  // a bow tie: its edges cross
+  EXPECT_THROW(mesh_plc_cgal(crossing), MesherError);
+
+  CgalMeshParams params;
+  params.max_size = 0.01;  // long enough to be cancelled
+  params.progress = [](std::string_view, double) { return false; };
+  try {
+    mesh_plc_cgal(unit_box(), params);
+    FAIL() << "not cancelled";
+  } catch (const MesherError& e) {
+    EXPECT_EQ(e.tetgen_code(), -1);
+  }
+}
+
+}  // namespace
+}  // namespace foxi
