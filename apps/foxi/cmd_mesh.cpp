@@ -13,6 +13,7 @@
 #include "cli.hpp"
 #include "foxi/mesher/conforming.hpp"
 #include "foxi/mesher/quality_report.hpp"
+#include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/mesher/size_field.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/delaunay.hpp"
@@ -108,8 +109,10 @@ int cmd_mesh(Args args) {
   const std::string max_size = args.option("--max-size");
   MeshParams params;
   params.max_volume = number(args.option("--max-volume", "0"), "--max-volume");
-  params.radius_edge = number(args.option("--quality", args.option("--radius-edge", "1.414")), "--quality");
-  params.min_dihedral = number(args.option("--min-dihedral", "0"), "--min-dihedral");
+  const std::string quality = args.option("--quality", args.option("--radius-edge", ""));
+  const std::string min_dihedral = args.option("--min-dihedral", "");
+  params.radius_edge = quality.empty() ? 1.414 : number(quality, "--quality");
+  params.min_dihedral = min_dihedral.empty() ? 0 : number(min_dihedral, "--min-dihedral");
   params.optimize = args.flag("--optimize");
   const bool conform = !args.flag("--no-conform") && !params.optimize;
   args.flag("--check-delaunay");  // the certificate is always part of the report now
@@ -138,7 +141,18 @@ int cmd_mesh(Args args) {
     plc = read_poly(in);
   }
 
+  // A model's [mesh] table first; the command line overrides its global size and bounds and adds to
+  // its part sizes and boxes.
   SizeControls controls;
+  if (is_model) {
+    controls = size_controls_from_model(model);
+    if (controls.max_size > 0 && max_size.empty()) {
+      const double v = regular_tet_volume(controls.max_size);
+      params.max_volume = params.max_volume > 0 ? std::min(params.max_volume, v) : v;
+    }
+    if (quality.empty() && model.mesh.quality >= 0) params.radius_edge = model.mesh.quality;
+    if (min_dihedral.empty()) params.min_dihedral = model.mesh.min_dihedral;
+  }
   if (!max_size.empty()) {
     controls.max_size = length(max_size, unit_scale, "--max-size");
     const double v = regular_tet_volume(controls.max_size);

@@ -3,7 +3,6 @@
 
 #include "foxi/mesher/size_field.hpp"
 
-
 namespace foxi {
 
 ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double default_size) {
@@ -20,6 +19,27 @@ ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double defa
           if (seed.id == static_cast<std::int32_t>(i + 1)) seed.max_volume = regular_tet_volume(ps.max_size);
   out.ignored_refine_boxes = mc.refine.size();
   return out;
+}
+
+SizeControls size_controls_from_model(const Model& model) {
+  SizeControls controls;
+  controls.max_size = model.mesh.max_size;
+  for (const PartSize& ps : model.mesh.part_sizes)
+    for (std::size_t i = 0; i < model.parts.size(); ++i)
+      if (model.parts[i].name == ps.part) {
+        controls.region_ids.push_back(static_cast<std::int32_t>(i + 1));
+        controls.region_sizes.push_back(ps.max_size);
+      }
+  for (const RefineBox& b : model.mesh.refine) {
+    RefinementBox box;
+    for (int k = 0; k < 3; ++k) {
+      box.lo[k] = b.lo[k];
+      box.hi[k] = b.hi[k];
+    }
+    box.size = b.max_size;
+    controls.boxes.push_back(box);
+  }
+  return controls;
 }
 
 }  // namespace foxi

@@ -20,4 +20,9 @@ struct ModelMeshParams {
 };
 ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double default_size = 0);
 
+// A model's [mesh] controls as the mesher's size controls (size_field.hpp): the global size, each
+// sized part's region (id = part index + 1) and the refinement boxes. Quality and dihedral bounds are
+// not size controls: take them from mesh_params_from_model or model.mesh.
+SizeControls size_controls_from_model(const Model& model);
+
 }  // namespace foxi
