@@ -111,9 +111,9 @@ int cmd_solve_thermoelastic(Args args) {
   params.solver = parse_solver_options(args);
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
-  const auto files = args.positional(1, 1, kThermoelasticUsage);
   const bool from_thermal = args.flag("--temperature-from-thermal");
   const std::vector<std::string> sets = all_options(args, "--set");
+  const auto files = args.positional(1, 1, kThermoelasticUsage);
   const bool from_model = is_model_path(files[0]);
   if (!from_model && (from_thermal || !sets.empty()))
     throw UsageError("--set and --temperature-from-thermal are for model files (MODEL.toml)");
