@@ -7,11 +7,11 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "model_run.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermoelastic.hpp"
+#include "model_run.hpp"
 #include "solve_options.hpp"
 
 namespace foxi::cli {
@@ -118,7 +118,8 @@ int cmd_solve_thermoelastic(Args args) {
   if (!from_model && (from_thermal || !sets.empty()))
     throw UsageError("--set and --temperature-from-thermal are for model files (MODEL.toml)");
   if (!dt.empty() + !temperature.empty() + from_thermal > 1)
-    throw UsageError("--physics thermoelastic takes one of --dT, --temperature and --temperature-from-thermal");
+    throw UsageError(
+        "--physics thermoelastic takes one of --dT, --temperature and --temperature-from-thermal");
   if (!from_model && dt.empty() && temperature.empty())
     throw UsageError("--physics thermoelastic on a mesh takes one of --dT and --temperature");
   if (!tref.empty() && temperature.empty() && !from_thermal)
@@ -143,8 +144,9 @@ int cmd_solve_thermoelastic(Args args) {
     bool has_load = false;
     for (const Load& l : run.model.loads) has_load = has_load || l.kind == LoadKind::temperature_change;
     if (!has_load && dt.empty() && temperature.empty() && !from_thermal)
-      throw UsageError(files[0] +
-                       ": no temperature_change load; give one, --dT, --temperature or --temperature-from-thermal");
+      throw UsageError(
+          files[0] +
+          ": no temperature_change load; give one, --dT, --temperature or --temperature-from-thermal");
     if (has_load && from_thermal)
       std::printf("note: the thermal solve's temperatures replace the model's temperature_change load\n");
   }
@@ -155,10 +157,11 @@ int cmd_solve_thermoelastic(Args args) {
     const Field* t = mesh.find_field("temperature");
     params.temperature.assign(t->values.begin(), t->values.end());
     params.delta_t = 0;
-    std::printf("thermal solve (the model's thermal conditions and power loads): max temperature %.6g K (%.6g C), "
-                "%zu iterations, %.3f s; stress-free at %s K\n",
-                tr.max_temperature, tr.max_temperature - 273.15, tr.iterations, tr.solve_seconds,
-                tref.empty() ? "293.15" : tref.c_str());
+    std::printf(
+        "thermal solve (the model's thermal conditions and power loads): max temperature %.6g K (%.6g C), "
+        "%zu iterations, %.3f s; stress-free at %s K\n",
+        tr.max_temperature, tr.max_temperature - 273.15, tr.iterations, tr.solve_seconds,
+        tref.empty() ? "293.15" : tref.c_str());
   }
   for (const std::string& s : fix) params.fixed.push_back(parse_fix(mesh, s));
   for (const std::string& s : slide) params.sliding.push_back({boundary_tag(mesh, s, "--slide")});

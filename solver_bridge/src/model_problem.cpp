@@ -87,8 +87,8 @@ ThermoelasticParams thermoelastic_params_from_model(const Model& model, const Me
   for (std::size_t i = 0; i < model.parts.size(); ++i)
     for (const Material& m : model.materials)
       if (m.name == model.parts[i].material)
-        p.materials.push_back({static_cast<std::int32_t>(i + 1), m.youngs_modulus, m.poisson_ratio,
-                               m.thermal_expansion});
+        p.materials.push_back(
+            {static_cast<std::int32_t>(i + 1), m.youngs_modulus, m.poisson_ratio, m.thermal_expansion});
   // dT per part: NaN where no load names it
   std::vector<double> part_dt(model.parts.size(), std::nan(""));
   std::uint64_t first_line = 0;

@@ -205,7 +205,9 @@ max_size = "0.5 mm"
 )TOML");
   const std::string bar = "'" + (dir_ / "bar.toml").string() + "'";
   const std::string out = (dir_ / "bar.vtu").string();
-  ASSERT_EQ(foxi("solve " + bar + " --physics thermoelastic --temperature-from-thermal --tref 300 -o '" + out + "'"), 0)
+  ASSERT_EQ(foxi("solve " + bar + " --physics thermoelastic --temperature-from-thermal --tref 300 -o '" +
+                 out + "'"),
+            0)
       << test::read_text(dir_ / "out.log");
   std::string log = test::read_text(dir_ / "out.log");
   EXPECT_NE(log.find("max von Mises stress 8e+07 Pa"), std::string::npos) << log;  // E alpha 80 K
