@@ -17,6 +17,7 @@
 
 #include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
+#include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/physics.hpp"
 #include "foxi/model/structure.hpp"
@@ -245,6 +246,26 @@ value = "50 K"
   for (std::size_t i = 0; i < s.mesh.xyz.size(); ++i)
     ASSERT_NEAR(u[i], kAlpha * 50 * s.mesh.xyz[i], 1e-9 * kAlpha * 50 * 4e-3) << "node " << i / 3;
   EXPECT_LT(r.max_von_mises, 1e-6 * kE * kAlpha * 50);
+}
+
+// Thermal stress needs a condition that holds the body: a temperature condition alone does not.
+TEST(ModelSolve, ThermalStressWithoutDisplacementOrSlidingIsNotReady) {
+  TempDir dir;
+  test::write_text(dir / "loose.toml", block(R"TOML(
+[[conditions]]
+type = "temperature"
+surface = "west"
+value = "300 K"
+)TOML"));
+  const Model model = load_model(dir / "loose.toml");
+  check_physics(model, Physics::thermal);
+  try {
+    check_physics(model, Physics::thermal_stress);
+    ADD_FAILURE() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("a displacement or sliding condition"), std::string::npos)
+        << e.what();
+  }
 }
 
 // A per-part temperature change that differs between parts is refused (interface nodes are shared).
