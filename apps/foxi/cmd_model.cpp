@@ -124,7 +124,26 @@ int cmd_model(Args args) {
     if (!has) continue;
     try {
       check_physics(model, ph);
-      std::printf("physics %s: ready\n", physics_name(ph));
+      if (ph != Physics::thermal_stress) {
+        std::printf("physics %s: ready (foxi solve MODEL --physics %s)\n", physics_name(ph),
+                    physics_name(ph));
+        continue;
+      }
+      // the stress solve also needs a temperature: the model's load, or its own thermal run
+      bool load = false, thermal = true;
+      for (const Load& l : model.loads) load = load || l.kind == LoadKind::temperature_change;
+      try {
+        check_physics(model, Physics::thermal);
+      } catch (const IoError&) {
+        thermal = false;
+      }
+      std::printf(
+          "physics %s: ready (foxi solve MODEL --physics thermoelastic%s)%s\n", physics_name(ph),
+          load      ? ""
+          : thermal ? " --temperature-from-thermal, or --dT K"
+                    : " --dT K",
+          load ? (thermal ? "; or with the thermal run's temperatures: --temperature-from-thermal" : "")
+               : "; the model has no temperature_change load");
     } catch (const IoError& e) {
       std::printf("physics %s: not ready: %s\n", physics_name(ph), e.what());
     }

@@ -23,6 +23,7 @@ namespace {
 
 const char* kSolveUsage =
     "foxi solve MODEL.toml --physics thermal|electrostatic|current [--set NAME=VALUE]... [options below]\n"
+    "  (--physics thermoelastic: see 'foxi solve --physics thermoelastic --help')\n"
     "  Meshes the model (TetGen, its [mesh] controls) and solves with its [[conditions]] and [[loads]];\n"
     "  the options below add to them, boundaries and regions named as in 'foxi model check'.\n"
     "\n"
@@ -58,7 +59,8 @@ const char* kSolveUsage =
     "  sigma defaults to the region's material. OUT gets 'potential' (V), 'current_density' (A/m^2)\n"
     "  and 'joule_heat' (W/m^3).\n"
     "\n"
-    "foxi solve MESH --physics thermoelastic ... : thermal stress, see 'foxi solve --physics thermoelastic --help'.";
+    "foxi solve MESH --physics thermoelastic ... : thermal stress, see 'foxi solve --physics thermoelastic "
+    "--help'.";
 
 }  // namespace
 

@@ -9,7 +9,9 @@
 #include "cli.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
+#include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermoelastic.hpp"
+#include "model_run.hpp"
 #include "solve_options.hpp"
 
 namespace foxi::cli {
@@ -17,6 +19,14 @@ namespace foxi::cli {
 namespace {
 
 const char* kThermoelasticUsage =
+    "foxi solve MODEL.toml --physics thermoelastic [--set NAME=VALUE]... [--temperature-from-thermal]\n"
+    "                [--tref K] [the options below]\n"
+    "  Meshes the model (its [mesh] controls) and solves with its displacement and sliding conditions,\n"
+    "  its materials' E, nu, alpha and its uniform temperature_change load; the options below add to\n"
+    "  them (--dT replaces the load). --temperature-from-thermal first solves the model's steady heat\n"
+    "  (its thermal conditions and power loads) and takes that temperature field as the load against\n"
+    "  the stress-free --tref (default 293.15 K) instead of a temperature_change load.\n"
+    "\n"
     "foxi solve MESH --physics thermoelastic [--fix TAG[=COMPONENTS]] [--slide TAG]\n"
     "                (--dT K | --temperature FILE[:FIELD] [--tref K])\n"
     "                [--E REGION=Pa] [--nu REGION=nu] [--alpha REGION=1/K]\n"
@@ -101,17 +111,57 @@ int cmd_solve_thermoelastic(Args args) {
   params.solver = parse_solver_options(args);
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
+  const bool from_thermal = args.flag("--temperature-from-thermal");
+  const std::vector<std::string> sets = all_options(args, "--set");
   const auto files = args.positional(1, 1, kThermoelasticUsage);
-  if (dt.empty() == temperature.empty()) throw UsageError("--physics thermoelastic takes one of --dT and --temperature");
-  if (!tref.empty() && temperature.empty()) throw UsageError("--tref goes with --temperature");
+  const bool from_model = is_model_path(files[0]);
+  if (!from_model && (from_thermal || !sets.empty()))
+    throw UsageError("--set and --temperature-from-thermal are for model files (MODEL.toml)");
+  if (!dt.empty() + !temperature.empty() + from_thermal > 1)
+    throw UsageError(
+        "--physics thermoelastic takes one of --dT, --temperature and --temperature-from-thermal");
+  if (!from_model && dt.empty() && temperature.empty())
+    throw UsageError("--physics thermoelastic on a mesh takes one of --dT and --temperature");
+  if (!tref.empty() && temperature.empty() && !from_thermal)
+    throw UsageError("--tref goes with --temperature or --temperature-from-thermal");
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 
   const auto t0 = std::chrono::steady_clock::now();
-  Mesh mesh = read_mesh(files[0]);
+  // the thermal conditions are checked before meshing, as mesh_model checks the stress conditions
+  if (from_thermal) check_physics(load_model(files[0], sets), Physics::thermal);
+  MeshedModel run;
+  if (from_model) run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress));
+  Mesh mesh = from_model ? std::move(run.mesh) : read_mesh(files[0]);
   const ValidationReport validation = validate_and_repair(mesh);
   if (!validation.ok()) {
     std::fprintf(stderr, "foxi solve: warning: %s has problems:\n", files[0].c_str());
     for (const std::string& m : validation.messages) std::fprintf(stderr, "  %s\n", m.c_str());
+  }
+  if (from_model) {
+    const ThermoelasticParams mp = thermoelastic_params_from_model(run.model, mesh);
+    params.materials = mp.materials, params.fixed = mp.fixed, params.sliding = mp.sliding;
+    params.delta_t = mp.delta_t;
+    bool has_load = false;
+    for (const Load& l : run.model.loads) has_load = has_load || l.kind == LoadKind::temperature_change;
+    if (!has_load && dt.empty() && temperature.empty() && !from_thermal)
+      throw UsageError(
+          files[0] +
+          ": no temperature_change load; give one, --dT, --temperature or --temperature-from-thermal");
+    if (has_load && from_thermal)
+      std::printf("note: the thermal solve's temperatures replace the model's temperature_change load\n");
+  }
+  if (from_thermal) {
+    ThermalParams tp = thermal_params_from_model(run.model, mesh);
+    tp.solver = params.solver;
+    const ThermalReport tr = solve_thermal(mesh, tp);
+    const Field* t = mesh.find_field("temperature");
+    params.temperature.assign(t->values.begin(), t->values.end());
+    params.delta_t = 0;
+    std::printf(
+        "thermal solve (the model's thermal conditions and power loads): max temperature %.6g K (%.6g C), "
+        "%zu iterations, %.3f s; stress-free at %s K\n",
+        tr.max_temperature, tr.max_temperature - 273.15, tr.iterations, tr.solve_seconds,
+        tref.empty() ? "293.15" : tref.c_str());
   }
   for (const std::string& s : fix) params.fixed.push_back(parse_fix(mesh, s));
   for (const std::string& s : slide) params.sliding.push_back({boundary_tag(mesh, s, "--slide")});

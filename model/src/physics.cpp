@@ -57,7 +57,8 @@ void check_physics(const Model& model, Physics physics) {
   bool fixes = false;
   for (const BoundaryCondition& c : model.conditions)
     fixes = fixes || (condition_applies(c.kind, physics) && c.kind != ConditionKind::heat_flux &&
-                      c.kind != ConditionKind::current && c.kind != ConditionKind::sliding);
+                      c.kind != ConditionKind::current &&
+                      (c.kind != ConditionKind::sliding || physics == Physics::thermal_stress));
   std::size_t electrodes = 0;
   for (const BoundaryCondition& c : model.conditions)
     electrodes += (physics == Physics::electrostatic || physics == Physics::current) &&
@@ -70,7 +71,7 @@ void check_physics(const Model& model, Physics physics) {
     throw IoError(model.file, 0, IoError::kNoOffset,
                   std::string("no [[conditions]] fix the ") + physics_name(physics) + " solution (give " +
                       (physics == Physics::thermal          ? "a temperature or a convection"
-                       : physics == Physics::thermal_stress ? "a displacement"
+                       : physics == Physics::thermal_stress ? "a displacement or sliding"
                                                             : "a voltage or ground") +
                       " condition)");
 }

@@ -170,5 +170,64 @@ TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) 
   EXPECT_EQ(foxi("solve --physics thermoelastic --help"), 0);
 }
 
+// foxi solve MODEL.toml --physics thermoelastic: a 4 x 1 x 1 mm bar whose end faces slide (and its
+// y = 0, z = 0 faces: symmetry planes). --temperature-from-thermal: both ends at 380 K, so the thermal
+// run's field is uniform and the stress uniaxial, sigma_xx = -E alpha (380 - 300) K everywhere; --dT
+// replaces it; no temperature load at all is a usage error (2).
+TEST_F(SolveCliTest, ThermoelasticModelWithTheTemperatureOfItsThermalRun) {
+  test::write_text(dir_ / "bar.toml", R"TOML(units.length = "mm"
+[materials.m]
+thermal_conductivity = 10.0
+youngs_modulus = 100e9
+poisson_ratio = 0.3
+thermal_expansion = 1e-5
+[[parts]]
+name = "bar"
+material = "m"
+shape = "box"
+origin = [0, 0, 0]
+size = [4, 1, 1]
+[surfaces.west]
+plane = { point = [0, 0, 0], normal = [1, 0, 0] }
+[surfaces.east]
+plane = { point = [4, 0, 0], normal = [1, 0, 0] }
+[surfaces.south]
+plane = { point = [0, 0, 0], normal = [0, 1, 0] }
+[[conditions]]
+type = "temperature"
+surface = ["west", "east"]
+value = "380 K"
+[[conditions]]
+type = "sliding"
+surface = ["west", "east", "south", "bar.bottom"]
+[mesh]
+max_size = "0.5 mm"
+)TOML");
+  const std::string bar = "'" + (dir_ / "bar.toml").string() + "'";
+  const std::string out = (dir_ / "bar.vtu").string();
+  ASSERT_EQ(foxi("solve " + bar + " --physics thermoelastic --temperature-from-thermal --tref 300 -o '" +
+                 out + "'"),
+            0)
+      << test::read_text(dir_ / "out.log");
+  std::string log = test::read_text(dir_ / "out.log");
+  EXPECT_NE(log.find("max von Mises stress 8e+07 Pa"), std::string::npos) << log;  // E alpha 80 K
+  EXPECT_NE(log.find("1 (bar)"), std::string::npos) << log;
+  const Mesh m = read_mesh(out);
+  const Field* stress = m.find_field("stress");
+  ASSERT_NE(stress, nullptr);
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    ASSERT_NEAR(stress->values[6 * t], -8e7, 1e-6 * 8e7) << "tet " << t;
+    ASSERT_NEAR(stress->values[6 * t + 1], 0, 1e-6 * 8e7) << "tet " << t;
+  }
+  ASSERT_EQ(foxi("solve " + bar + " --physics thermoelastic --dT -20 -o '" + out + "'"), 0)
+      << test::read_text(dir_ / "out.log");
+  EXPECT_NEAR(read_mesh(out).find_field("stress")->values[0], 2e7, 1e-6 * 2e7);
+
+  EXPECT_EQ(foxi("solve " + bar + " --physics thermoelastic"), 2);  // no temperature_change load
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("no temperature_change load"), std::string::npos);
+  EXPECT_EQ(foxi("solve " + mesh() + " --physics thermoelastic --temperature-from-thermal"), 2);
+  EXPECT_EQ(foxi("solve " + bar + " --physics thermoelastic --dT 1 --temperature-from-thermal"), 2);
+}
+
 }  // namespace
 }  // namespace foxi

@@ -19,8 +19,8 @@ bool condition_applies(ConditionKind c, Physics physics);
 // property) when a part's material lacks a property `physics` needs (thermal_conductivity;
 // relative_permittivity; electrical_conductivity; youngs_modulus, poisson_ratio and
 // thermal_expansion), and (line 0) when the model has no condition that fixes the solution (a
-// temperature or convection; a voltage; a voltage; a displacement) or, for electrostatic and current,
-// fewer than two electrodes.
+// temperature or convection; a voltage; a voltage; a displacement or sliding) or, for electrostatic
+// and current, fewer than two electrodes.
 void check_physics(const Model& model, Physics physics);
 
 }  // namespace foxi
