@@ -298,12 +298,16 @@ Mesh quadratic_boundary(const Mesh& mesh, const TetEdges& edges) {
   for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
     const std::uint32_t* c = &mesh.bface[3 * f];
     std::uint32_t mid[3];  // mid[i]: edge c[i] c[i + 1]
+    bool split_it = true;
     for (int i = 0; i < 3; ++i) {
       const std::uint32_t e = edges.find(c[i], c[(i + 1) % 3]);
-      if (e == kNone)
-        throw SolverError("boundary triangle " + std::to_string(f) + " has an edge (nodes " + std::to_string(c[i]) +
-                          ", " + std::to_string(c[(i + 1) % 3]) + ") that is no tet's edge");
+      split_it = split_it && e != kNone;
       mid[i] = static_cast<std::uint32_t>(nn + e);
+    }
+    if (!split_it) {  // not on a tet's face: no mid-edge nodes to constrain, the corners as for P1
+      out.bface.insert(out.bface.end(), c, c + 3);
+      out.bface_tag.push_back(mesh.bface_tag[f]);
+      continue;
     }
     const std::uint32_t split[4][3] = {
         {c[0], mid[0], mid[2]}, {mid[0], c[1], mid[1]}, {mid[2], mid[1], c[2]}, {mid[0], mid[1], mid[2]}};

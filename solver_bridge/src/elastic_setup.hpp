@@ -64,7 +64,8 @@ TetEdges tet_edges(const Mesh& mesh);
 // The mesh's nodes followed by one node per edge (its midpoint, node mesh.node_count() + e), and
 // each boundary triangle split into 4 through its mid-edge nodes with the triangle's tag: the
 // boundary on which displacement_frames gives the mid-edge nodes of a constrained boundary the same
-// constraints as its corners. SolverError when a boundary triangle has an edge no tet has.
+// constraints as its corners. A boundary triangle with an edge that no tet has (not on a tet's face)
+// is kept whole.
 Mesh quadratic_boundary(const Mesh& mesh, const TetEdges& edges);
 
 }  // namespace foxi::detail

@@ -5,6 +5,9 @@
 // rotated into that frame (R K R^T), so every constraint becomes a fixed unknown that is eliminated.
 // The well-posedness check counts, per connected part, the rigid-body motions that no constraint
 // resists (the null space of the 6x6 Gram matrix of the constraints' rigid-body rows).
+// Quadratic (P2) tets add one node per unique edge (numbered after the mesh's nodes) and assemble
+// element by element into the same node-block structure; constraints, elimination, the rigid-body
+// near-null space and the solve are shared with P1.
 #include "foxi/solver/thermoelastic.hpp"
 
 #include <Eigen/Dense>
@@ -183,11 +186,45 @@ std::array<std::uint32_t, 10> p2_nodes(const Mesh& mesh, const detail::TetEdges&
   return n;
 }
 
-// 10-node tets: N_i = L_i (2 L_i - 1) at the corners, N_ij = 4 L_i L_j at the edges; the gradients are
-// linear, so the stiffness (quadratic integrand) and the load with a P1 temperature (quadratic too) are
-// exact with the degree-2 4-point Gauss rule. Serial element loop.
+// Tet t's 10-node element stiffness (ke: 10 x 10 blocks of 3 x 3, block (a, b) at 9 (10 a + b)), its
+// thermal load (fe: 3 per node) and the positions of its blocks in `pat` (pos, 100). The gradients
+// are linear, so the stiffness (quadratic integrand) and the load with a P1 temperature (quadratic
+// too) are exact with the degree-2 4-point Gauss rule.
+void p2_element(const Mesh& mesh, const detail::TetEdges& edges, const ElasticCoefficients& co,
+                const std::vector<double>& node_dt, const detail::CsrPattern& pat, std::size_t t, double* ke,
+                double* fe, std::size_t* pos) {
+  std::array<std::array<double, 3>, 4> g;
+  std::array<std::array<double, 3>, 10> dn;
+  const double vol = detail::p1_gradients(mesh, t, g);
+  const auto nodes = p2_nodes(mesh, edges, t);
+  for (std::size_t i = 0; i < 10; ++i)
+    for (std::size_t j = 0; j < 10; ++j) pos[10 * i + j] = pat.find(nodes[i], nodes[j]);
+  std::fill(ke, ke + 900, 0.0);
+  std::fill(fe, fe + 30, 0.0);
+  const std::size_t r = co.tet_rix[t];
+  const double w = vol / 4, qa = 0.5854101966249685, qb = 0.1381966011250105;
+  for (int q = 0; q < 4; ++q) {
+    double l[4] = {qb, qb, qb, qb};
+    l[q] = qa;
+    for (std::size_t k = 0; k < 4; ++k)
+      for (int c = 0; c < 3; ++c) dn[k][c] = (4 * l[k] - 1) * g[k][c];
+    for (std::size_t k = 0; k < 6; ++k) {
+      const int i = detail::kTetEdge[k][0], j = detail::kTetEdge[k][1];
+      for (int c = 0; c < 3; ++c) dn[4 + k][c] = 4 * (l[i] * g[j][c] + l[j] * g[i][c]);
+    }
+    double dt = 0;
+    for (std::size_t k = 0; k < 4; ++k) dt += l[k] * node_dt[mesh.tet[4 * t + k]];
+    const double sigma_th = (3 * co.lambda[r] + 2 * co.mu[r]) * co.expansion[r] * dt * w;
+    for (std::size_t a = 0; a < 10; ++a) {
+      for (std::size_t c = 0; c < 3; ++c) fe[3 * a + c] += sigma_th * dn[a][c];
+      for (std::size_t b = 0; b < 10; ++b) add_block(&ke[9 * (10 * a + b)], dn[a], dn[b], co.lambda[r] * w, co.mu[r] * w);
+    }
+  }
+}
+
+// 10-node tets: N_i = L_i (2 L_i - 1) at the corners, N_ij = 4 L_i L_j at the edges.
 BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const ElasticCoefficients& co,
-                        const std::vector<double>& node_dt) {
+                        const std::vector<double>& node_dt, unsigned threads) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), n = nn + edges.size();
   BlockSystem sys;
   sys.used.assign(n, 0);
@@ -220,33 +257,25 @@ BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const E
   sys.kval.assign(9 * pat.col.size(), 0.0);
   sys.load.assign(3 * n, 0.0);
 
-  const double qa = 0.5854101966249685, qb = 0.1381966011250105;  // 4-point rule, degree 2
-  std::array<std::array<double, 3>, 4> g;
-  std::array<std::array<double, 3>, 10> dn;
-  for (std::size_t t = 0; t < nt; ++t) {
-    const double vol = detail::p1_gradients(mesh, t, g);
-    const auto nodes = p2_nodes(mesh, edges, t);
-    std::array<std::size_t, 100> pos;
-    for (std::size_t i = 0; i < 10; ++i)
-      for (std::size_t j = 0; j < 10; ++j) pos[10 * i + j] = pat.find(nodes[i], nodes[j]);
-    const std::size_t r = co.tet_rix[t];
-    const double w = vol / 4;
-    for (int q = 0; q < 4; ++q) {
-      double l[4] = {qb, qb, qb, qb};
-      l[q] = qa;
-      for (std::size_t k = 0; k < 4; ++k)
-        for (int c = 0; c < 3; ++c) dn[k][c] = (4 * l[k] - 1) * g[k][c];
-      double dt = 0;
-      for (std::size_t k = 0; k < 4; ++k) dt += l[k] * node_dt[mesh.tet[4 * t + k]];
-      for (std::size_t k = 0; k < 6; ++k) {
-        const int i = detail::kTetEdge[k][0], j = detail::kTetEdge[k][1];
-        for (int c = 0; c < 3; ++c) dn[4 + k][c] = 4 * (l[i] * g[j][c] + l[j] * g[i][c]);
-      }
-      const double sigma_th = (3 * co.lambda[r] + 2 * co.mu[r]) * co.expansion[r] * dt * w;
-      for (std::size_t a = 0; a < 10; ++a) {
-        for (int c = 0; c < 3; ++c) sys.load[3 * nodes[a] + c] += sigma_th * dn[a][c];
-        for (std::size_t b = 0; b < 10; ++b) add_block(&sys.kval[9 * pos[10 * a + b]], dn[a], dn[b], co.lambda[r] * w, co.mu[r] * w);
-      }
+  // Element matrices and loads in parallel batches, then added serially (a deterministic sum).
+  constexpr std::size_t kBatch = 2048;
+  const std::size_t batch = std::min(kBatch, nt);
+  std::vector<double> ke(900 * batch), fe(30 * batch);  // 10 x 10 blocks of 3 x 3; 10 x 3
+  std::vector<std::size_t> kpos(100 * batch);
+  for (std::size_t t0 = 0; t0 < nt; t0 += batch) {
+    const std::size_t nb = std::min(batch, nt - t0);
+    parallel_for(
+        nb, threads,
+        [&](std::size_t b, std::size_t e, unsigned) {
+          for (std::size_t i = b; i < e; ++i) p2_element(mesh, edges, co, node_dt, pat, t0 + i, &ke[900 * i], &fe[30 * i], &kpos[100 * i]);
+        },
+        256);
+    for (std::size_t i = 0; i < nb; ++i) {
+      const auto nodes = p2_nodes(mesh, edges, t0 + i);
+      for (std::size_t k = 0; k < 100; ++k)
+        for (std::size_t c = 0; c < 9; ++c) sys.kval[9 * kpos[100 * i + k] + c] += ke[900 * i + 9 * k + c];
+      for (std::size_t k = 0; k < 10; ++k)
+        for (std::size_t c = 0; c < 3; ++c) sys.load[3 * nodes[k] + c] += fe[30 * i + 3 * k + c];
     }
   }
   return sys;
@@ -407,7 +436,7 @@ ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& p
     std::vector<double> node_dt(nn, params.delta_t);
     if (!params.temperature.empty())  // sizes and values on used nodes checked by tet_temperature_change
       for (std::size_t v = 0; v < nn; ++v) node_dt[v] = params.temperature[v] - params.reference_temperature;
-    sys = assemble_p2(mesh, edges, co, node_dt);
+    sys = assemble_p2(mesh, edges, co, node_dt, threads);
     detail::report_progress(params.solver, "assemble", 0.4);
     fr = detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, sys.used);
   }
