@@ -224,7 +224,7 @@ void p2_element(const Mesh& mesh, const detail::TetEdges& edges, const ElasticCo
 
 // 10-node tets: N_i = L_i (2 L_i - 1) at the corners, N_ij = 4 L_i L_j at the edges.
 BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const ElasticCoefficients& co,
-                        const std::vector<double>& node_dt, unsigned threads) {
+                        const std::vector<double>& node_dt, const LinearSolverOptions& options, unsigned threads) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), n = nn + edges.size();
   BlockSystem sys;
   sys.used.assign(n, 0);
@@ -264,6 +264,7 @@ BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const E
   std::vector<std::size_t> kpos(100 * batch);
   for (std::size_t t0 = 0; t0 < nt; t0 += batch) {
     const std::size_t nb = std::min(batch, nt - t0);
+    detail::report_progress(options, "assemble", 0.4 * static_cast<double>(t0) / static_cast<double>(nt));
     parallel_for(
         nb, threads,
         [&](std::size_t b, std::size_t e, unsigned) {
@@ -436,7 +437,7 @@ ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& p
     std::vector<double> node_dt(nn, params.delta_t);
     if (!params.temperature.empty())  // sizes and values on used nodes checked by tet_temperature_change
       for (std::size_t v = 0; v < nn; ++v) node_dt[v] = params.temperature[v] - params.reference_temperature;
-    sys = assemble_p2(mesh, edges, co, node_dt, threads);
+    sys = assemble_p2(mesh, edges, co, node_dt, params.solver, threads);
     detail::report_progress(params.solver, "assemble", 0.4);
     fr = detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, sys.used);
   }

@@ -363,6 +363,9 @@ TEST_F(ThermoelasticTest, ReportsProgressAndCancels) {
   EXPECT_LT(r.relative_residual, 1e-12);
   p.solver.progress = [](std::string_view stage, double) { return stage != "factorize"; };
   EXPECT_THROW(solve_thermoelastic(m, p), SolverCancelled);
+  p.order = 2;  // cancelled during the P2 assembly
+  p.solver.progress = [](std::string_view stage, double fraction) { return stage != "assemble" || fraction == 0; };
+  EXPECT_THROW(solve_thermoelastic(m, p), SolverCancelled);
 }
 
 TEST_F(ThermoelasticTest, BadInputGivesClearErrors) {
