@@ -149,7 +149,8 @@ int cmd_solve_thermoelastic(Args args) {
     return std::string(text);
   };
   std::printf("%s: %zu nodes, %zu tets; linear thermoelasticity (P%d), %zu unknowns, %zu constrained nodes\n",
-              files[0].c_str(), mesh.node_count(), mesh.tet_count(), params.order, r.unknowns, r.constrained_nodes);
+              files[0].c_str(), mesh.node_count(), mesh.tet_count(), params.order, r.unknowns,
+              r.constrained_nodes);
   std::printf("max von Mises stress %.6g Pa in %s, %s\n", r.max_von_mises, centroid(r.max_tet).c_str(),
               ("region " + region_label(mesh, mesh.region_of(r.max_tet))).c_str());
   const double* p = &mesh.xyz[3 * std::size_t{r.max_displacement_node}];

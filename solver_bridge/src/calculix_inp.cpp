@@ -72,7 +72,8 @@ void write_nodes_and_elements(std::FILE* out, const Mesh& mesh, const std::vecto
       if (mesh.region_of(t) != ids[i]) continue;
       const std::uint32_t* tv = &mesh.tet[4 * t];
       std::fprintf(out, "%zu, %u, %u, %u, %u", t + 1, tv[0] + 1, tv[1] + 1, tv[2] + 1, tv[3] + 1);
-      for (std::size_t k = 0; edges && k < 6; ++k) std::fprintf(out, ", %zu", nn + edges->tet_edge[6 * t + k] + 1);
+      for (std::size_t k = 0; edges && k < 6; ++k)
+        std::fprintf(out, ", %zu", nn + edges->tet_edge[6 * t + k] + 1);
       std::fprintf(out, "\n");
     }
   }
@@ -224,8 +225,9 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
   std::vector<char> used(n, 0);
   for (std::uint32_t v : mesh.tet) used[v] = 1;
   std::fill(used.begin() + static_cast<std::ptrdiff_t>(nn), used.end(), 1);
-  const detail::NodeFrames fr = quadratic ? detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, used)
-                                          : detail::displacement_frames(mesh, params, used);
+  const detail::NodeFrames fr =
+      quadratic ? detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, used)
+                : detail::displacement_frames(mesh, params, used);
 
   DeckFile file(inp);
   std::FILE* out = file.get();

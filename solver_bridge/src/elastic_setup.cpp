@@ -251,7 +251,8 @@ TetEdges tet_edges(const Mesh& mesh) {
   for (std::size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 6; ++k) {
       const std::uint32_t p = mesh.tet[4 * t + kTetEdge[k][0]], q = mesh.tet[4 * t + kTetEdge[k][1]];
-      keys[6 * t + k] = {(std::uint64_t{std::min(p, q)} << 32) | std::max(p, q), 6 * t + static_cast<std::size_t>(k)};
+      keys[6 * t + k] = {(std::uint64_t{std::min(p, q)} << 32) | std::max(p, q),
+                         6 * t + static_cast<std::size_t>(k)};
     }
   std::sort(keys.begin(), keys.end());
   TetEdges e;

@@ -134,11 +134,12 @@ struct ElasticCoefficients {
 
 // Adds the isotropic block lam ga gc^T + mu gc ga^T + mu (ga . gc) I (integration weights folded into
 // lam and mu) to the row-major 3x3 block blk.
-inline void add_block(double* blk, const std::array<double, 3>& ga, const std::array<double, 3>& gc, double lam,
-                      double mu) {
+inline void add_block(double* blk, const std::array<double, 3>& ga, const std::array<double, 3>& gc,
+                      double lam, double mu) {
   const double gg = ga[0] * gc[0] + ga[1] * gc[1] + ga[2] * gc[2];
   for (int x = 0; x < 3; ++x)
-    for (int y = 0; y < 3; ++y) blk[3 * x + y] += lam * ga[x] * gc[y] + mu * ga[y] * gc[x] + (x == y ? mu * gg : 0.0);
+    for (int y = 0; y < 3; ++y)
+      blk[3 * x + y] += lam * ga[x] * gc[y] + mu * ga[y] * gc[x] + (x == y ? mu * gg : 0.0);
 }
 
 BlockSystem assemble_p1(const Mesh& mesh, const ElasticCoefficients& co, const std::vector<double>& tet_dt,
@@ -182,7 +183,8 @@ std::array<std::uint32_t, 10> p2_nodes(const Mesh& mesh, const detail::TetEdges&
   std::array<std::uint32_t, 10> n;
   for (int k = 0; k < 4; ++k) n[static_cast<std::size_t>(k)] = mesh.tet[4 * t + static_cast<std::size_t>(k)];
   for (int k = 0; k < 6; ++k)
-    n[4 + static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(mesh.node_count() + edges.tet_edge[6 * t + static_cast<std::size_t>(k)]);
+    n[4 + static_cast<std::size_t>(k)] =
+        static_cast<std::uint32_t>(mesh.node_count() + edges.tet_edge[6 * t + static_cast<std::size_t>(k)]);
   return n;
 }
 
@@ -217,14 +219,16 @@ void p2_element(const Mesh& mesh, const detail::TetEdges& edges, const ElasticCo
     const double sigma_th = (3 * co.lambda[r] + 2 * co.mu[r]) * co.expansion[r] * dt * w;
     for (std::size_t a = 0; a < 10; ++a) {
       for (std::size_t c = 0; c < 3; ++c) fe[3 * a + c] += sigma_th * dn[a][c];
-      for (std::size_t b = 0; b < 10; ++b) add_block(&ke[9 * (10 * a + b)], dn[a], dn[b], co.lambda[r] * w, co.mu[r] * w);
+      for (std::size_t b = 0; b < 10; ++b)
+        add_block(&ke[9 * (10 * a + b)], dn[a], dn[b], co.lambda[r] * w, co.mu[r] * w);
     }
   }
 }
 
 // 10-node tets: N_i = L_i (2 L_i - 1) at the corners, N_ij = 4 L_i L_j at the edges.
 BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const ElasticCoefficients& co,
-                        const std::vector<double>& node_dt, const LinearSolverOptions& options, unsigned threads) {
+                        const std::vector<double>& node_dt, const LinearSolverOptions& options,
+                        unsigned threads) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), n = nn + edges.size();
   BlockSystem sys;
   sys.used.assign(n, 0);
@@ -232,7 +236,8 @@ BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const E
   std::copy(mesh.xyz.begin(), mesh.xyz.end(), sys.xyz.begin());
   for (std::size_t e = 0; e < edges.size(); ++e)
     for (std::size_t i = 0; i < 3; ++i)
-      sys.xyz[3 * (nn + e) + i] = (mesh.xyz[3 * std::size_t{edges.a[e]} + i] + mesh.xyz[3 * std::size_t{edges.b[e]} + i]) / 2;
+      sys.xyz[3 * (nn + e) + i] =
+          (mesh.xyz[3 * std::size_t{edges.a[e]} + i] + mesh.xyz[3 * std::size_t{edges.b[e]} + i]) / 2;
   // Pattern: the sorted distinct (row, column) pairs of the tets' 10 x 10 node couplings.
   std::vector<std::uint64_t> pairs;
   pairs.reserve(100 * nt);
@@ -268,7 +273,8 @@ BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const E
     parallel_for(
         nb, threads,
         [&](std::size_t b, std::size_t e, unsigned) {
-          for (std::size_t i = b; i < e; ++i) p2_element(mesh, edges, co, node_dt, pat, t0 + i, &ke[900 * i], &fe[30 * i], &kpos[100 * i]);
+          for (std::size_t i = b; i < e; ++i)
+            p2_element(mesh, edges, co, node_dt, pat, t0 + i, &ke[900 * i], &fe[30 * i], &kpos[100 * i]);
         },
         256);
     for (std::size_t i = 0; i < nb; ++i) {
@@ -285,8 +291,9 @@ BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const E
 // Rotates the constrained nodes' blocks into their frames, eliminates the constrained unknowns, solves
 // the free system (AMG with the rigid-body modes of every solver node as near-null space) and returns
 // the displacement of every solver node in global coordinates (NaN on unused ones).
-std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr, const LinearSolverOptions& options,
-                                 unsigned threads, ThermoelasticReport& rep) {
+std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
+                                 const LinearSolverOptions& options, unsigned threads,
+                                 ThermoelasticReport& rep) {
   const std::size_t nn = sys.nodes();
   const detail::CsrPattern& pat = sys.pat;
   std::vector<double>&kval = sys.kval, &load = sys.load;

@@ -147,21 +147,24 @@ std::pair<double, double> thermal_stress_difference(const test::TempDir& dir, Me
   return {u_worst, s_worst};
 }
 
-// The same problem with quadratic tets against ccx C3D10 (mid-edge nodes written by foxi): the displacements at the mesh's nodes agree to ccx's printed digits, and foxi's
-// centroid stress per tet equals the mean of ccx's stresses at the element's 4 integration points
-// (the stress is linear in a straight-sided C3D10; ccx's .dat prints sxx syy szz sxy sxz syz).
+// The same problem with quadratic tets against ccx C3D10 (mid-edge nodes written by foxi): the displacements
+// at the mesh's nodes agree to ccx's printed digits, and foxi's centroid stress per tet equals the mean of
+// ccx's stresses at the element's 4 integration points (the stress is linear in a straight-sided C3D10; ccx's
+// .dat prints sxx syy szz sxy sxz syz).
 std::pair<double, double> quadratic_difference(const test::TempDir& dir, Mesh& m, ThermoelasticParams p) {
   p.order = 2;
   const ThermoelasticReport r = solve_thermoelastic(m, p);
   write_calculix_thermoelastic(m, p, dir / "quad.inp");
-  EXPECT_EQ(test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i quad", dir / "ccx.log"), 0)
+  EXPECT_EQ(test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i quad", dir / "ccx.log"),
+            0)
       << test::read_text(dir / "ccx.log");
   const std::size_t nn = m.node_count(), nt = m.tet_count();
   const std::vector<double> u_ccx = frd_nodal(dir / "quad.frd", "DISP", 3, nn);
   const std::vector<double>& u = m.find_field("displacement")->values;
   double u_worst = 0;
   for (std::size_t i = 0; i < 3 * nn; ++i)
-    u_worst = std::max(u_worst, std::isnan(u_ccx[i]) ? HUGE_VAL : std::abs(u[i] - u_ccx[i]) / r.max_displacement);
+    u_worst =
+        std::max(u_worst, std::isnan(u_ccx[i]) ? HUGE_VAL : std::abs(u[i] - u_ccx[i]) / r.max_displacement);
   // Integration-point stresses: lines "elem point sxx syy szz sxy sxz syz" after each "stresses" header.
   std::vector<double> s_ccx(6 * nt, 0.0), points(nt, 0.0);
   std::istringstream dat(test::read_text(dir / "quad.dat"));

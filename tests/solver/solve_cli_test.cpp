@@ -158,7 +158,8 @@ TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) 
       << test::read_text(dir_ / "out.log");
   EXPECT_LT(expansion_error(read_mesh(out)), 1e-12);
   // Quadratic tets: the same exact answer at the mesh's nodes; an order other than 1 or 2 is a usage error.
-  ASSERT_EQ(foxi("solve " + box + " --physics thermoelastic --order 2 --dT 50" + material + " -o '" + out + "'"), 0)
+  ASSERT_EQ(
+      foxi("solve " + box + " --physics thermoelastic --order 2 --dT 50" + material + " -o '" + out + "'"), 0)
       << test::read_text(dir_ / "out.log");
   EXPECT_NE(test::read_text(dir_ / "out.log").find("(P2)"), std::string::npos);
   EXPECT_LT(expansion_error(read_mesh(out)), 1e-12);

@@ -196,9 +196,11 @@ StripCurvature bimaterial_strip(double max_volume, int order = 1) {
     EXPECT_GT(r.interfaces[0].max_von_mises, 0.5 * r.max_von_mises);
     EXPECT_EQ(std::max(r.regions[0].max_von_mises, r.regions[1].max_von_mises), r.max_von_mises);
   }
-  std::printf("P%d, %zu tets, %zu unknowns: curvature %.5g 1/m, Timoshenko %.5g 1/m (%+.2f%%), %s, %zu levels, %zu it\n",
-              order, out.tets, r.unknowns, out.fitted, out.timoshenko, 100 * (out.fitted / out.timoshenko - 1),
-              r.solver.c_str(), r.amg_levels, r.iterations);
+  std::printf(
+      "P%d, %zu tets, %zu unknowns: curvature %.5g 1/m, Timoshenko %.5g 1/m (%+.2f%%), %s, %zu levels, %zu "
+      "it\n",
+      order, out.tets, r.unknowns, out.fitted, out.timoshenko, 100 * (out.fitted / out.timoshenko - 1),
+      r.solver.c_str(), r.amg_levels, r.iterations);
   std::printf("assembly %.3f s, solve %.3f s\n", r.assembly_seconds, r.solve_seconds);
   return out;
 }
@@ -236,9 +238,10 @@ TEST_F(ThermoelasticTest, QuadraticTetsKeepLinearFieldsExact) {
     p.solver.kind = kind;
     const ThermoelasticReport r = solve_thermoelastic(m, p);
     EXPECT_GT(r.unknowns, 3 * m.node_count());  // the mid-edge unknowns
-    EXPECT_LT(max_displacement_error(m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); },
-                                     kAlpha * kDt),
-              1e-8)
+    EXPECT_LT(
+        max_displacement_error(
+            m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); }, kAlpha * kDt),
+        1e-8)
         << r.solver;
     EXPECT_LT(max_stress_error(m, zero, kE * kAlpha * kDt), 1e-7) << r.solver;
   }
@@ -249,8 +252,7 @@ TEST_F(ThermoelasticTest, QuadraticTetsKeepLinearFieldsExact) {
   std::set<std::pair<std::uint32_t, std::uint32_t>> edges;  // brute force: the distinct tet edges
   for (std::size_t t = 0; t < m.tet_count(); ++t)
     for (std::size_t i = 0; i < 4; ++i)
-      for (std::size_t j = i + 1; j < 4; ++j)
-        edges.insert(std::minmax(m.tet[4 * t + i], m.tet[4 * t + j]));
+      for (std::size_t j = i + 1; j < 4; ++j) edges.insert(std::minmax(m.tet[4 * t + i], m.tet[4 * t + j]));
   EXPECT_EQ(r.unknowns, 3 * (m.node_count() + edges.size() - r.constrained_nodes));
   EXPECT_GT(r.constrained_nodes, m.bface_count());  // corners and mid-edge nodes of the faces
   const double s = kE * kAlpha * kDt / (1 - 2 * kNu);
@@ -286,9 +288,11 @@ TEST_F(ThermoelasticTest, QuadraticTetsReproduceALinearStressField) {
     double e = 0;
     for (std::size_t t = 0; t < m.tet_count(); ++t) {
       double y = 0;
-      for (int k = 0; k < 4; ++k) y += m.xyz[3 * std::size_t{m.tet[4 * t + static_cast<std::size_t>(k)]} + 1] / 4;
+      for (int k = 0; k < 4; ++k)
+        y += m.xyz[3 * std::size_t{m.tet[4 * t + static_cast<std::size_t>(k)]} + 1] / 4;
       const double want[6] = {0, 0, kE * kAlpha * gradient * y, 0, 0, 0};
-      for (int k = 0; k < 6; ++k) e = std::max(e, std::abs(s->values[6 * t + static_cast<std::size_t>(k)] - want[k]));
+      for (int k = 0; k < 6; ++k)
+        e = std::max(e, std::abs(s->values[6 * t + static_cast<std::size_t>(k)] - want[k]));
     }
     return e / (kE * kAlpha * gradient);
   };
@@ -364,7 +368,9 @@ TEST_F(ThermoelasticTest, ReportsProgressAndCancels) {
   p.solver.progress = [](std::string_view stage, double) { return stage != "factorize"; };
   EXPECT_THROW(solve_thermoelastic(m, p), SolverCancelled);
   p.order = 2;  // cancelled during the P2 assembly
-  p.solver.progress = [](std::string_view stage, double fraction) { return stage != "assemble" || fraction == 0; };
+  p.solver.progress = [](std::string_view stage, double fraction) {
+    return stage != "assemble" || fraction == 0;
+  };
   EXPECT_THROW(solve_thermoelastic(m, p), SolverCancelled);
 }
 

@@ -103,9 +103,9 @@ struct ThermoelasticReport {
 // fields listed above. Nodes used by no tet get NaN displacement. Throws SolverError when a region has
 // no E, nu or alpha (or an invalid one), a tag or region in `params` is unknown, a tag has two
 // conditions, a sliding tag is not planar, constraints at a node contradict each other, `temperature`
-// has the wrong size or a NaN on a used node, `order` is not 1 or 2, a connected part of the mesh can still move rigidly (the
-// message names the part and the free modes: translations and rotations), the factorization fails or
-// CG does not converge; SolverCancelled when the progress callback returns false.
+// has the wrong size or a NaN on a used node, `order` is not 1 or 2, a connected part of the mesh can still
+// move rigidly (the message names the part and the free modes: translations and rotations), the factorization
+// fails or CG does not converge; SolverCancelled when the progress callback returns false.
 ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params);
 
 }  // namespace foxi
