@@ -6,6 +6,9 @@
 //   foxi_thermoelastic/ichol_250k  the same with Eigen's incomplete Cholesky (the non-AMG option)
 //   foxi_thermoelastic/direct_10k  SimplicialLDLT on a smaller mesh (fill-in grows fast in 3D: on 48k
 //                                  tets it took 23 s of CPU against about 1 s for AMG on 250k)
+//   foxi_thermoelastic/p1_48k, p2_48k  linear and quadratic (10-node) tets with AMG on one 20^3 grid
+//                                  (48k tets; P2 has about 7x the unknowns of P1)
+//   ccx_c3d10_48k                  ccx on the same P2 problem (C3D10 deck with foxi's mid-edge nodes)
 //   ccx_250k                       CalculiX (Debian's ccx, SPOOLES) on the same mesh and problem, deck
 //                                  written by foxi::write_calculix_thermoelastic; wall time of ccx alone
 //                                  and its peak RSS (getrusage of the children). Skipped when ccx is
@@ -30,14 +33,15 @@ namespace {
 using namespace foxi;
 
 Mesh& grid(std::uint32_t n) {
-  static std::unique_ptr<Mesh> meshes[2];
-  auto& m = meshes[n == 35 ? 0 : 1];  // 35 or 12
+  static std::unique_ptr<Mesh> meshes[3];
+  auto& m = meshes[n == 35 ? 0 : n == 20 ? 1 : 2];  // 35, 20 or 12
   if (!m) m = std::make_unique<Mesh>(bench::kuhn_grid_mesh(n));
   return *m;
 }
 
-ThermoelasticParams params(LinearSolverKind kind) {
+ThermoelasticParams params(LinearSolverKind kind, int order = 1) {
   ThermoelasticParams p;
+  p.order = order;
   p.materials = {{1, 130e9, 0.28, 2.6e-6}, {2, 117e9, 0.34, 16.5e-6}};
   p.fixed = {{5}};
   p.delta_t = 100;
@@ -46,9 +50,9 @@ ThermoelasticParams params(LinearSolverKind kind) {
   return p;
 }
 
-void foxi_thermoelastic(benchmark::State& state, LinearSolverKind kind, std::uint32_t n) {
+void foxi_thermoelastic(benchmark::State& state, LinearSolverKind kind, std::uint32_t n, int order = 1) {
   Mesh& m = grid(n);
-  const ThermoelasticParams p = params(kind);
+  const ThermoelasticParams p = params(kind, order);
   ThermoelasticReport r;
   double assembly = 0, solve = 0;
   for (auto _ : state) {
@@ -70,14 +74,18 @@ void foxi_thermoelastic(benchmark::State& state, LinearSolverKind kind, std::uin
   state.counters["peak_rss_MB"] = bench::peak_rss_mb(RUSAGE_SELF);
 }
 
-void ccx_250k(benchmark::State& state) {
-  Mesh& m = grid(35);
+void ccx_run(benchmark::State& state, std::uint32_t n, int order) {
+  Mesh& m = grid(n);
   bench::time_ccx(
       state, "stress",
-      [&](const std::filesystem::path& inp) { write_calculix_thermoelastic(m, params(LinearSolverKind::automatic), inp); },
+      [&](const std::filesystem::path& inp) {
+        write_calculix_thermoelastic(m, params(LinearSolverKind::automatic, order), inp);
+      },
       std::getenv("FOXI_BENCH_NO_CCX") == nullptr, "ccx not installed (or FOXI_BENCH_NO_CCX set)");
   state.counters["tets"] = static_cast<double>(m.tet_count());
 }
+void ccx_250k(benchmark::State& state) { ccx_run(state, 35, 1); }
+void ccx_c3d10_48k(benchmark::State& state) { ccx_run(state, 20, 2); }
 
 BENCHMARK_CAPTURE(foxi_thermoelastic, amg_250k, LinearSolverKind::cg_amg, 35u)
     ->Unit(benchmark::kMillisecond)
@@ -92,6 +100,15 @@ BENCHMARK_CAPTURE(foxi_thermoelastic, direct_10k, LinearSolverKind::direct, 12u)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
+BENCHMARK_CAPTURE(foxi_thermoelastic, p1_48k, LinearSolverKind::cg_amg, 20u, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(foxi_thermoelastic, p2_48k, LinearSolverKind::cg_amg, 20u, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK(ccx_c3d10_48k)->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

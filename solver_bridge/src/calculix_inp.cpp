@@ -49,19 +49,32 @@ class DeckFile {
 };
 
 // *NODE (node i is CalculiX node i + 1, set NALL) and one C3D4 *ELEMENT block per region of `ids`
-// (elset R<index + 1>, tet t is element t + 1). Coordinates with 14 significant digits: ccx reads at
-// most 20 characters per field and rejects "-5.8690046200254745E-05".
-void write_nodes_and_elements(std::FILE* out, const Mesh& mesh, const std::vector<std::int32_t>& ids) {
+// (elset R<index + 1>, tet t is element t + 1). With `edges`, the mid-edge nodes follow (edge e is node
+// node_count + e + 1, at the edge's midpoint) and the elements are C3D10 (corners, then the edges in
+// kTetEdge order, which is CalculiX's: 1-2, 2-3, 3-1, 1-4, 2-4, 3-4). Coordinates with 14 significant
+// digits: ccx reads at most 20 characters per field and rejects "-5.8690046200254745E-05".
+void write_nodes_and_elements(std::FILE* out, const Mesh& mesh, const std::vector<std::int32_t>& ids,
+                              const detail::TetEdges* edges = nullptr) {
+  const std::size_t nn = mesh.node_count();
   std::fprintf(out, "*NODE, NSET=NALL\n");
-  for (std::size_t v = 0; v < mesh.node_count(); ++v)
+  for (std::size_t v = 0; v < nn; ++v)
     std::fprintf(out, "%zu, %.14g, %.14g, %.14g\n", v + 1, mesh.xyz[3 * v], mesh.xyz[3 * v + 1],
                  mesh.xyz[3 * v + 2]);
+  for (std::size_t e = 0; edges && e < edges->size(); ++e) {
+    const double* a = &mesh.xyz[3 * std::size_t{edges->a[e]}];
+    const double* b = &mesh.xyz[3 * std::size_t{edges->b[e]}];
+    std::fprintf(out, "%zu, %.14g, %.14g, %.14g\n", nn + e + 1, (a[0] + b[0]) / 2, (a[1] + b[1]) / 2,
+                 (a[2] + b[2]) / 2);
+  }
   for (std::size_t i = 0; i < ids.size(); ++i) {
-    std::fprintf(out, "*ELEMENT, TYPE=C3D4, ELSET=%s\n", elset_name(i).c_str());
+    std::fprintf(out, "*ELEMENT, TYPE=%s, ELSET=%s\n", edges ? "C3D10" : "C3D4", elset_name(i).c_str());
     for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
       if (mesh.region_of(t) != ids[i]) continue;
       const std::uint32_t* tv = &mesh.tet[4 * t];
-      std::fprintf(out, "%zu, %u, %u, %u, %u\n", t + 1, tv[0] + 1, tv[1] + 1, tv[2] + 1, tv[3] + 1);
+      std::fprintf(out, "%zu, %u, %u, %u, %u", t + 1, tv[0] + 1, tv[1] + 1, tv[2] + 1, tv[3] + 1);
+      for (std::size_t k = 0; edges && k < 6; ++k)
+        std::fprintf(out, ", %zu", nn + edges->tet_edge[6 * t + k] + 1);
+      std::fprintf(out, "\n");
     }
   }
 }
@@ -200,17 +213,27 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
                                   const std::filesystem::path& inp) {
   if (std::string problem = check_sizes(mesh); !problem.empty())
     throw SolverError("inconsistent mesh: " + problem);
+  if (params.order != 1 && params.order != 2)
+    throw SolverError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
+  const bool quadratic = params.order == 2;
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   const detail::ElasticMaterials mat = detail::elastic_materials(mesh, params);
   (void)detail::tet_temperature_change(mesh, params);  // checks the temperature field
-  std::vector<char> used(nn, 0);
+  // Quadratic: the mid-edge nodes (nn + e) with the constraints solve_thermoelastic gives them.
+  const detail::TetEdges edges = quadratic ? detail::tet_edges(mesh) : detail::TetEdges{};
+  const std::size_t n = nn + edges.size();
+  std::vector<char> used(n, 0);
   for (std::uint32_t v : mesh.tet) used[v] = 1;
-  const detail::NodeFrames fr = detail::displacement_frames(mesh, params, used);
+  std::fill(used.begin() + static_cast<std::ptrdiff_t>(nn), used.end(), 1);
+  const detail::NodeFrames fr =
+      quadratic ? detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, used)
+                : detail::displacement_frames(mesh, params, used);
 
   DeckFile file(inp);
   std::FILE* out = file.get();
-  std::fprintf(out, "** foxi: linear thermoelasticity, %zu nodes, %zu C3D4 elements, SI units\n", nn, nt);
-  write_nodes_and_elements(out, mesh, mat.regions.ids);
+  std::fprintf(out, "** foxi: linear thermoelasticity, %zu nodes, %zu %s elements, SI units\n", n, nt,
+               quadratic ? "C3D10" : "C3D4");
+  write_nodes_and_elements(out, mesh, mat.regions.ids, quadratic ? &edges : nullptr);
   for (std::size_t i = 0; i < mat.regions.size(); ++i) {
     std::fprintf(out, "*MATERIAL, NAME=M%zu\n*ELASTIC\n%.14g, %.14g\n*EXPANSION\n%.14g\n", i + 1, mat.young[i],
                  mat.poisson[i], mat.expansion[i]);
@@ -221,7 +244,7 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
   // orientations) as homogeneous *EQUATIONs whose dependent term is the largest free component.
   std::string boundary, equation;
   char line[256];
-  for (std::size_t v = 0; v < nn; ++v) {
+  for (std::size_t v = 0; v < n; ++v) {
     bool taken[3] = {false, false, false};
     std::vector<int> general;
     for (int a = 0; a < fr.m[v]; ++a) {
@@ -269,8 +292,15 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
   } else {
     for (std::size_t v = 0; v < nn; ++v)
       if (used[v]) std::fprintf(out, "%zu, %.14g\n", v + 1, params.temperature[v]);
+    for (std::size_t e = 0; e < edges.size(); ++e)  // the P1 interpolation, as solve_thermoelastic uses
+      std::fprintf(out, "%zu, %.14g\n", nn + e + 1,
+                   (params.temperature[edges.a[e]] + params.temperature[edges.b[e]]) / 2);
   }
-  std::fprintf(out, "*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n");
+  std::fprintf(out, "*NODE FILE\nU\n*EL FILE\nS\n");
+  // C3D10: the stresses at the 4 integration points in the .dat (their mean is the centroid stress).
+  for (std::size_t i = 0; quadratic && i < mat.regions.size(); ++i)
+    std::fprintf(out, "*EL PRINT, ELSET=%s\nS\n", elset_name(i).c_str());
+  std::fprintf(out, "*END STEP\n");
   file.close();
 }
 

@@ -245,4 +245,79 @@ NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& para
   return fr;
 }
 
+TetEdges tet_edges(const Mesh& mesh) {
+  const std::size_t nt = mesh.tet_count();
+  std::vector<std::pair<std::uint64_t, std::size_t>> keys(6 * nt);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 6; ++k) {
+      const std::uint32_t p = mesh.tet[4 * t + kTetEdge[k][0]], q = mesh.tet[4 * t + kTetEdge[k][1]];
+      keys[6 * t + k] = {(std::uint64_t{std::min(p, q)} << 32) | std::max(p, q),
+                         6 * t + static_cast<std::size_t>(k)};
+    }
+  std::sort(keys.begin(), keys.end());
+  TetEdges e;
+  e.tet_edge.resize(6 * nt);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (i == 0 || keys[i].first != keys[i - 1].first) {
+      e.a.push_back(static_cast<std::uint32_t>(keys[i].first >> 32));
+      e.b.push_back(static_cast<std::uint32_t>(keys[i].first & 0xffffffffu));
+    }
+    e.tet_edge[keys[i].second] = static_cast<std::uint32_t>(e.a.size() - 1);
+  }
+  return e;
+}
+
+std::uint32_t TetEdges::find(std::uint32_t p, std::uint32_t q) const {
+  const std::uint32_t lo = std::min(p, q), hi = std::max(p, q);
+  std::size_t first = 0, count = a.size();
+  while (count > 0) {  // lower bound of (lo, hi) in the (a, b)-sorted edges
+    const std::size_t half = count / 2, mid = first + half;
+    if (a[mid] < lo || (a[mid] == lo && b[mid] < hi)) {
+      first = mid + 1;
+      count -= half + 1;
+    } else {
+      count = half;
+    }
+  }
+  return first < a.size() && a[first] == lo && b[first] == hi ? static_cast<std::uint32_t>(first) : kNone;
+}
+
+Mesh quadratic_boundary(const Mesh& mesh, const TetEdges& edges) {
+  const std::size_t nn = mesh.node_count(), ne = edges.size();
+  Mesh out;
+  out.boundaries = mesh.boundaries;
+  out.xyz = mesh.xyz;
+  out.xyz.resize(3 * (nn + ne));
+  for (std::size_t e = 0; e < ne; ++e)
+    for (int i = 0; i < 3; ++i)
+      out.xyz[3 * (nn + e) + static_cast<std::size_t>(i)] =
+          (mesh.xyz[3 * std::size_t{edges.a[e]} + static_cast<std::size_t>(i)] +
+           mesh.xyz[3 * std::size_t{edges.b[e]} + static_cast<std::size_t>(i)]) /
+          2;
+  out.bface.reserve(12 * mesh.bface_count());
+  out.bface_tag.reserve(4 * mesh.bface_count());
+  for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
+    const std::uint32_t* c = &mesh.bface[3 * f];
+    std::uint32_t mid[3];  // mid[i]: edge c[i] c[i + 1]
+    bool split_it = true;
+    for (int i = 0; i < 3; ++i) {
+      const std::uint32_t e = edges.find(c[i], c[(i + 1) % 3]);
+      split_it = split_it && e != kNone;
+      mid[i] = static_cast<std::uint32_t>(nn + e);
+    }
+    if (!split_it) {  // not on a tet's face: no mid-edge nodes to constrain, the corners as for P1
+      out.bface.insert(out.bface.end(), c, c + 3);
+      out.bface_tag.push_back(mesh.bface_tag[f]);
+      continue;
+    }
+    const std::uint32_t split[4][3] = {
+        {c[0], mid[0], mid[2]}, {mid[0], c[1], mid[1]}, {mid[2], mid[1], c[2]}, {mid[0], mid[1], mid[2]}};
+    for (const auto& tri : split) {
+      out.bface.insert(out.bface.end(), tri, tri + 3);
+      out.bface_tag.push_back(mesh.bface_tag[f]);
+    }
+  }
+  return out;
+}
+
 }  // namespace foxi::detail

@@ -48,4 +48,24 @@ struct NodeFrames {
 // tag that is not planar, contradictory constraints at a node.
 NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& params, const std::vector<char>& used);
 
+// The unique edges of the tets (the mid-edge nodes of 10-node tets): edge e joins nodes a[e] < b[e],
+// edges sorted by (a, b); tet t's k-th edge joins its corners kTetEdge[k] (the C3D10 order 01, 12, 20,
+// 03, 13, 23) and is edge tet_edge[6 t + k].
+inline constexpr int kTetEdge[6][2] = {{0, 1}, {1, 2}, {2, 0}, {0, 3}, {1, 3}, {2, 3}};
+struct TetEdges {
+  std::vector<std::uint32_t> a, b;
+  std::vector<std::uint32_t> tet_edge;  // 6 per tet
+  std::size_t size() const { return a.size(); }
+  // Edge joining nodes p and q, or kNone when no tet has it.
+  std::uint32_t find(std::uint32_t p, std::uint32_t q) const;
+};
+TetEdges tet_edges(const Mesh& mesh);
+
+// The mesh's nodes followed by one node per edge (its midpoint, node mesh.node_count() + e), and
+// each boundary triangle split into 4 through its mid-edge nodes with the triangle's tag: the
+// boundary on which displacement_frames gives the mid-edge nodes of a constrained boundary the same
+// constraints as its corners. A boundary triangle with an edge that no tet has (not on a tet's face)
+// is kept whole.
+Mesh quadratic_boundary(const Mesh& mesh, const TetEdges& edges);
+
 }  // namespace foxi::detail

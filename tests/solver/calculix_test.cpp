@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "foxi/model/io_error.hpp"
@@ -146,6 +147,55 @@ std::pair<double, double> thermal_stress_difference(const test::TempDir& dir, Me
   return {u_worst, s_worst};
 }
 
+// The same problem with quadratic tets against ccx C3D10 (mid-edge nodes written by foxi): the displacements
+// at the mesh's nodes agree to ccx's printed digits, and foxi's centroid stress per tet equals the mean of
+// ccx's stresses at the element's 4 integration points (the stress is linear in a straight-sided C3D10; ccx's
+// .dat prints sxx syy szz sxy sxz syz).
+std::pair<double, double> quadratic_difference(const test::TempDir& dir, Mesh& m, ThermoelasticParams p) {
+  p.order = 2;
+  const ThermoelasticReport r = solve_thermoelastic(m, p);
+  write_calculix_thermoelastic(m, p, dir / "quad.inp");
+  EXPECT_EQ(test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i quad", dir / "ccx.log"),
+            0)
+      << test::read_text(dir / "ccx.log");
+  const std::size_t nn = m.node_count(), nt = m.tet_count();
+  const std::vector<double> u_ccx = frd_nodal(dir / "quad.frd", "DISP", 3, nn);
+  const std::vector<double>& u = m.find_field("displacement")->values;
+  double u_worst = 0;
+  for (std::size_t i = 0; i < 3 * nn; ++i)
+    u_worst =
+        std::max(u_worst, std::isnan(u_ccx[i]) ? HUGE_VAL : std::abs(u[i] - u_ccx[i]) / r.max_displacement);
+  // Integration-point stresses: lines "elem point sxx syy szz sxy sxz syz" after each "stresses" header.
+  std::vector<double> s_ccx(6 * nt, 0.0), points(nt, 0.0);
+  std::istringstream dat(test::read_text(dir / "quad.dat"));
+  std::string line;
+  bool in_stress = false;
+  while (std::getline(dat, line)) {
+    if (line.find("stresses") != std::string::npos) {
+      in_stress = true;
+      continue;
+    }
+    std::istringstream fields(line);
+    std::size_t elem = 0, point = 0;
+    double v[6];
+    if (!in_stress || !(fields >> elem >> point >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5])) continue;
+    if (elem < 1 || elem > nt) return {HUGE_VAL, HUGE_VAL};
+    const int order[6] = {0, 1, 2, 3, 5, 4};  // ccx xz, yz -> foxi yz, xz
+    for (int c = 0; c < 6; ++c) s_ccx[6 * (elem - 1) + static_cast<std::size_t>(order[c])] += v[c];
+    points[elem - 1] += 1;
+  }
+  const std::vector<double>& s = m.find_field("stress")->values;
+  double s_worst = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    EXPECT_EQ(points[t], 4.0) << "tet " << t;
+    for (std::size_t c = 0; c < 6; ++c)
+      s_worst = std::max(s_worst, std::abs(s[6 * t + c] - s_ccx[6 * t + c] / 4) / r.max_von_mises);
+  }
+  std::printf("C3D10: %zu tets, %zu unknowns; relative difference to ccx: u %.3g, centroid stress %.3g\n", nt,
+              r.unknowns, u_worst, s_worst);
+  return {u_worst, s_worst};
+}
+
 ThermoelasticParams two_layer_params(const Mesh& m) {
   ThermoelasticParams p;
   p.materials = {{1, 130e9, 0.28, 2.6e-6}, {2, 117e9, 0.34, 16.5e-6}};
@@ -159,7 +209,7 @@ ThermoelasticParams two_layer_params(const Mesh& m) {
 
 // Thermal stress on the same C3D4 mesh: a two-layer box (E, nu, alpha per layer), its bottom fixed,
 // x = 0 sliding, a nodal temperature field varying in x and z: displacements and nodal stresses agree
-// with ccx to its 6 printed digits.
+// with ccx to its 6 printed digits, on C3D4 and C3D10.
 TEST_F(CalculixTest, ThermalStressAgreesWithCcx) {
   test::TempDir dir;
   Mesh m = test::layered_box_mesh(2e-3, 1e-3, {0, 0.4e-3, 1e-3}, 4e-12);
@@ -169,6 +219,9 @@ TEST_F(CalculixTest, ThermalStressAgreesWithCcx) {
   const auto [du, ds] = thermal_stress_difference(dir, m, p);
   EXPECT_LT(du, 1e-5);
   EXPECT_LT(ds, 1e-5);
+  const auto [qu, qs] = quadratic_difference(dir, m, p);  // the mid-edge nodes' constraints too
+  EXPECT_LT(qu, 1e-5);
+  EXPECT_LT(qs, 1e-5);
 }
 
 // The same box turned off the axes, held only by three sliding planes: ccx gets them as *EQUATIONs.
@@ -187,6 +240,9 @@ TEST_F(CalculixTest, SlidingPlanesOffTheAxesAgreeWithCcx) {
   const auto [du, ds] = thermal_stress_difference(dir, m, p);
   EXPECT_LT(du, 1e-5);
   EXPECT_LT(ds, 1e-5);
+  const auto [qu, qs] = quadratic_difference(dir, m, p);  // the mid-edge nodes' constraints too
+  EXPECT_LT(qu, 1e-5);
+  EXPECT_LT(qs, 1e-5);
 }
 
 TEST(FrdReader, RejectsMalformedFiles) {

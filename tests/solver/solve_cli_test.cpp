@@ -157,6 +157,13 @@ TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) 
             0)
       << test::read_text(dir_ / "out.log");
   EXPECT_LT(expansion_error(read_mesh(out)), 1e-12);
+  // Quadratic tets: the same exact answer at the mesh's nodes; an order other than 1 or 2 is a usage error.
+  ASSERT_EQ(
+      foxi("solve " + box + " --physics thermoelastic --order 2 --dT 50" + material + " -o '" + out + "'"), 0)
+      << test::read_text(dir_ / "out.log");
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("(P2)"), std::string::npos);
+  EXPECT_LT(expansion_error(read_mesh(out)), 1e-12);
+  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic --order 3 --dT 50" + material), 2);
 
   // Bad input: no load (2), an unknown component (2), a body free to move (1, the modes named).
   EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic" + material), 2);

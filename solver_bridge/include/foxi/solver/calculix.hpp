@@ -30,7 +30,10 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
 // constraints of solve_thermoelastic node by node (components along a coordinate axis as *BOUNDARY,
 // sliding normals of other orientations as homogeneous *EQUATION), the reference temperature as
 // *INITIAL CONDITIONS and the temperature (reference + delta_t, or the nodal field) as *TEMPERATURE,
-// *NODE FILE U and *EL FILE S. Throws SolverError for what solve_thermoelastic rejects (except the
+// *NODE FILE U and *EL FILE S. With params.order 2: C3D10 elements whose mid-edge nodes (edge e of
+// detail::tet_edges is node node_count + e + 1) get the constraints and the linearly interpolated
+// temperature solve_thermoelastic gives them, and *EL PRINT S puts the integration-point stresses in
+// the .dat. Throws SolverError for what solve_thermoelastic rejects (except the
 // rigid-body check) and for a non-zero displacement along a direction that is no coordinate axis;
 // IoError when the file cannot be written.
 void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,

@@ -57,6 +57,13 @@ struct ThermoelasticParams {
   // (exact for the load of a P1 element with a P1 temperature; also what CalculiX C3D4 does).
   std::vector<double> temperature;
   double reference_temperature = 293.15;  // K
+  // Element order: 1 = linear 4-node tets, 2 = quadratic 10-node tets (for stress accuracy: P2
+  // reproduces quadratic displacements, i.e. linear stress, exactly). With order 2 the mid-edge nodes
+  // are the solver's own unknowns (with the constraints of the tagged boundary triangles they lie on);
+  // the displacement is still written at the mesh's nodes, the stress per tet at its centroid (equal
+  // to the tet's volume average for straight-sided P2 tets with a P1 temperature), and the thermal
+  // strain uses the P1-interpolated temperature (integrated exactly by a 4-point Gauss rule).
+  int order = 1;
   LinearSolverOptions solver;  // cg_amg uses the 6 rigid-body modes as AMG's near-null space
 };
 
@@ -83,7 +90,7 @@ struct ThermoelasticReport {
   std::uint32_t max_tet = kNone;
   double max_displacement = 0;  // m, largest |u| over the nodes
   std::uint32_t max_displacement_node = kNone;
-  std::size_t constrained_nodes = 0;  // nodes with at least one constrained direction
+  std::size_t constrained_nodes = 0;  // solver nodes (mid-edge ones too) with a constrained direction
   std::string solver;
   std::size_t unknowns = 0, nonzeros = 0;
   std::size_t iterations = 0;    // CG iterations (0 for the direct solver)
@@ -96,9 +103,9 @@ struct ThermoelasticReport {
 // fields listed above. Nodes used by no tet get NaN displacement. Throws SolverError when a region has
 // no E, nu or alpha (or an invalid one), a tag or region in `params` is unknown, a tag has two
 // conditions, a sliding tag is not planar, constraints at a node contradict each other, `temperature`
-// has the wrong size or a NaN on a used node, a connected part of the mesh can still move rigidly (the
-// message names the part and the free modes: translations and rotations), the factorization fails or
-// CG does not converge; SolverCancelled when the progress callback returns false.
+// has the wrong size or a NaN on a used node, `order` is not 1 or 2, a connected part of the mesh can still
+// move rigidly (the message names the part and the free modes: translations and rotations), the factorization
+// fails or CG does not converge; SolverCancelled when the progress callback returns false.
 ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params);
 
 }  // namespace foxi
