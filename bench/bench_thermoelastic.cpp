@@ -1,6 +1,6 @@
 // Linear thermoelasticity (issue 7), with CalculiX in the same run.
 //   foxi_thermoelastic/amg_250k    foxi::solve_thermoelastic: row-parallel 3x3-block assembly + CG with
-//                                  smoothed-aggregation AMG on the 6 rigid-body modes, to a relative
+//                                  aggregation AMG (amg.hpp) on the 6 rigid-body modes, to a relative
 //                                  residual of 1e-10 (counters: assembly and solve seconds, CG
 //                                  iterations, AMG levels, DOF/s, peak RSS of the process so far,
 //                                  process_cpu_s: CPU seconds of all threads per run)
