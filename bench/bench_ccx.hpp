@@ -21,6 +21,14 @@ inline double peak_rss_mb(int who) {
   return static_cast<double>(u.ru_maxrss) / 1024.0;  // KiB on Linux
 }
 
+// CPU seconds of the whole process (all threads) so far: the figure to compare on a loaded machine.
+inline double process_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 // write_deck(path) writes JOB.inp; skipped (with `why`) when ccx is missing or `enabled` is false.
 template <class WriteDeck>
 void time_ccx(benchmark::State& state, const std::string& job, WriteDeck&& write_deck, bool enabled,

@@ -65,14 +65,6 @@ double proc_status_kb(const char* key) {
   return 0;
 }
 
-// CPU seconds of the whole process (all threads) so far.
-double process_cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 // Resets the process's peak resident size (VmHWM) to its current size (Linux >= 4.0).
 void reset_peak_rss() { std::ofstream("/proc/self/clear_refs") << "5"; }
 
@@ -98,7 +90,7 @@ void foxi_thermal(benchmark::State& state, LinearSolverKind kind, std::uint32_t 
   malloc_trim(0);  // hand freed heap back, so that the solve's own allocations show in the peak
   reset_peak_rss();
   const double rss_before = proc_status_kb("VmRSS:");
-  const double cpu_before = process_cpu_seconds();
+  const double cpu_before = bench::process_cpu_seconds();
   for (auto _ : state) {
     r = solve_thermal(m, p);
     assembly += r.assembly_seconds;
@@ -107,7 +99,7 @@ void foxi_thermal(benchmark::State& state, LinearSolverKind kind, std::uint32_t 
   const double peak = proc_status_kb("VmHWM:");
   // CPU of all threads per run: on a busy machine a steadier figure than the wall time.
   state.counters["process_cpu_s"] =
-      (process_cpu_seconds() - cpu_before) / static_cast<double>(state.iterations());
+      (bench::process_cpu_seconds() - cpu_before) / static_cast<double>(state.iterations());
   // Process peak while solving (mesh and benchmark included) and what the solve added to it.
   state.counters["peak_MB"] = peak / 1024;
   state.counters["solver_MB"] = (peak - rss_before) / 1024;

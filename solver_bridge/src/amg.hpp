@@ -1,7 +1,9 @@
-// Internal: smoothed-aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) as the
-// preconditioner of CG for scalar diffusion matrices: aggregates of strongly connected nodes,
-// piecewise-constant tentative prolongation smoothed by one damped Jacobi step, Galerkin coarse
-// operators, symmetric Gauss-Seidel V(1,1) cycles, LDL^T on the coarsest level.
+// Internal: (smoothed-)aggregation algebraic multigrid (Vanek, Mandel, Brezina 1996) as the
+// preconditioner of CG: aggregates of strongly connected unknowns (or of nodes, for systems with a
+// near-null space such as elasticity's rigid-body modes), a tentative prolongation that interpolates
+// the near-null space (the constants for scalar problems) on each aggregate, optionally smoothed by one
+// damped Jacobi step, Galerkin coarse operators, symmetric Gauss-Seidel V(1,1) cycles, LDL^T on the
+// coarsest level.
 //
 // Plain CSR arrays throughout (no sparse-matrix library in the setup): the fine matrix is used in
 // place, the products P^T (A P) run row-parallel in two passes (count, then fill) so that nothing is
@@ -18,12 +20,26 @@
 
 namespace foxi::detail {
 
+struct AmgParams {
+  // The near-null space (referenced only while the constructor runs): with one, nodes are aggregated
+  // (their unknowns together) and the tentative prolongation interpolates these vectors exactly per
+  // aggregate (orthonormalised by a QR); without one, single unknowns and the constants.
+  const NearNullSpace* near_null = nullptr;
+  // Smooth the tentative prolongation by one damped Jacobi step (smoothed aggregation); off: plain
+  // aggregation, sparser coarse levels for more iterations.
+  bool smooth_prolongation = true;
+  // Hybrid Gauss-Seidel divides by a_ii + sum |a_ij| over the other threads' columns (the l1 smoother
+  // of Baker, Falgout, Kolev, Yang 2011), which keeps it convergent where A is far from diagonally
+  // dominant (elasticity); same as plain Gauss-Seidel on one thread.
+  bool l1_smoother = false;
+};
+
 class AmgPreconditioner {
  public:
   // Builds the hierarchy of `a` (referenced, not copied: it must outlive this object) on `threads`
   // threads. Throws SolverError when the coarsest matrix cannot be factorized or a coarse matrix
   // would exceed 2^31 nonzeros.
-  AmgPreconditioner(const SymmetricCsr& a, unsigned threads);
+  AmgPreconditioner(const SymmetricCsr& a, unsigned threads, const AmgParams& params = {});
   ~AmgPreconditioner();
   AmgPreconditioner(const AmgPreconditioner&) = delete;
   AmgPreconditioner& operator=(const AmgPreconditioner&) = delete;
