@@ -135,19 +135,21 @@ Csr transpose(const Csr& m) {
   return t;
 }
 
-// y = a x (rows split over threads).
-void spmv(const View& a, const double* x, double* y, unsigned threads) {
+// y = c - a x, or y = a x without c (rows split over threads).
+void residual(const View& a, const double* c, const double* x, double* y, unsigned threads) {
   parallel_for(
       a.rows, threads,
       [&](std::size_t b, std::size_t e, unsigned) {
         for (std::size_t i = b; i < e; ++i) {
           double s = 0;
           for (int k = a.start[i]; k < a.start[i + 1]; ++k) s += a.val[k] * x[a.col[k]];
-          y[i] = s;
+          y[i] = c ? c[i] - s : s;
         }
       },
       kSerialRows);
 }
+
+void spmv(const View& a, const double* x, double* y, unsigned threads) { residual(a, nullptr, x, y, threads); }
 
 // rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%). Each iteration is one
 // pass on threads: w = D^-1 A v and |w|^2 by slices (added in slice order: deterministic); no
@@ -403,10 +405,17 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads, co
     Impl::Level& l = m.levels.back();
     const std::size_t n = l.a.rows;
     l.inv_diag.assign(n, 0.0);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int k = l.a.start[i]; k < l.a.start[i + 1]; ++k)
-        if (static_cast<std::size_t>(l.a.col[k]) == i) l.inv_diag[i] += l.a.val[k];
-    for (double& d : l.inv_diag) d = 1.0 / d;
+    parallel_for(
+        n, m.threads,
+        [&](std::size_t lo, std::size_t hi, unsigned) {
+          for (std::size_t i = lo; i < hi; ++i) {
+            double d = 0;
+            for (int k = l.a.start[i]; k < l.a.start[i + 1]; ++k)
+              if (static_cast<std::size_t>(l.a.col[k]) == i) d += l.a.val[k];
+            l.inv_diag[i] = 1.0 / d;
+          }
+        },
+        kSerialRows);
     l.scratch.resize(n);
     if (n <= coarsest || m.levels.size() >= 12) break;
     Csr tentative = params.near_null ? block_tentative(l.a, ns) : scalar_tentative(l.a);
@@ -504,7 +513,7 @@ void AmgPreconditioner::apply(const double* r, double* z) { impl_->cycle(0, r, z
 
 // One hybrid Gauss-Seidel sweep: each thread's block of rows in order (forward) or in reverse, values
 // of the other blocks taken from l.scratch (the values before the sweep; the forward sweep starts
-// from x = 0, so there they are zero and skipped).
+// from x = 0, which it sets itself, so there they are zero and skipped).
 void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x, bool forward) const {
   const View& a = l.a;
   const double* before = l.scratch.data();
@@ -512,6 +521,7 @@ void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x,
       a.rows, threads,
       [&](std::size_t lo, std::size_t hi, unsigned) {
         const auto first = static_cast<int>(lo), end = static_cast<int>(hi);
+        if (forward) std::fill(x + lo, x + hi, 0.0);
         for (std::size_t s = lo; s < hi; ++s) {
           const std::size_t i = forward ? s : hi - 1 - (s - lo);
           double sum = b[i];
@@ -540,11 +550,9 @@ void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* 
     std::copy_n(coarse_x.data(), n, x);
     return;
   }
-  std::fill_n(x, n, 0.0);
   smooth(l, b, x, true);
-  // Residual, restricted to the next level.
-  spmv(l.a, x, l.scratch.data(), threads);
-  for (std::size_t i = 0; i < n; ++i) l.scratch[i] = b[i] - l.scratch[i];
+  // Residual (one pass on threads), restricted to the next level.
+  residual(l.a, b, x, l.scratch.data(), threads);
   Level& next = levels[level + 1];
   spmv(view(l.r), l.scratch.data(), next.b.data(), threads);
   cycle(level + 1, next.b.data(), next.x.data());
