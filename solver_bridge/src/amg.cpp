@@ -19,6 +19,10 @@ namespace {
 constexpr std::size_t kSerialRows = 20000;
 // Levels stop coarsening at this size; the coarsest is factorized.
 constexpr std::size_t kCoarsest = 2000;
+// Multiply-adds below which a sparse product stays on one thread. By work, not rows: R (A P) has
+// few rows (the coarse unknowns) but each is long, and on one thread it was a serial step as large
+// as A P.
+constexpr double kSerialProductWork = 2e6;
 
 // A sparse matrix by rows; columns within a row in no particular order.
 struct Csr {
@@ -38,6 +42,14 @@ struct View {
 
 View view(const Csr& m) { return {m.rows, m.start.data(), m.col.data(), m.val.data()}; }
 
+// The serial_below of parallel_for for a pass over the rows of a: by nonzeros, not rows, since the
+// coarse levels have few but long rows (on one thread they were a serial part of every cycle). The
+// hybrid smoother's thread blocks (and the l1 sums over them) follow the same split.
+constexpr std::size_t kSerialNonzeros = 250000;
+std::size_t serial_rows(const View& a) {
+  return static_cast<std::size_t>(a.start[a.rows]) >= kSerialNonzeros ? 0 : SIZE_MAX;
+}
+
 int checked_nonzeros(std::size_t n) {
   if (n > static_cast<std::size_t>(INT_MAX))
     throw SolverError("AMG: a coarse matrix would have more than 2^31 nonzeros");
@@ -48,7 +60,8 @@ int checked_nonzeros(std::size_t n) {
 // row(i, emit) calls emit(column, value) for the products of row i (repeated columns are summed).
 // The first pass counts the distinct columns of each row, the second fills them in place.
 template <class Row>
-Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row) {
+Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row,
+               std::size_t serial_below = kSerialRows) {
   Csr out;
   out.rows = rows;
   out.cols = cols;
@@ -71,7 +84,7 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row) 
           out.start[i + 1] = count;
         }
       },
-      kSerialRows);
+      serial_below);
   std::size_t total = 0;
   for (std::size_t i = 0; i < rows; ++i) {
     total += static_cast<std::size_t>(out.start[i + 1]);
@@ -100,20 +113,26 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row) 
           });
         }
       },
-      kSerialRows);
+      serial_below);
   return out;
 }
 
 // a * b.
 Csr multiply(const View& a, const Csr& b, unsigned threads) {
-  return build_rows(a.rows, b.cols, threads, [&](std::size_t i, auto&& emit) {
-    for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
-      const double av = a.val[k];
-      const auto j = static_cast<std::size_t>(a.col[k]);
-      for (int l = b.start[j]; l < b.start[j + 1]; ++l)
-        emit(b.col[static_cast<std::size_t>(l)], av * b.val[static_cast<std::size_t>(l)]);
-    }
-  });
+  // The products' count estimated from the mean row length of b.
+  const double work = static_cast<double>(a.start[a.rows]) * static_cast<double>(b.val.size()) /
+                      static_cast<double>(std::max<std::size_t>(b.rows, 1));
+  return build_rows(
+      a.rows, b.cols, threads,
+      [&](std::size_t i, auto&& emit) {
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+          const double av = a.val[k];
+          const auto j = static_cast<std::size_t>(a.col[k]);
+          for (int l = b.start[j]; l < b.start[j + 1]; ++l)
+            emit(b.col[static_cast<std::size_t>(l)], av * b.val[static_cast<std::size_t>(l)]);
+        }
+      },
+      work >= kSerialProductWork ? 0 : SIZE_MAX);
 }
 
 Csr transpose(const Csr& m) {
@@ -146,7 +165,7 @@ void residual(const View& a, const double* c, const double* x, double* y, unsign
           y[i] = c ? c[i] - s : s;
         }
       },
-      kSerialRows);
+      serial_rows(a));
 }
 
 void spmv(const View& a, const double* x, double* y, unsigned threads) { residual(a, nullptr, x, y, threads); }
@@ -470,7 +489,7 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads, co
               l.inv_diag[i] = 1.0 / (1.0 / l.inv_diag[i] + off);
             }
           },
-          kSerialRows);
+          serial_rows(l.a));
     }
   m.factorize_coarsest();
 }
@@ -535,7 +554,7 @@ void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x,
           x[i] += sum * l.inv_diag[i];
         }
       },
-      kSerialRows);
+      serial_rows(a));
 }
 
 void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* x) {
@@ -569,7 +588,7 @@ void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* 
           l.scratch[i] = x[i];
         }
       },
-      kSerialRows);
+      serial_rows(l.a));
   smooth(l, b, x, false);
 }
 
