@@ -399,7 +399,11 @@ struct AmgPreconditioner::Impl {
   };
   std::vector<Level> levels;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> coarse;
+  // Dense coarsest: Cholesky (blocked, several times faster than the pivoting LDL^T on ~1000
+  // unknowns), LDL^T only where Cholesky fails (a nearly singular coarse matrix).
+  Eigen::LLT<Eigen::MatrixXd> dense_llt;
   Eigen::LDLT<Eigen::MatrixXd> dense_coarse;
+  bool dense_pivoted = false;
   bool dense = false;
   Eigen::VectorXd coarse_b, coarse_x;
   unsigned threads = 1;
@@ -494,7 +498,7 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads, co
   m.factorize_coarsest();
 }
 
-// The coarsest level by LDL^T: dense where it is nearly full (block problems), sparse otherwise.
+// The coarsest level by Cholesky or LDL^T: dense where it is nearly full (block problems), sparse otherwise.
 void AmgPreconditioner::Impl::factorize_coarsest() {
   const Level& last = levels.back();
   const auto nl = static_cast<Eigen::Index>(last.a.rows);
@@ -507,6 +511,9 @@ void AmgPreconditioner::Impl::factorize_coarsest() {
     for (std::size_t i = 0; i < last.a.rows; ++i)
       for (int k = last.a.start[i]; k < last.a.start[i + 1]; ++k)
         c(static_cast<Eigen::Index>(i), last.a.col[k]) += last.a.val[k];
+    dense_llt.compute(c);
+    if (dense_llt.info() == Eigen::Success) return;
+    dense_pivoted = true;
     dense_coarse.compute(c);
     if (dense_coarse.info() != Eigen::Success)
       throw SolverError("AMG: the coarsest system could not be factorized");
@@ -562,10 +569,12 @@ void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* 
   const std::size_t n = l.a.rows;
   if (level + 1 == levels.size()) {
     coarse_b = Eigen::Map<const Eigen::VectorXd>(b, static_cast<Eigen::Index>(n));
-    if (dense)
+    if (!dense)
+      coarse_x = coarse.solve(coarse_b);
+    else if (dense_pivoted)
       coarse_x = dense_coarse.solve(coarse_b);
     else
-      coarse_x = coarse.solve(coarse_b);
+      coarse_x = dense_llt.solve(coarse_b);
     std::copy_n(coarse_x.data(), n, x);
     return;
   }
