@@ -19,6 +19,10 @@ namespace {
 constexpr std::size_t kSerialRows = 20000;
 // Levels stop coarsening at this size; the coarsest is factorized.
 constexpr std::size_t kCoarsest = 2000;
+// Multiply-adds below which a sparse product stays on one thread. By work, not rows: R (A P) has
+// few rows (the coarse unknowns) but each is long, and on one thread it was a serial step as large
+// as A P.
+constexpr double kSerialProductWork = 2e6;
 
 // A sparse matrix by rows; columns within a row in no particular order.
 struct Csr {
@@ -38,6 +42,14 @@ struct View {
 
 View view(const Csr& m) { return {m.rows, m.start.data(), m.col.data(), m.val.data()}; }
 
+// The serial_below of parallel_for for a pass over the rows of a: by nonzeros, not rows, since the
+// coarse levels have few but long rows (on one thread they were a serial part of every cycle). The
+// hybrid smoother's thread blocks (and the l1 sums over them) follow the same split.
+constexpr std::size_t kSerialNonzeros = 250000;
+std::size_t serial_rows(const View& a) {
+  return static_cast<std::size_t>(a.start[a.rows]) >= kSerialNonzeros ? 0 : SIZE_MAX;
+}
+
 int checked_nonzeros(std::size_t n) {
   if (n > static_cast<std::size_t>(INT_MAX))
     throw SolverError("AMG: a coarse matrix would have more than 2^31 nonzeros");
@@ -48,7 +60,8 @@ int checked_nonzeros(std::size_t n) {
 // row(i, emit) calls emit(column, value) for the products of row i (repeated columns are summed).
 // The first pass counts the distinct columns of each row, the second fills them in place.
 template <class Row>
-Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row) {
+Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row,
+               std::size_t serial_below = kSerialRows) {
   Csr out;
   out.rows = rows;
   out.cols = cols;
@@ -71,7 +84,7 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row) 
           out.start[i + 1] = count;
         }
       },
-      kSerialRows);
+      serial_below);
   std::size_t total = 0;
   for (std::size_t i = 0; i < rows; ++i) {
     total += static_cast<std::size_t>(out.start[i + 1]);
@@ -100,20 +113,26 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row) 
           });
         }
       },
-      kSerialRows);
+      serial_below);
   return out;
 }
 
 // a * b.
 Csr multiply(const View& a, const Csr& b, unsigned threads) {
-  return build_rows(a.rows, b.cols, threads, [&](std::size_t i, auto&& emit) {
-    for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
-      const double av = a.val[k];
-      const auto j = static_cast<std::size_t>(a.col[k]);
-      for (int l = b.start[j]; l < b.start[j + 1]; ++l)
-        emit(b.col[static_cast<std::size_t>(l)], av * b.val[static_cast<std::size_t>(l)]);
-    }
-  });
+  // The products' count estimated from the mean row length of b.
+  const double work = static_cast<double>(a.start[a.rows]) * static_cast<double>(b.val.size()) /
+                      static_cast<double>(std::max<std::size_t>(b.rows, 1));
+  return build_rows(
+      a.rows, b.cols, threads,
+      [&](std::size_t i, auto&& emit) {
+        for (int k = a.start[i]; k < a.start[i + 1]; ++k) {
+          const double av = a.val[k];
+          const auto j = static_cast<std::size_t>(a.col[k]);
+          for (int l = b.start[j]; l < b.start[j + 1]; ++l)
+            emit(b.col[static_cast<std::size_t>(l)], av * b.val[static_cast<std::size_t>(l)]);
+        }
+      },
+      work >= kSerialProductWork ? 0 : SIZE_MAX);
 }
 
 Csr transpose(const Csr& m) {
@@ -135,19 +154,21 @@ Csr transpose(const Csr& m) {
   return t;
 }
 
-// y = a x (rows split over threads).
-void spmv(const View& a, const double* x, double* y, unsigned threads) {
+// y = c - a x, or y = a x without c (rows split over threads).
+void residual(const View& a, const double* c, const double* x, double* y, unsigned threads) {
   parallel_for(
       a.rows, threads,
       [&](std::size_t b, std::size_t e, unsigned) {
         for (std::size_t i = b; i < e; ++i) {
           double s = 0;
           for (int k = a.start[i]; k < a.start[i + 1]; ++k) s += a.val[k] * x[a.col[k]];
-          y[i] = s;
+          y[i] = c ? c[i] - s : s;
         }
       },
-      kSerialRows);
+      serial_rows(a));
 }
+
+void spmv(const View& a, const double* x, double* y, unsigned threads) { residual(a, nullptr, x, y, threads); }
 
 // rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%). Each iteration is one
 // pass on threads: w = D^-1 A v and |w|^2 by slices (added in slice order: deterministic); no
@@ -378,7 +399,11 @@ struct AmgPreconditioner::Impl {
   };
   std::vector<Level> levels;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> coarse;
+  // Dense coarsest: Cholesky (blocked, several times faster than the pivoting LDL^T on ~1000
+  // unknowns), LDL^T only where Cholesky fails (a nearly singular coarse matrix).
+  Eigen::LLT<Eigen::MatrixXd> dense_llt;
   Eigen::LDLT<Eigen::MatrixXd> dense_coarse;
+  bool dense_pivoted = false;
   bool dense = false;
   Eigen::VectorXd coarse_b, coarse_x;
   unsigned threads = 1;
@@ -403,10 +428,17 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads, co
     Impl::Level& l = m.levels.back();
     const std::size_t n = l.a.rows;
     l.inv_diag.assign(n, 0.0);
-    for (std::size_t i = 0; i < n; ++i)
-      for (int k = l.a.start[i]; k < l.a.start[i + 1]; ++k)
-        if (static_cast<std::size_t>(l.a.col[k]) == i) l.inv_diag[i] += l.a.val[k];
-    for (double& d : l.inv_diag) d = 1.0 / d;
+    parallel_for(
+        n, m.threads,
+        [&](std::size_t lo, std::size_t hi, unsigned) {
+          for (std::size_t i = lo; i < hi; ++i) {
+            double d = 0;
+            for (int k = l.a.start[i]; k < l.a.start[i + 1]; ++k)
+              if (static_cast<std::size_t>(l.a.col[k]) == i) d += l.a.val[k];
+            l.inv_diag[i] = 1.0 / d;
+          }
+        },
+        kSerialRows);
     l.scratch.resize(n);
     if (n <= coarsest || m.levels.size() >= 12) break;
     Csr tentative = params.near_null ? block_tentative(l.a, ns) : scalar_tentative(l.a);
@@ -461,12 +493,12 @@ AmgPreconditioner::AmgPreconditioner(const SymmetricCsr& a, unsigned threads, co
               l.inv_diag[i] = 1.0 / (1.0 / l.inv_diag[i] + off);
             }
           },
-          kSerialRows);
+          serial_rows(l.a));
     }
   m.factorize_coarsest();
 }
 
-// The coarsest level by LDL^T: dense where it is nearly full (block problems), sparse otherwise.
+// The coarsest level by Cholesky or LDL^T: dense where it is nearly full (block problems), sparse otherwise.
 void AmgPreconditioner::Impl::factorize_coarsest() {
   const Level& last = levels.back();
   const auto nl = static_cast<Eigen::Index>(last.a.rows);
@@ -479,6 +511,9 @@ void AmgPreconditioner::Impl::factorize_coarsest() {
     for (std::size_t i = 0; i < last.a.rows; ++i)
       for (int k = last.a.start[i]; k < last.a.start[i + 1]; ++k)
         c(static_cast<Eigen::Index>(i), last.a.col[k]) += last.a.val[k];
+    dense_llt.compute(c);
+    if (dense_llt.info() == Eigen::Success) return;
+    dense_pivoted = true;
     dense_coarse.compute(c);
     if (dense_coarse.info() != Eigen::Success)
       throw SolverError("AMG: the coarsest system could not be factorized");
@@ -504,7 +539,7 @@ void AmgPreconditioner::apply(const double* r, double* z) { impl_->cycle(0, r, z
 
 // One hybrid Gauss-Seidel sweep: each thread's block of rows in order (forward) or in reverse, values
 // of the other blocks taken from l.scratch (the values before the sweep; the forward sweep starts
-// from x = 0, so there they are zero and skipped).
+// from x = 0, which it sets itself, so there they are zero and skipped).
 void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x, bool forward) const {
   const View& a = l.a;
   const double* before = l.scratch.data();
@@ -512,6 +547,7 @@ void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x,
       a.rows, threads,
       [&](std::size_t lo, std::size_t hi, unsigned) {
         const auto first = static_cast<int>(lo), end = static_cast<int>(hi);
+        if (forward) std::fill(x + lo, x + hi, 0.0);
         for (std::size_t s = lo; s < hi; ++s) {
           const std::size_t i = forward ? s : hi - 1 - (s - lo);
           double sum = b[i];
@@ -525,7 +561,7 @@ void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x,
           x[i] += sum * l.inv_diag[i];
         }
       },
-      kSerialRows);
+      serial_rows(a));
 }
 
 void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* x) {
@@ -533,18 +569,18 @@ void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* 
   const std::size_t n = l.a.rows;
   if (level + 1 == levels.size()) {
     coarse_b = Eigen::Map<const Eigen::VectorXd>(b, static_cast<Eigen::Index>(n));
-    if (dense)
+    if (!dense)
+      coarse_x = coarse.solve(coarse_b);
+    else if (dense_pivoted)
       coarse_x = dense_coarse.solve(coarse_b);
     else
-      coarse_x = coarse.solve(coarse_b);
+      coarse_x = dense_llt.solve(coarse_b);
     std::copy_n(coarse_x.data(), n, x);
     return;
   }
-  std::fill_n(x, n, 0.0);
   smooth(l, b, x, true);
-  // Residual, restricted to the next level.
-  spmv(l.a, x, l.scratch.data(), threads);
-  for (std::size_t i = 0; i < n; ++i) l.scratch[i] = b[i] - l.scratch[i];
+  // Residual (one pass on threads), restricted to the next level.
+  residual(l.a, b, x, l.scratch.data(), threads);
   Level& next = levels[level + 1];
   spmv(view(l.r), l.scratch.data(), next.b.data(), threads);
   cycle(level + 1, next.b.data(), next.x.data());
@@ -561,7 +597,7 @@ void AmgPreconditioner::Impl::cycle(std::size_t level, const double* b, double* 
           l.scratch[i] = x[i];
         }
       },
-      kSerialRows);
+      serial_rows(l.a));
   smooth(l, b, x, false);
 }
 

@@ -84,8 +84,14 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
     if (it == max_it)
       throw SolverError("conjugate gradients did not converge in " + std::to_string(max_it) +
                         " iterations (relative residual " + std::to_string(rnorm / bnorm) + ")");
-    multiply(a, pd, qd, threads);
-    const double pq = parallel_sum(n, threads, [&](std::size_t i) { return pd[i] * qd[i]; });
+    // q = A p and p.q in one pass.
+    const double pq = parallel_sum(n, threads, [&](std::size_t i) {
+      double s = 0;
+      for (int k = a.start[i]; k < a.start[i + 1]; ++k)
+        s += a.val[static_cast<std::size_t>(k)] * pd[a.col[static_cast<std::size_t>(k)]];
+      qd[i] = s;
+      return pd[i] * s;
+    });
     if (!(pq > 0))
       throw SolverError(
           "conjugate gradients broke down: the matrix is not positive definite (a part with "
