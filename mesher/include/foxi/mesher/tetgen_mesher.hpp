@@ -11,6 +11,7 @@
 #include <string>
 
 #include "foxi/mesher/size_field.hpp"
+#include "foxi/mesher/thin_layers.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/progress.hpp"
@@ -21,6 +22,9 @@ struct MeshParams {
   double max_volume = 0;      // global maximum tet volume (m^3); 0: none
   double radius_edge = 1.414; // radius-edge bound for quality refinement; 0: no quality refinement
   double min_dihedral = 0;    // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
+  // Thin layers at least this many times wider than thick are exempt from the quality bounds
+  // (thin_layers.hpp); 0: no exemption (a thin layer then fills with tets as wide as it is thick).
+  double thin_layer_aspect = kThinLayerAspect;
   bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
   bool regions = true;        // region seeds give tet regions (TetGen -A)
   // A sizing function (TetGen -m with a background mesh, size_field.hpp); null or empty: none. It must
@@ -35,6 +39,8 @@ struct MeshReport {
   std::string switches;           // the TetGen switches used
   std::size_t input_points = 0;
   std::size_t steiner_points = 0; // points TetGen added
+  std::size_t thin_layers = 0;    // thin layers exempt from the quality bounds
+  std::size_t thin_layer_tets = 0; // tets lying in them
   double seconds = 0;
 };
 

@@ -1,0 +1,208 @@
+#include "plc_edit.hpp"
+
+#include <limits>
+
+namespace foxi::detail {
+
+std::size_t EditablePlc::facet_at(const Vec& p) const {
+  for (std::size_t f = 0; f < facets.size(); ++f)
+    for (const auto& poly : facets[f]) {
+      if (poly.size() < 3) continue;
+      // Newell's normal gives the polygon's plane without choosing three vertices.
+      Vec n{0, 0, 0};
+      for (std::size_t i = 0; i < poly.size(); ++i) {
+        const Vec a = point(poly[i]), b = point(poly[(i + 1) % poly.size()]);
+        n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+      }
+      const double nn = std::sqrt(norm2(n));
+      if (!(nn > 0) || std::abs(dot(sub(p, point(poly[0])), n)) > tol * nn) continue;
+      const Vec p0 = point(poly[0]);
+      const Vec u = cross(n, Vec{1, 0, 0}), w = cross(n, Vec{0, 1, 0});
+      const Vec e = norm2(u) > norm2(w) ? u : w;  // any in-plane direction
+      if (in_polygon(poly, p0, add(p0, e), add(p0, cross(n, e)), p)) return f;
+    }
+  return facets.size();
+}
+
+bool EditablePlc::insert_surface_point(const Vec& p) {
+  std::uint32_t a = 0, b = 0;
+  if (find_segment(p, p, a, b)) {
+    split_segment(a, b, add_point(p));
+    return true;
+  }
+  const std::size_t f = facet_at(p);
+  if (f == facets.size()) return false;
+  facets[f].push_back({add_point(p)});
+  return true;
+}
+
+namespace {
+
+std::vector<std::uint32_t> used_vertices(const Mesh& mesh) {
+  std::vector<char> used(mesh.node_count(), 0);
+  for (std::uint32_t v : mesh.tet) used[v] = 1;
+  std::vector<std::uint32_t> vertices;
+  for (std::uint32_t v = 0; v < used.size(); ++v)
+    if (used[v]) vertices.push_back(v);
+  return vertices;
+}
+
+}  // namespace
+
+MeshSearch::MeshSearch(const Mesh& m) : mesh(m), vertices(m.xyz, used_vertices(m)) {
+  const std::size_t nf = m.bface_count();
+  face_ball.resize(nf);
+  for (std::size_t f = 0; f < nf; ++f)
+    face_ball[f] = triangle_ball(at(m.xyz, m.bface[3 * f]), at(m.xyz, m.bface[3 * f + 1]), at(m.xyz, m.bface[3 * f + 2]));
+  // Each triangle goes into the cells its ball's box covers; balls covering very many cells are
+  // checked for every query instead.
+  const std::size_t cells = vertices.dim[0] * vertices.dim[1] * vertices.dim[2];
+  face_begin_.assign(cells + 1, 0);
+  auto cover = [&](std::uint32_t f, auto&& visit) {
+    const Ball& b = face_ball[f];
+    const double r = std::sqrt(b.r2);
+    const std::array<std::size_t, 3> lo{vertices.coord(b.c[0] - r, 0), vertices.coord(b.c[1] - r, 1), vertices.coord(b.c[2] - r, 2)};
+    const std::array<std::size_t, 3> hi{vertices.coord(b.c[0] + r, 0), vertices.coord(b.c[1] + r, 1), vertices.coord(b.c[2] + r, 2)};
+    if ((hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > 512) return false;
+    for (std::size_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::size_t y = lo[1]; y <= hi[1]; ++y)
+        for (std::size_t x = lo[0]; x <= hi[0]; ++x) visit(vertices.index({x, y, z}));
+    return true;
+  };
+  std::vector<char> big(nf, 0);
+  for (std::uint32_t f = 0; f < nf; ++f) {
+    if (face_ball[f].r2 < 0) continue;
+    if (!cover(f, [&](std::size_t cell) { ++face_begin_[cell + 1]; })) {
+      big[f] = 1;
+      big_faces_.push_back(f);
+    }
+  }
+  for (std::size_t i = 1; i < face_begin_.size(); ++i) face_begin_[i] += face_begin_[i - 1];
+  face_items_.resize(face_begin_.back());
+  std::vector<std::uint32_t> fill(face_begin_.begin(), face_begin_.end() - 1);
+  for (std::uint32_t f = 0; f < nf; ++f)
+    if (face_ball[f].r2 >= 0 && !big[f]) cover(f, [&](std::size_t cell) { face_items_[fill[cell]++] = f; });
+}
+
+void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::uint32_t>& violating_tets,
+                               std::vector<char>& split) {
+  const Mesh& mesh = search.mesh;
+  for (std::uint32_t t : violating_tets) {
+    if (t >= mesh.tet_count()) continue;
+    const std::uint32_t* tv = &mesh.tet[4 * std::size_t(t)];
+    const Ball b = tet_ball(at(mesh.xyz, tv[0]), at(mesh.xyz, tv[1]), at(mesh.xyz, tv[2]), at(mesh.xyz, tv[3]));
+    if (b.r2 < 0) continue;
+    const double r = std::sqrt(b.r2);
+    // The vertices inside; the certificate is exact, so if rounding hides them take the deepest one.
+    std::vector<std::uint32_t> inside;
+    std::uint32_t deepest = kNone;
+    double deepest_ratio = std::numeric_limits<double>::infinity();
+    search.vertices.for_each_in_box(b.c, r * (1 + 1e-9), [&](std::uint32_t v) {
+      if (v == tv[0] || v == tv[1] || v == tv[2] || v == tv[3]) return;
+      const double ratio = norm2(sub(at(mesh.xyz, v), b.c)) / b.r2;
+      if (ratio < 1 - 1e-12) inside.push_back(v);
+      if (ratio < deepest_ratio) {
+        deepest_ratio = ratio;
+        deepest = v;
+      }
+    });
+    if (inside.empty() && deepest != kNone && deepest_ratio < 1 + 1e-9) inside.push_back(deepest);
+    for (std::uint32_t q : inside)
+      search.for_each_encroached(at(mesh.xyz, q), [&](std::uint32_t f) {
+        const std::uint32_t* fv = &mesh.bface[3 * std::size_t(f)];
+        if (fv[0] == q || fv[1] == q || fv[2] == q) return;
+        const Ball& fb = search.face_ball[f];
+        if (std::sqrt(norm2(sub(fb.c, b.c))) < std::sqrt(fb.r2) + r) split[f] = 1;
+      });
+  }
+}
+
+bool NearPoints::near(const Vec& p, double r) const {
+  const std::int64_t x0 = cell_of(p[0] - r), x1 = cell_of(p[0] + r), y0 = cell_of(p[1] - r), y1 = cell_of(p[1] + r),
+                     z0 = cell_of(p[2] - r), z1 = cell_of(p[2] + r);
+  if ((x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1) > 4096) {  // a huge ball: look at every point
+    for (const auto& kv : cells_)
+      for (const Vec& q : kv.second)
+        if (norm2(sub(q, p)) < r * r) return true;
+    return false;
+  }
+  for (std::int64_t z = z0; z <= z1; ++z)
+    for (std::int64_t y = y0; y <= y1; ++y)
+      for (std::int64_t x = x0; x <= x1; ++x) {
+        const auto it = cells_.find(key(x, y, z));
+        if (it == cells_.end()) continue;
+        for (const Vec& q : it->second)
+          if (norm2(sub(q, p)) < r * r) return true;
+      }
+  return false;
+}
+
+void NearPoints::add(const Vec& p) { cells_[key(cell_of(p[0]), cell_of(p[1]), cell_of(p[2]))].push_back(p); }
+
+std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, const std::vector<char>& split,
+                        EditablePlc& edit, NearPoints& added) {
+  const std::size_t before = edit.plc.point_count();
+  auto exists = [&](const Vec& q) { return added.near(q, 1e-9 * std::sqrt(norm2(q)) + edit.tol); };
+  auto accept = [&](const Vec& q) {
+    added.add(q);
+    edit.mirror(q, [&](const Vec& m) {
+      if (exists(m)) return true;
+      added.add(m);
+      return false;
+    });
+  };
+  for (std::size_t f = 0; f < split.size(); ++f) {
+    if (!split[f]) continue;
+    const std::uint32_t* fv = &mesh.bface[3 * f];
+    const Vec p[3] = {at(mesh.xyz, fv[0]), at(mesh.xyz, fv[1]), at(mesh.xyz, fv[2])};
+    const Ball& fb = face_ball[f];
+    const double size = std::sqrt(fb.r2);
+    const std::size_t facet = edit.find_facet(mesh.bface_tag[f], p[0], p[1], p[2]);
+    // Subsegments among the triangle's edges; the circumcentre encroaching one, or falling outside
+    // the facet, splits the subsegment instead (nearest to the centre first).
+    int seg_edge = -1;
+    double seg_dist = std::numeric_limits<double>::infinity();
+    std::uint32_t sa = 0, sb = 0;
+    const bool centre_in_facet = facet < edit.facets.size() && edit.in_facet(facet, p[0], p[1], p[2], fb.c);
+    for (int e = 0; e < 3; ++e) {
+      const Vec& u = p[e];
+      const Vec& v = p[(e + 1) % 3];
+      std::uint32_t a = 0, b = 0;
+      if (!edit.find_segment(u, v, a, b)) continue;
+      const Vec mid = scale(add(u, v), 0.5);
+      const double d2 = norm2(sub(fb.c, mid));
+      const bool encroached = d2 < 0.25 * norm2(sub(v, u));
+      if ((encroached || !centre_in_facet) && d2 < seg_dist) {
+        seg_dist = d2;
+        seg_edge = e;
+        sa = a;
+        sb = b;
+      }
+    }
+    if (seg_edge >= 0) {
+      const Vec mid = scale(add(p[seg_edge], p[(seg_edge + 1) % 3]), 0.5);
+      if (added.near(mid, 1e-3 * size)) continue;
+      // The segment may have been split already in this pass: find the piece that holds mid now.
+      std::uint32_t a = sa, b = sb;
+      if (!edit.on_segment(mid, a, b) || !edit.find_segment(mid, mid, a, b)) continue;
+      edit.split_segment(a, b, edit.add_point(mid));
+      accept(mid);
+    } else if (facet < edit.facets.size()) {
+      const Vec c = centre_in_facet ? fb.c : scale(add(add(p[0], p[1]), p[2]), 1.0 / 3);
+      if (added.near(c, 1e-3 * size)) continue;
+      // A point on some segment of the facet would be a second copy of a segment vertex to TetGen.
+      std::uint32_t a = 0, b = 0;
+      const std::uint32_t k = edit.add_point(c);
+      if (edit.find_segment(c, c, a, b))
+        edit.split_segment(a, b, k);
+      else
+        edit.facets[facet].push_back({k});
+      accept(c);
+    }
+  }
+  return edit.plc.point_count() - before;
+}
+
+}  // namespace foxi::detail

@@ -1,0 +1,319 @@
+// Internal to the mesher: small geometry helpers and an editable copy of a PLC's facets, shared by
+// the conforming refinement (conforming.cpp) and the thin-layer refinement (layer_refinement.cpp).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "foxi/mesher/thin_layers.hpp"
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/plc.hpp"
+
+namespace foxi::detail {
+
+using Vec = std::array<double, 3>;
+
+inline Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline Vec add(const Vec& a, const Vec& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+inline Vec scale(const Vec& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+inline double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline Vec cross(const Vec& a, const Vec& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+inline double norm2(const Vec& a) { return dot(a, a); }
+inline Vec at(const std::vector<double>& xyz, std::uint32_t i) { return {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; }
+
+struct Ball {
+  Vec c{};
+  double r2 = -1;  // negative: none (degenerate simplex)
+};
+
+// Circumsphere of a tet, in double (good enough to choose what to split; the certificate is exact).
+inline Ball tet_ball(const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p3) {
+  const Vec a = sub(p1, p0), b = sub(p2, p0), c = sub(p3, p0);
+  const double det = dot(a, cross(b, c));
+  if (!(std::abs(det) > 0)) return {};
+  const Vec num = add(add(scale(cross(b, c), norm2(a)), scale(cross(c, a), norm2(b))), scale(cross(a, b), norm2(c)));
+  const Vec off = scale(num, 0.5 / det);
+  return {add(p0, off), norm2(off)};
+}
+
+// Diametral sphere of a triangle: centred on its circumcentre, in its plane.
+inline Ball triangle_ball(const Vec& p0, const Vec& p1, const Vec& p2) {
+  const Vec a = sub(p1, p0), b = sub(p2, p0);
+  const Vec n = cross(a, b);
+  const double n2 = norm2(n);
+  if (!(n2 > 0)) return {};
+  const Vec off = scale(cross(sub(scale(b, norm2(a)), scale(a, norm2(b))), n), 0.5 / n2);
+  return {add(p0, off), norm2(off)};
+}
+
+// Vertices bucketed in a uniform grid, for "which vertices lie in this ball".
+struct PointGrid {
+  Vec lo{};
+  double cell = 1;
+  std::array<std::size_t, 3> dim{1, 1, 1};
+  std::vector<std::uint32_t> begin, items;
+
+  std::size_t index(const std::array<std::size_t, 3>& c) const { return (c[2] * dim[1] + c[1]) * dim[0] + c[0]; }
+  std::size_t coord(double v, int axis) const {
+    const double k = std::floor((v - lo[std::size_t(axis)]) / cell);
+    if (!(k > 0)) return 0;
+    const std::size_t last = dim[std::size_t(axis)] - 1;
+    return k >= double(last) ? last : std::size_t(k);  // no out-of-range conversion for huge balls
+  }
+
+  PointGrid(const std::vector<double>& xyz, const std::vector<std::uint32_t>& vertices) {
+    Vec hi{};
+    lo = hi = at(xyz, vertices.empty() ? 0 : vertices[0]);
+    for (std::uint32_t v : vertices)
+      for (int k = 0; k < 3; ++k) {
+        lo[std::size_t(k)] = std::min(lo[std::size_t(k)], xyz[3 * v + std::size_t(k)]);
+        hi[std::size_t(k)] = std::max(hi[std::size_t(k)], xyz[3 * v + std::size_t(k)]);
+      }
+    const Vec ext = sub(hi, lo);
+    const double vol = std::max(ext[0], 1e-300) * std::max(ext[1], 1e-300) * std::max(ext[2], 1e-300);
+    cell = std::max({std::cbrt(vol / double(std::max<std::size_t>(vertices.size(), 1))), ext[0] / 256, ext[1] / 256,
+                     ext[2] / 256, 1e-300});
+    for (int k = 0; k < 3; ++k) dim[std::size_t(k)] = std::size_t(ext[std::size_t(k)] / cell) + 1;
+    begin.assign(dim[0] * dim[1] * dim[2] + 1, 0);
+    std::vector<std::size_t> slot(vertices.size());
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+      const std::uint32_t v = vertices[i];
+      slot[i] = index({coord(xyz[3 * v], 0), coord(xyz[3 * v + 1], 1), coord(xyz[3 * v + 2], 2)});
+      ++begin[slot[i] + 1];
+    }
+    for (std::size_t i = 1; i < begin.size(); ++i) begin[i] += begin[i - 1];
+    items.resize(vertices.size());
+    std::vector<std::uint32_t> fill(begin.begin(), begin.end() - 1);
+    for (std::size_t i = 0; i < vertices.size(); ++i) items[fill[slot[i]]++] = vertices[i];
+  }
+
+  template <class F>
+  void for_each_in_box(const Vec& c, double r, F&& f) const {
+    const std::array<std::size_t, 3> a{coord(c[0] - r, 0), coord(c[1] - r, 1), coord(c[2] - r, 2)};
+    const std::array<std::size_t, 3> b{coord(c[0] + r, 0), coord(c[1] + r, 1), coord(c[2] + r, 2)};
+    for (std::size_t z = a[2]; z <= b[2]; ++z)
+      for (std::size_t y = a[1]; y <= b[1]; ++y)
+        for (std::size_t x = a[0]; x <= b[0]; ++x) {
+          const std::size_t i = index({x, y, z});
+          for (std::uint32_t k = begin[i]; k < begin[i + 1]; ++k) f(items[k]);
+        }
+  }
+};
+
+// The PLC's facets as nested lists while points are being added.
+struct EditablePlc {
+  Plc& plc;
+  std::vector<std::vector<std::vector<std::uint32_t>>> facets;  // facet -> polygons -> vertices
+  double tol = 0;                                               // "on a segment / plane", metres
+
+  explicit EditablePlc(Plc& p) : plc(p) {
+    facets.resize(plc.facet_count());
+    for (std::size_t f = 0; f < plc.facet_count(); ++f)
+      for (std::uint32_t g = plc.facet_polygon_begin[f]; g < plc.facet_polygon_begin[f + 1]; ++g)
+        facets[f].emplace_back(plc.polygon_vertices.begin() + plc.polygon_vertex_begin[g],
+                               plc.polygon_vertices.begin() + plc.polygon_vertex_begin[g + 1]);
+    Vec lo{}, hi{};
+    for (std::size_t i = 0; i < plc.point_count(); ++i)
+      for (std::size_t k = 0; k < 3; ++k) {
+        lo[k] = i == 0 ? plc.points[k] : std::min(lo[k], plc.points[3 * i + k]);
+        hi[k] = i == 0 ? plc.points[k] : std::max(hi[k], plc.points[3 * i + k]);
+      }
+    tol = 1e-9 * std::sqrt(norm2(sub(hi, lo)));
+  }
+
+  Vec point(std::uint32_t i) const { return at(plc.points, i); }
+
+  bool on_segment(const Vec& p, std::uint32_t a, std::uint32_t b) const {
+    const Vec pa = point(a), d = sub(point(b), pa), w = sub(p, pa);
+    const double l2 = norm2(d);
+    if (!(l2 > 0)) return false;
+    const double t = dot(w, d);
+    if (t < -tol * std::sqrt(l2) || t > l2 + tol * std::sqrt(l2)) return false;
+    return norm2(cross(d, w)) <= tol * tol * l2;
+  }
+
+  // A PLC segment (consecutive vertices of some polygon) that holds both p and q, as (a, b).
+  bool find_segment(const Vec& p, const Vec& q, std::uint32_t& a, std::uint32_t& b) const {
+    for (const auto& polys : facets)
+      for (const auto& poly : polys) {
+        if (poly.size() < 2) continue;
+        for (std::size_t i = 0; i < poly.size(); ++i) {
+          const std::uint32_t u = poly[i], v = poly[(i + 1) % poly.size()];
+          if (poly.size() == 2 && i == 1) break;
+          if (on_segment(p, u, v) && on_segment(q, u, v)) {
+            a = u;
+            b = v;
+            return true;
+          }
+        }
+      }
+    return false;
+  }
+
+  std::uint32_t add_point(const Vec& p) {
+    plc.points.insert(plc.points.end(), p.begin(), p.end());
+    return static_cast<std::uint32_t>(plc.point_count() - 1);
+  }
+
+  // Splits every polygon edge (a, b) or (b, a) with the new point k.
+  void split_segment(std::uint32_t a, std::uint32_t b, std::uint32_t k) {
+    for (auto& polys : facets)
+      for (auto& poly : polys) {
+        if (poly.size() < 2) continue;
+        for (std::size_t i = 0; i < poly.size(); ++i) {
+          const std::size_t j = (i + 1) % poly.size();
+          if (poly.size() == 2 && i == 1) break;
+          if ((poly[i] == a && poly[j] == b) || (poly[i] == b && poly[j] == a)) {
+            poly.insert(poly.begin() + std::ptrdiff_t(i + 1), k);
+            break;
+          }
+        }
+      }
+  }
+
+  // The facet with marker `marker` whose plane holds the triangle and whose polygons hold its centroid.
+  std::size_t find_facet(std::int32_t marker, const Vec& p0, const Vec& p1, const Vec& p2) const {
+    const Vec centroid = scale(add(add(p0, p1), p2), 1.0 / 3);
+    for (std::size_t f = 0; f < facets.size(); ++f) {
+      if (plc.facet_marker[f] != marker) continue;
+      for (const auto& poly : facets[f])
+        if (poly.size() >= 3 && in_polygon(poly, p0, p1, p2, centroid)) return f;
+    }
+    return facets.size();
+  }
+
+  // Whether p lies in the plane of the polygon and inside it (the triangle p0 p1 p2 gives the plane).
+  bool in_polygon(const std::vector<std::uint32_t>& poly, const Vec& p0, const Vec& p1, const Vec& p2,
+                  const Vec& p) const {
+    const Vec n = cross(sub(p1, p0), sub(p2, p0));
+    const double nn = std::sqrt(norm2(n));
+    if (!(nn > 0)) return false;
+    for (std::uint32_t v : poly)
+      if (std::abs(dot(sub(point(v), p0), n)) > tol * nn) return false;
+    // Drop the dominant axis of the normal and count crossings.
+    std::size_t drop = 0;
+    for (std::size_t k = 1; k < 3; ++k)
+      if (std::abs(n[k]) > std::abs(n[drop])) drop = k;
+    const std::size_t u = (drop + 1) % 3, w = (drop + 2) % 3;
+    bool inside = false;
+    for (std::size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++) {
+      const Vec a = point(poly[i]), b = point(poly[j]);
+      if ((a[w] > p[w]) != (b[w] > p[w])) {
+        const double x = a[u] + (p[w] - a[w]) / (b[w] - a[w]) * (b[u] - a[u]);
+        if (p[u] < x) inside = !inside;
+      }
+    }
+    return inside;
+  }
+
+  bool in_facet(std::size_t f, const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p) const {
+    for (const auto& poly : facets[f])
+      if (poly.size() >= 3 && in_polygon(poly, p0, p1, p2, p)) return true;
+    return false;
+  }
+
+  // The facet whose plane and polygons hold p, or facets.size().
+  std::size_t facet_at(const Vec& p) const;
+  // Adds p to the PLC segment that holds it (splitting that segment in every polygon) or else, as a
+  // one-vertex polygon, to the facet that holds it; returns false (and adds nothing) if neither does.
+  bool insert_surface_point(const Vec& p);
+  // Thin layers: a point added on one face of a layer is mirrored onto the opposite face, so the two
+  // faces keep the same vertices in projection and the flat tets between them stay Delaunay.
+  std::vector<ThinLayer> layers;
+  // The mirror images of p (on a layer face) that `insert_surface_point` accepted; `exists` tells
+  // whether a vertex is already at a position (then nothing is added there).
+  template <class Exists>
+  std::size_t mirror(const Vec& p, Exists&& exists) {
+    std::size_t n = 0;
+    for (const ThinLayer& l : layers) {
+      const Vec nrm{l.normal[0], l.normal[1], l.normal[2]};
+      if (!l.contains(p.data())) continue;
+      const double h = dot(nrm, p), gap = l.hi - l.lo;
+      Vec q;
+      if (std::abs(h - l.lo) <= l.tolerance)
+        q = add(p, scale(nrm, gap));
+      else if (std::abs(h - l.hi) <= l.tolerance)
+        q = sub(p, scale(nrm, gap));
+      else
+        continue;
+      if (!exists(q) && insert_surface_point(q)) ++n;
+    }
+    return n;
+  }
+
+  void write_back() {
+    plc.facet_polygon_begin.assign(1, 0);
+    plc.polygon_vertex_begin.assign(1, 0);
+    plc.polygon_vertices.clear();
+    for (const auto& polys : facets) {
+      for (const auto& poly : polys) {
+        plc.polygon_vertices.insert(plc.polygon_vertices.end(), poly.begin(), poly.end());
+        plc.polygon_vertex_begin.push_back(static_cast<std::uint32_t>(plc.polygon_vertices.size()));
+      }
+      plc.facet_polygon_begin.push_back(static_cast<std::uint32_t>(plc.polygon_vertex_begin.size() - 1));
+    }
+  }
+};
+
+// A mesh's vertices and its constraint triangles' diametral spheres, bucketed for the questions the
+// refinements ask: which vertices lie in a ball, which triangles a point encroaches.
+struct MeshSearch {
+  explicit MeshSearch(const Mesh& mesh);
+  const Mesh& mesh;
+  PointGrid vertices;
+  std::vector<Ball> face_ball;  // per mesh.bface; r2 < 0 for a degenerate triangle
+
+  // Calls f(face) for each constraint triangle whose diametral sphere holds p strictly inside.
+  template <class F>
+  void for_each_encroached(const Vec& p, F&& f) const {
+    auto test = [&](std::uint32_t face) {
+      const Ball& b = face_ball[face];
+      if (b.r2 > 0 && norm2(sub(p, b.c)) < b.r2 * (1 - 1e-12)) f(face);
+    };
+    for (std::uint32_t face : big_faces_) test(face);
+    const std::size_t cell = vertices.index({vertices.coord(p[0], 0), vertices.coord(p[1], 1), vertices.coord(p[2], 2)});
+    for (std::uint32_t k = face_begin_[cell]; k < face_begin_[cell + 1]; ++k) test(face_items_[k]);
+  }
+
+ private:
+  std::vector<std::uint32_t> face_begin_, face_items_, big_faces_;
+};
+
+// The constraint triangles to split for the non-Delaunay tets `violating_tets`: those encroached by
+// a vertex inside a violated circumsphere whose diametral sphere meets that circumsphere (the
+// triangle lies between the two). Sets split[face] = 1.
+void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::uint32_t>& violating_tets,
+                               std::vector<char>& split);
+
+// Points added in one refinement pass, for "is there one within r of p" (a hashed uniform grid).
+class NearPoints {
+ public:
+  explicit NearPoints(double cell) : cell_(cell > 0 ? cell : 1) {}
+  bool near(const Vec& p, double r) const;
+  void add(const Vec& p);
+
+ private:
+  std::int64_t key(std::int64_t x, std::int64_t y, std::int64_t z) const {
+    return (x * 73856093) ^ (y * 19349663) ^ (z * 83492791);
+  }
+  std::int64_t cell_of(double v) const { return static_cast<std::int64_t>(std::floor(v / cell_)); }
+  double cell_;
+  std::unordered_map<std::int64_t, std::vector<Vec>> cells_;
+};
+
+// Splits the constraint triangles flagged in `split` (mesh.bface indices; `face_ball` their
+// diametral spheres): a triangle's circumcentre goes into its facet, or, when that centre falls
+// outside the facet or encroaches a PLC segment among the triangle's edges, the nearest such
+// subsegment's midpoint into the segment (Ruppert/Shewchuk's rule); points on thin-layer faces are
+// mirrored. `added` holds this pass's points (no two closer than 1e-3 of the triangle's radius).
+// Returns the number of points added.
+std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, const std::vector<char>& split,
+                        EditablePlc& edit, NearPoints& added);
+
+}  // namespace foxi::detail
