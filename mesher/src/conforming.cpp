@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "foxi/model/delaunay.hpp"
+#include "layer_refinement.hpp"
 #include "plc_edit.hpp"
 
 namespace foxi {
@@ -34,6 +35,18 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   p.optimize = false;
   Plc current = plc;
   Mesh mesh;
+  const std::vector<ThinLayer> layers =
+      params.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 || (params.size_field && !params.size_field->empty()) ||
+                                       std::any_of(plc.regions.begin(), plc.regions.end(), [](const RegionSeed& s) { return s.max_volume > 0; }))
+          ? find_thin_layers(plc, params.thin_layer_aspect)
+          : std::vector<ThinLayer>{};
+  if (!layers.empty()) {
+    mesh = detail::refine_with_thin_layers(params, conforming, layers, current, rep);
+    rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (report) *report = rep;
+    if (refined_plc) *refined_plc = std::move(current);
+    return mesh;
+  }
   CertificateOptions copt;
   copt.max_listed = std::numeric_limits<std::size_t>::max();
   for (std::size_t it = 0;; ++it) {

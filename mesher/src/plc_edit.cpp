@@ -4,6 +4,38 @@
 
 namespace foxi::detail {
 
+namespace {
+
+double polygon_area2(const EditablePlc& e, const std::vector<std::uint32_t>& poly) {
+  Vec n{0, 0, 0};
+  for (std::size_t i = 0; i < poly.size(); ++i) n = add(n, cross(e.point(poly[i]), e.point(poly[(i + 1) % poly.size()])));
+  return norm2(n);
+}
+
+}  // namespace
+
+bool EditablePlc::in_facet(std::size_t f, const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p) const {
+  bool inside = false;
+  for (const auto& poly : facets[f])
+    if (poly.size() >= 3 && in_polygon(poly, p0, p1, p2, p)) inside = true;
+  if (!inside) return false;
+  for (std::uint32_t h = plc.facet_hole_begin[f]; h < plc.facet_hole_begin[f + 1]; ++h) {
+    const Vec hole = at(plc.facet_holes, h);
+    const std::vector<std::uint32_t>* smallest = nullptr;
+    double smallest_area = 0;
+    for (const auto& poly : facets[f])
+      if (poly.size() >= 3 && in_polygon(poly, p0, p1, p2, hole)) {
+        const double a = polygon_area2(*this, poly);
+        if (!smallest || a < smallest_area) {
+          smallest = &poly;
+          smallest_area = a;
+        }
+      }
+    if (smallest && in_polygon(*smallest, p0, p1, p2, p)) return false;
+  }
+  return true;
+}
+
 std::size_t EditablePlc::facet_at(const Vec& p) const {
   for (std::size_t f = 0; f < facets.size(); ++f)
     for (const auto& poly : facets[f]) {
@@ -21,7 +53,7 @@ std::size_t EditablePlc::facet_at(const Vec& p) const {
       const Vec p0 = point(poly[0]);
       const Vec u = cross(n, Vec{1, 0, 0}), w = cross(n, Vec{0, 1, 0});
       const Vec e = norm2(u) > norm2(w) ? u : w;  // any in-plane direction
-      if (in_polygon(poly, p0, add(p0, e), add(p0, cross(n, e)), p)) return f;
+      if (in_facet(f, p0, add(p0, e), add(p0, cross(n, e)), p)) return f;
     }
   return facets.size();
 }
@@ -142,7 +174,7 @@ bool NearPoints::near(const Vec& p, double r) const {
 void NearPoints::add(const Vec& p) { cells_[key(cell_of(p[0]), cell_of(p[1]), cell_of(p[2]))].push_back(p); }
 
 std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, const std::vector<char>& split,
-                        EditablePlc& edit, NearPoints& added) {
+                        EditablePlc& edit, NearPoints& added, double spacing) {
   const std::size_t before = edit.plc.point_count();
   auto exists = [&](const Vec& q) { return added.near(q, 1e-9 * std::sqrt(norm2(q)) + edit.tol); };
   auto accept = [&](const Vec& q) {
@@ -153,8 +185,11 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       return false;
     });
   };
-  for (std::size_t f = 0; f < split.size(); ++f) {
-    if (!split[f]) continue;
+  std::vector<std::uint32_t> order;
+  for (std::uint32_t f = 0; f < split.size(); ++f)
+    if (split[f]) order.push_back(f);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return face_ball[a].r2 > face_ball[b].r2; });
+  for (std::uint32_t f : order) {
     const std::uint32_t* fv = &mesh.bface[3 * f];
     const Vec p[3] = {at(mesh.xyz, fv[0]), at(mesh.xyz, fv[1]), at(mesh.xyz, fv[2])};
     const Ball& fb = face_ball[f];
@@ -183,7 +218,7 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
     }
     if (seg_edge >= 0) {
       const Vec mid = scale(add(p[seg_edge], p[(seg_edge + 1) % 3]), 0.5);
-      if (added.near(mid, 1e-3 * size)) continue;
+      if (added.near(mid, spacing * size)) continue;
       // The segment may have been split already in this pass: find the piece that holds mid now.
       std::uint32_t a = sa, b = sb;
       if (!edit.on_segment(mid, a, b) || !edit.find_segment(mid, mid, a, b)) continue;
@@ -191,7 +226,7 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       accept(mid);
     } else if (facet < edit.facets.size()) {
       const Vec c = centre_in_facet ? fb.c : scale(add(add(p[0], p[1]), p[2]), 1.0 / 3);
-      if (added.near(c, 1e-3 * size)) continue;
+      if (added.near(c, spacing * size)) continue;
       // A point on some segment of the facet would be a second copy of a segment vertex to TetGen.
       std::uint32_t a = 0, b = 0;
       const std::uint32_t k = edit.add_point(c);

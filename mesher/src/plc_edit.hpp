@@ -180,13 +180,11 @@ struct EditablePlc {
   // The facet with marker `marker` whose plane holds the triangle and whose polygons hold its centroid.
   std::size_t find_facet(std::int32_t marker, const Vec& p0, const Vec& p1, const Vec& p2) const {
     const Vec centroid = scale(add(add(p0, p1), p2), 1.0 / 3);
-    for (std::size_t f = 0; f < facets.size(); ++f) {
-      if (plc.facet_marker[f] != marker) continue;
-      for (const auto& poly : facets[f])
-        if (poly.size() >= 3 && in_polygon(poly, p0, p1, p2, centroid)) return f;
-    }
+    for (std::size_t f = 0; f < facets.size(); ++f)
+      if (plc.facet_marker[f] == marker && in_facet(f, p0, p1, p2, centroid)) return f;
     return facets.size();
   }
+
 
   // Whether p lies in the plane of the polygon and inside it (the triangle p0 p1 p2 gives the plane).
   bool in_polygon(const std::vector<std::uint32_t>& poly, const Vec& p0, const Vec& p1, const Vec& p2,
@@ -212,11 +210,10 @@ struct EditablePlc {
     return inside;
   }
 
-  bool in_facet(std::size_t f, const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p) const {
-    for (const auto& poly : facets[f])
-      if (poly.size() >= 3 && in_polygon(poly, p0, p1, p2, p)) return true;
-    return false;
-  }
+  // Inside one of the facet's polygons and not in one of its holes (the smallest polygon around a
+  // hole point). The triangle p0 p1 p2 gives the plane.
+  bool in_facet(std::size_t f, const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p) const;
+
 
   // The facet whose plane and polygons hold p, or facets.size().
   std::size_t facet_at(const Vec& p) const;
@@ -311,9 +308,10 @@ class NearPoints {
 // diametral spheres): a triangle's circumcentre goes into its facet, or, when that centre falls
 // outside the facet or encroaches a PLC segment among the triangle's edges, the nearest such
 // subsegment's midpoint into the segment (Ruppert/Shewchuk's rule); points on thin-layer faces are
-// mirrored. `added` holds this pass's points (no two closer than 1e-3 of the triangle's radius).
-// Returns the number of points added.
+// mirrored. `added` holds this pass's points: a split point closer to one of them than `spacing`
+// times the triangle's circumradius is skipped. Larger triangles are split first. Returns the number
+// of points added.
 std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, const std::vector<char>& split,
-                        EditablePlc& edit, NearPoints& added);
+                        EditablePlc& edit, NearPoints& added, double spacing = 1e-3);
 
 }  // namespace foxi::detail

@@ -26,6 +26,12 @@ MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& 
     const double bin = std::floor(q.min_dihedral_deg / 5);
     const std::size_t last = r.min_dihedral_histogram.size() - 1;
     r.min_dihedral_histogram[bin > 0 ? std::min(std::size_t(bin), last) : 0]++;
+    if (!conforming.thin_layers.empty()) {
+      if (tet_in_thin_layer(mesh, t, conforming.thin_layers))
+        ++r.thin_layer_tets;
+      else
+        r.max_radius_edge_outside_layers = std::max(r.max_radius_edge_outside_layers, q.radius_edge);
+    }
     RegionSize& rs = regions[mesh.region_of(t)];
     ++rs.tets;
     rs.volume += std::abs(q.volume);
@@ -41,6 +47,11 @@ MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& 
   r.conforming_overhead =
       conforming.first_mesh_points ? double(conforming.added_points) / double(conforming.first_mesh_points) : 0;
   r.iterations = conforming.iterations;
+  r.thin_layers = conforming.thin_layers.size();
+  r.quality_points = conforming.quality_points;
+  r.quality_unmet = conforming.quality_unmet;
+  if (r.thin_layers > 0 && r.nodes > r.conforming_points)  // the first mesh is the bare PLC there
+    r.conforming_overhead = double(r.conforming_points) / double(r.nodes - r.conforming_points);
   r.first_mesh_violations = conforming.first_mesh_violations;
   r.delaunay = conforming.delaunay;
   r.violating_tets = conforming.violations.empty() ? 0 : conforming.violations.back();
@@ -70,8 +81,17 @@ std::string format_quality_report(const MeshQualityReport& r) {
       r.shape.total_volume);
   for (const RegionSize& rs : r.regions)
     put("  region %d%s%s: %zu tets, %.6g m^3", rs.id, rs.name.empty() ? "" : " ", rs.name.c_str(), rs.tets, rs.volume);
-  put("Steiner points: %zu by TetGen, %zu for conformity (%.2f%% of the first -O0 mesh's points) in %zu iterations",
-      r.tetgen_steiner_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
+  if (r.thin_layers == 0) {
+    put("Steiner points: %zu by TetGen, %zu for conformity (%.2f%% of the first -O0 mesh's points) in %zu iterations",
+        r.tetgen_steiner_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
+  } else {
+    put("thin layers: %zu, exempt from the quality bounds: %zu tets in them; outside them radius-edge max %.3g, "
+        "%zu tets still over a bound",
+        r.thin_layers, r.thin_layer_tets, r.max_radius_edge_outside_layers, r.quality_unmet);
+    put("Steiner points: %zu by TetGen, %zu by foxi's refinement for quality and size, %zu for conformity (%.2f%% "
+        "of the other points) in %zu iterations",
+        r.tetgen_steiner_points, r.quality_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
+  }
   if (r.delaunay)
     put("delaunay: yes, every circumsphere is empty (exact; the first -O0 mesh had %zu non-Delaunay tets)",
         r.first_mesh_violations);

@@ -9,7 +9,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -163,74 +162,6 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   return r;
 }
 
-// TetGen 1.5.0 lets a callback (tetgenio::tetunsuitable) replace its radius-edge, dihedral and metric
-// tests for a tet (the volume bound is still its own): foxi's callback applies the same three tests
-// except to tets lying in a thin layer, where only the size (longest edge against the metric) is
-// bounded. TetGen's callback takes no user data, and TetGen runs in a forked child of the calling
-// thread, so the rule travels in a thread_local set around the call.
-struct QualityRule {
-  double radius_edge2 = 0;        // squared radius-edge bound; 0: none
-  double cos_min_dihedral = -2;   // cosine of the minimum dihedral angle; < -1: none
-  bool metric = false;            // TetGen -m: each point carries its target size after x, y, z
-  const std::vector<ThinLayer>* layers = nullptr;
-};
-thread_local const QualityRule* t_quality_rule = nullptr;
-
-bool tet_unsuitable(REAL* pa, REAL* pb, REAL* pc, REAL* pd, REAL*, REAL) {
-  const QualityRule& rule = *t_quality_rule;
-  const double a[3] = {pa[0] - pd[0], pa[1] - pd[1], pa[2] - pd[2]};
-  const double b[3] = {pb[0] - pd[0], pb[1] - pd[1], pb[2] - pd[2]};
-  const double c[3] = {pc[0] - pd[0], pc[1] - pd[1], pc[2] - pd[2]};
-  auto cross = [](const double* x, const double* y, double* out) {
-    out[0] = x[1] * y[2] - x[2] * y[1];
-    out[1] = x[2] * y[0] - x[0] * y[2];
-    out[2] = x[0] * y[1] - x[1] * y[0];
-  };
-  auto dot = [](const double* x, const double* y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
-  double bc[3], ca[3], ab[3];
-  cross(b, c, bc);
-  cross(c, a, ca);
-  cross(a, b, ab);
-  const double det = dot(a, bc);
-  if (!(std::abs(det) > 0)) return false;  // TetGen treats flat tets before asking
-  const double la = dot(a, a), lb = dot(b, b), lc = dot(c, c);
-  double off[3];
-  for (int k = 0; k < 3; ++k) off[k] = (la * bc[k] + lb * ca[k] + lc * ab[k]) / (2 * det);
-  const double rd2 = dot(off, off);
-  double e[3][3];
-  for (int k = 0; k < 3; ++k) {
-    e[0][k] = pb[k] - pa[k];
-    e[1][k] = pc[k] - pb[k];
-    e[2][k] = pa[k] - pc[k];
-  }
-  const double edges[6] = {la, lb, lc, dot(e[0], e[0]), dot(e[1], e[1]), dot(e[2], e[2])};
-  const double shortest2 = *std::min_element(edges, edges + 6), longest2 = *std::max_element(edges, edges + 6);
-  bool bad = rule.radius_edge2 > 0 && rd2 > rule.radius_edge2 * shortest2;
-  if (!bad && rule.cos_min_dihedral >= -1) {
-    // Gradients of the barycentric coordinates: the dihedral angle at the edge between the faces
-    // opposite vertices i and j has cosine -g_i . g_j / (|g_i| |g_j|).
-    const double* g[4] = {bc, ca, ab, nullptr};
-    const double gd[3] = {-bc[0] - ca[0] - ab[0], -bc[1] - ca[1] - ab[1], -bc[2] - ca[2] - ab[2]};
-    g[3] = gd;
-    for (int i = 0; i < 4 && !bad; ++i)
-      for (int j = i + 1; j < 4 && !bad; ++j)
-        bad = -dot(g[i], g[j]) > rule.cos_min_dihedral * std::sqrt(dot(g[i], g[i]) * dot(g[j], g[j]));
-  }
-  const REAL* p[4] = {pa, pb, pc, pd};
-  bool in_layer = false;
-  if (bad || rule.metric)
-    for (const ThinLayer& l : *rule.layers)
-      if (l.contains(pa) && l.contains(pb) && l.contains(pc) && l.contains(pd)) {
-        in_layer = true;
-        break;
-      }
-  if (bad && !in_layer) return true;
-  if (rule.metric)
-    for (const REAL* q : p)
-      if (q[3] > 0 && (in_layer ? longest2 : rd2) > q[3] * q[3]) return true;
-  return false;
-}
-
 std::string format_number(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.12g", v);
@@ -330,20 +261,6 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
     for (std::size_t i = 0; i < sf.tet.size(); ++i) background.tetrahedronlist[i] = static_cast<int>(sf.tet[i]);
     sw += "m";
   }
-  std::vector<ThinLayer> layers;
-  if (params.radius_edge > 0 && params.thin_layer_aspect > 0) layers = find_thin_layers(plc, params.thin_layer_aspect);
-  QualityRule rule;
-  if (!layers.empty()) {
-    rule.radius_edge2 = params.radius_edge * params.radius_edge;
-    if (params.min_dihedral > 0) rule.cos_min_dihedral = std::cos(params.min_dihedral * 3.14159265358979323846 / 180);
-    rule.metric = sized;
-    rule.layers = &layers;
-    in.tetunsuitable = &tet_unsuitable;
-  }
-  struct RuleScope {
-    explicit RuleScope(const QualityRule* r) { t_quality_rule = r; }
-    ~RuleScope() { t_quality_rule = nullptr; }
-  } rule_scope(layers.empty() ? nullptr : &rule);
   std::vector<char> switches(sw.begin(), sw.end());
   switches.push_back('\0');
   Result res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress);
@@ -380,10 +297,6 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
     report->switches = sw;
     report->input_points = plc.point_count();
     report->steiner_points = np > plc.point_count() ? np - plc.point_count() : 0;
-    report->thin_layers = layers.size();
-    report->thin_layer_tets = 0;
-    if (!layers.empty())
-      for (std::size_t t = 0; t < nt; ++t) report->thin_layer_tets += tet_in_thin_layer(m, t, layers);
     report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return m;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "foxi/mesher/tetgen_mesher.hpp"
+#include "foxi/mesher/thin_layers.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
 
@@ -27,6 +28,7 @@ namespace foxi {
 
 struct ConformingParams {
   std::size_t max_iterations = 12;  // TetGen runs after the first
+  std::size_t max_layer_iterations = 60;  // with thin layers: refinement rounds (one TetGen run each)
   double max_added_fraction = 0.15; // stop once the points added exceed this fraction of the
                                     // first (-O0) mesh's point count ...
   std::size_t min_added_budget = 100; // ... or this many, whichever is more (small meshes)
@@ -41,6 +43,13 @@ struct ConformingReport {
   std::vector<std::size_t> violations;     // non-Delaunay tets after each TetGen run
   bool delaunay = false;                   // the final mesh passed the exact certificate
   double seconds = 0;                      // all TetGen runs, certificates and splits
+  // Thin layers (thin_layers.hpp; MeshParams::thin_layer_aspect): when the PLC has any, TetGen runs
+  // without its own refinement (which would fill them with tets as wide as they are thick) and foxi
+  // refines for quality and size itself, outside the layers.
+  std::vector<ThinLayer> thin_layers;
+  std::size_t thin_layer_tets = 0;         // tets lying in them (exempt from the quality bounds)
+  std::size_t quality_points = 0;          // points foxi added for quality and size
+  std::size_t quality_unmet = 0;           // tets outside the layers still over a bound at the end
   double certificate_seconds = 0;          // of which the certificates
 };
 

@@ -41,6 +41,11 @@ struct MeshQualityReport {
   std::size_t conforming_points = 0;      // added for the Delaunay property
   double conforming_overhead = 0;         // conforming_points / points of the first -O0 mesh
   std::size_t iterations = 0;
+  // Thin layers (thin_layers.hpp), exempt from the quality bounds; the shape outside them.
+  std::size_t thin_layers = 0, thin_layer_tets = 0;
+  double max_radius_edge_outside_layers = 0;
+  std::size_t quality_points = 0;         // added by foxi's own refinement (thin-layer meshes)
+  std::size_t quality_unmet = 0;          // tets outside the layers still over a bound
   std::size_t first_mesh_violations = 0;
   bool delaunay = false;                  // the exact certificate of the final mesh
   std::size_t violating_tets = 0;

@@ -23,7 +23,8 @@ struct MeshParams {
   double radius_edge = 1.414; // radius-edge bound for quality refinement; 0: no quality refinement
   double min_dihedral = 0;    // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
   // Thin layers at least this many times wider than thick are exempt from the quality bounds
-  // (thin_layers.hpp); 0: no exemption (a thin layer then fills with tets as wide as it is thick).
+  // (thin_layers.hpp) in mesh_conforming, which then refines by itself; 0: no exemption (TetGen's
+  // refinement then fills a thin layer with tets as wide as it is thick). mesh_plc ignores it.
   double thin_layer_aspect = kThinLayerAspect;
   bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
   bool regions = true;        // region seeds give tet regions (TetGen -A)
@@ -39,8 +40,6 @@ struct MeshReport {
   std::string switches;           // the TetGen switches used
   std::size_t input_points = 0;
   std::size_t steiner_points = 0; // points TetGen added
-  std::size_t thin_layers = 0;    // thin layers exempt from the quality bounds
-  std::size_t thin_layer_tets = 0; // tets lying in them
   double seconds = 0;
 };
 
