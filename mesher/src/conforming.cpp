@@ -34,6 +34,7 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   MeshParams p = params;
   p.optimize = false;
   Plc current = plc;
+  detail::weld_coincident_points(current);
   Mesh mesh;
   const std::vector<ThinLayer> layers =
       params.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 || (params.size_field && !params.size_field->empty()) ||
@@ -49,8 +50,18 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   }
   CertificateOptions copt;
   copt.max_listed = std::numeric_limits<std::size_t>::max();
+  Plc previous;
+  Mesh previous_mesh;
   for (std::size_t it = 0;; ++it) {
-    mesh = mesh_plc(current, p, &rep.tetgen);
+    try {
+      mesh = mesh_plc_retrying(current, p, &rep.tetgen);
+    } catch (const MesherError& e) {
+      if (it == 0 || e.tetgen_code() != 2) throw;
+      current = std::move(previous);
+      mesh = std::move(previous_mesh);
+      rep.tetgen_failed = true;
+      break;
+    }
     const auto c0 = std::chrono::steady_clock::now();
     const DelaunayCertificate cert = compute_delaunay_certificate(mesh, copt);
     rep.certificate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
@@ -67,8 +78,10 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     if (params.progress &&
         !params.progress("conforming refinement", double(it + 1) / double(conforming.max_iterations + 1)))
       throw MesherError(-1, "meshing cancelled");
+    previous = current;
     const std::size_t n = split_encroached_constraints(mesh, cert.violating_tets, current);
     if (n == 0) break;
+    previous_mesh = mesh;
     rep.added_points += n;
     rep.iterations = it + 1;
   }

@@ -141,8 +141,18 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
   copt.max_listed = std::numeric_limits<std::size_t>::max();
   rep.thin_layers = layers;
   Mesh mesh;
+  Plc previous;
+  Mesh previous_mesh;
   for (std::size_t it = 0;; ++it) {
-    mesh = mesh_plc(current, p, &rep.tetgen);
+    try {
+      mesh = mesh_plc_retrying(current, p, &rep.tetgen);
+    } catch (const MesherError& e) {
+      if (it == 0 || e.tetgen_code() != 2) throw;
+      current = std::move(previous);
+      mesh = std::move(previous_mesh);
+      rep.tetgen_failed = true;
+      break;
+    }
     const auto c0 = std::chrono::steady_clock::now();
     const DelaunayCertificate cert = compute_delaunay_certificate(mesh, copt);
     rep.certificate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
@@ -208,6 +218,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
             std::abs(dot(n, Vec{l.normal[0], l.normal[1], l.normal[2]})) < (1 - 1e-6) * std::sqrt(norm2(n)))
           side_wall[f] = 1;
     }
+    previous = current;
     EditablePlc edit(current);
     edit.layers = layers;
     NearPoints added(search.vertices.cell);
@@ -267,6 +278,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
     for (const Vec& c : interior) current.points.insert(current.points.end(), c.begin(), c.end());
     const std::size_t n_quality = n_faces + n_layer + interior.size();
     if (n_conform + n_quality == 0) break;
+    previous_mesh = mesh;
     rep.added_points += n_conform;
     rep.quality_points += n_quality;
     rep.iterations = it + 1;

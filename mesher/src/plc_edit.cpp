@@ -58,6 +58,31 @@ std::size_t EditablePlc::facet_at(const Vec& p) const {
   return facets.size();
 }
 
+bool EditablePlc::nearest_facet_edge(std::size_t f, const Vec& p, double within, std::uint32_t& a,
+                                     std::uint32_t& b) const {
+  double best = within * within;
+  bool found = false;
+  for (const auto& poly : facets[f]) {
+    if (poly.size() < 2) continue;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      if (poly.size() == 2 && i == 1) break;
+      const std::uint32_t u = poly[i], v = poly[(i + 1) % poly.size()];
+      const Vec pu = point(u), d = sub(point(v), pu);
+      const double l2 = norm2(d);
+      if (!(l2 > 0)) continue;
+      const double t = std::clamp(dot(sub(p, pu), d) / l2, 0.0, 1.0);
+      const double d2 = norm2(sub(p, add(pu, scale(d, t))));
+      if (d2 < best && t > 0 && t < 1) {
+        best = d2;
+        a = u;
+        b = v;
+        found = true;
+      }
+    }
+  }
+  return found;
+}
+
 bool EditablePlc::insert_surface_point(const Vec& p) {
   std::uint32_t a = 0, b = 0;
   if (find_segment(p, p, a, b)) {
@@ -151,10 +176,78 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
   }
 }
 
+std::size_t weld_coincident_points(Plc& plc, double relative_tol) {
+  const std::size_t n = plc.point_count();
+  if (n == 0) return 0;
+  Vec lo = at(plc.points, 0), hi = lo;
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], plc.points[3 * i + k]);
+      hi[k] = std::max(hi[k], plc.points[3 * i + k]);
+    }
+  const double tol = relative_tol * std::sqrt(norm2(sub(hi, lo)));
+  std::vector<std::uint32_t> order(n), target(n);
+  for (std::uint32_t i = 0; i < n; ++i) order[i] = target[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return plc.points[3 * a] < plc.points[3 * b]; });
+  std::size_t merged = 0;
+  for (std::size_t a = 0; a < n; ++a) {
+    const std::uint32_t i = order[a];
+    if (target[i] != i) continue;
+    for (std::size_t b = a + 1; b < n && plc.points[3 * order[b]] - plc.points[3 * i] <= tol; ++b) {
+      const std::uint32_t j = order[b];
+      if (target[j] == j && norm2(sub(at(plc.points, j), at(plc.points, i))) <= tol * tol) {
+        target[j] = std::min(i, j);
+        target[i] = std::min(i, j);
+        ++merged;
+      }
+    }
+  }
+  if (merged == 0) return 0;
+  for (std::uint32_t i = 0; i < n; ++i)  // chains end at a point that is its own target
+    while (target[target[i]] != target[i]) target[i] = target[target[i]];
+  // Drop the merged points, renumbering the others in order.
+  std::vector<std::uint32_t> renumber(n);
+  std::vector<double> kept;
+  kept.reserve(plc.points.size());
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (target[i] == i) {
+      renumber[i] = static_cast<std::uint32_t>(kept.size() / 3);
+      kept.insert(kept.end(), plc.points.begin() + 3 * std::ptrdiff_t(i), plc.points.begin() + 3 * std::ptrdiff_t(i) + 3);
+    }
+  for (std::uint32_t i = 0; i < n; ++i) target[i] = renumber[target[i]];
+  plc.points = std::move(kept);
+  std::vector<std::uint32_t> begin{0}, vertices;
+  for (std::size_t g = 0; g + 1 < plc.polygon_vertex_begin.size(); ++g) {
+    const std::size_t first = vertices.size();
+    for (std::uint32_t k = plc.polygon_vertex_begin[g]; k < plc.polygon_vertex_begin[g + 1]; ++k) {
+      const std::uint32_t v = target[plc.polygon_vertices[k]];
+      if (vertices.size() > first && vertices.back() == v) continue;
+      vertices.push_back(v);
+    }
+    while (vertices.size() > first + 1 && vertices.back() == vertices[first]) vertices.pop_back();
+    begin.push_back(static_cast<std::uint32_t>(vertices.size()));
+  }
+  plc.polygon_vertices = std::move(vertices);
+  plc.polygon_vertex_begin = std::move(begin);
+  return merged;
+}
+
+Mesh mesh_plc_retrying(const Plc& plc, const MeshParams& params, MeshReport* report) {
+  try {
+    return mesh_plc(plc, params, report);
+  } catch (const MesherError& e) {
+    if (e.tetgen_code() != 2 || params.preserve_surface) throw;  // 2: crashed or internal error
+    MeshParams again = params;
+    again.preserve_surface = true;
+    return mesh_plc(plc, again, report);
+  }
+}
+
 bool NearPoints::near(const Vec& p, double r) const {
   const std::int64_t x0 = cell_of(p[0] - r), x1 = cell_of(p[0] + r), y0 = cell_of(p[1] - r), y1 = cell_of(p[1] + r),
                      z0 = cell_of(p[2] - r), z1 = cell_of(p[2] + r);
-  if ((x1 - x0 + 1) * (y1 - y0 + 1) * (z1 - z0 + 1) > 4096) {  // a huge ball: look at every point
+  const std::int64_t span = std::max({x1 - x0, y1 - y0, z1 - z0}) + 1;
+  if (span > 16) {  // a huge ball: look at every point
     for (const auto& kv : cells_)
       for (const Vec& q : kv.second)
         if (norm2(sub(q, p)) < r * r) return true;
@@ -225,10 +318,20 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       edit.split_segment(a, b, edit.add_point(mid));
       accept(mid);
     } else if (facet < edit.facets.size()) {
-      const Vec c = centre_in_facet ? fb.c : scale(add(add(p[0], p[1]), p[2]), 1.0 / 3);
+      Vec c = centre_in_facet ? fb.c : scale(add(add(p[0], p[1]), p[2]), 1.0 / 3);
+      // A point almost on a segment of its facet makes TetGen's segment recovery fail (it sees the
+      // point on the segment within its own tolerance): such a point splits that subsegment at its
+      // midpoint instead.
+      std::uint32_t a = 0, b = 0;
+      if (edit.nearest_facet_edge(facet, c, 0.05 * size, a, b)) {
+        const Vec mid = scale(add(edit.point(a), edit.point(b)), 0.5);
+        if (added.near(mid, spacing * size)) continue;
+        edit.split_segment(a, b, edit.add_point(mid));
+        accept(mid);
+        continue;
+      }
       if (added.near(c, spacing * size)) continue;
       // A point on some segment of the facet would be a second copy of a segment vertex to TetGen.
-      std::uint32_t a = 0, b = 0;
       const std::uint32_t k = edit.add_point(c);
       if (edit.find_segment(c, c, a, b))
         edit.split_segment(a, b, k);

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/mesher/thin_layers.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
@@ -162,20 +163,39 @@ struct EditablePlc {
   }
 
   // Splits every polygon edge (a, b) or (b, a) with the new point k.
+  // Puts the new point k into every polygon edge that holds it: the edge (a, b) and any longer
+  // edge of another polygon through it (a T-junction in the PLC), so that no facet keeps a segment
+  // with a vertex of the PLC lying inside it.
   void split_segment(std::uint32_t a, std::uint32_t b, std::uint32_t k) {
-    for (auto& polys : facets)
-      for (auto& poly : polys) {
-        if (poly.size() < 2) continue;
-        for (std::size_t i = 0; i < poly.size(); ++i) {
-          const std::size_t j = (i + 1) % poly.size();
-          if (poly.size() == 2 && i == 1) break;
-          if ((poly[i] == a && poly[j] == b) || (poly[i] == b && poly[j] == a)) {
+    const Vec pk = point(k);
+    auto holds = [&](std::uint32_t u, std::uint32_t v) {
+      return ((u == a && v == b) || (u == b && v == a)) ||
+             (u != k && v != k && on_segment(pk, u, v) && norm2(sub(pk, point(u))) > tol * tol &&
+              norm2(sub(pk, point(v))) > tol * tol);
+    };
+    for (auto& polys : facets) {
+      const std::size_t count = polys.size();
+      for (std::size_t g = 0; g < count; ++g) {
+        auto& poly = polys[g];
+        if (poly.size() == 2) {  // a lone segment becomes two (three vertices would be a triangle)
+          if (holds(poly[0], poly[1])) {
+            const std::uint32_t end = poly[1];
+            poly[1] = k;
+            polys.push_back({k, end});
+          }
+          continue;
+        }
+        if (poly.size() < 3) continue;
+        for (std::size_t i = 0; i < poly.size(); ++i)
+          if (holds(poly[i], poly[(i + 1) % poly.size()])) {
             poly.insert(poly.begin() + std::ptrdiff_t(i + 1), k);
             break;
           }
-        }
       }
+    }
   }
+
+
 
   // The facet with marker `marker` whose plane holds the triangle and whose polygons hold its centroid.
   std::size_t find_facet(std::int32_t marker, const Vec& p0, const Vec& p1, const Vec& p2) const {
@@ -215,6 +235,9 @@ struct EditablePlc {
   bool in_facet(std::size_t f, const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p) const;
 
 
+  // The edge (a, b) of one of facet f's polygons nearest to p, if closer than `within` and p projects
+  // inside it.
+  bool nearest_facet_edge(std::size_t f, const Vec& p, double within, std::uint32_t& a, std::uint32_t& b) const;
   // The facet whose plane and polygons hold p, or facets.size().
   std::size_t facet_at(const Vec& p) const;
   // Adds p to the PLC segment that holds it (splitting that segment in every polygon) or else, as a
@@ -287,6 +310,17 @@ struct MeshSearch {
 // triangle lies between the two). Sets split[face] = 1.
 void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::uint32_t>& violating_tets,
                                std::vector<char>& split);
+
+// Merges PLC points closer than `relative_tol` times the PLC's bounding-box diagonal (a builder may
+// emit one corner twice for two parts). The merged copies are removed (points renumbered in order);
+// polygons are remapped and lose repeated consecutive vertices. A segment split by the refinement must be one segment for every
+// polygon that has it, which index-based splitting only sees when shared corners are one point.
+// Returns the number of points merged.
+std::size_t weld_coincident_points(Plc& plc, double relative_tol = 1e-12);
+
+// mesh_plc, and once more with params.preserve_surface if TetGen crashed (TetGen 1.5.0's segment
+// recovery can fail on a refined PLC that it meshes when it adds no points on segments).
+Mesh mesh_plc_retrying(const Plc& plc, const MeshParams& params, MeshReport* report);
 
 // Points added in one refinement pass, for "is there one within r of p" (a hashed uniform grid).
 class NearPoints {

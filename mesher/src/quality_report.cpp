@@ -54,6 +54,7 @@ MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& 
     r.conforming_overhead = double(r.conforming_points) / double(r.nodes - r.conforming_points);
   r.first_mesh_violations = conforming.first_mesh_violations;
   r.delaunay = conforming.delaunay;
+  r.tetgen_failed = conforming.tetgen_failed;
   r.violating_tets = conforming.violations.empty() ? 0 : conforming.violations.back();
   r.mesh_seconds = conforming.seconds;
   r.certificate_seconds = conforming.certificate_seconds;
@@ -98,6 +99,8 @@ std::string format_quality_report(const MeshQualityReport& r) {
   else
     put("delaunay: NO, %zu tets have a vertex inside their circumsphere (the first -O0 mesh had %zu)",
         r.violating_tets, r.first_mesh_violations);
+  if (r.tetgen_failed)
+    put("refinement stopped early: TetGen failed on the refined PLC; this is the last mesh it made");
   put("time: %.3f s meshing and refinement, of which %.3f s certificates", r.mesh_seconds, r.certificate_seconds);
   return s;
 }

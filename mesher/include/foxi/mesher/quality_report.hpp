@@ -48,6 +48,7 @@ struct MeshQualityReport {
   std::size_t quality_unmet = 0;          // tets outside the layers still over a bound
   std::size_t first_mesh_violations = 0;
   bool delaunay = false;                  // the exact certificate of the final mesh
+  bool tetgen_failed = false;             // refinement stopped where TetGen failed (conforming.hpp)
   std::size_t violating_tets = 0;
   double mesh_seconds = 0, certificate_seconds = 0;
 };
