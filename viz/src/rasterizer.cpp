@@ -864,8 +864,8 @@ struct TetRasterizer::Impl {
     return n;
   }
 
-  // Draws tet t's front faces (only face `only_face` when it is 0..3) into the rows of `rows`.
-  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count, int only_face = -1) {
+  // Draws tet t's front faces into the rows of `rows`.
+  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
     TetCorners k;
     if (!load_corners(t, k)) return;
     const double* const* c = k.c;
@@ -884,26 +884,33 @@ struct TetRasterizer::Impl {
       if (!rows.any(int(y0), int(y1))) return;
     }
     PolyVertex poly[4];
-    FaceSetup fs;
     for (int fi = 0; fi < 4; ++fi) {
       const int f = reverse ? 3 - fi : fi;
-      if (only_face >= 0 && f != only_face) continue;
       bool clipped = false;
       const int n = face_polygon(k, f, false, poly, &clipped);
       if (clipped && count) ++stats.faces_clipped;
       if (n == 0) continue;
-      if (use_mask && !clipped) {  // hidden behind what this batch drew already?
-        const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
-                                  std::max({poly[0].X, poly[1].X, poly[2].X}),
-                                  std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
-                                  std::max({poly[0].Y, poly[1].Y, poly[2].Y}), fb.width, fb.height);
-        if (box.x0 > box.x1 || box_written(rows, box, fb.height)) continue;
-      }
       const auto& face = kFace[f];
       const double* v[3] = {c[face[0]], c[face[1]], c[face[2]]};
-      setup_face(fs, t, v, poly, n);
-      raster_polygon(fb, rows, fs, poly, n);
+      draw_face(fb, rows, t, v, poly, n, clipped);
     }
+  }
+
+  // Draws front face polygon `poly` (n vertices, positive area, from face_polygon; `clipped` if the
+  // near plane cut it) of tet t, whose corners are v (camera frame, outward order), into the rows of
+  // `rows`; skipped when the mask shows it hidden.
+  void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
+                 const PolyVertex* poly, int n, bool clipped) {
+    if (use_mask && !clipped) {  // hidden behind what this batch drew already?
+      const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
+                                std::max({poly[0].X, poly[1].X, poly[2].X}),
+                                std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
+                                std::max({poly[0].Y, poly[1].Y, poly[2].Y}), fb.width, fb.height);
+      if (box.x0 > box.x1 || box_written(rows, box, fb.height)) return;
+    }
+    FaceSetup fs;
+    setup_face(fs, t, v, poly, n);
+    raster_polygon(fb, rows, fs, poly, n);
   }
 
   void check_framebuffer(const Framebuffer& fb) const {
@@ -1092,7 +1099,7 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // Calls fn(f, poly, n) for each back face of drawn tet t that covers pixels.
+  // Calls fn(f, poly, n, clipped) for each back face of drawn tet t that covers pixels.
   template <class Fn>
   void for_each_back_face(std::uint32_t t, Fn&& fn) const {
     TetCorners k;
@@ -1101,7 +1108,7 @@ struct TetRasterizer::Impl {
     for (int f = 0; f < 4; ++f) {
       bool clipped = false;
       const int n = face_polygon(k, f, true, poly, &clipped);
-      if (n > 0) fn(f, poly, n);
+      if (n > 0) fn(f, poly, n, clipped);
     }
   }
 
@@ -1134,7 +1141,7 @@ struct TetRasterizer::Impl {
     Lane& lane = lanes[std::size_t(rows.thread)];
     std::vector<std::uint32_t>& saved_pixel = lane.saved_pixel;
     lane.saves.push_back(Save{drawn_at[t], saved_pixel.size()});
-    for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
+    for_each_back_face(t, [&](int f, const PolyVertex* poly, int n, bool) {
       if (earlier_neighbour(t, f) != kNone) return;
       for_each_run(poly, n, rows, [&](int y, int lo, int hi) {
         const std::size_t row = std::size_t(y) * std::size_t(fb.width);
@@ -1204,9 +1211,18 @@ struct TetRasterizer::Impl {
             fb.id[p] = lane.saved_id[j];
           }
         }
-        for_each_back_face(t, [&](int f, const PolyVertex*, int) {
+        for_each_back_face(t, [&](int f, const PolyVertex* poly, int n, bool clipped) {
+          // A back face shared with a tet drawn before the batch is repainted as that tet's front
+          // face: the same polygon (face_polygon), its corners in the neighbour's order for the
+          // shading. One shared with an earlier tet of the batch is already written: that tet, met
+          // before t in this walk, wrote every pixel of its projection in these rows.
           const std::uint32_t nb = earlier_neighbour(t, f);
-          if (nb != kNone) draw_tet(fb, rows, nb >> 2, false, int(nb & 3));  // as the neighbour drew it
+          if (nb == kNone || drawn_at[nb >> 2] >= first) return;
+          const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
+          const auto& face = kFace[nb & 3];
+          const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
+                                &cam[3 * std::size_t(nv[face[2]])]};
+          draw_face(fb, rows, nb >> 2, v, poly, n, clipped);
         });
       }
     };
