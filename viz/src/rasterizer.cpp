@@ -570,70 +570,45 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // Painter mode, one run of pixels [lo, hi] of row y: constant colour except within reach of an
-  // edge line, where each pixel is shaded by shade_pixel (the intervals are widened by a pixel so
-  // that rounding in solving for them never changes a pixel's colour: every pixel gets exactly
-  // shade_pixel's colour, whatever the run).
+  // Painter mode, one run of pixels [lo, hi] of row y: constant colour in the part of the run at
+  // least edge_width from every edge line, each other pixel shaded by face_color. The flat part is
+  // narrowed by a pixel at each end so that rounding in solving for it never changes a pixel's
+  // colour: every pixel gets exactly face_color's colour, whatever the run.
   void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
-    const std::size_t row = std::size_t(y) * std::size_t(fb.width);
-    auto fill = [&](int a, int b) {
-      if (a > b) return;
-      std::fill(fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(a)),
-                fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(b) + 1), fs.color);
-      std::fill(fb.id.begin() + std::ptrdiff_t(row + std::size_t(a)),
-                fb.id.begin() + std::ptrdiff_t(row + std::size_t(b) + 1), fs.tet);
-    };
-    if (fs.lines == 0) {
-      fill(lo, hi);
-      return;
-    }
-    const double sy = y + 0.5, w = params.edge_width;
-    int s[4], e[4], line[4], m = 0;
-    for (int k = 0; k < fs.lines; ++k) {
-      // d(x) = la (x + 0.5) + base; dark where d < w.
-      const double la = fs.la[k], base = fs.lb[k] * sy + fs.lc[k];
-      int a, b;
-      if (std::abs(la) < 1e-6) {
-        if (std::min(la * (lo + 0.5), la * (hi + 0.5)) + base >= w + 1e-3) continue;
-        a = lo;
-        b = hi;
-      } else {
-        const double xc = std::clamp((w - base) / la - 0.5, double(lo) - 4, double(hi) + 4);
-        if (la > 0) {
-          a = lo;
-          b = std::min(hi, int(std::floor(xc)) + 1);
-        } else {
-          a = std::max(lo, int(std::ceil(xc)) - 1);
-          b = hi;
+    std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
+    std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+    int a = lo, b = hi;  // the flat part
+    if (fs.lines != 0) {
+      const double sy = y + 0.5, w = params.edge_width;
+      for (int k = 0; k < fs.lines && a <= b; ++k) {
+        // d(x) = la (x + 0.5) + base >= w beyond xc (la != 0).
+        const double la = fs.la[k], base = fs.lb[k] * sy + fs.lc[k];
+        if (std::abs(la) < 1e-6) {
+          if (std::min(la * (lo + 0.5), la * (hi + 0.5)) + base < w + 1e-3) b = a - 1;
+          continue;
         }
+        const double xc = std::clamp((w - base) / la - 0.5, double(lo) - 4, double(hi) + 4);
+        const int i = int(xc);  // |xc| is small: truncation, then floor or ceiling by one test
+        if (la > 0)
+          a = std::max(a, i - int(double(i) > xc) + 2);
+        else
+          b = std::min(b, i + int(double(i) < xc) - 2);
       }
-      if (a > b) continue;
-      int i = m++;
-      for (; i > 0 && s[i - 1] > a; --i) {
-        s[i] = s[i - 1];
-        e[i] = e[i - 1];
-        line[i] = line[i - 1];
-      }
-      s[i] = a;
-      e[i] = b;
-      line[i] = k;
     }
-    // A pixel outside line k's interval is at least edge_width from it, so the lines whose
-    // intervals hold the pixel give face_color's nearest-line distance whenever it darkens.
-    int x = lo;
-    for (int i = 0; i < m; ++i) {
-      fill(x, s[i] - 1);
-      for (int p = std::max(x, s[i]); p <= e[i]; ++p) {
-        const double sx = p + 0.5;
-        double d = 1e300;
-        for (int j = i; j < m && s[j] <= p; ++j)
-          if (p <= e[j]) d = std::min(d, edge_distance(fs, line[j], sx, sy));
-        fb.rgba[row + std::size_t(p)] = darkened(fs, d);
-        fb.id[row + std::size_t(p)] = fs.tet;
-      }
-      x = std::max(x, e[i] + 1);
+    if (a > b) {  // no flat part
+      a = hi + 1;
+      b = hi;
     }
-    fill(x, hi);
+    for (int x = lo; x < a; ++x) {
+      rgba[x] = face_color(fs, x, y);
+      id[x] = fs.tet;
+    }
+    std::fill(rgba + a, rgba + b + 1, fs.color);
+    std::fill(id + a, id + b + 1, fs.tet);
+    for (int x = std::max(a, b + 1); x <= hi; ++x) {
+      rgba[x] = face_color(fs, x, y);
+      id[x] = fs.tet;
+    }
   }
 
   // Draws a convex polygon (positive area) as a fan from vertex 0.
