@@ -38,10 +38,12 @@ std::int64_t to_fixed(double p) {
       std::llround(std::clamp(p, -4.0 * kMaxPixel, 4.0 * kMaxPixel) * double(kOne)));
 }
 
-// Which rows a thread owns: bands of 16 rows, band b belongs to thread b % count.
+// Which rows a thread owns: bands of 16 rows, band b belongs to thread b % count, and of those only
+// the rows in [lo, hi] (undraw gives each thread one such range, see split_rows).
 struct Rows {
   int thread = 0, count = 1;
-  bool owns(int y) const { return count == 1 || ((y >> kBandShift) % count) == thread; }
+  int lo = 0, hi = std::numeric_limits<int>::max();
+  bool owns(int y) const { return y >= lo && y <= hi && (count == 1 || ((y >> kBandShift) % count) == thread); }
   // The first owned row >= y, and the owned row after the owned row y (one division per band).
   int first(int y) const {
     if (count == 1) return y;
@@ -54,6 +56,8 @@ struct Rows {
   }
   // True if some row in [y0, y1] is owned.
   bool any(int y0, int y1) const {
+    y0 = std::max(y0, lo);
+    y1 = std::min(y1, hi);
     if (count == 1) return y0 <= y1;
     if (y0 > y1) return false;
     int b0 = y0 >> kBandShift, b1 = y1 >> kBandShift;
@@ -76,6 +80,8 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
   std::int64_t x1 = std::min<std::int64_t>(width - 1, floor_div(maxx - kHalf, kOne));
   std::int64_t y0 = std::max<std::int64_t>(0, -floor_div(-(miny - kHalf), kOne));
   std::int64_t y1 = std::min<std::int64_t>(height - 1, floor_div(maxy - kHalf, kOne));
+  y0 = std::max<std::int64_t>(y0, rows.lo);
+  y1 = std::min<std::int64_t>(y1, rows.hi);
   if (x0 > x1 || y0 > y1) return;
   if (!rows.any(int(y0), int(y1))) return;
   // Edge i goes from vertex i to vertex i+1; E_i(p) = (bx - ax)(py - ay) - (by - ay)(px - ax) >= 0
@@ -470,10 +476,10 @@ struct TetRasterizer::Impl {
   // True if every owned pixel of the pixel box b (not empty, y0 >= 0) is already written: nothing
   // drawn inside it can show.
   bool box_written(const Rows& rows, const Box& b, int height) {
-    const int w0 = b.x0 >> 6, w1 = b.x1 >> 6;
-    for (int y = rows.first(b.y0); y <= b.y1;) {
+    const int w0 = b.x0 >> 6, w1 = b.x1 >> 6, y1 = std::min(b.y1, rows.hi);
+    for (int y = rows.first(std::max(b.y0, rows.lo)); y <= y1;) {
       const int band = y >> kBandShift, band_end = std::min(((band + 1) << kBandShift) - 1, height - 1);
-      const int last = std::min(b.y1, band_end);
+      const int last = std::min(y1, band_end);
       std::uint8_t* tiles = &tile_full[std::size_t(band) * std::size_t(mask_words)];
       for (int w = w0; w <= w1; ++w) {
         if (tiles[w]) continue;
@@ -1158,25 +1164,31 @@ struct TetRasterizer::Impl {
     auto find_boxes = [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) boxes[i] = tet_box(history[first + i], fb.width, fb.height);
     };
-    auto work = [&](int k) {
-      const Rows rows{k, lane_count};
-      Lane& lane = lanes[std::size_t(k)];
-      std::size_t save = first_save(lane);
+    // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
+    // undrawn tets' faces there, walked in drawing order.
+    auto work = [&](const std::vector<int>& split, int k) {
+      const Rows rows{0, 1, split[std::size_t(k)], split[std::size_t(k) + 1] - 1};
+      const std::uint32_t p_lo = std::uint32_t(rows.lo) * std::uint32_t(fb.width),
+                          p_hi = std::uint32_t(rows.hi + 1) * std::uint32_t(fb.width);
+      std::vector<std::size_t> save(lanes.size());
+      for (std::size_t l = 0; l < lanes.size(); ++l) save[l] = first_save(lanes[l]);
       constexpr std::size_t kAhead = 8;
       for (std::size_t i = 0; i < count; ++i) {
         if (i + 2 * kAhead < count)
           __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(history[first + i + 2 * kAhead])]);
         if (i + kAhead < count) prefetch_neighbours(history[first + i + kAhead], true);
         const std::uint32_t t = history[first + i];
-        const bool saved = save < lane.saves.size() && lane.saves[save].at == first + i;
-        const std::size_t s = saved ? save++ : 0;
         const Box& b = boxes[i];
-        if (b.x0 > b.x1) continue;
-        if (b.y0 >= 0 && (!rows.any(b.y0, b.y1) || box_written(rows, b, fb.height))) continue;
-        if (saved) {
+        const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || (rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height)));
+        for (std::size_t l = 0; l < lanes.size(); ++l) {
+          const Lane& lane = lanes[l];
+          if (save[l] >= lane.saves.size() || lane.saves[save[l]].at != first + i) continue;
+          const std::size_t s = save[l]++;
+          if (!shows) continue;
           const std::size_t to = save_end(lane, s);
           for (std::size_t j = lane.saves[s].offset; j < to; ++j) {
             const std::uint32_t p = lane.saved_pixel[j];
+            if (p < p_lo || p >= p_hi) continue;
             const std::uint32_t x = p % std::uint32_t(fb.width), y = p / std::uint32_t(fb.width);
             std::uint64_t& word = written[std::size_t(y) * std::size_t(mask_words) + (x >> 6)];
             const std::uint64_t bit = std::uint64_t(1) << (x & 63);
@@ -1186,6 +1198,7 @@ struct TetRasterizer::Impl {
             fb.id[p] = lane.saved_id[j];
           }
         }
+        if (!shows) continue;
         for_each_back_face(t, [&](int f, const PolyVertex* poly, int n, bool clipped) {
           // A back face shared with a tet drawn before the batch is repainted as that tet's front
           // face: the same polygon (face_polygon), its corners in the neighbour's order for the
@@ -1201,17 +1214,18 @@ struct TetRasterizer::Impl {
         });
       }
     };
-    const bool spawn = lane_count > 1 && count >= 256;
-    if (!spawn) {
+    const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
+    if (threads == 1) {
       find_boxes(0, count);
-      for (int k = 0; k < lane_count; ++k) work(k);
+      work({0, fb.height}, 0);
     } else {
       std::thread helper(find_boxes, count / 2, count);
       find_boxes(0, count / 2);
       helper.join();
+      const std::vector<int> split = split_rows(count, threads, fb.height);
       std::vector<std::thread> pool;
-      for (int k = 1; k < lane_count; ++k) pool.emplace_back(work, k);
-      work(0);
+      for (int k = 1; k < threads; ++k) pool.emplace_back(work, std::cref(split), k);
+      work(split, 0);
       for (auto& th : pool) th.join();
     }
     clear_mask(count);
@@ -1226,6 +1240,41 @@ struct TetRasterizer::Impl {
       lane.saved_rgba.resize(lane.saved_pixel.size());
       lane.saved_id.resize(lane.saved_pixel.size());
     }
+  }
+
+  // Row ranges for `parts` threads undrawing the first n boxes: split[k] to split[k + 1] - 1 for
+  // thread k, whole bands of 16 rows (a thread's mask tiles are its own), of about equal work, each
+  // box counting its width plus a per-row cost on each of its rows (a box cut by the near plane,
+  // unknown, counts on none). Contiguous ranges, not interleaved bands: a tet is a few bands tall,
+  // and each thread whose rows it touches pays its setup.
+  std::vector<int> split_rows(std::size_t n, int parts, int height) const {
+    const int bands = (height + (1 << kBandShift) - 1) >> kBandShift;
+    std::vector<double> work(std::size_t(bands) + 1, 0.0);  // per band, as differences
+    constexpr double kRowCost = 16;  // pixels' worth of per-row setup
+    for (std::size_t i = 0; i < n; ++i) {
+      const Box& b = boxes[i];
+      if (b.x0 > b.x1 || b.y0 < 0) continue;
+      const double per_row = double(b.x1 - b.x0 + 1) + kRowCost;
+      // Spread over the bands the box touches, each by its rows in it (as a rate per band).
+      const int b0 = b.y0 >> kBandShift, b1 = b.y1 >> kBandShift;
+      work[std::size_t(b0)] += per_row * double(std::min(b.y1, ((b0 + 1) << kBandShift) - 1) - b.y0 + 1);
+      if (b1 > b0) {
+        work[std::size_t(b1)] += per_row * double(b.y1 - (b1 << kBandShift) + 1);
+        for (int band = b0 + 1; band < b1; ++band) work[std::size_t(band)] += per_row * double(1 << kBandShift);
+      }
+    }
+    double total = 0;
+    for (double w : work) total += w;
+    std::vector<int> split(std::size_t(parts) + 1, height);
+    split[0] = 0;
+    double sum = 0;
+    int k = 1;
+    for (int band = 0; band < bands && k < parts; ++band) {
+      sum += work[std::size_t(band)];
+      while (k < parts && sum >= total * double(k) / double(parts)) split[std::size_t(k++)] = std::min(height, (band + 1) << kBandShift);
+    }
+    for (; k < parts; ++k) split[std::size_t(k)] = height;
+    return split;
   }
 
   // Where save s of a lane's pixels end: saves of one draw() call were filed front to back, so in
