@@ -164,8 +164,14 @@ struct FaceSetup {
   std::uint32_t tet = 0;
   std::uint32_t color = 0;
   float r = 0, g = 0, b = 0;
+  // Mesh edges (up to 4; unused ones never darken): the edge function of edge k at the centre of
+  // pixel (x, y), ea x + eb y + ec, exact in 64 bits (fixed point squared, inside >= 0); times
+  // inv_len it is the distance in pixels. Exact integers make the distance the same bits whether a
+  // span steps along a row or a single pixel evaluates it.
   int lines = 0;
-  double la[4], lb[4], lc[4];  // distance to mesh edge k in pixels = la x + lb y + lc (inside > 0)
+  std::int64_t ea[4], eb[4], ec[4];
+  double inv_len[4];
+  double flat_e[4];  // edge_width / inv_len: a pixel with edge function >= this is not darkened by k
   // Depth mode, per fan triangle: nearness = w0 + da (x - x0) + db (y - y0), interpolated from the
   // snapped vertices so that faces sharing an edge agree on it exactly (up to rounding).
   double x0 = 0, y0 = 0, w0 = 0, da = 0, db = 0;
@@ -419,13 +425,24 @@ struct TetRasterizer::Impl {
         if (!poly[i].mesh_edge) continue;
         const PolyVertex& a = poly[i];
         const PolyVertex& b = poly[i + 1 == n ? 0 : i + 1];
-        double ex = double(b.X - a.X), ey = double(b.Y - a.Y), el = std::sqrt(ex * ex + ey * ey);
+        // E(p) = ex (py - ay) - ey (px - ax) at the pixel centre p = (x, y) kOne + kHalf; |coordinates|
+        // <= 2^30 keep every term below 2^62.
+        const std::int64_t ex = b.X - a.X, ey = b.Y - a.Y;
+        const double el = std::sqrt(double(ex) * double(ex) + double(ey) * double(ey));
         if (!(el > 0)) continue;
-        fs.la[fs.lines] = -ey / el;
-        fs.lb[fs.lines] = ex / el;
-        fs.lc[fs.lines] = (-ex * double(a.Y) + ey * double(a.X)) / (double(kOne) * el);
-        ++fs.lines;
+        const int k = fs.lines++;
+        fs.ea[k] = -ey * kOne;
+        fs.eb[k] = ex * kOne;
+        fs.ec[k] = ex * (kHalf - a.Y) - ey * (kHalf - a.X);
+        fs.inv_len[k] = 1 / (double(kOne) * el);
+        fs.flat_e[k] = params.edge_width / fs.inv_len[k];
       }
+    }
+    for (int k = fs.lines; k < 4; ++k) {  // padding: far from every pixel
+      fs.ea[k] = fs.eb[k] = 0;
+      fs.ec[k] = std::int64_t(1) << 62;
+      fs.inv_len[k] = 1;
+      fs.flat_e[k] = 0;
     }
   }
 
@@ -442,16 +459,15 @@ struct TetRasterizer::Impl {
 
   // The colour of a face at pixel (x, y): flat, darkened near its edges.
   std::uint32_t face_color(const FaceSetup& fs, int x, int y) const {
-    const double sx = x + 0.5, sy = y + 0.5;
-    double d = 1e300;
-    for (int k = 0; k < fs.lines; ++k) d = std::min(d, edge_distance(fs, k, sx, sy));
-    return darkened(fs, d);
+    std::int64_t e[4];
+    for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
+    return darkened(fs, nearest_edge(fs, e));
   }
 
-  // Distance in pixels from pixel centre (sx, sy) to the face's edge line k (one expression, so that
-  // every caller gets the same bits).
-  static double edge_distance(const FaceSetup& fs, int k, double sx, double sy) {
-    return fs.la[k] * sx + fs.lb[k] * sy + fs.lc[k];
+  // The distance in pixels to the nearest edge line from a pixel whose edge functions are e.
+  static double nearest_edge(const FaceSetup& fs, const std::int64_t* e) {
+    return std::min(std::min(double(e[0]) * fs.inv_len[0], double(e[1]) * fs.inv_len[1]),
+                    std::min(double(e[2]) * fs.inv_len[2], double(e[3]) * fs.inv_len[3]));
   }
 
   // The face's colour at distance d from its nearest edge line.
@@ -577,43 +593,63 @@ struct TetRasterizer::Impl {
   }
 
   // Painter mode, one run of pixels [lo, hi] of row y: constant colour in the part of the run at
-  // least edge_width from every edge line, each other pixel shaded by face_color. The flat part is
-  // narrowed by a pixel at each end so that rounding in solving for it never changes a pixel's
-  // colour: every pixel gets exactly face_color's colour, whatever the run.
+  // least edge_width from every edge line, each other pixel shaded as face_color does, stepping the
+  // edge functions along the row. The flat part is solved for in floating point, narrowed by a
+  // pixel, and checked exactly at its ends (the distance to each line is monotone along the row), so
+  // every pixel gets exactly face_color's colour whatever the run.
   void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
     std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
     std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+    if (fs.lines == 0) {
+      std::fill(rgba + lo, rgba + hi + 1, fs.color);
+      std::fill(id + lo, id + hi + 1, fs.tet);
+      return;
+    }
+    std::int64_t e[4];
+    for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * lo + fs.eb[k] * y + fs.ec[k];
     int a = lo, b = hi;  // the flat part
-    if (fs.lines != 0) {
-      const double sy = y + 0.5, w = params.edge_width;
+    if (hi - lo >= 12) {  // short runs: not worth solving for
       for (int k = 0; k < fs.lines && a <= b; ++k) {
-        // d(x) = la (x + 0.5) + base >= w beyond xc (la != 0).
-        const double la = fs.la[k], base = fs.lb[k] * sy + fs.lc[k];
-        if (std::abs(la) < 1e-6) {
-          if (std::min(la * (lo + 0.5), la * (hi + 0.5)) + base < w + 1e-3) b = a - 1;
+        // e_k + ea_k (x - lo) >= flat_e_k beyond x = lo + t.
+        if (fs.ea[k] == 0) {
+          if (double(e[k]) < fs.flat_e[k]) b = a - 1;
           continue;
         }
-        const double xc = std::clamp((w - base) / la - 0.5, double(lo) - 4, double(hi) + 4);
-        const int i = int(xc);  // |xc| is small: truncation, then floor or ceiling by one test
-        if (la > 0)
-          a = std::max(a, i - int(double(i) > xc) + 2);
+        const double t = std::clamp((fs.flat_e[k] - double(e[k])) / double(fs.ea[k]), -4.0, double(hi - lo) + 4);
+        const int i = int(t);  // truncation, then floor or ceiling by one test
+        if (fs.ea[k] > 0)
+          a = std::max(a, lo + i - int(double(i) > t) + 1);
         else
-          b = std::min(b, i + int(double(i) < xc) - 2);
+          b = std::min(b, lo + i + int(double(i) < t) - 1);
       }
+      if (a <= b) {
+        std::int64_t ea[4], eb[4];
+        for (int k = 0; k < 4; ++k) {
+          ea[k] = e[k] + fs.ea[k] * (a - lo);
+          eb[k] = e[k] + fs.ea[k] * (b - lo);
+        }
+        if (!(nearest_edge(fs, ea) >= params.edge_width && nearest_edge(fs, eb) >= params.edge_width)) b = a - 1;
+      }
+    } else {
+      b = a - 1;
     }
     if (a > b) {  // no flat part
       a = hi + 1;
       b = hi;
     }
-    for (int x = lo; x < a; ++x) {
-      rgba[x] = face_color(fs, x, y);
-      id[x] = fs.tet;
-    }
+    auto edge_pixels = [&](int from, int to) {
+      for (int x = from; x <= to; ++x) {
+        rgba[x] = darkened(fs, nearest_edge(fs, e));
+        id[x] = fs.tet;
+        for (int k = 0; k < 4; ++k) e[k] += fs.ea[k];
+      }
+    };
+    edge_pixels(lo, a - 1);
     std::fill(rgba + a, rgba + b + 1, fs.color);
     std::fill(id + a, id + b + 1, fs.tet);
-    for (int x = std::max(a, b + 1); x <= hi; ++x) {
-      rgba[x] = face_color(fs, x, y);
-      id[x] = fs.tet;
+    if (b < hi) {
+      for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
+      edge_pixels(b + 1, hi);
     }
   }
 
