@@ -461,13 +461,14 @@ struct TetRasterizer::Impl {
   std::uint32_t face_color(const FaceSetup& fs, int x, int y) const {
     std::int64_t e[4];
     for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
-    return darkened(fs, nearest_edge(fs, e));
+    return darkened(fs, nearest_edge(fs, e[0], e[1], e[2], e[3]));
   }
 
-  // The distance in pixels to the nearest edge line from a pixel whose edge functions are e.
-  static double nearest_edge(const FaceSetup& fs, const std::int64_t* e) {
-    return std::min(std::min(double(e[0]) * fs.inv_len[0], double(e[1]) * fs.inv_len[1]),
-                    std::min(double(e[2]) * fs.inv_len[2], double(e[3]) * fs.inv_len[3]));
+  // The distance in pixels to the nearest edge line from a pixel whose edge functions are e0..e3.
+  static double nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
+                             std::int64_t e3) {
+    return std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
+                    std::min(double(e2) * fs.inv_len[2], double(e3) * fs.inv_len[3]));
   }
 
   // The face's colour at distance d from its nearest edge line.
@@ -528,6 +529,15 @@ struct TetRasterizer::Impl {
     }
     std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
     const int w0 = lo >> 6, w1 = hi >> 6;
+    const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
+    if (w0 == w1 && (row[w0] & m0 & m1) == 0) {  // a short run, none of it written yet (the common case)
+      if (recording)
+        record_span(fb, fs, y, lo, hi);
+      else
+        shade_span(fb, fs, y, lo, hi);
+      row[w0] |= m0 & m1;
+      return;
+    }
     int x = lo;
     while (x <= hi) {
       // The first unwritten pixel at or after x.
@@ -548,7 +558,6 @@ struct TetRasterizer::Impl {
         shade_span(fb, fs, y, a, b - 1);
       x = b;
     }
-    const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
     if (w0 == w1) {
       row[w0] |= m0 & m1;
     } else {
@@ -628,7 +637,9 @@ struct TetRasterizer::Impl {
           ea[k] = e[k] + fs.ea[k] * (a - lo);
           eb[k] = e[k] + fs.ea[k] * (b - lo);
         }
-        if (!(nearest_edge(fs, ea) >= params.edge_width && nearest_edge(fs, eb) >= params.edge_width)) b = a - 1;
+        if (!(nearest_edge(fs, ea[0], ea[1], ea[2], ea[3]) >= params.edge_width &&
+              nearest_edge(fs, eb[0], eb[1], eb[2], eb[3]) >= params.edge_width))
+          b = a - 1;
       }
     } else {
       b = a - 1;
@@ -637,12 +648,24 @@ struct TetRasterizer::Impl {
       a = hi + 1;
       b = hi;
     }
-    auto edge_pixels = [&](int from, int to) {
+    auto edge_pixels = [&](int from, int to) {  // the edge functions and colours in registers
+      const std::uint32_t tet = fs.tet, color = fs.color;
+      const double w = params.edge_width;
+      std::int64_t e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
+      const std::int64_t s0 = fs.ea[0], s1 = fs.ea[1], s2 = fs.ea[2], s3 = fs.ea[3];
       for (int x = from; x <= to; ++x) {
-        rgba[x] = darkened(fs, nearest_edge(fs, e));
-        id[x] = fs.tet;
-        for (int k = 0; k < 4; ++k) e[k] += fs.ea[k];
+        const double d = nearest_edge(fs, e0, e1, e2, e3);
+        rgba[x] = d < w ? darkened(fs, d) : color;
+        id[x] = tet;
+        e0 += s0;
+        e1 += s1;
+        e2 += s2;
+        e3 += s3;
       }
+      e[0] = e0;
+      e[1] = e1;
+      e[2] = e2;
+      e[3] = e3;
     };
     edge_pixels(lo, a - 1);
     std::fill(rgba + a, rgba + b + 1, fs.color);
