@@ -932,16 +932,16 @@ struct TetRasterizer::Impl {
       if (n == 0) continue;
       const auto& face = kFace[f];
       const double* v[3] = {c[face[0]], c[face[1]], c[face[2]]};
-      draw_face(fb, rows, t, v, poly, n, clipped);
+      draw_face(fb, rows, t, v, poly, n, !clipped);
     }
   }
 
-  // Draws front face polygon `poly` (n vertices, positive area, from face_polygon; `clipped` if the
-  // near plane cut it) of tet t, whose corners are v (camera frame, outward order), into the rows of
-  // `rows`; skipped when the mask shows it hidden.
+  // Draws front face polygon `poly` (n vertices, positive area, from face_polygon) of tet t, whose
+  // corners are v (camera frame, outward order), into the rows of `rows`. test_hidden (a triangle):
+  // first test its pixel box against the mask, skipping it if hidden.
   void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
-                 const PolyVertex* poly, int n, bool clipped) {
-    if (use_mask && !clipped) {  // hidden behind what this batch drew already?
+                 const PolyVertex* poly, int n, bool test_hidden) {
+    if (use_mask && test_hidden) {  // hidden behind what this batch drew already?
       const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
                                 std::max({poly[0].X, poly[1].X, poly[2].X}),
                                 std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
@@ -1139,7 +1139,7 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // Calls fn(f, poly, n, clipped) for each back face of drawn tet t that covers pixels.
+  // Calls fn(f, poly, n) for each back face of drawn tet t that covers pixels.
   template <class Fn>
   void for_each_back_face(std::uint32_t t, Fn&& fn) const {
     TetCorners k;
@@ -1148,7 +1148,7 @@ struct TetRasterizer::Impl {
     for (int f = 0; f < 4; ++f) {
       bool clipped = false;
       const int n = face_polygon(k, f, true, poly, &clipped);
-      if (n > 0) fn(f, poly, n, clipped);
+      if (n > 0) fn(f, poly, n);
     }
   }
 
@@ -1181,7 +1181,7 @@ struct TetRasterizer::Impl {
     Lane& lane = lanes[std::size_t(rows.thread)];
     std::vector<std::uint32_t>& saved_pixel = lane.saved_pixel;
     lane.saves.push_back(Save{drawn_at[t], saved_pixel.size()});
-    for_each_back_face(t, [&](int f, const PolyVertex* poly, int n, bool) {
+    for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
       if (earlier_neighbour(t, f) != kNone) return;
       for_each_run(poly, n, rows, [&](int y, int lo, int hi) {
         const std::size_t row = std::size_t(y) * std::size_t(fb.width);
@@ -1258,7 +1258,7 @@ struct TetRasterizer::Impl {
           }
         }
         if (!shows) continue;
-        for_each_back_face(t, [&](int f, const PolyVertex* poly, int n, bool clipped) {
+        for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
           // A back face shared with a tet drawn before the batch is repainted as that tet's front
           // face: the same polygon (face_polygon), its corners in the neighbour's order for the
           // shading. One shared with an earlier tet of the batch is already written: that tet, met
@@ -1269,7 +1269,7 @@ struct TetRasterizer::Impl {
           const auto& face = kFace[nb & 3];
           const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
                                 &cam[3 * std::size_t(nv[face[2]])]};
-          draw_face(fb, rows, nb >> 2, v, poly, n, clipped);
+          draw_face(fb, rows, nb >> 2, v, poly, n, false);  // seldom hidden: not worth the test
         });
       }
     };
