@@ -699,15 +699,25 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // The pixel box of tet t (see Box): what draw_tet would draw is inside it, and if it is empty,
-  // draw_tet draws and counts nothing.
-  Box tet_box(std::uint32_t t, int width, int height) const {
-    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+  // A tet's corners as `corners` gives them (c may point into local). Filled by load_corners, not
+  // initialized here: it is made for every tet of every batch.
+  struct TetCorners {
+    const std::uint32_t* tv;
     const double* c[4];
     double local[12];
     std::int64_t X[4], Y[4];
     std::uint8_t st[4];
-    corners(tv, c, local, X, Y, st);
+  };  // The pixel box of tet t (see Box): what draw_tet would draw is inside it, and if it is empty,
+  // draw_tet draws and counts nothing.
+  Box tet_box(std::uint32_t t, int width, int height) const {
+    TetCorners k;
+    load_corners(t, k);
+    return tet_box(k, width, height);
+  }
+  // The same from the tet's corners (load_corners).
+  static Box tet_box(const TetCorners& k, int width, int height) {
+    const std::int64_t *X = k.X, *Y = k.Y;
+    const std::uint8_t* st = k.st;
     Box box;
     if (st[0] == 2 || st[1] == 2 || st[2] == 2 || st[3] == 2) return box;
     if (st[0] + st[1] + st[2] + st[3] != 0) {
@@ -780,14 +790,7 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // A tet's corners as `corners` gives them (c may point into local).
-  struct TetCorners {
-    const std::uint32_t* tv = nullptr;
-    const double* c[4] = {};
-    double local[12] = {};
-    std::int64_t X[4] = {}, Y[4] = {};
-    std::uint8_t st[4] = {};
-  };
+
   // Loads tet t's corners into k; false if one of them is not finite (the tet draws nothing).
   bool load_corners(std::uint32_t t, TetCorners& k) const {
     k.tv = &mesh->tet[4 * std::size_t(t)];
@@ -1048,8 +1051,10 @@ struct TetRasterizer::Impl {
           if (i + 2 * kAhead < end) __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
           if (i + kAhead < end) prefetch_neighbours(tets[i + kAhead], false);
         }
-        boxes[i] = tet_box(tets[i], fb.width, fb.height);
-        if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i]);
+        TetCorners k;
+        load_corners(tets[i], k);
+        boxes[i] = tet_box(k, fb.width, fb.height);
+        if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i], k);
       }
     };
     auto draw_one = [&](const Rows& rows, std::size_t i, bool first) {
@@ -1154,10 +1159,8 @@ struct TetRasterizer::Impl {
 
   // Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
   // for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
-  // its projected area (as face_polygon does) without building its polygon.
-  bool has_unshared_back_face(std::uint32_t t) const {
-    TetCorners k;
-    if (!load_corners(t, k)) return false;
+  // its projected area (as face_polygon does) without building its polygon; k: its corners (finite).
+  bool has_unshared_back_face(std::uint32_t t, const TetCorners& k) const {
     const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
     for (int f = 0; f < 4; ++f) {
       bool back;
