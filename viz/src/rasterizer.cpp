@@ -644,10 +644,6 @@ struct TetRasterizer::Impl {
     } else {
       b = a - 1;
     }
-    if (a > b) {  // no flat part
-      a = hi + 1;
-      b = hi;
-    }
     auto edge_pixels = [&](int from, int to) {  // the edge functions and colours in registers
       const std::uint32_t tet = fs.tet, color = fs.color;
       const double w = params.edge_width;
@@ -667,13 +663,15 @@ struct TetRasterizer::Impl {
       e[2] = e2;
       e[3] = e3;
     };
+    if (a > b) {  // no flat part
+      edge_pixels(lo, hi);
+      return;
+    }
     edge_pixels(lo, a - 1);
     std::fill(rgba + a, rgba + b + 1, fs.color);
     std::fill(id + a, id + b + 1, fs.tet);
-    if (b < hi) {
-      for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
-      edge_pixels(b + 1, hi);
-    }
+    for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
+    edge_pixels(b + 1, hi);
   }
 
   // Draws a convex polygon (positive area) as a fan from vertex 0.
