@@ -530,13 +530,17 @@ struct TetRasterizer::Impl {
     std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
     const int w0 = lo >> 6, w1 = hi >> 6;
     const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
-    if (w0 == w1 && (row[w0] & m0 & m1) == 0) {  // a short run, none of it written yet (the common case)
-      if (recording)
-        record_span(fb, fs, y, lo, hi);
-      else
-        shade_span(fb, fs, y, lo, hi);
-      row[w0] |= m0 & m1;
-      return;
+    if (w0 == w1) {  // a short run: none of it written yet, or all of it (the common cases)
+      const std::uint64_t m = m0 & m1, set = row[w0] & m;
+      if (set == m) return;
+      if (set == 0) {
+        if (recording)
+          record_span(fb, fs, y, lo, hi);
+        else
+          shade_span(fb, fs, y, lo, hi);
+        row[w0] |= m;
+        return;
+      }
     }
     int x = lo;
     while (x <= hi) {
