@@ -500,16 +500,14 @@ struct TetRasterizer::Impl {
       std::uint8_t* tiles = &tile_full[std::size_t(band) * std::size_t(mask_words)];
       for (int w = w0; w <= w1; ++w) {
         if (tiles[w]) continue;
-        bool full = true;
-        for (int r = band << kBandShift; r <= band_end && full; ++r)
-          full = written[std::size_t(r) * std::size_t(mask_words) + std::size_t(w)] == ~std::uint64_t(0);
-        if (full) {
-          tiles[w] = 1;
-          continue;
-        }
         const int lo = std::max(b.x0, w << 6), hi = std::min(b.x1, (w << 6) + 63);
         for (int r = y; r <= last; ++r)
           if (!row_written(r, lo, hi)) return false;
+        // The box's part of the tile is written; is all of it (later boxes then skip it)?
+        bool full = true;
+        for (int r = band << kBandShift; r <= band_end && full; ++r)
+          full = written[std::size_t(r) * std::size_t(mask_words) + std::size_t(w)] == ~std::uint64_t(0);
+        if (full) tiles[w] = 1;
       }
       y = rows.first(band_end + 1);
     }
