@@ -761,7 +761,10 @@ struct TetRasterizer::Impl {
     for (int f = 0; f < 4; ++f) {
       if (nb[f] == kNone) continue;
       __builtin_prefetch(&drawn_at[nb[f] >> 2]);
-      if (nodes) __builtin_prefetch(&mesh->tet[4 * std::size_t(nb[f] >> 2)]);
+      if (nodes) {  // and its region, for the colour of the face repainted
+        __builtin_prefetch(&mesh->tet[4 * std::size_t(nb[f] >> 2)]);
+        if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
+      }
     }
   }
 
@@ -1224,7 +1227,12 @@ struct TetRasterizer::Impl {
     };
     boxes.resize(count);
     auto find_boxes = [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) boxes[i] = tet_box(history[first + i], fb.width, fb.height);
+      constexpr std::size_t kAhead = 8;  // the undrawn tets lie all over the mesh's arrays
+      for (std::size_t i = begin; i < end; ++i) {
+        if (i + kAhead < end) prefetch_tet(history[first + i + kAhead]);
+        if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(history[first + i + 2 * kAhead])]);
+        boxes[i] = tet_box(history[first + i], fb.width, fb.height);
+      }
     };
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
