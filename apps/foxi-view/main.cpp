@@ -16,7 +16,7 @@ namespace {
 
 const char* kUsage =
     "foxi-view MESH [--size WxH] [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z]\n"
-    "               [--shrink f] [--save PREFIX] [--script \"COMMANDS\" [--dump-ids]]\n"
+    "               [--shrink f] [--no-undo] [--save PREFIX] [--script \"COMMANDS\" [--dump-ids]]\n"
     "  Opens a window and draws the mesh back to front in the power-function visibility order,\n"
     "  batch by batch, with a status line (tets drawn / total, %, ms for the draw so far, ms per frame).\n"
     "  Mouse: left-drag orbits, right-drag or wheel zooms, middle-drag pans (each redraws).\n"
@@ -26,6 +26,7 @@ const char* kUsage =
     "  s save the picture as PREFIX-NNN.png (default PREFIX foxi-view), q or Escape quit.\n"
     "  Camera options as foxi render (same defaults, so the pictures agree); --size default 800x600.\n"
     "  Meshes that fail the Delaunay certificate are drawn with a depth buffer (MPVO order).\n"
+    "  --no-undo draws without recording what undraw needs (faster drawing; u is refused).\n"
     "  --script runs without a window: whitespace-separated commands\n"
     "     d (draw all)  c (restart, draw nothing)  n (one batch)  f (finish, drawing on)\n"
     "     u (undraw all)  u:N (undraw N tets)  r  b  s\n"
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
   try {
     std::vector<std::string> args(argv + 1, argv + argc);
     std::string mesh_path, size = "800x600", eye, at, up, fov, dir, shrink, save = "foxi-view", script;
-    bool script_mode = false, dump = false;
+    bool script_mode = false, dump = false, no_undo = false;
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string& a = args[i];
       auto value = [&]() -> std::string {
@@ -75,6 +76,8 @@ int main(int argc, char** argv) {
         script_mode = true;
       } else if (a == "--dump-ids") {
         dump = true;
+      } else if (a == "--no-undo") {
+        no_undo = true;
       } else if (a.rfind("-", 0) == 0) {
         throw Usage("unknown option " + a);
       } else if (mesh_path.empty()) {
@@ -98,6 +101,7 @@ int main(int argc, char** argv) {
       height = int(lh);
     }
     foxi::RenderParams params;
+    params.undoable = !no_undo;
     if (!shrink.empty()) {
       char* end = nullptr;
       params.shrink = std::strtod(shrink.c_str(), &end);

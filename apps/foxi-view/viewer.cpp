@@ -81,7 +81,7 @@ Viewer::Viewer(const Mesh& mesh, const Camera& camera, int width, int height, co
   delaunay_ = delaunay_certificate(mesh).delaunay;
   table_ = compute_spheres(mesh);
   params_.depth_buffer = !delaunay_;
-  params_.undoable = delaunay_;  // the painter can undraw
+  params_.undoable = delaunay_ && params.undoable;  // the painter can undraw, if asked to record
   fb_.resize(width_, height_, params_.depth_buffer);
 }
 
@@ -296,7 +296,7 @@ void run_script(Viewer& viewer, const std::string& script, const std::string& pr
       viewer.set_undrawing(false);
       viewer.finish();
     } else if (name == "u") {
-      if (!viewer.set_undrawing(true)) throw std::invalid_argument("script: 'u' needs the painter (a Delaunay mesh)");
+      if (!viewer.set_undrawing(true)) throw std::invalid_argument("script: 'u' needs the painter (a Delaunay mesh) and no --no-undo");
       if (arg.empty()) {
         while (viewer.step()) {
         }

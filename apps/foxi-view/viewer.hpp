@@ -26,7 +26,8 @@ namespace foxi::view {
 class Viewer {
  public:
   // The mesh is lent and must outlive the viewer. Computes the Delaunay certificate and the sphere
-  // table once; nothing is drawn until restart().
+  // table once; nothing is drawn until restart(). params.undoable: the painter records what undraw
+  // needs (false: cheaper drawing, and set_undrawing refuses).
   Viewer(const Mesh& mesh, const Camera& camera, int width, int height, const RenderParams& params = {});
   ~Viewer();
 
@@ -44,7 +45,7 @@ class Viewer {
   void set_running(bool on) { running_ = on; }
   // 'u': undraw (front to back, the seed paper's undraw: each frame equals drawing fewer tets from
   // scratch) or, set to false, draw on again from where the undraw stopped. Returns false (nothing
-  // changes) for meshes drawn with the depth buffer, which cannot undraw.
+  // changes) for meshes drawn with the depth buffer, which cannot undraw, or without undoable.
   bool set_undrawing(bool on);
   bool undrawing() const { return undrawing_; }
   // Undraws up to `count` tets at once (the script's u:N); returns how many.

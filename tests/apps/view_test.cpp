@@ -155,6 +155,27 @@ TEST_F(ViewTest, UndrawEqualsRenderingFewerTets) {
   EXPECT_NE(run_logged(q(view_path()) + " " + q(mesh_path_) + " --script 'u:x'", dir_ / "bad.log", &out), 0);
 }
 
+// --no-undo: the same picture as foxi render (drawing without recording for undraw changes no
+// pixel), and an undraw is refused with a message.
+TEST_F(ViewTest, NoUndoDrawsTheSamePictureAndRefusesUndraw) {
+  std::string out;
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --no-undo --save " + q(dir_ / "n") +
+                           " --script 'd s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  ASSERT_EQ(
+      run_logged(q(test::cli_path()) + " render " + q(mesh_path_) + " " + kSize + " -o " + q(dir_ / "r.png"),
+                 dir_ / "render.log", &out),
+      0)
+      << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "n-001.png"), read_png(dir_ / "r.png")), 0u);
+  EXPECT_NE(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --no-undo --script 'd u'",
+                       dir_ / "undo.log", &out),
+            0);
+  EXPECT_NE(out.find("no --no-undo"), std::string::npos) << out;
+}
+
 TEST_F(ViewTest, RegionOfInterestDrawsExactlyTheSubsetAndBackRestores) {
   std::string out;
   // Draw two batches, save, take them as the region, turn, draw the region, save; back up, draw, save.

@@ -110,6 +110,52 @@ TEST(Undraw, EqualsDrawingFromScratchOnNonConvexMultiMaterial) {
   check_undraw(m, {}, 9, 23, 0.8);  // shrunk tets: no face is shared
 }
 
+// Undraw in batches (walked on 1 to 5 threads over row ranges split by the batch's work, see
+// TetRasterizer::undraw) against undraw one tet at a time and a fresh drawing of what remains, pixel
+// for pixel, colours and ids: batch sizes from 1 to the whole rest, on a convex multi-material mesh,
+// a non-convex subset of it, and views from inside (near-plane clipping). Batches of 256 tets or
+// more take the threaded path.
+TEST(Undraw, BatchesOnThreadsEqualOneTetAtATime) {
+  constexpr int kBigW = 320, kBigH = 240;
+  test::TempDir dir;
+  Mesh m = test::random_delaunay(dir, 900, 83, 2, 1, 1);
+  test::regions_along_x(m, 0.7, 1.3);
+  const SphereTable table = compute_spheres(m);
+  std::vector<std::uint32_t> subset;  // every tet but a band across the middle: non-convex, two pieces
+  for (std::uint32_t t = 0; t < m.tet_count(); ++t)
+    if (m.tet_region[t] != 2) subset.push_back(t);
+  const std::vector<Camera> cams = test::random_cameras(m, 6, 29, double(kBigW) / kBigH);
+  std::size_t threaded = 0;
+  for (std::size_t v = 0; v < cams.size(); ++v) {
+    const auto order = visibility_order(m, table, view_of(cams[v]), v % 2 == 0 ? std::span<const std::uint32_t>{} : subset);
+    const std::span<const std::uint32_t> all(order);
+    const std::size_t j = order.size() / 5;  // undraw down to the back fifth
+    const Framebuffer fresh = render_tets(m, cams[v], kBigW, kBigH, all.first(j));
+    for (int threads : {1, 2, 5}) {
+      for (std::size_t batch : {std::size_t(1), std::size_t(97), std::size_t(300), std::size_t(1400), order.size()}) {
+        if (batch == 1 && threads != 2) continue;  // one tet at a time never spawns threads
+        RenderParams p;
+        p.undoable = true;
+        p.threads = threads;
+        TetRasterizer r(m, cams[v], kBigW, kBigH, p);
+        Framebuffer fb(kBigW, kBigH);
+        r.draw(fb, all);
+        while (r.drawn_tets().size() > j) {
+          const std::size_t s = std::min(batch, r.drawn_tets().size() - j);
+          threaded += s >= 256 && threads > 1;
+          r.undraw(fb, s);
+        }
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < fresh.rgba.size(); ++i)
+          differ += fresh.rgba[i] != fb.rgba[i] || fresh.id[i] != fb.id[i];
+        EXPECT_EQ(differ, 0u) << "view " << v << " threads " << threads << " batch " << batch << " of "
+                              << order.size();
+      }
+    }
+  }
+  EXPECT_GT(threaded, 20u) << "the threaded path should be exercised";
+}
+
 // A convex mesh seen from outside: the unshared back faces met in drawing are the far boundary
 // faces, which cover the silhouette once, so the saved pixels are the picture's covered ones (up to
 // a pixel or two where snapping to fixed point folds a nearly edge-on face over the silhouette).

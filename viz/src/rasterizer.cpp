@@ -38,10 +38,12 @@ std::int64_t to_fixed(double p) {
       std::llround(std::clamp(p, -4.0 * kMaxPixel, 4.0 * kMaxPixel) * double(kOne)));
 }
 
-// Which rows a thread owns: bands of 16 rows, band b belongs to thread b % count.
+// Which rows a thread owns: bands of 16 rows, band b belongs to thread b % count, and of those only
+// the rows in [lo, hi] (undraw gives each thread one such range, see split_rows).
 struct Rows {
   int thread = 0, count = 1;
-  bool owns(int y) const { return count == 1 || ((y >> kBandShift) % count) == thread; }
+  int lo = 0, hi = std::numeric_limits<int>::max();
+  bool owns(int y) const { return y >= lo && y <= hi && (count == 1 || ((y >> kBandShift) % count) == thread); }
   // The first owned row >= y, and the owned row after the owned row y (one division per band).
   int first(int y) const {
     if (count == 1) return y;
@@ -54,6 +56,8 @@ struct Rows {
   }
   // True if some row in [y0, y1] is owned.
   bool any(int y0, int y1) const {
+    y0 = std::max(y0, lo);
+    y1 = std::min(y1, hi);
     if (count == 1) return y0 <= y1;
     if (y0 > y1) return false;
     int b0 = y0 >> kBandShift, b1 = y1 >> kBandShift;
@@ -76,6 +80,8 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
   std::int64_t x1 = std::min<std::int64_t>(width - 1, floor_div(maxx - kHalf, kOne));
   std::int64_t y0 = std::max<std::int64_t>(0, -floor_div(-(miny - kHalf), kOne));
   std::int64_t y1 = std::min<std::int64_t>(height - 1, floor_div(maxy - kHalf, kOne));
+  y0 = std::max<std::int64_t>(y0, rows.lo);
+  y1 = std::min<std::int64_t>(y1, rows.hi);
   if (x0 > x1 || y0 > y1) return;
   if (!rows.any(int(y0), int(y1))) return;
   // Edge i goes from vertex i to vertex i+1; E_i(p) = (bx - ax)(py - ay) - (by - ay)(px - ax) >= 0
@@ -158,8 +164,14 @@ struct FaceSetup {
   std::uint32_t tet = 0;
   std::uint32_t color = 0;
   float r = 0, g = 0, b = 0;
+  // Mesh edges (up to 4; unused ones never darken): the edge function of edge k at the centre of
+  // pixel (x, y), ea x + eb y + ec, exact in 64 bits (fixed point squared, inside >= 0); times
+  // inv_len it is the distance in pixels. Exact integers make the distance the same bits whether a
+  // span steps along a row or a single pixel evaluates it.
   int lines = 0;
-  double la[4], lb[4], lc[4];  // distance to mesh edge k in pixels = la x + lb y + lc (inside > 0)
+  std::int64_t ea[4], eb[4], ec[4];
+  double inv_len[4];
+  double flat_e[4];  // edge_width / inv_len: a pixel with edge function >= this is not darkened by k
   // Depth mode, per fan triangle: nearness = w0 + da (x - x0) + db (y - y0), interpolated from the
   // snapped vertices so that faces sharing an edge agree on it exactly (up to rounding).
   double x0 = 0, y0 = 0, w0 = 0, da = 0, db = 0;
@@ -413,13 +425,24 @@ struct TetRasterizer::Impl {
         if (!poly[i].mesh_edge) continue;
         const PolyVertex& a = poly[i];
         const PolyVertex& b = poly[i + 1 == n ? 0 : i + 1];
-        double ex = double(b.X - a.X), ey = double(b.Y - a.Y), el = std::sqrt(ex * ex + ey * ey);
+        // E(p) = ex (py - ay) - ey (px - ax) at the pixel centre p = (x, y) kOne + kHalf; |coordinates|
+        // <= 2^30 keep every term below 2^62.
+        const std::int64_t ex = b.X - a.X, ey = b.Y - a.Y;
+        const double el = std::sqrt(double(ex) * double(ex) + double(ey) * double(ey));
         if (!(el > 0)) continue;
-        fs.la[fs.lines] = -ey / el;
-        fs.lb[fs.lines] = ex / el;
-        fs.lc[fs.lines] = (-ex * double(a.Y) + ey * double(a.X)) / (double(kOne) * el);
-        ++fs.lines;
+        const int k = fs.lines++;
+        fs.ea[k] = -ey * kOne;
+        fs.eb[k] = ex * kOne;
+        fs.ec[k] = ex * (kHalf - a.Y) - ey * (kHalf - a.X);
+        fs.inv_len[k] = 1 / (double(kOne) * el);
+        fs.flat_e[k] = params.edge_width / fs.inv_len[k];
       }
+    }
+    for (int k = fs.lines; k < 4; ++k) {  // padding: far from every pixel
+      fs.ea[k] = fs.eb[k] = 0;
+      fs.ec[k] = std::int64_t(1) << 62;
+      fs.inv_len[k] = 1;
+      fs.flat_e[k] = 0;
     }
   }
 
@@ -436,16 +459,16 @@ struct TetRasterizer::Impl {
 
   // The colour of a face at pixel (x, y): flat, darkened near its edges.
   std::uint32_t face_color(const FaceSetup& fs, int x, int y) const {
-    const double sx = x + 0.5, sy = y + 0.5;
-    double d = 1e300;
-    for (int k = 0; k < fs.lines; ++k) d = std::min(d, edge_distance(fs, k, sx, sy));
-    return darkened(fs, d);
+    std::int64_t e[4];
+    for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
+    return darkened(fs, nearest_edge(fs, e[0], e[1], e[2], e[3]));
   }
 
-  // Distance in pixels from pixel centre (sx, sy) to the face's edge line k (one expression, so that
-  // every caller gets the same bits).
-  static double edge_distance(const FaceSetup& fs, int k, double sx, double sy) {
-    return fs.la[k] * sx + fs.lb[k] * sy + fs.lc[k];
+  // The distance in pixels to the nearest edge line from a pixel whose edge functions are e0..e3.
+  static double nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
+                             std::int64_t e3) {
+    return std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
+                    std::min(double(e2) * fs.inv_len[2], double(e3) * fs.inv_len[3]));
   }
 
   // The face's colour at distance d from its nearest edge line.
@@ -470,23 +493,21 @@ struct TetRasterizer::Impl {
   // True if every owned pixel of the pixel box b (not empty, y0 >= 0) is already written: nothing
   // drawn inside it can show.
   bool box_written(const Rows& rows, const Box& b, int height) {
-    const int w0 = b.x0 >> 6, w1 = b.x1 >> 6;
-    for (int y = rows.first(b.y0); y <= b.y1;) {
+    const int w0 = b.x0 >> 6, w1 = b.x1 >> 6, y1 = std::min(b.y1, rows.hi);
+    for (int y = rows.first(std::max(b.y0, rows.lo)); y <= y1;) {
       const int band = y >> kBandShift, band_end = std::min(((band + 1) << kBandShift) - 1, height - 1);
-      const int last = std::min(b.y1, band_end);
+      const int last = std::min(y1, band_end);
       std::uint8_t* tiles = &tile_full[std::size_t(band) * std::size_t(mask_words)];
       for (int w = w0; w <= w1; ++w) {
         if (tiles[w]) continue;
-        bool full = true;
-        for (int r = band << kBandShift; r <= band_end && full; ++r)
-          full = written[std::size_t(r) * std::size_t(mask_words) + std::size_t(w)] == ~std::uint64_t(0);
-        if (full) {
-          tiles[w] = 1;
-          continue;
-        }
         const int lo = std::max(b.x0, w << 6), hi = std::min(b.x1, (w << 6) + 63);
         for (int r = y; r <= last; ++r)
           if (!row_written(r, lo, hi)) return false;
+        // The box's part of the tile is written; is all of it (later boxes then skip it)?
+        bool full = true;
+        for (int r = band << kBandShift; r <= band_end && full; ++r)
+          full = written[std::size_t(r) * std::size_t(mask_words) + std::size_t(w)] == ~std::uint64_t(0);
+        if (full) tiles[w] = 1;
       }
       y = rows.first(band_end + 1);
     }
@@ -506,6 +527,19 @@ struct TetRasterizer::Impl {
     }
     std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
     const int w0 = lo >> 6, w1 = hi >> 6;
+    const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
+    if (w0 == w1) {  // a short run: none of it written yet, or all of it (the common cases)
+      const std::uint64_t m = m0 & m1, set = row[w0] & m;
+      if (set == m) return;
+      if (set == 0) {
+        if (recording)
+          record_span(fb, fs, y, lo, hi);
+        else
+          shade_span(fb, fs, y, lo, hi);
+        row[w0] |= m;
+        return;
+      }
+    }
     int x = lo;
     while (x <= hi) {
       // The first unwritten pixel at or after x.
@@ -526,7 +560,6 @@ struct TetRasterizer::Impl {
         shade_span(fb, fs, y, a, b - 1);
       x = b;
     }
-    const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
     if (w0 == w1) {
       row[w0] |= m0 & m1;
     } else {
@@ -570,70 +603,77 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // Painter mode, one run of pixels [lo, hi] of row y: constant colour except within reach of an
-  // edge line, where each pixel is shaded by shade_pixel (the intervals are widened by a pixel so
-  // that rounding in solving for them never changes a pixel's colour: every pixel gets exactly
-  // shade_pixel's colour, whatever the run).
+  // Painter mode, one run of pixels [lo, hi] of row y: constant colour in the part of the run at
+  // least edge_width from every edge line, each other pixel shaded as face_color does, stepping the
+  // edge functions along the row. The flat part is solved for in floating point, narrowed by a
+  // pixel, and checked exactly at its ends (the distance to each line is monotone along the row), so
+  // every pixel gets exactly face_color's colour whatever the run.
   void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
-    const std::size_t row = std::size_t(y) * std::size_t(fb.width);
-    auto fill = [&](int a, int b) {
-      if (a > b) return;
-      std::fill(fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(a)),
-                fb.rgba.begin() + std::ptrdiff_t(row + std::size_t(b) + 1), fs.color);
-      std::fill(fb.id.begin() + std::ptrdiff_t(row + std::size_t(a)),
-                fb.id.begin() + std::ptrdiff_t(row + std::size_t(b) + 1), fs.tet);
-    };
+    std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
+    std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
     if (fs.lines == 0) {
-      fill(lo, hi);
+      std::fill(rgba + lo, rgba + hi + 1, fs.color);
+      std::fill(id + lo, id + hi + 1, fs.tet);
       return;
     }
-    const double sy = y + 0.5, w = params.edge_width;
-    int s[4], e[4], line[4], m = 0;
-    for (int k = 0; k < fs.lines; ++k) {
-      // d(x) = la (x + 0.5) + base; dark where d < w.
-      const double la = fs.la[k], base = fs.lb[k] * sy + fs.lc[k];
-      int a, b;
-      if (std::abs(la) < 1e-6) {
-        if (std::min(la * (lo + 0.5), la * (hi + 0.5)) + base >= w + 1e-3) continue;
-        a = lo;
-        b = hi;
-      } else {
-        const double xc = std::clamp((w - base) / la - 0.5, double(lo) - 4, double(hi) + 4);
-        if (la > 0) {
-          a = lo;
-          b = std::min(hi, int(std::floor(xc)) + 1);
-        } else {
-          a = std::max(lo, int(std::ceil(xc)) - 1);
-          b = hi;
+    std::int64_t e[4];
+    for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * lo + fs.eb[k] * y + fs.ec[k];
+    int a = lo, b = hi;  // the flat part
+    if (hi - lo >= 12) {  // short runs: not worth solving for
+      for (int k = 0; k < fs.lines && a <= b; ++k) {
+        // e_k + ea_k (x - lo) >= flat_e_k beyond x = lo + t.
+        if (fs.ea[k] == 0) {
+          if (double(e[k]) < fs.flat_e[k]) b = a - 1;
+          continue;
         }
+        const double t = std::clamp((fs.flat_e[k] - double(e[k])) / double(fs.ea[k]), -4.0, double(hi - lo) + 4);
+        const int i = int(t);  // truncation, then floor or ceiling by one test
+        if (fs.ea[k] > 0)
+          a = std::max(a, lo + i - int(double(i) > t) + 1);
+        else
+          b = std::min(b, lo + i + int(double(i) < t) - 1);
       }
-      if (a > b) continue;
-      int i = m++;
-      for (; i > 0 && s[i - 1] > a; --i) {
-        s[i] = s[i - 1];
-        e[i] = e[i - 1];
-        line[i] = line[i - 1];
+      if (a <= b) {
+        std::int64_t ea[4], eb[4];
+        for (int k = 0; k < 4; ++k) {
+          ea[k] = e[k] + fs.ea[k] * (a - lo);
+          eb[k] = e[k] + fs.ea[k] * (b - lo);
+        }
+        if (!(nearest_edge(fs, ea[0], ea[1], ea[2], ea[3]) >= params.edge_width &&
+              nearest_edge(fs, eb[0], eb[1], eb[2], eb[3]) >= params.edge_width))
+          b = a - 1;
       }
-      s[i] = a;
-      e[i] = b;
-      line[i] = k;
+    } else {
+      b = a - 1;
     }
-    // A pixel outside line k's interval is at least edge_width from it, so the lines whose
-    // intervals hold the pixel give face_color's nearest-line distance whenever it darkens.
-    int x = lo;
-    for (int i = 0; i < m; ++i) {
-      fill(x, s[i] - 1);
-      for (int p = std::max(x, s[i]); p <= e[i]; ++p) {
-        const double sx = p + 0.5;
-        double d = 1e300;
-        for (int j = i; j < m && s[j] <= p; ++j)
-          if (p <= e[j]) d = std::min(d, edge_distance(fs, line[j], sx, sy));
-        fb.rgba[row + std::size_t(p)] = darkened(fs, d);
-        fb.id[row + std::size_t(p)] = fs.tet;
+    auto edge_pixels = [&](int from, int to) {  // the edge functions and colours in registers
+      const std::uint32_t tet = fs.tet, color = fs.color;
+      const double w = params.edge_width;
+      std::int64_t e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
+      const std::int64_t s0 = fs.ea[0], s1 = fs.ea[1], s2 = fs.ea[2], s3 = fs.ea[3];
+      for (int x = from; x <= to; ++x) {
+        const double d = nearest_edge(fs, e0, e1, e2, e3);
+        rgba[x] = d < w ? darkened(fs, d) : color;
+        id[x] = tet;
+        e0 += s0;
+        e1 += s1;
+        e2 += s2;
+        e3 += s3;
       }
-      x = std::max(x, e[i] + 1);
+      e[0] = e0;
+      e[1] = e1;
+      e[2] = e2;
+      e[3] = e3;
+    };
+    if (a > b) {  // no flat part
+      edge_pixels(lo, hi);
+      return;
     }
-    fill(x, hi);
+    edge_pixels(lo, a - 1);
+    std::fill(rgba + a, rgba + b + 1, fs.color);
+    std::fill(id + a, id + b + 1, fs.tet);
+    for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
+    edge_pixels(b + 1, hi);
   }
 
   // Draws a convex polygon (positive area) as a fan from vertex 0.
@@ -659,15 +699,25 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // The pixel box of tet t (see Box): what draw_tet would draw is inside it, and if it is empty,
-  // draw_tet draws and counts nothing.
-  Box tet_box(std::uint32_t t, int width, int height) const {
-    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+  // A tet's corners as `corners` gives them (c may point into local). Filled by load_corners, not
+  // initialized here: it is made for every tet of every batch.
+  struct TetCorners {
+    const std::uint32_t* tv;
     const double* c[4];
     double local[12];
     std::int64_t X[4], Y[4];
     std::uint8_t st[4];
-    corners(tv, c, local, X, Y, st);
+  };  // The pixel box of tet t (see Box): what draw_tet would draw is inside it, and if it is empty,
+  // draw_tet draws and counts nothing.
+  Box tet_box(std::uint32_t t, int width, int height) const {
+    TetCorners k;
+    load_corners(t, k);
+    return tet_box(k, width, height);
+  }
+  // The same from the tet's corners (load_corners).
+  static Box tet_box(const TetCorners& k, int width, int height) {
+    const std::int64_t *X = k.X, *Y = k.Y;
+    const std::uint8_t* st = k.st;
     Box box;
     if (st[0] == 2 || st[1] == 2 || st[2] == 2 || st[3] == 2) return box;
     if (st[0] + st[1] + st[2] + st[3] != 0) {
@@ -711,7 +761,10 @@ struct TetRasterizer::Impl {
     for (int f = 0; f < 4; ++f) {
       if (nb[f] == kNone) continue;
       __builtin_prefetch(&drawn_at[nb[f] >> 2]);
-      if (nodes) __builtin_prefetch(&mesh->tet[4 * std::size_t(nb[f] >> 2)]);
+      if (nodes) {  // and its region, for the colour of the face repainted
+        __builtin_prefetch(&mesh->tet[4 * std::size_t(nb[f] >> 2)]);
+        if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
+      }
     }
   }
 
@@ -740,14 +793,7 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // A tet's corners as `corners` gives them (c may point into local).
-  struct TetCorners {
-    const std::uint32_t* tv = nullptr;
-    const double* c[4] = {};
-    double local[12] = {};
-    std::int64_t X[4] = {}, Y[4] = {};
-    std::uint8_t st[4] = {};
-  };
+
   // Loads tet t's corners into k; false if one of them is not finite (the tet draws nothing).
   bool load_corners(std::uint32_t t, TetCorners& k) const {
     k.tv = &mesh->tet[4 * std::size_t(t)];
@@ -864,8 +910,8 @@ struct TetRasterizer::Impl {
     return n;
   }
 
-  // Draws tet t's front faces (only face `only_face` when it is 0..3) into the rows of `rows`.
-  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count, int only_face = -1) {
+  // Draws tet t's front faces into the rows of `rows`.
+  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
     TetCorners k;
     if (!load_corners(t, k)) return;
     const double* const* c = k.c;
@@ -884,26 +930,33 @@ struct TetRasterizer::Impl {
       if (!rows.any(int(y0), int(y1))) return;
     }
     PolyVertex poly[4];
-    FaceSetup fs;
     for (int fi = 0; fi < 4; ++fi) {
       const int f = reverse ? 3 - fi : fi;
-      if (only_face >= 0 && f != only_face) continue;
       bool clipped = false;
       const int n = face_polygon(k, f, false, poly, &clipped);
       if (clipped && count) ++stats.faces_clipped;
       if (n == 0) continue;
-      if (use_mask && !clipped) {  // hidden behind what this batch drew already?
-        const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
-                                  std::max({poly[0].X, poly[1].X, poly[2].X}),
-                                  std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
-                                  std::max({poly[0].Y, poly[1].Y, poly[2].Y}), fb.width, fb.height);
-        if (box.x0 > box.x1 || box_written(rows, box, fb.height)) continue;
-      }
       const auto& face = kFace[f];
       const double* v[3] = {c[face[0]], c[face[1]], c[face[2]]};
-      setup_face(fs, t, v, poly, n);
-      raster_polygon(fb, rows, fs, poly, n);
+      draw_face(fb, rows, t, v, poly, n, !clipped);
     }
+  }
+
+  // Draws front face polygon `poly` (n vertices, positive area, from face_polygon) of tet t, whose
+  // corners are v (camera frame, outward order), into the rows of `rows`. test_hidden (a triangle):
+  // first test its pixel box against the mask, skipping it if hidden.
+  void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
+                 const PolyVertex* poly, int n, bool test_hidden) {
+    if (use_mask && test_hidden) {  // hidden behind what this batch drew already?
+      const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
+                                std::max({poly[0].X, poly[1].X, poly[2].X}),
+                                std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
+                                std::max({poly[0].Y, poly[1].Y, poly[2].Y}), fb.width, fb.height);
+      if (box.x0 > box.x1 || box_written(rows, box, fb.height)) return;
+    }
+    FaceSetup fs;
+    setup_face(fs, t, v, poly, n);
+    raster_polygon(fb, rows, fs, poly, n);
   }
 
   void check_framebuffer(const Framebuffer& fb) const {
@@ -1001,8 +1054,10 @@ struct TetRasterizer::Impl {
           if (i + 2 * kAhead < end) __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
           if (i + kAhead < end) prefetch_neighbours(tets[i + kAhead], false);
         }
-        boxes[i] = tet_box(tets[i], fb.width, fb.height);
-        if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i]);
+        TetCorners k;
+        load_corners(tets[i], k);
+        boxes[i] = tet_box(k, fb.width, fb.height);
+        if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i], k);
       }
     };
     auto draw_one = [&](const Rows& rows, std::size_t i, bool first) {
@@ -1107,10 +1162,8 @@ struct TetRasterizer::Impl {
 
   // Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
   // for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
-  // its projected area (as face_polygon does) without building its polygon.
-  bool has_unshared_back_face(std::uint32_t t) const {
-    TetCorners k;
-    if (!load_corners(t, k)) return false;
+  // its projected area (as face_polygon does) without building its polygon; k: its corners (finite).
+  bool has_unshared_back_face(std::uint32_t t, const TetCorners& k) const {
     const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
     for (int f = 0; f < 4; ++f) {
       bool back;
@@ -1174,27 +1227,38 @@ struct TetRasterizer::Impl {
     };
     boxes.resize(count);
     auto find_boxes = [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) boxes[i] = tet_box(history[first + i], fb.width, fb.height);
+      constexpr std::size_t kAhead = 8;  // the undrawn tets lie all over the mesh's arrays
+      for (std::size_t i = begin; i < end; ++i) {
+        if (i + kAhead < end) prefetch_tet(history[first + i + kAhead]);
+        if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(history[first + i + 2 * kAhead])]);
+        boxes[i] = tet_box(history[first + i], fb.width, fb.height);
+      }
     };
-    auto work = [&](int k) {
-      const Rows rows{k, lane_count};
-      Lane& lane = lanes[std::size_t(k)];
-      std::size_t save = first_save(lane);
+    // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
+    // undrawn tets' faces there, walked in drawing order.
+    auto work = [&](const std::vector<int>& split, int k) {
+      const Rows rows{0, 1, split[std::size_t(k)], split[std::size_t(k) + 1] - 1};
+      const std::uint32_t p_lo = std::uint32_t(rows.lo) * std::uint32_t(fb.width),
+                          p_hi = std::uint32_t(rows.hi + 1) * std::uint32_t(fb.width);
+      std::vector<std::size_t> save(lanes.size());
+      for (std::size_t l = 0; l < lanes.size(); ++l) save[l] = first_save(lanes[l]);
       constexpr std::size_t kAhead = 8;
       for (std::size_t i = 0; i < count; ++i) {
         if (i + 2 * kAhead < count)
           __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(history[first + i + 2 * kAhead])]);
         if (i + kAhead < count) prefetch_neighbours(history[first + i + kAhead], true);
         const std::uint32_t t = history[first + i];
-        const bool saved = save < lane.saves.size() && lane.saves[save].at == first + i;
-        const std::size_t s = saved ? save++ : 0;
         const Box& b = boxes[i];
-        if (b.x0 > b.x1) continue;
-        if (b.y0 >= 0 && (!rows.any(b.y0, b.y1) || box_written(rows, b, fb.height))) continue;
-        if (saved) {
+        const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || (rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height)));
+        for (std::size_t l = 0; l < lanes.size(); ++l) {
+          const Lane& lane = lanes[l];
+          if (save[l] >= lane.saves.size() || lane.saves[save[l]].at != first + i) continue;
+          const std::size_t s = save[l]++;
+          if (!shows) continue;
           const std::size_t to = save_end(lane, s);
           for (std::size_t j = lane.saves[s].offset; j < to; ++j) {
             const std::uint32_t p = lane.saved_pixel[j];
+            if (p < p_lo || p >= p_hi) continue;
             const std::uint32_t x = p % std::uint32_t(fb.width), y = p / std::uint32_t(fb.width);
             std::uint64_t& word = written[std::size_t(y) * std::size_t(mask_words) + (x >> 6)];
             const std::uint64_t bit = std::uint64_t(1) << (x & 63);
@@ -1204,23 +1268,34 @@ struct TetRasterizer::Impl {
             fb.id[p] = lane.saved_id[j];
           }
         }
-        for_each_back_face(t, [&](int f, const PolyVertex*, int) {
+        if (!shows) continue;
+        for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
+          // A back face shared with a tet drawn before the batch is repainted as that tet's front
+          // face: the same polygon (face_polygon), its corners in the neighbour's order for the
+          // shading. One shared with an earlier tet of the batch is already written: that tet, met
+          // before t in this walk, wrote every pixel of its projection in these rows.
           const std::uint32_t nb = earlier_neighbour(t, f);
-          if (nb != kNone) draw_tet(fb, rows, nb >> 2, false, int(nb & 3));  // as the neighbour drew it
+          if (nb == kNone || drawn_at[nb >> 2] >= first) return;
+          const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
+          const auto& face = kFace[nb & 3];
+          const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
+                                &cam[3 * std::size_t(nv[face[2]])]};
+          draw_face(fb, rows, nb >> 2, v, poly, n, false);  // seldom hidden: not worth the test
         });
       }
     };
-    const bool spawn = lane_count > 1 && count >= 256;
-    if (!spawn) {
+    const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
+    if (threads == 1) {
       find_boxes(0, count);
-      for (int k = 0; k < lane_count; ++k) work(k);
+      work({0, fb.height}, 0);
     } else {
       std::thread helper(find_boxes, count / 2, count);
       find_boxes(0, count / 2);
       helper.join();
+      const std::vector<int> split = split_rows(count, threads, fb.height);
       std::vector<std::thread> pool;
-      for (int k = 1; k < lane_count; ++k) pool.emplace_back(work, k);
-      work(0);
+      for (int k = 1; k < threads; ++k) pool.emplace_back(work, std::cref(split), k);
+      work(split, 0);
       for (auto& th : pool) th.join();
     }
     clear_mask(count);
@@ -1235,6 +1310,41 @@ struct TetRasterizer::Impl {
       lane.saved_rgba.resize(lane.saved_pixel.size());
       lane.saved_id.resize(lane.saved_pixel.size());
     }
+  }
+
+  // Row ranges for `parts` threads undrawing the first n boxes: split[k] to split[k + 1] - 1 for
+  // thread k, whole bands of 16 rows (a thread's mask tiles are its own), of about equal work, each
+  // box counting its width plus a per-row cost on each of its rows (a box cut by the near plane,
+  // unknown, counts on none). Contiguous ranges, not interleaved bands: a tet is a few bands tall,
+  // and each thread whose rows it touches pays its setup.
+  std::vector<int> split_rows(std::size_t n, int parts, int height) const {
+    const int bands = (height + (1 << kBandShift) - 1) >> kBandShift;
+    std::vector<double> work(std::size_t(bands) + 1, 0.0);  // per band, as differences
+    constexpr double kRowCost = 16;  // pixels' worth of per-row setup
+    for (std::size_t i = 0; i < n; ++i) {
+      const Box& b = boxes[i];
+      if (b.x0 > b.x1 || b.y0 < 0) continue;
+      const double per_row = double(b.x1 - b.x0 + 1) + kRowCost;
+      // Spread over the bands the box touches, each by its rows in it (as a rate per band).
+      const int b0 = b.y0 >> kBandShift, b1 = b.y1 >> kBandShift;
+      work[std::size_t(b0)] += per_row * double(std::min(b.y1, ((b0 + 1) << kBandShift) - 1) - b.y0 + 1);
+      if (b1 > b0) {
+        work[std::size_t(b1)] += per_row * double(b.y1 - (b1 << kBandShift) + 1);
+        for (int band = b0 + 1; band < b1; ++band) work[std::size_t(band)] += per_row * double(1 << kBandShift);
+      }
+    }
+    double total = 0;
+    for (double w : work) total += w;
+    std::vector<int> split(std::size_t(parts) + 1, height);
+    split[0] = 0;
+    double sum = 0;
+    int k = 1;
+    for (int band = 0; band < bands && k < parts; ++band) {
+      sum += work[std::size_t(band)];
+      while (k < parts && sum >= total * double(k) / double(parts)) split[std::size_t(k++)] = std::min(height, (band + 1) << kBandShift);
+    }
+    for (; k < parts; ++k) split[std::size_t(k)] = height;
+    return split;
   }
 
   // Where save s of a lane's pixels end: saves of one draw() call were filed front to back, so in

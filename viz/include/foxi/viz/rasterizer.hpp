@@ -68,18 +68,18 @@ class TetRasterizer {
   // with the next batch of an order (progressive drawing). Tet indices must be < tet_count.
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
 
-  // Undoable mode (RenderParams::undoable; the seed paper's undrawing, section 6.2). draw() keeps the
-  // tets drawn so far (each tet at most once, else std::invalid_argument) and saves, for each tet
-  // with a back face not shared with an earlier-drawn tet (mesh boundary, subset boundary, shrunk
-  // tets), the pixels that face covers as they were just before the tet was drawn. It walks each
-  // batch front to back like the painter (on its threads, each keeping the saved pixels of its own
-  // bands of rows), the saved values being filled in by the farther tets met later in the walk. undraw(fb, k) takes back the last k drawn tets: each tet's
-  // back faces are repainted as the earlier neighbour's front face, or restored from its saved
-  // pixels; the k tets are walked back to front writing each pixel once (the farthest undrawn tet
-  // over a pixel decides it), each thread in its bands. For a visibility order, fb (colours and ids) is then pixel for pixel
-  // the picture of the remaining tets drawn from scratch; fb must not be changed in between. Cost
-  // is proportional to the undrawn tets' pixels, not to the mesh. Throws std::logic_error if not
-  // undoable, std::out_of_range if k exceeds the tets drawn.
+  // Undoable mode (RenderParams::undoable; the seed paper's undrawing, section 6.2). draw() keeps the tets
+  // drawn so far (each tet at most once, else std::invalid_argument) and saves, for each tet with a back
+  // face not shared with an earlier-drawn tet (mesh boundary, subset boundary, shrunk tets), the pixels that
+  // face covers as they were just before the tet was drawn. It walks each batch front to back like the
+  // painter (on its threads, each keeping the saved pixels of its own bands of rows), the saved values being
+  // filled in by the farther tets met later in the walk. undraw(fb, k) takes back the last k drawn tets:
+  // each tet's back faces are repainted as the earlier neighbour's front face, or restored from its saved
+  // pixels; the k tets are walked back to front writing each pixel once (the farthest undrawn tet over a
+  // pixel decides it), each thread in its own range of rows (batches of 256 tets or more). For a visibility
+  // order, fb (colours and ids) is then pixel for pixel the picture of the remaining tets drawn from
+  // scratch; fb must not be changed in between. Cost is proportional to the undrawn tets' pixels, not to the
+  // mesh. Throws std::logic_error if not undoable, std::out_of_range if k exceeds the tets drawn.
   void undraw(Framebuffer& fb, std::size_t count);
   std::span<const std::uint32_t> drawn_tets() const;  // undoable: the tets drawn, in order
   std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
