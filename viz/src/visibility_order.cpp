@@ -8,10 +8,11 @@
 #include <limits>
 #include <mutex>
 #include <queue>
-#include <thread>
+#include <future>
 
 #include "exact.hpp"
 #include "foxi/model/adjacency.hpp"
+#include "thread_pool.hpp"
 
 namespace foxi {
 
@@ -28,10 +29,8 @@ void parallel_for(std::size_t n, F f) {
     f(std::size_t{0}, n, 0);
     return;
   }
-  std::size_t half = n / 2;
-  std::thread other([&] { f(half, n, 1); });
-  f(std::size_t{0}, half, 0);
-  other.join();
+  const std::size_t half = n / 2;
+  pool::on_two_cores([&](int part) { part == 0 ? f(std::size_t{0}, half, 0) : f(half, n, 1); });
 }
 
 const double* node(const Mesh& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
@@ -141,6 +140,14 @@ struct ProgressiveOrder::Impl {
   }
 
   bool tet_in(std::uint32_t t) const { return in_subset.empty() || in_subset[t]; }
+  // Per cluster, its tets in the subset (empty when the whole mesh is ordered).
+  std::vector<std::uint32_t> cluster_in;
+  // The tets an item stands for in this order.
+  std::uint32_t tets_of(std::uint32_t item) const {
+    if (!(item & kClusterBit)) return 1;
+    const std::uint32_t k = item & ~kClusterBit;
+    return cluster_in.empty() ? table->cluster_begin[k + 1] - table->cluster_begin[k] : cluster_in[k];
+  }
 
   // The view's keys in the table's local frame: key = s - c.(2 eye) (perspective) or c.dir, drawn
   // in increasing sign * key; an item's lo is sign * key - its radius.
@@ -190,7 +197,7 @@ struct ProgressiveOrder::Impl {
 
   // The progressive path sorts ahead on a second thread (started by the first next()), so that the
   // caller can draw one batch while the next buckets are being sorted.
-  std::thread worker;
+  std::future<void> worker;                 // valid while the sorting ahead runs or has not been waited for
   std::mutex mu;
   std::condition_variable cv;
   std::deque<std::vector<std::uint32_t>> ready;
@@ -199,9 +206,9 @@ struct ProgressiveOrder::Impl {
   void run_worker();
 
   ~Impl() {
-    if (worker.joinable()) {
+    if (worker.valid()) {
       stop = true;
-      worker.join();
+      worker.wait();
     }
     // Hand the big buffer back for the next view on this thread. (A buffer the worker thread made
     // is the same memory; the thread_local slot is this thread's.)
@@ -231,12 +238,17 @@ struct ProgressiveOrder::Impl {
   }
   void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
-  void expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc);
-  // Hands out buckets [first, last) into out (sorting, tie fix-up, cluster expansion); returns the
-  // next bucket not consumed: a run of joined entries may take in buckets from `last` up to `limit`.
-  // With no clusters, `direct` (if given) receives the tets at their entries' places instead.
+  // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
+  void expand(std::uint32_t item, std::uint32_t*& o, Scratch& sc);
+  // Hands out buckets [first, last) (sorting, tie fix-up, cluster expansion), appended to out, or if
+  // `direct` is given, written at their places in the whole order (direct + tet_begin[bucket]);
+  // returns the next bucket not consumed: a run of joined entries may take in buckets from `last`
+  // up to `limit`.
   std::size_t emit_buckets(std::size_t first, std::size_t last, std::size_t limit, std::vector<std::uint32_t>& out,
                            Scratch& sc, std::uint32_t* direct = nullptr);
+  // Per first-level bucket, the number of tets before it in the order (size buckets + 1): the
+  // same as bucket_begin when no item is a cluster.
+  std::vector<std::uint32_t> tet_begin;
 };
 
 void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
@@ -256,15 +268,14 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     total_tets = n;
   } else {
     if (t.cluster_count() > 0) in_subset.assign(n, 0);
-    std::vector<std::uint8_t> cluster_seen(t.cluster_count(), 0);
+    cluster_in.assign(t.cluster_count(), 0);
     own_items.reserve(subset.size());
     for (std::uint32_t tet : subset) {
       if (!in_subset.empty()) in_subset[tet] = 1;
       std::uint32_t k = t.cluster_of.empty() ? kNone : t.cluster_of[tet];
       std::uint32_t item = tet, rep = tet;
       if (k != kNone) {
-        if (cluster_seen[k]) continue;
-        cluster_seen[k] = 1;
+        if (cluster_in[k]++ > 0) continue;
         item = k | kClusterBit;
         rep = t.cluster_tets[t.cluster_begin[k]];
       }
@@ -290,6 +301,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   stats.wide_items = wide_items.size();
   if (m == 0) {
     bucket_begin.assign(1, 0);
+    tet_begin.assign(1, 0);
     return;
   }
 
@@ -347,6 +359,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   keyed.swap(t_workspace.keyed);
   if (keyed.size() < m) keyed.resize(m);
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
+  // With clusters, the tets per bucket too (an item stands for one or more tets), so that every
+  // bucket's tets can be written at their final places.
+  std::vector<std::uint32_t> thist[2];
+  if (!t_cluster_free) thist[0].assign(nb, 0), thist[1].assign(nb, 0);
   // Tight loops over the ordinary items, on locals (the stores to the histogram could alias anything
   // reached through a reference).
   const std::uint32_t* rep_p = reps.data();
@@ -358,13 +374,16 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
                p2 = perspective ? eye2[2] : dir[2];
   const double shift_lo = double(bound), sgn = sign, qmin = q_min, qscale = q_scale;
   const bool persp_view = perspective;
-  auto key_pass = [=, &hist](std::size_t b, std::size_t e, int part) {
+  auto key_pass_of = [=, this, &hist, &thist](auto with_tets) {
+   return [=, this, &hist, &thist](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
-    auto put = [=](std::size_t i, double lo) {
+    std::uint32_t* thp = thist[part].data();
+    auto put = [=, this](std::size_t i, double lo) {
       const double x = (lo - qmin) * qscale;
       const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
       keyed_p[i] = (Packed(q) << 32) | item_p[i];
       ++hp[q >> shift];
+      if constexpr (decltype(with_tets)::value) thp[q >> shift] += tets_of(item_p[i]);
     };
     if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
@@ -378,8 +397,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo);
       }
     }
+   };
   };
-  parallel_for(m_main, key_pass);
+  if (t_cluster_free) parallel_for(m_main, key_pass_of(std::false_type{}));
+  else parallel_for(m_main, key_pass_of(std::true_type{}));
   // The wide items (few) go with the second part, and each makes a zone of joined q values.
   const std::size_t split = m_main < 50000 ? m : m_main / 2;  // as parallel_for splits
   const int wide_part = split == m ? 0 : 1;
@@ -391,6 +412,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     const std::uint32_t q = quantise(lo);
     keyed_p[i] = (Packed(q) << 32) | wide_items[i - m_main];
     ++hist[wide_part][q >> shift];
+    if (!t_cluster_free) thist[wide_part][q >> shift] += tets_of(wide_items[i - m_main]);
     // Whatever overlaps [lo, lo + 2r] has its lo in [lo - 2 bound, lo + 2r] (ordinary items), or
     // its own zone meets this one (wide items).
     const std::uint64_t za = quantise(lo - 2.0 * double(bound)), zb = quantise(lo + 2.0 * double(r));
@@ -419,6 +441,15 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     acc += hist[1][b];
   }
   bucket_begin[nb] = acc;
+  if (!t_cluster_free) {
+    tet_begin.assign(nb + 1, 0);
+    std::uint32_t tets = 0;
+    for (std::size_t b = 0; b < nb; ++b) {
+      tet_begin[b] = tets;
+      tets += thist[0][b] + thist[1][b];
+    }
+    tet_begin[nb] = tets;
+  }
   scatter_start[0].swap(start0);
   scatter_start[1].swap(start1);
   scatter_split = split;
@@ -454,9 +485,10 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
   if (split == m) {
     run(0, m, scatter_start[0].data());
   } else {
-    std::thread other([&] { run(split, m, scatter_start[1].data()); });
-    run(0, split, scatter_start[0].data());
-    other.join();
+    pool::on_two_cores([&](int part) {
+      if (part == 0) run(0, split, scatter_start[0].data());
+      else run(split, m, scatter_start[1].data());
+    });
   }
   if (to < nb) return;
   const SphereTable& t = *table;
@@ -584,13 +616,13 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
 }
 
 // Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
-void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_t>& out, Scratch& sc) {
+void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scratch& sc) {
   auto& local_tets = sc.local_tets;
   auto& local_indeg = sc.local_indeg;
   auto& local_queue = sc.local_queue;
   auto& local_edges = sc.local_edges;
   if (!(item & kClusterBit)) {
-    out.push_back(item);
+    *o++ = item;
     return;
   }
   const SphereTable& t = *table;
@@ -650,7 +682,7 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_
           }
       }
       emitted |= std::uint64_t(1) << pick;
-      out.push_back(t.cluster_tets[cb + pick]);
+      *o++ = t.cluster_tets[cb + pick];
     }
     return;
   }
@@ -658,7 +690,7 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_
   for (std::uint32_t i = t.cluster_begin[k]; i < t.cluster_begin[k + 1]; ++i)
     if (tet_in(t.cluster_tets[i])) local_tets.push_back(t.cluster_tets[i]);
   if (local_tets.size() == 1) {
-    out.push_back(local_tets[0]);
+    *o++ = local_tets[0];
     return;
   }
   auto local_index = [&](std::uint32_t tet) -> std::uint32_t {
@@ -702,7 +734,7 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::vector<std::uint32_
     if (done[x]) continue;
     done[x] = 1;
     ++emitted;
-    out.push_back(local_tets[x]);
+    *o++ = local_tets[x];
     for (auto& e : local_edges)
       if (e.first == x && !done[e.second] && --local_indeg[e.second] == 0) local_queue.push_back(e.second);
   }
@@ -726,6 +758,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
                                                  std::vector<std::uint32_t>& out, Scratch& sc, std::uint32_t* direct) {
   std::size_t b = first;
   while (b < last) {
+    const std::size_t group = b;  // the first bucket of this group
     const std::size_t begin = bucket_begin[b];
     std::size_t end = bucket_begin[b + 1];
     ++b;
@@ -746,18 +779,19 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       end = nb_end;
       ++b;
     }
+    const std::uint32_t* tb = t_cluster_free ? bucket_begin.data() : tet_begin.data();
+    std::uint32_t* o = direct + tb[group];
+    if (direct == nullptr) {
+      const std::size_t at = out.size();
+      out.resize(at + (tb[b] - tb[group]));
+      o = out.data() + at;
+    }
     if (t_cluster_free) {
-      std::uint32_t* o = direct + begin;
-      if (direct == nullptr) {
-        const std::size_t at = out.size();
-        out.resize(at + (end - begin));
-        o = out.data() + at;
-      }
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
       scan_runs(begin, end, sc, [&](std::uint32_t item) {
-        if (item & kClusterBit) expand(item, out, sc);
-        else out.push_back(item);
+        if (item & kClusterBit) expand(item, o, sc);
+        else *o++ = item;
       });
     }
   }
@@ -826,7 +860,7 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
       d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch);
     d.add_counts(d.scratch);
   } else {
-    if (!d.worker.joinable() && !d.worker_done) d.worker = std::thread([&d] { d.run_worker(); });
+    if (!d.worker.valid() && !d.worker_done) d.worker = pool::run_async([&d] { d.run_worker(); });
     std::unique_lock<std::mutex> lock(d.mu);
     d.cv.wait(lock, [&d] { return !d.ready.empty() || d.worker_done; });
     if (!d.ready.empty()) {
@@ -835,7 +869,7 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
     }
     if (d.ready.empty() && d.worker_done) {
       lock.unlock();
-      if (d.worker.joinable()) d.worker.join();
+      if (d.worker.valid()) d.worker.get();
       d.add_counts(d.scratch);
     }
   }
@@ -850,13 +884,22 @@ const OrderStats& ProgressiveOrder::stats() const { return impl_->stats; }
 std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
                                             std::span<const std::uint32_t> subset, bool front_to_back,
                                             OrderStats* stats) {
+  std::vector<std::uint32_t> out;
+  visibility_order_into(out, mesh, table, view, subset, front_to_back, stats);
+  return out;
+}
+
+void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
+                           const View& view, std::span<const std::uint32_t> subset, bool front_to_back,
+                           OrderStats* stats) {
   ProgressiveOrder order(mesh, table, view, subset, front_to_back);
   ProgressiveOrder::Impl& d = *order.impl_;
   const std::size_t nb = d.bucket_begin.size() - 1;
   d.scatter(0, nb);
   d.scattered = true;
-  std::vector<std::uint32_t> out;
-  out.reserve(order.total());
+  // Every bucket's tets go straight to their final places.
+  out.resize(order.total());
+  std::uint32_t* direct = out.data();
   // Both cores: the first half of the buckets here, the second half on another thread. A tie chain
   // across the split (rare) sends everything back through one thread.
   std::size_t split = 0;
@@ -866,29 +909,20 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
                                                       static_cast<std::uint32_t>(m / 2)) - d.bucket_begin.begin());
     if (split >= nb) split = 0;
   }
-  // With no clusters, the tets go straight to their final places (those of their entries).
-  std::uint32_t* direct = nullptr;
-  if (d.t_cluster_free) {
-    out.resize(m);
-    direct = out.data();
-  }
   bool done = false;
   if (split > 0) {
-    std::vector<std::uint32_t> second;
-    if (!direct) second.reserve(order.total() - order.total() / 2 + 1024);
     ProgressiveOrder::Impl::Scratch other_scratch;
-    std::thread other([&] { d.emit_buckets(split, nb, nb, second, other_scratch, direct); });
-    d.emit_buckets(0, split, split, out, d.scratch, direct);
-    other.join();
+    pool::on_two_cores([&](int part) {
+      if (part == 0) d.emit_buckets(0, split, split, out, d.scratch, direct);
+      else d.emit_buckets(split, nb, nb, out, other_scratch, direct);
+    });
     // The halves are independent unless the last entry of the first joins the first of the second.
     const std::size_t at = d.bucket_begin[split];
     if (at == 0 || at == m || !d.joined(d.sorted[at - 1], d.sorted[at])) {
-      out.insert(out.end(), second.begin(), second.end());
       d.add_counts(d.scratch);
       d.add_counts(other_scratch);
       done = true;
     } else {
-      if (!direct) out.clear();
       d.scratch = {};
     }
   }
@@ -899,7 +933,6 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
   d.next_bucket = nb;
   d.handed = out.size();
   if (stats) *stats = d.stats;
-  return out;
 }
 
 std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,

@@ -59,8 +59,8 @@ class ProgressiveOrder {
   const OrderStats& stats() const;
 
  private:
-  friend std::vector<std::uint32_t> visibility_order(const Mesh&, const SphereTable&, const View&,
-                                                     std::span<const std::uint32_t>, bool, OrderStats*);
+  friend void visibility_order_into(std::vector<std::uint32_t>&, const Mesh&, const SphereTable&, const View&,
+                                    std::span<const std::uint32_t>, bool, OrderStats*);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -69,6 +69,12 @@ class ProgressiveOrder {
 std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
                                             std::span<const std::uint32_t> subset = {},
                                             bool front_to_back = false, OrderStats* stats = nullptr);
+
+// The same into `out`, resized to the order's size: a caller that orders view after view and keeps
+// `out` allocates nothing per view (the internal buffers are kept per thread as well).
+void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
+                           const View& view, std::span<const std::uint32_t> subset = {},
+                           bool front_to_back = false, OrderStats* stats = nullptr);
 
 // MPVO for meshes without a visibility order guarantee: a topological sort of the view-directed
 // face-adjacency graph of the subset, ready tets taken in decreasing power key; cycles are broken at
