@@ -191,6 +191,13 @@ struct ProgressiveOrder::Impl {
   std::vector<std::uint32_t> scatter_start[2];  // per bucket, the next slot of each part
   std::size_t scatter_split = 0;                // part 0 is keyed[0, split), part 1 the rest
   std::size_t head_buckets = 0;                 // buckets a progressive order places first
+  // The entries of the head buckets, gathered by the key pass (per part), so that a progressive
+  // order hands out its first batch without waiting for the scatter; head_fits is false if there
+  // were more than the room kept for them.
+  std::vector<Packed> head[2];
+  std::size_t head_count[2] = {0, 0};
+  bool head_fits = false;
+  std::size_t scatter_from = 0;                 // the first bucket the worker's scatter places
   bool scattered = false;
   double key_range_found = 0;                   // set by the scatter, published by add_counts
   void scatter(std::size_t from, std::size_t to);
@@ -204,6 +211,10 @@ struct ProgressiveOrder::Impl {
   bool worker_done = false;
   std::atomic<bool> stop{false};
   void run_worker();
+  // The first batch of a progressive order: the head buckets (gathered by the key pass) put in
+  // place, sorted and emitted into `batch` on the caller's thread, unless a run of joined entries
+  // may cross their end (then batch stays empty and the worker starts from bucket 0).
+  void hand_out_head();
 
   ~Impl() {
     if (worker.valid()) {
@@ -358,6 +369,15 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   stats.buckets = nb;
   keyed.swap(t_workspace.keyed);
   if (keyed.size() < m) keyed.resize(m);
+  // The head: the buckets up to the one of the sample's 0.2% quantile, gathered by the key pass so
+  // that a progressive order can hand them out before the scatter. Room for a few times what the
+  // sample predicts; more means a skewed sample, and the head is then placed by the scatter.
+  head_buckets = m >= 50000 ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb) : 0;
+  const std::uint32_t q_head =
+      head_buckets == 0 || head_buckets >= nb ? 0u : static_cast<std::uint32_t>(head_buckets << shift);
+  const std::size_t head_room = q_head == 0 ? 0 : m / 128 + 8192;
+  for (auto& h : head)
+    if (h.size() < head_room) h.resize(head_room);
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
   // With clusters, the tets per bucket too (an item stands for one or more tets), so that every
   // bucket's tets can be written at their final places.
@@ -378,12 +398,19 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
    return [=, this, &hist, &thist](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
     std::uint32_t* thp = thist[part].data();
-    auto put = [=, this](std::size_t i, double lo) {
+    Packed* head_p = head[part].data();
+    std::size_t heads = 0;
+    auto put = [=, this, &heads](std::size_t i, double lo) {
       const double x = (lo - qmin) * qscale;
       const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
-      keyed_p[i] = (Packed(q) << 32) | item_p[i];
+      const Packed p = (Packed(q) << 32) | item_p[i];
+      keyed_p[i] = p;
       ++hp[q >> shift];
       if constexpr (decltype(with_tets)::value) thp[q >> shift] += tets_of(item_p[i]);
+      if (q < q_head) {
+        if (heads < head_room) head_p[heads] = p;
+        ++heads;
+      }
     };
     if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
@@ -397,8 +424,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo);
       }
     }
+    head_count[part] = heads;
    };
   };
+  head_count[0] = head_count[1] = 0;
   if (t_cluster_free) parallel_for(m_main, key_pass_of(std::false_type{}));
   else parallel_for(m_main, key_pass_of(std::true_type{}));
   // The wide items (few) go with the second part, and each makes a zone of joined q values.
@@ -412,6 +441,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     const std::uint32_t q = quantise(lo);
     keyed_p[i] = (Packed(q) << 32) | wide_items[i - m_main];
     ++hist[wide_part][q >> shift];
+    if (q < q_head) {
+      if (head_count[wide_part] < head_room) head[wide_part][head_count[wide_part]] = keyed_p[i];
+      ++head_count[wide_part];
+    }
     if (!t_cluster_free) thist[wide_part][q >> shift] += tets_of(wide_items[i - m_main]);
     // Whatever overlaps [lo, lo + 2r] has its lo in [lo - 2 bound, lo + 2r] (ordinary items), or
     // its own zone meets this one (wide items).
@@ -455,29 +488,32 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   scatter_split = split;
   sorted.swap(t_workspace.entries);
   if (sorted.size() < m) sorted.resize(m);
-  // The head: the buckets up to the one of the sample's 0.2% quantile, which a progressive order
-  // places by a scan of their own and hands out before the whole scatter.
-  head_buckets = m >= 50000 ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb) : 0;
+  head_fits = q_head > 0 && head_count[0] <= head_room && head_count[1] <= head_room;
 }
 
 // Places the entries of buckets [from, to) of keyed into sorted (both cores), each part into its
-// own slots of every bucket: the same layout whatever ranges the buckets are placed in.
+// own slots of every bucket: the same layout whatever ranges the buckets are placed in. Gives up
+// early (leaving the placement unfinished) when the order is stopped.
 void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
   const std::size_t m = bucket_begin.back(), nb = bucket_begin.size() - 1;
   const Packed* keyed_p = keyed.data();
   Packed* out = sorted.data();
   const int shift = bucket_shift;
-  auto run = [=](std::size_t b, std::size_t e, std::uint32_t* ps) {
-    if (from == 0 && to == nb) {
-      for (std::size_t i = b; i < e; ++i) {
-        const Packed p = keyed_p[i];
-        out[ps[q_of(p) >> shift]++] = p;
-      }
-    } else {
-      for (std::size_t i = b; i < e; ++i) {
-        const Packed p = keyed_p[i];
-        const std::size_t k = q_of(p) >> shift;
-        if (k >= from && k < to) out[ps[k]++] = p;
+  auto run = [=, this](std::size_t b, std::size_t e, std::uint32_t* ps) {
+    constexpr std::size_t kChunk = 1 << 16;  // entries between looks at the stop flag
+    for (std::size_t c = b; c < e && !stop.load(std::memory_order_relaxed); c += kChunk) {
+      const std::size_t ce = std::min(e, c + kChunk);
+      if (from == 0 && to == nb) {
+        for (std::size_t i = c; i < ce; ++i) {
+          const Packed p = keyed_p[i];
+          out[ps[q_of(p) >> shift]++] = p;
+        }
+      } else {
+        for (std::size_t i = c; i < ce; ++i) {
+          const Packed p = keyed_p[i];
+          const std::size_t k = q_of(p) >> shift;
+          if (k >= from && k < to) out[ps[k]++] = p;
+        }
       }
     }
   };
@@ -490,7 +526,7 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
       else run(split, m, scatter_start[1].data());
     });
   }
-  if (to < nb) return;
+  if (to < nb || stop) return;
   const SphereTable& t = *table;
   // The key range: q is monotone in lo, so the extremes lie in the first and last non-empty buckets.
   std::size_t first = 0, last = nb - 1;
@@ -798,6 +834,25 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
   return b;
 }
 
+void ProgressiveOrder::Impl::hand_out_head() {
+  const std::size_t at = bucket_begin[head_buckets];
+  Packed* dst = sorted.data();
+  dst = std::copy(head[0].data(), head[0].data() + head_count[0], dst);
+  std::copy(head[1].data(), head[1].data() + head_count[1], dst);
+  std::sort(sorted.data(), sorted.data() + at);  // every head bucket in its place, and sorted
+  scatter_from = head_buckets;
+  const std::size_t counts[3] = {scratch.near_tie_runs, scratch.near_tie_items, scratch.cluster_cycles};
+  next_bucket = emit_buckets(0, head_buckets, head_buckets, batch, scratch);
+  if (at > 0 && joined(sorted[at - 1], Packed(head_buckets) << (32 + bucket_shift))) {
+    // A run of joined entries may go on past the head: the worker hands it all out in order.
+    batch.clear();
+    next_bucket = 0;
+    scratch.near_tie_runs = counts[0];
+    scratch.near_tie_items = counts[1];
+    scratch.cluster_cycles = counts[2];
+  }
+}
+
 void ProgressiveOrder::Impl::run_worker() {
   const std::size_t nb = bucket_begin.size() - 1;
   std::size_t b = next_bucket;
@@ -810,28 +865,9 @@ void ProgressiveOrder::Impl::run_worker() {
     pending.clear();
     cv.notify_one();
   };
+  first = b == 0;
   if (!scattered) {
-    // The head buckets first: placed, sorted and handed out before the rest is scattered, unless a
-    // run of joined entries may go on past them.
-    const std::size_t head = head_buckets;
-    if (head > 0 && head < nb) {
-      scatter(0, head);
-      const std::size_t counts[3] = {scratch.near_tie_runs, scratch.near_tie_items, scratch.cluster_cycles};
-      b = emit_buckets(0, head, head, pending, scratch);
-      const std::size_t at = bucket_begin[head];
-      if (at > 0 && joined(sorted[at - 1], Packed(head) << (32 + bucket_shift))) {
-        pending.clear();
-        b = 0;
-        scratch.near_tie_runs = counts[0];
-        scratch.near_tie_items = counts[1];
-        scratch.cluster_cycles = counts[2];
-      } else if (!pending.empty()) {
-        hand_out();
-      }
-      scatter(head, nb);
-    } else {
-      scatter(0, nb);
-    }
+    scatter(scatter_from, nb);
     scattered = true;
   }
   while (b < nb && !stop) {
@@ -860,7 +896,15 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
       d.next_bucket = d.emit_buckets(d.next_bucket, d.next_bucket + 1, nb, d.batch, d.scratch);
     d.add_counts(d.scratch);
   } else {
-    if (!d.worker.valid() && !d.worker_done) d.worker = pool::run_async([&d] { d.run_worker(); });
+    if (!d.worker.valid() && !d.worker_done) {
+      // The head buckets here, at once; the rest is placed and sorted ahead by the worker.
+      if (d.head_fits) d.hand_out_head();
+      d.worker = pool::run_async([&d] { d.run_worker(); });
+      if (!d.batch.empty()) {
+        d.handed += d.batch.size();
+        return d.batch;
+      }
+    }
     std::unique_lock<std::mutex> lock(d.mu);
     d.cv.wait(lock, [&d] { return !d.ready.empty() || d.worker_done; });
     if (!d.ready.empty()) {
