@@ -249,6 +249,22 @@ struct ProgressiveOrder::Impl {
   }
   void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
+  // Prefetches a cluster item's faces and tets ahead of its expansion (nothing for a tet).
+  bool many_clusters = false;               // clusters are a sizeable part of the items
+  void prefetch_cluster(std::uint32_t item) const {
+    if (!(item & kClusterBit)) return;
+    const SphereTable& t = *table;
+    const std::uint32_t k = item & ~kClusterBit;
+    const std::uint32_t f = t.cluster_face_begin[k], fe = t.cluster_face_begin[k + 1];
+    __builtin_prefetch(t.cluster_tets.data() + t.cluster_begin[k]);
+    if (f == fe) return;
+    const char* plane = reinterpret_cast<const char*>(t.face_plane.data() + 4 * std::size_t(f));
+    const char* plane_end = reinterpret_cast<const char*>(t.face_plane.data() + 4 * std::size_t(fe));
+    for (const char* p = plane; p < plane_end && p < plane + 256; p += 64) __builtin_prefetch(p);
+    __builtin_prefetch(t.face_local.data() + 2 * std::size_t(f));
+    __builtin_prefetch(t.face_scale.data() + f);
+    __builtin_prefetch(t.face_anorm.data() + f);
+  }
   // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
   void expand(std::uint32_t item, std::uint32_t*& o, Scratch& sc);
   // Hands out buckets [first, last) (sorting, tie fix-up, cluster expansion), appended to out, or if
@@ -308,6 +324,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   }
   const std::size_t m_main = items.size(), m = m_main + wide_items.size();
   t_cluster_free = t.cluster_count() == 0;
+  many_clusters = t.cluster_count() * 16 > t.all_items.size();
   stats.items = m;
   stats.wide_items = wide_items.size();
   if (m == 0) {
@@ -669,9 +686,10 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
   if (ce - cb <= 64) {
     // Small cells (a grid cube: 5 or 6 tets): predecessor bit masks, planes tested in double with a
     // rounding bound, exact orientation only when in doubt.
-    std::uint64_t pred[64] = {};
+    std::uint64_t pred[64];
     std::uint64_t emitted = 0;
     const std::uint32_t size = ce - cb;
+    std::fill(pred, pred + size, std::uint64_t(0));
     if (!in_subset.empty())
       for (std::uint32_t i = 0; i < size; ++i)
         if (!in_subset[t.cluster_tets[cb + i]]) emitted |= std::uint64_t(1) << i;  // not drawn, no constraints
@@ -827,6 +845,11 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     if (t_cluster_free) {
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
+      // Clusters met in key order are scattered over memory, and each expansion is a chain of
+      // dependent cache misses (offsets, then faces): a first pass fetches the data of all the
+      // group's clusters, its iterations independent so that the misses overlap.
+      if (many_clusters)
+        for (std::size_t k = begin; k < end; ++k) prefetch_cluster(item_of(sorted[k]));
       scan_runs(begin, end, sc, [&](std::uint32_t item) {
         if (item & kClusterBit) expand(item, o, sc);
         else *o++ = item;
