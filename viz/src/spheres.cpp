@@ -173,7 +173,8 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   if (progress && !progress("spheres", 0.5)) return t;
 
   // Cospherical clusters: across each interior face, is the neighbour's far vertex on this tet's
-  // sphere? A double filter rejects the clear cases; CGAL's exact test decides the rest.
+  // sphere? Two filters in double reject the clear cases (centres apart, then the power of the far
+  // vertex); CGAL's exact test decides the rest.
   const FaceAdjacency& adj = face_adjacency(mesh);
   std::vector<std::uint8_t> same(4 * n, 0);
   parallel_for(n, [&](std::size_t begin, std::size_t end, int) {
@@ -189,6 +190,12 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
         if (nb == kNone) continue;
         std::uint32_t u = nb >> 2;
         if (u < i || t.flat[u]) continue;  // each face once, from its lower tet
+        // Cospherical tets have one centre: centres apart by more than their error bounds (key_b
+        // is at least 4 times the bound of each coordinate's error) are not, with no look at the
+        // neighbour's vertices (which are scattered over memory, the centres follow the tets).
+        const double* cu = t.c.data() + 3 * std::size_t(u);
+        const double apart = std::max({std::abs(cc[0] - cu[0]), std::abs(cc[1] - cu[1]), std::abs(cc[2] - cu[2])});
+        if (apart > double(t.key_b[i]) + double(t.key_b[u])) continue;
         std::uint32_t qv = T[4 * std::size_t(u) + (nb & 3)];
         const double* q = X + 3 * std::size_t(qv);
         double qa[3] = {q[0] - a[0], q[1] - a[1], q[2] - a[2]};
