@@ -402,8 +402,9 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   if (!t_cluster_free) thist[0].assign(nb, 0), thist[1].assign(nb, 0);
   // Tight loops over the ordinary items, on locals (the stores to the histogram could alias anything
   // reached through a reference).
-  const std::uint32_t* rep_p = reps.data();
-  const std::uint32_t* item_p = t_cluster_free ? rep_p : items.data();  // items are their reps then
+  const std::uint32_t* item_p = t_cluster_free ? reps.data() : items.data();  // items are their reps then
+  const std::uint32_t* cl_tets = t.cluster_tets.data();
+  const std::uint32_t* cl_begin = t.cluster_begin.data();
   Packed* keyed_p = keyed.data();
   const double* C = t.c.data();
   const double* S = t.s.data();
@@ -417,6 +418,16 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     std::uint32_t* thp = thist[part].data();
     Packed* head_p = head[part].data();
     std::size_t heads = 0;
+    // An item's tet: the item itself, or a cluster's first tet (reps[i], read from the cluster
+    // tables instead, which saves a stream of 4 bytes per item when few items are clusters).
+    auto rep_at = [=](std::size_t i) -> std::size_t {
+      if constexpr (decltype(with_tets)::value) {
+        const std::uint32_t item = item_p[i];
+        return (item & kClusterBit) ? cl_tets[cl_begin[item & ~kClusterBit]] : item;
+      } else {
+        return item_p[i];
+      }
+    };
     auto put = [=, this, &heads](std::size_t i, double lo) {
       const double x = (lo - qmin) * qscale;
       const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
@@ -432,13 +443,13 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     };
     if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
-        const std::size_t tet = rep_p[i];
+        const std::size_t tet = rep_at(i);
         const double* c = C + 3 * tet;
         put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo);
       }
     } else {
       for (std::size_t i = b; i < e; ++i) {
-        const double* c = C + 3 * std::size_t(rep_p[i]);
+        const double* c = C + 3 * rep_at(i);
         put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo);
       }
     }
