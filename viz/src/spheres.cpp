@@ -347,10 +347,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
     }
   };
   // Planes and local indices of the cluster faces.
-  t.face_plane.resize(4 * faces);
-  t.face_local.resize(2 * faces);
-  t.face_scale.resize(faces);
-  t.face_anorm.resize(faces);
+  t.face_test.resize(faces);
   {
     std::vector<std::uint32_t> local(n, 0);
     for (std::uint32_t k = 0; k < clusters; ++k)
@@ -363,16 +360,17 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
       double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
       double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
       double nn[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-      t.face_plane[4 * f] = nn[0];
-      t.face_plane[4 * f + 1] = nn[1];
-      t.face_plane[4 * f + 2] = nn[2];
-      t.face_plane[4 * f + 3] = nn[0] * p0[0] + nn[1] * p0[1] + nn[2] * p0[2];
-      t.face_scale[f] = static_cast<float>((std::abs(u[0]) + std::abs(u[1]) + std::abs(u[2])) *
+      SphereTable::ClusterFace& ft = t.face_test[f];
+      ft.plane[0] = nn[0];
+      ft.plane[1] = nn[1];
+      ft.plane[2] = nn[2];
+      ft.plane[3] = nn[0] * p0[0] + nn[1] * p0[1] + nn[2] * p0[2];
+      ft.scale = static_cast<float>((std::abs(u[0]) + std::abs(u[1]) + std::abs(u[2])) *
                                            (std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2])) * (1 + 1e-6));
-      t.face_anorm[f] = static_cast<float>((std::abs(p0[0]) + std::abs(p0[1]) + std::abs(p0[2])) * (1 + 1e-6));
+      ft.anorm = static_cast<float>((std::abs(p0[0]) + std::abs(p0[1]) + std::abs(p0[2])) * (1 + 1e-6));
       std::uint32_t la = local[t.face_tet[2 * f]], lb = local[t.face_tet[2 * f + 1]];
-      t.face_local[2 * f] = la < 0xFFFF ? static_cast<std::uint16_t>(la) : 0xFFFF;
-      t.face_local[2 * f + 1] = lb < 0xFFFF ? static_cast<std::uint16_t>(lb) : 0xFFFF;
+      ft.local[0] = la < 0xFFFF ? static_cast<std::uint16_t>(la) : 0xFFFF;
+      ft.local[1] = lb < 0xFFFF ? static_cast<std::uint16_t>(lb) : 0xFFFF;
     }
   }
   t.all_items.reserve(n - t.cluster_tets.size() + clusters);

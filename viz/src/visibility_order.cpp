@@ -258,12 +258,9 @@ struct ProgressiveOrder::Impl {
     const std::uint32_t f = t.cluster_face_begin[k], fe = t.cluster_face_begin[k + 1];
     __builtin_prefetch(t.cluster_tets.data() + t.cluster_begin[k]);
     if (f == fe) return;
-    const char* plane = reinterpret_cast<const char*>(t.face_plane.data() + 4 * std::size_t(f));
-    const char* plane_end = reinterpret_cast<const char*>(t.face_plane.data() + 4 * std::size_t(fe));
-    for (const char* p = plane; p < plane_end && p < plane + 256; p += 64) __builtin_prefetch(p);
-    __builtin_prefetch(t.face_local.data() + 2 * std::size_t(f));
-    __builtin_prefetch(t.face_scale.data() + f);
-    __builtin_prefetch(t.face_anorm.data() + f);
+    const char* faces = reinterpret_cast<const char*>(t.face_test.data() + f);
+    const char* faces_end = reinterpret_cast<const char*>(t.face_test.data() + fe);
+    for (const char* p = faces; p < faces_end && p < faces + 512; p += 64) __builtin_prefetch(p);
   }
   // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
   void expand(std::uint32_t item, std::uint32_t*& o, Scratch& sc);
@@ -710,15 +707,16 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
     const double en = persp ? std::abs(e[0]) + std::abs(e[1]) + std::abs(e[2])
                             : std::abs(back[0]) + std::abs(back[1]) + std::abs(back[2]);
     for (std::uint32_t f = t.cluster_face_begin[k]; f < t.cluster_face_begin[k + 1]; ++f) {
-      const std::uint32_t a = t.face_local[2 * f], b = t.face_local[2 * f + 1];
-      const double* pl = t.face_plane.data() + 4 * std::size_t(f);
+      const SphereTable::ClusterFace& ft = t.face_test[f];
+      const std::uint32_t a = ft.local[0], b = ft.local[1];
+      const double* pl = ft.plane;
       double val, err;
       if (persp) {
         val = pl[0] * e[0] + pl[1] * e[1] + pl[2] * e[2] - pl[3];
-        err = 96 * kEps * double(t.face_scale[f]) * (en + double(t.face_anorm[f]));
+        err = 96 * kEps * double(ft.scale) * (en + double(ft.anorm));
       } else {
         val = pl[0] * back[0] + pl[1] * back[1] + pl[2] * back[2];
-        err = 32 * kEps * double(t.face_scale[f]) * en;
+        err = 32 * kEps * double(ft.scale) * en;
       }
       int side = val > err ? 1 : val < -err ? -1 : 2;
       if (side == 2) {
