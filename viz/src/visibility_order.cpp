@@ -933,7 +933,17 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
     if (!d.worker.valid() && !d.worker_done) {
       // The head buckets here, at once; the rest is placed and sorted ahead by the worker.
       if (d.head_fits) d.hand_out_head();
-      d.worker = pool::run_async([&d] { d.run_worker(); });
+      d.worker = pool::run_async([&d] {
+        try {
+          d.run_worker();
+        } catch (...) {
+          // Wake the caller, which rethrows it from the future.
+          std::lock_guard<std::mutex> g(d.mu);
+          d.worker_done = true;
+          d.cv.notify_one();
+          throw;
+        }
+      });
       if (!d.batch.empty()) {
         d.handed += d.batch.size();
         return d.batch;
