@@ -357,7 +357,17 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     const std::size_t samples = std::min<std::size_t>(m, 2048);
     std::vector<double> sample(samples);
     for (std::size_t k = 0; k < samples; ++k) sample[k] = item_lo(k * m / samples);
-    std::sort(sample.begin(), sample.end());
+    // Only the few smallest and the 3 largest are read: selections, not a sort (on the path to the
+    // first batch).
+    if (samples < 64) {
+      std::sort(sample.begin(), sample.end());
+    } else {
+      const auto low_end = sample.begin() + std::max<std::ptrdiff_t>(std::ptrdiff_t(samples / 512), 2) + 1;
+      std::nth_element(sample.begin(), low_end - 1, sample.end());
+      std::sort(sample.begin(), low_end);
+      std::nth_element(low_end, sample.end() - 3, sample.end());
+      std::sort(sample.end() - 3, sample.end());
+    }
     double kmin = sample.front(), kmax = sample.back();
     head_lo = sample[samples / 512];
     if (samples < m) {
