@@ -105,6 +105,7 @@ inline std::uint32_t item_of(Packed p) { return static_cast<std::uint32_t>(p); }
 struct Workspace {
   std::vector<Packed> keyed;    // pass 1: the items with their q, in input order (8 bytes per item)
   std::vector<Packed> entries;  // the bucketed entries (8 bytes per item)
+  std::vector<Packed> head[2];  // the head buckets' entries gathered by the key pass (per part)
 };
 thread_local Workspace t_workspace;
 
@@ -225,6 +226,8 @@ struct ProgressiveOrder::Impl {
     // is the same memory; the thread_local slot is this thread's.)
     if (sorted.capacity() > t_workspace.entries.capacity()) t_workspace.entries.swap(sorted);
     if (keyed.capacity() > t_workspace.keyed.capacity()) t_workspace.keyed.swap(keyed);
+    for (int part = 0; part < 2; ++part)
+      if (head[part].capacity() > t_workspace.head[part].capacity()) t_workspace.head[part].swap(head[part]);
   }
   void prepare(std::span<const std::uint32_t> subset);
   // Sorts one first-level bucket [begin, end) by packed value.
@@ -400,8 +403,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   const std::uint32_t q_head =
       head_buckets == 0 || head_buckets >= nb ? 0u : static_cast<std::uint32_t>(head_buckets << shift);
   const std::size_t head_room = q_head == 0 ? 0 : m / 128 + 8192;
-  for (auto& h : head)
-    if (h.size() < head_room) h.resize(head_room);
+  for (int part = 0; part < 2; ++part) {
+    head[part].swap(t_workspace.head[part]);
+    if (head[part].size() < head_room) head[part].resize(head_room);
+  }
   std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
   // With clusters, the tets per bucket too (an item stands for one or more tets: counted here are
   // the tets beyond the first), so that every bucket's tets can be written at their final places.
