@@ -38,10 +38,11 @@ struct OrderStats {
 };
 
 // Hands out the order of one view progressively: next() returns the next batch of tets (back to
-// front, or front to back if asked). Buckets are sorted in order on a second thread started by the
-// first next() (for orders of 50,000 tets or more), so the caller draws one batch while the next
-// are sorted; the first bucket is handed out as soon as it is sorted. Destroying the object stops
-// the sorting. The table and the mesh are lent and must outlive it; one object is used from one
+// front, or front to back if asked). The constructor computes every key (both cores); for orders
+// of 50,000 items or more the first next() sorts and returns the first buckets, gathered by the
+// key pass, on the caller's thread, and hands the rest to a pooled thread that places and sorts
+// them ahead while the caller draws. Destroying the object stops that work within a fraction of a
+// millisecond. The table and the mesh are lent and must outlive it; one object is used from one
 // thread.
 class ProgressiveOrder {
  public:
