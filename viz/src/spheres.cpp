@@ -181,21 +181,21 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
     for (std::size_t i = begin; i < end; ++i) {
       if (t.flat[i]) continue;
       const std::uint32_t* v = T + 4 * i;
-      const double* a = X + 3 * std::size_t(v[0]);
       const double* cc = t.c.data() + 3 * i;
-      double o[3] = {cc[0] + org[0] - a[0], cc[1] + org[1] - a[1], cc[2] + org[2] - a[2]};
-      const double no = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
       for (int f = 0; f < 4; ++f) {
         std::uint32_t nb = adj.neighbour[4 * i + f];
         if (nb == kNone) continue;
         std::uint32_t u = nb >> 2;
-        if (u < i || t.flat[u]) continue;  // each face once, from its lower tet
+        if (u < i) continue;  // each face once, from its lower tet
         // Cospherical tets have one centre: centres apart by more than their error bounds (key_b
         // is at least 4 times the bound of each coordinate's error) are not, with no look at the
-        // neighbour's vertices (which are scattered over memory, the centres follow the tets).
+        // vertices (scattered over memory; the centres follow the tets).
         const double* cu = t.c.data() + 3 * std::size_t(u);
         const double apart = std::max({std::abs(cc[0] - cu[0]), std::abs(cc[1] - cu[1]), std::abs(cc[2] - cu[2])});
-        if (apart > double(t.key_b[i]) + double(t.key_b[u])) continue;
+        if (apart > double(t.key_b[i]) + double(t.key_b[u]) || t.flat[u]) continue;
+        const double* a = X + 3 * std::size_t(v[0]);
+        const double o[3] = {cc[0] + org[0] - a[0], cc[1] + org[1] - a[1], cc[2] + org[2] - a[2]};
+        const double no = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
         std::uint32_t qv = T[4 * std::size_t(u) + (nb & 3)];
         const double* q = X + 3 * std::size_t(qv);
         double qa[3] = {q[0] - a[0], q[1] - a[1], q[2] - a[2]};
