@@ -621,11 +621,20 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
   for (std::size_t i = 0; i < n; ++i) tmp[cnt[(q_of(a[i]) >> sub_shift) & mask]++] = a[i];
   // Back into place by one insertion pass (nothing moves across sub-buckets), with a budget of
   // moves: keys crowded into a few sub-buckets go to std::sort instead.
+  // Most entries are alone in their sub-bucket and come in order: that case is one compare.
   std::size_t budget = 4 * n;
-  for (std::size_t i = 0; i < n; ++i) {
+  a[0] = tmp[0];
+  for (std::size_t i = 1; i < n; ++i) {
     const Packed v = tmp[i];
+    if (!(v < a[i - 1])) {
+      a[i] = v;
+      continue;
+    }
     std::size_t j = i;
-    for (; j > 0 && v < a[j - 1]; --j) a[j] = a[j - 1];
+    do {
+      a[j] = a[j - 1];
+      --j;
+    } while (j > 0 && v < a[j - 1]);
     a[j] = v;
     budget -= std::min(budget, i - j);
     if (budget == 0) {
