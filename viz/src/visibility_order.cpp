@@ -203,8 +203,8 @@ struct ProgressiveOrder::Impl {
   double key_range_found = 0;                   // set by the scatter, published by add_counts
   void scatter(std::size_t from, std::size_t to);
 
-  // The progressive path sorts ahead on a second thread (started by the first next()), so that the
-  // caller can draw one batch while the next buckets are being sorted.
+  // The progressive path sorts ahead on a pooled thread (handed the work by the first next()), so
+  // that the caller can draw one batch while the next buckets are being sorted.
   std::future<void> worker;                 // valid while the sorting ahead runs or has not been waited for
   std::mutex mu;
   std::condition_variable cv;
