@@ -1,5 +1,6 @@
 // The per-view visibility order (issue 3), with its baselines in the same run.
 //   power_order       whole back-to-front order, ties resolved (foxi::visibility_order)
+//   power_order_into  the same into an output kept from view to view (foxi::visibility_order_into)
 //   first_batch       time until the first batch of the progressive order is handed out
 //   precompute        spheres + cospherical clusters (face adjacency computed before, cached)
 //   keys_only         computing the float keys alone: the bandwidth-bound floor
@@ -89,6 +90,23 @@ void BM_power_order(benchmark::State& state) {
   per_tet(state, c.mesh.tet_count());
 }
 
+// The same with the output kept from view to view (a viewer's frame loop): no allocation per view.
+void BM_power_order_into(benchmark::State& state) {
+  const int which = static_cast<int>(state.range(0));
+  if (skip(state, which)) return;
+  Case& c = get_case(which);
+  std::size_t i = 0, runs = 0;
+  std::vector<std::uint32_t> order;
+  for (auto _ : state) {
+    OrderStats stats;
+    visibility_order_into(order, c.mesh, c.table, eye_for(i++), {}, false, &stats);
+    runs += stats.near_tie_runs;
+    benchmark::DoNotOptimize(order.data());
+  }
+  state.counters["near_tie_runs"] = double(runs) / double(std::max<std::size_t>(i, 1));
+  per_tet(state, c.mesh.tet_count());
+}
+
 void BM_first_batch(benchmark::State& state) {
   const int which = static_cast<int>(state.range(0));
   if (skip(state, which)) return;
@@ -170,6 +188,7 @@ void BM_centroid_order(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_power_order)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_power_order_into)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_first_batch)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_keys_only)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_std_sort)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();

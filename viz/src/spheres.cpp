@@ -173,22 +173,29 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   if (progress && !progress("spheres", 0.5)) return t;
 
   // Cospherical clusters: across each interior face, is the neighbour's far vertex on this tet's
-  // sphere? A double filter rejects the clear cases; CGAL's exact test decides the rest.
+  // sphere? Two filters in double reject the clear cases (centres apart, then the power of the far
+  // vertex); CGAL's exact test decides the rest.
   const FaceAdjacency& adj = face_adjacency(mesh);
   std::vector<std::uint8_t> same(4 * n, 0);
   parallel_for(n, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t i = begin; i < end; ++i) {
       if (t.flat[i]) continue;
       const std::uint32_t* v = T + 4 * i;
-      const double* a = X + 3 * std::size_t(v[0]);
       const double* cc = t.c.data() + 3 * i;
-      double o[3] = {cc[0] + org[0] - a[0], cc[1] + org[1] - a[1], cc[2] + org[2] - a[2]};
-      const double no = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
       for (int f = 0; f < 4; ++f) {
         std::uint32_t nb = adj.neighbour[4 * i + f];
         if (nb == kNone) continue;
         std::uint32_t u = nb >> 2;
-        if (u < i || t.flat[u]) continue;  // each face once, from its lower tet
+        if (u < i) continue;  // each face once, from its lower tet
+        // Cospherical tets have one centre: centres apart by more than their error bounds (key_b
+        // is at least 4 times the bound of each coordinate's error) are not, with no look at the
+        // vertices (scattered over memory; the centres follow the tets).
+        const double* cu = t.c.data() + 3 * std::size_t(u);
+        const double apart = std::max({std::abs(cc[0] - cu[0]), std::abs(cc[1] - cu[1]), std::abs(cc[2] - cu[2])});
+        if (apart > double(t.key_b[i]) + double(t.key_b[u]) || t.flat[u]) continue;
+        const double* a = X + 3 * std::size_t(v[0]);
+        const double o[3] = {cc[0] + org[0] - a[0], cc[1] + org[1] - a[1], cc[2] + org[2] - a[2]};
+        const double no = std::sqrt(o[0] * o[0] + o[1] * o[1] + o[2] * o[2]);
         std::uint32_t qv = T[4 * std::size_t(u) + (nb & 3)];
         const double* q = X + 3 * std::size_t(qv);
         double qa[3] = {q[0] - a[0], q[1] - a[1], q[2] - a[2]};
@@ -340,10 +347,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
     }
   };
   // Planes and local indices of the cluster faces.
-  t.face_plane.resize(4 * faces);
-  t.face_local.resize(2 * faces);
-  t.face_scale.resize(faces);
-  t.face_anorm.resize(faces);
+  t.face_test.resize(faces);
   {
     std::vector<std::uint32_t> local(n, 0);
     for (std::uint32_t k = 0; k < clusters; ++k)
@@ -356,16 +360,17 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
       double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
       double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
       double nn[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-      t.face_plane[4 * f] = nn[0];
-      t.face_plane[4 * f + 1] = nn[1];
-      t.face_plane[4 * f + 2] = nn[2];
-      t.face_plane[4 * f + 3] = nn[0] * p0[0] + nn[1] * p0[1] + nn[2] * p0[2];
-      t.face_scale[f] = static_cast<float>((std::abs(u[0]) + std::abs(u[1]) + std::abs(u[2])) *
+      SphereTable::ClusterFace& ft = t.face_test[f];
+      ft.plane[0] = nn[0];
+      ft.plane[1] = nn[1];
+      ft.plane[2] = nn[2];
+      ft.plane[3] = nn[0] * p0[0] + nn[1] * p0[1] + nn[2] * p0[2];
+      ft.scale = static_cast<float>((std::abs(u[0]) + std::abs(u[1]) + std::abs(u[2])) *
                                            (std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2])) * (1 + 1e-6));
-      t.face_anorm[f] = static_cast<float>((std::abs(p0[0]) + std::abs(p0[1]) + std::abs(p0[2])) * (1 + 1e-6));
+      ft.anorm = static_cast<float>((std::abs(p0[0]) + std::abs(p0[1]) + std::abs(p0[2])) * (1 + 1e-6));
       std::uint32_t la = local[t.face_tet[2 * f]], lb = local[t.face_tet[2 * f + 1]];
-      t.face_local[2 * f] = la < 0xFFFF ? static_cast<std::uint16_t>(la) : 0xFFFF;
-      t.face_local[2 * f + 1] = lb < 0xFFFF ? static_cast<std::uint16_t>(lb) : 0xFFFF;
+      ft.local[0] = la < 0xFFFF ? static_cast<std::uint16_t>(la) : 0xFFFF;
+      ft.local[1] = lb < 0xFFFF ? static_cast<std::uint16_t>(lb) : 0xFFFF;
     }
   }
   t.all_items.reserve(n - t.cluster_tets.size() + clusters);

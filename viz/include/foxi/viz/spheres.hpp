@@ -55,12 +55,14 @@ struct SphereTable {
   std::vector<std::uint32_t> cluster_face_begin;
   std::vector<std::uint32_t> face_tet;
   std::vector<std::uint32_t> face_vertex;
-  // Per cluster face, for a fast side test: plane n.x = d (n = (v1 - v0) x (v2 - v0), positive on
-  // the first tet's side) as 4 doubles, the local indices of its two tets within the cluster, and
-  // magnitudes for the rounding bound: |v1 - v0|_1 |v2 - v0|_1 and |v0|_1.
-  std::vector<double> face_plane;
-  std::vector<std::uint16_t> face_local;      // 2 per face; 0xFFFF if the cluster is too large
-  std::vector<float> face_scale, face_anorm;
+  // Per cluster face, for a fast side test, in one record so that a cluster's faces lie together
+  // in memory (clusters are expanded in key order, i.e. at scattered places).
+  struct ClusterFace {
+    double plane[4];          // n.x = d, n = (v1 - v0) x (v2 - v0), positive on the first tet's side
+    float scale, anorm;       // for the rounding bound: |v1 - v0|_1 |v2 - v0|_1 and |v0|_1
+    std::uint16_t local[2];   // its two tets' indices within the cluster; 0xFFFF if it is too large
+  };
+  std::vector<ClusterFace> face_test;
   // The sort items of the whole mesh that are not wide, built once: each tet not in a cluster, and
   // each cluster as (cluster | kClusterBit). A cluster's key is the key of its first tet.
   std::vector<std::uint32_t> all_items;

@@ -38,10 +38,11 @@ struct OrderStats {
 };
 
 // Hands out the order of one view progressively: next() returns the next batch of tets (back to
-// front, or front to back if asked). Buckets are sorted in order on a second thread started by the
-// first next() (for orders of 50,000 tets or more), so the caller draws one batch while the next
-// are sorted; the first bucket is handed out as soon as it is sorted. Destroying the object stops
-// the sorting. The table and the mesh are lent and must outlive it; one object is used from one
+// front, or front to back if asked). The constructor computes every key (both cores); for orders
+// of 50,000 items or more the first next() sorts and returns the first buckets, gathered by the
+// key pass, on the caller's thread, and hands the rest to a pooled thread that places and sorts
+// them ahead while the caller draws. Destroying the object stops that work within a fraction of a
+// millisecond. The table and the mesh are lent and must outlive it; one object is used from one
 // thread.
 class ProgressiveOrder {
  public:
@@ -59,8 +60,8 @@ class ProgressiveOrder {
   const OrderStats& stats() const;
 
  private:
-  friend std::vector<std::uint32_t> visibility_order(const Mesh&, const SphereTable&, const View&,
-                                                     std::span<const std::uint32_t>, bool, OrderStats*);
+  friend void visibility_order_into(std::vector<std::uint32_t>&, const Mesh&, const SphereTable&, const View&,
+                                    std::span<const std::uint32_t>, bool, OrderStats*);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -69,6 +70,12 @@ class ProgressiveOrder {
 std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
                                             std::span<const std::uint32_t> subset = {},
                                             bool front_to_back = false, OrderStats* stats = nullptr);
+
+// The same into `out`, resized to the order's size: a caller that orders view after view and keeps
+// `out` allocates nothing per view (the internal buffers are kept per thread as well).
+void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
+                           const View& view, std::span<const std::uint32_t> subset = {},
+                           bool front_to_back = false, OrderStats* stats = nullptr);
 
 // MPVO for meshes without a visibility order guarantee: a topological sort of the view-directed
 // face-adjacency graph of the subset, ready tets taken in decreasing power key; cycles are broken at
