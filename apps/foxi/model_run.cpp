@@ -24,7 +24,10 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
   const ModelMeshParams mp = mesh_params_from_model(controls, plc);
   const MeshParams params = mp.params;
   m.ignored_refine_boxes = mp.ignored_refine_boxes;
-  m.mesh = mesh_plc(plc, params, &m.report);
+  // The same conforming Delaunay path as `foxi mesh` (thin layers included), so that the mesh the
+  // solver gets is certified and the viewer's order is exact.
+  m.mesh = mesh_conforming(plc, params, {}, &m.conforming);
+  m.report = m.conforming.tetgen;
   name_mesh(m.model, m.structure, m.mesh);
   return m;
 }
@@ -36,10 +39,11 @@ MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::s
     if (physics == physics_name(p)) ph = p;
   MeshedModel m = mesh_model(file, sets, ph);
   std::printf("model %s: %zu parts, %zu conditions, %zu loads -> PLC %zu points, %zu facets -> %zu nodes, %zu tets "
-              "(TetGen %s, %.3f s)\n",
+              "(TetGen %s, %.3f s; Delaunay %s%s)\n",
               file.c_str(), m.model.parts.size(), m.model.conditions.size(), m.model.loads.size(),
               m.structure.plc.point_count(), m.structure.plc.facet_count(), m.mesh.node_count(), m.mesh.tet_count(),
-              m.report.switches.c_str(), m.report.seconds);
+              m.report.switches.c_str(), m.conforming.seconds, m.conforming.delaunay ? "certified" : "NOT certified",
+              m.conforming.thin_layers.empty() ? "" : ", thin layers meshed flat");
   if (m.ignored_refine_boxes > 0)
     std::printf("note: %zu [[mesh.refine]] boxes are not applied (TetGen takes no box sizes yet)\n",
                 m.ignored_refine_boxes);

@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 
+#include "foxi/mesher/conforming.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/model_file.hpp"
@@ -21,7 +22,8 @@ struct MeshedModel {
   Model model;
   Structure structure;
   Mesh mesh;  // regions named after the parts, boundaries after the structure's surfaces
-  MeshReport report;
+  MeshReport report;            // the last TetGen run
+  ConformingReport conforming;  // the conforming refinement (certificate, thin layers)
   std::size_t ignored_refine_boxes = 0;
 };
 

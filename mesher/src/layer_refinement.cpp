@@ -136,7 +136,11 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
   }
   const SizeLookup sizes(params.size_field);
   const double q2 = params.radius_edge * params.radius_edge;
-  const double cos_min = params.min_dihedral > 0 ? std::cos(params.min_dihedral * 3.14159265358979323846 / 180) : -2;
+  // Near-flat tets outside the layers (dihedral angle under 1 degree; four almost cocircular
+  // coplanar points, which symmetric refinement makes) are always split: one would make a solver's
+  // matrix singular in all but name.
+  const double min_dihedral = std::max(params.min_dihedral, 1.0);
+  const double cos_min = std::cos(min_dihedral * 3.14159265358979323846 / 180);
   CertificateOptions copt;
   copt.max_listed = std::numeric_limits<std::size_t>::max();
   rep.thin_layers = layers;
@@ -243,8 +247,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
         const Vec g = scale(add(add(x[0], x[1]), add(x[2], x[3])), 0.25);
         for (const ThinLayer& l : layers) {
           if (!all_in(l, x)) continue;
-          const Vec n{l.normal[0], l.normal[1], l.normal[2]};
-          const Vec onto = sub(g, scale(n, dot(n, g) - l.lo));
+          const Vec onto = onto_layer_plane(l, g, l.lo);
           double longest2 = 0;
           for (int i = 0; i < 4; ++i)
             for (int j = i + 1; j < 4; ++j) longest2 = std::max(longest2, norm2(sub(x[i], x[j])));

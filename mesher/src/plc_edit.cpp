@@ -91,7 +91,7 @@ bool EditablePlc::insert_surface_point(const Vec& p) {
   }
   const std::size_t f = facet_at(p);
   if (f == facets.size()) return false;
-  facets[f].push_back({add_point(p)});
+  facet_points[f].push_back(add_point(p));
   return true;
 }
 
@@ -336,7 +336,7 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       if (edit.find_segment(c, c, a, b))
         edit.split_segment(a, b, k);
       else
-        edit.facets[facet].push_back({k});
+        edit.facet_points[facet].push_back(k);
       accept(c);
     }
   }

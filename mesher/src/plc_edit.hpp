@@ -107,18 +107,38 @@ struct PointGrid {
   }
 };
 
+// p moved along the layer's normal onto the plane normal . x = level. For a layer normal to an axis
+// the other two coordinates are kept bit for bit: a point and its mirror then lie exactly on one
+// normal line, so four of them make an exact rectangle and TetGen makes no near-flat tet across it.
+inline Vec onto_layer_plane(const ThinLayer& l, const Vec& p, double level) {
+  for (std::size_t k = 0; k < 3; ++k)
+    if (l.normal[k] == 1 && l.normal[(k + 1) % 3] == 0 && l.normal[(k + 2) % 3] == 0) {
+      Vec q = p;
+      q[k] = level;
+      return q;
+    }
+  const Vec n{l.normal[0], l.normal[1], l.normal[2]};
+  return add(p, scale(n, level - dot(n, p)));
+}
+
 // The PLC's facets as nested lists while points are being added.
 struct EditablePlc {
   Plc& plc;
-  std::vector<std::vector<std::vector<std::uint32_t>>> facets;  // facet -> polygons -> vertices
+  std::vector<std::vector<std::vector<std::uint32_t>>> facets;  // facet -> polygons (2+ vertices) -> vertices
+  std::vector<std::vector<std::uint32_t>> facet_points;         // facet -> its lone vertices (1-vertex polygons)
   double tol = 0;                                               // "on a segment / plane", metres
 
   explicit EditablePlc(Plc& p) : plc(p) {
     facets.resize(plc.facet_count());
+    facet_points.resize(plc.facet_count());
     for (std::size_t f = 0; f < plc.facet_count(); ++f)
-      for (std::uint32_t g = plc.facet_polygon_begin[f]; g < plc.facet_polygon_begin[f + 1]; ++g)
-        facets[f].emplace_back(plc.polygon_vertices.begin() + plc.polygon_vertex_begin[g],
-                               plc.polygon_vertices.begin() + plc.polygon_vertex_begin[g + 1]);
+      for (std::uint32_t g = plc.facet_polygon_begin[f]; g < plc.facet_polygon_begin[f + 1]; ++g) {
+        const std::uint32_t b = plc.polygon_vertex_begin[g], e = plc.polygon_vertex_begin[g + 1];
+        if (e - b == 1)
+          facet_points[f].push_back(plc.polygon_vertices[b]);
+        else
+          facets[f].emplace_back(plc.polygon_vertices.begin() + b, plc.polygon_vertices.begin() + e);
+      }
     Vec lo{}, hi{};
     for (std::size_t i = 0; i < plc.point_count(); ++i)
       for (std::size_t k = 0; k < 3; ++k) {
@@ -254,12 +274,12 @@ struct EditablePlc {
     for (const ThinLayer& l : layers) {
       const Vec nrm{l.normal[0], l.normal[1], l.normal[2]};
       if (!l.contains(p.data())) continue;
-      const double h = dot(nrm, p), gap = l.hi - l.lo;
+      const double h = dot(nrm, p);
       Vec q;
       if (std::abs(h - l.lo) <= l.tolerance)
-        q = add(p, scale(nrm, gap));
+        q = onto_layer_plane(l, p, l.hi);
       else if (std::abs(h - l.hi) <= l.tolerance)
-        q = sub(p, scale(nrm, gap));
+        q = onto_layer_plane(l, p, l.lo);
       else
         continue;
       if (!exists(q) && insert_surface_point(q)) ++n;
@@ -271,9 +291,13 @@ struct EditablePlc {
     plc.facet_polygon_begin.assign(1, 0);
     plc.polygon_vertex_begin.assign(1, 0);
     plc.polygon_vertices.clear();
-    for (const auto& polys : facets) {
-      for (const auto& poly : polys) {
+    for (std::size_t f = 0; f < facets.size(); ++f) {
+      for (const auto& poly : facets[f]) {
         plc.polygon_vertices.insert(plc.polygon_vertices.end(), poly.begin(), poly.end());
+        plc.polygon_vertex_begin.push_back(static_cast<std::uint32_t>(plc.polygon_vertices.size()));
+      }
+      for (std::uint32_t v : facet_points[f]) {
+        plc.polygon_vertices.push_back(v);
         plc.polygon_vertex_begin.push_back(static_cast<std::uint32_t>(plc.polygon_vertices.size()));
       }
       plc.facet_polygon_begin.push_back(static_cast<std::uint32_t>(plc.polygon_vertex_begin.size() - 1));
