@@ -30,8 +30,9 @@ struct ThinLayer {
   bool contains(const double* p) const;
 };
 
-// Default aspect: layers 30 times wider than thick are exempt (a 1 mm substrate 14 mm wide is not).
-inline constexpr double kThinLayerAspect = 30;
+// Default aspect: layers 100 times wider than thick are exempt (TetGen would put ~(100/1)^2 x 6 tets
+// of the thickness in one; a 1 mm substrate 14 mm wide or a 0.8 mm ceramic 30 mm wide is not thin).
+inline constexpr double kThinLayerAspect = 100;
 
 // The thin layers between pairs of parallel facets (see above). A layer that lies inside a larger one
 // is dropped. Facets whose polygons are degenerate are ignored. O(facets^2).
