@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "foxi/model/delaunay.hpp"
 #include "layer_refinement.hpp"
@@ -52,9 +53,12 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   copt.max_listed = std::numeric_limits<std::size_t>::max();
   Plc previous;
   Mesh previous_mesh;
+  std::map<std::int32_t, double> first_volumes;
   for (std::size_t it = 0;; ++it) {
     try {
-      mesh = mesh_plc_retrying(current, p, &rep.tetgen);
+      mesh = mesh_plc(current, p, &rep.tetgen);
+      if (it == 0) first_volumes = region_volumes(mesh);
+      if (it > 0 && !same_region_volumes(first_volumes, region_volumes(mesh))) throw MesherError(2, "regions lost");
     } catch (const MesherError& e) {
       if (it == 0 || e.tetgen_code() != 2) throw;
       current = std::move(previous);

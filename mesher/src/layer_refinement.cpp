@@ -147,9 +147,12 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
   Mesh mesh;
   Plc previous;
   Mesh previous_mesh;
+  std::map<std::int32_t, double> first_volumes;
   for (std::size_t it = 0;; ++it) {
     try {
-      mesh = mesh_plc_retrying(current, p, &rep.tetgen);
+      mesh = mesh_plc(current, p, &rep.tetgen);
+      if (it == 0) first_volumes = region_volumes(mesh);
+      if (it > 0 && !same_region_volumes(first_volumes, region_volumes(mesh))) throw MesherError(2, "regions lost");
     } catch (const MesherError& e) {
       if (it == 0 || e.tetgen_code() != 2) throw;
       current = std::move(previous);

@@ -232,15 +232,24 @@ std::size_t weld_coincident_points(Plc& plc, double relative_tol) {
   return merged;
 }
 
-Mesh mesh_plc_retrying(const Plc& plc, const MeshParams& params, MeshReport* report) {
-  try {
-    return mesh_plc(plc, params, report);
-  } catch (const MesherError& e) {
-    if (e.tetgen_code() != 2 || params.preserve_surface) throw;  // 2: crashed or internal error
-    MeshParams again = params;
-    again.preserve_surface = true;
-    return mesh_plc(plc, again, report);
+std::map<std::int32_t, double> region_volumes(const Mesh& mesh) {
+  std::map<std::int32_t, double> v;
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const std::uint32_t* n = &mesh.tet[4 * t];
+    const Vec a = at(mesh.xyz, n[0]);
+    v[mesh.region_of(t)] +=
+        std::abs(dot(sub(at(mesh.xyz, n[1]), a), cross(sub(at(mesh.xyz, n[2]), a), sub(at(mesh.xyz, n[3]), a)))) / 6;
   }
+  return v;
+}
+
+bool same_region_volumes(const std::map<std::int32_t, double>& a, const std::map<std::int32_t, double>& b) {
+  if (a.size() != b.size()) return false;
+  for (const auto& [id, vol] : a) {
+    const auto it = b.find(id);
+    if (it == b.end() || std::abs(it->second - vol) > 1e-9 * std::max(vol, it->second)) return false;
+  }
+  return true;
 }
 
 bool NearPoints::near(const Vec& p, double r) const {

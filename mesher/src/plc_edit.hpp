@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <unordered_map>
 #include <vector>
 
@@ -342,9 +343,11 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
 // Returns the number of points merged.
 std::size_t weld_coincident_points(Plc& plc, double relative_tol = 1e-12);
 
-// mesh_plc, and once more with params.preserve_surface if TetGen crashed (TetGen 1.5.0's segment
-// recovery can fail on a refined PLC that it meshes when it adds no points on segments).
-Mesh mesh_plc_retrying(const Plc& plc, const MeshParams& params, MeshReport* report);
+// Volume per tet region. A refinement only adds points on the PLC's facets and inside its regions,
+// so every round's mesh must have the first mesh's regions and volumes: a round that does not
+// (TetGen lost a facet of the refined PLC and a region leaked into another) is rejected.
+std::map<std::int32_t, double> region_volumes(const Mesh& mesh);
+bool same_region_volumes(const std::map<std::int32_t, double>& a, const std::map<std::int32_t, double>& b);
 
 // Points added in one refinement pass, for "is there one within r of p" (a hashed uniform grid).
 class NearPoints {

@@ -100,7 +100,7 @@ std::string format_quality_report(const MeshQualityReport& r) {
     put("delaunay: NO, %zu tets have a vertex inside their circumsphere (the first -O0 mesh had %zu)",
         r.violating_tets, r.first_mesh_violations);
   if (r.tetgen_failed)
-    put("refinement stopped early: TetGen failed on the refined PLC; this is the last mesh it made");
+    put("refinement stopped early: TetGen failed on the refined PLC (or lost a region); this is the last good mesh");
   put("time: %.3f s meshing and refinement, of which %.3f s certificates", r.mesh_seconds, r.certificate_seconds);
   return s;
 }

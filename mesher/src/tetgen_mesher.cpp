@@ -238,7 +238,6 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   for (const RegionSeed& s : plc.regions) any_region_volume = any_region_volume || s.max_volume > 0;
   if (params.max_volume > 0) sw += "a" + format_number(params.max_volume);
   if (any_region_volume) sw += "a";
-  if (params.preserve_surface) sw += "Y";
   if (!params.optimize) sw += "O0";
   tetgenio background;
   const bool sized = params.size_field && !params.size_field->empty();

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/mesher/conforming.hpp"
 #include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/io_error.hpp"
@@ -45,7 +46,7 @@ Solved mesh_model(const std::filesystem::path& file, std::vector<std::string> se
   s.structure = build_structure(s.model);
   Plc plc = s.structure.plc;
   const ModelMeshParams mp = mesh_params_from_model(s.model, plc);
-  s.mesh = mesh_plc(plc, mp.params);
+  s.mesh = mesh_conforming(plc, mp.params);  // the path foxi solve MODEL takes
   name_mesh(s.model, s.structure, s.mesh);
   validate_and_repair(s.mesh);
   return s;

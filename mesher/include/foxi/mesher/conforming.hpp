@@ -42,8 +42,9 @@ struct ConformingReport {
   std::size_t iterations = 0;              // TetGen re-runs after the first
   std::vector<std::size_t> violations;     // non-Delaunay tets after each TetGen run
   bool delaunay = false;                   // the final mesh passed the exact certificate
-  // TetGen 1.5.0 failed on a refined PLC (its segment recovery asserts on some inputs): the last
-  // mesh it made is returned, with that mesh's certificate, and refinement stops.
+  // TetGen 1.5.0 failed on a refined PLC (its segment recovery asserts on some inputs), or its mesh
+  // of it lost a region (a region's volume changed): the last good mesh is returned, with that
+  // mesh's certificate, and refinement stops.
   bool tetgen_failed = false;
   double seconds = 0;                      // all TetGen runs, certificates and splits
   // Thin layers (thin_layers.hpp; MeshParams::thin_layer_aspect): when the PLC has any, TetGen runs

@@ -28,9 +28,6 @@ struct MeshParams {
   double thin_layer_aspect = kThinLayerAspect;
   bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
   bool regions = true;        // region seeds give tet regions (TetGen -A)
-  // TetGen -Y: no Steiner points on the PLC's facets and segments (the refinements put their own
-  // points there); the conforming refinement retries a run TetGen crashed on with it.
-  bool preserve_surface = false;
   // A sizing function (TetGen -m with a background mesh, size_field.hpp); null or empty: none. It must
   // outlive the call.
   const SizeField* size_field = nullptr;
