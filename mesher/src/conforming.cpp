@@ -10,6 +10,7 @@
 #include "foxi/model/delaunay.hpp"
 #include "layer_refinement.hpp"
 #include "plc_edit.hpp"
+#include "refinement_round.hpp"
 
 namespace foxi {
 
@@ -38,43 +39,16 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   detail::weld_coincident_points(current);
   Mesh mesh;
   const std::vector<ThinLayer> layers =
-      params.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 || (params.size_field && !params.size_field->empty()) ||
+      conforming.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 || (params.size_field && !params.size_field->empty()) ||
                                        std::any_of(plc.regions.begin(), plc.regions.end(), [](const RegionSeed& s) { return s.max_volume > 0; }))
-          ? find_thin_layers(plc, params.thin_layer_aspect)
+          ? find_thin_layers(plc, conforming.thin_layer_aspect)
           : std::vector<ThinLayer>{};
-  if (!layers.empty()) {
-    mesh = detail::refine_with_thin_layers(params, conforming, layers, current, rep);
-    rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (report) *report = rep;
-    if (refined_plc) *refined_plc = std::move(current);
-    return mesh;
-  }
-  CertificateOptions copt;
-  copt.max_listed = std::numeric_limits<std::size_t>::max();
-  Plc previous;
-  Mesh previous_mesh;
-  std::map<std::int32_t, double> first_volumes;
-  for (std::size_t it = 0;; ++it) {
-    try {
-      mesh = mesh_plc(current, p, &rep.tetgen);
-      if (it == 0) first_volumes = region_volumes(mesh);
-      if (it > 0 && !same_region_volumes(first_volumes, region_volumes(mesh))) throw MesherError(2, "regions lost");
-    } catch (const MesherError& e) {
-      if (it == 0 || e.tetgen_code() != 2) throw;
-      current = std::move(previous);
-      mesh = std::move(previous_mesh);
-      rep.tetgen_failed = true;
-      break;
-    }
-    const auto c0 = std::chrono::steady_clock::now();
-    const DelaunayCertificate cert = compute_delaunay_certificate(mesh, copt);
-    rep.certificate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
-    rep.violations.push_back(cert.violating_tet_count);
-    if (it == 0) {
-      rep.first_mesh_points = mesh.node_count();
-      rep.first_mesh_violations = cert.violating_tet_count;
-    }
-    rep.delaunay = cert.delaunay;
+  RefinementRounds rounds(p, rep);
+  if (!layers.empty()) mesh = detail::refine_with_thin_layers(params, conforming, layers, current, rep);
+  for (std::size_t it = 0; layers.empty(); ++it) {
+    const std::optional<DelaunayCertificate> round = rounds.run(it, current, mesh);
+    if (!round) break;
+    const DelaunayCertificate& cert = *round;
     if (cert.delaunay || it >= conforming.max_iterations) break;
     const double budget =
         std::max(conforming.max_added_fraction * double(rep.first_mesh_points), double(conforming.min_added_budget));
@@ -82,10 +56,9 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     if (params.progress &&
         !params.progress("conforming refinement", double(it + 1) / double(conforming.max_iterations + 1)))
       throw MesherError(-1, "meshing cancelled");
-    previous = current;
+    rounds.keep(current, mesh);
     const std::size_t n = split_encroached_constraints(mesh, cert.violating_tets, current);
     if (n == 0) break;
-    previous_mesh = mesh;
     rep.added_points += n;
     rep.iterations = it + 1;
   }

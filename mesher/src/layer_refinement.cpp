@@ -1,13 +1,13 @@
 #include "layer_refinement.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
 
 #include "foxi/model/delaunay.hpp"
 #include "plc_edit.hpp"
+#include "refinement_round.hpp"
 
 namespace foxi::detail {
 
@@ -141,34 +141,13 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
   // matrix singular in all but name.
   const double min_dihedral = std::max(params.min_dihedral, 1.0);
   const double cos_min = std::cos(min_dihedral * 3.14159265358979323846 / 180);
-  CertificateOptions copt;
-  copt.max_listed = std::numeric_limits<std::size_t>::max();
   rep.thin_layers = layers;
   Mesh mesh;
-  Plc previous;
-  Mesh previous_mesh;
-  std::map<std::int32_t, double> first_volumes;
+  RefinementRounds rounds(p, rep);
   for (std::size_t it = 0;; ++it) {
-    try {
-      mesh = mesh_plc(current, p, &rep.tetgen);
-      if (it == 0) first_volumes = region_volumes(mesh);
-      if (it > 0 && !same_region_volumes(first_volumes, region_volumes(mesh))) throw MesherError(2, "regions lost");
-    } catch (const MesherError& e) {
-      if (it == 0 || e.tetgen_code() != 2) throw;
-      current = std::move(previous);
-      mesh = std::move(previous_mesh);
-      rep.tetgen_failed = true;
-      break;
-    }
-    const auto c0 = std::chrono::steady_clock::now();
-    const DelaunayCertificate cert = compute_delaunay_certificate(mesh, copt);
-    rep.certificate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - c0).count();
-    rep.violations.push_back(cert.violating_tet_count);
-    if (it == 0) {
-      rep.first_mesh_points = mesh.node_count();
-      rep.first_mesh_violations = cert.violating_tet_count;
-    }
-    rep.delaunay = cert.delaunay;
+    const std::optional<DelaunayCertificate> round = rounds.run(it, current, mesh);
+    if (!round) break;
+    const DelaunayCertificate& cert = *round;
 
     // Tets over a bound.
     const std::size_t nt = mesh.tet_count();
@@ -225,7 +204,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
             std::abs(dot(n, Vec{l.normal[0], l.normal[1], l.normal[2]})) < (1 - 1e-6) * std::sqrt(norm2(n)))
           side_wall[f] = 1;
     }
-    previous = current;
+    rounds.keep(current, mesh);
     EditablePlc edit(current);
     edit.layers = layers;
     NearPoints added(search.vertices.cell);
@@ -284,7 +263,6 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
     for (const Vec& c : interior) current.points.insert(current.points.end(), c.begin(), c.end());
     const std::size_t n_quality = n_faces + n_layer + interior.size();
     if (n_conform + n_quality == 0) break;
-    previous_mesh = mesh;
     rep.added_points += n_conform;
     rep.quality_points += n_quality;
     rep.iterations = it + 1;

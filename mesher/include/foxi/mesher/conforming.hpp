@@ -29,6 +29,10 @@ namespace foxi {
 struct ConformingParams {
   std::size_t max_iterations = 12;  // TetGen runs after the first
   std::size_t max_layer_iterations = 60;  // with thin layers: refinement rounds (one TetGen run each)
+  // Thin layers at least this many times wider than thick are exempt from the quality bounds
+  // (thin_layers.hpp), and foxi then refines by itself; 0: no exemption (TetGen's refinement then
+  // fills a thin layer with tets as wide as it is thick).
+  double thin_layer_aspect = kThinLayerAspect;
   double max_added_fraction = 0.15; // stop once the points added exceed this fraction of the
                                     // first (-O0) mesh's point count ...
   std::size_t min_added_budget = 100; // ... or this many, whichever is more (small meshes)
@@ -47,7 +51,7 @@ struct ConformingReport {
   // mesh's certificate, and refinement stops.
   bool tetgen_failed = false;
   double seconds = 0;                      // all TetGen runs, certificates and splits
-  // Thin layers (thin_layers.hpp; MeshParams::thin_layer_aspect): when the PLC has any, TetGen runs
+  // Thin layers (thin_layers.hpp; ConformingParams::thin_layer_aspect): when the PLC has any, TetGen runs
   // without its own refinement (which would fill them with tets as wide as they are thick) and foxi
   // refines for quality and size itself, outside the layers.
   std::vector<ThinLayer> thin_layers;

@@ -11,7 +11,6 @@
 #include <string>
 
 #include "foxi/mesher/size_field.hpp"
-#include "foxi/mesher/thin_layers.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/progress.hpp"
@@ -22,10 +21,6 @@ struct MeshParams {
   double max_volume = 0;      // global maximum tet volume (m^3); 0: none
   double radius_edge = 1.414; // radius-edge bound for quality refinement; 0: no quality refinement
   double min_dihedral = 0;    // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
-  // Thin layers at least this many times wider than thick are exempt from the quality bounds
-  // (thin_layers.hpp) in mesh_conforming, which then refines by itself; 0: no exemption (TetGen's
-  // refinement then fills a thin layer with tets as wide as it is thick). mesh_plc ignores it.
-  double thin_layer_aspect = kThinLayerAspect;
   bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
   bool regions = true;        // region seeds give tet regions (TetGen -A)
   // A sizing function (TetGen -m with a background mesh, size_field.hpp); null or empty: none. It must
