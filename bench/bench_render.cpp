@@ -8,7 +8,10 @@
 //   painter_draw_undoable painter_draw recording what undraw needs (saved pixels of unshared back
 //                     faces); counter undo_MB = memory held for undraw after the whole mesh is drawn
 //   undraw_front10    (after an untimed undoable draw of all tets) undraw the front 10% of the order
-//                     in 10 frames of 1%, each frame copied out as a display would; counters
+//                     in 10 frames of 1%, each frame presented as a display would (the rectangle the
+//                     frame changed, changed_rect, copied into the displayed image, checked untimed
+//                     to equal the frame: shown_wrong_px must be 0; rect_px_per_frame its size);
+//                     counters
 //                     ms_per_frame, tets_per_s (tets undrawn), undo_MB, px_per_frame (pixels a frame
 //                     changes, counted untimed: the work a frame must do), and the issue 4 target
 //                     (undrawing the 10 frames in at most a fifth of a full redraw): redraw_ms, a
@@ -99,13 +102,22 @@ void run(benchmark::State& state, bool depth, bool with_order, double shrink, in
   counters(state, c);
 }
 
+// A display's update after a frame: the rectangle of fb the last call changed, copied into `shown`
+// (what the display holds) row by row, as XPutImage of a sub-image would.
+void present(const Framebuffer& fb, const PixelRect& rect, Framebuffer& shown) {
+  if (rect.x0 > rect.x1) return;
+  for (int y = rect.y0; y <= rect.y1; ++y)
+    std::copy_n(fb.rgba.begin() + std::ptrdiff_t(fb.index(rect.x0, y)), rect.x1 - rect.x0 + 1,
+                shown.rgba.begin() + std::ptrdiff_t(shown.index(rect.x0, y)));
+}
+
 // The whole order drawn undoably (timed or not), then (undraw) the front 10% undrawn in 10 frames.
 void run_undo(benchmark::State& state, bool undraw) {
   Case& c = get_case(int(state.range(0)));
   RenderParams params;
   params.undoable = true;
   Framebuffer fb(kWidth, kHeight), shown(kWidth, kHeight), before(kWidth, kHeight);
-  std::size_t i = 0, undo_bytes = 0, changed = 0;
+  std::size_t i = 0, undo_bytes = 0, changed = 0, mismatch = 0, presented = 0;
   double undraw_ms = 0, undraw_cpu_ms = 0, redraw_ms = 0, redraw_cpu_ms = 0;
   std::vector<std::uint32_t> order;
   constexpr int kFrames = 10;
@@ -131,17 +143,23 @@ void run_undo(benchmark::State& state, bool undraw) {
       const std::size_t step = order.size() / 100;
       before.id = fb.id;
       before.rgba = fb.rgba;
+      shown.rgba = fb.rgba;  // on the display
       state.ResumeTiming();
       auto t0 = std::chrono::steady_clock::now();
       double c0 = process_cpu_ms();
       double frame_ms = 0;
       for (int f = 0; f < kFrames; ++f) {
         r->undraw(fb, step);
-        std::copy(fb.rgba.begin(), fb.rgba.end(), shown.rgba.begin());  // the frame shown
+        present(fb, r->changed_rect(), shown);  // the frame shown
         frame_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         undraw_cpu_ms += process_cpu_ms() - c0;
-        state.PauseTiming();  // how many pixels the frame changed (colour or id)
-        for (std::size_t p = 0; p < fb.id.size(); ++p) changed += fb.id[p] != before.id[p] || fb.rgba[p] != before.rgba[p];
+        state.PauseTiming();  // how many pixels the frame changed (colour or id), and presented
+        const PixelRect rect = r->changed_rect();
+        if (rect.x0 <= rect.x1) presented += std::size_t(rect.x1 - rect.x0 + 1) * std::size_t(rect.y1 - rect.y0 + 1);
+        for (std::size_t p = 0; p < fb.id.size(); ++p) {
+          changed += fb.id[p] != before.id[p] || fb.rgba[p] != before.rgba[p];
+          mismatch += fb.rgba[p] != shown.rgba[p];
+        }
         before.id = fb.id;
         before.rgba = fb.rgba;
         state.ResumeTiming();
@@ -172,6 +190,8 @@ void run_undo(benchmark::State& state, bool undraw) {
     state.counters["redraw_ms"] = redraw_ms / double(state.iterations());
     state.counters["ratio"] = undraw_ms / redraw_ms;
     state.counters["cpu_ratio"] = undraw_cpu_ms / redraw_cpu_ms;
+    state.counters["rect_px_per_frame"] = double(presented) / double(state.iterations() * kFrames);
+    state.counters["shown_wrong_px"] = double(mismatch);  // displayed pixels unlike fb: must be 0
   }
 }
 

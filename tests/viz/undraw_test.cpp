@@ -184,6 +184,66 @@ TEST(Undraw, SavedPixelsOfAConvexMeshAreItsSilhouette) {
   }
 }
 
+// changed_rect() after each draw() and undraw() (batches of random sizes, painter undoable, plain
+// painter and depth-buffer mode; eyes outside and inside, so that some tets are cut by the near
+// plane) holds every pixel the call changed, found by comparing the picture before and after; it is
+// empty after an empty call and inside the image.
+TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
+  test::TempDir dir;
+  Mesh m = test::random_delaunay(dir, 700, 89, 2, 1, 1);
+  test::regions_along_x(m, 0.7, 1.3);
+  const SphereTable table = compute_spheres(m);
+  std::mt19937 rng(31);
+  std::size_t changed_calls = 0, partial_calls = 0;
+  for (const Camera& cam : test::random_cameras(m, 9, 37, double(kW) / kH)) {
+    const auto order = visibility_order(m, table, view_of(cam));
+    const std::span<const std::uint32_t> all(order);
+    for (int mode = 0; mode < 3; ++mode) {
+      RenderParams p;
+      p.undoable = mode == 0;
+      p.depth_buffer = mode == 2;
+      TetRasterizer r(m, cam, kW, kH, p);
+      Framebuffer fb(kW, kH, p.depth_buffer);
+      auto check = [&](const Framebuffer& before, const char* what) {
+        const PixelRect rect = r.changed_rect();
+        std::size_t outside = 0, changed = 0;
+        for (int y = 0; y < kH; ++y)
+          for (int x = 0; x < kW; ++x) {
+            const std::size_t i = fb.index(x, y);
+            if (fb.rgba[i] == before.rgba[i] && fb.id[i] == before.id[i]) continue;
+            ++changed;
+            outside += x < rect.x0 || x > rect.x1 || y < rect.y0 || y > rect.y1;
+          }
+        EXPECT_EQ(outside, 0u) << what << " mode " << mode;
+        if (rect.x0 <= rect.x1) {
+          EXPECT_TRUE(rect.x0 >= 0 && rect.y0 >= 0 && rect.x1 < kW && rect.y1 < kH && rect.y0 <= rect.y1);
+          partial_calls += (rect.x1 - rect.x0 + 1) * (rect.y1 - rect.y0 + 1) < kW * kH;
+        }
+        changed_calls += changed > 0;
+      };
+      std::size_t at = 0;
+      for (std::size_t s : random_cuts(order.size(), 1 + order.size() / 6, rng)) {
+        const Framebuffer before = fb;
+        r.draw(fb, all.subspan(at, s));
+        at += s;
+        check(before, "draw");
+      }
+      r.draw(fb, all.subspan(at, 0));
+      EXPECT_GT(r.changed_rect().x0, r.changed_rect().x1) << "an empty draw changes nothing";
+      if (mode != 0) continue;
+      for (std::size_t s : random_cuts(order.size(), 1 + order.size() / 6, rng)) {
+        const Framebuffer before = fb;
+        r.undraw(fb, s);
+        check(before, "undraw");
+      }
+      r.undraw(fb, 0);
+      EXPECT_GT(r.changed_rect().x0, r.changed_rect().x1) << "an empty undraw changes nothing";
+    }
+  }
+  EXPECT_GT(changed_calls, 50u);
+  EXPECT_GT(partial_calls, 20u) << "some calls should change less than the whole image";
+}
+
 TEST(Undraw, BadUseIsRejected) {
   Mesh m = test::grid_mesh(2, 2, 2, 1, 1, 1, 5);
   Camera cam;

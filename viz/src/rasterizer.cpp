@@ -159,6 +159,12 @@ struct PolyVertex {
   bool mesh_edge = true;  // the edge from this vertex to the next is (part of) a mesh edge
 };
 
+// A face's flat colour (before edge darkening): packed, and its channels unrounded.
+struct FaceShade {
+  std::uint32_t color = 0;
+  float r = 0, g = 0, b = 0;
+};
+
 // Everything a face's pixels need.
 struct FaceSetup {
   std::uint32_t tet = 0;
@@ -260,6 +266,18 @@ struct TetRasterizer::Impl {
   std::vector<std::uint64_t> shown;
   std::vector<std::uint32_t> slot, before_rgba, before_id;
   std::vector<std::uint8_t> need_save;  // per batch tet
+  // Per undraw() call, per undrawn tet (in drawing order): what the walk over its rows needs, found
+  // up front on both threads, where the lookups of consecutive tets (scattered over the mesh's
+  // arrays) overlap, rather than in the walk, where each thread would wait for them in turn.
+  struct UndrawTet {
+    Box box;                         // as tet_box; y0 < 0: cut by the near plane (walked the slow way)
+    std::int32_t X[4], Y[4];         // fixed-point corners (box.y0 >= 0)
+    std::uint8_t repaint = 0;        // bit f: back face f is shared with a kept tet (box.y0 >= 0)
+    std::uint32_t neighbour[4];      // repaint face f: that tet's face (4 tet + face)
+    FaceShade shade[4];              // repaint face f: that tet's front face's flat colour
+  };
+  std::vector<UndrawTet> undrawn;
+  PixelRect changed;  // see changed_rect
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
       : mesh(&m), proj(c, w, h), params(p) {
@@ -398,11 +416,9 @@ struct TetRasterizer::Impl {
     project_camera(c, X, Y, st);
   }
 
-  // Shading and edge lines of a face; `v` = the face's three corners (camera frame)
-  // in outward order; poly = the polygon to draw (positive area), n its size.
-  void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const PolyVertex* poly,
-                  int n) const {
-    fs.tet = tet;
+  // The flat shade of tet `tet`'s face whose corners are `v` (camera frame) in outward order: its
+  // region's colour, Lambert + ambient.
+  FaceShade face_shade(std::uint32_t tet, const double* const v[3]) const {
     double u[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
     double w[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
     double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
@@ -415,10 +431,28 @@ struct TetRasterizer::Impl {
     std::uint32_t base = region >= 0 && std::size_t(region) < params.region_colors.size()
                              ? params.region_colors[std::size_t(region)]
                              : region_color(region);
-    fs.r = float((base & 255u) * intensity);
-    fs.g = float(((base >> 8) & 255u) * intensity);
-    fs.b = float(((base >> 16) & 255u) * intensity);
-    fs.color = pack_rgba(std::uint32_t(fs.r + 0.5f), std::uint32_t(fs.g + 0.5f), std::uint32_t(fs.b + 0.5f));
+    FaceShade sh;
+    sh.r = float((base & 255u) * intensity);
+    sh.g = float(((base >> 8) & 255u) * intensity);
+    sh.b = float(((base >> 16) & 255u) * intensity);
+    sh.color = pack_rgba(std::uint32_t(sh.r + 0.5f), std::uint32_t(sh.g + 0.5f), std::uint32_t(sh.b + 0.5f));
+    return sh;
+  }
+
+  // Shading and edge lines of a face; `v` = the face's three corners (camera frame)
+  // in outward order; poly = the polygon to draw (positive area), n its size.
+  void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const PolyVertex* poly,
+                  int n) const {
+    setup_face(fs, tet, face_shade(tet, v), poly, n);
+  }
+
+  // The same with the shade known.
+  void setup_face(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly, int n) const {
+    fs.tet = tet;
+    fs.r = sh.r;
+    fs.g = sh.g;
+    fs.b = sh.b;
+    fs.color = sh.color;
     fs.lines = 0;
     if (params.edges) {
       for (int i = 0; i < n; ++i) {
@@ -745,12 +779,14 @@ struct TetRasterizer::Impl {
     return box;
   }
 
-  // Hints the cache about tet t's corners (the batch order jumps around the mesh).
-  void prefetch_tet(std::uint32_t t) const {
+  // Hints the cache about tet t's corners (the batch order jumps around the mesh), their camera
+  // coordinates too if `camera`.
+  void prefetch_tet(std::uint32_t t, bool camera = false) const {
     const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+    camera = camera || params.shrink != 1;
     for (int k = 0; k < 4; ++k) {
       __builtin_prefetch(&fix[tv[k]]);
-      if (params.shrink != 1) __builtin_prefetch(&cam[3 * std::size_t(tv[k])]);
+      if (camera) __builtin_prefetch(&cam[3 * std::size_t(tv[k])]);
     }
   }
 
@@ -974,8 +1010,10 @@ struct TetRasterizer::Impl {
     for (std::uint32_t t : tets)
       if (t >= tc) throw std::out_of_range("render: tet index " + std::to_string(t) + " out of range");
     stats.tets_drawn += tets.size();
+    changed = PixelRect{};
     if (!params.undoable) {
       draw_batch(fb, tets);
+      if (!reverse) changed = boxes_union(tets.size());  // the painter's clear_mask found it
       return;
     }
     // Undoable: positions first (a back face is shared with a tet drawn earlier), then one
@@ -1100,20 +1138,26 @@ struct TetRasterizer::Impl {
     if (reverse && !recording) clear_mask(tets.size());
   }
 
-  // Zeroes the written-pixel mask on the rows the batch's boxes span (all rows if a box is unknown).
-  void clear_mask(std::size_t n) {
-    int y0 = proj.height, y1 = -1;
+  // The union of the first n boxes of the batch (the whole image if one is unknown): where drawing or
+  // undrawing them may have changed pixels.
+  PixelRect boxes_union(std::size_t n) const {
+    PixelRect r{proj.width, proj.height, -1, -1};
     for (std::size_t i = 0; i < n; ++i) {
       const Box& b = boxes[i];
       if (b.x0 > b.x1) continue;
-      if (b.y0 < 0) {
-        y0 = 0;
-        y1 = proj.height - 1;
-        break;
-      }
-      y0 = std::min(y0, b.y0);
-      y1 = std::max(y1, b.y1);
+      if (b.y0 < 0) return PixelRect{0, 0, proj.width - 1, proj.height - 1};
+      r.x0 = std::min(r.x0, b.x0);
+      r.x1 = std::max(r.x1, b.x1);
+      r.y0 = std::min(r.y0, b.y0);
+      r.y1 = std::max(r.y1, b.y1);
     }
+    return r.x0 <= r.x1 ? r : PixelRect{};
+  }
+
+  // Zeroes the written-pixel mask on the rows the batch's boxes span; `changed` becomes their union.
+  void clear_mask(std::size_t n) {
+    changed = boxes_union(n);
+    const int y0 = changed.y0, y1 = changed.y1;
     if (y0 > y1) return;
     const std::size_t words = std::size_t(mask_words);
     std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
@@ -1206,6 +1250,38 @@ struct TetRasterizer::Impl {
     lane.saved_id.resize(saved_pixel.size());
   }
 
+  // Fills u for undrawn tet t (undraw of the tets from position `first` on): its box, and unless the
+  // near plane cuts it, its corners and its back faces shared with kept tets (drawn before `first`),
+  // which the walk repaints as those tets' front faces, with their shades. A face is back when its
+  // outward-ordered projection has positive area (face_polygon's test); the neighbour's front face
+  // is shaded from the neighbour's own corner order, bit for bit as drawing it did.
+  void gather_undrawn(std::uint32_t t, std::size_t first, int width, int height, UndrawTet& u) const {
+    TetCorners k;
+    load_corners(t, k);
+    u.box = tet_box(k, width, height);
+    u.repaint = 0;
+    if (u.box.x0 > u.box.x1 || u.box.y0 < 0) return;
+    for (int j = 0; j < 4; ++j) {
+      u.X[j] = std::int32_t(k.X[j]);
+      u.Y[j] = std::int32_t(k.Y[j]);
+    }
+    if (params.shrink != 1) return;  // no face is shared
+    const std::uint32_t* nbs = &adjacency->neighbour[4 * std::size_t(t)];
+    for (int f = 0; f < 4; ++f) {
+      const std::uint32_t nb = nbs[f];
+      if (nb == kNone || drawn_at[nb >> 2] >= first) continue;
+      const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
+      if ((k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) <= 0) continue;
+      const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
+      const auto& face = kFace[nb & 3];
+      const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
+                            &cam[3 * std::size_t(nv[face[2]])]};
+      u.repaint = std::uint8_t(u.repaint | (1 << f));
+      u.neighbour[f] = nb;
+      u.shade[f] = face_shade(nb >> 2, v);
+    }
+  }
+
   // Takes back the last `count` tets. Sequentially (front to back) each tet's back-face pixels are
   // repainted; the last write to a pixel is by the farthest undrawn tet covering it, so the tets are
   // walked back to front instead and each pixel is written once, first write wins (the mask). Each
@@ -1214,6 +1290,7 @@ struct TetRasterizer::Impl {
     if (!params.undoable) throw std::logic_error("render: undraw needs RenderParams::undoable");
     check_framebuffer(fb);
     if (count > history.size()) throw std::out_of_range("render: undraw of more tets than are drawn");
+    changed = PixelRect{};
     if (count == 0) return;
     if (written.empty()) {
       written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
@@ -1226,12 +1303,22 @@ struct TetRasterizer::Impl {
                          lane.saves.begin());
     };
     boxes.resize(count);
+    undrawn.resize(count);
     auto find_boxes = [&](std::size_t begin, std::size_t end) {
       constexpr std::size_t kAhead = 8;  // the undrawn tets lie all over the mesh's arrays
       for (std::size_t i = begin; i < end; ++i) {
-        if (i + kAhead < end) prefetch_tet(history[first + i + kAhead]);
-        if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(history[first + i + 2 * kAhead])]);
-        boxes[i] = tet_box(history[first + i], fb.width, fb.height);
+        if (i + 2 * kAhead < end) {
+          const std::uint32_t ahead = history[first + i + 2 * kAhead];
+          __builtin_prefetch(&mesh->tet[4 * std::size_t(ahead)]);
+          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(ahead)]);
+        }
+        if (i + kAhead < end) {
+          const std::uint32_t ahead = history[first + i + kAhead];
+          prefetch_tet(ahead, true);  // the shared faces' shading reads the corners' camera coordinates
+          prefetch_neighbours(ahead, true);
+        }
+        gather_undrawn(history[first + i], first, fb.width, fb.height, undrawn[i]);
+        boxes[i] = undrawn[i].box;
       }
     };
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
@@ -1242,11 +1329,7 @@ struct TetRasterizer::Impl {
                           p_hi = std::uint32_t(rows.hi + 1) * std::uint32_t(fb.width);
       std::vector<std::size_t> save(lanes.size());
       for (std::size_t l = 0; l < lanes.size(); ++l) save[l] = first_save(lanes[l]);
-      constexpr std::size_t kAhead = 8;
       for (std::size_t i = 0; i < count; ++i) {
-        if (i + 2 * kAhead < count)
-          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(history[first + i + 2 * kAhead])]);
-        if (i + kAhead < count) prefetch_neighbours(history[first + i + kAhead], true);
         const std::uint32_t t = history[first + i];
         const Box& b = boxes[i];
         const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || (rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height)));
@@ -1269,18 +1352,34 @@ struct TetRasterizer::Impl {
           }
         }
         if (!shows) continue;
-        for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
-          // A back face shared with a tet drawn before the batch is repainted as that tet's front
-          // face: the same polygon (face_polygon), its corners in the neighbour's order for the
-          // shading. One shared with an earlier tet of the batch is already written: that tet, met
-          // before t in this walk, wrote every pixel of its projection in these rows.
+        const UndrawTet& u = undrawn[i];
+        if (b.y0 >= 0) {
+          // Each back face shared with a kept tet is repainted as that tet's front face: the same
+          // polygon (face_polygon's back order), in its colour. One shared with an earlier tet of the
+          // batch is already written: that tet, met before t in this walk, wrote every pixel of its
+          // projection in these rows.
+          for (int f = 0; f < 4; ++f) {
+            if (!(u.repaint >> f & 1)) continue;
+            const auto& face = kFace[f];
+            PolyVertex poly[3];
+            for (int j = 0; j < 3; ++j) {
+              poly[j].X = u.X[face[j]];
+              poly[j].Y = u.Y[face[j]];
+            }
+            FaceSetup fs;
+            setup_face(fs, u.neighbour[f] >> 2, u.shade[f], poly, 3);
+            raster_polygon(fb, rows, fs, poly, 3);  // seldom hidden: not worth the test
+          }
+          continue;
+        }
+        for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {  // cut by the near plane
           const std::uint32_t nb = earlier_neighbour(t, f);
           if (nb == kNone || drawn_at[nb >> 2] >= first) return;
           const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
           const auto& face = kFace[nb & 3];
           const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
                                 &cam[3 * std::size_t(nv[face[2]])]};
-          draw_face(fb, rows, nb >> 2, v, poly, n, false);  // seldom hidden: not worth the test
+          draw_face(fb, rows, nb >> 2, v, poly, n, false);
         });
       }
     };
@@ -1397,6 +1496,7 @@ void TetRasterizer::undraw(Framebuffer& fb, std::size_t count) { impl_->undraw(f
 std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_->history; }
 std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_pixels(); }
 std::size_t TetRasterizer::undo_bytes() const { return impl_->undo_bytes(); }
+PixelRect TetRasterizer::changed_rect() const { return impl_->changed; }
 void TetRasterizer::forget_drawn() { impl_->forget(); }
 
 Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,

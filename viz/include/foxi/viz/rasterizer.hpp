@@ -46,6 +46,11 @@ struct RenderParams {
 // The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).
 std::uint32_t region_color(std::int32_t id);
 
+// A rectangle of pixels, bounds included; empty when x0 > x1.
+struct PixelRect {
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+};
+
 struct RasterStats {
   std::size_t tets_drawn = 0;     // tets handed to draw() (skipped ones included)
   std::size_t tets_behind = 0;    // tets entirely behind the near plane
@@ -85,6 +90,10 @@ class TetRasterizer {
   std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
   std::size_t undo_bytes() const;  // undoable: memory held for undraw (bytes; saved pixels 12 each,
                                    // 4 per tet, per-image buffers of 20 bytes a pixel)
+  // Holds every pixel the last draw() or undraw() call changed (a display need present only these;
+  // empty before the first call and after an empty one): the union of the pixel boxes of the tets it
+  // drew or undrew, the whole image if the near plane cuts one of them.
+  PixelRect changed_rect() const;
   // Undoable: forgets the tets drawn (call after clearing fb to start a new picture).
   void forget_drawn();
 
