@@ -237,6 +237,9 @@ struct TetRasterizer::Impl {
   const FaceAdjacency* adjacency = nullptr;
   std::vector<std::uint32_t> history;
   std::vector<std::uint32_t> drawn_at;
+  // Bit t (of word t / 64): tet t is drawn and not being undrawn (a compact drawn_at < first for the
+  // neighbour tests of undraw, which fit the cache where drawn_at does not).
+  std::vector<std::uint64_t> kept;
   struct Save {
     std::uint32_t at = 0;    // position in history
     std::size_t offset = 0;  // first saved pixel (in its lane)
@@ -293,6 +296,7 @@ struct TetRasterizer::Impl {
       if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
       adjacency = &face_adjacency(m);
       drawn_at.assign(m.tet_count(), kNone);
+      kept.assign((m.tet_count() + 63) / 64, 0);
       const std::size_t pixels = std::size_t(w) * std::size_t(h);
       shown.assign(std::size_t(mask_words) * std::size_t(h), 0);
       slot.assign(pixels, kNone);
@@ -1028,6 +1032,7 @@ struct TetRasterizer::Impl {
       drawn_at[tets[i]] = std::uint32_t(start + i);
     }
     history.insert(history.end(), tets.begin(), tets.end());
+    for (std::uint32_t t : tets) kept[t >> 6] |= std::uint64_t(1) << (t & 63);
     for (Lane& lane : lanes) lane.regions.push_back(SaveRegion{lane.saves.size(), lane.saved_pixel.size()});
     recording = true;
     try {
@@ -1250,12 +1255,11 @@ struct TetRasterizer::Impl {
     lane.saved_id.resize(saved_pixel.size());
   }
 
-  // Fills u for undrawn tet t (undraw of the tets from position `first` on): its box, and unless the
-  // near plane cuts it, its corners and its back faces shared with kept tets (drawn before `first`),
-  // which the walk repaints as those tets' front faces, with their shades. A face is back when its
-  // outward-ordered projection has positive area (face_polygon's test); the neighbour's front face
-  // is shaded from the neighbour's own corner order, bit for bit as drawing it did.
-  void gather_undrawn(std::uint32_t t, std::size_t first, int width, int height, UndrawTet& u) const {
+  // Fills u for undrawn tet t: its box, and unless the near plane cuts it, its corners and its back
+  // faces shared with kept tets (see `kept`), which the walk repaints as those tets' front faces
+  // (their shades come after, from shade_repainted). A face is back when its outward-ordered
+  // projection has positive area (face_polygon's test).
+  void gather_undrawn(std::uint32_t t, int width, int height, UndrawTet& u) const {
     TetCorners k;
     load_corners(t, k);
     u.box = tet_box(k, width, height);
@@ -1269,16 +1273,37 @@ struct TetRasterizer::Impl {
     const std::uint32_t* nbs = &adjacency->neighbour[4 * std::size_t(t)];
     for (int f = 0; f < 4; ++f) {
       const std::uint32_t nb = nbs[f];
-      if (nb == kNone || drawn_at[nb >> 2] >= first) continue;
+      if (nb == kNone || !(kept[nb >> 8] >> (nb >> 2 & 63) & 1)) continue;
       const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
       if ((k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) <= 0) continue;
+      u.repaint = std::uint8_t(u.repaint | (1 << f));
+      u.neighbour[f] = nb;
+    }
+  }
+
+  // The shades of u's repainted faces: each the kept neighbour's front face, shaded from the
+  // neighbour's own corner order, bit for bit as drawing it did.
+  void shade_repainted(UndrawTet& u) const {
+    for (int f = 0; f < 4; ++f) {
+      if (!(u.repaint >> f & 1)) continue;
+      const std::uint32_t nb = u.neighbour[f];
       const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
       const auto& face = kFace[nb & 3];
       const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
                             &cam[3 * std::size_t(nv[face[2]])]};
-      u.repaint = std::uint8_t(u.repaint | (1 << f));
-      u.neighbour[f] = nb;
       u.shade[f] = face_shade(nb >> 2, v);
+    }
+  }
+
+  // Hints the cache about what shade_repainted(u) reads.
+  void prefetch_repainted(const UndrawTet& u, std::uint32_t t) const {
+    if (u.repaint == 0) return;
+    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+    for (int j = 0; j < 4; ++j) __builtin_prefetch(&cam[3 * std::size_t(tv[j])]);  // the faces' corners
+    for (int f = 0; f < 4; ++f) {
+      if (!(u.repaint >> f & 1)) continue;
+      __builtin_prefetch(&mesh->tet[4 * std::size_t(u.neighbour[f] >> 2)]);
+      if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[u.neighbour[f] >> 2]);
     }
   }
 
@@ -1304,21 +1329,25 @@ struct TetRasterizer::Impl {
     };
     boxes.resize(count);
     undrawn.resize(count);
+    // The undrawn tets are no longer kept.
+    for (std::size_t i = first; i < history.size(); ++i) kept[history[i] >> 6] &= ~(std::uint64_t(1) << (history[i] & 63));
     auto find_boxes = [&](std::size_t begin, std::size_t end) {
-      constexpr std::size_t kAhead = 8;  // the undrawn tets lie all over the mesh's arrays
+      // The undrawn tets lie all over the mesh's arrays: one pass over the tets and their neighbours'
+      // marks, then one over the few faces to repaint, each hinting the cache well ahead.
+      constexpr std::size_t kAhead = 16;
       for (std::size_t i = begin; i < end; ++i) {
-        if (i + 2 * kAhead < end) {
-          const std::uint32_t ahead = history[first + i + 2 * kAhead];
-          __builtin_prefetch(&mesh->tet[4 * std::size_t(ahead)]);
-          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(ahead)]);
-        }
+        if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(history[first + i + 2 * kAhead])]);
         if (i + kAhead < end) {
           const std::uint32_t ahead = history[first + i + kAhead];
-          prefetch_tet(ahead, true);  // the shared faces' shading reads the corners' camera coordinates
-          prefetch_neighbours(ahead, true);
+          prefetch_tet(ahead);
+          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(ahead)]);
         }
-        gather_undrawn(history[first + i], first, fb.width, fb.height, undrawn[i]);
+        gather_undrawn(history[first + i], fb.width, fb.height, undrawn[i]);
         boxes[i] = undrawn[i].box;
+      }
+      for (std::size_t i = begin; i < end; ++i) {
+        if (i + kAhead < end) prefetch_repainted(undrawn[i + kAhead], history[first + i + kAhead]);
+        shade_repainted(undrawn[i]);
       }
     };
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
@@ -1458,6 +1487,7 @@ struct TetRasterizer::Impl {
 
   void forget() {
     for (std::uint32_t t : history) drawn_at[t] = kNone;
+    std::fill(kept.begin(), kept.end(), 0);
     history.clear();
     for (Lane& lane : lanes) lane = Lane{};
   }
@@ -1472,7 +1502,7 @@ struct TetRasterizer::Impl {
     std::size_t bytes = (history.capacity() + drawn_at.capacity() + slot.capacity() + before_rgba.capacity() +
                          before_id.capacity()) *
                             sizeof(std::uint32_t) +
-                        (shown.capacity() + written.capacity()) * sizeof(std::uint64_t);
+                        (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t);
     for (const Lane& lane : lanes)
       bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
                    sizeof(std::uint32_t) +
