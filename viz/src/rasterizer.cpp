@@ -4,15 +4,17 @@
 #include "foxi/viz/rasterizer.hpp"
 
 #include "foxi/model/adjacency.hpp"
+#include "thread_pool.hpp"
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <exception>
 #include <functional>
+#include <future>
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 #ifdef __SSE2__
 #include <emmintrin.h>
@@ -30,6 +32,29 @@ constexpr double kMaxPixel = 1048576.0;  // |pixel coordinate - centre| bound (2
 // Local vertex triples of the 4 faces of a positively oriented tet, ordered so that (b - a) x (c - a)
 // points out of the tet (world frame); face f is opposite vertex f.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+// Runs f(0), ..., f(parts - 1): f(0) on the calling thread, the others on pooled threads (starting a
+// thread per call would cost tens of microseconds each, per frame); returns when all are done,
+// rethrowing the first exception.
+template <class F>
+void run_parts(int parts, F&& f) {
+  std::vector<std::future<void>> others;
+  std::exception_ptr error;
+  try {
+    for (int k = 1; k < parts; ++k) others.push_back(pool::run_async([&f, k] { f(k); }));
+    f(0);
+  } catch (...) {
+    error = std::current_exception();
+  }
+  for (auto& other : others) {
+    try {
+      other.get();
+    } catch (...) {
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
+}
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
   std::int64_t q = a / b;
@@ -353,9 +378,7 @@ struct TetRasterizer::Impl {
       Part parts[2];
       const std::size_t total = m.tet.size(), half = total / 2;
       if (total > 80000 && params.threads > 1) {
-        std::thread t(scan, half, total, std::ref(parts[1]));
-        scan(0, half, parts[0]);
-        t.join();
+        run_parts(2, [&](int k) { k == 0 ? scan(0, half, parts[0]) : scan(half, total, parts[1]); });
       } else {
         scan(0, total, parts[0]);
         scan(total, total, parts[1]);
@@ -397,9 +420,7 @@ struct TetRasterizer::Impl {
       }
     };
     if (n > 20000 && params.threads > 1) {
-      std::thread t(work, n / 2, n);
-      work(0, n / 2);
-      t.join();
+      run_parts(2, [&](int k) { k == 0 ? work(0, n / 2) : work(n / 2, n); });
     } else {
       work(0, n);
     }
@@ -1156,17 +1177,13 @@ struct TetRasterizer::Impl {
     if (!spawn || tets.size() < 4096) {
       find_boxes(0, tets.size());
     } else {
-      std::thread helper(find_boxes, tets.size() / 2, tets.size());
-      find_boxes(0, tets.size() / 2);
-      helper.join();
+      const std::size_t half = tets.size() / 2;
+      run_parts(2, [&](int k) { k == 0 ? find_boxes(0, half) : find_boxes(half, tets.size()); });
     }
     if (!spawn) {
       for (int k = 0; k < count; ++k) work(k);
     } else {
-      std::vector<std::thread> pool;
-      for (int k = 1; k < count; ++k) pool.emplace_back(work, k);
-      work(0);
-      for (auto& th : pool) th.join();
+      run_parts(count, work);
     }
     if (reverse && !recording) clear_mask(tets.size());
   }
@@ -1445,14 +1462,9 @@ struct TetRasterizer::Impl {
       find_boxes(0, count);
       work({0, fb.height}, 0);
     } else {
-      std::thread helper(find_boxes, count / 2, count);
-      find_boxes(0, count / 2);
-      helper.join();
+      run_parts(2, [&](int k) { k == 0 ? find_boxes(0, count / 2) : find_boxes(count / 2, count); });
       const std::vector<int> split = split_rows(count, threads, fb.height);
-      std::vector<std::thread> pool;
-      for (int k = 1; k < threads; ++k) pool.emplace_back(work, std::cref(split), k);
-      work(split, 0);
-      for (auto& th : pool) th.join();
+      run_parts(threads, [&](int k) { work(split, k); });
     }
     clear_mask(count);
     for (std::size_t i = history.size(); i-- > first;) drawn_at[history[i]] = kNone;
