@@ -843,18 +843,12 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // Undoable: hints the cache about tet t's neighbours' positions in the drawing (and their nodes,
-  // `nodes`), read by earlier_neighbour and undraw; t's adjacency row should be prefetched earlier.
-  void prefetch_neighbours(std::uint32_t t, bool nodes) const {
+  // Undoable: hints the cache about tet t's neighbours' positions in the drawing, read by
+  // earlier_neighbour; t's adjacency row should be prefetched earlier.
+  void prefetch_neighbours(std::uint32_t t) const {
     const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(t)];
-    for (int f = 0; f < 4; ++f) {
-      if (nb[f] == kNone) continue;
-      __builtin_prefetch(&drawn_at[nb[f] >> 2]);
-      if (nodes) {  // and its region, for the colour of the face repainted
-        __builtin_prefetch(&mesh->tet[4 * std::size_t(nb[f] >> 2)]);
-        if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
-      }
-    }
+    for (int f = 0; f < 4; ++f)
+      if (nb[f] != kNone) __builtin_prefetch(&drawn_at[nb[f] >> 2]);
   }
 
   // A tet's corners: camera coordinates (c, pointing into cam or local), fixed-point pixel
@@ -1087,12 +1081,12 @@ struct TetRasterizer::Impl {
     try {
       draw_batch(fb, tets);
     } catch (...) {
-      recording = false;
       clear_mask(tets.size());
+      recording = false;
       throw;
     }
-    recording = false;
     clear_mask(tets.size());
+    recording = false;
     for (Lane& lane : lanes)
       if (lane.saves.size() == lane.regions.back().first_save) lane.regions.pop_back();
   }
@@ -1144,7 +1138,7 @@ struct TetRasterizer::Impl {
         if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 2 * kAhead])]);
         if (recording) {  // has_unshared_back_face reads the tet's neighbours and their positions
           if (i + 2 * kAhead < end) __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
-          if (i + kAhead < end) prefetch_neighbours(tets[i + kAhead], false);
+          if (i + kAhead < end) prefetch_neighbours(tets[i + kAhead]);
         }
         TetCorners k;
         load_corners(tets[i], k);
@@ -1204,7 +1198,8 @@ struct TetRasterizer::Impl {
     return r.x0 <= r.x1 ? r : PixelRect{};
   }
 
-  // Zeroes the written-pixel mask on the rows the batch's boxes span; `changed` becomes their union.
+  // Zeroes the written-pixel mask (and while recording, `shown`) on the rows the batch's boxes span;
+  // `changed` becomes their union.
   void clear_mask(std::size_t n) {
     changed = boxes_union(n);
     const int y0 = changed.y0, y1 = changed.y1;
@@ -1214,7 +1209,7 @@ struct TetRasterizer::Impl {
               written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
     std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
               tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
-    if (!shown.empty())
+    if (recording)  // else all zero
       std::fill(shown.begin() + std::ptrdiff_t(std::size_t(y0) * words),
                 shown.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
   }
@@ -1300,6 +1295,14 @@ struct TetRasterizer::Impl {
     lane.saved_id.resize(saved_pixel.size());
   }
 
+  // During undraw, the tet across face f of undrawn tet t if it is kept (unshrunk tets only; the
+  // earlier_neighbour of t then), else kNone.
+  std::uint32_t kept_neighbour(std::uint32_t t, int f) const {
+    if (params.shrink != 1) return kNone;
+    const std::uint32_t nb = adjacency->neighbour[4 * std::size_t(t) + std::size_t(f)];
+    return nb != kNone && (kept[nb >> 8] >> (nb >> 2 & 63) & 1) ? nb : kNone;
+  }
+
   // Fills u for undrawn tet t: its box, and unless the near plane cuts it, its corners and its back
   // faces shared with kept tets (see `kept`), which the walk repaints as those tets' front faces
   // (their shades come after, from shade_repainted). A face is back when its outward-ordered
@@ -1314,11 +1317,9 @@ struct TetRasterizer::Impl {
       u.X[j] = std::int32_t(k.X[j]);
       u.Y[j] = std::int32_t(k.Y[j]);
     }
-    if (params.shrink != 1) return;  // no face is shared
-    const std::uint32_t* nbs = &adjacency->neighbour[4 * std::size_t(t)];
     for (int f = 0; f < 4; ++f) {
-      const std::uint32_t nb = nbs[f];
-      if (nb == kNone || !(kept[nb >> 8] >> (nb >> 2 & 63) & 1)) continue;
+      const std::uint32_t nb = kept_neighbour(t, f);
+      if (nb == kNone) continue;
       const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
       if ((k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) <= 0) continue;
       u.repaint = std::uint8_t(u.repaint | (1 << f));
@@ -1389,6 +1390,7 @@ struct TetRasterizer::Impl {
         }
         gather_undrawn(history[first + i], fb.width, fb.height, undrawn[i]);
         boxes[i] = undrawn[i].box;
+        drawn_at[history[first + i]] = kNone;  // no longer drawn (the walk reads `kept`)
       }
       for (std::size_t i = begin; i < end; ++i) {
         if (i + kAhead < end) prefetch_repainted(undrawn[i + kAhead], history[first + i + kAhead]);
@@ -1447,8 +1449,8 @@ struct TetRasterizer::Impl {
           continue;
         }
         for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {  // cut by the near plane
-          const std::uint32_t nb = earlier_neighbour(t, f);
-          if (nb == kNone || drawn_at[nb >> 2] >= first) return;
+          const std::uint32_t nb = kept_neighbour(t, f);
+          if (nb == kNone) return;
           const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
           const auto& face = kFace[nb & 3];
           const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
@@ -1467,7 +1469,6 @@ struct TetRasterizer::Impl {
       run_parts(threads, [&](int k) { work(split, k); });
     }
     clear_mask(count);
-    for (std::size_t i = history.size(); i-- > first;) drawn_at[history[i]] = kNone;
     history.resize(first);
     for (Lane& lane : lanes) {
       lane.saves.resize(first_save(lane));
