@@ -555,18 +555,6 @@ struct TetRasterizer::Impl {
 #endif
   }
 
-  // True if every pixel x in [lo, hi] of row y is already written (lo <= hi, inside the image).
-  bool row_written(int y, int lo, int hi) const {
-    const std::uint64_t* row = &written[std::size_t(y) * std::size_t(mask_words)];
-    const int w0 = lo >> 6, w1 = hi >> 6;
-    const std::uint64_t m0 = ~std::uint64_t(0) << (lo & 63), m1 = ~std::uint64_t(0) >> (63 - (hi & 63));
-    if (w0 == w1) return (row[w0] & m0 & m1) == (m0 & m1);
-    if ((row[w0] & m0) != m0) return false;
-    for (int w = w0 + 1; w < w1; ++w)
-      if (row[w] != ~std::uint64_t(0)) return false;
-    return (row[w1] & m1) == m1;
-  }
-
   // True if every owned pixel of the pixel box b (not empty, y0 >= 0) is already written: nothing
   // drawn inside it can show.
   bool box_written(const Rows& rows, const Box& b, int height) {
@@ -577,9 +565,10 @@ struct TetRasterizer::Impl {
       std::uint8_t* tiles = &tile_full[std::size_t(band) * std::size_t(mask_words)];
       for (int w = w0; w <= w1; ++w) {
         if (tiles[w]) continue;
-        const int lo = std::max(b.x0, w << 6), hi = std::min(b.x1, (w << 6) + 63);
+        const int lo = std::max(b.x0, w << 6) & 63, hi = std::min(b.x1, (w << 6) + 63) & 63;
+        const std::uint64_t m = (~std::uint64_t(0) << lo) & (~std::uint64_t(0) >> (63 - hi));
         for (int r = y; r <= last; ++r)
-          if (!row_written(r, lo, hi)) return false;
+          if ((written[std::size_t(r) * std::size_t(mask_words) + std::size_t(w)] & m) != m) return false;
         // The box's part of the tile is written; is all of it (later boxes then skip it)?
         bool full = true;
         for (int r = band << kBandShift; r <= band_end && full; ++r)
@@ -694,7 +683,8 @@ struct TetRasterizer::Impl {
       return;
     }
     std::int64_t e[4];
-    for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * lo + fs.eb[k] * y + fs.ec[k];
+    for (int k = 0; k < 3; ++k) e[k] = fs.ea[k] * lo + fs.eb[k] * y + fs.ec[k];
+    e[3] = fs.lines > 3 ? fs.ea[3] * lo + fs.eb[3] * y + fs.ec[3] : fs.ec[3];  // padding: constant
     int a = lo, b = hi;  // the flat part
     if (hi - lo >= 12) {  // short runs: not worth solving for
       for (int k = 0; k < fs.lines && a <= b; ++k) {
