@@ -244,6 +244,40 @@ TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
   EXPECT_GT(partial_calls, 20u) << "some calls should change less than the whole image";
 }
 
+// An undraw of more tets than one part (undraw takes back at most 2^16 tets at a time) equals drawing
+// what remains from scratch, and its changed rectangle holds every pixel it changed.
+TEST(Undraw, LongUndrawInPartsEqualsDrawingFromScratch) {
+  const Mesh m = test::grid_mesh(24, 23, 22, 1.0, 0.9, 1.1, 6);  // 72,864 tets
+  ASSERT_GT(m.tet_count(), std::size_t(1) << 16);
+  const SphereTable table = compute_spheres(m);
+  for (const Camera& cam : test::random_cameras(m, 2, 41, double(kW) / kH)) {
+    const auto order = visibility_order(m, table, view_of(cam));
+    const std::span<const std::uint32_t> all(order);
+    RenderParams p;
+    p.undoable = true;
+    TetRasterizer r(m, cam, kW, kH, p);
+    Framebuffer fb(kW, kH);
+    r.draw(fb, all);
+    const Framebuffer before = fb;
+    const std::size_t j = 1500;
+    r.undraw(fb, order.size() - j);
+    const Framebuffer fresh = render_tets(m, cam, kW, kH, all.first(j));
+    EXPECT_EQ(fb.rgba, fresh.rgba);
+    EXPECT_EQ(fb.id, fresh.id);
+    const PixelRect rect = r.changed_rect();
+    std::size_t outside = 0, changed = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const std::size_t i = fb.index(x, y);
+        if (fb.rgba[i] == before.rgba[i] && fb.id[i] == before.id[i]) continue;
+        ++changed;
+        outside += x < rect.x0 || x > rect.x1 || y < rect.y0 || y > rect.y1;
+      }
+    EXPECT_EQ(outside, 0u);
+    EXPECT_GT(changed, std::size_t(kW * kH / 20)) << "the undraw should change the picture";
+  }
+}
+
 TEST(Undraw, BadUseIsRejected) {
   Mesh m = test::grid_mesh(2, 2, 2, 1, 1, 1, 5);
   Camera cam;

@@ -1351,8 +1351,24 @@ struct TetRasterizer::Impl {
     if (!params.undoable) throw std::logic_error("render: undraw needs RenderParams::undoable");
     check_framebuffer(fb);
     if (count > history.size()) throw std::out_of_range("render: undraw of more tets than are drawn");
-    changed = PixelRect{};
-    if (count == 0) return;
+    // In parts of at most kUndrawPart tets (the per-tet records of a part stay small; taking back the
+    // last a tets, then the b before them, gives the picture of taking back a + b), the changed
+    // rectangle the union of the parts'.
+    constexpr std::size_t kUndrawPart = std::size_t(1) << 16;
+    PixelRect all{proj.width, proj.height, -1, -1};
+    while (count > 0) {
+      const std::size_t part = std::min(count, kUndrawPart);
+      undraw_part(fb, part);
+      count -= part;
+      if (changed.x0 > changed.x1) continue;
+      all = PixelRect{std::min(all.x0, changed.x0), std::min(all.y0, changed.y0), std::max(all.x1, changed.x1),
+                      std::max(all.y1, changed.y1)};
+    }
+    changed = all.x0 <= all.x1 ? all : PixelRect{};
+  }
+
+  // undraw of count > 0 tets, at most kUndrawPart.
+  void undraw_part(Framebuffer& fb, std::size_t count) {
     if (written.empty()) {
       written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
       tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
