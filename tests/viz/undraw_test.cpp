@@ -184,6 +184,21 @@ TEST(Undraw, SavedPixelsOfAConvexMeshAreItsSilhouette) {
   }
 }
 
+// The pixels (colour or id) that differ between `before` and `after` outside `rect`; `changed`
+// counts all that differ.
+std::size_t changes_outside(const Framebuffer& before, const Framebuffer& after, const PixelRect& rect,
+                            std::size_t& changed) {
+  std::size_t outside = 0;
+  for (int y = 0; y < after.height; ++y)
+    for (int x = 0; x < after.width; ++x) {
+      const std::size_t i = after.index(x, y);
+      if (after.rgba[i] == before.rgba[i] && after.id[i] == before.id[i]) continue;
+      ++changed;
+      outside += x < rect.x0 || x > rect.x1 || y < rect.y0 || y > rect.y1;
+    }
+  return outside;
+}
+
 // changed_rect() after each draw() and undraw() (batches of random sizes, painter undoable, plain
 // painter and depth-buffer mode; eyes outside and inside, so that some tets are cut by the near
 // plane) holds every pixel the call changed, found by comparing the picture before and after; it is
@@ -206,15 +221,8 @@ TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
       Framebuffer fb(kW, kH, p.depth_buffer);
       auto check = [&](const Framebuffer& before, const char* what) {
         const PixelRect rect = r.changed_rect();
-        std::size_t outside = 0, changed = 0;
-        for (int y = 0; y < kH; ++y)
-          for (int x = 0; x < kW; ++x) {
-            const std::size_t i = fb.index(x, y);
-            if (fb.rgba[i] == before.rgba[i] && fb.id[i] == before.id[i]) continue;
-            ++changed;
-            outside += x < rect.x0 || x > rect.x1 || y < rect.y0 || y > rect.y1;
-          }
-        EXPECT_EQ(outside, 0u) << what << " mode " << mode;
+        std::size_t changed = 0;
+        EXPECT_EQ(changes_outside(before, fb, rect, changed), 0u) << what << " mode " << mode;
         if (rect.x0 <= rect.x1) {
           EXPECT_TRUE(rect.x0 >= 0 && rect.y0 >= 0 && rect.x1 < kW && rect.y1 < kH && rect.y0 <= rect.y1);
           partial_calls += (rect.x1 - rect.x0 + 1) * (rect.y1 - rect.y0 + 1) < kW * kH;
@@ -264,16 +272,8 @@ TEST(Undraw, LongUndrawInPartsEqualsDrawingFromScratch) {
     const Framebuffer fresh = render_tets(m, cam, kW, kH, all.first(j));
     EXPECT_EQ(fb.rgba, fresh.rgba);
     EXPECT_EQ(fb.id, fresh.id);
-    const PixelRect rect = r.changed_rect();
-    std::size_t outside = 0, changed = 0;
-    for (int y = 0; y < kH; ++y)
-      for (int x = 0; x < kW; ++x) {
-        const std::size_t i = fb.index(x, y);
-        if (fb.rgba[i] == before.rgba[i] && fb.id[i] == before.id[i]) continue;
-        ++changed;
-        outside += x < rect.x0 || x > rect.x1 || y < rect.y0 || y > rect.y1;
-      }
-    EXPECT_EQ(outside, 0u);
+    std::size_t changed = 0;
+    EXPECT_EQ(changes_outside(before, fb, r.changed_rect(), changed), 0u);
     EXPECT_GT(changed, std::size_t(kW * kH / 20)) << "the undraw should change the picture";
   }
 }
