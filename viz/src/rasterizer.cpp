@@ -1549,7 +1549,8 @@ struct TetRasterizer::Impl {
     std::size_t bytes = (history.capacity() + drawn_at.capacity() + slot.capacity() + before_rgba.capacity() +
                          before_id.capacity()) *
                             sizeof(std::uint32_t) +
-                        (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t);
+                        (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t) +
+                        undrawn.capacity() * sizeof(UndrawTet);
     for (const Lane& lane : lanes)
       bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
                    sizeof(std::uint32_t) +
