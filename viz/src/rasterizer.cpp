@@ -262,15 +262,16 @@ struct TetRasterizer::Impl {
   std::vector<std::uint8_t> tile_full;
   // Whether painter drawing tests and sets the mask (off while undraw repaints neighbours' faces).
   bool use_mask = false;
-  // Undoable mode (params.undoable): the tets drawn so far in order, each tet's position in it
-  // (kNone if not drawn), and the undraw stack of saved pixels: per tet with an unshared back face,
-  // where its pixels start in saved_rgba / saved_id (the runs of those faces, in raster order).
+  // Undoable mode (params.undoable): the tets drawn so far in order, which tets are drawn (`kept`,
+  // bit t of word t / 64; during undraw, less the tets being undrawn), each drawn tet's position in
+  // the order (drawn_at, stale where the bit is clear: undraw leaves it), and the undraw stack of
+  // saved pixels: per tet with an unshared back face, where its pixels start in saved_rgba / saved_id
+  // (the runs of those faces, in raster order). The bits fit the cache where drawn_at does not.
   const FaceAdjacency* adjacency = nullptr;
   std::vector<std::uint32_t> history;
   std::vector<std::uint32_t> drawn_at;
-  // Bit t (of word t / 64): tet t is drawn and not being undrawn (a compact drawn_at < first for the
-  // neighbour tests of undraw, which fit the cache where drawn_at does not).
   std::vector<std::uint64_t> kept;
+  bool is_kept(std::uint32_t t) const { return kept[t >> 6] >> (t & 63) & 1; }
   struct Save {
     std::uint32_t at = 0;    // position in history
     std::size_t offset = 0;  // first saved pixel (in its lane)
@@ -328,7 +329,7 @@ struct TetRasterizer::Impl {
     if (params.undoable) {
       if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
       adjacency = &face_adjacency(m);
-      drawn_at.assign(m.tet_count(), kNone);
+      drawn_at.assign(m.tet_count(), 0);
       kept.assign((m.tet_count() + 63) / 64, 0);
       const std::size_t pixels = std::size_t(w) * std::size_t(h);
       shown.assign(std::size_t(mask_words) * std::size_t(h), 0);
@@ -838,7 +839,7 @@ struct TetRasterizer::Impl {
   void prefetch_neighbours(std::uint32_t t) const {
     const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(t)];
     for (int f = 0; f < 4; ++f)
-      if (nb[f] != kNone) __builtin_prefetch(&drawn_at[nb[f] >> 2]);
+      if (nb[f] != kNone && is_kept(nb[f] >> 2)) __builtin_prefetch(&drawn_at[nb[f] >> 2]);
   }
 
   // A tet's corners: camera coordinates (c, pointing into cam or local), fixed-point pixel
@@ -1057,15 +1058,15 @@ struct TetRasterizer::Impl {
     // front-to-back walk that answers the saves' requests (see `recording`).
     const std::size_t start = history.size();
     for (std::size_t i = 0; i < tets.size(); ++i) {
-      if (drawn_at[tets[i]] != kNone) {
-        for (std::size_t k = 0; k < i; ++k) drawn_at[tets[k]] = kNone;
+      if (is_kept(tets[i])) {
+        for (std::size_t k = 0; k < i; ++k) kept[tets[k] >> 6] &= ~(std::uint64_t(1) << (tets[k] & 63));
         throw std::invalid_argument("render: undoable drawing draws each tet once (tet " +
                                     std::to_string(tets[i]) + " again)");
       }
+      kept[tets[i] >> 6] |= std::uint64_t(1) << (tets[i] & 63);
       drawn_at[tets[i]] = std::uint32_t(start + i);
     }
     history.insert(history.end(), tets.begin(), tets.end());
-    for (std::uint32_t t : tets) kept[t >> 6] |= std::uint64_t(1) << (t & 63);
     for (Lane& lane : lanes) lane.regions.push_back(SaveRegion{lane.saves.size(), lane.saved_pixel.size()});
     recording = true;
     try {
@@ -1210,7 +1211,7 @@ struct TetRasterizer::Impl {
   std::uint32_t earlier_neighbour(std::uint32_t t, int f) const {
     if (params.shrink != 1) return kNone;
     const std::uint32_t nb = adjacency->neighbour[4 * std::size_t(t) + std::size_t(f)];
-    if (nb == kNone || drawn_at[nb >> 2] >= drawn_at[t]) return kNone;
+    if (nb == kNone || !is_kept(nb >> 2) || drawn_at[nb >> 2] >= drawn_at[t]) return kNone;
     return nb;
   }
 
@@ -1290,7 +1291,7 @@ struct TetRasterizer::Impl {
   std::uint32_t kept_neighbour(std::uint32_t t, int f) const {
     if (params.shrink != 1) return kNone;
     const std::uint32_t nb = adjacency->neighbour[4 * std::size_t(t) + std::size_t(f)];
-    return nb != kNone && (kept[nb >> 8] >> (nb >> 2 & 63) & 1) ? nb : kNone;
+    return nb != kNone && is_kept(nb >> 2) ? nb : kNone;
   }
 
   // Fills u for undrawn tet t: its box, and unless the near plane cuts it, its corners and its back
@@ -1396,7 +1397,6 @@ struct TetRasterizer::Impl {
         }
         gather_undrawn(history[first + i], fb.width, fb.height, undrawn[i]);
         boxes[i] = undrawn[i].box;
-        drawn_at[history[first + i]] = kNone;  // no longer drawn (the walk reads `kept`)
       }
       for (std::size_t i = begin; i < end; ++i) {
         if (i + kAhead < end) prefetch_repainted(undrawn[i + kAhead], history[first + i + kAhead]);
@@ -1533,7 +1533,6 @@ struct TetRasterizer::Impl {
   }
 
   void forget() {
-    for (std::uint32_t t : history) drawn_at[t] = kNone;
     std::fill(kept.begin(), kept.end(), 0);
     history.clear();
     for (Lane& lane : lanes) lane = Lane{};
