@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "foxi/model/delaunay.hpp"
 #include "foxi/viz/png.hpp"
@@ -83,9 +84,22 @@ Viewer::Viewer(const Mesh& mesh, const Camera& camera, int width, int height, co
   params_.depth_buffer = !delaunay_;
   params_.undoable = delaunay_ && params.undoable;  // the painter can undraw, if asked to record
   fb_.resize(width_, height_, params_.depth_buffer);
+  damage_ = PixelRect{0, 0, width_ - 1, height_ - 1};
 }
 
 Viewer::~Viewer() = default;
+
+void Viewer::add_damage(const PixelRect& r) {
+  if (r.x0 > r.x1) return;
+  if (damage_.x0 > damage_.x1) {
+    damage_ = r;
+    return;
+  }
+  damage_ = PixelRect{std::min(damage_.x0, r.x0), std::min(damage_.y0, r.y0), std::max(damage_.x1, r.x1),
+                      std::max(damage_.y1, r.y1)};
+}
+
+PixelRect Viewer::take_damage() { return std::exchange(damage_, PixelRect{}); }
 
 std::span<const std::uint32_t> Viewer::current_subset() const {
   if (stack_.empty()) return {};
@@ -106,6 +120,7 @@ void Viewer::begin_draw() {
   else
     mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
   fb_.resize(width_, height_, params_.depth_buffer);
+  damage_ = PixelRect{0, 0, width_ - 1, height_ - 1};
   drawn_.clear();
   handed_.clear();
   done_ = false;
@@ -146,6 +161,7 @@ bool Viewer::step() {
     return false;
   }
   raster_->draw(fb_, batch);
+  add_damage(raster_->changed_rect());
   drawn_.insert(drawn_.end(), batch.begin(), batch.end());
   step_ms_ = ms_since(t0);
   frame_ms_ += step_ms_;
@@ -166,6 +182,7 @@ std::size_t Viewer::undraw(std::size_t count) {
   if (!params_.undoable || !raster_) return 0;
   const std::size_t n = std::min(count, drawn_.size());
   raster_->undraw(fb_, n);
+  add_damage(raster_->changed_rect());
   drawn_.resize(drawn_.size() - n);
   if (n > 0) done_ = false;
   return n;

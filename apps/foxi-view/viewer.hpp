@@ -67,6 +67,9 @@ class Viewer {
 
   const Camera& camera() const { return camera_; }
   const Framebuffer& framebuffer() const { return fb_; }
+  // The part of the framebuffer changed since the last call (all of it after a draw restarts or a
+  // resize; empty if nothing changed): what a display must update.
+  PixelRect take_damage();
   // The tets drawn in the current draw, in drawing order.
   const std::vector<std::uint32_t>& drawn() const { return drawn_; }
   std::size_t total() const;  // tets in the current draw's order
@@ -102,6 +105,8 @@ class Viewer {
   std::size_t mpvo_pos_ = 0;
   std::unique_ptr<TetRasterizer> raster_;
   Framebuffer fb_;
+  PixelRect damage_;  // see take_damage
+  void add_damage(const PixelRect& r);
   std::vector<std::uint32_t> drawn_;    // the prefix of handed_ on the screen
   std::vector<std::uint32_t> handed_;   // the order as far as it has been handed out
   bool done_ = true, running_ = true, started_ = false, undrawing_ = false;

@@ -93,30 +93,38 @@ class Screen {
     image_->data = static_cast<char*>(std::calloc(std::size_t(image_->bytes_per_line) * std::size_t(h), 1));
   }
 
-  void put(Window win, GC gc, const Framebuffer& fb) {
+  // Shows the rectangle `rect` of fb (all of it when the image is new); an empty rect shows nothing.
+  void put(Window win, GC gc, const Framebuffer& fb, PixelRect rect) {
+    if (!image_ || w_ != fb.width || h_ != fb.height) rect = PixelRect{0, 0, fb.width - 1, fb.height - 1};
     ensure(fb.width, fb.height);
-    for (int y = 0; y < fb.height; ++y) {
+    rect.x0 = std::max(rect.x0, 0);
+    rect.y0 = std::max(rect.y0, 0);
+    rect.x1 = std::min(rect.x1, fb.width - 1);
+    rect.y1 = std::min(rect.y1, fb.height - 1);
+    if (rect.x0 > rect.x1 || rect.y0 > rect.y1) return;
+    for (int y = rect.y0; y <= rect.y1; ++y) {
       const std::uint32_t* src = fb.rgba.data() + fb.index(0, y);
       // The fast path writes host-order words: right when the image is 32-bit and in our byte order.
       if (image_->bits_per_pixel == 32 &&
           image_->byte_order == (std::endian::native == std::endian::little ? LSBFirst : MSBFirst)) {
         auto* dst = reinterpret_cast<std::uint32_t*>(image_->data +
                                                      std::size_t(y) * std::size_t(image_->bytes_per_line));
-        for (int x = 0; x < fb.width; ++x) {
+        for (int x = rect.x0; x <= rect.x1; ++x) {
           std::uint32_t p = src[x];
           dst[x] = (p & 255u) << rs_ | (p >> 8 & 255u) << gs_ | (p >> 16 & 255u) << bs_;
         }
       } else {
-        for (int x = 0; x < fb.width; ++x) {
+        for (int x = rect.x0; x <= rect.x1; ++x) {
           std::uint32_t p = src[x];
           XPutPixel(image_, x, y, (p & 255u) << rs_ | (p >> 8 & 255u) << gs_ | (p >> 16 & 255u) << bs_);
         }
       }
     }
+    const unsigned w = unsigned(rect.x1 - rect.x0 + 1), h = unsigned(rect.y1 - rect.y0 + 1);
     if (attached_)
-      XShmPutImage(dpy_, win, gc, image_, 0, 0, 0, 0, unsigned(fb.width), unsigned(fb.height), False);
+      XShmPutImage(dpy_, win, gc, image_, rect.x0, rect.y0, rect.x0, rect.y0, w, h, False);
     else
-      XPutImage(dpy_, win, gc, image_, 0, 0, 0, 0, unsigned(fb.width), unsigned(fb.height));
+      XPutImage(dpy_, win, gc, image_, rect.x0, rect.y0, rect.x0, rect.y0, w, h);
   }
 
  private:
@@ -197,8 +205,13 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
     const int base = height + kStatusHeight - 5;
     XDrawString(dpy, win, gc, 4, base, s.c_str(), int(s.size()));
   };
+  bool exposed = true;  // the whole picture must be shown again (exposed or resized window)
   auto show = [&] {
-    screen.put(win, gc, viewer.framebuffer());
+    // Only what changed since the last show, unless the window needs all of it.
+    const Framebuffer& fb = viewer.framebuffer();
+    const PixelRect damage = viewer.take_damage();
+    screen.put(win, gc, fb, exposed ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : damage);
+    exposed = false;
     draw_status();
     XSync(dpy, False);  // the server has read the shared image before the next batch changes it
   };
@@ -224,7 +237,7 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
           mapped = true;
           break;
         case Expose:
-          if (ev.xexpose.count == 0) changed = true;
+          if (ev.xexpose.count == 0) changed = exposed = true;
           break;
         case ConfigureNotify: {
           int w = ev.xconfigure.width, h = ev.xconfigure.height - kStatusHeight;
@@ -233,7 +246,7 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
             height = h;
             viewer.resize(w, h);
             viewer.set_running(true);
-            changed = true;
+            changed = exposed = true;
           }
           break;
         }

@@ -289,7 +289,8 @@ bool read_xwd(const std::filesystem::path& path, Framebuffer& fb) {
 
 // The real window under Xvfb: keys sent with xdotool (d, wait for the draw, s, u undraw all, s,
 // u draw on, s, q). The PNG it saves
-// equals the headless one, and so does a screenshot of the window above its status line.
+// equals the headless one, and so does a screenshot of the window above its status line (the window
+// is updated with each frame's changed rectangle only, so a missed change would show there).
 TEST_F(ViewTest, WindowUnderXvfbDrivenByXdotool) {
   if (!test::have_program("xvfb-run") || !test::have_program("xdotool"))
     GTEST_SKIP() << "xvfb-run or xdotool is missing (scripts/install-deps.sh installs them)";
