@@ -210,7 +210,7 @@ TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
   const SphereTable table = compute_spheres(m);
   std::mt19937 rng(31);
   std::size_t changed_calls = 0, partial_calls = 0;
-  for (const Camera& cam : test::random_cameras(m, 9, 37, double(kW) / kH)) {
+  for (const Camera& cam : test::random_cameras(m, 6, 37, double(kW) / kH)) {
     const auto order = visibility_order(m, table, view_of(cam));
     const std::span<const std::uint32_t> all(order);
     for (int mode = 0; mode < 3; ++mode) {
