@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 
+#include "coplanar_facets.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "layer_refinement.hpp"
 #include "plc_edit.hpp"
@@ -36,7 +37,9 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   MeshParams p = params;
   p.optimize = false;
   Plc current = plc;
+  detail::snap_coordinates(current);
   detail::weld_coincident_points(current);
+  if (conforming.surface_rescue) detail::merge_coplanar_facets(current);
   Mesh mesh;
   const std::vector<ThinLayer> layers =
       conforming.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 || (params.size_field && !params.size_field->empty()) ||
@@ -50,6 +53,9 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     if (!round) break;
     const DelaunayCertificate& cert = *round;
     if (cert.delaunay || it >= conforming.max_iterations) break;
+    // TetGen's own refinement answering a round's splits with new violations: the rounds are not
+    // settling, and the surface rescue below settles faster from here.
+    if (conforming.surface_rescue && it > 0 && rep.violations[it] >= rep.violations[it - 1]) break;
     const double budget =
         std::max(conforming.max_added_fraction * double(rep.first_mesh_points), double(conforming.min_added_budget));
     if (double(rep.added_points) >= budget) break;
@@ -61,6 +67,29 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     if (n == 0) break;
     rep.added_points += n;
     rep.iterations = it + 1;
+  }
+  // TetGen 1.5.0 fails on some refined PLCs (curved faceted surfaces, slivers from corefinement),
+  // and its own quality refinement can undo a round's splits: from the last mesh this loop made, go on
+  // refining the mesh's own surface triangles, TetGen recovering them without refinement of its own.
+  if (conforming.surface_rescue && layers.empty() && !rep.delaunay && rep.violations.size() > 0) {
+    ConformingReport rescue;
+    // TetGen's refinement made the quality; the rescue only makes the certificate pass (a radius-edge
+    // bound of its own, near the boundary where TetGen's -q leaves some tets over it, does not settle).
+    MeshParams certify_only = params;
+    certify_only.radius_edge = 0;
+    certify_only.max_volume = 0;
+    certify_only.size_field = nullptr;
+    for (RegionSeed& s : current.regions) s.max_volume = 0;
+    mesh = detail::refine_with_thin_layers(certify_only, conforming, {}, current, rescue, &mesh);
+    rep.added_points += rescue.added_points;
+    rep.quality_points += rescue.quality_points;
+    rep.quality_unmet = rescue.quality_unmet;
+    rep.iterations += rescue.iterations;
+    rep.violations.insert(rep.violations.end(), rescue.violations.begin() + 1, rescue.violations.end());
+    rep.delaunay = rescue.delaunay;
+    rep.tetgen_failed = rescue.tetgen_failed;
+    rep.certificate_seconds += rescue.certificate_seconds;
+    rep.surface_rounds = rescue.iterations;
   }
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (report) *report = rep;

@@ -6,6 +6,7 @@
 #include <map>
 
 #include "foxi/model/delaunay.hpp"
+#include "facet_triangulation.hpp"
 #include "plc_edit.hpp"
 #include "refinement_round.hpp"
 
@@ -122,7 +123,8 @@ bool all_in(const ThinLayer& l, const Vec (&x)[4]) {
 }  // namespace
 
 Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& conforming,
-                             const std::vector<ThinLayer>& layers, Plc& current, ConformingReport& rep) {
+                             const std::vector<ThinLayer>& layers, Plc& current, ConformingReport& rep,
+                             const Mesh* first_mesh) {
   MeshParams p = params;
   p.optimize = false;
   p.radius_edge = 0;
@@ -143,9 +145,10 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
   const double cos_min = std::cos(min_dihedral * 3.14159265358979323846 / 180);
   rep.thin_layers = layers;
   Mesh mesh;
+  if (first_mesh) mesh = *first_mesh;
   RefinementRounds rounds(p, rep);
   for (std::size_t it = 0;; ++it) {
-    const std::optional<DelaunayCertificate> round = rounds.run(it, current, mesh);
+    const std::optional<DelaunayCertificate> round = rounds.run(it, current, mesh, first_mesh != nullptr);
     if (!round) break;
     const DelaunayCertificate& cert = *round;
 
@@ -205,7 +208,9 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
           side_wall[f] = 1;
     }
     rounds.keep(current, mesh);
+    if (first_mesh) current = surface_plc(mesh, current);
     EditablePlc edit(current);
+    if (first_mesh) edit.index_surface();
     edit.layers = layers;
     NearPoints added(search.vertices.cell);
     std::size_t n_conform = 0;
@@ -260,6 +265,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
     }
     const std::size_t n_faces = split_faces(mesh, search.face_ball, split, edit, added, 0.5);
     edit.write_back();
+    if (first_mesh) triangulate_facets(current);
     for (const Vec& c : interior) current.points.insert(current.points.end(), c.begin(), c.end());
     const std::size_t n_quality = n_faces + n_layer + interior.size();
     if (n_conform + n_quality == 0) break;

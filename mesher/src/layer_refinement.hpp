@@ -17,7 +17,10 @@ namespace foxi::detail {
 // layer's faces. Points on a layer's face are always mirrored onto its other face, and a layer's side
 // walls are never split. Stops when the mesh is certified and no tet is over a bound, when nothing
 // can be added, or after conforming.max_layer_iterations rounds; fills `rep` and returns the last mesh.
+// With `first_mesh`, that mesh (of `current`) is round 0's instead of TetGen's: the conforming loop
+// hands over the last mesh it could make when TetGen failed on its refined PLC.
 Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& conforming,
-                             const std::vector<ThinLayer>& layers, Plc& current, ConformingReport& rep);
+                             const std::vector<ThinLayer>& layers, Plc& current, ConformingReport& rep,
+                             const Mesh* first_mesh = nullptr);
 
 }  // namespace foxi::detail

@@ -176,6 +176,63 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
   }
 }
 
+Plc surface_plc(const Mesh& mesh, const Plc& plc) {
+  Plc out;
+  out.points = mesh.xyz;
+  const std::size_t nf = mesh.bface_count();
+  out.polygon_vertices = mesh.bface;
+  out.polygon_vertex_begin.resize(nf + 1);
+  out.facet_polygon_begin.resize(nf + 1);
+  for (std::uint32_t f = 0; f <= nf; ++f) {
+    out.polygon_vertex_begin[f] = 3 * f;
+    out.facet_polygon_begin[f] = f;
+  }
+  out.facet_marker = mesh.bface_tag;
+  out.facet_hole_begin.assign(nf + 1, 0);
+  out.holes = plc.holes;
+  out.regions = plc.regions;
+  return out;
+}
+
+std::size_t snap_coordinates(Plc& plc, double relative_tol) {
+  const std::size_t n = plc.point_count();
+  if (n == 0) return 0;
+  std::size_t changed = 0;
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t k = 0; k < 3; ++k) {
+    auto value = [&](std::uint32_t i) { return plc.points[3 * i + k]; };
+    for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return value(a) < value(b); });
+    const double tol = relative_tol * (std::abs(value(order.front())) + std::abs(value(order.back())) +
+                                       (value(order.back()) - value(order.front())));
+    // Clusters no wider than tol (no chaining along a dense run); the most common value wins.
+    for (std::size_t a = 0; a < n;) {
+      std::size_t b = a + 1;
+      while (b < n && value(order[b]) - value(order[a]) <= tol) ++b;
+      if (value(order[b - 1]) != value(order[a])) {
+        double best = value(order[a]);
+        std::size_t best_count = 0;
+        for (std::size_t i = a; i < b;) {
+          std::size_t j = i;
+          while (j < b && value(order[j]) == value(order[i])) ++j;
+          if (j - i > best_count) {
+            best_count = j - i;
+            best = value(order[i]);
+          }
+          i = j;
+        }
+        for (std::size_t i = a; i < b; ++i)
+          if (value(order[i]) != best) {
+            plc.points[3 * order[i] + k] = best;
+            ++changed;
+          }
+      }
+      a = b;
+    }
+  }
+  return changed;
+}
+
 std::size_t weld_coincident_points(Plc& plc, double relative_tol) {
   const std::size_t n = plc.point_count();
   if (n == 0) return 0;
@@ -296,7 +353,7 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
     const Vec p[3] = {at(mesh.xyz, fv[0]), at(mesh.xyz, fv[1]), at(mesh.xyz, fv[2])};
     const Ball& fb = face_ball[f];
     const double size = std::sqrt(fb.r2);
-    const std::size_t facet = edit.find_facet(mesh.bface_tag[f], p[0], p[1], p[2]);
+    const std::size_t facet = edit.surface ? f : edit.find_facet(mesh.bface_tag[f], p[0], p[1], p[2]);
     // Subsegments among the triangle's edges; the circumcentre encroaching one, or falling outside
     // the facet, splits the subsegment instead (nearest to the centre first).
     int seg_edge = -1;
@@ -307,7 +364,14 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       const Vec& u = p[e];
       const Vec& v = p[(e + 1) % 3];
       std::uint32_t a = 0, b = 0;
-      if (!edit.find_segment(u, v, a, b)) continue;
+      if (edit.surface) {
+        a = fv[e];
+        b = fv[(e + 1) % 3];
+        if (!edit.edge_facets.count(EditablePlc::edge_key(a, b)) && !edit.split_at.count(EditablePlc::edge_key(a, b)))
+          continue;
+      } else if (!edit.find_segment(u, v, a, b)) {
+        continue;
+      }
       const Vec mid = scale(add(u, v), 0.5);
       const double d2 = norm2(sub(fb.c, mid));
       const bool encroached = d2 < 0.25 * norm2(sub(v, u));
@@ -323,7 +387,10 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       if (added.near(mid, spacing * size)) continue;
       // The segment may have been split already in this pass: find the piece that holds mid now.
       std::uint32_t a = sa, b = sb;
-      if (!edit.on_segment(mid, a, b) || !edit.find_segment(mid, mid, a, b)) continue;
+      if (edit.surface)
+        edit.piece_holding(mid, a, b);
+      else if (!edit.on_segment(mid, a, b) || !edit.find_segment(mid, mid, a, b))
+        continue;
       edit.split_segment(a, b, edit.add_point(mid));
       accept(mid);
     } else if (facet < edit.facets.size()) {
@@ -342,7 +409,7 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       if (added.near(c, spacing * size)) continue;
       // A point on some segment of the facet would be a second copy of a segment vertex to TetGen.
       const std::uint32_t k = edit.add_point(c);
-      if (edit.find_segment(c, c, a, b))
+      if (!edit.surface && edit.find_segment(c, c, a, b))
         edit.split_segment(a, b, k);
       else
         edit.facet_points[facet].push_back(k);

@@ -128,6 +128,36 @@ struct EditablePlc {
   std::vector<std::vector<std::vector<std::uint32_t>>> facets;  // facet -> polygons (2+ vertices) -> vertices
   std::vector<std::vector<std::uint32_t>> facet_points;         // facet -> its lone vertices (1-vertex polygons)
   double tol = 0;                                               // "on a segment / plane", metres
+  // Surface mode (index_surface()): the PLC is a mesh's surface (surface_plc), facet f is the mesh's
+  // boundary triangle f and PLC point i its vertex i, and edges are found through these maps instead
+  // of by scanning every facet, which is quadratic on a surface of 10^5 triangles.
+  bool surface = false;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_facets;  // polygon edge -> facets
+  std::unordered_map<std::uint64_t, std::uint32_t> split_at;                   // split edge -> its new point
+
+  static std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+    if (a > b) std::swap(a, b);
+    return (std::uint64_t(a) << 32) | b;
+  }
+  void index_surface() {
+    surface = true;
+    for (std::uint32_t f = 0; f < facets.size(); ++f)
+      for (const auto& poly : facets[f])
+        for (std::size_t i = 0; i < poly.size() && poly.size() >= 2; ++i) {
+          if (poly.size() == 2 && i == 1) break;
+          edge_facets[edge_key(poly[i], poly[(i + 1) % poly.size()])].push_back(f);
+        }
+  }
+  // Surface mode: the current piece of the (maybe already split) PLC edge (a, b) that holds p.
+  void piece_holding(const Vec& p, std::uint32_t& a, std::uint32_t& b) const {
+    for (auto it = split_at.find(edge_key(a, b)); it != split_at.end(); it = split_at.find(edge_key(a, b))) {
+      const std::uint32_t k = it->second;
+      if (on_segment(p, a, k))
+        b = k;
+      else
+        a = k;
+    }
+  }
 
   explicit EditablePlc(Plc& p) : plc(p) {
     facets.resize(plc.facet_count());
@@ -188,21 +218,46 @@ struct EditablePlc {
   // edge of another polygon through it (a T-junction in the PLC), so that no facet keeps a segment
   // with a vertex of the PLC lying inside it.
   void split_segment(std::uint32_t a, std::uint32_t b, std::uint32_t k) {
+    if (surface) {
+      // A mesh's surface has no T-junctions: the polygons with the edge (a, b) are all there is.
+      const auto it = edge_facets.find(edge_key(a, b));
+      if (it == edge_facets.end()) return;
+      const std::vector<std::uint32_t> owners = std::move(it->second);
+      edge_facets.erase(it);
+      for (std::uint32_t f : owners)
+        for (auto& poly : facets[f])
+          for (std::size_t i = 0; i < poly.size(); ++i) {
+            const std::uint32_t u = poly[i], v = poly[(i + 1) % poly.size()];
+            if (edge_key(u, v) != edge_key(a, b)) continue;
+            poly.insert(poly.begin() + std::ptrdiff_t(i + 1), k);
+            break;
+          }
+      auto& ak = edge_facets[edge_key(a, k)];
+      ak.insert(ak.end(), owners.begin(), owners.end());
+      auto& kb = edge_facets[edge_key(k, b)];
+      kb.insert(kb.end(), owners.begin(), owners.end());
+      split_at[edge_key(a, b)] = k;
+      return;
+    }
     const Vec pk = point(k);
     auto holds = [&](std::uint32_t u, std::uint32_t v) {
       return ((u == a && v == b) || (u == b && v == a)) ||
              (u != k && v != k && on_segment(pk, u, v) && norm2(sub(pk, point(u))) > tol * tol &&
               norm2(sub(pk, point(v))) > tol * tol);
     };
-    for (auto& polys : facets) {
-      const std::size_t count = polys.size();
+    const std::size_t facet_count = facets.size();
+    for (std::size_t f = 0; f < facet_count; ++f) {
+      const std::size_t count = facets[f].size();
       for (std::size_t g = 0; g < count; ++g) {
-        auto& poly = polys[g];
-        if (poly.size() == 2) {  // a lone segment becomes two (three vertices would be a triangle)
+        auto& poly = facets[f][g];
+        if (poly.size() == 2) {
+          // A lone segment becomes two, the second in a facet of its own: TetGen triangulates the
+          // vertices of one facet in its plane, and three almost collinear vertices make a sliver
+          // triangle that it then finds crossing the facets along the segment.
           if (holds(poly[0], poly[1])) {
             const std::uint32_t end = poly[1];
             poly[1] = k;
-            polys.push_back({k, end});
+            add_segment_facet(k, end, plc.facet_marker[f]);
           }
           continue;
         }
@@ -217,6 +272,14 @@ struct EditablePlc {
   }
 
 
+
+  // A new facet holding the single segment (a, b).
+  void add_segment_facet(std::uint32_t a, std::uint32_t b, std::int32_t marker) {
+    facets.push_back({{a, b}});
+    facet_points.emplace_back();
+    plc.facet_marker.push_back(marker);
+    plc.facet_hole_begin.push_back(plc.facet_hole_begin.back());
+  }
 
   // The facet with marker `marker` whose plane holds the triangle and whose polygons hold its centroid.
   std::size_t find_facet(std::int32_t marker, const Vec& p0, const Vec& p1, const Vec& p2) const {
@@ -342,6 +405,20 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
 // polygon that has it, which index-based splitting only sees when shared corners are one point.
 // Returns the number of points merged.
 std::size_t weld_coincident_points(Plc& plc, double relative_tol = 1e-12);
+
+// The mesh's constraint triangles as a PLC: every mesh vertex a point, every boundary/interface
+// triangle a facet of its own (its tag the marker), the volume holes and region seeds of `plc`.
+// A refinement round edits this PLC, not the model's: a triangle's three corners are always coplanar,
+// so points added to it never leave TetGen a large facet that is planar only to rounding, and the
+// vertices of every earlier round (TetGen's own among them) stay where they were.
+Plc surface_plc(const Mesh& mesh, const Plc& plc);
+
+// Makes coordinates that differ by rounding alone (within relative_tol of the PLC's extent, per axis)
+// equal: the value most points have wins. A model's arithmetic leaves the corners of one straight
+// edge at x = 0.0025 and x = 0.0025000000000000005; to TetGen's exact predicates that edge then has a
+// kink, and its segment recovery loops or asserts on the split points along it. Returns the number
+// of coordinates changed.
+std::size_t snap_coordinates(Plc& plc, double relative_tol = 1e-12);
 
 // Volume per tet region. A refinement only adds points on the PLC's facets and inside its regions,
 // so every round's mesh must have the first mesh's regions and volumes: a round that does not

@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "foxi/mesher/tetgen_mesher.hpp"  // MesherError
+#include "union_find.hpp"
 
 namespace foxi::detail {
 
@@ -129,15 +130,6 @@ void triangulate_facet(const Plc& plc, std::size_t f, const std::vector<std::uin
   }
 }
 
-struct UnionFind {
-  std::vector<std::uint32_t> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  std::uint32_t find(std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(std::uint32_t a, std::uint32_t b) { parent[find(a)] = find(b); }
-};
 
 Vec tri_normal(const PlcSurface& s, std::size_t t) {
   const Point a = point(s.points, s.tri[3 * t]), b = point(s.points, s.tri[3 * t + 1]), c = point(s.points, s.tri[3 * t + 2]);

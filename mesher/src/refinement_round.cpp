@@ -1,5 +1,6 @@
 #include "refinement_round.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 
@@ -7,9 +8,17 @@
 
 namespace foxi::detail {
 
-std::optional<DelaunayCertificate> RefinementRounds::run(std::size_t it, Plc& current, Mesh& mesh) {
+std::optional<DelaunayCertificate> RefinementRounds::run(std::size_t it, Plc& current, Mesh& mesh, bool mesh_given) {
   try {
-    mesh = mesh_plc(current, params_, &rep_.tetgen);
+    if (it > 0 || !mesh_given) {
+      MeshParams p = params_;
+      // A later round's PLC is the first one's with some points more: a run that takes many times
+      // longer is TetGen looping, not working.
+      if (it > 0) p.time_limit = std::max(30.0, 20 * first_seconds_);
+      const auto t0 = std::chrono::steady_clock::now();
+      mesh = mesh_plc(current, p, &rep_.tetgen);
+      if (it == 0) first_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
     if (it == 0) first_volumes_ = region_volumes(mesh);
     if (it > 0 && !same_region_volumes(first_volumes_, region_volumes(mesh))) throw MesherError(2, "regions lost");
   } catch (const MesherError& e) {

@@ -20,7 +20,8 @@ class RefinementRounds {
   // whose mesh has other regions or region volumes than the first (TetGen lost a facet and a region
   // leaked) is rejected: `current` and `mesh` go back to what keep() saved, rep.tetgen_failed is set
   // and nothing is returned. Other errors (a bad PLC, cancel) propagate.
-  std::optional<DelaunayCertificate> run(std::size_t it, Plc& current, Mesh& mesh);
+  // With `mesh_given`, round 0 takes `mesh` as TetGen's mesh of `current` instead of running TetGen.
+  std::optional<DelaunayCertificate> run(std::size_t it, Plc& current, Mesh& mesh, bool mesh_given = false);
 
   // Saves the PLC and mesh a rejected next round returns to; call before editing `current`.
   void keep(const Plc& current, const Mesh& mesh) {
@@ -34,6 +35,7 @@ class RefinementRounds {
   Plc previous_;
   Mesh previous_mesh_;
   std::map<std::int32_t, double> first_volumes_;
+  double first_seconds_ = 0;  // round 0's TetGen run (0 when round 0's mesh was given)
 };
 
 }  // namespace foxi::detail

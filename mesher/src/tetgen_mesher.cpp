@@ -54,7 +54,7 @@ struct Result {
 // Runs TetGen in a child process: TetGen 1.5's library frees its memory twice when it stops on an
 // error (terminatetetgen() then the mesh destructor), which crashes the caller; in a child the crash
 // becomes an error message.
-Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const ProgressFn& progress) {
+Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const ProgressFn& progress, double time_limit) {
   int fds[2];
   if (::pipe(fds) != 0) throw MesherError(1, std::string("cannot create a pipe: ") + std::strerror(errno));
   std::fflush(nullptr);
@@ -101,8 +101,20 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   std::vector<char> buf;
   char chunk[1 << 16];
   const auto start = std::chrono::steady_clock::now();
+  auto stop_child = [&] {
+    ::kill(pid, SIGKILL);
+    ::close(fds[0]);
+    int ws = 0;
+    while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
+    }
+  };
   for (;;) {
-    if (progress) {
+    if (time_limit > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > time_limit) {
+      stop_child();
+      throw MesherError(2, "TetGen did not finish within " + std::to_string(int(time_limit)) + " s on this PLC");
+    }
+    if (progress || time_limit > 0) {
       // TetGen reports no progress of its own: the callback is asked every 100 ms (fraction -1,
       // "unknown") so that a user can cancel, which stops the child.
       pollfd pfd{fds[0], POLLIN, 0};
@@ -112,12 +124,8 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
       if (ready == 0 || (ready < 0 && errno == EINTR)) {
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         (void)elapsed;
-        if (!progress("meshing", -1.0)) {
-          ::kill(pid, SIGKILL);
-          ::close(fds[0]);
-          int ws = 0;
-          while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
-          }
+        if (progress && !progress("meshing", -1.0)) {
+          stop_child();
           throw MesherError(-1, "meshing cancelled");
         }
         continue;
@@ -263,7 +271,7 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   }
   std::vector<char> switches(sw.begin(), sw.end());
   switches.push_back('\0');
-  Result res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress);
+  Result res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress, params.time_limit);
   if (res.status != 0) throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
 
   Mesh m;

@@ -29,6 +29,12 @@ namespace foxi {
 struct ConformingParams {
   std::size_t max_iterations = 12;  // TetGen runs after the first
   std::size_t max_layer_iterations = 60;  // with thin layers: refinement rounds (one TetGen run each)
+  // When the conforming rounds end uncertified (TetGen failed on a refined PLC, or a round did not
+  // lower the violations), go on from the last mesh by splitting its own surface triangles, TetGen
+  // recovering them without refinement of its own: certifies PLCs on which TetGen's facet
+  // triangulation fails (curved faceted surfaces, corefinement slivers). Also joins coplanar facet
+  // pieces of the input first (coplanar_facets.hpp). No effect on PLCs with thin layers.
+  bool surface_rescue = true;
   // Thin layers at least this many times wider than thick are exempt from the quality bounds
   // (thin_layers.hpp), and foxi then refines by itself; 0: no exemption (TetGen's refinement then
   // fills a thin layer with tets as wide as it is thick).
@@ -59,13 +65,17 @@ struct ConformingReport {
   std::size_t quality_points = 0;          // points foxi added for quality and size
   std::size_t quality_unmet = 0;           // tets outside the layers still over a bound at the end
   double certificate_seconds = 0;          // of which the certificates
+  // Rounds that refined the mesh's own surface triangles after TetGen failed on a refined PLC or the
+  // conforming rounds ran out (0: none were needed).
+  std::size_t surface_rounds = 0;
 };
 
 // Meshes `plc` with TetGen (params.optimize is forced off) and refines until the exact Delaunay
 // certificate passes. Returns the last mesh even when it is not certified (report->delaunay says);
 // throws MesherError like mesh_plc, and MesherError(-1) when params.progress cancels (stage
 // "conforming refinement" between runs, fraction = iteration / max_iterations). `refined_plc`, if
-// given, receives the PLC with the added points.
+// given, receives the PLC with the added points (after surface rounds: the mesh's surface triangles
+// as facets and all its vertices, TetGen's Steiner points among them).
 Mesh mesh_conforming(const Plc& plc, const MeshParams& params = {}, const ConformingParams& conforming = {},
                      ConformingReport* report = nullptr, Plc* refined_plc = nullptr);
 

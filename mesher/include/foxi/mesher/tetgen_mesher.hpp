@@ -29,6 +29,10 @@ struct MeshParams {
   // Asked about every 100 ms while TetGen runs (fraction -1: TetGen tells no progress); returning
   // false stops TetGen and mesh_plc throws MesherError (code -1, "meshing cancelled").
   ProgressFn progress;
+  // Wall-clock limit for the TetGen run in seconds (0: none). TetGen 1.5.0 can loop forever on a PLC
+  // with almost collinear points; past the limit it is stopped and mesh_plc throws MesherError (code
+  // 2, as for a TetGen failure). The refinement rounds set it from their first run's time.
+  double time_limit = 0;
 };
 
 struct MeshReport {
