@@ -54,6 +54,41 @@ struct UnionFind {
   }
 };
 
+// The fixed-point keys of the non-wide items (see spheres.hpp): units of 2^-31 of the largest
+// |c| component and |s|, rounded up to powers of two so that scaling is exact. A rounded value is
+// off by at most one unit; the key s - 2 c.p (or c.d) evaluated from them in double is then off by
+// at most s_unit + 2 c_unit |p|_1 plus its own rounding (a few ulps of the largest terms).
+void make_fixed_keys(SphereTable& t) {
+  const std::size_t m = t.all_rep.size();
+  double cmax = 0, smax = 0;
+  for (std::uint32_t rep : t.all_rep) {
+    const double* c = t.c.data() + 3 * std::size_t(rep);
+    cmax = std::max({cmax, std::abs(c[0]), std::abs(c[1]), std::abs(c[2])});
+    smax = std::max(smax, std::abs(t.s[rep]));
+  }
+  if (!std::isfinite(cmax) || !std::isfinite(smax)) return;  // no fixed keys: the double path
+  // Units such that |x| / unit < 2^31 for every value (|x| < 2^e); the rounding is clamped to the
+  // int32 range, which keeps it within one unit.
+  t.c_unit = std::ldexp(1.0, (cmax > 0 ? std::ilogb(cmax) + 1 : -1000) - 31);
+  t.s_unit = std::ldexp(1.0, (smax > 0 ? std::ilogb(smax) + 1 : -1000) - 31);
+  t.fixed_a = 2 * (t.s_unit + 8 * kEps * smax);
+  t.fixed_b = 2 * (2 * t.c_unit + 32 * kEps * cmax);
+  t.fixed_keys.resize(m);
+  auto fix = [](double x, double unit) {
+    const long long v = std::llround(x / unit);
+    return static_cast<std::int32_t>(std::clamp<long long>(v, -0x7FFFFFFF, 0x7FFFFFFF));
+  };
+  parallel_for(m, [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t rep = t.all_rep[i];
+      const double* c = t.c.data() + 3 * std::size_t(rep);
+      SphereTable::FixedKey& k = t.fixed_keys[i];
+      for (int j = 0; j < 3; ++j) k.c[j] = fix(c[j], t.c_unit);
+      k.s = fix(t.s[rep], t.s_unit);
+    }
+  });
+}
+
 }  // namespace
 
 SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
@@ -377,6 +412,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   for (std::size_t i = 0; i < n; ++i)
     if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
   for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
+  make_fixed_keys(t);
   if (progress) progress("clusters", 1.0);
   return t;
 }

@@ -155,16 +155,18 @@ struct ProgressiveOrder::Impl {
   bool perspective = true;
   double eye2[3] = {0, 0, 0}, dir[3] = {0, 0, 0};
   double sign = -1, ka = 1, np = 0;
-  float bound = 0;                          // the radius of ordinary items
+  float bound = 0;                          // the radius of ordinary items (their q)
+  float double_bound = 0;                   // the same for keys recomputed in double (near ties)
   double lo_of(std::uint32_t tet, float radius) const {
     const double* c = table->c.data() + 3 * std::size_t(tet);
     const double k = perspective ? table->s[tet] - (c[0] * eye2[0] + c[1] * eye2[1] + c[2] * eye2[2])
                                  : c[0] * dir[0] + c[1] * dir[1] + c[2] * dir[2];
     return sign * k - double(radius);
   }
-  float radius_of(std::uint32_t rep) const {
-    if (!table->wide[rep]) return bound;
-    return std::max(bound, static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) *
+  float radius_of(std::uint32_t rep) const { return radius_of(rep, bound); }
+  float radius_of(std::uint32_t rep, float ordinary) const {
+    if (!table->wide[rep]) return ordinary;
+    return std::max(ordinary, static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) *
                                               (1 + 1e-6)));
   }
   // q = floor((lo - q_min) q_scale) clamped to 32 bits: monotone in lo (NaN goes to 0).
@@ -343,8 +345,12 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
                    : std::abs(dir[0]) + std::abs(dir[1]) + std::abs(dir[2]);
   ka = perspective ? 1.0 : 0.0;
   sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
+  // A whole-mesh order reads the fixed-point keys (their rounding widens the bound a little).
+  const bool fixed = subset.empty() && !t.fixed_keys.empty() && t.fixed_keys.size() == m_main;
+  const double bound_a = t.bound_a + (fixed ? t.fixed_a : 0.0), bound_b = t.bound_b + (fixed ? t.fixed_b : 0.0);
   // Rounded up to float, and a little more for the subtraction that places lo.
-  bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
+  bound = static_cast<float>((ka * bound_a + bound_b * np) * (1 + 1e-6));
+  double_bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
   stats.key_bound = bound;
 
   // 1. The quantisation of lo to 32 bits, over the bulk of a sample of the keys ([0.1%, 99.9%]
@@ -424,6 +430,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
                p2 = perspective ? eye2[2] : dir[2];
   const double shift_lo = double(bound), sgn = sign, qmin = q_min, qscale = q_scale;
   const bool persp_view = perspective;
+  const SphereTable::FixedKey* fixed_p = fixed ? t.fixed_keys.data() : nullptr;
+  const double f0 = p0 * t.c_unit, f1 = p1 * t.c_unit, f2 = p2 * t.c_unit, s_unit = t.s_unit;
   auto key_pass_of = [=, this, &hist, &thist](auto with_tets) {
    return [=, this, &hist, &thist](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
@@ -453,7 +461,18 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         ++heads;
       }
     };
-    if (persp_view) {
+    if (fixed_p != nullptr && persp_view) {
+      for (std::size_t i = b; i < e; ++i) {
+        const SphereTable::FixedKey& k = fixed_p[i];
+        put(i, sgn * (double(k.s) * s_unit - (double(k.c[0]) * f0 + double(k.c[1]) * f1 + double(k.c[2]) * f2)) -
+                   shift_lo);
+      }
+    } else if (fixed_p != nullptr) {
+      for (std::size_t i = b; i < e; ++i) {
+        const SphereTable::FixedKey& k = fixed_p[i];
+        put(i, sgn * (double(k.c[0]) * f0 + double(k.c[1]) * f1 + double(k.c[2]) * f2) - shift_lo);
+      }
+    } else if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t tet = rep_at(i);
         const double* c = C + 3 * tet;
@@ -655,7 +674,7 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t item = item_of(sorted[k]);
     const std::uint32_t rep = rep_tet(*table, item);
-    const float r = radius_of(rep);
+    const float r = radius_of(rep, double_bound);
     run.push_back({lo_of(rep, r), r, item});
   }
   // By (lo, item): the same order whatever order the run came in.
