@@ -165,6 +165,69 @@ TEST(VisibilityOrder, RandomDelaunayMeshesHaveNoViolationsFromAnyView) {
   }
 }
 
+TEST(VisibilityOrder, FixedPointKeysStayWithinTheirBound) {
+  // The whole-mesh key pass reads the table's fixed-point keys; its near-tie window relies on the
+  // bound (bound_a + fixed_a) + (bound_b + fixed_b) |p|_1. Oracle: each item's key from its tet's
+  // circumcentre computed again from the nodes in long double. A grid (clusters as items) and a
+  // random mesh moved far from the coordinate origin.
+  if (!test::have_program("tetgen")) GTEST_SKIP();
+  test::TempDir dir;
+  std::vector<Mesh> meshes;
+  meshes.push_back(test::random_delaunay(dir, 4000, 41, 2, 1, 1));
+  for (std::size_t i = 0; i < meshes[0].xyz.size(); i += 3) meshes[0].xyz[i] += 1000;
+  meshes.push_back(test::grid_mesh(9, 8, 7, 1, 0.5, 0.2, 6));
+  for (const Mesh& m : meshes) {
+    SphereTable t = compute_spheres(m);
+    ASSERT_EQ(t.fixed_keys.size(), t.all_items.size());
+    const double a = t.bound_a + t.fixed_a, b = t.bound_b + t.fixed_b;
+    for (const View& v : random_views(m, 30, 17)) {
+      if (!v.perspective) continue;
+      long double p[3];
+      for (int k = 0; k < 3; ++k) p[k] = static_cast<long double>(v.eye[k]) - t.origin[k];
+      const double p1 = static_cast<double>(std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]));
+      double worst = 0;
+      for (std::size_t i = 0; i < t.all_items.size(); ++i) {
+        const SphereTable::FixedKey& f = t.fixed_keys[i];
+        const long double key_fixed =
+            f.s * static_cast<long double>(t.s_unit) -
+            2 * static_cast<long double>(t.c_unit) * (f.c[0] * p[0] + f.c[1] * p[1] + f.c[2] * p[2]);
+        const std::uint32_t* q = &m.tet[4 * std::size_t(t.all_rep[i])];
+        long double x[4][3];
+        for (int j = 0; j < 4; ++j)
+          for (int k = 0; k < 3; ++k) x[j][k] = static_cast<long double>(m.xyz[3 * q[j] + k]) - t.origin[k];
+        long double e[3][3], l[3];
+        for (int j = 0; j < 3; ++j) {
+          for (int k = 0; k < 3; ++k) e[j][k] = x[j + 1][k] - x[0][k];
+          l[j] = e[j][0] * e[j][0] + e[j][1] * e[j][1] + e[j][2] * e[j][2];
+        }
+        auto cross = [](const long double* u, const long double* w, long double* r) {
+          r[0] = u[1] * w[2] - u[2] * w[1];
+          r[1] = u[2] * w[0] - u[0] * w[2];
+          r[2] = u[0] * w[1] - u[1] * w[0];
+        };
+        long double cd[3], db[3], bc[3];
+        cross(e[1], e[2], cd);
+        cross(e[2], e[0], db);
+        cross(e[0], e[1], bc);
+        const long double det = e[0][0] * cd[0] + e[0][1] * cd[1] + e[0][2] * cd[2];
+        long double o[3], c[3];
+        for (int k = 0; k < 3; ++k) {
+          o[k] = (l[0] * cd[k] + l[1] * db[k] + l[2] * bc[k]) / (2 * det);
+          c[k] = x[0][k] + o[k];
+        }
+        // s = |c|^2 - r^2 = |x0|^2 + 2 x0.o
+        const long double s_exact = x[0][0] * x[0][0] + x[0][1] * x[0][1] + x[0][2] * x[0][2] +
+                                    2 * (x[0][0] * o[0] + x[0][1] * o[1] + x[0][2] * o[2]);
+        const long double key_exact = s_exact - 2 * (c[0] * p[0] + c[1] * p[1] + c[2] * p[2]);
+        worst = std::max(worst, static_cast<double>(std::abs(key_fixed - key_exact)) / (a + b * p1));
+      }
+      EXPECT_LE(worst, 1.0);
+      // The bound is not vacuous: the fixed-point rounding is what it is made of.
+      EXPECT_GT(worst, 1e-3);
+    }
+  }
+}
+
 TEST(VisibilityOrder, NonConvexRandomSubsetsAndFrontToBack) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
