@@ -222,8 +222,8 @@ TEST(VisibilityOrder, FixedPointKeysStayWithinTheirBound) {
         worst = std::max(worst, static_cast<double>(std::abs(key_fixed - key_exact)) / (a + b * p1));
       }
       EXPECT_LE(worst, 1.0);
-      // The bound is not vacuous: the fixed-point rounding is what it is made of.
-      EXPECT_GT(worst, 1e-3);
+      // The bound is tight (it sets the near-tie window): the rounding to fixed point is most of it.
+      EXPECT_GT(worst, 0.05);
     }
   }
 }

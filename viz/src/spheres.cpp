@@ -56,8 +56,10 @@ struct UnionFind {
 
 // The fixed-point keys of the non-wide items (see spheres.hpp): units of 2^-31 of the largest
 // |c| component and |s|, rounded up to powers of two so that scaling is exact. A rounded value is
-// off by at most one unit; the key s - 2 c.p (or c.d) evaluated from them in double is then off by
-// at most s_unit + 2 c_unit |p|_1 plus its own rounding (a few ulps of the largest terms).
+// off by at most half a unit (a whole one where the int32 range clamps it); the key s - 2 c.p (or
+// c.d) evaluated from them in double is then off by at most that times (1, 2 |p|_1) plus its own
+// rounding (a few ulps of the largest terms). The window of near ties grows with this bound, so
+// it is kept tight.
 void make_fixed_keys(SphereTable& t) {
   const std::size_t m = t.all_rep.size();
   double cmax = 0, smax = 0;
@@ -67,26 +69,30 @@ void make_fixed_keys(SphereTable& t) {
     smax = std::max(smax, std::abs(t.s[rep]));
   }
   if (!std::isfinite(cmax) || !std::isfinite(smax)) return;  // no fixed keys: the double path
-  // Units such that |x| / unit < 2^31 for every value (|x| < 2^e); the rounding is clamped to the
-  // int32 range, which keeps it within one unit.
-  t.c_unit = std::ldexp(1.0, (cmax > 0 ? std::ilogb(cmax) + 1 : -1000) - 31);
-  t.s_unit = std::ldexp(1.0, (smax > 0 ? std::ilogb(smax) + 1 : -1000) - 31);
-  t.fixed_a = 2 * (t.s_unit + 8 * kEps * smax);
-  t.fixed_b = 2 * (2 * t.c_unit + 32 * kEps * cmax);
-  t.fixed_keys.resize(m);
-  auto fix = [](double x, double unit) {
+  // Units such that |x| / unit < 2^31 for every value (|x| < 2^e).
+  const double c_unit = std::ldexp(1.0, (cmax > 0 ? std::ilogb(cmax) + 1 : -1000) - 31);
+  const double s_unit = std::ldexp(1.0, (smax > 0 ? std::ilogb(smax) + 1 : -1000) - 31);
+  std::atomic<bool> clamped{false};
+  auto fix = [&clamped](double x, double unit) {
     const long long v = std::llround(x / unit);
+    if (v > 0x7FFFFFFF || v < -0x7FFFFFFF) clamped = true;
     return static_cast<std::int32_t>(std::clamp<long long>(v, -0x7FFFFFFF, 0x7FFFFFFF));
   };
+  t.fixed_keys.resize(m);
   parallel_for(m, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t rep = t.all_rep[i];
       const double* c = t.c.data() + 3 * std::size_t(rep);
       SphereTable::FixedKey& k = t.fixed_keys[i];
-      for (int j = 0; j < 3; ++j) k.c[j] = fix(c[j], t.c_unit);
-      k.s = fix(t.s[rep], t.s_unit);
+      for (int j = 0; j < 3; ++j) k.c[j] = fix(c[j], c_unit);
+      k.s = fix(t.s[rep], s_unit);
     }
   });
+  const double off = clamped ? 1.0 : 0.5;  // the rounding, in units
+  t.c_unit = c_unit;
+  t.s_unit = s_unit;
+  t.fixed_a = off * s_unit + 8 * kEps * smax;
+  t.fixed_b = 2 * off * c_unit + 32 * kEps * cmax;
 }
 
 }  // namespace
