@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <deque>
@@ -1023,11 +1024,15 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
 void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
                            const View& view, std::span<const std::uint32_t> subset, bool front_to_back,
                            OrderStats* stats) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point t0 = Clock::now();
   ProgressiveOrder order(mesh, table, view, subset, front_to_back);
   ProgressiveOrder::Impl& d = *order.impl_;
+  const Clock::time_point t1 = Clock::now();
   const std::size_t nb = d.bucket_begin.size() - 1;
   d.scatter(0, nb);
   d.scattered = true;
+  const Clock::time_point t2 = Clock::now();
   // Every bucket's tets go straight to their final places.
   out.resize(order.total());
   std::uint32_t* direct = out.data();
@@ -1063,6 +1068,9 @@ void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, co
   }
   d.next_bucket = nb;
   d.handed = out.size();
+  d.stats.keys_seconds = std::chrono::duration<double>(t1 - t0).count();
+  d.stats.scatter_seconds = std::chrono::duration<double>(t2 - t1).count();
+  d.stats.sort_seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   if (stats) *stats = d.stats;
 }
 
