@@ -13,6 +13,7 @@
 
 #include "exact.hpp"
 #include "foxi/model/adjacency.hpp"
+#include "huge_page_allocator.hpp"
 #include "thread_pool.hpp"
 
 namespace foxi {
@@ -32,6 +33,17 @@ void parallel_for(std::size_t n, F f) {
   }
   const std::size_t half = n / 2;
   pool::on_two_cores([&](int part) { part == 0 ? f(std::size_t{0}, half, 0) : f(half, n, 1); });
+}
+
+// A prefetch that the optimiser keeps. GCC deems __builtin_prefetch free of side effects, so a
+// function that only prefetches is found const by its IPA pass and every call to it removed (it
+// happened to prefetch_cluster and prefetch_near_ties below); a volatile asm cannot be removed.
+inline void prefetch(const void* p) {
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  asm volatile("prefetcht0 %0" : : "m"(*static_cast<const char*>(p)));
+#else
+  __builtin_prefetch(p);
+#endif
 }
 
 const double* node(const Mesh& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
@@ -101,12 +113,13 @@ struct Entry {
 using Packed = std::uint64_t;
 inline std::uint32_t q_of(Packed p) { return static_cast<std::uint32_t>(p >> 32); }
 inline std::uint32_t item_of(Packed p) { return static_cast<std::uint32_t>(p); }
+using PackedBuffer = std::vector<Packed, HugePageAllocator<Packed>>;
 
 // Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
 struct Workspace {
-  std::vector<Packed> keyed;    // pass 1: the items with their q, in input order (8 bytes per item)
-  std::vector<Packed> entries;  // the bucketed entries (8 bytes per item)
-  std::vector<Packed> head[2];  // the head buckets' entries gathered by the key pass (per part)
+  PackedBuffer keyed;           // pass 1: the items with their q, in input order (8 bytes per item)
+  PackedBuffer entries;         // the bucketed entries (8 bytes per item)
+  PackedBuffer head[2];         // the head buckets' entries gathered by the key pass (per part)
 };
 thread_local Workspace t_workspace;
 
@@ -116,7 +129,7 @@ struct ProgressiveOrder::Impl {
   View view;
   bool front_to_back = false;
   std::vector<std::uint8_t> in_subset;          // per tet, only when a subset meets clusters
-  std::vector<Packed> sorted;                   // bucketed; each bucket sorted when handed out
+  PackedBuffer sorted;                          // bucketed; each bucket sorted when handed out
   std::vector<std::uint32_t> bucket_begin;      // size buckets + 1
   std::size_t next_bucket = 0;
   std::vector<std::uint32_t> batch;
@@ -131,6 +144,8 @@ struct ProgressiveOrder::Impl {
     std::vector<std::uint32_t> counts;
     std::vector<Entry> run;
     std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
+    // Buckets below this one, from where this thread began, are sorted already (sorted ahead).
+    std::size_t sorted_upto = 0;
   };
   Scratch scratch;
   void add_counts(Scratch& sc) {
@@ -191,14 +206,14 @@ struct ProgressiveOrder::Impl {
   }
   int bucket_shift = 32;                    // first-level bucket of an entry: q >> bucket_shift
   // The entries in input order (pass 1) and what the scatter of them into `sorted` needs.
-  std::vector<Packed> keyed;
+  PackedBuffer keyed;
   std::vector<std::uint32_t> scatter_start[2];  // per bucket, the next slot of each part
   std::size_t scatter_split = 0;                // part 0 is keyed[0, split), part 1 the rest
   std::size_t head_buckets = 0;                 // buckets a progressive order places first
   // The entries of the head buckets, gathered by the key pass (per part), so that a progressive
   // order hands out its first batch without waiting for the scatter; head_fits is false if there
   // were more than the room kept for them.
-  std::vector<Packed> head[2];
+  PackedBuffer head[2];
   std::size_t head_count[2] = {0, 0};
   bool head_fits = false;
   std::size_t scatter_from = 0;                 // the first bucket the worker's scatter places
@@ -262,11 +277,31 @@ struct ProgressiveOrder::Impl {
     const SphereTable& t = *table;
     const std::uint32_t k = item & ~kClusterBit;
     const std::uint32_t f = t.cluster_face_begin[k], fe = t.cluster_face_begin[k + 1];
-    __builtin_prefetch(t.cluster_tets.data() + t.cluster_begin[k]);
+    prefetch(t.cluster_tets.data() + t.cluster_begin[k]);
     if (f == fe) return;
     const char* faces = reinterpret_cast<const char*>(t.face_test.data() + f);
     const char* faces_end = reinterpret_cast<const char*>(t.face_test.data() + fe);
-    for (const char* p = faces; p < faces_end && p < faces + 512; p += 64) __builtin_prefetch(p);
+    for (const char* p = faces; p < faces_end && p < faces + 512; p += 64) prefetch(p);
+  }
+  // Prefetches the double keys of the tets in near-tie pairs of [begin, end) (sorted), which
+  // resolve_run reads: they lie at random places, and fetched one run after another each is a
+  // cache miss waited for (a few thousand a view at 1M tets, tens of thousands at 4M).
+  void prefetch_near_ties(std::size_t begin, std::size_t end) const {
+    const Packed* a = sorted.data();
+    const std::uint64_t w = q_window;
+    const double* C = table->c.data();
+    const double* S = table->s.data();
+    const std::uint8_t* wide = table->wide.data();
+    for (std::size_t i = begin; i + 1 < end; ++i) {
+      if (std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w) continue;
+      for (std::uint32_t item : {item_of(a[i]), item_of(a[i + 1])}) {
+        if (item & kClusterBit) continue;  // found through the cluster tables first
+        prefetch(C + 3 * std::size_t(item));
+        prefetch(C + 3 * std::size_t(item) + 2);
+        prefetch(S + item);
+        prefetch(wide + item);
+      }
+    }
   }
   // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
   void expand(std::uint32_t item, std::uint32_t*& o, Scratch& sc);
@@ -865,6 +900,13 @@ ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = def
 
 std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
                                                  std::vector<std::uint32_t>& out, Scratch& sc, std::uint32_t* direct) {
+  // Sorts bucket k unless this thread has sorted it ahead (a bucket once emitted has its near
+  // ties resolved, which a second sort would undo, so each is sorted once).
+  auto ensure_sorted = [&](std::size_t k) {
+    if (k < sc.sorted_upto && k >= first) return;
+    sort_bucket(bucket_begin[k], bucket_begin[k + 1], sc);
+    sc.sorted_upto = k + 1;
+  };
   std::size_t b = first;
   while (b < last) {
     const std::size_t group = b;  // the first bucket of this group
@@ -872,7 +914,9 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     std::size_t end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    sort_bucket(begin, end, sc);
+    const bool fetched = group < sc.sorted_upto && group >= first;  // sorted ahead, its keys fetched
+    ensure_sorted(group);
+    if (!fetched) prefetch_near_ties(begin, end);
     // A run of joined entries may cross into the following buckets: take them in while it may.
     // Bucket b holds no q below b << bucket_shift, so most checks need not look into it.
     while (b < limit) {
@@ -883,10 +927,18 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       }
       const Packed bucket_low = Packed(b) << (32 + bucket_shift);
       if (!joined(sorted[end - 1], bucket_low)) break;
-      sort_bucket(nb_begin, nb_end, sc);
+      ensure_sorted(b);
       if (!joined(sorted[end - 1], sorted[nb_begin])) break;  // sorted now, handed out next
       end = nb_end;
       ++b;
+    }
+    // The next bucket sorted now and its near ties' keys fetched, arriving while this group is
+    // scanned (one group after another, each resolve_run would wait for its misses).
+    std::size_t ahead = b;
+    while (ahead < limit && bucket_begin[ahead] == bucket_begin[ahead + 1]) ++ahead;
+    if (ahead < limit && ahead >= sc.sorted_upto) {
+      ensure_sorted(ahead);
+      prefetch_near_ties(bucket_begin[ahead], bucket_begin[ahead + 1]);
     }
     const std::uint32_t* tb = t_cluster_free ? bucket_begin.data() : tet_begin.data();
     std::uint32_t* o = direct + tb[group];
