@@ -468,6 +468,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   const bool persp_view = perspective;
   const SphereTable::FixedKey* fixed_p = fixed ? t.fixed_keys.data() : nullptr;
   const double f0 = p0 * t.c_unit, f1 = p1 * t.c_unit, f2 = p2 * t.c_unit, s_unit = t.s_unit;
+  // No clusters and no wide items: all_items lists every tet in order.
+  const bool identity = fixed && t_cluster_free && m_main == n;
   auto key_pass_of = [=, this, &hist, &thist](auto with_tets) {
    return [=, this, &hist, &thist](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
@@ -484,10 +486,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         return item_p[i];
       }
     };
-    auto put = [=, this, &heads](std::size_t i, double lo) {
+    auto put = [=, this, &heads](std::size_t i, double lo, std::uint32_t item) {
       const double x = (lo - qmin) * qscale;
       const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
-      const Packed p = (Packed(q) << 32) | item_p[i];
+      const Packed p = (Packed(q) << 32) | item;
       keyed_p[i] = p;
       ++hp[q >> shift];
       if constexpr (decltype(with_tets)::value)
@@ -497,27 +499,29 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         ++heads;
       }
     };
+    // Item i is tet i when every tet is an ordinary item: then the item list is not read.
+    auto item_at = [=](std::size_t i) { return identity ? static_cast<std::uint32_t>(i) : item_p[i]; };
     if (fixed_p != nullptr && persp_view) {
       for (std::size_t i = b; i < e; ++i) {
         const SphereTable::FixedKey& k = fixed_p[i];
         put(i, sgn * (double(k.s) * s_unit - (double(k.c[0]) * f0 + double(k.c[1]) * f1 + double(k.c[2]) * f2)) -
-                   shift_lo);
+                   shift_lo, item_at(i));
       }
     } else if (fixed_p != nullptr) {
       for (std::size_t i = b; i < e; ++i) {
         const SphereTable::FixedKey& k = fixed_p[i];
-        put(i, sgn * (double(k.c[0]) * f0 + double(k.c[1]) * f1 + double(k.c[2]) * f2) - shift_lo);
+        put(i, sgn * (double(k.c[0]) * f0 + double(k.c[1]) * f1 + double(k.c[2]) * f2) - shift_lo, item_at(i));
       }
     } else if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t tet = rep_at(i);
         const double* c = C + 3 * tet;
-        put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo);
+        put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo, item_p[i]);
       }
     } else {
       for (std::size_t i = b; i < e; ++i) {
         const double* c = C + 3 * rep_at(i);
-        put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo);
+        put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo, item_p[i]);
       }
     }
     head_count[part] = heads;
