@@ -326,6 +326,56 @@ TEST(VisibilityOrder, LargeGridSubsetsSplitAcrossThreadsAndBatches) {
   }
 }
 
+TEST(VisibilityOrder, OrdersBeyondTheCacheAreSortedPermutations) {
+  // Over 2^21 items (a jittered grid: no cospherical cells, 2.24M tets): the key pass and the
+  // scatter write around the cache (non-temporal stores, write-combining lines per bucket).
+  // Oracles: the order is a permutation of the tets whose keys, recomputed in double from the
+  // table, never rise by more than the two tets' rounding bounds; the progressive order, which
+  // places its buckets by the plain scatter, hands out the same order.
+  const int n = 72;
+  Mesh m = test::grid_mesh(n, n, n, 1, 1, 1, 6);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> jitter(-0.1, 0.1);
+  for (std::size_t v = 0; v < m.node_count(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      double& x = m.xyz[3 * v + k];
+      if (x > 0 && x < n) x += jitter(rng);
+    }
+  SphereTable t = compute_spheres(m);
+  ASSERT_GT(t.all_items.size() + t.wide_items.size(), std::size_t(1) << 21);
+  std::vector<std::uint32_t> order, expected(m.tet_count());
+  for (std::uint32_t i = 0; i < m.tet_count(); ++i) expected[i] = i;
+  const View views[3] = {View::at(-30, 20, 150), View::at(36, 37, 35), View::along(0.3, -0.5, 0.8)};
+  for (const View& v : views)
+    for (bool front_to_back : {false, true}) {
+      if (front_to_back && !v.perspective) continue;
+      visibility_order_into(order, m, t, v, {}, front_to_back);
+      std::vector<std::uint32_t> sorted_order = order;
+      std::sort(sorted_order.begin(), sorted_order.end());
+      ASSERT_EQ(sorted_order, expected);
+      double p[3];
+      for (int k = 0; k < 3; ++k) p[k] = v.perspective ? v.eye[k] - t.origin[k] : v.dir[k];
+      const double np = std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]);
+      auto key = [&](std::uint32_t tet) {  // drawn in decreasing key, back to front
+        const double* c = &t.c[3 * std::size_t(tet)];
+        const double k = v.perspective ? t.s[tet] - 2 * (c[0] * p[0] + c[1] * p[1] + c[2] * p[2])
+                                       : c[0] * p[0] + c[1] * p[1] + c[2] * p[2];
+        return front_to_back ? -k : k;
+      };
+      auto err = [&](std::uint32_t tet) { return (v.perspective ? t.key_a[tet] : 0.f) + t.key_b[tet] * np; };
+      std::size_t rises = 0;
+      for (std::size_t i = 0; i + 1 < order.size(); ++i)
+        if (key(order[i + 1]) > key(order[i]) + err(order[i]) + err(order[i + 1])) ++rises;
+      EXPECT_EQ(rises, 0u);
+      ProgressiveOrder progressive(m, t, v, {}, front_to_back);
+      std::size_t at = 0, mismatches = 0;
+      for (auto b = progressive.next(); !b.empty(); b = progressive.next())
+        for (std::uint32_t tet : b) mismatches += at < order.size() && order[at++] == tet ? 0 : 1;
+      EXPECT_EQ(at, order.size());
+      EXPECT_EQ(mismatches, 0u);
+    }
+}
+
 TEST(VisibilityOrder, ExactlyCosphericalPointsFormOneCluster) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;

@@ -11,6 +11,10 @@
 #include <queue>
 #include <future>
 
+#if defined(__SSE2__) && defined(__x86_64__)
+#include <emmintrin.h>
+#endif
+
 #include "exact.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "huge_page_allocator.hpp"
@@ -43,6 +47,36 @@ inline void prefetch(const void* p) {
   asm volatile("prefetcht0 %0" : : "m"(*static_cast<const char*>(p)));
 #else
   __builtin_prefetch(p);
+#endif
+}
+
+// Stores an 8-byte entry, around the cache if `stream` (a non-temporal store: no read of the line
+// before it is written); store_fence() then orders such stores before the thread's later ones.
+inline void store_entry(std::uint64_t* at, std::uint64_t value, bool stream) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  if (stream) {
+    _mm_stream_si64(reinterpret_cast<long long*>(at), static_cast<long long>(value));
+    return;
+  }
+#endif
+  (void)stream;
+  *at = value;
+}
+// Writes one 64-byte line of entries at `at` (64-byte aligned) around the cache.
+inline void write_line(std::uint64_t* at, const std::uint64_t* line) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  for (int k = 0; k < 4; ++k)
+    _mm_stream_si128(reinterpret_cast<__m128i*>(at) + k, _mm_loadu_si128(reinterpret_cast<const __m128i*>(line) + k));
+#else
+  std::copy(line, line + 8, at);
+#endif
+}
+// Orders of 2^21 entries or more are beyond the last-level cache (16 MB for the keyed
+// entries, as much again for the buckets): their big buffers are written around it.
+inline bool stream_entries(std::size_t m) { return m > (std::size_t(1) << 21); }
+inline void store_fence() {
+#if defined(__SSE2__) && defined(__x86_64__)
+  _mm_sfence();
 #endif
 }
 
@@ -430,8 +464,11 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   // 2. Keys, q and the first-level histogram in one pass (both cores). About 1000 entries a bucket:
   // few enough buckets that the scatter's write fronts stay in cache, and each bucket sorted when
   // handed out (sort_bucket) stays in L1/L2 (measured against 256 to 2048 a bucket).
+  // Beyond the cache, at most 4096 buckets: each thread's write-combining lines (64 bytes a
+  // bucket) must stay in its L2.
+  const int max_bits = stream_entries(m) ? 12 : 16;
   int bits = 4;
-  while (bits < 16 && (std::size_t(1024) << bits) < m) ++bits;
+  while (bits < max_bits && (std::size_t(1024) << bits) < m) ++bits;
   const std::size_t nb = std::size_t(1) << bits;
   const int shift = 32 - bits;
   bucket_shift = shift;
@@ -468,6 +505,9 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   const bool persp_view = perspective;
   const SphereTable::FixedKey* fixed_p = fixed ? t.fixed_keys.data() : nullptr;
   const double f0 = p0 * t.c_unit, f1 = p1 * t.c_unit, f2 = p2 * t.c_unit, s_unit = t.s_unit;
+  // Beyond the last-level cache the entries are written around it: they are read next by the
+  // scatter, from memory either way, and a plain store would first read each line it writes.
+  const bool stream = stream_entries(m);
   // No clusters and no wide items: all_items lists every tet in order.
   const bool identity = fixed && t_cluster_free && m_main == n;
   auto key_pass_of = [=, this, &hist, &thist](auto with_tets) {
@@ -490,7 +530,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
       const double x = (lo - qmin) * qscale;
       const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
       const Packed p = (Packed(q) << 32) | item;
-      keyed_p[i] = p;
+      store_entry(keyed_p + i, p, stream);
       ++hp[q >> shift];
       if constexpr (decltype(with_tets)::value)
         if (item_p[i] & kClusterBit) thp[q >> shift] += tets_of(item_p[i]) - 1;
@@ -525,6 +565,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
       }
     }
     head_count[part] = heads;
+    if (stream) store_fence();
    };
   };
   head_count[0] = head_count[1] = 0;
@@ -617,13 +658,46 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
       }
     }
   };
+  // Beyond the last-level cache, the whole scatter writes through per-thread line buffers
+  // (software write-combining): each bucket's line is filled in a buffer that stays in L2 and a full
+  // line goes to memory in one non-temporal write, with no read of the destination line first.
+  const bool combine = from == 0 && to == nb && stream_entries(m);
+  auto run_combined = [=, this](std::size_t b, std::size_t e, std::uint32_t* ps) {
+    thread_local std::vector<Packed> t_lines;
+    thread_local std::vector<std::uint32_t> t_first;
+    if (t_lines.size() < 8 * nb) t_lines.resize(8 * nb);
+    t_first.assign(ps, ps + nb);
+    Packed* lines = t_lines.data();
+    const std::uint32_t* first = t_first.data();
+    for (std::size_t i = b; i < e; ++i) {
+      const Packed p = keyed_p[i];
+      const std::size_t k = q_of(p) >> shift;
+      const std::uint32_t pos = ps[k]++;
+      Packed* line = lines + 8 * k;
+      line[pos & 7] = p;
+      if ((pos & 7) != 7) continue;
+      // The line [pos - 7, pos] is complete; its first slots may belong to the bucket (or part)
+      // before, when it is this part's first line of bucket k: then only its own slots are stored.
+      if (pos - 7 >= first[k]) write_line(out + (pos - 7), line);
+      else
+        for (std::uint32_t slot = first[k]; slot <= pos; ++slot) out[slot] = line[slot & 7];
+    }
+    for (std::size_t k = 0; k < nb; ++k) {  // the partial last lines
+      const std::uint32_t end = ps[k];
+      if ((end & 7) == 0 || end == first[k]) continue;
+      for (std::uint32_t slot = std::max(end & ~7u, first[k]); slot < end; ++slot) out[slot] = lines[8 * k + (slot & 7)];
+    }
+    store_fence();
+  };
   const std::size_t split = scatter_split;
   if (split == m) {
     run(0, m, scatter_start[0].data());
   } else {
     pool::on_two_cores([&](int part) {
-      if (part == 0) run(0, split, scatter_start[0].data());
-      else run(split, m, scatter_start[1].data());
+      std::uint32_t* ps = scatter_start[part].data();
+      const std::size_t b = part == 0 ? 0 : split, e = part == 0 ? split : m;
+      if (combine) run_combined(b, e, ps);
+      else run(b, e, ps);
     });
   }
   if (to < nb || stop) return;
