@@ -62,21 +62,33 @@ struct UnionFind {
 // it is kept tight.
 void make_fixed_keys(SphereTable& t) {
   const std::size_t m = t.all_rep.size();
-  double cmax = 0, smax = 0;
-  for (std::uint32_t rep : t.all_rep) {
-    const double* c = t.c.data() + 3 * std::size_t(rep);
-    cmax = std::max({cmax, std::abs(c[0]), std::abs(c[1]), std::abs(c[2])});
-    smax = std::max(smax, std::abs(t.s[rep]));
-  }
+  double cmax_part[2] = {0, 0}, smax_part[2] = {0, 0};
+  parallel_for(m, [&](std::size_t begin, std::size_t end, int part) {
+    double cm = cmax_part[part], sm = smax_part[part];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t rep = t.all_rep[i];
+      const double* c = t.c.data() + 3 * std::size_t(rep);
+      cm = std::max({cm, std::abs(c[0]), std::abs(c[1]), std::abs(c[2])});
+      sm = std::max(sm, std::abs(t.s[rep]));
+    }
+    cmax_part[part] = cm;
+    smax_part[part] = sm;
+  });
+  const double cmax = std::max(cmax_part[0], cmax_part[1]), smax = std::max(smax_part[0], smax_part[1]);
   if (!std::isfinite(cmax) || !std::isfinite(smax)) return;  // no fixed keys: the double path
   // Units such that |x| / unit < 2^31 for every value (|x| < 2^e).
   const double c_unit = std::ldexp(1.0, (cmax > 0 ? std::ilogb(cmax) + 1 : -1000) - 31);
   const double s_unit = std::ldexp(1.0, (smax > 0 ? std::ilogb(smax) + 1 : -1000) - 31);
+  // Rounded half away from zero (x / unit is exact, and so is adding a half below 2^52), by a
+  // truncating conversion.
   std::atomic<bool> clamped{false};
   auto fix = [&clamped](double x, double unit) {
-    const long long v = std::llround(x / unit);
-    if (v > 0x7FFFFFFF || v < -0x7FFFFFFF) clamped = true;
-    return static_cast<std::int32_t>(std::clamp<long long>(v, -0x7FFFFFFF, 0x7FFFFFFF));
+    const double y = x / unit + (x < 0 ? -0.5 : 0.5);
+    if (!(std::abs(y) < 2147483647.0)) {
+      clamped = true;
+      return static_cast<std::int32_t>(x < 0 ? -0x7FFFFFFF : 0x7FFFFFFF);
+    }
+    return static_cast<std::int32_t>(y);
   };
   t.fixed_keys.resize(m);
   parallel_for(m, [&](std::size_t begin, std::size_t end, int) {
