@@ -74,6 +74,13 @@ inline void write_line(std::uint64_t* at, const std::uint64_t* line) {
 // Orders of 2^21 entries or more are beyond the last-level cache (16 MB for the keyed
 // entries, as much again for the buckets): their big buffers are written around it.
 inline bool stream_entries(std::size_t m) { return m > (std::size_t(1) << 21); }
+inline void store_item(std::uint32_t* at, std::uint32_t value) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  _mm_stream_si32(reinterpret_cast<int*>(at), static_cast<int>(value));
+#else
+  *at = value;
+#endif
+}
 inline void store_fence() {
 #if defined(__SSE2__) && defined(__x86_64__)
   _mm_sfence();
@@ -985,6 +992,9 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     sort_bucket(bucket_begin[k], bucket_begin[k + 1], sc);
     sc.sorted_upto = k + 1;
   };
+  // A whole order beyond the cache is written around it (the caller's buffer, read next by the
+  // drawing, from memory either way).
+  const bool stream_out = direct != nullptr && stream_entries(bucket_begin.back());
   std::size_t b = first;
   while (b < last) {
     const std::size_t group = b;  // the first bucket of this group
@@ -1025,7 +1035,9 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       out.resize(at + (tb[b] - tb[group]));
       o = out.data() + at;
     }
-    if (t_cluster_free) {
+    if (t_cluster_free && stream_out) {
+      scan_runs(begin, end, sc, [&o](std::uint32_t item) { store_item(o++, item); });
+    } else if (t_cluster_free) {
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
       // Clusters met in key order are scattered over memory, and each expansion is a chain of
@@ -1039,6 +1051,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       });
     }
   }
+  if (stream_out) store_fence();
   return b;
 }
 
