@@ -311,6 +311,13 @@ struct ProgressiveOrder::Impl {
   }
   void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
+  // Prefetches where a cluster item's faces and tets are listed (nothing for a tet).
+  void prefetch_offsets(std::uint32_t item) const {
+    if (!(item & kClusterBit)) return;
+    const std::uint32_t k = item & ~kClusterBit;
+    prefetch(table->cluster_face_begin.data() + k);
+    prefetch(table->cluster_begin.data() + k);
+  }
   // Prefetches a cluster item's faces and tets ahead of its expansion (nothing for a tet).
   bool many_clusters = false;               // clusters are a sizeable part of the items
   void prefetch_cluster(std::uint32_t item) const {
@@ -1041,14 +1048,29 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
       // Clusters met in key order are scattered over memory, and each expansion is a chain of
-      // dependent cache misses (offsets, then faces): a first pass fetches the data of all the
-      // group's clusters, its iterations independent so that the misses overlap.
-      if (many_clusters)
-        for (std::size_t k = begin; k < end; ++k) prefetch_cluster(item_of(sorted[k]));
-      scan_runs(begin, end, sc, [&](std::uint32_t item) {
-        if (item & kClusterBit) expand(item, o, sc);
-        else *o++ = item;
-      });
+      // dependent cache misses (offsets, then faces): the offsets of the cluster kFar items ahead
+      // and the faces and tets of the one kNear ahead are fetched as each item is expanded, so
+      // that a bounded number of misses overlap (a whole group fetched at once overflows L1).
+      constexpr std::size_t kNear = 8, kFar = 24;
+      const Packed* a = sorted.data();
+      std::size_t at = begin, near = begin, far = begin;
+      auto fetch_ahead = [&] {
+        for (; far < end && far < at + kFar; ++far) prefetch_offsets(item_of(a[far]));
+        for (; near < end && near < at + kNear; ++near) prefetch_cluster(item_of(a[near]));
+        ++at;
+      };
+      if (many_clusters) {
+        scan_runs(begin, end, sc, [&](std::uint32_t item) {
+          fetch_ahead();
+          if (item & kClusterBit) expand(item, o, sc);
+          else *o++ = item;
+        });
+      } else {
+        scan_runs(begin, end, sc, [&](std::uint32_t item) {
+          if (item & kClusterBit) expand(item, o, sc);
+          else *o++ = item;
+        });
+      }
     }
   }
   if (stream_out) store_fence();
