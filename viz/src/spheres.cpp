@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "exact.hpp"
+#include "huge_page_allocator.hpp"
 #include "foxi/model/adjacency.hpp"
 
 namespace foxi {
@@ -90,6 +91,8 @@ void make_fixed_keys(SphereTable& t) {
     }
     return static_cast<std::int32_t>(y);
   };
+  t.fixed_keys.reserve(m);
+  advise_huge_pages(t.fixed_keys.data(), m * sizeof(SphereTable::FixedKey));
   t.fixed_keys.resize(m);
   parallel_for(m, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t i = begin; i < end; ++i) {
@@ -114,6 +117,11 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   const std::size_t n = mesh.tet_count();
   const bool weighted = !mesh.weight.empty();
   t.weighted = weighted;
+  // The centres and s of near ties are read at random places per view: huge pages (no TLB miss).
+  t.c.reserve(3 * n);
+  t.s.reserve(n);
+  advise_huge_pages(t.c.data(), 3 * n * sizeof(double));
+  advise_huge_pages(t.s.data(), n * sizeof(double));
   t.c.resize(3 * n);
   t.s.resize(n);
   t.flat.assign(n, 0);
