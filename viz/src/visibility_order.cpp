@@ -1,6 +1,7 @@
 #include "foxi/viz/visibility_order.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <limits>
 #include <mutex>
 #include <queue>
+#include <utility>
 #include <future>
 
 #if defined(__SSE2__) && defined(__x86_64__)
@@ -155,6 +157,62 @@ using Packed = std::uint64_t;
 inline std::uint32_t q_of(Packed p) { return static_cast<std::uint32_t>(p >> 32); }
 inline std::uint32_t item_of(Packed p) { return static_cast<std::uint32_t>(p); }
 using PackedBuffer = std::vector<Packed, HugePageAllocator<Packed>>;
+
+// The key pass of a whole-mesh order over the table's fixed-point keys (see prepare): for items
+// [b, e) the entries, the first-level histogram (and tets per bucket beyond each item's first) and
+// the head entries; returns the number of head entries met. Its inputs are plain values copied
+// into the loop's frame, so that none is reloaded after each store.
+struct FixedPass {
+  const SphereTable::FixedKey* keys = nullptr;
+  const std::uint32_t* items = nullptr;
+  const std::uint32_t* cluster_begin = nullptr;
+  Packed* out = nullptr;
+  std::uint32_t* hist = nullptr;
+  std::uint32_t* tets_hist = nullptr;
+  Packed* head = nullptr;
+  std::size_t head_room = 0;
+  std::uint32_t q_head = 0;
+  int shift = 32;
+  double f[3] = {0, 0, 0};  // the eye (twice, local frame) or direction, times c_unit
+  double s_unit = 0, sign = -1, shift_lo = 0, q_min = 0, q_scale = 0;
+};
+
+template <bool kPerspective, bool kIdentity, bool kStream, bool kClusters>
+std::size_t fixed_key_pass(const FixedPass& in, std::size_t b, std::size_t e) {
+  const FixedPass p = in;
+  std::size_t heads = 0;
+  for (std::size_t i = b; i < e; ++i) {
+    const SphereTable::FixedKey& k = p.keys[i];
+    const double dot = double(k.c[0]) * p.f[0] + double(k.c[1]) * p.f[1] + double(k.c[2]) * p.f[2];
+    const double key = kPerspective ? double(k.s) * p.s_unit - dot : dot;
+    const double x = (p.sign * key - p.shift_lo - p.q_min) * p.q_scale;
+    const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+    const std::uint32_t item = kIdentity ? static_cast<std::uint32_t>(i) : p.items[i];
+    const Packed entry = (Packed(q) << 32) | item;
+    store_entry(p.out + i, entry, kStream);
+    ++p.hist[q >> p.shift];
+    if constexpr (kClusters) {
+      if (item & kClusterBit) {
+        const std::uint32_t c = item & ~kClusterBit;
+        p.tets_hist[q >> p.shift] += p.cluster_begin[c + 1] - p.cluster_begin[c] - 1;
+      }
+    }
+    if (q < p.q_head) {
+      if (heads < p.head_room) p.head[heads] = entry;
+      ++heads;
+    }
+  }
+  if (kStream) store_fence();
+  return heads;
+}
+
+using FixedPassFn = std::size_t (*)(const FixedPass&, std::size_t, std::size_t);
+template <std::size_t... kFlags>
+constexpr std::array<FixedPassFn, sizeof...(kFlags)> fixed_passes(std::index_sequence<kFlags...>) {
+  return {&fixed_key_pass<(kFlags & 1) != 0, (kFlags & 2) != 0, (kFlags & 4) != 0, (kFlags & 8) != 0>...};
+}
+// Indexed by perspective | identity << 1 | stream << 2 | clusters << 3.
+constexpr std::array<FixedPassFn, 16> kFixedPasses = fixed_passes(std::make_index_sequence<16>{});
 
 // Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
 struct Workspace {
@@ -517,13 +575,9 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
                p2 = perspective ? eye2[2] : dir[2];
   const double shift_lo = double(bound), sgn = sign, qmin = q_min, qscale = q_scale;
   const bool persp_view = perspective;
-  const SphereTable::FixedKey* fixed_p = fixed ? t.fixed_keys.data() : nullptr;
-  const double f0 = p0 * t.c_unit, f1 = p1 * t.c_unit, f2 = p2 * t.c_unit, s_unit = t.s_unit;
   // Beyond the last-level cache the entries are written around it: they are read next by the
   // scatter, from memory either way, and a plain store would first read each line it writes.
   const bool stream = stream_entries(m);
-  // No clusters and no wide items: all_items lists every tet in order.
-  const bool identity = fixed && t_cluster_free && m_main == n;
   auto key_pass_of = [=, this, &hist, &thist](auto with_tets) {
    return [=, this, &hist, &thist](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
@@ -553,20 +607,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         ++heads;
       }
     };
-    // Item i is tet i when every tet is an ordinary item: then the item list is not read.
-    auto item_at = [=](std::size_t i) { return identity ? static_cast<std::uint32_t>(i) : item_p[i]; };
-    if (fixed_p != nullptr && persp_view) {
-      for (std::size_t i = b; i < e; ++i) {
-        const SphereTable::FixedKey& k = fixed_p[i];
-        put(i, sgn * (double(k.s) * s_unit - (double(k.c[0]) * f0 + double(k.c[1]) * f1 + double(k.c[2]) * f2)) -
-                   shift_lo, item_at(i));
-      }
-    } else if (fixed_p != nullptr) {
-      for (std::size_t i = b; i < e; ++i) {
-        const SphereTable::FixedKey& k = fixed_p[i];
-        put(i, sgn * (double(k.c[0]) * f0 + double(k.c[1]) * f1 + double(k.c[2]) * f2) - shift_lo, item_at(i));
-      }
-    } else if (persp_view) {
+    if (persp_view) {
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t tet = rep_at(i);
         const double* c = C + 3 * tet;
@@ -583,8 +624,39 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
    };
   };
   head_count[0] = head_count[1] = 0;
-  if (t_cluster_free) parallel_for(m_main, key_pass_of(std::false_type{}));
-  else parallel_for(m_main, key_pass_of(std::true_type{}));
+  if (fixed) {
+    FixedPass pass;
+    pass.keys = t.fixed_keys.data();
+    pass.items = items.data();
+    pass.out = keyed_p;
+    pass.cluster_begin = t.cluster_begin.data();
+    pass.head_room = head_room;
+    pass.q_head = q_head;
+    pass.shift = shift;
+    pass.f[0] = p0 * t.c_unit;
+    pass.f[1] = p1 * t.c_unit;
+    pass.f[2] = p2 * t.c_unit;
+    pass.s_unit = t.s_unit;
+    pass.sign = sign;
+    pass.shift_lo = double(bound);
+    pass.q_min = q_min;
+    pass.q_scale = q_scale;
+    // No clusters and no wide items: all_items lists every tet in order (item i is tet i).
+    const bool identity = t_cluster_free && m_main == n;
+    const FixedPassFn run = kFixedPasses[(perspective ? 1 : 0) | (identity ? 2 : 0) | (stream ? 4 : 0) |
+                                         (t_cluster_free ? 0 : 8)];
+    parallel_for(m_main, [&](std::size_t b, std::size_t e, int part) {
+      FixedPass own = pass;
+      own.hist = hist[part].data();
+      own.tets_hist = thist[part].data();
+      own.head = head[part].data();
+      head_count[part] = run(own, b, e);
+    });
+  } else if (t_cluster_free) {
+    parallel_for(m_main, key_pass_of(std::false_type{}));
+  } else {
+    parallel_for(m_main, key_pass_of(std::true_type{}));
+  }
   // The wide items (few) go with the second part, and each makes a zone of joined q values.
   const std::size_t split = m_main < 50000 ? m : m_main / 2;  // as parallel_for splits
   const int wide_part = split == m ? 0 : 1;
