@@ -294,6 +294,9 @@ struct ProgressiveOrder::Impl {
   // their q differ by at most q_window, or both lie in one zone: the q range of everything whose
   // interval may overlap a wide item's (merged, sorted).
   std::uint64_t q_window = 0;
+  // Near ties are fetched ahead (prefetch_near_ties) when they are expected to be more than 0.1% of
+  // the entries (from about 2M tets): below that the extra pass costs more than the misses.
+  bool prefetch_ties = false;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> zones;
   bool joined(Packed a, Packed b) const {
     const std::uint32_t qa = q_of(a), qb = q_of(b);
@@ -531,6 +534,7 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     // Joined neighbours: q apart by at most 2 radius q_scale plus the rounding of the map and floor.
     const double w = 2.0 * double(bound) * q_scale * (1 + 1e-9) + 2;
     q_window = w < 8e9 ? static_cast<std::uint64_t>(w) : std::uint64_t(1) << 33;
+    prefetch_ties = double(q_window) * double(m) > 0.001 * 4294967296.0;
   }
 
   // 2. Keys, q and the first-level histogram in one pass (both cores). About 1000 entries a bucket:
@@ -1083,7 +1087,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     if (begin == end) continue;
     const bool fetched = group < sc.sorted_upto && group >= first;  // sorted ahead, its keys fetched
     ensure_sorted(group);
-    if (!fetched) prefetch_near_ties(begin, end);
+    if (!fetched && prefetch_ties) prefetch_near_ties(begin, end);
     // A run of joined entries may cross into the following buckets: take them in while it may.
     // Bucket b holds no q below b << bucket_shift, so most checks need not look into it.
     while (b < limit) {
@@ -1103,7 +1107,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     // scanned (one group after another, each resolve_run would wait for its misses).
     std::size_t ahead = b;
     while (ahead < limit && bucket_begin[ahead] == bucket_begin[ahead + 1]) ++ahead;
-    if (ahead < limit && ahead >= sc.sorted_upto) {
+    if (prefetch_ties && ahead < limit && ahead >= sc.sorted_upto) {
       ensure_sorted(ahead);
       prefetch_near_ties(bucket_begin[ahead], bucket_begin[ahead + 1]);
     }
