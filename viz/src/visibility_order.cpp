@@ -760,6 +760,11 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
     Packed* lines = t_lines.data();
     const std::uint32_t* first = t_first.data();
     for (std::size_t i = b; i < e; ++i) {
+      // Gives up (unfinished) when the order is stopped, as run() does.
+      if ((i & 0xFFFF) == 0 && stop.load(std::memory_order_relaxed)) {
+        store_fence();
+        return;
+      }
       const Packed p = keyed_p[i];
       const std::size_t k = q_of(p) >> shift;
       const std::uint32_t pos = ps[k]++;
