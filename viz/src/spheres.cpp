@@ -82,8 +82,9 @@ void make_fixed_keys(SphereTable& t) {
   const double s_unit = std::ldexp(1.0, (smax > 0 ? std::ilogb(smax) + 1 : -1000) - 31);
   // Rounded half away from zero (x / unit is exact, and so is adding a half below 2^52), by a
   // truncating conversion.
-  std::atomic<bool> clamped{false};
-  auto fix = [&clamped](double x, double unit) {
+  std::atomic<bool> clamped{false}, not_finite{false};
+  auto fix = [&clamped, &not_finite](double x, double unit) {
+    if (!std::isfinite(x)) not_finite = true;
     const double y = x / unit + (x < 0 ? -0.5 : 0.5);
     if (!(std::abs(y) < 2147483647.0)) {
       clamped = true;
@@ -103,6 +104,10 @@ void make_fixed_keys(SphereTable& t) {
       k.s = fix(t.s[rep], s_unit);
     }
   });
+  if (not_finite) {  // (a broken table) no fixed keys: the double path, which clamps it
+    t.fixed_keys.clear();
+    return;
+  }
   const double off = clamped ? 1.0 : 0.5;  // the rounding, in units
   t.c_unit = c_unit;
   t.s_unit = s_unit;

@@ -751,7 +751,8 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
   // Beyond the last-level cache, the whole scatter writes through per-thread line buffers
   // (software write-combining): each bucket's line is filled in a buffer that stays in L2 and a full
   // line goes to memory in one non-temporal write, with no read of the destination line first.
-  const bool combine = from == 0 && to == nb && stream_entries(m);
+  // (Full lines need the buffer 64-byte aligned, which the huge-page allocator gives such sizes.)
+  const bool combine = from == 0 && to == nb && stream_entries(m) && reinterpret_cast<std::uintptr_t>(out) % 64 == 0;
   auto run_combined = [=, this](std::size_t b, std::size_t e, std::uint32_t* ps) {
     thread_local std::vector<Packed> t_lines;
     thread_local std::vector<std::uint32_t> t_first;
