@@ -165,6 +165,69 @@ TEST(VisibilityOrder, RandomDelaunayMeshesHaveNoViolationsFromAnyView) {
   }
 }
 
+TEST(VisibilityOrder, FixedPointKeysStayWithinTheirBound) {
+  // The whole-mesh key pass reads the table's fixed-point keys; its near-tie window relies on the
+  // bound (bound_a + fixed_a) + (bound_b + fixed_b) |p|_1. Oracle: each item's key from its tet's
+  // circumcentre computed again from the nodes in long double. A grid (clusters as items) and a
+  // random mesh moved far from the coordinate origin.
+  if (!test::have_program("tetgen")) GTEST_SKIP();
+  test::TempDir dir;
+  std::vector<Mesh> meshes;
+  meshes.push_back(test::random_delaunay(dir, 4000, 41, 2, 1, 1));
+  for (std::size_t i = 0; i < meshes[0].xyz.size(); i += 3) meshes[0].xyz[i] += 1000;
+  meshes.push_back(test::grid_mesh(9, 8, 7, 1, 0.5, 0.2, 6));
+  for (const Mesh& m : meshes) {
+    SphereTable t = compute_spheres(m);
+    ASSERT_EQ(t.fixed_keys.size(), t.all_items.size());
+    const double a = t.bound_a + t.fixed_a, b = t.bound_b + t.fixed_b;
+    for (const View& v : random_views(m, 30, 17)) {
+      if (!v.perspective) continue;
+      long double p[3];
+      for (int k = 0; k < 3; ++k) p[k] = static_cast<long double>(v.eye[k]) - t.origin[k];
+      const double p1 = static_cast<double>(std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]));
+      double worst = 0;
+      for (std::size_t i = 0; i < t.all_items.size(); ++i) {
+        const SphereTable::FixedKey& f = t.fixed_keys[i];
+        const long double key_fixed =
+            f.s * static_cast<long double>(t.s_unit) -
+            2 * static_cast<long double>(t.c_unit) * (f.c[0] * p[0] + f.c[1] * p[1] + f.c[2] * p[2]);
+        const std::uint32_t* q = &m.tet[4 * std::size_t(t.all_rep[i])];
+        long double x[4][3];
+        for (int j = 0; j < 4; ++j)
+          for (int k = 0; k < 3; ++k) x[j][k] = static_cast<long double>(m.xyz[3 * q[j] + k]) - t.origin[k];
+        long double e[3][3], l[3];
+        for (int j = 0; j < 3; ++j) {
+          for (int k = 0; k < 3; ++k) e[j][k] = x[j + 1][k] - x[0][k];
+          l[j] = e[j][0] * e[j][0] + e[j][1] * e[j][1] + e[j][2] * e[j][2];
+        }
+        auto cross = [](const long double* u, const long double* w, long double* r) {
+          r[0] = u[1] * w[2] - u[2] * w[1];
+          r[1] = u[2] * w[0] - u[0] * w[2];
+          r[2] = u[0] * w[1] - u[1] * w[0];
+        };
+        long double cd[3], db[3], bc[3];
+        cross(e[1], e[2], cd);
+        cross(e[2], e[0], db);
+        cross(e[0], e[1], bc);
+        const long double det = e[0][0] * cd[0] + e[0][1] * cd[1] + e[0][2] * cd[2];
+        long double o[3], c[3];
+        for (int k = 0; k < 3; ++k) {
+          o[k] = (l[0] * cd[k] + l[1] * db[k] + l[2] * bc[k]) / (2 * det);
+          c[k] = x[0][k] + o[k];
+        }
+        // s = |c|^2 - r^2 = |x0|^2 + 2 x0.o
+        const long double s_exact = x[0][0] * x[0][0] + x[0][1] * x[0][1] + x[0][2] * x[0][2] +
+                                    2 * (x[0][0] * o[0] + x[0][1] * o[1] + x[0][2] * o[2]);
+        const long double key_exact = s_exact - 2 * (c[0] * p[0] + c[1] * p[1] + c[2] * p[2]);
+        worst = std::max(worst, static_cast<double>(std::abs(key_fixed - key_exact)) / (a + b * p1));
+      }
+      EXPECT_LE(worst, 1.0);
+      // The bound is tight (it sets the near-tie window): the rounding to fixed point is most of it.
+      EXPECT_GT(worst, 0.05);
+    }
+  }
+}
+
 TEST(VisibilityOrder, NonConvexRandomSubsetsAndFrontToBack) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
@@ -261,6 +324,56 @@ TEST(VisibilityOrder, LargeGridSubsetsSplitAcrossThreadsAndBatches) {
       EXPECT_EQ(all, order);
     }
   }
+}
+
+TEST(VisibilityOrder, OrdersBeyondTheCacheAreSortedPermutations) {
+  // Over 2^21 items (a jittered grid: no cospherical cells, 2.24M tets): the key pass and the
+  // scatter write around the cache (non-temporal stores, write-combining lines per bucket).
+  // Oracles: the order is a permutation of the tets whose keys, recomputed in double from the
+  // table, never rise by more than the two tets' rounding bounds; the progressive order, which
+  // places its buckets by the plain scatter, hands out the same order.
+  const int n = 72;
+  Mesh m = test::grid_mesh(n, n, n, 1, 1, 1, 6);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> jitter(-0.1, 0.1);
+  for (std::size_t v = 0; v < m.node_count(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      double& x = m.xyz[3 * v + k];
+      if (x > 0 && x < n) x += jitter(rng);
+    }
+  SphereTable t = compute_spheres(m);
+  ASSERT_GT(t.all_items.size() + t.wide_items.size(), std::size_t(1) << 21);
+  std::vector<std::uint32_t> order, expected(m.tet_count());
+  for (std::uint32_t i = 0; i < m.tet_count(); ++i) expected[i] = i;
+  const View views[3] = {View::at(-30, 20, 150), View::at(36, 37, 35), View::along(0.3, -0.5, 0.8)};
+  for (const View& v : views)
+    for (bool front_to_back : {false, true}) {
+      if (front_to_back && !v.perspective) continue;
+      visibility_order_into(order, m, t, v, {}, front_to_back);
+      std::vector<std::uint32_t> sorted_order = order;
+      std::sort(sorted_order.begin(), sorted_order.end());
+      ASSERT_EQ(sorted_order, expected);
+      double p[3];
+      for (int k = 0; k < 3; ++k) p[k] = v.perspective ? v.eye[k] - t.origin[k] : v.dir[k];
+      const double np = std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]);
+      auto key = [&](std::uint32_t tet) {  // drawn in decreasing key, back to front
+        const double* c = &t.c[3 * std::size_t(tet)];
+        const double k = v.perspective ? t.s[tet] - 2 * (c[0] * p[0] + c[1] * p[1] + c[2] * p[2])
+                                       : c[0] * p[0] + c[1] * p[1] + c[2] * p[2];
+        return front_to_back ? -k : k;
+      };
+      auto err = [&](std::uint32_t tet) { return (v.perspective ? t.key_a[tet] : 0.f) + t.key_b[tet] * np; };
+      std::size_t rises = 0;
+      for (std::size_t i = 0; i + 1 < order.size(); ++i)
+        if (key(order[i + 1]) > key(order[i]) + err(order[i]) + err(order[i + 1])) ++rises;
+      EXPECT_EQ(rises, 0u);
+      ProgressiveOrder progressive(m, t, v, {}, front_to_back);
+      std::size_t at = 0, mismatches = 0;
+      for (auto b = progressive.next(); !b.empty(); b = progressive.next())
+        for (std::uint32_t tet : b) mismatches += at < order.size() && order[at++] == tet ? 0 : 1;
+      EXPECT_EQ(at, order.size());
+      EXPECT_EQ(mismatches, 0u);
+    }
 }
 
 TEST(VisibilityOrder, ExactlyCosphericalPointsFormOneCluster) {

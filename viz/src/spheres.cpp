@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "exact.hpp"
+#include "huge_page_allocator.hpp"
 #include "foxi/model/adjacency.hpp"
 
 namespace foxi {
@@ -54,6 +55,66 @@ struct UnionFind {
   }
 };
 
+// The fixed-point keys of the non-wide items (see spheres.hpp): units of 2^-31 of the largest
+// |c| component and |s|, rounded up to powers of two so that scaling is exact. A rounded value is
+// off by at most half a unit (a whole one where the int32 range clamps it); the key s - 2 c.p (or
+// c.d) evaluated from them in double is then off by at most that times (1, 2 |p|_1) plus its own
+// rounding (a few ulps of the largest terms). The window of near ties grows with this bound, so
+// it is kept tight.
+void make_fixed_keys(SphereTable& t) {
+  const std::size_t m = t.all_rep.size();
+  double cmax_part[2] = {0, 0}, smax_part[2] = {0, 0};
+  parallel_for(m, [&](std::size_t begin, std::size_t end, int part) {
+    double cm = cmax_part[part], sm = smax_part[part];
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t rep = t.all_rep[i];
+      const double* c = t.c.data() + 3 * std::size_t(rep);
+      cm = std::max({cm, std::abs(c[0]), std::abs(c[1]), std::abs(c[2])});
+      sm = std::max(sm, std::abs(t.s[rep]));
+    }
+    cmax_part[part] = cm;
+    smax_part[part] = sm;
+  });
+  const double cmax = std::max(cmax_part[0], cmax_part[1]), smax = std::max(smax_part[0], smax_part[1]);
+  if (!std::isfinite(cmax) || !std::isfinite(smax)) return;  // no fixed keys: the double path
+  // Units such that |x| / unit < 2^31 for every value (|x| < 2^e).
+  const double c_unit = std::ldexp(1.0, (cmax > 0 ? std::ilogb(cmax) + 1 : -1000) - 31);
+  const double s_unit = std::ldexp(1.0, (smax > 0 ? std::ilogb(smax) + 1 : -1000) - 31);
+  // Rounded half away from zero (x / unit is exact, and so is adding a half below 2^52), by a
+  // truncating conversion.
+  std::atomic<bool> clamped{false}, not_finite{false};
+  auto fix = [&clamped, &not_finite](double x, double unit) {
+    if (!std::isfinite(x)) not_finite = true;
+    const double y = x / unit + (x < 0 ? -0.5 : 0.5);
+    if (!(std::abs(y) < 2147483647.0)) {
+      clamped = true;
+      return static_cast<std::int32_t>(x < 0 ? -0x7FFFFFFF : 0x7FFFFFFF);
+    }
+    return static_cast<std::int32_t>(y);
+  };
+  t.fixed_keys.reserve(m);
+  advise_huge_pages(t.fixed_keys.data(), m * sizeof(SphereTable::FixedKey));
+  t.fixed_keys.resize(m);
+  parallel_for(m, [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t rep = t.all_rep[i];
+      const double* c = t.c.data() + 3 * std::size_t(rep);
+      SphereTable::FixedKey& k = t.fixed_keys[i];
+      for (int j = 0; j < 3; ++j) k.c[j] = fix(c[j], c_unit);
+      k.s = fix(t.s[rep], s_unit);
+    }
+  });
+  if (not_finite) {  // (a broken table) no fixed keys: the double path, which clamps it
+    t.fixed_keys.clear();
+    return;
+  }
+  const double off = clamped ? 1.0 : 0.5;  // the rounding, in units
+  t.c_unit = c_unit;
+  t.s_unit = s_unit;
+  t.fixed_a = off * s_unit + 8 * kEps * smax;
+  t.fixed_b = 2 * off * c_unit + 32 * kEps * cmax;
+}
+
 }  // namespace
 
 SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
@@ -61,6 +122,11 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   const std::size_t n = mesh.tet_count();
   const bool weighted = !mesh.weight.empty();
   t.weighted = weighted;
+  // The centres and s of near ties are read at random places per view: huge pages (no TLB miss).
+  t.c.reserve(3 * n);
+  t.s.reserve(n);
+  advise_huge_pages(t.c.data(), 3 * n * sizeof(double));
+  advise_huge_pages(t.s.data(), n * sizeof(double));
   t.c.resize(3 * n);
   t.s.resize(n);
   t.flat.assign(n, 0);
@@ -377,6 +443,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   for (std::size_t i = 0; i < n; ++i)
     if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
   for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
+  make_fixed_keys(t);
   if (progress) progress("clusters", 1.0);
   return t;
 }

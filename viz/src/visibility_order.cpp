@@ -1,17 +1,25 @@
 #include "foxi/viz/visibility_order.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <limits>
 #include <mutex>
 #include <queue>
+#include <utility>
 #include <future>
+
+#if defined(__SSE2__) && defined(__x86_64__)
+#include <emmintrin.h>
+#endif
 
 #include "exact.hpp"
 #include "foxi/model/adjacency.hpp"
+#include "huge_page_allocator.hpp"
 #include "thread_pool.hpp"
 
 namespace foxi {
@@ -31,6 +39,54 @@ void parallel_for(std::size_t n, F f) {
   }
   const std::size_t half = n / 2;
   pool::on_two_cores([&](int part) { part == 0 ? f(std::size_t{0}, half, 0) : f(half, n, 1); });
+}
+
+// A prefetch that the optimiser keeps. GCC deems __builtin_prefetch free of side effects, so a
+// function that only prefetches is found const by its IPA pass and every call to it removed (it
+// happened to prefetch_cluster and prefetch_near_ties below); a volatile asm cannot be removed.
+inline void prefetch(const void* p) {
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  asm volatile("prefetcht0 %0" : : "m"(*static_cast<const char*>(p)));
+#else
+  __builtin_prefetch(p);
+#endif
+}
+
+// Stores an 8-byte entry, around the cache if `stream` (a non-temporal store: no read of the line
+// before it is written); store_fence() then orders such stores before the thread's later ones.
+inline void store_entry(std::uint64_t* at, std::uint64_t value, bool stream) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  if (stream) {
+    _mm_stream_si64(reinterpret_cast<long long*>(at), static_cast<long long>(value));
+    return;
+  }
+#endif
+  (void)stream;
+  *at = value;
+}
+// Writes one 64-byte line of entries at `at` (64-byte aligned) around the cache.
+inline void write_line(std::uint64_t* at, const std::uint64_t* line) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  for (int k = 0; k < 4; ++k)
+    _mm_stream_si128(reinterpret_cast<__m128i*>(at) + k, _mm_loadu_si128(reinterpret_cast<const __m128i*>(line) + k));
+#else
+  std::copy(line, line + 8, at);
+#endif
+}
+// Orders of 2^21 entries or more are beyond the last-level cache (16 MB for the keyed
+// entries, as much again for the buckets): their big buffers are written around it.
+inline bool stream_entries(std::size_t m) { return m > (std::size_t(1) << 21); }
+inline void store_item(std::uint32_t* at, std::uint32_t value) {
+#if defined(__SSE2__) && defined(__x86_64__)
+  _mm_stream_si32(reinterpret_cast<int*>(at), static_cast<int>(value));
+#else
+  *at = value;
+#endif
+}
+inline void store_fence() {
+#if defined(__SSE2__) && defined(__x86_64__)
+  _mm_sfence();
+#endif
 }
 
 const double* node(const Mesh& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
@@ -100,12 +156,69 @@ struct Entry {
 using Packed = std::uint64_t;
 inline std::uint32_t q_of(Packed p) { return static_cast<std::uint32_t>(p >> 32); }
 inline std::uint32_t item_of(Packed p) { return static_cast<std::uint32_t>(p); }
+using PackedBuffer = std::vector<Packed, HugePageAllocator<Packed>>;
+
+// The key pass of a whole-mesh order over the table's fixed-point keys (see prepare): for items
+// [b, e) the entries, the first-level histogram (and tets per bucket beyond each item's first) and
+// the head entries; returns the number of head entries met. Its inputs are plain values copied
+// into the loop's frame, so that none is reloaded after each store.
+struct FixedPass {
+  const SphereTable::FixedKey* keys = nullptr;
+  const std::uint32_t* items = nullptr;
+  const std::uint32_t* cluster_begin = nullptr;
+  Packed* out = nullptr;
+  std::uint32_t* hist = nullptr;
+  std::uint32_t* tets_hist = nullptr;
+  Packed* head = nullptr;
+  std::size_t head_room = 0;
+  std::uint32_t q_head = 0;
+  int shift = 32;
+  double f[3] = {0, 0, 0};  // the eye (twice, local frame) or direction, times c_unit
+  double s_unit = 0, sign = -1, shift_lo = 0, q_min = 0, q_scale = 0;
+};
+
+template <bool kPerspective, bool kIdentity, bool kStream, bool kClusters>
+std::size_t fixed_key_pass(const FixedPass& in, std::size_t b, std::size_t e) {
+  const FixedPass p = in;
+  std::size_t heads = 0;
+  for (std::size_t i = b; i < e; ++i) {
+    const SphereTable::FixedKey& k = p.keys[i];
+    const double dot = double(k.c[0]) * p.f[0] + double(k.c[1]) * p.f[1] + double(k.c[2]) * p.f[2];
+    const double key = kPerspective ? double(k.s) * p.s_unit - dot : dot;
+    const double x = (p.sign * key - p.shift_lo - p.q_min) * p.q_scale;
+    const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+    const std::uint32_t item = kIdentity ? static_cast<std::uint32_t>(i) : p.items[i];
+    const Packed entry = (Packed(q) << 32) | item;
+    store_entry(p.out + i, entry, kStream);
+    ++p.hist[q >> p.shift];
+    if constexpr (kClusters) {
+      if (item & kClusterBit) {
+        const std::uint32_t c = item & ~kClusterBit;
+        p.tets_hist[q >> p.shift] += p.cluster_begin[c + 1] - p.cluster_begin[c] - 1;
+      }
+    }
+    if (q < p.q_head) {
+      if (heads < p.head_room) p.head[heads] = entry;
+      ++heads;
+    }
+  }
+  if (kStream) store_fence();
+  return heads;
+}
+
+using FixedPassFn = std::size_t (*)(const FixedPass&, std::size_t, std::size_t);
+template <std::size_t... kFlags>
+constexpr std::array<FixedPassFn, sizeof...(kFlags)> fixed_passes(std::index_sequence<kFlags...>) {
+  return {&fixed_key_pass<(kFlags & 1) != 0, (kFlags & 2) != 0, (kFlags & 4) != 0, (kFlags & 8) != 0>...};
+}
+// Indexed by perspective | identity << 1 | stream << 2 | clusters << 3.
+constexpr std::array<FixedPassFn, 16> kFixedPasses = fixed_passes(std::make_index_sequence<16>{});
 
 // Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
 struct Workspace {
-  std::vector<Packed> keyed;    // pass 1: the items with their q, in input order (8 bytes per item)
-  std::vector<Packed> entries;  // the bucketed entries (8 bytes per item)
-  std::vector<Packed> head[2];  // the head buckets' entries gathered by the key pass (per part)
+  PackedBuffer keyed;           // pass 1: the items with their q, in input order (8 bytes per item)
+  PackedBuffer entries;         // the bucketed entries (8 bytes per item)
+  PackedBuffer head[2];         // the head buckets' entries gathered by the key pass (per part)
 };
 thread_local Workspace t_workspace;
 
@@ -115,7 +228,7 @@ struct ProgressiveOrder::Impl {
   View view;
   bool front_to_back = false;
   std::vector<std::uint8_t> in_subset;          // per tet, only when a subset meets clusters
-  std::vector<Packed> sorted;                   // bucketed; each bucket sorted when handed out
+  PackedBuffer sorted;                          // bucketed; each bucket sorted when handed out
   std::vector<std::uint32_t> bucket_begin;      // size buckets + 1
   std::size_t next_bucket = 0;
   std::vector<std::uint32_t> batch;
@@ -130,6 +243,8 @@ struct ProgressiveOrder::Impl {
     std::vector<std::uint32_t> counts;
     std::vector<Entry> run;
     std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
+    // Buckets below this one, from where this thread began, are sorted already (sorted ahead).
+    std::size_t sorted_upto = 0;
   };
   Scratch scratch;
   void add_counts(Scratch& sc) {
@@ -155,16 +270,18 @@ struct ProgressiveOrder::Impl {
   bool perspective = true;
   double eye2[3] = {0, 0, 0}, dir[3] = {0, 0, 0};
   double sign = -1, ka = 1, np = 0;
-  float bound = 0;                          // the radius of ordinary items
+  float bound = 0;                          // the radius of ordinary items (their q)
+  float double_bound = 0;                   // the same for keys recomputed in double (near ties)
   double lo_of(std::uint32_t tet, float radius) const {
     const double* c = table->c.data() + 3 * std::size_t(tet);
     const double k = perspective ? table->s[tet] - (c[0] * eye2[0] + c[1] * eye2[1] + c[2] * eye2[2])
                                  : c[0] * dir[0] + c[1] * dir[1] + c[2] * dir[2];
     return sign * k - double(radius);
   }
-  float radius_of(std::uint32_t rep) const {
-    if (!table->wide[rep]) return bound;
-    return std::max(bound, static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) *
+  float radius_of(std::uint32_t rep) const { return radius_of(rep, bound); }
+  float radius_of(std::uint32_t rep, float ordinary) const {
+    if (!table->wide[rep]) return ordinary;
+    return std::max(ordinary, static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) *
                                               (1 + 1e-6)));
   }
   // q = floor((lo - q_min) q_scale) clamped to 32 bits: monotone in lo (NaN goes to 0).
@@ -177,6 +294,9 @@ struct ProgressiveOrder::Impl {
   // their q differ by at most q_window, or both lie in one zone: the q range of everything whose
   // interval may overlap a wide item's (merged, sorted).
   std::uint64_t q_window = 0;
+  // Near ties are fetched ahead (prefetch_near_ties) when they are expected to be more than 0.1% of
+  // the entries (from about 2M tets): below that the extra pass costs more than the misses.
+  bool prefetch_ties = false;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> zones;
   bool joined(Packed a, Packed b) const {
     const std::uint32_t qa = q_of(a), qb = q_of(b);
@@ -188,14 +308,14 @@ struct ProgressiveOrder::Impl {
   }
   int bucket_shift = 32;                    // first-level bucket of an entry: q >> bucket_shift
   // The entries in input order (pass 1) and what the scatter of them into `sorted` needs.
-  std::vector<Packed> keyed;
+  PackedBuffer keyed;
   std::vector<std::uint32_t> scatter_start[2];  // per bucket, the next slot of each part
   std::size_t scatter_split = 0;                // part 0 is keyed[0, split), part 1 the rest
   std::size_t head_buckets = 0;                 // buckets a progressive order places first
   // The entries of the head buckets, gathered by the key pass (per part), so that a progressive
   // order hands out its first batch without waiting for the scatter; head_fits is false if there
   // were more than the room kept for them.
-  std::vector<Packed> head[2];
+  PackedBuffer head[2];
   std::size_t head_count[2] = {0, 0};
   bool head_fits = false;
   std::size_t scatter_from = 0;                 // the first bucket the worker's scatter places
@@ -252,6 +372,13 @@ struct ProgressiveOrder::Impl {
   }
   void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
+  // Prefetches where a cluster item's faces and tets are listed (nothing for a tet).
+  void prefetch_offsets(std::uint32_t item) const {
+    if (!(item & kClusterBit)) return;
+    const std::uint32_t k = item & ~kClusterBit;
+    prefetch(table->cluster_face_begin.data() + k);
+    prefetch(table->cluster_begin.data() + k);
+  }
   // Prefetches a cluster item's faces and tets ahead of its expansion (nothing for a tet).
   bool many_clusters = false;               // clusters are a sizeable part of the items
   void prefetch_cluster(std::uint32_t item) const {
@@ -259,11 +386,31 @@ struct ProgressiveOrder::Impl {
     const SphereTable& t = *table;
     const std::uint32_t k = item & ~kClusterBit;
     const std::uint32_t f = t.cluster_face_begin[k], fe = t.cluster_face_begin[k + 1];
-    __builtin_prefetch(t.cluster_tets.data() + t.cluster_begin[k]);
+    prefetch(t.cluster_tets.data() + t.cluster_begin[k]);
     if (f == fe) return;
     const char* faces = reinterpret_cast<const char*>(t.face_test.data() + f);
     const char* faces_end = reinterpret_cast<const char*>(t.face_test.data() + fe);
-    for (const char* p = faces; p < faces_end && p < faces + 512; p += 64) __builtin_prefetch(p);
+    for (const char* p = faces; p < faces_end && p < faces + 512; p += 64) prefetch(p);
+  }
+  // Prefetches the double keys of the tets in near-tie pairs of [begin, end) (sorted), which
+  // resolve_run reads: they lie at random places, and fetched one run after another each is a
+  // cache miss waited for (a few thousand a view at 1M tets, tens of thousands at 4M).
+  void prefetch_near_ties(std::size_t begin, std::size_t end) const {
+    const Packed* a = sorted.data();
+    const std::uint64_t w = q_window;
+    const double* C = table->c.data();
+    const double* S = table->s.data();
+    const std::uint8_t* wide = table->wide.data();
+    for (std::size_t i = begin; i + 1 < end; ++i) {
+      if (std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w) continue;
+      for (std::uint32_t item : {item_of(a[i]), item_of(a[i + 1])}) {
+        if (item & kClusterBit) continue;  // found through the cluster tables first
+        prefetch(C + 3 * std::size_t(item));
+        prefetch(C + 3 * std::size_t(item) + 2);
+        prefetch(S + item);
+        prefetch(wide + item);
+      }
+    }
   }
   // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
   void expand(std::uint32_t item, std::uint32_t*& o, Scratch& sc);
@@ -343,8 +490,12 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
                    : std::abs(dir[0]) + std::abs(dir[1]) + std::abs(dir[2]);
   ka = perspective ? 1.0 : 0.0;
   sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
+  // A whole-mesh order reads the fixed-point keys (their rounding widens the bound a little).
+  const bool fixed = subset.empty() && !t.fixed_keys.empty() && t.fixed_keys.size() == m_main;
+  const double bound_a = t.bound_a + (fixed ? t.fixed_a : 0.0), bound_b = t.bound_b + (fixed ? t.fixed_b : 0.0);
   // Rounded up to float, and a little more for the subtraction that places lo.
-  bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
+  bound = static_cast<float>((ka * bound_a + bound_b * np) * (1 + 1e-6));
+  double_bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
   stats.key_bound = bound;
 
   // 1. The quantisation of lo to 32 bits, over the bulk of a sample of the keys ([0.1%, 99.9%]
@@ -383,13 +534,17 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     // Joined neighbours: q apart by at most 2 radius q_scale plus the rounding of the map and floor.
     const double w = 2.0 * double(bound) * q_scale * (1 + 1e-9) + 2;
     q_window = w < 8e9 ? static_cast<std::uint64_t>(w) : std::uint64_t(1) << 33;
+    prefetch_ties = double(q_window) * double(m) > 0.001 * 4294967296.0;
   }
 
   // 2. Keys, q and the first-level histogram in one pass (both cores). About 1000 entries a bucket:
   // few enough buckets that the scatter's write fronts stay in cache, and each bucket sorted when
   // handed out (sort_bucket) stays in L1/L2 (measured against 256 to 2048 a bucket).
+  // Beyond the cache, at most 4096 buckets: each thread's write-combining lines (64 bytes a
+  // bucket) must stay in its L2.
+  const int max_bits = stream_entries(m) ? 12 : 16;
   int bits = 4;
-  while (bits < 16 && (std::size_t(1024) << bits) < m) ++bits;
+  while (bits < max_bits && (std::size_t(1024) << bits) < m) ++bits;
   const std::size_t nb = std::size_t(1) << bits;
   const int shift = 32 - bits;
   bucket_shift = shift;
@@ -424,6 +579,9 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
                p2 = perspective ? eye2[2] : dir[2];
   const double shift_lo = double(bound), sgn = sign, qmin = q_min, qscale = q_scale;
   const bool persp_view = perspective;
+  // Beyond the last-level cache the entries are written around it: they are read next by the
+  // scatter, from memory either way, and a plain store would first read each line it writes.
+  const bool stream = stream_entries(m);
   auto key_pass_of = [=, this, &hist, &thist](auto with_tets) {
    return [=, this, &hist, &thist](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
@@ -440,11 +598,11 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
         return item_p[i];
       }
     };
-    auto put = [=, this, &heads](std::size_t i, double lo) {
+    auto put = [=, this, &heads](std::size_t i, double lo, std::uint32_t item) {
       const double x = (lo - qmin) * qscale;
       const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
-      const Packed p = (Packed(q) << 32) | item_p[i];
-      keyed_p[i] = p;
+      const Packed p = (Packed(q) << 32) | item;
+      store_entry(keyed_p + i, p, stream);
       ++hp[q >> shift];
       if constexpr (decltype(with_tets)::value)
         if (item_p[i] & kClusterBit) thp[q >> shift] += tets_of(item_p[i]) - 1;
@@ -457,20 +615,52 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
       for (std::size_t i = b; i < e; ++i) {
         const std::size_t tet = rep_at(i);
         const double* c = C + 3 * tet;
-        put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo);
+        put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo, item_p[i]);
       }
     } else {
       for (std::size_t i = b; i < e; ++i) {
         const double* c = C + 3 * rep_at(i);
-        put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo);
+        put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo, item_p[i]);
       }
     }
     head_count[part] = heads;
+    if (stream) store_fence();
    };
   };
   head_count[0] = head_count[1] = 0;
-  if (t_cluster_free) parallel_for(m_main, key_pass_of(std::false_type{}));
-  else parallel_for(m_main, key_pass_of(std::true_type{}));
+  if (fixed) {
+    FixedPass pass;
+    pass.keys = t.fixed_keys.data();
+    pass.items = items.data();
+    pass.out = keyed_p;
+    pass.cluster_begin = t.cluster_begin.data();
+    pass.head_room = head_room;
+    pass.q_head = q_head;
+    pass.shift = shift;
+    pass.f[0] = p0 * t.c_unit;
+    pass.f[1] = p1 * t.c_unit;
+    pass.f[2] = p2 * t.c_unit;
+    pass.s_unit = t.s_unit;
+    pass.sign = sign;
+    pass.shift_lo = double(bound);
+    pass.q_min = q_min;
+    pass.q_scale = q_scale;
+    // No clusters and no wide items: all_items lists every tet in order (item i is tet i).
+    const bool identity = t_cluster_free && m_main == n;
+    const FixedPassFn run = kFixedPasses[(perspective ? 1 : 0) | (identity ? 2 : 0) | (stream ? 4 : 0) |
+                                         (t_cluster_free ? 0 : 8)];
+    parallel_for(m_main, [&](std::size_t b, std::size_t e, int part) {
+      FixedPass own = pass;
+      own.hist = hist[part].data();
+      own.tets_hist = thist[part].data();
+      own.head = head[part].data();
+      head_count[part] = run(own, b, e);
+    });
+  } else if (t_cluster_free) {
+    parallel_for(m_main, key_pass_of(std::false_type{}));
+  } else {
+    parallel_for(m_main, key_pass_of(std::true_type{}));
+  }
   // The wide items (few) go with the second part, and each makes a zone of joined q values.
   const std::size_t split = m_main < 50000 ? m : m_main / 2;  // as parallel_for splits
   const int wide_part = split == m ? 0 : 1;
@@ -558,13 +748,52 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
       }
     }
   };
+  // Beyond the last-level cache, the whole scatter writes through per-thread line buffers
+  // (software write-combining): each bucket's line is filled in a buffer that stays in L2 and a full
+  // line goes to memory in one non-temporal write, with no read of the destination line first.
+  // (Full lines need the buffer 64-byte aligned, which the huge-page allocator gives such sizes.)
+  const bool combine = from == 0 && to == nb && stream_entries(m) && reinterpret_cast<std::uintptr_t>(out) % 64 == 0;
+  auto run_combined = [=, this](std::size_t b, std::size_t e, std::uint32_t* ps) {
+    thread_local std::vector<Packed> t_lines;
+    thread_local std::vector<std::uint32_t> t_first;
+    if (t_lines.size() < 8 * nb) t_lines.resize(8 * nb);
+    t_first.assign(ps, ps + nb);
+    Packed* lines = t_lines.data();
+    const std::uint32_t* first = t_first.data();
+    for (std::size_t i = b; i < e; ++i) {
+      // Gives up (unfinished) when the order is stopped, as run() does.
+      if ((i & 0xFFFF) == 0 && stop.load(std::memory_order_relaxed)) {
+        store_fence();
+        return;
+      }
+      const Packed p = keyed_p[i];
+      const std::size_t k = q_of(p) >> shift;
+      const std::uint32_t pos = ps[k]++;
+      Packed* line = lines + 8 * k;
+      line[pos & 7] = p;
+      if ((pos & 7) != 7) continue;
+      // The line [pos - 7, pos] is complete; its first slots may belong to the bucket (or part)
+      // before, when it is this part's first line of bucket k: then only its own slots are stored.
+      if (pos - 7 >= first[k]) write_line(out + (pos - 7), line);
+      else
+        for (std::uint32_t slot = first[k]; slot <= pos; ++slot) out[slot] = line[slot & 7];
+    }
+    for (std::size_t k = 0; k < nb; ++k) {  // the partial last lines
+      const std::uint32_t end = ps[k];
+      if ((end & 7) == 0 || end == first[k]) continue;
+      for (std::uint32_t slot = std::max(end & ~7u, first[k]); slot < end; ++slot) out[slot] = lines[8 * k + (slot & 7)];
+    }
+    store_fence();
+  };
   const std::size_t split = scatter_split;
   if (split == m) {
     run(0, m, scatter_start[0].data());
   } else {
     pool::on_two_cores([&](int part) {
-      if (part == 0) run(0, split, scatter_start[0].data());
-      else run(split, m, scatter_start[1].data());
+      std::uint32_t* ps = scatter_start[part].data();
+      const std::size_t b = part == 0 ? 0 : split, e = part == 0 ? split : m;
+      if (combine) run_combined(b, e, ps);
+      else run(b, e, ps);
     });
   }
   if (to < nb || stop) return;
@@ -655,7 +884,7 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
   for (std::size_t k = begin; k < end; ++k) {
     const std::uint32_t item = item_of(sorted[k]);
     const std::uint32_t rep = rep_tet(*table, item);
-    const float r = radius_of(rep);
+    const float r = radius_of(rep, double_bound);
     run.push_back({lo_of(rep, r), r, item});
   }
   // By (lo, item): the same order whatever order the run came in.
@@ -845,6 +1074,16 @@ ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = def
 
 std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
                                                  std::vector<std::uint32_t>& out, Scratch& sc, std::uint32_t* direct) {
+  // Sorts bucket k unless this thread has sorted it ahead (a bucket once emitted has its near
+  // ties resolved, which a second sort would undo, so each is sorted once).
+  auto ensure_sorted = [&](std::size_t k) {
+    if (k < sc.sorted_upto && k >= first) return;
+    sort_bucket(bucket_begin[k], bucket_begin[k + 1], sc);
+    sc.sorted_upto = k + 1;
+  };
+  // A whole order beyond the cache is written around it (the caller's buffer, read next by the
+  // drawing, from memory either way).
+  const bool stream_out = direct != nullptr && stream_entries(bucket_begin.back());
   std::size_t b = first;
   while (b < last) {
     const std::size_t group = b;  // the first bucket of this group
@@ -852,7 +1091,9 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     std::size_t end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    sort_bucket(begin, end, sc);
+    const bool fetched = group < sc.sorted_upto && group >= first;  // sorted ahead, its keys fetched
+    ensure_sorted(group);
+    if (!fetched && prefetch_ties) prefetch_near_ties(begin, end);
     // A run of joined entries may cross into the following buckets: take them in while it may.
     // Bucket b holds no q below b << bucket_shift, so most checks need not look into it.
     while (b < limit) {
@@ -863,10 +1104,18 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       }
       const Packed bucket_low = Packed(b) << (32 + bucket_shift);
       if (!joined(sorted[end - 1], bucket_low)) break;
-      sort_bucket(nb_begin, nb_end, sc);
+      ensure_sorted(b);
       if (!joined(sorted[end - 1], sorted[nb_begin])) break;  // sorted now, handed out next
       end = nb_end;
       ++b;
+    }
+    // The next bucket sorted now and its near ties' keys fetched, arriving while this group is
+    // scanned (one group after another, each resolve_run would wait for its misses).
+    std::size_t ahead = b;
+    while (ahead < limit && bucket_begin[ahead] == bucket_begin[ahead + 1]) ++ahead;
+    if (prefetch_ties && ahead < limit && ahead >= sc.sorted_upto) {
+      ensure_sorted(ahead);
+      prefetch_near_ties(bucket_begin[ahead], bucket_begin[ahead + 1]);
     }
     const std::uint32_t* tb = t_cluster_free ? bucket_begin.data() : tet_begin.data();
     std::uint32_t* o = direct + tb[group];
@@ -875,20 +1124,38 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       out.resize(at + (tb[b] - tb[group]));
       o = out.data() + at;
     }
-    if (t_cluster_free) {
+    if (t_cluster_free && stream_out) {
+      scan_runs(begin, end, sc, [&o](std::uint32_t item) { store_item(o++, item); });
+    } else if (t_cluster_free) {
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
     } else {
       // Clusters met in key order are scattered over memory, and each expansion is a chain of
-      // dependent cache misses (offsets, then faces): a first pass fetches the data of all the
-      // group's clusters, its iterations independent so that the misses overlap.
-      if (many_clusters)
-        for (std::size_t k = begin; k < end; ++k) prefetch_cluster(item_of(sorted[k]));
-      scan_runs(begin, end, sc, [&](std::uint32_t item) {
-        if (item & kClusterBit) expand(item, o, sc);
-        else *o++ = item;
-      });
+      // dependent cache misses (offsets, then faces): the offsets of the cluster kFar items ahead
+      // and the faces and tets of the one kNear ahead are fetched as each item is expanded, so
+      // that a bounded number of misses overlap (a whole group fetched at once overflows L1).
+      constexpr std::size_t kNear = 8, kFar = 24;
+      const Packed* a = sorted.data();
+      std::size_t at = begin, near = begin, far = begin;
+      auto fetch_ahead = [&] {
+        for (; far < end && far < at + kFar; ++far) prefetch_offsets(item_of(a[far]));
+        for (; near < end && near < at + kNear; ++near) prefetch_cluster(item_of(a[near]));
+        ++at;
+      };
+      if (many_clusters) {
+        scan_runs(begin, end, sc, [&](std::uint32_t item) {
+          fetch_ahead();
+          if (item & kClusterBit) expand(item, o, sc);
+          else *o++ = item;
+        });
+      } else {
+        scan_runs(begin, end, sc, [&](std::uint32_t item) {
+          if (item & kClusterBit) expand(item, o, sc);
+          else *o++ = item;
+        });
+      }
     }
   }
+  if (stream_out) store_fence();
   return b;
 }
 
@@ -1004,11 +1271,15 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
 void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
                            const View& view, std::span<const std::uint32_t> subset, bool front_to_back,
                            OrderStats* stats) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point t0 = Clock::now();
   ProgressiveOrder order(mesh, table, view, subset, front_to_back);
   ProgressiveOrder::Impl& d = *order.impl_;
+  const Clock::time_point t1 = Clock::now();
   const std::size_t nb = d.bucket_begin.size() - 1;
   d.scatter(0, nb);
   d.scattered = true;
+  const Clock::time_point t2 = Clock::now();
   // Every bucket's tets go straight to their final places.
   out.resize(order.total());
   std::uint32_t* direct = out.data();
@@ -1044,6 +1315,9 @@ void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, co
   }
   d.next_bucket = nb;
   d.handed = out.size();
+  d.stats.keys_seconds = std::chrono::duration<double>(t1 - t0).count();
+  d.stats.scatter_seconds = std::chrono::duration<double>(t2 - t1).count();
+  d.stats.sort_seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   if (stats) *stats = d.stats;
 }
 

@@ -69,6 +69,18 @@ struct SphereTable {
   std::vector<std::uint32_t> all_rep;     // the tet whose key each item takes (same order)
   // Per-tet key bounds, kept for subsets (which must find their own wide items).
   std::vector<float> key_a, key_b;
+  // The keys of all_items in fixed point (same order): c = c_fixed * c_unit, s = s_fixed * s_unit
+  // (units powers of two, set so that every non-wide item fits), so that the key pass of a
+  // whole-mesh order reads 16 bytes an item, in sequence, instead of 32 (and a cluster's from
+  // wherever its first tet lies). Their rounding widens the key bound by (fixed_a, fixed_b) in the
+  // terms of (bound_a, bound_b): a few 2^-31 of the mesh's extent, far below the keys' spacing.
+  struct FixedKey {
+    std::int32_t c[3];
+    std::int32_t s;
+  };
+  std::vector<FixedKey> fixed_keys;
+  double c_unit = 0, s_unit = 0;
+  double fixed_a = 0, fixed_b = 0;
 
   std::size_t tet_count() const { return s.size(); }
   std::size_t cluster_count() const { return cluster_begin.empty() ? 0 : cluster_begin.size() - 1; }

@@ -35,6 +35,10 @@ struct OrderStats {
   double key_bound = 0;                // the rounding bound of ordinary items (key units)
   double key_range = 0;                // largest minus smallest key
   std::size_t wide_items = 0;          // items sorted with their own, wider bound
+  // Wall time of the phases of visibility_order_into (seconds): keys with the first-level histogram,
+  // the scatter into first-level buckets, and the per-bucket sorts with near-tie fix-up and cluster
+  // expansion (both cores in each).
+  double keys_seconds = 0, scatter_seconds = 0, sort_seconds = 0;
 };
 
 // Hands out the order of one view progressively: next() returns the next batch of tets (back to
