@@ -15,11 +15,6 @@ namespace foxi::detail {
 
 namespace {
 
-std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
-  if (a > b) std::swap(a, b);
-  return (std::uint64_t(a) << 32) | b;
-}
-
 struct Facets {
   const Plc& plc;
   std::size_t polygon_count(std::size_t f) const { return plc.facet_polygon_begin[f + 1] - plc.facet_polygon_begin[f]; }
@@ -147,12 +142,7 @@ CoplanarMerge merge_coplanar_facets(Plc& plc, double relative_tol) {
     if (big != 1) continue;
     const auto [v, n] = F.polygon(main_polygon[f]);
     Vec nn{0, 0, 0};
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec a = at(plc.points, v[i]), b = at(plc.points, v[(i + 1) % n]);
-      nn[0] += (a[1] - b[1]) * (a[2] + b[2]);
-      nn[1] += (a[2] - b[2]) * (a[0] + b[0]);
-      nn[2] += (a[0] - b[0]) * (a[1] + b[1]);
-    }
+    add_newell_normal(plc.points, v, n, nn);
     const double len = std::sqrt(norm2(nn));
     if (!(len > 0)) continue;
     Plane& p = plane[f];

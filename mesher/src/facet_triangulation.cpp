@@ -8,6 +8,8 @@
 #include <cmath>
 #include <deque>
 
+#include "plc_edit.hpp"
+
 namespace foxi::detail {
 
 namespace {
@@ -56,22 +58,15 @@ std::size_t triangulate_facets(Plc& plc) {
       continue;
     }
     // The plane of the largest projection (Newell's normal of the polygons).
-    double n[3] = {0, 0, 0};
+    Vec n{0, 0, 0};
     for (std::uint32_t g = g0; g < g1; ++g) {
       const std::uint32_t b = plc.polygon_vertex_begin[g], e = plc.polygon_vertex_begin[g + 1];
-      if (e - b < 3) continue;
-      for (std::uint32_t i = b; i < e; ++i) {
-        const double* p = &plc.points[3 * std::size_t(plc.polygon_vertices[i])];
-        const double* q = &plc.points[3 * std::size_t(plc.polygon_vertices[i + 1 < e ? i + 1 : b])];
-        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-      }
+      if (e - b >= 3) add_newell_normal(plc.points, plc.polygon_vertices.data() + b, e - b, n);
     }
-    int drop = 0;
-    for (int k = 1; k < 3; ++k)
+    std::size_t drop = 0;
+    for (std::size_t k = 1; k < 3; ++k)
       if (std::abs(n[k]) > std::abs(n[drop])) drop = k;
-    const int u = (drop + 1) % 3, w = (drop + 2) % 3;
+    const std::size_t u = (drop + 1) % 3, w = (drop + 2) % 3;
     Cdt cdt;
     auto vertex = [&](std::uint32_t i) {
       const double* p = &plc.points[3 * std::size_t(i)];

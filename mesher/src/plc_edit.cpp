@@ -40,14 +40,8 @@ std::size_t EditablePlc::facet_at(const Vec& p) const {
   for (std::size_t f = 0; f < facets.size(); ++f)
     for (const auto& poly : facets[f]) {
       if (poly.size() < 3) continue;
-      // Newell's normal gives the polygon's plane without choosing three vertices.
       Vec n{0, 0, 0};
-      for (std::size_t i = 0; i < poly.size(); ++i) {
-        const Vec a = point(poly[i]), b = point(poly[(i + 1) % poly.size()]);
-        n[0] += (a[1] - b[1]) * (a[2] + b[2]);
-        n[1] += (a[2] - b[2]) * (a[0] + b[0]);
-        n[2] += (a[0] - b[0]) * (a[1] + b[1]);
-      }
+      add_newell_normal(plc.points, poly.data(), poly.size(), n);
       const double nn = std::sqrt(norm2(n));
       if (!(nn > 0) || std::abs(dot(sub(p, point(poly[0])), n)) > tol * nn) continue;
       const Vec p0 = point(poly[0]);
@@ -367,7 +361,7 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       if (edit.surface) {
         a = fv[e];
         b = fv[(e + 1) % 3];
-        if (!edit.edge_facets.count(EditablePlc::edge_key(a, b)) && !edit.split_at.count(EditablePlc::edge_key(a, b)))
+        if (!edit.edge_facets.count(edge_key(a, b)) && !edit.split_at.count(edge_key(a, b)))
           continue;
       } else if (!edit.find_segment(u, v, a, b)) {
         continue;

@@ -29,6 +29,23 @@ inline Vec cross(const Vec& a, const Vec& b) {
 inline double norm2(const Vec& a) { return dot(a, a); }
 inline Vec at(const std::vector<double>& xyz, std::uint32_t i) { return {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; }
 
+// An undirected edge as one integer (the smaller index in the high half).
+inline std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+  if (a > b) std::swap(a, b);
+  return (std::uint64_t(a) << 32) | b;
+}
+
+// Adds the Newell normal of the closed polygon v[0..n) (twice its vector area; no need to choose
+// three vertices) to `normal`.
+inline void add_newell_normal(const std::vector<double>& xyz, const std::uint32_t* v, std::size_t n, Vec& normal) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec a = at(xyz, v[i]), b = at(xyz, v[i + 1 < n ? i + 1 : 0]);
+    normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    normal[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    normal[2] += (a[0] - b[0]) * (a[1] + b[1]);
+  }
+}
+
 struct Ball {
   Vec c{};
   double r2 = -1;  // negative: none (degenerate simplex)
@@ -135,10 +152,6 @@ struct EditablePlc {
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_facets;  // polygon edge -> facets
   std::unordered_map<std::uint64_t, std::uint32_t> split_at;                   // split edge -> its new point
 
-  static std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
-    if (a > b) std::swap(a, b);
-    return (std::uint64_t(a) << 32) | b;
-  }
   void index_surface() {
     surface = true;
     for (std::uint32_t f = 0; f < facets.size(); ++f)

@@ -122,8 +122,6 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
       // A signal (the app's Ctrl-C handler) interrupts poll: ask the callback now rather than
       // blocking in read() until TetGen ends.
       if (ready == 0 || (ready < 0 && errno == EINTR)) {
-        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        (void)elapsed;
         if (progress && !progress("meshing", -1.0)) {
           stop_child();
           throw MesherError(-1, "meshing cancelled");
