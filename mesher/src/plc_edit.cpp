@@ -160,14 +160,42 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
       }
     });
     if (inside.empty() && deepest != kNone && deepest_ratio < 1 + 1e-9) inside.push_back(deepest);
+    std::size_t marked = 0;
     for (std::uint32_t q : inside)
       search.for_each_encroached(at(mesh.xyz, q), [&](std::uint32_t f) {
         const std::uint32_t* fv = &mesh.bface[3 * std::size_t(f)];
         if (fv[0] == q || fv[1] == q || fv[2] == q) return;
         const Ball& fb = search.face_ball[f];
-        if (std::sqrt(norm2(sub(fb.c, b.c))) < std::sqrt(fb.r2) + r) split[f] = 1;
+        if (std::sqrt(norm2(sub(fb.c, b.c))) < std::sqrt(fb.r2) + r) {
+          split[f] = 1;
+          ++marked;
+        }
+      });
+    if (marked > 0) continue;
+    const Vec centroid = scale(add(add(at(mesh.xyz, tv[0]), at(mesh.xyz, tv[1])), add(at(mesh.xyz, tv[2]), at(mesh.xyz, tv[3]))), 0.25);
+    for (std::uint32_t q : inside)
+      search.for_each_face_crossed(centroid, at(mesh.xyz, q), [&](std::uint32_t f) {
+        const std::uint32_t* fv = &mesh.bface[3 * std::size_t(f)];
+        if (fv[0] != q && fv[1] != q && fv[2] != q) split[f] = 1;
       });
   }
+}
+
+bool MeshSearch::segment_crosses_face(const Vec& p, const Vec& q, std::uint32_t face) const {
+  const std::uint32_t* fv = &mesh.bface[3 * std::size_t(face)];
+  const Vec a = at(mesh.xyz, fv[0]), e1 = sub(at(mesh.xyz, fv[1]), a), e2 = sub(at(mesh.xyz, fv[2]), a);
+  const Vec d = sub(q, p), h = cross(d, e2);
+  const double det = dot(e1, h);
+  if (!(std::abs(det) > 1e-12 * std::sqrt(norm2(d) * norm2(e1) * norm2(e2)))) return false;  // parallel
+  const double eps = 1e-9;
+  const Vec s = sub(p, a);
+  const double u = dot(s, h) / det;
+  if (u < -eps || u > 1 + eps) return false;
+  const Vec sxe = cross(s, e1);
+  const double v = dot(d, sxe) / det;
+  if (v < -eps || u + v > 1 + eps) return false;
+  const double t = dot(e2, sxe) / det;
+  return t > -eps && t < 1 + eps;
 }
 
 Plc surface_plc(const Mesh& mesh, const Plc& plc) {

@@ -390,6 +390,43 @@ struct MeshSearch {
   PointGrid vertices;
   std::vector<Ball> face_ball;  // per mesh.bface; r2 < 0 for a degenerate triangle
 
+  // Calls f(face) once for each constraint triangle that the segment p q crosses or touches (in
+  // double, with a relative tolerance; enough to choose what to split).
+  template <class F>
+  void for_each_face_crossed(const Vec& p, const Vec& q, F&& f) const {
+    std::vector<std::uint32_t> seen;
+    auto test = [&](std::uint32_t face) {
+      if (segment_crosses_face(p, q, face)) seen.push_back(face);
+    };
+    for (std::uint32_t face : big_faces_) test(face);
+    // A face that the segment crosses at x holds x in its diametral ball, so it is listed in x's
+    // cell; the cells along the segment are visited by sampling at a quarter cell with their
+    // neighbours.
+    const double len = std::sqrt(norm2(sub(q, p)));
+    const std::size_t steps = std::size_t(std::min(4 * len / vertices.cell, 1e6)) + 1;
+    std::vector<std::size_t> cells;
+    for (std::size_t i = 0; i <= steps; ++i) {
+      const Vec x = add(p, scale(sub(q, p), double(i) / double(steps)));
+      const std::array<std::size_t, 3> c{vertices.coord(x[0], 0), vertices.coord(x[1], 1), vertices.coord(x[2], 2)};
+      for (std::size_t dz = 0; dz < 3; ++dz)
+        for (std::size_t dy = 0; dy < 3; ++dy)
+          for (std::size_t dx = 0; dx < 3; ++dx) {
+            const std::array<std::size_t, 3> n{c[0] + dx, c[1] + dy, c[2] + dz};
+            if (n[0] == 0 || n[1] == 0 || n[2] == 0 || n[0] > vertices.dim[0] || n[1] > vertices.dim[1] ||
+                n[2] > vertices.dim[2])
+              continue;
+            cells.push_back(vertices.index({n[0] - 1, n[1] - 1, n[2] - 1}));
+          }
+    }
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    for (std::size_t cell : cells)
+      for (std::uint32_t k = face_begin_[cell]; k < face_begin_[cell + 1]; ++k) test(face_items_[k]);
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    for (std::uint32_t face : seen) f(face);
+  }
+
   // Calls f(face) for each constraint triangle whose diametral sphere holds p strictly inside.
   template <class F>
   void for_each_encroached(const Vec& p, F&& f) const {
@@ -403,12 +440,17 @@ struct MeshSearch {
   }
 
  private:
+  bool segment_crosses_face(const Vec& p, const Vec& q, std::uint32_t face) const;
   std::vector<std::uint32_t> face_begin_, face_items_, big_faces_;
 };
 
 // The constraint triangles to split for the non-Delaunay tets `violating_tets`: those encroached by
 // a vertex inside a violated circumsphere whose diametral sphere meets that circumsphere (the
-// triangle lies between the two). Sets split[face] = 1.
+// triangle lies between the two). When no vertex inside a tet's circumsphere encroaches a triangle
+// (the sphere reaches past a non-convex part of the boundary, e.g. under an overhanging plate, to a
+// vertex hidden behind a triangle whose diametral sphere is smaller than that sphere's cap), the
+// triangles that separate the tet from those vertices (crossed by the segment from the tet's centroid)
+// are split instead: otherwise nothing is found to split and the violation stays. Sets split[face] = 1.
 void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::uint32_t>& violating_tets,
                                std::vector<char>& split);
 
