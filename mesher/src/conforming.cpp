@@ -44,7 +44,7 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   const std::vector<ThinLayer> layers =
       conforming.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 || (params.size_field && !params.size_field->empty()) ||
                                        std::any_of(plc.regions.begin(), plc.regions.end(), [](const RegionSeed& s) { return s.max_volume > 0; }))
-          ? find_thin_layers(plc, conforming.thin_layer_aspect)
+          ? find_thin_layers(plc, conforming.thin_layer_aspect, conforming.thin_layer_min_area)
           : std::vector<ThinLayer>{};
   RefinementRounds rounds(p, rep);
   if (!layers.empty()) mesh = detail::refine_with_thin_layers(params, conforming, layers, current, rep);

@@ -43,7 +43,7 @@ bool ThinLayer::contains(const double* p) const {
          b >= v_lo - tolerance && b <= v_hi + tolerance;
 }
 
-std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect) {
+std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect, double min_area) {
   std::vector<ThinLayer> layers;
   if (!(min_aspect > 0) || plc.point_count() == 0) return layers;
   Vec lo{plc.points[0], plc.points[1], plc.points[2]}, hi = lo;
@@ -108,7 +108,8 @@ std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect) {
       if (!(gap > 1e3 * tol)) continue;
       const double u0 = std::max(a.u_lo, b.u_lo), u1 = std::min(a.u_hi, b.u_hi);
       const double v0 = std::max(a.v_lo, b.v_lo), v1 = std::min(a.v_hi, b.v_hi);
-      if (u1 - u0 < min_aspect * gap || v1 - v0 < min_aspect * gap) continue;
+      if (u1 - u0 < min_aspect * gap || v1 - v0 < min_aspect * gap || (u1 - u0) * (v1 - v0) < min_area * gap * gap)
+        continue;
       ThinLayer l;
       l.normal = a.normal;
       plane_frame(l.normal, l.u, l.v);

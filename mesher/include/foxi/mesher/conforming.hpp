@@ -39,6 +39,9 @@ struct ConformingParams {
   // (thin_layers.hpp), and foxi then refines by itself; 0: no exemption (TetGen's refinement then
   // fills a thin layer with tets as wide as it is thick).
   double thin_layer_aspect = kThinLayerAspect;
+  // ... and whose area is at least this many thicknesses squared (thin_layers.hpp: below it TetGen's
+  // own refinement meshes the layer at an affordable cost, and the quality bounds hold everywhere).
+  double thin_layer_min_area = kThinLayerMinArea;
   double max_added_fraction = 0.15; // stop once the points added exceed this fraction of the
                                     // first (-O0) mesh's point count ...
   std::size_t min_added_budget = 100; // ... or this many, whichever is more (small meshes)
