@@ -85,6 +85,7 @@ INSTANTIATE_TEST_SUITE_P(
                       ModelCase{"../../models/flip_chip.toml", 0, 1.414},
                       ModelCase{"../../models/multi_chip.toml", 0, 1.414},
                       ModelCase{"../../models/via_in_dielectric.toml", 0, 1.414},
+                      ModelCase{"../../models/trench.toml", 0, 1.414},
                       // Corefined faceted balls: TetGen 1.5.0 fails on the refined PLC, the surface
                       // rounds certify it.
                       ModelCase{"../../models/bga.toml", 1e-3, 1.414},
