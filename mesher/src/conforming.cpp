@@ -9,6 +9,7 @@
 
 #include "coplanar_facets.hpp"
 #include "foxi/model/delaunay.hpp"
+#include "foxi/model/quality.hpp"
 #include "layer_refinement.hpp"
 #include "plc_edit.hpp"
 #include "refinement_round.hpp"
@@ -90,6 +91,14 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     rep.tetgen_failed = rescue.tetgen_failed;
     rep.certificate_seconds += rescue.certificate_seconds;
     rep.surface_rounds = rescue.iterations;
+  }
+  if (layers.empty() && params.radius_edge > 0) {
+    rep.radius_edge_bound = params.radius_edge;
+    for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+      const std::uint32_t* v = &mesh.tet[4 * t];
+      const TetQuality q = tet_quality(&mesh.xyz[3 * v[0]], &mesh.xyz[3 * v[1]], &mesh.xyz[3 * v[2]], &mesh.xyz[3 * v[3]]);
+      rep.over_radius_edge += q.radius_edge > params.radius_edge * (1 + 1e-9);
+    }
   }
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (report) *report = rep;

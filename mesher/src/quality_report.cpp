@@ -50,6 +50,8 @@ MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& 
   r.thin_layers = conforming.thin_layers.size();
   r.quality_points = conforming.quality_points;
   r.quality_unmet = conforming.quality_unmet;
+  r.radius_edge_bound = conforming.radius_edge_bound;
+  r.over_radius_edge = conforming.over_radius_edge;
   if (r.thin_layers > 0 && r.nodes > r.conforming_points)  // the first mesh is the bare PLC there
     r.conforming_overhead = double(r.conforming_points) / double(r.nodes - r.conforming_points);
   r.first_mesh_violations = conforming.first_mesh_violations;
@@ -85,6 +87,10 @@ std::string format_quality_report(const MeshQualityReport& r) {
   if (r.thin_layers == 0) {
     put("Steiner points: %zu by TetGen, %zu for conformity (%.2f%% of the first -O0 mesh's points) in %zu iterations",
         r.tetgen_steiner_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
+    if (r.over_radius_edge > 0)
+      put("radius-edge bound %g: %zu tets over it, next to boundary points added for conformity (left: refining "
+          "them as well did not settle on faceted curved surfaces)",
+          r.radius_edge_bound, r.over_radius_edge);
   } else {
     put("thin layers: %zu, exempt from the quality bounds: %zu tets in them; outside them radius-edge max %.3g, "
         "%zu tets still over a bound",

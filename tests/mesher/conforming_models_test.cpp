@@ -73,6 +73,16 @@ TEST_P(Models, ConformingMeshIsDelaunayWithExactRegionsAndBoundaries) {
     ASSERT_TRUE(area.count(tag)) << "boundary " << s.boundary_names[k] << " has no triangles";
     EXPECT_NEAR(area[tag], s.boundary_area[k], 1e-9 * s.boundary_area[k]) << s.boundary_names[k];
   }
+  // The report's count of tets over the radius-edge bound, counted here again.
+  std::size_t over = 0;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    const std::uint32_t* v = &m.tet[4 * t];
+    over += tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).radius_edge >
+            c.radius_edge * (1 + 1e-6);
+  }
+  if (report.thin_layers.empty()) {
+    EXPECT_EQ(report.over_radius_edge, over);
+  }
   // Histogram counts every tet once.
   std::size_t hist = 0;
   for (std::size_t h : q.min_dihedral_histogram) hist += h;

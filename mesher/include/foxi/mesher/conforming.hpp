@@ -67,6 +67,11 @@ struct ConformingReport {
   std::size_t thin_layer_tets = 0;         // tets lying in them (exempt from the quality bounds)
   std::size_t quality_points = 0;          // points foxi added for quality and size
   std::size_t quality_unmet = 0;           // tets outside the layers still over a bound at the end
+  // Without thin layers: TetGen's refinement met the radius-edge bound, and the conformity rounds
+  // (surface rounds above all) may leave tets over it next to the boundary points they added. The
+  // bound (0: none) and the tets of the final mesh over it.
+  double radius_edge_bound = 0;
+  std::size_t over_radius_edge = 0;
   double certificate_seconds = 0;          // of which the certificates
   // Rounds that refined the mesh's own surface triangles after TetGen failed on a refined PLC or the
   // conforming rounds ran out (0: none were needed).

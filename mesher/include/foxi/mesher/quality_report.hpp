@@ -46,6 +46,8 @@ struct MeshQualityReport {
   double max_radius_edge_outside_layers = 0;
   std::size_t quality_points = 0;         // added by foxi's own refinement (thin-layer meshes)
   std::size_t quality_unmet = 0;          // tets outside the layers still over a bound
+  double radius_edge_bound = 0;           // without layers (ConformingReport): the bound, 0: none,
+  std::size_t over_radius_edge = 0;       // and the tets over it
   std::size_t first_mesh_violations = 0;
   bool delaunay = false;                  // the exact certificate of the final mesh
   bool tetgen_failed = false;             // refinement stopped where TetGen failed (conforming.hpp)
