@@ -22,8 +22,13 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
   if (coarse) controls.mesh = {.max_size = 0, .quality = m.model.mesh.quality,
                                .min_dihedral = m.model.mesh.min_dihedral, .part_sizes = {}, .refine = {}};
   const ModelMeshParams mp = mesh_params_from_model(controls, plc);
-  const MeshParams params = mp.params;
-  m.ignored_refine_boxes = mp.ignored_refine_boxes;
+  MeshParams params = mp.params;
+  // The model's refinement boxes as a size field, as `foxi mesh` applies them.
+  SizeField boxes;
+  if (!controls.mesh.refine.empty()) {
+    boxes = box_size_field(plc, params, size_controls_from_model(controls));
+    params.size_field = &boxes;
+  }
   // The same conforming Delaunay path as `foxi mesh` (thin layers included), so that the mesh the
   // solver gets is certified and the viewer's order is exact.
   m.mesh = mesh_conforming(plc, params, {}, &m.conforming);
@@ -44,9 +49,6 @@ MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::s
               m.structure.plc.point_count(), m.structure.plc.facet_count(), m.mesh.node_count(), m.mesh.tet_count(),
               m.report.switches.c_str(), m.conforming.seconds, m.conforming.delaunay ? "certified" : "NOT certified",
               m.conforming.thin_layers.empty() ? "" : ", thin layers meshed flat");
-  if (m.ignored_refine_boxes > 0)
-    std::printf("note: %zu [[mesh.refine]] boxes are not applied (TetGen takes no box sizes yet)\n",
-                m.ignored_refine_boxes);
   return m;
 }
 

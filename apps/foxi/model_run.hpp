@@ -24,7 +24,6 @@ struct MeshedModel {
   Mesh mesh;  // regions named after the parts, boundaries after the structure's surfaces
   MeshReport report;            // the last TetGen run
   ConformingReport conforming;  // the conforming refinement (certificate, thin layers)
-  std::size_t ignored_refine_boxes = 0;
 };
 
 // Loads `file` with the --set overrides, checks what `physics` needs (before meshing), builds the

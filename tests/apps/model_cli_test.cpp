@@ -6,6 +6,8 @@
 #include <regex>
 #include <string>
 
+#include "foxi/model/delaunay.hpp"
+#include "foxi/model/mesh_io.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/viz/png.hpp"
 #include "test_util.hpp"
@@ -79,6 +81,38 @@ TEST(ModelCli, SolveModelUsesItsConditionsAndLoads) {
   ASSERT_EQ(foxi_cli("solve '" + kModels + "via_in_dielectric.toml' --physics current", dir / "cur.txt"), 0)
       << test::read_text(dir / "cur.txt");
   EXPECT_NE(test::read_text(dir / "cur.txt").find("resistance"), std::string::npos);
+}
+
+// A [[mesh.refine]] box in the model: `foxi solve` meshes with it as `foxi mesh` does. The nodes in
+// the box (counted on the solved mesh read back) against the same model without the box.
+TEST(ModelCli, SolveAppliesTheModelsRefinementBoxes) {
+  TempDir dir;
+  std::filesystem::copy(kModels + "materials.toml", dir / "materials.toml");
+  const std::string model = test::read_text(kModels + "die_on_substrate.toml");
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::FILE* f = std::fopen((dir / name).c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fputs(text.c_str(), f);
+    std::fclose(f);
+  };
+  write("plain.toml", model);
+  write("boxed.toml", model + "\n[[mesh.refine]]\nmin = [0, 0, 0]\nmax = [2, 2, 1]\nmax_size = \"0.25 mm\"\n");
+  auto nodes_in_box = [&](const std::string& name, const std::string& command = "solve", const std::string& args = " --physics thermal") {
+    const auto out = dir / (name + command + ".vtu");
+    EXPECT_EQ(foxi_cli(command + " '" + (dir / (name + ".toml")).string() + "'" + args + " -o '" + out.string() + "'",
+                       dir / "log.txt"),
+              0)
+        << test::read_text(dir / "log.txt");
+    const foxi::Mesh m = foxi::read_mesh(out);
+    EXPECT_TRUE(foxi::compute_delaunay_certificate(m).delaunay);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < m.node_count(); ++i)
+      n += m.xyz[3 * i] <= 2e-3 && m.xyz[3 * i + 1] <= 2e-3 && m.xyz[3 * i + 2] <= 1e-3;
+    return n;
+  };
+  const std::size_t plain = nodes_in_box("plain"), boxed = nodes_in_box("boxed");
+  EXPECT_GT(boxed, 3 * plain) << plain << " nodes in the box without it";
+  EXPECT_EQ(boxed, nodes_in_box("boxed", "mesh", ""));  // the mesh `foxi mesh` makes
 }
 
 TEST(ModelCli, SolveModelErrorsBeforeMeshing) {
