@@ -88,8 +88,9 @@ std::string format_quality_report(const MeshQualityReport& r) {
     put("Steiner points: %zu by TetGen, %zu for conformity (%.2f%% of the first -O0 mesh's points) in %zu iterations",
         r.tetgen_steiner_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
     if (r.over_radius_edge > 0)
-      put("radius-edge bound %g: %zu tets over it, next to boundary points added for conformity (left: refining "
-          "them as well did not settle on faceted curved surfaces)",
+      put("radius-edge bound %g: %zu tets over it (TetGen leaves some near small input angles, the conformity "
+          "rounds some next to the boundary points they add; refining those did not settle on faceted curved "
+          "surfaces)",
           r.radius_edge_bound, r.over_radius_edge);
   } else {
     put("thin layers: %zu, exempt from the quality bounds: %zu tets in them; outside them radius-edge max %.3g, "

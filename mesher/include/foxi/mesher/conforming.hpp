@@ -67,9 +67,9 @@ struct ConformingReport {
   std::size_t thin_layer_tets = 0;         // tets lying in them (exempt from the quality bounds)
   std::size_t quality_points = 0;          // points foxi added for quality and size
   std::size_t quality_unmet = 0;           // tets outside the layers still over a bound at the end
-  // Without thin layers: TetGen's refinement met the radius-edge bound, and the conformity rounds
-  // (surface rounds above all) may leave tets over it next to the boundary points they added. The
-  // bound (0: none) and the tets of the final mesh over it.
+  // Without thin layers: the radius-edge bound (0: none) and the tets of the final mesh over it.
+  // TetGen's refinement leaves some near small input angles, and the conformity rounds (surface
+  // rounds above all) some next to the boundary points they add.
   double radius_edge_bound = 0;
   std::size_t over_radius_edge = 0;
   double certificate_seconds = 0;          // of which the certificates
