@@ -13,6 +13,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace foxi {
@@ -168,6 +170,36 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   return r;
 }
 
+std::string format_number(double v);
+
+// TetGen 1.5 crashes on some self-intersecting PLCs instead of saying so: its self-intersection check
+// (-d) names them. Returns "; TetGen's self-intersection check finds ..." or "" (none found, or the
+// check itself failed).
+std::string intersections_found(tetgenio& in, const MeshParams& params) {
+  char switches[] = "pdzQ";
+  Result r;
+  try {
+    r = run_isolated(in, nullptr, switches, params.progress, params.time_limit);
+  } catch (const MesherError& e) {
+    if (e.tetgen_code() == -1) throw;  // cancelled
+    return "";
+  }
+  const std::size_t nf = r.trifaces.size() / 3, np = r.points.size() / 3;
+  if (r.status != 0 || nf < 2) return "";
+  auto triangle = [&](std::size_t f) {
+    std::string t;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t v = std::size_t(r.trifaces[3 * f + std::size_t(k)]);
+      if (v >= np) return std::string("(?)");
+      t += (k ? " (" : "(") + format_number(r.points[3 * v]) + ", " + format_number(r.points[3 * v + 1]) + ", " +
+           format_number(r.points[3 * v + 2]) + ")";
+    }
+    return t;
+  };
+  return "; TetGen's self-intersection check finds " + std::to_string(nf) +
+         " facet triangles that intersect others, e.g. " + triangle(0) + " and " + triangle(1);
+}
+
 std::string format_number(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.12g", v);
@@ -269,7 +301,13 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   }
   std::vector<char> switches(sw.begin(), sw.end());
   switches.push_back('\0');
-  Result res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress, params.time_limit);
+  Result res;
+  try {
+    res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress, params.time_limit);
+  } catch (const MesherError& e) {
+    if (e.tetgen_code() != 2 || std::string_view(e.what()).find("crashed") == std::string_view::npos) throw;
+    throw MesherError(2, e.what() + intersections_found(in, params));
+  }
   if (res.status != 0) throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
 
   Mesh m;

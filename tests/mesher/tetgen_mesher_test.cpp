@@ -165,6 +165,26 @@ TEST(TetgenMesher, BrokenInputGivesTypedErrors) {
   plc.add_facet({1, 2, 6, 5}, 1);
   plc.add_facet({8, 9, 10, 11}, 2);  // cuts through the cube and sticks out of it
   EXPECT_THROW(mesh_plc(plc), MesherError);
+
+  // A triangle through the bottom of a tet: TetGen 1.5 crashes on it (signal 11) rather than stopping
+  // with its self-intersection error; foxi's message still says what is wrong, and where.
+  Plc crossing;
+  crossing.points = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.2, 0.2, -0.5, 0.2, 0.2, 0.5};
+  crossing.add_facet({0, 1, 2}, 1);
+  crossing.add_facet({0, 1, 3}, 1);
+  crossing.add_facet({0, 2, 3}, 1);
+  crossing.add_facet({1, 2, 3}, 1);
+  crossing.add_facet({0, 4, 5}, 2);
+  try {
+    mesh_plc(crossing);
+    FAIL() << "no error";
+  } catch (const MesherError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("intersect"), std::string::npos) << what;
+    if (what.find("crashed") != std::string::npos) {  // then the check names the crossing triangle
+      EXPECT_NE(what.find("(0.2, 0.2, -0.5)"), std::string::npos) << what;
+    }
+  }
 }
 
 }  // namespace
