@@ -305,7 +305,9 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   try {
     res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress, params.time_limit);
   } catch (const MesherError& e) {
-    if (e.tetgen_code() != 2 || std::string_view(e.what()).find("crashed") == std::string_view::npos) throw;
+    // The child died (a signal; under a sanitizer, an exit after its report) without a result.
+    const std::string_view what = e.what();
+    if (e.tetgen_code() != 2 || (what.find("crashed") == what.npos && what.find("without a result") == what.npos)) throw;
     throw MesherError(2, e.what() + intersections_found(in, params));
   }
   if (res.status != 0) throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
