@@ -1,4 +1,4 @@
-// foxi mesh PLC.poly --mesher cgal -o OUT: the CGAL Mesh_3 path of `foxi mesh` (options in cmd_mesh.cpp's
+// foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT: the CGAL Mesh_3 path of `foxi mesh` (options in cmd_mesh.cpp's
 // usage text): meshes, writes, and prints counts, time, dihedral angles and the weighted certificate.
 #include <csignal>
 #include <cmath>
@@ -7,7 +7,10 @@
 
 #include "cli.hpp"
 #include "foxi/mesher/cgal_mesher.hpp"
+#include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/model/delaunay.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/model/structure.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/quality.hpp"
@@ -57,16 +60,32 @@ int mesh_with_cgal(Args& args) {
   CgalMeshParams params;
   const double max_volume = non_negative(args.option("--max-volume", "0"), "--max-volume");
   // The circumradius of the regular tet of that volume: CGAL bounds tet sizes by circumradius.
-  if (max_volume > 0) params.max_size = std::cbrt(6 * std::sqrt(2.0) * max_volume) * std::sqrt(6.0) / 4;
+  if (max_volume > 0) params.max_size = regular_tet_circumradius(max_volume);
   params.radius_edge = non_negative(args.option("--radius-edge", "2"), "--radius-edge");
   params.perturb = args.flag("--perturb");
   args.flag("--check-delaunay");  // the CGAL path always certifies
   const std::string out = args.option("-o");
   if (out.empty()) throw UsageError("give the output file with -o OUT (see foxi mesh --help)");
-  const std::string in = args.positional(1, 1, "foxi mesh PLC.poly --mesher cgal -o OUT")[0];
+  std::vector<std::string> sets;
+  while (args.has_option("--set")) sets.push_back(args.option("--set"));
+  const std::string in = args.positional(1, 1, "foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT")[0];
   format_from_path(out);  // an unknown output format fails before any meshing
 
-  const Plc plc = read_poly(in);
+  // A model: its PLC, its [mesh] sizes (global and per part, as region volume bounds) and its names.
+  const bool is_model = in.size() > 5 && in.compare(in.size() - 5, 5, ".toml") == 0;
+  Model model;
+  Structure structure;
+  Plc plc;
+  if (is_model) {
+    model = load_model(in, sets);
+    structure = build_structure(model);
+    plc = structure.plc;
+    const ModelMeshParams mp = mesh_params_from_model(model, plc);
+    if (params.max_size == 0 && mp.params.max_volume > 0) params.max_size = regular_tet_circumradius(mp.params.max_volume);
+  } else {
+    if (!sets.empty()) throw UsageError("--set needs a model file (.toml), not a .poly");
+    plc = read_poly(in);
+  }
   g_interrupted = 0;
   auto* previous = std::signal(SIGINT, on_interrupt);
   params.progress = [](std::string_view, double) { return g_interrupted == 0; };
@@ -80,6 +99,7 @@ int mesh_with_cgal(Args& args) {
     return 1;
   }
   std::signal(SIGINT, previous);
+  if (is_model) name_mesh(model, structure, mesh);
   write_mesh(mesh, out);
   const QualitySummary q = summarize_quality(mesh);
   double max_dihedral = 0;

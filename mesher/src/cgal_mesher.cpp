@@ -1,6 +1,7 @@
 // The CGAL Mesh_3 path. Mesh_3 translation units are heavy (minutes of compile time, GBs of memory):
 // all Mesh_3 code of foxi stays in this one file.
 #include "foxi/mesher/cgal_mesher.hpp"
+#include "foxi/mesher/size_field.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
@@ -45,9 +46,6 @@ class Domain : public ComplexDomain {
 using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
-
-// Circumradius of the regular tet of volume v: edge a = (6 sqrt2 v)^(1/3), R = a sqrt6 / 4.
-double regular_tet_circumradius(double v) { return std::cbrt(6 * std::sqrt(2.0) * v) * std::sqrt(6.0) / 4; }
 
 // Cell size bound: the global one, lowered in subdomains whose region seed sets a max volume.
 struct CellSize {

@@ -52,6 +52,7 @@ double tet_gradient(const Mesh& m, std::size_t t, const double* u, double g[3]) 
 }  // namespace
 
 double regular_tet_volume(double edge) { return edge * edge * edge / (6 * std::sqrt(2.0)); }
+double regular_tet_circumradius(double volume) { return std::cbrt(6 * std::sqrt(2.0) * volume) * std::sqrt(6.0) / 4; }
 
 Plc with_region_sizes(const Plc& plc, const SizeControls& controls) {
   Plc out = plc;

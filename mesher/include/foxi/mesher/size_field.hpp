@@ -39,6 +39,9 @@ struct SizeControls {
 
 // The volume of the regular tet with edge h: what TetGen's -a needs for a target edge length.
 double regular_tet_volume(double edge);
+// The circumradius of the regular tet of volume v (CGAL bounds cell sizes by circumradius):
+// edge a = (6 sqrt2 v)^(1/3), R = a sqrt6 / 4.
+double regular_tet_circumradius(double volume);
 
 // `plc` with each region seed's max_volume set from controls.region_sizes (the smaller of its own and
 // the control). Throws MesherError(10) naming a region id that has no seed in the PLC.
