@@ -5,8 +5,11 @@
 // - Region and boundary names and field units / step values are not part of the VTK formats. The
 //   .vtu writer keeps them in attributes that VTK, ParaView and meshio ignore: foxi_region_names
 //   and foxi_boundary_names on the "region" DataArray ("id=name;id=name", names %-escaped), and
-//   foxi_unit / foxi_step_value on each field array. The reader restores them when present; the
-//   legacy format keeps none of them (multi-step fields get step values 0, 1, 2, ...).
+//   foxi_unit / foxi_step_value on each field array. Each region's material (name and properties)
+//   goes into foxi_region_materials on the region array ("id=name|k|sigma|eps|E|nu|alpha;...", NaN
+//   for a property not set), so that a mesh written from a model solves without restating them.
+//   The reader restores them when present; the legacy format keeps none of them (multi-step fields
+//   get step values 0, 1, 2, ...).
 // - A field with several steps is written as arrays "name", "name@2", "name@3", ...; the reader
 //   groups such a consecutive run (same location and components) back into one field.
 // - Cell fields keep the values of the tet cells only; the writer gives boundary triangle cells NaN.
@@ -16,6 +19,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -167,6 +171,7 @@ struct NamedArray {
   std::string unit;
   std::optional<double> step_value;
   std::string region_names;    // foxi_region_names attribute (region array only)
+  std::string region_materials;  // foxi_region_materials attribute (region array only)
   std::string boundary_names;  // foxi_boundary_names attribute
   std::size_t at = 0;          // file offset of its declaration (for errors)
 };
@@ -278,6 +283,36 @@ std::map<std::int32_t, std::string> parse_names(std::string_view s) {
     auto r = std::from_chars(item.data(), item.data() + eq, id);
     if (r.ec != std::errc() || r.ptr != item.data() + eq) continue;
     m[id] = percent_decode(item.substr(eq + 1));
+  }
+  return m;
+}
+
+// A material's properties in the order foxi_region_materials keeps them, as bit patterns (so that
+// NaN, "not set", compares equal to NaN).
+std::array<std::uint64_t, 6> material_values(const Material& m) {
+  const double v[6] = {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity,
+                       m.youngs_modulus,       m.poisson_ratio,           m.thermal_expansion};
+  std::array<std::uint64_t, 6> bits{};
+  for (std::size_t i = 0; i < 6; ++i) bits[i] = std::isnan(v[i]) ? 0x7ff8000000000000ull : std::bit_cast<std::uint64_t>(v[i]);
+  return bits;
+}
+
+// "name|k|sigma|eps|E|nu|alpha" (name %-escaped, "nan" for a property not set); nothing when it
+// does not have that form (an attribute another writer put there is ignored, not an error).
+std::optional<Material> parse_material(std::string_view s) {
+  std::vector<std::string_view> parts;
+  for (std::size_t bar; (bar = s.find('|')) != std::string_view::npos; s = s.substr(bar + 1)) parts.push_back(s.substr(0, bar));
+  parts.push_back(s);
+  if (parts.size() != 7) return std::nullopt;
+  Material m;
+  m.name = percent_decode(parts[0]);
+  double* v[6] = {&m.thermal_conductivity, &m.electrical_conductivity, &m.relative_permittivity,
+                  &m.youngs_modulus,       &m.poisson_ratio,           &m.thermal_expansion};
+  for (std::size_t i = 0; i < 6; ++i) {
+    const std::string_view t = parts[i + 1];
+    if (t == "nan") continue;
+    auto r = std::from_chars(t.data(), t.data() + t.size(), *v[i]);
+    if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;
   }
   return m;
 }
@@ -417,6 +452,8 @@ class Assembler {
         }
       });
       for (auto& [id, n] : parse_names(ra.region_names)) region_names_[id] = n;
+      for (auto& [id, m] : parse_names(ra.region_materials))
+        if (std::optional<Material> mat = parse_material(m)) region_materials_[id] = *mat;
       for (auto& [id, n] : parse_names(ra.boundary_names)) boundary_names_[id] = n;
     } else {
       if (have_region_) mesh_.tet_region.resize(mesh_.tet_count(), 0);
@@ -513,6 +550,13 @@ class Assembler {
       for (std::int32_t id : ids) {
         auto it = region_names_.find(id);
         mesh_.regions.push_back({id, it == region_names_.end() ? std::string() : it->second, kNone});
+        if (auto m = region_materials_.find(id); m != region_materials_.end()) {
+          // Regions of one material share it (equal name and properties, NaN equal to NaN).
+          auto same = [&](const Material& a) { return a.name == m->second.name && material_values(a) == material_values(m->second); };
+          auto at = std::find_if(mesh_.materials.begin(), mesh_.materials.end(), same);
+          if (at == mesh_.materials.end()) at = mesh_.materials.insert(mesh_.materials.end(), m->second);
+          mesh_.regions.back().material = static_cast<std::uint32_t>(at - mesh_.materials.begin());
+        }
       }
     }
     for (std::int32_t tag : io::distinct_ids(mesh_.bface_tag)) {
@@ -554,6 +598,7 @@ class Assembler {
   std::vector<CollectedArray> arrays_;
   std::map<std::pair<std::string, FieldLocation>, std::size_t> index_;
   std::map<std::int32_t, std::string> region_names_, boundary_names_;
+  std::map<std::int32_t, Material> region_materials_;
 };
 
 // ------------------------------------------------------------------------------------------------
@@ -868,6 +913,7 @@ NamedArray read_data_array(VtuContext& c, pugi::xml_node da, std::uint64_t tuple
     if (r.ec == std::errc() && r.ptr == s.data() + s.size()) out.step_value = v;
   }
   out.region_names = da.attribute("foxi_region_names").value();
+  out.region_materials = da.attribute("foxi_region_materials").value();
   out.boundary_names = da.attribute("foxi_boundary_names").value();
   return out;
 }
@@ -1122,6 +1168,23 @@ std::string names_attribute(const std::vector<std::pair<std::int32_t, std::strin
   return s;
 }
 
+// parse_material's form: "name|k|sigma|eps|E|nu|alpha", shortest round-trip numbers.
+std::string material_attribute(const Material& m) {
+  std::string s = percent_encode(m.name, ";=|");
+  for (double v : {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity, m.youngs_modulus,
+                   m.poisson_ratio, m.thermal_expansion}) {
+    s += '|';
+    if (std::isnan(v)) {
+      s += "nan";
+      continue;
+    }
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    s.append(buf, r.ptr);
+  }
+  return s;
+}
+
 struct OutArray {
   std::string name;
   VType type;
@@ -1217,8 +1280,12 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
     std::vector<std::pair<std::int32_t, std::string>> rn, bn;
     for (const Region& g : mesh.regions) rn.emplace_back(g.id, g.name);
     for (const Boundary& b : mesh.boundaries) bn.emplace_back(b.tag, b.name);
-    std::string ra = names_attribute(rn), ba = names_attribute(bn);
+    std::vector<std::pair<std::int32_t, std::string>> rm;
+    for (const Region& g : mesh.regions)
+      if (g.material < mesh.materials.size()) rm.emplace_back(g.id, material_attribute(mesh.materials[g.material]));
+    std::string ra = names_attribute(rn), ba = names_attribute(bn), ma = names_attribute(rm);
     if (!ra.empty()) r.extra += " foxi_region_names=\"" + xml_escape(ra) + "\"";
+    if (!ma.empty()) r.extra += " foxi_region_materials=\"" + xml_escape(ma) + "\"";
     if (!ba.empty()) r.extra += " foxi_boundary_names=\"" + xml_escape(ba) + "\"";
     cell_arrays.push_back(std::move(r));
   }

@@ -48,6 +48,13 @@ TEST(MeshCli, ModelToCertifiedMeshWithReport) {
   bool named = false;
   for (const foxi::Region& r : m.regions) named = named || r.name == "die";
   EXPECT_TRUE(named);
+  // The materials travel with the mesh: it solves without restating them, and the substrate's k is
+  // the library's FR-4 value.
+  ASSERT_EQ(foxi_cli("solve '" + out.string() + "' --physics thermal --fix substrate.bottom=300 --power die=1", dir / "solve.txt"),
+            0)
+      << test::read_text(dir / "solve.txt");
+  const std::string solved = test::read_text(dir / "solve.txt");
+  EXPECT_NE(solved.find("(substrate)                   0.4"), std::string::npos) << solved;
 }
 
 TEST(MeshCli, UsageErrors) {

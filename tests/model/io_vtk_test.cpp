@@ -320,6 +320,18 @@ Mesh rich_mesh() {
   m.regions[0].name = "lower part";
   m.regions[1].name = "up;per=&<\"";
   m.boundaries[0].name = "inlet";
+  // Two regions of one material (a name that needs escaping, one property not set); a third region,
+  // if any, without one.
+  Material cu;
+  cu.name = "copper|OFHC; 99%=";
+  cu.thermal_conductivity = 401;
+  cu.electrical_conductivity = 5.8e7;
+  cu.youngs_modulus = 1.1e11;
+  cu.poisson_ratio = 0.34;
+  cu.thermal_expansion = 1.7e-5 / 3;  // not a short decimal
+  m.materials = {cu};
+  m.regions[0].material = 0;
+  m.regions[1].material = 0;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1e3, 1e3);
   Field t{"temperature", FieldLocation::node, 1, "K", {0.0, 0.5, 1.25}, {}};
@@ -355,7 +367,20 @@ void expect_same_mesh(const Mesh& a, const Mesh& b, bool names) {
     EXPECT_EQ(a.regions[i].id, b.regions[i].id);
     if (names) {
       EXPECT_EQ(a.regions[i].name, b.regions[i].name);
+      // The same material (as a value: the reader numbers them in the order it meets them).
+      const bool has = a.regions[i].material < a.materials.size();
+      ASSERT_EQ(has, b.regions[i].material < b.materials.size()) << "region " << a.regions[i].id;
+      if (!has) continue;
+      const Material &x = a.materials[a.regions[i].material], &y = b.materials[b.regions[i].material];
+      EXPECT_EQ(x.name, y.name);
+      EXPECT_TRUE(same_bits({x.thermal_conductivity, x.electrical_conductivity, x.relative_permittivity, x.youngs_modulus,
+                             x.poisson_ratio, x.thermal_expansion},
+                            {y.thermal_conductivity, y.electrical_conductivity, y.relative_permittivity, y.youngs_modulus,
+                             y.poisson_ratio, y.thermal_expansion}));
     }
+  }
+  if (names) {
+    EXPECT_EQ(a.materials.size(), b.materials.size());  // regions of one material share it
   }
   ASSERT_EQ(a.boundaries.size(), b.boundaries.size());
   for (std::size_t i = 0; i < a.boundaries.size(); ++i) {
