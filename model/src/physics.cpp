@@ -12,7 +12,7 @@ const char* physics_name(Physics physics) {
     case Physics::thermal: return "thermal";
     case Physics::electrostatic: return "electrostatic";
     case Physics::current: return "current";
-    case Physics::thermal_stress: return "thermal_stress";
+    case Physics::thermal_stress: return "thermoelastic";  // the name foxi solve --physics takes
   }
   return "?";
 }

@@ -29,7 +29,7 @@ TEST(ModelCli, CheckReportsPartsBoundariesAndParameters) {
   const std::string out = test::read_text(dir / "out.txt");
   for (const char* s :
        {"substrate", "underfill", "bumps", "die", "sac305", "bumps/die", "die.top", "from --set",
-        "physics thermal: ready", "physics thermal_stress: ready (foxi solve MODEL --physics thermoelastic)"})
+        "physics thermal: ready", "physics thermoelastic: ready (foxi solve MODEL --physics thermoelastic)"})
     EXPECT_NE(out.find(s), std::string::npos) << s << " missing in:\n" << out;
   // the die is 7 x 7 x 0.5 mm with --set die_w=7mm
   EXPECT_NE(out.find("24.5 mm^3"), std::string::npos) << out;

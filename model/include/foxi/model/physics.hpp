@@ -8,7 +8,7 @@ namespace foxi {
 
 enum class Physics : std::uint8_t { thermal, electrostatic, current, thermal_stress };
 
-// "thermal", "electrostatic", "current", "thermal_stress".
+// "thermal", "electrostatic", "current", "thermoelastic" (as foxi solve --physics names them).
 const char* physics_name(Physics physics);
 
 // True if `c` belongs to `physics` (temperature/heat_flux/convection: thermal; voltage: electrostatic
