@@ -144,7 +144,7 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   std::size_t at = 0;
   auto take = [&](void* dst, std::size_t bytes) {
     if (buf.size() - at < bytes) return false;
-    std::memcpy(dst, buf.data() + at, bytes);
+    if (bytes > 0) std::memcpy(dst, buf.data() + at, bytes);  // an empty list's data() may be null
     at += bytes;
     return true;
   };
