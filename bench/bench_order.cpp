@@ -126,7 +126,7 @@ void BM_first_batch(benchmark::State& state) {
   const int which = static_cast<int>(state.range(0));
   if (skip(state, which)) return;
   Case& c = get_case(which);
-  std::size_t i = 0, first_tets = 0;
+  std::size_t i = 0, first_tets = 0, first_keys = 0;
   for (auto _ : state) {
     // Timed from the view's start to the first batch in hand; stopping the sorting ahead when the
     // order is dropped (its destructor) is not part of the wait.
@@ -136,8 +136,11 @@ void BM_first_batch(benchmark::State& state) {
     benchmark::DoNotOptimize(batch.data());
     state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     first_tets += batch.size();
+    first_keys += order.stats().first_batch_keys;
   }
+  // Tets in the first batch, and the keys computed before it (mean per view).
   state.counters["first_tets"] = double(first_tets) / double(std::max<std::size_t>(i, 1));
+  state.counters["first_keys"] = double(first_keys) / double(std::max<std::size_t>(i, 1));
   state.SetLabel(case_name(which));
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 #include <thread>
+#include <utility>
 
 #include "exact.hpp"
 #include "huge_page_allocator.hpp"
@@ -61,7 +62,9 @@ struct UnionFind {
 // c.d) evaluated from them in double is then off by at most that times (1, 2 |p|_1) plus its own
 // rounding (a few ulps of the largest terms). The window of near ties grows with this bound, so
 // it is kept tight.
-void make_fixed_keys(SphereTable& t) {
+void make_key_blocks(SphereTable& t, const double half[3]);
+
+void make_fixed_keys(SphereTable& t, const double half[3]) {
   const std::size_t m = t.all_rep.size();
   double cmax_part[2] = {0, 0}, smax_part[2] = {0, 0};
   parallel_for(m, [&](std::size_t begin, std::size_t end, int part) {
@@ -113,6 +116,62 @@ void make_fixed_keys(SphereTable& t) {
   t.s_unit = s_unit;
   t.fixed_a = off * s_unit + 8 * kEps * smax;
   t.fixed_b = 2 * off * c_unit + 32 * kEps * cmax;
+  make_key_blocks(t, half);
+}
+
+// SphereTable::key_order and key_blocks: a counting sort of the fixed keys by the Morton code of
+// their centre's cell in a grid of about 16 items a cell over the bounding box (half sizes `half`,
+// local frame) widened by a quarter; centres beyond it (slivers' spheres) go to its border cells.
+// The blocks' bounds are taken as the keys are placed (reading the keys in sequence; the blocks,
+// 0.5 byte an item, stay in cache).
+void make_key_blocks(SphereTable& t, const double half[3]) {
+  const std::size_t m = t.fixed_keys.size();
+  int bits = 1;  // per axis
+  while (bits < 7 && (std::size_t(1) << (3 * (bits + 1))) * 16 <= m) ++bits;
+  const std::uint32_t side = 1u << bits;
+  double lo[3], scale[3];
+  for (int k = 0; k < 3; ++k) {
+    const double h = 1.25 * half[k] / t.c_unit;
+    lo[k] = -h;
+    scale[k] = h > 0 ? double(side) / (2 * h) : 0.0;
+  }
+  // Bit b of x to bit 3b (x < 2^7).
+  auto spread = [](std::uint32_t x) {
+    x = (x | (x << 8)) & 0x0000F00Fu;
+    x = (x | (x << 4)) & 0x000C30C3u;
+    return (x | (x << 2)) & 0x00249249u;
+  };
+  std::vector<std::uint32_t> codes(m), start(std::size_t(1) << (3 * bits), 0);
+  parallel_for(m, [&](std::size_t begin, std::size_t end, int) {
+    for (std::size_t i = begin; i < end; ++i) {
+      std::uint32_t code = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double x = (double(t.fixed_keys[i].c[k]) - lo[k]) * scale[k];
+        const std::uint32_t at = x > 0 ? (x < double(side - 1) ? static_cast<std::uint32_t>(x) : side - 1) : 0u;
+        code |= spread(at) << k;
+      }
+      codes[i] = code;
+    }
+  });
+  for (std::uint32_t code : codes) ++start[code];
+  std::uint32_t acc = 0;
+  for (std::uint32_t& s : start) acc += std::exchange(s, acc);
+  const std::size_t block = SphereTable::kKeyBlock;
+  constexpr std::int32_t kMax = std::numeric_limits<std::int32_t>::max(), kMin = std::numeric_limits<std::int32_t>::min();
+  t.key_order.resize(m);
+  t.key_blocks.assign((m + block - 1) / block, {{kMax, kMax, kMax}, {kMin, kMin, kMin}, kMax, kMin});
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::uint32_t at = start[codes[i]]++;
+    t.key_order[at] = static_cast<std::uint32_t>(i);
+    const SphereTable::FixedKey& k = t.fixed_keys[i];
+    SphereTable::KeyBlock& box = t.key_blocks[at / block];
+    for (int j = 0; j < 3; ++j) {
+      box.c_lo[j] = std::min(box.c_lo[j], k.c[j]);
+      box.c_hi[j] = std::max(box.c_hi[j], k.c[j]);
+    }
+    box.s_lo = std::min(box.s_lo, k.s);
+    box.s_hi = std::max(box.s_hi, k.s);
+  }
 }
 
 }  // namespace
@@ -137,6 +196,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   const double* W = weighted ? mesh.weight.data() : nullptr;
 
   // The local frame: the centre of the bounding box.
+  double half[3] = {0, 0, 0};
   if (mesh.node_count() > 0) {
     double lo[3] = {X[0], X[1], X[2]}, hi[3] = {X[0], X[1], X[2]};
     for (std::size_t i = 1; i < mesh.node_count(); ++i)
@@ -144,7 +204,10 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
         lo[k] = std::min(lo[k], X[3 * i + k]);
         hi[k] = std::max(hi[k], X[3 * i + k]);
       }
-    for (int k = 0; k < 3; ++k) t.origin[k] = 0.5 * (lo[k] + hi[k]);
+    for (int k = 0; k < 3; ++k) {
+      t.origin[k] = 0.5 * (lo[k] + hi[k]);
+      half[k] = 0.5 * (hi[k] - lo[k]);
+    }
   }
   const double org[3] = {t.origin[0], t.origin[1], t.origin[2]};
   t.key_a.resize(n);
@@ -443,7 +506,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   for (std::size_t i = 0; i < n; ++i)
     if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
   for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
-  make_fixed_keys(t);
+  make_fixed_keys(t, half);
   if (progress) progress("clusters", 1.0);
   return t;
 }
