@@ -372,7 +372,10 @@ struct ProgressiveOrder::Impl {
   void head_from_blocks();
   bool deferred_key_pass();
   // Sorts one first-level bucket [begin, end) by packed value.
+  // With prefetch_ties, also prefetches the keys of the near ties it finds (prefetch_near_ties).
   void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc);
+  template <bool kFetch>
+  void sort_bucket_of(std::size_t begin, std::size_t end, Scratch& sc);
   // Calls put(item) for the items of [begin, end) in order, after putting each maximal run of joined
   // neighbours in exact order (resolve_run).
   template <class Put>
@@ -416,21 +419,20 @@ struct ProgressiveOrder::Impl {
   // Prefetches the double keys of the tets in near-tie pairs of [begin, end) (sorted), which
   // resolve_run reads: they lie at random places, and fetched one run after another each is a
   // cache miss waited for (a few thousand a view at 1M tets, tens of thousands at 4M).
+  // (sort_bucket does it as it sorts; this pass is for the few buckets it sorts otherwise.)
   void prefetch_near_ties(std::size_t begin, std::size_t end) const {
     const Packed* a = sorted.data();
-    const std::uint64_t w = q_window;
-    const double* C = table->c.data();
-    const double* S = table->s.data();
-    const std::uint8_t* wide = table->wide.data();
-    for (std::size_t i = begin; i + 1 < end; ++i) {
-      if (std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w) continue;
-      for (std::uint32_t item : {item_of(a[i]), item_of(a[i + 1])}) {
-        if (item & kClusterBit) continue;  // found through the cluster tables first
-        prefetch(C + 3 * std::size_t(item));
-        prefetch(C + 3 * std::size_t(item) + 2);
-        prefetch(S + item);
-        prefetch(wide + item);
-      }
+    for (std::size_t i = begin; i + 1 < end; ++i) prefetch_if_tie(a[i], a[i + 1]);
+  }
+  // The same for one pair of neighbours (a before b in q order).
+  void prefetch_if_tie(Packed a, Packed b) const {
+    if (std::uint64_t(q_of(b)) - q_of(a) > q_window) return;
+    for (std::uint32_t item : {item_of(a), item_of(b)}) {
+      if (item & kClusterBit) continue;  // found through the cluster tables first
+      prefetch(table->c.data() + 3 * std::size_t(item));
+      prefetch(table->c.data() + 3 * std::size_t(item) + 2);
+      prefetch(table->s.data() + item);
+      prefetch(table->wide.data() + item);
     }
   }
   // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
@@ -962,6 +964,12 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
 // pass that follows mispredicts little; 2n to 4n measured 12% slower: more counters to clear and
 // sum), then the insertion pass.
 void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
+  if (prefetch_ties) sort_bucket_of<true>(begin, end, sc);
+  else sort_bucket_of<false>(begin, end, sc);
+}
+
+template <bool kFetch>
+void ProgressiveOrder::Impl::sort_bucket_of(std::size_t begin, std::size_t end, Scratch& sc) {
   Packed* a = sorted.data() + begin;
   const std::size_t n = end - begin;
   auto insertion = [](Packed* x, std::size_t len) {
@@ -974,6 +982,7 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
   };
   if (n <= 32) {
     insertion(a, n);
+    if (kFetch) prefetch_near_ties(begin, end);
     return;
   }
   int sub_bits = 1;
@@ -994,12 +1003,15 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
   for (std::size_t i = 0; i < n; ++i) tmp[cnt[(q_of(a[i]) >> sub_shift) & mask]++] = a[i];
   // Back into place by one insertion pass (nothing moves across sub-buckets), with a budget of
   // moves: keys crowded into a few sub-buckets go to std::sort instead.
-  // Most entries are alone in their sub-bucket and come in order: that case is one compare.
+  // Most entries are alone in their sub-bucket and come in order: that case is one compare. The
+  // near ties' keys are fetched on the way (a pair found here may still be parted by a later
+  // insertion, or one missed: a prefetch is only a hint).
   std::size_t budget = 4 * n;
   a[0] = tmp[0];
   for (std::size_t i = 1; i < n; ++i) {
     const Packed v = tmp[i];
     if (!(v < a[i - 1])) {
+      if (kFetch) prefetch_if_tie(a[i - 1], v);
       a[i] = v;
       continue;
     }
@@ -1009,10 +1021,15 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
       --j;
     } while (j > 0 && v < a[j - 1]);
     a[j] = v;
+    if (kFetch) {
+      prefetch_if_tie(v, a[j + 1]);
+      if (j > 0) prefetch_if_tie(a[j - 1], v);
+    }
     budget -= std::min(budget, i - j);
     if (budget == 0) {
       std::copy(tmp + i + 1, tmp + n, a + i + 1);
       std::sort(a, a + n);
+      if (kFetch) prefetch_near_ties(begin, end);
       break;
     }
   }
@@ -1235,9 +1252,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     std::size_t end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    const bool fetched = group < sc.sorted_upto && group >= first;  // sorted ahead, its keys fetched
     ensure_sorted(group);
-    if (!fetched && prefetch_ties) prefetch_near_ties(begin, end);
     // A run of joined entries may cross into the following buckets: take them in while it may.
     // Bucket b holds no q below b << bucket_shift, so most checks need not look into it.
     while (b < limit) {
@@ -1257,10 +1272,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     // scanned (one group after another, each resolve_run would wait for its misses).
     std::size_t ahead = b;
     while (ahead < limit && bucket_begin[ahead] == bucket_begin[ahead + 1]) ++ahead;
-    if (prefetch_ties && ahead < limit && ahead >= sc.sorted_upto) {
-      ensure_sorted(ahead);
-      prefetch_near_ties(bucket_begin[ahead], bucket_begin[ahead + 1]);
-    }
+    if (prefetch_ties && ahead < limit && ahead >= sc.sorted_upto) ensure_sorted(ahead);
     const std::uint32_t* tb = t_cluster_free ? bucket_begin.data() : tet_begin.data();
     std::uint32_t* o = direct + tb[group];
     if (direct == nullptr) {
