@@ -1317,10 +1317,15 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
 
 void ProgressiveOrder::Impl::hand_out_head() {
   const std::size_t at = bucket_begin[head_buckets];
+  // Every head entry to its bucket (a counting scatter over the few head buckets, whose sizes
+  // bucket_begin holds); emit_buckets sorts each bucket.
+  std::vector<std::uint32_t> slot(bucket_begin.begin(), bucket_begin.begin() + std::ptrdiff_t(head_buckets));
   Packed* dst = sorted.data();
-  dst = std::copy(head[0].data(), head[0].data() + head_count[0], dst);
-  std::copy(head[1].data(), head[1].data() + head_count[1], dst);
-  std::sort(sorted.data(), sorted.data() + at);  // every head bucket in its place, and sorted
+  for (int part = 0; part < 2; ++part)
+    for (std::size_t i = 0; i < head_count[part]; ++i) {
+      const Packed p = head[part][i];
+      dst[slot[q_of(p) >> bucket_shift]++] = p;
+    }
   scatter_from = head_buckets;
   const std::size_t counts[3] = {scratch.near_tie_runs, scratch.near_tie_items, scratch.cluster_cycles};
   next_bucket = emit_buckets(0, head_buckets, head_buckets, batch, scratch);
