@@ -1,11 +1,13 @@
 #include "foxi/viz/spheres.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <thread>
+#include <utility>
 
 #include "exact.hpp"
 #include "huge_page_allocator.hpp"
@@ -38,6 +40,19 @@ void parallel_for(std::size_t n, F f) {
   other.join();
 }
 
+// f(0, n / 2, 0) and f(n / 2, n, 1) on two threads (all of it as part 0 below 20000): the same
+// split every time, for passes that must see the parts of an earlier one.
+template <class F>
+void two_halves(std::size_t n, F f) {
+  if (n < 20000) {
+    f(std::size_t{0}, n, 0);
+    return;
+  }
+  std::thread other([&] { f(n / 2, n, 1); });
+  f(std::size_t{0}, n / 2, 0);
+  other.join();
+}
+
 struct UnionFind {
   std::vector<std::uint32_t> parent;
   explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
@@ -61,7 +76,9 @@ struct UnionFind {
 // c.d) evaluated from them in double is then off by at most that times (1, 2 |p|_1) plus its own
 // rounding (a few ulps of the largest terms). The window of near ties grows with this bound, so
 // it is kept tight.
-void make_fixed_keys(SphereTable& t) {
+void make_key_blocks(SphereTable& t, const double half[3]);
+
+void make_fixed_keys(SphereTable& t, const double half[3]) {
   const std::size_t m = t.all_rep.size();
   double cmax_part[2] = {0, 0}, smax_part[2] = {0, 0};
   parallel_for(m, [&](std::size_t begin, std::size_t end, int part) {
@@ -113,6 +130,78 @@ void make_fixed_keys(SphereTable& t) {
   t.s_unit = s_unit;
   t.fixed_a = off * s_unit + 8 * kEps * smax;
   t.fixed_b = 2 * off * c_unit + 32 * kEps * cmax;
+  make_key_blocks(t, half);
+}
+
+// SphereTable::key_order and key_blocks: a counting sort of the fixed keys by the Morton code of
+// their centre's cell in a grid of about 16 items a cell over the bounding box (half sizes `half`,
+// local frame) widened by a quarter; centres beyond it (slivers' spheres) go to its border cells.
+// Both cores: each codes, counts and bounds (per cell: box of c, range of s) its half of the items,
+// then places them in its own slots of every cell. A block's bounds are those of the cells it
+// meets (consecutive in Morton order): a little wider than its own keys', found without reading
+// them again at scattered places.
+void make_key_blocks(SphereTable& t, const double half[3]) {
+  using KeyBlock = SphereTable::KeyBlock;
+  const std::size_t m = t.fixed_keys.size();
+  int bits = 1;  // per axis
+  while (bits < 7 && (std::size_t(1) << (3 * (bits + 1))) * 16 <= m) ++bits;
+  const std::uint32_t side = 1u << bits;
+  const std::size_t cells = std::size_t(1) << (3 * bits);
+  double scale[3], offset[3];  // cell coordinate = c * scale + offset
+  for (int k = 0; k < 3; ++k) {
+    const double h = 1.25 * half[k] / t.c_unit;
+    scale[k] = h > 0 ? double(side) / (2 * h) : 0.0;
+    offset[k] = h > 0 ? double(side) / 2 : 0.0;
+  }
+  std::array<std::uint32_t, 128> spread{};  // bit b of x to bit 3b
+  for (std::uint32_t x = 0; x < 128; ++x)
+    for (int b = 0; b < 7; ++b) spread[x] |= ((x >> b) & 1u) << (3 * b);
+  constexpr std::int32_t kMax = std::numeric_limits<std::int32_t>::max(), kMin = std::numeric_limits<std::int32_t>::min();
+  const KeyBlock empty = {{kMax, kMax, kMax}, {kMin, kMin, kMin}, kMax, kMin};
+  auto merge = [](KeyBlock& into, const KeyBlock& b) {
+    for (int c = 0; c < 3; ++c) {
+      into.c_lo[c] = std::min(into.c_lo[c], b.c_lo[c]);
+      into.c_hi[c] = std::max(into.c_hi[c], b.c_hi[c]);
+    }
+    into.s_lo = std::min(into.s_lo, b.s_lo);
+    into.s_hi = std::max(into.s_hi, b.s_hi);
+  };
+  std::vector<std::uint32_t> codes(m);
+  std::vector<std::uint32_t> slots[2] = {std::vector<std::uint32_t>(cells, 0), std::vector<std::uint32_t>(cells, 0)};
+  std::vector<KeyBlock> cell_box[2] = {std::vector<KeyBlock>(cells, empty), std::vector<KeyBlock>(m < 20000 ? 0 : cells, empty)};
+  two_halves(m, [&](std::size_t begin, std::size_t end, int part) {
+    std::uint32_t* count = slots[part].data();
+    KeyBlock* box = cell_box[part].data();
+    for (std::size_t i = begin; i < end; ++i) {
+      const SphereTable::FixedKey& key = t.fixed_keys[i];
+      std::uint32_t code = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double x = std::min(std::max(double(key.c[k]) * scale[k] + offset[k], 0.0), double(side - 1));
+        code |= spread[static_cast<std::uint32_t>(x)] << k;
+      }
+      codes[i] = code;
+      ++count[code];
+      merge(box[code], {{key.c[0], key.c[1], key.c[2]}, {key.c[0], key.c[1], key.c[2]}, key.s, key.s});
+    }
+  });
+  if (!cell_box[1].empty())
+    for (std::size_t c = 0; c < cells; ++c) merge(cell_box[0][c], cell_box[1][c]);
+  std::uint32_t acc = 0;
+  for (std::size_t c = 0; c < cells; ++c)
+    for (auto& part : slots) acc += std::exchange(part[c], acc);
+  t.key_order.resize(m);
+  two_halves(m, [&](std::size_t begin, std::size_t end, int part) {
+    std::uint32_t* next = slots[part].data();
+    for (std::size_t i = begin; i < end; ++i) t.key_order[next[codes[i]]++] = static_cast<std::uint32_t>(i);
+  });
+  const std::size_t block = SphereTable::kKeyBlock, blocks = (m + block - 1) / block;
+  t.key_blocks.resize(blocks);
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::uint32_t first = codes[t.key_order[b * block]], last = codes[t.key_order[std::min(m, (b + 1) * block) - 1]];
+    KeyBlock box = empty;
+    for (std::uint32_t c = first; c <= last; ++c) merge(box, cell_box[0][c]);
+    t.key_blocks[b] = box;
+  }
 }
 
 }  // namespace
@@ -137,6 +226,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   const double* W = weighted ? mesh.weight.data() : nullptr;
 
   // The local frame: the centre of the bounding box.
+  double half[3] = {0, 0, 0};
   if (mesh.node_count() > 0) {
     double lo[3] = {X[0], X[1], X[2]}, hi[3] = {X[0], X[1], X[2]};
     for (std::size_t i = 1; i < mesh.node_count(); ++i)
@@ -144,7 +234,10 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
         lo[k] = std::min(lo[k], X[3 * i + k]);
         hi[k] = std::max(hi[k], X[3 * i + k]);
       }
-    for (int k = 0; k < 3; ++k) t.origin[k] = 0.5 * (lo[k] + hi[k]);
+    for (int k = 0; k < 3; ++k) {
+      t.origin[k] = 0.5 * (lo[k] + hi[k]);
+      half[k] = 0.5 * (hi[k] - lo[k]);
+    }
   }
   const double org[3] = {t.origin[0], t.origin[1], t.origin[2]};
   t.key_a.resize(n);
@@ -443,7 +536,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   for (std::size_t i = 0; i < n; ++i)
     if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
   for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
-  make_fixed_keys(t);
+  make_fixed_keys(t, half);
   if (progress) progress("clusters", 1.0);
   return t;
 }

@@ -177,16 +177,22 @@ struct FixedPass {
   double s_unit = 0, sign = -1, shift_lo = 0, q_min = 0, q_scale = 0;
 };
 
+// The q of one fixed-point key: the one evaluation that the key pass and the head's block search
+// (head_from_blocks) share, so that both give an item the same q.
+template <bool kPerspective>
+inline std::uint32_t fixed_q(const FixedPass& p, const SphereTable::FixedKey& k) {
+  const double dot = double(k.c[0]) * p.f[0] + double(k.c[1]) * p.f[1] + double(k.c[2]) * p.f[2];
+  const double key = kPerspective ? double(k.s) * p.s_unit - dot : dot;
+  const double x = (p.sign * key - p.shift_lo - p.q_min) * p.q_scale;
+  return x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+}
+
 template <bool kPerspective, bool kIdentity, bool kStream, bool kClusters>
 std::size_t fixed_key_pass(const FixedPass& in, std::size_t b, std::size_t e) {
   const FixedPass p = in;
   std::size_t heads = 0;
   for (std::size_t i = b; i < e; ++i) {
-    const SphereTable::FixedKey& k = p.keys[i];
-    const double dot = double(k.c[0]) * p.f[0] + double(k.c[1]) * p.f[1] + double(k.c[2]) * p.f[2];
-    const double key = kPerspective ? double(k.s) * p.s_unit - dot : dot;
-    const double x = (p.sign * key - p.shift_lo - p.q_min) * p.q_scale;
-    const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+    const std::uint32_t q = fixed_q<kPerspective>(p, p.keys[i]);
     const std::uint32_t item = kIdentity ? static_cast<std::uint32_t>(i) : p.items[i];
     const Packed entry = (Packed(q) << 32) | item;
     store_entry(p.out + i, entry, kStream);
@@ -312,9 +318,9 @@ struct ProgressiveOrder::Impl {
   std::vector<std::uint32_t> scatter_start[2];  // per bucket, the next slot of each part
   std::size_t scatter_split = 0;                // part 0 is keyed[0, split), part 1 the rest
   std::size_t head_buckets = 0;                 // buckets a progressive order places first
-  // The entries of the head buckets, gathered by the key pass (per part), so that a progressive
-  // order hands out its first batch without waiting for the scatter; head_fits is false if there
-  // were more than the room kept for them.
+  // The entries of the head buckets, gathered by the key pass (per part) or by head_from_blocks
+  // (part 0), so that a progressive order hands out its first batch without waiting for the
+  // scatter; head_fits is false if there were more than the room kept for them.
   PackedBuffer head[2];
   std::size_t head_count[2] = {0, 0};
   bool head_fits = false;
@@ -349,9 +355,27 @@ struct ProgressiveOrder::Impl {
     for (int part = 0; part < 2; ++part)
       if (head[part].capacity() > t_workspace.head[part].capacity()) t_workspace.head[part].swap(head[part]);
   }
-  void prepare(std::span<const std::uint32_t> subset);
+  // Lays out the order (sample, quantisation, buckets) and computes the keys, except for a
+  // whole-mesh progressive order, which finds only its head now (head_from_blocks) and leaves the
+  // other keys to its worker (deferred_key_pass).
+  void prepare(std::span<const std::uint32_t> subset, bool progressive);
+  std::size_t item_count = 0;                   // sort items, wide ones included
+  std::size_t ordinary_count = 0;               // the items that are not wide (first in keyed)
+  std::uint32_t q_head = 0;                     // the head's entries have q below this (0: no head)
+  std::size_t head_room = 0;                    // room for head entries per part
+  std::vector<std::uint32_t> hist[2], thist[2]; // per part: entries per bucket, tets beyond each item's first
+  FixedPass fixed_pass;                         // the key pass over fixed-point keys (fixed_run)
+  FixedPassFn fixed_run = nullptr;
+  bool keys_deferred = false;                   // keys left to the worker (head_from_blocks)
+  std::size_t head_total = 0;                   // the head's entries found by head_from_blocks
+  void place_buckets(std::size_t split, bool gather);
+  void head_from_blocks();
+  bool deferred_key_pass();
   // Sorts one first-level bucket [begin, end) by packed value.
+  // With prefetch_ties, also prefetches the keys of the near ties it finds (prefetch_near_ties).
   void sort_bucket(std::size_t begin, std::size_t end, Scratch& sc);
+  template <bool kFetch>
+  void sort_bucket_of(std::size_t begin, std::size_t end, Scratch& sc);
   // Calls put(item) for the items of [begin, end) in order, after putting each maximal run of joined
   // neighbours in exact order (resolve_run).
   template <class Put>
@@ -395,21 +419,20 @@ struct ProgressiveOrder::Impl {
   // Prefetches the double keys of the tets in near-tie pairs of [begin, end) (sorted), which
   // resolve_run reads: they lie at random places, and fetched one run after another each is a
   // cache miss waited for (a few thousand a view at 1M tets, tens of thousands at 4M).
+  // (sort_bucket does it as it sorts; this pass is for the few buckets it sorts otherwise.)
   void prefetch_near_ties(std::size_t begin, std::size_t end) const {
     const Packed* a = sorted.data();
-    const std::uint64_t w = q_window;
-    const double* C = table->c.data();
-    const double* S = table->s.data();
-    const std::uint8_t* wide = table->wide.data();
-    for (std::size_t i = begin; i + 1 < end; ++i) {
-      if (std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w) continue;
-      for (std::uint32_t item : {item_of(a[i]), item_of(a[i + 1])}) {
-        if (item & kClusterBit) continue;  // found through the cluster tables first
-        prefetch(C + 3 * std::size_t(item));
-        prefetch(C + 3 * std::size_t(item) + 2);
-        prefetch(S + item);
-        prefetch(wide + item);
-      }
+    for (std::size_t i = begin; i + 1 < end; ++i) prefetch_if_tie(a[i], a[i + 1]);
+  }
+  // The same for one pair of neighbours (a before b in q order).
+  void prefetch_if_tie(Packed a, Packed b) const {
+    if (std::uint64_t(q_of(b)) - q_of(a) > q_window) return;
+    for (std::uint32_t item : {item_of(a), item_of(b)}) {
+      if (item & kClusterBit) continue;  // found through the cluster tables first
+      prefetch(table->c.data() + 3 * std::size_t(item));
+      prefetch(table->c.data() + 3 * std::size_t(item) + 2);
+      prefetch(table->s.data() + item);
+      prefetch(table->wide.data() + item);
     }
   }
   // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
@@ -425,7 +448,7 @@ struct ProgressiveOrder::Impl {
   std::vector<std::uint32_t> tet_begin;
 };
 
-void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
+void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset, bool progressive) {
   const SphereTable& t = *table;
   const std::size_t n = t.tet_count();
   // The items: all of the mesh (precomputed), or the subset's tets and clusters.
@@ -470,6 +493,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     total_tets = subset.size();
   }
   const std::size_t m_main = items.size(), m = m_main + wide_items.size();
+  item_count = m;
+  ordinary_count = m_main;
   t_cluster_free = t.cluster_count() == 0;
   many_clusters = t.cluster_count() * 16 > t.all_items.size();
   stats.items = m;
@@ -551,28 +576,57 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   stats.buckets = nb;
   keyed.swap(t_workspace.keyed);
   if (keyed.size() < m) keyed.resize(m);
-  // The head: the buckets up to the one of the sample's 0.2% quantile, gathered by the key pass so
-  // that a progressive order can hand them out before the scatter. Room for a few times what the
+  sorted.swap(t_workspace.entries);
+  if (sorted.size() < m) sorted.resize(m);
+  // The head (progressive orders only): the buckets up to the one of the sample's 0.2% quantile,
+  // gathered before the scatter so that they are handed out first. Room for a few times what the
   // sample predicts; more means a skewed sample, and the head is then placed by the scatter.
-  head_buckets = m >= 50000 ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb) : 0;
-  const std::uint32_t q_head =
-      head_buckets == 0 || head_buckets >= nb ? 0u : static_cast<std::uint32_t>(head_buckets << shift);
-  const std::size_t head_room = q_head == 0 ? 0 : m / 128 + 8192;
+  head_buckets =
+      progressive && m >= 50000 ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb) : 0;
+  q_head = head_buckets == 0 || head_buckets >= nb ? 0u : static_cast<std::uint32_t>(head_buckets << shift);
+  head_room = q_head == 0 ? 0 : m / 128 + 8192;
   for (int part = 0; part < 2; ++part) {
     head[part].swap(t_workspace.head[part]);
     if (head[part].size() < head_room) head[part].resize(head_room);
   }
-  std::vector<std::uint32_t> hist[2] = {std::vector<std::uint32_t>(nb, 0), std::vector<std::uint32_t>(nb, 0)};
-  // With clusters, the tets per bucket too (an item stands for one or more tets: counted here are
-  // the tets beyond the first), so that every bucket's tets can be written at their final places.
-  std::vector<std::uint32_t> thist[2];
-  if (!t_cluster_free) thist[0].assign(nb, 0), thist[1].assign(nb, 0);
+  for (int part = 0; part < 2; ++part) {
+    hist[part].assign(nb, 0);
+    // With clusters, the tets per bucket too (an item stands for one or more tets: counted here are
+    // the tets beyond the first), so that every bucket's tets can be written at their final places.
+    if (!t_cluster_free) thist[part].assign(nb, 0);
+  }
+  bucket_begin.assign(nb + 1, 0);
+  if (!t_cluster_free) tet_begin.assign(nb + 1, 0);
+  Packed* keyed_p = keyed.data();
+
+  // The wide items (few) come after the others in keyed, and each makes a zone of joined q values.
+  zones.clear();
+  for (std::size_t i = m_main; i < m; ++i) {
+    const std::uint32_t rep = rep_tet(t, wide_items[i - m_main]);
+    const float r = radius_of(rep);
+    const double lo = lo_of(rep, r);
+    keyed_p[i] = (Packed(quantise(lo)) << 32) | wide_items[i - m_main];
+    // Whatever overlaps [lo, lo + 2r] has its lo in [lo - 2 bound, lo + 2r] (ordinary items), or
+    // its own zone meets this one (wide items).
+    const std::uint64_t za = quantise(lo - 2.0 * double(bound)), zb = quantise(lo + 2.0 * double(r));
+    zones.emplace_back(static_cast<std::uint32_t>(za > q_window ? za - q_window : 0),
+                       static_cast<std::uint32_t>(std::min<std::uint64_t>(zb + q_window, 0xFFFFFFFFu)));
+  }
+  if (!zones.empty()) {
+    std::sort(zones.begin(), zones.end());
+    std::size_t k = 0;
+    for (std::size_t z = 1; z < zones.size(); ++z) {
+      if (zones[z].first <= zones[k].second) zones[k].second = std::max(zones[k].second, zones[z].second);
+      else zones[++k] = zones[z];
+    }
+    zones.resize(k + 1);
+  }
+
   // Tight loops over the ordinary items, on locals (the stores to the histogram could alias anything
   // reached through a reference).
   const std::uint32_t* item_p = t_cluster_free ? reps.data() : items.data();  // items are their reps then
   const std::uint32_t* cl_tets = t.cluster_tets.data();
   const std::uint32_t* cl_begin = t.cluster_begin.data();
-  Packed* keyed_p = keyed.data();
   const double* C = t.c.data();
   const double* S = t.s.data();
   const double p0 = perspective ? eye2[0] : dir[0], p1 = perspective ? eye2[1] : dir[1],
@@ -582,8 +636,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   // Beyond the last-level cache the entries are written around it: they are read next by the
   // scatter, from memory either way, and a plain store would first read each line it writes.
   const bool stream = stream_entries(m);
-  auto key_pass_of = [=, this, &hist, &thist](auto with_tets) {
-   return [=, this, &hist, &thist](std::size_t b, std::size_t e, int part) {
+  const std::uint32_t q_head_v = q_head;
+  const std::size_t head_room_v = head_room;
+  auto key_pass_of = [=, this](auto with_tets) {
+   return [=, this](std::size_t b, std::size_t e, int part) {
     std::uint32_t* hp = hist[part].data();
     std::uint32_t* thp = thist[part].data();
     Packed* head_p = head[part].data();
@@ -606,8 +662,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
       ++hp[q >> shift];
       if constexpr (decltype(with_tets)::value)
         if (item_p[i] & kClusterBit) thp[q >> shift] += tets_of(item_p[i]) - 1;
-      if (q < q_head) {
-        if (heads < head_room) head_p[heads] = p;
+      if (q < q_head_v) {
+        if (heads < head_room_v) head_p[heads] = p;
         ++heads;
       }
     };
@@ -629,7 +685,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   };
   head_count[0] = head_count[1] = 0;
   if (fixed) {
-    FixedPass pass;
+    FixedPass& pass = fixed_pass;
+    pass = FixedPass{};
     pass.keys = t.fixed_keys.data();
     pass.items = items.data();
     pass.out = keyed_p;
@@ -647,8 +704,14 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
     pass.q_scale = q_scale;
     // No clusters and no wide items: all_items lists every tet in order (item i is tet i).
     const bool identity = t_cluster_free && m_main == n;
-    const FixedPassFn run = kFixedPasses[(perspective ? 1 : 0) | (identity ? 2 : 0) | (stream ? 4 : 0) |
-                                         (t_cluster_free ? 0 : 8)];
+    fixed_run = kFixedPasses[(perspective ? 1 : 0) | (identity ? 2 : 0) | (stream ? 4 : 0) | (t_cluster_free ? 0 : 8)];
+    if (q_head > 0 && t.key_order.size() == m_main) {
+      // A progressive order: its head now, from the blocks that may hold it; every key later, by the
+      // worker, while the caller draws the first batch.
+      head_from_blocks();
+      return;
+    }
+    const FixedPassFn run = fixed_run;
     parallel_for(m_main, [&](std::size_t b, std::size_t e, int part) {
       FixedPass own = pass;
       own.hist = hist[part].data();
@@ -661,65 +724,148 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset) {
   } else {
     parallel_for(m_main, key_pass_of(std::true_type{}));
   }
-  // The wide items (few) go with the second part, and each makes a zone of joined q values.
-  const std::size_t split = m_main < 50000 ? m : m_main / 2;  // as parallel_for splits
+  // The wide items go with the second part (as parallel_for splits).
+  place_buckets(m_main < 50000 ? m : m_main / 2, true);
+}
+
+// Counts the wide items (and gathers those of the head if `gather`) with part 1 (part 0 if the
+// key pass had one part: split == m), then places the buckets: bucket_begin, tet_begin, and where
+// each part's entries of each bucket go.
+void ProgressiveOrder::Impl::place_buckets(std::size_t split, bool gather) {
+  const std::size_t m = item_count, nb = hist[0].size();
+  const int shift = bucket_shift;
   const int wide_part = split == m ? 0 : 1;
-  zones.clear();
-  for (std::size_t i = m_main; i < m; ++i) {
-    const std::uint32_t rep = rep_tet(t, wide_items[i - m_main]);
-    const float r = radius_of(rep);
-    const double lo = lo_of(rep, r);
-    const std::uint32_t q = quantise(lo);
-    keyed_p[i] = (Packed(q) << 32) | wide_items[i - m_main];
+  for (std::size_t i = ordinary_count; i < m; ++i) {
+    const Packed p = keyed[i];
+    const std::uint32_t q = q_of(p);
     ++hist[wide_part][q >> shift];
-    if (q < q_head) {
-      if (head_count[wide_part] < head_room) head[wide_part][head_count[wide_part]] = keyed_p[i];
+    if (gather && q < q_head) {
+      if (head_count[wide_part] < head_room) head[wide_part][head_count[wide_part]] = p;
       ++head_count[wide_part];
     }
-    if (!t_cluster_free) thist[wide_part][q >> shift] += tets_of(wide_items[i - m_main]) - 1;
-    // Whatever overlaps [lo, lo + 2r] has its lo in [lo - 2 bound, lo + 2r] (ordinary items), or
-    // its own zone meets this one (wide items).
-    const std::uint64_t za = quantise(lo - 2.0 * double(bound)), zb = quantise(lo + 2.0 * double(r));
-    zones.emplace_back(static_cast<std::uint32_t>(za > q_window ? za - q_window : 0),
-                       static_cast<std::uint32_t>(std::min<std::uint64_t>(zb + q_window, 0xFFFFFFFFu)));
+    if (!t_cluster_free) thist[wide_part][q >> shift] += tets_of(item_of(p)) - 1;
   }
-  if (!zones.empty()) {
-    std::sort(zones.begin(), zones.end());
-    std::size_t k = 0;
-    for (std::size_t z = 1; z < zones.size(); ++z) {
-      if (zones[z].first <= zones[k].second) zones[k].second = std::max(zones[k].second, zones[z].second);
-      else zones[++k] = zones[z];
-    }
-    zones.resize(k + 1);
-  }
-
-  // 3. The scatter by first-level bucket (both cores, each into its own slots of every bucket).
-  bucket_begin.assign(nb + 1, 0);
-  std::vector<std::uint32_t> start0(nb), start1(nb);
-  std::uint32_t acc = 0;
+  // Filled in place: a worker placing the buckets after the head was handed out writes the same
+  // values there.
+  scatter_start[0].resize(nb);
+  scatter_start[1].resize(nb);
+  std::uint32_t acc = 0, tets = 0;
   for (std::size_t b = 0; b < nb; ++b) {
     bucket_begin[b] = acc;
-    start0[b] = acc;
+    scatter_start[0][b] = acc;
     acc += hist[0][b];
-    start1[b] = acc;
+    scatter_start[1][b] = acc;
     acc += hist[1][b];
-  }
-  bucket_begin[nb] = acc;
-  if (!t_cluster_free) {
-    tet_begin.assign(nb + 1, 0);
-    std::uint32_t tets = 0;
-    for (std::size_t b = 0; b < nb; ++b) {
+    if (!t_cluster_free) {
       tet_begin[b] = tets;
       tets += hist[0][b] + hist[1][b] + thist[0][b] + thist[1][b];
     }
-    tet_begin[nb] = tets;
   }
-  scatter_start[0].swap(start0);
-  scatter_start[1].swap(start1);
+  bucket_begin[nb] = acc;
+  if (!t_cluster_free) tet_begin[nb] = tets;
   scatter_split = split;
-  sorted.swap(t_workspace.entries);
-  if (sorted.size() < m) sorted.resize(m);
-  head_fits = q_head > 0 && head_count[0] <= head_room && head_count[1] <= head_room;
+  if (gather) head_fits = q_head > 0 && head_count[0] <= head_room && head_count[1] <= head_room;
+}
+
+// The head of a progressive order from the key blocks (see SphereTable::KeyBlock): a block is read
+// only if the least q its box allows is in the head; every entry of the head is then found (and no
+// other), with the q the key pass would give it. Places the head buckets; the key pass of the
+// whole mesh is left to the worker (keys_deferred).
+void ProgressiveOrder::Impl::head_from_blocks() {
+  const SphereTable& t = *table;
+  const FixedPass& p = fixed_pass;
+  const std::size_t block = SphereTable::kKeyBlock, m_keys = ordinary_count;
+  const std::uint32_t* order = t.key_order.data();
+  const double qh = double(q_head);
+  Packed* out = head[0].data();
+  std::size_t count = 0, read = 0;
+  auto gather = [&](auto persp) {
+    constexpr bool kPerspective = decltype(persp)::value;
+    for (std::size_t k = 0; k < t.key_blocks.size(); ++k) {
+      const SphereTable::KeyBlock& box = t.key_blocks[k];
+      // The exact key's range over the box, widened by the rounding of the key pass and of this
+      // bound (each a few ulps of the largest term: 16 is ample).
+      double lo = 0, hi = 0, mag = 0;
+      for (int j = 0; j < 3; ++j) {
+        const double a = double(box.c_lo[j]) * p.f[j], b = double(box.c_hi[j]) * p.f[j];
+        lo += std::min(a, b);
+        hi += std::max(a, b);
+        mag += std::max(std::abs(a), std::abs(b));
+      }
+      if (kPerspective) {
+        const double s_lo = double(box.s_lo) * p.s_unit, s_hi = double(box.s_hi) * p.s_unit;
+        const double dot_lo = lo;
+        lo = s_lo - hi;
+        hi = s_hi - dot_lo;
+        mag += std::max(std::abs(s_lo), std::abs(s_hi));
+      }
+      const double least = (p.sign > 0 ? lo : -hi) - 16 * kEps * mag;
+      // x is monotone in the key as evaluated (each rounding is), so no entry of the block has a q
+      // below that of `least`. (A NaN bound reads the block.)
+      const double x = (least - p.shift_lo - p.q_min) * p.q_scale;
+      if (x >= qh) continue;
+      const std::size_t e = std::min(m_keys, (k + 1) * block);
+      read += e - k * block;
+      // The block's keys lie at scattered places: all their misses at once.
+      for (std::size_t j = k * block; j < e; ++j) {
+        prefetch(p.keys + order[j]);
+        prefetch(p.items + order[j]);
+      }
+      for (std::size_t j = k * block; j < e; ++j) {
+        const std::uint32_t i = order[j];
+        const std::uint32_t q = fixed_q<kPerspective>(p, p.keys[i]);
+        if (q >= q_head) continue;
+        if (count < head_room) out[count] = (Packed(q) << 32) | p.items[i];
+        ++count;
+      }
+    }
+  };
+  if (perspective) gather(std::true_type{});
+  else gather(std::false_type{});
+  for (std::size_t i = ordinary_count; i < item_count; ++i)
+    if (q_of(keyed[i]) < q_head) {
+      if (count < head_room) out[count] = keyed[i];
+      ++count;
+    }
+  stats.first_batch_keys = read;
+  head_count[0] = count;
+  head_count[1] = 0;
+  head_total = count;
+  head_fits = count <= head_room;
+  keys_deferred = true;
+  if (!head_fits) return;  // the worker places everything
+  // The head buckets' places (the same as the whole histogram gives them).
+  const int shift = bucket_shift;
+  for (std::size_t i = 0; i < count; ++i) {
+    ++bucket_begin[(q_of(out[i]) >> shift) + 1];
+    if (!t_cluster_free) tet_begin[(q_of(out[i]) >> shift) + 1] += tets_of(item_of(out[i]));
+  }
+  for (std::size_t b = 1; b <= head_buckets; ++b) {
+    bucket_begin[b] += bucket_begin[b - 1];
+    if (!t_cluster_free) tet_begin[b] += tet_begin[b - 1];
+  }
+}
+
+// The worker's key pass after a head found by head_from_blocks: one core (the caller draws on the
+// other), in chunks between looks at the stop flag. False if stopped.
+bool ProgressiveOrder::Impl::deferred_key_pass() {
+  FixedPass own = fixed_pass;
+  own.hist = hist[0].data();
+  own.tets_hist = thist[0].data();
+  own.head = nullptr;
+  own.head_room = 0;
+  own.q_head = 0;  // gathers nothing
+  constexpr std::size_t kChunk = 1 << 16;
+  for (std::size_t c = 0; c < ordinary_count; c += kChunk) {
+    if (stop.load(std::memory_order_relaxed)) return false;
+    fixed_run(own, c, std::min(ordinary_count, c + kChunk));
+  }
+  place_buckets(item_count, false);
+  keys_deferred = false;
+  // The blocks' bounds are proved to miss no entry of the head; the count checks it.
+  if (bucket_begin[head_buckets] != head_total)
+    throw std::logic_error("visibility order: the key blocks missed entries of the first batch");
+  return true;
 }
 
 // Places the entries of buckets [from, to) of keyed into sorted (both cores), each part into its
@@ -818,6 +964,12 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
 // pass that follows mispredicts little; 2n to 4n measured 12% slower: more counters to clear and
 // sum), then the insertion pass.
 void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
+  if (prefetch_ties) sort_bucket_of<true>(begin, end, sc);
+  else sort_bucket_of<false>(begin, end, sc);
+}
+
+template <bool kFetch>
+void ProgressiveOrder::Impl::sort_bucket_of(std::size_t begin, std::size_t end, Scratch& sc) {
   Packed* a = sorted.data() + begin;
   const std::size_t n = end - begin;
   auto insertion = [](Packed* x, std::size_t len) {
@@ -830,6 +982,7 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
   };
   if (n <= 32) {
     insertion(a, n);
+    if (kFetch) prefetch_near_ties(begin, end);
     return;
   }
   int sub_bits = 1;
@@ -850,12 +1003,15 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
   for (std::size_t i = 0; i < n; ++i) tmp[cnt[(q_of(a[i]) >> sub_shift) & mask]++] = a[i];
   // Back into place by one insertion pass (nothing moves across sub-buckets), with a budget of
   // moves: keys crowded into a few sub-buckets go to std::sort instead.
-  // Most entries are alone in their sub-bucket and come in order: that case is one compare.
+  // Most entries are alone in their sub-bucket and come in order: that case is one compare. The
+  // near ties' keys are fetched on the way (a pair found here may still be parted by a later
+  // insertion, or one missed: a prefetch is only a hint).
   std::size_t budget = 4 * n;
   a[0] = tmp[0];
   for (std::size_t i = 1; i < n; ++i) {
     const Packed v = tmp[i];
     if (!(v < a[i - 1])) {
+      if (kFetch) prefetch_if_tie(a[i - 1], v);
       a[i] = v;
       continue;
     }
@@ -865,10 +1021,15 @@ void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scr
       --j;
     } while (j > 0 && v < a[j - 1]);
     a[j] = v;
+    if (kFetch) {
+      prefetch_if_tie(v, a[j + 1]);
+      if (j > 0) prefetch_if_tie(a[j - 1], v);
+    }
     budget -= std::min(budget, i - j);
     if (budget == 0) {
       std::copy(tmp + i + 1, tmp + n, a + i + 1);
       std::sort(a, a + n);
+      if (kFetch) prefetch_near_ties(begin, end);
       break;
     }
   }
@@ -1065,7 +1226,7 @@ ProgressiveOrder::ProgressiveOrder(const Mesh& mesh, const SphereTable& table, c
   impl_->table = &table;
   impl_->view = view;
   impl_->front_to_back = front_to_back;
-  impl_->prepare(subset);
+  impl_->prepare(subset, true);
 }
 
 ProgressiveOrder::~ProgressiveOrder() = default;
@@ -1091,9 +1252,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     std::size_t end = bucket_begin[b + 1];
     ++b;
     if (begin == end) continue;
-    const bool fetched = group < sc.sorted_upto && group >= first;  // sorted ahead, its keys fetched
     ensure_sorted(group);
-    if (!fetched && prefetch_ties) prefetch_near_ties(begin, end);
     // A run of joined entries may cross into the following buckets: take them in while it may.
     // Bucket b holds no q below b << bucket_shift, so most checks need not look into it.
     while (b < limit) {
@@ -1113,10 +1272,7 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     // scanned (one group after another, each resolve_run would wait for its misses).
     std::size_t ahead = b;
     while (ahead < limit && bucket_begin[ahead] == bucket_begin[ahead + 1]) ++ahead;
-    if (prefetch_ties && ahead < limit && ahead >= sc.sorted_upto) {
-      ensure_sorted(ahead);
-      prefetch_near_ties(bucket_begin[ahead], bucket_begin[ahead + 1]);
-    }
+    if (prefetch_ties && ahead < limit && ahead >= sc.sorted_upto) ensure_sorted(ahead);
     const std::uint32_t* tb = t_cluster_free ? bucket_begin.data() : tet_begin.data();
     std::uint32_t* o = direct + tb[group];
     if (direct == nullptr) {
@@ -1161,10 +1317,15 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
 
 void ProgressiveOrder::Impl::hand_out_head() {
   const std::size_t at = bucket_begin[head_buckets];
+  // Every head entry to its bucket (a counting scatter over the few head buckets, whose sizes
+  // bucket_begin holds); emit_buckets sorts each bucket.
+  std::vector<std::uint32_t> slot(bucket_begin.begin(), bucket_begin.begin() + std::ptrdiff_t(head_buckets));
   Packed* dst = sorted.data();
-  dst = std::copy(head[0].data(), head[0].data() + head_count[0], dst);
-  std::copy(head[1].data(), head[1].data() + head_count[1], dst);
-  std::sort(sorted.data(), sorted.data() + at);  // every head bucket in its place, and sorted
+  for (int part = 0; part < 2; ++part)
+    for (std::size_t i = 0; i < head_count[part]; ++i) {
+      const Packed p = head[part][i];
+      dst[slot[q_of(p) >> bucket_shift]++] = p;
+    }
   scatter_from = head_buckets;
   const std::size_t counts[3] = {scratch.near_tie_runs, scratch.near_tie_items, scratch.cluster_cycles};
   next_bucket = emit_buckets(0, head_buckets, head_buckets, batch, scratch);
@@ -1191,7 +1352,8 @@ void ProgressiveOrder::Impl::run_worker() {
     cv.notify_one();
   };
   first = b == 0;
-  if (!scattered) {
+  if (keys_deferred && !deferred_key_pass()) b = nb;  // stopped
+  if (!scattered && b < nb) {
     scatter(scatter_from, nb);
     scattered = true;
   }
@@ -1210,8 +1372,9 @@ void ProgressiveOrder::Impl::run_worker() {
 std::span<const std::uint32_t> ProgressiveOrder::next() {
   Impl& d = *impl_;
   d.batch.clear();
+  // (bucket_begin is the worker's while it runs: only its size is read here.)
   const std::size_t nb = d.bucket_begin.size() - 1;
-  if (d.bucket_begin[nb] < 50000) {
+  if (d.item_count < 50000) {
     // Small orders: on this thread, bucket by bucket.
     if (!d.scattered) {
       d.scatter(0, nb);
@@ -1273,15 +1436,19 @@ void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, co
                            OrderStats* stats) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point t0 = Clock::now();
-  ProgressiveOrder order(mesh, table, view, subset, front_to_back);
-  ProgressiveOrder::Impl& d = *order.impl_;
+  ProgressiveOrder::Impl d;
+  d.mesh = &mesh;
+  d.table = &table;
+  d.view = view;
+  d.front_to_back = front_to_back;
+  d.prepare(subset, false);
   const Clock::time_point t1 = Clock::now();
   const std::size_t nb = d.bucket_begin.size() - 1;
   d.scatter(0, nb);
   d.scattered = true;
   const Clock::time_point t2 = Clock::now();
   // Every bucket's tets go straight to their final places.
-  out.resize(order.total());
+  out.resize(d.total_tets);
   std::uint32_t* direct = out.data();
   // Both cores: the first half of the buckets here, the second half on another thread. A tie chain
   // across the split (rare) sends everything back through one thread.

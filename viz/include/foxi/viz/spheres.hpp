@@ -81,6 +81,18 @@ struct SphereTable {
   std::vector<FixedKey> fixed_keys;
   double c_unit = 0, s_unit = 0;
   double fixed_a = 0, fixed_b = 0;
+  // The indices of fixed_keys in space order (by the Morton order of the cell of their centre in
+  // a grid over the mesh's bounding box), and per block of kKeyBlock consecutive ones (the last one
+  // shorter) the box of their c and the range of their s, in the fixed-point units. A view bounds
+  // the keys of a whole block from these alone, so that a progressive order finds its first
+  // (farthest) items by reading only the few blocks that may hold them. Empty when fixed_keys is.
+  static constexpr std::size_t kKeyBlock = 64;
+  struct KeyBlock {
+    std::int32_t c_lo[3], c_hi[3];
+    std::int32_t s_lo, s_hi;
+  };
+  std::vector<std::uint32_t> key_order;
+  std::vector<KeyBlock> key_blocks;
 
   std::size_t tet_count() const { return s.size(); }
   std::size_t cluster_count() const { return cluster_begin.empty() ? 0 : cluster_begin.size() - 1; }

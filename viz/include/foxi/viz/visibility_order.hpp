@@ -39,13 +39,17 @@ struct OrderStats {
   // the scatter into first-level buckets, and the per-bucket sorts with near-tie fix-up and cluster
   // expansion (both cores in each).
   double keys_seconds = 0, scatter_seconds = 0, sort_seconds = 0;
+  // Keys computed before a progressive order's first batch (from the key blocks that may hold it).
+  std::size_t first_batch_keys = 0;
 };
 
 // Hands out the order of one view progressively: next() returns the next batch of tets (back to
-// front, or front to back if asked). The constructor computes every key (both cores); for orders
-// of 50,000 items or more the first next() sorts and returns the first buckets, gathered by the
-// key pass, on the caller's thread, and hands the rest to a pooled thread that places and sorts
-// them ahead while the caller draws. Destroying the object stops that work within a fraction of a
+// front, or front to back if asked). Orders of fewer than 50,000 items are computed on the
+// caller's thread. For larger ones the constructor finds only the first buckets (a whole-mesh order
+// reads just the blocks of keys whose bounds may reach them, SphereTable::key_blocks; a subset
+// computes every key on both cores), the first next() sorts and returns them on the caller's thread
+// and hands the rest to a pooled thread that computes the other keys, places and sorts them ahead
+// while the caller draws. Destroying the object stops that work within a fraction of a
 // millisecond. The table and the mesh are lent and must outlive it; one object is used from one
 // thread.
 class ProgressiveOrder {
