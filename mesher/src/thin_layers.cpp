@@ -3,16 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plc_edit.hpp"
+
 namespace foxi {
 
 namespace {
 
-using Vec = std::array<double, 3>;
+using detail::cross;
+using detail::dot;
+using detail::Vec;
 
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 Vec unit(const Vec& a) {
   const double n = std::sqrt(dot(a, a));
   return {a[0] / n, a[1] / n, a[2] / n};
@@ -52,9 +52,9 @@ std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect, doubl
       lo[k] = std::min(lo[k], plc.points[3 * i + k]);
       hi[k] = std::max(hi[k], plc.points[3 * i + k]);
     }
-  const double diag = std::sqrt(dot({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}, {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}));
+  const double diag = std::sqrt(detail::norm2(detail::sub(hi, lo)));
   const double tol = 1e-9 * diag;
-  auto point = [&](std::uint32_t i) { return Vec{plc.points[3 * i], plc.points[3 * i + 1], plc.points[3 * i + 2]}; };
+  auto point = [&](std::uint32_t i) { return detail::at(plc.points, i); };
 
   std::vector<FacetPlane> planes;
   for (std::size_t f = 0; f < plc.facet_count(); ++f) {
@@ -62,12 +62,7 @@ std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect, doubl
     Vec n{0, 0, 0};
     for (std::uint32_t g = plc.facet_polygon_begin[f]; g < plc.facet_polygon_begin[f + 1]; ++g) {
       const std::uint32_t b = plc.polygon_vertex_begin[g], e = plc.polygon_vertex_begin[g + 1];
-      for (std::uint32_t i = b; i < e; ++i) {
-        const Vec p = point(plc.polygon_vertices[i]), q = point(plc.polygon_vertices[i + 1 < e ? i + 1 : b]);
-        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-      }
+      detail::add_newell_normal(plc.points, &plc.polygon_vertices[b], e - b, n);
     }
     const double nn = std::sqrt(dot(n, n));
     if (!(nn > tol * tol)) continue;
