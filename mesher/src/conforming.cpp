@@ -54,6 +54,7 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     if (!round) break;
     const DelaunayCertificate& cert = *round;
     if (cert.delaunay || it >= conforming.max_iterations) break;
+    if (conforming.surface_rescue && !conforming.remesh_plc_first) break;  // straight to the surface rounds
     // TetGen's own refinement answering a round's splits with new violations: the rounds are not
     // settling, and the surface rescue below settles faster from here.
     if (conforming.surface_rescue && it > 0 && rep.violations[it] >= rep.violations[it - 1]) break;

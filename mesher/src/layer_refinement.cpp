@@ -188,7 +188,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
     rep.quality_unmet = 0;
     for (const auto& [r2, t] : bad) rep.quality_unmet += !in_layer[t];
     if ((cert.delaunay && bad.empty()) || it >= conforming.max_layer_iterations) break;
-    if (params.progress && !params.progress("refinement around thin layers",
+    if (params.progress && !params.progress(first_mesh ? "conforming refinement" : "refinement around thin layers",
                                             double(it + 1) / double(conforming.max_layer_iterations + 1)))
       throw MesherError(-1, "meshing cancelled");
 
