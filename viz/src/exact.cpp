@@ -2,6 +2,8 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
+#include <CGAL/Gmpzf.h>
+#include <CGAL/Interval_nt.h>
 
 namespace foxi::exact {
 
@@ -90,9 +92,100 @@ int in_sphere(const double* a, const double* b, const double* c, const double* d
       WP(pt(a), w[0]), WP(pt(b), w[1]), WP(pt(c), w[2]), WP(pt(d), w[3]), WP(pt(q), wq)));
 }
 
+namespace {
+
+// The key in interval arithmetic (the caller holds the rounding mode upward): the same formulas as
+// PowerKey's exact ones. False when the tet's determinant may be zero (the exact path decides
+// whether it is flat).
+using I = CGAL::Interval_nt<false>;
+struct IVec {
+  I x, y, z;
+};
+IVec iv(const double* p) { return {I(p[0]), I(p[1]), I(p[2])}; }
+IVec isub(const IVec& a, const IVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+IVec iadd(const IVec& a, const IVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+IVec iscale(const IVec& a, const I& s) { return {a.x * s, a.y * s, a.z * s}; }
+IVec icross(const IVec& a, const IVec& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+I idot(const IVec& a, const IVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+bool interval_key(const double* a, const double* b, const double* c, const double* d, const double* w,
+                  bool perspective, const double* v, I& first, I& second) {
+  const IVec A = iv(a), B = isub(iv(b), A), C = isub(iv(c), A), D = isub(iv(d), A);
+  const I det = idot(B, icross(C, D));
+  if (!(det.inf() > 0 || det.sup() < 0)) return false;
+  I lb = idot(B, B), lc = idot(C, C), ld = idot(D, D), w0(0);
+  if (w != nullptr) {
+    w0 = I(w[0]);
+    lb = lb - I(w[1]) + w0;
+    lc = lc - I(w[2]) + w0;
+    ld = ld - I(w[3]) + w0;
+  }
+  const IVec num = iadd(iadd(iscale(icross(C, D), lb), iscale(icross(D, B), lc)), iscale(icross(B, C), ld));
+  const IVec o = iscale(num, I(1) / (I(2) * det));
+  const IVec V = iv(v);
+  if (perspective) {
+    const IVec pa = isub(V, A);
+    first = idot(pa, pa) - I(2) * idot(pa, o) + w0;
+    second = I(0);
+  } else {
+    first = idot(iadd(A, o), V);
+    second = idot(A, A) + I(2) * idot(A, o) + w0;
+  }
+  return true;
+}
+
+// -1, 0, +1 as a < b, a == b, a > b when the intervals decide it; 2 when they do not.
+int interval_compare(const I& a, const I& b) {
+  if (a.sup() < b.inf()) return -1;
+  if (b.sup() < a.inf()) return 1;
+  if (a.is_point() && b.is_point()) return 0;  // overlapping points: equal
+  return 2;
+}
+
+}  // namespace
+
+// Near ties are re-compared in interval arithmetic first (a few hundred flops); only when the
+// intervals of two keys overlap (equal spheres: the tets of a faceted ball whose four corners lie on
+// the ball) is the key computed exactly, as a fraction n / d of exact binary floats (Gmpzf: products
+// and sums without the gcds of rationals, which made a bga view 2 us per tet).
+using Z = CGAL::Gmpzf;
+struct ZVec {
+  Z x, y, z;
+};
+namespace {
+ZVec zv(const double* p) { return {Z(p[0]), Z(p[1]), Z(p[2])}; }
+ZVec zsub(const ZVec& a, const ZVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+ZVec zadd(const ZVec& a, const ZVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+ZVec zscale(const ZVec& a, const Z& s) { return {a.x * s, a.y * s, a.z * s}; }
+ZVec zcross(const ZVec& a, const ZVec& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Z zdot(const ZVec& a, const ZVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+// n / d with d > 0.
+struct Fraction {
+  Z n, d;
+};
+Fraction fraction(Z n, Z d) {
+  if (CGAL::is_negative(d)) return {-n, -d};
+  return {std::move(n), std::move(d)};
+}
+int compare_fractions(const Fraction& a, const Fraction& b) {
+  const Z l = a.n * b.d, r = b.n * a.d;
+  return l < r ? -1 : (r < l ? 1 : 0);
+}
+}  // namespace
+
 struct PowerKey::Impl {
-  Q first;   // perspective: the power; orthographic: c.d
-  Q second;  // orthographic: s
+  double p[4][3]{};
+  double w[4]{};
+  bool weighted = false, perspective = false;
+  double v[3]{};
+  bool filtered = false;  // the intervals below hold the key
+  I first_i, second_i;
+  bool exact = false;  // the fractions below hold the key
+  Fraction first;      // perspective: the power; orthographic: c.d
+  Fraction second;     // orthographic: s
+
+  void make_exact();
 };
 
 PowerKey::PowerKey() : impl_(std::make_unique<Impl>()) {}
@@ -102,34 +195,72 @@ PowerKey& PowerKey::operator=(PowerKey&&) noexcept = default;
 
 void PowerKey::set(const double* a, const double* b, const double* c, const double* d, const double* w,
                    bool perspective, const double* v) {
-  QVec A, o;
-  Q w0 = w != nullptr ? Q(w[0]) : Q(0);
-  if (!centre_offset(a, b, c, d, w, A, o)) {
-    // Flat tet: a point sphere at the centroid (see spheres.hpp).
-    QVec sum = add(add(qv(a), qv(b)), add(qv(c), qv(d)));
-    QVec cen = scale(sum, Q(1, 4));
-    A = cen;
-    o = QVec{Q(0), Q(0), Q(0)};
-    w0 = Q(0);
+  Impl& k = *impl_;
+  for (int i = 0; i < 3; ++i) {
+    k.p[0][i] = a[i];
+    k.p[1][i] = b[i];
+    k.p[2][i] = c[i];
+    k.p[3][i] = d[i];
+    k.v[i] = v[i];
   }
-  QVec V = qv(v);
+  k.weighted = w != nullptr;
+  for (int i = 0; i < 4; ++i) k.w[i] = w != nullptr ? w[i] : 0;
+  k.perspective = perspective;
+  k.exact = false;
+  CGAL::Protect_FPU_rounding<true> upward;
+  k.filtered = interval_key(a, b, c, d, w, perspective, v, k.first_i, k.second_i);
+}
+
+// The formulas of interval_key over the common denominator det: with o = num / (2 det),
+// perspective |p-a|^2 - 2 (p-a).o + w0 = (|p-a|^2 det - (p-a).num + w0 det) / det; orthographic
+// (a + o).v = (2 det a.v + num.v) / (2 det) and |a|^2 + 2 a.o + w0 = (|a|^2 det + a.num + w0 det) / det.
+// A flat tet is a point sphere at its centroid g = sum / 4 (see spheres.hpp), without weight.
+void PowerKey::Impl::make_exact() {
+  if (exact) return;
+  exact = true;
+  const ZVec A = zv(p[0]), B = zsub(zv(p[1]), A), C = zsub(zv(p[2]), A), D = zsub(zv(p[3]), A), V = zv(v);
+  const Z det = zdot(B, zcross(C, D));
+  if (CGAL::is_zero(det)) {
+    const ZVec sum = zadd(zadd(A, zv(p[1])), zadd(zv(p[2]), zv(p[3])));
+    if (perspective) {
+      const ZVec d4 = zsub(zscale(V, Z(4)), sum);  // 4 (p - g)
+      first = fraction(zdot(d4, d4), Z(16));
+      second = fraction(Z(0), Z(1));
+    } else {
+      first = fraction(zdot(sum, V), Z(4));
+      second = fraction(zdot(sum, sum), Z(16));
+    }
+    return;
+  }
+  Z lb = zdot(B, B), lc = zdot(C, C), ld = zdot(D, D), w0(0);
+  if (weighted) {
+    w0 = Z(w[0]);
+    lb = lb - Z(w[1]) + w0;
+    lc = lc - Z(w[2]) + w0;
+    ld = ld - Z(w[3]) + w0;
+  }
+  const ZVec num = zadd(zadd(zscale(zcross(C, D), lb), zscale(zcross(D, B), lc)), zscale(zcross(B, C), ld));
   if (perspective) {
-    QVec pa = sub(V, A);
-    impl_->first = dot(pa, pa) - Q(2) * dot(pa, o) + w0;  // |p-c|^2 - R^2
-    impl_->second = Q(0);
+    const ZVec pa = zsub(V, A);
+    first = fraction(zdot(pa, pa) * det - zdot(pa, num) + w0 * det, det);
+    second = fraction(Z(0), Z(1));
   } else {
-    QVec cc = add(A, o);
-    impl_->first = dot(cc, V);
-    impl_->second = dot(A, A) + Q(2) * dot(A, o) + w0;
+    first = fraction(Z(2) * det * zdot(A, V) + zdot(num, V), Z(2) * det);
+    second = fraction(zdot(A, A) * det + zdot(A, num) + w0 * det, det);
   }
 }
 
 int PowerKey::compare(const PowerKey& other) const {
-  if (impl_->first < other.impl_->first) return -1;
-  if (other.impl_->first < impl_->first) return 1;
-  if (impl_->second < other.impl_->second) return -1;
-  if (other.impl_->second < impl_->second) return 1;
-  return 0;
+  Impl &x = *impl_, &y = *other.impl_;
+  if (x.filtered && y.filtered) {
+    int c = interval_compare(x.first_i, y.first_i);
+    if (c == 0) c = interval_compare(x.second_i, y.second_i);
+    if (c != 2) return c;
+  }
+  x.make_exact();
+  y.make_exact();
+  const int c = compare_fractions(x.first, y.first);
+  return c != 0 ? c : compare_fractions(x.second, y.second);
 }
 
 }  // namespace foxi::exact
