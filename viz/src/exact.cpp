@@ -5,6 +5,8 @@
 #include <CGAL/Gmpzf.h>
 #include <CGAL/Interval_nt.h>
 
+#include <type_traits>
+
 namespace foxi::exact {
 
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
@@ -14,17 +16,37 @@ namespace {
 
 K::Point_3 pt(const double* p) { return K::Point_3(p[0], p[1], p[2]); }
 
-struct QVec {
-  Q x, y, z;
+// 3-vectors over the number types below: rationals, intervals, exact binary floats.
+template <class T>
+struct V3 {
+  T x, y, z;
 };
-QVec qv(const double* p) { return {Q(p[0]), Q(p[1]), Q(p[2])}; }
-QVec sub(const QVec& a, const QVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-QVec cross(const QVec& a, const QVec& b) {
+template <class T>
+V3<T> vec(const double* p) {
+  return {T(p[0]), T(p[1]), T(p[2])};
+}
+template <class T>
+V3<T> sub(const V3<T>& a, const V3<T>& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class T>
+V3<T> add(const V3<T>& a, const V3<T>& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class T>
+V3<T> cross(const V3<T>& a, const V3<T>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-Q dot(const QVec& a, const QVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-QVec scale(const QVec& a, const Q& s) { return {a.x * s, a.y * s, a.z * s}; }
-QVec add(const QVec& a, const QVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+template <class T>
+T dot(const V3<T>& a, const V3<T>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+template <class T>
+V3<T> scale(const V3<T>& a, const std::type_identity_t<T>& s) {  // s may be an expression template
+  return {a.x * s, a.y * s, a.z * s};
+}
+using QVec = V3<Q>;
+QVec qv(const double* p) { return vec<Q>(p); }
 
 // Exact centre offset o (relative to a) of the tet; false if flat.
 bool centre_offset(const double* a, const double* b, const double* c, const double* d, const double* w,
@@ -98,38 +120,31 @@ namespace {
 // PowerKey's exact ones. False when the tet's determinant may be zero (the exact path decides
 // whether it is flat).
 using I = CGAL::Interval_nt<false>;
-struct IVec {
-  I x, y, z;
-};
-IVec iv(const double* p) { return {I(p[0]), I(p[1]), I(p[2])}; }
-IVec isub(const IVec& a, const IVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-IVec iadd(const IVec& a, const IVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-IVec iscale(const IVec& a, const I& s) { return {a.x * s, a.y * s, a.z * s}; }
-IVec icross(const IVec& a, const IVec& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-I idot(const IVec& a, const IVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+using IVec = V3<I>;
+IVec iv(const double* p) { return vec<I>(p); }
 
 bool interval_key(const double* a, const double* b, const double* c, const double* d, const double* w,
                   bool perspective, const double* v, I& first, I& second) {
-  const IVec A = iv(a), B = isub(iv(b), A), C = isub(iv(c), A), D = isub(iv(d), A);
-  const I det = idot(B, icross(C, D));
+  const IVec A = iv(a), B = sub(iv(b), A), C = sub(iv(c), A), D = sub(iv(d), A);
+  const I det = dot(B, cross(C, D));
   if (!(det.inf() > 0 || det.sup() < 0)) return false;
-  I lb = idot(B, B), lc = idot(C, C), ld = idot(D, D), w0(0);
+  I lb = dot(B, B), lc = dot(C, C), ld = dot(D, D), w0(0);
   if (w != nullptr) {
     w0 = I(w[0]);
     lb = lb - I(w[1]) + w0;
     lc = lc - I(w[2]) + w0;
     ld = ld - I(w[3]) + w0;
   }
-  const IVec num = iadd(iadd(iscale(icross(C, D), lb), iscale(icross(D, B), lc)), iscale(icross(B, C), ld));
-  const IVec o = iscale(num, I(1) / (I(2) * det));
+  const IVec num = add(add(scale(cross(C, D), lb), scale(cross(D, B), lc)), scale(cross(B, C), ld));
+  const IVec o = scale(num, I(1) / (I(2) * det));
   const IVec V = iv(v);
   if (perspective) {
-    const IVec pa = isub(V, A);
-    first = idot(pa, pa) - I(2) * idot(pa, o) + w0;
+    const IVec pa = sub(V, A);
+    first = dot(pa, pa) - I(2) * dot(pa, o) + w0;
     second = I(0);
   } else {
-    first = idot(iadd(A, o), V);
-    second = idot(A, A) + I(2) * idot(A, o) + w0;
+    first = dot(add(A, o), V);
+    second = dot(A, A) + I(2) * dot(A, o) + w0;
   }
   return true;
 }
@@ -149,16 +164,9 @@ int interval_compare(const I& a, const I& b) {
 // the ball) is the key computed exactly, as a fraction n / d of exact binary floats (Gmpzf: products
 // and sums without the gcds of rationals, which made a bga view 2 us per tet).
 using Z = CGAL::Gmpzf;
-struct ZVec {
-  Z x, y, z;
-};
+using ZVec = V3<Z>;
 namespace {
-ZVec zv(const double* p) { return {Z(p[0]), Z(p[1]), Z(p[2])}; }
-ZVec zsub(const ZVec& a, const ZVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-ZVec zadd(const ZVec& a, const ZVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-ZVec zscale(const ZVec& a, const Z& s) { return {a.x * s, a.y * s, a.z * s}; }
-ZVec zcross(const ZVec& a, const ZVec& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-Z zdot(const ZVec& a, const ZVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+ZVec zv(const double* p) { return vec<Z>(p); }
 
 // n / d with d > 0.
 struct Fraction {
@@ -218,35 +226,35 @@ void PowerKey::set(const double* a, const double* b, const double* c, const doub
 void PowerKey::Impl::make_exact() {
   if (exact) return;
   exact = true;
-  const ZVec A = zv(p[0]), B = zsub(zv(p[1]), A), C = zsub(zv(p[2]), A), D = zsub(zv(p[3]), A), V = zv(v);
-  const Z det = zdot(B, zcross(C, D));
+  const ZVec A = zv(p[0]), B = sub(zv(p[1]), A), C = sub(zv(p[2]), A), D = sub(zv(p[3]), A), V = zv(v);
+  const Z det = dot(B, cross(C, D));
   if (CGAL::is_zero(det)) {
-    const ZVec sum = zadd(zadd(A, zv(p[1])), zadd(zv(p[2]), zv(p[3])));
+    const ZVec sum = add(add(A, zv(p[1])), add(zv(p[2]), zv(p[3])));
     if (perspective) {
-      const ZVec d4 = zsub(zscale(V, Z(4)), sum);  // 4 (p - g)
-      first = fraction(zdot(d4, d4), Z(16));
+      const ZVec d4 = sub(scale(V, Z(4)), sum);  // 4 (p - g)
+      first = fraction(dot(d4, d4), Z(16));
       second = fraction(Z(0), Z(1));
     } else {
-      first = fraction(zdot(sum, V), Z(4));
-      second = fraction(zdot(sum, sum), Z(16));
+      first = fraction(dot(sum, V), Z(4));
+      second = fraction(dot(sum, sum), Z(16));
     }
     return;
   }
-  Z lb = zdot(B, B), lc = zdot(C, C), ld = zdot(D, D), w0(0);
+  Z lb = dot(B, B), lc = dot(C, C), ld = dot(D, D), w0(0);
   if (weighted) {
     w0 = Z(w[0]);
     lb = lb - Z(w[1]) + w0;
     lc = lc - Z(w[2]) + w0;
     ld = ld - Z(w[3]) + w0;
   }
-  const ZVec num = zadd(zadd(zscale(zcross(C, D), lb), zscale(zcross(D, B), lc)), zscale(zcross(B, C), ld));
+  const ZVec num = add(add(scale(cross(C, D), lb), scale(cross(D, B), lc)), scale(cross(B, C), ld));
   if (perspective) {
-    const ZVec pa = zsub(V, A);
-    first = fraction(zdot(pa, pa) * det - zdot(pa, num) + w0 * det, det);
+    const ZVec pa = sub(V, A);
+    first = fraction(dot(pa, pa) * det - dot(pa, num) + w0 * det, det);
     second = fraction(Z(0), Z(1));
   } else {
-    first = fraction(Z(2) * det * zdot(A, V) + zdot(num, V), Z(2) * det);
-    second = fraction(zdot(A, A) * det + zdot(A, num) + w0 * det, det);
+    first = fraction(Z(2) * det * dot(A, V) + dot(num, V), Z(2) * det);
+    second = fraction(dot(A, A) * det + dot(A, num) + w0 * det, det);
   }
 }
 
