@@ -301,17 +301,23 @@ struct TetRasterizer::Impl {
   std::vector<std::uint64_t> shown;
   std::vector<std::uint32_t> slot, before_rgba, before_id;
   std::vector<std::uint8_t> need_save;  // per batch tet
-  // Per undraw() call, per undrawn tet (in drawing order): what the walk over its rows needs, found
-  // up front on both threads, where the lookups of consecutive tets (scattered over the mesh's
-  // arrays) overlap, rather than in the walk, where each thread would wait for them in turn.
+  // Undoable: each drawn tet's pixel box (tet_box, in drawing order, 8 bytes), so that undraw finds
+  // the undrawn tets hidden behind farther undrawn ones (most of them) without reading the mesh.
+  struct SmallBox {
+    std::int16_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+  };
+  std::vector<SmallBox> drawn_box;
+  // What undraw's walk needs of an undrawn tet that shows (gather_undrawn, shade_repainted): the
+  // walk fetches it a few tets ahead (see undraw_part), so the mesh's scattered arrays are read only
+  // for the tets that show, their lookups overlapping.
   struct UndrawTet {
     Box box;                         // as tet_box; y0 < 0: cut by the near plane (walked the slow way)
     std::int32_t X[4], Y[4];         // fixed-point corners (box.y0 >= 0)
+    std::uint32_t node[4];           // the tet's nodes (box.y0 >= 0)
     std::uint8_t repaint = 0;        // bit f: back face f is shared with a kept tet (box.y0 >= 0)
     std::uint32_t neighbour[4];      // repaint face f: that tet's face (4 tet + face)
     FaceShade shade[4];              // repaint face f: that tet's front face's flat colour
   };
-  std::vector<UndrawTet> undrawn;
   PixelRect changed;  // see changed_rect
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
@@ -328,6 +334,8 @@ struct TetRasterizer::Impl {
     use_mask = reverse;
     if (params.undoable) {
       if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
+      if (w > 32767 || h > 32767)
+        throw std::invalid_argument("render: undoable drawing needs an image at most 32767 pixels wide and high");
       adjacency = &face_adjacency(m);
       drawn_at.assign(m.tet_count(), 0);
       kept.assign((m.tet_count() + 63) / 64, 0);
@@ -450,15 +458,32 @@ struct TetRasterizer::Impl {
     project_camera(c, X, Y, st);
   }
 
-  // The flat shade of tet `tet`'s face whose corners are `v` (camera frame) in outward order: its
-  // region's colour, Lambert + ambient.
-  FaceShade face_shade(std::uint32_t tet, const double* const v[3]) const {
-    double u[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
-    double w[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
+  // The flat shade of tet `tet`'s face whose corners are `v` (camera frame) in outward order, node[j]
+  // the node of v[j]: its region's colour, Lambert + ambient. The normal is computed from the corners
+  // in ascending node order (its sign from the permutation's parity), so the two tets sharing a face
+  // get the same bits, each side with its sign: undraw shades a kept neighbour's face from the
+  // undrawn tet's own corners, as drawing the neighbour did.
+  FaceShade face_shade(std::uint32_t tet, const double* const v[3], const std::uint32_t node[3]) const {
+    int s0 = 0, s1 = 1, s2 = 2;
+    bool odd = false;
+    auto swap_if = [&](int& i, int& j) {
+      if (node[i] > node[j]) {
+        std::swap(i, j);
+        odd = !odd;
+      }
+    };
+    swap_if(s0, s1);
+    swap_if(s1, s2);
+    swap_if(s0, s1);
+    const double *p0 = v[s0], *p1 = v[s1], *p2 = v[s2];
+    double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
     double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     double len = std::sqrt(nc[0] * nc[0] + nc[1] * nc[1] + nc[2] * nc[2]);
-    // The camera frame is a mirror of the world: the outward normal is -nc there.
+    // The camera frame is a mirror of the world: the outward normal is -nc there (+nc for an odd
+    // permutation of the outward order).
     double lambert = len > 0 ? -(nc[0] * light[0] + nc[1] * light[1] + nc[2] * light[2]) / len : 0;
+    if (odd) lambert = -lambert;
     double intensity = params.ambient + (1 - params.ambient) * std::max(0.0, lambert);
     intensity = std::clamp(intensity, 0.0, 1.0);
     const std::int32_t region = mesh->region_of(tet);
@@ -474,10 +499,10 @@ struct TetRasterizer::Impl {
   }
 
   // Shading and edge lines of a face; `v` = the face's three corners (camera frame)
-  // in outward order; poly = the polygon to draw (positive area), n its size.
-  void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const PolyVertex* poly,
-                  int n) const {
-    setup_face(fs, tet, face_shade(tet, v), poly, n);
+  // in outward order, node their nodes; poly = the polygon to draw (positive area), n its size.
+  void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const std::uint32_t node[3],
+                  const PolyVertex* poly, int n) const {
+    setup_face(fs, tet, face_shade(tet, v, node), poly, n);
   }
 
   // The same with the shade known.
@@ -1012,15 +1037,16 @@ struct TetRasterizer::Impl {
       if (n == 0) continue;
       const auto& face = kFace[f];
       const double* v[3] = {c[face[0]], c[face[1]], c[face[2]]};
-      draw_face(fb, rows, t, v, poly, n, !clipped);
+      const std::uint32_t node[3] = {k.tv[face[0]], k.tv[face[1]], k.tv[face[2]]};
+      draw_face(fb, rows, t, v, node, poly, n, !clipped);
     }
   }
 
   // Draws front face polygon `poly` (n vertices, positive area, from face_polygon) of tet t, whose
-  // corners are v (camera frame, outward order), into the rows of `rows`. test_hidden (a triangle):
-  // first test its pixel box against the mask, skipping it if hidden.
+  // corners are v (camera frame, outward order; nodes `node`), into the rows of `rows`. test_hidden
+  // (a triangle): first test its pixel box against the mask, skipping it if hidden.
   void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
-                 const PolyVertex* poly, int n, bool test_hidden) {
+                 const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden) {
     if (use_mask && test_hidden) {  // hidden behind what this batch drew already?
       const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
                                 std::max({poly[0].X, poly[1].X, poly[2].X}),
@@ -1029,7 +1055,7 @@ struct TetRasterizer::Impl {
       if (box.x0 > box.x1 || box_written(rows, box, fb.height)) return;
     }
     FaceSetup fs;
-    setup_face(fs, t, v, poly, n);
+    setup_face(fs, t, v, node, poly, n);
     raster_polygon(fb, rows, fs, poly, n);
   }
 
@@ -1067,6 +1093,7 @@ struct TetRasterizer::Impl {
       drawn_at[tets[i]] = std::uint32_t(start + i);
     }
     history.insert(history.end(), tets.begin(), tets.end());
+    drawn_box.resize(history.size(), SmallBox{0, 0, -1, -1});  // "unknown" until draw_batch finds them
     for (Lane& lane : lanes) lane.regions.push_back(SaveRegion{lane.saves.size(), lane.saved_pixel.size()});
     recording = true;
     try {
@@ -1164,6 +1191,12 @@ struct TetRasterizer::Impl {
     } else {
       const std::size_t half = tets.size() / 2;
       run_parts(2, [&](int k) { k == 0 ? find_boxes(0, half) : find_boxes(half, tets.size()); });
+    }
+    if (recording) {  // the batch is the end of the history
+      SmallBox* kept_box = drawn_box.data() + (drawn_box.size() - tets.size());
+      for (std::size_t i = 0; i < tets.size(); ++i)
+        kept_box[i] = SmallBox{std::int16_t(boxes[i].x0), std::int16_t(boxes[i].x1), std::int16_t(boxes[i].y0),
+                               std::int16_t(boxes[i].y1)};
     }
     if (!spawn) {
       for (int k = 0; k < count; ++k) work(k);
@@ -1307,6 +1340,7 @@ struct TetRasterizer::Impl {
     for (int j = 0; j < 4; ++j) {
       u.X[j] = std::int32_t(k.X[j]);
       u.Y[j] = std::int32_t(k.Y[j]);
+      u.node[j] = k.tv[j];
     }
     for (int f = 0; f < 4; ++f) {
       const std::uint32_t nb = kept_neighbour(t, f);
@@ -1318,29 +1352,17 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // The shades of u's repainted faces: each the kept neighbour's front face, shaded from the
-  // neighbour's own corner order, bit for bit as drawing it did.
+  // The shades of u's repainted faces: each the kept neighbour's front face, which is u's face seen
+  // from the other side (u's corners in reverse outward order), shaded bit for bit as drawing the
+  // neighbour did (see face_shade).
   void shade_repainted(UndrawTet& u) const {
     for (int f = 0; f < 4; ++f) {
       if (!(u.repaint >> f & 1)) continue;
-      const std::uint32_t nb = u.neighbour[f];
-      const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
-      const auto& face = kFace[nb & 3];
-      const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
-                            &cam[3 * std::size_t(nv[face[2]])]};
-      u.shade[f] = face_shade(nb >> 2, v);
-    }
-  }
-
-  // Hints the cache about what shade_repainted(u) reads.
-  void prefetch_repainted(const UndrawTet& u, std::uint32_t t) const {
-    if (u.repaint == 0) return;
-    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
-    for (int j = 0; j < 4; ++j) __builtin_prefetch(&cam[3 * std::size_t(tv[j])]);  // the faces' corners
-    for (int f = 0; f < 4; ++f) {
-      if (!(u.repaint >> f & 1)) continue;
-      __builtin_prefetch(&mesh->tet[4 * std::size_t(u.neighbour[f] >> 2)]);
-      if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[u.neighbour[f] >> 2]);
+      const int a = kFace[f][0], b = kFace[f][2], d = kFace[f][1];  // reversed
+      const double* v[3] = {&cam[3 * std::size_t(u.node[a])], &cam[3 * std::size_t(u.node[b])],
+                            &cam[3 * std::size_t(u.node[d])]};
+      const std::uint32_t node[3] = {u.node[a], u.node[b], u.node[d]};
+      u.shade[f] = face_shade(u.neighbour[f] >> 2, v, node);
     }
   }
 
@@ -1381,28 +1403,12 @@ struct TetRasterizer::Impl {
                          lane.saves.begin());
     };
     boxes.resize(count);
-    undrawn.resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      const SmallBox& b = drawn_box[first + i];
+      boxes[i] = Box{b.x0, b.x1, b.y0, b.y1};
+    }
     // The undrawn tets are no longer kept.
     for (std::size_t i = first; i < history.size(); ++i) kept[history[i] >> 6] &= ~(std::uint64_t(1) << (history[i] & 63));
-    auto find_boxes = [&](std::size_t begin, std::size_t end) {
-      // The undrawn tets lie all over the mesh's arrays: one pass over the tets and their neighbours'
-      // marks, then one over the few faces to repaint, each hinting the cache well ahead.
-      constexpr std::size_t kAhead = 16;
-      for (std::size_t i = begin; i < end; ++i) {
-        if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(history[first + i + 2 * kAhead])]);
-        if (i + kAhead < end) {
-          const std::uint32_t ahead = history[first + i + kAhead];
-          prefetch_tet(ahead);
-          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(ahead)]);
-        }
-        gather_undrawn(history[first + i], fb.width, fb.height, undrawn[i]);
-        boxes[i] = undrawn[i].box;
-      }
-      for (std::size_t i = begin; i < end; ++i) {
-        if (i + kAhead < end) prefetch_repainted(undrawn[i + kAhead], history[first + i + kAhead]);
-        shade_repainted(undrawn[i]);
-      }
-    };
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
     auto work = [&](const std::vector<int>& split, int k) {
@@ -1411,10 +1417,45 @@ struct TetRasterizer::Impl {
                           p_hi = std::uint32_t(rows.hi + 1) * std::uint32_t(fb.width);
       std::vector<std::size_t> save(lanes.size());
       for (std::size_t l = 0; l < lanes.size(); ++l) save[l] = first_save(lanes[l]);
+      // Tet j may show in these rows (known kFar tets ahead: a tet hidden then stays hidden, the mask
+      // only grows); its mesh rows are fetched then, its nodes' positions and shades' inputs kNear
+      // tets ahead, so that the walk finds them in the cache.
+      constexpr std::size_t kFar = 24, kNear = 12, kRing = 32;
+      bool may_show[kRing];
+      auto look_far = [&](std::size_t j) {
+        const Box& b = boxes[j];
+        const bool may = b.x0 <= b.x1 && b.y0 >= 0 && rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height);
+        may_show[j % kRing] = may;
+        if (!may) return;
+        const std::uint32_t t = history[first + j];
+        __builtin_prefetch(&mesh->tet[4 * std::size_t(t)]);
+        __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(t)]);
+      };
+      auto look_near = [&](std::size_t j) {
+        if (!may_show[j % kRing]) return;
+        const std::uint32_t t = history[first + j];
+        const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+        const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(t)];
+        bool repaints = false;
+        for (int f = 0; f < 4; ++f) {
+          if (nb[f] == kNone || !is_kept(nb[f] >> 2)) continue;
+          repaints = true;
+          if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
+        }
+        for (int c = 0; c < 4; ++c) {
+          __builtin_prefetch(&fix[tv[c]]);
+          if (repaints) __builtin_prefetch(&cam[3 * std::size_t(tv[c])]);
+        }
+      };
+      for (std::size_t j = 0; j < std::min(count, kFar); ++j) look_far(j);
+      for (std::size_t j = 0; j < std::min(count, kNear); ++j) look_near(j);
       for (std::size_t i = 0; i < count; ++i) {
+        if (i + kFar < count) look_far(i + kFar);
+        if (i + kNear < count) look_near(i + kNear);
         const std::uint32_t t = history[first + i];
         const Box& b = boxes[i];
-        const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || (rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height)));
+        const bool shows =
+            b.x0 <= b.x1 && (b.y0 < 0 || (may_show[i % kRing] && !box_written(rows, b, fb.height)));
         for (std::size_t l = 0; l < lanes.size(); ++l) {
           const Lane& lane = lanes[l];
           if (save[l] >= lane.saves.size() || lane.saves[save[l]].at != first + i) continue;
@@ -1434,8 +1475,10 @@ struct TetRasterizer::Impl {
           }
         }
         if (!shows) continue;
-        const UndrawTet& u = undrawn[i];
         if (b.y0 >= 0) {
+          UndrawTet u;
+          gather_undrawn(t, fb.width, fb.height, u);
+          shade_repainted(u);
           // Each back face shared with a kept tet is repainted as that tet's front face: the same
           // polygon (face_polygon's back order), in its colour. One shared with an earlier tet of the
           // batch is already written: that tet, met before t in this walk, wrote every pixel of its
@@ -1459,23 +1502,23 @@ struct TetRasterizer::Impl {
           if (nb == kNone) return;
           const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
           const auto& face = kFace[nb & 3];
-          const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
-                                &cam[3 * std::size_t(nv[face[2]])]};
-          draw_face(fb, rows, nb >> 2, v, poly, n, false);
+          const std::uint32_t node[3] = {nv[face[0]], nv[face[1]], nv[face[2]]};
+          const double* v[3] = {&cam[3 * std::size_t(node[0])], &cam[3 * std::size_t(node[1])],
+                                &cam[3 * std::size_t(node[2])]};
+          draw_face(fb, rows, nb >> 2, v, node, poly, n, false);
         });
       }
     };
     const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
     if (threads == 1) {
-      find_boxes(0, count);
       work({0, fb.height}, 0);
     } else {
-      run_parts(2, [&](int k) { k == 0 ? find_boxes(0, count / 2) : find_boxes(count / 2, count); });
       const std::vector<int> split = split_rows(count, threads, fb.height);
       run_parts(threads, [&](int k) { work(split, k); });
     }
     clear_mask(count);
     history.resize(first);
+    drawn_box.resize(first);
     for (Lane& lane : lanes) {
       lane.saves.resize(first_save(lane));
       while (!lane.regions.empty() && lane.regions.back().first_save >= lane.saves.size()) {
@@ -1535,6 +1578,7 @@ struct TetRasterizer::Impl {
   void forget() {
     std::fill(kept.begin(), kept.end(), 0);
     history.clear();
+    drawn_box.clear();
     for (Lane& lane : lanes) lane = Lane{};
   }
 
@@ -1549,7 +1593,7 @@ struct TetRasterizer::Impl {
                          before_id.capacity()) *
                             sizeof(std::uint32_t) +
                         (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t) +
-                        undrawn.capacity() * sizeof(UndrawTet);
+                        drawn_box.capacity() * sizeof(SmallBox);
     for (const Lane& lane : lanes)
       bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
                    sizeof(std::uint32_t) +
