@@ -1402,13 +1402,29 @@ struct TetRasterizer::Impl {
                                           [](const Save& s, std::size_t at) { return s.at < at; }) -
                          lane.saves.begin());
     };
+    // One pass over the undrawn tets: they are no longer kept; their boxes, the rectangle they may
+    // change (changed_rect, the whole image if the near plane cuts one) and their work per band of
+    // rows (for the threads' split, see split_rows).
+    const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
+    std::vector<double> band_work(threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
     boxes.resize(count);
+    PixelRect rect{fb.width, fb.height, -1, -1};
+    bool unknown = false;
     for (std::size_t i = 0; i < count; ++i) {
-      const SmallBox& b = drawn_box[first + i];
-      boxes[i] = Box{b.x0, b.x1, b.y0, b.y1};
+      const std::uint32_t t = history[first + i];
+      kept[t >> 6] &= ~(std::uint64_t(1) << (t & 63));
+      const SmallBox& small = drawn_box[first + i];
+      const Box b{small.x0, small.x1, small.y0, small.y1};
+      boxes[i] = b;
+      if (b.x0 > b.x1) continue;
+      if (b.y0 < 0) {
+        unknown = true;
+        continue;
+      }
+      rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1), std::max(rect.y1, b.y1)};
+      if (threads > 1) add_band_work(band_work, b);
     }
-    // The undrawn tets are no longer kept.
-    for (std::size_t i = first; i < history.size(); ++i) kept[history[i] >> 6] &= ~(std::uint64_t(1) << (history[i] & 63));
+    changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
     auto work = [&](const std::vector<int>& split, int k) {
@@ -1417,9 +1433,10 @@ struct TetRasterizer::Impl {
                           p_hi = std::uint32_t(rows.hi + 1) * std::uint32_t(fb.width);
       std::vector<std::size_t> save(lanes.size());
       for (std::size_t l = 0; l < lanes.size(); ++l) save[l] = first_save(lanes[l]);
-      // Tet j may show in these rows (known kFar tets ahead: a tet hidden then stays hidden, the mask
-      // only grows); its mesh rows are fetched then, its nodes' positions and shades' inputs kNear
-      // tets ahead, so that the walk finds them in the cache.
+      // Whether tet j may show in these rows is decided kFar tets ahead (a tet hidden then stays
+      // hidden, the mask only grows; one that shows then but is hidden when met writes nothing, the
+      // mask holding its pixels): its mesh rows are fetched then, its nodes' positions and shades'
+      // inputs kNear tets ahead, so that the walk finds them in the cache.
       constexpr std::size_t kFar = 24, kNear = 12, kRing = 32;
       bool may_show[kRing];
       auto look_far = [&](std::size_t j) {
@@ -1454,8 +1471,7 @@ struct TetRasterizer::Impl {
         if (i + kNear < count) look_near(i + kNear);
         const std::uint32_t t = history[first + i];
         const Box& b = boxes[i];
-        const bool shows =
-            b.x0 <= b.x1 && (b.y0 < 0 || (may_show[i % kRing] && !box_written(rows, b, fb.height)));
+        const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || may_show[i % kRing]);
         for (std::size_t l = 0; l < lanes.size(); ++l) {
           const Lane& lane = lanes[l];
           if (save[l] >= lane.saves.size() || lane.saves[save[l]].at != first + i) continue;
@@ -1508,15 +1524,21 @@ struct TetRasterizer::Impl {
           draw_face(fb, rows, nb >> 2, v, node, poly, n, false);
         });
       }
+      // The mask back to zero on the changed rows of these rows (whole bands: their tiles too).
+      const int y0 = std::max(rows.lo, changed.y0), y1 = std::min(rows.hi, changed.y1);
+      if (y0 > y1) return;
+      const std::size_t words = std::size_t(mask_words);
+      std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
+                written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
+      std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
+                tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
     };
-    const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
     if (threads == 1) {
       work({0, fb.height}, 0);
     } else {
-      const std::vector<int> split = split_rows(count, threads, fb.height);
+      const std::vector<int> split = split_rows(band_work, threads, fb.height);
       run_parts(threads, [&](int k) { work(split, k); });
     }
-    clear_mask(count);
     history.resize(first);
     drawn_box.resize(first);
     for (Lane& lane : lanes) {
@@ -1530,27 +1552,20 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // Row ranges for `parts` threads undrawing the first n boxes: split[k] to split[k + 1] - 1 for
-  // thread k, whole bands of 16 rows (a thread's mask tiles are its own), of about equal work, each
-  // box counting its width plus a per-row cost on each of its rows (a box cut by the near plane,
-  // unknown, counts on none). Contiguous ranges, not interleaved bands: a tet is a few bands tall,
-  // and each thread whose rows it touches pays its setup.
-  std::vector<int> split_rows(std::size_t n, int parts, int height) const {
-    const int bands = (height + (1 << kBandShift) - 1) >> kBandShift;
-    std::vector<double> work(std::size_t(bands) + 1, 0.0);  // per band, as differences
-    constexpr double kRowCost = 16;  // pixels' worth of per-row setup
-    for (std::size_t i = 0; i < n; ++i) {
-      const Box& b = boxes[i];
-      if (b.x0 > b.x1 || b.y0 < 0) continue;
-      const double per_row = double(b.x1 - b.x0 + 1) + kRowCost;
-      // Spread over the bands the box touches, each by its rows in it (as a rate per band).
-      const int b0 = b.y0 >> kBandShift, b1 = b.y1 >> kBandShift;
-      work[std::size_t(b0)] += per_row * double(std::min(b.y1, ((b0 + 1) << kBandShift) - 1) - b.y0 + 1);
-      if (b1 > b0) {
-        work[std::size_t(b1)] += per_row * double(b.y1 - (b1 << kBandShift) + 1);
-        for (int band = b0 + 1; band < b1; ++band) work[std::size_t(band)] += per_row * double(1 << kBandShift);
-      }
-    }
+  // Adds box b's undraw work to `work` (per band of 16 rows): its width plus a per-row cost, times its
+  // rows, all on the band of its middle row (a box is a few bands tall at most where it matters: the
+  // split need only be about even).
+  static void add_band_work(std::vector<double>& work, const Box& b) {
+    constexpr int kRowCost = 16;  // pixels' worth of per-row setup
+    work[std::size_t(((b.y0 + b.y1) >> 1) >> kBandShift)] += double((b.x1 - b.x0 + 1 + kRowCost) * (b.y1 - b.y0 + 1));
+  }
+
+  // Row ranges for `parts` threads undrawing, from their work per band (add_band_work; a box cut by
+  // the near plane, unknown, counts on none): split[k] to split[k + 1] - 1 for thread k, whole bands
+  // of 16 rows (a thread's mask tiles are its own), of about equal work. Contiguous ranges, not
+  // interleaved bands: a tet is a few bands tall, and each thread whose rows it touches pays its setup.
+  static std::vector<int> split_rows(const std::vector<double>& work, int parts, int height) {
+    const int bands = int(work.size());
     double total = 0;
     for (double w : work) total += w;
     std::vector<int> split(std::size_t(parts) + 1, height);
