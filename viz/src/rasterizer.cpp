@@ -1222,17 +1222,23 @@ struct TetRasterizer::Impl {
     return r.x0 <= r.x1 ? r : PixelRect{};
   }
 
+  // Zeroes the written-pixel mask on rows y0 to y1 (y0 <= y1) and the tiles of their bands.
+  void zero_mask(int y0, int y1) {
+    const std::size_t words = std::size_t(mask_words);
+    std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
+              written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
+    std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
+              tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
+  }
+
   // Zeroes the written-pixel mask (and while recording, `shown`) on the rows the batch's boxes span;
   // `changed` becomes their union.
   void clear_mask(std::size_t n) {
     changed = boxes_union(n);
     const int y0 = changed.y0, y1 = changed.y1;
     if (y0 > y1) return;
+    zero_mask(y0, y1);
     const std::size_t words = std::size_t(mask_words);
-    std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
-              written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
-    std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
-              tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
     if (recording)  // else all zero
       std::fill(shown.begin() + std::ptrdiff_t(std::size_t(y0) * words),
                 shown.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
@@ -1526,12 +1532,7 @@ struct TetRasterizer::Impl {
       }
       // The mask back to zero on the changed rows of these rows (whole bands: their tiles too).
       const int y0 = std::max(rows.lo, changed.y0), y1 = std::min(rows.hi, changed.y1);
-      if (y0 > y1) return;
-      const std::size_t words = std::size_t(mask_words);
-      std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
-                written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
-      std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
-                tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
+      if (y0 <= y1) zero_mask(y0, y1);
     };
     if (threads == 1) {
       work({0, fb.height}, 0);
