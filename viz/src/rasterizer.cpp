@@ -699,8 +699,62 @@ struct TetRasterizer::Impl {
   // least edge_width from every edge line, each other pixel shaded as face_color does, stepping the
   // edge functions along the row. The flat part is solved for in floating point, narrowed by a
   // pixel, and checked exactly at its ends (the distance to each line is monotone along the row), so
-  // every pixel gets exactly face_color's colour whatever the run.
-  void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+  // every pixel gets exactly face_color's colour whatever the run. Runs of 12 pixels or fewer (most
+  // runs of a fine mesh's faces) are not worth solving for: inlined here, each pixel shaded.
+  [[gnu::always_inline]] void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+    if (hi - lo >= 12 || fs.lines == 0) {
+      shade_long_span(fb, fs, y, lo, hi);
+      return;
+    }
+    std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
+    std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+    std::int64_t e[4];
+    edges_at(fs, lo, y, e);
+    edge_pixels(rgba, id, fs, e, lo, hi);
+  }
+
+  // The edge functions of fs's lines at pixel (x, y) (the padding line's is constant).
+  static void edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e) {
+    for (int k = 0; k < 3; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
+    e[3] = fs.lines > 3 ? fs.ea[3] * x + fs.eb[3] * y + fs.ec[3] : fs.ec[3];
+  }
+
+  // Pixels [from, to] of a row shaded one by one (rgba, id: the row), e: the edge functions at
+  // `from`, stepped on past `to`. The edge functions and colours are held in registers; a face of 3
+  // lines or fewer skips the fourth (padding, never the nearest).
+  [[gnu::always_inline]] void edge_pixels(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                          std::int64_t* e, int from, int to) const {
+    if (fs.lines > 3)
+      edge_pixels_of<true>(rgba, id, fs, e, from, to);
+    else
+      edge_pixels_of<false>(rgba, id, fs, e, from, to);
+  }
+  template <bool kFourLines>
+  [[gnu::always_inline]] void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                             std::int64_t* e, int from, int to) const {
+    const std::uint32_t tet = fs.tet, color = fs.color;
+    const double w = params.edge_width;
+    std::int64_t e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
+    const std::int64_t s0 = fs.ea[0], s1 = fs.ea[1], s2 = fs.ea[2], s3 = fs.ea[3];
+    for (int x = from; x <= to; ++x) {
+      const double d = kFourLines ? nearest_edge(fs, e0, e1, e2, e3)
+                                  : std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
+                                             double(e2) * fs.inv_len[2]);
+      rgba[x] = d < w ? darkened(fs, d) : color;
+      id[x] = tet;
+      e0 += s0;
+      e1 += s1;
+      e2 += s2;
+      if (kFourLines) e3 += s3;
+    }
+    e[0] = e0;
+    e[1] = e1;
+    e[2] = e2;
+    e[3] = e3;  // padding steps by 0
+  }
+
+  // shade_span's long runs (and faces without edge lines).
+  [[gnu::noinline]] void shade_long_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
     std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
     std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
     if (fs.lines == 0) {
@@ -709,74 +763,40 @@ struct TetRasterizer::Impl {
       return;
     }
     std::int64_t e[4];
-    for (int k = 0; k < 3; ++k) e[k] = fs.ea[k] * lo + fs.eb[k] * y + fs.ec[k];
-    e[3] = fs.lines > 3 ? fs.ea[3] * lo + fs.eb[3] * y + fs.ec[3] : fs.ec[3];  // padding: constant
+    edges_at(fs, lo, y, e);
     int a = lo, b = hi;  // the flat part
-    if (hi - lo >= 12) {  // short runs: not worth solving for
-      for (int k = 0; k < fs.lines && a <= b; ++k) {
-        // e_k + ea_k (x - lo) >= flat_e_k beyond x = lo + t.
-        if (fs.ea[k] == 0) {
-          if (double(e[k]) < fs.flat_e[k]) b = a - 1;
-          continue;
-        }
-        const double t = std::clamp((fs.flat_e[k] - double(e[k])) / double(fs.ea[k]), -4.0, double(hi - lo) + 4);
-        const int i = int(t);  // truncation, then floor or ceiling by one test
-        if (fs.ea[k] > 0)
-          a = std::max(a, lo + i - int(double(i) > t) + 1);
-        else
-          b = std::min(b, lo + i + int(double(i) < t) - 1);
+    for (int k = 0; k < fs.lines && a <= b; ++k) {
+      // e_k + ea_k (x - lo) >= flat_e_k beyond x = lo + t.
+      if (fs.ea[k] == 0) {
+        if (double(e[k]) < fs.flat_e[k]) b = a - 1;
+        continue;
       }
-      if (a <= b) {
-        std::int64_t ea[4], eb[4];
-        for (int k = 0; k < 4; ++k) {
-          ea[k] = e[k] + fs.ea[k] * (a - lo);
-          eb[k] = e[k] + fs.ea[k] * (b - lo);
-        }
-        if (!(nearest_edge(fs, ea[0], ea[1], ea[2], ea[3]) >= params.edge_width &&
-              nearest_edge(fs, eb[0], eb[1], eb[2], eb[3]) >= params.edge_width))
-          b = a - 1;
-      }
-    } else {
-      b = a - 1;
-    }
-    // The edge functions and colours in registers; a face of 3 lines or fewer skips the fourth
-    // (padding, never the nearest).
-    auto edge_pixels_of = [&]<bool kFourLines>(int from, int to) {
-      const std::uint32_t tet = fs.tet, color = fs.color;
-      const double w = params.edge_width;
-      std::int64_t e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
-      const std::int64_t s0 = fs.ea[0], s1 = fs.ea[1], s2 = fs.ea[2], s3 = fs.ea[3];
-      for (int x = from; x <= to; ++x) {
-        const double d = kFourLines ? nearest_edge(fs, e0, e1, e2, e3)
-                                    : std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
-                                               double(e2) * fs.inv_len[2]);
-        rgba[x] = d < w ? darkened(fs, d) : color;
-        id[x] = tet;
-        e0 += s0;
-        e1 += s1;
-        e2 += s2;
-        if (kFourLines) e3 += s3;
-      }
-      e[0] = e0;
-      e[1] = e1;
-      e[2] = e2;
-      e[3] = e3;  // padding steps by 0
-    };
-    auto edge_pixels = [&](int from, int to) {
-      if (fs.lines > 3)
-        edge_pixels_of.template operator()<true>(from, to);
+      const double t = std::clamp((fs.flat_e[k] - double(e[k])) / double(fs.ea[k]), -4.0, double(hi - lo) + 4);
+      const int i = int(t);  // truncation, then floor or ceiling by one test
+      if (fs.ea[k] > 0)
+        a = std::max(a, lo + i - int(double(i) > t) + 1);
       else
-        edge_pixels_of.template operator()<false>(from, to);
-    };
+        b = std::min(b, lo + i + int(double(i) < t) - 1);
+    }
+    if (a <= b) {
+      std::int64_t ea[4], eb[4];
+      for (int k = 0; k < 4; ++k) {
+        ea[k] = e[k] + fs.ea[k] * (a - lo);
+        eb[k] = e[k] + fs.ea[k] * (b - lo);
+      }
+      if (!(nearest_edge(fs, ea[0], ea[1], ea[2], ea[3]) >= params.edge_width &&
+            nearest_edge(fs, eb[0], eb[1], eb[2], eb[3]) >= params.edge_width))
+        b = a - 1;
+    }
     if (a > b) {  // no flat part
-      edge_pixels(lo, hi);
+      edge_pixels(rgba, id, fs, e, lo, hi);
       return;
     }
-    edge_pixels(lo, a - 1);
+    edge_pixels(rgba, id, fs, e, lo, a - 1);
     std::fill(rgba + a, rgba + b + 1, fs.color);
     std::fill(id + a, id + b + 1, fs.tet);
     for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
-    edge_pixels(b + 1, hi);
+    edge_pixels(rgba, id, fs, e, b + 1, hi);
   }
 
   // Draws a convex polygon (positive area) as a fan from vertex 0.
