@@ -206,6 +206,11 @@ struct FaceSetup {
   std::int64_t ea[4], eb[4], ec[4];
   double inv_len[4];
   double flat_e[4];  // edge_width / inv_len: a pixel with edge function >= this is not darkened by k
+  // Every edge line's function is below 2^52 in magnitude on the whole image, so a row may step it in
+  // double exactly (each value an integer that a double holds): the same bits as converting the
+  // 64-bit one at each pixel.
+  bool exact_double = false;
+  double step[4];  // ea as doubles (exact_double)
   // Depth mode, per fan triangle: nearness = w0 + da (x - x0) + db (y - y0), interpolated from the
   // snapped vertices so that faces sharing an edge agree on it exactly (up to rounding).
   double x0 = 0, y0 = 0, w0 = 0, da = 0, db = 0;
@@ -531,12 +536,17 @@ struct TetRasterizer::Impl {
         fs.flat_e[k] = params.edge_width / fs.inv_len[k];
       }
     }
+    fs.exact_double = true;
+    for (int k = 0; k < fs.lines; ++k)
+      fs.exact_double = fs.exact_double && std::abs(double(fs.ea[k])) * proj.width + std::abs(double(fs.eb[k])) * proj.height +
+                                                   std::abs(double(fs.ec[k])) < 0x1p52;
     for (int k = fs.lines; k < 4; ++k) {  // padding: far from every pixel
       fs.ea[k] = fs.eb[k] = 0;
       fs.ec[k] = std::int64_t(1) << 62;
       fs.inv_len[k] = 1;
       fs.flat_e[k] = 0;
     }
+    for (int k = 0; k < 4; ++k) fs.step[k] = double(fs.ea[k]);
   }
 
   void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
@@ -734,6 +744,13 @@ struct TetRasterizer::Impl {
                                              std::int64_t* e, int from, int to) const {
     const std::uint32_t tet = fs.tet, color = fs.color;
     const double w = params.edge_width;
+    if (fs.exact_double) {
+      double d[4] = {double(e[0]), double(e[1]), double(e[2]), kFourLines ? double(e[3]) : 0};
+      edge_pixels_double<kFourLines>(rgba, id, fs, d, from, to);
+      if (to >= from)
+        for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (to - from + 1);
+      return;
+    }
     std::int64_t e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
     const std::int64_t s0 = fs.ea[0], s1 = fs.ea[1], s2 = fs.ea[2], s3 = fs.ea[3];
     for (int x = from; x <= to; ++x) {
@@ -751,6 +768,28 @@ struct TetRasterizer::Impl {
     e[1] = e1;
     e[2] = e2;
     e[3] = e3;  // padding steps by 0
+  }
+
+  // edge_pixels_of with the edge functions at `from` in double, stepped in double (see
+  // FaceSetup::exact_double): no conversions.
+  template <bool kFourLines>
+  [[gnu::always_inline]] void edge_pixels_double(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                                 const double* e, int from, int to) const {
+    const std::uint32_t tet = fs.tet, color = fs.color;
+    const double w = params.edge_width;
+    double d0 = e[0], d1 = e[1], d2 = e[2], d3 = e[3];
+    const double t0 = fs.step[0], t1 = fs.step[1], t2 = fs.step[2], t3 = fs.step[3];
+    const double i0 = fs.inv_len[0], i1 = fs.inv_len[1], i2 = fs.inv_len[2], i3 = fs.inv_len[3];
+    for (int x = from; x <= to; ++x) {
+      const double d = kFourLines ? std::min(std::min(d0 * i0, d1 * i1), std::min(d2 * i2, d3 * i3))
+                                  : std::min(std::min(d0 * i0, d1 * i1), d2 * i2);
+      rgba[x] = d < w ? darkened(fs, d) : color;
+      id[x] = tet;
+      d0 += t0;
+      d1 += t1;
+      d2 += t2;
+      if (kFourLines) d3 += t3;
+    }
   }
 
   // shade_span's long runs (and faces without edge lines).
