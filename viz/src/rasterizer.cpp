@@ -15,6 +15,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #ifdef __SSE2__
 #include <emmintrin.h>
@@ -742,21 +743,31 @@ struct TetRasterizer::Impl {
   template <bool kFourLines>
   [[gnu::always_inline]] void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
                                              std::int64_t* e, int from, int to) const {
-    const std::uint32_t tet = fs.tet, color = fs.color;
-    const double w = params.edge_width;
-    if (fs.exact_double) {
-      double d[4] = {double(e[0]), double(e[1]), double(e[2]), kFourLines ? double(e[3]) : 0};
-      edge_pixels_double<kFourLines>(rgba, id, fs, d, from, to);
-      if (to >= from)
-        for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (to - from + 1);
+    if (!fs.exact_double) [[unlikely]] {  // huge coordinates (near-plane cuts)
+      edge_pixels_stepped<kFourLines>(rgba, id, fs, e, fs.ea, from, to);
       return;
     }
-    std::int64_t e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
-    const std::int64_t s0 = fs.ea[0], s1 = fs.ea[1], s2 = fs.ea[2], s3 = fs.ea[3];
+    // Stepped in double (see FaceSetup::exact_double): no conversion per pixel.
+    double d[4] = {double(e[0]), double(e[1]), double(e[2]), kFourLines ? double(e[3]) : 0};
+    edge_pixels_stepped<kFourLines>(rgba, id, fs, d, fs.step, from, to);
+    if (to >= from)
+      for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (to - from + 1);
+  }
+  // The loop of edge_pixels_of, its edge functions e (at `from`, stepped by `step` per pixel; integers
+  // are left past `to`) 64-bit integers or exact doubles.
+  template <bool kFourLines, class Edge>
+  [[gnu::always_inline]] void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                                  Edge* e, const Edge* step, int from, int to) const {
+    const std::uint32_t tet = fs.tet, color = fs.color;
+    const double w = params.edge_width;
+    Edge e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
+    const Edge s0 = step[0], s1 = step[1], s2 = step[2], s3 = step[3];
+    const double i0 = fs.inv_len[0], i1 = fs.inv_len[1], i2 = fs.inv_len[2], i3 = fs.inv_len[3];
     for (int x = from; x <= to; ++x) {
-      const double d = kFourLines ? nearest_edge(fs, e0, e1, e2, e3)
-                                  : std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
-                                             double(e2) * fs.inv_len[2]);
+      // As nearest_edge (min is exact: the order of the minima does not matter).
+      const double d = kFourLines ? std::min(std::min(double(e0) * i0, double(e1) * i1),
+                                             std::min(double(e2) * i2, double(e3) * i3))
+                                  : std::min(std::min(double(e0) * i0, double(e1) * i1), double(e2) * i2);
       rgba[x] = d < w ? darkened(fs, d) : color;
       id[x] = tet;
       e0 += s0;
@@ -764,31 +775,11 @@ struct TetRasterizer::Impl {
       e2 += s2;
       if (kFourLines) e3 += s3;
     }
-    e[0] = e0;
-    e[1] = e1;
-    e[2] = e2;
-    e[3] = e3;  // padding steps by 0
-  }
-
-  // edge_pixels_of with the edge functions at `from` in double, stepped in double (see
-  // FaceSetup::exact_double): no conversions.
-  template <bool kFourLines>
-  [[gnu::always_inline]] void edge_pixels_double(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                                 const double* e, int from, int to) const {
-    const std::uint32_t tet = fs.tet, color = fs.color;
-    const double w = params.edge_width;
-    double d0 = e[0], d1 = e[1], d2 = e[2], d3 = e[3];
-    const double t0 = fs.step[0], t1 = fs.step[1], t2 = fs.step[2], t3 = fs.step[3];
-    const double i0 = fs.inv_len[0], i1 = fs.inv_len[1], i2 = fs.inv_len[2], i3 = fs.inv_len[3];
-    for (int x = from; x <= to; ++x) {
-      const double d = kFourLines ? std::min(std::min(d0 * i0, d1 * i1), std::min(d2 * i2, d3 * i3))
-                                  : std::min(std::min(d0 * i0, d1 * i1), d2 * i2);
-      rgba[x] = d < w ? darkened(fs, d) : color;
-      id[x] = tet;
-      d0 += t0;
-      d1 += t1;
-      d2 += t2;
-      if (kFourLines) d3 += t3;
+    if constexpr (std::is_integral_v<Edge>) {  // (the double path steps the integers once)
+      e[0] = e0;
+      e[1] = e1;
+      e[2] = e2;
+      e[3] = e3;  // padding steps by 0
     }
   }
 
