@@ -84,9 +84,9 @@ class TetRasterizer {
   // pixel decides it), each thread in its own range of rows (batches of 256 tets or more), skipping by
   // their pixel boxes (kept from drawing) the tets hidden behind farther undrawn ones, and reading the mesh
   // only for the others, a few tets ahead; more than 2^16 tets go in parts of 2^16 (last first). For a
-  // visibility order, fb (colours and ids) is then pixel for pixel the picture of the
-  // remaining tets drawn from scratch; fb must not be changed in between. Cost is proportional to the
-  // undrawn tets and their pixels, not to the mesh. Throws std::logic_error if not undoable,
+  // visibility order, fb (colours and ids) is then pixel for pixel the picture of the remaining tets
+  // drawn from scratch; fb must not be changed in between. Cost is proportional to the undrawn tets and
+  // their pixels, not to the mesh. Throws std::logic_error if not undoable,
   // std::out_of_range if k exceeds the tets drawn. Undoable images are at most 32767 pixels wide and high
   // (else the constructor throws std::invalid_argument).
   void undraw(Framebuffer& fb, std::size_t count);
