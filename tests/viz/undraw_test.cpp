@@ -290,6 +290,9 @@ TEST(Undraw, BadUseIsRejected) {
   RenderParams p;
   p.undoable = true;
   TetRasterizer r(m, cam, 20, 10, p);
+  // Undraw keeps pixel boxes in 16 bits: wider images are refused up front (no buffer is allocated).
+  EXPECT_THROW(TetRasterizer(m, cam, 32768, 1, p), std::invalid_argument);
+  EXPECT_THROW(TetRasterizer(m, cam, 1, 40000, p), std::invalid_argument);
   const std::uint32_t twice[2] = {3, 3};
   EXPECT_THROW(r.draw(fb, twice), std::invalid_argument);
   EXPECT_EQ(r.drawn_tets().size(), 0u);

@@ -15,6 +15,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #ifdef __SSE2__
 #include <emmintrin.h>
@@ -206,6 +207,11 @@ struct FaceSetup {
   std::int64_t ea[4], eb[4], ec[4];
   double inv_len[4];
   double flat_e[4];  // edge_width / inv_len: a pixel with edge function >= this is not darkened by k
+  // Every edge line's function is below 2^52 in magnitude on the whole image, so a row may step it in
+  // double exactly (each value an integer that a double holds): the same bits as converting the
+  // 64-bit one at each pixel.
+  bool exact_double = false;
+  double step[4];  // ea as doubles (exact_double)
   // Depth mode, per fan triangle: nearness = w0 + da (x - x0) + db (y - y0), interpolated from the
   // snapped vertices so that faces sharing an edge agree on it exactly (up to rounding).
   double x0 = 0, y0 = 0, w0 = 0, da = 0, db = 0;
@@ -301,17 +307,23 @@ struct TetRasterizer::Impl {
   std::vector<std::uint64_t> shown;
   std::vector<std::uint32_t> slot, before_rgba, before_id;
   std::vector<std::uint8_t> need_save;  // per batch tet
-  // Per undraw() call, per undrawn tet (in drawing order): what the walk over its rows needs, found
-  // up front on both threads, where the lookups of consecutive tets (scattered over the mesh's
-  // arrays) overlap, rather than in the walk, where each thread would wait for them in turn.
+  // Undoable: each drawn tet's pixel box (tet_box, in drawing order, 8 bytes), so that undraw finds
+  // the undrawn tets hidden behind farther undrawn ones (most of them) without reading the mesh.
+  struct SmallBox {
+    std::int16_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
+  };
+  std::vector<SmallBox> drawn_box;
+  // What undraw's walk needs of an undrawn tet that shows (gather_undrawn, shade_repainted): the
+  // walk fetches it a few tets ahead (see undraw_part), so the mesh's scattered arrays are read only
+  // for the tets that show, their lookups overlapping.
   struct UndrawTet {
     Box box;                         // as tet_box; y0 < 0: cut by the near plane (walked the slow way)
     std::int32_t X[4], Y[4];         // fixed-point corners (box.y0 >= 0)
+    std::uint32_t node[4];           // the tet's nodes (box.y0 >= 0)
     std::uint8_t repaint = 0;        // bit f: back face f is shared with a kept tet (box.y0 >= 0)
     std::uint32_t neighbour[4];      // repaint face f: that tet's face (4 tet + face)
     FaceShade shade[4];              // repaint face f: that tet's front face's flat colour
   };
-  std::vector<UndrawTet> undrawn;
   PixelRect changed;  // see changed_rect
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
@@ -328,6 +340,8 @@ struct TetRasterizer::Impl {
     use_mask = reverse;
     if (params.undoable) {
       if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
+      if (w > 32767 || h > 32767)
+        throw std::invalid_argument("render: undoable drawing needs an image at most 32767 pixels wide and high");
       adjacency = &face_adjacency(m);
       drawn_at.assign(m.tet_count(), 0);
       kept.assign((m.tet_count() + 63) / 64, 0);
@@ -450,15 +464,32 @@ struct TetRasterizer::Impl {
     project_camera(c, X, Y, st);
   }
 
-  // The flat shade of tet `tet`'s face whose corners are `v` (camera frame) in outward order: its
-  // region's colour, Lambert + ambient.
-  FaceShade face_shade(std::uint32_t tet, const double* const v[3]) const {
-    double u[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
-    double w[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
+  // The flat shade of tet `tet`'s face whose corners are `v` (camera frame) in outward order, node[j]
+  // the node of v[j]: its region's colour, Lambert + ambient. The normal is computed from the corners
+  // in ascending node order (its sign from the permutation's parity), so the two tets sharing a face
+  // get the same bits, each side with its sign: undraw shades a kept neighbour's face from the
+  // undrawn tet's own corners, as drawing the neighbour did.
+  FaceShade face_shade(std::uint32_t tet, const double* const v[3], const std::uint32_t node[3]) const {
+    int s0 = 0, s1 = 1, s2 = 2;
+    bool odd = false;
+    auto swap_if = [&](int& i, int& j) {
+      if (node[i] > node[j]) {
+        std::swap(i, j);
+        odd = !odd;
+      }
+    };
+    swap_if(s0, s1);
+    swap_if(s1, s2);
+    swap_if(s0, s1);
+    const double *p0 = v[s0], *p1 = v[s1], *p2 = v[s2];
+    double u[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    double w[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
     double nc[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     double len = std::sqrt(nc[0] * nc[0] + nc[1] * nc[1] + nc[2] * nc[2]);
-    // The camera frame is a mirror of the world: the outward normal is -nc there.
+    // The camera frame is a mirror of the world: the outward normal is -nc there (+nc for an odd
+    // permutation of the outward order).
     double lambert = len > 0 ? -(nc[0] * light[0] + nc[1] * light[1] + nc[2] * light[2]) / len : 0;
+    if (odd) lambert = -lambert;
     double intensity = params.ambient + (1 - params.ambient) * std::max(0.0, lambert);
     intensity = std::clamp(intensity, 0.0, 1.0);
     const std::int32_t region = mesh->region_of(tet);
@@ -474,10 +505,10 @@ struct TetRasterizer::Impl {
   }
 
   // Shading and edge lines of a face; `v` = the face's three corners (camera frame)
-  // in outward order; poly = the polygon to draw (positive area), n its size.
-  void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const PolyVertex* poly,
-                  int n) const {
-    setup_face(fs, tet, face_shade(tet, v), poly, n);
+  // in outward order, node their nodes; poly = the polygon to draw (positive area), n its size.
+  void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const std::uint32_t node[3],
+                  const PolyVertex* poly, int n) const {
+    setup_face(fs, tet, face_shade(tet, v, node), poly, n);
   }
 
   // The same with the shade known.
@@ -506,12 +537,17 @@ struct TetRasterizer::Impl {
         fs.flat_e[k] = params.edge_width / fs.inv_len[k];
       }
     }
+    fs.exact_double = true;
+    for (int k = 0; k < fs.lines; ++k)
+      fs.exact_double = fs.exact_double && std::abs(double(fs.ea[k])) * proj.width + std::abs(double(fs.eb[k])) * proj.height +
+                                                   std::abs(double(fs.ec[k])) < 0x1p52;
     for (int k = fs.lines; k < 4; ++k) {  // padding: far from every pixel
       fs.ea[k] = fs.eb[k] = 0;
       fs.ec[k] = std::int64_t(1) << 62;
       fs.inv_len[k] = 1;
       fs.flat_e[k] = 0;
     }
+    for (int k = 0; k < 4; ++k) fs.step[k] = double(fs.ea[k]);
   }
 
   void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
@@ -674,8 +710,81 @@ struct TetRasterizer::Impl {
   // least edge_width from every edge line, each other pixel shaded as face_color does, stepping the
   // edge functions along the row. The flat part is solved for in floating point, narrowed by a
   // pixel, and checked exactly at its ends (the distance to each line is monotone along the row), so
-  // every pixel gets exactly face_color's colour whatever the run.
-  void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+  // every pixel gets exactly face_color's colour whatever the run. Runs of 12 pixels or fewer (most
+  // runs of a fine mesh's faces) are not worth solving for: inlined here, each pixel shaded.
+  [[gnu::always_inline]] void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+    if (hi - lo >= 12 || fs.lines == 0) {
+      shade_long_span(fb, fs, y, lo, hi);
+      return;
+    }
+    std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
+    std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+    std::int64_t e[4];
+    edges_at(fs, lo, y, e);
+    edge_pixels(rgba, id, fs, e, lo, hi);
+  }
+
+  // The edge functions of fs's lines at pixel (x, y) (the padding line's is constant).
+  static void edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e) {
+    for (int k = 0; k < 3; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
+    e[3] = fs.lines > 3 ? fs.ea[3] * x + fs.eb[3] * y + fs.ec[3] : fs.ec[3];
+  }
+
+  // Pixels [from, to] of a row shaded one by one (rgba, id: the row), e: the edge functions at
+  // `from`, stepped on past `to`. The edge functions and colours are held in registers; a face of 3
+  // lines or fewer skips the fourth (padding, never the nearest).
+  [[gnu::always_inline]] void edge_pixels(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                          std::int64_t* e, int from, int to) const {
+    if (fs.lines > 3)
+      edge_pixels_of<true>(rgba, id, fs, e, from, to);
+    else
+      edge_pixels_of<false>(rgba, id, fs, e, from, to);
+  }
+  template <bool kFourLines>
+  [[gnu::always_inline]] void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                             std::int64_t* e, int from, int to) const {
+    if (!fs.exact_double) [[unlikely]] {  // huge coordinates (near-plane cuts)
+      edge_pixels_stepped<kFourLines>(rgba, id, fs, e, fs.ea, from, to);
+      return;
+    }
+    // Stepped in double (see FaceSetup::exact_double): no conversion per pixel.
+    double d[4] = {double(e[0]), double(e[1]), double(e[2]), kFourLines ? double(e[3]) : 0};
+    edge_pixels_stepped<kFourLines>(rgba, id, fs, d, fs.step, from, to);
+    if (to >= from)
+      for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (to - from + 1);
+  }
+  // The loop of edge_pixels_of, its edge functions e (at `from`, stepped by `step` per pixel; integers
+  // are left past `to`) 64-bit integers or exact doubles.
+  template <bool kFourLines, class Edge>
+  [[gnu::always_inline]] void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                                  Edge* e, const Edge* step, int from, int to) const {
+    const std::uint32_t tet = fs.tet, color = fs.color;
+    const double w = params.edge_width;
+    Edge e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
+    const Edge s0 = step[0], s1 = step[1], s2 = step[2], s3 = step[3];
+    const double i0 = fs.inv_len[0], i1 = fs.inv_len[1], i2 = fs.inv_len[2], i3 = fs.inv_len[3];
+    for (int x = from; x <= to; ++x) {
+      // As nearest_edge (min is exact: the order of the minima does not matter).
+      const double d = kFourLines ? std::min(std::min(double(e0) * i0, double(e1) * i1),
+                                             std::min(double(e2) * i2, double(e3) * i3))
+                                  : std::min(std::min(double(e0) * i0, double(e1) * i1), double(e2) * i2);
+      rgba[x] = d < w ? darkened(fs, d) : color;
+      id[x] = tet;
+      e0 += s0;
+      e1 += s1;
+      e2 += s2;
+      if (kFourLines) e3 += s3;
+    }
+    if constexpr (std::is_integral_v<Edge>) {  // (the double path steps the integers once)
+      e[0] = e0;
+      e[1] = e1;
+      e[2] = e2;
+      e[3] = e3;  // padding steps by 0
+    }
+  }
+
+  // shade_span's long runs (and faces without edge lines).
+  [[gnu::noinline]] void shade_long_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
     std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
     std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
     if (fs.lines == 0) {
@@ -684,74 +793,40 @@ struct TetRasterizer::Impl {
       return;
     }
     std::int64_t e[4];
-    for (int k = 0; k < 3; ++k) e[k] = fs.ea[k] * lo + fs.eb[k] * y + fs.ec[k];
-    e[3] = fs.lines > 3 ? fs.ea[3] * lo + fs.eb[3] * y + fs.ec[3] : fs.ec[3];  // padding: constant
+    edges_at(fs, lo, y, e);
     int a = lo, b = hi;  // the flat part
-    if (hi - lo >= 12) {  // short runs: not worth solving for
-      for (int k = 0; k < fs.lines && a <= b; ++k) {
-        // e_k + ea_k (x - lo) >= flat_e_k beyond x = lo + t.
-        if (fs.ea[k] == 0) {
-          if (double(e[k]) < fs.flat_e[k]) b = a - 1;
-          continue;
-        }
-        const double t = std::clamp((fs.flat_e[k] - double(e[k])) / double(fs.ea[k]), -4.0, double(hi - lo) + 4);
-        const int i = int(t);  // truncation, then floor or ceiling by one test
-        if (fs.ea[k] > 0)
-          a = std::max(a, lo + i - int(double(i) > t) + 1);
-        else
-          b = std::min(b, lo + i + int(double(i) < t) - 1);
+    for (int k = 0; k < fs.lines && a <= b; ++k) {
+      // e_k + ea_k (x - lo) >= flat_e_k beyond x = lo + t.
+      if (fs.ea[k] == 0) {
+        if (double(e[k]) < fs.flat_e[k]) b = a - 1;
+        continue;
       }
-      if (a <= b) {
-        std::int64_t ea[4], eb[4];
-        for (int k = 0; k < 4; ++k) {
-          ea[k] = e[k] + fs.ea[k] * (a - lo);
-          eb[k] = e[k] + fs.ea[k] * (b - lo);
-        }
-        if (!(nearest_edge(fs, ea[0], ea[1], ea[2], ea[3]) >= params.edge_width &&
-              nearest_edge(fs, eb[0], eb[1], eb[2], eb[3]) >= params.edge_width))
-          b = a - 1;
-      }
-    } else {
-      b = a - 1;
-    }
-    // The edge functions and colours in registers; a face of 3 lines or fewer skips the fourth
-    // (padding, never the nearest).
-    auto edge_pixels_of = [&]<bool kFourLines>(int from, int to) {
-      const std::uint32_t tet = fs.tet, color = fs.color;
-      const double w = params.edge_width;
-      std::int64_t e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
-      const std::int64_t s0 = fs.ea[0], s1 = fs.ea[1], s2 = fs.ea[2], s3 = fs.ea[3];
-      for (int x = from; x <= to; ++x) {
-        const double d = kFourLines ? nearest_edge(fs, e0, e1, e2, e3)
-                                    : std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
-                                               double(e2) * fs.inv_len[2]);
-        rgba[x] = d < w ? darkened(fs, d) : color;
-        id[x] = tet;
-        e0 += s0;
-        e1 += s1;
-        e2 += s2;
-        if (kFourLines) e3 += s3;
-      }
-      e[0] = e0;
-      e[1] = e1;
-      e[2] = e2;
-      e[3] = e3;  // padding steps by 0
-    };
-    auto edge_pixels = [&](int from, int to) {
-      if (fs.lines > 3)
-        edge_pixels_of.template operator()<true>(from, to);
+      const double t = std::clamp((fs.flat_e[k] - double(e[k])) / double(fs.ea[k]), -4.0, double(hi - lo) + 4);
+      const int i = int(t);  // truncation, then floor or ceiling by one test
+      if (fs.ea[k] > 0)
+        a = std::max(a, lo + i - int(double(i) > t) + 1);
       else
-        edge_pixels_of.template operator()<false>(from, to);
-    };
+        b = std::min(b, lo + i + int(double(i) < t) - 1);
+    }
+    if (a <= b) {
+      std::int64_t ea[4], eb[4];
+      for (int k = 0; k < 4; ++k) {
+        ea[k] = e[k] + fs.ea[k] * (a - lo);
+        eb[k] = e[k] + fs.ea[k] * (b - lo);
+      }
+      if (!(nearest_edge(fs, ea[0], ea[1], ea[2], ea[3]) >= params.edge_width &&
+            nearest_edge(fs, eb[0], eb[1], eb[2], eb[3]) >= params.edge_width))
+        b = a - 1;
+    }
     if (a > b) {  // no flat part
-      edge_pixels(lo, hi);
+      edge_pixels(rgba, id, fs, e, lo, hi);
       return;
     }
-    edge_pixels(lo, a - 1);
+    edge_pixels(rgba, id, fs, e, lo, a - 1);
     std::fill(rgba + a, rgba + b + 1, fs.color);
     std::fill(id + a, id + b + 1, fs.tet);
     for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
-    edge_pixels(b + 1, hi);
+    edge_pixels(rgba, id, fs, e, b + 1, hi);
   }
 
   // Draws a convex polygon (positive area) as a fan from vertex 0.
@@ -1012,15 +1087,16 @@ struct TetRasterizer::Impl {
       if (n == 0) continue;
       const auto& face = kFace[f];
       const double* v[3] = {c[face[0]], c[face[1]], c[face[2]]};
-      draw_face(fb, rows, t, v, poly, n, !clipped);
+      const std::uint32_t node[3] = {k.tv[face[0]], k.tv[face[1]], k.tv[face[2]]};
+      draw_face(fb, rows, t, v, node, poly, n, !clipped);
     }
   }
 
   // Draws front face polygon `poly` (n vertices, positive area, from face_polygon) of tet t, whose
-  // corners are v (camera frame, outward order), into the rows of `rows`. test_hidden (a triangle):
-  // first test its pixel box against the mask, skipping it if hidden.
+  // corners are v (camera frame, outward order; nodes `node`), into the rows of `rows`. test_hidden
+  // (a triangle): first test its pixel box against the mask, skipping it if hidden.
   void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
-                 const PolyVertex* poly, int n, bool test_hidden) {
+                 const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden) {
     if (use_mask && test_hidden) {  // hidden behind what this batch drew already?
       const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
                                 std::max({poly[0].X, poly[1].X, poly[2].X}),
@@ -1029,7 +1105,7 @@ struct TetRasterizer::Impl {
       if (box.x0 > box.x1 || box_written(rows, box, fb.height)) return;
     }
     FaceSetup fs;
-    setup_face(fs, t, v, poly, n);
+    setup_face(fs, t, v, node, poly, n);
     raster_polygon(fb, rows, fs, poly, n);
   }
 
@@ -1067,6 +1143,7 @@ struct TetRasterizer::Impl {
       drawn_at[tets[i]] = std::uint32_t(start + i);
     }
     history.insert(history.end(), tets.begin(), tets.end());
+    drawn_box.resize(history.size(), SmallBox{0, 0, -1, -1});  // "unknown" until draw_batch finds them
     for (Lane& lane : lanes) lane.regions.push_back(SaveRegion{lane.saves.size(), lane.saved_pixel.size()});
     recording = true;
     try {
@@ -1165,6 +1242,12 @@ struct TetRasterizer::Impl {
       const std::size_t half = tets.size() / 2;
       run_parts(2, [&](int k) { k == 0 ? find_boxes(0, half) : find_boxes(half, tets.size()); });
     }
+    if (recording) {  // the batch is the end of the history
+      SmallBox* kept_box = drawn_box.data() + (drawn_box.size() - tets.size());
+      for (std::size_t i = 0; i < tets.size(); ++i)
+        kept_box[i] = SmallBox{std::int16_t(boxes[i].x0), std::int16_t(boxes[i].x1), std::int16_t(boxes[i].y0),
+                               std::int16_t(boxes[i].y1)};
+    }
     if (!spawn) {
       for (int k = 0; k < count; ++k) work(k);
     } else {
@@ -1189,17 +1272,23 @@ struct TetRasterizer::Impl {
     return r.x0 <= r.x1 ? r : PixelRect{};
   }
 
+  // Zeroes the written-pixel mask on rows y0 to y1 (y0 <= y1) and the tiles of their bands.
+  void zero_mask(int y0, int y1) {
+    const std::size_t words = std::size_t(mask_words);
+    std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
+              written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
+    std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
+              tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
+  }
+
   // Zeroes the written-pixel mask (and while recording, `shown`) on the rows the batch's boxes span;
   // `changed` becomes their union.
   void clear_mask(std::size_t n) {
     changed = boxes_union(n);
     const int y0 = changed.y0, y1 = changed.y1;
     if (y0 > y1) return;
+    zero_mask(y0, y1);
     const std::size_t words = std::size_t(mask_words);
-    std::fill(written.begin() + std::ptrdiff_t(std::size_t(y0) * words),
-              written.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
-    std::fill(tile_full.begin() + std::ptrdiff_t(std::size_t(y0 >> kBandShift) * words),
-              tile_full.begin() + std::ptrdiff_t(std::size_t((y1 >> kBandShift) + 1) * words), 0);
     if (recording)  // else all zero
       std::fill(shown.begin() + std::ptrdiff_t(std::size_t(y0) * words),
                 shown.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
@@ -1307,6 +1396,7 @@ struct TetRasterizer::Impl {
     for (int j = 0; j < 4; ++j) {
       u.X[j] = std::int32_t(k.X[j]);
       u.Y[j] = std::int32_t(k.Y[j]);
+      u.node[j] = k.tv[j];
     }
     for (int f = 0; f < 4; ++f) {
       const std::uint32_t nb = kept_neighbour(t, f);
@@ -1318,29 +1408,17 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // The shades of u's repainted faces: each the kept neighbour's front face, shaded from the
-  // neighbour's own corner order, bit for bit as drawing it did.
+  // The shades of u's repainted faces: each the kept neighbour's front face, which is u's face seen
+  // from the other side (u's corners in reverse outward order), shaded bit for bit as drawing the
+  // neighbour did (see face_shade).
   void shade_repainted(UndrawTet& u) const {
     for (int f = 0; f < 4; ++f) {
       if (!(u.repaint >> f & 1)) continue;
-      const std::uint32_t nb = u.neighbour[f];
-      const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
-      const auto& face = kFace[nb & 3];
-      const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
-                            &cam[3 * std::size_t(nv[face[2]])]};
-      u.shade[f] = face_shade(nb >> 2, v);
-    }
-  }
-
-  // Hints the cache about what shade_repainted(u) reads.
-  void prefetch_repainted(const UndrawTet& u, std::uint32_t t) const {
-    if (u.repaint == 0) return;
-    const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
-    for (int j = 0; j < 4; ++j) __builtin_prefetch(&cam[3 * std::size_t(tv[j])]);  // the faces' corners
-    for (int f = 0; f < 4; ++f) {
-      if (!(u.repaint >> f & 1)) continue;
-      __builtin_prefetch(&mesh->tet[4 * std::size_t(u.neighbour[f] >> 2)]);
-      if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[u.neighbour[f] >> 2]);
+      const int a = kFace[f][0], b = kFace[f][2], d = kFace[f][1];  // reversed
+      const double* v[3] = {&cam[3 * std::size_t(u.node[a])], &cam[3 * std::size_t(u.node[b])],
+                            &cam[3 * std::size_t(u.node[d])]};
+      const std::uint32_t node[3] = {u.node[a], u.node[b], u.node[d]};
+      u.shade[f] = face_shade(u.neighbour[f] >> 2, v, node);
     }
   }
 
@@ -1380,29 +1458,29 @@ struct TetRasterizer::Impl {
                                           [](const Save& s, std::size_t at) { return s.at < at; }) -
                          lane.saves.begin());
     };
+    // One pass over the undrawn tets: they are no longer kept; their boxes, the rectangle they may
+    // change (changed_rect, the whole image if the near plane cuts one) and their work per band of
+    // rows (for the threads' split, see split_rows).
+    const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
+    std::vector<double> band_work(threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
     boxes.resize(count);
-    undrawn.resize(count);
-    // The undrawn tets are no longer kept.
-    for (std::size_t i = first; i < history.size(); ++i) kept[history[i] >> 6] &= ~(std::uint64_t(1) << (history[i] & 63));
-    auto find_boxes = [&](std::size_t begin, std::size_t end) {
-      // The undrawn tets lie all over the mesh's arrays: one pass over the tets and their neighbours'
-      // marks, then one over the few faces to repaint, each hinting the cache well ahead.
-      constexpr std::size_t kAhead = 16;
-      for (std::size_t i = begin; i < end; ++i) {
-        if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(history[first + i + 2 * kAhead])]);
-        if (i + kAhead < end) {
-          const std::uint32_t ahead = history[first + i + kAhead];
-          prefetch_tet(ahead);
-          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(ahead)]);
-        }
-        gather_undrawn(history[first + i], fb.width, fb.height, undrawn[i]);
-        boxes[i] = undrawn[i].box;
+    PixelRect rect{fb.width, fb.height, -1, -1};
+    bool unknown = false;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::uint32_t t = history[first + i];
+      kept[t >> 6] &= ~(std::uint64_t(1) << (t & 63));
+      const SmallBox& small = drawn_box[first + i];
+      const Box b{small.x0, small.x1, small.y0, small.y1};
+      boxes[i] = b;
+      if (b.x0 > b.x1) continue;
+      if (b.y0 < 0) {
+        unknown = true;
+        continue;
       }
-      for (std::size_t i = begin; i < end; ++i) {
-        if (i + kAhead < end) prefetch_repainted(undrawn[i + kAhead], history[first + i + kAhead]);
-        shade_repainted(undrawn[i]);
-      }
-    };
+      rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1), std::max(rect.y1, b.y1)};
+      if (threads > 1) add_band_work(band_work, b);
+    }
+    changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
     auto work = [&](const std::vector<int>& split, int k) {
@@ -1411,10 +1489,45 @@ struct TetRasterizer::Impl {
                           p_hi = std::uint32_t(rows.hi + 1) * std::uint32_t(fb.width);
       std::vector<std::size_t> save(lanes.size());
       for (std::size_t l = 0; l < lanes.size(); ++l) save[l] = first_save(lanes[l]);
+      // Whether tet j may show in these rows is decided kFar tets ahead (a tet hidden then stays
+      // hidden, the mask only grows; one that shows then but is hidden when met writes nothing, the
+      // mask holding its pixels): its mesh rows are fetched then, its nodes' positions and shades'
+      // inputs kNear tets ahead, so that the walk finds them in the cache.
+      constexpr std::size_t kFar = 24, kNear = 12, kRing = 32;
+      bool may_show[kRing];
+      auto look_far = [&](std::size_t j) {
+        const Box& b = boxes[j];
+        const bool may = b.x0 <= b.x1 && b.y0 >= 0 && rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height);
+        may_show[j % kRing] = may;
+        if (!may) return;
+        const std::uint32_t t = history[first + j];
+        __builtin_prefetch(&mesh->tet[4 * std::size_t(t)]);
+        __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(t)]);
+      };
+      auto look_near = [&](std::size_t j) {
+        if (!may_show[j % kRing]) return;
+        const std::uint32_t t = history[first + j];
+        const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
+        const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(t)];
+        bool repaints = false;
+        for (int f = 0; f < 4; ++f) {
+          if (nb[f] == kNone || !is_kept(nb[f] >> 2)) continue;
+          repaints = true;
+          if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
+        }
+        for (int c = 0; c < 4; ++c) {
+          __builtin_prefetch(&fix[tv[c]]);
+          if (repaints) __builtin_prefetch(&cam[3 * std::size_t(tv[c])]);
+        }
+      };
+      for (std::size_t j = 0; j < std::min(count, kFar); ++j) look_far(j);
+      for (std::size_t j = 0; j < std::min(count, kNear); ++j) look_near(j);
       for (std::size_t i = 0; i < count; ++i) {
+        if (i + kFar < count) look_far(i + kFar);
+        if (i + kNear < count) look_near(i + kNear);
         const std::uint32_t t = history[first + i];
         const Box& b = boxes[i];
-        const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || (rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height)));
+        const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || may_show[i % kRing]);
         for (std::size_t l = 0; l < lanes.size(); ++l) {
           const Lane& lane = lanes[l];
           if (save[l] >= lane.saves.size() || lane.saves[save[l]].at != first + i) continue;
@@ -1434,8 +1547,10 @@ struct TetRasterizer::Impl {
           }
         }
         if (!shows) continue;
-        const UndrawTet& u = undrawn[i];
         if (b.y0 >= 0) {
+          UndrawTet u;
+          gather_undrawn(t, fb.width, fb.height, u);
+          shade_repainted(u);
           // Each back face shared with a kept tet is repainted as that tet's front face: the same
           // polygon (face_polygon's back order), in its colour. One shared with an earlier tet of the
           // batch is already written: that tet, met before t in this walk, wrote every pixel of its
@@ -1459,23 +1574,24 @@ struct TetRasterizer::Impl {
           if (nb == kNone) return;
           const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
           const auto& face = kFace[nb & 3];
-          const double* v[3] = {&cam[3 * std::size_t(nv[face[0]])], &cam[3 * std::size_t(nv[face[1]])],
-                                &cam[3 * std::size_t(nv[face[2]])]};
-          draw_face(fb, rows, nb >> 2, v, poly, n, false);
+          const std::uint32_t node[3] = {nv[face[0]], nv[face[1]], nv[face[2]]};
+          const double* v[3] = {&cam[3 * std::size_t(node[0])], &cam[3 * std::size_t(node[1])],
+                                &cam[3 * std::size_t(node[2])]};
+          draw_face(fb, rows, nb >> 2, v, node, poly, n, false);
         });
       }
+      // The mask back to zero on the changed rows of these rows (whole bands: their tiles too).
+      const int y0 = std::max(rows.lo, changed.y0), y1 = std::min(rows.hi, changed.y1);
+      if (y0 <= y1) zero_mask(y0, y1);
     };
-    const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
     if (threads == 1) {
-      find_boxes(0, count);
       work({0, fb.height}, 0);
     } else {
-      run_parts(2, [&](int k) { k == 0 ? find_boxes(0, count / 2) : find_boxes(count / 2, count); });
-      const std::vector<int> split = split_rows(count, threads, fb.height);
+      const std::vector<int> split = split_rows(band_work, threads, fb.height);
       run_parts(threads, [&](int k) { work(split, k); });
     }
-    clear_mask(count);
     history.resize(first);
+    drawn_box.resize(first);
     for (Lane& lane : lanes) {
       lane.saves.resize(first_save(lane));
       while (!lane.regions.empty() && lane.regions.back().first_save >= lane.saves.size()) {
@@ -1487,27 +1603,20 @@ struct TetRasterizer::Impl {
     }
   }
 
-  // Row ranges for `parts` threads undrawing the first n boxes: split[k] to split[k + 1] - 1 for
-  // thread k, whole bands of 16 rows (a thread's mask tiles are its own), of about equal work, each
-  // box counting its width plus a per-row cost on each of its rows (a box cut by the near plane,
-  // unknown, counts on none). Contiguous ranges, not interleaved bands: a tet is a few bands tall,
-  // and each thread whose rows it touches pays its setup.
-  std::vector<int> split_rows(std::size_t n, int parts, int height) const {
-    const int bands = (height + (1 << kBandShift) - 1) >> kBandShift;
-    std::vector<double> work(std::size_t(bands) + 1, 0.0);  // per band, as differences
-    constexpr double kRowCost = 16;  // pixels' worth of per-row setup
-    for (std::size_t i = 0; i < n; ++i) {
-      const Box& b = boxes[i];
-      if (b.x0 > b.x1 || b.y0 < 0) continue;
-      const double per_row = double(b.x1 - b.x0 + 1) + kRowCost;
-      // Spread over the bands the box touches, each by its rows in it (as a rate per band).
-      const int b0 = b.y0 >> kBandShift, b1 = b.y1 >> kBandShift;
-      work[std::size_t(b0)] += per_row * double(std::min(b.y1, ((b0 + 1) << kBandShift) - 1) - b.y0 + 1);
-      if (b1 > b0) {
-        work[std::size_t(b1)] += per_row * double(b.y1 - (b1 << kBandShift) + 1);
-        for (int band = b0 + 1; band < b1; ++band) work[std::size_t(band)] += per_row * double(1 << kBandShift);
-      }
-    }
+  // Adds box b's undraw work to `work` (per band of 16 rows): its width plus a per-row cost, times its
+  // rows, all on the band of its middle row (a box is a few bands tall at most where it matters: the
+  // split need only be about even).
+  static void add_band_work(std::vector<double>& work, const Box& b) {
+    constexpr int kRowCost = 16;  // pixels' worth of per-row setup
+    work[std::size_t(((b.y0 + b.y1) >> 1) >> kBandShift)] += double((b.x1 - b.x0 + 1 + kRowCost) * (b.y1 - b.y0 + 1));
+  }
+
+  // Row ranges for `parts` threads undrawing, from their work per band (add_band_work; a box cut by
+  // the near plane, unknown, counts on none): split[k] to split[k + 1] - 1 for thread k, whole bands
+  // of 16 rows (a thread's mask tiles are its own), of about equal work. Contiguous ranges, not
+  // interleaved bands: a tet is a few bands tall, and each thread whose rows it touches pays its setup.
+  static std::vector<int> split_rows(const std::vector<double>& work, int parts, int height) {
+    const int bands = int(work.size());
     double total = 0;
     for (double w : work) total += w;
     std::vector<int> split(std::size_t(parts) + 1, height);
@@ -1535,6 +1644,7 @@ struct TetRasterizer::Impl {
   void forget() {
     std::fill(kept.begin(), kept.end(), 0);
     history.clear();
+    drawn_box.clear();
     for (Lane& lane : lanes) lane = Lane{};
   }
 
@@ -1549,7 +1659,7 @@ struct TetRasterizer::Impl {
                          before_id.capacity()) *
                             sizeof(std::uint32_t) +
                         (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t) +
-                        undrawn.capacity() * sizeof(UndrawTet);
+                        drawn_box.capacity() * sizeof(SmallBox);
     for (const Lane& lane : lanes)
       bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
                    sizeof(std::uint32_t) +
