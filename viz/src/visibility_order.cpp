@@ -398,6 +398,11 @@ struct ProgressiveOrder::Impl {
     }
   }
   void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
+  // scan_runs for the common case, items that are tets and no zones, as a loop of its own that keeps
+  // its output pointer in a register (through a lambda's reference it was stored at every item):
+  // writes the items of [begin, end) from o on (around the cache if kStream), returns the end.
+  template <bool kStream>
+  std::uint32_t* emit_tets(std::size_t begin, std::size_t end, std::uint32_t* o, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
   // A whole-mesh order of a table with clusters_split: every item is a tet (t_cluster_free), and
   // resolve_run draws each cluster whose tets meet in its run as one unit.
@@ -1147,6 +1152,30 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
   }
 }
 
+template <bool kStream>
+std::uint32_t* ProgressiveOrder::Impl::emit_tets(std::size_t begin, std::size_t end, std::uint32_t* o, Scratch& sc) {
+  auto put = [](std::uint32_t* at, std::uint32_t item) {
+    if constexpr (kStream) store_item(at, item);
+    else *at = item;
+  };
+  const Packed* a = sorted.data();
+  const std::uint64_t w = q_window;
+  for (std::size_t i = begin; i + 1 < end; ++i) {
+    if (std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w) {
+      put(o++, item_of(a[i]));
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j + 1 < end && std::uint64_t(q_of(a[j + 1])) - q_of(a[j]) <= w) ++j;
+    resolve_run(i, j + 1, sc);
+    for (; i < j; ++i) put(o++, item_of(a[i]));
+    if (i + 1 == end) break;
+    put(o++, item_of(a[i]));
+  }
+  if (end > begin) put(o++, item_of(a[end - 1]));
+  return o;
+}
+
 // Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
 void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scratch& sc) {
   auto& local_tets = sc.local_tets;
@@ -1335,7 +1364,9 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       out.resize(at + (tb[b] - tb[group]));
       o = out.data() + at;
     }
-    if (t_cluster_free && stream_out) {
+    if (t_cluster_free && zones.empty()) {
+      o = stream_out ? emit_tets<true>(begin, end, o, sc) : emit_tets<false>(begin, end, o, sc);
+    } else if (t_cluster_free && stream_out) {
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { store_item(o++, item); });
     } else if (t_cluster_free) {
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });
