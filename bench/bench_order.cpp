@@ -119,6 +119,10 @@ void BM_power_order_into(benchmark::State& state) {
   state.counters["sort_ms"] = 1e3 * phase[2] / views;
   // CPU time of the whole process (both cores) per view: steadier than wall time on a loaded machine.
   state.counters["cpu_ms"] = 1e3 * double(std::clock() - cpu0) / CLOCKS_PER_SEC / views;
+  // The mesh's cospherical clusters, their tets, and whether they are split (SphereTable::clusters_split).
+  state.counters["clusters"] = double(c.table.cluster_count());
+  state.counters["cluster_tets"] = double(c.table.cluster_tets.size());
+  state.counters["split"] = c.table.clusters_split ? 1 : 0;
   per_tet(state, c.mesh.tet_count());
 }
 

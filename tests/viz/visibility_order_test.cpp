@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -512,6 +513,89 @@ TEST(VisibilityOrder, FirstBatchFromKeyBlocksIsThePrefixOfTheWholeOrder) {
   // A small first batch came from a small part of the keys (about 64 a block read).
   ASSERT_GE(compared, 30u);
   EXPECT_LT(keys_read / compared, n / 5);
+}
+
+// TetGen's Delaunay mesh of random points in the unit cube with a few small cubes' corners added,
+// each cube inscribed in a ball kept free of the random points, so that each cube is meshed by
+// 5 or 6 tets with one circumsphere: a few cospherical clusters (with those of 2 tets that each
+// square face makes with an outside apex) in a mesh otherwise without any.
+Mesh few_cubes_delaunay(const test::TempDir& dir, int points, int cubes, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double radius = 0.03, half = radius / std::sqrt(3.0);
+  std::vector<std::array<double, 3>> centres;
+  for (int k = 0; k < cubes; ++k) centres.push_back({0.15 + 0.7 * u(rng), 0.15 + 0.7 * u(rng), 0.15 + 0.7 * u(rng)});
+  std::vector<std::array<double, 3>> xyz;
+  while (xyz.size() < std::size_t(points)) {
+    const std::array<double, 3> p = {u(rng), u(rng), u(rng)};
+    bool free = true;
+    for (const auto& c : centres) {
+      const double d[3] = {p[0] - c[0], p[1] - c[1], p[2] - c[2]};
+      free = free && d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > 1.5 * 1.5 * radius * radius;
+    }
+    if (free) xyz.push_back(p);
+  }
+  for (const auto& c : centres)
+    for (int corner = 0; corner < 8; ++corner)
+      xyz.push_back({c[0] + (corner & 1 ? half : -half), c[1] + (corner & 2 ? half : -half),
+                     c[2] + (corner & 4 ? half : -half)});
+  std::string text = std::to_string(xyz.size()) + " 3 0 0\n";
+  char line[128];
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    std::snprintf(line, sizeof line, "%zu %.17g %.17g %.17g\n", i + 1, xyz[i][0], xyz[i][1], xyz[i][2]);
+    text += line;
+  }
+  test::write_text(dir / "cubes.node", text);
+  test::run("cd '" + dir.path().string() + "' && tetgen -Q cubes.node", dir / "tetgen.log");
+  return read_tetgen(dir / "cubes.1");
+}
+
+TEST(VisibilityOrder, AFewSplitClustersAreDrawnAsUnits) {
+  // A mesh with a few clusters keeps them split in its whole-mesh items (SphereTable::
+  // clusters_split): each cluster must still come out as one unit, in its local order. Oracles: the
+  // violation count, each cluster's tets adjacent in the order, and the order with clusters as
+  // items (a subset of every tet takes that path) giving the same order; the progressive order
+  // (first batch from key blocks, the rest on a worker) concatenating to it too.
+  if (!test::have_program("tetgen")) GTEST_SKIP();
+  test::TempDir dir;
+  Mesh m = few_cubes_delaunay(dir, 17000, 4, 5);
+  const std::size_t n = m.tet_count();
+  ASSERT_GE(n, 100000u);  // both cores sort (two halves)
+  ASSERT_TRUE(compute_delaunay_certificate(m).delaunay);
+  SphereTable t = compute_spheres(m);
+  // Each cube (6 tets here), and on each of its faces the two tets outside it that share the
+  // face's square and an apex (2 tets on one sphere).
+  std::size_t cubes = 0;
+  for (std::size_t k = 0; k < t.cluster_count(); ++k) cubes += t.cluster_begin[k + 1] - t.cluster_begin[k] >= 5;
+  ASSERT_EQ(cubes, 4u);
+  ASSERT_TRUE(t.clusters_split);
+  ASSERT_EQ(t.all_items.size() + t.wide_items.size(), n);
+  std::vector<std::uint32_t> every(n);
+  for (std::uint32_t i = 0; i < n; ++i) every[i] = i;
+  for (const View& v : random_views(m, 18, 23)) {
+    for (bool ftb : {false, true}) {
+      const std::vector<std::uint32_t> whole = visibility_order(m, t, v, {}, ftb);
+      ASSERT_EQ(whole.size(), n);
+      if (!ftb) {
+        EXPECT_EQ(count_violations(m, v, whole).violations, 0u);
+      }
+      std::vector<std::uint32_t> pos(n);
+      for (std::uint32_t i = 0; i < n; ++i) pos[whole[i]] = i;
+      for (std::size_t k = 0; k < t.cluster_count(); ++k) {
+        std::uint32_t lo = kNone, hi = 0;
+        for (std::uint32_t i = t.cluster_begin[k]; i < t.cluster_begin[k + 1]; ++i) {
+          lo = std::min(lo, pos[t.cluster_tets[i]]);
+          hi = std::max(hi, pos[t.cluster_tets[i]]);
+        }
+        EXPECT_EQ(hi - lo + 1, t.cluster_begin[k + 1] - t.cluster_begin[k]);
+      }
+      EXPECT_EQ(whole, visibility_order(m, t, v, every, ftb));
+      ProgressiveOrder progressive(m, t, v, {}, ftb);
+      std::vector<std::uint32_t> all;
+      for (auto b = progressive.next(); !b.empty(); b = progressive.next()) all.insert(all.end(), b.begin(), b.end());
+      EXPECT_EQ(all, whole);
+    }
+  }
 }
 
 TEST(VisibilityOrder, NonDelaunayMeshIsReportedAndMpvoOrdersIt) {

@@ -532,10 +532,16 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
       ft.local[1] = lb < 0xFFFF ? static_cast<std::uint16_t>(lb) : 0xFFFF;
     }
   }
-  t.all_items.reserve(n - t.cluster_tets.size() + clusters);
-  for (std::size_t i = 0; i < n; ++i)
-    if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
-  for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
+  t.clusters_split = clusters > 0 && t.cluster_tets.size() * SphereTable::kSplitClusters <= n;
+  if (t.clusters_split) {
+    t.all_items.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
+  } else {
+    t.all_items.reserve(n - t.cluster_tets.size() + clusters);
+    for (std::size_t i = 0; i < n; ++i)
+      if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
+    for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
+  }
   make_fixed_keys(t, half);
   if (progress) progress("clusters", 1.0);
   return t;

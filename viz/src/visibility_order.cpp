@@ -248,6 +248,9 @@ struct ProgressiveOrder::Impl {
     std::vector<Packed> tmp;           // the second-level counting sort
     std::vector<std::uint32_t> counts;
     std::vector<Entry> run;
+    // Split clusters met in a near-tie run (cluster, members in it), and one cluster's local order.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> run_clusters;
+    std::vector<std::uint32_t> cluster_out;
     std::size_t near_tie_runs = 0, near_tie_items = 0, cluster_cycles = 0;
     // Buckets below this one, from where this thread began, are sorted already (sorted ahead).
     std::size_t sorted_upto = 0;
@@ -395,7 +398,15 @@ struct ProgressiveOrder::Impl {
     }
   }
   void resolve_run(std::size_t begin, std::size_t end, Scratch& sc);
+  // scan_runs for the common case, items that are tets and no zones, as a loop of its own that keeps
+  // its output pointer in a register (through a lambda's reference it was stored at every item):
+  // writes the items of [begin, end) from o on (around the cache if kStream), returns the end.
+  template <bool kStream>
+  std::uint32_t* emit_tets(std::size_t begin, std::size_t end, std::uint32_t* o, Scratch& sc);
   bool t_cluster_free = false;              // no item is a cluster: copy items straight out
+  // A whole-mesh order of a table with clusters_split: every item is a tet (t_cluster_free), and
+  // resolve_run draws each cluster whose tets meet in its run as one unit.
+  bool split_clusters = false;
   // Prefetches where a cluster item's faces and tets are listed (nothing for a tet).
   void prefetch_offsets(std::uint32_t item) const {
     if (!(item & kClusterBit)) return;
@@ -433,6 +444,7 @@ struct ProgressiveOrder::Impl {
       prefetch(table->c.data() + 3 * std::size_t(item) + 2);
       prefetch(table->s.data() + item);
       prefetch(table->wide.data() + item);
+      if (split_clusters) prefetch(table->cluster_of.data() + item);
     }
   }
   // Writes the tets of one item at o (advancing it): a tet, or a cluster in its local MPVO order.
@@ -495,7 +507,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset, bool
   const std::size_t m_main = items.size(), m = m_main + wide_items.size();
   item_count = m;
   ordinary_count = m_main;
-  t_cluster_free = t.cluster_count() == 0;
+  split_clusters = subset.empty() && t.clusters_split && t.cluster_count() > 0;
+  t_cluster_free = t.cluster_count() == 0 || split_clusters;
   many_clusters = t.cluster_count() * 16 > t.all_items.size();
   stats.items = m;
   stats.wide_items = wide_items.size();
@@ -1042,9 +1055,37 @@ void ProgressiveOrder::Impl::sort_bucket_of(std::size_t begin, std::size_t end, 
 void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scratch& sc) {
   std::vector<Entry>& run = sc.run;
   run.clear();
+  // Split clusters (see SphereTable::clusters_split): their tets tie exactly, so all of a
+  // cluster's tets are in this run; each cluster becomes one entry, the first of its tets met
+  // (with that tet's own interval), expanded below. (A cluster not wholly here, which the bounds
+  // rule out, would stay as separate tets.)
+  auto& clusters = sc.run_clusters;
+  clusters.clear();
+  auto cluster_at = [&](std::uint32_t k) {
+    return std::find_if(clusters.begin(), clusters.end(), [k](const auto& c) { return c.first == k; });
+  };
+  if (split_clusters) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t c = table->cluster_of[item_of(sorted[k])];
+      if (c == kNone) continue;
+      auto at = cluster_at(c);
+      if (at == clusters.end()) clusters.emplace_back(c, 1);
+      else ++at->second;
+    }
+    for (auto& [c, count] : clusters)
+      if (count != table->cluster_begin[c + 1] - table->cluster_begin[c]) count = 0;  // not wholly here
+  }
   for (std::size_t k = begin; k < end; ++k) {
-    const std::uint32_t item = item_of(sorted[k]);
+    std::uint32_t item = item_of(sorted[k]);
     const std::uint32_t rep = rep_tet(*table, item);
+    if (!clusters.empty() && table->cluster_of[rep] != kNone) {
+      auto at = cluster_at(table->cluster_of[rep]);
+      if (at->second == kNone) continue;  // its cluster's entry is in the run already
+      if (at->second != 0) {
+        item = at->first | kClusterBit;
+        at->second = kNone;
+      }
+    }
     const float r = radius_of(rep, double_bound);
     run.push_back({lo_of(rep, r), r, item});
   }
@@ -1089,7 +1130,50 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
     i = j + 1;
   }
   // The items in their order; the q values stay where they were (ascending).
-  for (std::size_t k = begin; k < end; ++k) sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | run[k - begin].item;
+  if (clusters.empty()) {
+    for (std::size_t k = begin; k < end; ++k) sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | run[k - begin].item;
+    return;
+  }
+  std::size_t k = begin;
+  for (const Entry& e : run) {
+    if (!(e.item & kClusterBit)) {
+      sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | e.item;
+      ++k;
+      continue;
+    }
+    const std::uint32_t c = e.item & ~kClusterBit;
+    sc.cluster_out.resize(table->cluster_begin[c + 1] - table->cluster_begin[c]);
+    std::uint32_t* o = sc.cluster_out.data();
+    expand(e.item, o, sc);
+    for (std::uint32_t tet : sc.cluster_out) {
+      sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | tet;
+      ++k;
+    }
+  }
+}
+
+template <bool kStream>
+std::uint32_t* ProgressiveOrder::Impl::emit_tets(std::size_t begin, std::size_t end, std::uint32_t* o, Scratch& sc) {
+  auto put = [](std::uint32_t* at, std::uint32_t item) {
+    if constexpr (kStream) store_item(at, item);
+    else *at = item;
+  };
+  const Packed* a = sorted.data();
+  const std::uint64_t w = q_window;
+  for (std::size_t i = begin; i + 1 < end; ++i) {
+    if (std::uint64_t(q_of(a[i + 1])) - q_of(a[i]) > w) {
+      put(o++, item_of(a[i]));
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j + 1 < end && std::uint64_t(q_of(a[j + 1])) - q_of(a[j]) <= w) ++j;
+    resolve_run(i, j + 1, sc);
+    for (; i < j; ++i) put(o++, item_of(a[i]));
+    if (i + 1 == end) break;
+    put(o++, item_of(a[i]));
+  }
+  if (end > begin) put(o++, item_of(a[end - 1]));
+  return o;
 }
 
 // Appends the tets of one item: a tet, or a cluster in its local MPVO order for the view.
@@ -1280,7 +1364,9 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       out.resize(at + (tb[b] - tb[group]));
       o = out.data() + at;
     }
-    if (t_cluster_free && stream_out) {
+    if (t_cluster_free && zones.empty()) {
+      o = stream_out ? emit_tets<true>(begin, end, o, sc) : emit_tets<false>(begin, end, o, sc);
+    } else if (t_cluster_free && stream_out) {
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { store_item(o++, item); });
     } else if (t_cluster_free) {
       scan_runs(begin, end, sc, [&o](std::uint32_t item) { *o++ = item; });

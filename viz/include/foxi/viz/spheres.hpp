@@ -64,9 +64,17 @@ struct SphereTable {
   };
   std::vector<ClusterFace> face_test;
   // The sort items of the whole mesh that are not wide, built once: each tet not in a cluster, and
-  // each cluster as (cluster | kClusterBit). A cluster's key is the key of its first tet.
+  // each cluster as (cluster | kClusterBit), unless clusters_split (below). A cluster's key is the
+  // key of its first tet.
   std::vector<std::uint32_t> all_items;
   std::vector<std::uint32_t> all_rep;     // the tet whose key each item takes (same order)
+  // A mesh with few cluster tets (at most 1 in kSplitClusters) has its clusters split instead:
+  // all_items (and wide_items, fixed_keys) list every tet as itself, in tet order, cluster
+  // members too, so that a whole-mesh order takes the cluster-free paths (one tet an item, no
+  // cluster checks per item). A cluster's tets tie exactly, so they always meet in one near-tie
+  // run, where they are drawn as one unit (its local order). Subsets take clusters as units.
+  static constexpr std::size_t kSplitClusters = 1024;
+  bool clusters_split = false;
   // Per-tet key bounds, kept for subsets (which must find their own wide items).
   std::vector<float> key_a, key_b;
   // The keys of all_items in fixed point (same order): c = c_fixed * c_unit, s = s_fixed * s_unit
