@@ -4,9 +4,10 @@
 //
 // Exactness: keys are computed in double, mapped monotonically to 32-bit integers and sorted in a
 // progressive MSD radix sort; every run of keys whose integers are closer than the rounding bound is
-// re-sorted in double, and chains of overlapping intervals in it with exact rational comparisons of
-// the powers; cospherical clusters are single items expanded by a local MPVO. Extra memory per view:
-// 16 bytes per item (besides the output). For a Delaunay (or regular) mesh
+// re-sorted in double, and chains of overlapping intervals in it with exact comparisons of the powers
+// (interval arithmetic first, exact binary-float fractions where the intervals overlap); cospherical
+// clusters are single items expanded by a local MPVO. Extra memory per view: 16 bytes per item
+// (besides the output's 4 a tet). For a Delaunay (or regular) mesh
 // the result is a visibility order: no face-adjacent pair is drawn in the wrong order.
 //
 // Non-Delaunay meshes (see delaunay.hpp) have no such guarantee; use mpvo_order() for them, which
