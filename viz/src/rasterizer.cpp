@@ -212,6 +212,9 @@ struct FaceSetup {
   // 64-bit one at each pixel.
   bool exact_double = false;
   double step[4];  // ea as doubles (exact_double)
+  // eb and ec as doubles (exact_double): a short run's edge functions at its first pixel evaluated in
+  // double, step x + step_y y + at0, exactly (every partial sum an integer below 2^52).
+  double step_y[4], at0[4];
   // Depth mode, per fan triangle: nearness = w0 + da (x - x0) + db (y - y0), interpolated from the
   // snapped vertices so that faces sharing an edge agree on it exactly (up to rounding).
   double x0 = 0, y0 = 0, w0 = 0, da = 0, db = 0;
@@ -547,7 +550,11 @@ struct TetRasterizer::Impl {
       fs.inv_len[k] = 1;
       fs.flat_e[k] = 0;
     }
-    for (int k = 0; k < 4; ++k) fs.step[k] = double(fs.ea[k]);
+    for (int k = 0; k < 4; ++k) {
+      fs.step[k] = double(fs.ea[k]);
+      fs.step_y[k] = double(fs.eb[k]);
+      fs.at0[k] = double(fs.ec[k]);
+    }
   }
 
   void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
@@ -719,6 +726,19 @@ struct TetRasterizer::Impl {
     }
     std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
     std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+    if (fs.exact_double) [[likely]] {  // the edge functions at lo straight in double (no 64-bit products)
+      const double dx = double(lo), dy = double(y);
+      double d[4];
+      for (int k = 0; k < 3; ++k) d[k] = fs.step[k] * dx + (fs.step_y[k] * dy + fs.at0[k]);
+      if (fs.lines > 3) {
+        d[3] = fs.step[3] * dx + (fs.step_y[3] * dy + fs.at0[3]);
+        edge_pixels_stepped<true>(rgba, id, fs, d, fs.step, lo, hi);
+      } else {
+        d[3] = 0;
+        edge_pixels_stepped<false>(rgba, id, fs, d, fs.step, lo, hi);
+      }
+      return;
+    }
     std::int64_t e[4];
     edges_at(fs, lo, y, e);
     edge_pixels(rgba, id, fs, e, lo, hi);
