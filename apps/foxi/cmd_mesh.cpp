@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "model_run.hpp"
 #include "foxi/mesher/conforming.hpp"
 #include "foxi/mesher/quality_report.hpp"
 #include "foxi/mesher/model_mesh_params.hpp"
@@ -87,9 +88,6 @@ std::pair<std::string, std::string> split_eq(const std::string& s, const char* w
   return {s.substr(0, eq), s.substr(eq + 1)};
 }
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
 
 }  // namespace
 
@@ -127,7 +125,7 @@ int cmd_mesh(Args args) {
   format_from_path(out);  // an unknown output format fails before any meshing
 
   // The PLC, from a model or a .poly.
-  const bool is_model = ends_with(in, ".toml");
+  const bool is_model = is_model_path(in);
   Model model;
   Structure structure;
   Plc plc;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "model_run.hpp"
 #include "foxi/mesher/cgal_mesher.hpp"
 #include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/model/delaunay.hpp"
@@ -72,7 +73,7 @@ int mesh_with_cgal(Args& args) {
   format_from_path(out);  // an unknown output format fails before any meshing
 
   // A model: its PLC, its [mesh] sizes (global and per part, as region volume bounds) and its names.
-  const bool is_model = in.size() > 5 && in.compare(in.size() - 5, 5, ".toml") == 0;
+  const bool is_model = is_model_path(in);
   Model model;
   Structure structure;
   Plc plc;
