@@ -778,6 +778,12 @@ struct TetRasterizer::Impl {
   template <bool kFourLines, class Edge>
   [[gnu::always_inline]] void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
                                                   Edge* e, const Edge* step, int from, int to) const {
+#ifdef __SSE2__
+    if constexpr (std::is_same_v<Edge, double>) {
+      edge_pixels_x4<kFourLines>(rgba, id, fs, e, step, from, to);
+      return;
+    }
+#endif
     const std::uint32_t tet = fs.tet, color = fs.color;
     const double w = params.edge_width;
     Edge e0 = e[0], e1 = e[1], e2 = e[2], e3 = e[3];
@@ -802,6 +808,82 @@ struct TetRasterizer::Impl {
       e[3] = e3;  // padding steps by 0
     }
   }
+
+#ifdef __SSE2__
+  // edge_pixels_stepped's exact-double loop four pixels at a time: each pixel goes through the same
+  // IEEE operations in the same order as the one-pixel loop and darkened() (the edge functions are
+  // integers, so e + k step is the stepped value exactly; min and max differ from std::min and
+  // std::max only in the sign of a zero, which max(0, d) and d < w do not see; no FMA in an SSE2
+  // build), so every pixel gets the same bits. A last group of fewer than 4 stores only its pixels.
+  template <bool kFourLines>
+  [[gnu::always_inline]] void edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+                                             const double* e, const double* step, int from, int to) const {
+    if (to < from) return;
+    const __m128d w = _mm_set1_pd(params.edge_width), zero = _mm_setzero_pd();
+    const __m128d base = _mm_set1_pd(edge_base), slope = _mm_set1_pd(edge_slope);
+    const __m128 r = _mm_set1_ps(fs.rgb[0]), g = _mm_set1_ps(fs.rgb[1]), b = _mm_set1_ps(fs.rgb[2]);
+    const __m128 half = _mm_set1_ps(0.5f);
+    const __m128i color = _mm_set1_epi32(int(fs.color)), tet = _mm_set1_epi32(int(fs.tet));
+    const __m128i alpha = _mm_set1_epi32(int(0xff000000u)), none = _mm_setzero_si128();
+    constexpr int kLines = kFourLines ? 4 : 3;
+    __m128d lo[kLines], hi[kLines], inv[kLines], step4[kLines];  // pixels (x, x + 1), (x + 2, x + 3)
+    for (int k = 0; k < kLines; ++k) {
+      lo[k] = _mm_set_pd(e[k] + step[k], e[k]);
+      hi[k] = _mm_set_pd(e[k] + 3 * step[k], e[k] + 2 * step[k]);
+      inv[k] = _mm_set1_pd(fs.inv_len[k]);
+      step4[k] = _mm_set1_pd(4 * step[k]);
+    }
+    for (int x = from;; x += 4) {
+      __m128d d_lo = _mm_min_pd(_mm_mul_pd(lo[0], inv[0]), _mm_mul_pd(lo[1], inv[1]));
+      __m128d d_hi = _mm_min_pd(_mm_mul_pd(hi[0], inv[0]), _mm_mul_pd(hi[1], inv[1]));
+      if constexpr (kFourLines) {
+        d_lo = _mm_min_pd(d_lo, _mm_min_pd(_mm_mul_pd(lo[2], inv[2]), _mm_mul_pd(lo[3], inv[3])));
+        d_hi = _mm_min_pd(d_hi, _mm_min_pd(_mm_mul_pd(hi[2], inv[2]), _mm_mul_pd(hi[3], inv[3])));
+      } else {
+        d_lo = _mm_min_pd(d_lo, _mm_mul_pd(lo[2], inv[2]));
+        d_hi = _mm_min_pd(d_hi, _mm_mul_pd(hi[2], inv[2]));
+      }
+      const __m128 darken = _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(d_lo, w)), _mm_castpd_ps(_mm_cmplt_pd(d_hi, w)),
+                                         _MM_SHUFFLE(2, 0, 2, 0));
+      __m128i out = color;
+      if (_mm_movemask_ps(darken) != 0) {
+        const __m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_lo, zero)))),
+                                       _mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_hi, zero)))));
+        const __m128i cr = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(r, f), half));
+        const __m128i cg = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(g, f), half));
+        const __m128i cb = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(b, f), half));
+        // Saturated to bytes as darkened() does: r0..r3 g0..g3 b0..b3, then interleaved per pixel.
+        const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(cr, cg), _mm_packs_epi32(cb, cb));
+        const __m128i rg = _mm_unpacklo_epi8(bytes, _mm_srli_si128(bytes, 4));
+        const __m128i b0 = _mm_unpacklo_epi8(_mm_srli_si128(bytes, 8), none);
+        const __m128i dark = _mm_or_si128(_mm_unpacklo_epi16(rg, b0), alpha);
+        const __m128i m = _mm_castps_si128(darken);
+        out = _mm_or_si128(_mm_and_si128(m, dark), _mm_andnot_si128(m, color));
+      }
+      const int left = to - x + 1;
+      if (left >= 4) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(rgba + x), out);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(id + x), tet);
+        if (left == 4) return;
+      } else {
+        if (left >= 2) {
+          _mm_storel_epi64(reinterpret_cast<__m128i*>(rgba + x), out);
+          _mm_storel_epi64(reinterpret_cast<__m128i*>(id + x), tet);
+        }
+        if (left != 2) {
+          const int last = x + left - 1;
+          rgba[last] = std::uint32_t(_mm_cvtsi128_si32(left == 1 ? out : _mm_srli_si128(out, 8)));
+          id[last] = fs.tet;
+        }
+        return;
+      }
+      for (int k = 0; k < kLines; ++k) {
+        lo[k] = _mm_add_pd(lo[k], step4[k]);
+        hi[k] = _mm_add_pd(hi[k], step4[k]);
+      }
+    }
+  }
+#endif
 
   // shade_span's long runs (and faces without edge lines).
   [[gnu::noinline]] void shade_long_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
