@@ -310,12 +310,20 @@ struct TetRasterizer::Impl {
   std::vector<std::uint64_t> shown;
   std::vector<std::uint32_t> slot, before_rgba, before_id;
   std::vector<std::uint8_t> need_save;  // per batch tet
+  std::vector<std::uint16_t> batch_reach;  // per batch tet: its repaint reach (see drawn_reach)
   // Undoable: each drawn tet's pixel box (tet_box, in drawing order, 8 bytes), so that undraw finds
   // the undrawn tets hidden behind farther undrawn ones (most of them) without reading the mesh.
   struct SmallBox {
     std::int16_t x0 = 0, x1 = -1, y0 = 0, y1 = -1;
   };
   std::vector<SmallBox> drawn_box;
+  // Undoable: per drawn tet (in drawing order), how far back in the drawing its back faces' earlier
+  // neighbours reach: its position less the least of theirs, at most 65535 (0: none). Undrawing the
+  // tets from position `first` on, tet i of them (position first + i) repaints a face only if one
+  // of those neighbours is kept (drawn before first): reach > i (or reach 65535; parts are at most
+  // 2^16 tets). A third of the undrawn tets that show repaint nothing (their neighbours behind are
+  // undrawn too): this spares the walk their mesh rows, nodes and neighbours.
+  std::vector<std::uint16_t> drawn_reach;
   // What undraw's walk needs of an undrawn tet that shows (gather_undrawn, shade_repainted): the
   // walk fetches it a few tets ahead (see undraw_part), so the mesh's scattered arrays are read only
   // for the tets that show, their lookups overlapping.
@@ -1246,6 +1254,7 @@ struct TetRasterizer::Impl {
     }
     history.insert(history.end(), tets.begin(), tets.end());
     drawn_box.resize(history.size(), SmallBox{0, 0, -1, -1});  // "unknown" until draw_batch finds them
+    drawn_reach.resize(history.size(), 0xffff);
     for (Lane& lane : lanes) lane.regions.push_back(SaveRegion{lane.saves.size(), lane.saved_pixel.size()});
     recording = true;
     try {
@@ -1313,7 +1322,11 @@ struct TetRasterizer::Impl {
         TetCorners k;
         load_corners(tets[i], k);
         boxes[i] = tet_box(k, fb.width, fb.height);
-        if (recording) need_save[i] = boxes[i].x0 <= boxes[i].x1 && has_unshared_back_face(tets[i], k);
+        if (recording) {
+          need_save[i] = false;
+          batch_reach[i] = 0;
+          if (boxes[i].x0 <= boxes[i].x1) need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i]);
+        }
       }
     };
     auto draw_one = [&](const Rows& rows, std::size_t i, bool first) {
@@ -1337,7 +1350,10 @@ struct TetRasterizer::Impl {
       }
       if (recording) answer_requests(fb, k);
     };
-    if (recording) need_save.resize(tets.size());
+    if (recording) {
+      need_save.resize(tets.size());
+      batch_reach.resize(tets.size());
+    }
     if (!spawn || tets.size() < 4096) {
       find_boxes(0, tets.size());
     } else {
@@ -1349,6 +1365,7 @@ struct TetRasterizer::Impl {
       for (std::size_t i = 0; i < tets.size(); ++i)
         kept_box[i] = SmallBox{std::int16_t(boxes[i].x0), std::int16_t(boxes[i].x1), std::int16_t(boxes[i].y0),
                                std::int16_t(boxes[i].y1)};
+      std::copy(batch_reach.begin(), batch_reach.end(), drawn_reach.end() - std::ptrdiff_t(tets.size()));
     }
     if (!spawn) {
       for (int k = 0; k < count; ++k) work(k);
@@ -1434,7 +1451,10 @@ struct TetRasterizer::Impl {
   // Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
   // for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
   // its projected area (as face_polygon does) without building its polygon; k: its corners (finite).
-  bool has_unshared_back_face(std::uint32_t t, const TetCorners& k) const {
+  // reach: t's repaint reach (see drawn_reach).
+  bool has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach) const {
+    bool unshared = false;
+    std::uint32_t least = drawn_at[t];
     const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
     for (int f = 0; f < 4; ++f) {
       bool back;
@@ -1446,9 +1466,15 @@ struct TetRasterizer::Impl {
         bool clipped = false;
         back = face_polygon(k, f, true, poly, &clipped) > 0;
       }
-      if (back && earlier_neighbour(t, f) == kNone) return true;
+      if (!back) continue;
+      const std::uint32_t nb = earlier_neighbour(t, f);
+      if (nb == kNone)
+        unshared = true;
+      else
+        least = std::min(least, drawn_at[nb >> 2]);
     }
-    return false;
+    reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
+    return unshared;
   }
 
   // Files t's save in the lane of `rows`: a request for each pixel of its unshared back faces in
@@ -1597,29 +1623,28 @@ struct TetRasterizer::Impl {
       // inputs kNear tets ahead, so that the walk finds them in the cache.
       constexpr std::size_t kFar = 24, kNear = 12, kRing = 32;
       bool may_show[kRing];
+      const std::uint16_t* reach = drawn_reach.data() + first;
+      auto repaints = [&](std::size_t j) { return reach[j] > j || reach[j] == 0xffff; };
       auto look_far = [&](std::size_t j) {
         const Box& b = boxes[j];
         const bool may = b.x0 <= b.x1 && b.y0 >= 0 && rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height);
         may_show[j % kRing] = may;
-        if (!may) return;
+        if (!may || !repaints(j)) return;
         const std::uint32_t t = history[first + j];
         __builtin_prefetch(&mesh->tet[4 * std::size_t(t)]);
         __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(t)]);
       };
       auto look_near = [&](std::size_t j) {
-        if (!may_show[j % kRing]) return;
+        if (!may_show[j % kRing] || !repaints(j)) return;
         const std::uint32_t t = history[first + j];
         const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
         const std::uint32_t* nb = &adjacency->neighbour[4 * std::size_t(t)];
-        bool repaints = false;
-        for (int f = 0; f < 4; ++f) {
-          if (nb[f] == kNone || !is_kept(nb[f] >> 2)) continue;
-          repaints = true;
-          if (!mesh->tet_region.empty()) __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
-        }
-        for (int c = 0; c < 4; ++c) {
+        for (int f = 0; f < 4; ++f)
+          if (nb[f] != kNone && is_kept(nb[f] >> 2) && !mesh->tet_region.empty())
+            __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
+        for (int c = 0; c < 4; ++c) {  // it repaints a face: its nodes' positions and shades' inputs
           __builtin_prefetch(&fix[tv[c]]);
-          if (repaints) __builtin_prefetch(&cam[3 * std::size_t(tv[c])]);
+          __builtin_prefetch(&cam[3 * std::size_t(tv[c])]);
         }
       };
       for (std::size_t j = 0; j < std::min(count, kFar); ++j) look_far(j);
@@ -1650,6 +1675,7 @@ struct TetRasterizer::Impl {
         }
         if (!shows) continue;
         if (b.y0 >= 0) {
+          if (!repaints(i)) continue;
           UndrawTet u;
           gather_undrawn(t, fb.width, fb.height, u);
           shade_repainted(u);
@@ -1694,6 +1720,7 @@ struct TetRasterizer::Impl {
     }
     history.resize(first);
     drawn_box.resize(first);
+    drawn_reach.resize(first);
     for (Lane& lane : lanes) {
       lane.saves.resize(first_save(lane));
       while (!lane.regions.empty() && lane.regions.back().first_save >= lane.saves.size()) {
@@ -1747,6 +1774,7 @@ struct TetRasterizer::Impl {
     std::fill(kept.begin(), kept.end(), 0);
     history.clear();
     drawn_box.clear();
+    drawn_reach.clear();
     for (Lane& lane : lanes) lane = Lane{};
   }
 
@@ -1761,7 +1789,7 @@ struct TetRasterizer::Impl {
                          before_id.capacity()) *
                             sizeof(std::uint32_t) +
                         (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t) +
-                        drawn_box.capacity() * sizeof(SmallBox);
+                        drawn_box.capacity() * sizeof(SmallBox) + drawn_reach.capacity() * sizeof(std::uint16_t);
     for (const Lane& lane : lanes)
       bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
                    sizeof(std::uint32_t) +
