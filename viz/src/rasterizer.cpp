@@ -49,7 +49,7 @@ void run_parts(int parts, F&& f) {
   }
   for (auto& other : others) {
     try {
-      other.get();
+      pool::finish(other);
     } catch (...) {
       if (!error) error = std::current_exception();
     }

@@ -12,6 +12,10 @@ namespace foxi::pool {
 // future is ready when the task has run and carries its exception, if any.
 std::future<void> run_async(std::function<void()> task);
 
+// done.get(), after spinning a little while for it to be ready (a caller whose part ended first
+// would otherwise sleep and pay a wake-up; see thread_pool.cpp).
+void finish(std::future<void>& done);
+
 // Runs f(0) on the calling thread and f(1) on a pooled thread; returns when both are done (an
 // exception from either is rethrown, f(1)'s after f(0) has finished).
 void on_two_cores(const std::function<void(int)>& f);
