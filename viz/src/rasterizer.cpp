@@ -7,6 +7,7 @@
 #include "thread_pool.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <exception>
@@ -15,6 +16,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #ifdef __SSE2__
@@ -55,6 +57,15 @@ void run_parts(int parts, F&& f) {
     }
   }
   if (error) std::rethrow_exception(error);
+}
+
+// A spinning thread's wait: a few hundred cycles, the other threads' work left alone.
+void pause_briefly() {
+#ifdef __SSE2__
+  for (int i = 0; i < 16; ++i) _mm_pause();
+#else
+  std::this_thread::yield();
+#endif
 }
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
@@ -1586,20 +1597,20 @@ struct TetRasterizer::Impl {
                                           [](const Save& s, std::size_t at) { return s.at < at; }) -
                          lane.saves.begin());
     };
-    // One pass over the undrawn tets: they are no longer kept; their boxes, the rectangle they may
-    // change (changed_rect, the whole image if the near plane cuts one) and their work per band of
-    // rows (for the threads' split, see split_rows).
+    // One pass over the undrawn tets' boxes: the rectangle they may change (changed_rect, the whole
+    // image if the near plane cuts one) and their work per band of rows (for the threads' split, see
+    // split_rows). The threads then take them off `kept`, half each, before walking.
     const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
     std::vector<double> band_work(threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
-    boxes.resize(count);
+    const SmallBox* small_box = drawn_box.data() + first;
+    auto box_of = [small_box](std::size_t i) {
+      const SmallBox& small = small_box[i];
+      return Box{small.x0, small.x1, small.y0, small.y1};
+    };
     PixelRect rect{fb.width, fb.height, -1, -1};
     bool unknown = false;
     for (std::size_t i = 0; i < count; ++i) {
-      const std::uint32_t t = history[first + i];
-      kept[t >> 6] &= ~(std::uint64_t(1) << (t & 63));
-      const SmallBox& small = drawn_box[first + i];
-      const Box b{small.x0, small.x1, small.y0, small.y1};
-      boxes[i] = b;
+      const Box b = box_of(i);
       if (b.x0 > b.x1) continue;
       if (b.y0 < 0) {
         unknown = true;
@@ -1611,7 +1622,16 @@ struct TetRasterizer::Impl {
     changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
+    std::atomic<int> unkept{0};  // threads done taking their share of the tets off `kept`
     auto work = [&](const std::vector<int>& split, int k) {
+      for (std::size_t i = 0; i < count; ++i) {  // thread k: the words w of `kept` with w % threads == k
+        const std::uint32_t t = history[first + i];
+        if (threads == 1 || int((t >> 6) % std::uint32_t(threads)) == k) kept[t >> 6] &= ~(std::uint64_t(1) << (t & 63));
+      }
+      if (threads > 1) {  // the walk reads `kept` (first thing: nothing above throws)
+        unkept.fetch_add(1, std::memory_order_acq_rel);
+        while (unkept.load(std::memory_order_acquire) < threads) pause_briefly();
+      }
       const Rows rows{0, 1, split[std::size_t(k)], split[std::size_t(k) + 1] - 1};
       const std::uint32_t p_lo = std::uint32_t(rows.lo) * std::uint32_t(fb.width),
                           p_hi = std::uint32_t(rows.hi + 1) * std::uint32_t(fb.width);
@@ -1626,7 +1646,7 @@ struct TetRasterizer::Impl {
       const std::uint16_t* reach = drawn_reach.data() + first;
       auto repaints = [&](std::size_t j) { return reach[j] > j || reach[j] == 0xffff; };
       auto look_far = [&](std::size_t j) {
-        const Box& b = boxes[j];
+        const Box b = box_of(j);
         const bool may = b.x0 <= b.x1 && b.y0 >= 0 && rows.any(b.y0, b.y1) && !box_written(rows, b, fb.height);
         may_show[j % kRing] = may;
         if (!may || !repaints(j)) return;
@@ -1653,7 +1673,7 @@ struct TetRasterizer::Impl {
         if (i + kFar < count) look_far(i + kFar);
         if (i + kNear < count) look_near(i + kNear);
         const std::uint32_t t = history[first + i];
-        const Box& b = boxes[i];
+        const Box b = box_of(i);
         const bool shows = b.x0 <= b.x1 && (b.y0 < 0 || may_show[i % kRing]);
         for (std::size_t l = 0; l < lanes.size(); ++l) {
           const Lane& lane = lanes[l];
