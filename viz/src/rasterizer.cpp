@@ -4,6 +4,7 @@
 #include "foxi/viz/rasterizer.hpp"
 
 #include "foxi/model/adjacency.hpp"
+#include "huge_page_allocator.hpp"
 #include "thread_pool.hpp"
 
 #include <algorithm>
@@ -253,16 +254,17 @@ struct TetRasterizer::Impl {
   // Edge darkening: a pixel at distance d < edge_width from an edge is scaled by edge_base +
   // edge_slope d (1 - edge_darkness at the edge, 1 at edge_width).
   double edge_base = 1, edge_slope = 0;
-  // Per node: camera coordinates, fixed-point pixel coordinates, state (0 in front, 1 behind the
-  // near plane, 2 not finite).
-  std::vector<double> cam;
-  // Fixed-point coordinates fit 32 bits (|p| <= 4 kMaxPixel kOne = 2^30); packed with the state so
-  // that a tet's corners cost one cache line each.
-  struct NodeFix {
-    std::int32_t X = 0, Y = 0;
-    std::uint8_t state = 0;
+  // Per node, in one 32-byte record (two to a cache line: the tets a view reads at random, the undraw
+  // walk's above all, cost a line per corner): camera coordinates, fixed-point pixel coordinates
+  // (they fit 32 bits: |p| <= 4 kMaxPixel kOne = 2^30) and the state (0 in front, 1 behind the near
+  // plane, 2 not finite), the last as X = kNoPixel, Y = state where it is not 0.
+  struct alignas(32) NodeView {
+    double c[3];
+    std::int32_t X, Y;
   };
-  std::vector<NodeFix> fix;
+  static constexpr std::int32_t kNoPixel = std::numeric_limits<std::int32_t>::min();
+  std::vector<NodeView, HugePageAllocator<NodeView>> node_view;
+  const double* cam(std::uint32_t n) const { return node_view[n].c; }
   // Per draw() call, per tet of the batch (in batch order): its pixel box, filled by both threads
   // from halves of the batch so that hidden or off-band tets cost each thread a sequential read.
   struct Box {
@@ -446,14 +448,14 @@ struct TetRasterizer::Impl {
       throw std::invalid_argument("render: orthographic zoom too large for the fixed-point range (" +
                                   std::to_string(dmax * proj.scale) + " pixels)");
     }
-    cam.resize(3 * n);
-    fix.resize(n);
+    node_view.resize(n);
     auto work = [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         std::int64_t X = 0, Y = 0;
-        project_node(&m.xyz[3 * i], &cam[3 * i], X, Y, fix[i].state);
-        fix[i].X = std::int32_t(X);
-        fix[i].Y = std::int32_t(Y);
+        std::uint8_t state = 0;
+        project_node(&m.xyz[3 * i], node_view[i].c, X, Y, state);
+        node_view[i].X = state == 0 ? std::int32_t(X) : kNoPixel;
+        node_view[i].Y = state == 0 ? std::int32_t(Y) : state;
       }
     };
     if (n > 20000 && params.threads > 1) {
@@ -1024,10 +1026,8 @@ struct TetRasterizer::Impl {
   void prefetch_tet(std::uint32_t t, bool camera = false) const {
     const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
     camera = camera || params.shrink != 1;
-    for (int k = 0; k < 4; ++k) {
-      __builtin_prefetch(&fix[tv[k]]);
-      if (camera) __builtin_prefetch(&cam[3 * std::size_t(tv[k])]);
-    }
+    (void)camera;  // one record holds both
+    for (int k = 0; k < 4; ++k) __builtin_prefetch(&node_view[tv[k]]);
   }
 
   // Undoable: hints the cache about tet t's neighbours' positions in the drawing, read by
@@ -1044,18 +1044,19 @@ struct TetRasterizer::Impl {
                std::uint8_t* st) const {
     if (params.shrink == 1) {
       for (int k = 0; k < 4; ++k) {
-        std::uint32_t n = tv[k];
-        c[k] = &cam[3 * std::size_t(n)];
-        X[k] = fix[n].X;
-        Y[k] = fix[n].Y;
-        st[k] = fix[n].state;
+        const NodeView& v = node_view[tv[k]];
+        c[k] = v.c;
+        const bool in_front = v.X != kNoPixel;
+        X[k] = v.X;
+        Y[k] = v.Y;
+        st[k] = in_front ? 0 : std::uint8_t(v.Y);
       }
     } else {
       double centre[3] = {0, 0, 0};
       for (int k = 0; k < 4; ++k)
-        for (int j = 0; j < 3; ++j) centre[j] += 0.25 * cam[3 * std::size_t(tv[k]) + j];
+        for (int j = 0; j < 3; ++j) centre[j] += 0.25 * cam(tv[k])[j];
       for (int k = 0; k < 4; ++k) {
-        const double* p = &cam[3 * std::size_t(tv[k])];
+        const double* p = cam(tv[k]);
         for (int j = 0; j < 3; ++j) local[3 * k + j] = centre[j] + params.shrink * (p[j] - centre[j]);
         c[k] = &local[3 * k];
         project_camera(c[k], X[k], Y[k], st[k]);
@@ -1554,8 +1555,7 @@ struct TetRasterizer::Impl {
     for (int f = 0; f < 4; ++f) {
       if (!(u.repaint >> f & 1)) continue;
       const int a = kFace[f][0], b = kFace[f][2], d = kFace[f][1];  // reversed
-      const double* v[3] = {&cam[3 * std::size_t(u.node[a])], &cam[3 * std::size_t(u.node[b])],
-                            &cam[3 * std::size_t(u.node[d])]};
+      const double* v[3] = {cam(u.node[a]), cam(u.node[b]), cam(u.node[d])};
       const std::uint32_t node[3] = {u.node[a], u.node[b], u.node[d]};
       u.shade[f] = face_shade(u.neighbour[f] >> 2, v, node);
     }
@@ -1663,8 +1663,7 @@ struct TetRasterizer::Impl {
           if (nb[f] != kNone && is_kept(nb[f] >> 2) && !mesh->tet_region.empty())
             __builtin_prefetch(&mesh->tet_region[nb[f] >> 2]);
         for (int c = 0; c < 4; ++c) {  // it repaints a face: its nodes' positions and shades' inputs
-          __builtin_prefetch(&fix[tv[c]]);
-          __builtin_prefetch(&cam[3 * std::size_t(tv[c])]);
+          __builtin_prefetch(&node_view[tv[c]]);
         }
       };
       for (std::size_t j = 0; j < std::min(count, kFar); ++j) look_far(j);
@@ -1723,8 +1722,7 @@ struct TetRasterizer::Impl {
           const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
           const auto& face = kFace[nb & 3];
           const std::uint32_t node[3] = {nv[face[0]], nv[face[1]], nv[face[2]]};
-          const double* v[3] = {&cam[3 * std::size_t(node[0])], &cam[3 * std::size_t(node[1])],
-                                &cam[3 * std::size_t(node[2])]};
+          const double* v[3] = {cam(node[0]), cam(node[1]), cam(node[2])};
           draw_face(fb, rows, nb >> 2, v, node, poly, n, false);
         });
       }
