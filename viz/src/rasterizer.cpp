@@ -1624,9 +1624,14 @@ struct TetRasterizer::Impl {
     // undrawn tets' faces there, walked in drawing order.
     std::atomic<int> unkept{0};  // threads done taking their share of the tets off `kept`
     auto work = [&](const std::vector<int>& split, int k) {
-      for (std::size_t i = 0; i < count; ++i) {  // thread k: the words w of `kept` with w % threads == k
-        const std::uint32_t t = history[first + i];
-        if (threads == 1 || int((t >> 6) % std::uint32_t(threads)) == k) kept[t >> 6] &= ~(std::uint64_t(1) << (t & 63));
+      {  // thread k: the tets t whose word of `kept` is in [w_lo, w_hi)
+        const std::size_t words = kept.size();
+        const std::uint32_t w_lo = std::uint32_t(words * std::size_t(k) / std::size_t(threads)),
+                            w_hi = std::uint32_t(words * std::size_t(k + 1) / std::size_t(threads));
+        for (std::size_t i = 0; i < count; ++i) {
+          const std::uint32_t t = history[first + i], w = t >> 6;
+          if (w >= w_lo && w < w_hi) kept[w] &= ~(std::uint64_t(1) << (t & 63));
+        }
       }
       if (threads > 1) {  // the walk reads `kept` (first thing: nothing above throws)
         unkept.fetch_add(1, std::memory_order_acq_rel);
