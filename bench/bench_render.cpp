@@ -9,14 +9,15 @@
 //                     faces); counter undo_MB = memory held for undraw after the whole mesh is drawn
 //   undraw_front10    (after an untimed undoable draw of all tets) undraw the front 10% of the order
 //                     in 10 frames of 1%, back to back, each frame presented as a display would (the
-//                     rectangle it changed, changed_rect, copied into the displayed image); counters
+//                     rectangles it changed, changed_rects, copied into the displayed image); counters
 //                     ms_per_frame, tets_per_s (tets undrawn), undo_MB, and the issue 4 target
 //                     (undrawing the 10 frames in at most a fifth of a full redraw): redraw_ms, a
 //                     painter_draw of the same view in the same iteration (outside the timing), and
 //                     ratio = undraw time / redraw time, wall clock (cpu_ratio: process CPU time).
 //                     The first view's frames are replayed untimed to count px_per_frame (pixels a
 //                     frame changes, colour or id: the work a frame must do), rect_px_per_frame (the
-//                     rectangle presented) and shown_wrong_px (displayed pixels unlike the frame: 0).
+//                     rectangles presented; union_px_per_frame: changed_rect's area) and
+//                     shown_wrong_px (displayed pixels unlike the frame: 0).
 // Times are process CPU time (all threads) and real time.
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-5 (~100k tets) and a4e-6 (~0.97M tets). The camera
 // is fitted to the box from an oblique direction (the mesh fills about 90% of the image height) and
@@ -102,13 +103,13 @@ void run(benchmark::State& state, bool depth, bool with_order, double shrink, in
   counters(state, c);
 }
 
-// A display's update after a frame: the rectangle of fb the last call changed, copied into `shown`
-// (what the display holds) row by row, as XPutImage of a sub-image would.
-void present(const Framebuffer& fb, const PixelRect& rect, Framebuffer& shown) {
-  if (rect.x0 > rect.x1) return;
-  for (int y = rect.y0; y <= rect.y1; ++y)
-    std::copy_n(fb.rgba.begin() + std::ptrdiff_t(fb.index(rect.x0, y)), rect.x1 - rect.x0 + 1,
-                shown.rgba.begin() + std::ptrdiff_t(shown.index(rect.x0, y)));
+// A display's update after a frame: the rectangles of fb the last call changed, copied into `shown`
+// (what the display holds) row by row, as XPutImage of sub-images would.
+void present(const Framebuffer& fb, std::span<const PixelRect> rects, Framebuffer& shown) {
+  for (const PixelRect& rect : rects)
+    for (int y = rect.y0; y <= rect.y1; ++y)
+      std::copy_n(fb.rgba.begin() + std::ptrdiff_t(fb.index(rect.x0, y)), rect.x1 - rect.x0 + 1,
+                  shown.rgba.begin() + std::ptrdiff_t(shown.index(rect.x0, y)));
 }
 
 // The whole order drawn undoably (timed or not), then (undraw) the front 10% undrawn in 10 frames.
@@ -117,7 +118,7 @@ void run_undo(benchmark::State& state, bool undraw) {
   RenderParams params;
   params.undoable = true;
   Framebuffer fb(kWidth, kHeight), shown(kWidth, kHeight), before(kWidth, kHeight);
-  std::size_t i = 0, undo_bytes = 0, changed = 0, mismatch = 0, presented = 0;
+  std::size_t i = 0, undo_bytes = 0, changed = 0, mismatch = 0, presented = 0, union_px = 0;
   double undraw_ms = 0, undraw_cpu_ms = 0, redraw_ms = 0, redraw_cpu_ms = 0;
   std::vector<std::uint32_t> order;
   constexpr int kFrames = 10;
@@ -155,10 +156,12 @@ void run_undo(benchmark::State& state, bool undraw) {
         const double c0 = process_cpu_ms();
         for (int f = 0; f < kFrames; ++f) {
           r->undraw(fb, step);
-          present(fb, r->changed_rect(), shown);  // the frame shown
+          present(fb, r->changed_rects(), shown);  // the frame shown
           if (timed) continue;
-          const PixelRect rect = r->changed_rect();
-          if (rect.x0 <= rect.x1) presented += std::size_t(rect.x1 - rect.x0 + 1) * std::size_t(rect.y1 - rect.y0 + 1);
+          for (const PixelRect& rect : r->changed_rects())
+            presented += std::size_t(rect.x1 - rect.x0 + 1) * std::size_t(rect.y1 - rect.y0 + 1);
+          const PixelRect all = r->changed_rect();
+          if (all.x0 <= all.x1) union_px += std::size_t(all.x1 - all.x0 + 1) * std::size_t(all.y1 - all.y0 + 1);
           for (std::size_t p = 0; p < fb.id.size(); ++p) {
             changed += fb.id[p] != before.id[p] || fb.rgba[p] != before.rgba[p];
             mismatch += fb.rgba[p] != shown.rgba[p];
@@ -195,6 +198,7 @@ void run_undo(benchmark::State& state, bool undraw) {
     state.counters["ratio"] = undraw_ms / redraw_ms;
     state.counters["cpu_ratio"] = undraw_cpu_ms / redraw_cpu_ms;
     state.counters["rect_px_per_frame"] = double(presented) / kFrames;
+    state.counters["union_px_per_frame"] = double(union_px) / kFrames;
     state.counters["shown_wrong_px"] = double(mismatch);  // displayed pixels unlike fb: must be 0
   }
 }

@@ -199,17 +199,39 @@ std::size_t changes_outside(const Framebuffer& before, const Framebuffer& after,
   return outside;
 }
 
+// The changed pixels outside every rectangle of `rects`, checking that the rectangles are disjoint,
+// in row order and inside `bound`; `area` adds up theirs.
+std::size_t changes_outside_rects(const Framebuffer& before, const Framebuffer& after,
+                                  std::span<const PixelRect> rects, const PixelRect& bound, std::size_t& area) {
+  std::vector<std::uint8_t> covered(after.rgba.size(), 0);
+  int last_y1 = -1;
+  for (const PixelRect& r : rects) {
+    EXPECT_TRUE(r.x0 <= r.x1 && r.y0 <= r.y1) << "an empty rectangle";
+    EXPECT_TRUE(r.x0 >= bound.x0 && r.x1 <= bound.x1 && r.y0 >= bound.y0 && r.y1 <= bound.y1) << "outside changed_rect";
+    EXPECT_GT(r.y0, last_y1) << "rectangles overlap or are out of row order";
+    last_y1 = r.y1;
+    area += std::size_t(r.x1 - r.x0 + 1) * std::size_t(r.y1 - r.y0 + 1);
+    for (int y = std::max(r.y0, 0); y <= std::min(r.y1, after.height - 1); ++y)
+      for (int x = std::max(r.x0, 0); x <= std::min(r.x1, after.width - 1); ++x) covered[after.index(x, y)] = 1;
+  }
+  std::size_t outside = 0;
+  for (std::size_t i = 0; i < covered.size(); ++i)
+    outside += !covered[i] && (after.rgba[i] != before.rgba[i] || after.id[i] != before.id[i]);
+  return outside;
+}
+
 // changed_rect() after each draw() and undraw() (batches of random sizes, painter undoable, plain
 // painter and depth-buffer mode; eyes outside and inside, so that some tets are cut by the near
 // plane) holds every pixel the call changed, found by comparing the picture before and after; it is
-// empty after an empty call and inside the image.
+// empty after an empty call and inside the image. So do changed_rects() (disjoint, inside
+// changed_rect), and after some undraws they cover less than changed_rect.
 TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
   test::TempDir dir;
   Mesh m = test::random_delaunay(dir, 700, 89, 2, 1, 1);
   test::regions_along_x(m, 0.7, 1.3);
   const SphereTable table = compute_spheres(m);
   std::mt19937 rng(31);
-  std::size_t changed_calls = 0, partial_calls = 0;
+  std::size_t changed_calls = 0, partial_calls = 0, tighter_calls = 0;
   for (const Camera& cam : test::random_cameras(m, 6, 37, double(kW) / kH)) {
     const auto order = visibility_order(m, table, view_of(cam));
     const std::span<const std::uint32_t> all(order);
@@ -228,6 +250,12 @@ TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
           partial_calls += (rect.x1 - rect.x0 + 1) * (rect.y1 - rect.y0 + 1) < kW * kH;
         }
         changed_calls += changed > 0;
+        std::size_t area = 0;
+        EXPECT_EQ(changes_outside_rects(before, fb, r.changed_rects(), rect, area), 0u) << what << " mode " << mode;
+        if (rect.x0 > rect.x1) {
+          EXPECT_TRUE(r.changed_rects().empty());
+        }
+        if (rect.x0 <= rect.x1) tighter_calls += area < std::size_t(rect.x1 - rect.x0 + 1) * std::size_t(rect.y1 - rect.y0 + 1);
       };
       std::size_t at = 0;
       for (std::size_t s : random_cuts(order.size(), 1 + order.size() / 6, rng)) {
@@ -246,8 +274,10 @@ TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
       }
       r.undraw(fb, 0);
       EXPECT_GT(r.changed_rect().x0, r.changed_rect().x1) << "an empty undraw changes nothing";
+      EXPECT_TRUE(r.changed_rects().empty());
     }
   }
+  EXPECT_GT(tighter_calls, 5u) << "undraw's rectangles should often be tighter than changed_rect";
   EXPECT_GT(changed_calls, 50u);
   EXPECT_GT(partial_calls, 20u) << "some calls should change less than the whole image";
 }
@@ -272,8 +302,9 @@ TEST(Undraw, LongUndrawInPartsEqualsDrawingFromScratch) {
     const Framebuffer fresh = render_tets(m, cam, kW, kH, all.first(j));
     EXPECT_EQ(fb.rgba, fresh.rgba);
     EXPECT_EQ(fb.id, fresh.id);
-    std::size_t changed = 0;
+    std::size_t changed = 0, area = 0;
     EXPECT_EQ(changes_outside(before, fb, r.changed_rect(), changed), 0u);
+    EXPECT_EQ(changes_outside_rects(before, fb, r.changed_rects(), r.changed_rect(), area), 0u);
     EXPECT_GT(changed, std::size_t(kW * kH / 20)) << "the undraw should change the picture";
   }
 }

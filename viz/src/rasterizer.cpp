@@ -349,6 +349,13 @@ struct TetRasterizer::Impl {
     FaceShade shade[4];              // repaint face f: that tet's front face's flat colour
   };
   PixelRect changed;  // see changed_rect
+  // See changed_rects; during an undraw, per band of 16 rows the x-extent of the undrawn tets' boxes.
+  std::vector<PixelRect> changed_list;
+  std::vector<int> band_x0, band_x1;
+  void changed_is_one_rect() {
+    changed_list.clear();
+    if (changed.x0 <= changed.x1) changed_list.push_back(changed);
+  }
 
   Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
       : mesh(&m), proj(c, w, h), params(p) {
@@ -1250,6 +1257,7 @@ struct TetRasterizer::Impl {
     if (!params.undoable) {
       draw_batch(fb, tets);
       if (!reverse) changed = boxes_union(tets.size());  // the painter's clear_mask found it
+      changed_is_one_rect();
       return;
     }
     // Undoable: positions first (a back face is shared with a tet drawn earlier), then one
@@ -1278,6 +1286,7 @@ struct TetRasterizer::Impl {
     }
     clear_mask(tets.size());
     recording = false;
+    changed_is_one_rect();
     for (Lane& lane : lanes)
       if (lane.saves.size() == lane.regions.back().first_save) lane.regions.pop_back();
   }
@@ -1574,6 +1583,9 @@ struct TetRasterizer::Impl {
     // rectangle the union of the parts'.
     constexpr std::size_t kUndrawPart = std::size_t(1) << 16;
     PixelRect all{proj.width, proj.height, -1, -1};
+    const std::size_t bands = std::size_t((proj.height + (1 << kBandShift) - 1) >> kBandShift);
+    band_x0.assign(bands, proj.width);
+    band_x1.assign(bands, -1);
     while (count > 0) {
       const std::size_t part = std::min(count, kUndrawPart);
       undraw_part(fb, part);
@@ -1583,6 +1595,24 @@ struct TetRasterizer::Impl {
                       std::max(all.y1, changed.y1)};
     }
     changed = all.x0 <= all.x1 ? all : PixelRect{};
+    // The changed bands' rectangles (the whole image if the near plane cut a tet), consecutive bands
+    // of the same extent as one.
+    if (changed.x0 > changed.x1 || (changed.x0 == 0 && changed.y0 == 0 && changed.x1 == proj.width - 1 &&
+                                    changed.y1 == proj.height - 1)) {
+      changed_is_one_rect();
+      return;
+    }
+    changed_list.clear();
+    for (std::size_t band = 0; band < bands; ++band) {
+      if (band_x0[band] > band_x1[band]) continue;
+      const int y0 = std::max(int(band) << kBandShift, changed.y0);
+      const int y1 = std::min(((int(band) + 1) << kBandShift) - 1, changed.y1);
+      PixelRect* last = changed_list.empty() ? nullptr : &changed_list.back();
+      if (last && last->x0 == band_x0[band] && last->x1 == band_x1[band] && last->y1 + 1 == y0)
+        last->y1 = y1;
+      else
+        changed_list.push_back(PixelRect{band_x0[band], y0, band_x1[band], y1});
+    }
   }
 
   // undraw of count > 0 tets, at most kUndrawPart.
@@ -1617,6 +1647,10 @@ struct TetRasterizer::Impl {
         continue;
       }
       rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1), std::max(rect.y1, b.y1)};
+      for (int band = b.y0 >> kBandShift; band <= b.y1 >> kBandShift; ++band) {
+        band_x0[std::size_t(band)] = std::min(band_x0[std::size_t(band)], b.x0);
+        band_x1[std::size_t(band)] = std::max(band_x1[std::size_t(band)], b.x1);
+      }
       if (threads > 1) add_band_work(band_work, b);
     }
     changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
@@ -1837,6 +1871,7 @@ std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_-
 std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_pixels(); }
 std::size_t TetRasterizer::undo_bytes() const { return impl_->undo_bytes(); }
 PixelRect TetRasterizer::changed_rect() const { return impl_->changed; }
+std::span<const PixelRect> TetRasterizer::changed_rects() const { return impl_->changed_list; }
 void TetRasterizer::forget_drawn() { impl_->forget(); }
 
 Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
