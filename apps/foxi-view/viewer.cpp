@@ -84,22 +84,45 @@ Viewer::Viewer(const Mesh& mesh, const Camera& camera, int width, int height, co
   params_.depth_buffer = !delaunay_;
   params_.undoable = delaunay_ && params.undoable;  // the painter can undraw, if asked to record
   fb_.resize(width_, height_, params_.depth_buffer);
-  damage_ = PixelRect{0, 0, width_ - 1, height_ - 1};
+  damage_all();
 }
 
 Viewer::~Viewer() = default;
 
-void Viewer::add_damage(const PixelRect& r) {
-  if (r.x0 > r.x1) return;
-  if (damage_.x0 > damage_.x1) {
-    damage_ = r;
-    return;
+constexpr int kDamageBand = 16;  // rows
+
+void Viewer::add_damage(std::span<const PixelRect> rects) {
+  damage_.resize(std::size_t((height_ + kDamageBand - 1) / kDamageBand));
+  for (const PixelRect& r : rects) {
+    if (r.x0 > r.x1 || r.y0 > r.y1) continue;
+    for (int band = std::max(r.y0, 0) / kDamageBand; band <= std::min(r.y1, height_ - 1) / kDamageBand; ++band) {
+      PixelRect& d = damage_[std::size_t(band)];
+      const int y0 = std::max(r.y0, band * kDamageBand), y1 = std::min(r.y1, band * kDamageBand + kDamageBand - 1);
+      d = d.x0 > d.x1 ? PixelRect{r.x0, y0, r.x1, y1}
+                      : PixelRect{std::min(d.x0, r.x0), std::min(d.y0, y0), std::max(d.x1, r.x1), std::max(d.y1, y1)};
+    }
   }
-  damage_ = PixelRect{std::min(damage_.x0, r.x0), std::min(damage_.y0, r.y0), std::max(damage_.x1, r.x1),
-                      std::max(damage_.y1, r.y1)};
 }
 
-PixelRect Viewer::take_damage() { return std::exchange(damage_, PixelRect{}); }
+void Viewer::damage_all() {
+  damage_.clear();
+  const PixelRect all{0, 0, width_ - 1, height_ - 1};
+  add_damage(std::span<const PixelRect>(&all, 1));
+}
+
+std::vector<PixelRect> Viewer::take_damage() {
+  std::vector<PixelRect> rects;
+  for (PixelRect& d : damage_) {
+    if (d.x0 <= d.x1) {
+      if (!rects.empty() && rects.back().x0 == d.x0 && rects.back().x1 == d.x1 && rects.back().y1 + 1 == d.y0)
+        rects.back().y1 = d.y1;  // whole bands of the same extent as one
+      else
+        rects.push_back(d);
+    }
+    d = PixelRect{};
+  }
+  return rects;
+}
 
 std::span<const std::uint32_t> Viewer::current_subset() const {
   if (stack_.empty()) return {};
@@ -120,7 +143,7 @@ void Viewer::begin_draw() {
   else
     mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
   fb_.resize(width_, height_, params_.depth_buffer);
-  damage_ = PixelRect{0, 0, width_ - 1, height_ - 1};
+  damage_all();
   drawn_.clear();
   handed_.clear();
   done_ = false;
@@ -161,7 +184,7 @@ bool Viewer::step() {
     return false;
   }
   raster_->draw(fb_, batch);
-  add_damage(raster_->changed_rect());
+  add_damage(raster_->changed_rects());
   drawn_.insert(drawn_.end(), batch.begin(), batch.end());
   step_ms_ = ms_since(t0);
   frame_ms_ += step_ms_;
@@ -182,7 +205,7 @@ std::size_t Viewer::undraw(std::size_t count) {
   if (!params_.undoable || !raster_) return 0;
   const std::size_t n = std::min(count, drawn_.size());
   raster_->undraw(fb_, n);
-  add_damage(raster_->changed_rect());
+  add_damage(raster_->changed_rects());
   drawn_.resize(drawn_.size() - n);
   if (n > 0) done_ = false;
   return n;

@@ -67,9 +67,10 @@ class Viewer {
 
   const Camera& camera() const { return camera_; }
   const Framebuffer& framebuffer() const { return fb_; }
-  // The part of the framebuffer changed since the last call (all of it after a draw restarts or a
-  // resize; empty if nothing changed): what a display must update.
-  PixelRect take_damage();
+  // The parts of the framebuffer changed since the last call, as disjoint rectangles in row order
+  // (all of it after a draw restarts or a resize; none if nothing changed): what a display must
+  // update. Per band of 16 rows, the box of what the draw and undraw steps changed there.
+  std::vector<PixelRect> take_damage();
   // The tets drawn in the current draw, in drawing order.
   const std::vector<std::uint32_t>& drawn() const { return drawn_; }
   std::size_t total() const;  // tets in the current draw's order
@@ -105,8 +106,9 @@ class Viewer {
   std::size_t mpvo_pos_ = 0;
   std::unique_ptr<TetRasterizer> raster_;
   Framebuffer fb_;
-  PixelRect damage_;  // see take_damage
-  void add_damage(const PixelRect& r);
+  std::vector<PixelRect> damage_;  // see take_damage: per band of 16 rows (x0 > x1: none)
+  void add_damage(std::span<const PixelRect> rects);
+  void damage_all();
   std::vector<std::uint32_t> drawn_;    // the prefix of handed_ on the screen
   std::vector<std::uint32_t> handed_;   // the order as far as it has been handed out
   bool done_ = true, running_ = true, started_ = false, undrawing_ = false;

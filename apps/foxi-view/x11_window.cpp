@@ -209,8 +209,11 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
   auto show = [&] {
     // Only what changed since the last show, unless the window needs all of it.
     const Framebuffer& fb = viewer.framebuffer();
-    const PixelRect damage = viewer.take_damage();
-    screen.put(win, gc, fb, exposed ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : damage);
+    const std::vector<PixelRect> damage = viewer.take_damage();
+    if (exposed)
+      screen.put(win, gc, fb, PixelRect{0, 0, fb.width - 1, fb.height - 1});
+    else
+      for (const PixelRect& rect : damage) screen.put(win, gc, fb, rect);
     exposed = false;
     draw_status();
     XSync(dpy, False);  // the server has read the shared image before the next batch changes it
