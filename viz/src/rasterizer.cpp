@@ -1629,7 +1629,7 @@ struct TetRasterizer::Impl {
     };
     // One pass over the undrawn tets' boxes: the rectangle they may change (changed_rect, the whole
     // image if the near plane cuts one) and their work per band of rows (for the threads' split, see
-    // split_rows). The threads then take them off `kept`, half each, before walking.
+    // split_rows). The first thread then takes them off `kept` while the others wake up.
     const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
     std::vector<double> band_work(threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
     const SmallBox* small_box = drawn_box.data() + first;
@@ -1656,20 +1656,18 @@ struct TetRasterizer::Impl {
     changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
-    std::atomic<int> unkept{0};  // threads done taking their share of the tets off `kept`
+    std::atomic<int> unkept{0};  // 1 once the undrawn tets are off `kept`
     auto work = [&](const std::vector<int>& split, int k) {
-      {  // thread k: the tets t whose word of `kept` is in [w_lo, w_hi)
-        const std::size_t words = kept.size();
-        const std::uint32_t w_lo = std::uint32_t(words * std::size_t(k) / std::size_t(threads)),
-                            w_hi = std::uint32_t(words * std::size_t(k + 1) / std::size_t(threads));
+      // Thread 0 (the caller's) takes the tets off `kept` while the others wake up, then all wait
+      // for that: the walk reads `kept` (first thing: nothing above the wait throws).
+      if (k == 0)
         for (std::size_t i = 0; i < count; ++i) {
-          const std::uint32_t t = history[first + i], w = t >> 6;
-          if (w >= w_lo && w < w_hi) kept[w] &= ~(std::uint64_t(1) << (t & 63));
+          const std::uint32_t t = history[first + i];
+          kept[t >> 6] &= ~(std::uint64_t(1) << (t & 63));
         }
-      }
-      if (threads > 1) {  // the walk reads `kept` (first thing: nothing above throws)
-        unkept.fetch_add(1, std::memory_order_acq_rel);
-        while (unkept.load(std::memory_order_acquire) < threads) pause_briefly();
+      if (threads > 1) {
+        if (k == 0) unkept.store(1, std::memory_order_release);
+        while (unkept.load(std::memory_order_acquire) == 0) pause_briefly();
       }
       const Rows rows{0, 1, split[std::size_t(k)], split[std::size_t(k) + 1] - 1};
       const std::uint32_t p_lo = std::uint32_t(rows.lo) * std::uint32_t(fb.width),
