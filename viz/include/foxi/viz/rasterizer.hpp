@@ -93,7 +93,7 @@ class TetRasterizer {
   std::span<const std::uint32_t> drawn_tets() const;  // undoable: the tets drawn, in order
   std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
   std::size_t undo_bytes() const;  // undoable: memory held for undraw (bytes; saved pixels 12 each,
-                                   // 12 per drawn tet (its index and pixel box), 4 and a bit per mesh
+                                   // 14 per drawn tet (its index, pixel box and repaint reach), 4 and a bit per mesh
                                    // tet, per-image buffers of 12 bytes and 2 bits a pixel)
   // Holds every pixel the last draw() or undraw() call changed (a display need present only these;
   // empty before the first call and after an empty one): the union of the pixel boxes of the tets it
