@@ -39,16 +39,20 @@ constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
 // Runs f(0), ..., f(parts - 1): f(0) on the calling thread, the others on pooled threads (starting a
 // thread per call would cost tens of microseconds each, per frame); returns when all are done,
-// rethrowing the first exception.
-template <class F>
-void run_parts(int parts, F&& f) {
+// rethrowing the first exception. not_started() is called if f(0) will not run because a part could
+// not be handed to a thread (parts already running may be waiting for f(0): it must let them go).
+template <class F, class G>
+void run_parts(int parts, F&& f, G&& not_started) {
   std::vector<std::future<void>> others;
   std::exception_ptr error;
+  bool posted = false;
   try {
     for (int k = 1; k < parts; ++k) others.push_back(pool::run_async([&f, k] { f(k); }));
+    posted = true;
     f(0);
   } catch (...) {
     error = std::current_exception();
+    if (!posted) not_started();
   }
   for (auto& other : others) {
     try {
@@ -58,6 +62,12 @@ void run_parts(int parts, F&& f) {
     }
   }
   if (error) std::rethrow_exception(error);
+}
+
+// The same when no part waits for another.
+template <class F>
+void run_parts(int parts, F&& f) {
+  run_parts(parts, f, [] {});
 }
 
 // A spinning thread's wait: a few hundred cycles, the other threads' work left alone.
@@ -1656,7 +1666,7 @@ struct TetRasterizer::Impl {
     changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
-    std::atomic<int> unkept{0};  // 1 once the undrawn tets are off `kept`
+    std::atomic<int> unkept{0};  // 1 once the undrawn tets are off `kept`, 2 if that will not happen
     auto work = [&](const std::vector<int>& split, int k) {
       // Thread 0 (the caller's) takes the tets off `kept` while the others wake up, then all wait
       // for that: the walk reads `kept` (first thing: nothing above the wait throws).
@@ -1667,7 +1677,9 @@ struct TetRasterizer::Impl {
         }
       if (threads > 1) {
         if (k == 0) unkept.store(1, std::memory_order_release);
-        while (unkept.load(std::memory_order_acquire) == 0) pause_briefly();
+        int state;
+        while ((state = unkept.load(std::memory_order_acquire)) == 0) pause_briefly();
+        if (state == 2) return;  // thread 0 will not run (a part could not be handed out)
       }
       const Rows rows{0, 1, split[std::size_t(k)], split[std::size_t(k) + 1] - 1};
       const std::uint32_t p_lo = std::uint32_t(rows.lo) * std::uint32_t(fb.width),
@@ -1771,7 +1783,7 @@ struct TetRasterizer::Impl {
       work({0, fb.height}, 0);
     } else {
       const std::vector<int> split = split_rows(band_work, threads, fb.height);
-      run_parts(threads, [&](int k) { work(split, k); });
+      run_parts(threads, [&](int k) { work(split, k); }, [&] { unkept.store(2, std::memory_order_release); });
     }
     history.resize(first);
     drawn_box.resize(first);
