@@ -17,7 +17,6 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <type_traits>
 #include <utility>
 #ifdef __SSE2__
@@ -68,15 +67,6 @@ void run_parts(int parts, F&& f, G&& not_started) {
 template <class F>
 void run_parts(int parts, F&& f) {
   run_parts(parts, f, [] {});
-}
-
-// A spinning thread's wait: a few hundred cycles, the other threads' work left alone.
-void pause_briefly() {
-#ifdef __SSE2__
-  for (int i = 0; i < 16; ++i) _mm_pause();
-#else
-  std::this_thread::yield();
-#endif
 }
 
 std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
@@ -1038,12 +1028,9 @@ struct TetRasterizer::Impl {
     return box;
   }
 
-  // Hints the cache about tet t's corners (the batch order jumps around the mesh), their camera
-  // coordinates too if `camera`.
-  void prefetch_tet(std::uint32_t t, bool camera = false) const {
+  // Hints the cache about tet t's corners (the batch order jumps around the mesh): their node records.
+  void prefetch_tet(std::uint32_t t) const {
     const std::uint32_t* tv = &mesh->tet[4 * std::size_t(t)];
-    camera = camera || params.shrink != 1;
-    (void)camera;  // one record holds both
     for (int k = 0; k < 4; ++k) __builtin_prefetch(&node_view[tv[k]]);
   }
 
@@ -1678,7 +1665,7 @@ struct TetRasterizer::Impl {
       if (threads > 1) {
         if (k == 0) unkept.store(1, std::memory_order_release);
         int state;
-        while ((state = unkept.load(std::memory_order_acquire)) == 0) pause_briefly();
+        while ((state = unkept.load(std::memory_order_acquire)) == 0) pool::relax();
         if (state == 2) return;  // thread 0 will not run (a part could not be handed out)
       }
       const Rows rows{0, 1, split[std::size_t(k)], split[std::size_t(k) + 1] - 1};

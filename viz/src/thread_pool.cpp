@@ -24,13 +24,6 @@ namespace {
 // pool every few hundred microseconds. The spin yields the CPU to any other runnable thread.
 constexpr auto kSpin = std::chrono::microseconds(300);
 
-void relax() {
-#if defined(__x86_64__) || defined(__i386__)
-  for (int i = 0; i < 16; ++i) _mm_pause();
-#endif
-  sched_yield();
-}
-
 // Spins until ready() or kSpin has passed; returns ready().
 template <class Ready>
 bool spin_for(Ready&& ready) {
@@ -137,6 +130,13 @@ Pool& the_pool() {
 }
 
 }  // namespace
+
+void relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  for (int i = 0; i < 16; ++i) _mm_pause();
+#endif
+  sched_yield();
+}
 
 std::future<void> run_async(std::function<void()> task) { return the_pool().run(std::move(task)); }
 

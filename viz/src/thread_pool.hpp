@@ -12,6 +12,10 @@ namespace foxi::pool {
 // future is ready when the task has run and carries its exception, if any.
 std::future<void> run_async(std::function<void()> task);
 
+// One step of a spinning wait: a few hundred cycles, then the CPU offered to any other runnable
+// thread.
+void relax();
+
 // done.get(), after spinning a little while for it to be ready (a caller whose part ended first
 // would otherwise sleep and pay a wake-up; see thread_pool.cpp).
 void finish(std::future<void>& done);
