@@ -1002,32 +1002,29 @@ struct TetRasterizer::Impl {
         cover &= _mm512_cmp_pd_mask(e0, at_least[0], _CMP_GE_OQ);
         cover &= _mm512_cmp_pd_mask(e1, at_least[1], _CMP_GE_OQ);
         cover &= _mm512_cmp_pd_mask(e2, at_least[2], _CMP_GE_OQ);
-        if (!cover) continue;
+        // The mask's 8 bits at x (they may run into the next word), then all covered set; no branch
+        // on the data (a pixel already written, or none covered, is a lane the stores skip).
         const int w = x >> 6, shift = x & 63;
-        const bool spills = shift > 56 && w + 1 < mask_words;
-        std::uint64_t set = done[w] >> shift;
-        if (spills) set |= done[w + 1] << (64 - shift);
+        std::uint64_t past_row = 0;
+        std::uint64_t* next = w + 1 < mask_words ? &done[w + 1] : &past_row;
+        const std::uint64_t set = (done[w] >> shift) | ((*next << 1) << (63 - shift));
         done[w] |= std::uint64_t(cover) << shift;
-        if (spills) done[w + 1] |= std::uint64_t(cover) >> (64 - shift);
+        *next |= (std::uint64_t(cover) >> 1) >> (63 - shift);
         const __mmask8 todo = __mmask8(cover & ~set);
-        if (!todo) continue;
         const __m512d d = _mm512_min_pd(_mm512_min_pd(_mm512_mul_pd(e0, inv[0]), _mm512_mul_pd(e1, inv[1])),
                                         _mm512_mul_pd(e2, inv[2]));
         const __mmask8 dark = _mm512_cmp_pd_mask(d, width, _CMP_LT_OQ);
-        __m256i out = color;
-        if (dark & todo) {
-          const __m256 f = _mm512_cvtpd_ps(_mm512_add_pd(base, _mm512_mul_pd(slope, _mm512_max_pd(d, zero))));
-          __m256i cr = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(r, f), half));
-          __m256i cg = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(g, f), half));
-          __m256i cb = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(b, f), half));
-          // Saturated to bytes as darkened() does.
-          cr = _mm256_min_epi32(_mm256_max_epi32(cr, none), byte_max);
-          cg = _mm256_min_epi32(_mm256_max_epi32(cg, none), byte_max);
-          cb = _mm256_min_epi32(_mm256_max_epi32(cb, none), byte_max);
-          const __m256i px_dark = _mm256_or_si256(_mm256_or_si256(cr, _mm256_slli_epi32(cg, 8)),
-                                                  _mm256_or_si256(_mm256_slli_epi32(cb, 16), alpha));
-          out = _mm256_mask_blend_epi32(dark, color, px_dark);
-        }
+        const __m256 f = _mm512_cvtpd_ps(_mm512_add_pd(base, _mm512_mul_pd(slope, _mm512_max_pd(d, zero))));
+        __m256i cr = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(r, f), half));
+        __m256i cg = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(g, f), half));
+        __m256i cb = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(b, f), half));
+        // Saturated to bytes as darkened() does.
+        cr = _mm256_min_epi32(_mm256_max_epi32(cr, none), byte_max);
+        cg = _mm256_min_epi32(_mm256_max_epi32(cg, none), byte_max);
+        cb = _mm256_min_epi32(_mm256_max_epi32(cb, none), byte_max);
+        const __m256i px_dark = _mm256_or_si256(_mm256_or_si256(cr, _mm256_slli_epi32(cg, 8)),
+                                                _mm256_or_si256(_mm256_slli_epi32(cb, 16), alpha));
+        const __m256i out = _mm256_mask_blend_epi32(dark, color, px_dark);
         _mm256_mask_storeu_epi32(rgba + x, todo, out);
         _mm256_mask_storeu_epi32(id + x, todo, tet);
       }
