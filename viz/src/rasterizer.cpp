@@ -1766,11 +1766,18 @@ struct TetRasterizer::Impl {
         continue;
       }
       rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1), std::max(rect.y1, b.y1)};
-      for (int band = b.y0 >> kBandShift; band <= b.y1 >> kBandShift; ++band) {
+      // The box's first and last band (often the same), then any between: no branch on its height.
+      const int band_a = b.y0 >> kBandShift, band_b = b.y1 >> kBandShift;
+      band_x0[std::size_t(band_a)] = std::min(band_x0[std::size_t(band_a)], b.x0);
+      band_x1[std::size_t(band_a)] = std::max(band_x1[std::size_t(band_a)], b.x1);
+      band_x0[std::size_t(band_b)] = std::min(band_x0[std::size_t(band_b)], b.x0);
+      band_x1[std::size_t(band_b)] = std::max(band_x1[std::size_t(band_b)], b.x1);
+      for (int band = band_a + 1; band < band_b; ++band) {
         band_x0[std::size_t(band)] = std::min(band_x0[std::size_t(band)], b.x0);
         band_x1[std::size_t(band)] = std::max(band_x1[std::size_t(band)], b.x1);
       }
-      if (threads > 1) add_band_work(band_work, b);
+      // The threads' split needs only an estimate of each band's work: every 8th box's.
+      if (threads > 1 && i % 8 == 0) add_band_work(band_work, b);
     }
     changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
