@@ -933,7 +933,7 @@ struct TetRasterizer::Impl {
   // raster_triangle covers and shade_row writes, with the same bits, eight at a time. Line k is edge
   // k's coverage function without the top-left bias, so a pixel is covered when every line's value is
   // at least 0 (top-left edges) or 1 (the others); the colour goes through edge_pixels_x4's
-  // operations (no FMA: the file is built without contraction). A row's candidate pixels come from a
+  // operations (no FMA: viz is built with -ffp-contract=off). A row's candidate pixels come from a
   // floating-point bound on each edge, widened to whole pixels, then tested exactly.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
