@@ -117,6 +117,10 @@ struct Rows {
 // Calls fn(y, x_first, x_last) for every row run of pixels whose centres the triangle covers under the
 // top-left rule; the triangle must have positive area: (x1 - x0)(y2 - y0) - (y1 - y0)(x2 - x0) > 0 (clockwise
 // on the screen, y down). Only rows owned by `rows` are visited.
+// The top-left rule: an edge from (x, y) to (x + dx, y + dy) of a triangle clockwise on the screen
+// owns the pixels on it if it is a top or left edge.
+bool owns_boundary(std::int64_t dx, std::int64_t dy) { return dy < 0 || (dy == 0 && dx > 0); }
+
 template <class Fn>
 void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, int height, const Rows& rows,
                      Fn&& fn) {
@@ -139,7 +143,7 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
     int j = i == 2 ? 0 : i + 1;
     dx[i] = X[j] - X[i];
     dy[i] = Y[j] - Y[i];
-    bias[i] = (dy[i] < 0 || (dy[i] == 0 && dx[i] > 0)) ? 0 : -1;
+    bias[i] = owns_boundary(dx[i], dy[i]) ? 0 : -1;
   }
   const std::int64_t px0 = x0 * kOne + kHalf;
   // The covered run of a row, exactly: E_i(x) = e_i + s_i (x - x0) >= 0 for all i, with
@@ -955,7 +959,7 @@ struct TetRasterizer::Impl {
     for (int k = 0; k < 3; ++k) {
       const int j = k == 2 ? 0 : k + 1;
       const std::int64_t dx = X[j] - X[k], dy = Y[j] - Y[k];
-      least[k] = (dy < 0 || (dy == 0 && dx > 0)) ? 0 : 1;
+      least[k] = owns_boundary(dx, dy) ? 0 : 1;
       inv_a[k] = fs.step[k] != 0 ? 1 / fs.step[k] : 0;
       a[k] = _mm512_set1_pd(fs.step[k]);
       inv[k] = _mm512_set1_pd(fs.inv_len[k]);
