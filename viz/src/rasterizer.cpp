@@ -1750,51 +1750,63 @@ struct TetRasterizer::Impl {
                                           [](const Save& s, std::size_t at) { return s.at < at; }) -
                          lane.saves.begin());
     };
-    // One pass over the undrawn tets' boxes: the rectangle they may change (changed_rect, the whole
-    // image if the near plane cuts one) and their work per band of rows (for the threads' split, see
-    // split_rows). The first thread then takes them off `kept` while the others wake up.
     const int threads = count >= 256 ? std::min(params.threads, std::max(1, fb.height >> kBandShift)) : 1;
-    std::vector<double> band_work(threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
     const SmallBox* small_box = drawn_box.data() + first;
     auto box_of = [small_box](std::size_t i) {
       const SmallBox& small = small_box[i];
       return Box{small.x0, small.x1, small.y0, small.y1};
     };
-    PixelRect rect{fb.width, fb.height, -1, -1};
-    bool unknown = false;
-    for (std::size_t i = 0; i < count; ++i) {
-      const Box b = box_of(i);
-      if (b.x0 > b.x1) continue;
-      if (b.y0 < 0) {
-        unknown = true;
-        continue;
+    // The threads' split of the rows (see split_rows) needs only an estimate of each band's work:
+    // every 8th box's.
+    std::vector<double> band_work(threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
+    if (threads > 1)
+      for (std::size_t i = 0; i < count; i += 8) {
+        const Box b = box_of(i);
+        if (b.x0 <= b.x1 && b.y0 >= 0) add_band_work(band_work, b);
       }
-      rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1), std::max(rect.y1, b.y1)};
-      // The box's first and last band (often the same), then any between: no branch on its height.
-      const int band_a = b.y0 >> kBandShift, band_b = b.y1 >> kBandShift;
-      band_x0[std::size_t(band_a)] = std::min(band_x0[std::size_t(band_a)], b.x0);
-      band_x1[std::size_t(band_a)] = std::max(band_x1[std::size_t(band_a)], b.x1);
-      band_x0[std::size_t(band_b)] = std::min(band_x0[std::size_t(band_b)], b.x0);
-      band_x1[std::size_t(band_b)] = std::max(band_x1[std::size_t(band_b)], b.x1);
-      for (int band = band_a + 1; band < band_b; ++band) {
-        band_x0[std::size_t(band)] = std::min(band_x0[std::size_t(band)], b.x0);
-        band_x1[std::size_t(band)] = std::max(band_x1[std::size_t(band)], b.x1);
+    // One pass over the undrawn tets' boxes: the rectangle they may change (`changed`, the whole
+    // image if the near plane cuts one) and each band's extent (see changed_rects).
+    auto find_extent = [&] {
+      PixelRect rect{fb.width, fb.height, -1, -1};
+      bool unknown = false;
+      for (std::size_t i = 0; i < count; ++i) {
+        const Box b = box_of(i);
+        if (b.x0 > b.x1) continue;
+        if (b.y0 < 0) {
+          unknown = true;
+          continue;
+        }
+        rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1), std::max(rect.y1, b.y1)};
+        // The box's first and last band (often the same), then any between: no branch on its height.
+        const int band_a = b.y0 >> kBandShift, band_b = b.y1 >> kBandShift;
+        band_x0[std::size_t(band_a)] = std::min(band_x0[std::size_t(band_a)], b.x0);
+        band_x1[std::size_t(band_a)] = std::max(band_x1[std::size_t(band_a)], b.x1);
+        band_x0[std::size_t(band_b)] = std::min(band_x0[std::size_t(band_b)], b.x0);
+        band_x1[std::size_t(band_b)] = std::max(band_x1[std::size_t(band_b)], b.x1);
+        for (int band = band_a + 1; band < band_b; ++band) {
+          band_x0[std::size_t(band)] = std::min(band_x0[std::size_t(band)], b.x0);
+          band_x1[std::size_t(band)] = std::max(band_x1[std::size_t(band)], b.x1);
+        }
       }
-      // The threads' split needs only an estimate of each band's work: every 8th box's.
-      if (threads > 1 && i % 8 == 0) add_band_work(band_work, b);
-    }
-    changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
+      changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
+    };
     // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
     // undrawn tets' faces there, walked in drawing order.
     std::atomic<int> unkept{0};  // 1 once the undrawn tets are off `kept`, 2 if that will not happen
+    std::atomic<bool> extent_found{false};
     auto work = [&](const std::vector<int>& split, int k) {
-      // Thread 0 (the caller's) takes the tets off `kept` while the others wake up, then all wait
-      // for that: the walk reads `kept` (first thing: nothing above the wait throws).
+      // Thread 0 (the caller's) takes the tets off `kept` while thread 1 finds their extent, then
+      // all wait for `kept`, which the walk reads, and before clearing the mask for the extent (first
+      // thing: nothing above the waits throws).
       if (k == 0)
         for (std::size_t i = 0; i < count; ++i) {
           const std::uint32_t t = history[first + i];
           kept[t >> 6] &= ~(std::uint64_t(1) << (t & 63));
         }
+      if (k == (threads > 1 ? 1 : 0)) {
+        find_extent();
+        extent_found.store(true, std::memory_order_release);
+      }
       if (threads > 1) {
         if (k == 0) unkept.store(1, std::memory_order_release);
         int state;
@@ -1902,6 +1914,7 @@ struct TetRasterizer::Impl {
         });
       }
       // The mask back to zero on the changed rows of these rows (whole bands: their tiles too).
+      while (!extent_found.load(std::memory_order_acquire)) pool::relax();  // long since, as a rule
       const int y0 = std::max(rows.lo, changed.y0), y1 = std::min(rows.hi, changed.y1);
       if (y0 <= y1) zero_mask(y0, y1);
     };
