@@ -544,6 +544,48 @@ struct TetRasterizer::Impl {
     return sh;
   }
 
+  // The edge line from a to b: E(p) = ex (py - ay) - ey (px - ax) at the pixel centre
+  // p = (x, y) kOne + kHalf, as ea x + eb y + ec (|coordinates| <= 2^30 keep every term below 2^62);
+  // length: the edge's, in fixed-point units.
+  struct EdgeLine {
+    std::int64_t ea, eb, ec;
+    double length;
+  };
+  static EdgeLine edge_line(const PolyVertex& a, const PolyVertex& b) {
+    const std::int64_t ex = b.X - a.X, ey = b.Y - a.Y;
+    return EdgeLine{-ey * kOne, ex * kOne, ex * (kHalf - a.Y) - ey * (kHalf - a.X),
+                    std::sqrt(double(ex) * double(ex) + double(ey) * double(ey))};
+  }
+
+  // Whether the line ea x + eb y + ec is below 2^52 in magnitude on the whole image (see
+  // FaceSetup::exact_double).
+  bool exact_in_double(std::int64_t ea, std::int64_t eb, std::int64_t ec) const {
+    return std::abs(double(ea)) * proj.width + std::abs(double(eb)) * proj.height + std::abs(double(ec)) < 0x1p52;
+  }
+
+#ifdef FOXI_AVX512_REPAINT
+  // What repaint_triangle_avx512 reads of setup_face's work for triangle poly (the shade, and the
+  // three edge lines in double), false if it does not apply (an edge of no length, or a line not
+  // exact in double).
+  bool setup_repaint(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly) const {
+    fs.tet = tet;
+    fs.rgb[0] = sh.r;
+    fs.rgb[1] = sh.g;
+    fs.rgb[2] = sh.b;
+    fs.color = sh.color;
+    fs.lines = 3;
+    for (int k = 0; k < 3; ++k) {
+      const EdgeLine line = edge_line(poly[k], poly[k == 2 ? 0 : k + 1]);
+      if (!(line.length > 0) || !exact_in_double(line.ea, line.eb, line.ec)) return false;
+      fs.step[k] = double(line.ea);
+      fs.step_y[k] = double(line.eb);
+      fs.at0[k] = double(line.ec);
+      fs.inv_len[k] = 1 / (double(kOne) * line.length);
+    }
+    return true;
+  }
+#endif
+
   // Shading and edge lines of a face; `v` = the face's three corners (camera frame)
   // in outward order, node their nodes; poly = the polygon to draw (positive area), n its size.
   void setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const std::uint32_t node[3],
@@ -562,25 +604,18 @@ struct TetRasterizer::Impl {
     if (params.edges) {
       for (int i = 0; i < n; ++i) {
         if (!poly[i].mesh_edge) continue;
-        const PolyVertex& a = poly[i];
-        const PolyVertex& b = poly[i + 1 == n ? 0 : i + 1];
-        // E(p) = ex (py - ay) - ey (px - ax) at the pixel centre p = (x, y) kOne + kHalf; |coordinates|
-        // <= 2^30 keep every term below 2^62.
-        const std::int64_t ex = b.X - a.X, ey = b.Y - a.Y;
-        const double el = std::sqrt(double(ex) * double(ex) + double(ey) * double(ey));
-        if (!(el > 0)) continue;
+        const EdgeLine line = edge_line(poly[i], poly[i + 1 == n ? 0 : i + 1]);
+        if (!(line.length > 0)) continue;
         const int k = fs.lines++;
-        fs.ea[k] = -ey * kOne;
-        fs.eb[k] = ex * kOne;
-        fs.ec[k] = ex * (kHalf - a.Y) - ey * (kHalf - a.X);
-        fs.inv_len[k] = 1 / (double(kOne) * el);
+        fs.ea[k] = line.ea;
+        fs.eb[k] = line.eb;
+        fs.ec[k] = line.ec;
+        fs.inv_len[k] = 1 / (double(kOne) * line.length);
         fs.flat_e[k] = params.edge_width / fs.inv_len[k];
       }
     }
     fs.exact_double = true;
-    for (int k = 0; k < fs.lines; ++k)
-      fs.exact_double = fs.exact_double && std::abs(double(fs.ea[k])) * proj.width + std::abs(double(fs.eb[k])) * proj.height +
-                                                   std::abs(double(fs.ec[k])) < 0x1p52;
+    for (int k = 0; k < fs.lines; ++k) fs.exact_double = fs.exact_double && exact_in_double(fs.ea[k], fs.eb[k], fs.ec[k]);
     for (int k = fs.lines; k < 4; ++k) {  // padding: far from every pixel
       fs.ea[k] = fs.eb[k] = 0;
       fs.ec[k] = std::int64_t(1) << 62;
@@ -932,8 +967,8 @@ struct TetRasterizer::Impl {
     return yes;
   }
 
-  // Undraw's repaint of a triangle face in painter mode with the mask (not recording), fs set up for
-  // poly[0..2] with 3 mesh-edge lines exact in double (edge k from vertex k to k + 1): the pixels
+  // Undraw's repaint of a triangle face in painter mode with the mask (not recording), fs from
+  // setup_repaint for poly[0..2] (3 mesh-edge lines exact in double, edge k from vertex k to k + 1): the pixels
   // raster_triangle covers and shade_row writes, with the same bits, eight at a time. Line k is edge
   // k's coverage function without the top-left bias, so a pixel is covered when every line's value is
   // at least 0 (top-left edges) or 1 (the others); the colour goes through edge_pixels_x4's
@@ -1659,10 +1694,11 @@ struct TetRasterizer::Impl {
   // faces shared with kept tets (see `kept`), which the walk repaints as those tets' front faces
   // (their shades come after, from shade_repainted). A face is back when its outward-ordered
   // projection has positive area (face_polygon's test).
-  void gather_undrawn(std::uint32_t t, int width, int height, UndrawTet& u) const {
+  // box: t's as drawn (tet_box), known to the walk.
+  void gather_undrawn(std::uint32_t t, const Box& box, UndrawTet& u) const {
     TetCorners k;
     load_corners(t, k);
-    u.box = tet_box(k, width, height);
+    u.box = box;
     u.repaint = 0;
     if (u.box.x0 > u.box.x1 || u.box.y0 < 0) return;
     for (int j = 0; j < 4; ++j) {
@@ -1877,7 +1913,7 @@ struct TetRasterizer::Impl {
         if (b.y0 >= 0) {
           if (!repaints(i)) continue;
           UndrawTet u;
-          gather_undrawn(t, fb.width, fb.height, u);
+          gather_undrawn(t, b, u);
           shade_repainted(u);
           // Each back face shared with a kept tet is repainted as that tet's front face: the same
           // polygon (face_polygon's back order), in its colour. One shared with an earlier tet of the
@@ -1892,13 +1928,13 @@ struct TetRasterizer::Impl {
               poly[j].Y = u.Y[face[j]];
             }
             FaceSetup fs;
-            setup_face(fs, u.neighbour[f] >> 2, u.shade[f], poly, 3);
 #ifdef FOXI_AVX512_REPAINT
-            if (fs.lines == 3 && fs.exact_double && avx512_repaint()) {
+            if (params.edges && avx512_repaint() && setup_repaint(fs, u.neighbour[f] >> 2, u.shade[f], poly)) {
               repaint_triangle_avx512(fb, rows, fs, poly);
               continue;
             }
 #endif
+            setup_face(fs, u.neighbour[f] >> 2, u.shade[f], poly, 3);
             raster_polygon(fb, rows, fs, poly, 3);  // seldom hidden: not worth the test
           }
           continue;
