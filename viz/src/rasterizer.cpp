@@ -263,6 +263,9 @@ struct TetRasterizer::Impl {
   // Edge darkening: a pixel at distance d < edge_width from an edge is scaled by edge_base +
   // edge_slope d (1 - edge_darkness at the edge, 1 at edge_width).
   double edge_base = 1, edge_slope = 0;
+  // Whether undraw repaints triangles with repaint_triangle_avx512: the CPU has it, edges are drawn
+  // and a darkened channel stays in [0, 255] unclamped (edge_darkness in [0, 1]).
+  bool fast_repaint = false;
   // Per node, in one 32-byte record (two to a cache line: the tets a view reads at random, the undraw
   // walk's above all, cost a line per corner): camera coordinates, fixed-point pixel coordinates
   // (they fit 32 bits: |p| <= 4 kMaxPixel kOne = 2^30) and the state (0 in front, 1 behind the near
@@ -375,6 +378,9 @@ struct TetRasterizer::Impl {
     if (!(params.edge_width > 0)) params.edges = false;
     edge_base = 1 - params.edge_darkness;
     edge_slope = params.edges ? params.edge_darkness / params.edge_width : 0;
+#ifdef FOXI_AVX512_REPAINT
+    fast_repaint = params.edges && params.edge_darkness >= 0 && params.edge_darkness <= 1 && avx512_repaint();
+#endif
     reverse = !params.depth_buffer;
     mask_words = (w + 63) / 64;
     use_mask = reverse;
@@ -990,24 +996,24 @@ struct TetRasterizer::Impl {
     const int by1 = int(std::min<std::int64_t>({fb.height - 1, floor_div(maxy - kHalf, kOne), rows.hi}));
     if (bx0 > bx1 || by0 > by1) return;
     double least[3], inv_a[3];  // per edge: the least covered value (0 or 1), 1 / its x step
-    __m512d a[3], inv[3], at_least[3];
+    __m512d a[3], a8[3], inv[3], at_least[3];
     for (int k = 0; k < 3; ++k) {
       const int j = k == 2 ? 0 : k + 1;
       const std::int64_t dx = X[j] - X[k], dy = Y[j] - Y[k];
       least[k] = owns_boundary(dx, dy) ? 0 : 1;
       inv_a[k] = fs.step[k] != 0 ? 1 / fs.step[k] : 0;
       a[k] = _mm512_set1_pd(fs.step[k]);
+      a8[k] = _mm512_set1_pd(8 * fs.step[k]);  // exact: 8 pixels' step of a line exact in double
       inv[k] = _mm512_set1_pd(fs.inv_len[k]);
       at_least[k] = _mm512_set1_pd(least[k]);
     }
-    const __m512d lane = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0), zero = _mm512_setzero_pd();
+    const __m512d lane = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0);
     const __m512d width = _mm512_set1_pd(params.edge_width), base = _mm512_set1_pd(edge_base),
                   slope = _mm512_set1_pd(edge_slope);
     const __m256 r = _mm256_set1_ps(fs.rgb[0]), g = _mm256_set1_ps(fs.rgb[1]), b = _mm256_set1_ps(fs.rgb[2]);
     const __m256 half = _mm256_set1_ps(0.5f);
     const __m256i color = _mm256_set1_epi32(int(fs.color)), tet = _mm256_set1_epi32(int(fs.tet));
-    const __m256i alpha = _mm256_set1_epi32(int(0xff000000u)), byte_max = _mm256_set1_epi32(255),
-                  none = _mm256_setzero_si256();
+    const __m256i alpha = _mm256_set1_epi32(int(0xff000000u));
     const double lo_clamp = bx0 - 1, hi_clamp = bx1 + 1;
     for (int y = rows.first(by0); y <= by1; y = rows.next(y)) {
       double row_at[3];
@@ -1031,11 +1037,12 @@ struct TetRasterizer::Impl {
       std::uint64_t* done = &written[std::size_t(y) * std::size_t(mask_words)];
       const __m512d at0 = _mm512_set1_pd(row_at[0]), at1 = _mm512_set1_pd(row_at[1]),
                     at2 = _mm512_set1_pd(row_at[2]);
+      // The lines at the run's first 8 pixels, then 8 pixels on at each step (integers: exact).
+      const __m512d px = _mm512_add_pd(_mm512_set1_pd(double(xa)), lane);
+      __m512d e0 = _mm512_add_pd(_mm512_mul_pd(a[0], px), at0);
+      __m512d e1 = _mm512_add_pd(_mm512_mul_pd(a[1], px), at1);
+      __m512d e2 = _mm512_add_pd(_mm512_mul_pd(a[2], px), at2);
       for (int x = xa; x <= xb; x += 8) {
-        const __m512d px = _mm512_add_pd(_mm512_set1_pd(double(x)), lane);
-        const __m512d e0 = _mm512_add_pd(_mm512_mul_pd(a[0], px), at0);
-        const __m512d e1 = _mm512_add_pd(_mm512_mul_pd(a[1], px), at1);
-        const __m512d e2 = _mm512_add_pd(_mm512_mul_pd(a[2], px), at2);
         const int left = xb - x + 1;
         __mmask8 cover = __mmask8(left >= 8 ? 0xff : (1u << left) - 1);
         cover &= _mm512_cmp_pd_mask(e0, at_least[0], _CMP_GE_OQ);
@@ -1052,15 +1059,17 @@ struct TetRasterizer::Impl {
         const __mmask8 todo = __mmask8(cover & ~set);
         const __m512d d = _mm512_min_pd(_mm512_min_pd(_mm512_mul_pd(e0, inv[0]), _mm512_mul_pd(e1, inv[1])),
                                         _mm512_mul_pd(e2, inv[2]));
+        e0 = _mm512_add_pd(e0, a8[0]);
+        e1 = _mm512_add_pd(e1, a8[1]);
+        e2 = _mm512_add_pd(e2, a8[2]);
+        // A covered pixel's d is at least +0 (every line's value is), so darkened()'s max(0, d) is
+        // d; the channels are in [0, 255] (edge_darkness in [0, 1], see fast_repaint), so its
+        // saturation changes nothing. Lanes not covered are garbage the stores skip.
         const __mmask8 dark = _mm512_cmp_pd_mask(d, width, _CMP_LT_OQ);
-        const __m256 f = _mm512_cvtpd_ps(_mm512_add_pd(base, _mm512_mul_pd(slope, _mm512_max_pd(d, zero))));
-        __m256i cr = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(r, f), half));
-        __m256i cg = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(g, f), half));
-        __m256i cb = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(b, f), half));
-        // Saturated to bytes as darkened() does.
-        cr = _mm256_min_epi32(_mm256_max_epi32(cr, none), byte_max);
-        cg = _mm256_min_epi32(_mm256_max_epi32(cg, none), byte_max);
-        cb = _mm256_min_epi32(_mm256_max_epi32(cb, none), byte_max);
+        const __m256 f = _mm512_cvtpd_ps(_mm512_add_pd(base, _mm512_mul_pd(slope, d)));
+        const __m256i cr = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(r, f), half));
+        const __m256i cg = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(g, f), half));
+        const __m256i cb = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(b, f), half));
         const __m256i px_dark = _mm256_or_si256(_mm256_or_si256(cr, _mm256_slli_epi32(cg, 8)),
                                                 _mm256_or_si256(_mm256_slli_epi32(cb, 16), alpha));
         const __m256i out = _mm256_mask_blend_epi32(dark, color, px_dark);
@@ -1929,7 +1938,7 @@ struct TetRasterizer::Impl {
             }
             FaceSetup fs;
 #ifdef FOXI_AVX512_REPAINT
-            if (params.edges && avx512_repaint() && setup_repaint(fs, u.neighbour[f] >> 2, u.shade[f], poly)) {
+            if (fast_repaint && setup_repaint(fs, u.neighbour[f] >> 2, u.shade[f], poly)) {
               repaint_triangle_avx512(fb, rows, fs, poly);
               continue;
             }
