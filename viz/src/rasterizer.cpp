@@ -569,16 +569,21 @@ struct TetRasterizer::Impl {
     return std::abs(double(ea)) * proj.width + std::abs(double(eb)) * proj.height + std::abs(double(ec)) < 0x1p52;
   }
 
-#ifdef FOXI_AVX512_REPAINT
-  // What repaint_triangle_avx512 reads of setup_face's work for triangle poly (the shade, and the
-  // three edge lines in double), false if it does not apply (an edge of no length, or a line not
-  // exact in double).
-  bool setup_repaint(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly) const {
+  // A face of tet `tet` in shade sh.
+  static void set_shade(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh) {
     fs.tet = tet;
     fs.rgb[0] = sh.r;
     fs.rgb[1] = sh.g;
     fs.rgb[2] = sh.b;
     fs.color = sh.color;
+  }
+
+#ifdef FOXI_AVX512_REPAINT
+  // What repaint_triangle_avx512 reads of setup_face's work for triangle poly (the shade, and the
+  // three edge lines in double), false if it does not apply (an edge of no length, or a line not
+  // exact in double).
+  bool setup_repaint(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly) const {
+    set_shade(fs, tet, sh);
     fs.lines = 3;
     for (int k = 0; k < 3; ++k) {
       const EdgeLine line = edge_line(poly[k], poly[k == 2 ? 0 : k + 1]);
@@ -601,11 +606,7 @@ struct TetRasterizer::Impl {
 
   // The same with the shade known.
   void setup_face(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly, int n) const {
-    fs.tet = tet;
-    fs.rgb[0] = sh.r;
-    fs.rgb[1] = sh.g;
-    fs.rgb[2] = sh.b;
-    fs.color = sh.color;
+    set_shade(fs, tet, sh);
     fs.lines = 0;
     if (params.edges) {
       for (int i = 0; i < n; ++i) {
