@@ -349,14 +349,13 @@ struct TetRasterizer::Impl {
   // 2^16 tets). A third of the undrawn tets that show repaint nothing (their neighbours behind are
   // undrawn too): this spares the walk their mesh rows, nodes and neighbours.
   std::vector<std::uint16_t> drawn_reach;
-  // What undraw's walk needs of an undrawn tet that shows (gather_undrawn, shade_repainted): the
-  // walk fetches it a few tets ahead (see undraw_part), so the mesh's scattered arrays are read only
-  // for the tets that show, their lookups overlapping.
+  // What undraw's walk needs of an undrawn tet that shows, its box not cut by the near plane
+  // (gather_undrawn, shade_repainted): the walk fetches it a few tets ahead (see undraw_part), so the
+  // mesh's scattered arrays are read only for the tets that show, their lookups overlapping.
   struct UndrawTet {
-    Box box;                         // as tet_box; y0 < 0: cut by the near plane (walked the slow way)
-    std::int32_t X[4], Y[4];         // fixed-point corners (box.y0 >= 0)
-    std::uint32_t node[4];           // the tet's nodes (box.y0 >= 0)
-    std::uint8_t repaint = 0;        // bit f: back face f is shared with a kept tet (box.y0 >= 0)
+    std::int32_t X[4], Y[4];         // fixed-point corners
+    std::uint32_t node[4];           // the tet's nodes
+    std::uint8_t repaint = 0;        // bit f: back face f is shared with a kept tet
     std::uint32_t neighbour[4];      // repaint face f: that tet's face (4 tet + face)
     FaceShade shade[4];              // repaint face f: that tet's front face's flat colour
   };
@@ -1700,17 +1699,15 @@ struct TetRasterizer::Impl {
     return nb != kNone && is_kept(nb >> 2) ? nb : kNone;
   }
 
-  // Fills u for undrawn tet t: its box, and unless the near plane cuts it, its corners and its back
-  // faces shared with kept tets (see `kept`), which the walk repaints as those tets' front faces
-  // (their shades come after, from shade_repainted). A face is back when its outward-ordered
-  // projection has positive area (face_polygon's test).
-  // box: t's as drawn (tet_box), known to the walk.
-  void gather_undrawn(std::uint32_t t, const Box& box, UndrawTet& u) const {
+  // Fills u for undrawn tet t, whose drawn box (tet_box) is not empty and not cut by the near plane
+  // (all its corners in front): its corners and its back faces shared with kept tets (see `kept`),
+  // which the walk repaints as those tets' front faces (their shades come after, from
+  // shade_repainted). A face is back when its outward-ordered projection has positive area
+  // (face_polygon's test).
+  void gather_undrawn(std::uint32_t t, UndrawTet& u) const {
     TetCorners k;
     load_corners(t, k);
-    u.box = box;
     u.repaint = 0;
-    if (u.box.x0 > u.box.x1 || u.box.y0 < 0) return;
     for (int j = 0; j < 4; ++j) {
       u.X[j] = std::int32_t(k.X[j]);
       u.Y[j] = std::int32_t(k.Y[j]);
@@ -1923,7 +1920,7 @@ struct TetRasterizer::Impl {
         if (b.y0 >= 0) {
           if (!repaints(i)) continue;
           UndrawTet u;
-          gather_undrawn(t, b, u);
+          gather_undrawn(t, u);
           shade_repainted(u);
           // Each back face shared with a kept tet is repainted as that tet's front face: the same
           // polygon (face_polygon's back order), in its colour. One shared with an earlier tet of the
