@@ -81,9 +81,14 @@ void triangulate_facet(const Plc& plc, std::size_t f, const std::vector<std::uin
       const Point a = point(s.points, poly[i]), b = point(s.points, poly[(i + 1) % poly.size()]);
       normal = normal + Vec((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()), (a.x() - b.x()) * (a.y() + b.y()));
     }
-    break;  // the first polygon fixes the plane; the others lie in it
+    if (normal.squared_length() > 0) break;  // the first polygon with an area fixes the plane; the others lie in it
   }
-  if (normal.squared_length() == 0) reject("facet " + std::to_string(f + 1) + " has no polygon with an area");
+  // Only segments, points or collinear polygons: TetGen takes such a facet as edges to keep, but it
+  // bounds no area, and every PLC point already splits the polygon edges it lies on.
+  if (normal.squared_length() == 0) {
+    ++s.facets_without_area;
+    return;
+  }
 
   Cdt cdt{Proj(normal)};
   try {
