@@ -14,6 +14,8 @@
 #include <CGAL/make_mesh_3.h>
 
 #include <algorithm>
+#include <array>
+#include <iterator>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -63,6 +65,59 @@ struct CellSize {
     return sd < per_subdomain.size() ? per_subdomain[sd] : global;
   }
 };
+
+// The protecting ball radius at corners (dim 0) and along features. Mesh_3 caps a corner's ball at a
+// third of the distance to the nearest other corner: on a faceted cylinder every wall facet is a
+// narrow rectangle whose four corners then get equal balls, four co-planar weighted points on one
+// orthocircle, and so a flat tet (dihedral angle 0) that no optimiser removes (exudation does not
+// pump protecting balls). Here each corner's ball is below that cap by a factor in (0.7, 0.95] drawn
+// from a hash of its coordinates: deterministic, and different at mirror-image corners.
+struct EdgeSize {
+  using FT = K::FT;
+  using Point_3 = K::Point_3;
+  using Index = Domain::Index;
+  double global = 0;
+  std::map<std::array<double, 3>, double> corner_size;  // by the corner's coordinates
+  FT operator()(const Point_3& p, int dim, const Index&) const {
+    if (dim != 0) return global;
+    const auto it = corner_size.find({p.x(), p.y(), p.z()});
+    return it == corner_size.end() ? global : it->second;
+  }
+};
+
+double hash01(const std::array<double, 3>& p) {
+  std::uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (double x : p) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &x, sizeof bits);
+    h ^= bits + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    h ^= h >> 31;
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 29;
+  }
+  return static_cast<double>(h >> 11) * 0x1p-53;
+}
+
+EdgeSize edge_size_field(const Domain& domain, double global) {
+  std::vector<std::pair<Domain::Corner_index, K::Point_3>> corners;
+  domain.get_corners(std::back_inserter(corners));
+  EdgeSize e;
+  e.global = global;
+  // The nearest other corner, by sorting along x and scanning while the x gap can still beat the best.
+  std::vector<std::array<double, 3>> pts;
+  for (const auto& c : corners) pts.push_back({c.second.x(), c.second.y(), c.second.z()});
+  std::sort(pts.begin(), pts.end());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    double best = HUGE_VAL;
+    for (std::size_t j = i + 1; j < pts.size() && (pts[j][0] - pts[i][0]) * (pts[j][0] - pts[i][0]) < best; ++j)
+      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]), K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
+    for (std::size_t j = i; j-- > 0 && (pts[i][0] - pts[j][0]) * (pts[i][0] - pts[j][0]) < best;)
+      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]), K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
+    const double cap = std::min(global, std::isfinite(best) ? std::sqrt(best) / 3 : global);
+    e.corner_size[pts[i]] = cap * (0.7 + 0.25 * (1 - hash01(pts[i])));
+  }
+  return e;
+}
 
 // The PLC surface grouped into the domain's input polyhedra: one per plane region (per_facet) or per
 // facet marker, and pair of cells. A patch's borders are protected features (detect_borders /
@@ -275,7 +330,8 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
         if (s.cell_region[c] == seed.id) cell_size.per_subdomain[c] = std::min(cell_size.per_subdomain[c], regular_tet_circumradius(seed.max_volume));
   // Facets keep their vertices on one patch (or its bounding features): without it a coarse mesh of a thin
   // part takes facets that cut across its corners (the dual edge meets a patch, the facet does not lie in it).
-  Criteria criteria(P::edge_size = sizes.edge_size, P::facet_angle = params.facet_angle, P::facet_size = sizes.facet_size,
+  const EdgeSize edge_size = edge_size_field(domain, sizes.edge_size);
+  Criteria criteria(P::edge_size = edge_size, P::facet_angle = params.facet_angle, P::facet_size = sizes.facet_size,
                     P::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH_WITH_ADJACENCY_CHECK,
                     P::facet_distance = sizes.facet_distance,
                     P::cell_radius_edge_ratio = params.radius_edge, P::cell_size = cell_size);
