@@ -59,7 +59,7 @@ const char* kMeshUsage =
     "                     --resample: only edges turning by more than --feature-angle (default 60)\n"
     "                     and patch borders are protected, a faceted cylinder's wall is resampled\n"
     "                     (each region's volume change is printed); --time-limit S stops CGAL after\n"
-    "                     S seconds (default 120; 0: none) with an error\n"
+    "                     S seconds (default 300; 0: none) with an error\n"
     "  Ctrl-C cancels (nothing is written).";
 
 std::atomic<bool> g_interrupted{false};

@@ -85,7 +85,7 @@ int mesh_with_cgal(Args& args) {
     if (params.feature_angle > 180) throw UsageError("--feature-angle takes degrees in [0, 180]");
     if (!params.resample) throw UsageError("--feature-angle needs --resample (without it every facet edge is protected)");
   }
-  params.time_limit = non_negative(args.option("--time-limit", "120"), "--time-limit");
+  params.time_limit = non_negative(args.option("--time-limit", "300"), "--time-limit");
   args.flag("--check-delaunay");  // the CGAL path always certifies
   const std::string out = args.option("-o");
   if (out.empty()) throw UsageError("give the output file with -o OUT (see foxi mesh --help)");
@@ -137,8 +137,10 @@ int mesh_with_cgal(Args& args) {
       if (r.id == id && !r.name.empty()) return " (" + r.name + ")";
     return std::string();
   };
-  std::printf("PLC: %zu facet triangles in %zu patches (%zu coplanar facets joined a neighbour's), %zu facets without area left out\n",
-              report.facet_triangles, report.patches, report.facets_joined, report.facets_without_area);
+  std::printf("PLC: %zu coordinates snapped and %zu points welded (rounding), %zu facet triangles in %zu patches (%zu coplanar "
+              "facets joined a neighbour's), %zu facets without area left out; %zu tets labelled by centroid, not circumcentre\n",
+              report.coordinates_snapped, report.points_welded, report.facet_triangles, report.patches, report.facets_joined,
+              report.facets_without_area, report.tets_relabelled);
   std::printf("region volumes against the PLC (%s):\n", report.resampled ? "facets resampled" : "every facet edge protected");
   for (const CgalRegionVolume& v : report.volumes)
     std::printf("  region %d%s: PLC %.6g, mesh %.6g, change %+.3g%%\n", v.region, region_name(v.region).c_str(), v.plc, v.mesh,

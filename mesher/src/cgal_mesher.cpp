@@ -25,6 +25,7 @@
 #include <unordered_map>
 
 #include "child_process.hpp"
+#include "plc_edit.hpp"
 #include "plc_surface.hpp"
 #include "union_find.hpp"
 
@@ -246,6 +247,7 @@ std::vector<double> cell_volumes(const detail::PlcSurface& s) {
 
 // The meshed tets, crossing the pipe from the child process.
 struct Result {
+  std::vector<std::uint64_t> relabelled;  // one count: cells whose centroid's part is not Mesh_3's label
   std::vector<double> xyz, weight;
   std::vector<std::uint32_t> tet, bface;
   std::vector<std::int32_t> tet_region, bface_tag;
@@ -284,12 +286,33 @@ Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& pat
     }
     return it->second;
   };
-  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
+  // Mesh_3 labels a cell by the subdomain its circumcentre (orthocentre) lies in. In a thin layer the
+  // circumcentre of a flat cell can lie across the interface, in the next part (the power module's
+  // die attach took 1.25% of the die's volume): every cell is labelled here by its centroid, with the
+  // domain's own point location. Where the mesh's boundary facets lie on the PLC, a cell lies inside
+  // one part and its centroid says which.
+  const auto locate = domain.is_in_domain_object();
+  std::uint64_t relabelled = 0;
+  for (auto c = c3t3.triangulation().finite_cells_begin(); c != c3t3.triangulation().finite_cells_end(); ++c) {
+    const auto& p0 = c->vertex(0)->point();
+    const auto& p1 = c->vertex(1)->point();
+    const auto& p2 = c->vertex(2)->point();
+    const auto& p3 = c->vertex(3)->point();
+    const K::Point_3 centroid((p0.x() + p1.x() + p2.x() + p3.x()) / 4, (p0.y() + p1.y() + p2.y() + p3.y()) / 4,
+                              (p0.z() + p1.z() + p2.z() + p3.z()) / 4);
+    const auto where = locate(centroid);
+    const bool was_in = c3t3.is_in_complex(c);
+    if (!where) {
+      relabelled += was_in;
+      continue;
+    }
+    const auto sd = static_cast<std::size_t>(*where);
+    relabelled += !was_in || static_cast<std::size_t>(c3t3.subdomain_index(c)) != sd;
     // CGAL's cells are positively oriented, as foxi's tets.
     for (int i = 0; i < 4; ++i) r.tet.push_back(node(c->vertex(i)));
-    const auto sd = static_cast<std::size_t>(c3t3.subdomain_index(c));
     r.tet_region.push_back(sd < cell_region.size() ? cell_region[sd] : 0);
   }
+  r.relabelled = {relabelled};
   for (auto f = c3t3.facets_in_complex_begin(); f != c3t3.facets_in_complex_end(); ++f) {
     std::uint32_t v[3];
     bool in_mesh = true;
@@ -355,6 +378,7 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
 
   const Result r = export_complex(c3t3, domain, patches, s.cell_region);
   std::vector<char> out;
+  put(out, r.relabelled);
   put(out, r.xyz);
   put(out, r.weight);
   put(out, r.tet);
@@ -372,7 +396,7 @@ std::vector<std::int32_t> distinct(std::vector<std::int32_t> v) {
 
 }  // namespace
 
-Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport* report) {
+Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshReport* report) {
   const auto t0 = Clock::now();
   if (!(params.max_size >= 0 && params.facet_size >= 0 && params.edge_size >= 0 && params.radius_edge >= 0 &&
         params.facet_angle >= 0 && params.facet_angle <= 30 && params.optimiser_seconds >= 0 && params.sliver_bound >= 0 &&
@@ -385,6 +409,12 @@ Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport*
                       "feature angle in [0, 180] degrees, time limit >= 0, volume tolerance > 0)");
   CgalMeshReport rep;
   rep.resampled = params.resample;
+  // Coordinates that differ by rounding alone made equal, points that coincide to rounding made one (a
+  // corefined structure has corners 1 ulp apart): every protected facet edge between two such points
+  // would ask Mesh_3 for protecting balls 1e-19 wide. Facet numbers stay those of the input.
+  Plc plc = input;
+  rep.coordinates_snapped = detail::snap_coordinates(plc);
+  rep.points_welded = detail::weld_coincident_points(plc);
   const detail::PlcSurface s = detail::plc_surface(plc);
   const Patches patches = make_patches(plc, s, !params.resample);
 
@@ -435,11 +465,13 @@ Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport*
     std::snprintf(limit, sizeof limit, "%g", params.time_limit);
     throw MesherError(MesherFailure::time_limit,
                       std::string("CGAL Mesh_3 did not finish within the time limit of ") + limit +
-                          " s and was stopped (a thin part under a wide one asks Mesh_3 for millions of tets at radius-edge " +
-                          "2: a larger cell size, a larger time limit, or TetGen, which grades thin layers)");
+                          " s and was stopped. Mesh_3 has no bound of its own on its work: a part much thinner than it is wide "
+                          "(a die attach or solder layer) is sampled at its thickness all over, millions of tets at radius-edge 2. "
+                          "Raise the time limit, or mesh with TetGen (the default mesher), which grades thin layers");
   }
   Result r;
   std::size_t at = 0;
+  get(bytes, at, r.relabelled);
   get(bytes, at, r.xyz);
   get(bytes, at, r.weight);
   get(bytes, at, r.tet);
@@ -447,7 +479,7 @@ Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport*
   get(bytes, at, r.bface);
   get(bytes, at, r.bface_tag);
   const std::size_t nn = r.weight.size();
-  if (r.xyz.size() != 3 * nn || r.tet.size() != 4 * r.tet_region.size() || r.bface.size() != 3 * r.bface_tag.size())
+  if (r.relabelled.size() != 1 || r.xyz.size() != 3 * nn || r.tet.size() != 4 * r.tet_region.size() || r.bface.size() != 3 * r.bface_tag.size())
     throw MesherError(MesherFailure::internal_error, "CGAL's result is inconsistent");
   for (std::uint32_t v : r.tet)
     if (v >= nn) throw MesherError(MesherFailure::internal_error, "CGAL returned a tet index out of range");
@@ -489,6 +521,7 @@ Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params, CgalMeshReport*
     rep.worst_volume_change = std::max(rep.worst_volume_change, change);
     if (!(change <= params.volume_tolerance)) rep.volumes_match = false;
   }
+  rep.tets_relabelled = static_cast<std::size_t>(r.relabelled[0]);
   rep.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   if (report) *report = rep;
   return m;

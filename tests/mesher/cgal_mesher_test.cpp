@@ -275,7 +275,8 @@ TEST(CgalMesher, ResamplingCutsTheViaAndReportsByHowMuch) {
 // A shipped model meshed as `foxi mesh MODEL --mesher cgal` does (the model's max_size and part sizes):
 // each region's volume against the model builder's own part volume (structure.cpp, from the parts, not
 // from the PLC's facets) to 0.1%, every boundary tag present, and the mesh certified.
-void expect_model_meshes(const std::string& name, double time_limit = 120) {
+// The limit is the default's 300 s times three: the test machines are shared.
+void expect_model_meshes(const std::string& name, double time_limit = 900) {
   const Model model = load_model(source_file("models/" + name + ".toml"));
   const Structure st = build_structure(model);
   Plc plc = st.plc;
@@ -298,15 +299,19 @@ void expect_model_meshes(const std::string& name, double time_limit = 120) {
   EXPECT_TRUE(report.volumes_match) << name << ": worst change " << report.worst_volume_change;
   const auto area = tag_areas(m);
   EXPECT_EQ(area.size(), st.boundary_area.size()) << name << ": every named surface is covered";
-  std::printf("%s: CGAL %zu tets in %.1f s, %zu patches (%zu facets joined), worst part volume change %.2e, min dihedral %.2f deg\n",
-              name.c_str(), m.tet_count(), seconds, report.patches, report.facets_joined, worst, min_dihedral(m));
+  std::printf("%s: CGAL %zu tets in %.1f s, %zu patches (%zu facets joined, %zu without area), %zu points welded, %zu tets "
+              "relabelled, worst part volume change %.2e, min dihedral %.2f deg\n",
+              name.c_str(), m.tet_count(), seconds, report.patches, report.facets_joined, report.facets_without_area,
+              report.points_welded, report.tets_relabelled, worst, min_dihedral(m));
   expect_certified(m, 6);
 }
 
 TEST(CgalMesher, ViaModelKeepsItsVolumes) { expect_model_meshes("via_in_dielectric"); }
 TEST(CgalMesher, TrenchModelKeepsItsVolumes) { expect_model_meshes("trench"); }
 TEST(CgalMesher, MultiChipModelKeepsItsVolumes) { expect_model_meshes("multi_chip"); }
-TEST(CgalMesher, PowerModuleModelKeepsItsVolumes) { expect_model_meshes("power_module"); }
+// Thin solder layers under wide parts: about a million tets. Mesh_3's own labels (by circumcentre) gave
+// the die attach 1.25% of the die's volume; labelled by centroid, every part is exact.
+TEST(CgalMesherSlow, PowerModuleModelKeepsItsVolumes) { expect_model_meshes("power_module"); }
 TEST(CgalMesherSlow, FlipChipBumpsKeepTheirVolumes) { expect_model_meshes("flip_chip"); }
 // The bga's structure is a corefined triangle soup (balls cut by two boards); it failed with "facet
 // 488 has no polygon with an area" before.

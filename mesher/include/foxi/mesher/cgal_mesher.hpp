@@ -20,7 +20,8 @@
 // subset are dropped with those vertices; they bound nothing that is drawn.
 //
 // Regions: each cell of the PLC (component of space minus the facets) takes the id of the first region
-// seed inside it; enclosed cells with no seed are region 0; the unbounded cell and cells holding a
+// seed inside it, and each tet the region of the PLC cell its centroid lies in (Mesh_3's own label, by
+// circumcentre, puts flat tets of a thin layer in the next part); enclosed cells with no seed are region 0; the unbounded cell and cells holding a
 // volume hole point are not meshed. Boundary triangles carry their facet's marker. Facets with the same
 // cell on both sides (a membrane inside one region) are not kept.
 #pragma once
@@ -61,7 +62,7 @@ struct CgalMeshParams {
   // Wall-clock limit of the whole run in seconds; 0: none. Mesh_3 has no bound on its refinement (a
   // thin layer under a wide part asks for millions of tets): past the limit its child process is
   // killed and MesherFailure::time_limit is thrown.
-  double time_limit = 120;
+  double time_limit = 300;
   // Relative tolerance of each region's volume against the PLC's (CgalMeshReport::volumes_match).
   double volume_tolerance = 1e-3;
   // Asked about every 100 ms while Mesh_3 runs in its child process (fraction -1: unknown);
@@ -82,11 +83,16 @@ struct CgalMeshReport {
   std::size_t facet_triangles = 0;  // triangles of the PLC's facets handed to CGAL
   std::size_t patches = 0;          // surface patches of the domain (input polyhedra)
   std::size_t cells = 0;            // meshed cells (regions of space) of the PLC
+  std::size_t coordinates_snapped = 0;  // coordinates made equal to others they differ from by rounding (1e-12 of the extent)
+  std::size_t points_welded = 0;        // points merged into one they coincide with to 1e-12 of the extent
   std::size_t facets_joined = 0;    // PLC facets in the patch of a coplanar neighbour (see above)
   std::size_t facets_without_area = 0;  // facets of only segments or points (or collinear): they bound nothing, left out
   bool resampled = false;           // CgalMeshParams::resample was set
   double max_size = 0;              // the size bounds used
   double facet_size = 0, edge_size = 0, facet_distance = 0;
+  // Cells labelled by their centroid's part where Mesh_3's label (its circumcentre's part) differs,
+  // cells taken in or left out included (see "Regions" above).
+  std::size_t tets_relabelled = 0;
   std::vector<CgalRegionVolume> volumes;  // by region id, every meshed region of the PLC
   double worst_volume_change = 0;         // largest |relative_change()|
   // Every region's volume within volume_tolerance of the PLC's. Always expected without `resample`
