@@ -1,14 +1,17 @@
 // foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT: the CGAL Mesh_3 path of `foxi mesh` (options in cmd_mesh.cpp's
-// usage text): meshes, writes, and prints counts, time, dihedral angles and the weighted certificate.
+// usage text): meshes, writes, and prints counts, time, dihedral angles, each region's volume against the
+// PLC's and the weighted certificate. A mesh that fails either check is written but refused (exit 4).
 #include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
 #include "model_run.hpp"
 #include "foxi/mesher/cgal_mesher.hpp"
 #include "foxi/mesher/model_mesh_params.hpp"
+#include "foxi/mesher/size_field.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/structure.hpp"
@@ -55,6 +58,18 @@ double max_dihedral_deg(const Mesh& m, std::size_t t) {
   return worst;
 }
 
+// The exit status of a mesher failure: the input's fault, a stop asked for, or the mesher's.
+int exit_code(MesherFailure f) {
+  switch (f) {
+    case MesherFailure::bad_input:
+    case MesherFailure::self_intersection:
+    case MesherFailure::feature_too_small:
+    case MesherFailure::facets_too_close: return kExitBadInput;
+    case MesherFailure::cancelled: return kExitInterrupted;
+    default: return kExitFailure;
+  }
+}
+
 }  // namespace
 
 int mesh_with_cgal(Args& args) {
@@ -64,6 +79,13 @@ int mesh_with_cgal(Args& args) {
   if (max_volume > 0) params.max_size = regular_tet_circumradius(max_volume);
   params.radius_edge = non_negative(args.option("--radius-edge", "2"), "--radius-edge");
   params.perturb = args.flag("--perturb");
+  params.resample = args.flag("--resample");
+  if (args.has_option("--feature-angle")) {
+    params.feature_angle = non_negative(args.option("--feature-angle"), "--feature-angle");
+    if (params.feature_angle > 180) throw UsageError("--feature-angle takes degrees in [0, 180]");
+    if (!params.resample) throw UsageError("--feature-angle needs --resample (without it every facet edge is protected)");
+  }
+  params.time_limit = non_negative(args.option("--time-limit", "300"), "--time-limit");
   args.flag("--check-delaunay");  // the CGAL path always certifies
   const std::string out = args.option("-o");
   if (out.empty()) throw UsageError("give the output file with -o OUT (see foxi mesh --help)");
@@ -96,8 +118,8 @@ int mesh_with_cgal(Args& args) {
     mesh = mesh_plc_cgal(plc, params, &report);
   } catch (const MesherError& e) {
     std::signal(SIGINT, previous);
-    std::fprintf(stderr, "foxi mesh: error: %s: %s\n", in.c_str(), e.what());
-    return 1;
+    std::fprintf(stderr, "foxi mesh: error: %s: %s: %s\n", in.c_str(), failure_name(e.failure()), e.what());
+    return exit_code(e.failure());
   }
   std::signal(SIGINT, previous);
   if (is_model) name_mesh(model, structure, mesh);
@@ -109,13 +131,39 @@ int mesh_with_cgal(Args& args) {
               out.c_str(), mesh.node_count(), mesh.tet_count(), mesh.bface_count(), mesh.regions.size(), report.seconds);
   std::printf("sizes: cell %.4g, facet %.4g, edge %.4g; radius-edge max %.4g, dihedral min %.3g max %.4g deg, %zu slivers below 5 deg\n",
               report.max_size, report.facet_size, report.edge_size, q.radius_edge.max, q.min_dihedral_deg.min, max_dihedral, q.slivers);
+  // Each region's volume against the PLC's (the divergence theorem over its facets).
+  auto region_name = [&](std::int32_t id) {
+    for (const Region& r : mesh.regions)
+      if (r.id == id && !r.name.empty()) return " (" + r.name + ")";
+    return std::string();
+  };
+  std::printf("PLC: %zu coordinates snapped and %zu points welded (rounding), %zu facet triangles in %zu patches (%zu coplanar "
+              "facets joined a neighbour's), %zu facets without area left out; %zu tets labelled by centroid, not circumcentre\n",
+              report.coordinates_snapped, report.points_welded, report.facet_triangles, report.patches, report.facets_joined,
+              report.facets_without_area, report.tets_relabelled);
+  std::printf("region volumes against the PLC (%s):\n", report.resampled ? "facets resampled" : "every facet edge protected");
+  for (const CgalRegionVolume& v : report.volumes)
+    std::printf("  region %d%s: PLC %.6g, mesh %.6g, change %+.3g%%\n", v.region, region_name(v.region).c_str(), v.plc, v.mesh,
+                100 * v.relative_change());
   const DelaunayCertificate cert = compute_delaunay_certificate(mesh);
   if (cert.delaunay)
     std::printf("regular (weighted Delaunay): yes, every orthosphere is empty (%zu tets); weights written\n", cert.tets_checked);
   else
     std::printf("regular (weighted Delaunay): NO, %zu of %zu tets violated, %zu degenerate\n", cert.violating_tet_count,
                 cert.tets_checked, cert.degenerate_tet_count);
-  return cert.delaunay ? 0 : 1;
+  int status = kExitOk;
+  if (!cert.delaunay) {
+    std::fprintf(stderr, "foxi mesh: error: %s: the mesh written to %s fails the weighted Delaunay certificate\n", in.c_str(), out.c_str());
+    status = kExitUnreliable;
+  }
+  if (!report.resampled && !report.volumes_match) {
+    std::fprintf(stderr,
+                 "foxi mesh: error: %s: a region's volume differs from the PLC's by %.3g%% (more than %.3g%%) although every facet "
+                 "edge was protected: the mesh written to %s does not cover its PLC\n",
+                 in.c_str(), 100 * report.worst_volume_change, 100 * params.volume_tolerance, out.c_str());
+    status = kExitUnreliable;
+  }
+  return status;
 }
 
 }  // namespace foxi::cli

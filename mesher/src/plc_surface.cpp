@@ -81,9 +81,19 @@ void triangulate_facet(const Plc& plc, std::size_t f, const std::vector<std::uin
       const Point a = point(s.points, poly[i]), b = point(s.points, poly[(i + 1) % poly.size()]);
       normal = normal + Vec((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()), (a.x() - b.x()) * (a.y() + b.y()));
     }
-    break;  // the first polygon fixes the plane; the others lie in it
+    if (normal.squared_length() > 0) break;  // the first polygon with an area fixes the plane; the others lie in it
   }
-  if (normal.squared_length() == 0) reject("facet " + std::to_string(f + 1) + " has no polygon with an area");
+  if (normal.squared_length() == 0) {
+    // A polygon whose points are not all on one line but whose signed area is zero crosses itself.
+    for (const auto& poly : polys)
+      for (std::size_t i = 2; i < poly.size(); ++i)
+        if (!CGAL::collinear(point(s.points, poly[0]), point(s.points, poly[1]), point(s.points, poly[i])))
+          reject("facet " + std::to_string(f + 1) + " has crossing edges (a polygon's signed area is zero)");
+    // Only segments, points or collinear polygons: TetGen takes such a facet as edges to keep, but it
+    // bounds no area, and every PLC point already splits the polygon edges it lies on.
+    ++s.facets_without_area;
+    return;
+  }
 
   Cdt cdt{Proj(normal)};
   try {

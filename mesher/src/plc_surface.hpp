@@ -20,6 +20,7 @@ struct PlcSurface {
   // a volume hole point.
   std::vector<std::uint32_t> side_cell;
   std::size_t cell_count = 0;               // cells 0 .. cell_count-1, kOutside included
+  std::size_t facets_without_area = 0;      // facets of only segments, points or collinear polygons: left out
   // The region id of each cell (from the first region seed inside it; 0 for an enclosed cell with no
   // seed, and for kOutside).
   std::vector<std::int32_t> cell_region;
@@ -29,8 +30,10 @@ struct PlcSurface {
 // Triangulates every facet (polygons, segments and points inside it are constraints; parts enclosed by
 // no polygon and parts reachable from a facet hole point without crossing a constraint are left out),
 // after splitting polygon edges at PLC points lying on them (T-junctions between facets), then finds the
-// cells. Throws MesherError (code 10) naming the facet or seed on a PLC it cannot read: a facet with no
-// area or crossing edges, a region seed outside every closed surface or on a facet.
+// cells. Facets with no area (only segments or points, as the structure builder and TetGen's .poly
+// allow, or collinear polygons) are left out and counted. Throws MesherError (code 10) naming the
+// facet or seed on a PLC it cannot read: a facet with crossing edges, no facet with an area, a region
+// seed outside every closed surface or on a facet.
 PlcSurface plc_surface(const Plc& plc);
 
 }  // namespace foxi::detail

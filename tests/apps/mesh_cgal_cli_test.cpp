@@ -1,9 +1,16 @@
 // foxi mesh --mesher cgal end to end: a model's PLC meshed by CGAL, certified by the program, ordered
-// without violations by `foxi order --check`, and its weights read back by meshio (another reader).
+// without violations by `foxi order --check`, and its weights read back by meshio (another reader);
+// every region's volume in the written file against the part volumes `foxi model check` prints (the
+// model builder's, not the mesher's), the resampling option's printed volume changes, the time limit
+// and the exit statuses of its failures. Tests named *Slow* carry the CTest label `slow`.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
+#include <sstream>
+#include <string>
 
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/quality.hpp"
@@ -77,6 +84,135 @@ TEST(MeshCgalCli, ModelFileWithSetKeepsPartVolumesAndNames) {
   for (std::size_t t = 0; t < m.tet_count(); ++t) largest = std::max(largest, std::abs(tet_quality(&m.xyz[3 * m.tet[4 * t]],
       &m.xyz[3 * m.tet[4 * t + 1]], &m.xyz[3 * m.tet[4 * t + 2]], &m.xyz[3 * m.tet[4 * t + 3]]).volume));
   EXPECT_LT(largest, 1e-9 / (6 * std::sqrt(2.0)) * 1.5);
+}
+
+// Each region's volume (by region name) in a mesh file.
+std::map<std::string, double> volumes_by_name(const Mesh& m) {
+  std::map<std::string, double> volume;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    const std::uint32_t* v = &m.tet[4 * t];
+    const double vol = tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume;
+    for (const Region& r : m.regions)
+      if (r.id == m.region_of(t)) volume[r.name] += vol;
+  }
+  return volume;
+}
+
+// The part volumes `foxi model check` prints: "  ID NAME SHAPE MATERIAL V m^3 (...)".
+std::map<std::string, double> model_check_volumes(const std::string& model, const test::TempDir& dir) {
+  EXPECT_EQ(test::run_cli("model check " + model, dir / "check.log"), 0) << test::read_text(dir / "check.log");
+  std::istringstream in(test::read_text(dir / "check.log"));
+  std::map<std::string, double> volume;
+  std::string line;
+  bool parts = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("parts (", 0) == 0) {
+      parts = true;
+      continue;
+    }
+    if (parts && line.rfind("  ", 0) != 0) break;
+    if (!parts) continue;
+    std::istringstream words(line);
+    int id = 0;
+    std::string name, shape, material;
+    double v = 0;
+    if (words >> id >> name >> shape >> material >> v) volume[name] = v;
+  }
+  return volume;
+}
+
+// `foxi mesh MODEL --mesher cgal` (exit 0: certified, volumes checked), and every part's volume in the
+// file against `foxi model check`'s to 0.1% (the mesh is exact to rounding; model check prints 6 digits).
+void expect_cli_meshes_model(const std::string& name, double* seconds = nullptr) {
+  test::TempDir dir;
+  const std::string model = test::models_dir() + name + ".toml";
+  const std::map<std::string, double> want = model_check_volumes(model, dir);
+  ASSERT_FALSE(want.empty());
+  const auto t0 = std::chrono::steady_clock::now();
+  const int status = test::run_cli("mesh " + model + " --mesher cgal -o " + (dir / "m.vtu").string(), dir / "mesh.log");
+  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string log = test::read_text(dir / "mesh.log");
+  ASSERT_EQ(status, 0) << log;
+  EXPECT_NE(log.find("regular (weighted Delaunay): yes"), std::string::npos) << log;
+  EXPECT_NE(log.find("region volumes against the PLC (every facet edge protected)"), std::string::npos) << log;
+  const auto got = volumes_by_name(read_mesh(dir / "m.vtu"));
+  ASSERT_EQ(got.size(), want.size()) << log;
+  for (const auto& [part, v] : want) {
+    ASSERT_TRUE(got.count(part)) << name << ": no region named " << part;
+    EXPECT_NEAR(got.at(part), v, 1e-3 * v) << name << ": part " << part;
+  }
+}
+
+// The via (a 16-gon prism through a layer): it lost 1.7% of its volume when its wall was resampled.
+TEST(MeshCgalCli, ViaModelKeepsThePartVolumesModelCheckPrints) { expect_cli_meshes_model("via_in_dielectric"); }
+
+// The bga: a corefined triangle soup with segment facets; it failed with "facet 488 has no polygon
+// with an area" before.
+TEST(MeshCgalCliSlow, BgaModelKeepsThePartVolumesModelCheckPrints) { expect_cli_meshes_model("bga"); }
+
+// die_attach (a 20 um layer under a 10 mm die) ran past 60 s: it now finishes (volumes checked) or
+// stops at --time-limit with exit 1 and a message naming the limit, well within the limit.
+TEST(MeshCgalCliSlow, DieAttachFinishesOrStopsWithinItsTimeLimit) {
+  test::TempDir dir;
+  const auto t0 = std::chrono::steady_clock::now();
+  const int status = test::run_cli("mesh " + test::models_dir() + "die_attach.toml --mesher cgal --time-limit 60 -o " +
+                                       (dir / "m.vtu").string(),
+                                   dir / "mesh.log");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string log = test::read_text(dir / "mesh.log");
+  EXPECT_LT(seconds, 90) << log;
+  if (status == 0) {
+    EXPECT_NE(log.find("regular (weighted Delaunay): yes"), std::string::npos) << log;
+  } else {
+    EXPECT_EQ(status, 1) << log;
+    EXPECT_NE(log.find("time limit: CGAL Mesh_3 did not finish within the time limit of 60 s"), std::string::npos) << log;
+    EXPECT_FALSE(std::filesystem::exists(dir / "m.vtu"));
+  }
+  std::printf("die_attach with --mesher cgal --time-limit 60: exit %d after %.1f s\n", status, seconds);
+}
+
+// --resample: the via's wall is resampled, and the printed change is the file's volume against the PLC's.
+TEST(MeshCgalCli, ResampleReportsTheViaVolumeChange) {
+  test::TempDir dir;
+  const std::string model = test::models_dir() + "via_in_dielectric.toml";
+  const std::map<std::string, double> want = model_check_volumes(model, dir);
+  ASSERT_EQ(test::run_cli("mesh " + model + " --mesher cgal --resample -o " + (dir / "m.vtu").string(), dir / "mesh.log"), 0)
+      << test::read_text(dir / "mesh.log");
+  const std::string log = test::read_text(dir / "mesh.log");
+  EXPECT_NE(log.find("region volumes against the PLC (facets resampled)"), std::string::npos) << log;
+  const auto got = volumes_by_name(read_mesh(dir / "m.vtu"));
+  std::size_t checked = 0;
+  for (const auto& [part, v] : want) {
+    const std::string tag = "(" + part + "): PLC ";
+    const auto at = log.find(tag);
+    ASSERT_NE(at, std::string::npos) << log;
+    double plc = 0, mesh = 0, change = 0;
+    ASSERT_EQ(std::sscanf(log.c_str() + at + tag.size(), "%lf, mesh %lf, change %lf%%", &plc, &mesh, &change), 3) << log;
+    EXPECT_NEAR(plc, v, 1e-5 * v) << part;
+    EXPECT_NEAR(mesh, got.at(part), 1e-5 * got.at(part)) << part;
+    EXPECT_NEAR(change, 100 * (got.at(part) / v - 1), 1e-3 + 1e-2 * std::abs(change)) << part;
+    ++checked;
+  }
+  EXPECT_EQ(checked, want.size());
+}
+
+TEST(MeshCgalCli, BadOptionsAndBadInputHaveTheirExitStatuses) {
+  test::TempDir dir;
+  const std::string model = test::models_dir() + "die_on_substrate.toml", out = " -o " + (dir / "m.vtu").string();
+  EXPECT_EQ(test::run_cli("mesh " + model + " --mesher cgal --feature-angle 30" + out, dir / "log"), 2);
+  EXPECT_NE(test::read_text(dir / "log").find("--feature-angle needs --resample"), std::string::npos) << test::read_text(dir / "log");
+  EXPECT_EQ(test::run_cli("mesh " + model + " --mesher cgal --time-limit -1" + out, dir / "log"), 2);
+  // A region seed outside the PLC: bad input (3), the file and the seed named.
+  std::FILE* f = std::fopen((dir / "out.poly").c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs("8 3 0 0\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n6 1\n"
+             "1 0 1\n4 1 2 3 4\n1 0 2\n4 5 6 7 8\n1 0 3\n4 1 2 6 5\n1 0 4\n4 2 3 7 6\n1 0 5\n4 3 4 8 7\n1 0 6\n4 4 1 5 8\n"
+             "0\n1\n1 5 5 5 7 -1\n", f);
+  std::fclose(f);
+  EXPECT_EQ(test::run_cli("mesh " + (dir / "out.poly").string() + " --mesher cgal" + out, dir / "log"), 3);
+  const std::string log = test::read_text(dir / "log");
+  EXPECT_NE(log.find("out.poly: bad input: region seed 1 (region 7) lies outside every closed surface"), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.vtu"));
 }
 
 TEST(MeshCgalCli, UnknownMesherIsAUsageError) {

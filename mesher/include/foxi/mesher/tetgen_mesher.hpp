@@ -7,9 +7,9 @@
 // Delaunay mesh at material interfaces. Check with delaunay_certificate() (foxi/model/delaunay.hpp).
 #pragma once
 
-#include <stdexcept>
 #include <string>
 
+#include "foxi/mesher/mesher.hpp"  // MesherError, MesherFailure
 #include "foxi/mesher/size_field.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
@@ -40,18 +40,6 @@ struct MeshReport {
   std::size_t input_points = 0;
   std::size_t steiner_points = 0; // points TetGen added
   double seconds = 0;
-};
-
-// A PLC TetGen rejects (self-intersecting facets, features below its tolerance, an internal error)
-// or a mesh it cannot finish; the message says which.
-class MesherError : public std::runtime_error {
- public:
-  MesherError(int tetgen_code, const std::string& message)
-      : std::runtime_error(message), code_(tetgen_code) {}
-  int tetgen_code() const { return code_; }
-
- private:
-  int code_;
 };
 
 Mesh mesh_plc(const Plc& plc, const MeshParams& params = {}, MeshReport* report = nullptr);
