@@ -2,8 +2,8 @@
 # Runs every test on a fresh machine: installs what is missing, builds (Release), runs all tests
 # with CTest; then builds the model tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs
 # them again (readers on broken files must never crash). Set FOXI_SKIP_SANITIZE=1 to skip the second.
-# Last, the fuzz targets (clang, libFuzzer, build-fuzz) run FOXI_FUZZ_SECONDS each (default 30), two
-# at a time: about 5 minutes of build and 2.5 of fuzzing on 2 cores. FOXI_SKIP_FUZZ=1 skips them.
+# Last, the fuzz targets (clang, libFuzzer, build-fuzz) run FOXI_FUZZ_SECONDS each (default 20), two
+# at a time: about 8 minutes of build and 1.5 of fuzzing on 2 cores. FOXI_SKIP_FUZZ=1 skips them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -17,5 +17,5 @@ if [ "${FOXI_SKIP_SANITIZE:-0}" != "1" ]; then
     ctest --test-dir build-asan --output-on-failure -j2 --timeout 1800
 fi
 if [ "${FOXI_SKIP_FUZZ:-0}" != "1" ]; then
-  FUZZ_JOBS=2 FUZZ_NICE=0 bash scripts/fuzz.sh "${FOXI_FUZZ_SECONDS:-30}"
+  FUZZ_JOBS=2 FUZZ_NICE=0 bash scripts/fuzz.sh "${FOXI_FUZZ_SECONDS:-20}"
 fi

@@ -34,7 +34,6 @@ class ByteReader {
  public:
   ByteReader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
   std::uint8_t u8() { return pos_ < size_ ? data_[pos_++] : 0; }
-  std::uint16_t u16() { return std::uint16_t(u8() | u8() << 8); }
   double f64() {
     std::uint64_t bits = 0;
     for (int k = 0; k < 8; ++k) bits |= std::uint64_t(u8()) << (8 * k);
