@@ -4,7 +4,8 @@
 # it found. Usage: scripts/fuzz.sh SECONDS [TARGET...]   (targets: gmsh vtu vtk medit tetgen poly
 # model expression mesh_pipeline; default all).
 # Environment: FUZZ_JOBS (targets run at once, default 1), FUZZ_KEEP_GOING=1 (go on after a crash,
-# hang or out-of-memory, collecting every one: libFuzzer's fork mode), FUZZ_NICE (default 19).
+# hang or out-of-memory, collecting every one: libFuzzer's fork mode), FUZZ_NICE (default 19),
+# FUZZ_NO_BUILD=1 (run what build-fuzz holds).
 # The corpus grows in build-fuzz/corpus/TARGET across runs; seeds are written afresh each run into
 # build-fuzz/seeds; inputs that crashed, hung or over-allocated land in build-fuzz/artifacts/TARGET/
 # (crash-*, timeout-*, oom-*, leak-*): each becomes a file in tests/data/bad with a test.
@@ -26,7 +27,7 @@ if [ ! -f "$build/build.ninja" ]; then
     -DFOXI_BUILD_FUZZERS=ON -DFOXI_BUILD_TESTS=OFF -DFOXI_BUILD_BENCH=OFF -DFOXI_WITH_QT=OFF -DFOXI_WITH_X11=OFF \
     > "$build.log" 2>&1 || { cat "$build.log"; exit 1; }
 fi
-nice -n "$nice_level" ninja -C "$build" -j2 foxi_fuzzers
+[ "${FUZZ_NO_BUILD:-0}" = "1" ] || nice -n "$nice_level" ninja -C "$build" -j2 foxi_fuzzers
 rm -rf "$build/seeds"
 "$build/tests/fuzz/fuzz_make_seeds" "$build/seeds" > /dev/null
 
@@ -81,7 +82,7 @@ for t in "${targets[@]}"; do
   [ -n "$execs" ] || execs=0
   corpus=$(find "$build/corpus/$t" -type f | wc -l)
   findings=$(find "$build/artifacts/$t" -type f -newer "$build/fuzz-start" | wc -l)
-  rate=$(awk -v e="$execs" -v w="$wall" 'BEGIN { printf "%d", w > 0 ? e / w : 0 }')
+  rate=$(awk -v e="$execs" -v w="$wall" 'BEGIN { printf "%d", (w > 0 ? e / w : 0) }')
   printf '%-14s %12s %8.0f %8.0f %10s %8s %s\n' "$t" "$execs" "$wall" "$(awk -v u="$user" -v s="$sys" 'BEGIN { print u + s }')" "$rate" "$corpus" \
     "$([ "$findings" -gt 0 ] && echo "$findings in $build/artifacts/$t (log $log)" || echo none)"
   if [ "$status" != 0 ] || [ "$findings" -gt 0 ]; then found=1; fi
