@@ -124,6 +124,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   foxi::View view;
   foxi::Mesh m = decode(in, view);
   if (!foxi::validate_and_repair(m).ok()) return 0;
+  // Two tets on the same four nodes pass validation today (issue 22, "Found": duplicate tets, to be
+  // refused by validation), and share all four faces, so count_violations finds pairs out of order
+  // (tests/data/bad/fuzz/mesh_pipeline/duplicate_tets). Skipped until validation refuses them, so that
+  // fuzzing looks for what is not known.
+  {
+    std::set<std::array<std::uint32_t, 4>> seen;
+    for (std::size_t t = 0; t < m.tet_count(); ++t) {
+      std::array<std::uint32_t, 4> key = {m.tet[4 * t], m.tet[4 * t + 1], m.tet[4 * t + 2], m.tet[4 * t + 3]};
+      std::sort(key.begin(), key.end());
+      if (!seen.insert(key).second) return 0;
+    }
+  }
 
   const foxi::DelaunayCertificate cert = foxi::compute_delaunay_certificate(m);
   FOXI_FUZZ_CHECK(cert.tets_checked == m.tet_count(), "");
