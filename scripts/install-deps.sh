@@ -11,6 +11,8 @@ packages=(
   qtbase5-dev libx11-dev libxext-dev libpng-dev zlib1g-dev libpugixml-dev libfreetype-dev libgif-dev libtoml11-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev xvfb xdotool x11-apps
+  # the fuzz targets (scripts/fuzz.sh): clang with libFuzzer and its sanitizer runtimes
+  clang-14 libclang-rt-14-dev
   # outside programs the tests use as oracles
   gmsh tetgen calculix-ccx python3-meshio python3-numpy
   # optional: foxi movie writes MP4 through it, and the movie tests decode APNG/GIF/MP4 with it

@@ -91,12 +91,16 @@ PointGrid build_grid(const Mesh& mesh, bool weighted) {
   }
   if (emax > 0) {
     // Cubic cells, about one point per cell.
+    // The volume relative to emax^3, so that it neither overflows nor underflows for coordinates
+    // near 1e160 or 1e-160 (then h was inf or 0 and the cell counts inf: UBSan, converting to int).
     double vol = 1;
-    for (int d = 0; d < 3; ++d) vol *= std::max(hi[d] - lo[d], emax * 1e-3);
-    double h = std::cbrt(vol / static_cast<double>(m));
-    for (int d = 0; d < 3; ++d)
-      g.dims[d] =
-          std::clamp<std::int64_t>(static_cast<std::int64_t>(std::ceil((hi[d] - lo[d]) / h)), 1, 4096);
+    for (int d = 0; d < 3; ++d) vol *= std::max((hi[d] - lo[d]) / emax, 1e-3);
+    double h = emax * std::cbrt(vol / static_cast<double>(m));
+    if (!(h > 0) || !std::isfinite(h)) h = std::numeric_limits<double>::infinity();  // extent overflows: one cell
+    for (int d = 0; d < 3; ++d) {
+      const double n = std::ceil((hi[d] - lo[d]) / h);  // (NaN for an infinite extent: one cell)
+      g.dims[d] = n >= 1 ? static_cast<std::int64_t>(std::min(n, 4096.0)) : 1;
+    }
     g.inv_h = 1 / h;
   }
   const std::size_t cells = static_cast<std::size_t>(g.dims[0] * g.dims[1] * g.dims[2]);

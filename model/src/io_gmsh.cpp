@@ -525,7 +525,7 @@ class Reader {
       const std::uint64_t per = 3 + extra;
       std::uint64_t* tags = node_tags_.data() + done;
       double* xyz = mesh_.xyz.data() + 3 * done;
-      if (binary_) {
+      if (binary_ && m > 0) {  // (an empty block: no memcpy, whose pointers may then be null)
         const char* p = need(m * (8 + 8 * per), "node block");
         std::memcpy(tags, p, 8 * m);
         p += 8 * m;

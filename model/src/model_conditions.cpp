@@ -74,9 +74,12 @@ class ConditionReader {
     return *v;
   }
   void allow_keys(const Value& table, const std::string& who, std::initializer_list<const char*> keys) const {
-    for (const auto& [k, v] : table.as_table())
+    // Not a structured binding: clang before 16 cannot capture one in the lambda (the fuzz build).
+    for (const auto& entry : table.as_table()) {
+      const std::string& k = entry.first;
       if (std::none_of(keys.begin(), keys.end(), [&](const char* a) { return k == a; }))
-        fail(v, who + ": unknown key '" + k + "'");
+        fail(entry.second, who + ": unknown key '" + k + "'");
+    }
   }
   std::string text(const Value& v, const std::string& what) const {
     if (!v.is_string()) fail(v, what + " must be a string");

@@ -106,9 +106,10 @@ class Parser {
     while (p_ < s_.size() && ident_char(s_[p_])) ++p_;
     return s_.substr(b, p_ - b);
   }
-  void same(const Quantity& a, const Quantity& b, const char* op) const {
+  // op: "+", "-", or a function's name (a view into the text, not NUL-terminated).
+  void same(const Quantity& a, const Quantity& b, std::string_view op) const {
     if (a.dims != b.dims)
-      fail("unit mismatch: " + dims_to_string(a.dims) + " " + op + " " + dims_to_string(b.dims));
+      fail("unit mismatch: " + dims_to_string(a.dims) + " " + std::string(op) + " " + dims_to_string(b.dims));
   }
 
   Quantity expr() {
@@ -244,7 +245,7 @@ class Parser {
       if (args.empty()) fail(std::string(f) + " takes at least one argument");
       Quantity r = args[0];
       for (auto& a : args) {
-        same(r, a, f.data());
+        same(r, a, f);
         r.value = f == "min" ? std::min(r.value, a.value) : std::max(r.value, a.value);
       }
       return r;

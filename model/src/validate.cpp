@@ -41,6 +41,11 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
       finite[v] = 0;
       ++r.nonfinite_nodes;
       note(r, "node " + std::to_string(v) + ": non-finite coordinate");
+    } else if (!mesh.weight.empty() && !std::isfinite(mesh.weight[v])) {
+      // A weight (read from a .vtu/.vtk 'weight' array) that is NaN or infinite has no orthosphere.
+      finite[v] = 0;
+      ++r.nonfinite_nodes;
+      note(r, "node " + std::to_string(v) + ": non-finite weight");
     }
   }
   std::vector<std::uint8_t> used(nv, 0);

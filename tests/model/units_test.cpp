@@ -70,4 +70,19 @@ TEST(Units, MismatchesAndUnknownNamesAreErrors) {
   EXPECT_NE(error_of("").find("unexpected end"), std::string::npos);
 }
 
+// Found by fuzzing (tests/data/bad/fuzz/expression/min_max_mismatch): min/max named themselves in a
+// unit mismatch through the text's pointer, read as a C string past the end of the view (ASan: a
+// heap overflow) and quoting the rest of the text as the operator.
+TEST(Units, MinMaxMismatchNamesOnlyTheFunction) {
+  const std::string text = "max(1, 2 mm)TRAILING";
+  try {
+    foxi::evaluate_expression(std::string_view(text).substr(0, 12), [](std::string_view) { return std::nullopt; });
+    FAIL() << "no error";
+  } catch (const foxi::ExpressionError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("unit mismatch: 1 (dimensionless) max m in 'max(1, 2 mm)'"), std::string::npos) << what;
+    EXPECT_EQ(what.find("TRAILING"), std::string::npos) << what;
+  }
+}
+
 }  // namespace

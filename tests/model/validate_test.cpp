@@ -81,6 +81,18 @@ TEST(Validate, NonFiniteCoordinates) {
   EXPECT_TRUE(mentions(r, "node 4"));
 }
 
+// Found by fuzzing (tests/data/bad/fuzz/mesh_pipeline/infinite_weight): an infinite vertex weight
+// passed validation, and the sphere table then crashed in GMP (SIGFPE converting it exactly).
+TEST(Validate, NonFiniteWeights) {
+  Mesh m = two_tets();
+  m.weight = {0, 0, std::numeric_limits<double>::infinity(), 0, std::numeric_limits<double>::quiet_NaN()};
+  ValidationReport r = validate(m);
+  EXPECT_EQ(r.nonfinite_nodes, 2u);
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(mentions(r, "node 2: non-finite weight"));
+  EXPECT_TRUE(mentions(r, "node 4: non-finite weight"));
+}
+
 TEST(Validate, ZeroVolumeExactly) {
   // Tet 0 lies exactly in the plane z = x (the stored doubles satisfy it exactly); tet 1 is lifted
   // off that plane by one unit in the last place, which an exact predicate must still see.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "foxi/model/delaunay.hpp"
@@ -633,6 +634,26 @@ TEST(VisibilityOrder, EqualWeightsGiveTheUnweightedOrder) {
   for (const View& v : random_views(m, 20, 3)) {
     EXPECT_EQ(count_violations(w, v, visibility_order(w, tw, v)).violations, 0u);
     EXPECT_EQ(visibility_order(w, tw, v), visibility_order(m, tm, v));
+  }
+}
+
+// Found by fuzzing (tests/data/bad/fuzz/mesh_pipeline/infinite_weight): a weight of infinity or NaN
+// (a .vtu's 'weight' array may hold one; validation now refuses it, foxi render does not validate)
+// reached the exact recomputation of the orthocentre, where GMP raised SIGFPE. Such a tet has no
+// sphere: it is ordered as a flat tet, like the certificate's degenerate ones.
+TEST(VisibilityOrder, NonFiniteWeightsGiveFlatTetsNotACrash) {
+  for (double bad : {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    Mesh m;
+    m.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.3, 0.3, 1, 0.3, 0.3, -1};
+    test::push_tet(m, 0, 1, 2, 3);
+    test::push_tet(m, 0, 1, 2, 4);
+    m.weight = {0, bad, 0, 0, 0};
+    const SphereTable t = compute_spheres(m);
+    EXPECT_EQ(t.flat[0], 1);
+    EXPECT_EQ(t.flat[1], 1);
+    auto order = visibility_order(m, t, View::at(0.2, 0.2, 5));
+    std::sort(order.begin(), order.end());
+    EXPECT_EQ(order, (std::vector<std::uint32_t>{0, 1}));
   }
 }
 

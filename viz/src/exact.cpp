@@ -1,5 +1,7 @@
 #include "exact.hpp"
 
+#include <cmath>
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 #include <CGAL/Gmpzf.h>
@@ -51,6 +53,11 @@ QVec qv(const double* p) { return vec<Q>(p); }
 // Exact centre offset o (relative to a) of the tet; false if flat.
 bool centre_offset(const double* a, const double* b, const double* c, const double* d, const double* w,
                    QVec& A, QVec& o) {
+  // A NaN or infinity has no exact value (GMP raises SIGFPE converting it): no sphere, like a flat tet.
+  for (const double* p : {a, b, c, d})
+    if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) return false;
+  if (w != nullptr && !(std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]) && std::isfinite(w[3])))
+    return false;
   A = qv(a);
   QVec B = sub(qv(b), A), C = sub(qv(c), A), D = sub(qv(d), A);
   Q det = dot(B, cross(C, D));

@@ -284,7 +284,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
       double rel = std::abs(det) > 0 ? det_err / std::abs(det) + (num_norm > 0 ? num_err / num_norm : 1.0) : 1.0;
       double* cc = t.c.data() + 3 * i;
       double& s = t.s[i];
-      if (rel > kRecomputeAbove) {
+      if (!(rel <= kRecomputeAbove)) {  // NaN too (a non-finite weight): the exact path calls it flat
         const double* wv = nullptr;
         double wq[4];
         if (W != nullptr) {

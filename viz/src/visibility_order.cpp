@@ -1358,11 +1358,13 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
     while (ahead < limit && bucket_begin[ahead] == bucket_begin[ahead + 1]) ++ahead;
     if (prefetch_ties && ahead < limit && ahead >= sc.sorted_upto) ensure_sorted(ahead);
     const std::uint32_t* tb = t_cluster_free ? bucket_begin.data() : tet_begin.data();
-    std::uint32_t* o = direct + tb[group];
+    std::uint32_t* o;  // (no offset added to a null `direct`: undefined, UBSan's pointer-overflow check)
     if (direct == nullptr) {
       const std::size_t at = out.size();
       out.resize(at + (tb[b] - tb[group]));
       o = out.data() + at;
+    } else {
+      o = direct + tb[group];
     }
     if (t_cluster_free && zones.empty()) {
       o = stream_out ? emit_tets<true>(begin, end, o, sc) : emit_tets<false>(begin, end, o, sc);

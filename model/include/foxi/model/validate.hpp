@@ -13,7 +13,7 @@ struct ValidationReport {
   std::string size_problem;            // from check_sizes(); when not empty nothing else is checked
   std::size_t index_out_of_range = 0;  // tets and boundary triangles with an index >= node_count
   std::size_t repeated_vertex = 0;     // tets or triangles naming one node twice
-  std::size_t nonfinite_nodes = 0;     // NaN or Inf coordinates
+  std::size_t nonfinite_nodes = 0;     // NaN or Inf coordinates or weight
   std::size_t zero_volume = 0;         // exactly flat tets (exact orientation predicate)
   std::size_t inverted = 0;            // negatively oriented tets (re-oriented by repair)
   std::size_t unused_nodes = 0;        // nodes no tet uses

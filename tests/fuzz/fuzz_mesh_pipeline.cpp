@@ -1,0 +1,215 @@
+// Fuzz target: any small mesh through validation, the Delaunay certificate, the visibility order and
+// a small render. The input decodes to up to 16 nodes (on a lattice at one of several scales, or raw
+// doubles), up to 24 tets naming them, optional regions and vertex weights, and a view. A mesh that
+// validation refuses stops there; one it accepts (re-oriented) must then go through the rest without
+// a crash, a hang or an exception, and the results are checked against independent oracles:
+// - the certificate against a brute-force test of every tet's circumsphere against every vertex
+//   (CGAL's exact side_of_bounded_sphere, unweighted meshes);
+// - every order is a permutation of what was asked for;
+// - for a certified mesh the power order draws no face-adjacent pair in the wrong order
+//   (count_violations), and the undoable painter, undrawing half of the picture, leaves the picture
+//   of the other half drawn from scratch (rasterizer.hpp).
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <vector>
+
+#include "foxi/model/delaunay.hpp"
+#include "foxi/model/validate.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/visibility_order.hpp"
+#include "fuzz_util.hpp"
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using foxi::fuzz::ByteReader;
+
+// Scales of the lattice: ordinary, small and large meshes, and the extremes where squared lengths
+// and volumes leave the double range.
+constexpr double kScales[8] = {1, 1e-3, 1e3, 0.37, 1e-100, 1e100, 1e-160, 1e160};
+
+foxi::Mesh decode(ByteReader& in, foxi::View& view) {
+  const std::uint8_t mode = in.u8();
+  const bool raw = (mode & 1) != 0, weighted = (mode & 2) != 0, regions = (mode & 4) != 0;
+  const double scale = kScales[(mode >> 4) & 7];
+  // Lattice coordinates in [-4, 4] in quarter steps with an offset: many cospherical and coplanar
+  // sets (the hard cases of the certificate and the order), and a whole mesh far from the origin.
+  const double offset = scale * double(std::int8_t(in.u8())) * ((mode & 8) != 0 ? 1000.0 : 1.0);
+  auto coordinate = [&] {
+    if (raw) return in.f64();
+    const std::uint8_t b = in.u8();
+    return offset + scale * (double(b % 9) - 4 + double(b / 9 % 4) * 0.25);
+  };
+  foxi::Mesh m;
+  const std::size_t nodes = 4 + in.u8() % 13, tets = 1 + in.u8() % 24;
+  for (std::size_t i = 0; i < 3 * nodes; ++i) m.xyz.push_back(coordinate());
+  for (std::size_t t = 0; t < tets; ++t)
+    for (int k = 0; k < 4; ++k) m.tet.push_back(in.u8() % nodes);
+  if (regions)
+    for (std::size_t t = 0; t < tets; ++t) m.tet_region.push_back(in.u8() % 3);
+  if (weighted)
+    for (std::size_t i = 0; i < nodes; ++i) m.weight.push_back(scale * scale * double(in.u8() % 5) * 0.125);
+  const std::uint8_t v = in.u8();
+  view.perspective = (v & 1) == 0;
+  double* p = view.perspective ? view.eye : view.dir;
+  for (int k = 0; k < 3; ++k) p[k] = offset + scale * (double(std::int8_t(in.u8())) / 8);
+  if (!view.perspective && p[0] == 0 && p[1] == 0 && p[2] == 0) p[2] = 1;
+  return m;
+}
+
+// True if some face is shared by more than two tets, or by two whose fourth nodes lie on the same
+// side of it (exact orientation).
+bool folded(const foxi::Mesh& m) {
+  auto point = [&](std::uint32_t v) { return K::Point_3(m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]); };
+  std::map<std::array<std::uint32_t, 3>, std::vector<std::uint32_t>> apexes;  // face -> 4th nodes
+  for (std::size_t t = 0; t < m.tet_count(); ++t)
+    for (int k = 0; k < 4; ++k) {
+      std::array<std::uint32_t, 3> f;
+      for (int j = 0, i = 0; j < 4; ++j)
+        if (j != k) f[i++] = m.tet[4 * t + j];
+      std::sort(f.begin(), f.end());
+      apexes[f].push_back(m.tet[4 * t + k]);
+    }
+  for (const auto& [f, a] : apexes) {
+    if (a.size() > 2) return true;
+    if (a.size() == 2 &&
+        CGAL::orientation(point(f[0]), point(f[1]), point(f[2]), point(a[0])) ==
+            CGAL::orientation(point(f[0]), point(f[1]), point(f[2]), point(a[1])))
+      return true;
+  }
+  return false;
+}
+
+void check_permutation(std::span<const std::uint32_t> order, std::vector<std::uint32_t> expected) {
+  std::vector<std::uint32_t> got(order.begin(), order.end());
+  std::sort(got.begin(), got.end());
+  std::sort(expected.begin(), expected.end());
+  FOXI_FUZZ_CHECK(got == expected, "the order is not a permutation of the tets asked for");
+}
+
+// The certificate by brute force: every tet against every vertex (used node), exact predicates.
+std::size_t brute_force_violations(const foxi::Mesh& m) {
+  std::vector<char> used(m.node_count(), 0);
+  for (std::uint32_t v : m.tet) used[v] = 1;
+  auto point = [&](std::uint32_t v) { return K::Point_3(m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]); };
+  std::size_t violating = 0;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    const std::uint32_t* q = &m.tet[4 * t];
+    for (std::uint32_t v = 0; v < m.node_count(); ++v)
+      if (used[v] && CGAL::side_of_bounded_sphere(point(q[0]), point(q[1]), point(q[2]), point(q[3]), point(v)) ==
+                         CGAL::ON_BOUNDED_SIDE) {
+        ++violating;
+        break;
+      }
+  }
+  return violating;
+}
+
+void render_checks(const foxi::Mesh& m, const foxi::View& view, std::span<const std::uint32_t> order,
+                   bool visibility_order) {
+  constexpr int kW = 24, kH = 16;
+  double lo[3], hi[3];
+  foxi::mesh_bounds(m, lo, hi);
+  foxi::RenderParams params;
+  params.undoable = visibility_order;
+  try {
+    const foxi::Camera camera = foxi::camera_from_options(lo, hi, double(kW) / kH, view.perspective ? view.eye : nullptr,
+                                                          nullptr, nullptr, 30, view.perspective ? nullptr : view.dir);
+    foxi::TetRasterizer raster(m, camera, kW, kH, params);
+    foxi::Framebuffer fb(kW, kH);
+    raster.draw(fb, order);
+    if (!visibility_order) return;
+    // Open finding (tests/data/bad/fuzz/mesh_pipeline/undraw_eye_inside_tet_*): with the eye inside a
+    // tet, whose faces the near plane clips, undrawing differs from a fresh drawing. Checked only
+    // where the near plane cuts nothing, until that is resolved.
+    if (raster.stats().faces_clipped > 0 || raster.stats().tets_behind > 0) return;
+    const std::size_t half = order.size() / 2;
+    raster.undraw(fb, order.size() - half);
+    foxi::RenderParams fresh_params;
+    const foxi::Framebuffer fresh = foxi::render_tets(m, camera, kW, kH, order.first(half), fresh_params);
+    FOXI_FUZZ_CHECK(fresh.rgba == fb.rgba && fresh.id == fb.id,
+                    "undrawing to " + std::to_string(half) + " of " + std::to_string(order.size()) +
+                        " tets differs from drawing them afresh");
+  } catch (const std::invalid_argument&) {
+    // A degenerate camera (eye on the target point), bounds too large to fit a camera to, or one
+    // zoomed past the fixed-point range: refused, which is the documented answer.
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  ByteReader in(data, size);
+  foxi::View view;
+  foxi::Mesh m = decode(in, view);
+  if (!foxi::validate_and_repair(m).ok()) return 0;
+  // Two tets on the same four nodes pass validation today (issue 22, "Found": duplicate tets, to be
+  // refused by validation), and share all four faces, so count_violations finds pairs out of order
+  // (tests/data/bad/fuzz/mesh_pipeline/duplicate_tets). Skipped until validation refuses them, so that
+  // fuzzing looks for what is not known.
+  {
+    std::set<std::array<std::uint32_t, 4>> seen;
+    for (std::size_t t = 0; t < m.tet_count(); ++t) {
+      std::array<std::uint32_t, 4> key = {m.tet[4 * t], m.tet[4 * t + 1], m.tet[4 * t + 2], m.tet[4 * t + 3]};
+      std::sort(key.begin(), key.end());
+      if (!seen.insert(key).second) return 0;
+    }
+  }
+  // The same for folds: a face shared by three tets, or by two on the same side of it (they
+  // overlap), passes validation today and breaks the order's promise (tests/data/bad/fuzz/
+  // mesh_pipeline/folded_face_weighted). Skipped until validation refuses them.
+  if (folded(m)) return 0;
+
+  // Coordinates beyond 1e150 overflow squared lengths and volumes (circumspheres, keys) to infinity,
+  // yet pass validation today (issue 22, "Found": validation's part is to refuse overflowing
+  // geometry); the order then has pairs out of order (tests/data/bad/fuzz/mesh_pipeline/
+  // order_coordinates_1e160). Skipped here until validation refuses them.
+  for (double x : m.xyz)
+    if (std::abs(x) > 1e150) return 0;
+
+  const foxi::DelaunayCertificate cert = foxi::compute_delaunay_certificate(m);
+  FOXI_FUZZ_CHECK(cert.tets_checked == m.tet_count(), "");
+  if (m.weight.empty()) {
+    const std::size_t expected = brute_force_violations(m);
+    FOXI_FUZZ_CHECK(cert.violating_tet_count == expected,
+                    std::to_string(cert.violating_tet_count) + " violating tets, brute force " + std::to_string(expected));
+    FOXI_FUZZ_CHECK(cert.delaunay == (expected == 0 && cert.degenerate_tet_count == 0), "");
+  }
+
+  const foxi::SphereTable table = foxi::compute_spheres(m);
+  std::vector<std::uint32_t> all(m.tet_count());
+  for (std::uint32_t t = 0; t < all.size(); ++t) all[t] = t;
+  std::vector<std::uint32_t> order;
+  if (cert.delaunay) {
+    order = foxi::visibility_order(m, table, view);
+    check_permutation(order, all);
+    const foxi::ViolationReport report = foxi::count_violations(m, view, order);
+    FOXI_FUZZ_CHECK(report.violations == 0, std::to_string(report.violations) + " face-adjacent pairs out of order");
+  } else {
+    std::size_t cycles = 0;
+    order = foxi::mpvo_order(m, table, view, {}, &cycles);
+    check_permutation(order, all);
+  }
+  // A subset (one region) in progressive batches.
+  std::vector<std::uint32_t> subset;
+  for (std::uint32_t t = 0; t < m.tet_count(); ++t)
+    if (m.region_of(t) == 1) subset.push_back(t);
+  if (!subset.empty()) {
+    foxi::ProgressiveOrder progressive(m, table, view, subset);
+    std::vector<std::uint32_t> got;
+    for (auto batch = progressive.next(); !batch.empty(); batch = progressive.next())
+      got.insert(got.end(), batch.begin(), batch.end());
+    check_permutation(got, subset);
+  }
+  render_checks(m, view, order, cert.delaunay);
+  return 0;
+}
