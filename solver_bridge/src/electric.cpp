@@ -116,11 +116,11 @@ std::vector<std::vector<double>> energy_matrix(const Mesh& mesh, const RegionTab
 // constant: 1 where the set touches electrode j, 0 where it touches another, else its value at one
 // node. The Maxwell matrix a(w_i, w_j) then takes nothing from such tets, whose c |grad u|^2 would be
 // round-off times the metal's conductivity (1e-7 of the FR-4 current in a copper-FR-4 series pair,
-// where the copper's true share is 1e-21). The true energy left out is at most c (kFlat / h)^2 per tet.
-constexpr double kFlat = 1e-9;  // V, per volt applied
-
+// where the copper's true share is 1e-21). The true energy left out is at most c (flat / h)^2 per tet.
+// flat (V per volt applied): 1e-9, or 10 times a looser solver tolerance (whose error in the metal is
+// of that order).
 std::vector<std::vector<double>> flattened(const Mesh& mesh, const std::vector<std::vector<double>>& unit,
-                                           const std::vector<std::uint32_t>& electrode_of) {
+                                           const std::vector<std::uint32_t>& electrode_of, double flat) {
   const std::size_t nn = mesh.node_count();
   std::vector<std::vector<double>> out = unit;
   for (std::size_t j = 0; j < unit.size(); ++j) {
@@ -129,7 +129,7 @@ std::vector<std::vector<double>> flattened(const Mesh& mesh, const std::vector<s
       const std::uint32_t* n = &mesh.tet[4 * t];
       const double lo = std::min({u[n[0]], u[n[1]], u[n[2]], u[n[3]]});
       const double hi = std::max({u[n[0]], u[n[1]], u[n[2]], u[n[3]]});
-      return hi - lo <= kFlat;
+      return hi - lo <= flat;
     });
     // The value of each flat set: an electrode's where it touches one, else its root's.
     std::vector<double> value(nn, std::numeric_limits<double>::quiet_NaN());
@@ -313,7 +313,11 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
     }
     s.unit[j] = std::move(u);
   }
-  s.matrix = energy_matrix(mesh, s.regions, s.coefficient, flattened(mesh, s.unit, owner), threads);
+  // The flattened fields are the solution from here on: the matrix, the operating field by
+  // superposition, its Joule heat or field energy and the written fields (which so carry no
+  // round-off energy in the metal either).
+  s.unit = flattened(mesh, s.unit, owner, std::max(1e-9, 10 * options.relative_tolerance));
+  s.matrix = energy_matrix(mesh, s.regions, s.coefficient, s.unit, threads);
   s.assembly_seconds = std::chrono::duration<double>(t1 - t0).count();
   s.solve_seconds = std::chrono::duration<double>(t2 - t1).count();
   return s;

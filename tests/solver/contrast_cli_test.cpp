@@ -13,7 +13,9 @@
 //   from above: R <= t / (sigma A) = 0.1 um / (1e-14 S/m * 1.6 um^2) = 6.25e18 ohm (the conforming P1
 //   conductance is at least the true one, so the computed R is below the true one too). Dirichlet's
 //   principle with the potential linear across each wall and (x z) / t^2 in the two corner squares
-//   bounds it from below: G <= sigma * 1 um * (6 + 6 + 4 + 2/3 + 2/3), R >= 5.769e18 ohm.
+//   bounds it from below: G <= sigma * 1 um * (6 + 6 + 4 + 2/3 + 2/3), R >= 5.769e18 ohm. The model's
+//   mesh (0.15 um, one tet across the liner) gives 5.569e18, 3.5 % under; at 0.04 um (582k tets)
+//   5.800e18, inside the bounds.
 // - via_in_dielectric: copper via (1 V) on a 0.5 mm silicon block grounded below. Thomson (the current
 //   straight down the 16-gon cylinder under the via) bounds R <= 0.5 mm / (4.3e-4 S/m * 0.122459 mm^2)
 //   = 9.495e6 ohm; Dirichlet (the potential linear in z through the silicon, 1 V on its whole top)
@@ -75,7 +77,7 @@ TEST_F(ContrastCliTest, TrenchLinerResistance) {
   for (const char* solver : {"auto", "amg"}) {
     SCOPED_TRACE(solver);
     const double r = resistance("trench.toml", solver);
-    EXPECT_GT(r, 5.769e18 * 0.98);  // the P1 value lies below the true one, by the mesh's error
+    EXPECT_GT(r, 5.769e18 * 0.95);  // P1 lies below the true R (by 3.5 % on this mesh, one tet across)
     EXPECT_LT(r, 6.25e18);
   }
 }

@@ -16,14 +16,22 @@
 // metal rows' round-off. Both forms agree for an exact discrete solution (u_i = 1 on electrode i and 0
 // on the others, K u_j = 0 at the free nodes). The linear solve measures each row's residual against
 // its own diagonal (LinearSolverOptions), so the insulator's rows are solved as well as the metal's.
-// M is symmetric by construction.
+// M is symmetric by construction. One step more keeps the metal's round-off out: in each unit
+// solution, every connected set of tets on which it is flat to 1e-9 V (or 10 x a looser solver
+// tolerance; a metal body carrying none of that solve's current) is made exactly constant (1 or 0
+// where it touches an electrode) before the energy form, the superposition and the written fields
+// use it; else c |grad u|^2 of the metal's round-off (1e-15 V over a tet of copper) would outweigh
+// the FR-4's true current (1e-7 of it in a copper-FR-4 series pair). The energy so left out is at
+// most c (1e-9 V / h)^2 V per flat tet.
 //
 // Checks (BalanceCheck, in the reports): Kirchhoff / charge neutrality (each column of M sums to 0,
 // relative to its diagonal: the potentials of the separate solves must add up to 1 everywhere a
 // coefficient is), the Maxwell sign pattern (M_ii > 0, M_ij <= 0 off the diagonal, relative to
 // sqrt(M_ii M_jj)), energy (sum V_i I_i against the Joule heat of the written field; 1/2 sum Q_i V_i
-// against its field energy) and the linear solve's residual, max |r_k| / A_kk per volt applied
-// (recomputed, not CG's recursion). Tolerance: max(1e-6, 100 x the solver's relative tolerance).
+// against its field energy: both come from the same unit fields, so this one guards the
+// superposition and the fixed-current terminals' voltages, not the solve) and the linear solve's
+// residual, max |r_k| / A_kk per volt applied (recomputed, not CG's recursion), which with Kirchhoff
+// guards the solve. Tolerance: max(1e-6, 100 x the solver's relative tolerance).
 //
 // Electrostatics: metal is part of the conductor it touches. A region is metal when its material's
 // electrical_conductivity is at least ElectrostaticParams::metal_conductivity (1e4 S/m: metals, solder,
