@@ -1,7 +1,9 @@
 // foxi model check|plc MODEL [--set k=v]...: load a parametrized structure model, report it, write
 // its PLC.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,7 @@
 #include "foxi/model/physics.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/structure.hpp"
+#include "foxi/solver/electric.hpp"
 
 namespace foxi::cli {
 
@@ -37,6 +40,83 @@ void print_quantity(const Quantity& q, const Model& model) {
     std::printf("%.6g %s", q.value / model.length_scale, model.length_unit.c_str());
   else
     std::printf("%.6g %s", q.value, q.dims == kDimensionless ? "" : dims_to_string(q.dims).c_str());
+}
+
+}  // namespace
+
+namespace {
+
+// Electrostatics: each conductor with the metal parts that become part of it (electric.hpp: metal is
+// a material of electrical_conductivity >= ElectrostaticParams::metal_conductivity, joined through
+// shared points: the PLC's, which the mesh keeps), and the metal that floats.
+void print_conductors(const Model& model, const Structure& s) {
+  const double threshold = ElectrostaticParams{}.metal_conductivity;
+  const std::size_t np = model.parts.size();
+  std::vector<char> metal(np, 0);
+  for (std::size_t i = 0; i < np; ++i)
+    for (const Material& m : model.materials)
+      if (m.name == model.parts[i].material) metal[i] = m.electrical_conductivity >= threshold;
+  if (std::find(metal.begin(), metal.end(), 1) == metal.end()) return;
+  auto part_index = [&](const std::string& name) {
+    for (std::size_t i = 0; i < np; ++i)
+      if (model.parts[i].name == name) return i;
+    return np;
+  };
+  // The PLC points of each marker's facets, and of each part's facets (markers "P.face", "A/B").
+  std::vector<std::set<std::uint32_t>> marker_points(s.boundary_names.size()), part_points(np);
+  for (std::size_t f = 0; f < s.plc.facet_count(); ++f) {
+    const std::int32_t m = s.plc.facet_marker[f];
+    if (m < 1 || static_cast<std::size_t>(m) > s.boundary_names.size()) continue;
+    const std::string& name = s.boundary_names[static_cast<std::size_t>(m) - 1];
+    std::vector<std::size_t> parts;
+    if (const auto slash = name.find('/'); slash != std::string::npos) {
+      parts = {part_index(name.substr(0, slash)), part_index(name.substr(slash + 1))};
+    } else if (const auto dot = name.rfind('.'); dot != std::string::npos) {
+      parts = {part_index(name.substr(0, dot))};
+    }
+    for (std::uint32_t p = s.plc.facet_polygon_begin[f]; p < s.plc.facet_polygon_begin[f + 1]; ++p)
+      for (std::uint32_t v = s.plc.polygon_vertex_begin[p]; v < s.plc.polygon_vertex_begin[p + 1]; ++v) {
+        marker_points[static_cast<std::size_t>(m) - 1].insert(s.plc.polygon_vertices[v]);
+        for (std::size_t part : parts)
+          if (part < np) part_points[part].insert(s.plc.polygon_vertices[v]);
+      }
+  }
+  std::vector<int> owner(np, -1);
+  int index = 0;
+  for (const BoundaryCondition& c : model.conditions) {
+    if (c.kind != ConditionKind::voltage || !condition_applies(c, Physics::electrostatic)) continue;
+    std::set<std::uint32_t> points;
+    for (const std::string& surface : c.surfaces)
+      for (std::size_t b = 0; b < s.boundary_names.size(); ++b)
+        if (s.boundary_names[b] == surface) points.insert(marker_points[b].begin(), marker_points[b].end());
+    std::vector<std::size_t> joined;
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (std::size_t i = 0; i < np; ++i) {
+        if (!metal[i] || std::find(joined.begin(), joined.end(), i) != joined.end()) continue;
+        if (std::none_of(part_points[i].begin(), part_points[i].end(),
+                         [&](std::uint32_t v) { return points.count(v) > 0; }))
+          continue;
+        joined.push_back(i);
+        points.insert(part_points[i].begin(), part_points[i].end());
+        grew = true;
+      }
+    }
+    std::printf("  conductor %-16s", ("'" + c.name + "'").c_str());
+    if (joined.empty()) std::printf(" no metal part touches it\n");
+    for (std::size_t k = 0; k < joined.size(); ++k) {
+      const std::size_t i = joined[k];
+      std::printf("%s%s", k ? ", " : " with the metal parts ", model.parts[i].name.c_str());
+      if (owner[i] >= 0)
+        std::printf(" (also on an earlier conductor: they are shorted, foxi solve refuses it)");
+      owner[i] = index;
+    }
+    if (!joined.empty()) std::printf("\n");
+    ++index;
+  }
+  for (std::size_t i = 0; i < np; ++i)
+    if (metal[i] && owner[i] < 0)
+      std::printf("  floating metal   %s: one unknown potential, no net charge\n", model.parts[i].name.c_str());
 }
 
 }  // namespace
@@ -120,13 +200,14 @@ int cmd_model(Args args) {
   // which solves the model is ready for (foxi solve MODEL --physics NAME), or why not
   for (Physics ph : {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress}) {
     bool has = false;
-    for (const BoundaryCondition& c : model.conditions) has = has || condition_applies(c.kind, ph);
+    for (const BoundaryCondition& c : model.conditions) has = has || condition_applies(c, ph);
     if (!has) continue;
     try {
       check_physics(model, ph);
       if (ph != Physics::thermal_stress) {
         std::printf("physics %s: ready (foxi solve MODEL --physics %s)\n", physics_name(ph),
                     physics_name(ph));
+        if (ph == Physics::electrostatic) print_conductors(model, s);
         continue;
       }
       // the stress solve also needs a temperature: the model's load, or its own thermal run

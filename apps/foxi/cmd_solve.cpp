@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
 #include "model_run.hpp"
 #include "solve_options.hpp"
 #include "foxi/model/mesh_io.hpp"
@@ -47,8 +48,10 @@ const char* kSolveUsage =
     "\n"
     "foxi solve MESH --physics electrostatic --conductor TAG[,TAG...]=NAME[:V] ... [--eps REGION=eps_r]\n"
     "  Electrostatics: each conductor is a set of boundary tags at one potential (V, default 0 V, used\n"
-    "  for the written fields); other boundaries carry no normal field. Prints the capacitance matrix\n"
-    "  (F; C_ij = charge on i with 1 V on j, 0 V on the others), its energy check and the charges.\n"
+    "  for the written fields); other boundaries carry no normal field. A region whose material\n"
+    "  conducts at least 1e4 S/m (and has no --eps) is metal: a metal body touching a conductor is part\n"
+    "  of it, one touching none floats uncharged. Prints the capacitance matrix (F; C_ij = charge on i\n"
+    "  with 1 V on j, 0 V on the others), the charges and each conductor's metal, the energy.\n"
     "  eps_r defaults to the region's material. OUT gets 'potential' (V) and 'electric_field' (V/m).\n"
     "\n"
     "foxi solve MESH --physics current --terminal TAG[,TAG...]=V ... [--terminal-current TAG[,TAG...]=A]\n"
@@ -58,6 +61,10 @@ const char* kSolveUsage =
     "  resistance (two terminals: (V1 - V2) / I1), the conductance matrix and the Joule heat per region.\n"
     "  sigma defaults to the region's material. OUT gets 'potential' (V), 'current_density' (A/m^2)\n"
     "  and 'joule_heat' (W/m^3).\n"
+    "\n"
+    "  Every physics prints its own checks (heat balance against the heat that flows; Kirchhoff,\n"
+    "  Maxwell matrix signs, energy and the solve's residual for the electric ones); a failed check is\n"
+    "  an UNRELIABLE line with the figures and exit status 4.\n"
     "\n"
     "foxi solve MESH --physics thermoelastic ... : thermal stress, see 'foxi solve --physics thermoelastic "
     "--help'.";
@@ -150,6 +157,14 @@ std::string region_label(const Mesh& mesh, std::int32_t id) {
   return std::to_string(id) + (r && !r->name.empty() ? " (" + r->name + ")" : "");
 }
 
+namespace {
+std::string regions_label(const Mesh& mesh, const std::vector<std::int32_t>& ids) {
+  std::string s;
+  for (std::int32_t id : ids) s += (s.empty() ? "region " : ", ") + region_label(mesh, id);
+  return s;
+}
+}  // namespace
+
 std::vector<std::int32_t> boundary_tags(const Mesh& mesh, const std::string& list,
                                         const std::string& option) {
   std::vector<std::int32_t> tags;
@@ -199,6 +214,26 @@ void print_matrix(const char* title, const char* unit, const std::vector<Electro
     std::printf("\n");
   }
 }
+
+// One line per check; a failed one is a loud UNRELIABLE line (on stdout with the figures, and on
+// stderr). Returns the exit status: kExitUnreliable when a check failed.
+int print_checks(const std::vector<BalanceCheck>& checks) {
+  int status = kExitOk;
+  for (const BalanceCheck& c : checks) {
+    std::printf("check %-14s %-5s %.3g (tolerance %.3g): %s\n", c.name.c_str(), c.passed ? "ok" : "FAIL",
+                c.figure, c.tolerance, c.what.c_str());
+    if (!c.passed) {
+      std::printf("UNRELIABLE: the %s check failed (%.3g > %.3g); the figures above are not to be trusted\n",
+                  c.name.c_str(), c.figure, c.tolerance);
+      std::fprintf(stderr, "foxi solve: UNRELIABLE result: the %s check failed (%.3g > %.3g: %s)\n",
+                   c.name.c_str(), c.figure, c.tolerance, c.what.c_str());
+      status = kExitUnreliable;
+    }
+  }
+  return status;
+}
+
+std::string regions_label(const Mesh& mesh, const std::vector<std::int32_t>& ids);
 
 }  // namespace
 
@@ -273,21 +308,27 @@ int cmd_solve(Args args) {
       std::printf("%s: %zu nodes, %zu tets; electrostatics, %zu unknowns, %zu conductors\n", files[0].c_str(),
                   mesh.node_count(), mesh.tet_count(), r.unknowns, r.conductors.size());
       print_matrix("capacitance matrix", "F", r.conductors, r.capacitance);
-      std::printf("energy check 2W/V^2 (F):");
-      for (std::size_t i = 0; i < r.conductors.size(); ++i) std::printf(" %.6e", r.energy_capacitance[i]);
-      std::printf("\nconductors at their potentials:\n");
-      for (std::size_t i = 0; i < r.conductors.size(); ++i)
+      std::printf("conductors at their potentials:\n");
+      for (std::size_t i = 0; i < r.conductors.size(); ++i) {
         std::printf("  %-16s tags %-20s area %-10.4g m^2  %.6g V  charge %.6e C\n",
                     r.conductors[i].name.c_str(), tags_label(mesh, ep.conductors[i].tags).c_str(),
                     r.conductors[i].area, r.conductors[i].voltage, r.conductors[i].charge);
-      std::printf("stored energy %.6e J\n", r.energy);
+        if (!r.conductors[i].metal_regions.empty())
+          std::printf("  %-16s with the metal of %s\n", "",
+                      regions_label(mesh, r.conductors[i].metal_regions).c_str());
+      }
+      for (const FloatingMetal& f : r.floating)
+        std::printf("  floating metal   %s (%zu nodes): %.6g V, no net charge\n",
+                    regions_label(mesh, f.regions).c_str(), f.nodes, f.voltage);
+      std::printf("stored energy %.6e J (1/2 sum Q V), field energy %.6e J\n", r.energy, r.field_energy);
       std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
                   r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
+      const int status = print_checks(r.checks);
       if (!out.empty()) {
         write_mesh(mesh, out);
         std::printf("wrote %s (fields potential [V], electric_field [V/m])\n", out.c_str());
       }
-      return 0;
+      return status;
     }
     if (!conductor.empty() || !eps.empty())
       throw UsageError("--conductor and --eps are for --physics electrostatic");
@@ -325,15 +366,16 @@ int cmd_solve(Args args) {
     for (const RegionJoule& j : r.regions)
       std::printf("  %-20s sigma %-10.4g S/m  volume %-10.4g m^3  %.6e W\n",
                   region_label(mesh, j.region).c_str(), j.conductivity, j.volume, j.power);
-    std::printf("total Joule heat %.6e W\n", r.total_power);
+    std::printf("total Joule heat %.6e W (sum V I %.6e W)\n", r.total_power, r.terminal_power);
     std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
                 r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
+    const int status = print_checks(r.checks);
     if (!out.empty()) {
       write_mesh(mesh, out);
       std::printf("wrote %s (fields potential [V], current_density [A/m^2], joule_heat [W/m^3])\n",
                   out.c_str());
     }
-    return 0;
+    return status;
   }
   if (!conductor.empty() || !eps.empty() || !terminal.empty() || !terminal_current.empty() || !sigma.empty())
     throw UsageError("--conductor/--eps are for --physics electrostatic, --terminal/--sigma for current");
@@ -401,11 +443,9 @@ int cmd_solve(Args args) {
                 b.area, b.heat_in, b.mean_temperature);
     boundary_heat += b.heat_in;
   }
-  const double imbalance = r.total_power + boundary_heat;
-  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W",
-              r.total_power, boundary_heat, imbalance);
-  const double scale = std::max(std::abs(r.total_power), std::abs(boundary_heat));
-  if (scale > 0) std::printf(" (%.2g of the heat flow)", std::abs(imbalance) / scale);
+  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W", r.total_power,
+              boundary_heat, r.imbalance);
+  if (r.heat_flow > 0) std::printf(" (%.2g of the %.6g W that flow)", std::abs(r.imbalance) / r.heat_flow, r.heat_flow);
   std::printf("\n");
   for (const ThermalResistance& t : r.resistances) {
     auto side = [&](const ThermalProbe& probe) {
@@ -435,11 +475,12 @@ int cmd_solve(Args args) {
       r.solver.c_str(), r.nonzeros, r.iterations, r.relative_residual,
       std::chrono::duration<double>(t1 - t0).count(), r.assembly_seconds, r.solve_seconds);
   (void)t2;
+  const int status = print_checks(r.checks);
   if (!out.empty()) {
     write_mesh(mesh, out);
     std::printf("wrote %s (fields temperature [K], heat_flux [W/m^2])\n", out.c_str());
   }
-  return 0;
+  return status;
 }
 
 }  // namespace foxi::cli

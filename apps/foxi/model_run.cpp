@@ -74,7 +74,9 @@ void print_model_conditions(const Model& model) {
       case ConditionKind::convection:
         std::printf("h %g W/(m^2 K), ambient %g K (%g C)", c.h, c.ambient, c.ambient - 273.15);
         break;
-      case ConditionKind::voltage: std::printf("%g V", c.value); break;
+      case ConditionKind::voltage:
+        std::printf("%g V%s%s", c.value, c.physics.empty() ? "" : ", --physics ", c.physics.c_str());
+        break;
       case ConditionKind::current: std::printf("%g A into the body", c.value); break;
       case ConditionKind::displacement:
         std::printf("(%g, %g, %g) %s", c.displacement[0] / s, c.displacement[1] / s, c.displacement[2] / s, u);

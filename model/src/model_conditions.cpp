@@ -251,10 +251,15 @@ class ConditionReader {
     } else if (type == "voltage" || type == "ground") {
       bc.kind = ConditionKind::voltage;
       if (type == "voltage") {
-        allow_keys(c, who, {"type", "surface", "value", "name"});
+        allow_keys(c, who, {"type", "surface", "value", "name", "physics"});
         bc.value = quantity(need(c, "value", on), kVoltage, on, 1);
       } else {
-        allow_keys(c, who, {"type", "surface", "name"});
+        allow_keys(c, who, {"type", "surface", "name", "physics"});
+      }
+      if (const Value* ph = find(c, "physics")) {
+        bc.physics = text(*ph, who + " physics");
+        if (bc.physics != "electrostatic" && bc.physics != "current")
+          fail(*ph, on + ": physics must be \"electrostatic\" or \"current\", not '" + bc.physics + "'");
       }
     } else if (type == "current") {
       bc.kind = ConditionKind::current;

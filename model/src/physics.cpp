@@ -30,6 +30,10 @@ bool condition_applies(ConditionKind c, Physics physics) {
   return false;
 }
 
+bool condition_applies(const BoundaryCondition& c, Physics physics) {
+  return condition_applies(c.kind, physics) && (c.physics.empty() || c.physics == physics_name(physics));
+}
+
 void check_physics(const Model& model, Physics physics) {
   struct Need {
     const char* property;
@@ -56,13 +60,13 @@ void check_physics(const Model& model, Physics physics) {
                               ", which --physics " + physics_name(physics) + " needs");
   bool fixes = false;
   for (const BoundaryCondition& c : model.conditions)
-    fixes = fixes || (condition_applies(c.kind, physics) && c.kind != ConditionKind::heat_flux &&
+    fixes = fixes || (condition_applies(c, physics) && c.kind != ConditionKind::heat_flux &&
                       c.kind != ConditionKind::current &&
                       (c.kind != ConditionKind::sliding || physics == Physics::thermal_stress));
   std::size_t electrodes = 0;
   for (const BoundaryCondition& c : model.conditions)
     electrodes += (physics == Physics::electrostatic || physics == Physics::current) &&
-                  condition_applies(c.kind, physics);
+                  condition_applies(c, physics);
   if (fixes && electrodes == 1)
     throw IoError(model.file, 0, IoError::kNoOffset,
                   std::string("--physics ") + physics_name(physics) +

@@ -110,7 +110,7 @@ void check_conditions(const Model& model, const Structure& s) {
       for (std::size_t j = 0; j < i; ++j) {
         const BoundaryCondition& d = model.conditions[j];
         const bool same_physics = std::any_of(std::begin(kGroups), std::end(kGroups), [&](Physics p) {
-          return condition_applies(c.kind, p) && condition_applies(d.kind, p);
+          return condition_applies(c, p) && condition_applies(d, p);
         });
         if (same_physics && std::find(d.surfaces.begin(), d.surfaces.end(), name) != d.surfaces.end())
           throw IoError(model.file, c.line, IoError::kNoOffset,

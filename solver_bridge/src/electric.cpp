@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <array>
+#include <limits>
 #include <map>
 
 #include "scalar_p1.hpp"
@@ -18,23 +20,136 @@ using namespace detail;
 
 struct ElectrodeSolve {
   RegionTable regions;
-  std::vector<double> coefficient;  // per region, scaled (eps0 eps_r or sigma)
+  std::vector<double> coefficient;  // per region, scaled (eps0 eps_r or sigma); 0 for metal
+  std::vector<char> metal;          // per region (electrostatics)
   std::vector<double> region_volume;
   std::vector<double> area;                 // per electrode
   std::vector<std::vector<double>> unit;    // per electrode: nodal potential with 1 V on it
-  std::vector<std::vector<double>> matrix;  // M[i][j]: reaction on i in solve j
-  std::vector<double> energy2;              // per electrode: u_j^T K u_j (twice the energy)
-  double asymmetry = 0;
+  std::vector<std::vector<double>> matrix;  // M[i][j]: energy form a(u_i, u_j)
+  std::vector<std::vector<std::int32_t>> electrode_metal;  // per electrode: metal regions in it
+  struct Floating {
+    std::vector<std::int32_t> regions;
+    std::size_t nodes = 0;
+    std::uint32_t node = 0;  // one of its nodes
+  };
+  std::vector<Floating> floating;
+  double residual = 0;  // max over solves of |r_k| / A_kk
   LinearSolveResult lin;
   std::size_t unknowns = 0;
   double assembly_seconds = 0, solve_seconds = 0;
 };
 
+// The system on the unknowns: dof[v] >= 0 is node v's unknown (several nodes of a floating metal body
+// share one: their rows and columns are summed, P^T K P), -1 a fixed node or one without tets.
+SymmetricCsr merged_system(const P1Stiffness& k, const std::vector<int>& dof, std::size_t ndof) {
+  const std::size_t nn = dof.size();
+  std::vector<std::size_t> count(ndof + 1, 0);
+  for (std::size_t v = 0; v < nn; ++v)
+    if (dof[v] >= 0) count[static_cast<std::size_t>(dof[v]) + 1] += k.pat.row_start[v + 1] - k.pat.row_start[v];
+  for (std::size_t i = 0; i < ndof; ++i) count[i + 1] += count[i];
+  std::vector<std::pair<int, double>> entries(count[ndof]);
+  std::vector<std::size_t> at(count.begin(), count.end() - 1);
+  for (std::size_t v = 0; v < nn; ++v) {
+    if (dof[v] < 0) continue;
+    for (std::size_t p = k.pat.row_start[v]; p < k.pat.row_start[v + 1]; ++p)
+      if (const int c = dof[k.pat.col[p]]; c >= 0) entries[at[static_cast<std::size_t>(dof[v])]++] = {c, k.val[p]};
+  }
+  SymmetricCsr a;
+  a.start.assign(ndof + 1, 0);
+  for (std::size_t i = 0; i < ndof; ++i) {
+    auto b = entries.begin() + static_cast<std::ptrdiff_t>(count[i]);
+    auto e = entries.begin() + static_cast<std::ptrdiff_t>(at[i]);
+    std::sort(b, e, [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (auto it = b; it != e; ++it) {
+      if (!a.col.empty() && static_cast<std::size_t>(a.start[i]) < a.col.size() && a.col.back() == it->first)
+        a.val.back() += it->second;
+      else {
+        a.col.push_back(it->first);
+        a.val.push_back(it->second);
+      }
+    }
+    if (a.col.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+      throw SolverError("the system has more than 2^31 nonzeros");
+    a.start[i + 1] = static_cast<int>(a.col.size());
+  }
+  return a;
+}
+
+// The energy form M_ij = sum_t c_t V_t grad(u_i) . grad(u_j) for every pair of the given fields.
+std::vector<std::vector<double>> energy_matrix(const Mesh& mesh, const RegionTable& regions,
+                                               const std::vector<double>& coefficient,
+                                               const std::vector<std::vector<double>>& u, unsigned threads) {
+  const std::size_t ne = u.size(), nt = mesh.tet_count();
+  std::vector<std::vector<double>> part(threads, std::vector<double>(ne * ne, 0.0));
+  parallel_for(nt, threads, [&](std::size_t b, std::size_t e, unsigned th) {
+    std::array<std::array<double, 3>, 4> g;
+    std::vector<double> grad(3 * ne);
+    for (std::size_t t = b; t < e; ++t) {
+      const double c = coefficient[regions.tet_rix[t]];
+      if (c == 0) continue;
+      const double cv = c * p1_gradients(mesh, t, g);
+      for (std::size_t i = 0; i < ne; ++i) {
+        double* gi = &grad[3 * i];
+        gi[0] = gi[1] = gi[2] = 0;
+        for (int a = 0; a < 4; ++a) {
+          const double ua = u[i][mesh.tet[4 * t + a]];
+          for (int d = 0; d < 3; ++d) gi[d] += ua * g[a][d];
+        }
+      }
+      for (std::size_t i = 0; i < ne; ++i)
+        for (std::size_t j = 0; j <= i; ++j)
+          part[th][i * ne + j] +=
+              cv * (grad[3 * i] * grad[3 * j] + grad[3 * i + 1] * grad[3 * j + 1] + grad[3 * i + 2] * grad[3 * j + 2]);
+    }
+  });
+  std::vector<std::vector<double>> m(ne, std::vector<double>(ne, 0.0));
+  for (std::size_t i = 0; i < ne; ++i)
+    for (std::size_t j = 0; j <= i; ++j) {
+      for (unsigned th = 0; th < threads; ++th) m[i][j] += part[th][i * ne + j];
+      m[j][i] = m[i][j];
+    }
+  return m;
+}
+
+// Each unit solution u_j with every connected set of tets on which it is flat to kFlat (a metal body
+// that carries none of that solve's current: its potential differences are round-off) made exactly
+// constant: 1 where the set touches electrode j, 0 where it touches another, else its value at one
+// node. The Maxwell matrix a(w_i, w_j) then takes nothing from such tets, whose c |grad u|^2 would be
+// round-off times the metal's conductivity (1e-7 of the FR-4 current in a copper-FR-4 series pair,
+// where the copper's true share is 1e-21). The true energy left out is at most c (flat / h)^2 per tet.
+// flat (V per volt applied): 1e-9, or 10 times a looser solver tolerance (whose error in the metal is
+// of that order).
+std::vector<std::vector<double>> flattened(const Mesh& mesh, const std::vector<std::vector<double>>& unit,
+                                           const std::vector<std::uint32_t>& electrode_of, double flat) {
+  const std::size_t nn = mesh.node_count();
+  std::vector<std::vector<double>> out = unit;
+  for (std::size_t j = 0; j < unit.size(); ++j) {
+    const std::vector<double>& u = unit[j];
+    const std::vector<std::uint32_t> set = tet_set_components(mesh, [&](std::size_t t) {
+      const std::uint32_t* n = &mesh.tet[4 * t];
+      const double lo = std::min({u[n[0]], u[n[1]], u[n[2]], u[n[3]]});
+      const double hi = std::max({u[n[0]], u[n[1]], u[n[2]], u[n[3]]});
+      return hi - lo <= flat;
+    });
+    // The value of each flat set: an electrode's where it touches one, else its root's.
+    std::vector<double> value(nn, std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t v = 0; v < nn; ++v)
+      if (set[v] != UINT32_MAX && electrode_of[v] != UINT32_MAX) value[set[v]] = electrode_of[v] == j ? 1.0 : 0.0;
+    for (std::size_t v = 0; v < nn; ++v) {
+      if (set[v] == UINT32_MAX) continue;
+      if (std::isnan(value[set[v]])) value[set[v]] = u[set[v]];
+      out[j][v] = value[set[v]];
+    }
+  }
+  return out;
+}
+
 ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& electrodes,
                                 const std::function<double(const Material&)>& from_material,
                                 const std::vector<RegionCoefficient>& overrides, double scale,
                                 const std::string& what, const std::string& hint, const std::string& problem,
-                                const std::string& kind, const LinearSolverOptions& options) {
+                                const std::string& kind, const LinearSolverOptions& options,
+                                const std::function<bool(std::int32_t region)>& is_metal = {}) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   check_mesh(mesh);
@@ -42,10 +157,16 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   report_progress(options, "assemble", 0.0);
   ElectrodeSolve s;
   s.regions = region_table(mesh);
+  const std::size_t nr = s.regions.size();
+  s.metal.assign(nr, 0);
+  if (is_metal)
+    for (std::size_t i = 0; i < nr; ++i) s.metal[i] = is_metal(s.regions.ids[i]) ? 1 : 0;
   std::vector<std::pair<std::int32_t, double>> ov;
   for (const RegionCoefficient& c : overrides) ov.emplace_back(c.region, c.value);
+  for (std::size_t i = 0; i < nr; ++i)
+    if (s.metal[i]) ov.emplace_back(s.regions.ids[i], 1.0);  // unused: metal is no dielectric
   s.coefficient = region_coefficients(mesh, s.regions, from_material, ov, what, hint);
-  for (double& c : s.coefficient) c *= scale;
+  for (std::size_t i = 0; i < nr; ++i) s.coefficient[i] = s.metal[i] ? 0.0 : s.coefficient[i] * scale;
   (void)tet_volumes(mesh, s.regions, threads, s.region_volume);
 
   const std::size_t ne = electrodes.size(), nn = mesh.node_count(), nt = mesh.tet_count();
@@ -79,60 +200,172 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   // would be averaged between them: refuse it.
   Dirichlet d = dirichlet_from_tags(mesh, k, fixed_tags, ne);
   s.area = d.area;
-  {
-    std::vector<std::uint32_t> owner(nn, UINT32_MAX);
-    for (const Dirichlet::Share& sh : d.shares) {
-      if (owner[sh.node] != UINT32_MAX && owner[sh.node] != sh.slot)
-        throw SolverError(kind + "s '" + electrodes[owner[sh.node]].name + "' and '" +
-                          electrodes[sh.slot].name + "' touch (node " + std::to_string(sh.node) +
-                          " is on both): they would be one electrode; merge them or separate them");
-      owner[sh.node] = sh.slot;
-    }
-    for (std::size_t v = 0; v < nn; ++v)
-      if (d.fixed[v]) d.value[v] = static_cast<double>(owner[v]);
+  std::vector<std::uint32_t> owner(nn, UINT32_MAX);
+  for (const Dirichlet::Share& sh : d.shares) {
+    if (owner[sh.node] != UINT32_MAX && owner[sh.node] != sh.slot)
+      throw SolverError(kind + "s '" + electrodes[owner[sh.node]].name + "' and '" + electrodes[sh.slot].name +
+                        "' touch (node " + std::to_string(sh.node) +
+                        " is on both): they would be one electrode; merge them or separate them");
+    owner[sh.node] = sh.slot;
   }
+  // Metal bodies: the connected sets of metal tets (through shared nodes).
+  std::vector<int> dof(nn, -1);
+  std::size_t ndof = 0;
+  s.electrode_metal.assign(ne, {});
+  std::vector<std::uint32_t> body(nn, UINT32_MAX);
+  if (std::find(s.metal.begin(), s.metal.end(), 1) != s.metal.end()) {
+    const std::vector<std::uint32_t> metal_set =
+        tet_set_components(mesh, [&](std::size_t t) { return s.metal[s.regions.tet_rix[t]] != 0; });
+    // Per body root: the electrode it touches (UINT32_MAX none), its regions, its node count.
+    std::map<std::uint32_t, std::uint32_t> touches;
+    std::map<std::uint32_t, std::vector<std::int32_t>> body_regions;
+    std::map<std::uint32_t, std::size_t> body_nodes;
+    for (std::size_t v = 0; v < nn; ++v) {
+      if (metal_set[v] == UINT32_MAX) continue;
+      const std::uint32_t r = body[v] = metal_set[v];
+      ++body_nodes[r];
+      auto [it, inserted] = touches.emplace(r, owner[v]);
+      if (owner[v] == UINT32_MAX) continue;
+      if (it->second == UINT32_MAX) it->second = owner[v];
+      if (it->second != owner[v])
+        throw SolverError("conductors '" + electrodes[it->second].name + "' and '" + electrodes[owner[v]].name +
+                          "' are joined by metal (the body containing node " + std::to_string(v) +
+                          "): they are one conductor; merge them, or make the metal a dielectric");
+    }
+    for (std::size_t t = 0; t < nt; ++t)
+      if (s.metal[s.regions.tet_rix[t]]) {
+        std::vector<std::int32_t>& rs = body_regions[body[mesh.tet[4 * t]]];
+        if (std::find(rs.begin(), rs.end(), mesh.region_of(t)) == rs.end()) rs.push_back(mesh.region_of(t));
+      }
+    std::map<std::uint32_t, int> floating_dof;
+    for (auto& [r, e] : touches) {
+      std::vector<std::int32_t>& rs = body_regions[r];
+      std::sort(rs.begin(), rs.end());
+      if (e != UINT32_MAX) {
+        for (std::int32_t id : rs) {
+          std::vector<std::int32_t>& em = s.electrode_metal[e];
+          if (std::find(em.begin(), em.end(), id) == em.end()) em.push_back(id);
+        }
+      } else {
+        floating_dof[r] = static_cast<int>(ndof++);
+        s.floating.push_back({rs, body_nodes[r], r});
+      }
+    }
+    for (std::vector<std::int32_t>& em : s.electrode_metal) std::sort(em.begin(), em.end());
+    for (std::size_t v = 0; v < nn; ++v) {
+      if (body[v] == UINT32_MAX) continue;
+      if (const std::uint32_t e = touches[body[v]]; e != UINT32_MAX) {
+        owner[v] = e;
+        d.fixed[v] = 1;
+      } else {
+        dof[v] = floating_dof[body[v]];
+      }
+    }
+  }
+  for (std::size_t v = 0; v < nn; ++v)
+    if (d.fixed[v]) d.value[v] = static_cast<double>(owner[v]);
   check_anchored(mesh, d.fixed, "ill-posed " + problem,
                  "touches no " + kind + ", so its potential is undetermined");
-  const ReducedSystem r = reduce(k, d.fixed, threads);
-  s.unknowns = r.a.rows();
-  std::vector<std::vector<double>> rhs(ne);
+  for (std::size_t v = 0; v < nn; ++v)
+    if (!d.fixed[v] && k.has_tets(v) && body[v] == UINT32_MAX) dof[v] = static_cast<int>(ndof++);
+  SymmetricCsr a = merged_system(k, dof, ndof);
+  s.unknowns = ndof;
+  std::vector<std::vector<double>> rhs(ne, std::vector<double>(ndof, 0.0));
   std::vector<std::vector<double>> fixed_u(ne, std::vector<double>(nn, 0.0));
   for (std::size_t e = 0; e < ne; ++e) {
     for (std::size_t v = 0; v < nn; ++v)
-      if (d.fixed[v]) fixed_u[e][v] = d.value[v] == static_cast<double>(e) ? 1.0 : 0.0;
-    rhs[e] = reduced_rhs(k, r, {}, d.fixed, fixed_u[e], threads);
+      if (d.fixed[v]) fixed_u[e][v] = owner[v] == e ? 1.0 : 0.0;
+    for (std::size_t v = 0; v < nn; ++v) {
+      if (dof[v] < 0) continue;
+      double sum = 0;
+      for (std::size_t p = k.pat.row_start[v]; p < k.pat.row_start[v + 1]; ++p)
+        if (d.fixed[k.pat.col[p]]) sum -= k.val[p] * fixed_u[e][k.pat.col[p]];
+      rhs[e][static_cast<std::size_t>(dof[v])] += sum;
+    }
   }
   report_progress(options, "assemble", 1.0);
   const auto t1 = clock::now();
   std::vector<std::vector<double>> x;
-  s.lin = solve_spd_many(r.a, rhs, x, options);
+  s.lin = solve_spd_many(a, rhs, x, options);
   const auto t2 = clock::now();
+  // The residual of each solve, row by row against the row's diagonal: volts of potential per volt
+  // applied, recomputed from the solution (CG's own residual is a recursion).
+  {
+    std::vector<double> diag(ndof, 0.0), ax(ndof);
+    for (std::size_t i = 0; i < ndof; ++i)
+      for (int p = a.start[i]; p < a.start[i + 1]; ++p)
+        if (static_cast<std::size_t>(a.col[static_cast<std::size_t>(p)]) == i)
+          diag[i] = a.val[static_cast<std::size_t>(p)];
+    for (std::size_t e = 0; e < ne; ++e) {
+      multiply(a, x[e].data(), ax.data(), threads);
+      for (std::size_t i = 0; i < ndof; ++i)
+        s.residual = std::max(s.residual, std::abs(rhs[e][i] - ax[i]) / diag[i]);
+    }
+  }
   s.unit.resize(ne);
-  s.matrix.assign(ne, std::vector<double>(ne, 0.0));
-  s.energy2.assign(ne, 0.0);
   for (std::size_t j = 0; j < ne; ++j) {
     std::vector<double>& u = fixed_u[j];
-    for (std::size_t v = 0; v < nn; ++v)
-      if (!k.has_tets(v)) u[v] = std::numeric_limits<double>::quiet_NaN();
-    scatter(r, x[j], u);
-    const std::vector<double> react = slot_reactions(k, d, {}, u, ne);
-    for (std::size_t i = 0; i < ne; ++i) s.matrix[i][j] = react[i];
-    std::vector<double> e2;
-    (void)cell_gradients(mesh, s.regions, s.coefficient, u, 1.0, threads, &e2);
-    for (double v : e2) s.energy2[j] += v;
+    for (std::size_t v = 0; v < nn; ++v) {
+      if (!k.has_tets(v))
+        u[v] = std::numeric_limits<double>::quiet_NaN();
+      else if (dof[v] >= 0)
+        u[v] = x[j][static_cast<std::size_t>(dof[v])];
+    }
     s.unit[j] = std::move(u);
   }
-  double big = 0;
-  for (std::size_t i = 0; i < ne; ++i)
-    for (std::size_t j = 0; j < ne; ++j) big = std::max(big, std::abs(s.matrix[i][j]));
-  for (std::size_t i = 0; i < ne; ++i)
-    for (std::size_t j = 0; j < i; ++j) {
-      if (big > 0) s.asymmetry = std::max(s.asymmetry, std::abs(s.matrix[i][j] - s.matrix[j][i]) / big);
-      s.matrix[i][j] = s.matrix[j][i] = 0.5 * (s.matrix[i][j] + s.matrix[j][i]);
-    }
+  // The flattened fields are the solution from here on: the matrix, the operating field by
+  // superposition, its Joule heat or field energy and the written fields (which so carry no
+  // round-off energy in the metal either).
+  s.unit = flattened(mesh, s.unit, owner, std::max(1e-9, 10 * options.relative_tolerance));
+  s.matrix = energy_matrix(mesh, s.regions, s.coefficient, s.unit, threads);
   s.assembly_seconds = std::chrono::duration<double>(t1 - t0).count();
   s.solve_seconds = std::chrono::duration<double>(t2 - t1).count();
   return s;
+}
+
+}  // namespace
+
+std::vector<BalanceCheck> maxwell_matrix_checks(const std::vector<std::vector<double>>& m, double residual,
+                                                double tolerance, const std::string& flow) {
+  std::vector<BalanceCheck> checks;
+  const std::size_t ne = m.size();
+  double kirchhoff = 0, sign = 0;
+  for (std::size_t j = 0; j < ne; ++j) {
+    double sum = 0, mag = 0;
+    for (std::size_t i = 0; i < ne; ++i) {
+      sum += m[i][j];
+      mag = std::max(mag, std::abs(m[i][j]));
+    }
+    kirchhoff = std::max(kirchhoff, mag > 0 ? std::abs(sum) / mag : 0.0);
+    if (!(m[j][j] > 0)) sign = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < ne; ++i)
+      if (i != j && m[i][j] > 0 && m[i][i] > 0 && m[j][j] > 0)
+        sign = std::max(sign, m[i][j] / std::sqrt(m[i][i] * m[j][j]));
+  }
+  if (ne > 1)
+    checks.push_back(make_check("Kirchhoff", "largest |column sum| / largest |entry| of the matrix (" + flow +
+                                                 " into all electrodes with one at 1 V must add to 0)",
+                                kirchhoff, tolerance));
+  checks.push_back(make_check("Maxwell signs",
+                              "largest positive off-diagonal M_ij / sqrt(M_ii M_jj) (inf: a diagonal <= 0)", sign,
+                              tolerance));
+  checks.push_back(make_check("residual", "largest |b - A x|_k / A_kk per volt applied, over the solves",
+                              residual, tolerance));
+  return checks;
+}
+
+namespace {
+
+// The matrix checks and the energy check: `reported` (from the matrix: sum V I, 1/2 sum Q V) against
+// `field` (the written field's energy), relative to the larger of `scale` (sum |V I|) and `field`.
+std::vector<BalanceCheck> electrode_checks(const ElectrodeSolve& s, const LinearSolverOptions& o,
+                                           const std::string& flow, const std::string& energy_what,
+                                           double reported, double scale, double field) {
+  const double tol = std::max(1e-6, 100 * o.relative_tolerance);
+  std::vector<BalanceCheck> checks = maxwell_matrix_checks(s.matrix, s.residual, tol, flow);
+  scale = std::max(scale, field);
+  checks.push_back(make_check("energy", energy_what, scale > 0 ? std::abs(reported - field) / scale : 0.0, tol));
+  return checks;
 }
 
 // sum_j V_j u_j
@@ -171,32 +404,54 @@ ElectrostaticReport solve_electrostatic(Mesh& mesh, const ElectrostaticParams& p
     if (e.fixed_current)
       throw SolverError("conductor '" + e.name + "': a fixed current has no meaning in electrostatics");
   }
+  auto is_metal = [&](std::int32_t id) {
+    for (const RegionCoefficient& c : params.permittivity)
+      if (c.region == id) return false;
+    if (std::find(params.metal_regions.begin(), params.metal_regions.end(), id) != params.metal_regions.end())
+      return true;
+    const Region* r = mesh.find_region(id);
+    if (!r || r->material >= mesh.materials.size()) return false;
+    const double sigma = mesh.materials[r->material].electrical_conductivity;
+    return !std::isnan(sigma) && sigma >= params.metal_conductivity;
+  };
   const ElectrodeSolve s = solve_electrodes(
       mesh, params.conductors, [](const Material& m) { return m.relative_permittivity; }, params.permittivity,
       kVacuumPermittivity, "relative permittivity", "ElectrostaticParams::permittivity (foxi solve --eps",
-      "electrostatic problem", "conductor", params.solver);
+      "electrostatic problem", "conductor", params.solver, is_metal);
   const std::size_t ne = params.conductors.size();
   ElectrostaticReport rep;
   rep.capacitance = s.matrix;
-  rep.asymmetry = s.asymmetry;
-  rep.energy_capacitance = s.energy2;
   std::vector<double> volt(ne);
   for (std::size_t i = 0; i < ne; ++i) volt[i] = params.conductors[i].voltage;
+  double qv = 0;  // sum |Q_i V_i|: the scale of the energy check
   for (std::size_t i = 0; i < ne; ++i) {
     ElectrodeResult c;
     c.name = params.conductors[i].name;
     c.area = s.area[i];
     c.voltage = volt[i];
+    c.metal_regions = s.electrode_metal[i];
     for (std::size_t j = 0; j < ne; ++j) c.charge += s.matrix[i][j] * volt[j];
     rep.energy += 0.5 * c.charge * c.voltage;
+    qv += 0.5 * std::abs(c.charge * c.voltage);
     rep.conductors.push_back(c);
   }
   std::vector<double> u = superpose(s, volt);
+  for (const ElectrodeSolve::Floating& f : s.floating)
+    rep.floating.push_back({f.regions, f.nodes, u[f.node]});
   const unsigned threads = detail::thread_count(params.solver.threads);
+  std::vector<double> e2;
   std::vector<double> one(s.regions.size(), 1.0);
-  detail::set_field(mesh,
-                    cell_field("electric_field", "V/m", 3,
-                               detail::cell_gradients(mesh, s.regions, one, u, -1.0, threads, nullptr)));
+  (void)detail::cell_gradients(mesh, s.regions, s.coefficient, u, 1.0, threads, &e2);
+  for (double v : e2) rep.field_energy += 0.5 * v;
+  rep.residual = s.residual;
+  rep.checks = electrode_checks(s, params.solver, "the charges", "|1/2 sum Q V - field energy| / field energy",
+                                rep.energy, qv, rep.field_energy);
+  // In a metal body the field is zero (its tets have no coefficient): write that, not the gradient of
+  // the round-off.
+  std::vector<double> field = detail::cell_gradients(mesh, s.regions, one, u, -1.0, threads, nullptr);
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t)
+    if (s.metal[s.regions.tet_rix[t]]) field[3 * t] = field[3 * t + 1] = field[3 * t + 2] = 0;
+  detail::set_field(mesh, cell_field("electric_field", "V/m", 3, std::move(field)));
   detail::set_field(mesh, node_field("potential", "V", std::move(u)));
   rep.solver = s.lin.solver;
   rep.unknowns = s.unknowns;
@@ -278,6 +533,14 @@ CurrentReport solve_current(Mesh& mesh, const CurrentParams& params) {
     rep.regions.push_back({s.regions.ids[i], s.coefficient[i], s.region_volume[i], power[i]});
     rep.total_power += power[i];
   }
+  double vi = 0;  // sum |V_i I_i|: the scale of the energy check
+  for (const ElectrodeResult& t : rep.terminals) {
+    rep.terminal_power += t.voltage * t.charge;
+    vi += std::abs(t.voltage * t.charge);
+  }
+  rep.residual = s.residual;
+  rep.checks = electrode_checks(s, params.solver, "the currents", "|sum V I - Joule heat| / Joule heat",
+                                rep.terminal_power, vi, rep.total_power);
   detail::set_field(mesh, cell_field("current_density", "A/m^2", 3, std::move(j)));
   detail::set_field(mesh, cell_field("joule_heat", "W/m^3", 1, std::move(joule)));
   detail::set_field(mesh, node_field("potential", "V", std::move(u)));

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "foxi/model/physics.hpp"
+
 namespace foxi {
 
 std::vector<std::int32_t> surface_tags(const BoundaryCondition& c, const Mesh& mesh) {
@@ -41,10 +43,11 @@ ThermalParams thermal_params_from_model(const Model& model, const Mesh& mesh) {
 
 namespace {
 
-std::vector<Electrode> electrodes(const Model& model, const Mesh& mesh, bool with_current) {
+std::vector<Electrode> electrodes(const Model& model, const Mesh& mesh, Physics physics) {
   std::vector<Electrode> out;
   for (const BoundaryCondition& c : model.conditions) {
-    if (c.kind != ConditionKind::voltage && !(with_current && c.kind == ConditionKind::current)) continue;
+    if ((c.kind != ConditionKind::voltage && c.kind != ConditionKind::current) || !condition_applies(c, physics))
+      continue;
     Electrode e;
     e.name = c.name;
     e.tags = surface_tags(c, mesh);
@@ -59,13 +62,13 @@ std::vector<Electrode> electrodes(const Model& model, const Mesh& mesh, bool wit
 
 ElectrostaticParams electrostatic_params_from_model(const Model& model, const Mesh& mesh) {
   ElectrostaticParams p;
-  p.conductors = electrodes(model, mesh, false);
+  p.conductors = electrodes(model, mesh, Physics::electrostatic);
   return p;
 }
 
 CurrentParams current_params_from_model(const Model& model, const Mesh& mesh) {
   CurrentParams p;
-  p.terminals = electrodes(model, mesh, true);
+  p.terminals = electrodes(model, mesh, Physics::current);
   return p;
 }
 

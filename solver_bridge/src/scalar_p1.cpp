@@ -180,21 +180,32 @@ Dirichlet dirichlet_from_tags(const Mesh& mesh, const P1Stiffness& k,
   return d;
 }
 
-std::vector<std::uint32_t> node_components(const Mesh& mesh) {
+std::vector<std::uint32_t> tet_set_components(const Mesh& mesh, const std::function<bool(std::size_t)>& keep) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   std::vector<std::uint32_t> parent(nn);
   for (std::size_t v = 0; v < nn; ++v) parent[v] = static_cast<std::uint32_t>(v);
+  std::vector<char> used(nn, 0);
   auto root = [&](std::uint32_t v) {
     while (parent[v] != v) v = parent[v] = parent[parent[v]];
     return v;
   };
-  for (std::size_t t = 0; t < nt; ++t)
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (keep && !keep(t)) continue;
+    for (int a = 0; a < 4; ++a) used[mesh.tet[4 * t + a]] = 1;
     for (int a = 1; a < 4; ++a) {
       const std::uint32_t r0 = root(mesh.tet[4 * t]), r1 = root(mesh.tet[4 * t + a]);
       if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
     }
-  for (std::size_t v = 0; v < nn; ++v) parent[v] = root(static_cast<std::uint32_t>(v));
+  }
+  for (std::size_t v = 0; v < nn; ++v) parent[v] = used[v] ? root(static_cast<std::uint32_t>(v)) : UINT32_MAX;
   return parent;
+}
+
+std::vector<std::uint32_t> node_components(const Mesh& mesh) {
+  std::vector<std::uint32_t> part = tet_set_components(mesh, {});
+  for (std::size_t v = 0; v < part.size(); ++v)
+    if (part[v] == UINT32_MAX) part[v] = static_cast<std::uint32_t>(v);
+  return part;
 }
 
 std::vector<std::int32_t> boundary_tag_list(const Mesh& mesh) {

@@ -90,6 +90,9 @@ Dirichlet dirichlet_from_tags(const Mesh& mesh, const P1Stiffness& k,
 // Per node, the smallest node of its connected part (parts joined through tets); unused nodes are
 // their own part.
 std::vector<std::uint32_t> node_components(const Mesh& mesh);
+// Per node, the smallest node of its connected set of the tets `keep` accepts (all when empty),
+// joined through shared nodes; UINT32_MAX for a node of no such tet.
+std::vector<std::uint32_t> tet_set_components(const Mesh& mesh, const std::function<bool(std::size_t)>& keep);
 // The distinct boundary tags of the mesh's triangles, sorted.
 std::vector<std::int32_t> boundary_tag_list(const Mesh& mesh);
 

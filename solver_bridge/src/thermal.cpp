@@ -372,6 +372,21 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   for (BoundaryHeat& b : rep.boundaries) b.mean_temperature = boundary_mean_temperature(mesh, b.tag, temp);
   for (const ThermalResistanceSpec& spec : params.resistances)
     rep.resistances.push_back(evaluate_resistance(mesh, spec, rep, temp, bc));
+  // Energy balance against the heat that flows (what enters, or what leaves if more): with no sources
+  // the net boundary heat is ~0 and no scale for itself.
+  {
+    double in = std::max(0.0, rep.total_power), out = std::max(0.0, -rep.total_power);
+    rep.imbalance = rep.total_power;
+    for (const BoundaryHeat& b : rep.boundaries) {
+      rep.imbalance += b.heat_in;
+      (b.heat_in > 0 ? in : out) += std::abs(b.heat_in);
+    }
+    rep.heat_flow = std::max(in, out);
+    rep.checks.push_back(make_check(
+        "energy", "|sources + boundary heat in| / the heat that flows through the body",
+        rep.heat_flow > 0 ? std::abs(rep.imbalance) / rep.heat_flow : 0.0,
+        std::max(1e-6, 100 * params.solver.relative_tolerance)));
+  }
 
   Field temp_field;
   temp_field.name = "temperature";

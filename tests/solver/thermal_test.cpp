@@ -119,6 +119,14 @@ TEST_F(ThermalTest, SlabBetweenTwoTemperaturesIsLinearAndExact) {
     EXPECT_NEAR(heat_of(r, 2).heat_in, q, 1e-9 * q);
     EXPECT_NEAR(heat_of(r, 1).heat_in, -q, 1e-9 * q);
     EXPECT_NEAR(heat_of(r, 1).area, kArea, 1e-12);
+    // With no sources the balance is measured against the heat that flows through, not against the
+    // (vanishing) net boundary heat.
+    EXPECT_NEAR(r.heat_flow, q, 1e-9 * q);
+    ASSERT_EQ(r.checks.size(), 1u);
+    EXPECT_EQ(r.checks[0].name, "energy");
+    EXPECT_TRUE(r.checks[0].passed);
+    EXPECT_LT(r.checks[0].figure, 1e-9);
+    EXPECT_NEAR(r.checks[0].figure, std::abs(r.imbalance) / q, 1e-15);
     const Field* flux = m.find_field("heat_flux");
     ASSERT_NE(flux, nullptr);
     ASSERT_EQ(flux->values.size(), 3 * m.tet_count());

@@ -15,6 +15,9 @@
 //                         # current (A into the body), displacement ([ux, uy, uz], lengths)
 //   h = "10 W/(m^2*K)"  ambient = "25 degC"            # convection
 //   name = "anode"        # optional: the electrode's name (voltage, ground, current)
+//   physics = "current"   # optional, voltage and ground: only that physics ("electrostatic" or
+//                         # "current"; default both), e.g. a terminal on a bump's end that would
+//                         # short an electrostatic conductor through the metal
 //
 //   [[loads]]
 //   type = "power"  part = "die"  value = "0.5 W"      # or a density, "2e9 W/m^3"
@@ -52,6 +55,7 @@ struct BoundaryCondition {
   ConditionKind kind = ConditionKind::temperature;
   std::vector<std::string> surfaces;  // boundary names; interfaces as "A/B" with A earlier in the file
   std::string name;                   // the electrode's name (defaults to the surfaces joined by ',')
+  std::string physics;                // voltage: "electrostatic" or "current" only; empty: both
   double value = 0;
   double h = 0, ambient = 0;
   double displacement[3] = {0, 0, 0};

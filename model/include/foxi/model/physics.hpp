@@ -14,6 +14,8 @@ const char* physics_name(Physics physics);
 // True if `c` belongs to `physics` (temperature/heat_flux/convection: thermal; voltage: electrostatic
 // and current; current: current; displacement/sliding: thermal_stress).
 bool condition_applies(ConditionKind c, Physics physics);
+// The same for one condition, which may be restricted to one physics (BoundaryCondition::physics).
+bool condition_applies(const BoundaryCondition& c, Physics physics);
 
 // Throws IoError (the model file, the line of the part, naming the part, its material and the
 // property) when a part's material lacks a property `physics` needs (thermal_conductivity;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "foxi/model/mesh.hpp"
@@ -31,6 +32,25 @@ struct SolverCancelled : SolverError {
   using SolverError::SolverError;
 };
 
+// A check a solver makes of its own result (a balance, a sign pattern, a residual): a relative figure
+// against its tolerance. A result with a failed check is not to be trusted: foxi prints it as an
+// UNRELIABLE line with the figures and exits with status 4.
+struct BalanceCheck {
+  std::string name;  // "Kirchhoff", "energy", ...
+  std::string what;  // what the figure measures, in words
+  double figure = 0;
+  double tolerance = 0;
+  bool passed = true;
+};
+inline BalanceCheck make_check(std::string name, std::string what, double figure, double tolerance) {
+  return {std::move(name), std::move(what), figure, tolerance, figure <= tolerance};  // NaN fails
+}
+inline bool all_passed(const std::vector<BalanceCheck>& checks) {
+  for (const BalanceCheck& c : checks)
+    if (!c.passed) return false;
+  return true;
+}
+
 enum class LinearSolverKind : std::uint8_t {
   automatic,  // direct up to LinearSolverOptions::direct_max_unknowns, else cg_amg
   direct,     // sparse LDL^T (Eigen SimplicialLDLT, AMD ordering)
@@ -42,7 +62,11 @@ enum class LinearSolverKind : std::uint8_t {
 struct LinearSolverOptions {
   LinearSolverKind kind = LinearSolverKind::automatic;
   std::size_t direct_max_unknowns = 5000;
-  double relative_tolerance = 1e-10;  // CG stops at |b - A x| <= tol |b|
+  // CG stops at |W (b - A x)| <= tol |W b|, and restarts on the true residual (a few times) where it
+  // misses that. W = diag(A)^-1 for the scalar problems (heat, electrostatics, conduction): each row's
+  // residual in units of the unknown, so that a row of FR-4 counts as much as a row of copper at a
+  // contrast of 1e20; W = I for elasticity.
+  double relative_tolerance = 1e-10;
   std::size_t max_iterations = 0;     // 0: 10 * unknowns + 100
   unsigned threads = 0;               // 0: std::thread::hardware_concurrency()
   ProgressFn progress;                // stages "assemble", "factorize", "solve"; false cancels
@@ -149,12 +173,15 @@ struct ThermalReport {
   double max_temperature = 0;              // K
   std::uint32_t max_node = kNone;
   double total_power = 0;        // W from the sources
+  double imbalance = 0;          // W, sources + heat in through all boundaries (~0)
+  double heat_flow = 0;          // W through the body: the larger of what enters and what leaves
+  std::vector<BalanceCheck> checks;  // "energy": |imbalance| / heat_flow
   std::vector<ThermalResistance> resistances;  // one per ThermalParams::resistances
   std::string solver;            // "SimplicialLDLT", "CG+IncompleteCholesky", "CG+SmoothedAggregationAMG"
   std::size_t unknowns = 0;      // free nodes
   std::size_t nonzeros = 0;      // of the free-free matrix (both triangles)
   std::size_t iterations = 0;    // CG iterations (0 for the direct solver)
-  double relative_residual = 0;  // |b - A x| / |b| of the free system
+  double relative_residual = 0;  // |W (b - A x)| / |W b| of the free system (LinearSolverOptions)
   double assembly_seconds = 0, solve_seconds = 0;
 };
 
