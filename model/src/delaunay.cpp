@@ -43,7 +43,6 @@ struct PointGrid {
   std::int64_t dims[3] = {1, 1, 1};
   std::vector<std::uint32_t> cell_start;  // dims product + 1
   std::vector<GridPoint> pts;             // in cell order
-  double scale = 0;                       // largest absolute coordinate
   double wmax = 0;                        // largest weight (0 when unweighted)
   std::vector<std::uint32_t> cell_of;     // per node: its cell (0 for nodes not in the grid)
 
@@ -87,7 +86,6 @@ PointGrid build_grid(const Mesh& mesh, bool weighted) {
   for (int d = 0; d < 3; ++d) {
     g.lo[d] = lo[d];
     emax = std::max(emax, hi[d] - lo[d]);
-    g.scale = std::max({g.scale, std::abs(lo[d]), std::abs(hi[d])});
   }
   if (emax > 0) {
     // Cubic cells, about one point per cell.
@@ -220,13 +218,21 @@ class Checker {
 
     // Candidates: the cells of the sphere's box (or every point when the centre is unreliable).
     const double xn = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
-    const double eq = 4 * kU * grid_.scale;  // bound on the rounding of q - a (vector norm)
+    // The rounding of dq = (q - a) - x: q - a is one correctly rounded subtraction (error <= u|q - a|
+    // per coordinate, whatever the size of a), and so is the second, so |error| <= u (2|dq| + |x|)
+    // (a little more for the second-order terms). Near the sphere |dq| ~ |x|, so 4u|x| covers it
+    // there; the weighted test below adds the 2u|dq| term itself. The bound is local to the tet: a
+    // global one (4u times the largest coordinate) made every point a candidate for exact tests on
+    // meshes that mix magnitudes (1e-40 next to 1e40), minutes of exact arithmetic (issue 22).
+    const double eq = 4 * kU * xn;
     const double e1 = eq + ex;
+    const double amax = std::max({std::abs(a[0]), std::abs(a[1]), std::abs(a[2])});
     // Largest possible power radius^2 (with room for the rounding of the weight terms).
     const double rmax =
         (xn + ex) * (xn + ex) + grid_.wmax - wv[0] + 8 * kU * (std::abs(grid_.wmax) + std::abs(wv[0]));
     double half = e1 + std::sqrt(std::max(0.0, rmax));
-    half = half * (1 + 1e-9) + 8 * kU * (grid_.scale + xn);
+    // The box's corners a + x +- half are rounded twice: within 2u (|a| + |x| + half) each.
+    half = half * (1 + 1e-9) + 8 * kU * (amax + xn + half);
     std::int64_t c0[3] = {0, 0, 0}, c1[3] = {grid_.dims[0] - 1, grid_.dims[1] - 1, grid_.dims[2] - 1};
     if (reliable && std::isfinite(half)) {
       for (int d = 0; d < 3; ++d) {
@@ -255,7 +261,7 @@ class Checker {
             if (!weighted_) {
               if (d2 > t_out) continue;
             } else {
-              const double dl = std::sqrt(d2) - e1;
+              const double dl = std::sqrt(d2) * (1 - 8 * kU) - e1;  // the 2u|dq| rounding term
               if (dl > 0) {
                 const double lower = dl * dl - q->w - (xn + ex) * (xn + ex) + wa;
                 const double margin = 1e-12 * (d2 + (xn + ex) * (xn + ex) + std::abs(q->w) + std::abs(wa));

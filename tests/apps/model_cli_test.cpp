@@ -58,7 +58,7 @@ TEST(ModelCli, ErrorsAndUsage) {
       << test::read_text(dir / "e1.txt");
   EXPECT_EQ(foxi_cli("model plc '" + kModels + "die_on_substrate.toml'", dir / "e2.txt"), 2);  // no -o
   EXPECT_EQ(foxi_cli("model frobnicate x.toml", dir / "e3.txt"), 2);
-  EXPECT_EQ(foxi_cli("model check '" + (dir / "missing.toml").string() + "'", dir / "e4.txt"), 1);
+  EXPECT_EQ(foxi_cli("model check '" + (dir / "missing.toml").string() + "'", dir / "e4.txt"), 3);
   EXPECT_NE(test::read_text(dir / "e4.txt").find("missing.toml"), std::string::npos)
       << test::read_text(dir / "e4.txt");
 }
