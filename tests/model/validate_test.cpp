@@ -218,22 +218,28 @@ TEST(Validate, GeometryBeyondDoubleRangeIsRefused) {
 
 TEST(Validate, AcceptedGeometryHasFiniteExactlyScaledVolumes) {
   // For every power of ten that validation accepts, the double volume is finite, positive and
-  // equals s^3 / 6 (the analytic volume of the scaled corner tet) to rounding; and the accepted
-  // range covers every physical scale (1e-60 .. 1e60 metres).
-  int accepted_lo = 1000, accepted_hi = -1000;
+  // equals s^3 / 6 (the analytic volume of the scaled corner tet) to rounding. The accepted powers
+  // are one unbroken range covering every physical scale in SI units (1e-9 .. 1e20 m), and stop
+  // before the visibility order's float error bounds fail (circumspheres reaching 1e24, or a mesh
+  // under 1e-12 across).
+  int accepted_lo = 1000, accepted_hi = -1000, accepted = 0;
   for (int k = -320; k <= 308; ++k) {
     const double s = std::pow(10.0, k);
     Mesh m = two_tets();
     for (double& x : m.xyz) x *= s;
     if (!validate(m).ok()) continue;
+    ++accepted;
     accepted_lo = std::min(accepted_lo, k);
     accepted_hi = std::max(accepted_hi, k);
-    const double v = scaled_volume(s), expected = std::pow(10.0L, 3 * k) / 6;
+    const double v = scaled_volume(s), expected = static_cast<double>(std::pow(10.0L, 3 * k) / 6);
     ASSERT_TRUE(std::isfinite(v) && v > 0) << k;
-    EXPECT_NEAR(v / double(expected), 1.0, 1e-14) << k;
+    EXPECT_NEAR(v / expected, 1.0, 1e-14) << k;
   }
-  EXPECT_LE(accepted_lo, -60);
-  EXPECT_GE(accepted_hi, 60);
+  EXPECT_EQ(accepted, accepted_hi - accepted_lo + 1);
+  EXPECT_LE(accepted_lo, -9);
+  EXPECT_GE(accepted_hi, 20);
+  EXPECT_GE(accepted_lo, -12);  // 2 x 1e-13 across: refused
+  EXPECT_LE(accepted_hi, 24);   // spheres reaching 1.7e24: refused
 }
 
 }  // namespace

@@ -19,10 +19,12 @@ struct ValidationReport {
   std::size_t inverted = 0;            // negatively oriented tets (re-oriented by repair)
   std::size_t duplicate_tets = 0;      // tets with the same four nodes as an earlier tet
   std::size_t duplicate_nodes = 0;     // nodes used by tets at the very point of an earlier such node
-  // Tets whose geometry leaves the range where double arithmetic holds it: 6 x volume, the
+  // Tets whose geometry leaves the range where foxi's arithmetic holds it: 6 x volume, the
   // circumcentre's terms or the circumradius^2 overflow, or 6 x volume is below 2^-969 (it has
-  // underflowed or lost its precision), e.g. coordinates near 1e300 or 1e-300 or scaled by 1e154.
-  // Volumes, gradients, circumspheres and visibility keys of such tets would be inf, 0 or NaN.
+  // underflowed or lost its precision), e.g. coordinates near 1e300 or 1e-300 or scaled by 1e154;
+  // or the circumsphere reaches beyond 1e24 from the bounding box's centre, or the whole mesh is
+  // less than 1e-12 across (the visibility order's error bounds are floats). Volumes, gradients,
+  // circumspheres and visibility keys of such tets would be inf, 0, NaN or wrongly bounded.
   std::size_t out_of_range = 0;
   std::size_t unused_nodes = 0;        // nodes no tet uses
   std::vector<std::string> messages;   // first few problems, human-readable, with element numbers
