@@ -28,8 +28,8 @@ const char* kInfoUsage =
     "  --check-delaunay  also certify that every tet's circumsphere is empty (exact predicates)\n"
     "  --no-quality      skip the quality statistics\n"
     "  Validation: sizes and indices, non-finite coordinates, flat tets (exact predicate), geometry\n"
-    "  beyond the range of double (volumes, circumspheres), duplicate tets, coincident nodes, no\n"
-    "  tets; warnings: inverted tets (every command re-orients them), unused nodes.\n"
+    "  beyond the range foxi computes in (volumes, circumspheres, keys), duplicate tets, coincident\n"
+    "  nodes, no tets; warnings: inverted tets (every command re-orients them), unused nodes.\n"
     "  Exit status: 0 usable mesh, 2 usage error, 3 unreadable file or unusable mesh.";
 
 struct RegionStats {

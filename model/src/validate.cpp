@@ -68,11 +68,11 @@ bool geometry_in_range(const double* a, const double* b, const double* c, const 
   cross(B, C, BC);
   const double six_v = B[0] * CD[0] + B[1] * CD[1] + B[2] * CD[2];
   if (!std::isfinite(six_v)) {
-    why = "6 x volume overflows (" + num(six_v) + ")";
+    why = "6 x volume overflows double (" + num(six_v) + ")";
     return false;
   }
   if (!(std::abs(six_v) >= kMinSixVolume)) {
-    why = "6 x volume underflows (" + num(six_v) + ")";
+    why = "6 x volume underflows double (" + num(six_v) + ")";
     return false;
   }
   const double lB = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
@@ -84,7 +84,7 @@ bool geometry_in_range(const double* a, const double* b, const double* c, const 
     const double n0 = lB * CD[k], n1 = lC * DB[k], n2 = lD * BC[k];
     const double x = (n0 + n1 + n2) / (2 * six_v);
     if (!(std::isfinite(n0) && std::isfinite(n1) && std::isfinite(n2) && std::isfinite(x))) {
-      why = "the circumcentre overflows";
+      why = "the circumcentre overflows double";
       return false;
     }
     r2 += x * x;
@@ -92,13 +92,13 @@ bool geometry_in_range(const double* a, const double* b, const double* c, const 
     o2 += rel * rel;
   }
   if (!std::isfinite(r2)) {
-    why = "the circumradius^2 overflows (" + num(r2) + ")";
+    why = "the circumradius^2 overflows double (" + num(r2) + ")";
     return false;
   }
   const double reach = std::sqrt(o2) + std::sqrt(r2);
   if (!(reach <= kMaxSphereReach)) {
-    why = "its circumsphere reaches " + num(reach) + " from the mesh's centre, beyond the " +
-          num(kMaxSphereReach) + " the visibility order's error bounds hold";
+    why = "the circumsphere reaches " + num(reach) + " from the mesh's centre, beyond the " +
+          num(kMaxSphereReach) + " that the visibility order's float error bounds hold";
     return false;
   }
   return true;
@@ -156,8 +156,8 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
     if (mesh.tet_count() > 0 && extent < kMinExtent) {
       // Every tet is affected; counted as such, with one message for the mesh.
       tiny_mesh = true;
-      note(r, "the mesh is " + num(extent) + " across, below the " + num(kMinExtent) +
-                  " that the visibility order's error bounds hold (rescale the coordinates)");
+      note(r, "geometry beyond the range foxi computes in: the mesh is " + num(extent) + " across, below the " +
+                  num(kMinExtent) + " that the visibility order's float error bounds hold (rescale the coordinates)");
     }
   }
   std::vector<std::uint8_t> used(nv, 0);
@@ -213,7 +213,7 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
                            x + 3 * std::size_t(v[pos ? 2 : 3]), x + 3 * std::size_t(v[pos ? 3 : 2]), origin,
                            why)) {
       ++r.out_of_range;
-      note(r, "tet " + std::to_string(t) + " " + ids(v, 4) + ": geometry beyond the range of double: " + why +
+      note(r, "tet " + std::to_string(t) + " " + ids(v, 4) + ": geometry beyond the range foxi computes in: " + why +
                   " (rescale the coordinates)");
     }
   }
@@ -283,7 +283,7 @@ std::vector<std::string> describe(const ValidationReport& r) {
   add(r.repeated_vertex, "element", "elements", " naming one node twice");
   add(r.nonfinite_nodes, "node", "nodes", " with NaN or infinite coordinates");
   add(r.zero_volume, "tet", "tets", " of zero volume");
-  add(r.out_of_range, "tet", "tets", " whose volume or circumsphere is beyond the range of double");
+  add(r.out_of_range, "tet", "tets", " with geometry beyond the range foxi computes in (volumes, circumspheres, keys)");
   add(r.duplicate_tets, "tet", "tets", " repeating an earlier tet's nodes");
   add(r.duplicate_nodes, "node", "nodes", " at the point of another node (the mesh is torn there)");
   add(r.inverted, "inverted tet", "inverted tets", " (negative orientation; every command re-orients them)");
