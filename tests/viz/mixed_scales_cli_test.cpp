@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/model/adjacency.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
@@ -30,16 +31,18 @@ using Vb = CGAL::Triangulation_vertex_base_with_info_3<std::uint32_t, K>;
 using Tds = CGAL::Triangulation_data_structure_3<Vb>;
 using Delaunay = CGAL::Delaunay_triangulation_3<K, Tds>;
 
-// `n` points u * 10^k, u uniform in [-1, 1]^3, k a uniform integer in [-kmax, kmax], and their
-// Delaunay tetrahedralization (CGAL's cells are positively oriented).
-Mesh mixed_scale_mesh(int n, int kmax, unsigned seed) {
+// `n` points u * 10^k, u uniform in [-1, 1]^3, k a uniform integer in [kmin, kmax] (by default
+// [-kmax, kmax]), then `far` points u * 10^20, and their Delaunay tetrahedralization (CGAL's cells
+// are positively oriented).
+Mesh mixed_scale_mesh(int n, int kmax, unsigned seed, int kmin = 1, int far = 0) {
+  if (kmin > 0) kmin = -kmax;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
-  std::uniform_int_distribution<int> k(-kmax, kmax);
+  std::uniform_int_distribution<int> k(kmin, kmax);
   std::vector<std::pair<K::Point_3, std::uint32_t>> pts;
   Mesh m;
-  for (int i = 0; i < n; ++i) {
-    const double s = std::pow(10.0, k(rng));
+  for (int i = 0; i < n + far; ++i) {
+    const double s = std::pow(10.0, i < n ? k(rng) : 20);
     const double p[3] = {u(rng) * s, u(rng) * s, u(rng) * s};
     m.xyz.insert(m.xyz.end(), p, p + 3);
     pts.emplace_back(K::Point_3(p[0], p[1], p[2]), static_cast<std::uint32_t>(i));
@@ -104,6 +107,84 @@ TEST(MixedScales, CertificateAndOrderFinishAndAreRight) {
     }
     std::printf("kmax %d: %zu tets; certificate %.3f s, spheres %.3f s\n", kmax, m.tet_count(), cert_s, spheres_s);
   }
+}
+
+// The certificate on a mixed-scale mesh (its points crowd one grid cell, so it takes the k-d tree)
+// against brute force: every tet against every point with CGAL's exact insphere test. Once on the
+// Delaunay mesh, once after a 2-3 flip of one interior face, which makes it non-Delaunay.
+std::size_t brute_force_violating(const Mesh& m) {
+  auto point = [&](std::uint32_t v) { return K::Point_3(m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]); };
+  std::size_t violating = 0;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    const std::uint32_t* v = &m.tet[4 * t];
+    for (std::uint32_t q = 0; q < m.node_count(); ++q) {
+      if (q == v[0] || q == v[1] || q == v[2] || q == v[3]) continue;
+      if (CGAL::side_of_oriented_sphere(point(v[0]), point(v[1]), point(v[2]), point(v[3]), point(q)) ==
+          CGAL::ON_POSITIVE_SIDE) {
+        ++violating;
+        break;
+      }
+    }
+  }
+  return violating;
+}
+
+TEST(MixedScales, CertificateMatchesBruteForce) {
+  // 400 points within 1 of the origin (scales 1e-20 .. 1) and 20 out to 1e20: the grid's cells are
+  // about 1e19 wide, so the 400 share one cell (a boundary within 1 of the origin is a 1e-19
+  // chance), more than the 256 that switch the certificate to its k-d tree.
+  const Mesh base = mixed_scale_mesh(400, 0, 5, -20, 20);
+  auto point = [&](std::uint32_t v) {
+    return K::Point_3(base.xyz[3 * v], base.xyz[3 * v + 1], base.xyz[3 * v + 2]);
+  };
+  // Two tets sharing a face whose opposite vertices a, b see the segment ab cross the face's
+  // interior: replaced by the three tets around ab.
+  Mesh flipped;
+  flipped.xyz = base.xyz;
+  const FaceAdjacency& adj = face_adjacency(base);
+  bool done = false;
+  std::size_t skip0 = kNone, skip1 = kNone;
+  for (std::size_t t = 0; t < base.tet_count() && !done; ++t)
+    for (int i = 0; i < 4 && !done; ++i) {
+      const std::uint32_t nb = adj.neighbour[4 * t + i];  // 4 u + g
+      if (nb == kNone || nb / 4 < t) continue;
+      const std::uint32_t n = nb / 4;
+      const std::uint32_t* vt = &base.tet[4 * t];
+      const std::uint32_t* vn = &base.tet[4 * std::size_t(n)];
+      const std::uint32_t a = vt[i];
+      std::uint32_t b = kNone;
+      for (int j = 0; j < 4; ++j)
+        if (vn[j] != vt[0] && vn[j] != vt[1] && vn[j] != vt[2] && vn[j] != vt[3]) b = vn[j];
+      std::uint32_t f[3];
+      for (int j = 0, k = 0; j < 4; ++j)
+        if (j != i) f[k++] = vt[j];
+      const auto o0 = CGAL::orientation(point(a), point(b), point(f[0]), point(f[1]));
+      const auto o1 = CGAL::orientation(point(a), point(b), point(f[1]), point(f[2]));
+      const auto o2 = CGAL::orientation(point(a), point(b), point(f[2]), point(f[0]));
+      if (o0 == CGAL::COPLANAR || o0 != o1 || o1 != o2) continue;
+      for (int j = 0; j < 3; ++j) {
+        std::uint32_t c = f[j], d = f[(j + 1) % 3];
+        if (CGAL::orientation(point(a), point(b), point(c), point(d)) == CGAL::NEGATIVE) std::swap(c, d);
+        flipped.tet.insert(flipped.tet.end(), {a, b, c, d});
+      }
+      skip0 = t;
+      skip1 = n;
+      done = true;
+    }
+  ASSERT_TRUE(done);
+  for (std::size_t t = 0; t < base.tet_count(); ++t)
+    if (t != skip0 && t != skip1) flipped.tet.insert(flipped.tet.end(), &base.tet[4 * t], &base.tet[4 * t + 4]);
+  flipped.tet_region.assign(flipped.tet_count(), 1);
+  ASSERT_TRUE(validate(flipped).ok());
+
+  const DelaunayCertificate c0 = compute_delaunay_certificate(base);
+  EXPECT_TRUE(c0.delaunay);
+  EXPECT_EQ(c0.violating_tet_count, brute_force_violating(base));
+  const DelaunayCertificate c1 = compute_delaunay_certificate(flipped);
+  const std::size_t want = brute_force_violating(flipped);
+  EXPECT_GT(want, 0u);  // the flip made it non-Delaunay
+  EXPECT_FALSE(c1.delaunay);
+  EXPECT_EQ(c1.violating_tet_count, want);
 }
 
 // The command line on the same kind of file: both must end (refusing, or answering) well within
