@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "../foxi/exit_codes.hpp"
+#include "foxi/model/io_error.hpp"
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/model/validate.hpp"
 #include "viewer.hpp"
 #include "x11_window.hpp"
 
@@ -26,6 +29,7 @@ const char* kUsage =
     "  s save the picture as PREFIX-NNN.png (default PREFIX foxi-view), q or Escape quit.\n"
     "  Camera options as foxi render (same defaults, so the pictures agree); --size default 800x600.\n"
     "  Meshes that fail the Delaunay certificate are drawn with a depth buffer (MPVO order).\n"
+    "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused.\n"
     "  --no-undo draws without recording what undraw needs (faster drawing; u is refused).\n"
     "  --script runs without a window: whitespace-separated commands\n"
     "     d (draw all)  c (restart, draw nothing)  n (one batch)  f (finish, drawing on)\n"
@@ -33,15 +37,21 @@ const char* kUsage =
     "     orbit:YAW,PITCH (degrees)  zoom:F  pan:DX,DY (fractions of the height)\n"
     "  e.g. --script \"d r orbit:30,0 d s\"; --dump-ids also writes PREFIX-NNN.ids (the id buffer,\n"
     "  uint32 little-endian) and PREFIX-NNN.tets (the drawn tets, in drawing order).\n"
-    "  Environment: FOXI_VIEW_NO_SHM=1 uses plain XPutImage even where XShm is available.";
+    "  Environment: FOXI_VIEW_NO_SHM=1 uses plain XPutImage even where XShm is available.\n"
+    "  Exit status as foxi's: 0 ok, 1 failure, 2 usage error, 3 unreadable or unusable mesh.";
 
 struct Usage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// A mesh not fit to view (exit status 3).
+struct BadInput : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  using namespace foxi::cli;
   try {
     std::vector<std::string> args(argv + 1, argv + argc);
     std::string mesh_path, size = "800x600", eye, at, up, fov, dir, shrink, save = "foxi-view", script;
@@ -54,7 +64,7 @@ int main(int argc, char** argv) {
       };
       if (a == "--help" || a == "-h") {
         std::puts(kUsage);
-        return 0;
+        return kExitOk;
       } else if (a == "--size") {
         size = value();
       } else if (a == "--eye") {
@@ -108,8 +118,20 @@ int main(int argc, char** argv) {
       if (*end != 0 || !(params.shrink > 0 && params.shrink <= 1))
         throw Usage("--shrink takes a factor in (0, 1]");
     }
-    const foxi::Mesh mesh = foxi::read_mesh(mesh_path);
-    if (mesh.tet_count() == 0) throw std::runtime_error(mesh_path + " has no tets");
+    foxi::Mesh mesh = foxi::read_mesh(mesh_path);
+    {
+      // The same gate as foxi's commands (apps/foxi/mesh_input.cpp): repair what can be, refuse the rest.
+      const foxi::ValidationReport report = foxi::validate_and_repair(mesh);
+      if (!report.ok()) {
+        std::string why = mesh_path + " is not a usable mesh:";
+        for (const std::string& line : foxi::describe(report)) why += "\n  " + line;
+        for (const std::string& m : report.messages) why += "\n  " + m;
+        throw BadInput(why);
+      }
+      if (report.inverted > 0)
+        std::fprintf(stderr, "foxi-view: note: %s: %zu inverted tet%s (negative orientation) re-oriented\n",
+                     mesh_path.c_str(), report.inverted, report.inverted == 1 ? "" : "s");
+    }
     foxi::Camera camera;
     try {
       camera = foxi::view::default_camera(mesh, width, height, eye, at, up, fov, dir);
@@ -122,14 +144,20 @@ int main(int argc, char** argv) {
                   mesh_path.c_str());
     if (script_mode) {
       foxi::view::run_script(viewer, script, save, dump);
-      return 0;
+      return kExitOk;
     }
     return foxi::view::run_window(viewer, save);
   } catch (const Usage& e) {
     std::fprintf(stderr, "foxi-view: %s\nusage: %s\n", e.what(), kUsage);
-    return 2;
+    return kExitUsage;
+  } catch (const BadInput& e) {
+    std::fprintf(stderr, "foxi-view: error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const foxi::IoError& e) {
+    std::fprintf(stderr, "foxi-view: error: %s\n", e.what());
+    return kExitBadInput;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "foxi-view: %s\n", e.what());
-    return 1;
+    return kExitFailure;
   }
 }

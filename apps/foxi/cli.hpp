@@ -14,6 +14,12 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// An input that is not fit for the command (exit status 3, kExitBadInput): a mesh that validation
+// refuses, a file with no tets, ...; the message names the file and says why.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // The arguments of one subcommand, with flags taken out as they are asked for.
 class Args {
  public:

@@ -4,6 +4,8 @@
 #include <string>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
 
@@ -13,11 +15,12 @@ namespace {
 
 const char* kConvertUsage =
     "foxi convert IN OUT [--ascii | --binary] [--msh-version 2.2|4.1]\n"
-    "                    [--vtu-encoding raw|zlib|base64|ascii] [--keep-orientation]\n"
+    "                    [--vtu-encoding raw|zlib|base64|ascii] [--keep-orientation] [--keep-invalid]\n"
     "  Reads IN and writes OUT, each format chosen from the file extension (.msh .vtu .vtk\n"
     "  .node/.ele/.face .mesh). Regions, boundary tags, vertex weights and fields are carried\n"
     "  where the output format can hold them. Inverted tets are re-oriented (and counted) unless\n"
-    "  --keep-orientation. OUT is written to a temporary file and renamed, so a failure leaves\n"
+    "  --keep-orientation. A mesh that validation calls unusable (see foxi info) is refused (exit\n"
+    "  status 3) unless --keep-invalid, which converts it as it is, with a warning. OUT is written to a temporary file and renamed, so a failure leaves\n"
     "  no partial file. Defaults: binary, Gmsh 4.1, appended raw .vtu.";
 
 }  // namespace
@@ -25,7 +28,7 @@ const char* kConvertUsage =
 int cmd_convert(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kConvertUsage);
-    return 0;
+    return kExitOk;
   }
   WriteOptions options;
   const bool ascii = args.flag("--ascii");
@@ -45,6 +48,7 @@ int cmd_convert(Args args) {
   else throw UsageError("--vtu-encoding takes raw, zlib, base64 or ascii, not '" + encoding + "'");
   if (ascii && !encoding_given) options.vtu_encoding = VtuEncoding::ascii;
   const bool keep_orientation = args.flag("--keep-orientation");
+  const bool keep_invalid = args.flag("--keep-invalid");
   const auto files = args.positional(2, 2, kConvertUsage);
 
   // Both formats are checked before any work, so a typo costs nothing.
@@ -54,10 +58,20 @@ int cmd_convert(Args args) {
   auto t0 = std::chrono::steady_clock::now();
   Mesh mesh = read_mesh(files[0]);
   auto t1 = std::chrono::steady_clock::now();
-  ValidationReport report = keep_orientation ? validate(mesh) : validate_and_repair(mesh);
-  if (!report.ok()) {
-    std::fprintf(stderr, "foxi convert: warning: %s has problems (converted as they are):\n", files[0].c_str());
-    for (const std::string& m : report.messages) std::fprintf(stderr, "  %s\n", m.c_str());
+  ValidationReport report;
+  if (keep_invalid) {
+    report = keep_orientation ? validate(mesh) : validate_and_repair(mesh);
+    if (!report.ok()) {
+      std::fprintf(stderr, "foxi convert: warning: %s is not a usable mesh (converted as it is, --keep-invalid):\n",
+                   files[0].c_str());
+      for (const std::string& m : describe(report)) std::fprintf(stderr, "  %s\n", m.c_str());
+      for (const std::string& m : report.messages) std::fprintf(stderr, "  %s\n", m.c_str());
+    }
+  } else if (keep_orientation) {
+    report = validate(mesh);
+    if (!report.ok()) require_usable(mesh, files[0], "convert");  // throws: says why
+  } else {
+    report = require_usable(mesh, files[0], "convert");
   }
   write_mesh(mesh, files[1], options);
   auto t2 = std::chrono::steady_clock::now();
@@ -70,7 +84,7 @@ int cmd_convert(Args args) {
     std::printf("%zu inverted tets %s\n", report.inverted,
                 keep_orientation ? "kept as they were (--keep-orientation)" : "re-oriented");
   }
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace foxi::cli

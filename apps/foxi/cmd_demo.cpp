@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/quality.hpp"
@@ -37,7 +39,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 int cmd_demo(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kDemoUsage);
-    return 0;
+    return kExitOk;
   }
   std::vector<std::string> sets;
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
@@ -61,8 +63,8 @@ int cmd_demo(Args args) {
   const QualitySummary q = summarize_quality(m.mesh);
   std::printf("   radius-edge max %.3g, min dihedral %.3g deg, %zu slivers below 5 deg\n", q.radius_edge.max,
               q.min_dihedral_deg.min, q.slivers);
-  const ValidationReport v = validate_and_repair(m.mesh);
-  std::printf("   validation: %s\n", v.ok() ? "ok" : v.messages.front().c_str());
+  const ValidationReport v = require_usable(m.mesh, file + " (its mesh)", "demo");
+  std::printf("   validation: %s\n", v.clean() ? "ok" : "usable, with warnings");
 
   t = std::chrono::steady_clock::now();
   const DelaunayCertificate cert = compute_delaunay_certificate(m.mesh);
@@ -97,7 +99,7 @@ int cmd_demo(Args args) {
   print_legend(m, pic);
   std::printf("wrote %s (temperature, heat flux), %s (inside), %s (parts)\n", vtu.c_str(), png.c_str(),
               parts.c_str());
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace foxi::cli

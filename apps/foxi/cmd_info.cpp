@@ -8,6 +8,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
@@ -26,7 +27,10 @@ const char* kInfoUsage =
     "  --json            the same as one JSON object on stdout\n"
     "  --check-delaunay  also certify that every tet's circumsphere is empty (exact predicates)\n"
     "  --no-quality      skip the quality statistics\n"
-    "  Exit status: 0 usable mesh, 1 unreadable file or invalid mesh, 2 usage error.";
+    "  Validation: sizes and indices, non-finite coordinates, flat tets (exact predicate), geometry\n"
+    "  beyond the range foxi computes in (volumes, circumspheres, keys), duplicate tets, coincident\n"
+    "  nodes, no tets; warnings: inverted tets (every command re-orients them), unused nodes.\n"
+    "  Exit status: 0 usable mesh, 2 usage error, 3 unreadable file or unusable mesh.";
 
 struct RegionStats {
   std::size_t tets = 0;
@@ -53,7 +57,7 @@ const char* location_name(FieldLocation l) { return l == FieldLocation::node ? "
 int cmd_info(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kInfoUsage);
-    return 0;
+    return kExitOk;
   }
   const bool json = args.flag("--json");
   const bool check_delaunay = args.flag("--check-delaunay");
@@ -98,8 +102,10 @@ int cmd_info(Args args) {
   for (std::int32_t tag : mesh.bface_tag) ++boundaries[tag];
   for (const Boundary& b : mesh.boundaries) boundaries.try_emplace(b.tag, 0);
 
+  // Quality figures of non-finite or out-of-range geometry would be inf or NaN: not printed.
+  const bool quality_ok = indices_ok && report.nonfinite_nodes == 0 && report.out_of_range == 0;
   QualitySummary q;
-  if (quality && indices_ok) q = summarize_quality(mesh);
+  if (quality && quality_ok) q = summarize_quality(mesh);
   FaceAdjacency adjacency;
   bool have_adjacency = indices_ok && report.repeated_vertex == 0;
   if (have_adjacency) adjacency = compute_face_adjacency(mesh);
@@ -162,7 +168,7 @@ int cmd_info(Args args) {
            ", \"unit\": " + json_string(f.unit) + "}";
     }
     o += first ? "],\n" : "\n  ],\n";
-    if (quality && indices_ok) {
+    if (quality && quality_ok) {
       auto stat = [](const Stat& s) {
         return "{\"min\": " + json_number(s.min) + ", \"mean\": " + json_number(s.mean) +
                ", \"max\": " + json_number(s.max) + "}";
@@ -190,12 +196,16 @@ int cmd_info(Args args) {
          ", \"nonfinite_nodes\": " + std::to_string(report.nonfinite_nodes) +
          ", \"zero_volume\": " + std::to_string(report.zero_volume) +
          ", \"inverted\": " + std::to_string(report.inverted) +
+         ", \"out_of_range\": " + std::to_string(report.out_of_range) +
+         ", \"duplicate_tets\": " + std::to_string(report.duplicate_tets) +
+         ", \"duplicate_nodes\": " + std::to_string(report.duplicate_nodes) +
+         ", \"no_tets\": " + std::string(report.no_tets ? "true" : "false") +
          ", \"unused_nodes\": " + std::to_string(report.unused_nodes) + ", \"messages\": [";
     for (std::size_t i = 0; i < report.messages.size(); ++i)
       o += (i ? ", " : "") + json_string(report.messages[i]);
     o += "]}\n}\n";
     std::fputs(o.c_str(), stdout);
-    return report.ok() ? 0 : 1;
+    return report.ok() ? kExitOk : kExitBadInput;
   }
 
   std::printf("file                %s (%s, read in %.3f s)\n", path.c_str(), format_name(format), read_s);
@@ -221,7 +231,7 @@ int cmd_info(Args args) {
     std::printf("  %-24s %s, %u component%s, %zu step%s%s%s\n", f.name.c_str(), location_name(f.location),
                 f.components, f.components == 1 ? "" : "s", f.step_count(), f.step_count() == 1 ? "" : "s",
                 f.unit.empty() ? "" : ", ", f.unit.c_str());
-  if (quality && indices_ok && mesh.tet_count() > 0) {
+  if (quality && quality_ok && mesh.tet_count() > 0) {
     std::printf("radius-edge ratio   min %.4g  mean %.4g  max %.4g\n", q.radius_edge.min, q.radius_edge.mean,
                 q.radius_edge.max);
     std::printf("min dihedral (deg)  min %.4g  mean %.4g  max %.4g  (%zu slivers below 5 deg)\n",
@@ -242,20 +252,14 @@ int cmd_info(Args args) {
   } else if (check_delaunay) {
     std::printf("delaunay            not checked: the mesh is invalid\n");
   }
-  if (report.ok() && report.inverted == 0 && report.unused_nodes == 0) {
+  if (report.clean()) {
     std::printf("validation          ok\n");
   } else {
     std::printf("validation          %s\n", report.ok() ? "usable, with warnings" : "INVALID");
-    if (!report.size_problem.empty()) std::printf("  %s\n", report.size_problem.c_str());
-    if (report.index_out_of_range) std::printf("  %zu elements with a node index out of range\n", report.index_out_of_range);
-    if (report.repeated_vertex) std::printf("  %zu elements naming one node twice\n", report.repeated_vertex);
-    if (report.nonfinite_nodes) std::printf("  %zu nodes with NaN or infinite coordinates\n", report.nonfinite_nodes);
-    if (report.zero_volume) std::printf("  %zu tets of zero volume\n", report.zero_volume);
-    if (report.inverted) std::printf("  %zu inverted tets (negative orientation; convert re-orients them)\n", report.inverted);
-    if (report.unused_nodes) std::printf("  %zu nodes used by no tet\n", report.unused_nodes);
+    for (const std::string& line : describe(report)) std::printf("  %s\n", line.c_str());
     for (const std::string& m : report.messages) std::printf("  %s\n", m.c_str());
   }
-  return report.ok() ? 0 : 1;
+  return report.ok() ? kExitOk : kExitBadInput;
 }
 
 }  // namespace foxi::cli

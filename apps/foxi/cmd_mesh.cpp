@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
 #include "model_run.hpp"
 #include "foxi/mesher/conforming.hpp"
 #include "foxi/mesher/quality_report.hpp"
@@ -101,7 +102,7 @@ int mesh_with_cgal(Args& args);  // cmd_mesh_cgal.cpp
 int cmd_mesh(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kMeshUsage);
-    return 0;
+    return kExitOk;
   }
   const std::string mesher = args.option("--mesher", "tetgen");
   if (mesher == "cgal") return mesh_with_cgal(args);
@@ -204,7 +205,7 @@ int cmd_mesh(Args args) {
   Mesh mesh;
   ConformingReport report;
   SizeField field;
-  int status = 0;
+  int status = kExitOk;
   try {
     plc = with_region_sizes(plc, controls);
     if (!refine_from.empty()) {
@@ -238,7 +239,7 @@ int cmd_mesh(Args args) {
     if (is_model) name_mesh(model, structure, mesh);
   } catch (const MesherError& e) {
     std::fprintf(stderr, "%sfoxi mesh: error: %s: %s\n", tty ? "\n" : "", in.c_str(), e.what());
-    status = 1;
+    status = kExitFailure;
   }
   ::sigaction(SIGINT, &old, nullptr);
   if (tty && last_print > 0) std::fputc('\n', stderr);
@@ -246,7 +247,7 @@ int cmd_mesh(Args args) {
   write_mesh(mesh, out);
   std::printf("%s -> %s (TetGen switches %s)\n", in.c_str(), out.c_str(), report.tetgen.switches.c_str());
   std::printf("%s\n", format_quality_report(mesh_quality_report(mesh, report)).c_str());
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace foxi::cli

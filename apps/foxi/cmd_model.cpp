@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
 #include "model_picture.hpp"
 #include "model_run.hpp"
 #include "foxi/model/io_error.hpp"
@@ -124,7 +125,7 @@ void print_conductors(const Model& model, const Structure& s) {
 int cmd_model(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kModelUsage);
-    return 0;
+    return kExitOk;
   }
   std::vector<std::string> sets;
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
@@ -160,7 +161,7 @@ int cmd_model(Args args) {
                 pic.delaunay ? "painter, power order" : "not Delaunay: MPVO order, depth buffer", out.c_str());
     std::printf("colours (part, material, RGB):\n");
     print_legend(m, pic);
-    return 0;
+    return kExitOk;
   }
 
   const Model model = load_model(file, sets);
@@ -169,7 +170,7 @@ int cmd_model(Args args) {
     write_poly(s.plc, out);
     std::printf("%s -> %s: %zu points, %zu facets, %zu parts, %zu boundaries\n", file.c_str(), out.c_str(),
                 s.plc.point_count(), s.plc.facet_count(), model.parts.size(), s.boundary_names.size());
-    return 0;
+    return kExitOk;
   }
   std::printf("model %s (length unit %s)\n", file.c_str(), model.length_unit.c_str());
   std::printf("parameters:\n");
@@ -231,7 +232,7 @@ int cmd_model(Args args) {
   }
   std::printf("PLC: %zu points, %zu facets, %zu region seeds\n", s.plc.point_count(), s.plc.facet_count(),
               s.plc.regions.size());
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace foxi::cli

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/animation.hpp"
@@ -41,7 +43,8 @@ const std::string kMovieUsage = std::string(
     "  -o              .gif (giflib, 256 colours per frame), .apng (animated PNG), .mp4 (needs the\n"
     "                  ffmpeg program), or a name with a printf number, e.g. out/frame_%04d.png:\n"
     "                  numbered PNG frames (the folder is created)\n"
-    "  Meshes that fail the Delaunay certificate have no visibility order and are refused.";
+    "  Meshes that fail the Delaunay certificate have no visibility order and are refused (exit\n"
+    "  status 3), as are unusable ones (see foxi info); inverted tets are re-oriented (a note says so).";
 
 double percent(const std::string& s, const char* what, double fallback) {
   if (s.empty()) return fallback;
@@ -97,7 +100,7 @@ bool have_ffmpeg() { return std::system("command -v ffmpeg > /dev/null 2>&1") ==
 int cmd_movie(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kMovieUsage.c_str());
-    return 0;
+    return kExitOk;
   }
   const std::string mode = args.option("--mode", "backforth");
   const std::string frames_s = args.option("--frames"), cycles_s = args.option("--cycles");
@@ -143,11 +146,10 @@ int cmd_movie(Args args) {
     throw UsageError("-o " + out + ": give .gif, .apng, .mp4 or a numbered frame name like dir/frame_%04d.png");
   }
 
-  const Mesh mesh = read_mesh(path);
-  if (mesh.tet_count() == 0) throw UsageError(path + " has no tets");
+  const Mesh mesh = read_usable_mesh(path, "movie");
   const Picture picture = resolve_picture(options, mesh);
   if (!delaunay_certificate(mesh).delaunay)
-    throw std::runtime_error(path + " fails the Delaunay certificate: it has no visibility order to make a "
+    throw InputError(path + " fails the Delaunay certificate: it has no visibility order to make a "
                              "movie with (foxi render --zbuffer draws it)");
   const SphereTable table = compute_spheres(mesh);
 
@@ -209,7 +211,7 @@ int cmd_movie(Args args) {
   std::printf("painter     %zu tets drawn, %zu undrawn, undraw memory at most %.1f MB\n", stats.tets_drawn,
               stats.tets_undrawn, double(stats.max_undo_bytes) / 1e6);
   std::printf("wrote       %s\n", out.c_str());
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace foxi::cli

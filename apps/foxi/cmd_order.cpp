@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/spheres.hpp"
@@ -29,7 +31,9 @@ const char* kOrderUsage =
     "                  (tets whose centroid lies in the box)\n"
     "  --method        auto (default): power order if the mesh is Delaunay (certificate), MPVO\n"
     "                  otherwise; power, mpvo, centroid (the VTK-style baseline) force one\n"
-    "  --check         exit status 1 if any view has a violation";
+    "  --check         exit status 4 (a result that failed its own check) if any view has a violation\n"
+    "  The mesh is validated first: inverted tets are re-oriented (a note says so), an unusable\n"
+    "  mesh (see foxi info) is refused with exit status 3.";
 
 
 }  // namespace
@@ -37,7 +41,7 @@ const char* kOrderUsage =
 int cmd_order(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kOrderUsage);
-    return 0;
+    return kExitOk;
   }
   const std::string eye_s = args.option("--eye"), dir_s = args.option("--dir"), views_s = args.option("--views");
   const std::string subset_s = args.option("--subset"), method = args.option("--method", "auto");
@@ -49,8 +53,7 @@ int cmd_order(Args args) {
   if (method != "auto" && method != "power" && method != "mpvo" && method != "centroid")
     throw UsageError("--method takes auto, power, mpvo or centroid");
 
-  const Mesh mesh = read_mesh(path);
-  if (mesh.tet_count() == 0) throw UsageError(path + " has no tets");
+  const Mesh mesh = read_usable_mesh(path, "order");
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
   for (std::size_t i = 0; i < mesh.node_count(); ++i)
     for (int k = 0; k < 3; ++k) {
@@ -183,7 +186,7 @@ int cmd_order(Args args) {
   }
   std::printf("total       %zu violations over %zu views, %.2f ms per view\n", total_violations, views.size(),
               total_ms / double(views.size()));
-  return check && total_violations > 0 ? 1 : 0;
+  return check && total_violations > 0 ? kExitUnreliable : kExitOk;
 }
 
 }  // namespace foxi::cli

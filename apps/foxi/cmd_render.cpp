@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "render_options.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
@@ -36,7 +38,9 @@ const std::string kRenderUsage = std::string(
     "                  --at across the view. With --stop, whichever stops first\n"
     "  --zbuffer       draw with a depth buffer instead (the oracle; order irrelevant)\n"
     "  Meshes that fail the Delaunay certificate have no guaranteed order: their picture is drawn\n"
-    "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.";
+    "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.\n"
+  "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused\n"
+  "  with exit status 3, and no picture is written.";
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -47,7 +51,7 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 int cmd_render(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kRenderUsage.c_str());
-    return 0;
+    return kExitOk;
   }
   const std::string stop_s = args.option("--stop"), depth_s = args.option("--depth");
   std::string out = args.option("-o");
@@ -75,8 +79,7 @@ int cmd_render(Args args) {
   }
   RenderParams params = options.params;
 
-  const Mesh mesh = read_mesh(path);
-  if (mesh.tet_count() == 0) throw UsageError(path + " has no tets");
+  const Mesh mesh = read_usable_mesh(path, "render");
   const Picture picture = resolve_picture(options, mesh);
   const std::vector<std::uint32_t>& subset = picture.subset;
   const Camera& camera = picture.camera;
@@ -130,7 +133,7 @@ int cmd_render(Args args) {
     std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop, tet_depth(table, camera, order[count - 1]));
   if (raster.stats().tets_behind > 0) std::printf(", %zu tets behind the eye", raster.stats().tets_behind);
   std::printf("\nwrote       %s\n", out.c_str());
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace foxi::cli

@@ -10,10 +10,10 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "model_run.hpp"
 #include "solve_options.hpp"
 #include "foxi/model/mesh_io.hpp"
-#include "foxi/model/validate.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermal.hpp"
@@ -242,7 +242,7 @@ int cmd_solve(Args args) {
   if (physics == "thermoelastic") return cmd_solve_thermoelastic(std::move(args));
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kSolveUsage);
-    return 0;
+    return kExitOk;
   }
   if (physics != "thermal" && physics != "electrostatic" && physics != "current")
     throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics + "'");
@@ -271,11 +271,7 @@ int cmd_solve(Args args) {
   if (from_model) model_run = mesh_model_for_solve(files[0], sets, physics);
   if (!from_model && !sets.empty()) throw UsageError("--set is for model files (MODEL.toml)");
   Mesh mesh = from_model ? std::move(model_run.mesh) : read_mesh(files[0]);
-  const ValidationReport validation = validate_and_repair(mesh);
-  if (!validation.ok()) {
-    std::fprintf(stderr, "foxi solve: warning: %s has problems:\n", files[0].c_str());
-    for (const std::string& m : validation.messages) std::fprintf(stderr, "  %s\n", m.c_str());
-  }
+  require_usable(mesh, files[0], "solve");
   auto t1 = std::chrono::steady_clock::now();
 
   if (physics != "thermal") {

@@ -7,8 +7,9 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "foxi/model/mesh_io.hpp"
-#include "foxi/model/validate.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermoelastic.hpp"
 #include "model_run.hpp"
@@ -103,7 +104,7 @@ std::vector<double> read_temperature(const Mesh& mesh, const std::string& spec) 
 int cmd_solve_thermoelastic(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kThermoelasticUsage);
-    return 0;
+    return kExitOk;
   }
   const std::vector<std::string> fix = all_options(args, "--fix"), slide = all_options(args, "--slide"),
                                  young = all_options(args, "--E"), nu = all_options(args, "--nu"),
@@ -137,11 +138,7 @@ int cmd_solve_thermoelastic(Args args) {
   MeshedModel run;
   if (from_model) run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress));
   Mesh mesh = from_model ? std::move(run.mesh) : read_mesh(files[0]);
-  const ValidationReport validation = validate_and_repair(mesh);
-  if (!validation.ok()) {
-    std::fprintf(stderr, "foxi solve: warning: %s has problems:\n", files[0].c_str());
-    for (const std::string& m : validation.messages) std::fprintf(stderr, "  %s\n", m.c_str());
-  }
+  require_usable(mesh, files[0], "solve");
   if (from_model) {
     const ThermoelasticParams mp = thermoelastic_params_from_model(run.model, mesh);
     params.materials = mp.materials, params.fixed = mp.fixed, params.sliding = mp.sliding;
@@ -224,7 +221,7 @@ int cmd_solve_thermoelastic(Args args) {
     write_mesh(mesh, out);
     std::printf("wrote %s (fields displacement [m], stress, von_mises, principal_stress [Pa])\n", out.c_str());
   }
-  return 0;
+  return kExitOk;
 }
 
 }  // namespace foxi::cli

@@ -5,7 +5,9 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "exit_codes.hpp"
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/units.hpp"
 
 namespace {
 
@@ -33,19 +35,23 @@ const char* kUsage =
     "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"
     "              .node/.ele/.face (TetGen), .mesh (Medit)\n"
     "\n"
-    "'foxi COMMAND --help' describes a command.\n";
+    "'foxi COMMAND --help' describes a command.\n"
+    "\n"
+    "exit status: 0 ok, 1 failure, 2 usage error, 3 bad input (file, model, parameter),\n"
+    "             4 a result that failed its own checks, 130 SIGINT, 143 SIGTERM\n";
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  using namespace foxi::cli;
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     std::fputs(kUsage, stdout);
-    return args.empty() ? 2 : 0;
+    return args.empty() ? kExitUsage : kExitOk;
   }
   if (args[0] == "--version") {
     std::puts("foxi 0.1.0");
-    return 0;
+    return kExitOk;
   }
   std::string command = args[0];
   foxi::cli::Args rest(std::vector<std::string>(args.begin() + 1, args.end()));
@@ -60,18 +66,25 @@ int main(int argc, char** argv) {
     if (command == "model") return foxi::cli::cmd_model(std::move(rest));
     if (command == "demo") return foxi::cli::cmd_demo(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
-    return 2;
-  } catch (const foxi::cli::UsageError& e) {
+    return kExitUsage;
+  } catch (const UsageError& e) {
     std::fprintf(stderr, "foxi %s: %s\n", command.c_str(), e.what());
-    return 2;
-  } catch (const foxi::IoError& e) {
+    return kExitUsage;
+  } catch (const InputError& e) {
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
-    return 1;
+    return kExitBadInput;
+  } catch (const foxi::IoError& e) {
+    // Files that cannot be read or are not what they claim, model files and their parameters.
+    std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
+    return kExitBadInput;
+  } catch (const foxi::ExpressionError& e) {
+    std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
+    return kExitBadInput;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "foxi %s: error: out of memory\n", command.c_str());
-    return 1;
-  } catch (const std::exception& e) {
+    return kExitFailure;
+  } catch (const std::exception& e) {  // the mesher, the solver, a writer, ...
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
-    return 1;
+    return kExitFailure;
   }
 }

@@ -43,9 +43,20 @@ struct PointGrid {
   std::int64_t dims[3] = {1, 1, 1};
   std::vector<std::uint32_t> cell_start;  // dims product + 1
   std::vector<GridPoint> pts;             // in cell order
-  double scale = 0;                       // largest absolute coordinate
   double wmax = 0;                        // largest weight (0 when unweighted)
   std::vector<std::uint32_t> cell_of;     // per node: its cell (0 for nodes not in the grid)
+  // When the points crowd into a few cells (coordinates mixing magnitudes, 1e-20 next to 1e20: the
+  // cells are sized by the bounding box, so nearly all points share the cell at the origin and every
+  // tet scanned them all, 26 s for 130k tets), a k-d tree over them instead: `kd` holds the same
+  // points in tree order, node k covering kd[node.begin, node.end).
+  struct KdNode {
+    std::uint32_t begin, end;  // points
+    std::uint32_t left;        // children left and left + 1 (0: a leaf)
+    int dim;                   // split dimension; points of the left child have p[dim] <= split
+    double split;
+  };
+  std::vector<GridPoint> kd;
+  std::vector<KdNode> kd_nodes;
 
   // Monotone in v (rounding is monotone), so a box's cell range holds every point inside the box.
   std::int64_t cell(double v, int d) const {
@@ -57,6 +68,41 @@ struct PointGrid {
 };
 
 bool finite3(const double* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+
+double coord(const GridPoint& p, int d) { return d == 0 ? p.x : d == 1 ? p.y : p.z; }
+
+// A k-d tree of g.pts: median splits on the dimension of widest extent, leaves of at most 16 points.
+void build_kd(PointGrid& g) {
+  g.kd = g.pts;
+  g.kd_nodes.clear();
+  g.kd_nodes.push_back({0, static_cast<std::uint32_t>(g.kd.size()), 0, 0, 0.0});
+  for (std::size_t k = 0; k < g.kd_nodes.size(); ++k) {
+    const std::uint32_t begin = g.kd_nodes[k].begin, end = g.kd_nodes[k].end;
+    if (end - begin <= 16) continue;
+    double lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) lo[d] = hi[d] = coord(g.kd[begin], d);
+    for (std::uint32_t i = begin; i < end; ++i)
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::min(lo[d], coord(g.kd[i], d));
+        hi[d] = std::max(hi[d], coord(g.kd[i], d));
+      }
+    int dim = 0;
+    for (int d = 1; d < 3; ++d)
+      if (hi[d] - lo[d] > hi[dim] - lo[dim]) dim = d;
+    if (!(hi[dim] > lo[dim])) continue;  // all at one point: a leaf
+    const std::uint32_t mid = begin + (end - begin) / 2;
+    std::nth_element(g.kd.begin() + begin, g.kd.begin() + mid, g.kd.begin() + end,
+                     [dim](const GridPoint& p, const GridPoint& q) { return coord(p, dim) < coord(q, dim); });
+    // Left: [begin, mid], every point there <= the median; right: (mid, end), every one >= it.
+    const double split = coord(g.kd[mid], dim);
+    const std::uint32_t left = static_cast<std::uint32_t>(g.kd_nodes.size());
+    g.kd_nodes[k].left = left;
+    g.kd_nodes[k].dim = dim;
+    g.kd_nodes[k].split = split;
+    g.kd_nodes.push_back({begin, mid + 1, 0, 0, 0.0});
+    g.kd_nodes.push_back({mid + 1, end, 0, 0, 0.0});
+  }
+}
 
 PointGrid build_grid(const Mesh& mesh, bool weighted) {
   PointGrid g;
@@ -87,7 +133,6 @@ PointGrid build_grid(const Mesh& mesh, bool weighted) {
   for (int d = 0; d < 3; ++d) {
     g.lo[d] = lo[d];
     emax = std::max(emax, hi[d] - lo[d]);
-    g.scale = std::max({g.scale, std::abs(lo[d]), std::abs(hi[d])});
   }
   if (emax > 0) {
     // Cubic cells, about one point per cell.
@@ -124,6 +169,9 @@ PointGrid build_grid(const Mesh& mesh, bool weighted) {
     g.pts[fill[cell_of[v]]++] = {p[0], p[1], p[2], weighted ? mesh.weight[v] : 0.0,
                                  static_cast<std::uint32_t>(v)};
   }
+  std::uint32_t crowded = 0;
+  for (std::size_t c = 0; c < cells; ++c) crowded = std::max(crowded, g.cell_start[c + 1] - g.cell_start[c]);
+  if (crowded > 256) build_kd(g);
   return g;
 }
 
@@ -220,13 +268,21 @@ class Checker {
 
     // Candidates: the cells of the sphere's box (or every point when the centre is unreliable).
     const double xn = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
-    const double eq = 4 * kU * grid_.scale;  // bound on the rounding of q - a (vector norm)
+    // The rounding of dq = (q - a) - x: q - a is one correctly rounded subtraction (error <= u|q - a|
+    // per coordinate, whatever the size of a), and so is the second, so |error| <= u (2|dq| + |x|)
+    // (a little more for the second-order terms). Near the sphere |dq| ~ |x|, so 4u|x| covers it
+    // there; the weighted test below adds the 2u|dq| term itself. The bound is local to the tet: a
+    // global one (4u times the largest coordinate) made every point a candidate for exact tests on
+    // meshes that mix magnitudes (1e-40 next to 1e40), minutes of exact arithmetic (issue 22).
+    const double eq = 4 * kU * xn;
     const double e1 = eq + ex;
+    const double amax = std::max({std::abs(a[0]), std::abs(a[1]), std::abs(a[2])});
     // Largest possible power radius^2 (with room for the rounding of the weight terms).
     const double rmax =
         (xn + ex) * (xn + ex) + grid_.wmax - wv[0] + 8 * kU * (std::abs(grid_.wmax) + std::abs(wv[0]));
     double half = e1 + std::sqrt(std::max(0.0, rmax));
-    half = half * (1 + 1e-9) + 8 * kU * (grid_.scale + xn);
+    // The box's corners a + x +- half are rounded twice: within 2u (|a| + |x| + half) each.
+    half = half * (1 + 1e-9) + 8 * kU * (amax + xn + half);
     std::int64_t c0[3] = {0, 0, 0}, c1[3] = {grid_.dims[0] - 1, grid_.dims[1] - 1, grid_.dims[2] - 1};
     if (reliable && std::isfinite(half)) {
       for (int d = 0; d < 3; ++d) {
@@ -242,47 +298,71 @@ class Checker {
     const int s2 = sign > 0 ? 2 : 3, s3 = sign > 0 ? 3 : 2;  // positively oriented order
     bool violated = false;
     double depth = 0;
-    for (std::int64_t cz = c0[2]; cz <= c1[2]; ++cz)
-      for (std::int64_t cy = c0[1]; cy <= c1[1]; ++cy) {
-        const std::size_t row = static_cast<std::size_t>((cz * grid_.dims[1] + cy) * grid_.dims[0]);
-        const GridPoint* first = grid_.pts.data() + grid_.cell_start[row + static_cast<std::size_t>(c0[0])];
-        const GridPoint* last =
-            grid_.pts.data() + grid_.cell_start[row + static_cast<std::size_t>(c1[0]) + 1];
-        for (const GridPoint* q = first; q < last; ++q) {
-          if (reliable) {
-            const double dx = q->x - a[0] - x[0], dy = q->y - a[1] - x[1], dz = q->z - a[2] - x[2];
-            const double d2 = dx * dx + dy * dy + dz * dz;
-            if (!weighted_) {
-              if (d2 > t_out) continue;
-            } else {
-              const double dl = std::sqrt(d2) - e1;
-              if (dl > 0) {
-                const double lower = dl * dl - q->w - (xn + ex) * (xn + ex) + wa;
-                const double margin = 1e-12 * (d2 + (xn + ex) * (xn + ex) + std::abs(q->w) + std::abs(wa));
-                if (lower > margin) continue;
-              }
-            }
-          }
-          if (q->id == v[0] || q->id == v[1] || q->id == v[2] || q->id == v[3]) continue;
-          const Point pq(q->x, q->y, q->z);
-          CGAL::Oriented_side side;
-          if (!weighted_) {
-            side = CGAL::side_of_oriented_sphere(P[0], P[1], P[s2], P[s3], pq);
-          } else {
-            const WPoint W[4] = {WPoint(P[0], wv[0]), WPoint(P[1], wv[1]), WPoint(P[2], wv[2]),
-                                 WPoint(P[3], wv[3])};
-            side = K().power_side_of_oriented_power_sphere_3_object()(W[0], W[1], W[s2], W[s3],
-                                                                      WPoint(pq, q->w));
-          }
-          if (side == CGAL::ON_POSITIVE_SIDE) {
-            violated = true;
-            if (!weighted_ && reliable && xn > 0) {
-              const double dx = q->x - a[0] - x[0], dy = q->y - a[1] - x[1], dz = q->z - a[2] - x[2];
-              depth = std::max(depth, (xn - std::sqrt(dx * dx + dy * dy + dz * dz)) / xn);
-            }
+    auto visit = [&](const GridPoint* q) {
+      if (reliable) {
+        const double dx = q->x - a[0] - x[0], dy = q->y - a[1] - x[1], dz = q->z - a[2] - x[2];
+        const double d2 = dx * dx + dy * dy + dz * dz;
+        if (!weighted_) {
+          if (d2 > t_out) return;
+        } else {
+          const double dl = std::sqrt(d2) * (1 - 8 * kU) - e1;  // the 2u|dq| rounding term
+          if (dl > 0) {
+            const double lower = dl * dl - q->w - (xn + ex) * (xn + ex) + wa;
+            const double margin = 1e-12 * (d2 + (xn + ex) * (xn + ex) + std::abs(q->w) + std::abs(wa));
+            if (lower > margin) return;
           }
         }
       }
+      if (q->id == v[0] || q->id == v[1] || q->id == v[2] || q->id == v[3]) return;
+      const Point pq(q->x, q->y, q->z);
+      CGAL::Oriented_side side;
+      if (!weighted_) {
+        side = CGAL::side_of_oriented_sphere(P[0], P[1], P[s2], P[s3], pq);
+      } else {
+        const WPoint W[4] = {WPoint(P[0], wv[0]), WPoint(P[1], wv[1]), WPoint(P[2], wv[2]),
+                             WPoint(P[3], wv[3])};
+        side = K().power_side_of_oriented_power_sphere_3_object()(W[0], W[1], W[s2], W[s3],
+                                                                  WPoint(pq, q->w));
+      }
+      if (side == CGAL::ON_POSITIVE_SIDE) {
+        violated = true;
+        if (!weighted_ && reliable && xn > 0) {
+          const double dx = q->x - a[0] - x[0], dy = q->y - a[1] - x[1], dz = q->z - a[2] - x[2];
+          depth = std::max(depth, (xn - std::sqrt(dx * dx + dy * dy + dz * dz)) / xn);
+        }
+      }
+    };
+    if (!grid_.kd_nodes.empty()) {
+      // The k-d tree: the subtrees whose half-spaces meet the sphere's box (all points when the
+      // centre is unreliable).
+      const bool boxed = reliable && std::isfinite(half);
+      double blo[3], bhi[3];
+      for (int d = 0; d < 3; ++d) {
+        blo[d] = a[d] + x[d] - half;
+        bhi[d] = a[d] + x[d] + half;
+      }
+      std::uint32_t stack[128];
+      int top = 0;
+      stack[top++] = 0;
+      while (top > 0) {
+        const PointGrid::KdNode& node = grid_.kd_nodes[stack[--top]];
+        if (node.left == 0 || !boxed || top + 2 > 128) {
+          for (std::uint32_t i = node.begin; i < node.end; ++i) visit(&grid_.kd[i]);
+          continue;
+        }
+        if (blo[node.dim] <= node.split) stack[top++] = node.left;
+        if (bhi[node.dim] >= node.split) stack[top++] = node.left + 1;
+      }
+    } else {
+      for (std::int64_t cz = c0[2]; cz <= c1[2]; ++cz)
+        for (std::int64_t cy = c0[1]; cy <= c1[1]; ++cy) {
+          const std::size_t row = static_cast<std::size_t>((cz * grid_.dims[1] + cy) * grid_.dims[0]);
+          const GridPoint* first = grid_.pts.data() + grid_.cell_start[row + static_cast<std::size_t>(c0[0])];
+          const GridPoint* last =
+              grid_.pts.data() + grid_.cell_start[row + static_cast<std::size_t>(c1[0]) + 1];
+          for (const GridPoint* q = first; q < last; ++q) visit(q);
+        }
+    }
     if (violated) {
       ++out.violating_count;
       out.violating.push_back(static_cast<std::uint32_t>(t));

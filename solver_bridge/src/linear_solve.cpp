@@ -156,9 +156,34 @@ LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b,
   return result;
 }
 
-LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
-                                 std::vector<std::vector<double>>& xs, const LinearSolverOptions& options,
-                                 const NearNullSpace* near_null) {
+namespace {
+
+// A solve whose matrix, right-hand side or solution holds NaN or infinity (geometry or coefficients
+// beyond the range of double) has no result to report: conjugate gradients stop at once on a NaN
+// residual (NaN > tol is false) with x = 0, and LDL^T passes a NaN pivot (NaN <= 0 is false).
+void require_finite_input(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs) {
+  for (double v : a.val)
+    if (!std::isfinite(v))
+      throw SolverError("the system matrix holds NaN or infinity (mesh geometry or coefficients beyond the "
+                        "range of double)");
+  for (const std::vector<double>& b : bs)
+    for (double v : b)
+      if (!std::isfinite(v))
+        throw SolverError("the right-hand side holds NaN or infinity (loads or geometry beyond the range of "
+                          "double)");
+}
+
+void require_finite_output(const std::vector<std::vector<double>>& xs, const LinearSolveResult& result) {
+  for (const std::vector<double>& x : xs)
+    for (double v : x)
+      if (!std::isfinite(v)) throw SolverError("the solution holds NaN or infinity: no result to report");
+  if (!std::isfinite(result.relative_residual))
+    throw SolverError("the residual is NaN or infinite: no result to report");
+}
+
+LinearSolveResult solve_spd_many_unchecked(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
+                                           std::vector<std::vector<double>>& xs,
+                                           const LinearSolverOptions& options, const NearNullSpace* near_null) {
   const std::size_t n = a.rows();
   const unsigned threads = thread_count(options.threads);
   LinearSolveResult result;
@@ -273,6 +298,17 @@ LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::v
     run_all([&](const Vec& r, Vec& z) { z = ic.solve(r); });
   }
   report(options, "solve", 1.0);
+  return result;
+}
+
+}  // namespace
+
+LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
+                                 std::vector<std::vector<double>>& xs, const LinearSolverOptions& options,
+                                 const NearNullSpace* near_null) {
+  require_finite_input(a, bs);
+  LinearSolveResult result = solve_spd_many_unchecked(a, bs, xs, options, near_null);
+  require_finite_output(xs, result);
   return result;
 }
 

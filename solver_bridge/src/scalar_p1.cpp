@@ -115,9 +115,12 @@ std::vector<double> tet_volumes(const Mesh& mesh, const RegionTable& regions, un
   for (std::size_t i = 0; i < nr; ++i)
     for (unsigned th = 0; th < threads; ++th) region_volume[i] += part[th][i];
   for (std::size_t t = 0; t < nt; ++t)
-    if (!(vol[t] > 0))
-      throw SolverError("tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol[t]) +
-                        " (inverted or flat; validate_and_repair() re-orients inverted tets)");
+    if (!(vol[t] > 0) || !std::isfinite(vol[t]))
+      throw SolverError("tet " + std::to_string(t) + " has " +
+                        (vol[t] > 0 ? "a volume beyond the range of double (" + std::to_string(vol[t]) +
+                                          "; rescale the coordinates)"
+                                    : "non-positive volume " + std::to_string(vol[t]) +
+                                          " (inverted or flat; validate_and_repair() re-orients inverted tets)"));
   return vol;
 }
 

@@ -53,12 +53,12 @@ TEST(ModelCli, PlcIsWrittenAndTetgenMeshesIt) {
 TEST(ModelCli, ErrorsAndUsage) {
   TempDir dir;
   EXPECT_EQ(foxi_cli("model check '" + kModels + "die_on_substrate.toml' --set nothing=1mm", dir / "e1.txt"),
-            1);
+            3);
   EXPECT_NE(test::read_text(dir / "e1.txt").find("'nothing'"), std::string::npos)
       << test::read_text(dir / "e1.txt");
   EXPECT_EQ(foxi_cli("model plc '" + kModels + "die_on_substrate.toml'", dir / "e2.txt"), 2);  // no -o
   EXPECT_EQ(foxi_cli("model frobnicate x.toml", dir / "e3.txt"), 2);
-  EXPECT_EQ(foxi_cli("model check '" + (dir / "missing.toml").string() + "'", dir / "e4.txt"), 1);
+  EXPECT_EQ(foxi_cli("model check '" + (dir / "missing.toml").string() + "'", dir / "e4.txt"), 3);
   EXPECT_NE(test::read_text(dir / "e4.txt").find("missing.toml"), std::string::npos)
       << test::read_text(dir / "e4.txt");
 }
@@ -118,19 +118,19 @@ TEST(ModelCli, SolveAppliesTheModelsRefinementBoxes) {
 TEST(ModelCli, SolveModelErrorsBeforeMeshing) {
   TempDir dir;
   // die_on_substrate has no electrodes
-  EXPECT_EQ(foxi_cli("solve '" + kModels + "die_on_substrate.toml' --physics current", dir / "e1.txt"), 1);
+  EXPECT_EQ(foxi_cli("solve '" + kModels + "die_on_substrate.toml' --physics current", dir / "e1.txt"), 3);
   EXPECT_NE(test::read_text(dir / "e1.txt").find("no [[conditions]] fix the current solution"), std::string::npos)
       << test::read_text(dir / "e1.txt");
   std::filesystem::copy(kModels + "materials.toml", dir / "materials.toml");
   test::write_text(dir / "bad.toml", test::read_text(kModels + "die_on_substrate.toml") +
                                           "\n[[conditions]]\ntype = \"heat_flux\"\nsurface = \"die.bottom\"\n"
                                           "value = \"1 W/m^2\"\n");
-  EXPECT_EQ(foxi_cli("solve '" + (dir / "bad.toml").string() + "' --physics thermal", dir / "e2.txt"), 1);
+  EXPECT_EQ(foxi_cli("solve '" + (dir / "bad.toml").string() + "' --physics thermal", dir / "e2.txt"), 3);
   const std::string e2 = test::read_text(dir / "e2.txt");
   EXPECT_NE(e2.find("bad.toml:"), std::string::npos) << e2;
   EXPECT_NE(e2.find("surface 'die.bottom' does not exist"), std::string::npos) << e2;
   EXPECT_EQ(e2.find("nodes"), std::string::npos) << "meshed before the error:\n" << e2;
-  EXPECT_EQ(foxi_cli("solve '" + kModels + "die_on_substrate.toml' --set nothing=1", dir / "e3.txt"), 1);
+  EXPECT_EQ(foxi_cli("solve '" + kModels + "die_on_substrate.toml' --set nothing=1", dir / "e3.txt"), 3);
 }
 
 // Every part of the exploded picture shows: some pixel has the part's colour (up to shading).

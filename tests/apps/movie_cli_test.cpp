@@ -106,7 +106,7 @@ TEST_F(MovieCli, BadOptionsAreUsageErrors) {
   EXPECT_EQ(foxi("movie " + p("grid.vtu") + " --mode spin -o " + p("m.gif"), &out), 2);
   EXPECT_EQ(foxi("movie " + p("grid.vtu") + " --frames 1 -o " + p("m.gif"), &out), 2);
   EXPECT_EQ(foxi("movie " + p("grid.vtu") + " --from 60% --to 40% -o " + p("m.gif"), &out), 2);
-  EXPECT_EQ(foxi("movie " + p("missing.vtu") + " -o " + p("m.gif"), &out), 1);
+  EXPECT_EQ(foxi("movie " + p("missing.vtu") + " -o " + p("m.gif"), &out), 3);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "m.gif"));
   EXPECT_EQ(foxi("movie --help", &out), 0);
   EXPECT_NE(out.find("backforth"), std::string::npos);

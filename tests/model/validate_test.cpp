@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -143,6 +144,102 @@ TEST(Validate, MessagesAreFewButCountsComplete) {
   EXPECT_EQ(r.repeated_vertex, m.tet_count());
   EXPECT_LE(r.messages.size(), 50u);
   EXPECT_GT(r.messages.size(), 0u);
+}
+
+TEST(Validate, EmptyMeshIsUnusable) {
+  Mesh m;
+  m.xyz = {0, 0, 0, 1, 0, 0};
+  ValidationReport r = validate(m);
+  EXPECT_TRUE(r.no_tets);
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(mentions(r, "no tets"));
+  EXPECT_FALSE(validate(Mesh{}).ok());
+  EXPECT_FALSE(validate(two_tets()).no_tets);
+}
+
+TEST(Validate, DuplicateTetsAreErrors) {
+  Mesh m = two_tets();
+  m.tet.insert(m.tet.end(), {3, 2, 1, 0});  // tet 0's nodes in another order (inverted, too)
+  m.tet.insert(m.tet.end(), {1, 4, 2, 3});  // tet 1 again
+  ValidationReport r = validate(m);
+  EXPECT_EQ(r.duplicate_tets, 2u);
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(mentions(r, "the same nodes as tet 0"));
+  EXPECT_TRUE(mentions(r, "the same nodes as tet 1"));
+  // Sharing three nodes is no duplicate.
+  EXPECT_EQ(validate(two_tets()).duplicate_tets, 0u);
+}
+
+TEST(Validate, CoincidentUsedNodesAreErrors) {
+  // Tet 1 uses node 5, a copy of node 1: the two tets no longer share their face (a tear).
+  Mesh m = two_tets();
+  m.xyz.insert(m.xyz.end(), {1, 0, 0});
+  m.tet[4] = 5;
+  ValidationReport r = validate(m);
+  EXPECT_EQ(r.duplicate_nodes, 1u);
+  EXPECT_FALSE(r.ok());
+  EXPECT_TRUE(mentions(r, "nodes 1 and 5"));
+  // A copy that no tet uses is only an unused node.
+  Mesh u = two_tets();
+  u.xyz.insert(u.xyz.end(), {1, 0, 0});
+  ValidationReport ru = validate(u);
+  EXPECT_EQ(ru.duplicate_nodes, 0u);
+  EXPECT_EQ(ru.unused_nodes, 1u);
+  EXPECT_TRUE(ru.ok());
+  // -0.0 and 0.0 are one point.
+  Mesh z = two_tets();
+  z.xyz.insert(z.xyz.end(), {1, -0.0, -0.0});  // node 1 = (1, 0, 0), still used by tet 0
+  z.tet[4] = 5;
+  EXPECT_EQ(validate(z).duplicate_nodes, 1u);
+}
+
+// The volume of two_tets() scaled by s, computed as the solvers do (double determinant / 6).
+double scaled_volume(double s) {
+  const double B[3] = {s, 0, 0}, C[3] = {0, s, 0}, D[3] = {0, 0, s};
+  return (B[0] * (C[1] * D[2] - C[2] * D[1]) - B[1] * (C[0] * D[2] - C[2] * D[0]) +
+          B[2] * (C[0] * D[1] - C[1] * D[0])) / 6;
+}
+
+TEST(Validate, GeometryBeyondDoubleRangeIsRefused) {
+  // The cases: coordinates scaled by 1e154 (volumes overflow to inf), near 1e300, and
+  // near 1e-300 (volumes underflow to 0 while the exact orientation is still positive).
+  for (double s : {1e154, 1e300, 1e-300, 1e-120, 1e100}) {
+    Mesh m = two_tets();
+    for (double& x : m.xyz) x *= s;
+    ValidationReport r = validate(m);
+    EXPECT_EQ(r.out_of_range, 2u) << s;
+    EXPECT_FALSE(r.ok()) << s;
+    EXPECT_EQ(r.inverted + r.zero_volume, 0u) << s;
+    EXPECT_TRUE(mentions(r, "beyond the range")) << s;
+  }
+  EXPECT_FALSE(std::isfinite(scaled_volume(1e154)));  // what went unnoticed
+  EXPECT_EQ(scaled_volume(1e-300), 0.0);
+}
+
+TEST(Validate, AcceptedGeometryHasFiniteExactlyScaledVolumes) {
+  // For every power of ten that validation accepts, the double volume is finite, positive and
+  // equals s^3 / 6 (the analytic volume of the scaled corner tet) to rounding. The accepted powers
+  // are one unbroken range covering every physical scale in SI units (1e-9 .. 1e20 m), and stop
+  // before the visibility order's float error bounds fail (circumspheres reaching 1e24, or a mesh
+  // under 1e-12 across).
+  int accepted_lo = 1000, accepted_hi = -1000, accepted = 0;
+  for (int k = -320; k <= 308; ++k) {
+    const double s = std::pow(10.0, k);
+    Mesh m = two_tets();
+    for (double& x : m.xyz) x *= s;
+    if (!validate(m).ok()) continue;
+    ++accepted;
+    accepted_lo = std::min(accepted_lo, k);
+    accepted_hi = std::max(accepted_hi, k);
+    const double v = scaled_volume(s), expected = static_cast<double>(std::pow(10.0L, 3 * k) / 6);
+    ASSERT_TRUE(std::isfinite(v) && v > 0) << k;
+    EXPECT_NEAR(v / expected, 1.0, 1e-14) << k;
+  }
+  EXPECT_EQ(accepted, accepted_hi - accepted_lo + 1);
+  EXPECT_LE(accepted_lo, -9);
+  EXPECT_GE(accepted_hi, 20);
+  EXPECT_GE(accepted_lo, -12);  // 2 x 1e-13 across: refused
+  EXPECT_LE(accepted_hi, 24);   // spheres reaching 1.7e24: refused
 }
 
 }  // namespace
