@@ -386,7 +386,10 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
     // 1e-9 of those, so that a body held at one temperature balances.
     double terms = 0;
     for (std::size_t v = 0; v < fixed.size(); ++v)
-      if (fixed[v]) terms += std::abs(kval[pat.find(v, v)] * temp[v]);
+      if (fixed[v]) {
+        const auto n = static_cast<std::uint32_t>(v);
+        terms += std::abs(kval[pat.find(n, n)] * temp[v]);
+      }
     const double scale = std::max(rep.heat_flow, 1e-9 * terms);
     rep.checks.push_back(make_check(
         "energy", "|sources + boundary heat in| / the heat that flows through the body",
