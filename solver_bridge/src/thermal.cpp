@@ -382,10 +382,18 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
       (b.heat_in > 0 ? in : out) += std::abs(b.heat_in);
     }
     rep.heat_flow = std::max(in, out);
+    // Where (next to) nothing flows, the reactions are round-off of terms K_vv T_v: measure against
+    // 1e-9 of those, so that a body held at one temperature balances.
+    double terms = 0;
+    for (std::size_t v = 0; v < fixed.size(); ++v)
+      if (fixed[v]) {
+        const auto n = static_cast<std::uint32_t>(v);
+        terms += std::abs(kval[pat.find(n, n)] * temp[v]);
+      }
+    const double scale = std::max(rep.heat_flow, 1e-9 * terms);
     rep.checks.push_back(make_check(
         "energy", "|sources + boundary heat in| / the heat that flows through the body",
-        rep.heat_flow > 0 ? std::abs(rep.imbalance) / rep.heat_flow : 0.0,
-        std::max(1e-6, 100 * params.solver.relative_tolerance)));
+        scale > 0 ? std::abs(rep.imbalance) / scale : 0.0, std::max(1e-6, 100 * params.solver.relative_tolerance)));
   }
 
   Field temp_field;

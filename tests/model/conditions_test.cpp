@@ -247,6 +247,37 @@ TEST(ModelConditions, PhysicsNeedsItsMaterialProperties) {
   }
 }
 
+// A voltage or ground condition with `physics` applies to that physics only.
+TEST(ModelConditions, VoltageConditionForOnePhysics) {
+  TempDir dir;
+  const std::string only = replaced(kModel, "type = \"ground\"", "type = \"ground\"\nphysics = \"electrostatic\"");
+  const foxi::Model m = load(dir, only);
+  const foxi::BoundaryCondition* ground = nullptr;
+  for (const foxi::BoundaryCondition& c : m.conditions)
+    if (c.kind == foxi::ConditionKind::voltage) ground = &c;
+  ASSERT_NE(ground, nullptr);
+  EXPECT_EQ(ground->physics, "electrostatic");
+  EXPECT_TRUE(foxi::condition_applies(*ground, foxi::Physics::electrostatic));
+  EXPECT_FALSE(foxi::condition_applies(*ground, foxi::Physics::current));
+  EXPECT_TRUE(foxi::condition_applies(foxi::ConditionKind::voltage, foxi::Physics::current));
+  const foxi::Model n = load(dir, replaced(only, "thermal_conductivity = 10.0",
+                                           "thermal_conductivity = 10.0\nelectrical_conductivity = 50.0"));
+  try {
+    foxi::check_physics(n, foxi::Physics::current);  // the current terminal alone fixes nothing
+    ADD_FAILURE() << "no error";
+  } catch (const foxi::IoError& e) {
+    EXPECT_NE(e.reason().find("no [[conditions]] fix the current solution"), std::string::npos) << e.what();
+  }
+  const std::string bad = replaced(kModel, "type = \"ground\"", "type = \"ground\"\nphysics = \"thermal\"");
+  try {
+    load(dir, bad);
+    ADD_FAILURE() << "no error";
+  } catch (const foxi::IoError& e) {
+    EXPECT_NE(e.reason().find("physics must be \"electrostatic\" or \"current\""), std::string::npos) << e.what();
+    EXPECT_EQ(e.line(), line_of(bad, "physics = \"thermal\""));
+  }
+}
+
 TEST(ModelConditionsBadInput, UnknownSurfaceIsNamedWithItsLine) {
   const std::string t = replaced(kModel, "surface = \"island.top\"", "surface = \"iland.top\"");
   const foxi::IoError e = build_error(t);

@@ -15,6 +15,7 @@
 #include "foxi/model/io_gmsh.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "layered_box.hpp"
 #include "test_util.hpp"
 
 namespace foxi {
@@ -502,6 +503,34 @@ TEST(Current, SeriesAndParallelPairsAtContrast1e21) {
     EXPECT_NEAR(r.regions[0].power, g1, 1e-9 * g1);
     EXPECT_NEAR(r.regions[1].power, g2, 1e-6 * g2);
     expect_checks_pass(r.checks);
+  }
+}
+
+// The same on an unstructured TetGen mesh big enough for the automatic choice to take AMG: copper,
+// FR-4 and copper layers between terminals on the bottom and top faces. The field is linear in each
+// layer, so P1 is exact: R = sum t_i / (sigma_i A), the FR-4's to 1e-21.
+TEST(Current, TetgenCopperFr4CopperStackAtContrast1e21) {
+  if (!test::have_program("tetgen")) GTEST_SKIP() << "tetgen not installed";
+  const double w = 1e-3, t = 0.2e-3;
+  Mesh m = test::layered_box_mesh(w, w, {0, t, 2 * t, 3 * t}, 2e-14);
+  CurrentParams p;
+  p.conductivity = {{1, kCopper}, {2, kFr4}, {3, kCopper}};
+  p.terminals = {electrode("bottom", {5}, 1), electrode("top", {6}, 0)};
+  const double r = 2 * t / (kCopper * w * w) + t / (kFr4 * w * w);
+  for (LinearSolverKind kind : {LinearSolverKind::automatic, LinearSolverKind::cg_ichol}) {
+    SCOPED_TRACE(solver_name(kind));
+    p.solver.kind = kind;
+    const CurrentReport c = solve_current(m, p);
+    if (kind == LinearSolverKind::automatic) {
+      EXPECT_GT(c.unknowns, p.solver.direct_max_unknowns);
+      EXPECT_EQ(c.solver, "CG+SmoothedAggregationAMG");
+    }
+    // 1e-8: both solvers give the same 2.6e-9 off, the geometry as TetGen's files round it.
+    EXPECT_NEAR(c.resistance, r, 1e-8 * r);
+    EXPECT_NEAR(c.terminals[0].charge, 1 / r, 1e-8 / r);
+    EXPECT_NEAR(c.terminals[1].charge, -1 / r, 1e-8 / r);
+    EXPECT_NEAR(c.regions[1].power, 1 / r, 1e-8 / r);
+    expect_checks_pass(c.checks);
   }
 }
 

@@ -395,8 +395,8 @@ TEST(ModelSolve, EveryShippedModelMeshesAndSolvesWithBalancedEnergy) {
     bool thermal = false;
     std::size_t conductors = 0;
     for (const BoundaryCondition& c : s.model.conditions) {
-      thermal = thermal || condition_applies(c.kind, Physics::thermal);
-      conductors += condition_applies(c.kind, Physics::electrostatic);
+      thermal = thermal || condition_applies(c, Physics::thermal);
+      conductors += condition_applies(c, Physics::electrostatic);
     }
     const bool electric = conductors >= 2;
     bool stress = false;
@@ -435,6 +435,7 @@ TEST(ModelSolve, EveryShippedModelMeshesAndSolvesWithBalancedEnergy) {
       for (const BoundaryHeat& b : r.boundaries) out -= b.heat_in;
       EXPECT_NEAR(out, expected_power, 1e-6 * expected_power);
       EXPECT_GT(r.max_temperature, 0);
+      for (const BalanceCheck& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " " << c.figure;
     }
     if (electric) {
       // electrostatics: the capacitance matrix's diagonal is positive and every balance check passes

@@ -175,7 +175,9 @@ struct ThermalReport {
   double total_power = 0;        // W from the sources
   double imbalance = 0;          // W, sources + heat in through all boundaries (~0)
   double heat_flow = 0;          // W through the body: the larger of what enters and what leaves
-  std::vector<BalanceCheck> checks;  // "energy": |imbalance| / heat_flow
+  // "energy": |imbalance| / heat_flow (or / 1e-9 of the fixed nodes' sum |K_vv T_v| where that is
+  // larger: with nothing flowing, the reactions are round-off of those terms)
+  std::vector<BalanceCheck> checks;
   std::vector<ThermalResistance> resistances;  // one per ThermalParams::resistances
   std::string solver;            // "SimplicialLDLT", "CG+IncompleteCholesky", "CG+SmoothedAggregationAMG"
   std::size_t unknowns = 0;      // free nodes
