@@ -14,6 +14,11 @@
 //                          Kuhn grid (6.0M tets, 1.03M nodes); counters peak_MB (VmHWM of the process
 //                          while solving, mesh included), solver_MB (what the solve adds) and
 //                          process_cpu_s (CPU seconds of all threads per run)
+//   tetgen_thermal/{amg,ichol}_{box_948k,board_1M}, tetgen_ccx/{box_948k,board_1M}
+//                          the meshes users have: TetGen -pq1.414 -O0 meshes made in the run (tetgen
+//                          program) of a box with fixed bottom and top and of a board carrying a block
+//                          (k 1 and 1000, fixed board bottom and block top), AMG against incomplete
+//                          Cholesky and ccx (FOXI_BENCH_CCX=1) on the same mesh and problem
 // Mesh: a 57^3 Kuhn grid (1.11M tets, 195k nodes), two regions (k 1 and 10 W/(m K)), fixed 300 K at
 // z = 0, convection (h 100, 300 K) at z = 1, 1 kW in the upper region; with n = 30 (162k tets) for
 // the direct solver.
@@ -37,6 +42,7 @@
 
 #include "bench_ccx.hpp"
 #include "bench_meshes.hpp"
+#include "foxi/model/io_tetgen.hpp"
 #include "foxi/solver/calculix.hpp"
 #include "foxi/solver/thermal.hpp"
 
@@ -44,16 +50,81 @@ namespace {
 
 using namespace foxi;
 
-// One cached grid at a time, so that the memory counters of a case do not include another's mesh.
-Mesh& grid(std::uint32_t n) {
-  static std::uint32_t cached_n = 0;
+// One cached mesh at a time, so that the memory counters of a case do not include another's mesh.
+template <class Make>
+Mesh& cached_mesh(const std::string& key, Make&& make) {
+  static std::string cached_key;
   static std::unique_ptr<Mesh> cached;
-  if (!cached || cached_n != n) {
+  if (!cached || cached_key != key) {
     cached.reset();
-    cached = std::make_unique<Mesh>(bench::kuhn_grid_mesh(n));
-    cached_n = n;
+    cached = std::make_unique<Mesh>(make());
+    cached_key = key;
   }
   return *cached;
+}
+
+Mesh& grid(std::uint32_t n) {
+  return cached_mesh("kuhn" + std::to_string(n), [n] { return bench::kuhn_grid_mesh(n); });
+}
+
+// The meshes users have (issue 18): TetGen's -pq1.414 -O0 (no flips or smoothing) in TetGen's node
+// order, made by the tetgen program in the run. "box": 10 x 10 x 2, markers 1 bottom, 2 top, 3 sides,
+// 948k tets. "board": a 10 x 10 x 1 board (region 1) carrying a 4 x 4 x 0.5 block (region 2),
+// markers 1 board bottom, 6 block top (/work/shared/peers/box_block.poly), 1.0M tets.
+const char* const kBoxPoly =
+    "8 3 0 0\n1 0 0 0\n2 10 0 0\n3 10 10 0\n4 0 10 0\n5 0 0 2\n6 10 0 2\n7 10 10 2\n8 0 10 2\n"
+    "6 1\n1 0 1\n4 1 2 3 4\n1 0 2\n4 5 6 7 8\n1 0 3\n4 1 2 6 5\n1 0 3\n4 2 3 7 6\n1 0 3\n4 3 4 8 7\n"
+    "1 0 3\n4 4 1 5 8\n0\n0\n";
+const char* const kBoardPoly =
+    "16 3 0 0\n1 0 0 0\n2 10 0 0\n3 10 10 0\n4 0 10 0\n5 0 0 1\n6 10 0 1\n7 10 10 1\n8 0 10 1\n"
+    "9 3 3 1\n10 7 3 1\n11 7 7 1\n12 3 7 1\n13 3 3 1.5\n14 7 3 1.5\n15 7 7 1.5\n16 3 7 1.5\n"
+    "15 1\n1 0 1\n4 1 2 3 4\n1 0 2\n4 1 2 6 5\n1 0 2\n4 2 3 7 6\n1 0 2\n4 3 4 8 7\n1 0 2\n4 4 1 5 8\n"
+    "1 0 3\n4 5 6 10 9\n1 0 3\n4 6 7 11 10\n1 0 3\n4 7 8 12 11\n1 0 3\n4 8 5 9 12\n1 0 4\n4 9 10 11 12\n"
+    "1 0 5\n4 9 10 14 13\n1 0 5\n4 10 11 15 14\n1 0 5\n4 11 12 16 15\n1 0 5\n4 12 9 13 16\n"
+    "1 0 6\n4 13 14 15 16\n0\n2\n1 5 5 0.5 1 -1\n2 5 5 1.25 2 -1\n";
+
+// Null (and the benchmark skipped with the reason) where tetgen is missing or fails.
+Mesh* tetgen_mesh(benchmark::State& state, const std::string& which) {
+  if (std::system("command -v tetgen > /dev/null 2>&1") != 0) {
+    state.SkipWithError("needs the tetgen program (Debian's tetgen)");
+    return nullptr;
+  }
+  bool failed = false;
+  Mesh& m = cached_mesh("tetgen-" + which, [&] {
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("foxi-bench-tetgen-" + std::to_string(std::random_device{}()));
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "in.poly") << (which == "box" ? kBoxPoly : kBoardPoly);
+    const char* volume = which == "box" ? "0.00042" : "0.00022";
+    Mesh out;
+    if (std::system(("tetgen -Qpq1.414AO0a" + std::string(volume) + " '" + (dir / "in.poly").string() + "'").c_str()) == 0)
+      out = read_tetgen(dir / "in.1");
+    else
+      failed = true;
+    std::filesystem::remove_all(dir);
+    return out;
+  });
+  if (failed || m.tet_count() == 0) {
+    state.SkipWithError("tetgen failed");
+    return nullptr;
+  }
+  return &m;
+}
+
+// box: 300 K bottom, 400 K top, k 1; board: 300 K under the board, 400 K on the block, k 1 in the
+// board and 1000 in the block.
+ThermalParams tetgen_params(const std::string& which, LinearSolverKind kind) {
+  ThermalParams p;
+  if (which == "box") {
+    p.conductivity = {{1, 1.0}};
+    p.fixed = {{1, 300}, {2, 400}};
+  } else {
+    p.conductivity = {{1, 1.0}, {2, 1000.0}};
+    p.fixed = {{1, 300}, {6, 400}};
+  }
+  p.solver.kind = kind;
+  p.solver.relative_tolerance = 1e-10;
+  return p;
 }
 
 // kB of a "VmHWM:" / "VmRSS:" line of /proc/self/status (0 where there is none).
@@ -79,9 +150,7 @@ ThermalParams params(LinearSolverKind kind) {
   return p;
 }
 
-void foxi_thermal(benchmark::State& state, LinearSolverKind kind, std::uint32_t n) {
-  Mesh& m = grid(n);
-  const ThermalParams p = params(kind);
+void measure_thermal(benchmark::State& state, Mesh& m, const ThermalParams& p) {
   ThermalReport r;
   double assembly = 0, solve = 0;
   // The fields of an earlier run are dropped so that every run allocates them anew.
@@ -112,6 +181,23 @@ void foxi_thermal(benchmark::State& state, LinearSolverKind kind, std::uint32_t 
   state.counters["residual"] = r.relative_residual;
   state.counters["DOF_per_s"] = static_cast<double>(r.unknowns) / ((assembly + solve) / it);
   state.counters["Tmax"] = r.max_temperature;
+}
+
+void foxi_thermal(benchmark::State& state, LinearSolverKind kind, std::uint32_t n) {
+  measure_thermal(state, grid(n), params(kind));
+}
+
+void tetgen_thermal(benchmark::State& state, LinearSolverKind kind, const char* which) {
+  if (Mesh* m = tetgen_mesh(state, which)) measure_thermal(state, *m, tetgen_params(which, kind));
+}
+
+void tetgen_ccx(benchmark::State& state, const char* which) {
+  Mesh* m = tetgen_mesh(state, which);
+  if (!m) return;
+  bench::time_ccx(
+      state, "heat", [&](const std::filesystem::path& inp) { write_calculix_thermal(*m, tetgen_params(which, LinearSolverKind::automatic), inp); },
+      std::getenv("FOXI_BENCH_CCX") != nullptr, "set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
+  state.counters["tets"] = static_cast<double>(m->tet_count());
 }
 
 // The textbook baseline: element matrices into one serial triplet list, Dirichlet rows eliminated,
@@ -233,6 +319,25 @@ BENCHMARK_CAPTURE(foxi_thermal, amg_162k, LinearSolverKind::cg_amg, 30u)
 BENCHMARK_CAPTURE(foxi_thermal, direct_162k, LinearSolverKind::direct, 30u)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+// TetGen meshes (issue 18): AMG against incomplete Cholesky and CalculiX on the same mesh and problem.
+BENCHMARK_CAPTURE(tetgen_ccx, box_948k, "box")->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tetgen_thermal, amg_box_948k, LinearSolverKind::cg_amg, "box")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2);
+BENCHMARK_CAPTURE(tetgen_thermal, ichol_box_948k, LinearSolverKind::cg_ichol, "box")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2);
+BENCHMARK_CAPTURE(tetgen_ccx, board_1M, "board")->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tetgen_thermal, amg_board_1M, LinearSolverKind::cg_amg, "board")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2);
+BENCHMARK_CAPTURE(tetgen_thermal, ichol_board_1M, LinearSolverKind::cg_ichol, "board")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2);
 BENCHMARK(triplet_assembly)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(eigen_cg_jacobi)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -35,6 +35,10 @@ struct AmgParams {
   // of Baker, Falgout, Kolev, Yang 2011), which keeps it convergent where A is far from diagonally
   // dominant (elasticity); same as plain Gauss-Seidel on one thread.
   bool l1_smoother = false;
+  // Smoothing sweeps before and after the coarse correction: forward, backward, forward, ... before,
+  // their adjoints in reverse order after (1: V(1,1) symmetric Gauss-Seidel; 2: V(2,2), a symmetric
+  // Gauss-Seidel step on each side).
+  int sweeps = 1;
 };
 
 class AmgPreconditioner {
