@@ -30,7 +30,7 @@ const char* kModelUsage =
     "  check: loads the model, builds its PLC and prints parameters, materials, parts with volumes,\n"
     "         boundary names, conditions, loads and mesh controls (or the errors, with file and line)\n"
     "  plc:   writes the PLC (metres, region id = part number, boundary markers) as a TetGen .poly\n"
-    "  show:  meshes the model coarsely (TetGen, its quality bounds, no sizes) and draws it with the\n"
+    "  show:  meshes the model coarsely (TetGen, no sizes, no quality refinement) and draws it with the\n"
     "         painter, each part in its material's colour, seen from the front, above, right; --view\n"
     "         exploded (default: part i lifted by i gaps, so every part shows whole), cut (the back\n"
     "         half, tets beyond the middle of y) or whole; prints the colour legend\n"

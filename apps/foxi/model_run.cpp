@@ -42,9 +42,10 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
   if (physics) check_physics(m.model, *physics);
   m.structure = build_structure(m.model);
   Plc plc = m.structure.plc;
-  Model controls = m.model;  // coarse: the quality bounds only
-  if (coarse) controls.mesh = {.max_size = 0, .quality = m.model.mesh.quality,
-                               .min_dihedral = m.model.mesh.min_dihedral, .part_sizes = {}, .refine = {}};
+  // coarse (a picture of the parts): no sizes and no quality refinement, so the tets follow the PLC's
+  // points alone (TetGen's quality refinement filled power_module's thin solders with 612k tets)
+  Model controls = m.model;
+  if (coarse) controls.mesh = {.max_size = 0, .quality = 0, .min_dihedral = 0, .part_sizes = {}, .refine = {}};
   const ModelMeshParams mp = mesh_params_from_model(controls, plc);
   MeshParams params = mp.params;
   check_tet_estimate(file, plc, params, m.structure.part_volume, max_tets);

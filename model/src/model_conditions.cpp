@@ -118,7 +118,10 @@ class ConditionReader {
     return q.value;
   }
   double length(const Value& v, const std::string& entity) const {
-    return quantity(v, kLength, entity, m_.length_scale);
+    const double x = quantity(v, kLength, entity, m_.length_scale);
+    if (std::abs(x) > model_limits::kMaxLength)
+      fail(v, entity + " is beyond the limit of 1000 m for any coordinate or size");
+    return x;
   }
   double positive_length(const Value& v, const std::string& entity) const {
     const double x = length(v, entity);

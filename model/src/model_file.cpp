@@ -107,6 +107,16 @@ std::pair<std::uint64_t, std::string> toml_nesting(std::string_view s) {
                       " levels (the limit for model files)"};
   };
   const std::size_t n = s.size();
+  // toml11 looks through a value's whole line for every value on it (region::comments, even when it
+  // discards them), so a long line costs its length squared: a 440 KB line of numbers took a minute
+  for (std::size_t b = 0, l = 1; b < n; ++l) {
+    std::size_t e = s.find('\n', b);
+    if (e == std::string_view::npos) e = n;
+    if (e - b > lim::kLineBytes)
+      return {l, "the line has " + std::to_string(e - b) + " characters, more than the limit of " +
+                     std::to_string(lim::kLineBytes) + " (break long arrays over several lines)"};
+    b = e + 1;
+  }
   auto skip_string = [&](std::size_t& i) {  // i at the opening quote; leaves i at the closing one
     const char q = s[i];
     const bool multi = i + 2 < n && s[i + 1] == q && s[i + 2] == q;
@@ -156,7 +166,7 @@ std::pair<std::uint64_t, std::string> toml_nesting(std::string_view s) {
       else
         while (i + 1 < n && s[i + 1] == ']') ++i;
       at_key = false;
-    } else if (at_key) {
+    } else if (at_key && c != '[' && c != '{') {  // (a bracket where a key belongs is counted below)
       if (c == '.') ++key;
       if (c == '=') {
         if (auto d = deep(header + open + key + 1); d.first) return d;

@@ -16,13 +16,11 @@
 #include <CGAL/Surface_sweep_2_algorithms.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <functional>
 #include <map>
 #include <numeric>
 #include <tuple>
-#include <unordered_map>
 
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/surfaces.hpp"
@@ -424,57 +422,6 @@ class Builder {
   std::map<std::tuple<double, double, std::size_t>, std::uint32_t> points_;
 };
 
-// Two PLC points closer than kMinPointSpacing of the model's extent: parts whose outlines almost,
-// but not quite, meet (a sliver far below any part's own features, which check_features in the
-// loader cannot see) are refused, since TetGen takes points that close as one and fails or hangs.
-// A grid of cells as wide as the spacing: distinct points at least that far apart share a cell
-// with only a few others, so the search is linear.
-void check_point_spacing(const Model& model, const Structure& s) {
-  const std::size_t n = s.plc.point_count();
-  if (n < 2) return;
-  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (std::size_t i = 0; i < 3 * n; ++i)
-    lo[i % 3] = std::min(lo[i % 3], s.plc.points[i]), hi[i % 3] = std::max(hi[i % 3], s.plc.points[i]);
-  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  const double w = model_limits::kMinPointSpacing * extent;
-  if (!(w > 0)) return;
-  struct Hash {
-    std::size_t operator()(const std::array<std::int64_t, 3>& k) const {
-      return static_cast<std::size_t>(k[0] * 73856093 ^ k[1] * 19349663 ^ k[2] * 83492791);
-    }
-  };
-  std::unordered_map<std::array<std::int64_t, 3>, std::vector<std::uint32_t>, Hash> grid;
-  auto cell = [&](std::size_t i, int k) {
-    return static_cast<std::int64_t>(std::floor((s.plc.points[3 * i + static_cast<std::size_t>(k)] - lo[k]) / w));
-  };
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::array<std::int64_t, 3> c = {cell(i, 0), cell(i, 1), cell(i, 2)};
-    const double* p = &s.plc.points[3 * i];
-    for (std::int64_t dx = -1; dx <= 1; ++dx)
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
-          if (it == grid.end()) continue;
-          for (std::uint32_t j : it->second) {
-            const double* q = &s.plc.points[3 * std::size_t{j}];
-            const double d = std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
-            if (d >= w) continue;
-            char buf[320];
-            const double u = model.length_scale;
-            std::snprintf(buf, sizeof buf,
-                          "two corners of the parts' outlines, at (%g, %g, %g) and (%g, %g, %g) %s, are %g %s "
-                          "apart, below %g of the model's extent (%g %s): parts that almost but not quite "
-                          "meet (degenerate geometry); make them meet exactly or move them apart",
-                          p[0] / u, p[1] / u, p[2] / u, q[0] / u, q[1] / u, q[2] / u, model.length_unit.c_str(),
-                          d / u, model.length_unit.c_str(), model_limits::kMinPointSpacing, extent / u,
-                          model.length_unit.c_str());
-            throw IoError(model.file, 0, IoError::kNoOffset, buf);
-          }
-        }
-    grid[c].push_back(static_cast<std::uint32_t>(i));
-  }
-}
-
 }  // namespace
 
 std::int32_t boundary_marker(Structure& s, const std::string& name) {
@@ -489,7 +436,6 @@ Structure build_structure(const Model& model, const ProgressFn& progress) {
   bool solids = false;
   for (const Part& p : model.parts) solids = solids || !p.surface.tri.empty();
   Structure s = solids ? build_structure_from_solids(model, progress) : Builder(model).build();
-  check_point_spacing(model, s);
   tag_selected_surfaces(model, s);
   check_conditions(model, s);
   return s;

@@ -174,13 +174,16 @@ class Parser {
     }
   }
   Quantity unary() {
-    const Nest nest(*this);
     if (eat('-')) {
+      const Nest nest(*this);
       Quantity a = unary();
       a.value = -a.value;
       return a;
     }
-    if (eat('+')) return unary();
+    if (eat('+')) {
+      const Nest nest(*this);
+      return unary();
+    }
     return power();
   }
   Quantity raise(Quantity base, const Quantity& e) const {
@@ -199,7 +202,10 @@ class Parser {
   }
   Quantity power() {
     Quantity a = primary();
-    if (eat('^')) return raise(a, unary());
+    if (eat('^')) {
+      const Nest nest(*this);
+      return raise(a, unary());
+    }
     return a;
   }
   Quantity name_value(std::string_view name) {

@@ -2,6 +2,7 @@
 // program), --set, and errors that name the file and the entity.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -208,8 +209,12 @@ TEST(ModelCli, CrashesAndHangsOfIssue22AreRefused) {
   std::string outline;
   for (int i = 0; i < 20000; ++i) {
     const double a = 2 * 3.141592653589793 * i / 20000;
-    outline += (i ? ", [" : "[") + std::to_string(5 + 2 * std::cos(a)) + ", " + std::to_string(5 + 2 * std::sin(a)) + "]";
+    outline += (i ? ",\n [" : "[") + std::to_string(5 + 2 * std::cos(a)) + ", " + std::to_string(5 + 2 * std::sin(a)) + "]";
   }
+  std::string deep;  // 100,000 levels in 200 KB, a thousand brackets a line
+  for (int k = 0; k < 100; ++k) deep = std::string(1000, '[') + "\n" + deep + std::string(1000, ']') + "\n";
+  std::string one_line = outline;  // all on one line: toml11 took a minute over it
+  std::replace(one_line.begin(), one_line.end(), '\n', ' ');
   struct Case {
     std::string args, file, want;
   } cases[] = {
@@ -221,8 +226,7 @@ TEST(ModelCli, CrashesAndHangsOfIssue22AreRefused) {
       {model("inf.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
                                  "points = [[0, 0], [1, inf], [1, 1]]\nz = 1\nheight = 1\n"),
        "inf.toml", "not a finite number"},
-      {model("deep.toml", "x = " + std::string(100000, '[') + std::string(100000, ']') + "\n" + board), "deep.toml",
-       "nest deeper than 32"},
+      {model("deep.toml", "x = " + deep + board), "deep.toml", "nest deeper than 32"},
       {"'" + die + "' --set 'die_w=" + std::string(20000, '(') + "4 mm" + std::string(20000, ')') + "'",
        "die_on_substrate.toml", "parameter 'die_w' (from --set)"},
       {"'" + die + "' --set 'die_w=" + std::string(100, '(') + "4 mm" + std::string(100, ')') + "'",
@@ -238,6 +242,9 @@ TEST(ModelCli, CrashesAndHangsOfIssue22AreRefused) {
       {model("outline.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
                                      "points = [" + outline + "]\nz = 1\nheight = 1\n"),
        "outline.toml", "20000 points, more than the limit of 2000"},
+      {model("line.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
+                                  "points = [" + one_line + "]\nz = 1\nheight = 1\n"),
+       "line.toml", "more than the limit of 65536 (break long arrays over several lines)"},
   };
   for (const Case& c : cases) {
     const Outcome o = timed("model check " + c.args, dir / "log.txt");

@@ -43,6 +43,7 @@ namespace foxi {
 namespace model_limits {
 inline constexpr std::uintmax_t kFileBytes = 4u << 20;  // a model or materials library file
 inline constexpr std::uintmax_t kStlBytes = 64u << 20;  // an STL file
+inline constexpr std::size_t kLineBytes = 64u << 10;  // a line of a model or library file
 inline constexpr int kTomlDepth = 32;             // nested arrays, inline tables and dotted key parts
 inline constexpr std::size_t kParameterChain = 64;  // parameters whose values need each other, in a row
 inline constexpr std::size_t kParts = 1000;         // parts (each layer of a stack counts)
@@ -55,7 +56,6 @@ inline constexpr double kBallTolerance = 1e-3;  // a ball's tolerance is at leas
 inline constexpr double kMaxLength = 1e3;       // m: every coordinate and size, and the model's extent
 inline constexpr double kMinExtent = 1e-9;      // m: the model's extent (largest side of its box)
 inline constexpr double kMinFeature = 1e-6;     // times the extent: every edge, height and ball radius
-inline constexpr double kMinPointSpacing = 1e-8;  // times the extent: any two points of the PLC
 }  // namespace model_limits
 
 // A vertical prism: a simple (convex or not) counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
