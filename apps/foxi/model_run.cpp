@@ -42,8 +42,11 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
   if (physics) check_physics(m.model, *physics);
   m.structure = build_structure(m.model);
   Plc plc = m.structure.plc;
-  // coarse (a picture of the parts): no sizes and no quality refinement, so the tets follow the PLC's
-  // points alone (TetGen's quality refinement filled power_module's thin solders with 612k tets)
+  // coarse (a picture of the parts): no sizes, no quality refinement and no conforming rounds, so the
+  // tets follow the PLC's points and TetGen's boundary recovery alone; the picture takes the power
+  // order where that mesh is Delaunay, else a depth buffer (model_picture.cpp). With the quality
+  // bounds, power_module's thin solders took 612k tets and 44 s; the conforming rounds alone, 185k
+  // tets and 90 s; this way 377 tets in 0.1 s.
   Model controls = m.model;
   if (coarse) controls.mesh = {.max_size = 0, .quality = 0, .min_dihedral = 0, .part_sizes = {}, .refine = {}};
   const ModelMeshParams mp = mesh_params_from_model(controls, plc);
@@ -58,7 +61,11 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
   }
   // The same conforming Delaunay path as `foxi mesh` (thin layers included), so that the mesh the
   // solver gets is certified and the viewer's order is exact.
-  m.mesh = mesh_conforming(plc, params, {}, &m.conforming);
+  if (coarse) {
+    m.mesh = mesh_plc(plc, params, &m.conforming.tetgen);
+  } else {
+    m.mesh = mesh_conforming(plc, params, {}, &m.conforming);
+  }
   m.report = m.conforming.tetgen;
   name_mesh(m.model, m.structure, m.mesh);
   return m;

@@ -37,8 +37,8 @@ void check_tet_estimate(const std::string& input, const Plc& plc, const MeshPara
                         std::span<const double> region_volume, double max_tets);
 
 // Loads `file` with the --set overrides, checks what `physics` needs (before meshing), builds the
-// PLC and meshes it with the model's [mesh] controls; `coarse` meshes for a picture: no sizes, no
-// quality refinement (the tets of the PLC's points and the conforming splits).
+// PLC and meshes it with the model's [mesh] controls; `coarse` meshes for a picture: TetGen alone, no
+// sizes, no quality refinement, no conforming rounds (the mesh may not be Delaunay).
 // A mesh estimated past `max_tets` is refused before meshing (check_tet_estimate).
 // Errors: IoError from the model, MesherError from TetGen.
 MeshedModel mesh_model(const std::string& file, std::span<const std::string> sets,

@@ -340,4 +340,25 @@ TEST(ModelCli, RefineFromIsBoundedByTheEstimate) {
   EXPECT_LT(tets, estimate * 3) << estimate;
 }
 
+// model show meshes coarsely: power_module's thin solders once made a "coarse" mesh of 612,775 tets
+// (44 s); now the tets follow the PLC's points, and every part still shows (its legend line).
+TEST(ModelCli, ShowMeshIsCoarse) {
+  TempDir dir;
+  const Outcome o = timed("model show '" + kModels + "power_module.toml' --size 320x240 -o '" +
+                              (dir / "p.png").string() + "'",
+                          dir / "log.txt");
+  ASSERT_EQ(o.status, 0) << o.text;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(o.text, m, std::regex("coarse mesh (\\d+) nodes, (\\d+) tets"))) << o.text;
+  EXPECT_LT(std::stod(m[2]), 5000) << o.text;
+  EXPECT_NE(o.text.find("baseplate"), std::string::npos) << o.text;
+  EXPECT_EQ(foxi::read_png(dir / "p.png").width, 320);
+  EXPECT_EQ(foxi_cli("model show '" + kModels + "power_module.toml' --max-tets 10 -o '" + (dir / "q.png").string() + "'",
+                     dir / "log2.txt"),
+            kBadInput)
+      << test::read_text(dir / "log2.txt");
+  EXPECT_NE(test::read_text(dir / "log2.txt").find("over the limit of 10;"), std::string::npos)
+      << test::read_text(dir / "log2.txt");
+}
+
 }  // namespace
