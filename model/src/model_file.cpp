@@ -818,8 +818,10 @@ class Loader {
           if (!(len >= min_feature)) refuse("outline edge " + std::to_string(i) + item, len);
         }
       }
+      // STL surfaces only: a ball's faceting may put a ring of tiny edges next to a pole cut by its
+      // z_range (made by foxi, and carved and meshed fine)
       const TriSurface& s = p.surface;
-      for (std::size_t t = 0; t < s.triangle_count(); ++t)
+      for (std::size_t t = 0; !p.source.empty() && t < s.triangle_count(); ++t)
         for (int e = 0; e < 3; ++e) {
           const double* a = &s.xyz[3 * std::size_t{s.tri[3 * t + static_cast<std::size_t>(e)]}];
           const double* b = &s.xyz[3 * std::size_t{s.tri[3 * t + static_cast<std::size_t>((e + 1) % 3)]}];
