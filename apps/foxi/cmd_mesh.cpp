@@ -34,6 +34,7 @@ const char* kMeshUsage =
     "          [--min-dihedral DEG] [--max-volume V] [--region-size REGION=H]... [--refine-box X0,Y0,Z0,X1,Y1,Z1=H]...\n"
     "          [--refine-from RESULT.vtu [--field NAME] --target-error E] [--no-conform] [--optimize]\n"
     "          [--mesher tetgen|cgal] [--perturb] [--resample [--feature-angle DEG]] [--time-limit S]\n"
+    "          [--max-tets N]\n"
     "  Meshes a model (parts -> PLC) or a TetGen .poly into tets with TetGen (no optimisation), then\n"
     "  splits encroached boundary/interface triangles until every tet is Delaunay (exact certificate),\n"
     "  and prints a quality report. OUT in any mesh format foxi knows (.vtu .msh .vtk .node .mesh).\n"
@@ -48,6 +49,8 @@ const char* kMeshUsage =
     "  --refine-from F    remesh from a solved mesh F: elements shrink where the Zienkiewicz-Zhu\n"
     "                     error of its field (--field, default the first node field) is large, for a\n"
     "                     relative gradient error --target-error E (e.g. 0.05)\n"
+    "  --max-tets N       refuse a mesh estimated (before meshing, from the volumes and the sizes) to\n"
+    "                     have more than N tets (default 4000000)\n"
     "  --no-conform       TetGen's mesh as it is (may not be Delaunay)\n"
     "  --optimize         TetGen's flips and smoothing (implies --no-conform: the mesh stops being Delaunay)\n"
     "  --mesher cgal      CGAL Mesh_3 instead of TetGen (a model, with --set and its max_size and part sizes,\n"
@@ -125,6 +128,7 @@ int cmd_mesh(Args args) {
   const std::string field_name = args.option("--field");
   const std::string target_error = args.option("--target-error");
   const std::string out = args.option("-o");
+  const double max_tets = max_tets_option(args);
   if (out.empty()) throw UsageError("give the output file with -o OUT\nusage: " + std::string(kMeshUsage));
   const std::string in = args.positional(1, 1, kMeshUsage)[0];
   if (!refine_from.empty() && target_error.empty()) throw UsageError("--refine-from needs --target-error E");
@@ -208,6 +212,8 @@ int cmd_mesh(Args args) {
   int status = kExitOk;
   try {
     plc = with_region_sizes(plc, controls);
+    const std::span<const double> volumes = is_model ? std::span<const double>(structure.part_volume)
+                                                      : std::span<const double>();
     if (!refine_from.empty()) {
       const Mesh solved = read_mesh(refine_from);
       const Field* f = nullptr;
@@ -222,9 +228,11 @@ int cmd_mesh(Args args) {
       std::printf("refine from %s: field '%s', relative gradient error %.3g (Zienkiewicz-Zhu), target %s\n",
                   refine_from.c_str(), f->name.c_str(), e.relative_error(), target_error.c_str());
     } else if (!controls.boxes.empty()) {
+      check_tet_estimate(in, plc, params, volumes, max_tets);  // box_size_field meshes with params first
       field = box_size_field(plc, params, controls);
     }
     if (!field.empty()) params.size_field = &field;
+    check_tet_estimate(in, plc, params, volumes, max_tets);
     if (conform) {
       mesh = mesh_conforming(plc, params, {}, &report);
     } else {

@@ -88,6 +88,7 @@ int mesh_with_cgal(Args& args) {
   params.time_limit = non_negative(args.option("--time-limit", "300"), "--time-limit");
   args.flag("--check-delaunay");  // the CGAL path always certifies
   const std::string out = args.option("-o");
+  const double max_tets = max_tets_option(args);
   if (out.empty()) throw UsageError("give the output file with -o OUT (see foxi mesh --help)");
   std::vector<std::string> sets;
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
@@ -108,6 +109,13 @@ int mesh_with_cgal(Args& args) {
   } else {
     if (!sets.empty()) throw UsageError("--set needs a model file (.toml), not a .poly");
     plc = read_poly(in);
+  }
+  {  // the tet count estimated as for TetGen, at the regular tet of the circumradius bound
+    MeshParams estimate;
+    if (params.max_size > 0) estimate.max_volume = regular_tet_volume(4 * params.max_size / std::sqrt(6.0));
+    check_tet_estimate(in, plc, estimate,
+                       is_model ? std::span<const double>(structure.part_volume) : std::span<const double>(),
+                       max_tets);
   }
   g_interrupted = 0;
   auto* previous = std::signal(SIGINT, on_interrupt);

@@ -25,15 +25,18 @@ namespace {
 const char* kModelUsage =
     "foxi model check MODEL.toml [--set NAME=VALUE]...\n"
     "foxi model plc MODEL.toml [--set NAME=VALUE]... -o OUT.poly\n"
-    "foxi model show MODEL.toml [--set NAME=VALUE]... [--size WxH] [--view exploded|cut|whole] -o OUT.png\n"
+    "foxi model show MODEL.toml [--set NAME=VALUE]... [--size WxH] [--view exploded|cut|whole]\n"
+    "                [--max-tets N] -o OUT.png\n"
     "  check: loads the model, builds its PLC and prints parameters, materials, parts with volumes,\n"
     "         boundary names, conditions, loads and mesh controls (or the errors, with file and line)\n"
     "  plc:   writes the PLC (metres, region id = part number, boundary markers) as a TetGen .poly\n"
-    "  show:  meshes the model coarsely (TetGen, its quality bounds, no sizes) and draws it with the\n"
+    "  show:  meshes the model coarsely (TetGen, no sizes, no quality refinement, not made Delaunay:\n"
+    "         the tets of the PLC's points) and draws it with the\n"
     "         painter, each part in its material's colour, seen from the front, above, right; --view\n"
     "         exploded (default: part i lifted by i gaps, so every part shows whole), cut (the back\n"
     "         half, tets beyond the middle of y) or whole; prints the colour legend\n"
-    "  --set NAME=VALUE  overrides a parameter, e.g. --set die_w=8mm";
+    "  --set NAME=VALUE  overrides a parameter, e.g. --set die_w=8mm\n"
+    "  --max-tets N      show: refuse a mesh estimated to have more than N tets (default 4000000)";
 
 // Lengths in the model's unit, everything else in SI.
 void print_quantity(const Quantity& q, const Model& model) {
@@ -132,6 +135,7 @@ int cmd_model(Args args) {
   const std::string out = args.option("-o");
   const std::string size = args.option("--size", "1280x960");
   const std::string view = args.option("--view", "exploded");
+  const double max_tets = max_tets_option(args);
   const auto pos = args.positional(2, 2, kModelUsage);
   const std::string& action = pos[0];
   const std::string& file = pos[1];
@@ -153,7 +157,7 @@ int cmd_model(Args args) {
       throw UsageError("--size takes WxH, 16 to 8192 pixels each, not '" + size + "'");
     pp.width = static_cast<int>(wh[0]);
     pp.height = static_cast<int>(wh[1]);
-    const MeshedModel m = mesh_model(file, sets, std::nullopt, true);
+    const MeshedModel m = mesh_model(file, sets, std::nullopt, true, max_tets);
     const ModelPicture pic = render_model_picture(m, out, pp);
     std::printf("%s: %zu parts, coarse mesh %zu nodes, %zu tets (TetGen %s); drew %zu tets (%s) -> %s\n",
                 file.c_str(), m.model.parts.size(), m.mesh.node_count(), m.mesh.tet_count(),

@@ -6,7 +6,9 @@
 #include <span>
 #include <string>
 
+#include "cli.hpp"
 #include "foxi/mesher/conforming.hpp"
+#include "foxi/mesher/tet_estimate.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/model_file.hpp"
@@ -26,11 +28,21 @@ struct MeshedModel {
   ConformingReport conforming;  // the conforming refinement (certificate, thin layers)
 };
 
+// --max-tets N (a whole number >= 1; UsageError otherwise), or kDefaultMaxTets.
+double max_tets_option(Args& args);
+
+// Refuses with IoError (on `input`) a mesh of `plc` with `params` whose estimated tet count
+// (tet_estimate.hpp) is over `max_tets`; the message gives both and says how to raise the limit.
+void check_tet_estimate(const std::string& input, const Plc& plc, const MeshParams& params,
+                        std::span<const double> region_volume, double max_tets);
+
 // Loads `file` with the --set overrides, checks what `physics` needs (before meshing), builds the
-// PLC and meshes it with the model's [mesh] controls; `coarse` keeps only its quality bounds.
+// PLC and meshes it with the model's [mesh] controls; `coarse` meshes for a picture: TetGen alone, no
+// sizes, no quality refinement, no conforming rounds (the mesh may not be Delaunay).
+// A mesh estimated past `max_tets` is refused before meshing (check_tet_estimate).
 // Errors: IoError from the model, MesherError from TetGen.
 MeshedModel mesh_model(const std::string& file, std::span<const std::string> sets,
-                       std::optional<Physics> physics, bool coarse = false);
+                       std::optional<Physics> physics, bool coarse = false, double max_tets = kDefaultMaxTets);
 
 // mesh_model for foxi solve MODEL --physics NAME: prints one line on the model and its mesh.
 MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::string> sets,

@@ -75,10 +75,12 @@ class ConditionReader {
   }
   void allow_keys(const Value& table, const std::string& who, std::initializer_list<const char*> keys) const {
     // Not a structured binding: clang before 16 cannot capture one in the lambda (the fuzz build).
+    std::string list;
+    for (const char* a : keys) list += (list.empty() ? "" : ", ") + std::string(a);
     for (const auto& entry : table.as_table()) {
       const std::string& k = entry.first;
       if (std::none_of(keys.begin(), keys.end(), [&](const char* a) { return k == a; }))
-        fail(entry.second, who + ": unknown key '" + k + "'");
+        fail(entry.second, who + ": unknown key '" + k + "' (expected " + list + ")");
     }
   }
   std::string text(const Value& v, const std::string& what) const {
@@ -116,7 +118,10 @@ class ConditionReader {
     return q.value;
   }
   double length(const Value& v, const std::string& entity) const {
-    return quantity(v, kLength, entity, m_.length_scale);
+    const double x = quantity(v, kLength, entity, m_.length_scale);
+    if (std::abs(x) > model_limits::kMaxLength)
+      fail(v, entity + " is beyond the limit of 1000 m for any coordinate or size");
+    return x;
   }
   double positive_length(const Value& v, const std::string& entity) const {
     const double x = length(v, entity);

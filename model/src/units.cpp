@@ -62,12 +62,21 @@ Dims add_dims(const Dims& a, const Dims& b, int sign) {
   return r;
 }
 
+// Bounds that keep a hostile expression from exhausting the stack (the parser recurses once per
+// parenthesis, unary sign, exponent or call) or the time (each number copies the rest of the text).
+constexpr std::size_t kMaxLength = kMaxExpressionLength;
+constexpr int kMaxDepth = kMaxExpressionDepth;
+constexpr int kMaxUnitPower = 100;  // unit exponents are int8_t
+
 class Parser {
  public:
   Parser(std::string_view text, const std::function<std::optional<Quantity>(std::string_view)>& lookup)
       : s_(text), lookup_(lookup) {}
 
   Quantity parse() {
+    if (s_.size() > kMaxLength)
+      fail("the expression is " + std::to_string(s_.size()) + " characters long, more than the limit of " +
+           std::to_string(kMaxLength));
     Quantity q = expr();
     skip();
     if (p_ < s_.size()) fail("unexpected '" + std::string(1, s_[p_]) + "'");
@@ -77,8 +86,22 @@ class Parser {
 
  private:
   [[noreturn]] void fail(const std::string& why) const {
-    throw ExpressionError(why + " in '" + std::string(s_) + "'");
+    // a long expression is quoted by its start only
+    const std::string quoted = s_.size() <= 80 ? std::string(s_) : std::string(s_.substr(0, 60)) + "...";
+    throw ExpressionError(why + " in '" + quoted + "'");
   }
+  // Counts one level of recursion (parenthesis, sign, exponent, call) for as long as it lives.
+  struct Nest {
+    explicit Nest(Parser& p) : p_(p) {
+      if (++p_.depth_ > kMaxDepth)
+        p_.fail("the expression nests deeper than " + std::to_string(kMaxDepth) +
+                " levels (parentheses, signs, exponents, calls)");
+    }
+    ~Nest() { --p_.depth_; }
+    Nest(const Nest&) = delete;
+    Nest& operator=(const Nest&) = delete;
+    Parser& p_;
+  };
   void skip() {
     while (p_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[p_]))) ++p_;
   }
@@ -112,6 +135,14 @@ class Parser {
       fail("unit mismatch: " + dims_to_string(a.dims) + " " + std::string(op) + " " + dims_to_string(b.dims));
   }
 
+  // a * b (sign 1) or a / b (sign -1) of the units, refused where an exponent would leave int8_t
+  Dims combine(const Dims& a, const Dims& b, int sign) const {
+    for (int i = 0; i < 5; ++i)
+      if (std::abs(a[i] + sign * b[i]) > kMaxUnitPower)
+        fail("a unit raised past the power " + std::to_string(kMaxUnitPower));
+    return add_dims(a, b, sign);
+  }
+
   Quantity expr() {
     Quantity a = term();
     for (;;) {
@@ -133,10 +164,10 @@ class Parser {
     for (;;) {
       if (eat('*')) {
         Quantity b = unary();
-        a = {a.value * b.value, add_dims(a.dims, b.dims, 1)};
+        a = {a.value * b.value, combine(a.dims, b.dims, 1)};
       } else if (eat('/')) {
         Quantity b = unary();
-        a = {a.value / b.value, add_dims(a.dims, b.dims, -1)};
+        a = {a.value / b.value, combine(a.dims, b.dims, -1)};
       } else {
         return a;
       }
@@ -144,11 +175,15 @@ class Parser {
   }
   Quantity unary() {
     if (eat('-')) {
+      const Nest nest(*this);
       Quantity a = unary();
       a.value = -a.value;
       return a;
     }
-    if (eat('+')) return unary();
+    if (eat('+')) {
+      const Nest nest(*this);
+      return unary();
+    }
     return power();
   }
   Quantity raise(Quantity base, const Quantity& e) const {
@@ -156,14 +191,21 @@ class Parser {
     if (base.dims != kDimensionless) {
       const double n = std::round(e.value);
       if (n != e.value || std::abs(n) > 20) fail("a quantity with units takes only small integer exponents");
-      for (auto& d : base.dims) d = static_cast<std::int8_t>(d * static_cast<int>(n));
+      for (auto& d : base.dims) {
+        const int x = d * static_cast<int>(n);
+        if (std::abs(x) > kMaxUnitPower) fail("a unit raised past the power " + std::to_string(kMaxUnitPower));
+        d = static_cast<std::int8_t>(x);
+      }
     }
     base.value = std::pow(base.value, e.value);
     return base;
   }
   Quantity power() {
     Quantity a = primary();
-    if (eat('^')) return raise(a, unary());
+    if (eat('^')) {
+      const Nest nest(*this);
+      return raise(a, unary());
+    }
     return a;
   }
   Quantity name_value(std::string_view name) {
@@ -197,12 +239,16 @@ class Parser {
           fail("unknown unit '" + std::string(u) + "'");
         }
         Quantity unit = *uq;
-        if (eat('^')) unit = raise(unit, primary());
+        if (eat('^')) {
+          const Nest nest(*this);
+          unit = raise(unit, primary());
+        }
         q = {q.value * unit.value, unit.dims};
       }
       return q;
     }
     if (eat('(')) {
+      const Nest nest(*this);
       Quantity q = expr();
       if (!eat(')')) fail("missing ')'");
       return q;
@@ -215,6 +261,7 @@ class Parser {
     fail("unexpected '" + std::string(1, c) + "'");
   }
   Quantity call(std::string_view f) {
+    const Nest nest(*this);
     std::vector<Quantity> args;
     if (!eat(')')) {
       do args.push_back(expr());
@@ -264,6 +311,7 @@ class Parser {
   std::string_view s_;
   const std::function<std::optional<Quantity>(std::string_view)>& lookup_;
   std::size_t p_ = 0;
+  int depth_ = 0;
 };
 
 }  // namespace

@@ -2,7 +2,11 @@
 // program), --set, and errors that name the file and the entity.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <regex>
 #include <string>
 
@@ -18,6 +22,7 @@ using foxi::test::TempDir;
 namespace test = foxi::test;
 
 const std::string kModels = std::string(FOXI_TEST_DATA_DIR) + "/../../models/";
+constexpr int kBadInput = 3;  // kExitBadInput (apps/foxi/exit_codes.hpp)
 
 int foxi_cli(const std::string& args, const std::filesystem::path& log) {
   return test::run("'" + test::cli_path() + "' " + args, log);
@@ -173,6 +178,187 @@ TEST(ModelCli, DemoRunsAModelEndToEnd) {
     EXPECT_NE(out.find(s), std::string::npos) << s << " missing in:\n" << out;
   for (const char* f : {"trench.vtu", "trench.png", "trench_parts.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "d" / f)) << f;
+}
+
+// --- issue 22: model inputs that crashed or hung foxi; each is refused quickly with exit status 3 ---
+
+struct Outcome {
+  int status;
+  double seconds;
+  std::string text;
+};
+
+Outcome timed(const std::string& args, const std::filesystem::path& log) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int status = foxi_cli(args, log);
+  return {status, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), test::read_text(log)};
+}
+
+// The crashes (SIGSEGV in CGAL, SIGFPE in GMP and on nan, stack overflows in toml11 and in foxi's
+// expression parser) and the hangs (counts without a bound): exit 3, the file named, in seconds.
+TEST(ModelCli, CrashesAndHangsOfIssue22AreRefused) {
+  TempDir dir;
+  std::filesystem::copy(kModels + "materials.toml", dir / "materials.toml");
+  const std::string die = kModels + "die_on_substrate.toml", bga = kModels + "bga.toml";
+  auto model = [&](const std::string& name, const std::string& text) {
+    test::write_text(dir / name, "units.length = \"mm\"\nlibrary = \"materials.toml\"\n" + text);
+    return "'" + (dir / name).string() + "'";
+  };
+  const std::string board =
+      "[[parts]]\nname = \"board\"\nmaterial = \"fr4\"\nshape = \"box\"\norigin = [0, 0, 0]\nsize = [10, 10, 1]\n";
+  std::string outline;
+  for (int i = 0; i < 20000; ++i) {
+    const double a = 2 * 3.141592653589793 * i / 20000;
+    outline += (i ? ",\n [" : "[") + std::to_string(5 + 2 * std::cos(a)) + ", " + std::to_string(5 + 2 * std::sin(a)) + "]";
+  }
+  std::string deep;  // 100,000 levels in 200 KB, a thousand brackets a line
+  for (int k = 0; k < 100; ++k) deep = std::string(1000, '[') + "\n" + deep + std::string(1000, ']') + "\n";
+  std::string one_line = outline;  // all on one line: toml11 took a minute over it
+  std::replace(one_line.begin(), one_line.end(), '\n', ' ');
+  struct Case {
+    std::string args, file, want;
+  } cases[] = {
+      {"'" + die + "' --set 'die_w=1e-30 mm'", "die_on_substrate.toml", "degenerate geometry"},
+      {"'" + bga + "' --set 'die_w=1e300 mm'", "bga.toml", "beyond the limit of 1000 m"},
+      {model("nan.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
+                                 "points = [[0, 0], [nan, 0], [1, 1]]\nz = 1\nheight = 1\n"),
+       "nan.toml", "part 'e' points[1][0] is not a finite number"},
+      {model("inf.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
+                                 "points = [[0, 0], [1, inf], [1, 1]]\nz = 1\nheight = 1\n"),
+       "inf.toml", "not a finite number"},
+      {model("deep.toml", "x = " + deep + board), "deep.toml", "nest deeper than 32"},
+      {"'" + die + "' --set 'die_w=" + std::string(20000, '(') + "4 mm" + std::string(20000, ')') + "'",
+       "die_on_substrate.toml", "parameter 'die_w' (from --set)"},
+      {"'" + die + "' --set 'die_w=" + std::string(100, '(') + "4 mm" + std::string(100, ')') + "'",
+       "die_on_substrate.toml", "nests deeper than 64"},
+      {model("array.toml", board + "[[parts]]\nname = \"pins\"\nmaterial = \"copper\"\nshape = \"array\"\n"
+                                   "count = [100000, 1]\npitch = [0.1, 0.1]\nitem = { shape = \"box\", "
+                                   "origin = [0, 0, 1], size = [0.05, 0.05, 1] }\n"),
+       "array.toml", "must be an integer from 1 to 10000"},
+      {model("cyl.toml", board + "[[parts]]\nname = \"c\"\nmaterial = \"copper\"\nshape = \"cylinder\"\n"
+                                 "center = [5, 5, 1]\nradius = 1\nheight = 1\nsegments = 1e6\n"),
+       "cyl.toml", "must be an integer from 3 to 1000"},
+      {"'" + bga + "' --set 'ball_tol=1e-6 mm'", "bga.toml", "below the limit of 0.001 times the radius"},
+      {model("outline.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
+                                     "points = [" + outline + "]\nz = 1\nheight = 1\n"),
+       "outline.toml", "20000 points, more than the limit of 2000"},
+      {model("line.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
+                                  "points = [" + one_line + "]\nz = 1\nheight = 1\n"),
+       "line.toml", "more than the limit of 65536 (break long arrays over several lines)"},
+  };
+  for (const Case& c : cases) {
+    const Outcome o = timed("model check " + c.args, dir / "log.txt");
+    EXPECT_EQ(o.status, kBadInput) << c.want << "\n" << o.text;
+    EXPECT_LT(o.seconds, 5) << c.want;
+    EXPECT_NE(o.text.find(c.file + ":"), std::string::npos) << o.text;
+    EXPECT_NE(o.text.find(c.want), std::string::npos) << c.want << "\n" << o.text;
+  }
+}
+
+// Referenced files (library, STL): a directory, an empty name, an absolute path, a file of the wrong
+// kind; the error never quotes the file it opened.
+TEST(ModelCli, ReferencedFilesAreCheckedAndNeverQuoted) {
+  TempDir dir;
+  std::filesystem::create_directory(dir / "sub");
+  test::write_text(dir / "secret.txt", "root:x:0:0:SECRET:/root:/bin/bash\n");
+  const std::string part =
+      "[materials.a]\nthermal_conductivity = 1\n[[parts]]\nname = \"b\"\nmaterial = \"a\"\nshape = \"box\"\n"
+      "origin = [0, 0, 0]\nsize = [1, 1, 1]\n";
+  const std::string stl = "[[parts]]\nname = \"s\"\nmaterial = \"a\"\nshape = \"stl\"\nfile = ";
+  struct Case {
+    std::string text, want;
+  } cases[] = {
+      {"library = \"sub\"\n" + part, "library 'sub' is a directory, not a file"},
+      {"library = \"\"\n" + part, "library: the file name is empty"},
+      {"library = \"/etc/passwd\"\n" + part, "is an absolute path"},
+      {"library = \"secret.txt\"\n" + part, "not a TOML materials library"},
+      {part + stl + "\"sub\"\n", "part 's' file 'sub' is a directory, not a file"},
+      {part + stl + "\"\"\n", "part 's' file: the file name is empty"},
+      {part + stl + "\"secret.txt\"\n", "not an STL file"},
+  };
+  for (const Case& c : cases) {
+    test::write_text(dir / "m.toml", c.text);
+    const Outcome o = timed("model check '" + (dir / "m.toml").string() + "'", dir / "log.txt");
+    EXPECT_EQ(o.status, kBadInput) << o.text;
+    EXPECT_NE(o.text.find(c.want), std::string::npos) << c.want << "\n" << o.text;
+    EXPECT_EQ(o.text.find("SECRET"), std::string::npos) << o.text;
+    EXPECT_EQ(o.text.find("out of memory"), std::string::npos) << o.text;
+  }
+}
+
+// The tet-count estimate: a size far too small for the model is refused before meshing (in well
+// under the time TetGen would take), --max-tets raises or lowers the limit, and the estimate is
+// within a factor of 3 of the tets TetGen then makes.
+TEST(ModelCli, MeshRefusesAnEstimatePastMaxTets) {
+  TempDir dir;
+  const std::string die = "'" + kModels + "die_on_substrate.toml'", out = "'" + (dir / "m.vtu").string() + "'";
+  Outcome o = timed("mesh " + die + " --max-size 0.01mm -o " + out, dir / "log.txt");
+  EXPECT_EQ(o.status, kBadInput) << o.text;
+  EXPECT_LT(o.seconds, 5);
+  EXPECT_NE(o.text.find("over the limit of 4000000"), std::string::npos) << o.text;
+  EXPECT_NE(o.text.find("--max-tets"), std::string::npos) << o.text;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.vtu"));
+  // 0.4 mm: about 2 * 112 mm^3 / (0.4^3 / 8.49 mm^3) = 30k tets
+  o = timed("mesh " + die + " --max-size 0.4mm --max-tets 5000 -o " + out, dir / "log.txt");
+  EXPECT_EQ(o.status, kBadInput) << o.text;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(o.text, m, std::regex("about (\\S+) tets"))) << o.text;
+  const double estimate = std::stod(m[1]);
+  ASSERT_EQ(foxi_cli("mesh " + die + " --max-size 0.4mm -o " + out, dir / "log.txt"), 0) << test::read_text(dir / "log.txt");
+  const double tets = static_cast<double>(foxi::read_mesh(dir / "m.vtu").tet_count());
+  EXPECT_GT(tets, estimate / 3) << estimate;
+  EXPECT_LT(tets, estimate * 3) << estimate;
+  EXPECT_EQ(foxi_cli("mesh " + die + " --max-tets 0 -o " + out, dir / "log.txt"), 2);
+  EXPECT_EQ(foxi_cli("mesh " + die + " --max-tets lots -o " + out, dir / "log.txt"), 2);
+}
+
+// --refine-from with a small target error shrinks every size by up to 4 (64 times the tets) each
+// round, without end: the estimate (the size field integrated over the solved mesh) bounds it, and
+// is within a factor of 3 of what TetGen makes where it is allowed.
+TEST(ModelCli, RefineFromIsBoundedByTheEstimate) {
+  TempDir dir;
+  const std::string die = "'" + kModels + "die_on_substrate.toml'", solved = "'" + (dir / "s.vtu").string() + "'";
+  ASSERT_EQ(foxi_cli("solve " + die + " --physics thermal -o " + solved, dir / "log.txt"), 0)
+      << test::read_text(dir / "log.txt");
+  const double first = static_cast<double>(foxi::read_mesh(dir / "s.vtu").tet_count());
+  const std::string refine = "mesh " + die + " --refine-from " + solved + " -o '" + (dir / "r.vtu").string() + "'";
+  Outcome o = timed(refine + " --target-error 1e-9 --max-tets " + std::to_string(static_cast<long>(10 * first)),
+                    dir / "log.txt");
+  EXPECT_EQ(o.status, kBadInput) << o.text;
+  EXPECT_LT(o.seconds, 10);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(o.text, m, std::regex("about (\\S+) tets"))) << o.text;
+  EXPECT_GT(std::stod(m[1]), 10 * first) << o.text;
+  EXPECT_FALSE(std::filesystem::exists(dir / "r.vtu"));
+  // a moderate target: the estimate against the mesh made
+  o = timed(refine + " --target-error 0.3 --max-tets 1", dir / "log.txt");
+  ASSERT_TRUE(std::regex_search(o.text, m, std::regex("about (\\S+) tets"))) << o.text;
+  const double estimate = std::stod(m[1]);
+  ASSERT_EQ(foxi_cli(refine + " --target-error 0.3", dir / "log.txt"), 0) << test::read_text(dir / "log.txt");
+  const double tets = static_cast<double>(foxi::read_mesh(dir / "r.vtu").tet_count());
+  EXPECT_GT(tets, estimate / 3) << estimate;
+  EXPECT_LT(tets, estimate * 3) << estimate;
+}
+
+// model show meshes coarsely: power_module's thin solders once made a "coarse" mesh of 612,775 tets
+// (44 s); now the tets follow the PLC's points, and every part still shows (its legend line).
+TEST(ModelCli, ShowMeshIsCoarse) {
+  TempDir dir;
+  const Outcome o = timed("model show '" + kModels + "power_module.toml' --size 320x240 -o '" +
+                              (dir / "p.png").string() + "'",
+                          dir / "log.txt");
+  ASSERT_EQ(o.status, 0) << o.text;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(o.text, m, std::regex("coarse mesh (\\d+) nodes, (\\d+) tets"))) << o.text;
+  EXPECT_LT(std::stod(m[2]), 5000) << o.text;
+  EXPECT_NE(o.text.find("baseplate"), std::string::npos) << o.text;
+  EXPECT_EQ(foxi::read_png(dir / "p.png").width, 320);
+  EXPECT_EQ(foxi_cli("model show '" + kModels + "power_module.toml' --max-tets 10 -o '" + (dir / "q.png").string() + "'",
+                     dir / "log2.txt"),
+            kBadInput)
+      << test::read_text(dir / "log2.txt");
+  EXPECT_NE(test::read_text(dir / "log2.txt").find("over the limit of 10;"), std::string::npos)
+      << test::read_text(dir / "log2.txt");
 }
 
 }  // namespace

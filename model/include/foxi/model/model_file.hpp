@@ -2,7 +2,7 @@
 // and parts (boxes, z-axis cylinders, layer stacks, arrays), loaded into plain data in SI units.
 //
 //   units.length = "mm"              # bare numbers in part fields are in this unit
-//   library = "materials.toml"       # optional material library, relative to this file
+//   library = "materials.toml"       # optional material library, relative to this file's folder
 //   [parameters]
 //   die_w = "4 mm"                   # strings are expressions with units; bare numbers dimensionless
 //   sub_w = "die_w + 6 mm"
@@ -35,6 +35,28 @@
 #include "foxi/model/units.hpp"
 
 namespace foxi {
+
+// The bounds a model keeps (README, "Model limits"); load_model refuses a model past any of them with
+// an error that names the entity and the bound. They keep hostile or mistyped values from crashing the
+// TOML parser, CGAL or GMP (stack depth, overflow, degenerate geometry) and from hanging the structure
+// builder or the mesher (counts).
+namespace model_limits {
+inline constexpr std::uintmax_t kFileBytes = 4u << 20;  // a model or materials library file
+inline constexpr std::uintmax_t kStlBytes = 64u << 20;  // an STL file
+inline constexpr std::size_t kLineBytes = 64u << 10;  // a line of a model or library file
+inline constexpr int kTomlDepth = 32;             // nested arrays, inline tables and dotted key parts
+inline constexpr std::size_t kParameterChain = 64;  // parameters whose values need each other, in a row
+inline constexpr std::size_t kParts = 1000;         // parts (each layer of a stack counts)
+inline constexpr long kArrayItems = 10000;          // nx * ny of one array
+inline constexpr long kSegments = 1000;             // of a cylinder
+inline constexpr std::size_t kOutlinePoints = 2000;       // of an extrusion
+inline constexpr std::size_t kOutlineVertices = 100000;   // of all prisms (array items included)
+inline constexpr std::size_t kSurfaceTriangles = 200000;  // of all balls and STL surfaces
+inline constexpr double kBallTolerance = 1e-3;  // a ball's tolerance is at least this times its radius
+inline constexpr double kMaxLength = 1e3;       // m: every coordinate and size, and the model's extent
+inline constexpr double kMinExtent = 1e-9;      // m: the model's extent (largest side of its box)
+inline constexpr double kMinFeature = 1e-6;     // times the extent: every edge, height and ball radius
+}  // namespace model_limits
 
 // A vertical prism: a simple (convex or not) counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
 // over z in [z0, z1].
@@ -79,7 +101,10 @@ struct Model {
 // material) for TOML syntax errors, unknown parameters, unit mismatches, circular expressions,
 // sizes that are not positive, unknown materials, and unknown shapes or keys; for conditions and
 // loads: unknown types, units that do not fit the type, surfaces that name no part face, interface or
-// [surfaces] entry, unknown parts.
+// [surfaces] entry, unknown parts; for numbers that are not finite, and models past model_limits
+// (degenerate geometry included: a feature below kMinFeature of the model's extent). Referenced files
+// (library, STL) are named relative to the model's folder, must be regular files of the expected kind,
+// and their content is never quoted in an error.
 Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides = {});
 
 }  // namespace foxi

@@ -36,11 +36,17 @@ std::string dims_to_string(const Dims& d);
 // Absolute temperatures in degC are read by the boundary conditions (conditions.hpp), not here.
 std::optional<Quantity> unit_quantity(std::string_view name);
 
+// Limits on an expression (README, "Limits"): its length in characters and how deep it nests
+// (parentheses, unary signs, exponents and function calls each count one level).
+constexpr std::size_t kMaxExpressionLength = 4096;
+constexpr int kMaxExpressionDepth = 64;
+
 // Evaluates `text`: numbers, a number followed by a unit ("8 mm", "2.5um"), names (resolved by
 // `lookup` first, then as units; `lookup` returns nothing for an unknown name), + - * / ^ (integer
 // exponent on dimensioned bases), parentheses, pi, sqrt abs min max sin cos tan exp log (dimensionless
 // arguments except sqrt abs min max). Throws ExpressionError on syntax errors, unknown names ("unknown
-// parameter 'x'") and unit mismatches ("unit mismatch: m + K"); `lookup` may throw its own errors.
+// parameter 'x'") unit mismatches ("unit mismatch: m + K")
+// and expressions past the limits above; `lookup` may throw its own errors.
 Quantity evaluate_expression(std::string_view text,
                              const std::function<std::optional<Quantity>(std::string_view)>& lookup);
 
