@@ -422,9 +422,9 @@ std::string describe(const ModelWarning& w, const Model& model) {
              (w.parts.size() == 1 ? "it" : "them") + " and the rest of the model";
     case ModelWarningKind::overhang:
       return who + " overhangs what it sits on (" + quoted_list(w.supports) + ") at z = " +
-             format("%.6g ", w.z / s) + u + ": " + format("%.4g ", w.area / (s * s)) + u + "^2 of its bottom (" +
+             format("%.6g ", w.z / s) + u + ": " + format("%.4g ", w.area / (s * s)) + u + "^2 (" +
              format("%.3g%%", 100 * w.fraction) +
-             " of its bottom there) lies beyond the contact, exposed and insulated unless a condition is on it";
+             ") of its bottom there lies beyond the contact, exposed (insulated unless a condition is on it)";
     case ModelWarningKind::no_fixed_value: {
       const char* what = w.physics == Physics::thermal          ? "temperature or convection"
                          : w.physics == Physics::thermal_stress ? "displacement or sliding"

@@ -176,8 +176,9 @@ TEST(ModelDiagnostics, PathToAFixedValueDependsOnThePhysics) {
   // current into the top. Electrostatics has the spacer's dielectric: one group, fixed. DC current
   // does not pass the spacer: the top has only a current, no voltage. Thermal: the convection on the
   // top fixes the whole stack. Thermoelastic: held at the base, the stack is bonded.
-  const std::string stack = box("base", 0, 0, 0, 4, 4, 1) + box("spacer", 0, 0, 1, 4, 4, 1) +
-                            box("top", 0, 0, 2, 4, 4, 1);
+  std::string spacer = box("spacer", 0, 0, 1, 4, 4, 1);  // box() writes material "a"
+  spacer.replace(spacer.find("material = \"a\""), 14, "material = \"ins\"");
+  const std::string stack = box("base", 0, 0, 0, 4, 4, 1) + spacer + box("top", 0, 0, 2, 4, 4, 1);
   const std::string model = kMaterials + stack +
                             condition("voltage", "base.bottom", "value = \"1 V\"") +
                             condition("current", "top.top", "value = \"1 mA\"") +
