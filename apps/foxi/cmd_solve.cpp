@@ -268,6 +268,25 @@ int cmd_solve(Args args) {
   params.solver = solver_options;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 
+  // The values are checked before the meshing, which may take long (tags and regions need the mesh).
+  auto values = [](const std::vector<std::string>& list, const char* option, const char* unit) {
+    for (const std::string& s : list) (void)parse_value(split_assignment(s, option).second, option, unit);
+  };
+  for (const std::string& s : fix)
+    (void)parse_temperature(split_assignment(s, "--fix").second, "--fix", TemperatureKind::absolute);
+  for (const std::string& s : convect) {
+    const auto [h, tinf] = split_pair(split_assignment(s, "--convect").second, "--convect", "TAG=h,Tinf");
+    (void)parse_value(h, "--convect", "W/(m^2*K)");
+    (void)parse_temperature(tinf, "--convect", TemperatureKind::absolute);
+  }
+  values(flux, "--flux", "W/m^2");
+  values(power, "--power", "W");
+  values(density, "--power-density", "W/m^3");
+  values(cond, "--k", "W/(m*K)");
+  values(terminal, "--terminal", "V");
+  values(terminal_current, "--terminal-current", "A");
+  values(sigma, "--sigma", "S/m");
+
   auto t0 = std::chrono::steady_clock::now();
   const bool from_model = is_model_path(files[0]);
   MeshedModel model_run;

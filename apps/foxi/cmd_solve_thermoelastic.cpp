@@ -133,6 +133,9 @@ int cmd_solve_thermoelastic(Args args) {
   params.order = order == "2" ? 2 : 1;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 
+  // the temperatures are checked before the meshing, which may take long
+  if (!dt.empty()) (void)parse_temperature(dt, "--dT", TemperatureKind::difference);
+  if (!tref.empty()) (void)parse_temperature(tref, "--tref", TemperatureKind::absolute);
   const auto t0 = std::chrono::steady_clock::now();
   // the thermal conditions are checked before meshing, as mesh_model checks the stress conditions
   if (from_thermal) check_physics(load_model(files[0], sets), Physics::thermal);

@@ -134,6 +134,18 @@ TEST(SolveUnitsCli, WrongDimensionAndNegativeKelvinAreUsageErrors) {
     EXPECT_EQ(r.rc, 2) << b.args << "\n" << r.out;
     EXPECT_NE(r.out.find(b.says), std::string::npos) << b.args << "\n" << r.out;
   }
+  // refused before the meshing: a cube meshed at 1e-4 of its size would take hours
+  std::string huge = kCube;
+  huge.replace(huge.find("max_size = \"0.5 mm\""), 20, "max_size = \"0.1 um\"");
+  test::write_text(dir / "huge.toml", huge);
+  for (const char* bad : {"--physics thermal --fix cube.top=-1K", "--physics thermal --power cube=1m",
+                          "--physics thermal --convect cube.top=1,2m", "--physics thermoelastic --dT 1m",
+                          "--physics thermoelastic --temperature-from-thermal --tref -1"}) {
+    EXPECT_EQ(test::run("timeout 60 '" + test::cli_path() + "' solve '" + (dir / "huge.toml").string() + "' " + bad,
+                        dir / "huge.txt"),
+              2)
+        << bad << "\n" << test::read_text(dir / "huge.txt");
+  }
   const Result v = solve(dir, "--physics thermoelastic --dT 5V");
   EXPECT_EQ(v.rc, 2) << v.out;
   EXPECT_NE(v.out.find("--dT"), std::string::npos) << v.out;
