@@ -83,6 +83,8 @@ TEST(Units, MinMaxMismatchNamesOnlyTheFunction) {
     EXPECT_NE(what.find("unit mismatch: 1 (dimensionless) max m in 'max(1, 2 mm)'"), std::string::npos) << what;
     EXPECT_EQ(what.find("TRAILING"), std::string::npos) << what;
   }
+}
+
 // evaluate_in / evaluate_temperature: what foxi solve's options read (--power die=3W, --fix top=25degC).
 template <class F>
 std::string thrown(F f) {
