@@ -11,6 +11,7 @@
 #include "exit_codes.hpp"
 #include "model_picture.hpp"
 #include "model_run.hpp"
+#include "foxi/model/diagnostics.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/physics.hpp"
@@ -28,7 +29,10 @@ const char* kModelUsage =
     "foxi model show MODEL.toml [--set NAME=VALUE]... [--size WxH] [--view exploded|cut|whole]\n"
     "                [--max-tets N] -o OUT.png\n"
     "  check: loads the model, builds its PLC and prints parameters, materials, parts with volumes,\n"
-    "         boundary names, conditions, loads and mesh controls (or the errors, with file and line)\n"
+    "         boundary names, conditions, loads and mesh controls (or the errors, with file and line);\n"
+    "         warns about parts that touch no other part and parts that overhang what they sit on, and\n"
+    "         says for each physics whether the model is ready for it or why not (a missing material\n"
+    "         property, no condition, a group of parts with no path to a fixed value)\n"
     "  plc:   writes the PLC (metres, region id = part number, boundary markers) as a TetGen .poly\n"
     "  show:  meshes the model coarsely (TetGen, no sizes, no quality refinement, not made Delaunay:\n"
     "         the tets of the PLC's points) and draws it with the\n"
@@ -202,37 +206,45 @@ int cmd_model(Args args) {
   for (std::size_t b = 0; b < s.boundary_names.size(); ++b)
     std::printf("  %2zu %-28s %.6g m^2\n", b + 1, s.boundary_names[b].c_str(), s.boundary_area[b]);
   print_model_conditions(model);
+  // what the geometry and the conditions leave unsound (diagnostics.hpp)
+  const ModelDiagnostics diag = diagnose_model(model, s);
+  for (const ModelWarning& w : diag.warnings)
+    if (w.kind != ModelWarningKind::no_fixed_value) std::printf("warning: %s\n", describe(w, model).c_str());
   // which solves the model is ready for (foxi solve MODEL --physics NAME), or why not
   for (Physics ph : {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress}) {
-    bool has = false;
-    for (const BoundaryCondition& c : model.conditions) has = has || condition_applies(c, ph);
-    if (!has) continue;
     try {
       check_physics(model, ph);
-      if (ph != Physics::thermal_stress) {
-        std::printf("physics %s: ready (foxi solve MODEL --physics %s)\n", physics_name(ph),
-                    physics_name(ph));
-        if (ph == Physics::electrostatic) print_conductors(model, s);
-        continue;
-      }
-      // the stress solve also needs a temperature: the model's load, or its own thermal run
-      bool load = false, thermal = true;
-      for (const Load& l : model.loads) load = load || l.kind == LoadKind::temperature_change;
-      try {
-        check_physics(model, Physics::thermal);
-      } catch (const IoError&) {
-        thermal = false;
-      }
-      std::printf(
-          "physics %s: ready (foxi solve MODEL --physics thermoelastic%s)%s\n", physics_name(ph),
-          load      ? ""
-          : thermal ? " --temperature-from-thermal, or --dT K"
-                    : " --dT K",
-          load ? (thermal ? "; or with the thermal run's temperatures: --temperature-from-thermal" : "")
-               : "; the model has no temperature_change load");
     } catch (const IoError& e) {
       std::printf("physics %s: not ready: %s\n", physics_name(ph), e.what());
+      continue;
     }
+    std::size_t unfixed = 0;
+    for (const ModelWarning& w : diag.warnings)
+      if (w.kind == ModelWarningKind::no_fixed_value && w.physics == ph) {
+        std::printf("physics %s: not ready: %s\n", physics_name(ph), describe(w, model).c_str());
+        ++unfixed;
+      }
+    if (unfixed > 0) continue;
+    if (ph != Physics::thermal_stress) {
+      std::printf("physics %s: ready (foxi solve MODEL --physics %s)\n", physics_name(ph), physics_name(ph));
+      if (ph == Physics::electrostatic) print_conductors(model, s);
+      continue;
+    }
+    // the stress solve also needs a temperature: the model's load, or its own thermal run
+    bool load = false, thermal = true;
+    for (const Load& l : model.loads) load = load || l.kind == LoadKind::temperature_change;
+    try {
+      check_physics(model, Physics::thermal);
+    } catch (const IoError&) {
+      thermal = false;
+    }
+    std::printf(
+        "physics %s: ready (foxi solve MODEL --physics thermoelastic%s)%s\n", physics_name(ph),
+        load      ? ""
+        : thermal ? " --temperature-from-thermal, or --dT K"
+                  : " --dT K",
+        load ? (thermal ? "; or with the thermal run's temperatures: --temperature-from-thermal" : "")
+             : "; the model has no temperature_change load");
   }
   std::printf("PLC: %zu points, %zu facets, %zu region seeds\n", s.plc.point_count(), s.plc.facet_count(),
               s.plc.regions.size());

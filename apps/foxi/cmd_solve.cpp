@@ -27,6 +27,9 @@ const char* kSolveUsage =
     "  (--physics thermoelastic: see 'foxi solve --physics thermoelastic --help')\n"
     "  Meshes the model (TetGen, its [mesh] controls) and solves with its [[conditions]] and [[loads]];\n"
     "  the options below add to them, boundaries and regions named as in 'foxi model check'.\n"
+    "  Values take units as model files write them: --fix top=300K, --fix 'top=25 degC', --power die=3W,\n"
+    "  --k die='150 W/(m*K)', --convect 'top=10 W/(m^2*K),25degC'; a bare number is SI; a unit of\n"
+    "  another dimension is refused, and so is an absolute temperature not above 0 K.\n"
     "\n"
     "foxi solve MESH --physics thermal [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf]\n"
     "                [--power REGION=W] [--power-density REGION=W/m3] [--k REGION=k]\n"
@@ -265,6 +268,25 @@ int cmd_solve(Args args) {
   params.solver = solver_options;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 
+  // The values are checked before the meshing, which may take long (tags and regions need the mesh).
+  auto values = [](const std::vector<std::string>& list, const char* option, const char* unit) {
+    for (const std::string& s : list) (void)parse_value(split_assignment(s, option).second, option, unit);
+  };
+  for (const std::string& s : fix)
+    (void)parse_temperature(split_assignment(s, "--fix").second, "--fix", TemperatureKind::absolute);
+  for (const std::string& s : convect) {
+    const auto [h, tinf] = split_pair(split_assignment(s, "--convect").second, "--convect", "TAG=h,Tinf");
+    (void)parse_value(h, "--convect", "W/(m^2*K)");
+    (void)parse_temperature(tinf, "--convect", TemperatureKind::absolute);
+  }
+  values(flux, "--flux", "W/m^2");
+  values(power, "--power", "W");
+  values(density, "--power-density", "W/m^3");
+  values(cond, "--k", "W/(m*K)");
+  values(terminal, "--terminal", "V");
+  values(terminal_current, "--terminal-current", "A");
+  values(sigma, "--sigma", "S/m");
+
   auto t0 = std::chrono::steady_clock::now();
   const bool from_model = is_model_path(files[0]);
   MeshedModel model_run;
@@ -293,7 +315,7 @@ int cmd_solve(Args args) {
         e.tags = boundary_tags(mesh, k, "--conductor");
         const auto colon = v.rfind(':');
         e.name = v.substr(0, colon);
-        if (colon != std::string::npos) e.voltage = parse_number(v.substr(colon + 1), "--conductor");
+        if (colon != std::string::npos) e.voltage = parse_value(v.substr(colon + 1), "--conductor", "V");
         ep.conductors.push_back(e);
       }
       for (const std::string& s : eps) {
@@ -337,14 +359,14 @@ int cmd_solve(Args args) {
       e.tags = boundary_tags(mesh, k, option);
       e.name = tags_label(mesh, e.tags);
       e.fixed_current = current;
-      (current ? e.current : e.voltage) = parse_number(v, option);
+      (current ? e.current : e.voltage) = parse_value(v, option, current ? "A" : "V");
       cp.terminals.push_back(e);
     };
     for (const std::string& s : terminal) add_terminal(s, "--terminal", false);
     for (const std::string& s : terminal_current) add_terminal(s, "--terminal-current", true);
     for (const std::string& s : sigma) {
       auto [k, v] = split_assignment(s, "--sigma");
-      cp.conductivity.push_back({region_id(mesh, k, "--sigma"), parse_number(v, "--sigma")});
+      cp.conductivity.push_back({region_id(mesh, k, "--sigma"), parse_value(v, "--sigma", "S/m")});
     }
     const CurrentReport r = solve_current(mesh, cp);
     std::printf("%s: %zu nodes, %zu tets; DC conduction, %zu unknowns, %zu terminals\n", files[0].c_str(),
@@ -383,32 +405,31 @@ int cmd_solve(Args args) {
   }
   for (const std::string& s : fix) {
     auto [k, v] = split_assignment(s, "--fix");
-    params.fixed.push_back({boundary_tag(mesh, k, "--fix"), parse_number(v, "--fix")});
+    params.fixed.push_back(
+        {boundary_tag(mesh, k, "--fix"), parse_temperature(v, "--fix", TemperatureKind::absolute)});
   }
   for (const std::string& s : flux) {
     auto [k, v] = split_assignment(s, "--flux");
-    params.flux.push_back({boundary_tag(mesh, k, "--flux"), parse_number(v, "--flux")});
+    params.flux.push_back({boundary_tag(mesh, k, "--flux"), parse_value(v, "--flux", "W/m^2")});
   }
   for (const std::string& s : convect) {
     auto [k, v] = split_assignment(s, "--convect");
-    const auto comma = v.find(',');
-    if (comma == std::string::npos) throw UsageError("--convect takes TAG=h,Tinf, not '" + s + "'");
-    params.convection.push_back({boundary_tag(mesh, k, "--convect"),
-                                 parse_number(v.substr(0, comma), "--convect"),
-                                 parse_number(v.substr(comma + 1), "--convect")});
+    const auto [h, tinf] = split_pair(v, "--convect", "TAG=h,Tinf");
+    params.convection.push_back({boundary_tag(mesh, k, "--convect"), parse_value(h, "--convect", "W/(m^2*K)"),
+                                 parse_temperature(tinf, "--convect", TemperatureKind::absolute)});
   }
   for (const std::string& s : power) {
     auto [k, v] = split_assignment(s, "--power");
-    params.sources.push_back({region_id(mesh, k, "--power"), parse_number(v, "--power"), true});
+    params.sources.push_back({region_id(mesh, k, "--power"), parse_value(v, "--power", "W"), true});
   }
   for (const std::string& s : density) {
     auto [k, v] = split_assignment(s, "--power-density");
     params.sources.push_back(
-        {region_id(mesh, k, "--power-density"), parse_number(v, "--power-density"), false});
+        {region_id(mesh, k, "--power-density"), parse_value(v, "--power-density", "W/m^3"), false});
   }
   for (const std::string& s : cond) {
     auto [k, v] = split_assignment(s, "--k");
-    params.conductivity.push_back({region_id(mesh, k, "--k"), parse_number(v, "--k")});
+    params.conductivity.push_back({region_id(mesh, k, "--k"), parse_value(v, "--k", "W/(m*K)")});
   }
   for (const std::string& s : theta) {
     const auto colon = s.find(':');

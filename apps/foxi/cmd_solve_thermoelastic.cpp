@@ -32,8 +32,9 @@ const char* kThermoelasticUsage =
     "                (--dT K | --temperature FILE[:FIELD] [--tref K])\n"
     "                [--E REGION=Pa] [--nu REGION=nu] [--alpha REGION=1/K]\n"
     "                [--order 1|2] [--solver auto|direct|amg|ichol] [--tol REL] [-o OUT]\n"
-    "  Linear thermoelasticity with linear tets (SI units). Options may be repeated; TAG is a boundary\n"
-    "  tag number or name, REGION a region id or name.\n"
+    "  Linear thermoelasticity with linear tets. Options may be repeated; TAG is a boundary tag number\n"
+    "  or name, REGION a region id or name. Values take units as model files write them (--E die=130GPa,\n"
+    "  --alpha die='2.6 ppm/K', --dT 5degC = --dT 5K, --tref '25 degC'); a bare number is SI.\n"
     "  --order 2            quadratic (10-node) tets for stress accuracy: mid-edge unknowns internal to\n"
     "                       the solver (about 7x the unknowns); results still at the mesh's nodes and\n"
     "                       per tet (stress at the centroid = the tet's mean stress)\n"
@@ -67,7 +68,7 @@ FixedDisplacement parse_fix(const Mesh& mesh, const std::string& text) {
     const int c = name == "ux" ? 0 : name == "uy" ? 1 : name == "uz" ? 2 : -1;
     if (c < 0) throw UsageError("--fix: '" + name + "' is no component (ux, uy, uz) in '" + text + "'");
     f.fix[c] = true;
-    if (colon != std::string::npos) f.value[c] = parse_number(item.substr(colon + 1), "--fix");
+    if (colon != std::string::npos) f.value[c] = parse_value(item.substr(colon + 1), "--fix", "m");
     at = comma + 1;
   }
   return f;
@@ -132,6 +133,9 @@ int cmd_solve_thermoelastic(Args args) {
   params.order = order == "2" ? 2 : 1;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
 
+  // the temperatures are checked before the meshing, which may take long
+  if (!dt.empty()) (void)parse_temperature(dt, "--dT", TemperatureKind::difference);
+  if (!tref.empty()) (void)parse_temperature(tref, "--tref", TemperatureKind::absolute);
   const auto t0 = std::chrono::steady_clock::now();
   // the thermal conditions are checked before meshing, as mesh_model checks the stress conditions
   if (from_thermal) check_physics(load_model(files[0], sets), Physics::thermal);
@@ -167,7 +171,9 @@ int cmd_solve_thermoelastic(Args args) {
   }
   for (const std::string& s : fix) params.fixed.push_back(parse_fix(mesh, s));
   for (const std::string& s : slide) params.sliding.push_back({boundary_tag(mesh, s, "--slide")});
-  auto material = [&](const std::vector<std::string>& values, const char* option, double RegionElasticity::*field) {
+  // unit: what the option's value is in (nullptr: dimensionless)
+  auto material = [&](const std::vector<std::string>& values, const char* option, const char* unit,
+                      double RegionElasticity::*field) {
     for (const std::string& s : values) {
       auto [k, v] = split_assignment(s, option);
       const std::int32_t id = region_id(mesh, k, option);
@@ -175,15 +181,15 @@ int cmd_solve_thermoelastic(Args args) {
       for (RegionElasticity& e : params.materials)
         if (e.region == id) r = &e;
       if (!r) r = &params.materials.emplace_back(RegionElasticity{id});
-      r->*field = parse_number(v, option);
+      r->*field = unit ? parse_value(v, option, unit) : parse_number(v, option);
     }
   };
-  material(young, "--E", &RegionElasticity::youngs_modulus);
-  material(nu, "--nu", &RegionElasticity::poisson_ratio);
-  material(alpha, "--alpha", &RegionElasticity::thermal_expansion);
-  if (!dt.empty()) params.delta_t = parse_number(dt, "--dT");
+  material(young, "--E", "Pa", &RegionElasticity::youngs_modulus);
+  material(nu, "--nu", nullptr, &RegionElasticity::poisson_ratio);
+  material(alpha, "--alpha", "1/K", &RegionElasticity::thermal_expansion);
+  if (!dt.empty()) params.delta_t = parse_temperature(dt, "--dT", TemperatureKind::difference);
   if (!temperature.empty()) params.temperature = read_temperature(mesh, temperature);
-  if (!tref.empty()) params.reference_temperature = parse_number(tref, "--tref");
+  if (!tref.empty()) params.reference_temperature = parse_temperature(tref, "--tref", TemperatureKind::absolute);
   const auto t1 = std::chrono::steady_clock::now();
 
   const ThermoelasticReport r = solve_thermoelastic(mesh, params);

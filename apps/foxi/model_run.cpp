@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "foxi/mesher/model_mesh_params.hpp"
+#include "foxi/model/diagnostics.hpp"
 #include "foxi/model/io_error.hpp"
 
 namespace foxi::cli {
@@ -77,6 +78,10 @@ MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::s
   for (Physics p : {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress})
     if (physics == physics_name(p)) ph = p;
   MeshedModel m = mesh_model(file, sets, ph);
+  // the model's warnings before the work (foxi model check prints the same)
+  if (ph)
+    for (const ModelWarning& w : warnings_for(diagnose_model(m.model, m.structure), *ph))
+      std::fprintf(stderr, "foxi solve: warning: %s: %s\n", file.c_str(), describe(w, m.model).c_str());
   std::printf("model %s: %zu parts, %zu conditions, %zu loads -> PLC %zu points, %zu facets -> %zu nodes, %zu tets "
               "(TetGen %s, %.3f s; Delaunay %s%s)\n",
               file.c_str(), m.model.parts.size(), m.model.conditions.size(), m.model.loads.size(),

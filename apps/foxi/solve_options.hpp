@@ -9,12 +9,23 @@
 
 #include "cli.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/units.hpp"
 #include "foxi/solver/thermal.hpp"
 
 namespace foxi::cli {
 
 // A finite number.
 double parse_number(const std::string& text, const std::string& option);
+// A value with units as model files write them ("3 W", "3W", "3000 mW"; a bare number is SI), of the
+// dimension of `unit` ("W", "W/(m*K)", "V"); UsageError naming the option and the expected unit.
+double parse_value(const std::string& text, const std::string& option, const char* unit);
+// A temperature: "300", "300 K", "25 degC", "25degC", "25 °C". Absolute: degC adds 273.15 K and a
+// value not above 0 K is refused; a difference (--dT): 5 degC = 5 K.
+double parse_temperature(const std::string& text, const std::string& option, TemperatureKind kind);
+// "A,B" split at the last comma outside parentheses (values may be "max(1, 2) W"); UsageError
+// naming the option and `form` when there is none.
+std::pair<std::string, std::string> split_pair(const std::string& text, const std::string& option,
+                                               const char* form);
 // "KEY=VALUE" split at the first '='.
 std::pair<std::string, std::string> split_assignment(const std::string& text, const std::string& option);
 // A boundary tag given by number or by name; a region id by number or name.

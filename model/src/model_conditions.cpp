@@ -35,7 +35,6 @@ using Value = ModelToml;
 constexpr Dims kTemperature = {0, 0, 0, 1, 0}, kHeatFlux = {0, 1, -3, 0, 0}, kFilm = {0, 1, -3, -1, 0},
                kVoltage = {2, 1, -3, 0, -1}, kCurrent = {0, 0, 0, 0, 1}, kPower = {2, 1, -3, 0, 0},
                kPowerDensity = {-1, 1, -3, 0, 0};
-constexpr double kCelsiusOffset = 273.15;
 
 class ConditionReader {
  public:
@@ -88,15 +87,17 @@ class ConditionReader {
     return v.as_string().str;
   }
 
+  std::optional<Quantity> parameter(std::string_view n) const {
+    auto it = std::lower_bound(m_.parameters.begin(), m_.parameters.end(), n,
+                               [](const Parameter& p, std::string_view x) { return p.name < x; });
+    if (it == m_.parameters.end() || it->name != n) return std::nullopt;
+    return it->value;
+  }
+
   // The value of a TOML number or expression string: bare numbers get `want` times `bare_scale`.
   Quantity evaluate(const Value& v, const std::string& expr, const std::string& entity) const {
     try {
-      return evaluate_expression(expr, [&](std::string_view n) -> std::optional<Quantity> {
-        auto it = std::lower_bound(m_.parameters.begin(), m_.parameters.end(), n,
-                                   [](const Parameter& p, std::string_view x) { return p.name < x; });
-        if (it == m_.parameters.end() || it->name != n) return std::nullopt;
-        return it->value;
-      });
+      return evaluate_expression(expr, [&](std::string_view n) { return parameter(n); });
     } catch (const ExpressionError& x) {
       fail(v, entity + ": " + x.what());
     }
@@ -134,24 +135,20 @@ class ConditionReader {
       out[i] = length(v.as_array()[static_cast<std::size_t>(i)], entity + "[" + std::to_string(i) + "]");
   }
 
-  // A temperature in K: numbers and expressions in K, or "EXPR degC" (also "°C") with the offset;
-  // `absolute` false takes degC as a difference (no offset).
+  // A temperature in K: numbers and expressions in K, or "EXPR degC" (also "°C") with the offset
+  // (evaluate_temperature, units.hpp); `absolute` false takes degC as a difference (no offset).
+  // Absolute temperatures must be above 0 K, in degC too.
   double temperature(const Value& v, const std::string& entity, bool absolute) const {
+    const TemperatureKind kind = absolute ? TemperatureKind::absolute : TemperatureKind::difference;
     if (v.is_string()) {
-      std::string s = v.as_string().str;
-      while (!s.empty() && s.back() == ' ') s.pop_back();
-      for (const std::string suffix : {"degC", "\xC2\xB0" "C"}) {
-        if (s.size() <= suffix.size() || s.compare(s.size() - suffix.size(), suffix.size(), suffix) != 0)
-          continue;
-        const Quantity q = evaluate(v, s.substr(0, s.size() - suffix.size()), entity);
-        if (q.dims != kDimensionless)
-          fail(v, entity + ": unit mismatch: '" + s + "' puts " + dims_to_string(q.dims) + " before degC");
-        return q.value + (absolute ? kCelsiusOffset : 0.0);
+      try {
+        return evaluate_temperature(v.as_string().str, kind, [&](std::string_view n) { return parameter(n); });
+      } catch (const ExpressionError& x) {
+        fail(v, entity + ": " + x.what());
       }
     }
     const double t = quantity(v, kTemperature, entity, 1);
-    if (absolute && !(t > 0))
-    {
+    if (absolute && !(t > 0)) {
       char buf[96];
       std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero (for Celsius write \"%g degC\")", t, t);
       fail(v, entity + buf);

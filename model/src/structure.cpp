@@ -436,6 +436,7 @@ Structure build_structure(const Model& model, const ProgressFn& progress) {
   bool solids = false;
   for (const Part& p : model.parts) solids = solids || !p.surface.tri.empty();
   Structure s = solids ? build_structure_from_solids(model, progress) : Builder(model).build();
+  s.facet_own_marker = s.plc.facet_marker;
   tag_selected_surfaces(model, s);
   check_conditions(model, s);
   return s;

@@ -6,6 +6,7 @@
 
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/physics.hpp"
+#include "plc_geometry.hpp"
 
 namespace foxi {
 
@@ -13,15 +14,8 @@ namespace {
 
 // Area of polygon p of `plc` (Newell's normal; any planar polygon).
 double polygon_area(const Plc& plc, std::uint32_t p) {
-  double n[3] = {0, 0, 0};
-  const std::uint32_t b = plc.polygon_vertex_begin[p], e = plc.polygon_vertex_begin[p + 1];
-  for (std::uint32_t i = b; i < e; ++i) {
-    const double* u = &plc.points[3 * std::size_t{plc.polygon_vertices[i]}];
-    const double* v = &plc.points[3 * std::size_t{plc.polygon_vertices[i + 1 < e ? i + 1 : b]}];
-    n[0] += (u[1] - v[1]) * (u[2] + v[2]);
-    n[1] += (u[2] - v[2]) * (u[0] + v[0]);
-    n[2] += (u[0] - v[0]) * (u[1] + v[1]);
-  }
+  double n[3];
+  polygon_normal(plc, p, n);
   return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
 }
 

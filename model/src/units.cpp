@@ -3,6 +3,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <numbers>
 #include <vector>
@@ -337,6 +338,60 @@ std::optional<Quantity> unit_quantity(std::string_view name) {
 Quantity evaluate_expression(std::string_view text,
                              const std::function<std::optional<Quantity>(std::string_view)>& lookup) {
   return Parser(text, lookup).parse();
+}
+
+namespace {
+
+std::optional<Quantity> no_names(std::string_view) { return std::nullopt; }
+
+}  // namespace
+
+double evaluate_in(std::string_view text, std::string_view unit) {
+  const Quantity want = evaluate_expression(unit, no_names);
+  const Quantity q = evaluate_expression(text, no_names);
+  if (q.dims == kDimensionless) return q.value * want.value;  // a bare number: SI
+  if (q.dims != want.dims)
+    throw ExpressionError("unit mismatch: '" + std::string(text) + "' is " + dims_to_string(q.dims) + ", not " +
+                          std::string(unit) + " (" + dims_to_string(want.dims) + ")");
+  return q.value;
+}
+
+double evaluate_temperature(std::string_view text, TemperatureKind kind,
+                            const std::function<std::optional<Quantity>(std::string_view)>& lookup) {
+  constexpr double kCelsiusOffset = 273.15;
+  const bool absolute = kind == TemperatureKind::absolute;
+  const auto& names = lookup ? lookup : std::function<std::optional<Quantity>(std::string_view)>(no_names);
+  std::string_view s = text;
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  double t = 0;
+  bool celsius = false;
+  for (std::string_view suffix : {std::string_view("degC"), std::string_view("\xC2\xB0" "C")}) {
+    if (s.size() <= suffix.size() || s.substr(s.size() - suffix.size()) != suffix) continue;
+    const std::string_view before = s.substr(0, s.size() - suffix.size());
+    const Quantity q = evaluate_expression(before, names);
+    if (q.dims != kDimensionless)
+      throw ExpressionError("unit mismatch: '" + std::string(s) + "' puts " + dims_to_string(q.dims) +
+                            " before degC");
+    t = q.value + (absolute ? kCelsiusOffset : 0.0);
+    celsius = true;
+    break;
+  }
+  if (!celsius) {
+    const Quantity q = evaluate_expression(s, names);
+    if (q.dims != kDimensionless && q.dims != kTemp)
+      throw ExpressionError("unit mismatch: '" + std::string(s) + "' is " + dims_to_string(q.dims) +
+                            ", not a temperature (K or degC)");
+    t = q.value;
+  }
+  if (absolute && !(t > 0)) {
+    char buf[160];
+    if (celsius)
+      std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero", t);
+    else
+      std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero (for Celsius write \"%g degC\")", t, t);
+    throw ExpressionError("'" + std::string(s) + "'" + buf);
+  }
+  return t;
 }
 
 }  // namespace foxi

@@ -311,6 +311,11 @@ TEST(ModelConditionsBadInput, CelsiusWrittenAsKelvin) {
   const foxi::IoError e = build_error(t);
   EXPECT_NE(e.reason().find("not above absolute zero"), std::string::npos) << e.what();
   EXPECT_NE(e.reason().find("-20 degC"), std::string::npos) << e.what();
+  // below absolute zero in degC is refused as well (it was once taken as -26.85 K)
+  const std::string c = replaced(kModel, "value = \"t_amb degC\"", "value = \"-300 degC\"");
+  const foxi::IoError ce = build_error(c);
+  EXPECT_NE(ce.reason().find("not above absolute zero"), std::string::npos) << ce.what();
+  EXPECT_EQ(ce.line(), line_of(c, "value = \"-300 degC\""));
 }
 
 TEST(ModelConditionsBadInput, CelsiusInAParameterIsExplained) {

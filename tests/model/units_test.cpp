@@ -85,4 +85,61 @@ TEST(Units, MinMaxMismatchNamesOnlyTheFunction) {
   }
 }
 
+// evaluate_in / evaluate_temperature: what foxi solve's options read (--power die=3W, --fix top=25degC).
+template <class F>
+std::string thrown(F f) {
+  try {
+    f();
+  } catch (const foxi::ExpressionError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error";
+  return {};
+}
+
+TEST(UnitsValue, ValuesInTheExpectedUnitBareNumbersSI) {
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("3 W", "W"), 3);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("3000 mW", "W"), 3);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("3", "W"), 3);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("150 W/(m*K)", "W/(m*K)"), 150);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("1.5 W/(mm*K)", "W/(m*K)"), 1500);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("2.6 ppm/K", "1/K"), 2.6e-6);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("130GPa", "Pa"), 130e9);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_in("5 mV", "V"), 5e-3);
+  const std::string e = thrown([] { foxi::evaluate_in("3 m", "W"); });
+  EXPECT_NE(e.find("unit mismatch: '3 m' is m, not W"), std::string::npos) << e;
+  EXPECT_FALSE(thrown([] { foxi::evaluate_in("2 W", "W/(m*K)"); }).empty());
+}
+
+TEST(UnitsValue, TemperaturesAbsoluteAndDifferences) {
+  using foxi::TemperatureKind;
+  const auto abs = TemperatureKind::absolute, diff = TemperatureKind::difference;
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("300", abs), 300);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("300K", abs), 300);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("25 degC", abs), 298.15);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("25degC", abs), 298.15);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("25 \xC2\xB0" "C", abs), 298.15);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("-40 degC", abs), 233.15);
+  // a difference: 5 degC is 5 K, never 278.15 K; negative differences are fine
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("5 degC", diff), 5);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("5K", diff), 5);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("-100 K", diff), -100);
+  // names resolve through the lookup, before degC too
+  const auto t_amb = [](std::string_view n) -> std::optional<Quantity> {
+    if (n == "t") return Quantity{20, foxi::kDimensionless};
+    return std::nullopt;
+  };
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("t + 5 degC", abs, t_amb), 298.15);
+  // below absolute zero, in K or in degC; the wrong dimension; degC inside an expression
+  const std::string k = thrown([&] { foxi::evaluate_temperature("-5", abs); });
+  EXPECT_NE(k.find("not above absolute zero"), std::string::npos) << k;
+  EXPECT_NE(k.find("-5 degC"), std::string::npos) << k;  // the hint for Celsius
+  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("-300 degC", abs); }).find("absolute zero"), std::string::npos);
+  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("0 K", abs); }).find("absolute zero"), std::string::npos);
+  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("5 V", abs); }).find("not a temperature (K or degC)"),
+            std::string::npos);
+  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("5 mm degC", diff); }).find("before degC"), std::string::npos);
+  EXPECT_FALSE(thrown([&] { foxi::evaluate_temperature("5 degC + 1 K", abs); }).empty());
+}
+
 }  // namespace

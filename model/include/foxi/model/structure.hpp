@@ -18,6 +18,7 @@
 // "P.bottom", all others "P.side"; region seeds are points strictly inside every connected piece.
 #pragma once
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct Structure {
   std::vector<double> part_volume;          // 1 per part, after carving (m^3)
   std::vector<std::string> boundary_names;  // marker m (1-based) is boundary_names[m - 1]
   std::vector<double> boundary_area;        // 1 per marker (m^2)
+  // 1 per facet: the marker it had before the [surfaces] selectors took it (its part face "P.top",
+  // ... or interface "A/B"), so that a selected facet's part stays known (diagnostics.hpp).
+  std::vector<std::int32_t> facet_own_marker;
 };
 
 // Builds the PLC of `model`. Boundary names: "PART.top", "PART.bottom", "PART.side" for outer faces,

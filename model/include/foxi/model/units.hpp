@@ -50,4 +50,21 @@ constexpr int kMaxExpressionDepth = 64;
 Quantity evaluate_expression(std::string_view text,
                              const std::function<std::optional<Quantity>(std::string_view)>& lookup);
 
+// `text` (an expression with units, no parameters) in SI, checked to have the dimension of `unit`
+// (itself an expression: "W", "W/(m*K)", "V", "1/K"); a bare number is taken as SI. E.g. "3 W",
+// "3W", "3" and "3000 mW" are 3 for unit "W". Throws ExpressionError naming `unit` when the
+// dimension differs ("'3 m' is m, not W") and on syntax errors.
+double evaluate_in(std::string_view text, std::string_view unit);
+
+// How a temperature is read: a point on the scale (degC adds 273.15 K, and it must be above 0 K)
+// or a difference (1 degC = 1 K, any sign).
+enum class TemperatureKind : std::uint8_t { absolute, difference };
+
+// A temperature in K: "300", "300 K", "300K", "T_amb + 5 K" (`lookup` as for evaluate_expression),
+// or an expression followed by degC or °C ("25 degC", "25degC", "25 °C"). Throws
+// ExpressionError on other units (naming K and degC), on degC inside an expression, and (absolute)
+// on a value not above absolute zero.
+double evaluate_temperature(std::string_view text, TemperatureKind kind,
+                            const std::function<std::optional<Quantity>(std::string_view)>& lookup = {});
+
 }  // namespace foxi
