@@ -53,7 +53,7 @@ foxi::Mesh decode(ByteReader& in, foxi::View& view) {
   const std::size_t nodes = 4 + in.u8() % 13, tets = 1 + in.u8() % 24;
   for (std::size_t i = 0; i < 3 * nodes; ++i) m.xyz.push_back(coordinate());
   for (std::size_t t = 0; t < tets; ++t)
-    for (int k = 0; k < 4; ++k) m.tet.push_back(in.u8() % nodes);
+    for (int k = 0; k < 4; ++k) m.tet.push_back(static_cast<std::uint32_t>(in.u8() % nodes));
   if (regions)
     for (std::size_t t = 0; t < tets; ++t) m.tet_region.push_back(in.u8() % 3);
   if (weighted)
