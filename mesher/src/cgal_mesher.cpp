@@ -287,13 +287,14 @@ Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& pat
     return it->second;
   };
   // Mesh_3 labels a cell by the subdomain its circumcentre (orthocentre) lies in. In a thin layer the
-  // circumcentre of a flat cell can lie across the interface, in the next part (the power module's
-  // die attach took 1.25% of the die's volume): every cell is labelled here by its centroid, with the
-  // domain's own point location. Where the mesh's boundary facets lie on the PLC, a cell lies inside
-  // one part and its centroid says which.
+  // circumcentre of a flat cell can lie across an interface, in the next part (the power module's die
+  // attach took 1.25% of the die's volume): the cells of the complex are labelled here by their
+  // centroid, with the domain's own point location. Where the mesh's boundary facets lie on the PLC, a
+  // cell lies inside one part and its centroid says which. Which cells are meshed stays Mesh_3's
+  // choice: outside the complex lie flat cells on the boundary, whose centroid is on a facet.
   const auto locate = domain.is_in_domain_object();
   std::uint64_t relabelled = 0;
-  for (auto c = c3t3.triangulation().finite_cells_begin(); c != c3t3.triangulation().finite_cells_end(); ++c) {
+  for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
     const auto& p0 = c->vertex(0)->point();
     const auto& p1 = c->vertex(1)->point();
     const auto& p2 = c->vertex(2)->point();
@@ -301,13 +302,11 @@ Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& pat
     const K::Point_3 centroid((p0.x() + p1.x() + p2.x() + p3.x()) / 4, (p0.y() + p1.y() + p2.y() + p3.y()) / 4,
                               (p0.z() + p1.z() + p2.z() + p3.z()) / 4);
     const auto where = locate(centroid);
-    const bool was_in = c3t3.is_in_complex(c);
-    if (!where) {
-      relabelled += was_in;
-      continue;
+    auto sd = static_cast<std::size_t>(c3t3.subdomain_index(c));
+    if (where && static_cast<std::size_t>(*where) != sd) {
+      sd = static_cast<std::size_t>(*where);
+      ++relabelled;
     }
-    const auto sd = static_cast<std::size_t>(*where);
-    relabelled += !was_in || static_cast<std::size_t>(c3t3.subdomain_index(c)) != sd;
     // CGAL's cells are positively oriented, as foxi's tets.
     for (int i = 0; i < 4; ++i) r.tet.push_back(node(c->vertex(i)));
     r.tet_region.push_back(sd < cell_region.size() ? cell_region[sd] : 0);

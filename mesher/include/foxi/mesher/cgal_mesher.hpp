@@ -90,8 +90,8 @@ struct CgalMeshReport {
   bool resampled = false;           // CgalMeshParams::resample was set
   double max_size = 0;              // the size bounds used
   double facet_size = 0, edge_size = 0, facet_distance = 0;
-  // Cells labelled by their centroid's part where Mesh_3's label (its circumcentre's part) differs,
-  // cells taken in or left out included (see "Regions" above).
+  // Tets labelled by their centroid's part where Mesh_3's label (its circumcentre's part) differs
+  // (see "Regions" above).
   std::size_t tets_relabelled = 0;
   std::vector<CgalRegionVolume> volumes;  // by region id, every meshed region of the PLC
   double worst_volume_change = 0;         // largest |relative_change()|
