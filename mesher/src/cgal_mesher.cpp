@@ -520,6 +520,27 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
     rep.worst_volume_change = std::max(rep.worst_volume_change, change);
     if (!(change <= params.volume_tolerance)) rep.volumes_match = false;
   }
+  // Each facet marker's area: the PLC's triangles between two different cells against the mesh's
+  // boundary triangles. A surface Mesh_3 did not recover (an interface inside a thin stack) is missing.
+  std::map<std::int32_t, std::pair<double, double>> areas;  // marker -> (PLC, mesh)
+  auto tri_area = [](const double* a, const double* b, const double* c) {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  };
+  for (std::size_t t = 0; t < s.tri_facet.size(); ++t)
+    if (s.side_cell[2 * t] != s.side_cell[2 * t + 1])
+      areas[plc.facet_marker[s.tri_facet[t]]].first +=
+          tri_area(&s.points[3 * s.tri[3 * t]], &s.points[3 * s.tri[3 * t + 1]], &s.points[3 * s.tri[3 * t + 2]]);
+  for (std::size_t f = 0; f < m.bface_count(); ++f)
+    areas[m.bface_tag[f]].second += tri_area(&m.xyz[3 * m.bface[3 * f]], &m.xyz[3 * m.bface[3 * f + 1]], &m.xyz[3 * m.bface[3 * f + 2]]);
+  rep.areas_match = true;
+  for (const auto& [marker, a] : areas) {
+    const double change = a.first > 0 ? std::abs(a.second / a.first - 1) : (a.second > 0 ? 1.0 : 0.0);
+    if (!(change <= params.volume_tolerance) && (rep.areas_match || change > rep.worst_area_change)) rep.worst_area_marker = marker;
+    if (!(change <= params.volume_tolerance)) rep.areas_match = false;
+    rep.worst_area_change = std::max(rep.worst_area_change, change);
+  }
   rep.tets_relabelled = static_cast<std::size_t>(r.relabelled[0]);
   rep.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   if (report) *report = rep;
