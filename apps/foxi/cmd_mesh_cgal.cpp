@@ -164,6 +164,14 @@ int mesh_with_cgal(Args& args) {
     std::fprintf(stderr, "foxi mesh: error: %s: the mesh written to %s fails the weighted Delaunay certificate\n", in.c_str(), out.c_str());
     status = kExitUnreliable;
   }
+  if (!report.resampled && !report.areas_match) {
+    std::fprintf(stderr,
+                 "foxi mesh: error: %s: the area of boundary tag %d differs from the PLC's by more than %.3g%% (worst tag: %.3g%%) "
+                 "although every facet edge was protected: Mesh_3 did not recover that surface, the mesh written to %s "
+                 "does not follow its PLC\n",
+                 in.c_str(), report.worst_area_marker, 100 * params.volume_tolerance, 100 * report.worst_area_change, out.c_str());
+    status = kExitUnreliable;
+  }
   if (!report.resampled && !report.volumes_match) {
     std::fprintf(stderr,
                  "foxi mesh: error: %s: a region's volume differs from the PLC's by %.3g%% (more than %.3g%%) although every facet "

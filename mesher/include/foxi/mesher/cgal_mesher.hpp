@@ -90,8 +90,8 @@ struct CgalMeshReport {
   bool resampled = false;           // CgalMeshParams::resample was set
   double max_size = 0;              // the size bounds used
   double facet_size = 0, edge_size = 0, facet_distance = 0;
-  // Cells labelled by their centroid's part where Mesh_3's label (its circumcentre's part) differs,
-  // cells taken in or left out included (see "Regions" above).
+  // Tets labelled by their centroid's part where Mesh_3's label (its circumcentre's part) differs
+  // (see "Regions" above).
   std::size_t tets_relabelled = 0;
   std::vector<CgalRegionVolume> volumes;  // by region id, every meshed region of the PLC
   double worst_volume_change = 0;         // largest |relative_change()|
@@ -99,6 +99,12 @@ struct CgalMeshReport {
   // (false there means the mesh does not cover its PLC: a result to refuse); with it, the report says
   // by how much resampling changed each region.
   bool volumes_match = false;
+  // The same for each facet marker's area (PLC facets between two different cells against the mesh's
+  // boundary triangles of that tag), to the same tolerance: a surface Mesh_3 did not recover (an
+  // interface inside a thin stack, which the tets then straddle) shows here.
+  bool areas_match = false;
+  double worst_area_change = 0;
+  std::int32_t worst_area_marker = 0;  // a marker whose area is off (when !areas_match)
   double seconds = 0;
 };
 
