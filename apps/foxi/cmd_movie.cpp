@@ -212,10 +212,8 @@ int cmd_movie(Args args) {
                                       });
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (writer) writer->finish();
-  if (kind == Kind::frames) {
-    commit_together(frames);
-    forget_created.remove = false;  // the frames are in it now
-  }
+  if (!writer) commit_together(frames);  // numbered frames, or ffmpeg's input
+  if (kind == Kind::frames) forget_created.remove = false;  // the frames are in it now
   if (kind == Kind::mp4) {
     DurableFile video(out);
     const std::vector<std::string> ffmpeg = {
