@@ -3,6 +3,7 @@
 // or an MP4 (through the ffmpeg program, when it is installed).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -92,7 +93,20 @@ std::string frame_name(const std::string& pattern, std::size_t k) {
   return buf;
 }
 
-bool have_ffmpeg() { return std::system("command -v ffmpeg > /dev/null 2>&1") == 0; }
+// Looked up in PATH here rather than by a shell: a child process foxi does not track could outlive a stop.
+bool have_ffmpeg() {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  std::size_t at = 0;
+  while (at <= dirs.size()) {
+    const std::size_t colon = std::min(dirs.find(':', at), dirs.size());
+    const std::string dir = dirs.substr(at, colon - at);
+    const std::string exe = (dir.empty() ? std::string(".") : dir) + "/ffmpeg";
+    if (::access(exe.c_str(), X_OK) == 0 && !std::filesystem::is_directory(exe)) return true;
+    at = colon + 1;
+  }
+  return false;
+}
 
 }  // namespace
 

@@ -162,8 +162,9 @@ class SignalsCliSlow : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new TempDir;
-    // A mesh big enough that solving, drawing and converting it take a noticeable time.
-    const int rc = test::run_cli("mesh '" + test::models_dir() + "die_on_substrate.toml' --max-size 0.12mm -o '" +
+    // A mesh (212k tets) big enough that solving, drawing and converting it take a noticeable time
+    // (a second or so each on a shared 2-core machine).
+    const int rc = test::run_cli("mesh '" + test::models_dir() + "die_on_substrate.toml' --max-size 0.2mm -o '" +
                                      (dir_->path() / "big.vtu").string() + "'",
                                  dir_->path() / "setup.log");
     ASSERT_EQ(rc, 0) << test::read_text(dir_->path() / "setup.log");
@@ -208,7 +209,9 @@ class SignalsCliSlow : public ::testing::Test {
       EXPECT_EQ(leftovers(out), std::vector<std::string>{});
       bool wrote = false;
       EXPECT_EQ(c.check(out, wrote), "");
-      if (o.status == 0) EXPECT_TRUE(wrote) << "exit status 0 without the output";
+      if (o.status == 0) {
+        EXPECT_TRUE(wrote) << "exit status 0 without the output";
+      }
     }
     std::printf("%s: %d trials, %d stopped by the signal, %d finished first (a whole run %.2f s)\n", c.name.c_str(),
                 count, stopped, count - stopped, full.seconds);
@@ -223,14 +226,14 @@ constexpr int kTrials = 6;
 
 TEST_F(SignalsCliSlow, Mesh) {
   trials({"mesh",
-          {"mesh", test::models_dir() + "die_on_substrate.toml", "--max-size", "0.15mm", "-o", "OUT/m.vtu"},
+          {"mesh", test::models_dir() + "die_on_substrate.toml", "--max-size", "0.3mm", "-o", "OUT/m.vtu"},
           [](const fs::path& d, bool& e) { return mesh_ok(d / "m.vtu", e); }},
          kTrials);
 }
 
 TEST_F(SignalsCliSlow, MeshToTetgenSet) {
   trials({"mesh-tetgen",
-          {"mesh", test::models_dir() + "die_on_substrate.toml", "--max-size", "0.15mm", "-o", "OUT/m.node"},
+          {"mesh", test::models_dir() + "die_on_substrate.toml", "--max-size", "0.3mm", "-o", "OUT/m.node"},
           [](const fs::path& d, bool& e) {
             const int n = int(fs::exists(d / "m.node")) + int(fs::exists(d / "m.ele")) + int(fs::exists(d / "m.face"));
             if (n != 0 && n != 3) return std::string("a partial TetGen set: ") + std::to_string(n) + " of 3 files";
@@ -256,8 +259,19 @@ TEST_F(SignalsCliSlow, Render) {
 
 TEST_F(SignalsCliSlow, Convert) {
   trials({"convert",
-          {"convert", big().string(), "OUT/c.msh"},
-          [](const fs::path& d, bool& e) { return mesh_ok(d / "c.msh", e); }},
+          {"convert", big().string(), "OUT/c.vtu", "--vtu-encoding", "ascii"},
+          [](const fs::path& d, bool& e) { return mesh_ok(d / "c.vtu", e); }},
+         kTrials);
+}
+
+TEST_F(SignalsCli, ConvertToTetgenSet) {
+  trials({"convert-tetgen",
+          {"convert", big().string(), "OUT/c.node"},
+          [](const fs::path& d, bool& e) {
+            const int n = int(fs::exists(d / "c.node")) + int(fs::exists(d / "c.ele")) + int(fs::exists(d / "c.face"));
+            if (n != 0 && n != 3) return std::string("a partial TetGen set: ") + std::to_string(n) + " of 3 files";
+            return mesh_ok(d / "c.node", e);
+          }},
          kTrials);
 }
 
