@@ -201,6 +201,10 @@ int cmd_movie(Args args) {
       });
     }
     check_output_path(frame_name(pattern, 0));
+    // Once for the folder rather than once per frame (each a reading of the whole folder).
+    remove_stale_temporaries_in(std::filesystem::path(frame_name(pattern, 0)).parent_path().empty()
+                                    ? std::filesystem::path(".")
+                                    : std::filesystem::path(frame_name(pattern, 0)).parent_path());
   }
   struct Forget {
     std::filesystem::path dir;
@@ -219,7 +223,7 @@ int cmd_movie(Args args) {
                                         if (writer) {
                                           writer->add(fb);
                                         } else {
-                                          frames.emplace_back(frame_name(pattern, index));
+                                          frames.emplace_back(frame_name(pattern, index), false);
                                           write_png(frames.back(), fb);
                                         }
                                         ++index;

@@ -79,17 +79,22 @@ void check_output_path(const std::filesystem::path& path) {
                   "cannot write in the folder " + folder.string() + ": " + std::strerror(errno));
 }
 
-std::size_t remove_stale_temporaries(const std::filesystem::path& target) {
-  const std::string prefix = target.filename().string() + std::string(kTempTag);
+namespace {
+
+// Removes FOLDER/NAME.foxi-tmp-PID-* whose writer is gone, for one NAME (`name` given) or any.
+std::size_t remove_stale(const std::filesystem::path& folder, const std::string* name) {
   std::error_code ec;
-  std::filesystem::directory_iterator it(folder_of(target), ec), end;
+  std::filesystem::directory_iterator it(folder, ec), end;
   std::vector<std::filesystem::path> stale;
   for (; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.compare(0, prefix.size(), prefix) != 0) continue;
-    // PID-RANDOM after the prefix; anything else is not foxi's and is left alone.
-    const char* p = name.data() + prefix.size();
-    const char* e = name.data() + name.size();
+    const std::string entry = it->path().filename().string();
+    const std::size_t tag = name ? name->size() : entry.rfind(kTempTag);
+    if (tag == std::string::npos || tag == 0) continue;
+    if (name && (entry.compare(0, name->size(), *name) != 0 || entry.compare(tag, kTempTag.size(), kTempTag) != 0))
+      continue;
+    // PID-RANDOM after the tag; anything else is not foxi's and is left alone.
+    const char* p = entry.data() + tag + kTempTag.size();
+    const char* e = entry.data() + entry.size();
     long pid = 0;
     const auto [q, err] = std::from_chars(p, e, pid);
     if (err != std::errc() || q == p || q == e || *q != '-' || pid <= 0) continue;
@@ -100,8 +105,17 @@ std::size_t remove_stale_temporaries(const std::filesystem::path& target) {
   return removed;
 }
 
-DurableFile::DurableFile(std::filesystem::path target) : target_(std::move(target)) {
-  remove_stale_temporaries(target_);
+}  // namespace
+
+std::size_t remove_stale_temporaries(const std::filesystem::path& target) {
+  const std::string name = target.filename().string();
+  return remove_stale(folder_of(target), &name);
+}
+
+std::size_t remove_stale_temporaries_in(const std::filesystem::path& folder) { return remove_stale(folder, nullptr); }
+
+DurableFile::DurableFile(std::filesystem::path target, bool clean_stale) : target_(std::move(target)) {
+  if (clean_stale) remove_stale_temporaries(target_);
   std::random_device rd;
   char suffix[64];
   std::snprintf(suffix, sizeof suffix, "%.*s%ld-%08x", int(kTempTag.size()), kTempTag.data(), long(::getpid()),

@@ -127,6 +127,12 @@ TEST(DurableFile, StaleTemporariesOfDeadWritersOnlyAreRemoved) {
   // Now its writer is gone too: the next write removes it.
   EXPECT_EQ(remove_stale_temporaries(out), 1u);
   EXPECT_FALSE(fs::exists(dir / live_tmp));
+  // The whole folder's (a movie's frames): another target's temporary of a dead writer goes too,
+  // names that are not foxi's stay.
+  EXPECT_EQ(remove_stale_temporaries_in(dir.path()), 1u);
+  EXPECT_FALSE(fs::exists(dir / foreign[2]));
+  EXPECT_TRUE(fs::exists(dir / foreign[0]));
+  EXPECT_TRUE(fs::exists(dir / foreign[1]));
 }
 
 TEST(DurableFile, ConcurrentWritersOfOneProcessKeepEachOthersTemporaries) {

@@ -26,7 +26,9 @@ void check_output_path(const std::filesystem::path& path);
 
 class DurableFile {
  public:
-  explicit DurableFile(std::filesystem::path target);
+  // clean_stale = false skips the search for stale temporaries (a reading of the whole folder): for
+  // many files written into one folder, after one remove_stale_temporaries_in(folder).
+  explicit DurableFile(std::filesystem::path target, bool clean_stale = true);
   ~DurableFile();
   DurableFile(DurableFile&& other) noexcept;
   DurableFile& operator=(DurableFile&&) = delete;
@@ -82,5 +84,7 @@ void commit_together(std::span<DurableFile> files, std::ptrdiff_t marker = -1);
 // Removes temporaries of `target` (TARGET.foxi-tmp-PID-*) whose writer process no longer exists;
 // returns how many. DurableFile's constructor calls it.
 std::size_t remove_stale_temporaries(const std::filesystem::path& target);
+// The same for every target in `folder` (any NAME.foxi-tmp-PID-* of a writer that is gone).
+std::size_t remove_stale_temporaries_in(const std::filesystem::path& folder);
 
 }  // namespace foxi
