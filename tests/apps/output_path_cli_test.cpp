@@ -16,13 +16,13 @@ namespace fs = std::filesystem;
 using foxi::test::TempDir;
 namespace test = foxi::test;
 
-struct Run {
+struct CliRun {
   int status;
   double seconds;
   std::string log;
 };
 
-Run run(const std::string& args, const fs::path& log) {
+CliRun run(const std::string& args, const fs::path& log) {
   const auto t0 = std::chrono::steady_clock::now();
   const int status = test::run_cli(args, log);
   return {status, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), test::read_text(log)};
@@ -62,7 +62,7 @@ TEST(OutputPathCli, UnwritableOutputsFailBeforeTheWork) {
     };
     for (const std::string& c : commands) {
       SCOPED_TRACE(c);
-      const Run r = run(c, dir / "log.txt");
+      const CliRun r = run(c, dir / "log.txt");
       EXPECT_NE(r.status, 0) << r.log;
       EXPECT_NE(r.status, 2) << "not a usage error: " << r.log;
       EXPECT_NE(r.log.find(b.reason), std::string::npos) << r.log;
