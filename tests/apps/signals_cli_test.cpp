@@ -264,7 +264,7 @@ TEST_F(SignalsCliSlow, Convert) {
          kTrials);
 }
 
-TEST_F(SignalsCli, ConvertToTetgenSet) {
+TEST_F(SignalsCliSlow, ConvertToTetgenSet) {
   trials({"convert-tetgen",
           {"convert", big().string(), "OUT/c.node"},
           [](const fs::path& d, bool& e) {
