@@ -54,6 +54,21 @@ Outcome run_foxi(const std::vector<std::string>& args, const fs::path& log, int 
     ::execv(cargv[0], cargv.data());
     ::_exit(127);
   }
+  // The delay counts from the moment foxi has blocked SIGINT and SIGTERM (its stop handling, first
+  // thing in main; /proc shows the main thread's mask): before that no file and no child exists,
+  // and the signal's default action (death by the signal) is all there is to see.
+  if (sig != 0) {
+    const std::string status_file = "/proc/" + std::to_string(pid) + "/status";
+    for (int i = 0; i < 5000; ++i) {
+      const std::string st = test::read_text(status_file);
+      const auto at = st.find("SigBlk:");
+      if (st.empty() || (at != std::string::npos &&
+                         (std::stoull(st.substr(at + 7), nullptr, 16) & 0x4002) == 0x4002))
+        break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  const auto t_ready = Clock::now();
   Outcome o;
   bool sent = sig == 0;
   int ws = 0;
@@ -64,7 +79,7 @@ Outcome run_foxi(const std::vector<std::string>& args, const fs::path& log, int 
       o.seconds = s;
       break;
     }
-    if (!sent && s >= delay) {
+    if (!sent && std::chrono::duration<double>(Clock::now() - t_ready).count() >= delay) {
       ::kill(pid, sig);
       sent = true;
     }
