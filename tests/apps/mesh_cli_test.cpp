@@ -76,7 +76,7 @@ TEST(MeshCli, SigintCancelsWithoutOutput) {
   const auto out = dir / "big.vtu";
   // A run of minutes, interrupted after 1.5 s (`timeout` passes SIGINT on, and kills a run that
   // ignores it after 60 s so that a failing test ends).
-  const std::string cmd = "timeout -s KILL 60 '" + test::cli_path() + "' mesh '" + kModels + "flip_chip.toml' --max-size 0.03mm -o '" +
+  const std::string cmd = "timeout -s KILL 60 '" + test::cli_path() + "' mesh '" + kModels + "flip_chip.toml' --max-size 0.03mm --max-tets 100000000 -o '" +
                           out.string() + "' > '" + (dir / "log.txt").string() + "' 2>&1 & echo $! > '" +
                           (dir / "pid").string() + "'; wait";
   std::thread runner([&] { test::run(cmd); });
