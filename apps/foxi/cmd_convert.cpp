@@ -6,6 +6,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "mesh_input.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
 
@@ -54,6 +55,7 @@ int cmd_convert(Args args) {
   // Both formats are checked before any work, so a typo costs nothing.
   const MeshFormat in_format = format_from_path(files[0]);
   const MeshFormat out_format = format_from_path(files[1]);
+  check_output_path(files[1]);
 
   auto t0 = std::chrono::steady_clock::now();
   Mesh mesh = read_mesh(files[0]);

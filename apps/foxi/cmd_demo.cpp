@@ -9,6 +9,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "mesh_input.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/quality.hpp"
@@ -49,6 +50,7 @@ int cmd_demo(Args args) {
   if (!is_model_path(file)) throw UsageError("foxi demo takes a model file (.toml), not '" + file + "'");
   const std::string stem = std::filesystem::path(file).stem().string();
   std::filesystem::create_directories(dir);
+  check_output_path(dir / (stem + ".vtu"));
 
   std::printf("1. model %s\n", file.c_str());
   auto t = std::chrono::steady_clock::now();

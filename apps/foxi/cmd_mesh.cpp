@@ -1,9 +1,7 @@
 // foxi mesh MODEL.toml|PLC.poly -o OUT: a conforming Delaunay tetrahedral mesh of a model or a PLC,
 // through TetGen and the conforming refinement, with size controls and a quality report.
-#include <signal.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -19,6 +17,7 @@
 #include "foxi/mesher/size_field.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/delaunay.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/plc.hpp"
@@ -64,10 +63,8 @@ const char* kMeshUsage =
     "                     and patch borders are protected, a faceted cylinder's wall is resampled\n"
     "                     (each region's volume change is printed); --time-limit S stops CGAL after\n"
     "                     S seconds (default 300; 0: none) with an error\n"
-    "  Ctrl-C cancels (nothing is written).";
-
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) { g_interrupted = true; }
+    "  Ctrl-C (SIGINT) or SIGTERM stops it: TetGen or CGAL is killed, nothing is written, exit status\n"
+    "  130 or 143.";
 
 double number(const std::string& s, const char* what) {
   char* end = nullptr;
@@ -132,7 +129,8 @@ int cmd_mesh(Args args) {
   if (out.empty()) throw UsageError("give the output file with -o OUT\nusage: " + std::string(kMeshUsage));
   const std::string in = args.positional(1, 1, kMeshUsage)[0];
   if (!refine_from.empty() && target_error.empty()) throw UsageError("--refine-from needs --target-error E");
-  format_from_path(out);  // an unknown output format fails before any meshing
+  format_from_path(out);  // an unknown output format or an unwritable path fails before any meshing
+  check_output_path(out);
 
   // The PLC, from a model or a .poly.
   const bool is_model = is_model_path(in);
@@ -185,12 +183,8 @@ int cmd_mesh(Args args) {
     controls.boxes.push_back(box);
   }
 
-  // Progress on stderr for long runs; Ctrl-C makes the callback say stop.
-  g_interrupted = false;
-  struct sigaction sa{}, old{};
-  sa.sa_handler = on_sigint;
-  sigemptyset(&sa.sa_mask);
-  ::sigaction(SIGINT, &sa, &old);
+  // Progress on stderr for long runs (SIGINT and SIGTERM are handled by signals.hpp: they end the
+  // process, so the callback never cancels).
   const auto t0 = std::chrono::steady_clock::now();
   double last_print = 0;
   const bool tty = ::isatty(2);
@@ -203,7 +197,7 @@ int cmd_mesh(Args args) {
       else
         std::fprintf(stderr, "\r%.*s %5.0f s   ", int(stage.size()), stage.data(), s);
     }
-    return !g_interrupted.load();
+    return true;
   };
 
   Mesh mesh;
@@ -249,7 +243,6 @@ int cmd_mesh(Args args) {
     std::fprintf(stderr, "%sfoxi mesh: error: %s: %s\n", tty ? "\n" : "", in.c_str(), e.what());
     status = kExitFailure;
   }
-  ::sigaction(SIGINT, &old, nullptr);
   if (tty && last_print > 0) std::fputc('\n', stderr);
   if (status != 0) return status;
   write_mesh(mesh, out);

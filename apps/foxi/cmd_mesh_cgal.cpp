@@ -9,6 +9,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "model_run.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/mesher/cgal_mesher.hpp"
 #include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/mesher/size_field.hpp"
@@ -94,6 +95,7 @@ int mesh_with_cgal(Args& args) {
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
   const std::string in = args.positional(1, 1, "foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT")[0];
   format_from_path(out);  // an unknown output format fails before any meshing
+  check_output_path(out);
 
   // A model: its PLC, its [mesh] sizes (global and per part, as region volume bounds) and its names.
   const bool is_model = is_model_path(in);

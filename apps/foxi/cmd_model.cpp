@@ -12,6 +12,7 @@
 #include "model_picture.hpp"
 #include "model_run.hpp"
 #include "foxi/model/diagnostics.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/physics.hpp"
@@ -146,6 +147,7 @@ int cmd_model(Args args) {
   if (action != "check" && action != "plc" && action != "show")
     throw UsageError("unknown action '" + action + "'\nusage: " + kModelUsage);
   if (action == "plc" && out.empty()) throw UsageError("give the output file with -o OUT.poly");
+  if (!out.empty()) check_output_path(out);
   if (action == "show") {
     if (out.empty()) throw UsageError("give the output file with -o OUT.png");
     ModelPictureParams pp;

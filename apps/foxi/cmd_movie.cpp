@@ -1,6 +1,9 @@
 // foxi movie MESH: the painter's movies (seed paper, section 6.1): back-and-forth (draw back to
 // front, undraw front to back) or a rotating view, as numbered PNG frames, an animated PNG, a GIF,
 // or an MP4 (through the ffmpeg program, when it is installed).
+#include <unistd.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -14,13 +17,16 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "mesh_input.hpp"
+#include "foxi/model/cleanup.hpp"
 #include "foxi/model/delaunay.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/animation.hpp"
 #include "foxi/viz/movie.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "render_options.hpp"
+#include "signals.hpp"
 
 namespace foxi::cli {
 
@@ -87,13 +93,20 @@ std::string frame_name(const std::string& pattern, std::size_t k) {
   return buf;
 }
 
-std::string quoted(const std::filesystem::path& p) {
-  std::string s = "'";
-  for (char c : p.string()) s += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return s + "'";
+// Looked up in PATH here rather than by a shell: a child process foxi does not track could outlive a stop.
+bool have_ffmpeg() {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  std::size_t at = 0;
+  while (at <= dirs.size()) {
+    const std::size_t colon = std::min(dirs.find(':', at), dirs.size());
+    const std::string dir = dirs.substr(at, colon - at);
+    const std::string exe = (dir.empty() ? std::string(".") : dir) + "/ffmpeg";
+    if (::access(exe.c_str(), X_OK) == 0 && !std::filesystem::is_directory(exe)) return true;
+    at = colon + 1;
+  }
+  return false;
 }
-
-bool have_ffmpeg() { return std::system("command -v ffmpeg > /dev/null 2>&1") == 0; }
 
 }  // namespace
 
@@ -145,6 +158,7 @@ int cmd_movie(Args args) {
   } else {
     throw UsageError("-o " + out + ": give .gif, .apng, .mp4 or a numbered frame name like dir/frame_%04d.png");
   }
+  if (kind != Kind::frames) check_output_path(out);  // before the work (frames: once their folder is made)
 
   const Mesh mesh = read_usable_mesh(path, "movie");
   const Picture picture = resolve_picture(options, mesh);
@@ -158,51 +172,74 @@ int cmd_movie(Args args) {
   ap.height = options.height;
   ap.fps = fps;
   std::unique_ptr<AnimationWriter> writer;
-  std::filesystem::path frame_dir;  // mp4: PNG frames for ffmpeg, removed afterwards
+  // Numbered frames (and the mp4's frames for ffmpeg) are written as DurableFile temporaries and
+  // committed together at the end: a stopped or failed movie leaves no frame behind.
+  std::vector<DurableFile> frames;
+  std::filesystem::path frame_dir;  // mp4: the PNG frames for ffmpeg, a tracked temporary folder
   std::string pattern = out;
   if (kind == Kind::gif) writer = open_gif(out, ap);
   if (kind == Kind::apng) writer = open_apng(out, ap);
   if (kind == Kind::mp4) {
-    frame_dir = std::filesystem::path(out + ".frames.tmp");
-    std::filesystem::create_directories(frame_dir);
+    frame_dir = std::filesystem::path(out + ".foxi-tmp-" + std::to_string(::getpid()) + "-frames");
+    cleanup::with_lock([&] {
+      cleanup::track(frame_dir, true);
+      std::filesystem::create_directories(frame_dir);
+    });
     pattern = (frame_dir / "frame_%06d.png").string();
   }
+  std::filesystem::path created;  // the first folder of the frames' path that this run created
   if (kind == Kind::frames) {
     const std::filesystem::path parent = std::filesystem::path(frame_name(pattern, 0)).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-  }
-  struct RemoveDir {
-    std::filesystem::path dir;
-    ~RemoveDir() {
-      std::error_code ec;
-      if (!dir.empty()) std::filesystem::remove_all(dir, ec);
+    if (!parent.empty()) {
+      for (std::filesystem::path p = parent; !p.empty() && !std::filesystem::exists(p); p = p.parent_path()) {
+        created = p;
+        if (p == p.parent_path()) break;
+      }
+      cleanup::with_lock([&] {
+        if (!created.empty()) cleanup::track(created, true);
+        std::filesystem::create_directories(parent);
+      });
     }
-  } cleanup{frame_dir};
+    check_output_path(frame_name(pattern, 0));
+    // Once for the folder rather than once per frame (each a reading of the whole folder).
+    remove_stale_temporaries_in(std::filesystem::path(frame_name(pattern, 0)).parent_path().empty()
+                                    ? std::filesystem::path(".")
+                                    : std::filesystem::path(frame_name(pattern, 0)).parent_path());
+  }
+  struct Forget {
+    std::filesystem::path dir;
+    bool remove;
+    ~Forget() {
+      std::error_code ec;
+      if (!dir.empty() && remove) std::filesystem::remove_all(dir, ec);
+      if (!dir.empty()) cleanup::untrack(dir);
+    }
+  } forget_frames{frame_dir, true}, forget_created{created, true};
 
   std::size_t index = 0;
   const auto t0 = std::chrono::steady_clock::now();
   const MovieStats stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
                                       [&](const Framebuffer& fb) {
-                                        if (writer)
+                                        if (writer) {
                                           writer->add(fb);
-                                        else
-                                          write_png(frame_name(pattern, index), fb);
+                                        } else {
+                                          frames.emplace_back(frame_name(pattern, index), false);
+                                          write_png(frames.back(), fb);
+                                        }
                                         ++index;
                                       });
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (writer) writer->finish();
+  if (!writer) commit_together(frames);  // numbered frames, or ffmpeg's input
+  if (kind == Kind::frames) forget_created.remove = false;  // the frames are in it now
   if (kind == Kind::mp4) {
-    const std::filesystem::path tmp = out + ".tmp.mp4";
-    const std::string cmd = "ffmpeg -y -loglevel error -framerate " + std::to_string(fps) + " -i " +
-                            quoted(frame_dir / "frame_%06d.png") +
-                            " -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -pix_fmt yuv420p -c:v libx264 " + quoted(tmp) +
-                            " < /dev/null";
-    if (std::system(cmd.c_str()) != 0) {
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw std::runtime_error(out + ": ffmpeg failed to encode the frames");
-    }
-    std::filesystem::rename(tmp, out);
+    DurableFile video(out);
+    const std::vector<std::string> ffmpeg = {
+        "ffmpeg", "-y", "-loglevel", "error", "-framerate", std::to_string(fps), "-i",
+        (frame_dir / "frame_%06d.png").string(), "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p",
+        "-c:v", "libx264", "-f", "mp4", video.temp().string()};
+    if (run_program(ffmpeg) != 0) throw std::runtime_error(out + ": ffmpeg failed to encode the frames");
+    video.commit();
   }
   std::printf("mesh        %s: %zu tets, %zu shown\n", path.c_str(), mesh.tet_count(),
               picture.subset.empty() ? mesh.tet_count() : picture.subset.size());

@@ -11,6 +11,7 @@
 #include "exit_codes.hpp"
 #include "mesh_input.hpp"
 #include "render_options.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/camera.hpp"
@@ -60,6 +61,7 @@ int cmd_render(Args args) {
   PictureOptions options = take_picture_options(args, "1280x960");
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
+  check_output_path(out);
   const int width = options.width, height = options.height;
   double stop = 1;
   if (!stop_s.empty()) {

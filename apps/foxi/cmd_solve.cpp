@@ -13,6 +13,7 @@
 #include "mesh_input.hpp"
 #include "model_run.hpp"
 #include "solve_options.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/model_problem.hpp"
@@ -267,6 +268,7 @@ int cmd_solve(Args args) {
   ThermalParams params;
   params.solver = solver_options;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
+  if (!out.empty()) check_output_path(out);        // and so does a folder that cannot be written
 
   // The values are checked before the meshing, which may take long (tags and regions need the mesh).
   auto values = [](const std::vector<std::string>& list, const char* option, const char* unit) {

@@ -9,6 +9,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "mesh_input.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermoelastic.hpp"
@@ -132,6 +133,7 @@ int cmd_solve_thermoelastic(Args args) {
   if (order != "1" && order != "2") throw UsageError("--order takes 1 or 2, not '" + order + "'");
   params.order = order == "2" ? 2 : 1;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
+  if (!out.empty()) check_output_path(out);        // and so does a folder that cannot be written
 
   // the temperatures are checked before the meshing, which may take long
   if (!dt.empty()) (void)parse_temperature(dt, "--dT", TemperatureKind::difference);

@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "foxi/mesher/tetgen_mesher.hpp"  // MesherError
+#include "foxi/model/cleanup.hpp"
 
 namespace foxi::detail {
 
@@ -28,10 +29,15 @@ bool send(int fd, const void* data, std::size_t bytes) {
   return true;
 }
 
+// Reaped and forgotten with the cleanup list locked: an interrupt never kills a process id that was
+// already reaped (and could be reused), nor misses a live child.
 void reap(pid_t pid, int* wstatus) {
   int ws = 0;
-  while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
-  }
+  cleanup::with_lock([&] {
+    while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
+    }
+    cleanup::untrack_child(pid);
+  });
   if (wstatus) *wstatus = ws;
 }
 
@@ -62,7 +68,9 @@ std::vector<char> run_in_child(const std::function<std::vector<char>()>& work, c
   int fds[2];
   if (::pipe(fds) != 0) throw MesherError(1, std::string("cannot create a pipe: ") + std::strerror(errno));
   std::fflush(nullptr);
-  const pid_t pid = ::fork();
+  // Tracked (foxi/model/cleanup.hpp): a program stopped by a signal kills it, and it dies with
+  // its parent even if the parent is killed outright.
+  const pid_t pid = cleanup::fork_tracked();
   if (pid < 0) {
     ::close(fds[0]);
     ::close(fds[1]);

@@ -17,6 +17,8 @@
 #include <string_view>
 #include <vector>
 
+#include "foxi/model/cleanup.hpp"
+
 namespace foxi {
 
 namespace {
@@ -60,7 +62,9 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   int fds[2];
   if (::pipe(fds) != 0) throw MesherError(1, std::string("cannot create a pipe: ") + std::strerror(errno));
   std::fflush(nullptr);
-  pid_t pid = ::fork();
+  // Tracked (foxi/model/cleanup.hpp): a program stopped by a signal kills it, and it dies with
+  // its parent even if the parent is killed outright.
+  pid_t pid = cleanup::fork_tracked();
   if (pid < 0) {
     ::close(fds[0]);
     ::close(fds[1]);
@@ -103,12 +107,20 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   std::vector<char> buf;
   char chunk[1 << 16];
   const auto start = std::chrono::steady_clock::now();
+  // Reaped and forgotten with the cleanup list locked: an interrupt never kills a process id that
+  // was already reaped (and could be reused), nor misses a live child.
+  auto reap = [&](int* ws) {
+    cleanup::with_lock([&] {
+      while (::waitpid(pid, ws, 0) < 0 && errno == EINTR) {
+      }
+      cleanup::untrack_child(pid);
+    });
+  };
   auto stop_child = [&] {
     ::kill(pid, SIGKILL);
     ::close(fds[0]);
     int ws = 0;
-    while (::waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
-    }
+    reap(&ws);
   };
   for (;;) {
     if (time_limit > 0 &&
@@ -138,8 +150,7 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   }
   ::close(fds[0]);
   int wstatus = 0;
-  while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
-  }
+  reap(&wstatus);
   Result r;
   std::size_t at = 0;
   auto take = [&](void* dst, std::size_t bytes) {

@@ -481,9 +481,14 @@ void write_tetgen(const Mesh& mesh, const std::filesystem::path& base) {
   const std::filesystem::path ele_path = with_suffix(base, ".ele");
   const std::filesystem::path face_path = with_suffix(base, ".face");
   check_writable(mesh, node_path.string());
-  // All three are written to temporaries first; they are renamed into place only when all three
-  // are complete, and a failed rename removes those already renamed: never a partial set.
-  io::AtomicFile node_file(node_path), ele_file(ele_path), face_file(face_path);
+  // All three are written to temporaries first and committed together with the .node as the
+  // marker (commit_together): the old .node goes first and the new one comes last, so a .node on
+  // disk always has its own .ele and .face beside it, even after a kill or a power loss.
+  std::vector<io::AtomicFile> files;
+  files.emplace_back(node_path);
+  files.emplace_back(ele_path);
+  files.emplace_back(face_path);
+  io::AtomicFile &node_file = files[0], &ele_file = files[1], &face_file = files[2];
   {
     Out o(node_file);
     const std::size_t n = mesh.node_count();
@@ -536,21 +541,7 @@ void write_tetgen(const Mesh& mesh, const std::filesystem::path& base) {
     }
     o.flush();
   }
-  for (auto* f : {&node_file, &ele_file, &face_file}) {
-    if (!f->stream()) throw IoError(base.string(), 0, IoError::kNoOffset, "write failed (disk full?)");
-  }
-  std::vector<std::filesystem::path> placed;
-  try {
-    node_file.commit();
-    placed.push_back(node_path);
-    ele_file.commit();
-    placed.push_back(ele_path);
-    face_file.commit();
-  } catch (...) {
-    std::error_code ec;
-    for (const auto& p : placed) std::filesystem::remove(p, ec);
-    throw;
-  }
+  commit_together(files, 0);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <random>
 #include <system_error>
 
 namespace foxi {
@@ -80,46 +79,6 @@ void fail_text(const std::string& file, std::string_view text, std::size_t offse
 
 void fail_binary(const std::string& file, std::size_t offset, const std::string& reason) {
   throw IoError(file, 0, offset, reason);
-}
-
-AtomicFile::AtomicFile(const std::filesystem::path& path) : path_(path) {
-  std::random_device rd;
-  char suffix[32];
-  std::snprintf(suffix, sizeof suffix, ".tmp%08x", static_cast<unsigned>(rd()));
-  tmp_ = path_;
-  tmp_ += suffix;
-  out_.open(tmp_, std::ios::binary | std::ios::trunc);
-  if (!out_) {
-    throw IoError(path_.string(), 0, IoError::kNoOffset,
-                  "cannot create file: " + std::generic_category().message(errno));
-  }
-}
-
-AtomicFile::~AtomicFile() {
-  if (!committed_) {
-    out_.close();
-    std::error_code ec;
-    std::filesystem::remove(tmp_, ec);
-  }
-}
-
-void AtomicFile::commit() {
-  out_.flush();
-  bool ok = static_cast<bool>(out_);
-  out_.close();
-  if (!ok || out_.fail()) {
-    std::error_code ec;
-    std::filesystem::remove(tmp_, ec);
-    committed_ = true;
-    throw IoError(path_.string(), 0, IoError::kNoOffset, "write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp_, path_, ec);
-  committed_ = true;
-  if (ec) {
-    std::filesystem::remove(tmp_, ec);
-    throw IoError(path_.string(), 0, IoError::kNoOffset, "cannot rename into place: " + ec.message());
-  }
 }
 
 }  // namespace io

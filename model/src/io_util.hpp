@@ -14,6 +14,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 
 namespace foxi::io {
@@ -148,29 +149,9 @@ inline bool count_fits(std::uint64_t count, std::uint64_t min_bytes_each, std::u
   return count <= remaining / min_bytes_each;
 }
 
-// Writes a file through a temporary in the same folder, renamed into place by commit(); if commit()
-// is never reached (an exception), the destructor removes the temporary.
-class AtomicFile {
- public:
-  explicit AtomicFile(const std::filesystem::path& path);
-  ~AtomicFile();
-  AtomicFile(const AtomicFile&) = delete;
-  AtomicFile& operator=(const AtomicFile&) = delete;
-
-  std::ofstream& stream() { return out_; }
-  void write(const void* data, std::size_t bytes) {
-    out_.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
-  }
-  void write(std::string_view s) { write(s.data(), s.size()); }
-  // Flushes, checks for write errors, renames into place. Throws IoError on failure.
-  void commit();
-
- private:
-  std::filesystem::path path_;
-  std::filesystem::path tmp_;
-  std::ofstream out_;
-  bool committed_ = false;
-};
+// Writes a file through a temporary in the same folder, renamed into place by commit(), durably
+// (foxi/model/durable_file.hpp); if commit() is never reached, the destructor removes the temporary.
+using AtomicFile = DurableFile;
 
 // Appends the shortest round-trip text of a double (std::to_chars) to `out`.
 inline void append_double(std::string& out, double v) {

@@ -1,28 +1,24 @@
 #include "foxi/viz/animation.hpp"
 
-#include <fcntl.h>
 #include <gif_lib.h>
 #include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
 
+#include "foxi/model/durable_file.hpp"
+
 namespace foxi {
 
 namespace {
-
-std::filesystem::path temp_beside(const std::filesystem::path& path) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  return tmp;
-}
 
 void check_params(const std::filesystem::path& path, const AnimationParams& p) {
   if (p.width < 1 || p.height < 1 || p.width > 65535 || p.height > 65535)
@@ -37,12 +33,6 @@ void check_frame(const std::filesystem::path& path, const AnimationParams& p, co
     throw std::runtime_error(path.string() + ": frame of " + std::to_string(fb.width) + "x" +
                              std::to_string(fb.height) + " pixels in an animation of " +
                              std::to_string(p.width) + "x" + std::to_string(p.height));
-}
-
-void move_into_place(const std::filesystem::path& tmp, const std::filesystem::path& path) {
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw std::runtime_error(path.string() + ": " + ec.message());
 }
 
 void put32(std::string& s, std::uint32_t v) {
@@ -60,11 +50,8 @@ void put16(std::string& s, std::uint32_t v) {
 class ApngWriter final : public AnimationWriter {
  public:
   ApngWriter(const std::filesystem::path& path, const AnimationParams& params)
-      : path_(path), tmp_(temp_beside(path)), p_(params) {
-    check_params(path, params);
-    out_.open(tmp_, std::ios::binary | std::ios::trunc);
-    if (!out_) throw std::runtime_error(path.string() + ": cannot create " + tmp_.string());
-    out_.write("\x89PNG\r\n\x1a\n", 8);
+      : path_(path), p_(params), file_((check_params(path, params), path)) {
+    file_.write("\x89PNG\r\n\x1a\n", 8);
     std::string ihdr;
     put32(ihdr, std::uint32_t(p_.width));
     put32(ihdr, std::uint32_t(p_.height));
@@ -72,7 +59,7 @@ class ApngWriter final : public AnimationWriter {
     ihdr += char(2);  // colour type: RGB
     ihdr += std::string(3, '\0');  // compression, filter, interlace
     chunk("IHDR", ihdr);
-    actl_at_ = out_.tellp();
+    actl_at_ = file_.size();
     std::string actl;
     put32(actl, 0);  // frame count, patched by finish()
     put32(actl, std::uint32_t(p_.loops));
@@ -83,13 +70,6 @@ class ApngWriter final : public AnimationWriter {
     if (delay_den_ > 65535) {
       delay_num_ = 1;
       delay_den_ = std::uint32_t(std::round(p_.fps));
-    }
-  }
-  ~ApngWriter() override {
-    if (!finished_) {
-      out_.close();
-      std::error_code ec;
-      std::filesystem::remove(tmp_, ec);
     }
   }
 
@@ -134,34 +114,30 @@ class ApngWriter final : public AnimationWriter {
     }
     previous_ = fb.rgba;
     ++frames_;
-    if (!out_) throw std::runtime_error(path_.string() + ": write failed");
   }
 
   void finish() override {
     if (frames_ == 0) throw std::runtime_error(path_.string() + ": an animation needs at least one frame");
     chunk("IEND", "");
     // Patch the frame count into acTL (its CRC covers it, so rewrite the whole chunk).
-    out_.seekp(actl_at_);
     std::string actl;
     put32(actl, std::uint32_t(frames_));
     put32(actl, std::uint32_t(p_.loops));
-    chunk("acTL", actl);
-    out_.close();
-    if (!out_) throw std::runtime_error(path_.string() + ": write failed");
-    move_into_place(tmp_, path_);
-    finished_ = true;
+    file_.overwrite(actl_at_, chunk_bytes("acTL", actl));
+    file_.commit();
   }
   int frames() const override { return frames_; }
 
  private:
-  void chunk(const char* type, const std::string& data) {
+  void chunk(const char* type, const std::string& data) { file_.write(chunk_bytes(type, data)); }
+  static std::string chunk_bytes(const char* type, const std::string& data) {
     std::string c;
     put32(c, std::uint32_t(data.size()));
     c += type;
     c += data;
     const uLong crc = crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(c.data() + 4), uInt(c.size() - 4));
     put32(c, std::uint32_t(crc));
-    out_.write(c.data(), std::streamsize(c.size()));
+    return c;
   }
 
   // Scanlines of the rectangle, each with PNG filter "Up" (1 byte + 3 per pixel), deflated.
@@ -189,25 +165,24 @@ class ApngWriter final : public AnimationWriter {
     return out;
   }
 
-  std::filesystem::path path_, tmp_;
+  std::filesystem::path path_;
   AnimationParams p_;
-  std::ofstream out_;
-  std::streampos actl_at_{};
+  DurableFile file_;  // complete or absent, durable (foxi/model/durable_file.hpp)
+  std::uint64_t actl_at_ = 0;
   std::uint32_t delay_num_ = 1, delay_den_ = 12, sequence_ = 0;
   int frames_ = 0;
-  bool finished_ = false;
   std::vector<std::uint32_t> previous_;
 };
 
 class GifWriter final : public AnimationWriter {
  public:
   GifWriter(const std::filesystem::path& path, const AnimationParams& params)
-      : path_(path), tmp_(temp_beside(path)), p_(params) {
-    check_params(path, params);
+      : path_(path), p_(params), file_((check_params(path, params), path)) {
     int err = 0;
-    // Opened here rather than by giflib, which creates files readable by their owner only.
-    const int fd = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
-    if (fd < 0) throw std::runtime_error(path.string() + ": cannot create " + tmp_.string());
+    // A copy of the DurableFile's descriptor (giflib closes the one it is given), rather than a file
+    // giflib creates, which would be readable by its owner only.
+    const int fd = ::dup(file_.fd());
+    if (fd < 0) throw std::runtime_error(path.string() + ": cannot write: " + std::strerror(errno));
     gif_ = EGifOpenFileHandle(fd, &err);
     if (!gif_) {
       ::close(fd);
@@ -227,10 +202,6 @@ class GifWriter final : public AnimationWriter {
     if (gif_) {
       int err = 0;
       EGifCloseFile(gif_, &err);
-    }
-    if (!finished_) {
-      std::error_code ec;
-      std::filesystem::remove(tmp_, ec);
     }
   }
 
@@ -290,8 +261,7 @@ class GifWriter final : public AnimationWriter {
     const int closed = EGifCloseFile(gif_, &err);
     gif_ = nullptr;
     if (closed == GIF_ERROR) fail(err);
-    move_into_place(tmp_, path_);
-    finished_ = true;
+    file_.commit();
   }
   int frames() const override { return frames_; }
 
@@ -301,11 +271,11 @@ class GifWriter final : public AnimationWriter {
     throw std::runtime_error(path_.string() + ": " + (why ? why : "GIF error " + std::to_string(err)));
   }
 
-  std::filesystem::path path_, tmp_;
+  std::filesystem::path path_;
   AnimationParams p_;
+  DurableFile file_;  // complete or absent, durable (foxi/model/durable_file.hpp)
   GifFileType* gif_ = nullptr;
   int delay_cs_ = 8, frames_ = 0;
-  bool finished_ = false;
 };
 
 }  // namespace
