@@ -1,7 +1,9 @@
 // Validation of the mesh database: sizes, indices, repeated vertices, non-finite coordinates, exact
 // orientation of every tet (CGAL's filtered exact predicate), geometry beyond the range of double,
-// duplicate tets and coincident nodes, unused nodes.
+// duplicate tets and coincident nodes, overlapping tets (validate_overlap.cpp), unused nodes.
 #include "foxi/model/validate.hpp"
+
+#include "validate_overlap.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -259,6 +261,11 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
       note(r, "boundary triangle " + std::to_string(f) + " " + ids(v, 3) + ": repeated node");
     }
   }
+  if (r.ok()) {
+    const OverlapReport o = check_overlap(mesh, kMaxMessages);
+    r.overlapping = o.problems();
+    for (const std::string& m : o.examples) note(r, m);
+  }
   for (std::size_t v = 0; v < nv; ++v)
     if (!used[v]) {
       if (r.unused_nodes == 0)
@@ -285,6 +292,7 @@ std::vector<std::string> describe(const ValidationReport& r) {
   add(r.zero_volume, "tet", "tets", " of zero volume");
   add(r.out_of_range, "tet", "tets", " with geometry beyond the range foxi computes in (volumes, circumspheres, keys)");
   add(r.duplicate_tets, "tet", "tets", " repeating an earlier tet's nodes");
+  add(r.overlapping, "place", "places", " where tets overlap (folded or crossing faces, or a tet inside another)");
   add(r.duplicate_nodes, "node", "nodes", " at the point of another node (the mesh is torn there)");
   add(r.inverted, "inverted tet", "inverted tets", " (negative orientation; every command re-orients them)");
   add(r.unused_nodes, "node", "nodes", " used by no tet");

@@ -10,6 +10,8 @@
 
 #include "../../bench/bench_meshes.hpp"
 #include "foxi/model/adjacency.hpp"
+#include "foxi/model/io_tetgen.hpp"
+#include "../test_util.hpp"
 
 namespace foxi {
 namespace {
@@ -240,6 +242,120 @@ TEST(Validate, AcceptedGeometryHasFiniteExactlyScaledVolumes) {
   EXPECT_GE(accepted_hi, 20);
   EXPECT_GE(accepted_lo, -12);  // 2 x 1e-13 across: refused
   EXPECT_LE(accepted_hi, 24);   // spheres reaching 1.7e24: refused
+}
+
+
+// Overlapping tets. Each mesh below passes every local check (indices, orientation, volume,
+// duplicates) and yet two of its tets cover the same space; each was found by fuzzing or is the
+// smallest case of one kind. The oracle is the construction: the overlap is planted.
+
+// The six Kuhn tets of the cube [0,2]^3 around its diagonal 0-7 (node i at (2(i&1), 2(i>>1&1), 2(i>>2&1))).
+Mesh kuhn_cube() {
+  Mesh m;
+  for (int i = 0; i < 8; ++i) {
+    m.xyz.push_back(2.0 * (i & 1));
+    m.xyz.push_back(2.0 * (i >> 1 & 1));
+    m.xyz.push_back(2.0 * (i >> 2 & 1));
+  }
+  m.tet = {0, 1, 3, 7, 0, 1, 5, 7, 0, 2, 3, 7, 0, 2, 6, 7, 0, 4, 5, 7, 0, 4, 6, 7};
+  return m;
+}
+
+TEST(ValidateOverlap, KuhnCubeIsOneMesh) {
+  Mesh m = kuhn_cube();
+  ValidationReport r = validate_and_repair(m);
+  EXPECT_TRUE(r.ok()) << (r.messages.empty() ? "" : r.messages[0]);
+  EXPECT_EQ(r.overlapping, 0u);
+}
+
+TEST(ValidateOverlap, TetAcrossTheCubeIsRefused) {
+  // Found by fuzz_mesh_pipeline: tet (0,1,3,7) replaced by (6,1,3,7), which cuts through its
+  // neighbours. Every face is shared by at most two tets on opposite sides, so only the boundary
+  // crossing itself shows the overlap. The undoable painter then disagreed with a fresh drawing.
+  Mesh m = kuhn_cube();
+  m.tet[0] = 6;
+  ValidationReport r = validate_and_repair(m);
+  EXPECT_FALSE(r.ok());
+  EXPECT_GT(r.overlapping, 0u);
+  EXPECT_TRUE(mentions(r, "overlap")) << (r.messages.empty() ? "" : r.messages[0]);
+}
+
+TEST(ValidateOverlap, FoldedFaceIsRefused) {
+  // Two tets on the same side of their shared face (1,2,3).
+  Mesh m = two_tets();
+  m.xyz[12] = m.xyz[13] = m.xyz[14] = 0.1;  // node 4 moved to the side of node 0
+  ValidationReport r = validate_and_repair(m);
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.overlapping, 1u);
+  EXPECT_TRUE(mentions(r, "same side of their shared face"));
+}
+
+TEST(ValidateOverlap, FaceOfThreeTetsIsRefused) {
+  Mesh m = two_tets();
+  m.xyz.insert(m.xyz.end(), {2, 2, 2});
+  m.tet.insert(m.tet.end(), {1, 5, 2, 3});
+  ValidationReport r = validate_and_repair(m);
+  EXPECT_FALSE(r.ok());
+  EXPECT_GT(r.overlapping, 0u);
+  EXPECT_TRUE(mentions(r, "three or more tets"));
+}
+
+TEST(ValidateOverlap, MeshInsideAnotherIsRefused) {
+  // A small tet strictly inside a large one, sharing no node: no face is shared and no boundary face
+  // crosses another, so only the covering count finds it.
+  Mesh m;
+  m.xyz = {0, 0, 0, 10, 0, 0, 0, 10, 0, 0, 0, 10, 1, 1, 1, 2, 1, 1, 1, 2, 1, 1, 1, 2};
+  m.tet = {0, 1, 2, 3, 4, 5, 6, 7};
+  ValidationReport r = validate_and_repair(m);
+  EXPECT_FALSE(r.ok());
+  EXPECT_EQ(r.overlapping, 1u);
+  EXPECT_TRUE(mentions(r, "covers the inside of tet"));
+}
+
+TEST(ValidateOverlap, TouchingAtAVertexOrAnEdgeIsAllowed) {
+  // Two tets meeting in one vertex, and two meeting in one edge, coplanar faces included: a mesh.
+  Mesh vertex;
+  vertex.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, -1, 0, 0, 0, -1, 0, 0, 0, -1};
+  vertex.tet = {0, 1, 2, 3, 0, 4, 5, 6};
+  EXPECT_TRUE(validate_and_repair(vertex).ok());
+  Mesh edge;  // the edge 0-1; node 4 in the plane z=0 of the face (0,1,2), on the far side of 0-1
+  edge.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.5, -1, 0, 0.5, -1, -1};
+  edge.tet = {0, 1, 2, 3, 0, 1, 4, 5};
+  ValidationReport r = validate_and_repair(edge);
+  EXPECT_TRUE(r.ok()) << (r.messages.empty() ? "" : r.messages[0]);
+  // The same with node 4 on the near side of 0-1: the two coplanar faces overlap.
+  edge.xyz[13] = 0.2;
+  edge.xyz[16] = 0.2;
+  edge.xyz[17] = 1;
+  EXPECT_FALSE(validate_and_repair(edge).ok());
+}
+
+TEST(ValidateOverlap, TetgenMeshOfANonConvexDomainIsOneMesh) {
+  // An outside oracle: TetGen's conforming mesh of the seed paper's trench (non-convex, coplanar
+  // boundary faces meeting at reflex edges) is a mesh.
+  if (!test::have_program("tetgen")) GTEST_SKIP() << "no tetgen";
+  test::TempDir dir;
+  std::filesystem::copy_file(test::data_dir() + "/../../examples/trench.poly", dir / "t.poly");
+  ASSERT_EQ(test::run("tetgen -pq1.4a0.002Q '" + (dir / "t.poly").string() + "'", dir / "log"), 0);
+  Mesh m = read_tetgen(dir / "t.1");
+  ASSERT_GT(m.tet_count(), 500u);
+  ValidationReport r = validate_and_repair(m);
+  EXPECT_TRUE(r.ok()) << (r.messages.empty() ? "" : r.messages[0]);
+  // Removing nothing but moving one interior node far outside makes its tets overlap others.
+  const FaceAdjacency& adj = face_adjacency(m);
+  std::vector<char> on_boundary(m.node_count(), 0);
+  for (std::size_t t = 0; t < m.tet_count(); ++t)
+    for (int f = 0; f < 4; ++f)
+      if (adj.neighbour[4 * t + f] == kNone)
+        for (int j = 0; j < 4; ++j)
+          if (j != f) on_boundary[m.tet[4 * t + j]] = 1;
+  std::uint32_t inner = 0;
+  while (on_boundary[m.tet[inner]]) ++inner;
+  const std::uint32_t v = m.tet[inner];
+  m.xyz[3 * v + 2] += 0.3;  // through its neighbours' faces
+  invalidate_derived(m);
+  ValidationReport moved = validate_and_repair(m);
+  EXPECT_FALSE(moved.ok() && moved.inverted == 0) << "moving an interior node 0.3 up left a valid mesh";
 }
 
 }  // namespace
