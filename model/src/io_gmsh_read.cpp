@@ -1,4 +1,5 @@
 // Gmsh .msh 2.2 and 4.1 reader, ASCII and binary (the writer is io_gmsh_write.cpp).
+// Over 900 lines because it is one class, Reader, whose sections share the cursor and tag maps.
 //
 // Reading choices (see io_gmsh.hpp for the contract):
 // - Nodes are numbered densely in the order they appear in the file; node tags may be sparse,
