@@ -1,6 +1,7 @@
 // The painter's undo (TetRasterizer::Impl, raster_impl.hpp): the saves requested while drawing and
 // answered at the end of a batch, and undraw, which restores saved pixels and repaints the faces of
 // kept neighbours, split into row ranges across threads.
+#include "foxi/model/assert.hpp"
 #include "raster_impl.hpp"
 
 namespace foxi {
@@ -198,6 +199,10 @@ void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count) {
     written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
     tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
   }
+  FOXI_ASSERT(count > 0 && count <= history.size(), "undraw of " << count << " of " << history.size() << " tets");
+  FOXI_ASSERT(drawn_box.size() == history.size() && drawn_reach.size() == history.size(),
+              "per-tet undo records: " << drawn_box.size() << " boxes, " << drawn_reach.size() << " reaches for "
+                                       << history.size() << " drawn tets");
   const std::size_t first = history.size() - count;
   auto first_save = [&](const Lane& lane) {
     return std::size_t(std::lower_bound(lane.saves.begin(), lane.saves.end(), first,
@@ -389,6 +394,8 @@ void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count) {
     }
     lane.saved_rgba.resize(lane.saved_pixel.size());
     lane.saved_id.resize(lane.saved_pixel.size());
+    FOXI_ASSERT(lane.saves.empty() || (lane.saves.back().at < first && lane.saves.back().offset <= lane.saved_pixel.size()),
+                "a save of an undrawn tet (position " << lane.saves.back().at << " of " << first << ") or past the saved pixels");
   }
 }
 

@@ -22,6 +22,7 @@
 #endif
 
 #include "exact.hpp"
+#include "foxi/model/assert.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "huge_page_allocator.hpp"
 #include "order_geometry.hpp"
@@ -715,6 +716,7 @@ void ProgressiveOrder::Impl::place_buckets(std::size_t split, bool gather) {
   for (std::size_t i = ordinary_count; i < m; ++i) {
     const Packed p = keyed[i];
     const std::uint32_t q = q_of(p);
+    FOXI_ASSERT((q >> shift) < nb, "bucket " << (q >> shift) << " of " << nb);
     ++hist[wide_part][q >> shift];
     if (gather && q < q_head) {
       if (head_count[wide_part] < head_room) head[wide_part][head_count[wide_part]] = p;
@@ -739,6 +741,7 @@ void ProgressiveOrder::Impl::place_buckets(std::size_t split, bool gather) {
     }
   }
   bucket_begin[nb] = acc;
+  FOXI_ASSERT(acc == m, "the buckets hold " << acc << " of " << m << " entries");
   if (!t_cluster_free) tet_begin[nb] = tets;
   scatter_split = split;
   if (gather) head_fits = q_head > 0 && head_count[0] <= head_room && head_count[1] <= head_room;
