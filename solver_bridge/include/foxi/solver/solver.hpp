@@ -21,8 +21,8 @@ struct SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The progress callback returned false.
-struct SolverCancelled : SolverError {
+// The progress callback returned false (a foxi::Cancelled too).
+struct SolverCancelled : SolverError, Cancelled {
   using SolverError::SolverError;
 };
 
