@@ -7,6 +7,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/progress.hpp"
 #include "foxi/model/units.hpp"
 #include "signals.hpp"
 
@@ -82,6 +83,10 @@ int main(int argc, char** argv) {
   } catch (const foxi::ExpressionError& e) {
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
     return kExitBadInput;
+  } catch (const foxi::Cancelled& c) {  // a progress function said stop (an interrupt), in any library
+    const auto* e = dynamic_cast<const std::exception*>(&c);
+    std::fprintf(stderr, "foxi %s: %s\n", command.c_str(), e ? e->what() : "cancelled");
+    return kExitInterrupted;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "foxi %s: error: out of memory\n", command.c_str());
     return kExitFailure;

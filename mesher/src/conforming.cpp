@@ -63,7 +63,7 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     if (double(rep.added_points) >= budget) break;
     if (params.progress &&
         !params.progress("conforming refinement", double(it + 1) / double(conforming.max_iterations + 1)))
-      throw MesherError(-1, "meshing cancelled");
+      throw MesherCancelled("meshing cancelled");
     rounds.keep(current, mesh);
     const std::size_t n = split_encroached_constraints(mesh, cert.violating_tets, current);
     if (n == 0) break;

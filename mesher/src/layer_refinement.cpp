@@ -190,7 +190,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
     if ((cert.delaunay && bad.empty()) || it >= conforming.max_layer_iterations) break;
     if (params.progress && !params.progress(first_mesh ? "conforming refinement" : "refinement around thin layers",
                                             double(it + 1) / double(conforming.max_layer_iterations + 1)))
-      throw MesherError(-1, "meshing cancelled");
+      throw MesherCancelled("meshing cancelled");
 
     const MeshSearch search(mesh);
     const TetLocator locator(mesh, search.vertices);

@@ -14,19 +14,11 @@
 #include "foxi/mesher/thin_layers.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
+#include "foxi/model/vec3.hpp"
 
 namespace foxi::detail {
 
-using Vec = std::array<double, 3>;
-
-inline Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-inline Vec add(const Vec& a, const Vec& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-inline Vec scale(const Vec& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-inline double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-inline double norm2(const Vec& a) { return dot(a, a); }
+using Vec = Vec3;  // sub, add, scale, dot, cross, norm2: foxi/model/vec3.hpp
 inline Vec at(const std::vector<double>& xyz, std::uint32_t i) { return {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; }
 
 // An undirected edge as one integer (the smaller index in the high half).

@@ -138,7 +138,7 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
       if (ready == 0 || (ready < 0 && errno == EINTR)) {
         if (progress && !progress("meshing", -1.0)) {
           stop_child();
-          throw MesherError(-1, "meshing cancelled");
+          throw MesherCancelled("meshing cancelled");
         }
         continue;
       }

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "derived.hpp"
+#include "foxi/model/parallel.hpp"
 
 namespace foxi {
 namespace {
@@ -51,17 +52,10 @@ inline SortedTet sort_tet(const std::uint32_t* t) {
   return s;
 }
 
+// body(i) once on each of `threads` threads (thread i takes range(i)).
 template <class F>
 void parallel_for_threads(unsigned threads, F&& body) {
-  if (threads <= 1) {
-    body(0u);
-    return;
-  }
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
-  for (unsigned i = 1; i < threads; ++i) pool.emplace_back([&body, i] { body(i); });
-  body(0u);
-  for (auto& th : pool) th.join();
+  detail::parallel_for(threads, threads, [&](std::size_t, std::size_t, unsigned i) { body(i); }, 0);
 }
 
 struct Counts {

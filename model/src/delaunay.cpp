@@ -20,6 +20,7 @@
 #include <thread>
 
 #include "derived.hpp"
+#include "foxi/model/parallel.hpp"
 
 namespace foxi {
 namespace {
@@ -432,10 +433,7 @@ DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const Certifi
         cancel = true;
     }
   };
-  std::vector<std::thread> pool;
-  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(work, i);
-  work(0);
-  for (auto& th : pool) th.join();
+  detail::parallel_for(threads, threads, [&](std::size_t, std::size_t, unsigned i) { work(i); }, 0);
 
   for (ThreadResult& r : results) {
     cert.tets_checked += r.checked + r.degenerate;

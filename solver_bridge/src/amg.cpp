@@ -9,6 +9,7 @@
 #include <cmath>
 #include <vector>
 
+#include "foxi/model/assert.hpp"
 #include "p1_assembly.hpp"
 
 namespace foxi::detail {
@@ -40,7 +41,13 @@ struct View {
   const double* val = nullptr;
 };
 
-View view(const Csr& m) { return {m.rows, m.start.data(), m.col.data(), m.val.data()}; }
+View view(const Csr& m) {
+  FOXI_ASSERT(m.start.size() == m.rows + 1 && m.col.size() == m.val.size() &&
+                  std::size_t(m.start.back()) == m.col.size(),
+              "CSR of " << m.rows << " rows: " << m.start.size() << " row starts, last " << m.start.back() << ", "
+                        << m.col.size() << " columns, " << m.val.size() << " values");
+  return {m.rows, m.start.data(), m.col.data(), m.val.data()};
+}
 
 // The serial_below of parallel_for for a pass over the rows of a: by nonzeros, not rows, since the
 // coarse levels have few but long rows (on one thread they were a serial part of every cycle). The
@@ -102,6 +109,7 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row,
           const int first = out.start[i];
           int next = first;
           row(i, [&](int c, double v) {
+            FOXI_ASSERT(c >= 0 && static_cast<std::size_t>(c) < cols, "CSR row " << i << ": column " << c << " of " << cols);
             int& m = mark[static_cast<std::size_t>(c)];
             if (m < first) {
               m = next++;
@@ -111,6 +119,8 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row,
               out.val[static_cast<std::size_t>(m)] += v;
             }
           });
+          FOXI_ASSERT(next == out.start[i + 1], "CSR row " << i << ": " << next - first << " columns filled of "
+                                                           << out.start[i + 1] - first << " counted");
         }
       },
       serial_below);

@@ -7,16 +7,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "foxi/model/vec3.hpp"  // Vec3, dot, cross
 #include "foxi/solver/thermoelastic.hpp"
 #include "scalar_p1.hpp"
 
 namespace foxi::detail {
 
-using Vec3 = std::array<double, 3>;
-inline double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-inline Vec3 cross(const Vec3& a, const Vec3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
 inline Vec3 point(const Mesh& mesh, std::size_t v) {
   return {mesh.xyz[3 * v], mesh.xyz[3 * v + 1], mesh.xyz[3 * v + 2]};
 }

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "foxi/solver/thermal.hpp"
+#include "foxi/solver/solver.hpp"
 
 namespace foxi::detail {
 

@@ -1,4 +1,4 @@
-// Internal pieces shared by foxi's P1 solvers: a thread split, the node-adjacency CSR pattern of a
+// Internal pieces shared by foxi's P1 solvers: the node-adjacency CSR pattern of a
 // tet mesh and the gradients of the P1 shape functions.
 #pragma once
 
@@ -12,28 +12,9 @@
 #include <vector>
 
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/parallel.hpp"  // thread_count, parallel_for
 
 namespace foxi::detail {
-
-inline unsigned thread_count(unsigned requested) {
-  unsigned n = requested ? requested : std::thread::hardware_concurrency();
-  return std::max(1u, n);
-}
-
-// Calls fn(begin, end, thread) on `threads` contiguous slices of [0, n); serial when n is small.
-template <class Fn>
-void parallel_for(std::size_t n, unsigned threads, Fn&& fn, std::size_t serial_below = 20000) {
-  if (threads <= 1 || n < serial_below) {
-    fn(std::size_t{0}, n, 0u);
-    return;
-  }
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
-  for (unsigned t = 1; t < threads; ++t)
-    pool.emplace_back([&, t] { fn(n * t / threads, n * (t + 1) / threads, t); });
-  fn(std::size_t{0}, n / threads, 0u);
-  for (auto& th : pool) th.join();
-}
 
 // Compressed sparse rows with sorted column indices in each row.
 struct CsrPattern {

@@ -1,6 +1,6 @@
 // Fuzz target: the in-memory medit reader (parse_medit). Any input gives a consistent mesh or an IoError
 // naming the file; never a crash, a hang, an over-allocation or another exception.
-#include "foxi/model/io_tetgen.hpp"
+#include "foxi/model/io_medit.hpp"
 #include "fuzz_util.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

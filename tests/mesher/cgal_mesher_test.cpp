@@ -420,6 +420,7 @@ TEST(CgalMesher, BadPlcsTimeLimitAndCancelGiveTypedMesherErrors) {
   } catch (const MesherError& e) {
     EXPECT_EQ(e.failure(), MesherFailure::cancelled);
     EXPECT_EQ(e.tetgen_code(), -1);
+    EXPECT_NE(dynamic_cast<const Cancelled*>(&e), nullptr);  // the one cancellation outcome
   }
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/io_medit.hpp"
 #include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/mesh.hpp"
 #include "test_util.hpp"

@@ -307,6 +307,9 @@ TEST(StructureShapes, ProgressReportsStagesAndCancels) {
   EXPECT_THROW(
       foxi::build_structure(model, [](std::string_view stage, double) { return stage != "conform"; }),
       foxi::StructureCancelled);
+  EXPECT_THROW(  // the one cancellation outcome of every library
+      foxi::build_structure(model, [](std::string_view stage, double) { return stage != "conform"; }),
+      foxi::Cancelled);
 }
 
 // ---- STL surfaces ----

@@ -12,6 +12,7 @@
 #include "exact.hpp"
 #include "huge_page_allocator.hpp"
 #include "foxi/model/adjacency.hpp"
+#include "foxi/model/parallel.hpp"
 
 namespace foxi {
 
@@ -20,38 +21,6 @@ namespace {
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 // A centre computed in double whose estimated relative error exceeds this is recomputed exactly.
 constexpr double kRecomputeAbove = 0x1p-40;
-
-// Runs f(begin, end, part) over [0, n) on both cores (part 0 or 1: the thread), in chunks taken
-// in turn, so that the costly exact recomputations, bunched in some part of the mesh, do not leave
-// one core idle.
-template <class F>
-void parallel_for(std::size_t n, F f) {
-  if (n < 20000) {
-    f(std::size_t{0}, n, 0);
-    return;
-  }
-  const std::size_t chunk = std::max<std::size_t>(4096, n / 256);
-  std::atomic<std::size_t> next{0};
-  auto work = [&](int part) {
-    for (std::size_t b = next.fetch_add(chunk); b < n; b = next.fetch_add(chunk)) f(b, std::min(n, b + chunk), part);
-  };
-  std::thread other([&] { work(1); });
-  work(0);
-  other.join();
-}
-
-// f(0, n / 2, 0) and f(n / 2, n, 1) on two threads (all of it as part 0 below 20000): the same
-// split every time, for passes that must see the parts of an earlier one.
-template <class F>
-void two_halves(std::size_t n, F f) {
-  if (n < 20000) {
-    f(std::size_t{0}, n, 0);
-    return;
-  }
-  std::thread other([&] { f(n / 2, n, 1); });
-  f(std::size_t{0}, n / 2, 0);
-  other.join();
-}
 
 struct UnionFind {
   std::vector<std::uint32_t> parent;
@@ -81,7 +50,7 @@ void make_key_blocks(SphereTable& t, const double half[3]);
 void make_fixed_keys(SphereTable& t, const double half[3]) {
   const std::size_t m = t.all_rep.size();
   double cmax_part[2] = {0, 0}, smax_part[2] = {0, 0};
-  parallel_for(m, [&](std::size_t begin, std::size_t end, int part) {
+  detail::parallel_for_balanced(m, [&](std::size_t begin, std::size_t end, int part) {
     double cm = cmax_part[part], sm = smax_part[part];
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t rep = t.all_rep[i];
@@ -112,7 +81,7 @@ void make_fixed_keys(SphereTable& t, const double half[3]) {
   t.fixed_keys.reserve(m);
   advise_huge_pages(t.fixed_keys.data(), m * sizeof(SphereTable::FixedKey));
   t.fixed_keys.resize(m);
-  parallel_for(m, [&](std::size_t begin, std::size_t end, int) {
+  detail::parallel_for_balanced(m, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t rep = t.all_rep[i];
       const double* c = t.c.data() + 3 * std::size_t(rep);
@@ -169,7 +138,7 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
   std::vector<std::uint32_t> codes(m);
   std::vector<std::uint32_t> slots[2] = {std::vector<std::uint32_t>(cells, 0), std::vector<std::uint32_t>(cells, 0)};
   std::vector<KeyBlock> cell_box[2] = {std::vector<KeyBlock>(cells, empty), std::vector<KeyBlock>(m < 20000 ? 0 : cells, empty)};
-  two_halves(m, [&](std::size_t begin, std::size_t end, int part) {
+  detail::parallel_for(m, 2, [&](std::size_t begin, std::size_t end, int part) {
     std::uint32_t* count = slots[part].data();
     KeyBlock* box = cell_box[part].data();
     for (std::size_t i = begin; i < end; ++i) {
@@ -190,7 +159,7 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
   for (std::size_t c = 0; c < cells; ++c)
     for (auto& part : slots) acc += std::exchange(part[c], acc);
   t.key_order.resize(m);
-  two_halves(m, [&](std::size_t begin, std::size_t end, int part) {
+  detail::parallel_for(m, 2, [&](std::size_t begin, std::size_t end, int part) {
     std::uint32_t* next = slots[part].data();
     for (std::size_t i = begin; i < end; ++i) t.key_order[next[codes[i]]++] = static_cast<std::uint32_t>(i);
   });
@@ -244,7 +213,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   t.key_b.resize(n);
 
   std::size_t recomputed[2] = {0, 0}, flats[2] = {0, 0};
-  parallel_for(n, [&](std::size_t begin, std::size_t end, int part) {
+  detail::parallel_for_balanced(n, [&](std::size_t begin, std::size_t end, int part) {
     for (std::size_t i = begin; i < end; ++i) {
       const std::uint32_t* v = T + 4 * i;
       const double* pa = X + 3 * std::size_t(v[0]);
@@ -336,7 +305,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   // vertex); CGAL's exact test decides the rest.
   const FaceAdjacency& adj = face_adjacency(mesh);
   std::vector<std::uint8_t> same(4 * n, 0);
-  parallel_for(n, [&](std::size_t begin, std::size_t end, int) {
+  detail::parallel_for_balanced(n, [&](std::size_t begin, std::size_t end, int) {
     for (std::size_t i = begin; i < end; ++i) {
       if (t.flat[i]) continue;
       const std::uint32_t* v = T + 4 * i;

@@ -1,3 +1,7 @@
+// The power visibility order: ProgressiveOrder and visibility_order / visibility_order_into. Over 900
+// lines because it is one class, ProgressiveOrder::Impl, whose phases (key pass, buckets, near-tie
+// resolution, cluster expansion, the worker) share its state and its hot loops; MPVO is in
+// mpvo_order.cpp, the checks and the centroid baseline in order_check.cpp.
 #include "foxi/viz/visibility_order.hpp"
 
 #include <algorithm>
@@ -18,28 +22,17 @@
 #endif
 
 #include "exact.hpp"
+#include "foxi/model/assert.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "huge_page_allocator.hpp"
+#include "order_geometry.hpp"
 #include "thread_pool.hpp"
 
 namespace foxi {
 
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-
-// Face f of a positively oriented tet, listed so that the tet's own vertex f is on its negative side.
-constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-template <class F>
-void parallel_for(std::size_t n, F f) {
-  if (n < 50000) {
-    f(std::size_t{0}, n, 0);
-    return;
-  }
-  const std::size_t half = n / 2;
-  pool::on_two_cores([&](int part) { part == 0 ? f(std::size_t{0}, half, 0) : f(half, n, 1); });
-}
+using namespace order_detail;
 
 // A prefetch that the optimiser keeps. GCC deems __builtin_prefetch free of side effects, so a
 // function that only prefetches is found const by its IPA pass and every call to it removed (it
@@ -87,34 +80,6 @@ inline void store_fence() {
 #if defined(__SSE2__) && defined(__x86_64__)
   _mm_sfence();
 #endif
-}
-
-const double* node(const Mesh& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
-
-// +1: the eye is on the positive side of triangle (a, b, c); -1 negative; 0 on its plane.
-// orient3d(a, b, c, p) in double with Shewchuk's error bound; the exact predicate when in doubt.
-inline int fast_orientation(const double* a, const double* b, const double* c, const double* p) {
-  const double adx = a[0] - p[0], bdx = b[0] - p[0], cdx = c[0] - p[0];
-  const double ady = a[1] - p[1], bdy = b[1] - p[1], cdy = c[1] - p[1];
-  const double adz = a[2] - p[2], bdz = b[2] - p[2], cdz = c[2] - p[2];
-  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
-  const double cdxady = cdx * ady, adxcdy = adx * cdy;
-  const double adxbdy = adx * bdy, bdxady = bdx * ady;
-  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
-  const double permanent = (std::abs(bdxcdy) + std::abs(cdxbdy)) * std::abs(adz) +
-                           (std::abs(cdxady) + std::abs(adxcdy)) * std::abs(bdz) +
-                           (std::abs(adxbdy) + std::abs(bdxady)) * std::abs(cdz);
-  const double bound = (7.0 * kEps / 2 + 56.0 * kEps * kEps / 4) * permanent;  // o3derrboundA
-  // Shewchuk's orient3d is positive when p is below (a, b, c); ours is det[b-a, c-a, p-a].
-  if (det > bound) return -1;
-  if (-det > bound) return 1;
-  return exact::orientation(a, b, c, p);
-}
-
-int eye_side(const View& view, const double* a, const double* b, const double* c) {
-  if (view.perspective) return fast_orientation(a, b, c, view.eye);
-  const double back[3] = {-view.dir[0], -view.dir[1], -view.dir[2]};
-  return exact::orientation_at_infinity(a, b, c, back);
 }
 
 std::uint32_t rep_tet(const SphereTable& t, std::uint32_t item) {
@@ -751,6 +716,7 @@ void ProgressiveOrder::Impl::place_buckets(std::size_t split, bool gather) {
   for (std::size_t i = ordinary_count; i < m; ++i) {
     const Packed p = keyed[i];
     const std::uint32_t q = q_of(p);
+    FOXI_ASSERT((q >> shift) < nb, "bucket " << (q >> shift) << " of " << nb);
     ++hist[wide_part][q >> shift];
     if (gather && q < q_head) {
       if (head_count[wide_part] < head_room) head[wide_part][head_count[wide_part]] = p;
@@ -775,6 +741,7 @@ void ProgressiveOrder::Impl::place_buckets(std::size_t split, bool gather) {
     }
   }
   bucket_begin[nb] = acc;
+  FOXI_ASSERT(acc == m, "the buckets hold " << acc << " of " << m << " entries");
   if (!t_cluster_free) tet_begin[nb] = tets;
   scatter_split = split;
   if (gather) head_fits = q_head > 0 && head_count[0] <= head_room && head_count[1] <= head_room;
@@ -1574,137 +1541,6 @@ void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, co
   d.stats.scatter_seconds = std::chrono::duration<double>(t2 - t1).count();
   d.stats.sort_seconds = std::chrono::duration<double>(Clock::now() - t2).count();
   if (stats) *stats = d.stats;
-}
-
-std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,
-                                      std::span<const std::uint32_t> subset, std::size_t* cycles_broken) {
-  const std::size_t n = mesh.tet_count();
-  std::vector<std::uint32_t> tets;
-  if (subset.empty()) {
-    tets.resize(n);
-    for (std::size_t i = 0; i < n; ++i) tets[i] = static_cast<std::uint32_t>(i);
-  } else {
-    tets.assign(subset.begin(), subset.end());
-  }
-  std::vector<std::uint8_t> member(n, 0);
-  for (std::uint32_t t : tets) member[t] = 1;
-  const double e[3] = {view.eye[0] - table.origin[0], view.eye[1] - table.origin[1], view.eye[2] - table.origin[2]};
-  auto key = [&](std::uint32_t t) {
-    const double* c = table.c.data() + 3 * std::size_t(t);
-    return view.perspective ? table.s[t] - 2 * (c[0] * e[0] + c[1] * e[1] + c[2] * e[2])
-                            : c[0] * view.dir[0] + c[1] * view.dir[1] + c[2] * view.dir[2];
-  };
-  const FaceAdjacency& adj = face_adjacency(mesh);
-  // behind[4t+f]: 1 if the neighbour across face f must be drawn before t (it is behind t).
-  std::vector<std::uint32_t> indeg(n, 0);
-  std::vector<std::uint8_t> edge_out(4 * n, 0);  // 1: t -> neighbour (t drawn first)
-  for (std::uint32_t t : tets) {
-    const std::uint32_t* v = mesh.tet.data() + 4 * std::size_t(t);
-    for (int f = 0; f < 4; ++f) {
-      std::uint32_t nb = adj.neighbour[4 * std::size_t(t) + f];
-      if (nb == kNone || !member[nb >> 2]) continue;
-      std::uint32_t u = nb >> 2;
-      if (u < t) continue;
-      int side = eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]), node(mesh, v[kFace[f][2]]));
-      if (side == 0) continue;
-      // t's own vertex is on the negative side: side < 0 means the eye is on t's side (t in front).
-      if (side < 0) {
-        ++indeg[t];  // u first
-        edge_out[(std::size_t(u) << 2) | (nb & 3)] = 1;
-      } else {
-        ++indeg[u];
-        edge_out[4 * std::size_t(t) + f] = 1;
-      }
-    }
-  }
-  using Ready = std::pair<double, std::uint32_t>;
-  std::priority_queue<Ready> ready;  // largest key (farthest) first
-  for (std::uint32_t t : tets)
-    if (indeg[t] == 0) ready.emplace(key(t), t);
-  // For breaking cycles: all tets by decreasing key.
-  std::vector<std::uint32_t> by_key = tets;
-  std::sort(by_key.begin(), by_key.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) > key(b); });
-  std::size_t scan = 0, cycles = 0;
-  std::vector<std::uint8_t> done(n, 0);
-  std::vector<std::uint32_t> out;
-  out.reserve(tets.size());
-  while (out.size() < tets.size()) {
-    if (ready.empty()) {
-      while (done[by_key[scan]]) ++scan;
-      ready.emplace(key(by_key[scan]), by_key[scan]);
-      ++cycles;
-    }
-    std::uint32_t t = ready.top().second;
-    ready.pop();
-    if (done[t]) continue;
-    done[t] = 1;
-    out.push_back(t);
-    for (int f = 0; f < 4; ++f) {
-      if (!edge_out[4 * std::size_t(t) + f]) continue;
-      std::uint32_t u = adj.neighbour[4 * std::size_t(t) + f] >> 2;
-      if (!done[u] && indeg[u] > 0 && --indeg[u] == 0) ready.emplace(key(u), u);
-    }
-  }
-  if (cycles_broken) *cycles_broken = cycles;
-  return out;
-}
-
-std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view, std::span<const std::uint32_t> subset) {
-  std::vector<std::uint32_t> tets;
-  if (subset.empty()) {
-    tets.resize(mesh.tet_count());
-    for (std::size_t i = 0; i < tets.size(); ++i) tets[i] = static_cast<std::uint32_t>(i);
-  } else {
-    tets.assign(subset.begin(), subset.end());
-  }
-  std::vector<std::pair<double, std::uint32_t>> keyed(tets.size());
-  for (std::size_t i = 0; i < tets.size(); ++i) {
-    const std::uint32_t* v = mesh.tet.data() + 4 * std::size_t(tets[i]);
-    double c[3] = {0, 0, 0};
-    for (int k = 0; k < 4; ++k)
-      for (int j = 0; j < 3; ++j) c[j] += 0.25 * mesh.xyz[3 * std::size_t(v[k]) + j];
-    double d;
-    if (view.perspective) {
-      d = (c[0] - view.eye[0]) * (c[0] - view.eye[0]) + (c[1] - view.eye[1]) * (c[1] - view.eye[1]) +
-          (c[2] - view.eye[2]) * (c[2] - view.eye[2]);
-    } else {
-      d = c[0] * view.dir[0] + c[1] * view.dir[1] + c[2] * view.dir[2];
-    }
-    keyed[i] = {d, tets[i]};
-  }
-  std::sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
-  for (std::size_t i = 0; i < tets.size(); ++i) tets[i] = keyed[i].second;
-  return tets;
-}
-
-ViolationReport count_violations(const Mesh& mesh, const View& view, std::span<const std::uint32_t> order) {
-  const std::size_t n = mesh.tet_count();
-  std::vector<std::uint32_t> pos(n, kNone);
-  for (std::size_t i = 0; i < order.size(); ++i) pos[order[i]] = static_cast<std::uint32_t>(i);
-  const FaceAdjacency& adj = face_adjacency(mesh);
-  ViolationReport r;
-  std::size_t checked[2] = {0, 0}, wrong[2] = {0, 0};
-  parallel_for(order.size(), [&](std::size_t b, std::size_t e, int part) {
-    for (std::size_t i = b; i < e; ++i) {
-      std::uint32_t t = order[i];
-      const std::uint32_t* v = mesh.tet.data() + 4 * std::size_t(t);
-      for (int f = 0; f < 4; ++f) {
-        std::uint32_t nb = adj.neighbour[4 * std::size_t(t) + f];
-        if (nb == kNone) continue;
-        std::uint32_t u = nb >> 2;
-        if (u < t || pos[u] == kNone) continue;
-        int side = eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]), node(mesh, v[kFace[f][2]]));
-        if (side == 0) continue;
-        ++checked[part];
-        // side < 0: the eye is on t's side, t is in front and must come after u.
-        bool ok = side < 0 ? pos[u] < pos[t] : pos[t] < pos[u];
-        if (!ok) ++wrong[part];
-      }
-    }
-  });
-  r.pairs_checked = checked[0] + checked[1];
-  r.violations = wrong[0] + wrong[1];
-  return r;
 }
 
 }  // namespace foxi

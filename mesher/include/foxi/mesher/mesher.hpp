@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "foxi/model/progress.hpp"
+
 namespace foxi {
 
 enum class MesherFailure : int {
@@ -58,5 +60,17 @@ class MesherError : public std::runtime_error {
  private:
   int code_;
 };
+
+// A run the progress function stopped: MesherFailure::cancelled, and a foxi::Cancelled.
+struct MesherCancelled : MesherError, Cancelled {
+  explicit MesherCancelled(const std::string& message) : MesherError(MesherFailure::cancelled, message) {}
+};
+
+// MesherError(code, message), as MesherCancelled when the code is MesherFailure::cancelled (a code
+// that crossed the pipe from a mesher's child process, say).
+[[noreturn]] inline void throw_mesher_error(int code, const std::string& message) {
+  if (code == static_cast<int>(MesherFailure::cancelled)) throw MesherCancelled(message);
+  throw MesherError(code, message);
+}
 
 }  // namespace foxi

@@ -1,4 +1,4 @@
-// TetGen .node / .ele / .face and Medit .mesh.
+// TetGen .node / .ele / .face and (declared in io_medit.hpp) Medit .mesh.
 //
 // TetGen: `base` is the path without extension (x.1 for x.1.node, x.1.ele, x.1.face). The .ele's
 // first attribute (rounded to an integer) is the region id; the .face's boundary marker the boundary
@@ -31,6 +31,7 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/model/io_medit.hpp"  // read_medit, write_medit were declared here; kept for includers
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
@@ -40,9 +41,5 @@ Mesh read_tetgen(const std::filesystem::path& base);
 Mesh parse_tetgen(std::string_view node_text, std::string_view ele_text, std::string_view face_text,
                   const std::string& base_name);
 void write_tetgen(const Mesh& mesh, const std::filesystem::path& base);
-
-Mesh read_medit(const std::filesystem::path& path);
-Mesh parse_medit(std::string_view bytes, const std::string& name);
-void write_medit(const Mesh& mesh, const std::filesystem::path& path);
 
 }  // namespace foxi

@@ -49,7 +49,7 @@
 #include <string>
 #include <vector>
 
-#include "foxi/solver/thermal.hpp"
+#include "foxi/solver/thermal.hpp"  // HeatSource: joule_heat_sources feeds the heat solver
 
 namespace foxi {
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "foxi/model/mesh.hpp"
-#include "foxi/solver/thermal.hpp"
+#include "foxi/solver/solver.hpp"
 
 namespace foxi {
 

@@ -36,7 +36,7 @@ struct MovieStats {
 };
 
 // Thrown when the progress callback returns false.
-struct MovieCancelled : std::runtime_error {
+struct MovieCancelled : std::runtime_error, Cancelled {
   MovieCancelled() : std::runtime_error("movie cancelled") {}
 };
 

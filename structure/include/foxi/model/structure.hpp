@@ -48,7 +48,7 @@ struct Structure {
 // conditions are checked (surfaces.hpp).
 // `progress` (may be empty) is called by the triangle-surface path with the stages "surfaces",
 // "carve", "conform" and "seeds"; returning false cancels with StructureCancelled.
-struct StructureCancelled : std::runtime_error {
+struct StructureCancelled : std::runtime_error, Cancelled {
   StructureCancelled() : std::runtime_error("building the structure was cancelled") {}
 };
 Structure build_structure(const Model& model, const ProgressFn& progress = {});

@@ -40,6 +40,7 @@
 #include <numeric>
 
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/vec3.hpp"
 
 namespace foxi {
 
@@ -50,13 +51,10 @@ using K = CGAL::Exact_predicates_exact_constructions_kernel;
 using P3 = K::Point_3;
 using SMesh = CGAL::Surface_mesh<P3>;
 using Side = CGAL::Side_of_triangle_mesh<SMesh, K>;
-using V3 = std::array<double, 3>;
-
-V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V3 cross(const V3& a, const V3& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+using V3 = detail::Vec3;
+using detail::cross;
+using detail::dot;
+using detail::sub;
 V3 to_v3(const P3& p) { return {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())}; }
 
 // The triangles of a mesh as corner points (a triangulated mesh).
