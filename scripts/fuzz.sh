@@ -5,7 +5,10 @@
 # model expression mesh_pipeline; default all).
 # Environment: FUZZ_JOBS (targets run at once, default 1), FUZZ_KEEP_GOING=1 (go on after a crash,
 # hang or out-of-memory, collecting every one: libFuzzer's fork mode), FUZZ_NICE (default 19),
-# FUZZ_NO_BUILD=1 (run what build-fuzz holds).
+# FUZZ_NO_BUILD=1 (run what build-fuzz holds), FUZZ_SEED=N (reproducible: a fixed seed and a fixed
+# number of inputs per target, about SECONDS at the target's rate on the CI machine (runs_per_second
+# below), stopping at 3 x SECONDS whatever happens; CI uses it so that a run that passes here passes
+# there, and a finding is reproduced by running the same command).
 # The corpus grows in build-fuzz/corpus/TARGET across runs; seeds are written afresh each run into
 # build-fuzz/seeds; inputs that crashed, hung or over-allocated land in build-fuzz/artifacts/TARGET/
 # (crash-*, timeout-*, oom-*, leak-*): each becomes a file in tests/data/bad with a test.
@@ -42,16 +45,30 @@ max_len() {
   esac
 }
 
+# Inputs per second of each target on the CI machine (its log of 2026-11-26, ASan+UBSan+coverage).
+runs_per_second() {
+  case $1 in
+    gmsh) echo 9000 ;; vtu | vtk) echo 11000 ;; medit) echo 18000 ;; tetgen) echo 21000 ;;
+    poly) echo 18000 ;; model) echo 100 ;; expression) echo 18000 ;; mesh_pipeline) echo 2900 ;;
+    *) echo 1000 ;;
+  esac
+}
+
 run_target() {
   local t=$1 corpus="$build/corpus/$1" art="$build/artifacts/$1/" log="$build/fuzz-$1.log"
   mkdir -p "$corpus" "$art"
-  local extra=()
+  local extra=() limit=(-max_total_time="$seconds")
+  if [ -n "${FUZZ_SEED:-}" ]; then
+    # Reproducible: no corpus from earlier runs, no reloading, a fixed seed and count.
+    rm -rf "$corpus" && mkdir -p "$corpus"
+    limit=(-seed="$FUZZ_SEED" -runs=$(($(runs_per_second "$t") * seconds)) -max_total_time=$((3 * seconds)) -reload=0)
+  fi
   if [ "${FUZZ_KEEP_GOING:-0}" = "1" ]; then
     extra=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
   fi
   local status=0 TIMEFORMAT='%R %U %S'
   # bash's time: wall, and user and system CPU time of the fuzzer with its children (fork mode).
-  { time nice -n "$nice_level" "$build/tests/fuzz/fuzz_$t" -max_total_time="$seconds" \
+  { time nice -n "$nice_level" "$build/tests/fuzz/fuzz_$t" "${limit[@]}" \
       -max_len="$(max_len "$t")" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=512 -print_final_stats=1 \
       -artifact_prefix="$art" "${extra[@]}" "$corpus" "$build/seeds/$t" > "$log" 2>&1 || status=$?; } \
     2> "$log.time"
