@@ -22,6 +22,23 @@ bool Args::has_option(std::string_view name) const {
   return false;
 }
 
+bool Args::flag_with_file(std::string_view name, std::string_view suffix, std::string& file) {
+  file.clear();
+  for (auto it = args_.begin(); it != args_.end(); ++it) {
+    if (*it != name) continue;
+    const auto next = it + 1;
+    if (next != args_.end() && next->size() > suffix.size() &&
+        next->compare(next->size() - suffix.size(), suffix.size(), suffix) == 0) {
+      file = *next;
+      args_.erase(it, next + 1);
+    } else {
+      args_.erase(it);
+    }
+    return true;
+  }
+  return false;
+}
+
 std::string Args::option(std::string_view name, std::string fallback) {
   for (auto it = args_.begin(); it != args_.end(); ++it) {
     if (*it == name) {
