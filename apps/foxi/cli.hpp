@@ -60,5 +60,6 @@ int cmd_movie(Args args);
 int cmd_solve(Args args);
 int cmd_model(Args args);
 int cmd_demo(Args args);
+int cmd_sweep(Args args);
 
 }  // namespace foxi::cli
