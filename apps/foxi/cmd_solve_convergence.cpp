@@ -76,9 +76,9 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
       std::printf(" %7s %14s %10s\n", "-", "-", "-");
   }
   std::printf(
-      "order: observed p of f(h) = f* + C h^p on the last three levels ('-': no asymptotic range, the\n"
-      "differences change sign or vanish, or fewer than 3 levels); extrapolated: Richardson's f*; error est:\n"
-      "|finest - f*|\n");
+      "order: observed p of f(h) = f* + C h^p through the levels (3 levels: exactly; more: least squares;\n"
+      "'-': no asymptotic range, e.g. differences that change sign, or fewer than 3 levels); extrapolated:\n"
+      "Richardson's f*; error est: |finest - f*|\n");
   if (json.enabled) {
     std::string o = "{\"foxi_convergence\": 1, \"ratio\": " + json_number(ratio) + ",\n \"levels\": [\n";
     for (std::size_t k = 0; k < runs.size(); ++k) o += (k ? ",\n" : "") + results_json(runs[k]);

@@ -88,12 +88,13 @@ std::string results_json(const RunResults& results);
 RunResults parse_results_json(std::string_view text);
 
 // A convergence study (foxi solve --convergence): one record per mesh level, coarse to fine, and
-// for each key value common to all levels the observed order and the Richardson extrapolation.
-// The levels' sizes are h_k = (volume / tets_k)^(1/3) (the meshes are not nested, so the measured
-// ratios, not the requested one, enter). With f(h) = f* + C h^p on the last three levels, p solves
-// (f2 - f1) / (f1 - f0) = (h2^p - h1^p) / (h1^p - h0^p) (bisection on [0.05, 8]; NaN when the
-// differences change sign or one is zero: no asymptotic range), f* = f2 - C h2^p and the error
-// estimate |f2 - f*|. With two levels no order is observed: p is NaN and f* is NaN.
+// for each key value the observed order and the Richardson extrapolation. The levels' sizes h_k are
+// the caller's (foxi: tets_k^(-1/3): the meshes are not nested, so the measured ratios, not the
+// requested one, enter; any common factor cancels). f(h) = f* + C h^p is put through the levels:
+// with three, exactly (observed_order); with more, in the least-squares sense (p on [0.05, 8]),
+// which is much steadier on unstructured meshes, whose levels scatter. The error estimate is
+// |finest - f*|. Fewer than three levels, or no p (differences that change sign or vanish, a fit at
+// the ends of the range): order, f* and the estimate are NaN.
 struct ConvergenceRow {
   std::string name, unit;
   std::vector<double> level_values;  // one per level
@@ -104,7 +105,8 @@ struct ConvergenceRow {
 // `h`: one size per level (m). Throws std::invalid_argument if sizes and levels differ in number.
 std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels, const std::vector<double>& h);
 
-// The observed order p of three values at sizes h0 > h1 > h2 (see above); NaN when there is none.
+// The observed order p of three values at sizes h0 > h1 > h2: p solves (f2 - f1) / (f1 - f0) =
+// (h2^p - h1^p) / (h1^p - h0^p) (bisection on [0.05, 8]); NaN when there is none.
 double observed_order(double f0, double f1, double f2, double h0, double h1, double h2);
 
 }  // namespace foxi
