@@ -33,6 +33,14 @@ const char* kSolveUsage =
     "  Values take units as model files write them: --fix top=300K, --fix 'top=25 degC', --power die=3W,\n"
     "  --k die='150 W/(m*K)', --convect 'top=10 W/(m^2*K),25degC'; a bare number is SI; a unit of\n"
     "  another dimension is refused, and so is an absolute temperature not above 0 K.\n"
+    "  --json [FILE.json]   every printed figure as one JSON record (key results marked; see the\n"
+    "                       README) on stdout, the text silenced, or in FILE besides the text\n"
+    "  --size-scale S       the model's mesh sizes ([mesh] max_size, parts, boxes) times S\n"
+    "  --convergence K [--ratio R]  the solve on K meshes, sizes divided by R (default 1.5) each\n"
+    "                       time: each key result per level, its observed order, the Richardson-\n"
+    "                       extrapolated value and its error estimate (levels run as child processes)\n"
+    "  Every solve prints the Zienkiewicz-Zhu error indicator of its temperature or potential, and,\n"
+    "  on a terminal, the progress of a long solve (CG iterations, residual) on stderr.\n"
     "\n"
     "foxi solve MESH --physics thermal [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf]\n"
     "                [--power REGION=W] [--power-density REGION=W/m3] [--k REGION=k]\n"
@@ -272,6 +280,7 @@ int cmd_solve(Args args) {
 
   ThermalParams params;
   params.solver = solver_options;
+  params.solver.progress = terminal_progress(params.solver);
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
   if (!out.empty()) check_output_path(out);        // and so does a folder that cannot be written
 

@@ -30,6 +30,7 @@ const char* kThermoelasticUsage =
     "  them (--dT replaces the load). --temperature-from-thermal first solves the model's steady heat\n"
     "  (its thermal conditions and power loads) and takes that temperature field as the load against\n"
     "  the stress-free --tref (default 293.15 K) instead of a temperature_change load.\n"
+    "  --json [FILE.json], --size-scale S and --convergence K as for the other physics (foxi solve --help).\n"
     "\n"
     "foxi solve MESH --physics thermoelastic [--fix TAG[=COMPONENTS]] [--slide TAG]\n"
     "                (--dT K | --temperature FILE[:FIELD] [--tref K])\n"
@@ -117,6 +118,7 @@ int cmd_solve_thermoelastic(Args args) {
                     tref = args.option("--tref", ""), order = args.option("--order", "1");
   ThermoelasticParams params;
   params.solver = parse_solver_options(args);
+  params.solver.progress = terminal_progress(params.solver);
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
   const bool from_thermal = args.flag("--temperature-from-thermal");

@@ -4,7 +4,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
+#include <memory>
 #include <cstdio>
 #include <random>
 
@@ -73,6 +75,40 @@ void print_error_indicator(double relative, const char* field) {
         "error indicator (Zienkiewicz-Zhu, recovered against element gradient of the %s): %.3g relative "
         "(foxi mesh --refine-from refines where it is large)\n",
         field, relative);
+}
+
+ProgressFn terminal_progress(const LinearSolverOptions& options) {
+  if (!::isatty(2)) return {};
+  struct State {
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last{};
+    std::size_t reports = 0;
+    bool shown = false;
+  };
+  auto state = std::make_shared<State>();
+  const double relative_tolerance = options.relative_tolerance;
+  const bool cg = options.kind != LinearSolverKind::direct;
+  return [state, relative_tolerance, cg](std::string_view stage, double fraction) {
+    const auto now = std::chrono::steady_clock::now();
+    if (stage == "solve" && fraction > 0 && fraction < 1) ++state->reports;  // CG, every 10th iteration
+    const bool done = stage == "solve" && fraction >= 1;
+    if (done) {
+      if (state->shown) std::fprintf(stderr, "\r\033[K");
+      state->shown = false;
+      return true;
+    }
+    // quiet for the first second (a small solve shows nothing) and then at most 5 times a second
+    if (now - state->start < std::chrono::seconds(1) || now - state->last < std::chrono::milliseconds(200))
+      return true;
+    state->last = now;
+    const double seconds = std::chrono::duration<double>(now - state->start).count();
+    if (cg && stage == "solve" && state->reports > 0)
+      std::fprintf(stderr, "\r\033[Ksolve: about %zu CG iterations, relative residual %.2g (goal %.2g), %.1f s",
+                   10 * state->reports, std::pow(relative_tolerance, fraction), relative_tolerance, seconds);
+    else
+      std::fprintf(stderr, "\r\033[K%.*s %.0f%%, %.1f s", int(stage.size()), stage.data(), 100 * fraction, seconds);
+    state->shown = true;
+    return true;
+  };
 }
 
 std::string self_executable() {

@@ -10,7 +10,9 @@
 
 #include "cli.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/progress.hpp"
 #include "foxi/solver/results.hpp"
+#include "foxi/solver/thermal.hpp"
 
 namespace foxi::cli {
 
@@ -35,6 +37,14 @@ std::vector<RunParameter> run_parameters(std::span<const std::string> sets);
 // gradient) and its printed line.
 double error_indicator(const Mesh& mesh, const char* field);
 void print_error_indicator(double relative, const char* field);
+
+// Progress of a long solve on stderr, only when stderr is a terminal (else an empty function): one
+// line rewritten in place with the stage, the CG iterations (about: the solver reports every 10th)
+// and the relative residual against its goal, at most 5 times a second, cleared when the solve
+// ends. The solver reports CG's progress as log(residual) / log(goal), so the residual is goal^f.
+// A direct solver (--solver direct; `auto` takes it only for small, fast problems) shows its stage
+// and fraction alone.
+ProgressFn terminal_progress(const LinearSolverOptions& options);
 
 // This program's executable (/proc/self/exe).
 std::string self_executable();
