@@ -36,6 +36,7 @@ const char* kSolveUsage =
     "  --json [FILE.json]   every printed figure as one JSON record (key results marked; see the\n"
     "                       README) on stdout, the text silenced, or in FILE besides the text\n"
     "  --size-scale S       the model's mesh sizes ([mesh] max_size, parts, boxes) times S\n"
+    "  --max-tets N         refuse a model whose mesh would have more tets (default 4e6)\n"
     "  --convergence K [--ratio R]  the solve on K meshes, sizes divided by R (default 1.5) each\n"
     "                       time: each key result per level, its observed order, the Richardson-\n"
     "                       extrapolated value and its error estimate (levels run as child processes)\n"
@@ -44,7 +45,8 @@ const char* kSolveUsage =
     "\n"
     "foxi solve MESH --physics thermal [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf]\n"
     "                [--power REGION=W] [--power-density REGION=W/m3] [--k REGION=k]\n"
-    "                [--theta JUNCTION:REFERENCE] [--solver auto|direct|amg|ichol] [--tol REL] [-o OUT]\n"
+    "                [--theta JUNCTION:REFERENCE] [--solver auto|direct|amg|ichol] [--tol REL]\n"
+    "                [--threads N] [-o OUT]\n"
     "  Steady heat conduction with linear tets. Options may be repeated. TAG is a boundary tag\n"
     "  number or name, REGION a region id or name; SI units: T and Tinf in K, q in W/m^2 (into the\n"
     "  body), h in W/(m^2 K), k in W/(m K) (default: the region's material). Boundaries with no\n"
@@ -212,6 +214,13 @@ LinearSolverOptions parse_solver_options(Args& args) {
   else if (solver != "auto")
     throw UsageError("--solver takes auto, direct, amg or ichol, not '" + solver + "'");
   if (!tol.empty()) options.relative_tolerance = parse_number(tol, "--tol");
+  const std::string threads = args.option("--threads", "");
+  if (!threads.empty()) {
+    std::int32_t n = 0;
+    if (!parse_int(threads, n) || n < 1 || n > 4096)
+      throw UsageError("--threads takes a whole number from 1 to 4096, not '" + threads + "'");
+    options.threads = unsigned(n);
+  }
   return options;
 }
 
@@ -276,6 +285,7 @@ int cmd_solve(Args args) {
   const std::vector<std::string> sets = all_options(args, "--set");
   JsonOutput json = json_option(args);
   const double size_scale = size_scale_option(args);
+  const double max_tets = max_tets_option(args);
   const auto files = args.positional(1, 1, kSolveUsage);
 
   ThermalParams params;
@@ -309,7 +319,7 @@ int cmd_solve(Args args) {
   silence_text_for_json(json);
   auto t0 = std::chrono::steady_clock::now();
   MeshedModel model_run;
-  if (from_model) model_run = mesh_model_for_solve(files[0], sets, physics, size_scale);
+  if (from_model) model_run = mesh_model_for_solve(files[0], sets, physics, size_scale, max_tets);
   Mesh mesh = from_model ? std::move(model_run.mesh) : read_mesh(files[0]);
   require_usable(mesh, files[0], "solve");
   auto t1 = std::chrono::steady_clock::now();

@@ -125,6 +125,7 @@ int cmd_solve_thermoelastic(Args args) {
   const std::vector<std::string> sets = all_options(args, "--set");
   JsonOutput json = json_option(args);
   const double size_scale = size_scale_option(args);
+  const double max_tets = max_tets_option(args);
   const auto files = args.positional(1, 1, kThermoelasticUsage);
   const bool from_model = is_model_path(files[0]);
   if (!from_model && (from_thermal || !sets.empty() || size_scale != 1))
@@ -149,7 +150,7 @@ int cmd_solve_thermoelastic(Args args) {
   // the thermal conditions are checked before meshing, as mesh_model checks the stress conditions
   if (from_thermal) check_physics(load_model(files[0], sets), Physics::thermal);
   MeshedModel run;
-  if (from_model) run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress), size_scale);
+  if (from_model) run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress), size_scale, max_tets);
   Mesh mesh = from_model ? std::move(run.mesh) : read_mesh(files[0]);
   const auto t_mesh = std::chrono::steady_clock::now();
   require_usable(mesh, files[0], "solve");

@@ -32,7 +32,7 @@ namespace {
 const char* kSweepUsage =
     "foxi sweep MODEL.toml --vary NAME=LO:HI:N [--vary ...] [--physics thermal|electrostatic|current|\n"
     "           thermoelastic] [--jobs N] -o SWEEP.csv [--json [FILE.json]] [--set NAME=VALUE]...\n"
-    "           [--theta J:R]... [--solver S] [--tol REL] [--max-tets N]\n"
+    "           [--theta J:R]... [--solver S] [--tol REL] [--max-tets N] [--threads N]\n"
     "  Solves the model at every combination of the varied parameters (a grid: the product of the\n"
     "  --vary lists) and writes one CSV row per run: the parameters (as given and in SI), status (ok,\n"
     "  unreliable: a balance check failed, failed: no result), mesh size, times, the ZZ error\n"
@@ -42,10 +42,11 @@ const char* kSweepUsage =
     "  that failed and the error of a failed run. A failed run does not stop the sweep.\n"
     "  --vary NAME=LO:HI:N  N values from LO to HI evenly, in LO's unit (die_w=2mm:8mm:7); or a list\n"
     "                       NAME=V1,V2,... (die_w=2mm,3mm,5mm). NAME is one of the model's [parameters].\n"
-    "  --jobs N             runs at once (default: the cores)\n"
+    "  --jobs N             runs at once (default: the cores); each run's solver gets cores / N\n"
+    "                       threads unless --threads says otherwise\n"
     "  --json [FILE.json]   every run's whole record (foxi solve --json) as one JSON array, on stdout\n"
     "                       or in FILE\n"
-    "  --set, --theta, --solver, --tol, --max-tets go to every run as in foxi solve.\n"
+    "  --set, --theta, --solver, --tol, --max-tets, --threads go to every run as in foxi solve.\n"
     "  A progress line per finished run on stderr. Exit status 0 when every run is ok, 4 when one is\n"
     "  unreliable, 1 when one failed; a stop (Ctrl-C) writes nothing (130/143).";
 
@@ -174,9 +175,14 @@ int cmd_sweep(Args args) {
   std::vector<std::string> pass;
   const std::vector<std::string> sets = all_options(args, "--set");
   for (const std::string& s : sets) pass.insert(pass.end(), {"--set", s});
-  for (const std::string& s : all_options(args, "--theta")) pass.insert(pass.end(), {"--theta", s});
-  for (const char* o : {"--solver", "--tol", "--max-tets"})
+  const std::vector<std::string> theta = all_options(args, "--theta");
+  if (!theta.empty() && physics != "thermal") throw UsageError("--theta is for --physics thermal");
+  for (const std::string& s : theta) pass.insert(pass.end(), {"--theta", s});
+  for (const char* o : {"--solver", "--tol", "--max-tets", "--threads"})
     if (args.has_option(o)) pass.insert(pass.end(), {o, args.option(o)});
+  // Each run's solver threads share the cores with the other runs (unless --threads says otherwise).
+  if (std::find(pass.begin(), pass.end(), "--threads") == pass.end())
+    pass.insert(pass.end(), {"--threads", std::to_string(std::max(1u, cores / unsigned(jobs)))});
   const auto files = args.positional(1, 1, kSweepUsage);
   const std::string& model = files[0];
   if (!is_model_path(model)) throw UsageError("foxi sweep takes a model file (MODEL.toml), not '" + model + "'");

@@ -91,11 +91,11 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
 }
 
 MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::string> sets,
-                                 const std::string& physics, double size_scale) {
+                                 const std::string& physics, double size_scale, double max_tets) {
   std::optional<Physics> ph;
   for (Physics p : {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress})
     if (physics == physics_name(p)) ph = p;
-  MeshedModel m = mesh_model(file, sets, ph, false, kDefaultMaxTets, size_scale);
+  MeshedModel m = mesh_model(file, sets, ph, false, max_tets, size_scale);
   // the model's warnings before the work (foxi model check prints the same)
   if (ph)
     for (const ModelWarning& w : warnings_for(diagnose_model(m.model, m.structure), *ph))

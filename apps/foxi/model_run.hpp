@@ -50,7 +50,8 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
 
 // mesh_model for foxi solve MODEL --physics NAME: prints one line on the model and its mesh.
 MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::string> sets,
-                                 const std::string& physics, double size_scale = 1);
+                                 const std::string& physics, double size_scale = 1,
+                                 double max_tets = kDefaultMaxTets);
 
 // Prints the model's [surfaces], conditions, loads and mesh controls (lengths in its unit).
 void print_model_conditions(const Model& model);

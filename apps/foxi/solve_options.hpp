@@ -38,7 +38,7 @@ std::vector<std::string> all_options(Args& args, const char* name);
 // "3 (name)" for printing.
 std::string boundary_label(const Mesh& mesh, std::int32_t tag);
 std::string region_label(const Mesh& mesh, std::int32_t id);
-// --solver auto|direct|amg|ichol and --tol REL.
+// --solver auto|direct|amg|ichol, --tol REL and --threads N (the solver's threads; default the cores).
 LinearSolverOptions parse_solver_options(Args& args);
 
 // --size-scale S: a number > 0 multiplying the model's mesh sizes (model_run.hpp), default 1.
