@@ -136,6 +136,50 @@ print("R", repr(v["R"]), "G", len(g), "physics", d["physics"])
   EXPECT_NEAR(number_after(py, "R"), r, 1e-6 * r);
 }
 
+TEST(SolveJson, ElectrostaticAndThermoelasticFiguresEqualTheText) {
+  if (!test::have_program("/usr/bin/python3")) GTEST_SKIP() << "no python3";
+  TempDir dir;
+  const auto json = dir / "c.json", text = dir / "c.txt";
+  ASSERT_EQ(test::run_cli("solve '" + model("via_in_dielectric.toml") + "' --physics electrostatic --json '" +
+                              json.string() + "'",
+                          text),
+            0)
+      << test::read_text(text);
+  std::string py = python(dir, R"PY(
+import json, sys
+d = json.load(open(sys.argv[1]))
+v = {x["name"]: x for x in d["values"]}
+print("Cvv", repr(v["C[via,via]"]["value"]), "Cvb", repr(v["C[via,back]"]["value"]), v["C[via,via]"]["unit"],
+      v["C[via,via]"]["key"], "checks", len(d["checks"]))
+)PY",
+                     json);
+  const std::string out = test::read_text(text);
+  SCOPED_TRACE(py + out);
+  const double cvv = number_after(out, R"(\n  via)"), cvb = number_after(out, R"(\n  via\s+\S+)");
+  EXPECT_NEAR(number_after(py, "Cvv"), cvv, 1e-6 * std::abs(cvv));
+  EXPECT_NEAR(number_after(py, "Cvb"), cvb, 1e-6 * std::abs(cvb));
+  EXPECT_NE(py.find(" F True checks 4"), std::string::npos);
+
+  const auto tjson = dir / "t.json", ttext = dir / "t.txt";
+  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --physics thermoelastic --json '" +
+                              tjson.string() + "'",
+                          ttext),
+            0)
+      << test::read_text(ttext);
+  py = python(dir, R"PY(
+import json, sys
+d = json.load(open(sys.argv[1]))
+v = {x["name"]: x["value"] for x in d["values"]}
+print("vm", repr(v["von_mises_max"]), "die", repr(v["von_mises_max[die]"]), "physics", d["physics"])
+)PY",
+              tjson);
+  const std::string tout = test::read_text(ttext);
+  const double vm = number_after(tout, "max von Mises stress");
+  EXPECT_NEAR(number_after(py, "vm"), vm, 1e-5 * vm) << py;
+  const double die = number_after(tout, R"(\(die\)[^\n]*max von Mises)");
+  EXPECT_NEAR(number_after(py, "die"), die, 1e-5 * die) << py;
+}
+
 TEST(SolveJson, UsageErrors) {
   TempDir dir;
   const auto log = dir / "log.txt";
@@ -199,6 +243,30 @@ TEST(Sweep, ThetaFallsWithDieWidthAndRowsEqualSeparateSolves) {
     EXPECT_NEAR(std::stod(r[theta]), number_after(text, "theta"), 1e-5 * t) << r[w];
     EXPECT_EQ(std::stod(r[tets]), number_after(text, R"(nodes, )"));
   }
+}
+
+// Two --vary make a grid, the last one fastest; each row's parameters reach its run.
+TEST(Sweep, TwoVariedParametersMakeAGrid) {
+  TempDir dir;
+  const auto csv = dir / "grid.csv", log = dir / "grid.txt";
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
+                              "' --vary die_w=3mm,5mm --vary 'die_h=0.2 mm:0.6 mm:2' --jobs 2 -o '" + csv.string() + "'",
+                          log),
+            0)
+      << test::read_text(log);
+  const auto rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 5u);
+  const std::size_t w = column(rows[0], "die_w"), h = column(rows[0], "die_h (m)"),
+                    mean = column(rows[0], "T_mean[substrate] (K)");
+  const char* expect_w[] = {"3mm", "3mm", "5mm", "5mm"};
+  const double expect_h[] = {2e-4, 6e-4, 2e-4, 6e-4};
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i][w], expect_w[i - 1]);
+    EXPECT_NEAR(std::stod(rows[i][h]), expect_h[i - 1], 1e-15);
+  }
+  // different geometry, different results: no two rows alike
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    for (std::size_t j = 1; j < i; ++j) EXPECT_NE(rows[i][mean], rows[j][mean]);
 }
 
 TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {
@@ -320,6 +388,20 @@ print("levels", len(d["levels"]), "slope", slope, "order", row["order"], "extrap
   EXPECT_GT(std::abs(finest - exact), estimate / 3);
   EXPECT_LT(std::abs(finest - exact), estimate * 3);
   EXPECT_NE(test::read_text(log).find("level 3:"), std::string::npos);  // the text too, with --json FILE
+}
+
+// On a terminal (script(1) gives the run one) a long solve shows its CG iterations and residual on
+// stderr; with stderr not a terminal, nothing of that.
+TEST(SolveProgressSlow, OnATerminalOnly) {
+  if (!test::have_program("script")) GTEST_SKIP() << "no script(1)";
+  TempDir dir;
+  const std::string run = "'" + test::cli_path() + "' solve '" + model("die_on_substrate.toml") +
+                          "' --size-scale 0.3 --solver ichol --tol 1e-13";
+  const auto tty = dir / "tty.txt", plain = dir / "plain.txt";
+  ASSERT_EQ(test::run("script -qec \"" + run + "\" /dev/null", tty), 0) << test::read_text(tty);
+  ASSERT_EQ(test::run(run, plain), 0);
+  EXPECT_NE(test::read_text(tty).find("CG iterations, relative residual"), std::string::npos) << test::read_text(tty);
+  EXPECT_EQ(test::read_text(plain).find("CG iterations, relative residual"), std::string::npos);
 }
 
 }  // namespace
