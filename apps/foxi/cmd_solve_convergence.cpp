@@ -21,17 +21,20 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
     throw UsageError("--convergence takes a number of meshes from 2 to 8, not '" + k_text + "'");
   const std::string ratio_text = args.option("--ratio", "1.5");
   const double ratio = parse_number(ratio_text, "--ratio");
-  if (!(ratio >= 1.1 && ratio <= 4)) throw UsageError("--ratio takes a number from 1.1 to 4, not '" + ratio_text + "'");
+  if (!(ratio >= 1.1 && ratio <= 4))
+    throw UsageError("--ratio takes a number from 1.1 to 4, not '" + ratio_text + "'");
   if (args.has_option("-o") || args.has_option("--output"))
     throw UsageError("-o is not for --convergence (it solves several meshes); solve one level without it");
-  if (args.has_option("--size-scale")) throw UsageError("--size-scale is set by --convergence for each level");
+  if (args.has_option("--size-scale"))
+    throw UsageError("--size-scale is set by --convergence for each level");
   JsonOutput json = json_option(args);
   // What is left goes to each level as it is (the model, --set, conditions, solver options).
   std::vector<std::string> pass = args.remaining();
   std::string model;
   for (const std::string& a : pass)
     if (is_model_path(a)) model = a;
-  if (model.empty()) throw UsageError("--convergence is for model files (MODEL.toml): it meshes the model K times");
+  if (model.empty())
+    throw UsageError("--convergence is for model files (MODEL.toml): it meshes the model K times");
   pass.insert(pass.begin(), {"--physics", physics});
   silence_text_for_json(json);
 
@@ -49,7 +52,8 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
     const std::string n = std::to_string(k);
     RunResults r = run_solve_child(a, scratch / ("level" + n + ".json"), scratch / ("level" + n + ".log"));
     if (r.status == RunStatus::failed) {
-      std::fprintf(stderr, "foxi solve: error: level %d (size scale %s) failed: %s\n", k, scale, r.error.c_str());
+      std::fprintf(stderr, "foxi solve: error: level %d (size scale %s) failed: %s\n", k, scale,
+                   r.error.c_str());
       return kExitFailure;
     }
     if (r.status == RunStatus::unreliable) status = kExitUnreliable;
@@ -89,8 +93,10 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
       const ConvergenceRow& row = rows[i];
       o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_string(row.name) +
            ", \"unit\": " + json_string(row.unit) + ", \"values\": [";
-      for (std::size_t k = 0; k < row.level_values.size(); ++k) o += (k ? ", " : "") + json_number(row.level_values[k]);
-      o += "], \"order\": " + json_number(row.order) + ", \"extrapolated\": " + json_number(row.extrapolated) +
+      for (std::size_t k = 0; k < row.level_values.size(); ++k)
+        o += (k ? ", " : "") + json_number(row.level_values[k]);
+      o += "], \"order\": " + json_number(row.order) +
+           ", \"extrapolated\": " + json_number(row.extrapolated) +
            ", \"error_estimate\": " + json_number(row.error_estimate) + "}";
     }
     o += "]}\n";

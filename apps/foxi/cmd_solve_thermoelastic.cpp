@@ -8,12 +8,12 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
-#include "mesh_input.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/solver/thermoelastic.hpp"
+#include "mesh_input.hpp"
 #include "model_run.hpp"
 #include "run_results.hpp"
 #include "solve_options.hpp"
@@ -150,7 +150,8 @@ int cmd_solve_thermoelastic(Args args) {
   // the thermal conditions are checked before meshing, as mesh_model checks the stress conditions
   if (from_thermal) check_physics(load_model(files[0], sets), Physics::thermal);
   MeshedModel run;
-  if (from_model) run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress), size_scale, max_tets);
+  if (from_model)
+    run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress), size_scale, max_tets);
   Mesh mesh = from_model ? std::move(run.mesh) : read_mesh(files[0]);
   const auto t_mesh = std::chrono::steady_clock::now();
   require_usable(mesh, files[0], "solve");

@@ -17,13 +17,13 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
-#include "model_run.hpp"
-#include "run_results.hpp"
-#include "solve_options.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/units.hpp"
+#include "model_run.hpp"
+#include "run_results.hpp"
+#include "solve_options.hpp"
 
 namespace foxi::cli {
 
@@ -72,8 +72,8 @@ std::string unit_suffix(const std::string& text) {
   while (at < text.size() && (std::isdigit(static_cast<unsigned char>(text[at])) || text[at] == '.' ||
                               text[at] == '-' || text[at] == '+' ||
                               ((text[at] == 'e' || text[at] == 'E') && at + 1 < text.size() &&
-                               (std::isdigit(static_cast<unsigned char>(text[at + 1])) || text[at + 1] == '-' ||
-                                text[at + 1] == '+'))))
+                               (std::isdigit(static_cast<unsigned char>(text[at + 1])) ||
+                                text[at + 1] == '-' || text[at + 1] == '+'))))
     ++at;
   while (at < text.size() && text[at] == ' ') ++at;
   return text.substr(at);
@@ -154,11 +154,14 @@ int cmd_sweep(Args args) {
     return kExitOk;
   }
   const std::string physics = args.option("--physics", "thermal");
-  if (physics != "thermal" && physics != "electrostatic" && physics != "current" && physics != "thermoelastic")
-    throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics + "'");
+  if (physics != "thermal" && physics != "electrostatic" && physics != "current" &&
+      physics != "thermoelastic")
+    throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics +
+                     "'");
   std::vector<Varied> varied;
   for (const std::string& s : all_options(args, "--vary")) varied.push_back(parse_vary(s));
-  if (varied.empty()) throw UsageError("foxi sweep needs at least one --vary NAME=LO:HI:N\nusage: " + std::string(kSweepUsage));
+  if (varied.empty())
+    throw UsageError("foxi sweep needs at least one --vary NAME=LO:HI:N\nusage: " + std::string(kSweepUsage));
   for (std::size_t i = 0; i < varied.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (varied[i].name == varied[j].name) throw UsageError("--vary " + varied[i].name + " is given twice");
@@ -185,7 +188,8 @@ int cmd_sweep(Args args) {
     pass.insert(pass.end(), {"--threads", std::to_string(std::max(1u, cores / unsigned(jobs)))});
   const auto files = args.positional(1, 1, kSweepUsage);
   const std::string& model = files[0];
-  if (!is_model_path(model)) throw UsageError("foxi sweep takes a model file (MODEL.toml), not '" + model + "'");
+  if (!is_model_path(model))
+    throw UsageError("foxi sweep takes a model file (MODEL.toml), not '" + model + "'");
   check_output_path(out);
 
   // Every combination, the last --vary fastest.
@@ -203,7 +207,8 @@ int cmd_sweep(Args args) {
   auto run_sets = [&](std::size_t run) {
     std::vector<std::string> s = sets;
     const auto idx = combination(run);
-    for (std::size_t i = 0; i < varied.size(); ++i) s.push_back(varied[i].name + "=" + varied[i].texts[idx[i]]);
+    for (std::size_t i = 0; i < varied.size(); ++i)
+      s.push_back(varied[i].name + "=" + varied[i].texts[idx[i]]);
     return s;
   };
   // The parameters and the model are checked once here: a mistyped name fails before any run.
@@ -247,11 +252,11 @@ int cmd_sweep(Args args) {
       std::lock_guard lock(print);
       ++finished;
       if (r.status == RunStatus::failed)
-        std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: FAILED after %.2f s: %s\n", finished, total, label.c_str(),
-                     r.wall_seconds, r.error.c_str());
+        std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: FAILED after %.2f s: %s\n", finished, total,
+                     label.c_str(), r.wall_seconds, r.error.c_str());
       else
-        std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: %s, %zu tets, %.2f s%s\n", finished, total, label.c_str(),
-                     run_status_name(r.status), r.tets, r.wall_seconds, first.c_str());
+        std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: %s, %zu tets, %.2f s%s\n", finished, total,
+                     label.c_str(), run_status_name(r.status), r.tets, r.wall_seconds, first.c_str());
       results[run] = std::move(r);
     }
   };
@@ -264,7 +269,8 @@ int cmd_sweep(Args args) {
   std::vector<std::pair<std::string, std::string>> columns;  // name, unit
   for (const RunResults& r : results)
     for (const ResultValue& v : r.values)
-      if (v.key && std::none_of(columns.begin(), columns.end(), [&](const auto& c) { return c.first == v.name; }))
+      if (v.key &&
+          std::none_of(columns.begin(), columns.end(), [&](const auto& c) { return c.first == v.name; }))
         columns.emplace_back(v.name, v.unit);
   std::string text = "run";
   for (const Varied& v : varied)
@@ -291,14 +297,15 @@ int cmd_sweep(Args args) {
     }
     std::string bad;
     for (const BalanceCheck& c : r.checks)
-      if (!c.passed) bad += (bad.empty() ? "" : "; ") + c.name + " " + number(c.figure) + " > " + number(c.tolerance);
+      if (!c.passed)
+        bad += (bad.empty() ? "" : "; ") + c.name + " " + number(c.figure) + " > " + number(c.tolerance);
     text += "," + csv(bad) + "," + csv(r.error) + "\n";
   }
   DurableFile file(out);
   file.write(text);
   file.commit();
-  std::fprintf(stderr, "foxi sweep: %zu runs in %.2f s (%zu ok, %zu unreliable, %zu failed); wrote %s\n", total,
-               wall, ok, unreliable, failed, out.c_str());
+  std::fprintf(stderr, "foxi sweep: %zu runs in %.2f s (%zu ok, %zu unreliable, %zu failed); wrote %s\n",
+               total, wall, ok, unreliable, failed, out.c_str());
   if (json.enabled) {
     std::string o = "[\n";
     for (std::size_t run = 0; run < total; ++run) {

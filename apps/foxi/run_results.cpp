@@ -6,8 +6,8 @@
 
 #include <chrono>
 #include <cmath>
-#include <memory>
 #include <cstdio>
+#include <memory>
 #include <random>
 
 #include "foxi/mesher/size_field.hpp"
@@ -102,10 +102,12 @@ ProgressFn terminal_progress(const LinearSolverOptions& options) {
     state->last = now;
     const double seconds = std::chrono::duration<double>(now - state->start).count();
     if (cg && stage == "solve" && state->reports > 0)
-      std::fprintf(stderr, "\r\033[Ksolve: about %zu CG iterations, relative residual %.2g (goal %.2g), %.1f s",
+      std::fprintf(stderr,
+                   "\r\033[Ksolve: about %zu CG iterations, relative residual %.2g (goal %.2g), %.1f s",
                    10 * state->reports, std::pow(relative_tolerance, fraction), relative_tolerance, seconds);
     else
-      std::fprintf(stderr, "\r\033[K%.*s %.0f%%, %.1f s", int(stage.size()), stage.data(), 100 * fraction, seconds);
+      std::fprintf(stderr, "\r\033[K%.*s %.0f%%, %.1f s", int(stage.size()), stage.data(), 100 * fraction,
+                   seconds);
     state->shown = true;
     return true;
   };

@@ -10,9 +10,12 @@ namespace foxi {
 
 const char* run_status_name(RunStatus s) {
   switch (s) {
-    case RunStatus::ok: return "ok";
-    case RunStatus::unreliable: return "unreliable";
-    case RunStatus::failed: return "failed";
+    case RunStatus::ok:
+      return "ok";
+    case RunStatus::unreliable:
+      return "unreliable";
+    case RunStatus::failed:
+      return "failed";
   }
   return "failed";
 }
@@ -67,7 +70,8 @@ void solver_values(Values& v, std::size_t unknowns, std::size_t iterations, doub
 void matrix_values(Values& v, const char* symbol, const char* unit, const std::vector<ElectrodeResult>& e,
                    const std::vector<std::vector<double>>& m) {
   for (std::size_t i = 0; i < e.size(); ++i)
-    for (std::size_t j = 0; j < e.size(); ++j) v.key(bracket(symbol, e[i].name + "," + e[j].name), unit, m[i][j]);
+    for (std::size_t j = 0; j < e.size(); ++j)
+      v.key(bracket(symbol, e[i].name + "," + e[j].name), unit, m[i][j]);
 }
 
 // The text of one theta side as the CLI takes it: a bare name for the defaults (max= for the junction,
@@ -77,10 +81,14 @@ std::string probe_text(const Mesh& mesh, const ThermalProbe& p, ThermalProbeKind
   const std::string name = region ? region_name(mesh, p.id) : boundary_name(mesh, p.id);
   if (p.kind == bare) return name;
   switch (p.kind) {
-    case ThermalProbeKind::region_max: return "max=" + name;
-    case ThermalProbeKind::region_mean: return "mean=" + name;
-    case ThermalProbeKind::boundary_mean: return "surface=" + name;
-    case ThermalProbeKind::ambient: return "ambient=" + name;
+    case ThermalProbeKind::region_max:
+      return "max=" + name;
+    case ThermalProbeKind::region_mean:
+      return "mean=" + name;
+    case ThermalProbeKind::boundary_mean:
+      return "surface=" + name;
+    case ThermalProbeKind::ambient:
+      return "ambient=" + name;
   }
   return name;
 }
@@ -183,7 +191,8 @@ RunResults thermoelastic_results(const Mesh& mesh, const ThermoelasticReport& r)
   // (the elastic solve makes no balance checks of its own yet: status ok, no checks)
   Values v{res.values};
   v.key("von_mises_max", "Pa", r.max_von_mises);
-  for (const RegionStress& s : r.regions) v.key(bracket("von_mises_max", region_name(mesh, s.region)), "Pa", s.max_von_mises);
+  for (const RegionStress& s : r.regions)
+    v.key(bracket("von_mises_max", region_name(mesh, s.region)), "Pa", s.max_von_mises);
   v.add("displacement_max", "m", r.max_displacement);
   for (const InterfaceStress& s : r.interfaces)
     v.add(bracket("von_mises_max", region_name(mesh, s.region_a) + "/" + region_name(mesh, s.region_b)), "Pa",
@@ -207,11 +216,21 @@ std::string jstr(std::string_view s) {
   std::string out = "\"";
   for (char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
@@ -282,7 +301,8 @@ class Reader {
     throw std::runtime_error("results JSON: " + std::string(what) + " at byte " + std::to_string(at_));
   }
   void ws() {
-    while (at_ < t_.size() && (t_[at_] == ' ' || t_[at_] == '\n' || t_[at_] == '\r' || t_[at_] == '\t')) ++at_;
+    while (at_ < t_.size() && (t_[at_] == ' ' || t_[at_] == '\n' || t_[at_] == '\r' || t_[at_] == '\t'))
+      ++at_;
   }
   bool peek(char c) {
     ws();
@@ -307,11 +327,21 @@ class Reader {
         if (at_ >= t_.size()) fail("unfinished escape");
         c = t_[at_++];
         switch (c) {
-          case 'n': s += '\n'; break;
-          case 'r': s += '\r'; break;
-          case 't': s += '\t'; break;
-          case 'b': s += '\b'; break;
-          case 'f': s += '\f'; break;
+          case 'n':
+            s += '\n';
+            break;
+          case 'r':
+            s += '\r';
+            break;
+          case 't':
+            s += '\t';
+            break;
+          case 'b':
+            s += '\b';
+            break;
+          case 'f':
+            s += '\f';
+            break;
           case 'u': {
             if (at_ + 4 > t_.size()) fail("short \\u escape");
             unsigned code = 0;
@@ -330,7 +360,8 @@ class Reader {
             }
             break;
           }
-          default: s += c;
+          default:
+            s += c;
         }
       } else {
         s += c;
@@ -499,7 +530,8 @@ RunResults parse_results_json(std::string_view text) {
     }
   });
   in.end();
-  if (!tagged) throw std::runtime_error("results JSON: no \"foxi_results\": 1 member (not a foxi results file)");
+  if (!tagged)
+    throw std::runtime_error("results JSON: no \"foxi_results\": 1 member (not a foxi results file)");
   return r;
 }
 
@@ -511,7 +543,9 @@ double observed_order(double f0, double f1, double f2, double h0, double h1, dou
   const double ratio = d2 / d1;  // in (0, inf)
   // g(p) = (h2^p - h1^p) / (h1^p - h0^p) falls from (log h2 - log h1) / (log h1 - log h0) at p -> 0
   // towards 0 as p grows (the finer step's share shrinks); bisect g(p) = ratio.
-  auto g = [&](double p) { return (std::pow(h2, p) - std::pow(h1, p)) / (std::pow(h1, p) - std::pow(h0, p)); };
+  auto g = [&](double p) {
+    return (std::pow(h2, p) - std::pow(h1, p)) / (std::pow(h1, p) - std::pow(h0, p));
+  };
   double lo = 0.05, hi = 8;
   if (!(ratio <= g(lo) && ratio >= g(hi))) return NAN;
   for (int i = 0; i < 100; ++i) {
@@ -583,7 +617,8 @@ void fit_power_law(ConvergenceRow& row, const std::vector<double>& h) {
 
 }  // namespace
 
-std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels, const std::vector<double>& h) {
+std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels,
+                                              const std::vector<double>& h) {
   if (levels.size() != h.size()) throw std::invalid_argument("convergence_table: one size per level");
   std::vector<ConvergenceRow> rows;
   if (levels.empty()) return rows;

@@ -6,7 +6,6 @@
 // uniform heat density held at one end has the mean temperature T0 + q L^2 / (3 k) (1-D: -k T'' = q,
 // T(0) = T0, T'(L) = 0), and P1 elements converge to it at order 2 in h.
 #include <gtest/gtest.h>
-
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -38,7 +37,8 @@ double number_after(const std::string& text, const std::string& label) {
 std::string python(const TempDir& dir, const std::string& script, const std::filesystem::path& file) {
   test::write_text(dir / "script.py", script);
   const auto log = dir / "python.txt";
-  const int rc = test::run("/usr/bin/python3 '" + (dir / "script.py").string() + "' '" + file.string() + "'", log);
+  const int rc =
+      test::run("/usr/bin/python3 '" + (dir / "script.py").string() + "' '" + file.string() + "'", log);
   std::string out = test::read_text(log);
   if (rc != 0) return "python failed: " + out;
   return out;
@@ -78,8 +78,8 @@ TEST(SolveJson, ParsesWithPythonAndEqualsTheText) {
   if (!test::have_program("/usr/bin/python3")) GTEST_SKIP() << "no python3";
   TempDir dir;
   const auto json = dir / "r.json", log = dir / "text.txt";
-  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --theta die:substrate.bottom --json '" +
-                              json.string() + "'",
+  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") +
+                              "' --theta die:substrate.bottom --json '" + json.string() + "'",
                           log),
             0)
       << test::read_text(log);
@@ -107,7 +107,8 @@ print("indicator", d["error_indicator"])
   same(number_after(py, R"(T_max)"), number_after(text, "max temperature"));
   same(number_after(py, R"(T_mean\[die\])"), number_after(text, R"(\(die\)(?:\s+\S+){4})"));
   same(number_after(py, R"(theta\[die:substrate.bottom\])"), number_after(text, "theta"));
-  same(number_after(py, R"(heat_in\[substrate.bottom\])"), number_after(text, R"(\(substrate.bottom\)\s+fixed\s+\S+)"));
+  same(number_after(py, R"(heat_in\[substrate.bottom\])"),
+       number_after(text, R"(\(substrate.bottom\)\s+fixed\s+\S+)"));
   const double indicator = number_after(text, "Zhu, recovered[^:]*:");  // printed to 3 digits
   EXPECT_NEAR(number_after(py, "indicator"), indicator, 2e-3 * indicator);
   EXPECT_NE(py.find("K/W True"), std::string::npos);  // theta is a key figure
@@ -152,7 +153,7 @@ v = {x["name"]: x for x in d["values"]}
 print("Cvv", repr(v["C[via,via]"]["value"]), "Cvb", repr(v["C[via,back]"]["value"]), v["C[via,via]"]["unit"],
       v["C[via,via]"]["key"], "checks", len(d["checks"]))
 )PY",
-                     json);
+                          json);
   const std::string out = test::read_text(text);
   SCOPED_TRACE(py + out);
   const double cvv = number_after(out, R"(\n  via)"), cvb = number_after(out, R"(\n  via\s+\S+)");
@@ -191,7 +192,8 @@ TEST(SolveJson, UsageErrors) {
       << test::read_text(log);
   EXPECT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --size-scale 0", log), 2);
   EXPECT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --convergence 1", log), 2);
-  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' -o '" + (dir / "s.csv").string() + "'", log),
+  EXPECT_EQ(test::run_cli(
+                "sweep '" + model("die_on_substrate.toml") + "' -o '" + (dir / "s.csv").string() + "'", log),
             2);  // no --vary
   EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:3K:2 -o '" +
                               (dir / "s.csv").string() + "'",
@@ -210,7 +212,8 @@ TEST(Sweep, ThetaFallsWithDieWidthAndRowsEqualSeparateSolves) {
   TempDir dir;
   const auto csv = dir / "sweep.csv", log = dir / "sweep.txt";
   ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
-                              "' --vary die_w=2mm:6mm:3 --theta die:substrate.bottom --jobs 2 -o '" + csv.string() + "'",
+                              "' --vary die_w=2mm:6mm:3 --theta die:substrate.bottom --jobs 2 -o '" +
+                              csv.string() + "'",
                           log),
             0)
       << test::read_text(log);
@@ -250,7 +253,8 @@ TEST(Sweep, TwoVariedParametersMakeAGrid) {
   TempDir dir;
   const auto csv = dir / "grid.csv", log = dir / "grid.txt";
   ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
-                              "' --vary die_w=3mm,5mm --vary 'die_h=0.2 mm:0.6 mm:2' --jobs 2 -o '" + csv.string() + "'",
+                              "' --vary die_w=3mm,5mm --vary 'die_h=0.2 mm:0.6 mm:2' --jobs 2 -o '" +
+                              csv.string() + "'",
                           log),
             0)
       << test::read_text(log);
@@ -274,14 +278,16 @@ TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {
   TempDir dir;
   const auto csv = dir / "sweep.csv", log = dir / "sweep.txt", json = dir / "sweep.json";
   // die_w = -1 mm makes the model invalid in that run only (the first value is checked up front)
-  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=4mm,-1mm,5mm --jobs 1 -o '" +
-                              csv.string() + "' --json '" + json.string() + "'",
-                          log),
-            1)
+  EXPECT_EQ(
+      test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=4mm,-1mm,5mm --jobs 1 -o '" +
+                        csv.string() + "' --json '" + json.string() + "'",
+                    log),
+      1)
       << test::read_text(log);
   const auto rows = read_csv(csv);
   ASSERT_EQ(rows.size(), 4u) << test::read_text(csv);
-  const std::size_t st = column(rows[0], "status"), err = column(rows[0], "error"), tmax = column(rows[0], "T_max (K)");
+  const std::size_t st = column(rows[0], "status"), err = column(rows[0], "error"),
+                    tmax = column(rows[0], "T_max (K)");
   EXPECT_EQ(rows[1][st], "ok");
   EXPECT_EQ(rows[2][st], "failed");
   EXPECT_EQ(rows[3][st], "ok");
@@ -306,8 +312,8 @@ TEST(Sweep, InterruptLeavesNoPartialCsv) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     const std::string cmd = "exec '" + test::cli_path() + "' sweep '" + model("die_on_substrate.toml") +
-                            "' --vary die_w=2mm:8mm:40 --jobs 1 -o '" + csv.string() + "' > '" + log.string() +
-                            "' 2>&1";
+                            "' --vary die_w=2mm:8mm:40 --jobs 1 -o '" + csv.string() + "' > '" +
+                            log.string() + "' 2>&1";
     ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
@@ -400,7 +406,8 @@ TEST(SolveProgressSlow, OnATerminalOnly) {
   const auto tty = dir / "tty.txt", plain = dir / "plain.txt";
   ASSERT_EQ(test::run("script -qec \"" + run + "\" /dev/null", tty), 0) << test::read_text(tty);
   ASSERT_EQ(test::run(run, plain), 0);
-  EXPECT_NE(test::read_text(tty).find("CG iterations, relative residual"), std::string::npos) << test::read_text(tty);
+  EXPECT_NE(test::read_text(tty).find("CG iterations, relative residual"), std::string::npos)
+      << test::read_text(tty);
   EXPECT_EQ(test::read_text(plain).find("CG iterations, relative residual"), std::string::npos);
 }
 

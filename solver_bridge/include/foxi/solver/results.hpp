@@ -50,9 +50,9 @@ struct RunResults {
   RunStatus status = RunStatus::ok;  // unreliable: a check failed; failed: no result (see error)
   std::string error;                 // why it failed, in words
   std::size_t nodes = 0, tets = 0;
-  double mesh_seconds = 0;    // model to mesh (0 for a mesh file)
-  double solve_seconds = 0;   // assembly and solve
-  double wall_seconds = 0;    // the whole run
+  double mesh_seconds = 0;   // model to mesh (0 for a mesh file)
+  double solve_seconds = 0;  // assembly and solve
+  double wall_seconds = 0;   // the whole run
   // Zienkiewicz-Zhu a-posteriori estimate of the primary field's relative gradient error (||e||/||grad
   // u||, foxi/mesher/size_field.hpp); NaN when not computed.
   double error_indicator = NAN;
@@ -103,7 +103,8 @@ struct ConvergenceRow {
   double error_estimate = NAN;       // |finest - f*|
 };
 // `h`: one size per level (m). Throws std::invalid_argument if sizes and levels differ in number.
-std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels, const std::vector<double>& h);
+std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels,
+                                              const std::vector<double>& h);
 
 // The observed order p of three values at sizes h0 > h1 > h2: p solves (f2 - f1) / (f1 - f0) =
 // (h2^p - h1^p) / (h1^p - h0^p) (bisection on [0.05, 8]); NaN when there is none.
