@@ -117,6 +117,11 @@ RunResults thermal_results(const Mesh& mesh, const ThermalReport& r) {
   }
   if (r.max_node != kNone) {
     const double* p = &mesh.xyz[3 * std::size_t{r.max_node}];
+    for (const RegionTemperature& t : r.regions)
+      if (t.max_temperature == r.max_temperature) {
+        res.texts.push_back({"T_max_region", region_name(mesh, t.region)});
+        break;
+      }
     v.add("T_max_node", "", r.max_node);
     v.add("T_max_x", "m", p[0]);
     v.add("T_max_y", "m", p[1]);
@@ -133,6 +138,7 @@ RunResults thermal_results(const Mesh& mesh, const ThermalReport& r) {
     v.add(bracket("area", n), "m^2", b.area);
     v.add(bracket("heat_in", n), "W", b.heat_in);
     v.add(bracket("T_surface", n), "K", b.mean_temperature);
+    res.texts.push_back({bracket("condition", n), b.kind});
   }
   v.add("power_sources", "W", r.total_power);
   v.add("imbalance", "W", r.imbalance);
@@ -150,11 +156,15 @@ RunResults electrostatic_results(const Mesh& mesh, const ElectrostaticReport& r)
     v.add(bracket("area", e.name), "m^2", e.area);
     v.add(bracket("V", e.name), "V", e.voltage);
     v.add(bracket("Q", e.name), "C", e.charge);
+    std::string metal;
+    for (std::int32_t id : e.metal_regions) metal += (metal.empty() ? "" : "+") + region_name(mesh, id);
+    if (!metal.empty()) res.texts.push_back({bracket("metal", e.name), metal});
   }
   for (std::size_t i = 0; i < r.floating.size(); ++i) {
     std::string n;
     for (std::int32_t id : r.floating[i].regions) n += (n.empty() ? "" : "+") + region_name(mesh, id);
     v.add(bracket("V_floating", n), "V", r.floating[i].voltage);
+    v.add(bracket("nodes_floating", n), "", double(r.floating[i].nodes));
   }
   v.add("energy", "J", r.energy);
   v.add("field_energy", "J", r.field_energy);
@@ -278,6 +288,9 @@ std::string results_json(const RunResults& r) {
     o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + jstr(v.name) + ", \"unit\": " + jstr(v.unit) +
          ", \"value\": " + jnum(v.value) + ", \"key\": " + jbool(v.key) + "}";
   }
+  o += "],\n \"texts\": [";
+  for (std::size_t i = 0; i < r.texts.size(); ++i)
+    o += std::string(i ? ", " : "") + "{\"name\": " + jstr(r.texts[i].name) + ", \"text\": " + jstr(r.texts[i].text) + "}";
   o += "],\n \"checks\": [";
   for (std::size_t i = 0; i < r.checks.size(); ++i) {
     const BalanceCheck& c = r.checks[i];
@@ -505,6 +518,19 @@ RunResults parse_results_json(std::string_view text) {
             in.skip();
         });
         r.values.push_back(v);
+      });
+    } else if (m == "texts") {
+      in.array([&] {
+        ResultText t;
+        in.object([&](const std::string& k) {
+          if (k == "name")
+            t.name = in.string();
+          else if (k == "text")
+            t.text = in.string();
+          else
+            in.skip();
+        });
+        r.texts.push_back(t);
       });
     } else if (m == "checks") {
       in.array([&] {

@@ -62,6 +62,9 @@ TEST(Results, ThermalValuesFromOneTetByHand) {
   EXPECT_NEAR(r.find("heat_in[cold]")->value, -1.0, 1e-9);
   EXPECT_FALSE(r.find("heat_in[cold]")->key);
   EXPECT_EQ(r.checks.size(), report.checks.size());
+  ASSERT_FALSE(r.texts.empty());
+  EXPECT_EQ(r.texts[0].name, "T_max_region");
+  EXPECT_EQ(r.texts[0].text, "block");
 }
 
 TEST(Results, JsonRoundTripsEveryFigure) {
@@ -82,6 +85,7 @@ TEST(Results, JsonRoundTripsEveryFigure) {
               {"G[a,b]", "S", -1.2345678901234567e-17, true},
               {"odd", "", std::numeric_limits<double>::infinity(), false},
               {"tiny", "m", 5e-324, false}};
+  r.texts = {{"condition[cold]", "fixed"}, {"metal[a]", "bump+pad \u00b5"}};
   r.checks = {make_check("Kirchhoff", "column sums", 2e-3, 1e-6), make_check("energy", "ok", 0, 1e-6)};
   const RunResults back = parse_results_json(results_json(r));
   EXPECT_EQ(back.model, r.model);
@@ -107,6 +111,9 @@ TEST(Results, JsonRoundTripsEveryFigure) {
     else
       EXPECT_TRUE(std::isnan(back.values[i].value));  // JSON has no infinity: null
   }
+  ASSERT_EQ(back.texts.size(), 2u);
+  EXPECT_EQ(back.texts[1].name, "metal[a]");
+  EXPECT_EQ(back.texts[1].text, r.texts[1].text);
   ASSERT_EQ(back.checks.size(), 2u);
   EXPECT_FALSE(back.checks[0].passed);
   EXPECT_EQ(back.checks[0].figure, 2e-3);

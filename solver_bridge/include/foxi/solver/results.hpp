@@ -34,6 +34,13 @@ struct ResultValue {
   bool key = false;  // a figure the sweep table and the convergence study carry
 };
 
+// A printed fact that is not a number: a boundary's condition kind, a terminal's kind, the metal
+// regions a conductor takes in.
+struct ResultText {
+  std::string name;  // "condition[substrate.bottom]", "terminal[via]", "metal[via]", "T_max_region"
+  std::string text;  // "fixed", "voltage", "bump+pad", "die"
+};
+
 // A model parameter as the run was given it (foxi solve --set NAME=TEXT).
 struct RunParameter {
   std::string name;
@@ -58,6 +65,7 @@ struct RunResults {
   double error_indicator = NAN;
   std::string solver;  // the linear solver used
   std::vector<ResultValue> values;
+  std::vector<ResultText> texts;
   std::vector<BalanceCheck> checks;
 
   // The value named `name`, or nullptr.
@@ -79,7 +87,7 @@ RunResults thermoelastic_results(const Mesh& mesh, const ThermoelasticReport& re
 // One JSON object (UTF-8, one line per value), NaN and infinities as null:
 //   {"foxi_results": 1, "model": ..., "physics": ..., "parameters": [{"name", "text"}], "status",
 //    "error", "nodes", "tets", "mesh_seconds", "solve_seconds", "wall_seconds", "error_indicator",
-//    "solver", "values": [{"name", "unit", "value", "key"}],
+//    "solver", "values": [{"name", "unit", "value", "key"}], "texts": [{"name", "text"}],
 //    "checks": [{"name", "what", "figure", "tolerance", "passed"}]}
 std::string results_json(const RunResults& results);
 
