@@ -39,6 +39,16 @@ bool Args::flag_with_file(std::string_view name, std::string_view suffix, std::s
   return false;
 }
 
+std::vector<std::string> Args::take_after(std::string_view marker) {
+  for (auto it = args_.begin(); it != args_.end(); ++it) {
+    if (*it != marker) continue;
+    std::vector<std::string> rest(it + 1, args_.end());
+    args_.erase(it, args_.end());
+    return rest;
+  }
+  return {};
+}
+
 std::string Args::option(std::string_view name, std::string fallback) {
   for (auto it = args_.begin(); it != args_.end(); ++it) {
     if (*it == name) {

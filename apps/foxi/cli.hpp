@@ -36,6 +36,8 @@ class Args {
   // The remaining arguments; UsageError if any still starts with "--" (an unknown option) or their
   // count is not between min and max.
   std::vector<std::string> positional(std::size_t min, std::size_t max, std::string_view usage);
+  // Everything after `marker` ("--"), taken out with it; empty when it is absent.
+  std::vector<std::string> take_after(std::string_view marker);
   // The arguments not taken out yet, in order.
   const std::vector<std::string>& remaining() const { return args_; }
 

@@ -33,6 +33,7 @@ const char* kSweepUsage =
     "foxi sweep MODEL.toml --vary NAME=LO:HI:N [--vary ...] [--physics thermal|electrostatic|current|\n"
     "           thermoelastic] [--jobs N] -o SWEEP.csv [--json [FILE.json]] [--set NAME=VALUE]...\n"
     "           [--theta J:R]... [--solver S] [--tol REL] [--max-tets N] [--threads N]\n"
+    "           [-- FOXI SOLVE OPTIONS...]\n"
     "  Solves the model at every combination of the varied parameters (a grid: the product of the\n"
     "  --vary lists) and writes one CSV row per run: the parameters (as given and in SI), status (ok,\n"
     "  unreliable: a balance check failed, failed: no result), mesh size, times, the ZZ error\n"
@@ -46,7 +47,8 @@ const char* kSweepUsage =
     "                       threads unless --threads says otherwise\n"
     "  --json [FILE.json]   every run's whole record (foxi solve --json) as one JSON array, on stdout\n"
     "                       or in FILE\n"
-    "  --set, --theta, --solver, --tol, --max-tets, --threads go to every run as in foxi solve.\n"
+    "  --set, --theta, --solver, --tol, --max-tets, --threads go to every run as in foxi solve, and\n"
+    "  so does everything after '--' (e.g. -- --temperature-from-thermal, -- --k die=150).\n"
     "  A progress line per finished run on stderr. Exit status 0 when every run is ok, 4 when one is\n"
     "  unreliable, 1 when one failed; a stop (Ctrl-C) writes nothing (130/143).";
 
@@ -153,6 +155,8 @@ int cmd_sweep(Args args) {
     std::puts(kSweepUsage);
     return kExitOk;
   }
+  // after "--": options for every run's foxi solve as they are (--temperature-from-thermal, --k ...)
+  const std::vector<std::string> solve_options = args.take_after("--");
   const std::string physics = args.option("--physics", "thermal");
   if (physics != "thermal" && physics != "electrostatic" && physics != "current" &&
       physics != "thermoelastic")
@@ -183,6 +187,7 @@ int cmd_sweep(Args args) {
   for (const std::string& s : theta) pass.insert(pass.end(), {"--theta", s});
   for (const char* o : {"--solver", "--tol", "--max-tets", "--threads"})
     if (args.has_option(o)) pass.insert(pass.end(), {o, args.option(o)});
+  pass.insert(pass.end(), solve_options.begin(), solve_options.end());
   // Each run's solver threads share the cores with the other runs (unless --threads says otherwise).
   if (std::find(pass.begin(), pass.end(), "--threads") == pass.end())
     pass.insert(pass.end(), {"--threads", std::to_string(std::max(1u, cores / unsigned(jobs)))});

@@ -273,6 +273,27 @@ TEST(Sweep, TwoVariedParametersMakeAGrid) {
     for (std::size_t j = 1; j < i; ++j) EXPECT_NE(rows[i][mean], rows[j][mean]);
 }
 
+// Options after "--" reach every run: the row equals a solve with them, not one without.
+TEST(Sweep, OptionsAfterDashDashGoToEveryRun) {
+  TempDir dir;
+  const auto csv = dir / "k.csv", log = dir / "k.txt", one = dir / "one.txt", plain = dir / "plain.txt";
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=4mm:4mm:1 -o '" + csv.string() +
+                              "' -- --k 'substrate=4 W/(m*K)'",
+                          log),
+            0)
+      << test::read_text(log);
+  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --set die_w=4mm --k 'substrate=4 W/(m*K)'", one),
+            0);
+  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --set die_w=4mm", plain), 0);
+  const auto rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 2u);
+  const double t = std::stod(rows[1][column(rows[0], "T_max (K)")]);
+  const double with = number_after(test::read_text(one), "max temperature"),
+               without = number_after(test::read_text(plain), "max temperature");
+  EXPECT_NEAR(t, with, 1e-5 * with);
+  EXPECT_GT(std::abs(with - without), 1.0);  // a 10x better substrate is a different answer
+}
+
 TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {
   if (!test::have_program("/usr/bin/python3")) GTEST_SKIP() << "no python3";
   TempDir dir;
