@@ -10,16 +10,16 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
+#include "mesh_input.hpp"
+#include "model_run.hpp"
+#include "run_results.hpp"
+#include "solve_options.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/solver/thermal.hpp"
-#include "mesh_input.hpp"
-#include "model_run.hpp"
-#include "run_results.hpp"
-#include "solve_options.hpp"
 
 namespace foxi::cli {
 

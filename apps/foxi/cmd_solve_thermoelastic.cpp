@@ -8,12 +8,12 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
+#include "mesh_input.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/solver/thermoelastic.hpp"
-#include "mesh_input.hpp"
 #include "model_run.hpp"
 #include "run_results.hpp"
 #include "solve_options.hpp"
