@@ -22,6 +22,33 @@ bool Args::has_option(std::string_view name) const {
   return false;
 }
 
+bool Args::flag_with_file(std::string_view name, std::string_view suffix, std::string& file) {
+  file.clear();
+  for (auto it = args_.begin(); it != args_.end(); ++it) {
+    if (*it != name) continue;
+    const auto next = it + 1;
+    if (next != args_.end() && next->size() > suffix.size() &&
+        next->compare(next->size() - suffix.size(), suffix.size(), suffix) == 0) {
+      file = *next;
+      args_.erase(it, next + 1);
+    } else {
+      args_.erase(it);
+    }
+    return true;
+  }
+  return false;
+}
+
+std::vector<std::string> Args::take_after(std::string_view marker) {
+  for (auto it = args_.begin(); it != args_.end(); ++it) {
+    if (*it != marker) continue;
+    std::vector<std::string> rest(it + 1, args_.end());
+    args_.erase(it, args_.end());
+    return rest;
+  }
+  return {};
+}
+
 std::string Args::option(std::string_view name, std::string fallback) {
   for (auto it = args_.begin(); it != args_.end(); ++it) {
     if (*it == name) {

@@ -29,9 +29,17 @@ class Args {
   // The value after `name` (removed with it), or `fallback` if absent; UsageError if it has none.
   std::string option(std::string_view name, std::string fallback = {});
   bool has_option(std::string_view name) const;
+  // A flag that may take a file: true (and removed) if `name` is present; the argument after it is
+  // taken (removed) into `file` when it ends with `suffix` (e.g. "--json out.json"), else `file` is
+  // cleared ("--json" alone, the model file after it left alone).
+  bool flag_with_file(std::string_view name, std::string_view suffix, std::string& file);
   // The remaining arguments; UsageError if any still starts with "--" (an unknown option) or their
   // count is not between min and max.
   std::vector<std::string> positional(std::size_t min, std::size_t max, std::string_view usage);
+  // Everything after `marker` ("--"), taken out with it; empty when it is absent.
+  std::vector<std::string> take_after(std::string_view marker);
+  // The arguments not taken out yet, in order.
+  const std::vector<std::string>& remaining() const { return args_; }
 
  private:
   std::vector<std::string> args_;
@@ -54,5 +62,6 @@ int cmd_movie(Args args);
 int cmd_solve(Args args);
 int cmd_model(Args args);
 int cmd_demo(Args args);
+int cmd_sweep(Args args);
 
 }  // namespace foxi::cli

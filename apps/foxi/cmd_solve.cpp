@@ -12,11 +12,13 @@
 #include "exit_codes.hpp"
 #include "mesh_input.hpp"
 #include "model_run.hpp"
+#include "run_results.hpp"
 #include "solve_options.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/results.hpp"
 #include "foxi/solver/thermal.hpp"
 
 namespace foxi::cli {
@@ -31,10 +33,20 @@ const char* kSolveUsage =
     "  Values take units as model files write them: --fix top=300K, --fix 'top=25 degC', --power die=3W,\n"
     "  --k die='150 W/(m*K)', --convect 'top=10 W/(m^2*K),25degC'; a bare number is SI; a unit of\n"
     "  another dimension is refused, and so is an absolute temperature not above 0 K.\n"
+    "  --json [FILE.json]   every printed figure as one JSON record (key results marked; see the\n"
+    "                       README) on stdout, the text silenced, or in FILE besides the text\n"
+    "  --size-scale S       the model's mesh sizes ([mesh] max_size, parts, boxes) times S\n"
+    "  --max-tets N         refuse a model whose mesh would have more tets (default 4e6)\n"
+    "  --convergence K [--ratio R]  the solve on K meshes, sizes divided by R (default 1.5) each\n"
+    "                       time: each key result per level, its observed order, the Richardson-\n"
+    "                       extrapolated value and its error estimate (levels run as child processes)\n"
+    "  Every solve prints the Zienkiewicz-Zhu error indicator of its temperature or potential, and,\n"
+    "  on a terminal, the progress of a long solve (CG iterations, residual) on stderr.\n"
     "\n"
     "foxi solve MESH --physics thermal [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf]\n"
     "                [--power REGION=W] [--power-density REGION=W/m3] [--k REGION=k]\n"
-    "                [--theta JUNCTION:REFERENCE] [--solver auto|direct|amg|ichol] [--tol REL] [-o OUT]\n"
+    "                [--theta JUNCTION:REFERENCE] [--solver auto|direct|amg|ichol] [--tol REL]\n"
+    "                [--threads N] [-o OUT]\n"
     "  Steady heat conduction with linear tets. Options may be repeated. TAG is a boundary tag\n"
     "  number or name, REGION a region id or name; SI units: T and Tinf in K, q in W/m^2 (into the\n"
     "  body), h in W/(m^2 K), k in W/(m K) (default: the region's material). Boundaries with no\n"
@@ -202,6 +214,13 @@ LinearSolverOptions parse_solver_options(Args& args) {
   else if (solver != "auto")
     throw UsageError("--solver takes auto, direct, amg or ichol, not '" + solver + "'");
   if (!tol.empty()) options.relative_tolerance = parse_number(tol, "--tol");
+  const std::string threads = args.option("--threads", "");
+  if (!threads.empty()) {
+    std::int32_t n = 0;
+    if (!parse_int(threads, n) || n < 1 || n > 4096)
+      throw UsageError("--threads takes a whole number from 1 to 4096, not '" + threads + "'");
+    options.threads = unsigned(n);
+  }
   return options;
 }
 
@@ -243,6 +262,7 @@ std::string regions_label(const Mesh& mesh, const std::vector<std::int32_t>& ids
 
 int cmd_solve(Args args) {
   const std::string physics = args.option("--physics", "thermal");
+  if (args.has_option("--convergence")) return cmd_solve_convergence(std::move(args), physics);
   if (physics == "thermoelastic") return cmd_solve_thermoelastic(std::move(args));
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kSolveUsage);
@@ -263,10 +283,14 @@ int cmd_solve(Args args) {
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
   const std::vector<std::string> sets = all_options(args, "--set");
+  JsonOutput json = json_option(args);
+  const double size_scale = size_scale_option(args);
+  const double max_tets = max_tets_option(args);
   const auto files = args.positional(1, 1, kSolveUsage);
 
   ThermalParams params;
   params.solver = solver_options;
+  params.solver.progress = terminal_progress(params.solver);
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
   if (!out.empty()) check_output_path(out);        // and so does a folder that cannot be written
 
@@ -289,14 +313,28 @@ int cmd_solve(Args args) {
   values(terminal_current, "--terminal-current", "A");
   values(sigma, "--sigma", "S/m");
 
-  auto t0 = std::chrono::steady_clock::now();
   const bool from_model = is_model_path(files[0]);
-  MeshedModel model_run;
-  if (from_model) model_run = mesh_model_for_solve(files[0], sets, physics);
   if (!from_model && !sets.empty()) throw UsageError("--set is for model files (MODEL.toml)");
+  if (!from_model && size_scale != 1) throw UsageError("--size-scale is for model files (MODEL.toml)");
+  silence_text_for_json(json);
+  auto t0 = std::chrono::steady_clock::now();
+  MeshedModel model_run;
+  if (from_model) model_run = mesh_model_for_solve(files[0], sets, physics, size_scale, max_tets);
   Mesh mesh = from_model ? std::move(model_run.mesh) : read_mesh(files[0]);
   require_usable(mesh, files[0], "solve");
   auto t1 = std::chrono::steady_clock::now();
+  // The record of the run: the error indicator printed, the JSON written; the exit status of the checks.
+  auto finish = [&](RunResults res, const char* field) {
+    res.model = files[0];
+    res.parameters = run_parameters(sets);
+    res.mesh_seconds = std::chrono::duration<double>(t1 - t0).count();
+    res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    res.error_indicator = error_indicator(mesh, field);
+    print_error_indicator(res.error_indicator, field);
+    const int status = print_checks(res.checks);
+    write_json(json, results_json(res));
+    return status;
+  };
 
   if (physics != "thermal") {
     if (!fix.empty() || !flux.empty() || !convect.empty() || !power.empty() || !density.empty() ||
@@ -343,7 +381,7 @@ int cmd_solve(Args args) {
       std::printf("stored energy %.6e J (1/2 sum Q V), field energy %.6e J\n", r.energy, r.field_energy);
       std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
                   r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
-      const int status = print_checks(r.checks);
+      const int status = finish(electrostatic_results(mesh, r), "potential");
       if (!out.empty()) {
         write_mesh(mesh, out);
         std::printf("wrote %s (fields potential [V], electric_field [V/m])\n", out.c_str());
@@ -389,7 +427,7 @@ int cmd_solve(Args args) {
     std::printf("total Joule heat %.6e W (sum V I %.6e W)\n", r.total_power, r.terminal_power);
     std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
                 r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
-    const int status = print_checks(r.checks);
+    const int status = finish(current_results(mesh, r), "potential");
     if (!out.empty()) {
       write_mesh(mesh, out);
       std::printf("wrote %s (fields potential [V], current_density [A/m^2], joule_heat [W/m^3])\n",
@@ -494,7 +532,7 @@ int cmd_solve(Args args) {
       r.solver.c_str(), r.nonzeros, r.iterations, r.relative_residual,
       std::chrono::duration<double>(t1 - t0).count(), r.assembly_seconds, r.solve_seconds);
   (void)t2;
-  const int status = print_checks(r.checks);
+  const int status = finish(thermal_results(mesh, r), "temperature");
   if (!out.empty()) {
     write_mesh(mesh, out);
     std::printf("wrote %s (fields temperature [K], heat_flux [W/m^2])\n", out.c_str());

@@ -12,8 +12,10 @@
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/results.hpp"
 #include "foxi/solver/thermoelastic.hpp"
 #include "model_run.hpp"
+#include "run_results.hpp"
 #include "solve_options.hpp"
 
 namespace foxi::cli {
@@ -28,6 +30,7 @@ const char* kThermoelasticUsage =
     "  them (--dT replaces the load). --temperature-from-thermal first solves the model's steady heat\n"
     "  (its thermal conditions and power loads) and takes that temperature field as the load against\n"
     "  the stress-free --tref (default 293.15 K) instead of a temperature_change load.\n"
+    "  --json [FILE.json], --size-scale S and --convergence K as for the other physics (foxi solve --help).\n"
     "\n"
     "foxi solve MESH --physics thermoelastic [--fix TAG[=COMPONENTS]] [--slide TAG]\n"
     "                (--dT K | --temperature FILE[:FIELD] [--tref K])\n"
@@ -115,14 +118,18 @@ int cmd_solve_thermoelastic(Args args) {
                     tref = args.option("--tref", ""), order = args.option("--order", "1");
   ThermoelasticParams params;
   params.solver = parse_solver_options(args);
+  params.solver.progress = terminal_progress(params.solver);
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
   const bool from_thermal = args.flag("--temperature-from-thermal");
   const std::vector<std::string> sets = all_options(args, "--set");
+  JsonOutput json = json_option(args);
+  const double size_scale = size_scale_option(args);
+  const double max_tets = max_tets_option(args);
   const auto files = args.positional(1, 1, kThermoelasticUsage);
   const bool from_model = is_model_path(files[0]);
-  if (!from_model && (from_thermal || !sets.empty()))
-    throw UsageError("--set and --temperature-from-thermal are for model files (MODEL.toml)");
+  if (!from_model && (from_thermal || !sets.empty() || size_scale != 1))
+    throw UsageError("--set, --size-scale and --temperature-from-thermal are for model files (MODEL.toml)");
   if (!dt.empty() + !temperature.empty() + from_thermal > 1)
     throw UsageError(
         "--physics thermoelastic takes one of --dT, --temperature and --temperature-from-thermal");
@@ -138,12 +145,15 @@ int cmd_solve_thermoelastic(Args args) {
   // the temperatures are checked before the meshing, which may take long
   if (!dt.empty()) (void)parse_temperature(dt, "--dT", TemperatureKind::difference);
   if (!tref.empty()) (void)parse_temperature(tref, "--tref", TemperatureKind::absolute);
+  silence_text_for_json(json);
   const auto t0 = std::chrono::steady_clock::now();
   // the thermal conditions are checked before meshing, as mesh_model checks the stress conditions
   if (from_thermal) check_physics(load_model(files[0], sets), Physics::thermal);
   MeshedModel run;
-  if (from_model) run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress));
+  if (from_model)
+    run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress), size_scale, max_tets);
   Mesh mesh = from_model ? std::move(run.mesh) : read_mesh(files[0]);
+  const auto t_mesh = std::chrono::steady_clock::now();
   require_usable(mesh, files[0], "solve");
   if (from_model) {
     const ThermoelasticParams mp = thermoelastic_params_from_model(run.model, mesh);
@@ -225,6 +235,13 @@ int cmd_solve_thermoelastic(Args args) {
       "solve %.3f s\n",
       r.solver.c_str(), r.nonzeros, r.iterations, r.relative_residual,
       std::chrono::duration<double>(t1 - t0).count(), r.assembly_seconds, r.solve_seconds);
+  RunResults res = thermoelastic_results(mesh, r);
+  res.model = files[0];
+  res.parameters = run_parameters(sets);
+  res.mesh_seconds = std::chrono::duration<double>(t_mesh - t0).count();
+  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // the displacement is a vector field (the indicator takes a scalar): no indicator for the stress
+  write_json(json, results_json(res));
   if (!out.empty()) {
     write_mesh(mesh, out);
     std::printf("wrote %s (fields displacement [m], stress, von_mises, principal_stress [Pa])\n", out.c_str());

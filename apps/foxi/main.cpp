@@ -30,7 +30,10 @@ const char* kUsage =
     "  order MESH     visibility order for views (--eye, --dir, --views N), with violation counts\n"
     "  solve MESH|MODEL.toml  --physics thermal: temperatures, heat per boundary; electrostatic: the\n"
     "                 capacitance matrix; current: resistance, Joule heat; thermoelastic:\n"
-    "                 thermal stress, max von Mises and where; -o OUT.vtu\n"
+    "                 thermal stress, max von Mises and where; -o OUT.vtu; --json: the figures\n"
+    "                 as JSON; --convergence K: the solve on K finer meshes, observed order\n"
+    "  sweep MODEL.toml  the model solved over a grid of parameter values (--vary die_w=2mm:8mm:7),\n"
+    "                 in parallel, one CSV row per run with its key results (-o SWEEP.csv)\n"
     "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png\n"
     "  movie MESH     draw/undraw back and forth, or turn the view: -o OUT.gif|.apng|.mp4|frames\n"
     "\n"
@@ -68,6 +71,7 @@ int main(int argc, char** argv) {
     if (command == "solve") return foxi::cli::cmd_solve(std::move(rest));
     if (command == "model") return foxi::cli::cmd_model(std::move(rest));
     if (command == "demo") return foxi::cli::cmd_demo(std::move(rest));
+    if (command == "sweep") return foxi::cli::cmd_sweep(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return kExitUsage;
   } catch (const UsageError& e) {

@@ -1,6 +1,7 @@
 // A model file to a named mesh, and the report of its conditions (model_run.hpp).
 #include "model_run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -37,7 +38,7 @@ bool is_model_path(const std::string& path) {
 }
 
 MeshedModel mesh_model(const std::string& file, std::span<const std::string> sets,
-                       std::optional<Physics> physics, bool coarse, double max_tets) {
+                       std::optional<Physics> physics, bool coarse, double max_tets, double size_scale) {
   MeshedModel m;
   m.model = load_model(file, sets);
   if (physics) check_physics(m.model, *physics);
@@ -50,6 +51,23 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
   // tets and 90 s; this way 377 tets in 0.1 s.
   Model controls = m.model;
   if (coarse) controls.mesh = {.max_size = 0, .quality = 0, .min_dihedral = 0, .part_sizes = {}, .refine = {}};
+  if (size_scale != 1 && !coarse) {
+    if (controls.mesh.max_size <= 0) {
+      double d2 = 0;
+      for (int i = 0; i < 3; ++i) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (std::size_t p = 0; p < plc.point_count(); ++p) {
+          lo = std::min(lo, plc.points[3 * p + i]);
+          hi = std::max(hi, plc.points[3 * p + i]);
+        }
+        d2 += (hi - lo) * (hi - lo);
+      }
+      controls.mesh.max_size = std::sqrt(d2) / 10;
+    }
+    controls.mesh.max_size *= size_scale;
+    for (PartSize& p : controls.mesh.part_sizes) p.max_size *= size_scale;
+    for (RefineBox& b : controls.mesh.refine) b.max_size *= size_scale;
+  }
   const ModelMeshParams mp = mesh_params_from_model(controls, plc);
   MeshParams params = mp.params;
   check_tet_estimate(file, plc, params, m.structure.part_volume, max_tets);
@@ -73,11 +91,11 @@ MeshedModel mesh_model(const std::string& file, std::span<const std::string> set
 }
 
 MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::string> sets,
-                                 const std::string& physics) {
+                                 const std::string& physics, double size_scale, double max_tets) {
   std::optional<Physics> ph;
   for (Physics p : {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress})
     if (physics == physics_name(p)) ph = p;
-  MeshedModel m = mesh_model(file, sets, ph);
+  MeshedModel m = mesh_model(file, sets, ph, false, max_tets, size_scale);
   // the model's warnings before the work (foxi model check prints the same)
   if (ph)
     for (const ModelWarning& w : warnings_for(diagnose_model(m.model, m.structure), *ph))

@@ -39,14 +39,19 @@ void check_tet_estimate(const std::string& input, const Plc& plc, const MeshPara
 // Loads `file` with the --set overrides, checks what `physics` needs (before meshing), builds the
 // PLC and meshes it with the model's [mesh] controls; `coarse` meshes for a picture: TetGen alone, no
 // sizes, no quality refinement, no conforming rounds (the mesh may not be Delaunay).
-// A mesh estimated past `max_tets` is refused before meshing (check_tet_estimate).
+// A mesh estimated past `max_tets` is refused before meshing (check_tet_estimate). `size_scale`
+// multiplies every size of the model's [mesh] (max_size, the parts' sizes, the refinement boxes'):
+// 1/r meshes about r^3 times as many tets (foxi solve --convergence, --size-scale); a model with no
+// max_size gets one from its bounding box's diagonal / 10 first, so that every level is bounded.
 // Errors: IoError from the model, MesherError from TetGen.
 MeshedModel mesh_model(const std::string& file, std::span<const std::string> sets,
-                       std::optional<Physics> physics, bool coarse = false, double max_tets = kDefaultMaxTets);
+                       std::optional<Physics> physics, bool coarse = false, double max_tets = kDefaultMaxTets,
+                       double size_scale = 1);
 
 // mesh_model for foxi solve MODEL --physics NAME: prints one line on the model and its mesh.
 MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::string> sets,
-                                 const std::string& physics);
+                                 const std::string& physics, double size_scale = 1,
+                                 double max_tets = kDefaultMaxTets);
 
 // Prints the model's [surfaces], conditions, loads and mesh controls (lengths in its unit).
 void print_model_conditions(const Model& model);

@@ -57,7 +57,7 @@ void handle_stop_signals(const std::string& command) {
   }).detach();
 }
 
-int run_program(const std::vector<std::string>& argv) {
+int run_program(const std::vector<std::string>& argv, const std::string& output) {
   if (argv.empty()) return -1;
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
@@ -69,6 +69,12 @@ int run_program(const std::vector<std::string>& argv) {
     // The stop signals stay blocked: foxi kills this child itself when it stops.
     const int null = ::open("/dev/null", O_RDONLY);
     if (null >= 0) ::dup2(null, 0);
+    if (!output.empty()) {
+      const int out = ::open(output.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+      if (out < 0) ::_exit(127);
+      ::dup2(out, 1);
+      ::dup2(out, 2);
+    }
     ::execvp(args[0], args.data());
     ::_exit(127);
   }

@@ -21,7 +21,7 @@ void handle_stop_signals(const std::string& command);
 
 // Runs a program (argv[0] looked up in PATH) with stdin from /dev/null as a tracked child (killed
 // on a stop) and waits for it; returns its exit status, or -1 if it could not be run or died on a
-// signal.
-int run_program(const std::vector<std::string>& argv);
+// signal. A non-empty `output` gets the program's stdout and stderr (created or truncated).
+int run_program(const std::vector<std::string>& argv, const std::string& output = {});
 
 }  // namespace foxi::cli

@@ -27,6 +27,13 @@ double parse_temperature(const std::string& text, const std::string& option, Tem
   }
 }
 
+double size_scale_option(Args& args) {
+  const std::string text = args.option("--size-scale", "1");
+  const double v = parse_number(text, "--size-scale");
+  if (!(v > 0)) throw UsageError("--size-scale takes a number > 0, not '" + text + "'");
+  return v;
+}
+
 std::pair<std::string, std::string> split_pair(const std::string& text, const std::string& option,
                                                const char* form) {
   int depth = 0;

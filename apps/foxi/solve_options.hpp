@@ -14,6 +14,8 @@
 
 namespace foxi::cli {
 
+// A whole number (decimal); false when `s` is not one.
+bool parse_int(const std::string& s, std::int32_t& out);
 // A finite number.
 double parse_number(const std::string& text, const std::string& option);
 // A value with units as model files write them ("3 W", "3W", "3000 mW"; a bare number is SI), of the
@@ -36,9 +38,14 @@ std::vector<std::string> all_options(Args& args, const char* name);
 // "3 (name)" for printing.
 std::string boundary_label(const Mesh& mesh, std::int32_t tag);
 std::string region_label(const Mesh& mesh, std::int32_t id);
-// --solver auto|direct|amg|ichol and --tol REL.
+// --solver auto|direct|amg|ichol, --tol REL and --threads N (the solver's threads; default the cores).
 LinearSolverOptions parse_solver_options(Args& args);
 
+// --size-scale S: a number > 0 multiplying the model's mesh sizes (model_run.hpp), default 1.
+double size_scale_option(Args& args);
+
 int cmd_solve_thermoelastic(Args args);
+// foxi solve MODEL --convergence K ...: the same solve on K meshes, finer by --ratio each.
+int cmd_solve_convergence(Args args, const std::string& physics);
 
 }  // namespace foxi::cli

@@ -1,0 +1,331 @@
+// foxi sweep MODEL --vary NAME=LO:HI:N [--vary ...] --physics P [--jobs N] -o sweep.csv [--json [FILE]]:
+// the model solved at every combination of parameter values, one CSV row per run.
+//
+// Each run is a `foxi solve MODEL --set NAME=VALUE ... --json FILE` child process: runs are isolated
+// (a crash or an exhausted memory is that run's failed row, not the sweep's end), run in parallel up
+// to --jobs, and a stop (SIGINT/SIGTERM) kills them (signals.hpp) and removes the scratch folder; the
+// table is written once, durably, at the end, so an interrupted sweep leaves no partial CSV.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli.hpp"
+#include "exit_codes.hpp"
+#include "foxi/model/durable_file.hpp"
+#include "foxi/model/io_error.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/model/units.hpp"
+#include "model_run.hpp"
+#include "run_results.hpp"
+#include "solve_options.hpp"
+
+namespace foxi::cli {
+
+namespace {
+
+const char* kSweepUsage =
+    "foxi sweep MODEL.toml --vary NAME=LO:HI:N [--vary ...] [--physics thermal|electrostatic|current|\n"
+    "           thermoelastic] [--jobs N] -o SWEEP.csv [--json [FILE.json]] [--set NAME=VALUE]...\n"
+    "           [--theta J:R]... [--solver S] [--tol REL] [--max-tets N] [--threads N]\n"
+    "           [-- FOXI SOLVE OPTIONS...]\n"
+    "  Solves the model at every combination of the varied parameters (a grid: the product of the\n"
+    "  --vary lists) and writes one CSV row per run: the parameters (as given and in SI), status (ok,\n"
+    "  unreliable: a balance check failed, failed: no result), mesh size, times, the ZZ error\n"
+    "  indicator, the key results (max and mean temperature per part and theta values for thermal,\n"
+    "  R and the conductance matrix for current, the capacitance matrix for electrostatic, max von\n"
+    "  Mises per part for thermoelastic; a column per result, its unit in the header), the checks\n"
+    "  that failed and the error of a failed run. A failed run does not stop the sweep.\n"
+    "  --vary NAME=LO:HI:N  N values from LO to HI evenly, in LO's unit (die_w=2mm:8mm:7); or a list\n"
+    "                       NAME=V1,V2,... (die_w=2mm,3mm,5mm). NAME is one of the model's [parameters].\n"
+    "  --jobs N             runs at once (default: the cores); each run's solver gets cores / N\n"
+    "                       threads unless --threads says otherwise\n"
+    "  --json [FILE.json]   every run's whole record (foxi solve --json) as one JSON array, on stdout\n"
+    "                       or in FILE\n"
+    "  --set, --theta, --solver, --tol, --max-tets, --threads go to every run as in foxi solve, and\n"
+    "  so does everything after '--' (e.g. -- --temperature-from-thermal, -- --k die=150).\n"
+    "  A progress line per finished run on stderr. Exit status 0 when every run is ok, 4 when one is\n"
+    "  unreliable, 1 when one failed; a stop (Ctrl-C) writes nothing (130/143).";
+
+struct Varied {
+  std::string name;
+  std::vector<std::string> texts;  // as given to --set
+  std::vector<double> si;          // their SI values
+  std::string si_unit;             // "m", "W", "" (dimensionless)
+};
+
+// The SI value and unit text of a value with units ("2mm" -> 0.002, "m").
+Quantity quantity(const std::string& text, const std::string& option) {
+  try {
+    return evaluate_expression(text, [](std::string_view) { return std::optional<Quantity>{}; });
+  } catch (const ExpressionError& e) {
+    throw UsageError(option + ": " + e.what());
+  }
+}
+
+// The unit written after the number of `text` ("2mm" -> "mm", "2 mm" -> "mm", "2" -> "").
+std::string unit_suffix(const std::string& text) {
+  std::size_t at = 0;
+  while (at < text.size() && (std::isdigit(static_cast<unsigned char>(text[at])) || text[at] == '.' ||
+                              text[at] == '-' || text[at] == '+' ||
+                              ((text[at] == 'e' || text[at] == 'E') && at + 1 < text.size() &&
+                               (std::isdigit(static_cast<unsigned char>(text[at + 1])) ||
+                                text[at + 1] == '-' || text[at + 1] == '+'))))
+    ++at;
+  while (at < text.size() && text[at] == ' ') ++at;
+  return text.substr(at);
+}
+
+Varied parse_vary(const std::string& spec) {
+  const auto [name, range] = split_assignment(spec, "--vary");
+  Varied v;
+  v.name = name;
+  const std::string option = "--vary " + name;
+  if (range.find(':') != std::string::npos) {
+    const auto c1 = range.find(':'), c2 = range.find(':', c1 + 1);
+    if (c2 == std::string::npos || range.find(':', c2 + 1) != std::string::npos)
+      throw UsageError("--vary takes NAME=LO:HI:N or NAME=V1,V2,..., not '" + spec + "'");
+    const std::string lo_text = range.substr(0, c1), hi_text = range.substr(c1 + 1, c2 - c1 - 1);
+    std::int32_t n = 0;
+    if (!parse_int(range.substr(c2 + 1), n) || n < 1 || n > 10000)
+      throw UsageError(option + ": the count N must be a whole number from 1 to 10000, not '" +
+                       range.substr(c2 + 1) + "'");
+    const Quantity lo = quantity(lo_text, option), hi = quantity(hi_text, option);
+    if (lo.dims != hi.dims)
+      throw UsageError(option + ": " + lo_text + " and " + hi_text + " are not of one dimension (" +
+                       dims_to_string(lo.dims) + ", " + dims_to_string(hi.dims) + ")");
+    // The values are written in LO's unit ("2.5mm"), as the user would write them.
+    const std::string unit = unit_suffix(lo_text);
+    const double unit_si = unit.empty() ? 1 : quantity("1 " + unit, option).value;
+    if (!(unit_si != 0) || !std::isfinite(unit_si))
+      throw UsageError(option + ": cannot write values in '" + unit + "'");
+    for (std::int32_t i = 0; i < n; ++i) {
+      const double si = n == 1 ? lo.value : lo.value + (hi.value - lo.value) * i / (n - 1);
+      char text[64];
+      std::snprintf(text, sizeof text, "%.10g%s", si / unit_si, unit.c_str());
+      v.texts.push_back(text);
+      v.si.push_back(si);
+    }
+    v.si_unit = dims_to_string(lo.dims);
+  } else {
+    Dims dims{};
+    std::size_t at = 0;
+    while (at <= range.size()) {
+      const std::size_t comma = std::min(range.find(',', at), range.size());
+      const std::string item = range.substr(at, comma - at);
+      if (item.empty()) throw UsageError(option + ": empty value in '" + range + "'");
+      const Quantity q = quantity(item, option);
+      if (!v.texts.empty() && q.dims != dims)
+        throw UsageError(option + ": the values are not of one dimension ('" + item + "')");
+      dims = q.dims;
+      v.texts.push_back(item);
+      v.si.push_back(q.value);
+      at = comma + 1;
+    }
+    v.si_unit = dims_to_string(dims);
+  }
+  if (v.si_unit == "1") v.si_unit.clear();
+  return v;
+}
+
+// A CSV field, quoted when it holds a comma, a quote or a line break (RFC 4180).
+std::string csv(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string o = "\"";
+  for (char c : s) o += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return o + "\"";
+}
+
+std::string number(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+}  // namespace
+
+int cmd_sweep(Args args) {
+  if (args.flag("--help") || args.flag("-h")) {
+    std::puts(kSweepUsage);
+    return kExitOk;
+  }
+  // after "--": options for every run's foxi solve as they are (--temperature-from-thermal, --k ...)
+  const std::vector<std::string> solve_options = args.take_after("--");
+  const std::string physics = args.option("--physics", "thermal");
+  if (physics != "thermal" && physics != "electrostatic" && physics != "current" &&
+      physics != "thermoelastic")
+    throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics +
+                     "'");
+  std::vector<Varied> varied;
+  for (const std::string& s : all_options(args, "--vary")) varied.push_back(parse_vary(s));
+  if (varied.empty())
+    throw UsageError("foxi sweep needs at least one --vary NAME=LO:HI:N\nusage: " + std::string(kSweepUsage));
+  for (std::size_t i = 0; i < varied.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (varied[i].name == varied[j].name) throw UsageError("--vary " + varied[i].name + " is given twice");
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::string jobs_text = args.option("--jobs", std::to_string(cores));
+  std::int32_t jobs = 0;
+  if (!parse_int(jobs_text, jobs) || jobs < 1 || jobs > 1024)
+    throw UsageError("--jobs takes a whole number from 1 to 1024, not '" + jobs_text + "'");
+  std::string out = args.option("-o", "");
+  if (out.empty()) out = args.option("--output", "");
+  if (out.empty()) throw UsageError("foxi sweep needs -o SWEEP.csv");
+  JsonOutput json = json_option(args);
+  // passed to every run as given
+  std::vector<std::string> pass;
+  const std::vector<std::string> sets = all_options(args, "--set");
+  for (const std::string& s : sets) pass.insert(pass.end(), {"--set", s});
+  const std::vector<std::string> theta = all_options(args, "--theta");
+  if (!theta.empty() && physics != "thermal") throw UsageError("--theta is for --physics thermal");
+  for (const std::string& s : theta) pass.insert(pass.end(), {"--theta", s});
+  for (const char* o : {"--solver", "--tol", "--max-tets", "--threads"})
+    if (args.has_option(o)) pass.insert(pass.end(), {o, args.option(o)});
+  pass.insert(pass.end(), solve_options.begin(), solve_options.end());
+  // Each run's solver threads share the cores with the other runs (unless --threads says otherwise).
+  if (std::find(pass.begin(), pass.end(), "--threads") == pass.end())
+    pass.insert(pass.end(), {"--threads", std::to_string(std::max(1u, cores / unsigned(jobs)))});
+  const auto files = args.positional(1, 1, kSweepUsage);
+  const std::string& model = files[0];
+  if (!is_model_path(model))
+    throw UsageError("foxi sweep takes a model file (MODEL.toml), not '" + model + "'");
+  check_output_path(out);
+
+  // Every combination, the last --vary fastest.
+  std::size_t total = 1;
+  for (const Varied& v : varied) total *= v.texts.size();
+  if (total > 100000) throw UsageError("the sweep has " + std::to_string(total) + " runs; at most 100000");
+  auto combination = [&](std::size_t run) {
+    std::vector<std::size_t> idx(varied.size());
+    for (std::size_t i = varied.size(); i-- > 0;) {
+      idx[i] = run % varied[i].texts.size();
+      run /= varied[i].texts.size();
+    }
+    return idx;
+  };
+  auto run_sets = [&](std::size_t run) {
+    std::vector<std::string> s = sets;
+    const auto idx = combination(run);
+    for (std::size_t i = 0; i < varied.size(); ++i)
+      s.push_back(varied[i].name + "=" + varied[i].texts[idx[i]]);
+    return s;
+  };
+  // The parameters and the model are checked once here: a mistyped name fails before any run.
+  for (const Varied& v : varied) {
+    std::vector<std::string> one = sets;
+    one.push_back(v.name + "=" + v.texts.front());
+    (void)load_model(model, one);
+  }
+  (void)load_model(model, run_sets(0));
+  silence_text_for_json(json);
+
+  ScratchFolder scratch("foxi-sweep");
+  std::vector<RunResults> results(total);
+  std::atomic<std::size_t> next{0};
+  std::size_t finished = 0;
+  std::mutex print;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::fprintf(stderr, "foxi sweep: %zu runs of %s --physics %s, %d at a time\n", total, model.c_str(),
+               physics.c_str(), std::min<int>(jobs, int(total)));
+  auto worker = [&] {
+    for (std::size_t run; (run = next.fetch_add(1)) < total;) {
+      std::vector<std::string> a{model, "--physics", physics};
+      for (const std::string& s : run_sets(run)) a.insert(a.end(), {"--set", s});
+      // --set of a varied name replaces the sweep's own (the later --set wins in load_model)
+      a.insert(a.end(), pass.begin(), pass.end());
+      const std::string n = std::to_string(run);
+      const auto start = std::chrono::steady_clock::now();
+      RunResults r = run_solve_child(a, scratch / ("run" + n + ".json"), scratch / ("run" + n + ".log"));
+      if (r.status == RunStatus::failed)
+        r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::string label;
+      const auto idx = combination(run);
+      for (std::size_t i = 0; i < varied.size(); ++i)
+        label += (i ? " " : "") + varied[i].name + "=" + varied[i].texts[idx[i]];
+      std::string first;
+      for (const ResultValue& v : r.values)
+        if (v.key) {
+          first = ", " + v.name + " " + number(v.value) + " " + v.unit;
+          break;
+        }
+      std::lock_guard lock(print);
+      ++finished;
+      if (r.status == RunStatus::failed)
+        std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: FAILED after %.2f s: %s\n", finished, total,
+                     label.c_str(), r.wall_seconds, r.error.c_str());
+      else
+        std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: %s, %zu tets, %.2f s%s\n", finished, total,
+                     label.c_str(), run_status_name(r.status), r.tets, r.wall_seconds, first.c_str());
+      results[run] = std::move(r);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int i = 0; i < std::min<int>(jobs, int(total)); ++i) threads.emplace_back(worker);
+  for (std::thread& t : threads) t.join();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // Columns: the key results of every run, in the order first met.
+  std::vector<std::pair<std::string, std::string>> columns;  // name, unit
+  for (const RunResults& r : results)
+    for (const ResultValue& v : r.values)
+      if (v.key &&
+          std::none_of(columns.begin(), columns.end(), [&](const auto& c) { return c.first == v.name; }))
+        columns.emplace_back(v.name, v.unit);
+  std::string text = "run";
+  for (const Varied& v : varied)
+    text += "," + csv(v.name) + "," + csv(v.name + " (" + (v.si_unit.empty() ? "1" : v.si_unit) + ")");
+  text += ",status,nodes,tets,mesh_s,solve_s,wall_s,error_indicator";
+  for (const auto& [name, unit] : columns) text += "," + csv(unit.empty() ? name : name + " (" + unit + ")");
+  text += ",failed_checks,error\n";
+  std::size_t ok = 0, unreliable = 0, failed = 0;
+  for (std::size_t run = 0; run < total; ++run) {
+    const RunResults& r = results[run];
+    (r.status == RunStatus::ok ? ok : r.status == RunStatus::unreliable ? unreliable : failed)++;
+    text += std::to_string(run + 1);
+    const auto idx = combination(run);
+    for (std::size_t i = 0; i < varied.size(); ++i)
+      text += "," + csv(varied[i].texts[idx[i]]) + "," + number(varied[i].si[idx[i]]);
+    text += std::string(",") + run_status_name(r.status);
+    const bool has = r.status != RunStatus::failed;
+    text += "," + (has ? std::to_string(r.nodes) : "") + "," + (has ? std::to_string(r.tets) : "");
+    text += "," + (has ? number(r.mesh_seconds) : "") + "," + (has ? number(r.solve_seconds) : "") + "," +
+            number(r.wall_seconds) + "," + (has ? number(r.error_indicator) : "");
+    for (const auto& c : columns) {
+      const ResultValue* v = r.find(c.first);
+      text += "," + (v ? number(v->value) : "");
+    }
+    std::string bad;
+    for (const BalanceCheck& c : r.checks)
+      if (!c.passed)
+        bad += (bad.empty() ? "" : "; ") + c.name + " " + number(c.figure) + " > " + number(c.tolerance);
+    text += "," + csv(bad) + "," + csv(r.error) + "\n";
+  }
+  DurableFile file(out);
+  file.write(text);
+  file.commit();
+  std::fprintf(stderr, "foxi sweep: %zu runs in %.2f s (%zu ok, %zu unreliable, %zu failed); wrote %s\n",
+               total, wall, ok, unreliable, failed, out.c_str());
+  if (json.enabled) {
+    std::string o = "[\n";
+    for (std::size_t run = 0; run < total; ++run) {
+      RunResults r = results[run];
+      if (r.status == RunStatus::failed) {
+        r.model = model;
+        r.physics = physics;
+        r.parameters = run_parameters(run_sets(run));
+      }
+      o += (run ? ",\n" : "") + results_json(r);
+    }
+    o += "]\n";
+    write_json(json, o);
+  }
+  return failed ? kExitFailure : unreliable ? kExitUnreliable : kExitOk;
+}
+
+}  // namespace foxi::cli
