@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
 inline constexpr std::uint32_t kNone = 0xffffffffu;
@@ -67,7 +69,7 @@ struct Field {
 struct DerivedData;  // defined by the derived-data functions (adjacency.hpp, delaunay.hpp, ...)
 
 // Holds derived data; copying gives an empty cache so that copies never share stale results.
-class DerivedCache {
+class FOXI_API DerivedCache {
  public:
   DerivedCache() = default;
   DerivedCache(const DerivedCache&) {}
@@ -81,7 +83,7 @@ class DerivedCache {
   mutable std::shared_ptr<DerivedData> data_;
 };
 
-struct Mesh {
+struct FOXI_API Mesh {
   std::vector<double> xyz;                 // 3 per node
   std::vector<std::uint32_t> tet;          // 4 per tet, positively oriented (see validate.hpp)
   std::vector<std::int32_t> tet_region;    // 1 per tet (region id), or empty = all region 0
@@ -106,13 +108,13 @@ struct Mesh {
 
 // Drops every cached derived result. Call after changing xyz, tet or weight in place; the functions
 // of foxi that change a mesh call it themselves.
-void invalidate_derived(Mesh& mesh);
+FOXI_API void invalidate_derived(Mesh& mesh);
 
 // Entity count a field's location refers to (node_count or tet_count).
-std::size_t field_entity_count(const Mesh& mesh, const Field& field);
+FOXI_API std::size_t field_entity_count(const Mesh& mesh, const Field& field);
 
 // Checks the sizes of every array against each other (xyz % 3, tet % 4, tet_region, bface_tag,
 // weight, field value counts). Returns an empty string when consistent, else the first problem.
-std::string check_sizes(const Mesh& mesh);
+FOXI_API std::string check_sizes(const Mesh& mesh);
 
 }  // namespace foxi
