@@ -4,6 +4,12 @@
 // SI units (metres, kelvin, ...). Derived data (face adjacency, circumspheres, the Delaunay
 // certificate) is never stored here twice: it is computed on demand by the functions that own it and
 // cached in `derived`, which a copy of the mesh does not share.
+//
+// Host-owned data: a Mesh owns its arrays, so a host's own coordinates, tets and regions are moved
+// or copied into it once (there is no mesh view over host arrays yet). Everything after that takes
+// the mesh by reference and copies nothing: the certificate and adjacency (cached here), the
+// sphere table (a value the caller keeps), the orders and the painter (which lend the mesh and take
+// subsets and orders as std::span), the solvers (which add their result fields to it).
 #pragma once
 
 #include <cstdint>

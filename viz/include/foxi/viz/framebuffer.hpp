@@ -1,6 +1,10 @@
 // The picture the painter fills: RGBA8 pixels, an id buffer (the tet each pixel shows, for picking,
 // probing and recolouring) and, in depth-buffer mode only, a depth buffer (double: it is the test
 // oracle, and float rounding alone flips grazing layers).
+//
+// The framebuffer owns its pixels, rows `width` apart: the painter draws only into one, so a host
+// with its own RGBA buffer (its own row stride) copies the rows out after drawing
+// (examples/embed/field_buffer).
 #pragma once
 
 #include <algorithm>
