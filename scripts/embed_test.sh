@@ -37,6 +37,16 @@ if grep -rlF -e "$src" -e "$build" "$prefix"; then
   exit 1
 fi
 
+# The installed programs run from the prefix (a shared build's find lib/ through their rpath), and
+# foxi demo finds its default model there, not in the source tree.
+"$prefix/bin/foxi" --version
+model=$(cd "$work" && FOXI_MODELS_DIR= timeout 3 stdbuf -oL "$prefix/bin/foxi" demo -o "$work/demo" 2>&1 | sed -n 's/^1\. model //p' || true)
+if [ "$model" != "$prefix/share/foxi/models/flip_chip.toml" ]; then
+  echo "embed test: foxi demo took its default model from '$model'" >&2
+  exit 1
+fi
+step "installed foxi: --version, demo model"
+
 for example in grid_png field_buffer; do
   dir=$work/$example
   cmake -S "examples/embed/$example" -B "$dir" -G "$generator" -DCMAKE_BUILD_TYPE=Release \
