@@ -14,6 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
+bash scripts/check_exports.sh build  # what the programs and tests call is FOXI_API (shared builds link)
 ctest --test-dir build --output-on-failure -j2 --timeout 900
 # foxi installed into a temporary prefix, and the host programs of examples/embed built against it.
 bash scripts/embed_test.sh build
