@@ -6,13 +6,14 @@
 # the build folder, and that grid_png's PNG is there and not blank. Prints the time of each step
 # and the size of the install tree.
 #   scripts/embed_test.sh [BUILD]    (default build; e.g. a -DBUILD_SHARED_LIBS=ON build folder)
+# FOXI_KEEP_EMBED_TEST=1 keeps BUILD/embed-test (grid.png, field.ppm) to look at.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 src=$PWD
 build=$(cd "${1:-build}" && pwd)
 work=$build/embed-test
 rm -rf "$work"
-trap 'rm -rf "$work"' EXIT
+trap '[ -n "${FOXI_KEEP_EMBED_TEST:-}" ] || rm -rf "$work"' EXIT
 prefix=$work/prefix
 generator=$(sed -n 's/^CMAKE_GENERATOR:INTERNAL=//p' "$build/CMakeCache.txt")
 
