@@ -2,8 +2,9 @@
 # Checks, in a static build, that the programs and tests call into the libraries only through
 # exported symbols (FOXI_API, foxi/api.hpp), so that a shared build (-DBUILD_SHARED_LIBS=ON) links
 # too: no symbol defined with hidden visibility in a libfoxi_*.a may be undefined in an object of
-# apps/, tests/ or bench/. The tests of internals and bench_io_tetgen, which a shared build leaves out,
-# are left out here as well. A public entry point without FOXI_API fails here, in seconds, without a
+# apps/, tests/ or bench/. The tests of internals, which a shared build leaves out,
+# are left out here as well; and no library may use another's hidden symbols (libfoxi_structure.so
+# calls libfoxi_model.so). A public entry point without FOXI_API fails here, in seconds, without a
 # second (shared) build.
 #   scripts/check_exports.sh [BUILD]    (default build)
 set -euo pipefail
@@ -17,10 +18,18 @@ libs=$(find "$build" -name 'libfoxi_*.a' -not -name 'libfoxi_view_core.a')
 readelf -sW $libs | awk '($5 == "GLOBAL" || $5 == "WEAK") && $6 == "HIDDEN" && $7 != "UND" {print $8}' |
   sort -u > "$tmp/hidden"
 find "$build/apps" "$build/tests" "$build/bench" -name '*.o' 2>/dev/null |
-  grep -v -e 'plc_cleanup_test' -e 'exact_key_test' -e 'bench_io_tetgen' > "$tmp/objects" || true
+  grep -v -e 'plc_cleanup_test' -e 'exact_key_test' > "$tmp/objects" || true
 [ -s "$tmp/objects" ] || { echo "check_exports: no objects of apps, tests or bench in $build" >&2; exit 1; }
 xargs nm -u < "$tmp/objects" | awk '{print $NF}' | sort -u > "$tmp/used"
 comm -12 "$tmp/hidden" "$tmp/used" > "$tmp/missing"
+# Each library's own needs from the others: undefined in it, not defined in it, hidden in another.
+for lib in $libs; do
+  readelf -sW "$lib" | awk '($5 == "GLOBAL" || $5 == "WEAK") && $7 != "UND" {print $8}' | sort -u > "$tmp/own"
+  nm -u "$lib" | awk '$1 == "U" {print $2}' | sort -u | comm -23 - "$tmp/own" > "$tmp/needs"
+  readelf -sW $(echo "$libs" | grep -vxF "$lib") |
+    awk '($5 == "GLOBAL" || $5 == "WEAK") && $6 == "HIDDEN" && $7 != "UND" {print $8}' | sort -u |
+    comm -12 - "$tmp/needs" >> "$tmp/missing"
+done
 if [ -s "$tmp/missing" ]; then
   echo "check_exports: used outside the libraries but not exported (add FOXI_API to the declaration):" >&2
   c++filt < "$tmp/missing" | sed 's/^/  /' >&2

@@ -4,7 +4,7 @@
 //   mesh_plc(plc, params)                      TetGen's quality mesh of a PLC (tetgen_mesher.hpp)
 //   mesh_conforming(plc, params, conforming)   a conforming Delaunay mesh, certified (conforming.hpp)
 //   mesh_plc_cgal(plc, params)                 CGAL Mesh_3's mesh of a PLC (cgal_mesher.hpp)
-//   MeshParams, MesherError, MesherFailure     parameters, and why meshing failed (mesher.hpp)
+//   MeshParams, MesherError, MesherCancelled   parameters, and why meshing failed (mesher.hpp)
 //   estimate_tet_count(plc, params)            tets a mesh will have, before meshing (tet_estimate.hpp)
 //   mesh_params_from_model(model, plc)         a model's [mesh] controls as parameters (model_mesh_params.hpp)
 //   box_size_field, size_field_from_error      size control: boxes, per region, from an error (size_field.hpp)

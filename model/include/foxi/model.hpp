@@ -12,43 +12,30 @@
 //   tet_quality(p0..p3), summarize_quality(m)  radius-edge ratio, dihedral angles (quality.hpp)
 //   read_mesh(path), write_mesh(mesh, path)    any format, chosen from the file name (mesh_io.hpp)
 //   read_/parse_/write_gmsh, _vtu, _vtk_legacy, _tetgen, _medit   one format each (io_*.hpp)
+//   Cancelled                                  what a cancelled mesher, solver or movie throws (progress.hpp)
 //   IoError                                    a reader's or writer's error: file, place, reason (io_error.hpp)
 //   DurableFile, check_output_path             files that appear whole or not at all (durable_file.hpp)
 //   cleanup::track, cleanup::interrupt         what an interrupted run must remove (cleanup.hpp)
 //   Plc, read_poly, parse_poly, write_poly     the piecewise linear complex for the mesher (plc.hpp)
 //   ProgressFn                                 progress and cancel callback (progress.hpp)
 //
-// Structure models (TOML files of parts, materials and conditions):
-//   load_model(path)                           a model file as plain data in SI units (model_file.hpp)
-//   build_structure(model), name_mesh(...)     parts -> one conforming PLC; names on the mesh (structure.hpp)
-//   diagnose_model(model, structure)           what is unsound before meshing or solving (diagnostics.hpp)
-//   check_physics(model, physics)              what a solve of one physics needs is there (physics.hpp)
-//   tag_selected_surfaces, check_conditions    named surfaces of the conditions (surfaces.hpp)
-//   evaluate_expression, evaluate_in           quantities with units: "die_w + 2 mm" (units.hpp)
-//   ball_surface, read_stl                     closed triangle surfaces of parts (surface.hpp)
+// The structure modelling (model files, parts, conditions) is foxi::structure: foxi/structure.hpp.
 #pragma once
 
 #include "foxi/api.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "foxi/model/cleanup.hpp"
-#include "foxi/model/conditions.hpp"
 #include "foxi/model/delaunay.hpp"
-#include "foxi/model/diagnostics.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/io_gmsh.hpp"
+#include "foxi/model/io_medit.hpp"
 #include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/io_vtk.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/mesh_io.hpp"
-#include "foxi/model/model_file.hpp"
-#include "foxi/model/physics.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/quality.hpp"
-#include "foxi/model/structure.hpp"
-#include "foxi/model/surface.hpp"
-#include "foxi/model/surfaces.hpp"
-#include "foxi/model/units.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/version.hpp"

@@ -8,12 +8,13 @@
 //   solve_thermoelastic(mesh, params)          thermal stress: displacements, stresses (thermoelastic.hpp)
 //   thermal_params_from_model(model, mesh)     a model's conditions as solver parameters; also
 //     electrostatic_, current_, thermoelastic_params_from_model (model_problem.hpp)
-//   SolverError, SolverCancelled               why a solve failed (thermal.hpp)
+//   SolverError, SolverCancelled, LinearSolverOptions   why a solve failed; the linear solver (solver.hpp)
 //   write_calculix_thermal, read_frd           the same problem as a CalculiX deck, its results (calculix.hpp)
 #pragma once
 
 #include "foxi/solver/calculix.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/solver.hpp"
 #include "foxi/solver/thermal.hpp"
 #include "foxi/solver/thermoelastic.hpp"
