@@ -24,6 +24,10 @@ function(foxi_library target export_name)
     DEFINE_SYMBOL ""
     VERSION ${PROJECT_VERSION}
     SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+  # __FILE__ (FOXI_ASSERT's messages, in Debug or with FOXI_CHECKS) relative to the source tree, so
+  # that no path of the build machine is baked into an installed library.
+  target_compile_options(${target} PRIVATE
+    $<$<CXX_COMPILER_ID:GNU,Clang>:-fmacro-prefix-map=${PROJECT_SOURCE_DIR}/=>)
   # Warnings are for foxi's own build: a host linking a static foxi must not inherit them.
   target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:foxi_warnings>)
   install(TARGETS ${target} EXPORT foxiTargets
