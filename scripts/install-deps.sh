@@ -9,6 +9,8 @@ packages=(
   # libraries
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev libtet1.5-dev libeigen3-dev
   qtbase5-dev libx11-dev libxext-dev libpng-dev zlib1g-dev libpugixml-dev libfreetype-dev libgif-dev libtoml11-dev
+  # the API reference (scripts/docs.sh)
+  doxygen
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev xvfb xdotool x11-apps
   # the fuzz targets (scripts/fuzz.sh): clang with libFuzzer and its sanitizer runtimes

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test on a fresh machine: installs what is missing, builds (Release), runs all tests
-# with CTest; then builds every test with AddressSanitizer + UndefinedBehaviorSanitizer and runs them
-# again, less those labelled `slow` (whole-model meshing and signal trials: minutes each in Release,
+# with CTest, installs foxi into a temporary prefix and builds and runs examples/embed against it
+# (scripts/embed_test.sh); then builds every test with AddressSanitizer + UndefinedBehaviorSanitizer
+# and runs them again, less those labelled `slow` (whole-model meshing and signal trials: minutes each in Release,
 # too long under the sanitizers for CI's budget) and the CGAL Mesh_3 model tests (40-90 s each in
 # Debug with the sanitizers; they run in Release, and the PLC side is fuzzed), so readers on broken
 # files never crash.
@@ -14,7 +15,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
+bash scripts/check_exports.sh build  # what the programs and tests call is FOXI_API (shared builds link)
 ctest --test-dir build --output-on-failure -j2 --timeout 900
+# foxi installed into a temporary prefix, and the host programs of examples/embed built against it.
+bash scripts/embed_test.sh build
 if [ "${FOXI_SKIP_SANITIZE:-0}" != "1" ]; then
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DFOXI_SANITIZE=ON -DFOXI_BUILD_BENCH=OFF \
     > build-asan.log 2>&1 || { cat build-asan.log; exit 1; }

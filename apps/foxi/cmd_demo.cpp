@@ -2,6 +2,7 @@
 // a picture of the inside -- with what each step found.
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -31,6 +32,16 @@ const char* kDemoUsage =
     "  60 % of the visibility order drawn by the painter, parts in their materials' colours) and\n"
     "  MODEL_parts.png (the parts, exploded).";
 
+// The folder of the example models: $FOXI_MODELS_DIR if set, else FOXI_MODELS_RELATIVE_DIR next to
+// this program (share/foxi/models of an installed foxi; the build tree has a link to models/ there),
+// so that no path of the build machine is baked into the program.
+std::filesystem::path models_dir() {
+  if (const char* env = std::getenv("FOXI_MODELS_DIR"); env != nullptr && *env != '\0') return env;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return (ec ? std::filesystem::path(".") : exe.parent_path()) / FOXI_MODELS_RELATIVE_DIR;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
@@ -46,7 +57,7 @@ int cmd_demo(Args args) {
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
   const std::filesystem::path dir = args.option("-o", "out/demo");
   const auto pos = args.positional(0, 1, kDemoUsage);
-  const std::string file = pos.empty() ? std::string(FOXI_MODELS_DIR) + "/flip_chip.toml" : pos[0];
+  const std::string file = pos.empty() ? (models_dir() / "flip_chip.toml").lexically_normal().string() : pos[0];
   if (!is_model_path(file)) throw UsageError("foxi demo takes a model file (.toml), not '" + file + "'");
   const std::string stem = std::filesystem::path(file).stem().string();
   std::filesystem::create_directories(dir);

@@ -9,6 +9,7 @@
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/units.hpp"
+#include "foxi/version.hpp"
 #include "signals.hpp"
 
 namespace {
@@ -55,7 +56,7 @@ int main(int argc, char** argv) {
     return args.empty() ? kExitUsage : kExitOk;
   }
   if (args[0] == "--version") {
-    std::puts("foxi 0.1.0");
+    std::puts("foxi " FOXI_VERSION_STRING);
     return kExitOk;
   }
   std::string command = args[0];

@@ -15,21 +15,26 @@
 #include <vector>
 
 #include "foxi/model/durable_file.hpp"
+#include "foxi/api.hpp"
 #include "foxi/model/io_error.hpp"
 
 namespace foxi::io {
 
+// The functions below are internal (this header is not installed) but FOXI_API: foxi_structure
+// reads its files with them, and a shared libfoxi_structure.so can only call what libfoxi_model.so
+// exports.
+
 // Reads a whole file into memory. Throws IoError (line 0) if it cannot be opened or read.
-std::string read_file(const std::filesystem::path& path);
+FOXI_API std::string read_file(const std::filesystem::path& path);
 
 // 1-based line number of byte `offset` in `text` (counts '\n'; a lone '\r' also ends a line).
-std::uint64_t line_of(std::string_view text, std::size_t offset);
+FOXI_API std::uint64_t line_of(std::string_view text, std::size_t offset);
 
 // Throws IoError for a problem at byte `offset` of `text` (a text file: the line is computed).
-[[noreturn]] void fail_text(const std::string& file, std::string_view text, std::size_t offset,
-                            const std::string& reason);
+[[noreturn]] FOXI_API void fail_text(const std::string& file, std::string_view text, std::size_t offset,
+                                     const std::string& reason);
 // Throws IoError for a problem at byte `offset` of binary data (no line).
-[[noreturn]] void fail_binary(const std::string& file, std::size_t offset, const std::string& reason);
+[[noreturn]] FOXI_API void fail_binary(const std::string& file, std::size_t offset, const std::string& reason);
 
 // Reads whitespace-separated tokens from a text held in memory. Whitespace is space, tab, '\r',
 // '\n', '\f', '\v', so files with mixed line endings read the same. Errors name the line.

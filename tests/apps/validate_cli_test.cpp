@@ -9,7 +9,7 @@
 #include <regex>
 #include <string>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/png.hpp"
 #include "test_util.hpp"

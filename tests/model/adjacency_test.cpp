@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "plc_text.hpp"
 #include "test_util.hpp"
 

@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "plc_text.hpp"
 #include "test_util.hpp"
 

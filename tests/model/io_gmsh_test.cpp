@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "foxi/model/io_error.hpp"
 #include "test_util.hpp"
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/mesh.hpp"
 #include "test_util.hpp"

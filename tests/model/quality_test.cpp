@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "test_util.hpp"
 
 namespace foxi {

@@ -8,7 +8,7 @@
 #include <limits>
 #include <string>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "foxi/model/io_tetgen.hpp"
 #include "../test_util.hpp"

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "foxi/solver/thermal.hpp"
 
 namespace foxi {

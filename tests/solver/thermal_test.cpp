@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "../../bench/bench_meshes.hpp"
+#include "bench_meshes.hpp"
 #include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/validate.hpp"
 #include "test_util.hpp"

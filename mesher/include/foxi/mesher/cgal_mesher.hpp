@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/mesher/mesher.hpp"  // MesherError, MesherFailure
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
@@ -111,6 +112,6 @@ struct CgalMeshReport {
 // Throws MesherError: MesherFailure::bad_input for a PLC or parameters it cannot use (the message names
 // the facet, seed or value), time_limit past params.time_limit, cancelled when params.progress says stop,
 // internal_error for a CGAL failure (the message says which).
-Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params = {}, CgalMeshReport* report = nullptr);
+FOXI_API Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params = {}, CgalMeshReport* report = nullptr);
 
 }  // namespace foxi

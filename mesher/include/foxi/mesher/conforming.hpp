@@ -22,6 +22,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/mesher/thin_layers.hpp"
 #include "foxi/model/mesh.hpp"
@@ -94,13 +95,13 @@ struct ConformingReport {
 // "conforming refinement" between runs, fraction = iteration / max_iterations). `refined_plc`, if
 // given, receives the PLC with the added points (after surface rounds: the mesh's surface triangles
 // as facets and all its vertices, TetGen's Steiner points among them).
-Mesh mesh_conforming(const Plc& plc, const MeshParams& params = {}, const ConformingParams& conforming = {},
+FOXI_API Mesh mesh_conforming(const Plc& plc, const MeshParams& params = {}, const ConformingParams& conforming = {},
                      ConformingReport* report = nullptr, Plc* refined_plc = nullptr);
 
 // The split points for one mesh of `plc`: for every tet in `violating_tets`, every constraint
 // triangle (mesh.bface) encroached by a vertex inside that tet's circumsphere is split; `plc` gets
 // the points. Returns the number of points added (0: nothing found to split). Exposed for tests.
-std::size_t split_encroached_constraints(const Mesh& mesh, const std::vector<std::uint32_t>& violating_tets,
+FOXI_API std::size_t split_encroached_constraints(const Mesh& mesh, const std::vector<std::uint32_t>& violating_tets,
                                          Plc& plc);
 
 }  // namespace foxi

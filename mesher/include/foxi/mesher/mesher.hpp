@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "foxi/api.hpp"
 #include "foxi/model/progress.hpp"
 
 namespace foxi {
@@ -41,7 +42,7 @@ inline const char* failure_name(MesherFailure f) {
 }
 
 // A PLC a mesher rejects, a mesh it cannot finish, or a cancelled run; what() says which and why.
-class MesherError : public std::runtime_error {
+class FOXI_API MesherError : public std::runtime_error {
  public:
   MesherError(MesherFailure failure, const std::string& message)
       : std::runtime_error(message), code_(static_cast<int>(failure)) {}
@@ -62,7 +63,7 @@ class MesherError : public std::runtime_error {
 };
 
 // A run the progress function stopped: MesherFailure::cancelled, and a foxi::Cancelled.
-struct MesherCancelled : MesherError, Cancelled {
+struct FOXI_API MesherCancelled : MesherError, Cancelled {
   explicit MesherCancelled(const std::string& message) : MesherError(MesherFailure::cancelled, message) {}
 };
 

@@ -3,6 +3,7 @@
 // regular tet of edge a, a^3 / (6 sqrt 2).
 #pragma once
 
+#include "foxi/api.hpp"
 #include "foxi/mesher/size_field.hpp"  // regular_tet_volume
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/model_file.hpp"
@@ -18,11 +19,11 @@ struct ModelMeshParams {
   MeshParams params;
   std::size_t ignored_refine_boxes = 0;
 };
-ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double default_size = 0);
+FOXI_API ModelMeshParams mesh_params_from_model(const Model& model, Plc& plc, double default_size = 0);
 
 // A model's [mesh] controls as the mesher's size controls (size_field.hpp): the global size, each
 // sized part's region (id = part index + 1) and the refinement boxes. Quality and dihedral bounds are
 // not size controls: take them from mesh_params_from_model or model.mesh.
-SizeControls size_controls_from_model(const Model& model);
+FOXI_API SizeControls size_controls_from_model(const Model& model);
 
 }  // namespace foxi

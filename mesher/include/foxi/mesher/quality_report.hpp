@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/mesher/conforming.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/quality.hpp"
@@ -55,10 +56,10 @@ struct MeshQualityReport {
   double mesh_seconds = 0, certificate_seconds = 0;
 };
 
-MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& conforming,
+FOXI_API MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& conforming,
                                       const QualityReportParams& params = {});
 
 // Several lines of text, no trailing newline.
-std::string format_quality_report(const MeshQualityReport& report);
+FOXI_API std::string format_quality_report(const MeshQualityReport& report);
 
 }  // namespace foxi

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
 
@@ -38,26 +39,26 @@ struct SizeControls {
 };
 
 // The volume of the regular tet with edge h: what TetGen's -a needs for a target edge length.
-double regular_tet_volume(double edge);
+FOXI_API double regular_tet_volume(double edge);
 // The circumradius of the regular tet of volume v (CGAL bounds cell sizes by circumradius):
 // edge a = (6 sqrt2 v)^(1/3), R = a sqrt6 / 4.
-double regular_tet_circumradius(double volume);
+FOXI_API double regular_tet_circumradius(double volume);
 
 // `plc` with each region seed's max_volume set from controls.region_sizes (the smaller of its own and
 // the control). Throws MesherError(10) naming a region id that has no seed in the PLC.
-Plc with_region_sizes(const Plc& plc, const SizeControls& controls);
+FOXI_API Plc with_region_sizes(const Plc& plc, const SizeControls& controls);
 
 // Samples the box sizes (and the global size, where no box holds the node) at the nodes of
 // `background`; nodes in several boxes take the smallest. A node outside every box with no global
 // size gets the background's largest edge length.
-SizeField size_field_from_boxes(const Mesh& background, const SizeControls& controls);
+FOXI_API SizeField size_field_from_boxes(const Mesh& background, const SizeControls& controls);
 
 struct MeshParams;
 
 // The boxes (and the global size) as a sizing function over the PLC's domain: meshes `plc` with
 // `params` (no size field), samples the sizes at its nodes, and repeats with that field `passes - 1`
 // more times, so that boxes smaller than the first mesh's tets still get nodes inside.
-SizeField box_size_field(const Plc& plc, const MeshParams& params, const SizeControls& controls, int passes = 2);
+FOXI_API SizeField box_size_field(const Plc& plc, const MeshParams& params, const SizeControls& controls, int passes = 2);
 
 // A Zienkiewicz-Zhu error indicator of a P1 node field (scalar, first component, step 0): the
 // recovered gradient at each node is the volume-weighted mean of the gradients of the tets around it;
@@ -69,7 +70,7 @@ struct ErrorIndicator {
   double gradient_norm = 0;        // || grad u ||_L2 over the mesh
   double relative_error() const { return gradient_norm > 0 ? total_error / gradient_norm : 0; }
 };
-ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field);
+FOXI_API ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field);
 
 // Target sizes for a relative error `target_error` (total_error / gradient_norm), spread evenly over
 // the tets (each gets target_error * gradient_norm / sqrt(tet count)): a tet's size h (its longest
@@ -77,7 +78,7 @@ ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field);
 // to [h / 4, 2 h] and to [min_size, max_size] when those are > 0; a node takes the smallest size
 // among its tets. The mesh itself is the background mesh. Throws MesherError(10) if the field is not
 // a node field of this mesh or target_error <= 0.
-SizeField size_field_from_error(const Mesh& mesh, const Field& field, double target_error, double min_size = 0,
+FOXI_API SizeField size_field_from_error(const Mesh& mesh, const Field& field, double target_error, double min_size = 0,
                                 double max_size = 0);
 
 }  // namespace foxi

@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "foxi/api.hpp"
 #include "foxi/mesher/mesher.hpp"  // MesherError, MesherFailure
 #include "foxi/mesher/size_field.hpp"
 #include "foxi/model/mesh.hpp"
@@ -42,6 +43,6 @@ struct MeshReport {
   double seconds = 0;
 };
 
-Mesh mesh_plc(const Plc& plc, const MeshParams& params = {}, MeshReport* report = nullptr);
+FOXI_API Mesh mesh_plc(const Plc& plc, const MeshParams& params = {}, MeshReport* report = nullptr);
 
 }  // namespace foxi

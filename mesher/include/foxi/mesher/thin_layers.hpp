@@ -14,12 +14,13 @@
 #include <cstddef>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
 
 namespace foxi {
 
-struct ThinLayer {
+struct FOXI_API ThinLayer {
   std::array<double, 3> normal{};  // unit
   std::array<double, 3> u{}, v{};  // unit, in the layer's plane; (u, v, normal) right-handed
   double lo = 0, hi = 0;           // the slab: lo <= normal . p <= hi
@@ -45,10 +46,10 @@ inline constexpr double kThinLayerMinArea = 1e5;
 // The thin layers between pairs of parallel facets (see above) whose overlap rectangle's area is at
 // least `min_area` times the thickness squared. A layer that lies inside a larger one is dropped.
 // Facets whose polygons are degenerate are ignored. O(facets^2).
-std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect = kThinLayerAspect,
+FOXI_API std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect = kThinLayerAspect,
                                         double min_area = kThinLayerMinArea);
 
 // Whether all four vertices of tet t lie in one of the layers.
-bool tet_in_thin_layer(const Mesh& mesh, std::size_t t, const std::vector<ThinLayer>& layers);
+FOXI_API bool tet_in_thin_layer(const Mesh& mesh, std::size_t t, const std::vector<ThinLayer>& layers);
 
 }  // namespace foxi

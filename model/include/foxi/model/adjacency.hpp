@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
@@ -24,8 +25,8 @@ struct FaceAdjacency {
 // Computes the adjacency afresh (uses both cores on large meshes: 50k tets and more). Orientation is
 // not checked (two tets on one triangle are paired whatever their orientations). Indices >= node_count
 // are tolerated up to max(node_count, 4 * tet_count); beyond that std::invalid_argument is thrown.
-FaceAdjacency compute_face_adjacency(const Mesh& mesh);
+FOXI_API FaceAdjacency compute_face_adjacency(const Mesh& mesh);
 // Cached on the mesh (see invalidate_derived); the reference lives as long as the mesh's cache.
-const FaceAdjacency& face_adjacency(const Mesh& mesh);
+FOXI_API const FaceAdjacency& face_adjacency(const Mesh& mesh);
 
 }  // namespace foxi

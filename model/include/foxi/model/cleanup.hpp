@@ -13,29 +13,31 @@
 #include <filesystem>
 #include <functional>
 
+#include "foxi/api.hpp"
+
 namespace foxi::cleanup {
 
 // Runs fn with the list locked. A temporary is created and recorded, or renamed into place and
 // forgotten, inside one such call, so that interrupt() sees it either before or after, never half.
-void with_lock(const std::function<void()>& fn);
+FOXI_API void with_lock(const std::function<void()>& fn);
 
 // Records a temporary file (folder = false) or a folder removed with its contents (folder = true).
-void track(const std::filesystem::path& path, bool folder = false);
+FOXI_API void track(const std::filesystem::path& path, bool folder = false);
 // Forgets it (renamed into place, or removed by its owner).
-void untrack(const std::filesystem::path& path);
-bool is_tracked(const std::filesystem::path& path);
+FOXI_API void untrack(const std::filesystem::path& path);
+FOXI_API bool is_tracked(const std::filesystem::path& path);
 
 // fork() with the list locked, the child's process id recorded in the parent. In the child (which
 // returns 0 and must not use this list) the kernel is asked to kill it when the parent dies
 // (PR_SET_PDEATHSIG), so that not even a SIGKILL of the parent leaves it running on its own.
 // Returns -1 with errno set when fork fails.
-pid_t fork_tracked();
+FOXI_API pid_t fork_tracked();
 // Forgets a child once it has been reaped.
-void untrack_child(pid_t pid);
+FOXI_API void untrack_child(pid_t pid);
 
 // Kills (SIGKILL) and reaps every recorded child, removes every recorded temporary, and returns
 // with the list still locked for good: the caller exits next. Not async-signal-safe: call it from
 // a thread, not from a signal handler.
-void interrupt();
+FOXI_API void interrupt();
 
 }  // namespace foxi::cleanup

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/progress.hpp"
 
@@ -36,8 +37,8 @@ struct CertificateOptions {
                                            // calling thread only, stage "delaunay certificate"
 };
 
-DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const CertificateOptions& options = {});
+FOXI_API DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const CertificateOptions& options = {});
 // Cached on the mesh (computed with default options).
-const DelaunayCertificate& delaunay_certificate(const Mesh& mesh);
+FOXI_API const DelaunayCertificate& delaunay_certificate(const Mesh& mesh);
 
 }  // namespace foxi

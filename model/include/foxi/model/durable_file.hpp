@@ -17,14 +17,16 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
 // Throws IoError unless `path` can be written: its folder exists, is a folder and is writable, and
 // `path` itself is not a folder. Commands call it before long work, so that a mistyped -o fails
 // at once rather than after an hour of meshing.
-void check_output_path(const std::filesystem::path& path);
+FOXI_API void check_output_path(const std::filesystem::path& path);
 
-class DurableFile {
+class FOXI_API DurableFile {
  public:
   // clean_stale = false skips the search for stale temporaries (a reading of the whole folder): for
   // many files written into one folder, after one remove_stale_temporaries_in(folder).
@@ -79,12 +81,12 @@ class DurableFile {
 // is thrown. marker = -1: no marker, the files are simply renamed in order. (A reader that is
 // reading the old set while it is replaced can still mix them: a set of files has no atomic
 // replacement.)
-void commit_together(std::span<DurableFile> files, std::ptrdiff_t marker = -1);
+FOXI_API void commit_together(std::span<DurableFile> files, std::ptrdiff_t marker = -1);
 
 // Removes temporaries of `target` (TARGET.foxi-tmp-PID-*) whose writer process no longer exists;
 // returns how many. DurableFile's constructor calls it.
-std::size_t remove_stale_temporaries(const std::filesystem::path& target);
+FOXI_API std::size_t remove_stale_temporaries(const std::filesystem::path& target);
 // The same for every target in `folder` (any NAME.foxi-tmp-PID-* of a writer that is gone).
-std::size_t remove_stale_temporaries_in(const std::filesystem::path& folder);
+FOXI_API std::size_t remove_stale_temporaries_in(const std::filesystem::path& folder);
 
 }  // namespace foxi

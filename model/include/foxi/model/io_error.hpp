@@ -5,9 +5,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
-class IoError : public std::runtime_error {
+class FOXI_API IoError : public std::runtime_error {
  public:
   // line: 1-based line number, 0 when unknown or not meaningful (binary data);
   // byte_offset: offset of the problem in the file, or kNoOffset.

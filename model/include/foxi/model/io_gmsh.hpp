@@ -24,6 +24,7 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
@@ -33,9 +34,9 @@ struct GmshWriteOptions {
   bool binary = true;
 };
 
-Mesh read_gmsh(const std::filesystem::path& path);
+FOXI_API Mesh read_gmsh(const std::filesystem::path& path);
 // Parses a whole file held in memory; `name` is used in error messages.
-Mesh parse_gmsh(std::string_view bytes, const std::string& name);
-void write_gmsh(const Mesh& mesh, const std::filesystem::path& path, const GmshWriteOptions& options = {});
+FOXI_API Mesh parse_gmsh(std::string_view bytes, const std::string& name);
+FOXI_API void write_gmsh(const Mesh& mesh, const std::filesystem::path& path, const GmshWriteOptions& options = {});
 
 }  // namespace foxi

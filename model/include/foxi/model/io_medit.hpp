@@ -19,12 +19,13 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
 
-Mesh read_medit(const std::filesystem::path& path);
-Mesh parse_medit(std::string_view bytes, const std::string& name);
-void write_medit(const Mesh& mesh, const std::filesystem::path& path);
+FOXI_API Mesh read_medit(const std::filesystem::path& path);
+FOXI_API Mesh parse_medit(std::string_view bytes, const std::string& name);
+FOXI_API void write_medit(const Mesh& mesh, const std::filesystem::path& path);
 
 }  // namespace foxi

@@ -31,15 +31,16 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/api.hpp"
 #include "foxi/model/io_medit.hpp"  // read_medit, write_medit were declared here; kept for includers
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
 
-Mesh read_tetgen(const std::filesystem::path& base);
+FOXI_API Mesh read_tetgen(const std::filesystem::path& base);
 // In-memory: the .node and .ele texts are required, .face may be empty; names are for messages.
-Mesh parse_tetgen(std::string_view node_text, std::string_view ele_text, std::string_view face_text,
+FOXI_API Mesh parse_tetgen(std::string_view node_text, std::string_view ele_text, std::string_view face_text,
                   const std::string& base_name);
-void write_tetgen(const Mesh& mesh, const std::filesystem::path& base);
+FOXI_API void write_tetgen(const Mesh& mesh, const std::filesystem::path& base);
 
 }  // namespace foxi

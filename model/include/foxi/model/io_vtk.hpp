@@ -32,18 +32,19 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/mesh_io.hpp"
 
 namespace foxi {
 
-Mesh read_vtu(const std::filesystem::path& path);
-Mesh parse_vtu(std::string_view bytes, const std::string& name);
-void write_vtu(const Mesh& mesh, const std::filesystem::path& path,
+FOXI_API Mesh read_vtu(const std::filesystem::path& path);
+FOXI_API Mesh parse_vtu(std::string_view bytes, const std::string& name);
+FOXI_API void write_vtu(const Mesh& mesh, const std::filesystem::path& path,
                VtuEncoding encoding = VtuEncoding::appended_raw);
 
-Mesh read_vtk_legacy(const std::filesystem::path& path);
-Mesh parse_vtk_legacy(std::string_view bytes, const std::string& name);
-void write_vtk_legacy(const Mesh& mesh, const std::filesystem::path& path, bool binary = true);
+FOXI_API Mesh read_vtk_legacy(const std::filesystem::path& path);
+FOXI_API Mesh parse_vtk_legacy(std::string_view bytes, const std::string& name);
+FOXI_API void write_vtk_legacy(const Mesh& mesh, const std::filesystem::path& path, bool binary = true);
 
 }  // namespace foxi

@@ -4,6 +4,12 @@
 // SI units (metres, kelvin, ...). Derived data (face adjacency, circumspheres, the Delaunay
 // certificate) is never stored here twice: it is computed on demand by the functions that own it and
 // cached in `derived`, which a copy of the mesh does not share.
+//
+// Host-owned data: a Mesh owns its arrays, so a host's own coordinates, tets and regions are moved
+// or copied into it once (there is no mesh view over host arrays yet). Everything after that takes
+// the mesh by reference and copies nothing: the certificate and adjacency (cached here), the
+// sphere table (a value the caller keeps), the orders and the painter (which lend the mesh and take
+// subsets and orders as std::span), the solvers (which add their result fields to it).
 #pragma once
 
 #include <cstdint>
@@ -12,6 +18,8 @@
 #include <span>
 #include <string>
 #include <vector>
+
+#include "foxi/api.hpp"
 
 namespace foxi {
 
@@ -67,7 +75,7 @@ struct Field {
 struct DerivedData;  // defined by the derived-data functions (adjacency.hpp, delaunay.hpp, ...)
 
 // Holds derived data; copying gives an empty cache so that copies never share stale results.
-class DerivedCache {
+class FOXI_API DerivedCache {
  public:
   DerivedCache() = default;
   DerivedCache(const DerivedCache&) {}
@@ -81,7 +89,7 @@ class DerivedCache {
   mutable std::shared_ptr<DerivedData> data_;
 };
 
-struct Mesh {
+struct FOXI_API Mesh {
   std::vector<double> xyz;                 // 3 per node
   std::vector<std::uint32_t> tet;          // 4 per tet, positively oriented (see validate.hpp)
   std::vector<std::int32_t> tet_region;    // 1 per tet (region id), or empty = all region 0
@@ -106,13 +114,13 @@ struct Mesh {
 
 // Drops every cached derived result. Call after changing xyz, tet or weight in place; the functions
 // of foxi that change a mesh call it themselves.
-void invalidate_derived(Mesh& mesh);
+FOXI_API void invalidate_derived(Mesh& mesh);
 
 // Entity count a field's location refers to (node_count or tet_count).
-std::size_t field_entity_count(const Mesh& mesh, const Field& field);
+FOXI_API std::size_t field_entity_count(const Mesh& mesh, const Field& field);
 
 // Checks the sizes of every array against each other (xyz % 3, tet % 4, tet_region, bface_tag,
 // weight, field value counts). Returns an empty string when consistent, else the first problem.
-std::string check_sizes(const Mesh& mesh);
+FOXI_API std::string check_sizes(const Mesh& mesh);
 
 }  // namespace foxi

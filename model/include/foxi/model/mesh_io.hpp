@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <string>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
@@ -29,10 +30,10 @@ struct WriteOptions {
 };
 
 // The format of a path from its extension; throws IoError for an unknown one.
-MeshFormat format_from_path(const std::filesystem::path& path);
-const char* format_name(MeshFormat format);
+FOXI_API MeshFormat format_from_path(const std::filesystem::path& path);
+FOXI_API const char* format_name(MeshFormat format);
 
-Mesh read_mesh(const std::filesystem::path& path);
-void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
+FOXI_API Mesh read_mesh(const std::filesystem::path& path);
+FOXI_API void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
 
 }  // namespace foxi

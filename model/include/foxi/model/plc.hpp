@@ -10,6 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
 struct RegionSeed {
@@ -18,7 +20,7 @@ struct RegionSeed {
   double max_volume = 0;  // 0 or negative: no own limit
 };
 
-struct Plc {
+struct FOXI_API Plc {
   std::vector<double> points;                    // 3 per point
   // Facets: facet f owns polygons [facet_polygon_begin[f], facet_polygon_begin[f+1]); polygon p owns
   // polygon_vertices[polygon_vertex_begin[p] .. polygon_vertex_begin[p+1]) (0-based point indices).
@@ -40,9 +42,9 @@ struct Plc {
 
 // TetGen .poly: `# comments`, 0- or 1-based numbering (from the first point index). The points must
 // be in the .poly itself. Throws IoError (file, line, reason) on malformed input.
-Plc read_poly(const std::filesystem::path& path);
-Plc parse_poly(std::string_view text, const std::string& name);
+FOXI_API Plc read_poly(const std::filesystem::path& path);
+FOXI_API Plc parse_poly(std::string_view text, const std::string& name);
 // Writes 1-based .poly (through a temporary file and a rename).
-void write_poly(const Plc& plc, const std::filesystem::path& path);
+FOXI_API void write_poly(const Plc& plc, const std::filesystem::path& path);
 
 }  // namespace foxi

@@ -4,6 +4,8 @@
 #include <functional>
 #include <string_view>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
 // Called with the stage name and the fraction done in [0, 1]; returns false to cancel.
@@ -16,7 +18,7 @@ using ProgressFn = std::function<bool(std::string_view stage, double fraction)>;
 // MesherError, std::runtime_error) still see them. Cancelled is not a std::exception itself, so
 // that each of those is one std::exception, unambiguously (a catch of std::exception still works);
 // what() is the std::exception's.
-struct Cancelled {
+struct FOXI_API Cancelled {
   virtual ~Cancelled() = default;
 };
 

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <span>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
@@ -16,7 +17,7 @@ struct TetQuality {
 };
 
 // Each p points to 3 doubles. Exactly zero volume (in double) counts as flat.
-TetQuality tet_quality(const double* p0, const double* p1, const double* p2, const double* p3);
+FOXI_API TetQuality tet_quality(const double* p0, const double* p1, const double* p2, const double* p3);
 
 struct Stat {
   double min = 0, max = 0, mean = 0;
@@ -31,6 +32,6 @@ struct QualitySummary {
 
 // Over every tet whose indices are in range (others skipped; see validate()). Volume statistics are
 // signed; a flat tet makes radius_edge.max and .mean +inf.
-QualitySummary summarize_quality(const Mesh& mesh);
+FOXI_API QualitySummary summarize_quality(const Mesh& mesh);
 
 }  // namespace foxi

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
@@ -47,13 +48,13 @@ struct ValidationReport {
 
 // Checks without changing anything. Positive orientation means det[p1-p0, p2-p0, p3-p0] > 0 (CGAL's
 // orientation(p0,p1,p2,p3) == POSITIVE). At most 20 messages.
-ValidationReport validate(const Mesh& mesh);
+FOXI_API ValidationReport validate(const Mesh& mesh);
 // Checks and re-orients inverted tets (swapping their last two vertices); the report counts them
 // (as found before the repair). Calls invalidate_derived(mesh) when it changed anything.
-ValidationReport validate_and_repair(Mesh& mesh);
+FOXI_API ValidationReport validate_and_repair(Mesh& mesh);
 
 // One line per kind of problem found ("3 inverted tets (negative orientation)", ...), in the order
 // of the report's fields; empty when the report is clean. For the programs to print.
-std::vector<std::string> describe(const ValidationReport& report);
+FOXI_API std::vector<std::string> describe(const ValidationReport& report);
 
 }  // namespace foxi

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/solver/thermal.hpp"
 #include "foxi/solver/thermoelastic.hpp"
@@ -23,7 +24,7 @@ namespace foxi {
 // C3D4 needs). Throws SolverError for the problems solve_thermal rejects (missing conductivity,
 // unknown tags and regions, a boundary triangle that is no tet face) and IoError when the file
 // cannot be written.
-void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const std::filesystem::path& inp);
+FOXI_API void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const std::filesystem::path& inp);
 
 // Writes `mesh` and `params` as a CalculiX linear static thermal-stress deck (SI units): *NODE, C3D4
 // elements per region, *ELASTIC and *EXPANSION per region (params first, then the material), the
@@ -36,7 +37,7 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
 // the .dat. Throws SolverError for what solve_thermoelastic rejects (except the
 // rigid-body check) and for a non-zero displacement along a direction that is no coordinate axis;
 // IoError when the file cannot be written.
-void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,
+FOXI_API void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,
                                   const std::filesystem::path& inp);
 
 // One nodal result block of a CalculiX ASCII .frd file ("NDTEMP", "DISP", ...).
@@ -49,6 +50,6 @@ struct FrdBlock {
 
 // Reads every nodal result block of an ASCII .frd file (the last step's blocks come last). Throws
 // IoError (file and line) on a malformed or binary file.
-std::vector<FrdBlock> read_frd(const std::filesystem::path& frd);
+FOXI_API std::vector<FrdBlock> read_frd(const std::filesystem::path& frd);
 
 }  // namespace foxi

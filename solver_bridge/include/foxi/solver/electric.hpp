@@ -49,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/solver/thermal.hpp"  // HeatSource: joule_heat_sources feeds the heat solver
 
 namespace foxi {
@@ -116,7 +117,7 @@ struct ElectrostaticReport {
 // Stores "potential" (V, nodes) at the conductors' voltages and "electric_field" (V/m, cells). Throws
 // SolverError when a region has no permittivity, there is no conductor, a tag is unknown or on two
 // conductors, two conductors share a node, or a connected part touches no conductor.
-ElectrostaticReport solve_electrostatic(Mesh& mesh, const ElectrostaticParams& params);
+FOXI_API ElectrostaticReport solve_electrostatic(Mesh& mesh, const ElectrostaticParams& params);
 
 struct CurrentParams {
   // Overrides the region's material's electrical_conductivity; every region with tets needs one.
@@ -150,16 +151,16 @@ struct CurrentReport {
 
 // Stores "potential" (V, nodes), "current_density" (A/m^2, cells) and "joule_heat" (W/m^3, cells).
 // Errors as solve_electrostatic, plus: no terminal with a fixed voltage.
-CurrentReport solve_current(Mesh& mesh, const CurrentParams& params);
+FOXI_API CurrentReport solve_current(Mesh& mesh, const CurrentParams& params);
 
 // The checks of a Maxwell matrix M (capacitance or conductance) and of the solves behind it (see
 // above): "Kirchhoff" (columns sum to 0 relative to their largest entry; with more than one
 // electrode), "Maxwell signs" and "residual" (the given figure), each against `tolerance`. `flow`
 // names what M carries ("the currents") in the checks' text.
-std::vector<BalanceCheck> maxwell_matrix_checks(const std::vector<std::vector<double>>& m, double residual,
+FOXI_API std::vector<BalanceCheck> maxwell_matrix_checks(const std::vector<std::vector<double>>& m, double residual,
                                                 double tolerance, const std::string& flow);
 
 // The Joule heat of each region as total heat sources of a thermal run.
-std::vector<HeatSource> joule_heat_sources(const CurrentReport& report);
+FOXI_API std::vector<HeatSource> joule_heat_sources(const CurrentReport& report);
 
 }  // namespace foxi

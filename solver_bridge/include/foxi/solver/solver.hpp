@@ -11,18 +11,19 @@
 #include <utility>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/progress.hpp"
 
 namespace foxi {
 
 // A problem that cannot be solved as given (missing conductivity, unknown tag, ill-posed boundary
 // conditions, a failed factorization, no convergence); the message names the region or tag.
-struct SolverError : std::runtime_error {
+struct FOXI_API SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
 // The progress callback returned false (a foxi::Cancelled too).
-struct SolverCancelled : SolverError, Cancelled {
+struct FOXI_API SolverCancelled : SolverError, Cancelled {
   using SolverError::SolverError;
 };
 

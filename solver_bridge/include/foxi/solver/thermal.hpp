@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/solver/solver.hpp"  // SolverError, SolverCancelled, BalanceCheck, LinearSolverOptions
@@ -143,6 +144,6 @@ struct ThermalReport {
 // needs a convection tag) is not in the mesh, a tag has two conditions,
 // no tag fixes a temperature or convects (the temperature would be undetermined), the factorization
 // fails or CG does not converge; SolverCancelled when the progress callback returns false.
-ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params);
+FOXI_API ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params);
 
 }  // namespace foxi

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/solver/solver.hpp"
 
@@ -106,6 +107,6 @@ struct ThermoelasticReport {
 // has the wrong size or a NaN on a used node, `order` is not 1 or 2, a connected part of the mesh can still
 // move rigidly (the message names the part and the free modes: translations and rotations), the factorization
 // fails or CG does not converge; SolverCancelled when the progress callback returns false.
-ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params);
+FOXI_API ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params);
 
 }  // namespace foxi

@@ -36,6 +36,8 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
 enum class ConditionKind : std::uint8_t {
@@ -49,7 +51,7 @@ enum class ConditionKind : std::uint8_t {
 };
 
 // "temperature", "heat_flux", ... as written in model files.
-const char* condition_kind_name(ConditionKind kind);
+FOXI_API const char* condition_kind_name(ConditionKind kind);
 
 struct BoundaryCondition {
   ConditionKind kind = ConditionKind::temperature;

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/physics.hpp"
 #include "foxi/model/structure.hpp"
@@ -65,13 +66,13 @@ struct DiagnosticsParams {
 // A part conducts in a physics when its material has the property and it is positive (thermal
 // conductivity, permittivity, electrical conductivity; Young's modulus): a part that does not is left
 // out of that physics' groups and joins nothing.
-ModelDiagnostics diagnose_model(const Model& model, const Structure& structure,
+FOXI_API ModelDiagnostics diagnose_model(const Model& model, const Structure& structure,
                                 const DiagnosticsParams& params = {});
 
 // The warnings of `d` that concern `physics`: isolated and overhang, and no_fixed_value of `physics`.
-std::vector<ModelWarning> warnings_for(const ModelDiagnostics& d, Physics physics);
+FOXI_API std::vector<ModelWarning> warnings_for(const ModelDiagnostics& d, Physics physics);
 
 // One line in words, lengths in the model's unit: "part 'die' touches no other part ...".
-std::string describe(const ModelWarning& w, const Model& model);
+FOXI_API std::string describe(const ModelWarning& w, const Model& model);
 
 }  // namespace foxi

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/conditions.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/surface.hpp"
@@ -60,7 +61,7 @@ inline constexpr double kMinFeature = 1e-6;     // times the extent: every edge,
 
 // A vertical prism: a simple (convex or not) counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
 // over z in [z0, z1].
-struct Prism {
+struct FOXI_API Prism {
   std::vector<double> xy;
   double z0 = 0, z1 = 0;
   double area() const;  // of the polygon (m^2)
@@ -105,6 +106,6 @@ struct Model {
 // (degenerate geometry included: a feature below kMinFeature of the model's extent). Referenced files
 // (library, STL) are named relative to the model's folder, must be regular files of the expected kind,
 // and their content is never quoted in an error.
-Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides = {});
+FOXI_API Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides = {});
 
 }  // namespace foxi

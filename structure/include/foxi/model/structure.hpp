@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/plc.hpp"
@@ -48,13 +49,13 @@ struct Structure {
 // conditions are checked (surfaces.hpp).
 // `progress` (may be empty) is called by the triangle-surface path with the stages "surfaces",
 // "carve", "conform" and "seeds"; returning false cancels with StructureCancelled.
-struct StructureCancelled : std::runtime_error, Cancelled {
+struct FOXI_API StructureCancelled : std::runtime_error, Cancelled {
   StructureCancelled() : std::runtime_error("building the structure was cancelled") {}
 };
-Structure build_structure(const Model& model, const ProgressFn& progress = {});
+FOXI_API Structure build_structure(const Model& model, const ProgressFn& progress = {});
 
 // Names a mesh of the structure's PLC: region names and materials from the parts, boundary names
 // from the markers. Regions and boundaries the mesh lacks are added.
-void name_mesh(const Model& model, const Structure& structure, Mesh& mesh);
+FOXI_API void name_mesh(const Model& model, const Structure& structure, Mesh& mesh);
 
 }  // namespace foxi

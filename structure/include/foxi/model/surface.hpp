@@ -6,11 +6,13 @@
 #include <filesystem>
 #include <vector>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
 // A triangle surface: 3 doubles per vertex (metres), 3 vertex indices per triangle, counter-clockwise
 // seen from outside when the surface is closed. Several closed components may share one surface.
-struct TriSurface {
+struct FOXI_API TriSurface {
   std::vector<double> xyz;
   std::vector<std::uint32_t> tri;
   std::size_t vertex_count() const { return xyz.size() / 3; }
@@ -39,12 +41,12 @@ struct BallFaceting {
   std::uint32_t around = 0;
   std::vector<double> ring_z, ring_radius;
 };
-BallFaceting ball_faceting(const Ball& ball);
+FOXI_API BallFaceting ball_faceting(const Ball& ball);
 
 // The closed, outward oriented surface of the faceted ball: side trapezoids split in two, flat ends
 // (where z0 or z1 cuts the sphere) fanned from their centres. Throws std::invalid_argument for a
 // radius or tolerance that is not positive, or z0 >= z1 after clipping.
-TriSurface ball_surface(const Ball& ball);
+FOXI_API TriSurface ball_surface(const Ball& ball);
 
 // Reads an STL file, ASCII ("solid ... facet normal ... outer loop vertex x y z ... endloop endfacet
 // ... endsolid") or binary (80-byte header, uint32 count, 50 bytes per triangle; told apart by its
@@ -53,6 +55,6 @@ TriSurface ball_surface(const Ball& ball);
 // Throws IoError naming the file and the line (ASCII) or byte offset (binary) for malformed input,
 // non-finite coordinates, triangles with repeated vertices, and files without triangles. Whether the
 // surface is closed, oriented and free of self-intersections is checked by the structure builder.
-TriSurface read_stl(const std::filesystem::path& path, double scale = 1);
+FOXI_API TriSurface read_stl(const std::filesystem::path& path, double scale = 1);
 
 }  // namespace foxi

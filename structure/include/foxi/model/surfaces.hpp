@@ -2,6 +2,7 @@
 // into boundary markers, and the check that every condition names a surface that exists.
 #pragma once
 
+#include "foxi/api.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/structure.hpp"
 
@@ -13,11 +14,11 @@ namespace foxi {
 // old boundary to the new one. Facets are taken whole: a box that cuts a facet leaves it alone.
 // Throws IoError (model file, the selector's line) when a selector picks no facet or a facet another
 // selector already took. build_structure calls it.
-void tag_selected_surfaces(const Model& model, Structure& structure);
+FOXI_API void tag_selected_surfaces(const Model& model, Structure& structure);
 
 // Throws IoError (model file, the condition's line, naming the condition and the surface) when a
 // condition names a boundary the structure lacks or whose facets all went to a selector, or when two
 // conditions of one physics (thermal, electric, mechanical) share a surface. build_structure calls it.
-void check_conditions(const Model& model, const Structure& structure);
+FOXI_API void check_conditions(const Model& model, const Structure& structure);
 
 }  // namespace foxi

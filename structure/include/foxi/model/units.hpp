@@ -11,6 +11,8 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/api.hpp"
+
 namespace foxi {
 
 // Exponents of the SI base units metre, kilogram, second, kelvin, ampere.
@@ -24,17 +26,17 @@ struct Quantity {
 };
 
 // An error in an expression: what was wrong, with the expression text in the message.
-struct ExpressionError : std::runtime_error {
+struct FOXI_API ExpressionError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
 // "m", "kg K^-1", "m^2", "1" for dimensionless.
-std::string dims_to_string(const Dims& d);
+FOXI_API std::string dims_to_string(const Dims& d);
 
 // The SI value of unit `name` ("mm" -> 1e-3 m), or nothing if it is not a unit foxi knows: lengths
 // m cm mm um µm nm in mil; K s kg g W mW kW J V mV kV A mA uA S N Pa kPa MPa GPa Hz ppm (1e-6).
 // Absolute temperatures in degC are read by the boundary conditions (conditions.hpp), not here.
-std::optional<Quantity> unit_quantity(std::string_view name);
+FOXI_API std::optional<Quantity> unit_quantity(std::string_view name);
 
 // Limits on an expression (README, "Limits"): its length in characters and how deep it nests
 // (parentheses, unary signs, exponents and function calls each count one level).
@@ -47,14 +49,14 @@ constexpr int kMaxExpressionDepth = 64;
 // arguments except sqrt abs min max). Throws ExpressionError on syntax errors, unknown names ("unknown
 // parameter 'x'") unit mismatches ("unit mismatch: m + K")
 // and expressions past the limits above; `lookup` may throw its own errors.
-Quantity evaluate_expression(std::string_view text,
+FOXI_API Quantity evaluate_expression(std::string_view text,
                              const std::function<std::optional<Quantity>(std::string_view)>& lookup);
 
 // `text` (an expression with units, no parameters) in SI, checked to have the dimension of `unit`
 // (itself an expression: "W", "W/(m*K)", "V", "1/K"); a bare number is taken as SI. E.g. "3 W",
 // "3W", "3" and "3000 mW" are 3 for unit "W". Throws ExpressionError naming `unit` when the
 // dimension differs ("'3 m' is m, not W") and on syntax errors.
-double evaluate_in(std::string_view text, std::string_view unit);
+FOXI_API double evaluate_in(std::string_view text, std::string_view unit);
 
 // How a temperature is read: a point on the scale (degC adds 273.15 K, and it must be above 0 K)
 // or a difference (1 degC = 1 K, any sign).
@@ -64,7 +66,7 @@ enum class TemperatureKind : std::uint8_t { absolute, difference };
 // or an expression followed by degC or °C ("25 degC", "25degC", "25 °C"). Throws
 // ExpressionError on other units (naming K and degC), on degC inside an expression, and (absolute)
 // on a value not above absolute zero.
-double evaluate_temperature(std::string_view text, TemperatureKind kind,
+FOXI_API double evaluate_temperature(std::string_view text, TemperatureKind kind,
                             const std::function<std::optional<Quantity>(std::string_view)>& lookup = {});
 
 }  // namespace foxi

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "foxi/api.hpp"
 #include "foxi/viz/framebuffer.hpp"
 
 namespace foxi {
@@ -22,7 +23,7 @@ struct AnimationParams {
   int loops = 0;              // times to play; 0 = forever
 };
 
-class AnimationWriter {
+class FOXI_API AnimationWriter {
  public:
   virtual ~AnimationWriter() = default;
   // Appends a frame (fb.rgba of width x height; alpha ignored).
@@ -33,8 +34,8 @@ class AnimationWriter {
 };
 
 // APNG (.apng or .png; readers without APNG support show the first frame).
-std::unique_ptr<AnimationWriter> open_apng(const std::filesystem::path& path, const AnimationParams& params);
+FOXI_API std::unique_ptr<AnimationWriter> open_apng(const std::filesystem::path& path, const AnimationParams& params);
 // GIF89a with a NETSCAPE2.0 loop extension.
-std::unique_ptr<AnimationWriter> open_gif(const std::filesystem::path& path, const AnimationParams& params);
+FOXI_API std::unique_ptr<AnimationWriter> open_gif(const std::filesystem::path& path, const AnimationParams& params);
 
 }  // namespace foxi

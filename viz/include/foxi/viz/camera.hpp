@@ -7,6 +7,7 @@
 // z along `forward` (from the eye into the scene); z is the depth.
 #pragma once
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/view.hpp"
 
@@ -22,14 +23,14 @@ struct Camera {
 };
 
 // Axis-aligned bounds of the nodes used by tets (all nodes if there are no tets). lo > hi if none.
-void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
+FOXI_API void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
 
 // A camera looking along `dir` (from the eye into the scene) at the centre of the box [lo, hi], far
 // enough that the box's 8 corners project within `fill` (0..1] of the half-width and half-height of
 // an image of width/height `aspect` (and, perspective, the eye outside the box's bounding sphere).
 // Perspective with vertical field of view `fov_deg`, or orthographic. `up` is used as given when not parallel
 // to dir, else another axis is chosen.
-Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
+FOXI_API Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
                   bool perspective = true, double fov_deg = 30, double aspect = 1, double fill = 0.95);
 
 // The camera the front ends (foxi render, foxi-view) build from partly given options, so that they
@@ -37,21 +38,21 @@ Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], c
 // to +z. With dir: orthographic, fitted along dir, then moved to `at`. Otherwise perspective, fitted
 // from an oblique direction (front-right, above); `at` replaces the target and `eye` the eye; with
 // `at` but no `eye` the fitted eye's offset from the box centre is kept.
-Camera camera_from_options(const double lo[3], const double hi[3], double aspect, const double* eye,
+FOXI_API Camera camera_from_options(const double lo[3], const double hi[3], double aspect, const double* eye,
                            const double* at, const double* up, double fov_deg, const double* dir);
 
 // Turns the eye about `at`: by yaw_deg about the up axis, then by pitch_deg about the right axis.
 // Up is kept (re-orthogonalised). Distance to `at` is unchanged.
-Camera orbit(const Camera& camera, double yaw_deg, double pitch_deg);
+FOXI_API Camera orbit(const Camera& camera, double yaw_deg, double pitch_deg);
 // Moves eye and at together by (dx, dy) fractions of the visible height at `at` (right, up).
-Camera pan(const Camera& camera, double dx, double dy);
+FOXI_API Camera pan(const Camera& camera, double dx, double dy);
 // factor > 1 magnifies: perspective moves the eye toward `at` (distance / factor); orthographic
 // divides ortho_height by factor.
-Camera zoom(const Camera& camera, double factor);
+FOXI_API Camera zoom(const Camera& camera, double factor);
 
 // The per-image projection of a camera. Throws std::invalid_argument for a degenerate camera
 // (eye == at, up parallel to the view direction, fov outside (0, 180), size < 1).
-struct Projector {
+struct FOXI_API Projector {
   bool perspective = true;
   double eye[3] = {0, 0, 0};
   double right[3] = {1, 0, 0}, up[3] = {0, 1, 0}, forward[3] = {0, 0, 1};  // orthonormal
@@ -71,6 +72,6 @@ struct Projector {
 };
 
 // The ordering viewpoint of a camera: perspective -> View::at(eye), orthographic -> View::along(at - eye).
-View view_of(const Camera& camera);
+FOXI_API View view_of(const Camera& camera);
 
 }  // namespace foxi

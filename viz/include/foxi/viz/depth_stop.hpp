@@ -9,17 +9,18 @@
 #include <cstdint>
 #include <span>
 
+#include "foxi/api.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/spheres.hpp"
 
 namespace foxi {
 
 // The depth of tet t (t < table.tet_count()) seen by camera (world units).
-double tet_depth(const SphereTable& table, const Camera& camera, std::uint32_t t);
+FOXI_API double tet_depth(const SphereTable& table, const Camera& camera, std::uint32_t t);
 
 // How many tets of a back-to-front order come before the first one whose depth is below d: drawing
 // that many stops at depth d. The whole order if none is.
-std::size_t count_deeper(const SphereTable& table, const Camera& camera, std::span<const std::uint32_t> order,
+FOXI_API std::size_t count_deeper(const SphereTable& table, const Camera& camera, std::span<const std::uint32_t> order,
                          double d);
 
 }  // namespace foxi

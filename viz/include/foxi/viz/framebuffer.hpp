@@ -1,6 +1,10 @@
 // The picture the painter fills: RGBA8 pixels, an id buffer (the tet each pixel shows, for picking,
 // probing and recolouring) and, in depth-buffer mode only, a depth buffer (double: it is the test
 // oracle, and float rounding alone flips grazing layers).
+//
+// The framebuffer owns its pixels, rows `width` apart: the painter draws only into one, so a host
+// with its own RGBA buffer (its own row stride) copies the rows out after drawing
+// (examples/embed/field_buffer).
 #pragma once
 
 #include <algorithm>
@@ -9,6 +13,7 @@
 #include <limits>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 
 namespace foxi {
@@ -22,7 +27,7 @@ namespace detail {
 // Asks the OS for 2 MB pages for the untouched buffer [p, p + bytes) (advice only; defined in the viz
 // library): an image's rows lie 4 x width bytes apart, so with 4 kB pages each row a face covers
 // would cost a TLB miss.
-void advise_large_pages(void* p, std::size_t bytes);
+FOXI_API void advise_large_pages(void* p, std::size_t bytes);
 // Room for n pixels in v, fresh memory so advised, unless v has it already.
 inline void reserve_advised(std::vector<std::uint32_t>& v, std::size_t n) {
   if (v.capacity() >= n) return;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <span>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/viz/camera.hpp"
@@ -36,7 +37,7 @@ struct MovieStats {
 };
 
 // Thrown when the progress callback returns false.
-struct MovieCancelled : std::runtime_error, Cancelled {
+struct FOXI_API MovieCancelled : std::runtime_error, Cancelled {
   MovieCancelled() : std::runtime_error("movie cancelled") {}
 };
 
@@ -47,7 +48,7 @@ struct MovieCancelled : std::runtime_error, Cancelled {
 // turn_deg k / F. subset: tets to show (empty = all). Meshes without a visibility-order guarantee
 // should not be given (the painter's picture would be wrong; the caller checks the certificate).
 // Throws std::invalid_argument for bad parameters, MovieCancelled when progress returns false.
-MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& camera, int width, int height,
+FOXI_API MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& camera, int width, int height,
                       std::span<const std::uint32_t> subset, const MovieParams& params,
                       const std::function<void(const Framebuffer&)>& frame, const ProgressFn& progress = {});
 

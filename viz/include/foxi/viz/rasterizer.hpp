@@ -22,6 +22,7 @@
 #include <span>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/framebuffer.hpp"
@@ -44,7 +45,7 @@ struct RenderParams {
 };
 
 // The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).
-std::uint32_t region_color(std::int32_t id);
+FOXI_API std::uint32_t region_color(std::int32_t id);
 
 // A rectangle of pixels, bounds included; empty when x0 > x1.
 struct PixelRect {
@@ -60,7 +61,7 @@ struct RasterStats {
 // Per-frame state: the camera's projection of the mesh for one image size. The mesh is lent and must
 // outlive it. Throws std::invalid_argument for a degenerate camera or bad parameters, and for an
 // orthographic camera zoomed in so far that coordinates leave the fixed-point range.
-class TetRasterizer {
+class FOXI_API TetRasterizer {
  public:
   TetRasterizer(const Mesh& mesh, const Camera& camera, int width, int height,
                 const RenderParams& params = {});
@@ -117,13 +118,13 @@ class TetRasterizer {
 };
 
 // A convenience: a fresh framebuffer (background white) with `tets` drawn in order.
-Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
+FOXI_API Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
                         std::span<const std::uint32_t> tets, const RenderParams& params = {});
 
 // The pixels covered by one triangle under the rasterizer's fill rule (for tests): vertices in
 // fixed point (pixel coordinate * 256, rounded), either winding; returns y * width + x of every
 // covered pixel of the width x height image, in row order. A zero-area triangle covers nothing.
-std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3], int width,
+FOXI_API std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3], int width,
                                              int height);
 
 }  // namespace foxi

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/progress.hpp"
 
@@ -107,6 +108,6 @@ struct SphereTable {
 };
 
 // Builds the table (both cores). Uses the mesh's cached face adjacency.
-SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress = {});
+FOXI_API SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress = {});
 
 }  // namespace foxi

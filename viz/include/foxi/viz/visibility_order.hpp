@@ -21,6 +21,7 @@
 #include <span>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/view.hpp"
@@ -53,7 +54,7 @@ struct OrderStats {
 // while the caller draws. Destroying the object stops that work within a fraction of a
 // millisecond. The table and the mesh are lent and must outlive it; one object is used from one
 // thread.
-class ProgressiveOrder {
+class FOXI_API ProgressiveOrder {
  public:
   // subset: tet indices to order (each at most once); empty span = all tets.
   ProgressiveOrder(const Mesh& mesh, const SphereTable& table, const View& view,
@@ -76,26 +77,26 @@ class ProgressiveOrder {
 };
 
 // The whole order at once (both cores).
-std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
+FOXI_API std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
                                             std::span<const std::uint32_t> subset = {},
                                             bool front_to_back = false, OrderStats* stats = nullptr);
 
 // The same into `out`, resized to the order's size: a caller that orders view after view and keeps
 // `out` allocates nothing per view (the internal buffers are kept per thread as well).
-void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
+FOXI_API void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
                            const View& view, std::span<const std::uint32_t> subset = {},
                            bool front_to_back = false, OrderStats* stats = nullptr);
 
 // MPVO for meshes without a visibility order guarantee: a topological sort of the view-directed
 // face-adjacency graph of the subset, ready tets taken in decreasing power key; cycles are broken at
 // the tet of largest key and counted in `cycles_broken`.
-std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,
+FOXI_API std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,
                                       std::span<const std::uint32_t> subset = {},
                                       std::size_t* cycles_broken = nullptr);
 
 // A centroid-depth order (what VTK's vtkCellCenterDepthSort does): the baseline that power order
 // beats. Back to front by decreasing distance from the eye (or along dir) of each tet's centroid.
-std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view,
+FOXI_API std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view,
                                           std::span<const std::uint32_t> subset = {});
 
 struct ViolationReport {
@@ -106,6 +107,6 @@ struct ViolationReport {
 // Counts face-adjacent pairs drawn in the wrong order (back-to-front order expected): for each
 // interior face shared by two ordered tets, the tet on the eye's side of the face (exact
 // orientation test) must come later. Pairs whose face plane contains the eye are not compared.
-ViolationReport count_violations(const Mesh& mesh, const View& view, std::span<const std::uint32_t> order);
+FOXI_API ViolationReport count_violations(const Mesh& mesh, const View& view, std::span<const std::uint32_t> order);
 
 }  // namespace foxi

@@ -1,4 +1,5 @@
-// Meshes for the benchmarks, made in the run (never committed).
+// Meshes for the tests and the benchmarks, made in the run (never committed): the target
+// foxi_test_support (tests/support/CMakeLists.txt).
 #pragma once
 
 #include <cmath>

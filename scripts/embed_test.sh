@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Installs foxi from a build folder into a temporary prefix (BUILD/embed-test, removed afterwards),
+# then configures, builds and runs each host program of examples/embed/ against that prefix alone
+# (find_package(foxi) with CMAKE_PREFIX_PATH=prefix; the build tree exports no package, and the
+# script checks that foxi_DIR lies in the prefix). Checks that nothing installed names the source or
+# the build folder, and that grid_png's PNG is there and not blank. Prints the time of each step
+# and the size of the install tree.
+#   scripts/embed_test.sh [BUILD]    (default build; e.g. a -DBUILD_SHARED_LIBS=ON build folder)
+# FOXI_KEEP_EMBED_TEST=1 keeps BUILD/embed-test (grid.png, field.ppm) to look at.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+src=$PWD
+build=$(cd "${1:-build}" && pwd)
+work=$build/embed-test
+rm -rf "$work"
+trap '[ -n "${FOXI_KEEP_EMBED_TEST:-}" ] || rm -rf "$work"' EXIT
+prefix=$work/prefix
+generator=$(sed -n 's/^CMAKE_GENERATOR:INTERNAL=//p' "$build/CMakeCache.txt")
+
+t0=$(date +%s%N)
+step() {  # step NAME: prints NAME and the seconds since the last step
+  local t
+  t=$(date +%s%N)
+  printf '  %-38s %4d.%01d s\n' "$1" $(((t - t0) / 1000000000)) $(((t - t0) / 100000000 % 10))
+  t0=$t
+}
+
+echo "embed test: $build -> $prefix"
+cmake --install "$build" --prefix "$prefix" > "$work.install.log" 2>&1 || { cat "$work.install.log"; exit 1; }
+rm -f "$work.install.log"
+step "install"
+printf '  install tree: %s (%s files)\n' "$(du -sh "$prefix" | cut -f1)" "$(find "$prefix" -type f | wc -l)"
+
+# No path of this machine's source or build folder in the installed files (headers, CMake files,
+# libraries, programs): a host's machine has neither.
+if grep -rlF -e "$src" -e "$build" "$prefix"; then
+  echo "embed test: the files above name $src or $build" >&2
+  exit 1
+fi
+
+# The installed programs run from the prefix (a shared build's find lib/ through their rpath), and
+# foxi demo finds its default model there, not in the source tree.
+"$prefix/bin/foxi" --version
+model=$(cd "$work" && FOXI_MODELS_DIR= timeout 3 stdbuf -oL "$prefix/bin/foxi" demo -o "$work/demo" 2>&1 | sed -n 's/^1\. model //p' || true)
+if [ "$model" != "$prefix/share/foxi/models/flip_chip.toml" ]; then
+  echo "embed test: foxi demo took its default model from '$model'" >&2
+  exit 1
+fi
+step "installed foxi: --version, demo model"
+
+for example in grid_png field_buffer; do
+  dir=$work/$example
+  cmake -S "examples/embed/$example" -B "$dir" -G "$generator" -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF > "$dir.log" 2>&1 ||
+    { cat "$dir.log"; exit 1; }
+  found=$(sed -n 's/^foxi_DIR:PATH=//p' "$dir/CMakeCache.txt")
+  case "$found" in
+    "$prefix"/*) ;;
+    *) echo "embed test: $example found foxi at '$found', not in $prefix" >&2; exit 1 ;;
+  esac
+  step "$example: configure"
+  cmake --build "$dir" > "$dir.log" 2>&1 || { cat "$dir.log"; exit 1; }
+  step "$example: build"
+done
+
+"$work/grid_png/grid_png" "$work/grid.png" 16
+step "grid_png: run"
+# A PNG of the requested size, and far from blank (a 640 x 480 picture of one colour is under 2 kB).
+python3 - "$work/grid.png" <<'PY'
+import struct, sys
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+w, h = struct.unpack('>II', data[16:24])
+assert (w, h) == (640, 480), f'size {w} x {h}'
+assert len(data) > 20000, f'only {len(data)} bytes: blank?'
+print(f'  grid.png: {w} x {h}, {len(data)} bytes')
+PY
+"$work/field_buffer/field_buffer" "$work/field.ppm"
+step "field_buffer: run"
+echo "embed test: passed"

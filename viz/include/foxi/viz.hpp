@@ -1,0 +1,28 @@
+// foxi/viz.hpp: the visibility order of tets and the software painter (foxi::viz), in one include.
+// The entry points, one a line (declared in the topic headers below, which say more):
+//
+//   compute_spheres(mesh)                      per-mesh precompute of the power order (spheres.hpp)
+//   visibility_order(mesh, table, view, subset) back-to-front order for one view; Delaunay meshes (visibility_order.hpp)
+//   ProgressiveOrder                           the same handed out batch by batch (visibility_order.hpp)
+//   mpvo_order(mesh, table, view, subset)      order of a non-Delaunay mesh, cycles counted (visibility_order.hpp)
+//   count_violations(mesh, view, order)        face-adjacent pairs drawn in the wrong order (visibility_order.hpp)
+//   Camera, fit_camera, orbit, pan, zoom       the camera and its helpers (camera.hpp)
+//   view_of(camera), View                      the ordering viewpoint of a camera (camera.hpp, view.hpp)
+//   TetRasterizer, RenderParams                the painter: draw, undraw, changed rects (rasterizer.hpp)
+//   render_tets(mesh, camera, w, h, tets)      a fresh framebuffer with tets drawn (rasterizer.hpp)
+//   Framebuffer, pack_rgba                     RGBA8 pixels, tet ids, depth (framebuffer.hpp)
+//   write_png(path, fb), read_png(path)        PNG files of a framebuffer (png.hpp)
+//   tet_depth, count_deeper                    the painter's depth stop (depth_stop.hpp)
+//   make_movie(...)                            movies of the painter: APNG, GIF (movie.hpp, animation.hpp)
+#pragma once
+
+#include "foxi/viz/animation.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/depth_stop.hpp"
+#include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/movie.hpp"
+#include "foxi/viz/png.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/view.hpp"
+#include "foxi/viz/visibility_order.hpp"
