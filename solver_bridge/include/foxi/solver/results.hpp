@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/thermal.hpp"
@@ -48,7 +49,7 @@ struct RunParameter {
 };
 
 enum class RunStatus : std::uint8_t { ok, unreliable, failed };
-const char* run_status_name(RunStatus s);  // "ok", "unreliable", "failed"
+FOXI_API const char* run_status_name(RunStatus s);  // "ok", "unreliable", "failed"
 
 struct RunResults {
   std::string model;    // file the run came from (model or mesh)
@@ -73,27 +74,27 @@ struct RunResults {
 };
 
 // "die" for a named region or boundary, else its number.
-std::string region_name(const Mesh& mesh, std::int32_t id);
-std::string boundary_name(const Mesh& mesh, std::int32_t tag);
+FOXI_API std::string region_name(const Mesh& mesh, std::int32_t id);
+FOXI_API std::string boundary_name(const Mesh& mesh, std::int32_t tag);
 
 // The record of a physics' report on the mesh it solved (names from the mesh): values, checks,
 // solver, counts, solve time; status unreliable when a check failed. The caller adds the model,
 // parameters, mesh and wall times and the error indicator.
-RunResults thermal_results(const Mesh& mesh, const ThermalReport& report);
-RunResults electrostatic_results(const Mesh& mesh, const ElectrostaticReport& report);
-RunResults current_results(const Mesh& mesh, const CurrentReport& report);
-RunResults thermoelastic_results(const Mesh& mesh, const ThermoelasticReport& report);
+FOXI_API RunResults thermal_results(const Mesh& mesh, const ThermalReport& report);
+FOXI_API RunResults electrostatic_results(const Mesh& mesh, const ElectrostaticReport& report);
+FOXI_API RunResults current_results(const Mesh& mesh, const CurrentReport& report);
+FOXI_API RunResults thermoelastic_results(const Mesh& mesh, const ThermoelasticReport& report);
 
 // One JSON object (UTF-8, one line per value), NaN and infinities as null:
 //   {"foxi_results": 1, "model": ..., "physics": ..., "parameters": [{"name", "text"}], "status",
 //    "error", "nodes", "tets", "mesh_seconds", "solve_seconds", "wall_seconds", "error_indicator",
 //    "solver", "values": [{"name", "unit", "value", "key"}], "texts": [{"name", "text"}],
 //    "checks": [{"name", "what", "figure", "tolerance", "passed"}]}
-std::string results_json(const RunResults& results);
+FOXI_API std::string results_json(const RunResults& results);
 
 // Reads what results_json wrote (null as NaN; members it does not know are skipped). Throws
 // std::runtime_error naming the byte offset on text that is not such an object.
-RunResults parse_results_json(std::string_view text);
+FOXI_API RunResults parse_results_json(std::string_view text);
 
 // A convergence study (foxi solve --convergence): one record per mesh level, coarse to fine, and
 // for each key value the observed order and the Richardson extrapolation. The levels' sizes h_k are
@@ -111,11 +112,11 @@ struct ConvergenceRow {
   double error_estimate = NAN;       // |finest - f*|
 };
 // `h`: one size per level (m). Throws std::invalid_argument if sizes and levels differ in number.
-std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels,
+FOXI_API std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels,
                                               const std::vector<double>& h);
 
 // The observed order p of three values at sizes h0 > h1 > h2: p solves (f2 - f1) / (f1 - f0) =
 // (h2^p - h1^p) / (h1^p - h0^p) (bisection on [0.05, 8]); NaN when there is none.
-double observed_order(double f0, double f1, double f2, double h0, double h1, double h2);
+FOXI_API double observed_order(double f0, double f1, double f2, double h0, double h1, double h2);
 
 }  // namespace foxi
