@@ -23,18 +23,23 @@ std::string title_line(const ColorLegend& l) {
   return l.title + (l.unit.symbol.empty() ? "" : " (" + l.unit.symbol + ")");
 }
 
-// The ticks (display values) for a bar of bar_h rows whose labels are line_h high: the most that
-// leave a line and a half between neighbours.
+// The ticks (display values) for a bar of bar_h rows whose labels are at most line_h high: the most
+// (finest step) whose neighbours lie at least line_h + 2 rows apart, so labels never overlap.
 std::vector<double> legend_ticks(const ColorLegend& l, int bar_h, int line_h) {
   double lo = l.unit.to_display(l.scale.lo), hi = l.unit.to_display(l.scale.hi);
   if (lo > hi) std::swap(lo, hi);
   const bool log = l.scale.log && lo > 0;
-  const int most = std::max(2, bar_h / (line_h + line_h / 2) + 1);
-  for (int n = most; n >= 2; --n) {
+  std::vector<double> fallback;
+  for (int n = std::max(2, bar_h / 4); n >= 2; --n) {
     std::vector<double> t = nice_ticks(lo, hi, n, log);
-    if (int(t.size()) <= n) return t;
+    double closest = 1e300;
+    for (std::size_t i = 1; i < t.size(); ++i)
+      closest = std::min(closest, std::abs(l.scale.position(l.unit.to_si(t[i])) -
+                                           l.scale.position(l.unit.to_si(t[i - 1]))) * (bar_h - 1));
+    if (closest >= line_h + 2) return t;
+    if (fallback.empty() && !t.empty()) fallback = {t.front()};
   }
-  return nice_ticks(lo, hi, 2, log);
+  return fallback;
 }
 
 }  // namespace
@@ -89,7 +94,7 @@ LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const 
     throw std::invalid_argument("legend: the area is too small for a colour bar");
   r.bar = PixelRect{x, bar_top, x + p.bar_width - 1, bar_bottom};
   for (int row = bar_top; row <= bar_bottom; ++row) {
-    const double t = (double(bar_bottom - row) + 0.5) / double(bar_h);  // the row's centre
+    const double t = double(bar_bottom - row) / double(bar_h - 1);  // 0 at the bottom row, 1 at the top
     const std::uint32_t c = l.scale.color_at(t);
     for (int k = r.bar.x0; k <= r.bar.x1; ++k) fb.rgba[fb.index(k, row)] = c;
   }
@@ -103,7 +108,8 @@ LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const 
     fb.rgba[fb.index(r.bar.x1 + 1, row)] = frame;
   }
   r.ticks = legend_ticks(l, bar_h, fs);
-  const double step = r.ticks.size() > 1 ? r.ticks[1] - r.ticks[0] : std::abs(l.scale.hi - l.scale.lo);
+  // Log ticks span decades: each label in %g form (step 0).
+  const double step = l.scale.log ? 0 : r.ticks.size() > 1 ? r.ticks[1] - r.ticks[0] : std::abs(l.scale.hi - l.scale.lo);
   for (double v : r.ticks) {
     const double t = l.scale.position(l.unit.to_si(v));
     const int row = bar_bottom - int(std::lround(t * double(bar_h - 1)));
