@@ -35,6 +35,7 @@ TetRasterizer::Impl::Impl(const Mesh& m, const Camera& c, int w, int h, const Re
 #ifdef FOXI_AVX512_REPAINT
   fast_repaint = params.edges && params.edge_darkness >= 0 && params.edge_darkness <= 1 && avx512_repaint();
 #endif
+  setup_field();
   reverse = !params.depth_buffer;
   mask_words = (w + 63) / 64;
   use_mask = reverse;

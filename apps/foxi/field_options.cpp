@@ -1,0 +1,139 @@
+#include "field_options.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace foxi::cli {
+
+const char* const kFieldOptionsHelp =
+    "  --field NAME[:C] colour by a field: C a component (x y z, xx yy zz xy yz xz, or an index), mag\n"
+    "                  (a vector's magnitude, the default for vectors) or vm (von Mises, the default\n"
+    "                  for tensors); flat per tet (the value at its centroid) unless --graded\n"
+    "  --graded        graded facets: each face's colour interpolated from its corners (a cell field is\n"
+    "                  first averaged to the nodes within each region, never across an interface)\n"
+    "  --cmap M        viridis (default), cividis, coolwarm (diverging) or rainbow (Turbo)\n"
+    "  --range a,b     the colour range in display units (default: the drawn values' range)\n"
+    "  --log           logarithmic colour scale (values <= 0 get the no-value grey)\n"
+    "  --units U       display unit: degC, mm, um, nm, kPa, MPa, GPa, mV, kV, mW or the SI unit (default:\n"
+    "                  degC for K, MPa for Pa, um for m, mV for V below 1 V; the mesh stays SI)\n"
+    "  --step k        the field's step k (0-based; default the last)\n"
+    "  --legend on|off a colour bar with the field, unit, ticks, range and map (default on), in a panel\n"
+    "                  at the right of the picture: the mesh is drawn in what is left of --size\n";
+
+FieldOptions take_field_options(Args& args) {
+  FieldOptions o;
+  o.spec = args.option("--field");
+  const std::string cmap = args.option("--cmap"), range = args.option("--range"), legend = args.option("--legend");
+  const std::string step = args.option("--step");
+  o.units = args.option("--units");
+  o.log = args.flag("--log");
+  o.graded = args.flag("--graded");
+  if (o.spec.empty() && (!cmap.empty() || !range.empty() || !legend.empty() || !step.empty() || !o.units.empty() ||
+                         o.log || o.graded))
+    throw UsageError("--cmap, --range, --log, --graded, --units, --step and --legend colour by a field: give --field NAME");
+  if (!cmap.empty()) {
+    const auto m = parse_color_map(cmap);
+    if (!m) throw UsageError("--cmap takes viridis, cividis, coolwarm or rainbow, not '" + cmap + "'");
+    o.map = *m;
+  }
+  if (!range.empty()) {
+    const std::vector<double> r = parse_numbers(range, "--range");
+    if (r.size() != 2 || !(r[0] < r[1])) throw UsageError("--range takes a,b with a < b, not '" + range + "'");
+    o.has_range = true;
+    o.range[0] = r[0];
+    o.range[1] = r[1];
+  }
+  if (!legend.empty()) {
+    if (legend != "on" && legend != "off") throw UsageError("--legend takes on or off, not '" + legend + "'");
+    o.legend = legend == "on";
+  }
+  if (!step.empty()) {
+    char* end = nullptr;
+    o.step = std::strtol(step.c_str(), &end, 10);
+    if (*end != 0 || o.step < 0) throw UsageError("--step takes a step number 0, 1, ..., not '" + step + "'");
+  }
+  return o;
+}
+
+FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<const std::uint32_t> subset,
+                           const std::string& path) {
+  FieldPicture f;
+  try {
+    f.choice = choose_field(mesh, o.spec);
+    const std::size_t steps = f.choice.field->step_count();
+    if (o.step >= 0 && std::size_t(o.step) >= steps)
+      throw FieldSelectError("field '" + f.choice.field->name + "' has " + std::to_string(steps) +
+                             " step(s): --step takes 0.." + std::to_string(steps - 1));
+    f.step = o.step < 0 ? steps - 1 : std::size_t(o.step);
+  } catch (const FieldSelectError& e) {
+    throw UsageError(path + ": " + e.what());
+  }
+  const Field& field = *f.choice.field;
+  // The values drawn: per tet (flat) or per tet corner (graded), of the selected tets only.
+  const std::vector<double> all = o.graded ? tet_corner_values(mesh, f.choice, f.step)
+                                           : tet_centroid_values(mesh, f.choice, f.step);
+  const std::size_t per = o.graded ? 4 : 1;
+  std::vector<double> drawn;
+  if (subset.empty()) {
+    drawn = all;
+  } else {
+    for (std::uint32_t t : subset) drawn.insert(drawn.end(), all.begin() + std::ptrdiff_t(per * t),
+                                                all.begin() + std::ptrdiff_t(per * t + per));
+  }
+  for (double v : drawn) f.no_value += std::isnan(v);
+  std::tie(f.data_lo, f.data_hi) = finite_range(drawn, false);
+  const double max_abs = std::max(std::abs(f.data_lo), std::abs(f.data_hi));
+  if (o.units.empty()) {
+    f.legend.unit = default_display_unit(field.unit, std::isfinite(max_abs) ? max_abs : 0);
+  } else {
+    const auto u = display_unit(field.unit, o.units);
+    if (!u)
+      throw UsageError("--units " + o.units + " does not apply to field '" + field.name + "' in " +
+                       (field.unit.empty() ? std::string("no unit") : field.unit));
+    f.legend.unit = *u;
+  }
+  ColorScale& s = f.legend.scale;
+  s.map = o.map;
+  s.log = o.log;
+  if (o.has_range) {
+    s.lo = f.legend.unit.to_si(o.range[0]);
+    s.hi = f.legend.unit.to_si(o.range[1]);
+    if (s.lo > s.hi) std::swap(s.lo, s.hi);
+    if (o.log && !(s.lo > 0))
+      throw UsageError("--log needs a range above 0 in SI (" + field.unit + "), not " + std::to_string(s.lo));
+  } else {
+    auto [lo, hi] = finite_range(drawn, o.log);
+    if (std::isnan(lo))
+      throw UsageError(path + ": field '" + field.name + "' has no " + (o.log ? "positive" : "finite") +
+                       " value on the tets drawn" + (o.log ? " (a log scale needs one)" : ""));
+    if (!(lo < hi)) {  // a constant: a range around it, so it shows mid-map
+      const double d = lo != 0 ? std::abs(lo) * (o.log ? 0.5 : 0.01) : 1;
+      lo -= d;
+      hi += d;
+      f.range_widened = true;
+    }
+    s.lo = lo;
+    s.hi = hi;
+  }
+  f.legend.title = f.choice.label;
+  f.paint = std::make_shared<const FieldPaint>(o.graded ? graded_field_paint(all, s) : flat_field_paint(all, s));
+  return f;
+}
+
+int legend_panel_width(const TextRenderer& text, const FieldPicture& field) {
+  return legend_width(text, field.legend);
+}
+
+Framebuffer with_legend(const Framebuffer& scene, const TextRenderer& text, const FieldPicture& field, int panel) {
+  Framebuffer out(scene.width + panel, scene.height);
+  for (int y = 0; y < scene.height; ++y) {
+    std::copy_n(scene.rgba.begin() + std::ptrdiff_t(scene.index(0, y)), scene.width,
+                out.rgba.begin() + std::ptrdiff_t(out.index(0, y)));
+    std::copy_n(scene.id.begin() + std::ptrdiff_t(scene.index(0, y)), scene.width,
+                out.id.begin() + std::ptrdiff_t(out.index(0, y)));
+  }
+  draw_color_legend(out, text, field.legend, PixelRect{scene.width, 0, out.width - 1, out.height - 1});
+  return out;
+}
+
+}  // namespace foxi::cli
