@@ -24,22 +24,31 @@ std::string title_line(const ColorLegend& l) {
 }
 
 // The ticks (display values) for a bar of bar_h rows whose labels are at most line_h high: the most
-// (finest step) whose neighbours lie at least line_h + 2 rows apart, so labels never overlap.
+// (finest step) whose neighbours lie at least line_h + 2 rows apart, so labels never overlap, and
+// at most 11 and one per two label heights of bar, so that they stay readable.
 std::vector<double> legend_ticks(const ColorLegend& l, int bar_h, int line_h) {
   double lo = l.unit.to_display(l.scale.lo), hi = l.unit.to_display(l.scale.hi);
   if (lo > hi) std::swap(lo, hi);
   const bool log = l.scale.log && lo > 0;
-  std::vector<double> fallback;
-  for (int n = std::max(2, bar_h / 4); n >= 2; --n) {
-    std::vector<double> t = nice_ticks(lo, hi, n, log);
-    double closest = 1e300;
+  auto apart = [&](const std::vector<double>& t) {
     for (std::size_t i = 1; i < t.size(); ++i)
-      closest = std::min(closest, std::abs(l.scale.position(l.unit.to_si(t[i])) -
-                                           l.scale.position(l.unit.to_si(t[i - 1]))) * (bar_h - 1));
-    if (closest >= line_h + 2) return t;
-    if (fallback.empty() && !t.empty()) fallback = {t.front()};
+      if (std::abs(l.scale.position(l.unit.to_si(t[i])) - l.scale.position(l.unit.to_si(t[i - 1]))) * (bar_h - 1) <
+          line_h + 2)
+        return false;
+    return true;
+  };
+  const int readable = std::max(2, std::min(11, bar_h / (2 * line_h)));
+  std::vector<double> best;
+  for (int n = readable; n >= 2 && best.size() < 2; --n) {
+    std::vector<double> t = nice_ticks(lo, hi, n, log);
+    if (apart(t) && t.size() > best.size()) best = t;
   }
-  return fallback;
+  // A short bar: finer steps, as long as labels stay apart, rather than a single tick.
+  for (int n = readable + 1; n <= std::max(2, bar_h / 4) && best.size() < 2; ++n) {
+    std::vector<double> t = nice_ticks(lo, hi, n, log);
+    if (apart(t) && t.size() > best.size()) best = t;
+  }
+  return best;
 }
 
 }  // namespace
