@@ -46,8 +46,7 @@ const std::string kMovieUsage = std::string(
     "  rotate: the camera turned --turn degrees (default 360) about its up axis through --at over\n"
     "  N frames, each frame the first --to percent of its own order.\n") +
     kPictureOptionsHelp + kFieldOptionsHelp +
-    "  (--size defaults to 640x480; with --field the colour range is the same in every frame, and\n"
-    "  --graded needs --mode rotate: undrawing repaints faces flat)\n"
+    "  (--size defaults to 640x480; with --field the colour range is the same in every frame)\n"
     "  --frames N      frames per cycle (default 48), --cycles C cycles (default 1)\n"
     "  --fps F         frames per second of the animated file (default 12)\n"
     "  -o              .gif (giflib, 256 colours per frame), .apng (animated PNG), .mp4 (needs the\n"
@@ -145,8 +144,6 @@ int cmd_movie(Args args) {
   char* fps_end = nullptr;
   const double fps = std::strtod(fps_s.c_str(), &fps_end);
   if (*fps_end != 0 || !(fps > 0 && fps <= 100)) throw UsageError("--fps takes a rate in (0, 100]");
-  if (field_options.graded && !mp.rotate)
-    throw UsageError("--graded needs --mode rotate (backforth undraws, which repaints faces flat)");
 
   enum class Kind { frames, gif, apng, mp4 } kind;
   const std::string ext = std::filesystem::path(out).extension().string();

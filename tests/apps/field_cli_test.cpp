@@ -124,7 +124,7 @@ TEST_F(FieldCli, UsageErrorsSayWhatIsWrong) {
   EXPECT_EQ(foxi("render " + m + " --field temperature --step 3" + o, &log), 2);
   EXPECT_EQ(foxi("render " + m + " --field temperature --size 100x100" + o, &log), 2);
   EXPECT_NE(log.find("legend"), std::string::npos) << log;
-  EXPECT_EQ(foxi("movie " + m + " --field temperature --graded -o '" + (dir_ / "m.gif").string() + "'", &log), 2);
+  EXPECT_EQ(foxi("movie " + m + " --field temperature --graded --range 1 -o '" + (dir_ / "m.gif").string() + "'", &log), 2);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.png"));
   EXPECT_FALSE(std::filesystem::exists(dir_ / "m.gif"));
 }
@@ -154,6 +154,12 @@ TEST_F(FieldCli, MovieWithAFieldKeepsOneRange) {
   }
   ASSERT_EQ(foxi("movie '" + mesh_.string() + "' --field temperature --graded --mode rotate --frames 3 --size 400x240 -o '" +
                  (dir_ / "r.gif").string() + "'", &log), 0) << log;
+  ASSERT_EQ(foxi("movie '" + mesh_.string() + "' --field temperature --graded --frames 4 --size 400x240 -o '" +
+                 (dir_ / "g_%02d.png").string() + "'", &log), 0) << log;
+  // Back and forth: the frame at the high point (all tets) is foxi render's graded picture.
+  ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --graded --size 400x240 -o '" +
+                 (dir_ / "all.png").string() + "'", &log), 0) << log;
+  EXPECT_EQ(read_png(dir_ / "g_02.png").rgba, read_png(dir_ / "all.png").rgba);
 }
 
 }  // namespace

@@ -135,7 +135,8 @@ void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const Fac
 // orientation, same pixels under the fill rule). Returns its vertex count (3, or 4 when the near
 // plane cuts it) with positive area, or 0 when the face is not of the asked side or covers nothing.
 // *clipped is set when the near plane cuts a face of the asked side.
-int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped) const {
+int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped,
+                                      const float* pos_given) const {
   const std::uint32_t* tv = k.tv;
   const double* const* c = k.c;
   const std::int64_t *X = k.X, *Y = k.Y;
@@ -151,7 +152,7 @@ int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, Pol
     if (back ? area <= 0 : area >= 0) return 0;
     const int front_order[3] = {a, d, b}, back_order[3] = {a, b, d};  // positive area
     const int* order = back ? back_order : front_order;
-    const float* pos = corner_positions(tv);
+    const float* pos = pos_given != nullptr ? pos_given : corner_positions(tv);
     for (int i = 0; i < 3; ++i) {
       poly[i].X = X[order[i]];
       poly[i].Y = Y[order[i]];
@@ -201,7 +202,8 @@ int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, Pol
       out.c[1] = P[1] + tt * (Q[1] - P[1]);
       out.c[2] = near;
       out.w = 1 / near;
-      if (const float* pos = corner_positions(tv)) out.pos = float(pos[lo] + tt * (pos[hi] - pos[lo]));
+      if (const float* pos = pos_given != nullptr ? pos_given : corner_positions(tv))
+        out.pos = float(pos[lo] + tt * (pos[hi] - pos[lo]));
       std::uint8_t dummy;
       project_camera(out.c, out.X, out.Y, dummy);
     };
@@ -210,7 +212,7 @@ int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, Pol
       poly[n].Y = Y[pi];
       poly[n].w = nearness(c[pi]);
       poly[n].mesh_edge = true;
-      if (const float* pos = corner_positions(tv)) poly[n].pos = pos[pi];
+      if (const float* pos = pos_given != nullptr ? pos_given : corner_positions(tv)) poly[n].pos = pos[pi];
       ++n;
       if (!qin) {
         cut(poly[n]);

@@ -12,8 +12,6 @@ void TetRasterizer::Impl::setup_field() {
     throw std::invalid_argument("render: the field paint has " +
                                 std::to_string(field->graded ? field->corner_position.size() : field->tet_color.size()) +
                                 " values for a mesh of " + std::to_string(m.tet_count()) + " tets");
-  if (field->graded && params.undoable)
-    throw std::invalid_argument("render: graded field colours cannot be undrawn (undraw repaints flat faces)");
   if (!(field->shade_min >= 0 && field->shade_min <= 1))
     throw std::invalid_argument("render: the field paint's shade_min must be in [0, 1]");
   for (int i = 0; i < 256; ++i) {
@@ -40,6 +38,16 @@ std::uint32_t TetRasterizer::Impl::graded_color(const FaceSetup& fs, int x, int 
     c = field_lut[int(std::clamp(t * 256, 0.0, 255.0))];
   }
   return pack_rgba(std::uint32_t(c[0] * f + 0.5f), std::uint32_t(c[1] * f + 0.5f), std::uint32_t(c[2] * f + 0.5f));
+}
+
+void TetRasterizer::Impl::neighbour_positions(std::uint32_t nb, const std::uint32_t* tv, float out[4]) const {
+  const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb)];
+  const float* pos = &field->corner_position[4 * std::size_t(nb)];
+  for (int j = 0; j < 4; ++j) {
+    out[j] = 0;
+    for (int k = 0; k < 4; ++k)
+      if (nv[k] == tv[j]) out[j] = pos[k];
+  }
 }
 
 void TetRasterizer::Impl::graded_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {

@@ -443,6 +443,10 @@ struct TetRasterizer::Impl {
   const float* corner_positions(const std::uint32_t* tv) const {
     return field != nullptr && field->graded ? &field->corner_position[std::size_t(tv - mesh->tet.data())] : nullptr;
   }
+  // Graded: the scale positions the kept tet nb (mesh tet index) gives the nodes tv[0..3] (a cell
+  // field averaged per region gives a node a different position in each region); nodes not in nb
+  // keep 0 (the one corner off a shared face, never used).
+  void neighbour_positions(std::uint32_t nb, const std::uint32_t* tv, float out[4]) const;
   // The field paint's checks and colour table (raster_field.cpp; the constructor calls it).
   void setup_field();
 
@@ -605,7 +609,10 @@ struct TetRasterizer::Impl {
     return k.st[0] != 2 && k.st[1] != 2 && k.st[2] != 2 && k.st[3] != 2;
   }
 
-  int face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped) const;
+  // pos: graded field paint, the scale positions to give k's corners (4, k's local order) instead of
+  // the tet's own (undraw repaints a kept neighbour's face with the neighbour's, see neighbour_positions).
+  int face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped,
+                   const float* pos = nullptr) const;
 
   void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count);
 

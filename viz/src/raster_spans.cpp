@@ -379,17 +379,25 @@ void TetRasterizer::Impl::raster_polygon(Framebuffer& fb, const Rows& rows, Face
       fs.db = (x1 * w2 - x2 * w1) * inv;
     }
     if (fs.graded) {
-      const double inv = double(kOne) * double(kOne) / double(area), s = 1.0 / double(kOne);
-      const double x1 = double(X[1] - X[0]) * s, y1 = double(Y[1] - Y[0]) * s;
-      const double x2 = double(X[2] - X[0]) * s, y2 = double(Y[2] - Y[0]) * s;
+      // The triangle's corners in a canonical order (by y, then x), so that the plane has the same
+      // bits however the polygon was given: undraw repaints a neighbour's face from the other tet's
+      // corners, and must give its pixels the colours drawing it gave.
       const PolyVertex* v[3] = {&poly[0], &poly[i], &poly[i + 1]};
+      auto before = [](const PolyVertex* a, const PolyVertex* b) { return a->Y != b->Y ? a->Y < b->Y : a->X < b->X; };
+      if (before(v[1], v[0])) std::swap(v[0], v[1]);
+      if (before(v[2], v[1])) std::swap(v[1], v[2]);
+      if (before(v[1], v[0])) std::swap(v[0], v[1]);
+      const std::int64_t area_c = (v[1]->X - v[0]->X) * (v[2]->Y - v[0]->Y) - (v[1]->Y - v[0]->Y) * (v[2]->X - v[0]->X);
+      const double inv = double(kOne) * double(kOne) / double(area_c), s = 1.0 / double(kOne);
+      const double x1 = double(v[1]->X - v[0]->X) * s, y1 = double(v[1]->Y - v[0]->Y) * s;
+      const double x2 = double(v[2]->X - v[0]->X) * s, y2 = double(v[2]->Y - v[0]->Y) * s;
       double g[3], h[3];
       for (int k = 0; k < 3; ++k) {
         h[k] = proj.perspective ? v[k]->w : 1.0;
         g[k] = double(v[k]->pos) * h[k];
       }
-      fs.gx0 = double(X[0]) * s;
-      fs.gy0 = double(Y[0]) * s;
+      fs.gx0 = double(v[0]->X) * s;
+      fs.gy0 = double(v[0]->Y) * s;
       fs.g0 = g[0];
       fs.ga = ((g[1] - g[0]) * y2 - (g[2] - g[0]) * y1) * inv;
       fs.gb = (x1 * (g[2] - g[0]) - x2 * (g[1] - g[0])) * inv;

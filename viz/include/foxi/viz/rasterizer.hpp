@@ -47,8 +47,8 @@ struct RenderParams {
   // Colour by a field instead of by region (field_paint.hpp; shared, not copied: a graded paint of 1M
   // tets is 16 MB): flat, each tet's colour; graded, each face's colour interpolated per pixel from
   // its corners' positions on the scale. Lambert shading then scales the colour within
-  // [shade_min, 1] (FieldPaint) instead of [ambient, 1]. Graded paints are not undoable (the
-  // constructor throws std::invalid_argument).
+  // [shade_min, 1] (FieldPaint) instead of [ambient, 1]. Undraw repaints a face with its own tet's
+  // corner positions; the vector repaint (AVX-512) is flat only, so graded undraw takes the portable one.
   std::shared_ptr<const FieldPaint> field;
 };
 
