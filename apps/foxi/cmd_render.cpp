@@ -166,7 +166,9 @@ int cmd_render(Args args) {
                 field_options.graded ? "graded facets" : "flat per tet (centroid value)", color_map_name(sc.map),
                 sc.log ? " log" : "", u.to_display(field.data_lo), u.to_display(field.data_hi), u.symbol.c_str(),
                 u.to_display(sc.lo), u.to_display(sc.hi), u.symbol.c_str(),
-                field.range_widened ? " (a constant: range widened around it)" : "");
+                field.range_widened ? " (a constant: range widened around it)"
+                : field.range_centred ? " (symmetric about 0 for the diverging map)"
+                                      : "");
     if (field.no_value > 0) std::printf(", %zu values NaN (grey)", field.no_value);
     if (text) std::printf("\nlegend      %d pixels at the right, font %s", panel, text->font_file().c_str());
   }

@@ -12,7 +12,8 @@ const char* const kFieldOptionsHelp =
     "  --graded        graded facets: each face's colour interpolated from its corners (a cell field is\n"
     "                  first averaged to the nodes within each region, never across an interface)\n"
     "  --cmap M        viridis (default), cividis, coolwarm (diverging) or rainbow (Turbo)\n"
-    "  --range a,b     the colour range in display units (default: the drawn values' range)\n"
+    "  --range a,b     the colour range in display units (default: the drawn values' range; with\n"
+    "                  coolwarm and values of both signs, symmetric about 0 so that white is 0)\n"
     "  --log           logarithmic colour scale (values <= 0 get the no-value grey)\n"
     "  --units U       display unit: degC, mm, um, nm, kPa, MPa, GPa, mV, kV, mW or the SI unit (default:\n"
     "                  degC for K, MPa for Pa, um for m, mV for V below 1 V; the mesh stays SI)\n"
@@ -111,6 +112,12 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
       lo -= d;
       hi += d;
       f.range_widened = true;
+    }
+    // A diverging map shows signed values about zero: its centre (white) at 0.
+    if (o.map == ColorMapId::coolwarm && !o.log && lo < 0 && hi > 0) {
+      hi = std::max(-lo, hi);
+      lo = -hi;
+      f.range_centred = true;
     }
     s.lo = lo;
     s.hi = hi;

@@ -40,6 +40,7 @@ struct FieldPicture {
   double data_lo = 0, data_hi = 0;  // the drawn values' range, SI (NaN, NaN if none is finite)
   std::size_t no_value = 0;         // drawn values that are NaN
   bool range_widened = false;       // a constant field: the automatic range was widened around it
+  bool range_centred = false;       // coolwarm, both signs: the automatic range made symmetric about 0
 };
 
 // The field's paint for the tets of `subset` (all when empty); UsageError naming `path` and what it

@@ -24,7 +24,9 @@ class FieldCli : public ::testing::Test {
     Field s{"stress", FieldLocation::cell, 6, "Pa", {}, {}};
     for (std::size_t e = 0; e < m.tet_count(); ++e)
       for (double v : {-1e6, 0.0, 0.0, 0.0, 0.0, 0.0}) s.values.push_back(v);
-    m.fields = {t, s};
+    Field u{"u", FieldLocation::node, 1, "m", {}, {}};
+    for (std::size_t n = 0; n < m.node_count(); ++n) u.values.push_back((m.xyz[3 * n] - 2) * 1e-6);  // -2..6 um
+    m.fields = {t, s, u};
     mesh_ = dir_ / "grid.vtu";
     write_mesh(m, mesh_);
   }
@@ -83,6 +85,15 @@ TEST_F(FieldCli, GradedLinearFieldReadsBackAlongTheRow) {
   EXPECT_GE(last, 252);
 }
 
+TEST_F(FieldCli, DivergingMapCentresSignedValuesOnZero) {
+  const auto png = dir_ / "u.png";
+  std::string log;
+  ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field u --graded --cmap coolwarm -o '" + png.string() + "'", &log), 0);
+  EXPECT_NE(log.find("values -2 to 6 µm, colours -6 to 6 µm (symmetric about 0"), std::string::npos) << log;
+  ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field u --graded -o '" + png.string() + "'", &log), 0);
+  EXPECT_NE(log.find("colours -2 to 6 µm\n"), std::string::npos) << log;  // viridis: the values' range
+}
+
 TEST_F(FieldCli, LegendPanelHoldsTheWholeMap) {
   const auto png = dir_ / "t.png";
   ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --cmap coolwarm --size 640x400 -o '" +
@@ -112,7 +123,7 @@ TEST_F(FieldCli, UsageErrorsSayWhatIsWrong) {
   const std::string m = "'" + mesh_.string() + "'", o = " -o '" + (dir_ / "x.png").string() + "'";
   std::string log;
   EXPECT_EQ(foxi("render " + m + " --field pressure" + o, &log), 2);
-  EXPECT_NE(log.find("it has: temperature, stress"), std::string::npos) << log;
+  EXPECT_NE(log.find("it has: temperature, u, stress"), std::string::npos) << log;  // the .vtu lists node fields first
   EXPECT_EQ(foxi("render " + m + " --field temperature --cmap jet" + o, &log), 2);
   EXPECT_NE(log.find("viridis, cividis, coolwarm or rainbow"), std::string::npos) << log;
   EXPECT_EQ(foxi("render " + m + " --graded" + o, &log), 2);

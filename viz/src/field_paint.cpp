@@ -103,10 +103,10 @@ FieldChoice choose_field(const Mesh& mesh, std::string_view spec) {
   if (comp.empty()) {
     if (n == 3) {
       c.scalar.kind = FieldScalar::Kind::magnitude;
-      c.label += " (magnitude)";
+      c.label += ", magnitude";
     } else if (is_tensor(n)) {
       c.scalar.kind = FieldScalar::Kind::von_mises;
-      c.label += " (von Mises)";
+      c.label += ", von Mises";
     } else if (n != 1) {
       throw FieldSelectError("field '" + c.field->name + "' has " + std::to_string(n) +
                              " components: choose one as " + c.field->name + ":COMPONENT (" + component_names(n) + ")");
@@ -115,12 +115,12 @@ FieldChoice choose_field(const Mesh& mesh, std::string_view spec) {
   }
   if (comp == "mag" && n == 3) {
     c.scalar.kind = FieldScalar::Kind::magnitude;
-    c.label += " (magnitude)";
+    c.label += ", magnitude";
     return c;
   }
   if ((comp == "vm" || comp == "von_mises") && is_tensor(n)) {
     c.scalar.kind = FieldScalar::Kind::von_mises;
-    c.label += " (von Mises)";
+    c.label += ", von Mises";
     return c;
   }
   const int i = component_index(comp, n);

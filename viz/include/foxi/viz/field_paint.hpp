@@ -37,7 +37,7 @@ struct FieldScalar {
 struct FieldChoice {
   const Field* field = nullptr;
   FieldScalar scalar;
-  std::string label;  // "temperature", "displacement:mag", "stress:von Mises", ...
+  std::string label;  // "temperature", "displacement, magnitude", "stress, von Mises", "stress xy", ...
 };
 FieldChoice choose_field(const Mesh& mesh, std::string_view spec);
 
