@@ -7,6 +7,7 @@
 
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/colormap.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/png.hpp"
 #include "test_util.hpp"
 #include "viz/mesh_factory.hpp"
@@ -171,6 +172,21 @@ TEST_F(FieldCli, MovieWithAFieldKeepsOneRange) {
   ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --graded --size 400x240 -o '" +
                  (dir_ / "all.png").string() + "'", &log), 0) << log;
   EXPECT_EQ(read_png(dir_ / "g_02.png").rgba, read_png(dir_ / "all.png").rgba);
+}
+
+// The von Mises stress foxi colours by (from the stress tensor) against the one the thermoelastic
+// solver writes itself (another code path: the solver's own von_mises field), tet by tet.
+TEST_F(FieldCli, VonMisesOfStressEqualsTheSolversOwn) {
+  const auto vtu = dir_ / "te.vtu";
+  std::string log;
+  ASSERT_EQ(foxi("solve '" + test::models_dir() + "die_on_substrate.toml' --physics thermoelastic -o '" + vtu.string() + "'",
+                 &log), 0) << log;
+  const Mesh m = read_mesh(vtu);
+  const std::vector<double> ours = field_scalar_values(m, choose_field(m, "stress"));
+  const std::vector<double> solver = field_scalar_values(m, choose_field(m, "von_mises"));
+  ASSERT_EQ(ours.size(), solver.size());
+  ASSERT_GT(ours.size(), 1000u);
+  for (std::size_t t = 0; t < ours.size(); ++t) EXPECT_NEAR(ours[t], solver[t], 1e-9 * solver[t] + 1e-6) << "tet " << t;
 }
 
 }  // namespace
