@@ -24,14 +24,17 @@ const char* const kFieldOptionsHelp =
 FieldOptions take_field_options(Args& args) {
   FieldOptions o;
   o.spec = args.option("--field");
-  const std::string cmap = args.option("--cmap"), range = args.option("--range"), legend = args.option("--legend");
+  const std::string cmap = args.option("--cmap"), range = args.option("--range"),
+                    legend = args.option("--legend");
   const std::string step = args.option("--step");
   o.units = args.option("--units");
   o.log = args.flag("--log");
   o.graded = args.flag("--graded");
-  if (o.spec.empty() && (!cmap.empty() || !range.empty() || !legend.empty() || !step.empty() || !o.units.empty() ||
-                         o.log || o.graded))
-    throw UsageError("--cmap, --range, --log, --graded, --units, --step and --legend colour by a field: give --field NAME");
+  if (o.spec.empty() && (!cmap.empty() || !range.empty() || !legend.empty() || !step.empty() ||
+                         !o.units.empty() || o.log || o.graded))
+    throw UsageError(
+        "--cmap, --range, --log, --graded, --units, --step and --legend colour by a field: give --field "
+        "NAME");
   if (!cmap.empty()) {
     const auto m = parse_color_map(cmap);
     if (!m) throw UsageError("--cmap takes viridis, cividis, coolwarm or rainbow, not '" + cmap + "'");
@@ -39,7 +42,8 @@ FieldOptions take_field_options(Args& args) {
   }
   if (!range.empty()) {
     const std::vector<double> r = parse_numbers(range, "--range");
-    if (r.size() != 2 || !(r[0] < r[1])) throw UsageError("--range takes a,b with a < b, not '" + range + "'");
+    if (r.size() != 2 || !(r[0] < r[1]))
+      throw UsageError("--range takes a,b with a < b, not '" + range + "'");
     o.has_range = true;
     o.range[0] = r[0];
     o.range[1] = r[1];
@@ -71,15 +75,16 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
   }
   const Field& field = *f.choice.field;
   // The values drawn: per tet (flat) or per tet corner (graded), of the selected tets only.
-  const std::vector<double> all = o.graded ? tet_corner_values(mesh, f.choice, f.step)
-                                           : tet_centroid_values(mesh, f.choice, f.step);
+  const std::vector<double> all =
+      o.graded ? tet_corner_values(mesh, f.choice, f.step) : tet_centroid_values(mesh, f.choice, f.step);
   const std::size_t per = o.graded ? 4 : 1;
   std::vector<double> drawn;
   if (subset.empty()) {
     drawn = all;
   } else {
-    for (std::uint32_t t : subset) drawn.insert(drawn.end(), all.begin() + std::ptrdiff_t(per * t),
-                                                all.begin() + std::ptrdiff_t(per * t + per));
+    for (std::uint32_t t : subset)
+      drawn.insert(drawn.end(), all.begin() + std::ptrdiff_t(per * t),
+                   all.begin() + std::ptrdiff_t(per * t + per));
   }
   for (double v : drawn) f.no_value += std::isnan(v);
   std::tie(f.data_lo, f.data_hi) = finite_range(drawn, false);
@@ -123,7 +128,8 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
     s.hi = hi;
   }
   f.legend.title = f.choice.label;
-  f.paint = std::make_shared<const FieldPaint>(o.graded ? graded_field_paint(all, s) : flat_field_paint(all, s));
+  f.paint =
+      std::make_shared<const FieldPaint>(o.graded ? graded_field_paint(all, s) : flat_field_paint(all, s));
   return f;
 }
 
@@ -131,7 +137,8 @@ int legend_panel_width(const TextRenderer& text, const FieldPicture& field) {
   return legend_width(text, field.legend);
 }
 
-Framebuffer with_legend(const Framebuffer& scene, const TextRenderer& text, const FieldPicture& field, int panel) {
+Framebuffer with_legend(const Framebuffer& scene, const TextRenderer& text, const FieldPicture& field,
+                        int panel) {
   Framebuffer out(scene.width + panel, scene.height);
   for (int y = 0; y < scene.height; ++y) {
     std::copy_n(scene.rgba.begin() + std::ptrdiff_t(scene.index(0, y)), scene.width,

@@ -25,8 +25,8 @@ struct FieldOptions {
   bool has_range = false;
   double range[2] = {0, 0};  // --range, display units
   bool log = false, graded = false, legend = true;
-  std::string units;   // --units; empty: the field's usual display unit (°C for K, MPa for Pa, ...)
-  long step = -1;      // --step; -1: the last
+  std::string units;  // --units; empty: the field's usual display unit (°C for K, MPa for Pa, ...)
+  long step = -1;     // --step; -1: the last
 };
 
 // Takes the options out of args; UsageError for malformed ones.
@@ -45,14 +45,15 @@ struct FieldPicture {
 
 // The field's paint for the tets of `subset` (all when empty); UsageError naming `path` and what it
 // has for a field, component, step or unit that is not there, or a log scale without positive values.
-FieldPicture resolve_field(const FieldOptions& options, const Mesh& mesh, std::span<const std::uint32_t> subset,
-                           const std::string& path);
+FieldPicture resolve_field(const FieldOptions& options, const Mesh& mesh,
+                           std::span<const std::uint32_t> subset, const std::string& path);
 
 // The legend's width at the font found on the system (FontError if none).
 int legend_panel_width(const TextRenderer& text, const FieldPicture& field);
 // The picture `scene` with the legend in a panel of `panel` pixels at its right: the result is
 // scene.width + panel wide (id kNone in the panel). Callers draw the mesh panel pixels narrower than
 // the picture asked for.
-Framebuffer with_legend(const Framebuffer& scene, const TextRenderer& text, const FieldPicture& field, int panel);
+Framebuffer with_legend(const Framebuffer& scene, const TextRenderer& text, const FieldPicture& field,
+                        int panel);
 
 }  // namespace foxi::cli

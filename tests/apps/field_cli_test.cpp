@@ -21,12 +21,14 @@ class FieldCli : public ::testing::Test {
     Mesh m = test::grid_mesh(8, 4, 2, 1, 1, 1, 6);
     test::regions_along_x(m, 3, 6);
     Field t{"temperature", FieldLocation::node, 1, "K", {}, {}};
-    for (std::size_t n = 0; n < m.node_count(); ++n) t.values.push_back(300 + 10 * m.xyz[3 * n]);  // 300..380 K
+    for (std::size_t n = 0; n < m.node_count(); ++n)
+      t.values.push_back(300 + 10 * m.xyz[3 * n]);  // 300..380 K
     Field s{"stress", FieldLocation::cell, 6, "Pa", {}, {}};
     for (std::size_t e = 0; e < m.tet_count(); ++e)
       for (double v : {-1e6, 0.0, 0.0, 0.0, 0.0, 0.0}) s.values.push_back(v);
     Field u{"u", FieldLocation::node, 1, "m", {}, {}};
-    for (std::size_t n = 0; n < m.node_count(); ++n) u.values.push_back((m.xyz[3 * n] - 2) * 1e-6);  // -2..6 um
+    for (std::size_t n = 0; n < m.node_count(); ++n)
+      u.values.push_back((m.xyz[3 * n] - 2) * 1e-6);  // -2..6 um
     m.fields = {t, s, u};
     mesh_ = dir_ / "grid.vtu";
     write_mesh(m, mesh_);
@@ -58,8 +60,13 @@ class FieldCli : public ::testing::Test {
 TEST_F(FieldCli, GradedLinearFieldReadsBackAlongTheRow) {
   const auto png = dir_ / "t.png";
   std::string log;
-  ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --graded --no-edges --dir 0,0,-1 --up 0,1,0 "
-                 "--size 640x320 -o '" + png.string() + "'", &log), 0) << log;
+  ASSERT_EQ(foxi("render '" + mesh_.string() +
+                     "' --field temperature --graded --no-edges --dir 0,0,-1 --up 0,1,0 "
+                     "--size 640x320 -o '" +
+                     png.string() + "'",
+                 &log),
+            0)
+      << log;
   EXPECT_NE(log.find("graded facets"), std::string::npos) << log;
   EXPECT_NE(log.find("26.85 to 106.85 °C"), std::string::npos) << log;  // 300..380 K in °C
   const Framebuffer fb = read_png(png);
@@ -89,7 +96,10 @@ TEST_F(FieldCli, GradedLinearFieldReadsBackAlongTheRow) {
 TEST_F(FieldCli, DivergingMapCentresSignedValuesOnZero) {
   const auto png = dir_ / "u.png";
   std::string log;
-  ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field u --graded --cmap coolwarm -o '" + png.string() + "'", &log), 0);
+  ASSERT_EQ(
+      foxi("render '" + mesh_.string() + "' --field u --graded --cmap coolwarm -o '" + png.string() + "'",
+           &log),
+      0);
   EXPECT_NE(log.find("values -2 to 6 µm, colours -6 to 6 µm (symmetric about 0"), std::string::npos) << log;
   ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field u --graded -o '" + png.string() + "'", &log), 0);
   EXPECT_NE(log.find("colours -2 to 6 µm\n"), std::string::npos) << log;  // viridis: the values' range
@@ -98,7 +108,8 @@ TEST_F(FieldCli, DivergingMapCentresSignedValuesOnZero) {
 TEST_F(FieldCli, LegendPanelHoldsTheWholeMap) {
   const auto png = dir_ / "t.png";
   ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --cmap coolwarm --size 640x400 -o '" +
-                 png.string() + "'"), 0);
+                 png.string() + "'"),
+            0);
   const Framebuffer fb = read_png(png);
   // Some column on the right holds the first and the last entry of the map (the bar's ends).
   bool found = false;
@@ -112,8 +123,10 @@ TEST_F(FieldCli, LegendPanelHoldsTheWholeMap) {
   }
   EXPECT_TRUE(found);
   // --legend off: no bar.
-  ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --cmap coolwarm --legend off --size 640x400 -o '" +
-                 png.string() + "'"), 0);
+  ASSERT_EQ(
+      foxi("render '" + mesh_.string() +
+           "' --field temperature --cmap coolwarm --legend off --size 640x400 -o '" + png.string() + "'"),
+      0);
   const Framebuffer plain = read_png(png);
   int bar = 0;
   for (std::uint32_t p : plain.rgba) bar += p == color_map_entry(ColorMapId::coolwarm, 255);
@@ -124,7 +137,8 @@ TEST_F(FieldCli, UsageErrorsSayWhatIsWrong) {
   const std::string m = "'" + mesh_.string() + "'", o = " -o '" + (dir_ / "x.png").string() + "'";
   std::string log;
   EXPECT_EQ(foxi("render " + m + " --field pressure" + o, &log), 2);
-  EXPECT_NE(log.find("it has: temperature, u, stress"), std::string::npos) << log;  // the .vtu lists node fields first
+  EXPECT_NE(log.find("it has: temperature, u, stress"), std::string::npos)
+      << log;  // the .vtu lists node fields first
   EXPECT_EQ(foxi("render " + m + " --field temperature --cmap jet" + o, &log), 2);
   EXPECT_NE(log.find("viridis, cividis, coolwarm or rainbow"), std::string::npos) << log;
   EXPECT_EQ(foxi("render " + m + " --graded" + o, &log), 2);
@@ -136,7 +150,10 @@ TEST_F(FieldCli, UsageErrorsSayWhatIsWrong) {
   EXPECT_EQ(foxi("render " + m + " --field temperature --step 3" + o, &log), 2);
   EXPECT_EQ(foxi("render " + m + " --field temperature --size 100x100" + o, &log), 2);
   EXPECT_NE(log.find("legend"), std::string::npos) << log;
-  EXPECT_EQ(foxi("movie " + m + " --field temperature --graded --range 1 -o '" + (dir_ / "m.gif").string() + "'", &log), 2);
+  EXPECT_EQ(
+      foxi("movie " + m + " --field temperature --graded --range 1 -o '" + (dir_ / "m.gif").string() + "'",
+           &log),
+      2);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.png"));
   EXPECT_FALSE(std::filesystem::exists(dir_ / "m.gif"));
 }
@@ -153,8 +170,11 @@ TEST_F(FieldCli, InfoPrintsEachFieldsRange) {
 TEST_F(FieldCli, MovieWithAFieldKeepsOneRange) {
   const auto out = dir_ / "f_%02d.png";
   std::string log;
-  ASSERT_EQ(foxi("movie '" + mesh_.string() + "' --field temperature --frames 4 --size 400x240 -o '" + out.string() + "'",
-                 &log), 0) << log;
+  ASSERT_EQ(foxi("movie '" + mesh_.string() + "' --field temperature --frames 4 --size 400x240 -o '" +
+                     out.string() + "'",
+                 &log),
+            0)
+      << log;
   // Flat: the tets' centroid values, x from 0.25 to 7.75: 302.5 to 377.5 K.
   EXPECT_NE(log.find("colours 29.35 to 104.35 °C in every frame"), std::string::npos) << log;
   for (int k = 0; k < 4; ++k) {
@@ -164,13 +184,24 @@ TEST_F(FieldCli, MovieWithAFieldKeepsOneRange) {
     EXPECT_EQ(fb.width, 400);
     EXPECT_EQ(fb.height, 240);
   }
-  ASSERT_EQ(foxi("movie '" + mesh_.string() + "' --field temperature --graded --mode rotate --frames 3 --size 400x240 -o '" +
-                 (dir_ / "r.gif").string() + "'", &log), 0) << log;
-  ASSERT_EQ(foxi("movie '" + mesh_.string() + "' --field temperature --graded --frames 4 --size 400x240 -o '" +
-                 (dir_ / "g_%02d.png").string() + "'", &log), 0) << log;
+  ASSERT_EQ(foxi("movie '" + mesh_.string() +
+                     "' --field temperature --graded --mode rotate --frames 3 --size 400x240 -o '" +
+                     (dir_ / "r.gif").string() + "'",
+                 &log),
+            0)
+      << log;
+  ASSERT_EQ(
+      foxi("movie '" + mesh_.string() + "' --field temperature --graded --frames 4 --size 400x240 -o '" +
+               (dir_ / "g_%02d.png").string() + "'",
+           &log),
+      0)
+      << log;
   // Back and forth: the frame at the high point (all tets) is foxi render's graded picture.
   ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --graded --size 400x240 -o '" +
-                 (dir_ / "all.png").string() + "'", &log), 0) << log;
+                     (dir_ / "all.png").string() + "'",
+                 &log),
+            0)
+      << log;
   EXPECT_EQ(read_png(dir_ / "g_02.png").rgba, read_png(dir_ / "all.png").rgba);
 }
 
@@ -179,14 +210,18 @@ TEST_F(FieldCli, MovieWithAFieldKeepsOneRange) {
 TEST_F(FieldCli, VonMisesOfStressEqualsTheSolversOwn) {
   const auto vtu = dir_ / "te.vtu";
   std::string log;
-  ASSERT_EQ(foxi("solve '" + test::models_dir() + "die_on_substrate.toml' --physics thermoelastic -o '" + vtu.string() + "'",
-                 &log), 0) << log;
+  ASSERT_EQ(foxi("solve '" + test::models_dir() + "die_on_substrate.toml' --physics thermoelastic -o '" +
+                     vtu.string() + "'",
+                 &log),
+            0)
+      << log;
   const Mesh m = read_mesh(vtu);
   const std::vector<double> ours = field_scalar_values(m, choose_field(m, "stress"));
   const std::vector<double> solver = field_scalar_values(m, choose_field(m, "von_mises"));
   ASSERT_EQ(ours.size(), solver.size());
   ASSERT_GT(ours.size(), 1000u);
-  for (std::size_t t = 0; t < ours.size(); ++t) EXPECT_NEAR(ours[t], solver[t], 1e-9 * solver[t] + 1e-6) << "tet " << t;
+  for (std::size_t t = 0; t < ours.size(); ++t)
+    EXPECT_NEAR(ours[t], solver[t], 1e-9 * solver[t] + 1e-6) << "tet " << t;
 }
 
 }  // namespace

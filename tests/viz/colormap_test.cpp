@@ -11,11 +11,16 @@
 namespace foxi {
 namespace {
 
-std::uint32_t rgb(int r, int g, int b) { return pack_rgba(std::uint32_t(r), std::uint32_t(g), std::uint32_t(b)); }
+std::uint32_t rgb(int r, int g, int b) {
+  return pack_rgba(std::uint32_t(r), std::uint32_t(g), std::uint32_t(b));
+}
 
 // Relative luminance (Rec. 709 on linearized sRGB).
 double luminance(std::uint32_t c) {
-  auto lin = [](double v) { v /= 255; return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); };
+  auto lin = [](double v) {
+    v /= 255;
+    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+  };
   return 0.2126 * lin(c & 255u) + 0.7152 * lin((c >> 8) & 255u) + 0.0722 * lin((c >> 16) & 255u);
 }
 
@@ -41,10 +46,12 @@ TEST(ColorMap, EndsAreThePublishedColours) {
 TEST(ColorMap, SequentialMapsGrowInLightnessAndCoolwarmPeaksInTheMiddle) {
   for (ColorMapId m : {ColorMapId::viridis, ColorMapId::cividis})
     for (int i = 1; i < 256; ++i)
-      EXPECT_GE(luminance(color_map_entry(m, i)) + 1e-3, luminance(color_map_entry(m, i - 1))) << color_map_name(m) << i;
+      EXPECT_GE(luminance(color_map_entry(m, i)) + 1e-3, luminance(color_map_entry(m, i - 1)))
+          << color_map_name(m) << i;
   int brightest = 0;
   for (int i = 1; i < 256; ++i)
-    if (luminance(color_map_entry(ColorMapId::coolwarm, i)) > luminance(color_map_entry(ColorMapId::coolwarm, brightest)))
+    if (luminance(color_map_entry(ColorMapId::coolwarm, i)) >
+        luminance(color_map_entry(ColorMapId::coolwarm, brightest)))
       brightest = i;
   EXPECT_NEAR(brightest, 128, 8);
 }

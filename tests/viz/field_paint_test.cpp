@@ -63,8 +63,8 @@ TEST(FieldPaint, VonMisesOfUniaxialStressAndPureShear) {
     for (double v : {0.0, tau, 0.0, tau, 0.0, 0.0, 0.0, 0.0, 0.0}) full.values.push_back(v);
   m.fields = {s, full};
   const std::vector<double> vm = field_scalar_values(m, choose_field(m, "stress"));
-  EXPECT_NEAR(vm[0], 7e6, 1e-6);                     // uniaxial: sigma itself
-  EXPECT_NEAR(vm[1], std::sqrt(3.0) * tau, 1e-6);    // pure shear: sqrt(3) tau
+  EXPECT_NEAR(vm[0], 7e6, 1e-6);                   // uniaxial: sigma itself
+  EXPECT_NEAR(vm[1], std::sqrt(3.0) * tau, 1e-6);  // pure shear: sqrt(3) tau
   EXPECT_NEAR(field_scalar_values(m, choose_field(m, "sigma"))[2], std::sqrt(3.0) * tau, 1e-6);
 }
 
@@ -75,7 +75,8 @@ TEST(FieldPaint, CentroidValuesOfALinearFieldAreTheFieldAtTheCentroid) {
   for (std::size_t e = 0; e < m.tet_count(); ++e) {
     double c[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)
-      for (int j = 0; j < 3; ++j) c[j] += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * e + std::size_t(k)]) + std::size_t(j)];
+      for (int j = 0; j < 3; ++j)
+        c[j] += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * e + std::size_t(k)]) + std::size_t(j)];
     EXPECT_NEAR(t[e], linear(c), 1e-12);
     EXPECT_NEAR(mag[e], std::sqrt(14.0) * std::abs(linear(c)), 1e-11);  // |(1, 2, 3) f|
   }
@@ -101,7 +102,8 @@ TEST(FieldPaint, GradedCellFieldCornerLiesBetweenItsTetsValues) {
   for (std::size_t e = 0; e < m.tet_count(); ++e) {
     double c[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)
-      for (int j = 0; j < 3; ++j) c[j] += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * e + std::size_t(k)]) + std::size_t(j)];
+      for (int j = 0; j < 3; ++j)
+        c[j] += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * e + std::size_t(k)]) + std::size_t(j)];
     f.values.push_back(linear(c));
   }
   m.fields = {f};

@@ -66,7 +66,8 @@ TEST(FieldRender, FlatTetPixelsAreTheirValuesColourUnderTheShadingBand) {
   value[7] = std::nan("");
   const SphereTable table = compute_spheres(m);
   std::size_t checked = 0, decoded_exactly = 0;
-  for (ColorMapId map : {ColorMapId::viridis, ColorMapId::cividis, ColorMapId::coolwarm, ColorMapId::rainbow}) {
+  for (ColorMapId map :
+       {ColorMapId::viridis, ColorMapId::cividis, ColorMapId::coolwarm, ColorMapId::rainbow}) {
     int worst = 0;  // the farthest entry a pixel of this map could be read as
     ColorScale s;
     s.map = map;
@@ -94,15 +95,20 @@ TEST(FieldRender, FlatTetPixelsAreTheirValuesColourUnderTheShadingBand) {
         decoded_exactly += can.size() == 1;
       }
     }
-    std::printf("%s: a shaded pixel decodes to within %d entries of its value's\n", color_map_name(map), worst);
+    std::printf("%s: a shaded pixel decodes to within %d entries of its value's\n", color_map_name(map),
+                worst);
     // Measured bounds (8-bit tables, shading in [0.75, 1]): coolwarm and rainbow change hue from entry to
     // entry, so a pixel reads back within one entry; viridis has neighbouring entries equal in 8 bits
     // (two); cividis is almost a lightness ramp, which lightness shading aliases (17 entries, 7% of the
     // range): read cividis pictures by hue only roughly.
-    EXPECT_LE(worst, map == ColorMapId::cividis ? 17 : map == ColorMapId::viridis ? 2 : 1) << color_map_name(map);
+    EXPECT_LE(worst, map == ColorMapId::cividis   ? 17
+                     : map == ColorMapId::viridis ? 2
+                                                  : 1)
+        << color_map_name(map);
   }
   EXPECT_GT(checked, 20000u);
-  std::printf("flat: %zu pixels, %.1f%% decode to exactly one entry\n", checked, 100.0 * double(decoded_exactly) / double(checked));
+  std::printf("flat: %zu pixels, %.1f%% decode to exactly one entry\n", checked,
+              100.0 * double(decoded_exactly) / double(checked));
 }
 
 // The camera-frame ray of pixel centre (x, y): origin o + s dir (perspective: o = 0).
@@ -130,8 +136,8 @@ void pixel_ray(const Projector& p, int x, int y, double o[3], double d[3]) {
 // field's value there, by the barycentric weights of the face's corners. NaN if none is hit, if the
 // hit is within `margin` of the face's edges (barycentric) or the face is seen nearly edge-on.
 // Perspective: only hits beyond the near plane (the eye may be inside the mesh).
-double value_at_entry(const Mesh& m, const Projector& p, std::uint32_t t, const double o[3], const double d[3],
-                      double margin, double near) {
+double value_at_entry(const Mesh& m, const Projector& p, std::uint32_t t, const double o[3],
+                      const double d[3], double margin, double near) {
   static const int kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
   double c[4][3], f[4];
   for (int k = 0; k < 4; ++k) {
@@ -145,13 +151,16 @@ double value_at_entry(const Mesh& m, const Projector& p, std::uint32_t t, const 
     const double* B = c[face[1]];
     const double* C = c[face[2]];
     // Solve o + s d = A + u (B - A) + v (C - A) by Cramer's rule.
-    const double e1[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]}, e2[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
-    const double h[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2], d[0] * e2[1] - d[1] * e2[0]};
+    const double e1[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]},
+                 e2[3] = {C[0] - A[0], C[1] - A[1], C[2] - A[2]};
+    const double h[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2],
+                         d[0] * e2[1] - d[1] * e2[0]};
     const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
     if (std::abs(det) < 1e-300) continue;
     const double sv[3] = {o[0] - A[0], o[1] - A[1], o[2] - A[2]};
     const double uu = (sv[0] * h[0] + sv[1] * h[1] + sv[2] * h[2]) / det;
-    const double q[3] = {sv[1] * e1[2] - sv[2] * e1[1], sv[2] * e1[0] - sv[0] * e1[2], sv[0] * e1[1] - sv[1] * e1[0]};
+    const double q[3] = {sv[1] * e1[2] - sv[2] * e1[1], sv[2] * e1[0] - sv[0] * e1[2],
+                         sv[0] * e1[1] - sv[1] * e1[0]};
     const double vv = (d[0] * q[0] + d[1] * q[1] + d[2] * q[2]) / det;
     const double s = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) / det;
     if (uu < -1e-9 || vv < -1e-9 || uu + vv > 1 + 1e-9) continue;
@@ -161,9 +170,11 @@ double value_at_entry(const Mesh& m, const Projector& p, std::uint32_t t, const 
       best = (1 - uu - vv) * f[face[0]] + uu * f[face[1]] + vv * f[face[2]];
       // A face seen nearly edge-on projects to a sliver whose corners' snapping to 1/256 pixel moves
       // the interpolation by whole entries: not a clear sample (|cos| of the ray to the normal < 0.2).
-      const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-      const double cosine = (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]) /
-                            std::sqrt((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+      const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                           e1[0] * e2[1] - e1[1] * e2[0]};
+      const double cosine =
+          (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]) /
+          std::sqrt((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
       if (std::abs(cosine) < 0.2) best = std::nan("");
       // Within `margin` of the entry face's edges: the pixel may be drawn by a neighbouring face.
       if (uu < margin || vv < margin || uu + vv > 1 - margin) best = std::nan("");
@@ -204,8 +215,8 @@ TEST(FieldRender, GradedFacesInterpolateTheFieldLinearly) {
         ASSERT_FALSE(can.empty());
         // Within one entry: the pixel's position is interpolated from snapped corners in float.
         EXPECT_TRUE(std::abs(can.front() - entry) <= 1 || std::abs(can.back() - entry) <= 1)
-            << (cam.perspective ? "perspective " : "orthographic ") << "pixel " << x << "," << y << " value " << v << " entry " << entry << " decoded " << can.front() << ".."
-            << can.back();
+            << (cam.perspective ? "perspective " : "orthographic ") << "pixel " << x << "," << y << " value "
+            << v << " entry " << entry << " decoded " << can.front() << ".." << can.back();
         exact += std::find(can.begin(), can.end(), entry) != can.end();
         ++seen[std::size_t(entry)];
         ++checked;
@@ -237,10 +248,12 @@ TEST(FieldRender, PainterEqualsDepthBufferWithFieldColours) {
     for (bool graded : {false, true}) {
       const FieldChoice choice = choose_field(m, name);
       ColorScale s;
-      const std::vector<double> values = graded ? tet_corner_values(m, choice) : tet_centroid_values(m, choice);
+      const std::vector<double> values =
+          graded ? tet_corner_values(m, choice) : tet_centroid_values(m, choice);
       std::tie(s.lo, s.hi) = finite_range(values);
       RenderParams pp;
-      pp.field = std::make_shared<FieldPaint>(graded ? graded_field_paint(values, s) : flat_field_paint(values, s));
+      pp.field =
+          std::make_shared<FieldPaint>(graded ? graded_field_paint(values, s) : flat_field_paint(values, s));
       RenderParams zp = pp;
       zp.depth_buffer = true;
       RenderParams plain;  // region colours: the same geometry
@@ -256,7 +269,8 @@ TEST(FieldRender, PainterEqualsDepthBufferWithFieldColours) {
             continue;
           }
           ++compared;
-          ASSERT_EQ(painter.rgba[p], zbuf.rgba[p]) << name << (graded ? " graded" : " flat") << " pixel " << p;
+          ASSERT_EQ(painter.rgba[p], zbuf.rgba[p])
+              << name << (graded ? " graded" : " flat") << " pixel " << p;
         }
       }
     }
@@ -273,7 +287,8 @@ TEST(FieldRender, GradedUndrawEqualsDrawingFromScratch) {
   Mesh m = test::random_delaunay(dir, 300, 41);
   test::regions_along_x(m, 0.3, 0.6);
   Field cell{"c", FieldLocation::cell, 1, "", {}, {}};
-  for (std::size_t t = 0; t < m.tet_count(); ++t) cell.values.push_back(m.region_of(t) + 0.2 * std::sin(7.0 * double(t)));
+  for (std::size_t t = 0; t < m.tet_count(); ++t)
+    cell.values.push_back(m.region_of(t) + 0.2 * std::sin(7.0 * double(t)));
   Field node{"n", FieldLocation::node, 1, "", {}, {}};
   for (std::size_t n = 0; n < m.node_count(); ++n) node.values.push_back(linear_field(&m.xyz[3 * n]));
   m.fields = {cell, node};
@@ -302,7 +317,8 @@ TEST(FieldRender, GradedUndrawEqualsDrawingFromScratch) {
       r.undraw(fb, k - j - (k - j) / 3);
       const Framebuffer want = render_tets(m, cam, kW, kH, all.first(j), fresh);
       std::size_t differ = 0;
-      for (std::size_t p = 0; p < want.rgba.size(); ++p) differ += want.rgba[p] != fb.rgba[p] || want.id[p] != fb.id[p];
+      for (std::size_t p = 0; p < want.rgba.size(); ++p)
+        differ += want.rgba[p] != fb.rgba[p] || want.id[p] != fb.id[p];
       EXPECT_EQ(differ, 0u) << name << " k " << k << " j " << j << " of " << order.size();
       compared += want.rgba.size();
     }
@@ -318,11 +334,13 @@ TEST(FieldRender, BadPaintsAreRefused) {
   paint->tet_color.resize(3);
   rp.field = paint;
   EXPECT_THROW(TetRasterizer(m, cam, 10, 10, rp), std::invalid_argument);
-  auto graded = std::make_shared<FieldPaint>(graded_field_paint(tet_corner_values(m, choose_field(m, "f")), ColorScale{}));
+  auto graded = std::make_shared<FieldPaint>(
+      graded_field_paint(tet_corner_values(m, choose_field(m, "f")), ColorScale{}));
   graded->corner_position.pop_back();
   rp.field = graded;
   EXPECT_THROW(TetRasterizer(m, cam, 10, 10, rp), std::invalid_argument);
-  auto shade = std::make_shared<FieldPaint>(flat_field_paint(tet_centroid_values(m, choose_field(m, "f")), ColorScale{}));
+  auto shade = std::make_shared<FieldPaint>(
+      flat_field_paint(tet_centroid_values(m, choose_field(m, "f")), ColorScale{}));
   shade->shade_min = 1.5;
   rp.field = shade;
   EXPECT_THROW(TetRasterizer(m, cam, 10, 10, rp), std::invalid_argument);

@@ -31,8 +31,8 @@ TEST(Legend, TicksAreNiceInsideTheRangeAndLabelsApart) {
     bool log;
     int height;
   } cases[] = {{298.15, 358.4, "K", "degC", false, 400}, {0, 2.3e8, "Pa", "MPa", false, 300},
-               {-3e-6, 4.1e-6, "m", "um", false, 250},    {1e2, 3e7, "Pa", "Pa", true, 400},
-               {0.0312, 0.0318, "V", "mV", false, 160},   {-1, 1, "", "", false, 600}};
+               {-3e-6, 4.1e-6, "m", "um", false, 250},   {1e2, 3e7, "Pa", "Pa", true, 400},
+               {0.0312, 0.0318, "V", "mV", false, 160},  {-1, 1, "", "", false, 600}};
   for (const Case& c : cases) {
     ColorLegend l;
     l.title = "field";
@@ -69,7 +69,8 @@ TEST(Legend, TicksAreNiceInsideTheRangeAndLabelsApart) {
     // The bar: the bottom row shows entry 0, the top row entry 255, the rows between evenly spaced.
     for (int y = r.bar.y0; y <= r.bar.y1; ++y) {
       const double t = double(r.bar.y1 - y) / double(r.bar.y1 - r.bar.y0);
-      EXPECT_EQ(fb.rgba[fb.index(r.bar.x0 + 2, y)], color_map_entry(l.scale.map, std::min(255, int(std::floor(t * 256)))));
+      EXPECT_EQ(fb.rgba[fb.index(r.bar.x0 + 2, y)],
+                color_map_entry(l.scale.map, std::min(255, int(std::floor(t * 256)))));
     }
     EXPECT_EQ(fb.rgba[fb.index(r.bar.x0 + 2, r.bar.y1)], color_map_entry(l.scale.map, 0));
     EXPECT_EQ(fb.rgba[fb.index(r.bar.x0 + 2, r.bar.y0)], color_map_entry(l.scale.map, 255));

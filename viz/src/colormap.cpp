@@ -12,10 +12,14 @@ namespace {
 
 const std::uint8_t (*table(ColorMapId map))[3] {
   switch (map) {
-    case ColorMapId::cividis: return detail::kCividisTable;
-    case ColorMapId::coolwarm: return detail::kCoolwarmTable;
-    case ColorMapId::rainbow: return detail::kRainbowTable;
-    case ColorMapId::viridis: break;
+    case ColorMapId::cividis:
+      return detail::kCividisTable;
+    case ColorMapId::coolwarm:
+      return detail::kCoolwarmTable;
+    case ColorMapId::rainbow:
+      return detail::kRainbowTable;
+    case ColorMapId::viridis:
+      break;
   }
   return detail::kViridisTable;
 }
@@ -30,10 +34,14 @@ std::optional<ColorMapId> parse_color_map(std::string_view name) {
 
 const char* color_map_name(ColorMapId map) {
   switch (map) {
-    case ColorMapId::cividis: return "cividis";
-    case ColorMapId::coolwarm: return "coolwarm";
-    case ColorMapId::rainbow: return "rainbow";
-    case ColorMapId::viridis: break;
+    case ColorMapId::cividis:
+      return "cividis";
+    case ColorMapId::coolwarm:
+      return "coolwarm";
+    case ColorMapId::rainbow:
+      return "rainbow";
+    case ColorMapId::viridis:
+      break;
   }
   return "viridis";
 }

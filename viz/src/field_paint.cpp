@@ -25,7 +25,8 @@ int component_index(std::string_view c, std::uint32_t n) {
   if (n == 9)
     for (int i = 0; i < 9; ++i)
       if (c == k9[i]) return i;
-  if (!c.empty() && c.size() < 4 && std::all_of(c.begin(), c.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
+  if (!c.empty() && c.size() < 4 &&
+      std::all_of(c.begin(), c.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
     const int i = std::stoi(std::string(c));
     if (i >= 0 && std::uint32_t(i) < n) return i;
   }
@@ -45,7 +46,8 @@ bool is_tensor(std::uint32_t n) { return n == 6 || n == 9; }
 // The scalar of one entity's components c[0..n).
 double scalar_of(const FieldScalar& s, const double* c, std::uint32_t n) {
   switch (s.kind) {
-    case FieldScalar::Kind::component: return c[s.component];
+    case FieldScalar::Kind::component:
+      return c[s.component];
     case FieldScalar::Kind::magnitude: {
       double q = 0;
       for (std::uint32_t i = 0; i < n; ++i) q += c[i] * c[i];
@@ -56,7 +58,8 @@ double scalar_of(const FieldScalar& s, const double* c, std::uint32_t n) {
       if (n == 6) {
         xx = c[0], yy = c[1], zz = c[2], xy = c[3], yz = c[4], xz = c[5];
       } else {  // 9, row-major: the symmetric part
-        xx = c[0], yy = c[4], zz = c[8], xy = 0.5 * (c[1] + c[3]), yz = 0.5 * (c[5] + c[7]), xz = 0.5 * (c[2] + c[6]);
+        xx = c[0], yy = c[4], zz = c[8], xy = 0.5 * (c[1] + c[3]), yz = 0.5 * (c[5] + c[7]),
+        xz = 0.5 * (c[2] + c[6]);
       }
       return std::sqrt(0.5 * ((xx - yy) * (xx - yy) + (yy - zz) * (yy - zz) + (zz - xx) * (zz - xx)) +
                        3 * (xy * xy + yz * yz + xz * xz));
@@ -67,8 +70,8 @@ double scalar_of(const FieldScalar& s, const double* c, std::uint32_t n) {
 
 std::span<const double> step_values(const Mesh& mesh, const Field& f, std::size_t step) {
   if (step >= f.step_count())
-    throw FieldSelectError("field '" + f.name + "' has " + std::to_string(f.step_count()) + " step(s), not step " +
-                           std::to_string(step));
+    throw FieldSelectError("field '" + f.name + "' has " + std::to_string(f.step_count()) +
+                           " step(s), not step " + std::to_string(step));
   return f.step(step, field_entity_count(mesh, f));
 }
 
@@ -78,7 +81,8 @@ double tet_volume(const Mesh& mesh, std::size_t t) {
   double a[3][3];
   for (int k = 0; k < 3; ++k)
     for (int j = 0; j < 3; ++j) a[k][j] = mesh.xyz[3 * std::size_t(v[k + 1]) + std::size_t(j)] - p0[j];
-  return std::abs(a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+  return std::abs(a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                  a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
                   a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])) /
          6;
 }
@@ -109,7 +113,8 @@ FieldChoice choose_field(const Mesh& mesh, std::string_view spec) {
       c.label += ", von Mises";
     } else if (n != 1) {
       throw FieldSelectError("field '" + c.field->name + "' has " + std::to_string(n) +
-                             " components: choose one as " + c.field->name + ":COMPONENT (" + component_names(n) + ")");
+                             " components: choose one as " + c.field->name + ":COMPONENT (" +
+                             component_names(n) + ")");
     }
     return c;
   }
@@ -125,8 +130,8 @@ FieldChoice choose_field(const Mesh& mesh, std::string_view spec) {
   }
   const int i = component_index(comp, n);
   if (i < 0)
-    throw FieldSelectError("field '" + c.field->name + "' has no component '" + std::string(comp) + "' (it has " +
-                           component_names(n) + ")");
+    throw FieldSelectError("field '" + c.field->name + "' has no component '" + std::string(comp) +
+                           "' (it has " + component_names(n) + ")");
   c.scalar.component = std::uint32_t(i);
   c.label += " " + std::string(comp);
   return c;
@@ -137,7 +142,8 @@ std::vector<double> field_scalar_values(const Mesh& mesh, const FieldChoice& cho
   const std::span<const double> v = step_values(mesh, f, step);
   const std::size_t count = field_entity_count(mesh, f);
   std::vector<double> out(count);
-  for (std::size_t e = 0; e < count; ++e) out[e] = scalar_of(choice.scalar, &v[e * f.components], f.components);
+  for (std::size_t e = 0; e < count; ++e)
+    out[e] = scalar_of(choice.scalar, &v[e * f.components], f.components);
   return out;
 }
 
@@ -185,7 +191,8 @@ std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choic
     weight.assign(mesh.node_count(), 0.0);
   } else {
     for (std::size_t i = 0; i < slot_of.size(); ++i) {
-      auto [it, fresh] = slot.emplace(std::make_pair(tet_region_index[i / 4], mesh.tet[i]), std::uint32_t(weight.size()));
+      auto [it, fresh] =
+          slot.emplace(std::make_pair(tet_region_index[i / 4], mesh.tet[i]), std::uint32_t(weight.size()));
       if (fresh) weight.push_back(0);
       slot_of[i] = it->second;
     }
@@ -216,7 +223,7 @@ std::optional<DisplayUnit> display_unit(std::string_view si, std::string_view d)
     double factor, offset;
   };
   static const Conv kConv[] = {
-      {"K", "degC", "°C", 1, 273.15}, {"K", "°C", "°C", 1, 273.15}, {"K", "C", "°C", 1, 273.15},
+      {"K", "degC", "°C", 1, 273.15}, {"K", "°C", "°C", 1, 273.15},  {"K", "C", "°C", 1, 273.15},
       {"Pa", "kPa", "kPa", 1e-3, 0},  {"Pa", "MPa", "MPa", 1e-6, 0}, {"Pa", "GPa", "GPa", 1e-9, 0},
       {"m", "mm", "mm", 1e3, 0},      {"m", "um", "µm", 1e6, 0},     {"m", "µm", "µm", 1e6, 0},
       {"m", "nm", "nm", 1e9, 0},      {"V", "mV", "mV", 1e3, 0},     {"V", "kV", "kV", 1e-3, 0},
@@ -249,7 +256,8 @@ FieldPaint graded_field_paint(std::span<const double> corner_values, const Color
   p.scale = scale;
   p.graded = true;
   p.corner_position.resize(corner_values.size());
-  for (std::size_t i = 0; i < corner_values.size(); ++i) p.corner_position[i] = float(scale.position(corner_values[i]));
+  for (std::size_t i = 0; i < corner_values.size(); ++i)
+    p.corner_position[i] = float(scale.position(corner_values[i]));
   return p;
 }
 

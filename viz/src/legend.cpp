@@ -12,7 +12,8 @@ namespace {
 std::string range_line(const ColorLegend& l) {
   const double lo = l.unit.to_display(l.scale.lo), hi = l.unit.to_display(l.scale.hi);
   const double step = std::abs(hi - lo) / 100;
-  return tick_label(lo, step) + " to " + tick_label(hi, step) + (l.unit.symbol.empty() ? "" : " " + l.unit.symbol);
+  return tick_label(lo, step) + " to " + tick_label(hi, step) +
+         (l.unit.symbol.empty() ? "" : " " + l.unit.symbol);
 }
 
 std::string map_line(const ColorLegend& l) {
@@ -32,7 +33,8 @@ std::vector<double> legend_ticks(const ColorLegend& l, int bar_h, int line_h) {
   const bool log = l.scale.log && lo > 0;
   auto apart = [&](const std::vector<double>& t) {
     for (std::size_t i = 1; i < t.size(); ++i)
-      if (std::abs(l.scale.position(l.unit.to_si(t[i])) - l.scale.position(l.unit.to_si(t[i - 1]))) * (bar_h - 1) <
+      if (std::abs(l.scale.position(l.unit.to_si(t[i])) - l.scale.position(l.unit.to_si(t[i - 1]))) *
+              (bar_h - 1) <
           line_h + 2)
         return false;
     return true;
@@ -72,17 +74,19 @@ int legend_width(const TextRenderer& text, const ColorLegend& l, const LegendPar
                     text.measure(map_line(l), fs).advance});
   // Tick labels: the widest that the range's ends could need, at the finest step.
   const double lo = l.unit.to_display(l.scale.lo), hi = l.unit.to_display(l.scale.hi);
-  const std::vector<double> t = nice_ticks(std::min(lo, hi), std::max(lo, hi), 12, l.scale.log && std::min(lo, hi) > 0);
+  const std::vector<double> t =
+      nice_ticks(std::min(lo, hi), std::max(lo, hi), 12, l.scale.log && std::min(lo, hi) > 0);
   const double step = t.size() > 1 ? t[1] - t[0] : std::abs(hi - lo);
   int label = 0;
   for (double v : t) label = std::max(label, text.measure(tick_label(v, step), fs).advance);
-  label = std::max({label, text.measure(tick_label(lo, step), fs).advance, text.measure(tick_label(hi, step), fs).advance});
+  label = std::max({label, text.measure(tick_label(lo, step), fs).advance,
+                    text.measure(tick_label(hi, step), fs).advance});
   w = std::max(w, p.bar_width + 6 + label);
   return w + 2 * p.margin;
 }
 
-LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& l, PixelRect area,
-                               const LegendParams& p) {
+LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& l,
+                               PixelRect area, const LegendParams& p) {
   area.x0 = std::max(area.x0, 0);
   area.y0 = std::max(area.y0, 0);
   area.x1 = std::min(area.x1, fb.width - 1);
@@ -118,7 +122,9 @@ LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const 
   }
   r.ticks = legend_ticks(l, bar_h, fs);
   // Log ticks span decades: each label in %g form (step 0).
-  const double step = l.scale.log ? 0 : r.ticks.size() > 1 ? r.ticks[1] - r.ticks[0] : std::abs(l.scale.hi - l.scale.lo);
+  const double step = l.scale.log          ? 0
+                      : r.ticks.size() > 1 ? r.ticks[1] - r.ticks[0]
+                                           : std::abs(l.scale.hi - l.scale.lo);
   for (double v : r.ticks) {
     const double t = l.scale.position(l.unit.to_si(v));
     const int row = bar_bottom - int(std::lround(t * double(bar_h - 1)));

@@ -8,10 +8,12 @@ namespace foxi {
 void TetRasterizer::Impl::setup_field() {
   if ((field = params.field.get()) == nullptr) return;
   const Mesh& m = *mesh;
-  if (field->graded ? field->corner_position.size() != m.tet.size() : field->tet_color.size() != m.tet_count())
-    throw std::invalid_argument("render: the field paint has " +
-                                std::to_string(field->graded ? field->corner_position.size() : field->tet_color.size()) +
-                                " values for a mesh of " + std::to_string(m.tet_count()) + " tets");
+  if (field->graded ? field->corner_position.size() != m.tet.size()
+                    : field->tet_color.size() != m.tet_count())
+    throw std::invalid_argument(
+        "render: the field paint has " +
+        std::to_string(field->graded ? field->corner_position.size() : field->tet_color.size()) +
+        " values for a mesh of " + std::to_string(m.tet_count()) + " tets");
   if (!(field->shade_min >= 0 && field->shade_min <= 1))
     throw std::invalid_argument("render: the field paint's shade_min must be in [0, 1]");
   for (int i = 0; i < 256; ++i) {
@@ -37,7 +39,8 @@ std::uint32_t TetRasterizer::Impl::graded_color(const FaceSetup& fs, int x, int 
   } else {
     c = field_lut[int(std::clamp(t * 256, 0.0, 255.0))];
   }
-  return pack_rgba(std::uint32_t(c[0] * f + 0.5f), std::uint32_t(c[1] * f + 0.5f), std::uint32_t(c[2] * f + 0.5f));
+  return pack_rgba(std::uint32_t(c[0] * f + 0.5f), std::uint32_t(c[1] * f + 0.5f),
+                   std::uint32_t(c[2] * f + 0.5f));
 }
 
 void TetRasterizer::Impl::neighbour_positions(std::uint32_t nb, const std::uint32_t* tv, float out[4]) const {

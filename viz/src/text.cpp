@@ -147,7 +147,8 @@ PixelRect TextRenderer::draw(Framebuffer& fb, std::string_view text, int x, int 
         if (a == 0) continue;
         std::uint32_t& p = fb.rgba[fb.index(px, y)];
         auto mix = [a](std::uint32_t fg, std::uint32_t bg) { return (fg * a + bg * (255 - a) + 127) / 255; };
-        p = pack_rgba(mix(cr, p & 255u), mix(cg, (p >> 8) & 255u), mix(cb, (p >> 16) & 255u), (p >> 24) & 255u);
+        p = pack_rgba(mix(cr, p & 255u), mix(cg, (p >> 8) & 255u), mix(cb, (p >> 16) & 255u),
+                      (p >> 24) & 255u);
         box.x0 = std::min(box.x0, px);
         box.y0 = std::min(box.y0, y);
         box.x1 = std::max(box.x1, px);

@@ -21,19 +21,19 @@ struct ColorLegend {
 };
 
 struct LegendParams {
-  int font_px = 14;          // label size (the title is the same size)
-  int bar_width = 18;        // pixels
-  int margin = 10;           // around the legend's contents
+  int font_px = 14;    // label size (the title is the same size)
+  int bar_width = 18;  // pixels
+  int margin = 10;     // around the legend's contents
   std::uint32_t text_color = pack_rgba(0, 0, 0);
   std::uint32_t background = pack_rgba(255, 255, 255);
 };
 
 struct LegendReport {
-  std::vector<double> ticks;   // the tick values, display unit, ascending
-  std::vector<int> tick_rows;  // the row of each tick on the bar
+  std::vector<double> ticks;      // the tick values, display unit, ascending
+  std::vector<int> tick_rows;     // the row of each tick on the bar
   std::vector<PixelRect> labels;  // each tick label's ink box
-  PixelRect bar;               // the bar's pixels
-  PixelRect rect;              // all the legend drew (its area)
+  PixelRect bar;                  // the bar's pixels
+  PixelRect rect;                 // all the legend drew (its area)
 };
 
 // The width a legend needs (pixels) at these parameters.
@@ -41,8 +41,8 @@ int legend_width(const TextRenderer& text, const ColorLegend& legend, const Lege
 
 // Draws the legend into `area` of fb (filled with the background first; area inside the image and at
 // least legend_width wide). Throws std::invalid_argument if the area is too small for a bar.
-LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& legend, PixelRect area,
-                               const LegendParams& params = {});
+LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& legend,
+                               PixelRect area, const LegendParams& params = {});
 
 // A tick label: the value with as many decimals as the step between ticks needs (%g beyond 1e6 or
 // below 1e-3 in magnitude).
