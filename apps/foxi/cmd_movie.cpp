@@ -174,11 +174,7 @@ int cmd_movie(Args args) {
     options.params.field = field.paint;
     if (field_options.legend) {
       const TextRenderer text(find_font_file());
-      const int panel = legend_panel_width(text, field);
-      if (options.width - panel < 64)
-        throw UsageError("--size " + std::to_string(options.width) + "x" + std::to_string(options.height) +
-                         " leaves no room for the legend (" + std::to_string(panel) +
-                         " pixels wide): make it wider or give --legend off");
+      const int panel = legend_panel(text, field, options.width, options.height);
       framed = with_legend(Framebuffer(options.width - panel, options.height), text, field, panel);
       options.width -= panel;
       picture = resolve_picture(options, mesh);

@@ -98,10 +98,7 @@ int cmd_render(Args args) {
     params.field = field.paint;
     if (field_options.legend) {
       text = std::make_unique<TextRenderer>(find_font_file());
-      panel = legend_panel_width(*text, field);
-      if (options.width - panel < 64)
-        throw UsageError("--size " + std::to_string(options.width) + "x" + std::to_string(options.height) +
-                         " leaves no room for the legend (" + std::to_string(panel) + " pixels wide): make it wider or give --legend off");
+      panel = legend_panel(*text, field, options.width, options.height);
       options.width -= panel;
       picture = resolve_picture(options, mesh);
     }

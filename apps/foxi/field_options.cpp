@@ -133,8 +133,14 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
   return f;
 }
 
-int legend_panel_width(const TextRenderer& text, const FieldPicture& field) {
-  return legend_width(text, field.legend);
+int legend_panel(const TextRenderer& text, const FieldPicture& field, int width, int height) {
+  const int panel = legend_width(text, field.legend);
+  if (width - panel < 64 || height < legend_min_height())
+    throw UsageError("--size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " leaves no room for the legend (" + std::to_string(panel) + " pixels wide, " +
+                     std::to_string(legend_min_height()) +
+                     " high at least): make it larger or give --legend off");
+  return panel;
 }
 
 Framebuffer with_legend(const Framebuffer& scene, const TextRenderer& text, const FieldPicture& field,

@@ -48,8 +48,9 @@ struct FieldPicture {
 FieldPicture resolve_field(const FieldOptions& options, const Mesh& mesh,
                            std::span<const std::uint32_t> subset, const std::string& path);
 
-// The legend's width at the font found on the system (FontError if none).
-int legend_panel_width(const TextRenderer& text, const FieldPicture& field);
+// The legend panel's width for a width x height picture; UsageError if the picture is too narrow
+// (under 64 pixels left for the mesh) or too low (legend_min_height) for it.
+int legend_panel(const TextRenderer& text, const FieldPicture& field, int width, int height);
 // The picture `scene` with the legend in a panel of `panel` pixels at its right: the result is
 // scene.width + panel wide (id kNone in the panel). Callers draw the mesh panel pixels narrower than
 // the picture asked for.

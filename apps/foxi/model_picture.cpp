@@ -98,7 +98,7 @@ ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
     field = resolve_field(fo, mesh, subset, path);
     rp.field = field.paint;
     text = std::make_unique<TextRenderer>(find_font_file());
-    panel = legend_panel_width(*text, field);
+    panel = legend_panel(*text, field, p.width, p.height);
     width = std::max(64, p.width - panel);
     out.field_lo = field.legend.unit.to_display(field.legend.scale.lo);
     out.field_hi = field.legend.unit.to_display(field.legend.scale.hi);

@@ -150,6 +150,10 @@ TEST_F(FieldCli, UsageErrorsSayWhatIsWrong) {
   EXPECT_EQ(foxi("render " + m + " --field temperature --step 3" + o, &log), 2);
   EXPECT_EQ(foxi("render " + m + " --field temperature --size 100x100" + o, &log), 2);
   EXPECT_NE(log.find("legend"), std::string::npos) << log;
+  EXPECT_EQ(foxi("render " + m + " --field temperature --size 600x60" + o, &log), 2);  // too low for a bar
+  EXPECT_NE(log.find("legend"), std::string::npos) << log;
+  EXPECT_EQ(foxi("render " + m + " --field temperature --legend off --size 600x60" + o, &log), 0) << log;
+  std::filesystem::remove(dir_ / "x.png");
   EXPECT_EQ(
       foxi("movie " + m + " --field temperature --graded --range 1 -o '" + (dir_ / "m.gif").string() + "'",
            &log),

@@ -94,6 +94,12 @@ TEST(Legend, TooSmallAnAreaIsRefused) {
   l.title = "t";
   Framebuffer fb(100, 40);
   EXPECT_THROW(draw_color_legend(fb, text, l, PixelRect{0, 0, 99, 39}), std::invalid_argument);
+  // legend_min_height is exactly what a bar needs.
+  const int h = legend_min_height(), w = legend_width(text, l);
+  Framebuffer tall(w, h);
+  EXPECT_NO_THROW(draw_color_legend(tall, text, l, PixelRect{0, 0, w - 1, h - 1}));
+  Framebuffer low(w, h - 1);
+  EXPECT_THROW(draw_color_legend(low, text, l, PixelRect{0, 0, w - 1, h - 2}), std::invalid_argument);
 }
 
 }  // namespace

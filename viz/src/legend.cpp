@@ -68,6 +68,12 @@ std::string tick_label(double value, double step) {
   return buf;
 }
 
+int legend_min_height(const LegendParams& p) {
+  const int fs = p.font_px, line = fs + fs / 2;
+  // As draw_color_legend lays it out: title, bar (2 labels high at least), range and map lines.
+  return (p.margin + fs + line / 2 + fs / 2) + 2 * fs + (p.margin + 2 * line + fs / 2);
+}
+
 int legend_width(const TextRenderer& text, const ColorLegend& l, const LegendParams& p) {
   const int fs = p.font_px;
   int w = std::max({text.measure(title_line(l), fs).advance, text.measure(range_line(l), fs).advance,

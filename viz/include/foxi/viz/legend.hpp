@@ -36,6 +36,9 @@ struct LegendReport {
   PixelRect rect;                 // all the legend drew (its area)
 };
 
+// The height a legend needs at least (pixels) at these parameters: a bar two labels high.
+int legend_min_height(const LegendParams& params = {});
+
 // The width a legend needs (pixels) at these parameters.
 int legend_width(const TextRenderer& text, const ColorLegend& legend, const LegendParams& params = {});
 
