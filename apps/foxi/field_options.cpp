@@ -7,8 +7,9 @@ namespace foxi::cli {
 
 const char* const kFieldOptionsHelp =
     "  --field NAME[:C] colour by a field: C a component (x y z, xx yy zz xy yz xz, or an index), mag\n"
-    "                  (a vector's magnitude, the default for vectors) or vm (von Mises, the default\n"
-    "                  for tensors); flat per tet (the value at its centroid) unless --graded\n"
+    "                  (a vector's magnitude, the default for vectors), vm (von Mises, the default\n"
+    "                  for tensors) or p1 p2 p3 (a tensor's principal values, largest first); flat per\n"
+    "                  tet (the value at its centroid) unless --graded\n"
     "  --graded        graded facets: each face's colour interpolated from its corners (a cell field is\n"
     "                  first averaged to the nodes within each region, never across an interface)\n"
     "  --cmap M        viridis (default), cividis, coolwarm (diverging) or rainbow (Turbo)\n"

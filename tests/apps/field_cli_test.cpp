@@ -210,8 +210,9 @@ TEST_F(FieldCli, MovieWithAFieldKeepsOneRange) {
 }
 
 // The von Mises stress foxi colours by (from the stress tensor) against the one the thermoelastic
-// solver writes itself (another code path: the solver's own von_mises field), tet by tet.
-TEST_F(FieldCli, VonMisesOfStressEqualsTheSolversOwn) {
+// solver writes itself (another code path: the solver's own von_mises field), tet by tet, and the
+// principal values against the solver's principal_stress.
+TEST_F(FieldCli, VonMisesAndPrincipalValuesEqualTheSolversOwn) {
   const auto vtu = dir_ / "te.vtu";
   std::string log;
   ASSERT_EQ(foxi("solve '" + test::models_dir() + "die_on_substrate.toml' --physics thermoelastic -o '" +
@@ -226,6 +227,16 @@ TEST_F(FieldCli, VonMisesOfStressEqualsTheSolversOwn) {
   ASSERT_GT(ours.size(), 1000u);
   for (std::size_t t = 0; t < ours.size(); ++t)
     EXPECT_NEAR(ours[t], solver[t], 1e-9 * solver[t] + 1e-6) << "tet " << t;
+  // The principal values (Smith's closed form here, Eigen's eigensolver in the solver), largest first.
+  const Field* principal = m.find_field("principal_stress");
+  ASSERT_NE(principal, nullptr);
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double> p =
+        field_scalar_values(m, choose_field(m, std::string("stress:p") + char('1' + k)));
+    for (std::size_t t = 0; t < p.size(); ++t)
+      EXPECT_NEAR(p[t], principal->values[3 * t + std::size_t(k)], 1e-7 * solver[t] + 1e-3)
+          << "tet " << t << " p" << k + 1;
+  }
 }
 
 }  // namespace

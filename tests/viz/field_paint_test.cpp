@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <random>
 
 #include "mesh_factory.hpp"
 
@@ -66,6 +69,45 @@ TEST(FieldPaint, VonMisesOfUniaxialStressAndPureShear) {
   EXPECT_NEAR(vm[0], 7e6, 1e-6);                   // uniaxial: sigma itself
   EXPECT_NEAR(vm[1], std::sqrt(3.0) * tau, 1e-6);  // pure shear: sqrt(3) tau
   EXPECT_NEAR(field_scalar_values(m, choose_field(m, "sigma"))[2], std::sqrt(3.0) * tau, 1e-6);
+}
+
+TEST(FieldPaint, PrincipalValuesAreTheEigenvaluesOfRotatedDiagonalTensors) {
+  // A = R diag(l) R^T for random rotations R and eigenvalues l (some repeated): p1 >= p2 >= p3 are l.
+  Mesh m = test::grid_mesh(2, 2, 2, 1, 1, 1, 6);
+  std::mt19937 rng(12);
+  std::normal_distribution<double> g(0, 1);
+  Field s{"s", FieldLocation::cell, 6, "Pa", {}, {}};
+  std::vector<std::array<double, 3>> want;
+  for (std::size_t e = 0; e < m.tet_count(); ++e) {
+    double l[3] = {g(rng) * 1e6, g(rng) * 1e6, g(rng) * 1e6};
+    if (e % 5 == 0) l[1] = l[0];               // a double eigenvalue
+    if (e % 7 == 0) l[1] = l[2] = l[0] = 3e5;  // isotropic
+    // A random rotation: Gram-Schmidt on three Gaussian vectors.
+    double r[3][3];
+    for (auto& row : r)
+      for (double& v : row) v = g(rng);
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < i; ++j) {
+        const double d = r[i][0] * r[j][0] + r[i][1] * r[j][1] + r[i][2] * r[j][2];
+        for (int k = 0; k < 3; ++k) r[i][k] -= d * r[j][k];
+      }
+      const double n = std::sqrt(r[i][0] * r[i][0] + r[i][1] * r[i][1] + r[i][2] * r[i][2]);
+      for (int k = 0; k < 3; ++k) r[i][k] /= n;
+    }
+    auto a = [&](int i, int j) {
+      return r[0][i] * l[0] * r[0][j] + r[1][i] * l[1] * r[1][j] + r[2][i] * l[2] * r[2][j];
+    };
+    for (double v : {a(0, 0), a(1, 1), a(2, 2), a(0, 1), a(1, 2), a(0, 2)}) s.values.push_back(v);
+    std::sort(l, l + 3, [](double x, double y) { return x > y; });
+    want.push_back({l[0], l[1], l[2]});
+  }
+  m.fields = {s};
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<double> p = field_scalar_values(m, choose_field(m, std::string("s:p") + char('1' + k)));
+    for (std::size_t e = 0; e < m.tet_count(); ++e)  // the closed form loses digits near double roots
+      EXPECT_NEAR(p[e], want[e][std::size_t(k)], 1e-7 * 5e6) << "tet " << e << " p" << k + 1;
+  }
+  EXPECT_THROW(choose_field(m, "s:p4"), FieldSelectError);
 }
 
 TEST(FieldPaint, CentroidValuesOfALinearFieldAreTheFieldAtTheCentroid) {

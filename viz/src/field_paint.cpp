@@ -36,12 +36,46 @@ int component_index(std::string_view c, std::uint32_t n) {
 std::string component_names(std::uint32_t n) {
   if (n == 1) return "none (a scalar)";
   if (n == 3) return "x, y, z, mag or 0..2";
-  if (n == 6) return "xx, yy, zz, xy, yz, xz, vm or 0..5";
-  if (n == 9) return "xx, xy, ..., zz, vm or 0..8";
+  if (n == 6) return "xx, yy, zz, xy, yz, xz, vm, p1, p2, p3 or 0..5";
+  if (n == 9) return "xx, xy, ..., zz, vm, p1, p2, p3 or 0..8";
   return "0.." + std::to_string(n - 1);
 }
 
 bool is_tensor(std::uint32_t n) { return n == 6 || n == 9; }
+
+// The symmetric tensor of components c (6: xx yy zz xy yz xz; 9: row-major, its symmetric part).
+struct Sym {
+  double xx, yy, zz, xy, yz, xz;
+};
+Sym symmetric(const double* c, std::uint32_t n) {
+  if (n == 6) return {c[0], c[1], c[2], c[3], c[4], c[5]};
+  return {c[0], c[4], c[8], 0.5 * (c[1] + c[3]), 0.5 * (c[5] + c[7]), 0.5 * (c[2] + c[6])};
+}
+
+// The eigenvalues of a symmetric 3x3 matrix, largest first: the trigonometric solution of the
+// characteristic cubic (O. K. Smith, "Eigenvalues of a symmetric 3 x 3 matrix", CACM 4(4) 1961);
+// near a double eigenvalue acos loses about half the digits (1e-8 of the tensor's size).
+void principal_values(const Sym& a, double out[3]) {
+  const double p1 = a.xy * a.xy + a.yz * a.yz + a.xz * a.xz;
+  const double q = (a.xx + a.yy + a.zz) / 3;
+  if (p1 == 0) {  // diagonal
+    out[0] = a.xx, out[1] = a.yy, out[2] = a.zz;
+  } else {
+    const double p2 = (a.xx - q) * (a.xx - q) + (a.yy - q) * (a.yy - q) + (a.zz - q) * (a.zz - q) + 2 * p1;
+    const double p = std::sqrt(p2 / 6);
+    // B = (A - q I) / p; r = det(B) / 2, in [-1, 1] up to rounding.
+    const double bxx = (a.xx - q) / p, byy = (a.yy - q) / p, bzz = (a.zz - q) / p;
+    const double bxy = a.xy / p, byz = a.yz / p, bxz = a.xz / p;
+    const double det =
+        bxx * (byy * bzz - byz * byz) - bxy * (bxy * bzz - byz * bxz) + bxz * (bxy * byz - byy * bxz);
+    const double r = std::clamp(det / 2, -1.0, 1.0);
+    const double phi = std::acos(r) / 3, pi = 3.14159265358979323846;
+    out[0] = q + 2 * p * std::cos(phi);
+    out[2] = q + 2 * p * std::cos(phi + 2 * pi / 3);
+    out[1] = 3 * q - out[0] - out[2];
+  }
+  std::sort(out, out + 3, [](double x, double y) { return x > y; });
+}
 
 // The scalar of one entity's components c[0..n).
 double scalar_of(const FieldScalar& s, const double* c, std::uint32_t n) {
@@ -54,15 +88,15 @@ double scalar_of(const FieldScalar& s, const double* c, std::uint32_t n) {
       return std::sqrt(q);
     }
     case FieldScalar::Kind::von_mises: {
-      double xx, yy, zz, xy, yz, xz;
-      if (n == 6) {
-        xx = c[0], yy = c[1], zz = c[2], xy = c[3], yz = c[4], xz = c[5];
-      } else {  // 9, row-major: the symmetric part
-        xx = c[0], yy = c[4], zz = c[8], xy = 0.5 * (c[1] + c[3]), yz = 0.5 * (c[5] + c[7]),
-        xz = 0.5 * (c[2] + c[6]);
-      }
-      return std::sqrt(0.5 * ((xx - yy) * (xx - yy) + (yy - zz) * (yy - zz) + (zz - xx) * (zz - xx)) +
-                       3 * (xy * xy + yz * yz + xz * xz));
+      const Sym a = symmetric(c, n);
+      return std::sqrt(0.5 * ((a.xx - a.yy) * (a.xx - a.yy) + (a.yy - a.zz) * (a.yy - a.zz) +
+                              (a.zz - a.xx) * (a.zz - a.xx)) +
+                       3 * (a.xy * a.xy + a.yz * a.yz + a.xz * a.xz));
+    }
+    case FieldScalar::Kind::principal: {
+      double v[3];
+      principal_values(symmetric(c, n), v);
+      return v[s.component];
     }
   }
   return kNaN;
@@ -126,6 +160,14 @@ FieldChoice choose_field(const Mesh& mesh, std::string_view spec) {
   if ((comp == "vm" || comp == "von_mises") && is_tensor(n)) {
     c.scalar.kind = FieldScalar::Kind::von_mises;
     c.label += ", von Mises";
+    return c;
+  }
+  if ((comp == "p1" || comp == "p2" || comp == "p3") && is_tensor(n)) {
+    c.scalar.kind = FieldScalar::Kind::principal;
+    c.scalar.component = std::uint32_t(comp[1] - '1');
+    c.label += comp == "p1"   ? ", largest principal value"
+               : comp == "p2" ? ", middle principal value"
+                              : ", smallest principal value";
     return c;
   }
   const int i = component_index(comp, n);

@@ -26,13 +26,14 @@ struct FieldSelectError : std::invalid_argument {
 
 // Which scalar of a field: a component index, or a derived quantity.
 struct FieldScalar {
-  enum class Kind : std::uint8_t { component, magnitude, von_mises } kind = Kind::component;
-  std::uint32_t component = 0;  // Kind::component
+  enum class Kind : std::uint8_t { component, magnitude, von_mises, principal } kind = Kind::component;
+  std::uint32_t component = 0;  // Kind::component: the index; Kind::principal: 0 largest, 1 middle, 2 smallest
 };
 
 // "NAME" or "NAME:COMPONENT" against the field's component count. COMPONENT: an index 0..n-1;
 // x y z (vectors, 3 components); mag (vectors); xx yy zz xy yz xz (symmetric tensors, 6, or full
-// ones, 9); vm / von_mises (tensors). Without one: the value of a scalar, the magnitude of a vector,
+// ones, 9); vm / von_mises (tensors); p1 p2 p3 (tensors: the principal values, largest first, of the
+// symmetric part). Without one: the value of a scalar, the magnitude of a vector,
 // the von Mises stress of a tensor. Throws FieldSelectError naming the fields or components there are.
 struct FieldChoice {
   const Field* field = nullptr;
