@@ -126,6 +126,7 @@ int cmd_movie(Args args) {
   if (out.empty()) out = args.option("--output");
   PictureOptions options = take_picture_options(args, "640x480");
   const FieldOptions field_options = take_field_options(args);
+  if (field_options.markers) throw UsageError("--markers marks a picture: foxi render takes it, foxi movie does not");
   const std::string path = args.positional(1, 1, kMovieUsage)[0];
   if (out.empty()) throw UsageError("give the output with -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png");
   if (mode != "backforth" && mode != "rotate") throw UsageError("--mode takes backforth or rotate");
@@ -276,11 +277,11 @@ int cmd_movie(Args args) {
               stats.tets_undrawn, double(stats.max_undo_bytes) / 1e6);
   if (field.paint) {
     const DisplayUnit& u = field.legend.unit;
-    std::printf("field       %s, step %zu, %s, %s%s, colours %.6g to %.6g %s in every frame%s\n",
+    std::printf("field       %s, step %zu, %s, %s%s, colours %.6g to %.6g%s%s in every frame%s\n",
                 field.legend.title.c_str(), field.step, field_options.graded ? "graded facets" : "flat per tet",
                 color_map_name(field.legend.scale.map), field.legend.scale.log ? " log" : "",
-                u.to_display(field.legend.scale.lo), u.to_display(field.legend.scale.hi), u.symbol.c_str(),
-                framed.width > 0 ? ", legend at the right" : "");
+                u.to_display(field.legend.scale.lo), u.to_display(field.legend.scale.hi), u.symbol.empty() ? "" : " ",
+                u.symbol.c_str(), framed.width > 0 ? ", legend at the right" : "");
   }
   std::printf("wrote       %s\n", out.c_str());
   return kExitOk;

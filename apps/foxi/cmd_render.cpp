@@ -131,7 +131,12 @@ int cmd_render(Args args) {
   TetRasterizer raster(mesh, camera, width, height, params);
   raster.draw(fb, std::span<const std::uint32_t>(order).first(count));
   const double draw_ms = ms_since(t0);
-  write_png(out, text ? with_legend(fb, *text, field, panel) : fb);
+  MarkerReport markers;
+  if (field.paint && field_options.markers) {
+    if (!text) text = std::make_unique<TextRenderer>(find_font_file());
+    markers = draw_extreme_markers(fb, camera, *text, field);
+  }
+  write_png(out, field.paint && field_options.legend ? with_legend(fb, *text, field, panel) : fb);
 
   std::size_t covered = 0;
   for (std::uint32_t id : fb.id) covered += id != kNone;
@@ -158,16 +163,27 @@ int cmd_render(Args args) {
   if (field.paint) {
     const DisplayUnit& u = field.legend.unit;
     const ColorScale& sc = field.legend.scale;
-    std::printf("\nfield       %s, step %zu of %zu, %s, %s%s: values %.6g to %.6g %s, colours %.6g to %.6g %s%s",
+    auto shown = [&](double si) {  // a value in the display unit, with the unit if it has one
+      char b[64];
+      std::snprintf(b, sizeof b, "%.6g", u.to_display(si));
+      return u.symbol.empty() ? std::string(b) : std::string(b) + " " + u.symbol;
+    };
+    std::printf("\nfield       %s, step %zu of %zu, %s, %s%s: values %.6g to %s, colours %.6g to %s%s",
                 field.legend.title.c_str(), field.step, field.choice.field->step_count(),
                 field_options.graded ? "graded facets" : "flat per tet (centroid value)", color_map_name(sc.map),
-                sc.log ? " log" : "", u.to_display(field.data_lo), u.to_display(field.data_hi), u.symbol.c_str(),
-                u.to_display(sc.lo), u.to_display(sc.hi), u.symbol.c_str(),
-                field.range_widened ? " (a constant: range widened around it)"
+                sc.log ? " log" : "", u.to_display(field.data_lo), shown(field.data_hi).c_str(), u.to_display(sc.lo),
+                shown(sc.hi).c_str(),
+                field.range_widened    ? " (a constant: range widened around it)"
                 : field.range_centred ? " (symmetric about 0 for the diverging map)"
                                       : "");
     if (field.no_value > 0) std::printf(", %zu values NaN (grey)", field.no_value);
-    if (text) std::printf("\nlegend      %d pixels at the right, font %s", panel, text->font_file().c_str());
+    if (field_options.legend)
+      std::printf("\nlegend      %d pixels at the right, font %s", panel, text->font_file().c_str());
+    if (field_options.markers)
+      std::printf("\nmarkers     max %s at (%g, %g, %g) %s; min %s at (%g, %g, %g) %s", shown(field.data_hi).c_str(),
+                  field.max_at[0], field.max_at[1], field.max_at[2], markers.max_shown ? "marked" : "hidden in this view",
+                  shown(field.data_lo).c_str(), field.min_at[0], field.min_at[1], field.min_at[2],
+                  markers.min_shown ? "marked" : "hidden in this view");
   }
   std::printf("\nwrote       %s\n", out.c_str());
   return kExitOk;

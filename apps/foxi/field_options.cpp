@@ -19,6 +19,8 @@ const char* const kFieldOptionsHelp =
     "  --units U       display unit: degC, mm, um, nm, kPa, MPa, GPa, mV, kV, mW or the SI unit (default:\n"
     "                  degC for K, MPa for Pa, um for m, mV for V below 1 V; the mesh stays SI)\n"
     "  --step k        the field's step k (0-based; default the last)\n"
+    "  --markers       (foxi render) a ring at the drawn maximum and minimum with their values, where\n"
+    "                  they show in the picture\n"
     "  --legend on|off a colour bar with the field, unit, ticks, range and map (default on), in a panel\n"
     "                  at the right of the picture: the mesh is drawn in what is left of --size\n";
 
@@ -31,10 +33,12 @@ FieldOptions take_field_options(Args& args) {
   o.units = args.option("--units");
   o.log = args.flag("--log");
   o.graded = args.flag("--graded");
+  o.markers = args.flag("--markers");
   if (o.spec.empty() && (!cmap.empty() || !range.empty() || !legend.empty() || !step.empty() ||
-                         !o.units.empty() || o.log || o.graded))
+                         !o.units.empty() || o.log || o.graded || o.markers))
     throw UsageError(
-        "--cmap, --range, --log, --graded, --units, --step and --legend colour by a field: give --field "
+        "--cmap, --range, --log, --graded, --units, --step, --markers and --legend colour by a field: give "
+        "--field "
         "NAME");
   if (!cmap.empty()) {
     const auto m = parse_color_map(cmap);
@@ -88,6 +92,40 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
                    all.begin() + std::ptrdiff_t(per * t + per));
   }
   for (double v : drawn) f.no_value += std::isnan(v);
+  // The extremes' places: graded, the corner (node) of the largest / smallest value; flat, the tet.
+  {
+    std::size_t imax = kNone, imin = kNone;
+    auto visit = [&](std::size_t i) {
+      if (!std::isfinite(all[i])) return;
+      if (imax == kNone || all[i] > all[imax]) imax = i;
+      if (imin == kNone || all[i] < all[imin]) imin = i;
+    };
+    if (subset.empty()) {
+      for (std::size_t i = 0; i < all.size(); ++i) visit(i);
+    } else {
+      for (std::uint32_t t : subset)
+        for (std::size_t k = 0; k < per; ++k) visit(per * t + k);
+    }
+    auto place = [&](std::size_t i, double* at, std::vector<std::uint32_t>& tets) {
+      if (i == kNone) return;
+      const std::size_t t = i / per;
+      for (int j = 0; j < 3; ++j) at[j] = 0;
+      if (o.graded) {  // the node, and every tet that has it
+        const std::uint32_t node = mesh.tet[i];
+        for (int j = 0; j < 3; ++j) at[j] = mesh.xyz[3 * std::size_t(node) + std::size_t(j)];
+        for (std::size_t u = 0; u < mesh.tet_count(); ++u)
+          for (int k = 0; k < 4; ++k)
+            if (mesh.tet[4 * u + std::size_t(k)] == node) tets.push_back(std::uint32_t(u));
+      } else {
+        for (int k = 0; k < 4; ++k)
+          for (int j = 0; j < 3; ++j)
+            at[j] += 0.25 * mesh.xyz[3 * std::size_t(mesh.tet[4 * t + std::size_t(k)]) + std::size_t(j)];
+        tets.push_back(std::uint32_t(t));
+      }
+    };
+    place(imax, f.max_at, f.max_tets);
+    place(imin, f.min_at, f.min_tets);
+  }
   std::tie(f.data_lo, f.data_hi) = finite_range(drawn, false);
   const double max_abs = std::max(std::abs(f.data_lo), std::abs(f.data_hi));
   if (o.units.empty()) {
@@ -132,6 +170,52 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
   f.paint =
       std::make_shared<const FieldPaint>(o.graded ? graded_field_paint(all, s) : flat_field_paint(all, s));
   return f;
+}
+
+MarkerReport draw_extreme_markers(Framebuffer& scene, const Camera& camera, const TextRenderer& text,
+                                  const FieldPicture& field) {
+  MarkerReport report;
+  const Projector proj(camera, scene.width, scene.height);
+  const DisplayUnit& u = field.legend.unit;
+  const double step =
+      std::abs(u.to_display(field.legend.scale.hi) - u.to_display(field.legend.scale.lo)) / 100;
+  auto mark = [&](const double* at, const std::vector<std::uint32_t>& tets, double value, const char* what) {
+    double px[2];
+    if (tets.empty() || !proj.project(at, px)) return false;
+    const int cx = int(std::floor(px[0])), cy = int(std::floor(px[1]));
+    bool shows = false;
+    for (int dy = -1; dy <= 1 && !shows; ++dy)
+      for (int dx = -1; dx <= 1 && !shows; ++dx) {
+        const int x = cx + dx, y = cy + dy;
+        if (x < 0 || y < 0 || x >= scene.width || y >= scene.height) continue;
+        shows = std::find(tets.begin(), tets.end(), scene.id[scene.index(x, y)]) != tets.end();
+      }
+    if (!shows) return false;
+    // A ring of radius 6 (black inside white, readable on any colour), and the value beside it.
+    for (int y = cy - 8; y <= cy + 8; ++y)
+      for (int x = cx - 8; x <= cx + 8; ++x) {
+        if (x < 0 || y < 0 || x >= scene.width || y >= scene.height) continue;
+        const double r = std::hypot(x - cx, y - cy);
+        if (r >= 4.5 && r < 6)
+          scene.rgba[scene.index(x, y)] = pack_rgba(0, 0, 0);
+        else if (r >= 6 && r < 7.5)
+          scene.rgba[scene.index(x, y)] = pack_rgba(255, 255, 255);
+      }
+    const std::string label =
+        std::string(what) + " " + tick_label(u.to_display(value), step) + " " + u.symbol;
+    const TextExtent e = text.measure(label, 13);
+    const int lx = cx + 10 + e.advance < scene.width ? cx + 10 : cx - 10 - e.advance;
+    for (int y = cy - e.ascent / 2 - e.ascent - 2; y <= cy + e.ascent / 2 + e.descent + 2;
+         ++y)  // a white plate
+      for (int x = lx - 2; x <= lx + e.advance + 2; ++x)
+        if (x >= 0 && y >= 0 && x < scene.width && y < scene.height)
+          scene.rgba[scene.index(x, y)] = pack_rgba(255, 255, 255);
+    text.draw(scene, label, lx, cy + e.ascent / 2, 13);
+    return true;
+  };
+  report.max_shown = mark(field.max_at, field.max_tets, field.data_hi, "max");
+  report.min_shown = mark(field.min_at, field.min_tets, field.data_lo, "min");
+  return report;
 }
 
 int legend_panel(const TextRenderer& text, const FieldPicture& field, int width, int height) {

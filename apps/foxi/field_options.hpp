@@ -10,6 +10,7 @@
 
 #include "cli.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/viz/camera.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/framebuffer.hpp"
 #include "foxi/viz/legend.hpp"
@@ -25,8 +26,9 @@ struct FieldOptions {
   bool has_range = false;
   double range[2] = {0, 0};  // --range, display units
   bool log = false, graded = false, legend = true;
-  std::string units;  // --units; empty: the field's usual display unit (°C for K, MPa for Pa, ...)
-  long step = -1;     // --step; -1: the last
+  bool markers = false;  // --markers: mark the drawn maximum and minimum, with their values
+  std::string units;     // --units; empty: the field's usual display unit (°C for K, MPa for Pa, ...)
+  long step = -1;        // --step; -1: the last
 };
 
 // Takes the options out of args; UsageError for malformed ones.
@@ -41,12 +43,25 @@ struct FieldPicture {
   std::size_t no_value = 0;         // drawn values that are NaN
   bool range_widened = false;       // a constant field: the automatic range was widened around it
   bool range_centred = false;       // coolwarm, both signs: the automatic range made symmetric about 0
+  // Where the drawn maximum and minimum are (world; graded: a node, flat: a tet's centroid), and the
+  // tets that show them: a pixel showing one of these tets at the point's projection shows the point.
+  double max_at[3] = {0, 0, 0}, min_at[3] = {0, 0, 0};
+  std::vector<std::uint32_t> max_tets, min_tets;
 };
 
 // The field's paint for the tets of `subset` (all when empty); UsageError naming `path` and what it
 // has for a field, component, step or unit that is not there, or a log scale without positive values.
 FieldPicture resolve_field(const FieldOptions& options, const Mesh& mesh,
                            std::span<const std::uint32_t> subset, const std::string& path);
+
+// Marks the drawn maximum and minimum in `scene` (drawn with `camera`): a ring at the point and its
+// value, where the point shows (a pixel within 1 of its projection shows one of its tets); returns
+// for each whether it showed.
+struct MarkerReport {
+  bool max_shown = false, min_shown = false;
+};
+MarkerReport draw_extreme_markers(Framebuffer& scene, const Camera& camera, const TextRenderer& text,
+                                  const FieldPicture& field);
 
 // The legend panel's width for a width x height picture; UsageError if the picture is too narrow
 // (under 64 pixels left for the mesh) or too low (legend_min_height) for it.

@@ -28,8 +28,11 @@ class FieldCli : public ::testing::Test {
       for (double v : {-1e6, 0.0, 0.0, 0.0, 0.0, 0.0}) s.values.push_back(v);
     Field u{"u", FieldLocation::node, 1, "m", {}, {}};
     for (std::size_t n = 0; n < m.node_count(); ++n)
-      u.values.push_back((m.xyz[3 * n] - 2) * 1e-6);  // -2..6 um
-    m.fields = {t, s, u};
+      u.values.push_back((m.xyz[3 * n] - 2) * 1e-6);   // -2..6 um
+    Field q{"q", FieldLocation::node, 1, "", {}, {}};  // largest on the top face's x = 8 edge
+    for (std::size_t n = 0; n < m.node_count(); ++n)
+      q.values.push_back(m.xyz[3 * n] + 0.1 * m.xyz[3 * n + 2]);
+    m.fields = {t, s, u, q};
     mesh_ = dir_ / "grid.vtu";
     write_mesh(m, mesh_);
   }
@@ -105,6 +108,37 @@ TEST_F(FieldCli, DivergingMapCentresSignedValuesOnZero) {
   EXPECT_NE(log.find("colours -2 to 6 µm\n"), std::string::npos) << log;  // viridis: the values' range
 }
 
+// --markers: seen from above, the maximum (on the top face) is marked near the right end of the mesh,
+// the minimum (on the bottom face) is hidden and said to be.
+TEST_F(FieldCli, MarkersShowTheVisibleExtremes) {
+  const auto png = dir_ / "q.png";
+  std::string log;
+  ASSERT_EQ(foxi("render '" + mesh_.string() +
+                     "' --field q --graded --markers --no-edges --legend off --dir 0,0,-1 "
+                     "--up 0,1,0 --size 640x320 -o '" +
+                     png.string() + "'",
+                 &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("markers     max 8.2 at (8, "), std::string::npos) << log;
+  EXPECT_NE(log.find(", 2) marked; min 0 at (0, "), std::string::npos) << log;
+  EXPECT_NE(log.find(", 0) hidden in this view"), std::string::npos) << log;
+  // Black pixels (the ring and its label; no edges, no legend) only in the right part of the picture.
+  const Framebuffer fb = read_png(png);
+  int black = 0, left = 0;
+  for (int y = 0; y < fb.height; ++y)
+    for (int x = 0; x < fb.width; ++x)
+      if (fb.rgba[fb.index(x, y)] == pack_rgba(0, 0, 0)) {
+        ++black;
+        left += x < fb.width / 2;
+      }
+  EXPECT_GT(black, 20);
+  EXPECT_EQ(left, 0);
+  EXPECT_EQ(
+      foxi("movie '" + mesh_.string() + "' --field q --markers -o '" + (dir_ / "m.gif").string() + "'", &log),
+      2);
+}
+
 TEST_F(FieldCli, LegendPanelHoldsTheWholeMap) {
   const auto png = dir_ / "t.png";
   ASSERT_EQ(foxi("render '" + mesh_.string() + "' --field temperature --cmap coolwarm --size 640x400 -o '" +
@@ -137,7 +171,7 @@ TEST_F(FieldCli, UsageErrorsSayWhatIsWrong) {
   const std::string m = "'" + mesh_.string() + "'", o = " -o '" + (dir_ / "x.png").string() + "'";
   std::string log;
   EXPECT_EQ(foxi("render " + m + " --field pressure" + o, &log), 2);
-  EXPECT_NE(log.find("it has: temperature, u, stress"), std::string::npos)
+  EXPECT_NE(log.find("it has: temperature, u, q, stress"), std::string::npos)
       << log;  // the .vtu lists node fields first
   EXPECT_EQ(foxi("render " + m + " --field temperature --cmap jet" + o, &log), 2);
   EXPECT_NE(log.find("viridis, cividis, coolwarm or rainbow"), std::string::npos) << log;
