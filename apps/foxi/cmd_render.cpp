@@ -31,7 +31,7 @@ const std::string kRenderUsage = std::string(
     "foxi render MESH [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z] [--size WxH]\n"
     "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges]\n"
     "                 [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
-    "                 [--legend on|off]] -o OUT.png\n"
+    "                 [--legend on|off] [--markers]] -o OUT.png\n"
     "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
     "  faces flat-shaded in its region's colour (or a field's) with the mesh edges darkened (no depth\n"
     "  buffer).\n") +
