@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/viz/framebuffer.hpp"
 
 namespace foxi {
@@ -17,12 +18,12 @@ namespace foxi {
 enum class ColorMapId : std::uint8_t { viridis, cividis, coolwarm, rainbow };
 
 // The map named `name` ("viridis", "cividis", "coolwarm", "rainbow"), or nothing.
-std::optional<ColorMapId> parse_color_map(std::string_view name);
-const char* color_map_name(ColorMapId map);
+FOXI_API std::optional<ColorMapId> parse_color_map(std::string_view name);
+FOXI_API const char* color_map_name(ColorMapId map);
 // Entry i (0..255, clamped) of the map, opaque.
-std::uint32_t color_map_entry(ColorMapId map, int i);
+FOXI_API std::uint32_t color_map_entry(ColorMapId map, int i);
 
-struct ColorScale {
+struct FOXI_API ColorScale {
   ColorMapId map = ColorMapId::viridis;
   double lo = 0, hi = 1;  // the values of the first and last entry's outer edges (lo < hi; log: 0 < lo)
   bool log = false;       // entries evenly spaced in log(value)
@@ -43,6 +44,6 @@ struct ColorScale {
 // smallest step giving at most max_ticks (>= 2) of them; ascending. Log (0 < lo): the values
 // {1, 2, 5} x 10^k inside the range, thinned to decades and then to every n-th decade if there
 // are more than max_ticks. Empty for a bad range.
-std::vector<double> nice_ticks(double lo, double hi, int max_ticks, bool log = false);
+FOXI_API std::vector<double> nice_ticks(double lo, double hi, int max_ticks, bool log = false);
 
 }  // namespace foxi

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/colormap.hpp"
 
@@ -20,7 +21,7 @@ namespace foxi {
 
 // Bad field selection (unknown field or component, step out of range): the message says which,
 // and what there is.
-struct FieldSelectError : std::invalid_argument {
+struct FOXI_API FieldSelectError : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
@@ -40,20 +41,20 @@ struct FieldChoice {
   FieldScalar scalar;
   std::string label;  // "temperature", "displacement, magnitude", "stress, von Mises", "stress xy", ...
 };
-FieldChoice choose_field(const Mesh& mesh, std::string_view spec);
+FOXI_API FieldChoice choose_field(const Mesh& mesh, std::string_view spec);
 
 // The scalar at each of the field's entities (nodes or tets) in step `step` (FieldSelectError if
 // out of range): SI, NaN where the field has NaN.
-std::vector<double> field_scalar_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+FOXI_API std::vector<double> field_scalar_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
 
 // The scalar at each tet's centroid: a node field's components interpolated linearly (the mean of
 // the 4 corners) before taking the scalar; a cell field's own value.
-std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+FOXI_API std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
 
 // The scalar at each tet's 4 corners (4 per tet, in the tet's node order): a node field's value at
 // the node; a cell field averaged to the node over the tets of the SAME region only (volume-weighted
 // components, then the scalar), so values never blend across a material interface.
-std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+FOXI_API std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
 
 // Display units: value_display = (value_SI - offset) * factor. "degC" / "°C" from K, "MPa" / "kPa" /
 // "GPa" from Pa, "mm" / "um" / "µm" / "nm" from m, "mV" / "kV" from V, "mW" from W; the SI unit
@@ -64,10 +65,10 @@ struct DisplayUnit {
   double to_display(double si) const { return (si - offset) * factor; }
   double to_si(double shown) const { return shown / factor + offset; }
 };
-std::optional<DisplayUnit> display_unit(std::string_view si_unit, std::string_view display);
+FOXI_API std::optional<DisplayUnit> display_unit(std::string_view si_unit, std::string_view display);
 // The unit an engineer reads a field in by default: °C for K, MPa for Pa, µm for m, mV for V (below 1 V
 // in magnitude, else V); other units as they are. max_abs: the largest magnitude shown.
-DisplayUnit default_display_unit(std::string_view si_unit, double max_abs);
+FOXI_API DisplayUnit default_display_unit(std::string_view si_unit, double max_abs);
 
 // What the rasterizer needs to colour tets by a field (RenderParams::field). Shading multiplies
 // each channel of the colour-map colour by s in [shade_min, 1] (Lambert on the face's normal), so
@@ -83,11 +84,11 @@ struct FieldPaint {
 };
 
 // Flat: the colour of each tet's value (tet_centroid_values) on `scale`.
-FieldPaint flat_field_paint(std::span<const double> tet_values, const ColorScale& scale);
+FOXI_API FieldPaint flat_field_paint(std::span<const double> tet_values, const ColorScale& scale);
 // Graded: corner values (tet_corner_values) placed on `scale`.
-FieldPaint graded_field_paint(std::span<const double> corner_values, const ColorScale& scale);
+FOXI_API FieldPaint graded_field_paint(std::span<const double> corner_values, const ColorScale& scale);
 
 // The finite range of values (min, max); NaN, NaN if none is finite. Log: only positive values.
-std::pair<double, double> finite_range(std::span<const double> values, bool positive_only = false);
+FOXI_API std::pair<double, double> finite_range(std::span<const double> values, bool positive_only = false);
 
 }  // namespace foxi

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/framebuffer.hpp"
@@ -37,18 +38,18 @@ struct LegendReport {
 };
 
 // The height a legend needs at least (pixels) at these parameters: a bar two labels high.
-int legend_min_height(const LegendParams& params = {});
+FOXI_API int legend_min_height(const LegendParams& params = {});
 
 // The width a legend needs (pixels) at these parameters.
-int legend_width(const TextRenderer& text, const ColorLegend& legend, const LegendParams& params = {});
+FOXI_API int legend_width(const TextRenderer& text, const ColorLegend& legend, const LegendParams& params = {});
 
 // Draws the legend into `area` of fb (filled with the background first; area inside the image and at
 // least legend_width wide). Throws std::invalid_argument if the area is too small for a bar.
-LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& legend,
+FOXI_API LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& legend,
                                PixelRect area, const LegendParams& params = {});
 
 // A tick label: the value with as many decimals as the step between ticks needs (%g beyond 1e6 or
 // below 1e-3 in magnitude).
-std::string tick_label(double value, double step);
+FOXI_API std::string tick_label(double value, double step);
 
 }  // namespace foxi

@@ -9,19 +9,20 @@
 #include <string>
 #include <string_view>
 
+#include "foxi/api.hpp"
 #include "foxi/viz/framebuffer.hpp"
 #include "foxi/viz/rasterizer.hpp"
 
 namespace foxi {
 
 // No usable font, or FreeType failed: the message says which file and why.
-struct FontError : std::runtime_error {
+struct FOXI_API FontError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
 // The file of the installed font matching `family` (fontconfig; an exact family match only), else
 // the Debian path of fonts-dejavu-core's DejaVuSans.ttf if it exists. Throws FontError if neither.
-std::string find_font_file(std::string_view family = "DejaVu Sans");
+FOXI_API std::string find_font_file(std::string_view family = "DejaVu Sans");
 
 // A string's extent at a size, in pixels: from the pen's start, advance to the pen's end; ascent
 // above and descent below the baseline (both >= 0) of the glyphs' ink.
@@ -30,7 +31,7 @@ struct TextExtent {
 };
 
 // One font face, loaded once. Not thread-safe (FreeType's face is shared state): one per thread.
-class TextRenderer {
+class FOXI_API TextRenderer {
  public:
   // Loads the font file; throws FontError naming it if FreeType cannot.
   explicit TextRenderer(const std::string& font_file);
