@@ -18,6 +18,12 @@
 //                     frame changes, colour or id: the work a frame must do), rect_px_per_frame (the
 //                     rectangles presented; union_px_per_frame: changed_rect's area) and
 //                     shown_wrong_px (displayed pixels unlike the frame: 0).
+//   field_flat_draw   painter_draw with the tets coloured by a smooth node field, flat (centroid values)
+//   field_graded_draw painter_draw with graded facets of the same field (each pixel's colour from the
+//                     face's interpolated scale position, perspective-correct); counters plain_ms (a
+//                     painter_draw of the same view in the same iteration, outside the timing) and
+//                     ratio = graded time / plain time, wall clock (issue 17 target: at most 1.5);
+//                     cpu_ratio the same in process CPU time
 // Times are process CPU time (all threads) and real time.
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-5 (~100k tets) and a4e-6 (~0.97M tets). The camera
 // is fitted to the box from an oblique direction (the mesh fills about 90% of the image height) and
@@ -26,12 +32,14 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <memory>
 
 #include "bench_meshes.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/visibility_order.hpp"
@@ -52,7 +60,23 @@ struct Case {
   Mesh mesh;
   SphereTable table;
   Camera camera;
+  std::shared_ptr<const FieldPaint> flat, graded;  // a smooth field's paints (field_paint)
 };
+
+// A smooth node field over the box (a few periods of a product of sines), flat and graded paints.
+void add_field(Case& c) {
+  Field f{"f", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < c.mesh.node_count(); ++n) {
+    const double* p = &c.mesh.xyz[3 * n];
+    f.values.push_back(std::sin(3 * p[0]) * std::cos(4 * p[1]) + p[2]);
+  }
+  c.mesh.fields = {f};
+  const FieldChoice choice = choose_field(c.mesh, "f");
+  ColorScale scale;
+  std::tie(scale.lo, scale.hi) = finite_range(c.mesh.fields[0].values);
+  c.flat = std::make_shared<const FieldPaint>(flat_field_paint(tet_centroid_values(c.mesh, choice), scale));
+  c.graded = std::make_shared<const FieldPaint>(graded_field_paint(tet_corner_values(c.mesh, choice), scale));
+}
 
 Case& get_case(int which) {
   static std::unique_ptr<Case> cases[2];
@@ -65,6 +89,7 @@ Case& get_case(int which) {
     mesh_bounds(c->mesh, lo, hi);
     const double dir[3] = {-1.0, 1.6, -0.9}, up[3] = {0, 0, 1};
     c->camera = fit_camera(lo, hi, dir, up, true, 30, double(kWidth) / kHeight, 0.95);
+    add_field(*c);
     cases[which] = std::move(c);
   }
   return *cases[which];
@@ -203,7 +228,50 @@ void run_undo(benchmark::State& state, bool undraw) {
   }
 }
 
+// painter_draw with field colours (graded: and a plain painter_draw of each view as the baseline).
+void run_field(benchmark::State& state, bool graded) {
+  Case& c = get_case(int(state.range(0)));
+  RenderParams params, plain;
+  params.field = graded ? c.graded : c.flat;
+  Framebuffer fb(kWidth, kHeight);
+  std::size_t i = 0;
+  double field_ms = 0, plain_ms = 0, field_cpu_ms = 0, plain_cpu_ms = 0;
+  std::vector<std::uint32_t> order;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const Camera cam = orbit(c.camera, 7.0 * double(i++), 0);
+    order = visibility_order(c.mesh, c.table, view_of(cam));
+    if (graded) {  // the baseline: the same view, region colours
+      const auto w0 = std::chrono::steady_clock::now();
+      const double c0 = process_cpu_ms();
+      fb.clear();
+      TetRasterizer r(c.mesh, cam, kWidth, kHeight, plain);
+      r.draw(fb, order);
+      benchmark::DoNotOptimize(fb.rgba.data());
+      plain_cpu_ms += process_cpu_ms() - c0;
+      plain_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count();
+    }
+    state.ResumeTiming();
+    const auto w0 = std::chrono::steady_clock::now();
+    const double c0 = process_cpu_ms();
+    fb.clear();
+    TetRasterizer r(c.mesh, cam, kWidth, kHeight, params);
+    r.draw(fb, order);
+    benchmark::DoNotOptimize(fb.rgba.data());
+    field_cpu_ms += process_cpu_ms() - c0;
+    field_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count();
+  }
+  counters(state, c);
+  if (graded) {
+    state.counters["plain_ms"] = plain_ms / double(state.iterations());
+    state.counters["ratio"] = field_ms / plain_ms;
+    state.counters["cpu_ratio"] = field_cpu_ms / plain_cpu_ms;  // process CPU time: less noisy when shared
+  }
+}
+
 void BM_painter_draw(benchmark::State& state) { run(state, false, false, 1); }
+void BM_field_flat_draw(benchmark::State& state) { run_field(state, false); }
+void BM_field_graded_draw(benchmark::State& state) { run_field(state, true); }
 void BM_painter_draw_undoable(benchmark::State& state) { run_undo(state, false); }
 void BM_undraw_front10(benchmark::State& state) { run_undo(state, true); }
 void BM_zbuffer_draw(benchmark::State& state) { run(state, true, false, 1); }
@@ -219,6 +287,8 @@ BENCHMARK(BM_painter_frame)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->Me
 BENCHMARK(BM_painter_shrink)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_painter_draw_1thread)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_painter_draw_undoable)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_field_flat_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_field_graded_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_undraw_front10)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 BENCHMARK_MAIN();

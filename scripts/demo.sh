@@ -32,6 +32,10 @@ echo
 # The inside of the mesh: the far 60% of the tets, back to front, each shrunk a little.
 "$foxi" render "$out/die_on_substrate.node" --stop 60% --shrink 0.85 --size 1280x960 -o "$out/die_on_substrate.png"
 echo
+# The solved temperature inside: the far 60%, graded facets, a legend in degrees Celsius.
+"$foxi" render "$out/die_on_substrate_thermal.vtu" --field temperature --graded --stop 60% --size 1280x960 \
+  -o "$out/die_on_substrate_temperature.png"
+echo
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.vtu"
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.msh"
 "$foxi" info "$out/die_on_substrate.msh" --json > "$out/die_on_substrate.json"
@@ -41,6 +45,7 @@ echo
 "$foxi" model show models/power_module.toml --view exploded -o "$out/power_module_parts.png" --set solder_h=0.5mm \
   --set cu_h=0.5mm --set ceramic_h=0.6mm
 echo
-echo "demo: wrote $out/flip_chip.png and $out/flip_chip_parts.png (foxi demo), $out/power_module_parts.png,"
+echo "demo: wrote $out/flip_chip.png, $out/flip_chip_parts.png and $out/flip_chip_temperature.png (foxi demo),"
+echo "      $out/power_module_parts.png, $out/die_on_substrate_temperature.png (the solved temperature inside),"
 echo "demo: wrote $out/die_on_substrate.png (the mesh inside), $out/die_on_substrate_thermal.vtu (temperature and"
 echo "      heat flux, for ParaView), $out/die_on_substrate.vtu and .msh (the mesh), $out/die_on_substrate.json"

@@ -11,6 +11,8 @@ packages=(
   qtbase5-dev libx11-dev libxext-dev libpng-dev zlib1g-dev libpugixml-dev libfreetype-dev libgif-dev libtoml11-dev
   # the API reference (scripts/docs.sh)
   doxygen
+  # text in pictures (colour-bar legends): FreeType above, fontconfig to find the font, the DejaVu font
+  libfontconfig-dev fonts-dejavu-core
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev xvfb xdotool x11-apps
   # the fuzz targets (scripts/fuzz.sh): clang with libFuzzer and its sanitizer runtimes

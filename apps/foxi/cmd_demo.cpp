@@ -29,8 +29,9 @@ const char* kDemoUsage =
     "  meshes it with TetGen (its [mesh] controls), certifies the mesh (exact empty-circumsphere test),\n"
     "  solves its steady heat conduction with its [[conditions]] and [[loads]], and writes to DIR\n"
     "  (default out/demo): MODEL.vtu (mesh, temperature, heat flux; for ParaView), MODEL.png (the far\n"
-    "  60 % of the visibility order drawn by the painter, parts in their materials' colours) and\n"
-    "  MODEL_parts.png (the parts, exploded).";
+    "  60 % of the visibility order drawn by the painter, parts in their materials' colours),\n"
+    "  MODEL_parts.png (the parts, exploded) and MODEL_temperature.png (the same far 60 % coloured by\n"
+    "  the solved temperature, graded facets, with a colour-bar legend in degrees Celsius).";
 
 // The folder of the example models: $FOXI_MODELS_DIR if set, else FOXI_MODELS_RELATIVE_DIR next to
 // this program (share/foxi/models of an installed foxi; the build tree has a link to models/ there),
@@ -110,8 +111,16 @@ int cmd_demo(Args args) {
   pp.view = ModelView::exploded;
   render_model_picture(m, parts, pp);
   print_legend(m, pic);
-  std::printf("wrote %s (temperature, heat flux), %s (inside), %s (parts)\n", vtu.c_str(), png.c_str(),
-              parts.c_str());
+  const std::string temp_png = (dir / (stem + "_temperature.png")).string();
+  t = std::chrono::steady_clock::now();
+  pp.view = ModelView::interior;
+  pp.field = "temperature";
+  const ModelPicture tp = render_model_picture(m, temp_png, pp);
+  std::printf("6. temperature picture: the far 60 %% coloured by temperature (graded facets, viridis), %.2f to %.2f %s, "
+              "legend at the right, %.2f s\n",
+              tp.field_lo, tp.field_hi, tp.field_unit.c_str(), seconds_since(t));
+  std::printf("wrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature)\n", vtu.c_str(), png.c_str(),
+              parts.c_str(), temp_png.c_str());
   return kExitOk;
 }
 

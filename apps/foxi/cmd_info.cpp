@@ -14,6 +14,7 @@
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/quality.hpp"
 #include "foxi/model/validate.hpp"
+#include "foxi/viz/field_paint.hpp"
 
 namespace foxi::cli {
 
@@ -51,6 +52,42 @@ double tet_volume(const Mesh& m, std::size_t t) {
 }
 
 const char* location_name(FieldLocation l) { return l == FieldLocation::node ? "node" : "cell"; }
+
+// A field's range for foxi info: its default scalar (the value, a vector's magnitude, a tensor's von
+// Mises stress) over all its steps, SI; NaN, NaN when it has none (no finite value, or a component
+// count with no default scalar), and how many values are NaN.
+struct FieldRange {
+  std::string scalar;  // "value", "magnitude", "von Mises"
+  double lo = std::nan(""), hi = std::nan("");
+  std::size_t nan = 0;
+};
+FieldRange field_range(const Mesh& mesh, const Field& f) {
+  FieldRange r;
+  FieldChoice c;
+  try {
+    c = choose_field(mesh, f.name);
+  } catch (const FieldSelectError&) {
+    return r;
+  }
+  r.scalar = c.scalar.kind == FieldScalar::Kind::magnitude   ? "magnitude"
+             : c.scalar.kind == FieldScalar::Kind::von_mises ? "von Mises"
+                                                            : "value";
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t s = 0; s < f.step_count(); ++s)
+    for (double v : field_scalar_values(mesh, c, s)) {
+      if (std::isnan(v)) {
+        ++r.nan;
+      } else if (std::isfinite(v)) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    }
+  if (lo <= hi) {
+    r.lo = lo;
+    r.hi = hi;
+  }
+  return r;
+}
 
 }  // namespace
 
@@ -163,9 +200,12 @@ int cmd_info(Args args) {
     for (const Field& f : mesh.fields) {
       o += first ? "\n" : ",\n";
       first = false;
+      const FieldRange range = field_range(mesh, f);
       o += "    {\"name\": " + json_string(f.name) + ", \"location\": " + json_string(location_name(f.location)) +
            ", \"components\": " + std::to_string(f.components) + ", \"steps\": " + std::to_string(f.step_count()) +
-           ", \"unit\": " + json_string(f.unit) + "}";
+           ", \"unit\": " + json_string(f.unit) + ", \"scalar\": " + json_string(range.scalar) +
+           ", \"min\": " + json_number(range.lo) + ", \"max\": " + json_number(range.hi) +
+           ", \"nan_values\": " + std::to_string(range.nan) + "}";
     }
     o += first ? "],\n" : "\n  ],\n";
     if (quality && quality_ok) {
@@ -227,10 +267,24 @@ int cmd_info(Args args) {
     std::printf("  %6d  %-20s %10zu triangles\n", tag, name.empty() ? "-" : name.c_str(), n);
   }
   std::printf("fields              %zu\n", mesh.fields.size());
-  for (const Field& f : mesh.fields)
+  for (const Field& f : mesh.fields) {
     std::printf("  %-24s %s, %u component%s, %zu step%s%s%s\n", f.name.c_str(), location_name(f.location),
                 f.components, f.components == 1 ? "" : "s", f.step_count(), f.step_count() == 1 ? "" : "s",
                 f.unit.empty() ? "" : ", ", f.unit.c_str());
+    const FieldRange r = field_range(mesh, f);
+    if (r.scalar.empty()) continue;
+    if (std::isnan(r.lo)) {
+      std::printf("  %-24s %s: no finite value\n", "", r.scalar.c_str());
+      continue;
+    }
+    // SI, and in the unit an engineer reads it in when that differs (°C for K, MPa for Pa, ...).
+    const DisplayUnit u = default_display_unit(f.unit, std::max(std::abs(r.lo), std::abs(r.hi)));
+    std::printf("  %-24s %s %.6g to %.6g%s%s", "", r.scalar.c_str(), r.lo, r.hi, f.unit.empty() ? "" : " ", f.unit.c_str());
+    if (u.symbol != f.unit) std::printf(" (%.6g to %.6g %s)", u.to_display(r.lo), u.to_display(r.hi), u.symbol.c_str());
+    if (f.step_count() > 1) std::printf(" over all steps");
+    if (r.nan > 0) std::printf(", %zu values NaN", r.nan);
+    std::printf("\n");
+  }
   if (quality && quality_ok && mesh.tet_count() > 0) {
     std::printf("radius-edge ratio   min %.4g  mean %.4g  max %.4g\n", q.radius_edge.min, q.radius_edge.mean,
                 q.radius_edge.max);

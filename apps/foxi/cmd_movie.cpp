@@ -16,6 +16,7 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
+#include "field_options.hpp"
 #include "mesh_input.hpp"
 #include "foxi/model/cleanup.hpp"
 #include "foxi/model/delaunay.hpp"
@@ -35,6 +36,8 @@ namespace {
 const std::string kMovieUsage = std::string(
     "foxi movie MESH [camera and picture options] [--mode backforth|rotate] [--frames N]\n"
     "                [--cycles C] [--from P%] [--to P%] [--turn deg] [--fps F]\n"
+    "                [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
+    "                [--legend on|off]]\n"
     "                -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png\n"
     "  A movie of the painter. backforth (the default): the tets drawn back to front in the\n"
     "  visibility order from --from to --to percent of the order (default 0% to 100%), then\n"
@@ -42,8 +45,8 @@ const std::string kMovieUsage = std::string(
     "  front face, or restored from saved pixels), N frames per cycle, looping seamlessly.\n"
     "  rotate: the camera turned --turn degrees (default 360) about its up axis through --at over\n"
     "  N frames, each frame the first --to percent of its own order.\n") +
-    kPictureOptionsHelp +
-    "  (--size defaults to 640x480)\n"
+    kPictureOptionsHelp + kFieldOptionsHelp +
+    "  (--size defaults to 640x480; with --field the colour range is the same in every frame)\n"
     "  --frames N      frames per cycle (default 48), --cycles C cycles (default 1)\n"
     "  --fps F         frames per second of the animated file (default 12)\n"
     "  -o              .gif (giflib, 256 colours per frame), .apng (animated PNG), .mp4 (needs the\n"
@@ -122,6 +125,8 @@ int cmd_movie(Args args) {
   std::string out = args.option("-o");
   if (out.empty()) out = args.option("--output");
   PictureOptions options = take_picture_options(args, "640x480");
+  const FieldOptions field_options = take_field_options(args);
+  if (field_options.markers) throw UsageError("--markers marks a picture: foxi render takes it, foxi movie does not");
   const std::string path = args.positional(1, 1, kMovieUsage)[0];
   if (out.empty()) throw UsageError("give the output with -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png");
   if (mode != "backforth" && mode != "rotate") throw UsageError("--mode takes backforth or rotate");
@@ -140,7 +145,6 @@ int cmd_movie(Args args) {
   char* fps_end = nullptr;
   const double fps = std::strtod(fps_s.c_str(), &fps_end);
   if (*fps_end != 0 || !(fps > 0 && fps <= 100)) throw UsageError("--fps takes a rate in (0, 100]");
-  mp.render = options.params;
 
   enum class Kind { frames, gif, apng, mp4 } kind;
   const std::string ext = std::filesystem::path(out).extension().string();
@@ -161,14 +165,30 @@ int cmd_movie(Args args) {
   if (kind != Kind::frames) check_output_path(out);  // before the work (frames: once their folder is made)
 
   const Mesh mesh = read_usable_mesh(path, "movie");
-  const Picture picture = resolve_picture(options, mesh);
+  Picture picture = resolve_picture(options, mesh);
+  // Colour by a field: one paint (one range) for the whole movie; the legend drawn once into a frame
+  // whose left part each movie frame fills.
+  FieldPicture field;
+  Framebuffer framed;
+  if (!field_options.spec.empty()) {
+    field = resolve_field(field_options, mesh, picture.subset, path);
+    options.params.field = field.paint;
+    if (field_options.legend) {
+      const TextRenderer text(find_font_file());
+      const int panel = legend_panel(text, field, options.width, options.height);
+      framed = with_legend(Framebuffer(options.width - panel, options.height), text, field, panel);
+      options.width -= panel;
+      picture = resolve_picture(options, mesh);
+    }
+  }
+  mp.render = options.params;
   if (!delaunay_certificate(mesh).delaunay)
     throw InputError(path + " fails the Delaunay certificate: it has no visibility order to make a "
                              "movie with (foxi render --zbuffer draws it)");
   const SphereTable table = compute_spheres(mesh);
 
   AnimationParams ap;
-  ap.width = options.width;
+  ap.width = framed.width > 0 ? framed.width : options.width;
   ap.height = options.height;
   ap.fps = fps;
   std::unique_ptr<AnimationWriter> writer;
@@ -219,12 +239,20 @@ int cmd_movie(Args args) {
   std::size_t index = 0;
   const auto t0 = std::chrono::steady_clock::now();
   const MovieStats stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
-                                      [&](const Framebuffer& fb) {
+                                      [&](const Framebuffer& scene) {
+                                        const Framebuffer* fb = &scene;
+                                        if (framed.width > 0) {  // the scene beside the legend
+                                          for (int y = 0; y < scene.height; ++y)
+                                            std::copy_n(scene.rgba.begin() + std::ptrdiff_t(scene.index(0, y)),
+                                                        scene.width,
+                                                        framed.rgba.begin() + std::ptrdiff_t(framed.index(0, y)));
+                                          fb = &framed;
+                                        }
                                         if (writer) {
-                                          writer->add(fb);
+                                          writer->add(*fb);
                                         } else {
                                           frames.emplace_back(frame_name(pattern, index), false);
-                                          write_png(frames.back(), fb);
+                                          write_png(frames.back(), *fb);
                                         }
                                         ++index;
                                       });
@@ -244,9 +272,17 @@ int cmd_movie(Args args) {
   std::printf("mesh        %s: %zu tets, %zu shown\n", path.c_str(), mesh.tet_count(),
               picture.subset.empty() ? mesh.tet_count() : picture.subset.size());
   std::printf("movie       %s, %zu frames of %dx%d, %.1f ms per frame (frames written included)\n", mode.c_str(),
-              stats.frames, options.width, options.height, ms / double(std::max<std::size_t>(1, stats.frames)));
+              stats.frames, ap.width, options.height, ms / double(std::max<std::size_t>(1, stats.frames)));
   std::printf("painter     %zu tets drawn, %zu undrawn, undraw memory at most %.1f MB\n", stats.tets_drawn,
               stats.tets_undrawn, double(stats.max_undo_bytes) / 1e6);
+  if (field.paint) {
+    const DisplayUnit& u = field.legend.unit;
+    std::printf("field       %s, step %zu, %s, %s%s, colours %.6g to %.6g%s%s in every frame%s\n",
+                field.legend.title.c_str(), field.step, field_options.graded ? "graded facets" : "flat per tet",
+                color_map_name(field.legend.scale.map), field.legend.scale.log ? " log" : "",
+                u.to_display(field.legend.scale.lo), u.to_display(field.legend.scale.hi), u.symbol.empty() ? "" : " ",
+                u.symbol.c_str(), framed.width > 0 ? ", legend at the right" : "");
+  }
   std::printf("wrote       %s\n", out.c_str());
   return kExitOk;
 }

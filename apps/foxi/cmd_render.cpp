@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
+#include "field_options.hpp"
 #include "mesh_input.hpp"
 #include "render_options.hpp"
 #include "foxi/model/durable_file.hpp"
@@ -27,10 +29,13 @@ namespace {
 
 const std::string kRenderUsage = std::string(
     "foxi render MESH [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z] [--size WxH]\n"
-    "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges] -o OUT.png\n"
+    "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges]\n"
+    "                 [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
+    "                 [--legend on|off] [--markers]] -o OUT.png\n"
     "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
-    "  faces flat-shaded in its region's colour with the mesh edges darkened (no depth buffer).\n") +
-    kPictureOptionsHelp +
+    "  faces flat-shaded in its region's colour (or a field's) with the mesh edges darkened (no depth\n"
+    "  buffer).\n") +
+    kPictureOptionsHelp + kFieldOptionsHelp +
     "  (--size defaults to 1280x960)\n"
     "  --stop P%       draw only the first P percent of the back-to-front order (the far part)\n"
     "  --depth d       stop at the first tet whose power distance from the eye, sqrt(|eye-c|^2-r^2)\n"
@@ -59,10 +64,11 @@ int cmd_render(Args args) {
   if (out.empty()) out = args.option("--output");
   const bool zbuffer = args.flag("--zbuffer");
   PictureOptions options = take_picture_options(args, "1280x960");
+  const FieldOptions field_options = take_field_options(args);
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
   check_output_path(out);
-  const int width = options.width, height = options.height;
+  int width = options.width, height = options.height;
   double stop = 1;
   if (!stop_s.empty()) {
     std::string s = stop_s;
@@ -82,7 +88,21 @@ int cmd_render(Args args) {
   RenderParams params = options.params;
 
   const Mesh mesh = read_usable_mesh(path, "render");
-  const Picture picture = resolve_picture(options, mesh);
+  Picture picture = resolve_picture(options, mesh);
+  // Colour by a field: the legend's panel is taken from the picture's width, the camera fitted to the rest.
+  FieldPicture field;
+  std::unique_ptr<TextRenderer> text;
+  int panel = 0;
+  if (!field_options.spec.empty()) {
+    field = resolve_field(field_options, mesh, picture.subset, path);
+    params.field = field.paint;
+    if (field_options.legend) {
+      text = std::make_unique<TextRenderer>(find_font_file());
+      panel = legend_panel(*text, field, options.width, options.height);
+      options.width -= panel;
+      picture = resolve_picture(options, mesh);
+    }
+  }
   const std::vector<std::uint32_t>& subset = picture.subset;
   const Camera& camera = picture.camera;
 
@@ -106,11 +126,17 @@ int cmd_render(Args args) {
 
   params.depth_buffer = zbuffer || !cert.delaunay;
   t0 = std::chrono::steady_clock::now();
+  width = options.width;
   Framebuffer fb(width, height, params.depth_buffer);
   TetRasterizer raster(mesh, camera, width, height, params);
   raster.draw(fb, std::span<const std::uint32_t>(order).first(count));
   const double draw_ms = ms_since(t0);
-  write_png(out, fb);
+  MarkerReport markers;
+  if (field.paint && field_options.markers) {
+    if (!text) text = std::make_unique<TextRenderer>(find_font_file());
+    markers = draw_extreme_markers(fb, camera, *text, field);
+  }
+  write_png(out, field.paint && field_options.legend ? with_legend(fb, *text, field, panel) : fb);
 
   std::size_t covered = 0;
   for (std::uint32_t id : fb.id) covered += id != kNone;
@@ -134,6 +160,31 @@ int cmd_render(Args args) {
   if (!depth_s.empty() && count > 0)
     std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop, tet_depth(table, camera, order[count - 1]));
   if (raster.stats().tets_behind > 0) std::printf(", %zu tets behind the eye", raster.stats().tets_behind);
+  if (field.paint) {
+    const DisplayUnit& u = field.legend.unit;
+    const ColorScale& sc = field.legend.scale;
+    auto shown = [&](double si) {  // a value in the display unit, with the unit if it has one
+      char b[64];
+      std::snprintf(b, sizeof b, "%.6g", u.to_display(si));
+      return u.symbol.empty() ? std::string(b) : std::string(b) + " " + u.symbol;
+    };
+    std::printf("\nfield       %s, step %zu of %zu, %s, %s%s: values %.6g to %s, colours %.6g to %s%s",
+                field.legend.title.c_str(), field.step, field.choice.field->step_count(),
+                field_options.graded ? "graded facets" : "flat per tet (centroid value)", color_map_name(sc.map),
+                sc.log ? " log" : "", u.to_display(field.data_lo), shown(field.data_hi).c_str(), u.to_display(sc.lo),
+                shown(sc.hi).c_str(),
+                field.range_widened    ? " (a constant: range widened around it)"
+                : field.range_centred ? " (symmetric about 0 for the diverging map)"
+                                      : "");
+    if (field.no_value > 0) std::printf(", %zu values NaN (grey)", field.no_value);
+    if (field_options.legend)
+      std::printf("\nlegend      %d pixels at the right, font %s", panel, text->font_file().c_str());
+    if (field_options.markers)
+      std::printf("\nmarkers     max %s at (%g, %g, %g) %s; min %s at (%g, %g, %g) %s", shown(field.data_hi).c_str(),
+                  field.max_at[0], field.max_at[1], field.max_at[2], markers.max_shown ? "marked" : "hidden in this view",
+                  shown(field.data_lo).c_str(), field.min_at[0], field.min_at[1], field.min_at[2],
+                  markers.min_shown ? "marked" : "hidden in this view");
+  }
   std::printf("\nwrote       %s\n", out.c_str());
   return kExitOk;
 }

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <memory>
 
+#include "field_options.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/png.hpp"
@@ -85,9 +87,26 @@ ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
       if (cy >= 4 * mid) subset.push_back(static_cast<std::uint32_t>(t));
     }
   }
+  // A field: graded facets and a legend in a panel at the right; the mesh drawn in the rest.
+  FieldPicture field;
+  std::unique_ptr<TextRenderer> text;
+  int width = p.width, panel = 0;
+  if (!p.field.empty()) {
+    FieldOptions fo;
+    fo.spec = p.field;
+    fo.graded = true;
+    field = resolve_field(fo, mesh, subset, path);
+    rp.field = field.paint;
+    text = std::make_unique<TextRenderer>(find_font_file());
+    panel = legend_panel(*text, field, p.width, p.height);
+    width = std::max(64, p.width - panel);
+    out.field_lo = field.legend.unit.to_display(field.legend.scale.lo);
+    out.field_hi = field.legend.unit.to_display(field.legend.scale.hi);
+    out.field_unit = field.legend.unit.symbol;
+  }
   // flat structures (packages) fill the picture better seen from lower down
   const double dir[3] = {-0.55, 1, -0.55}, up[3] = {0, 0, 1};
-  const Camera camera = fit_camera(lo, hi, dir, up, true, 30, double(p.width) / p.height, 0.95);
+  const Camera camera = fit_camera(lo, hi, dir, up, true, 30, double(width) / p.height, 0.95);
   const DelaunayCertificate& cert = delaunay_certificate(mesh);
   const SphereTable table = compute_spheres(mesh);
   const View view = view_of(camera);
@@ -100,14 +119,14 @@ ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
   }
   if (p.view == ModelView::interior) {
     order.resize(order.size() * 6 / 10);
-    rp.shrink = 0.85;
+    if (!rp.field) rp.shrink = 0.85;
   }
   out.delaunay = cert.delaunay;
   rp.depth_buffer = !cert.delaunay;
-  Framebuffer fb(p.width, p.height, rp.depth_buffer);
-  TetRasterizer raster(mesh, camera, p.width, p.height, rp);
+  Framebuffer fb(width, p.height, rp.depth_buffer);
+  TetRasterizer raster(mesh, camera, width, p.height, rp);
   raster.draw(fb, order);
-  write_png(path, fb);
+  write_png(path, text ? with_legend(fb, *text, field, panel) : fb);
   out.tets_drawn = order.size();
   return out;
 }

@@ -24,10 +24,15 @@ enum class ModelView : std::uint8_t {
 struct ModelPictureParams {
   int width = 1280, height = 960;
   ModelView view = ModelView::exploded;
+  // A field of the mesh to colour by (e.g. "temperature") instead of the materials: graded facets, a
+  // colour-bar legend at the right, no shrinking (the interior view shows the field cut open).
+  std::string field;
 };
 
 struct ModelPicture {
   std::size_t tets_drawn = 0;
+  double field_lo = 0, field_hi = 0;  // with a field: its colour range, display unit
+  std::string field_unit;             // with a field: the display unit
   bool delaunay = false;  // painter in the power order; otherwise MPVO order with the depth buffer
   std::vector<std::uint32_t> part_color;  // 1 per part
 };

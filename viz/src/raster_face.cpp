@@ -30,13 +30,17 @@ FaceShade TetRasterizer::Impl::face_shade(std::uint32_t tet, const double* const
   // permutation of the outward order).
   double lambert = len > 0 ? -(nc[0] * light[0] + nc[1] * light[1] + nc[2] * light[2]) / len : 0;
   if (odd) lambert = -lambert;
-  double intensity = params.ambient + (1 - params.ambient) * std::max(0.0, lambert);
+  // A field's colour keeps its hue and at least shade_min of its lightness (FieldPaint).
+  const double ambient = field != nullptr ? field->shade_min : params.ambient;
+  double intensity = ambient + (1 - ambient) * std::max(0.0, lambert);
   intensity = std::clamp(intensity, 0.0, 1.0);
   const std::int32_t region = mesh->region_of(tet);
-  std::uint32_t base = region >= 0 && std::size_t(region) < params.region_colors.size()
+  std::uint32_t base = field != nullptr          ? (field->graded ? pack_rgba(255, 255, 255) : field->tet_color[tet])
+                       : region >= 0 && std::size_t(region) < params.region_colors.size()
                            ? params.region_colors[std::size_t(region)]
                            : region_color(region);
   FaceShade sh;
+  sh.intensity = float(intensity);
   sh.r = float((base & 255u) * intensity);
   sh.g = float(((base >> 8) & 255u) * intensity);
   sh.b = float(((base >> 16) & 255u) * intensity);
@@ -63,6 +67,7 @@ void TetRasterizer::Impl::set_shade(FaceSetup& fs, std::uint32_t tet, const Face
   fs.rgb[1] = sh.g;
   fs.rgb[2] = sh.b;
   fs.color = sh.color;
+  fs.intensity = sh.intensity;
 }
 
 #ifdef FOXI_AVX512_REPAINT
@@ -94,6 +99,7 @@ void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const dou
 // The same with the shade known.
 void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly, int n) const {
   set_shade(fs, tet, sh);
+  fs.graded = field != nullptr && field->graded;
   fs.lines = 0;
   if (params.edges) {
     for (int i = 0; i < n; ++i) {
@@ -129,7 +135,8 @@ void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const Fac
 // orientation, same pixels under the fill rule). Returns its vertex count (3, or 4 when the near
 // plane cuts it) with positive area, or 0 when the face is not of the asked side or covers nothing.
 // *clipped is set when the near plane cuts a face of the asked side.
-int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped) const {
+int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped,
+                                      const float* pos_given) const {
   const std::uint32_t* tv = k.tv;
   const double* const* c = k.c;
   const std::int64_t *X = k.X, *Y = k.Y;
@@ -145,11 +152,13 @@ int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, Pol
     if (back ? area <= 0 : area >= 0) return 0;
     const int front_order[3] = {a, d, b}, back_order[3] = {a, b, d};  // positive area
     const int* order = back ? back_order : front_order;
+    const float* pos = pos_given != nullptr ? pos_given : corner_positions(tv);
     for (int i = 0; i < 3; ++i) {
       poly[i].X = X[order[i]];
       poly[i].Y = Y[order[i]];
       poly[i].w = nearness(c[order[i]]);
       poly[i].mesh_edge = true;
+      poly[i].pos = pos != nullptr ? pos[order[i]] : 0.0f;
     }
     return 3;
   }
@@ -193,6 +202,8 @@ int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, Pol
       out.c[1] = P[1] + tt * (Q[1] - P[1]);
       out.c[2] = near;
       out.w = 1 / near;
+      if (const float* pos = pos_given != nullptr ? pos_given : corner_positions(tv))
+        out.pos = float(pos[lo] + tt * (pos[hi] - pos[lo]));
       std::uint8_t dummy;
       project_camera(out.c, out.X, out.Y, dummy);
     };
@@ -201,6 +212,7 @@ int TetRasterizer::Impl::face_polygon(const TetCorners& k, int f, bool back, Pol
       poly[n].Y = Y[pi];
       poly[n].w = nearness(c[pi]);
       poly[n].mesh_edge = true;
+      if (const float* pos = pos_given != nullptr ? pos_given : corner_positions(tv)) poly[n].pos = pos[pi];
       ++n;
       if (!qin) {
         cut(poly[n]);

@@ -12,6 +12,7 @@
 #include "foxi/viz/rasterizer.hpp"
 
 #include "foxi/model/adjacency.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "huge_page_allocator.hpp"
 #include "thread_pool.hpp"
 
@@ -214,12 +215,14 @@ struct PolyVertex {
   std::int64_t X = 0, Y = 0;
   double w = 0;           // nearness (1 / depth perspective, -depth orthographic), depth mode
   bool mesh_edge = true;  // the edge from this vertex to the next is (part of) a mesh edge
+  float pos = 0;          // graded field paint: the position on the colour scale (FieldPaint)
 };
 
 // A face's flat colour (before edge darkening): packed, and its channels unrounded.
 struct FaceShade {
   std::uint32_t color = 0;
   float r = 0, g = 0, b = 0;
+  float intensity = 1;  // the Lambert factor (graded field paint scales each pixel's colour by it)
 };
 
 // Everything a face's pixels need.
@@ -246,6 +249,13 @@ struct FaceSetup {
   // Depth mode, per fan triangle: nearness = w0 + da (x - x0) + db (y - y0), interpolated from the
   // snapped vertices so that faces sharing an edge agree on it exactly (up to rounding).
   double x0 = 0, y0 = 0, w0 = 0, da = 0, db = 0;
+  // Graded field paint, per fan triangle: the scale position at pixel centre (x, y) is
+  // (g0 + ga dx + gb dy) / (h0 + ha dx + hb dy), dx = x + 0.5 - gx0, dy = y + 0.5 - gy0: position x
+  // nearness and nearness are affine on the screen under perspective (h = 1 orthographic), so the
+  // position is interpolated linearly across the face in the world.
+  bool graded = false;
+  float intensity = 1;
+  double gx0 = 0, gy0 = 0, g0 = 0, ga = 0, gb = 0, h0 = 1, ha = 0, hb = 0;
 };
 
 }  // namespace raster_detail
@@ -258,6 +268,8 @@ struct TetRasterizer::Impl {
   RenderParams params;
   double near = 0;
   double light[3] = {0, 0, -1};  // toward the light, camera frame
+  const FieldPaint* field = nullptr;  // params.field, if any
+  float field_lut[256][3] = {};       // graded: the colour map's entries as floats
   // Edge darkening: a pixel at distance d < edge_width from an edge is scaled by edge_base +
   // edge_slope d (1 - edge_darkness at the edge, 1 at edge_width).
   double edge_base = 1, edge_slope = 0;
@@ -424,6 +436,20 @@ struct TetRasterizer::Impl {
 
   std::uint32_t darkened(const FaceSetup& fs, double d) const;
 
+  // Graded field paint (raster_field.cpp): the colour at pixel (x, y), d pixels from the nearest edge
+  // line; a run of a row in painter mode; the scale positions of the tet whose node row is tv.
+  std::uint32_t graded_color(const FaceSetup& fs, int x, int y, double d) const;
+  void graded_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
+  const float* corner_positions(const std::uint32_t* tv) const {
+    return field != nullptr && field->graded ? &field->corner_position[std::size_t(tv - mesh->tet.data())] : nullptr;
+  }
+  // Graded: the scale positions the kept tet nb (mesh tet index) gives the nodes tv[0..3] (a cell
+  // field averaged per region gives a node a different position in each region); nodes not in nb
+  // keep 0 (the one corner off a shared face, never used).
+  void neighbour_positions(std::uint32_t nb, const std::uint32_t* tv, float out[4]) const;
+  // The field paint's checks and colour table (raster_field.cpp; the constructor calls it).
+  void setup_field();
+
   // True if every owned pixel of the pixel box b (not empty, y0 >= 0) is already written: nothing
   // drawn inside it can show.
   bool box_written(const Rows& rows, const Box& b, int height) {
@@ -583,7 +609,10 @@ struct TetRasterizer::Impl {
     return k.st[0] != 2 && k.st[1] != 2 && k.st[2] != 2 && k.st[3] != 2;
   }
 
-  int face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped) const;
+  // pos: graded field paint, the scale positions to give k's corners (4, k's local order) instead of
+  // the tet's own (undraw repaints a kept neighbour's face with the neighbour's, see neighbour_positions).
+  int face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped,
+                   const float* pos = nullptr) const;
 
   void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count);
 

@@ -19,6 +19,7 @@ void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& fs, int 
 std::uint32_t TetRasterizer::Impl::face_color(const FaceSetup& fs, int x, int y) const {
   std::int64_t e[4];
   for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
+  if (fs.graded) return graded_color(fs, x, y, nearest_edge(fs, e[0], e[1], e[2], e[3]));
   return darkened(fs, nearest_edge(fs, e[0], e[1], e[2], e[3]));
 }
 
@@ -142,6 +143,10 @@ void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& fs, int 
 // every pixel gets exactly face_color's colour whatever the run. Runs of 12 pixels or fewer (most
 // runs of a fine mesh's faces) are not worth solving for: inlined here, each pixel shaded.
 [[gnu::always_inline]] inline void TetRasterizer::Impl::shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+  if (fs.graded) {
+    graded_span(fb, fs, y, lo, hi);
+    return;
+  }
   if (hi - lo >= 12 || fs.lines == 0) {
     shade_long_span(fb, fs, y, lo, hi);
     return;
@@ -372,6 +377,33 @@ void TetRasterizer::Impl::raster_polygon(Framebuffer& fb, const Rows& rows, Face
       fs.w0 = poly[0].w;
       fs.da = (w1 * y2 - w2 * y1) * inv;
       fs.db = (x1 * w2 - x2 * w1) * inv;
+    }
+    if (fs.graded) {
+      // The triangle's corners in a canonical order (by y, then x), so that the plane has the same
+      // bits however the polygon was given: undraw repaints a neighbour's face from the other tet's
+      // corners, and must give its pixels the colours drawing it gave.
+      const PolyVertex* v[3] = {&poly[0], &poly[i], &poly[i + 1]};
+      auto before = [](const PolyVertex* a, const PolyVertex* b) { return a->Y != b->Y ? a->Y < b->Y : a->X < b->X; };
+      if (before(v[1], v[0])) std::swap(v[0], v[1]);
+      if (before(v[2], v[1])) std::swap(v[1], v[2]);
+      if (before(v[1], v[0])) std::swap(v[0], v[1]);
+      const std::int64_t area_c = (v[1]->X - v[0]->X) * (v[2]->Y - v[0]->Y) - (v[1]->Y - v[0]->Y) * (v[2]->X - v[0]->X);
+      const double inv = double(kOne) * double(kOne) / double(area_c), s = 1.0 / double(kOne);
+      const double x1 = double(v[1]->X - v[0]->X) * s, y1 = double(v[1]->Y - v[0]->Y) * s;
+      const double x2 = double(v[2]->X - v[0]->X) * s, y2 = double(v[2]->Y - v[0]->Y) * s;
+      double g[3], h[3];
+      for (int k = 0; k < 3; ++k) {
+        h[k] = proj.perspective ? v[k]->w : 1.0;
+        g[k] = double(v[k]->pos) * h[k];
+      }
+      fs.gx0 = double(v[0]->X) * s;
+      fs.gy0 = double(v[0]->Y) * s;
+      fs.g0 = g[0];
+      fs.ga = ((g[1] - g[0]) * y2 - (g[2] - g[0]) * y1) * inv;
+      fs.gb = (x1 * (g[2] - g[0]) - x2 * (g[1] - g[0])) * inv;
+      fs.h0 = h[0];
+      fs.ha = ((h[1] - h[0]) * y2 - (h[2] - h[0]) * y1) * inv;
+      fs.hb = (x1 * (h[2] - h[0]) - x2 * (h[1] - h[0])) * inv;
     }
     raster_triangle(X, Y, fb.width, fb.height, rows,
                     [&](int y, int lo, int hi) { shade_row(fb, fs, y, lo, hi); });

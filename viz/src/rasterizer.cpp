@@ -35,6 +35,10 @@ TetRasterizer::Impl::Impl(const Mesh& m, const Camera& c, int w, int h, const Re
 #ifdef FOXI_AVX512_REPAINT
   fast_repaint = params.edges && params.edge_darkness >= 0 && params.edge_darkness <= 1 && avx512_repaint();
 #endif
+  setup_field();
+#ifdef FOXI_AVX512_REPAINT
+  fast_repaint = fast_repaint && !(field != nullptr && field->graded);  // the vector repaint is flat
+#endif
   reverse = !params.depth_buffer;
   mask_words = (w + 63) / 64;
   use_mask = reverse;

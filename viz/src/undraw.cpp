@@ -350,6 +350,14 @@ void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count) {
             poly[j].X = u.X[face[j]];
             poly[j].Y = u.Y[face[j]];
           }
+          if (field != nullptr && field->graded) {  // the neighbour's positions, and nearness for perspective
+            float pos[4];
+            neighbour_positions(u.neighbour[f] >> 2, u.node, pos);
+            for (int j = 0; j < 3; ++j) {
+              poly[j].pos = pos[face[j]];
+              poly[j].w = nearness(cam(u.node[face[j]]));
+            }
+          }
           FaceSetup fs;
 #ifdef FOXI_AVX512_REPAINT
           if (fast_repaint && setup_repaint(fs, u.neighbour[f] >> 2, u.shade[f], poly)) {
@@ -369,6 +377,17 @@ void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count) {
         const auto& face = kFace[nb & 3];
         const std::uint32_t node[3] = {nv[face[0]], nv[face[1]], nv[face[2]]};
         const double* v[3] = {cam(node[0]), cam(node[1]), cam(node[2])};
+        if (field != nullptr && field->graded) {  // the polygon again, with the neighbour's positions
+          TetCorners corners_t;
+          load_corners(t, corners_t);
+          float pos[4];
+          neighbour_positions(nb >> 2, corners_t.tv, pos);
+          PolyVertex again[4];
+          bool clipped = false;
+          const int m = face_polygon(corners_t, f, true, again, &clipped, pos);
+          if (m > 0) draw_face(fb, rows, nb >> 2, v, node, again, m, false);
+          return;
+        }
         draw_face(fb, rows, nb >> 2, v, node, poly, n, false);
       });
     }

@@ -14,15 +14,23 @@
 //   write_png(path, fb), read_png(path)        PNG files of a framebuffer (png.hpp)
 //   tet_depth, count_deeper                    the painter's depth stop (depth_stop.hpp)
 //   make_movie(...)                            movies of the painter: APNG, GIF (movie.hpp, animation.hpp)
+//   choose_field, tet_corner_values, FieldPaint colour by a field: flat or graded (field_paint.hpp, RenderParams::field)
+//   ColorScale, color_map_entry, nice_ticks    colour maps, ranges, colour-bar ticks (colormap.hpp)
+//   TextRenderer, find_font_file               text in pictures with FreeType (text.hpp)
+//   draw_color_legend, legend_width            a colour-bar legend drawn into a picture (legend.hpp)
 #pragma once
 
 #include "foxi/viz/animation.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/colormap.hpp"
 #include "foxi/viz/depth_stop.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/legend.hpp"
 #include "foxi/viz/movie.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
+#include "foxi/viz/text.hpp"
 #include "foxi/viz/view.hpp"
 #include "foxi/viz/visibility_order.hpp"

@@ -29,6 +29,8 @@
 
 namespace foxi {
 
+struct FieldPaint;
+
 struct RenderParams {
   bool depth_buffer = false;    // depth-buffer mode (the framebuffer must have a depth buffer)
   double shrink = 1;            // each tet scaled about its centroid by this factor, in (0, 1]
@@ -42,6 +44,12 @@ struct RenderParams {
   // regions take region_color(r).
   std::vector<std::uint32_t> region_colors;
   bool undoable = false;        // painter only: record what undraw() needs (see TetRasterizer::undraw)
+  // Colour by a field instead of by region (field_paint.hpp; shared, not copied: a graded paint of 1M
+  // tets is 16 MB): flat, each tet's colour; graded, each face's colour interpolated per pixel from
+  // its corners' positions on the scale. Lambert shading then scales the colour within
+  // [shade_min, 1] (FieldPaint) instead of [ambient, 1]. Undraw repaints a face with its own tet's
+  // corner positions; the vector repaint (AVX-512) is flat only, so graded undraw takes the portable one.
+  std::shared_ptr<const FieldPaint> field;
 };
 
 // The colour of region `id` in the fixed palette (opaque RGBA, see pack_rgba).

@@ -1,0 +1,94 @@
+// Colouring tets by a field (issue 17): which scalar of a field is drawn (a component, a vector's
+// magnitude, a tensor's von Mises stress), its values per tet (flat: at the centroid) or per tet
+// corner (graded facets), display units, and the FieldPaint the rasterizer reads
+// (RenderParams::field).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "foxi/api.hpp"
+#include "foxi/model/mesh.hpp"
+#include "foxi/viz/colormap.hpp"
+
+namespace foxi {
+
+// Bad field selection (unknown field or component, step out of range): the message says which,
+// and what there is.
+struct FOXI_API FieldSelectError : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+// Which scalar of a field: a component index, or a derived quantity.
+struct FieldScalar {
+  enum class Kind : std::uint8_t { component, magnitude, von_mises, principal } kind = Kind::component;
+  std::uint32_t component = 0;  // Kind::component: the index; Kind::principal: 0 largest, 1 middle, 2 smallest
+};
+
+// "NAME" or "NAME:COMPONENT" against the field's component count. COMPONENT: an index 0..n-1;
+// x y z (vectors, 3 components); mag (vectors); xx yy zz xy yz xz (symmetric tensors, 6, or full
+// ones, 9); vm / von_mises (tensors); p1 p2 p3 (tensors: the principal values, largest first, of the
+// symmetric part). Without one: the value of a scalar, the magnitude of a vector,
+// the von Mises stress of a tensor. Throws FieldSelectError naming the fields or components there are.
+struct FieldChoice {
+  const Field* field = nullptr;
+  FieldScalar scalar;
+  std::string label;  // "temperature", "displacement, magnitude", "stress, von Mises", "stress xy", ...
+};
+FOXI_API FieldChoice choose_field(const Mesh& mesh, std::string_view spec);
+
+// The scalar at each of the field's entities (nodes or tets) in step `step` (FieldSelectError if
+// out of range): SI, NaN where the field has NaN.
+FOXI_API std::vector<double> field_scalar_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+
+// The scalar at each tet's centroid: a node field's components interpolated linearly (the mean of
+// the 4 corners) before taking the scalar; a cell field's own value.
+FOXI_API std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+
+// The scalar at each tet's 4 corners (4 per tet, in the tet's node order): a node field's value at
+// the node; a cell field averaged to the node over the tets of the SAME region only (volume-weighted
+// components, then the scalar), so values never blend across a material interface.
+FOXI_API std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+
+// Display units: value_display = (value_SI - offset) * factor. "degC" / "°C" from K, "MPa" / "kPa" /
+// "GPa" from Pa, "mm" / "um" / "µm" / "nm" from m, "mV" / "kV" from V, "mW" from W; the SI unit
+// itself (factor 1). Nothing if `display` does not apply to `si_unit`.
+struct DisplayUnit {
+  std::string symbol;  // as shown ("°C", "MPa", ...); the SI symbol when no conversion
+  double factor = 1, offset = 0;
+  double to_display(double si) const { return (si - offset) * factor; }
+  double to_si(double shown) const { return shown / factor + offset; }
+};
+FOXI_API std::optional<DisplayUnit> display_unit(std::string_view si_unit, std::string_view display);
+// The unit an engineer reads a field in by default: °C for K, MPa for Pa, µm for m, mV for V (below 1 V
+// in magnitude, else V); other units as they are. max_abs: the largest magnitude shown.
+FOXI_API DisplayUnit default_display_unit(std::string_view si_unit, double max_abs);
+
+// What the rasterizer needs to colour tets by a field (RenderParams::field). Shading multiplies
+// each channel of the colour-map colour by s in [shade_min, 1] (Lambert on the face's normal), so
+// hue stays and a pixel's colour, divided by s, is its colour-map entry; mesh edges darken further.
+struct FieldPaint {
+  ColorScale scale;
+  bool graded = false;
+  std::vector<std::uint32_t> tet_color;  // flat: each tet's colour (size tet_count)
+  // Graded: each tet corner's position on the scale (ColorScale::position, NaN for no value), 4 per
+  // tet in the tet's node order; faces interpolate it linearly (perspective-correct) and pick the entry.
+  std::vector<float> corner_position;
+  double shade_min = 0.75;
+};
+
+// Flat: the colour of each tet's value (tet_centroid_values) on `scale`.
+FOXI_API FieldPaint flat_field_paint(std::span<const double> tet_values, const ColorScale& scale);
+// Graded: corner values (tet_corner_values) placed on `scale`.
+FOXI_API FieldPaint graded_field_paint(std::span<const double> corner_values, const ColorScale& scale);
+
+// The finite range of values (min, max); NaN, NaN if none is finite. Log: only positive values.
+FOXI_API std::pair<double, double> finite_range(std::span<const double> values, bool positive_only = false);
+
+}  // namespace foxi
