@@ -48,7 +48,7 @@ FaceShade TetRasterizer::Impl::face_shade(std::uint32_t tet, const double* const
   return sh;
 }
 
-TetRasterizer::Impl::EdgeLine TetRasterizer::Impl::edge_line(const PolyVertex& a, const PolyVertex& b) {
+inline TetRasterizer::Impl::EdgeLine TetRasterizer::Impl::edge_line(const PolyVertex& a, const PolyVertex& b) {
   const std::int64_t ex = b.X - a.X, ey = b.Y - a.Y;
   return EdgeLine{-ey * kOne, ex * kOne, ex * (kHalf - a.Y) - ey * (kHalf - a.X),
                   std::sqrt(double(ex) * double(ex) + double(ey) * double(ey))};
@@ -56,12 +56,12 @@ TetRasterizer::Impl::EdgeLine TetRasterizer::Impl::edge_line(const PolyVertex& a
 
 // Whether the line ea x + eb y + ec is below 2^52 in magnitude on the whole image (see
 // FaceSetup::exact_double).
-bool TetRasterizer::Impl::exact_in_double(std::int64_t ea, std::int64_t eb, std::int64_t ec) const {
+inline bool TetRasterizer::Impl::exact_in_double(std::int64_t ea, std::int64_t eb, std::int64_t ec) const {
   return std::abs(double(ea)) * proj.width + std::abs(double(eb)) * proj.height + std::abs(double(ec)) < 0x1p52;
 }
 
 // A face of tet `tet` in shade sh.
-void TetRasterizer::Impl::set_shade(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh) {
+inline void TetRasterizer::Impl::set_shade(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh) {
   fs.tet = tet;
   fs.rgb[0] = sh.r;
   fs.rgb[1] = sh.g;

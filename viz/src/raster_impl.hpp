@@ -3,6 +3,9 @@
 // draw, batches and the written-mask), raster_face.cpp (face shading, edge lines, near-plane
 // clipping), raster_spans.cpp (rows, spans and edge pixels), raster_avx512.cpp (undraw's vector
 // repaint) and undraw.cpp (the undo saves and undraw); the small ones several of them use stay here.
+// Members declared inline are defined in the one file that calls them: they were inline (defined in
+// the class) before the split, and GCC's inliner treats an inline function more generously (shade_row
+// into raster_polygon, answer_requests into draw_batch: without it the painter ran ~6% more instructions).
 //
 // The painter's rasterizer (see rasterizer.hpp). Face setup works in camera coordinates (x right,
 // y up, z depth; a left-handed frame, so cross products there are the mirror of world ones), pixels
@@ -412,11 +415,11 @@ struct TetRasterizer::Impl {
     std::int64_t ea, eb, ec;
     double length;
   };
-  static EdgeLine edge_line(const PolyVertex& a, const PolyVertex& b);
+  static inline EdgeLine edge_line(const PolyVertex& a, const PolyVertex& b);
 
-  bool exact_in_double(std::int64_t ea, std::int64_t eb, std::int64_t ec) const;
+  inline bool exact_in_double(std::int64_t ea, std::int64_t eb, std::int64_t ec) const;
 
-  static void set_shade(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh);
+  static inline void set_shade(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh);
 
 #ifdef FOXI_AVX512_REPAINT
   bool setup_repaint(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly) const;
@@ -427,14 +430,14 @@ struct TetRasterizer::Impl {
 
   void setup_face(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly, int n) const;
 
-  void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const;
+  inline void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const;
 
-  std::uint32_t face_color(const FaceSetup& fs, int x, int y) const;
+  inline std::uint32_t face_color(const FaceSetup& fs, int x, int y) const;
 
-  static double nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
+  static inline double nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
                              std::int64_t e3);
 
-  std::uint32_t darkened(const FaceSetup& fs, double d) const;
+  inline std::uint32_t darkened(const FaceSetup& fs, double d) const;
 
   // Graded field paint (raster_field.cpp): the colour at pixel (x, y), d pixels from the nearest edge
   // line; a run of a row in painter mode; the scale positions of the tet whose node row is tv.
@@ -475,26 +478,28 @@ struct TetRasterizer::Impl {
     return true;
   }
 
-  void shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi);
+  // Inlined into raster_polygon's row loop, as it was before the split (out of line it cost ~4% more
+  // instructions per frame: GCC now inlines raster_triangle into raster_polygon and stops there).
+  [[gnu::always_inline]] inline void shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi);
 
-  void record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi);
+  inline void record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi);
 
-  [[gnu::always_inline]] void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
+  [[gnu::always_inline]] inline void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
 
-  static void edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e);
+  static inline void edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e);
 
-  [[gnu::always_inline]] void edge_pixels(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+  [[gnu::always_inline]] inline void edge_pixels(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
                                           std::int64_t* e, int from, int to) const;
   template <bool kFourLines>
-  [[gnu::always_inline]] void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+  [[gnu::always_inline]] inline void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
                                              std::int64_t* e, int from, int to) const;
   template <bool kFourLines, class Edge>
-  [[gnu::always_inline]] void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+  [[gnu::always_inline]] inline void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
                                                   Edge* e, const Edge* step, int from, int to) const;
 
 #ifdef __SSE2__
   template <bool kFourLines>
-  [[gnu::always_inline]] void edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
+  [[gnu::always_inline]] inline void edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
                                              const double* e, const double* step, int from, int to) const;
 #endif
 
@@ -614,7 +619,7 @@ struct TetRasterizer::Impl {
   int face_polygon(const TetCorners& k, int f, bool back, PolyVertex* poly, bool* clipped,
                    const float* pos = nullptr) const;
 
-  void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count);
+  inline void draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count);
 
   void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
                  const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden);
@@ -623,15 +628,15 @@ struct TetRasterizer::Impl {
 
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
 
-  void answer_requests(const Framebuffer& fb, int k);
+  inline void answer_requests(const Framebuffer& fb, int k);
 
-  void draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets);
+  inline void draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets);
 
-  PixelRect boxes_union(std::size_t n) const;
+  inline PixelRect boxes_union(std::size_t n) const;
 
   void zero_mask(int y0, int y1);
 
-  void clear_mask(std::size_t n);
+  inline void clear_mask(std::size_t n);
 
   // --- Undraw (seed paper, section 6.2) ---
   // A back face of a drawn tet is shared when the tet across it was drawn before it (with unshrunk
@@ -644,12 +649,12 @@ struct TetRasterizer::Impl {
   }
 
   template <class Fn>
-  void for_each_run(const PolyVertex* poly, int n, const Rows& rows, Fn&& fn) const;
+  inline void for_each_run(const PolyVertex* poly, int n, const Rows& rows, Fn&& fn) const;
 
   template <class Fn>
-  void for_each_back_face(std::uint32_t t, Fn&& fn) const;
+  inline void for_each_back_face(std::uint32_t t, Fn&& fn) const;
 
-  bool has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach) const;
+  inline bool has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach) const;
 
   void request_saves(const Framebuffer& fb, const Rows& rows, std::uint32_t t);
 
@@ -661,17 +666,17 @@ struct TetRasterizer::Impl {
     return nb != kNone && is_kept(nb >> 2) ? nb : kNone;
   }
 
-  void gather_undrawn(std::uint32_t t, UndrawTet& u) const;
+  inline void gather_undrawn(std::uint32_t t, UndrawTet& u) const;
 
-  void shade_repainted(UndrawTet& u) const;
+  inline void shade_repainted(UndrawTet& u) const;
 
   void undraw(Framebuffer& fb, std::size_t count);
 
-  void undraw_part(Framebuffer& fb, std::size_t count);
+  inline void undraw_part(Framebuffer& fb, std::size_t count);
 
-  static void add_band_work(std::vector<double>& work, const Box& b);
+  static inline void add_band_work(std::vector<double>& work, const Box& b);
 
-  static std::vector<int> split_rows(const std::vector<double>& work, int parts, int height);
+  static inline std::vector<int> split_rows(const std::vector<double>& work, int parts, int height);
 
   // Where save s of a lane's pixels end: saves of one draw() call were filed front to back, so in
   // drawing order a save's pixels run up to those of the save before it in the same call.

@@ -4,7 +4,7 @@
 
 namespace foxi {
 
-void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
+inline void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
   const std::size_t p = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
   if (params.depth_buffer) {
     const double z = fs.w0 + fs.da * (x + 0.5 - fs.x0) + fs.db * (y + 0.5 - fs.y0);
@@ -16,7 +16,7 @@ void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& fs, int 
 }
 
 // The colour of a face at pixel (x, y): flat, darkened near its edges.
-std::uint32_t TetRasterizer::Impl::face_color(const FaceSetup& fs, int x, int y) const {
+inline std::uint32_t TetRasterizer::Impl::face_color(const FaceSetup& fs, int x, int y) const {
   std::int64_t e[4];
   for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
   if (fs.graded) return graded_color(fs, x, y, nearest_edge(fs, e[0], e[1], e[2], e[3]));
@@ -24,7 +24,7 @@ std::uint32_t TetRasterizer::Impl::face_color(const FaceSetup& fs, int x, int y)
 }
 
 // The distance in pixels to the nearest edge line from a pixel whose edge functions are e0..e3.
-double TetRasterizer::Impl::nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
+inline double TetRasterizer::Impl::nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
                            std::int64_t e3) {
   return std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
                   std::min(double(e2) * fs.inv_len[2], double(e3) * fs.inv_len[3]));
@@ -33,7 +33,7 @@ double TetRasterizer::Impl::nearest_edge(const FaceSetup& fs, std::int64_t e0, s
 // The face's colour at distance d from its nearest edge line: each channel scaled by
 // 1 - darkness (1 - d / width), rounded (the three channels at once where SSE2 is there, with the
 // same float operations).
-std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d) const {
+inline std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d) const {
   if (!(d < params.edge_width)) return fs.color;
   const float f = float(edge_base + edge_slope * std::max(0.0, d));
 #ifdef __SSE2__
@@ -49,7 +49,7 @@ std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d) const
 
 // One row run of a face. Painter mode: only the pixels not yet written (see `written`), then the
 // whole run is marked written.
-void TetRasterizer::Impl::shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
   if (params.depth_buffer) {
     for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
     return;
@@ -105,7 +105,7 @@ void TetRasterizer::Impl::shade_row(Framebuffer& fb, const FaceSetup& fs, int y,
 // Undoable drawing, a run of pixels not done in this batch: those not yet shown get the face
 // (their previous contents kept in `before`), the others hold undraw requests of tets drawn later
 // (nearer) whose unshared back faces cover them: this face is what lay behind, their saved value.
-void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
+inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
   const std::size_t row = std::size_t(y) * std::size_t(fb.width);
   std::uint64_t* shown_row = &shown[std::size_t(y) * std::size_t(mask_words)];
   for (int x = lo; x <= hi;) {
@@ -172,7 +172,7 @@ void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& fs, int 
 }
 
 // The edge functions of fs's lines at pixel (x, y) (the padding line's is constant).
-void TetRasterizer::Impl::edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e) {
+inline void TetRasterizer::Impl::edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e) {
   for (int k = 0; k < 3; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
   e[3] = fs.lines > 3 ? fs.ea[3] * x + fs.eb[3] * y + fs.ec[3] : fs.ec[3];
 }

@@ -146,7 +146,7 @@ TetRasterizer::Impl::Impl(const Mesh& m, const Camera& c, int w, int h, const Re
 }
 
 // Draws tet t's front faces into the rows of `rows`.
-void TetRasterizer::Impl::draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
+inline void TetRasterizer::Impl::draw_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t, bool count) {
   TetCorners k;
   if (!load_corners(t, k)) return;
   const double* const* c = k.c;
@@ -248,9 +248,63 @@ void TetRasterizer::Impl::draw(Framebuffer& fb, std::span<const std::uint32_t> t
     if (lane.saves.size() == lane.regions.back().first_save) lane.regions.pop_back();
 }
 
+// End of an undoable batch, in lane k (by its thread): requests no tet answered get what was there
+// before the batch; a request replaced at its pixel by a later one (a back face covering a pixel
+// its tet's front faces miss, after snapping) takes that one's answer. The lane's saves, filed
+// front to back, are then put in drawing order.
+inline void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
+  Lane& lane = lanes[std::size_t(k)];
+  const SaveRegion& region = lane.regions.back();
+  for (std::size_t i = region.first_pixel; i < lane.saved_pixel.size(); ++i) {
+    const std::uint32_t p = lane.saved_pixel[i];
+    if (slot[p] != i) continue;
+    const bool was_shown = (shown[std::size_t(p / std::uint32_t(fb.width)) * std::size_t(mask_words) +
+                                 ((p % std::uint32_t(fb.width)) >> 6)] >>
+                            ((p % std::uint32_t(fb.width)) & 63)) & 1;
+    lane.saved_rgba[i] = was_shown ? before_rgba[p] : fb.rgba[p];
+    lane.saved_id[i] = was_shown ? before_id[p] : fb.id[p];
+    slot[p] = kNone;
+  }
+  for (std::size_t i = lane.aliases.size(); i-- > 0;) {
+    lane.saved_rgba[lane.aliases[i].first] = lane.saved_rgba[lane.aliases[i].second];
+    lane.saved_id[lane.aliases[i].first] = lane.saved_id[lane.aliases[i].second];
+  }
+  lane.aliases.clear();
+  std::reverse(lane.saves.begin() + std::ptrdiff_t(region.first_save), lane.saves.end());
+}
+
+// Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
+// for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
+// its projected area (as face_polygon does) without building its polygon; k: its corners (finite).
+// reach: t's repaint reach (see drawn_reach).
+inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach) const {
+  bool unshared = false;
+  std::uint32_t least = drawn_at[t];
+  const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
+  for (int f = 0; f < 4; ++f) {
+    bool back;
+    if (unclipped) {
+      const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
+      back = (k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) > 0;
+    } else {
+      PolyVertex poly[4];
+      bool clipped = false;
+      back = face_polygon(k, f, true, poly, &clipped) > 0;
+    }
+    if (!back) continue;
+    const std::uint32_t nb = earlier_neighbour(t, f);
+    if (nb == kNone)
+      unshared = true;
+    else
+      least = std::min(least, drawn_at[nb >> 2]);
+  }
+  reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
+  return unshared;
+}
+
 // Painter or depth-buffer drawing of a batch (see draw); the written-pixel mask is all zero before
 // and after, cleared only on the rows the batch could touch (short batches cost what they draw).
-void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets) {
+inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std::uint32_t> tets) {
   if (tets.empty()) return;
   // Threads pay for themselves only on long batches. Undoable drawing always uses its lanes'
   // partition (saved pixels are kept per lane), on one thread for short batches.
@@ -330,7 +384,7 @@ void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std::uint3
 
 // The union of the first n boxes of the batch (the whole image if one is unknown): where drawing or
 // undrawing them may have changed pixels.
-PixelRect TetRasterizer::Impl::boxes_union(std::size_t n) const {
+inline PixelRect TetRasterizer::Impl::boxes_union(std::size_t n) const {
   PixelRect r{proj.width, proj.height, -1, -1};
   for (std::size_t i = 0; i < n; ++i) {
     const Box& b = boxes[i];
@@ -355,7 +409,7 @@ void TetRasterizer::Impl::zero_mask(int y0, int y1) {
 
 // Zeroes the written-pixel mask (and while recording, `shown`) on the rows the batch's boxes span;
 // `changed` becomes their union.
-void TetRasterizer::Impl::clear_mask(std::size_t n) {
+inline void TetRasterizer::Impl::clear_mask(std::size_t n) {
   changed = boxes_union(n);
   const int y0 = changed.y0, y1 = changed.y1;
   if (y0 > y1) return;

@@ -6,35 +6,10 @@
 
 namespace foxi {
 
-// End of an undoable batch, in lane k (by its thread): requests no tet answered get what was there
-// before the batch; a request replaced at its pixel by a later one (a back face covering a pixel
-// its tet's front faces miss, after snapping) takes that one's answer. The lane's saves, filed
-// front to back, are then put in drawing order.
-void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
-  Lane& lane = lanes[std::size_t(k)];
-  const SaveRegion& region = lane.regions.back();
-  for (std::size_t i = region.first_pixel; i < lane.saved_pixel.size(); ++i) {
-    const std::uint32_t p = lane.saved_pixel[i];
-    if (slot[p] != i) continue;
-    const bool was_shown = (shown[std::size_t(p / std::uint32_t(fb.width)) * std::size_t(mask_words) +
-                                 ((p % std::uint32_t(fb.width)) >> 6)] >>
-                            ((p % std::uint32_t(fb.width)) & 63)) & 1;
-    lane.saved_rgba[i] = was_shown ? before_rgba[p] : fb.rgba[p];
-    lane.saved_id[i] = was_shown ? before_id[p] : fb.id[p];
-    slot[p] = kNone;
-  }
-  for (std::size_t i = lane.aliases.size(); i-- > 0;) {
-    lane.saved_rgba[lane.aliases[i].first] = lane.saved_rgba[lane.aliases[i].second];
-    lane.saved_id[lane.aliases[i].first] = lane.saved_id[lane.aliases[i].second];
-  }
-  lane.aliases.clear();
-  std::reverse(lane.saves.begin() + std::ptrdiff_t(region.first_save), lane.saves.end());
-}
-
 // Calls fn(y, lo, hi) for the pixel runs of a polygon (positive area) in the rows of `rows`, in a
 // fixed order.
 template <class Fn>
-void TetRasterizer::Impl::for_each_run(const PolyVertex* poly, int n, const Rows& rows, Fn&& fn) const {
+inline void TetRasterizer::Impl::for_each_run(const PolyVertex* poly, int n, const Rows& rows, Fn&& fn) const {
   for (int q = 1; q + 1 < n; ++q) {
     std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X}, Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
     std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
@@ -45,7 +20,7 @@ void TetRasterizer::Impl::for_each_run(const PolyVertex* poly, int n, const Rows
 
 // Calls fn(f, poly, n) for each back face of drawn tet t that covers pixels.
 template <class Fn>
-void TetRasterizer::Impl::for_each_back_face(std::uint32_t t, Fn&& fn) const {
+inline void TetRasterizer::Impl::for_each_back_face(std::uint32_t t, Fn&& fn) const {
   TetCorners k;
   if (!load_corners(t, k)) return;
   PolyVertex poly[4];
@@ -54,35 +29,6 @@ void TetRasterizer::Impl::for_each_back_face(std::uint32_t t, Fn&& fn) const {
     const int n = face_polygon(k, f, true, poly, &clipped);
     if (n > 0) fn(f, poly, n);
   }
-}
-
-// Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
-// for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
-// its projected area (as face_polygon does) without building its polygon; k: its corners (finite).
-// reach: t's repaint reach (see drawn_reach).
-bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach) const {
-  bool unshared = false;
-  std::uint32_t least = drawn_at[t];
-  const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
-  for (int f = 0; f < 4; ++f) {
-    bool back;
-    if (unclipped) {
-      const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
-      back = (k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) > 0;
-    } else {
-      PolyVertex poly[4];
-      bool clipped = false;
-      back = face_polygon(k, f, true, poly, &clipped) > 0;
-    }
-    if (!back) continue;
-    const std::uint32_t nb = earlier_neighbour(t, f);
-    if (nb == kNone)
-      unshared = true;
-    else
-      least = std::min(least, drawn_at[nb >> 2]);
-  }
-  reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
-  return unshared;
 }
 
 // Files t's save in the lane of `rows`: a request for each pixel of its unshared back faces in
@@ -116,7 +62,7 @@ void TetRasterizer::Impl::request_saves(const Framebuffer& fb, const Rows& rows,
 // which the walk repaints as those tets' front faces (their shades come after, from
 // shade_repainted). A face is back when its outward-ordered projection has positive area
 // (face_polygon's test).
-void TetRasterizer::Impl::gather_undrawn(std::uint32_t t, UndrawTet& u) const {
+inline void TetRasterizer::Impl::gather_undrawn(std::uint32_t t, UndrawTet& u) const {
   TetCorners k;
   load_corners(t, k);
   u.repaint = 0;
@@ -138,7 +84,7 @@ void TetRasterizer::Impl::gather_undrawn(std::uint32_t t, UndrawTet& u) const {
 // The shades of u's repainted faces: each the kept neighbour's front face, which is u's face seen
 // from the other side (u's corners in reverse outward order), shaded bit for bit as drawing the
 // neighbour did (see face_shade).
-void TetRasterizer::Impl::shade_repainted(UndrawTet& u) const {
+inline void TetRasterizer::Impl::shade_repainted(UndrawTet& u) const {
   for (int f = 0; f < 4; ++f) {
     if (!(u.repaint >> f & 1)) continue;
     const int a = kFace[f][0], b = kFace[f][2], d = kFace[f][1];  // reversed
@@ -194,7 +140,7 @@ void TetRasterizer::Impl::undraw(Framebuffer& fb, std::size_t count) {
 }
 
 // undraw of count > 0 tets, at most kUndrawPart.
-void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count) {
+inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count) {
   if (written.empty()) {
     written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
     tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
@@ -421,7 +367,7 @@ void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count) {
 // Adds box b's undraw work to `work` (per band of 16 rows): its width plus a per-row cost, times its
 // rows, all on the band of its middle row (a box is a few bands tall at most where it matters: the
 // split need only be about even).
-void TetRasterizer::Impl::add_band_work(std::vector<double>& work, const Box& b) {
+inline void TetRasterizer::Impl::add_band_work(std::vector<double>& work, const Box& b) {
   constexpr int kRowCost = 16;  // pixels' worth of per-row setup
   work[std::size_t(((b.y0 + b.y1) >> 1) >> kBandShift)] += double((b.x1 - b.x0 + 1 + kRowCost) * (b.y1 - b.y0 + 1));
 }
@@ -430,7 +376,7 @@ void TetRasterizer::Impl::add_band_work(std::vector<double>& work, const Box& b)
 // the near plane, unknown, counts on none): split[k] to split[k + 1] - 1 for thread k, whole bands
 // of 16 rows (a thread's mask tiles are its own), of about equal work. Contiguous ranges, not
 // interleaved bands: a tet is a few bands tall, and each thread whose rows it touches pays its setup.
-std::vector<int> TetRasterizer::Impl::split_rows(const std::vector<double>& work, int parts, int height) {
+inline std::vector<int> TetRasterizer::Impl::split_rows(const std::vector<double>& work, int parts, int height) {
   const int bands = int(work.size());
   double total = 0;
   for (double w : work) total += w;
