@@ -695,4 +695,11 @@ struct TetRasterizer::Impl {
   std::size_t undo_bytes() const;
 };
 
+// The distance in pixels to the nearest edge line from a pixel whose edge functions are e0..e3.
+inline double TetRasterizer::Impl::nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
+                           std::int64_t e3) {
+  return std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
+                  std::min(double(e2) * fs.inv_len[2], double(e3) * fs.inv_len[3]));
+}
+
 }  // namespace foxi

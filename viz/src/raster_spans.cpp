@@ -23,13 +23,6 @@ inline std::uint32_t TetRasterizer::Impl::face_color(const FaceSetup& fs, int x,
   return darkened(fs, nearest_edge(fs, e[0], e[1], e[2], e[3]));
 }
 
-// The distance in pixels to the nearest edge line from a pixel whose edge functions are e0..e3.
-inline double TetRasterizer::Impl::nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
-                           std::int64_t e3) {
-  return std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
-                  std::min(double(e2) * fs.inv_len[2], double(e3) * fs.inv_len[3]));
-}
-
 // The face's colour at distance d from its nearest edge line: each channel scaled by
 // 1 - darkness (1 - d / width), rounded (the three channels at once where SSE2 is there, with the
 // same float operations).
