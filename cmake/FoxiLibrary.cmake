@@ -22,6 +22,9 @@ function(foxi_library target export_name)
     VISIBILITY_INLINES_HIDDEN ON
     POSITION_INDEPENDENT_CODE ON
     DEFINE_SYMBOL ""
+    # A shared library finds the foxi libraries it needs beside itself, whatever the host's own
+    # RUNPATH says (RUNPATH is not inherited by a program's libraries).
+    INSTALL_RPATH "$ORIGIN"
     VERSION ${PROJECT_VERSION}
     SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
   # __FILE__ (FOXI_ASSERT's messages, in Debug or with FOXI_CHECKS) relative to the source tree, so

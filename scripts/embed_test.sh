@@ -48,9 +48,45 @@ if [ "$model" != "$prefix/share/foxi/models/flip_chip.toml" ]; then
 fi
 step "installed foxi: --version, demo model"
 
-for example in grid_png field_buffer; do
+# Every imported target links in a host (a static build's private dependencies found by the
+# package: TetGen, CGAL with GMP/MPFR, ...): a program that calls into each library.
+mkdir -p "$work/all_targets.src"
+cat > "$work/all_targets.src/CMakeLists.txt" <<'CMAKE'
+cmake_minimum_required(VERSION 3.22)
+project(foxi_all_targets LANGUAGES CXX)
+find_package(foxi 0.1 REQUIRED)
+add_executable(all_targets main.cpp)
+target_compile_features(all_targets PRIVATE cxx_std_20)
+target_link_libraries(all_targets PRIVATE foxi::model foxi::structure foxi::mesher foxi::solver foxi::viz)
+CMAKE
+cat > "$work/all_targets.src/main.cpp" <<'CPP'
+#include <cmath>
+#include <cstdio>
+#include "foxi/mesher.hpp"
+#include "foxi/model.hpp"
+#include "foxi/solver.hpp"
+#include "foxi/structure.hpp"
+#include "foxi/viz.hpp"
+#include "foxi/version.hpp"
+int main() {
+  // Addresses of the heavy entry points make the linker resolve their dependencies (TetGen, CGAL).
+  void* volatile entry[] = {reinterpret_cast<void*>(&foxi::mesh_plc), reinterpret_cast<void*>(&foxi::mesh_plc_cgal),
+                            reinterpret_cast<void*>(&foxi::solve_thermal), reinterpret_cast<void*>(&foxi::load_model),
+                            reinterpret_cast<void*>(&foxi::compute_spheres)};
+  const double mm = foxi::evaluate_in("2 mm + 500 um", "m");       // structure
+  const double v = foxi::regular_tet_volume(1.0);                   // mesher
+  const bool ok = entry[0] != nullptr && std::abs(mm - 2.5e-3) < 1e-15 && std::abs(v - std::sqrt(2.0) / 12) < 1e-15;
+  std::printf("all_targets: foxi %s, 2 mm + 500 um = %g m, regular tet volume %.6f: %s\n", FOXI_VERSION_STRING, mm, v,
+              ok ? "ok" : "WRONG");
+  return ok ? 0 : 1;
+}
+CPP
+
+for example in grid_png field_buffer all_targets; do
   dir=$work/$example
-  cmake -S "examples/embed/$example" -B "$dir" -G "$generator" -DCMAKE_BUILD_TYPE=Release \
+  source_dir=examples/embed/$example
+  [ -d "$source_dir" ] || source_dir=$work/$example.src
+  cmake -S "$source_dir" -B "$dir" -G "$generator" -DCMAKE_BUILD_TYPE=Release \
     -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF > "$dir.log" 2>&1 ||
     { cat "$dir.log"; exit 1; }
   found=$(sed -n 's/^foxi_DIR:PATH=//p' "$dir/CMakeCache.txt")
@@ -77,4 +113,5 @@ print(f'  grid.png: {w} x {h}, {len(data)} bytes')
 PY
 "$work/field_buffer/field_buffer" "$work/field.ppm"
 step "field_buffer: run"
+"$work/all_targets/all_targets"
 echo "embed test: passed"
