@@ -10,11 +10,14 @@
 //     electrostatic_, current_, thermoelastic_params_from_model (model_problem.hpp)
 //   SolverError, SolverCancelled, LinearSolverOptions   why a solve failed; the linear solver (solver.hpp)
 //   write_calculix_thermal, read_frd           the same problem as a CalculiX deck, its results (calculix.hpp)
+//   thermal_results(mesh, report), results_json  a run's key values as a record, JSON (results.hpp)
+//   convergence_table, observed_order          convergence over refinement levels (results.hpp)
 #pragma once
 
 #include "foxi/solver/calculix.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/results.hpp"
 #include "foxi/solver/solver.hpp"
 #include "foxi/solver/thermal.hpp"
 #include "foxi/solver/thermoelastic.hpp"

@@ -51,7 +51,7 @@ struct RunParameter {
 enum class RunStatus : std::uint8_t { ok, unreliable, failed };
 FOXI_API const char* run_status_name(RunStatus s);  // "ok", "unreliable", "failed"
 
-struct RunResults {
+struct FOXI_API RunResults {
   std::string model;    // file the run came from (model or mesh)
   std::string physics;  // "thermal", "electrostatic", "current", "thermoelastic"
   std::vector<RunParameter> parameters;
