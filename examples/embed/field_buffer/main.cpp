@@ -7,16 +7,16 @@
 // (as its own solver would), T(x, y, z) = sin(pi x) sin(pi y) (1 + z) at every node, and its picture
 // buffer has rows `stride` pixels apart (wider than the image, as a window system's would be).
 //
-// Today's viz draws tets in per-region colours; it has no colouring by field yet. So the host
-// colours by field through the regions: each tet's mean nodal value picks one of kBins colours of a
-// blue-to-red map, given to foxi as the tet's region id and the painter's region_colors. Lighting and
-// edges are off (ambient 1), so every pixel is exactly the map colour of the tet it shows, which
-// the host checks through the framebuffer's id buffer.
+// The host hands foxi its per-tet values as a span (foxi::flat_field_paint: no copy into the mesh,
+// no foxi::Field): each tet's value is the mean of its 4 nodal values, and each tet is painted in
+// the colour of that value on a viridis scale over the field's range. Shading and edges are off
+// (shade_min 1), so every pixel is exactly its tet's colour, which the host checks through the
+// framebuffer's id buffer.
 //
 // Copies: the host's nodes and tets are copied into a foxi::Mesh (foxi::Mesh owns std::vectors;
 // there is no mesh view over host arrays yet), and foxi::Framebuffer owns its pixels, so the
-// picture is copied row by row into the host's buffer (width * height * 4 bytes). The order and the
-// painter read the mesh in place and take the tet order as a span.
+// picture is copied row by row into the host's buffer (width * height * 4 bytes). The field goes
+// in as a span; the order and the painter read the mesh in place and take the tet order as a span.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -24,9 +24,12 @@
 #include <cstring>
 #include <exception>
 #include <fstream>
+#include <memory>
 #include <numbers>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -35,21 +38,11 @@
 
 namespace {
 
-constexpr int kBins = 32;
-
 // The host's picture buffer: RGBA8 (R first in memory), `stride` pixels per row, padding included.
 struct HostImage {
   int width = 0, height = 0, stride = 0;
   std::vector<std::uint32_t> pixels;
 };
-
-// A blue (cold) to red (hot) map over [0, 1].
-std::uint32_t heat_color(double u) {
-  const double r = std::clamp(1.5 * u, 0.0, 1.0), g = std::clamp(1.5 - std::abs(3 * u - 1.5), 0.0, 1.0),
-               b = std::clamp(1.5 * (1 - u), 0.0, 1.0);
-  return foxi::pack_rgba(std::uint32_t(std::lround(255 * r)), std::uint32_t(std::lround(255 * g)),
-                         std::uint32_t(std::lround(255 * b)));
-}
 
 int run(const char* out) {
   // The host's mesh: an nx x ny x nz box of cubes, 6 Kuhn tets each, over [0,1] x [0,1] x [0,0.5].
@@ -80,25 +73,23 @@ int run(const char* out) {
   for (std::size_t v = 0; v < temperature.size(); ++v)
     temperature[v] = std::sin(std::numbers::pi * xyz[3 * v]) * std::sin(std::numbers::pi * xyz[3 * v + 1]) *
                      (1 + xyz[3 * v + 2]);
-  const double t_max = 1.5;  // the field's largest value (at x = y = 1/2, z = 1/2)
 
   foxi::Mesh mesh;  // copies of the host's arrays (see the top)
   mesh.xyz = xyz;
   mesh.tet = tets;
+
+  // The host's per-tet values, handed to foxi as a span.
+  std::vector<double> tet_value(mesh.tet_count());
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t)
+    for (int v = 0; v < 4; ++v) tet_value[t] += temperature[mesh.tet[4 * t + v]] / 4;
+  foxi::ColorScale scale;
+  scale.map = foxi::ColorMapId::viridis;
+  std::tie(scale.lo, scale.hi) = foxi::finite_range(tet_value);
+  auto paint = std::make_shared<foxi::FieldPaint>(foxi::flat_field_paint(tet_value, scale));
+  paint->shade_min = 1;  // no shading: each pixel is its tet's colour exactly
   foxi::RenderParams params;
   params.edges = false;
-  params.ambient = 1;  // no shading: each pixel is its tet's colour exactly
-  params.region_colors.resize(kBins);
-  for (int b = 0; b < kBins; ++b) {
-    params.region_colors[b] = heat_color((b + 0.5) / kBins);
-    mesh.regions.push_back({b, "", foxi::kNone});
-  }
-  mesh.tet_region.resize(mesh.tet_count());
-  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
-    double mean = 0;
-    for (int v = 0; v < 4; ++v) mean += temperature[mesh.tet[4 * t + v]] / 4;
-    mesh.tet_region[t] = std::clamp(int(mean / t_max * kBins), 0, kBins - 1);
-  }
+  params.field = paint;
 
   if (!foxi::validate(mesh).ok()) throw std::runtime_error("the host's mesh is not valid");
   if (!foxi::delaunay_certificate(mesh).delaunay) throw std::runtime_error("the host's mesh is not Delaunay");
@@ -127,7 +118,7 @@ int run(const char* out) {
   // Checks: every covered pixel has the map colour of the field at the tet it shows, the background
   // stays transparent, the padding untouched, and the picture spans the field's range.
   std::size_t covered = 0, wrong = 0, padding_changed = 0;
-  std::vector<bool> bin_seen(kBins, false);
+  std::set<std::uint32_t> colours;
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.stride; ++x) {
       const std::uint32_t px = image.pixels[std::size_t(y) * image.stride + x];
@@ -141,15 +132,12 @@ int run(const char* out) {
         continue;
       }
       ++covered;
-      const int bin = mesh.tet_region[t];
-      bin_seen[bin] = true;
-      wrong += px != params.region_colors[bin];
+      colours.insert(px);
+      wrong += px != scale.color(tet_value[t]);  // the colour of the host's value, on the host's scale
     }
-  int bins = 0;
-  for (bool b : bin_seen) bins += b;
-  std::printf("field_buffer: %zu tets, %zu pixels covered, %d of %d colours shown, %zu wrong pixels, "
-              "%zu padding pixels changed\n",
-              mesh.tet_count(), covered, bins, kBins, wrong, padding_changed);
+  std::printf("field_buffer: %zu tets, values %.3g..%.3g, %zu pixels covered, %zu colours shown, %zu wrong "
+              "pixels, %zu padding pixels changed\n",
+              mesh.tet_count(), scale.lo, scale.hi, covered, colours.size(), wrong, padding_changed);
 
   if (out != nullptr) {  // the host's own writer: binary PPM of its buffer, alpha dropped
     std::ofstream f(out, std::ios::binary);
@@ -162,7 +150,7 @@ int run(const char* out) {
       }
     if (!f.flush()) throw std::runtime_error(std::string("cannot write ") + out);
   }
-  return wrong == 0 && padding_changed == 0 && bins > kBins / 2 && covered > std::size_t(image.width) * image.height / 10
+  return wrong == 0 && padding_changed == 0 && colours.size() > 50 && covered > std::size_t(image.width) * image.height / 10
              ? 0
              : 1;
 }
