@@ -89,26 +89,28 @@ std::map<std::int32_t, std::string> parse_names(std::string_view s) {
 
 // A material's properties in the order foxi_region_materials keeps them, as bit patterns (so that
 // NaN, "not set", compares equal to NaN).
-std::array<std::uint64_t, 6> material_values(const Material& m) {
-  const double v[6] = {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity,
-                       m.youngs_modulus,       m.poisson_ratio,           m.thermal_expansion};
-  std::array<std::uint64_t, 6> bits{};
-  for (std::size_t i = 0; i < 6; ++i) bits[i] = std::isnan(v[i]) ? 0x7ff8000000000000ull : std::bit_cast<std::uint64_t>(v[i]);
+std::array<std::uint64_t, 8> material_values(const Material& m) {
+  const double v[8] = {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity,
+                       m.youngs_modulus,       m.poisson_ratio,           m.thermal_expansion,
+                       m.density,              m.specific_heat};
+  std::array<std::uint64_t, 8> bits{};
+  for (std::size_t i = 0; i < 8; ++i) bits[i] = std::isnan(v[i]) ? 0x7ff8000000000000ull : std::bit_cast<std::uint64_t>(v[i]);
   return bits;
 }
 
-// "name|k|sigma|eps|E|nu|alpha" (name %-escaped, "nan" for a property not set); nothing when it
-// does not have that form (an attribute another writer put there is ignored, not an error).
+// "name|k|sigma|eps|E|nu|alpha|rho|c" (name %-escaped, "nan" for a property not set; files written
+// before density and specific heat have the first seven only); nothing when it does not have that form (an attribute another writer put there is ignored, not an error).
 std::optional<Material> parse_material(std::string_view s) {
   std::vector<std::string_view> parts;
   for (std::size_t bar; (bar = s.find('|')) != std::string_view::npos; s = s.substr(bar + 1)) parts.push_back(s.substr(0, bar));
   parts.push_back(s);
-  if (parts.size() != 7) return std::nullopt;
+  if (parts.size() != 7 && parts.size() != 9) return std::nullopt;
   Material m;
   m.name = percent_decode(parts[0]);
-  double* v[6] = {&m.thermal_conductivity, &m.electrical_conductivity, &m.relative_permittivity,
-                  &m.youngs_modulus,       &m.poisson_ratio,           &m.thermal_expansion};
-  for (std::size_t i = 0; i < 6; ++i) {
+  double* v[8] = {&m.thermal_conductivity, &m.electrical_conductivity, &m.relative_permittivity,
+                  &m.youngs_modulus,       &m.poisson_ratio,           &m.thermal_expansion,
+                  &m.density,              &m.specific_heat};
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
     const std::string_view t = parts[i + 1];
     if (t == "nan") continue;
     auto r = std::from_chars(t.data(), t.data() + t.size(), *v[i]);

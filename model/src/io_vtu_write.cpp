@@ -71,11 +71,11 @@ std::string names_attribute(const std::vector<std::pair<std::int32_t, std::strin
   return s;
 }
 
-// parse_material's form: "name|k|sigma|eps|E|nu|alpha", shortest round-trip numbers.
+// parse_material's form: "name|k|sigma|eps|E|nu|alpha|rho|c", shortest round-trip numbers.
 std::string material_attribute(const Material& m) {
   std::string s = percent_encode(m.name, ";=|");
   for (double v : {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity, m.youngs_modulus,
-                   m.poisson_ratio, m.thermal_expansion}) {
+                   m.poisson_ratio, m.thermal_expansion, m.density, m.specific_heat}) {
     s += '|';
     if (std::isnan(v)) {
       s += "nan";

@@ -200,7 +200,8 @@ std::uint64_t line_of(const Value& v) {
 }
 
 constexpr Dims kConductivity = {1, 1, -3, -1, 0}, kElectrical = {-3, -1, 3, 0, 2},
-               kModulus = {-1, 1, -2, 0, 0}, kExpansion = {0, 0, 0, -1, 0};
+               kModulus = {-1, 1, -2, 0, 0}, kExpansion = {0, 0, 0, -1, 0},
+               kDensity = {-3, 1, 0, 0, 0}, kSpecificHeat = {2, 0, -2, -1, 0};
 
 class Loader {
  public:
@@ -450,11 +451,15 @@ class Loader {
           field = &mat.poisson_ratio;
         else if (k == "thermal_expansion")
           field = &mat.thermal_expansion, d = kExpansion;
+        else if (k == "density")
+          field = &mat.density, d = kDensity;
+        else if (k == "specific_heat")
+          field = &mat.specific_heat, d = kSpecificHeat;
         else
           throw Located{line_of(v), "material '" + name + "': unknown property '" + k +
                                         "' (expected thermal_conductivity, electrical_conductivity, "
                                         "relative_permittivity, youngs_modulus, poisson_ratio, "
-                                        "thermal_expansion, source, note)"};
+                                        "thermal_expansion, density, specific_heat, source, note)"};
         const double x = quantity(v, d, entity, 1).value;
         if (!(x >= 0) && k != "thermal_expansion")
           throw Located{line_of(v), entity + " must not be negative"};

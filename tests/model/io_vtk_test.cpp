@@ -329,6 +329,7 @@ Mesh rich_mesh() {
   cu.youngs_modulus = 1.1e11;
   cu.poisson_ratio = 0.34;
   cu.thermal_expansion = 1.7e-5 / 3;  // not a short decimal
+  cu.density = 8960;  // specific_heat left unset
   m.materials = {cu};
   m.regions[0].material = 0;
   m.regions[1].material = 0;
@@ -374,9 +375,9 @@ void expect_same_mesh(const Mesh& a, const Mesh& b, bool names) {
       const Material &x = a.materials[a.regions[i].material], &y = b.materials[b.regions[i].material];
       EXPECT_EQ(x.name, y.name);
       EXPECT_TRUE(same_bits({x.thermal_conductivity, x.electrical_conductivity, x.relative_permittivity, x.youngs_modulus,
-                             x.poisson_ratio, x.thermal_expansion},
+                             x.poisson_ratio, x.thermal_expansion, x.density, x.specific_heat},
                             {y.thermal_conductivity, y.electrical_conductivity, y.relative_permittivity, y.youngs_modulus,
-                             y.poisson_ratio, y.thermal_expansion}));
+                             y.poisson_ratio, y.thermal_expansion, y.density, y.specific_heat}));
     }
   }
   if (names) {

@@ -127,6 +127,10 @@ TEST(Structure, ModelsCarryMaterialsFromTheLibrary) {
     EXPECT_GT(mat.youngs_modulus, 1e9) << mat.name;
     EXPECT_GT(mat.poisson_ratio, 0) << mat.name;
     EXPECT_LT(mat.poisson_ratio, 0.5) << mat.name;
+    // Transient heat: every library material has rho and c, in the range of solids (water's
+    // volumetric heat capacity 4.2e6 J/(m^3 K) is above all of them, 1e6 below).
+    EXPECT_GT(mat.density * mat.specific_heat, 1e6) << mat.name;
+    EXPECT_LT(mat.density * mat.specific_heat, 4.2e6) << mat.name;
   }
   EXPECT_DOUBLE_EQ(m.length_scale, 1e-3);
 }
@@ -305,6 +309,25 @@ TEST(StructureBadInput, TheGoodModelLoads) {
   const foxi::Structure s = foxi::build_structure(m);
   EXPECT_NEAR(s.part_volume[0], 2e-3 * 2e-3 * 1e-3, 1e-20);
   EXPECT_DOUBLE_EQ(m.materials[0].thermal_conductivity, 2.0);
+}
+
+// Density and specific heat take units like the other properties (a bare number is SI), and a wrong
+// dimension or a negative value is refused with its line.
+TEST(StructureBadInput, DensityAndSpecificHeatTakeUnits) {
+  TempDir dir;
+  const std::string t = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"",
+                                 "thermal_conductivity = \"2 W/(m*K)\"\ndensity = \"8.96 g/cm^3\"\nspecific_heat = \"0.385 J/(g*K)\"");
+  foxi::test::write_text(dir / "u.toml", t);
+  const foxi::Model m = foxi::load_model(dir / "u.toml");
+  EXPECT_NEAR(m.materials[0].density, 8960, 1e-9);
+  EXPECT_NEAR(m.materials[0].specific_heat, 385, 1e-9);
+  const std::string bad = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"", "thermal_conductivity = \"2 W/(m*K)\"\ndensity = \"3 kg/m^2\"");
+  const foxi::IoError e = load_error(bad);
+  EXPECT_NE(e.reason().find("unit mismatch"), std::string::npos) << e.what();
+  EXPECT_EQ(e.line(), line_of(bad, "density ="));
+  const std::string neg = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"", "thermal_conductivity = \"2 W/(m*K)\"\nspecific_heat = -1");
+  const foxi::IoError n = load_error(neg);
+  EXPECT_NE(n.reason().find("must not be negative"), std::string::npos) << n.what();
 }
 
 TEST(StructureBadInput, UnknownParameterIsNamed) {

@@ -35,6 +35,8 @@ struct Material {
   double youngs_modulus = kUnset;          // Pa
   double poisson_ratio = kUnset;           // 1
   double thermal_expansion = kUnset;       // 1/K
+  double density = kUnset;                 // kg/m^3 (transient heat: rho c dT/dt)
+  double specific_heat = kUnset;           // J/(kg K), at constant pressure
 };
 
 // A region (a part, a physical volume group): tets whose tet_region equals `id`.
