@@ -6,6 +6,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "amg.hpp"
@@ -181,92 +182,62 @@ void require_finite_output(const std::vector<std::vector<double>>& xs, const Lin
     throw SolverError("the residual is NaN or infinite: no result to report");
 }
 
-LinearSolveResult solve_spd_many_unchecked(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
-                                           std::vector<std::vector<double>>& xs,
-                                           const LinearSolverOptions& options, const NearNullSpace* near_null) {
+}  // namespace
+
+struct SpdSolver::Impl {
+  const SymmetricCsr& a;
+  LinearSolverOptions options;
+  unsigned threads = 1;
+  LinearSolverKind kind = LinearSolverKind::direct;
+  std::vector<double> weight;
+  std::string name;
+  std::size_t levels = 0;
+  Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt;
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> ic;
+  std::unique_ptr<AmgPreconditioner> amg;
+  Impl(const SymmetricCsr& m, const LinearSolverOptions& o) : a(m), options(o) {}
+};
+
+SpdSolver::SpdSolver(const SymmetricCsr& a, const LinearSolverOptions& options, const NearNullSpace* near_null)
+    : impl_(std::make_unique<Impl>(a, options)) {
+  Impl& s = *impl_;
   const std::size_t n = a.rows();
-  const unsigned threads = thread_count(options.threads);
-  LinearSolveResult result;
-  xs.assign(bs.size(), std::vector<double>(n, 0.0));
+  s.threads = thread_count(options.threads);
   // Scalar problems (no near-null space) measure residuals row by row against the row's own scale
   // (W = diag(A)^-1): at a conductivity contrast of 1e20 the plain |r| is all metal rows, and a solve
   // that meets tol |b| there leaves the insulator's rows, which carry the small currents, unresolved.
-  std::vector<double> weight;
   if (!near_null) {
-    weight.assign(n, 0.0);
+    s.weight.assign(n, 0.0);
     for (std::size_t i = 0; i < n; ++i)
       for (int k = a.start[i]; k < a.start[i + 1]; ++k)
         if (static_cast<std::size_t>(a.col[static_cast<std::size_t>(k)]) == i)
-          weight[i] = 1.0 / a.val[static_cast<std::size_t>(k)];
-    for (double w : weight)
+          s.weight[i] = 1.0 / a.val[static_cast<std::size_t>(k)];
+    for (double w : s.weight)
       if (!(w > 0) || !std::isfinite(w))
         throw SolverError("the matrix has a non-positive diagonal (a non-positive coefficient?)");
   }
-  auto norm = [&](const std::vector<double>& b) { return weighted_norm(b, weight); };
-  LinearSolverKind kind = options.kind;
-  if (kind == LinearSolverKind::automatic)
-    kind = n <= options.direct_max_unknowns ? LinearSolverKind::direct : LinearSolverKind::cg_amg;
+  s.kind = options.kind;
+  if (s.kind == LinearSolverKind::automatic)
+    s.kind = n <= options.direct_max_unknowns ? LinearSolverKind::direct : LinearSolverKind::cg_amg;
   if (n == 0) {
-    result.solver = "none (no unknowns)";
-    return result;
+    s.name = "none (no unknowns)";
+    return;
   }
   Eigen::Map<const SpMat> A = as_eigen(a);
-
-  if (kind == LinearSolverKind::direct) {
-    result.solver = "SimplicialLDLT";
-    report(options, "factorize", 0.0);
-    Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt;
-    ldlt.compute(A);
-    if (ldlt.info() != Eigen::Success)
+  report(options, "factorize", 0.0);
+  if (s.kind == LinearSolverKind::direct) {
+    s.name = "SimplicialLDLT";
+    s.ldlt.compute(A);
+    if (s.ldlt.info() != Eigen::Success)
       throw SolverError(
           "sparse LDL^T factorization failed (matrix not positive definite: are the "
           "coefficients positive and every part connected to a fixed boundary?)");
-    const Vec d = ldlt.vectorD();
+    const Vec d = s.ldlt.vectorD();
     if (d.minCoeff() <= 0)
       throw SolverError(
           "sparse LDL^T: the matrix is singular or indefinite (a part with no fixed boundary, or a "
           "non-positive coefficient)");
-    for (std::size_t i = 0; i < bs.size(); ++i) {
-      report(options, "solve", static_cast<double>(i) / static_cast<double>(bs.size()));
-      Eigen::Map<const Vec> B(bs[i].data(), static_cast<Eigen::Index>(n));
-      Eigen::Map<Vec> X(xs[i].data(), static_cast<Eigen::Index>(n));
-      X = ldlt.solve(B);
-      const double bnorm = norm(bs[i]);
-      result.relative_residual = std::max(
-          result.relative_residual, bnorm > 0 ? norm(residual(a, bs[i], xs[i], threads)) / bnorm : 0.0);
-    }
-    report(options, "solve", 1.0);
-    return result;
-  }
-
-  report(options, "factorize", 0.0);
-  // CG's recursive residual drifts from the true one; where the true residual misses the tolerance
-  // (high contrast: the metal rows' round-off swamps the recursion), CG restarts on it (iterative
-  // refinement, a few rounds).
-  auto run_all = [&](auto&& precondition) {
-    constexpr int kRefinements = 4;
-    for (std::size_t i = 0; i < bs.size(); ++i) {
-      const double bnorm = norm(bs[i]);
-      if (bnorm == 0) continue;
-      const double tol = options.relative_tolerance * bnorm;
-      LinearSolveResult one;
-      pcg(a, bs[i], xs[i], bnorm, tol, weight, options, threads, one, precondition);
-      result.iterations += one.iterations;
-      std::vector<double> r = residual(a, bs[i], xs[i], threads);
-      double rnorm = norm(r);
-      for (int round = 0; round < kRefinements && rnorm > tol; ++round) {
-        std::vector<double> dx(n, 0.0);
-        LinearSolveResult more;
-        pcg(a, r, dx, bnorm, tol, weight, options, threads, more, precondition);
-        result.iterations += more.iterations;
-        for (std::size_t k = 0; k < n; ++k) xs[i][k] += dx[k];
-        r = residual(a, bs[i], xs[i], threads);
-        rnorm = norm(r);
-      }
-      result.relative_residual = std::max(result.relative_residual, rnorm / bnorm);
-    }
-  };
-  if (kind == LinearSolverKind::cg_amg) {
+  } else if (s.kind == LinearSolverKind::cg_amg) {
     AmgParams amg_params;
     amg_params.near_null = near_null;
     // The l1 smoother keeps hybrid Gauss-Seidel convergent on any thread count: without it the
@@ -285,23 +256,90 @@ LinearSolveResult solve_spd_many_unchecked(const SymmetricCsr& a, const std::vec
     // iterations (250k tets: 27 against 53) but makes the coarse operators denser, for 30% more CPU
     // time in all (2.43 s against 1.88 s on the CSR products) and 1.6 times the peak memory.
     amg_params.smooth_prolongation = near_null == nullptr;
-    result.solver = near_null ? (amg_params.smooth_prolongation ? "CG+SmoothedAggregationAMG(rigid-body modes)"
-                                                                : "CG+AggregationAMG(rigid-body modes)")
-                              : "CG+SmoothedAggregationAMG";
-    AmgPreconditioner amg(a, threads, amg_params);
-    result.levels = amg.level_count();
-    report(options, "solve", 0.0);
-    run_all([&](const Vec& r, Vec& z) { amg.apply(r.data(), z.data()); });
+    s.name = near_null ? (amg_params.smooth_prolongation ? "CG+SmoothedAggregationAMG(rigid-body modes)"
+                                                         : "CG+AggregationAMG(rigid-body modes)")
+                       : "CG+SmoothedAggregationAMG";
+    s.amg = std::make_unique<AmgPreconditioner>(a, s.threads, amg_params);
+    s.levels = s.amg->level_count();
   } else {
-    result.solver = "CG+IncompleteCholesky";
-    Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> ic;
+    s.name = "CG+IncompleteCholesky";
     {
       SpMat lower = SpMat(A).triangularView<Eigen::Lower>();
-      ic.compute(lower);
+      s.ic.compute(lower);
     }
-    if (ic.info() != Eigen::Success) throw SolverError("incomplete Cholesky factorization failed");
-    report(options, "solve", 0.0);
-    run_all([&](const Vec& r, Vec& z) { z = ic.solve(r); });
+    if (s.ic.info() != Eigen::Success) throw SolverError("incomplete Cholesky factorization failed");
+  }
+}
+
+SpdSolver::~SpdSolver() = default;
+
+const std::string& SpdSolver::name() const { return impl_->name; }
+std::size_t SpdSolver::levels() const { return impl_->levels; }
+
+LinearSolveResult SpdSolver::solve(const std::vector<double>& b, std::vector<double>& x) {
+  Impl& s = *impl_;
+  const SymmetricCsr& a = s.a;
+  const std::size_t n = a.rows();
+  LinearSolveResult result;
+  result.solver = s.name;
+  result.levels = s.levels;
+  x.assign(n, 0.0);
+  if (n == 0) return result;
+  auto norm = [&](const std::vector<double>& v) { return weighted_norm(v, s.weight); };
+  const double bnorm = norm(b);
+  if (s.kind == LinearSolverKind::direct) {
+    Eigen::Map<const Vec> B(b.data(), static_cast<Eigen::Index>(n));
+    Eigen::Map<Vec> X(x.data(), static_cast<Eigen::Index>(n));
+    X = s.ldlt.solve(B);
+    result.relative_residual = bnorm > 0 ? norm(residual(a, b, x, s.threads)) / bnorm : 0.0;
+    return result;
+  }
+  if (bnorm == 0) return result;
+  // CG's recursive residual drifts from the true one; where the true residual misses the tolerance
+  // (high contrast: the metal rows' round-off swamps the recursion), CG restarts on it (iterative
+  // refinement, a few rounds).
+  auto run = [&](auto&& precondition) {
+    constexpr int kRefinements = 4;
+    const double tol = s.options.relative_tolerance * bnorm;
+    LinearSolveResult one;
+    pcg(a, b, x, bnorm, tol, s.weight, s.options, s.threads, one, precondition);
+    result.iterations += one.iterations;
+    std::vector<double> r = residual(a, b, x, s.threads);
+    double rnorm = norm(r);
+    for (int round = 0; round < kRefinements && rnorm > tol; ++round) {
+      std::vector<double> dx(n, 0.0);
+      LinearSolveResult more;
+      pcg(a, r, dx, bnorm, tol, s.weight, s.options, s.threads, more, precondition);
+      result.iterations += more.iterations;
+      for (std::size_t k = 0; k < n; ++k) x[k] += dx[k];
+      r = residual(a, b, x, s.threads);
+      rnorm = norm(r);
+    }
+    result.relative_residual = rnorm / bnorm;
+  };
+  if (s.amg)
+    run([&](const Vec& r, Vec& z) { s.amg->apply(r.data(), z.data()); });
+  else
+    run([&](const Vec& r, Vec& z) { z = s.ic.solve(r); });
+  return result;
+}
+
+namespace {
+
+LinearSolveResult solve_spd_many_unchecked(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
+                                           std::vector<std::vector<double>>& xs,
+                                           const LinearSolverOptions& options, const NearNullSpace* near_null) {
+  SpdSolver solver(a, options, near_null);
+  LinearSolveResult result;
+  result.solver = solver.name();
+  result.levels = solver.levels();
+  xs.assign(bs.size(), {});
+  report(options, "solve", 0.0);
+  for (std::size_t i = 0; i < bs.size(); ++i) {
+    report(options, "solve", static_cast<double>(i) / static_cast<double>(bs.size()));
+    const LinearSolveResult one = solver.solve(bs[i], xs[i]);
+    result.iterations += one.iterations;
+    result.relative_residual = std::max(result.relative_residual, one.relative_residual);
   }
   report(options, "solve", 1.0);
   return result;

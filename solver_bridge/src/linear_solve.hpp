@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -47,6 +49,25 @@ LinearSolveResult solve_spd(const SymmetricCsr& a, const std::vector<double>& b,
 LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::vector<double>>& b,
                                  std::vector<std::vector<double>>& x, const LinearSolverOptions& options,
                                  const NearNullSpace* near_null = nullptr);
+
+// A factorization or preconditioner of A built once for many solves one after another (a time
+// stepper's fixed matrix). `a` is referenced, not copied: it must outlive the solver. The
+// constructor throws SolverError as solve_spd does; solve() throws on CG failure and does not check
+// for NaN (the caller's results do).
+class SpdSolver {
+ public:
+  SpdSolver(const SymmetricCsr& a, const LinearSolverOptions& options, const NearNullSpace* near_null = nullptr);
+  ~SpdSolver();
+  SpdSolver(const SpdSolver&) = delete;
+  SpdSolver& operator=(const SpdSolver&) = delete;
+  LinearSolveResult solve(const std::vector<double>& b, std::vector<double>& x);
+  const std::string& name() const;
+  std::size_t levels() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // y = A x on `threads` threads.
 void multiply(const SymmetricCsr& a, const double* x, double* y, unsigned threads);

@@ -14,6 +14,7 @@
 
 #include "linear_solve.hpp"
 #include "scalar_p1.hpp"
+#include "thermal_setup.hpp"
 
 namespace foxi {
 
@@ -24,13 +25,8 @@ using detail::parallel_for;
 using detail::region_label;
 using detail::tag_label;
 
-enum class BcKind : std::uint8_t { none, fixed, flux, convection };
-
-struct TagBc {
-  BcKind kind = BcKind::none;
-  double a = 0, b = 0;  // fixed: T; flux: q; convection: h, T_inf
-  std::size_t report = 0;
-};
+using detail::BcKind;
+using detail::TagBc;
 
 const char* probe_name(ThermalProbeKind kind) {
   switch (kind) {
@@ -122,32 +118,35 @@ ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceS
 
 }  // namespace
 
-ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
-  using clock = std::chrono::steady_clock;
-  const auto t_start = clock::now();
-  detail::check_mesh(mesh);
+namespace detail {
+
+ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, ThermalReport& rep,
+                              bool require_anchor) {
+  check_mesh(mesh);
+  ThermalSystem sys;
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), nf = mesh.bface_count();
-  const unsigned threads = detail::thread_count(params.solver.threads);
+  const unsigned threads = sys.threads = thread_count(params.solver.threads);
   auto progress = [&](std::string_view stage, double fraction) {
-    detail::report_progress(params.solver, stage, fraction);
+    report_progress(params.solver, stage, fraction);
   };
   progress("assemble", 0.0);
 
   // Regions with tets, dense indices, conductivity.
-  const detail::RegionTable regions = detail::region_table(mesh);
+  sys.regions = region_table(mesh);
+  const RegionTable& regions = sys.regions;
   const std::size_t nr = regions.size();
   std::vector<std::pair<std::int32_t, double>> overrides;
   for (const RegionConductivity& c : params.conductivity) overrides.emplace_back(c.region, c.k);
-  const std::vector<double> region_k = detail::region_coefficients(
+  sys.region_k = region_coefficients(
       mesh, regions, [](const Material& m) { return m.thermal_conductivity; }, overrides,
       "thermal conductivity", "ThermalParams::conductivity (foxi solve --k");
+  const std::vector<double>& region_k = sys.region_k;
   const std::vector<std::uint32_t>& tet_rix = regions.tet_rix;
   auto region_index = [&](std::int32_t id) { return regions.index(id); };
 
   // Boundary conditions by tag.
-  const std::vector<std::int32_t> tags = detail::boundary_tag_list(mesh);
-  std::map<std::int32_t, TagBc> bc;
-  ThermalReport rep;
+  const std::vector<std::int32_t> tags = boundary_tag_list(mesh);
+  std::map<std::int32_t, TagBc>& bc = sys.bc;
   auto add_bc = [&](std::int32_t tag, BcKind kind, double a, double b, const char* kind_name) {
     if (!std::binary_search(tags.begin(), tags.end(), tag))
       throw SolverError(std::string(kind_name) + " condition on " + tag_label(mesh, tag) +
@@ -174,7 +173,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
     add_bc(c.tag, BcKind::convection, c.h, c.ambient, "convection");
     has_convection = true;
   }
-  if (params.fixed.empty() && !has_convection)
+  if (require_anchor && params.fixed.empty() && !has_convection)
     throw SolverError(
         "ill-posed thermal problem: no boundary has a fixed temperature or convection, so the "
         "temperature is determined only up to a constant (and a net heat input has no way out); "
@@ -194,7 +193,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   // Tet volumes, region volumes, source densities.
   {
     std::vector<double> region_volume;
-    (void)detail::tet_volumes(mesh, regions, threads, region_volume);
+    (void)tet_volumes(mesh, regions, threads, region_volume);
     rep.regions.resize(nr);
     for (std::size_t i = 0; i < nr; ++i) {
       rep.regions[i].region = regions.ids[i];
@@ -202,7 +201,8 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
       rep.regions[i].volume = region_volume[i];
     }
   }
-  std::vector<double> region_q(nr, 0.0);  // W/m^3
+  sys.region_q.assign(nr, 0.0);  // W/m^3
+  std::vector<double>& region_q = sys.region_q;
   std::vector<bool> source_given(nr, false);
   for (const HeatSource& s : params.sources) {
     const std::size_t i = region_index(s.region);
@@ -221,29 +221,32 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   // Stiffness (row-wise over the node pattern) and source load.
   std::vector<double> tet_k(nt);
   for (std::size_t t = 0; t < nt; ++t) tet_k[t] = region_k[tet_rix[t]];
-  detail::P1Stiffness stiff = detail::assemble_stiffness(mesh, tet_k, threads);
+  sys.stiff = assemble_stiffness(mesh, tet_k, threads);
+  P1Stiffness& stiff = sys.stiff;
   std::vector<double>().swap(tet_k);  // not needed again; the solve needs the memory
-  const detail::CsrPattern& pat = stiff.pat;
+  const CsrPattern& pat = stiff.pat;
   std::vector<double>& kval = stiff.val;
-  std::vector<double> load(nn, 0.0);
+  sys.load.assign(nn, 0.0);
+  std::vector<double>& load = sys.load;
   {
     std::array<std::array<double, 3>, 4> g;
     for (std::size_t t = 0; t < nt; ++t) {
       const double q = region_q[tet_rix[t]];
       if (q == 0) continue;
-      const double share = q * detail::p1_gradients(mesh, t, g) * 0.25;
+      const double share = q * p1_gradients(mesh, t, g) * 0.25;
       for (int a = 0; a < 4; ++a) load[mesh.tet[4 * t + a]] += share;
     }
   }
   progress("assemble", 0.5);
 
   // Boundary triangles: Robin mass, flux and convection loads, fixed values (lumped-area mean).
-  std::vector<double> bface_area(nf, 0.0);
+  sys.bface_area.assign(nf, 0.0);
+  std::vector<double>& bface_area = sys.bface_area;
   for (std::size_t f = 0; f < nf; ++f) {
     auto it = bc.find(mesh.bface_tag[f]);
     if (it == bc.end()) continue;
     const TagBc& t = it->second;
-    const double area = detail::triangle_area(mesh, f);
+    const double area = triangle_area(mesh, f);
     bface_area[f] = area;
     rep.boundaries[t.report].area += area;
     const std::uint32_t* v = &mesh.bface[3 * f];
@@ -271,66 +274,58 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
     }
   }
   // Fixed values; a zero-area neighbourhood falls back to the plain mean of the tags' values.
-  std::map<std::int32_t, detail::FixedTag> fixed_tags;
+  std::map<std::int32_t, FixedTag> fixed_tags;
   for (const auto& [tag, t] : bc)
     if (t.kind == BcKind::fixed) fixed_tags[tag] = {t.a, t.report};
-  const detail::Dirichlet dir = detail::dirichlet_from_tags(mesh, stiff, fixed_tags, rep.boundaries.size());
-  const std::vector<char>& fixed = dir.fixed;
-  std::vector<double> temp = dir.value;
+  sys.dir = dirichlet_from_tags(mesh, stiff, fixed_tags, rep.boundaries.size());
+  const std::vector<char>& fixed = sys.dir.fixed;
 
   // Every connected part needs a fixed or convective node, else its temperature is undetermined.
-  {
+  if (require_anchor) {
     std::vector<char> anchored = fixed;
     for (std::size_t f = 0; f < nf; ++f) {
       auto it = bc.find(mesh.bface_tag[f]);
       if (it != bc.end() && it->second.kind == BcKind::convection) anchored[mesh.bface[3 * f]] = 1;
     }
-    detail::check_anchored(
+    check_anchored(
         mesh, anchored, "ill-posed thermal problem",
         "touches no fixed-temperature or convection boundary, so its temperature is undetermined");
   }
+  return sys;
+}
 
-  // Free unknowns and the reduced system.
-  const detail::ReducedSystem red = detail::reduce(stiff, fixed, threads);
-  const std::vector<double> rhs = detail::reduced_rhs(stiff, red, load, fixed, temp, threads);
-  rep.unknowns = red.a.rows();
-  rep.nonzeros = red.a.val.size();
-  progress("assemble", 1.0);
-  const auto t_assembled = clock::now();
-
-  std::vector<double> x;
-  const detail::LinearSolveResult lin = detail::solve_spd(red.a, rhs, x, params.solver);
-  rep.solver = lin.solver;
-  rep.iterations = lin.iterations;
-  rep.relative_residual = lin.relative_residual;
-  const auto t_solved = clock::now();
-  detail::scatter(red, x, temp);
-
-  // Heat through the boundaries.
-  {
-    const std::vector<double> heat = detail::slot_reactions(stiff, dir, load, temp, rep.boundaries.size());
-    for (std::size_t i = 0; i < heat.size(); ++i) rep.boundaries[i].heat_in += heat[i];
-  }
-  for (std::size_t f = 0; f < nf; ++f) {
-    auto it = bc.find(mesh.bface_tag[f]);
-    if (it == bc.end()) continue;
+void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector<double>& load,
+                   const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries) {
+  const std::vector<double> heat = slot_reactions(sys.stiff, sys.dir, load, temp, boundaries.size());
+  for (std::size_t i = 0; i < heat.size(); ++i) boundaries[i].heat_in = heat[i];
+  for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
+    auto it = sys.bc.find(mesh.bface_tag[f]);
+    if (it == sys.bc.end()) continue;
     const TagBc& t = it->second;
     const std::uint32_t* v = &mesh.bface[3 * f];
     if (t.kind == BcKind::flux) {
-      rep.boundaries[t.report].heat_in += t.a * bface_area[f];
+      boundaries[t.report].heat_in += t.a * sys.bface_area[f];
     } else if (t.kind == BcKind::convection) {
       const double mean = (temp[v[0]] + temp[v[1]] + temp[v[2]]) / 3;
-      rep.boundaries[t.report].heat_in += t.a * (t.b - mean) * bface_area[f];
+      boundaries[t.report].heat_in += t.a * (t.b - mean) * sys.bface_area[f];
     }
   }
 
-  // Cell heat flux and per-region temperatures.
+}
+
+Field region_results(const Mesh& mesh, const ThermalParams& params, const ThermalSystem& sys,
+                     const std::vector<double>& temp, ThermalReport& rep) {
+  const std::size_t nt = mesh.tet_count();
   Field flux_field;
   flux_field.name = "heat_flux";
   flux_field.location = FieldLocation::cell;
   flux_field.components = 3;
   flux_field.unit = "W/m^2";
   flux_field.values.resize(3 * nt);
+  const unsigned threads = sys.threads;
+  const std::size_t nr = sys.regions.size();
+  const std::vector<double>& region_k = sys.region_k;
+  const std::vector<std::uint32_t>& tet_rix = sys.regions.tet_rix;
   std::vector<std::vector<double>> region_tv(threads, std::vector<double>(nr, 0.0));
   parallel_for(nt, threads, [&](std::size_t b, std::size_t e, unsigned th) {
     std::array<std::array<double, 3>, 4> g;
@@ -371,7 +366,48 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
     }
   for (BoundaryHeat& b : rep.boundaries) b.mean_temperature = boundary_mean_temperature(mesh, b.tag, temp);
   for (const ThermalResistanceSpec& spec : params.resistances)
-    rep.resistances.push_back(evaluate_resistance(mesh, spec, rep, temp, bc));
+    rep.resistances.push_back(evaluate_resistance(mesh, spec, rep, temp, sys.bc));
+  return flux_field;
+}
+
+}  // namespace detail
+
+ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
+  using clock = std::chrono::steady_clock;
+  const auto t_start = clock::now();
+  ThermalReport rep;
+  const detail::ThermalSystem sys = detail::assemble_thermal(mesh, params, rep);
+  auto progress = [&](std::string_view stage, double fraction) {
+    detail::report_progress(params.solver, stage, fraction);
+  };
+  const unsigned threads = sys.threads;
+  const detail::P1Stiffness& stiff = sys.stiff;
+  const detail::CsrPattern& pat = stiff.pat;
+  const std::vector<double>& kval = stiff.val;
+  const std::vector<double>& load = sys.load;
+  const std::vector<char>& fixed = sys.dir.fixed;
+  std::vector<double> temp = sys.dir.value;
+
+  // Free unknowns and the reduced system.
+  const detail::ReducedSystem red = detail::reduce(stiff, fixed, threads);
+  const std::vector<double> rhs = detail::reduced_rhs(stiff, red, load, fixed, temp, threads);
+  rep.unknowns = red.a.rows();
+  rep.nonzeros = red.a.val.size();
+  progress("assemble", 1.0);
+  const auto t_assembled = clock::now();
+
+  std::vector<double> x;
+  const detail::LinearSolveResult lin = detail::solve_spd(red.a, rhs, x, params.solver);
+  rep.solver = lin.solver;
+  rep.iterations = lin.iterations;
+  rep.relative_residual = lin.relative_residual;
+  const auto t_solved = clock::now();
+  detail::scatter(red, x, temp);
+
+  // Heat through the boundaries, cell heat flux and per-region temperatures.
+  detail::boundary_heat(mesh, sys, load, temp, rep.boundaries);
+  Field flux_field = detail::region_results(mesh, params, sys, temp, rep);
+
   // Energy balance against the heat that flows (what enters, or what leaves if more): with no sources
   // the net boundary heat is ~0 and no scale for itself.
   {

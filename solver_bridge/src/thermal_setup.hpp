@@ -1,0 +1,53 @@
+// Internal: the steady heat-conduction system of thermal.cpp in pieces, so that the transient solver
+// (transient.cpp) assembles and post-processes exactly what the steady one does.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "foxi/solver/thermal.hpp"
+#include "scalar_p1.hpp"
+
+namespace foxi::detail {
+
+enum class BcKind : std::uint8_t { none, fixed, flux, convection };
+
+struct TagBc {
+  BcKind kind = BcKind::none;
+  double a = 0, b = 0;  // fixed: T; flux: q; convection: h, T_inf
+  std::size_t report = 0;
+};
+
+// K (conductivity plus the convection "mass"), the load of the sources, fluxes and convection, the
+// fixed values, per region the conductivity and source density (W/m^3).
+struct ThermalSystem {
+  unsigned threads = 1;
+  RegionTable regions;
+  std::vector<double> region_k, region_q;
+  std::map<std::int32_t, TagBc> bc;
+  P1Stiffness stiff;
+  std::vector<double> load;
+  std::vector<double> bface_area;  // per boundary triangle with a condition, else 0
+  Dirichlet dir;
+};
+
+// Checks `params` against the mesh (SolverError naming what is wrong) and assembles; fills
+// rep.boundaries (tag, kind, area), rep.regions (region, volume, conductivity, power), rep.total_power.
+// `require_anchor`: every connected part must touch a fixed or convective boundary (a steady solve;
+// a transient one is well posed without, its heat capacity anchors it).
+ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, ThermalReport& rep,
+                               bool require_anchor = true);
+
+// Sets boundaries[i].heat_in (W) for the nodal temperatures `temp`: reactions (K temp - load) at the
+// fixed nodes, q A on flux tags, h (T_inf - T) A on convection tags.
+void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector<double>& load,
+                   const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries);
+
+// Per-region mean and max temperatures, the overall max, boundary mean temperatures and the
+// resistances of params.resistances into `rep`; returns the cell field "heat_flux".
+Field region_results(const Mesh& mesh, const ThermalParams& params, const ThermalSystem& sys,
+                     const std::vector<double>& temp, ThermalReport& rep);
+
+}  // namespace foxi::detail

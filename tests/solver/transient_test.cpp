@@ -1,0 +1,242 @@
+// Transient heat conduction against exact solutions: a uniformly heated body with adiabatic walls
+// (T rises at P / (rho c V), exactly for the lumped capacity), a convectively cooled body at Biot
+// 1e-3 (exponential), the semi-infinite slab with a fixed surface temperature (erfc), the order of
+// accuracy in time of both schemes against a fine-step reference, the long-time limit against the
+// steady solver on the same mesh, and the energy balance asserted in every run.
+#include "foxi/solver/transient.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "foxi/model/io_error.hpp"
+#include "layered_box.hpp"
+#include "test_util.hpp"
+
+namespace foxi {
+namespace {
+
+// Layered box tags: 1 x = 0, 2 x = lx, 3 y = 0, 4 y = ly, 5 z = 0, 6 z = lz.
+TransientParams base(const Mesh& m, double k, double rho_c) {
+  TransientParams p;
+  for (const Region& r : m.regions) {
+    p.thermal.conductivity.push_back({r.id, k});
+    p.heat_capacity.push_back({r.id, rho_c});
+  }
+  p.thermal.solver.kind = LinearSolverKind::direct;
+  return p;
+}
+
+void expect_balanced(const TransientReport& rep) {
+  ASSERT_FALSE(rep.checks.empty());
+  for (const BalanceCheck& c : rep.checks) EXPECT_TRUE(c.passed) << c.name << " " << c.figure << " > " << c.tolerance;
+}
+
+const std::vector<double>& temperature(const Mesh& m) {
+  for (const Field& f : m.fields)
+    if (f.name == "temperature") return f.values;
+  throw std::runtime_error("no temperature");
+}
+
+TEST(Transient, AdiabaticBodyHeatedUniformlyRisesLinearly) {
+  Mesh m = test::layered_box_mesh(0.02, 0.01, {0, 0.005}, 1e-8);
+  const double V = 0.02 * 0.01 * 0.005, rho_c = 2e6, P = 3;
+  for (TimeScheme scheme : {TimeScheme::euler, TimeScheme::bdf2}) {
+    TransientParams p = base(m, 50, rho_c);
+    p.power.push_back({1, PowerWaveform::step_of(P)});
+    p.initial_temperature = 300;
+    p.end_time = 10;
+    p.steps = 7;
+    p.scheme = scheme;
+    p.junctions = {1};
+    const TransientReport r = solve_transient_thermal(m, p);
+    expect_balanced(r);
+    // Every node at 300 + P t / (rho c V): the source density is uniform and the lumped capacity is
+    // proportional to the same nodal volume shares, so no gradient ever forms.
+    const double exact = 300 + P * 10 / (rho_c * V);
+    for (double t : temperature(m)) EXPECT_NEAR(t, exact, 1e-9 * exact);
+    ASSERT_EQ(r.times.size(), 8u);
+    for (std::size_t n = 0; n < r.times.size(); ++n)
+      EXPECT_NEAR(r.junction_temperature[0][n], 300 + P * r.times[n] / (rho_c * V), 1e-9 * exact);
+    EXPECT_NEAR(r.stored_energy, P * 10, 1e-9 * P * 10);
+  }
+}
+
+TEST(Transient, ConvectivelyCooledBodyDecaysExponentially) {
+  // 10 x 10 x 10 mm, k 400, h 40: Biot h L / k = 1e-3, so the body is one lumped capacity with
+  // tau = rho c V / (h A). Lumped-body error O(Bi) ~ 1e-3 and BDF2's O((dt/tau)^2) = 1e-4 at 100 steps
+  // over one tau: the drop within 3e-3 of itself.
+  const double L = 0.01, h = 40, rho_c = 3e6, tinf = 300, t0 = 400;
+  Mesh m = test::layered_box_mesh(L, L, {0, L}, 1e-8);
+  for (TimeScheme scheme : {TimeScheme::euler, TimeScheme::bdf2}) {
+    TransientParams p = base(m, 400, rho_c);
+    for (std::int32_t tag = 1; tag <= 6; ++tag) p.thermal.convection.push_back({tag, h, tinf});
+    p.initial_temperature = t0;
+    const double tau = rho_c * L * L * L / (h * 6 * L * L);
+    p.end_time = tau;
+    p.steps = scheme == TimeScheme::euler ? 2000 : 100;  // Euler's O(dt / tau) error: 5e-4 at 2000
+    p.scheme = scheme;
+    p.junctions = {1};
+    const TransientReport r = solve_transient_thermal(m, p);
+    expect_balanced(r);
+    for (std::size_t n = 0; n < r.times.size(); n += p.steps / 10) {
+      const double exact = tinf + (t0 - tinf) * std::exp(-r.times[n] / tau);
+      EXPECT_NEAR(r.junction_temperature[0][n], exact, 3e-3 * (t0 - tinf)) << "t = " << r.times[n];
+    }
+    // The heat that left against the stored energy lost, in joules: exact for Euler; BDF2 within
+    // its O(dt) end terms (TransientReport::heat_in), about 0.3% here.
+    const double exact_loss = rho_c * L * L * L * (t0 - tinf) * (1 - std::exp(-1.0));
+    EXPECT_NEAR(-r.stored_energy, exact_loss, 3e-3 * exact_loss);
+    EXPECT_NEAR(r.heat_in, r.stored_energy, (scheme == TimeScheme::euler ? 1e-6 : 1e-2) * std::abs(r.stored_energy));
+  }
+}
+
+TEST(Transient, SemiInfiniteSlabFollowsErfc) {
+  // A column 0.5 m along z, alpha = k / (rho c) = 1 m^2/s, T = 1 at z = 0 from t = 0, 0 inside:
+  // T = erfc(z / (2 sqrt(alpha t))). At t = 0.01 s the front reaches ~0.3 m, well short of the far
+  // end. Mesh edge ~ 0.015 m, 200 BDF2 steps: every node with z >= 0.03 within 0.02 of erfc.
+  Mesh m = test::layered_box_mesh(0.03, 0.03, {0, 0.5}, 3e-7);
+  TransientParams p = base(m, 1, 1);
+  p.thermal.fixed.push_back({5, 1.0});
+  p.initial_temperature = 0;
+  p.end_time = 0.01;
+  p.steps = 200;
+  const TransientReport r = solve_transient_thermal(m, p);
+  expect_balanced(r);
+  const std::vector<double>& t = temperature(m);
+  double worst = 0;
+  for (std::size_t v = 0; v < m.node_count(); ++v) {
+    const double z = m.xyz[3 * v + 2];
+    if (z < 0.03) continue;
+    worst = std::max(worst, std::abs(t[v] - std::erfc(z / (2 * std::sqrt(0.01)))));
+  }
+  EXPECT_LT(worst, 0.02);
+}
+
+// The junction temperature at t_end of a convectively cooled body at Biot 0.5 (a real gradient).
+double cooled_at_end(const Mesh& m, TimeScheme scheme, std::size_t steps) {
+  Mesh copy = m;
+  TransientParams p = base(m, 1, 1e6);
+  for (std::int32_t tag = 1; tag <= 6; ++tag) p.thermal.convection.push_back({tag, 50, 300});
+  p.power.push_back({1, PowerWaveform::step_of(0.5)});
+  p.initial_temperature = 300;
+  p.end_time = 200;
+  p.steps = steps;
+  p.scheme = scheme;
+  p.junctions = {1};
+  const TransientReport r = solve_transient_thermal(copy, p);
+  expect_balanced(r);
+  return r.junction_temperature[0].back();
+}
+
+TEST(Transient, OrderOfAccuracyInTimeIsOneForEulerAndTwoForBdf2) {
+  Mesh m = test::layered_box_mesh(0.02, 0.02, {0, 0.02}, 2e-7);
+  const double reference = cooled_at_end(m, TimeScheme::bdf2, 1280);
+  for (TimeScheme scheme : {TimeScheme::euler, TimeScheme::bdf2}) {
+    const double e1 = std::abs(cooled_at_end(m, scheme, 20) - reference);
+    const double e2 = std::abs(cooled_at_end(m, scheme, 40) - reference);
+    const double e4 = std::abs(cooled_at_end(m, scheme, 80) - reference);
+    const double order1 = std::log2(e1 / e2), order2 = std::log2(e2 / e4);
+    const double want = scheme == TimeScheme::euler ? 1 : 2;
+    EXPECT_NEAR(order1, want, 0.2) << "errors " << e1 << " " << e2 << " " << e4;
+    EXPECT_NEAR(order2, want, 0.2) << "errors " << e1 << " " << e2 << " " << e4;
+  }
+}
+
+TEST(Transient, LongTimeLimitIsTheSteadySolution) {
+  // Two layers, 1 W in the top one, bottom fixed at 300 K: after 30 time constants of the slowest
+  // mode the transient is the steady solution of the same mesh to 1e-8 of the rise.
+  Mesh m = test::layered_box_mesh(0.01, 0.01, {0, 0.002, 0.003}, 2e-10);
+  TransientParams p = base(m, 10, 2e6);
+  p.thermal.conductivity[1].k = 100;
+  p.thermal.fixed.push_back({5, 300});
+  p.power.push_back({2, PowerWaveform::step_of(1.0)});
+  p.junctions = {2};
+  const double tau = 2e6 * 0.003 * 0.003 / 10;  // L^2 / alpha of the slow layer
+  p.end_time = 30 * tau;
+  p.steps = 300;
+  const TransientReport r = solve_transient_thermal(m, p);
+  expect_balanced(r);
+  const std::vector<double> transient = temperature(m);
+  Mesh s = m;
+  ThermalParams sp = p.thermal;
+  sp.sources.push_back({2, 1.0, true});
+  const ThermalReport steady = solve_thermal(s, sp);
+  const std::vector<double>& ts = temperature(s);
+  const double rise = steady.max_temperature - 300;
+  ASSERT_GT(rise, 0);
+  for (std::size_t v = 0; v < ts.size(); ++v) EXPECT_NEAR(transient[v], ts[v], 1e-8 * rise);
+  // Starting from the steady state without power, the junction starts at 300 K.
+  EXPECT_NEAR(r.junction_temperature[0][0], 300, 1e-9);
+}
+
+TEST(Transient, PulseAndTableWaveforms) {
+  PowerWaveform pulse;
+  pulse.kind = PowerWaveform::Kind::pulse;
+  pulse.power = 2.0;
+  pulse.width = 1e-3;
+  pulse.period = 4e-3;
+  pulse.count = 2;
+  EXPECT_EQ(pulse.at(0), 2.0);
+  EXPECT_EQ(pulse.at(0.5e-3), 2.0);
+  EXPECT_EQ(pulse.at(1.5e-3), 0.0);
+  EXPECT_EQ(pulse.at(4.5e-3), 2.0);
+  EXPECT_EQ(pulse.at(8.5e-3), 0.0);  // count 2: over
+  PowerWaveform table;
+  table.kind = PowerWaveform::Kind::table;
+  table.table = {{0, 0}, {1, 2}, {3, 0}};
+  EXPECT_DOUBLE_EQ(table.at(0.5), 1.0);
+  EXPECT_DOUBLE_EQ(table.at(2), 1.0);
+  EXPECT_DOUBLE_EQ(table.at(5), 0.0);
+}
+
+TEST(TransientBadInput, PowerTableRowsAreRefusedWithTheirLine) {
+  test::TempDir dir;
+  test::write_text(dir / "ok.csv", "time_s,power_W\n# comment\n0,1\n0.5, 2\n\n1,0\n");
+  const auto rows = read_power_table((dir / "ok.csv").string());
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[1].second, 2.0);
+  const std::pair<const char*, std::uint64_t> bad[] = {
+      {"0,1\n0.5,x\n", 2}, {"0,1\n0.5\n", 2}, {"0,1\n1,2\n1,3\n", 3}, {"0,1\n2,inf\n", 2}, {"# nothing\n", 1}};
+  for (const auto& [text, line] : bad) {
+    test::write_text(dir / "bad.csv", text);
+    try {
+      read_power_table((dir / "bad.csv").string());
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const IoError& e) {
+      EXPECT_EQ(e.line(), line) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bad.csv"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(TransientBadInput, MissingHeatCapacityIsNamed) {
+  Mesh m = test::layered_box_mesh(0.01, 0.01, {0, 0.01}, 1e-7);
+  TransientParams p;
+  p.thermal.conductivity.push_back({1, 1});
+  p.thermal.fixed.push_back({5, 300});
+  p.end_time = 1;
+  p.steps = 1;
+  try {
+    solve_transient_thermal(m, p);
+    ADD_FAILURE();
+  } catch (const SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find("heat capacity"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TransientBadInput, CancelThrowsFoxiCancelled) {
+  Mesh m = test::layered_box_mesh(0.01, 0.01, {0, 0.01}, 1e-7);
+  TransientParams p = base(m, 1, 1e6);
+  p.thermal.fixed.push_back({5, 300});
+  p.end_time = 1;
+  p.steps = 10;
+  p.on_step = [](std::size_t step, double, std::span<const double>) { return step < 3; };
+  EXPECT_THROW(solve_transient_thermal(m, p), Cancelled);
+}
+
+}  // namespace
+}  // namespace foxi
