@@ -27,7 +27,8 @@ namespace {
 
 const char* kSolveUsage =
     "foxi solve MODEL.toml --physics thermal|electrostatic|current [--set NAME=VALUE]... [options below]\n"
-    "  (--physics thermoelastic: see 'foxi solve --physics thermoelastic --help')\n"
+    "  (--physics thermoelastic: see 'foxi solve --physics thermoelastic --help';\n"
+    "   --physics transient: see 'foxi solve --physics transient --help')\n"
     "  Meshes the model (TetGen, its [mesh] controls) and solves with its [[conditions]] and [[loads]];\n"
     "  the options below add to them, boundaries and regions named as in 'foxi model check'.\n"
     "  Values take units as model files write them: --fix top=300K, --fix 'top=25 degC', --power die=3W,\n"
@@ -238,6 +239,10 @@ void print_matrix(const char* title, const char* unit, const std::vector<Electro
   }
 }
 
+std::string regions_label(const Mesh& mesh, const std::vector<std::int32_t>& ids);
+
+}  // namespace
+
 // One line per check; a failed one is a loud UNRELIABLE line (on stdout with the figures, and on
 // stderr). Returns the exit status: kExitUnreliable when a check failed.
 int print_checks(const std::vector<BalanceCheck>& checks) {
@@ -256,14 +261,11 @@ int print_checks(const std::vector<BalanceCheck>& checks) {
   return status;
 }
 
-std::string regions_label(const Mesh& mesh, const std::vector<std::int32_t>& ids);
-
-}  // namespace
-
 int cmd_solve(Args args) {
   const std::string physics = args.option("--physics", "thermal");
   if (args.has_option("--convergence")) return cmd_solve_convergence(std::move(args), physics);
   if (physics == "thermoelastic") return cmd_solve_thermoelastic(std::move(args));
+  if (physics == "transient") return cmd_solve_transient(std::move(args));
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kSolveUsage);
     return kExitOk;

@@ -44,7 +44,13 @@ LinearSolverOptions parse_solver_options(Args& args);
 // --size-scale S: a number > 0 multiplying the model's mesh sizes (model_run.hpp), default 1.
 double size_scale_option(Args& args);
 
+// One line per check; a failed one is a loud UNRELIABLE line (on stdout with the figures, and on
+// stderr). Returns the exit status: kExitUnreliable when a check failed.
+int print_checks(const std::vector<BalanceCheck>& checks);
+
 int cmd_solve_thermoelastic(Args args);
+// foxi solve MODEL --physics transient ...: transient heat conduction, a .pvd series and Zth(t).
+int cmd_solve_transient(Args args);
 // foxi solve MODEL --convergence K ...: the same solve on K meshes, finer by --ratio each.
 int cmd_solve_convergence(Args args, const std::string& physics);
 
