@@ -5,6 +5,8 @@
 //   solve_electrostatic(mesh, params)          potentials and capacitance matrix (electric.hpp)
 //   solve_current(mesh, params)                DC conduction: potentials and resistances (electric.hpp)
 //   joule_heat_sources(report)                 the Joule heat of a current solve, for thermal (electric.hpp)
+//   solve_transient_thermal(mesh, params)      transient heat: BDF2/Euler steps, junction T(t) (transient.hpp)
+//   read_power_table(path)                     a CSV power waveform (time, W) (transient.hpp)
 //   solve_thermoelastic(mesh, params)          thermal stress: displacements, stresses (thermoelastic.hpp)
 //   thermal_params_from_model(model, mesh)     a model's conditions as solver parameters; also
 //     electrostatic_, current_, thermoelastic_params_from_model (model_problem.hpp)
@@ -21,3 +23,4 @@
 #include "foxi/solver/solver.hpp"
 #include "foxi/solver/thermal.hpp"
 #include "foxi/solver/thermoelastic.hpp"
+#include "foxi/solver/transient.hpp"

@@ -37,6 +37,7 @@
 #include <utility>
 #include <vector>
 
+#include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/solver/thermal.hpp"
 
@@ -55,7 +56,7 @@ struct PowerWaveform {
   double width = 0, period = 0;  // s
   std::size_t count = 0;
   std::vector<std::pair<double, double>> table;
-  double at(double t) const;
+  FOXI_API double at(double t) const;
   static PowerWaveform step_of(double watts) {
     PowerWaveform w;
     w.power = watts;
@@ -66,7 +67,7 @@ struct PowerWaveform {
 // Reads a power table: CSV lines "time_s,power_W"; blank lines, lines starting with '#' and one header
 // line whose first field is not a number are skipped. Throws foxi::IoError naming the file and line
 // for a bad number, a missing field, a non-finite value, a time not above the previous one, or no rows.
-std::vector<std::pair<double, double>> read_power_table(const std::string& path);
+FOXI_API std::vector<std::pair<double, double>> read_power_table(const std::string& path);
 
 struct TransientPower {
   std::int32_t region = 0;
@@ -127,6 +128,6 @@ struct TransientReport {
 // Solves; stores "temperature" (last step) and "heat_flux" (last step) in mesh.fields like
 // solve_thermal. Throws SolverError as solve_thermal does, and when a region has no density or
 // specific heat, end_time or steps is not positive, or a waveform is invalid.
-TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& params);
+FOXI_API TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& params);
 
 }  // namespace foxi
