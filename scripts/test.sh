@@ -23,7 +23,7 @@ if [ "${FOXI_SKIP_SANITIZE:-0}" != "1" ]; then
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DFOXI_SANITIZE=ON -DFOXI_BUILD_BENCH=OFF \
     > build-asan.log 2>&1 || { cat build-asan.log; exit 1; }
   ninja -C build-asan
-  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp \
     ctest --test-dir build-asan --output-on-failure -j2 --timeout 1800 -LE slow -E '^(CgalMesher|MeshCgalCli)[.]'
 fi
 if [ "${FOXI_SKIP_FUZZ:-0}" != "1" ]; then
