@@ -9,8 +9,8 @@
 # Set FOXI_SKIP_SANITIZE=1 to skip the second.
 # Last, the fuzz targets (clang, libFuzzer, build-fuzz) run about FOXI_FUZZ_SECONDS each (default 20),
 # two at a time, from a fixed seed (FOXI_FUZZ_SEED, default 1: the same inputs on every run, so a
-# finding is reproducible and CI does not fail by chance; long exploring runs are scripts/fuzz.sh's): an estimated 6-8 minutes of build on 2 cores (48 sources; heavy ones measured at 18-27
-# CPU-s each under ASan+UBSan+coverage) and 1.5 minutes of fuzzing. FOXI_SKIP_FUZZ=1 skips them.
+# finding is reproducible and CI does not fail by chance; long exploring runs are scripts/fuzz.sh's): an estimated 6-8 minutes
+# of build on 2 cores (48 sources; heavy ones measured at 18-27 CPU-s each under ASan+UBSan+coverage) and 1.5 minutes of fuzzing. FOXI_SKIP_FUZZ=1 skips them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
