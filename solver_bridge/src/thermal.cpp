@@ -313,6 +313,17 @@ void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector
 
 }
 
+void store_temperature(Mesh& mesh, std::vector<double> temp, Field flux) {
+  Field temp_field;
+  temp_field.name = "temperature";
+  temp_field.location = FieldLocation::node;
+  temp_field.components = 1;
+  temp_field.unit = "K";
+  temp_field.values = std::move(temp);
+  set_field(mesh, std::move(temp_field));
+  set_field(mesh, std::move(flux));
+}
+
 Field region_results(const Mesh& mesh, const ThermalParams& params, const ThermalSystem& sys,
                      const std::vector<double>& temp, ThermalReport& rep) {
   const std::size_t nt = mesh.tet_count();
@@ -432,14 +443,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
         scale > 0 ? std::abs(rep.imbalance) / scale : 0.0, std::max(1e-6, 100 * params.solver.relative_tolerance)));
   }
 
-  Field temp_field;
-  temp_field.name = "temperature";
-  temp_field.location = FieldLocation::node;
-  temp_field.components = 1;
-  temp_field.unit = "K";
-  temp_field.values = std::move(temp);
-  detail::set_field(mesh, std::move(temp_field));
-  detail::set_field(mesh, std::move(flux_field));
+  detail::store_temperature(mesh, std::move(temp), std::move(flux_field));
   rep.assembly_seconds = std::chrono::duration<double>(t_assembled - t_start).count();
   rep.solve_seconds = std::chrono::duration<double>(t_solved - t_assembled).count();
   return rep;

@@ -47,6 +47,10 @@ void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector
 
 // Per-region mean and max temperatures, the overall max, boundary mean temperatures and the
 // resistances of params.resistances into `rep`; returns the cell field "heat_flux".
+// Puts the node temperature (K) and the flux field on the mesh, replacing earlier ones: the steady
+// and the transient solver's last state alike.
+void store_temperature(Mesh& mesh, std::vector<double> temp, Field flux);
+
 Field region_results(const Mesh& mesh, const ThermalParams& params, const ThermalSystem& sys,
                      const std::vector<double>& temp, ThermalReport& rep);
 

@@ -342,14 +342,7 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
   rep.unknowns = out.unknowns;
   rep.iterations = out.iterations;
   rep.relative_residual = out.relative_residual;
-  Field tf;
-  tf.name = "temperature";
-  tf.location = FieldLocation::node;
-  tf.components = 1;
-  tf.unit = "K";
-  tf.values = std::move(temp);
-  detail::set_field(mesh, std::move(tf));
-  detail::set_field(mesh, std::move(flux));
+  detail::store_temperature(mesh, std::move(temp), std::move(flux));
   out.setup_seconds = setup_seconds;
   out.solve_seconds = std::chrono::duration<double>(clock::now() - t_setup).count() - (setup_seconds -
                       std::chrono::duration<double>(t_setup - t_start).count());
