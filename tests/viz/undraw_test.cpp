@@ -10,6 +10,8 @@
 #include <random>
 #include <vector>
 
+#include "foxi/model/validate.hpp"
+#include "foxi/viz/camera.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/visibility_order.hpp"
@@ -306,6 +308,40 @@ TEST(Undraw, LongUndrawInPartsEqualsDrawingFromScratch) {
     EXPECT_EQ(changes_outside(before, fb, r.changed_rect(), changed), 0u);
     EXPECT_EQ(changes_outside_rects(before, fb, r.changed_rects(), r.changed_rect(), area), 0u);
     EXPECT_GT(changed, std::size_t(kW * kH / 20)) << "the undraw should change the picture";
+  }
+}
+
+// The eye inside a tet whose other faces are on the boundary (fuzz finding
+// tests/data/bad/fuzz/mesh_pipeline/undraw_eye_inside_tet_3): that tet draws nothing (it has no front
+// face), and undrawing it must give back the far tet's face seen through it, as a fresh drawing of
+// the far tet shows it. Oracle: the painter's own fresh drawing of the kept tets.
+TEST(Undraw, EyeInsideATetWithBoundaryFaces) {
+  Mesh m;
+  m.xyz = {-2, -3, -2, 0, -4, -4, 0, 2, 0, 2.75, 4.75, 4.75, -4, 1.25, 2};
+  m.tet = {0, 1, 2, 3, 0, 4, 2, 1};
+  ASSERT_TRUE(validate_and_repair(m).ok());
+  double lo[3], hi[3];
+  mesh_bounds(m, lo, hi);
+  const double eye[3] = {0.75, 0.75, 0.875};
+  for (const auto& [w, h] : {std::pair{24, 16}, std::pair{160, 120}}) {
+    const Camera cam = camera_from_options(lo, hi, double(w) / h, eye, nullptr, nullptr, 30, nullptr);
+    const std::uint32_t order[2] = {1, 0};  // tet 0 holds the eye: it is nearest
+    RenderParams p;
+    p.undoable = true;
+    TetRasterizer r(m, cam, w, h, p);
+    Framebuffer fb(w, h);
+    r.draw(fb, order);
+    const Framebuffer both = render_tets(m, cam, w, h, order);
+    EXPECT_EQ(fb.id, both.id);
+    r.undraw(fb, 1);
+    const Framebuffer far = render_tets(m, cam, w, h, std::span<const std::uint32_t>(order, 1));
+    std::size_t differ = 0, shown = 0;
+    for (std::size_t i = 0; i < far.id.size(); ++i) {
+      differ += far.rgba[i] != fb.rgba[i] || far.id[i] != fb.id[i];
+      shown += far.id[i] == 1;
+    }
+    EXPECT_GT(shown, 0u) << "the far tet should show through the eye's tet";
+    EXPECT_EQ(differ, 0u) << w << "x" << h;
   }
 }
 

@@ -335,6 +335,11 @@ struct TetRasterizer::Impl {
     std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;  // y * width + x, colour, id
     std::vector<SaveRegion> regions;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> aliases;  // (request, later request it equals)
+    // A request at a pixel its tet's front faces did not show (the tet holds the eye, so it has no
+    // front face; or snapping left the pixel to a back face alone) is answered by the next tet that
+    // shows the pixel, in record_span's unshown branch, which looks for requests only when this is
+    // set (for this batch).
+    bool unshown_requests = false;
   };
   std::vector<Lane> lanes;
   int lane_count = 1;

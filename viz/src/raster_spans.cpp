@@ -115,6 +115,16 @@ inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& f
                   before_id.begin() + std::ptrdiff_t(row + std::size_t(x)));
       shade_span(fb, fs, y, x, e);
       shown_row[x >> 6] |= (~std::uint64_t(0) >> (63 - (e - x))) << (x & 63);  // [x, e] in one word
+      Lane& lane = lanes[std::size_t(lane_of(y))];
+      if (lane.unshown_requests) {  // a nearer tet asked for a pixel it did not show: this is behind it
+        for (int k = x; k <= e; ++k) {
+          std::uint32_t& request = slot[row + std::size_t(k)];
+          if (request == kNone) continue;
+          lane.saved_rgba[request] = fb.rgba[row + std::size_t(k)];
+          lane.saved_id[request] = fb.id[row + std::size_t(k)];
+          request = kNone;
+        }
+      }
     } else {
       Lane& lane = lanes[std::size_t(lane_of(y))];
       for (int k = x; k <= e; ++k) {

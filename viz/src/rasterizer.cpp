@@ -270,6 +270,7 @@ inline void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
     lane.saved_id[lane.aliases[i].first] = lane.saved_id[lane.aliases[i].second];
   }
   lane.aliases.clear();
+  lane.unshown_requests = false;
   std::reverse(lane.saves.begin() + std::ptrdiff_t(region.first_save), lane.saves.end());
 }
 

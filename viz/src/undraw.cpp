@@ -43,8 +43,10 @@ void TetRasterizer::Impl::request_saves(const Framebuffer& fb, const Rows& rows,
     for_each_run(poly, n, rows, [&](int y, int lo, int hi) {
       const std::size_t row = std::size_t(y) * std::size_t(fb.width);
       std::uint64_t* done = &written[std::size_t(y) * std::size_t(mask_words)];
+      const std::uint64_t* shown_row = &shown[std::size_t(y) * std::size_t(mask_words)];
       for (int x = lo; x <= hi; ++x) {
         const std::uint32_t k = std::uint32_t(saved_pixel.size()), p = std::uint32_t(row + std::size_t(x));
+        if (!(shown_row[x >> 6] >> (x & 63) & 1)) lane.unshown_requests = true;
         if (slot[p] != kNone) lane.aliases.emplace_back(slot[p], k);
         slot[p] = k;
         saved_pixel.push_back(p);
