@@ -6,6 +6,7 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
+#include "foxi/solver/solver.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/units.hpp"
@@ -87,6 +88,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
     return kExitBadInput;
   } catch (const foxi::ExpressionError& e) {
+    std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
+    return kExitBadInput;
+  } catch (const foxi::SolverInputError& e) {  // the problem as given (coefficients, conditions, tags)
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
     return kExitBadInput;
   } catch (const foxi::Cancelled& c) {  // a progress function said stop (an interrupt), in any library

@@ -84,7 +84,7 @@ void write_nodes_and_elements(std::FILE* out, const Mesh& mesh, const std::vecto
 void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const std::filesystem::path& inp) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), nf = mesh.bface_count();
   if (std::string problem = check_sizes(mesh); !problem.empty())
-    throw SolverError("inconsistent mesh: " + problem);
+    throw SolverInputError("inconsistent mesh: " + problem);
   // Regions and conductivities, checked as solve_thermal checks them.
   std::vector<std::int32_t> ids;
   for (std::size_t t = 0; t < nt; ++t) ids.push_back(mesh.region_of(t));
@@ -92,7 +92,7 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   auto index_of = [&](std::int32_t id) -> std::size_t {
     auto it = std::lower_bound(ids.begin(), ids.end(), id);
-    if (it == ids.end() || *it != id) throw SolverError("region " + std::to_string(id) + " has no tets");
+    if (it == ids.end() || *it != id) throw SolverInputError("region " + std::to_string(id) + " has no tets");
     return static_cast<std::size_t>(it - ids.begin());
   };
   std::vector<double> k(ids.size(), Material::kUnset), q(ids.size(), 0.0), volume(ids.size(), 0.0);
@@ -102,7 +102,7 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
   for (const RegionConductivity& c : params.conductivity) k[index_of(c.region)] = c.k;
   for (std::size_t i = 0; i < ids.size(); ++i)
     if (!(k[i] > 0) || !std::isfinite(k[i]))
-      throw SolverError("region " + std::to_string(ids[i]) + " has no valid thermal conductivity");
+      throw SolverInputError("region " + std::to_string(ids[i]) + " has no valid thermal conductivity");
   std::array<std::array<double, 3>, 4> g;
   for (std::size_t t = 0; t < nt; ++t)
     volume[index_of(mesh.region_of(t))] += detail::p1_gradients(mesh, t, g);
@@ -130,7 +130,7 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
         return {t, kFaceOpposite[missing]};
       }
     }
-    throw SolverError("boundary triangle " + std::to_string(f) + " is not a face of any tet");
+    throw SolverInputError("boundary triangle " + std::to_string(f) + " is not a face of any tet");
   };
 
   enum Kind { kFixed, kFlux, kFilm };
@@ -141,9 +141,9 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
   std::map<std::int32_t, Bc> bc;
   auto add = [&](std::int32_t tag, Bc b) {
     if (std::find(mesh.bface_tag.begin(), mesh.bface_tag.end(), tag) == mesh.bface_tag.end())
-      throw SolverError("boundary tag " + std::to_string(tag) + " tags no boundary triangle");
+      throw SolverInputError("boundary tag " + std::to_string(tag) + " tags no boundary triangle");
     if (!bc.emplace(tag, b).second)
-      throw SolverError("boundary tag " + std::to_string(tag) + " has more than one boundary condition");
+      throw SolverInputError("boundary tag " + std::to_string(tag) + " has more than one boundary condition");
   };
   for (const FixedTemperature& f : params.fixed) add(f.tag, {kFixed, f.temperature, 0});
   for (const HeatFlux& f : params.flux) add(f.tag, {kFlux, f.flux, 0});
@@ -212,9 +212,9 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
 void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,
                                   const std::filesystem::path& inp) {
   if (std::string problem = check_sizes(mesh); !problem.empty())
-    throw SolverError("inconsistent mesh: " + problem);
+    throw SolverInputError("inconsistent mesh: " + problem);
   if (params.order != 1 && params.order != 2)
-    throw SolverError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
+    throw SolverInputError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
   const bool quadratic = params.order == 2;
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   const detail::ElasticMaterials mat = detail::elastic_materials(mesh, params);
@@ -263,12 +263,12 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
     for (int a : general) {
       const double* q = &fr.r[9 * v + 3 * a];
       if (fr.g[3 * v + a] != 0)
-        throw SolverError("CalculiX deck: node " + std::to_string(v) +
+        throw SolverInputError("CalculiX deck: node " + std::to_string(v) +
                           " has a non-zero displacement prescribed along a direction that is no coordinate axis");
       int dep = -1;
       for (int c = 0; c < 3; ++c)
         if (!taken[c] && std::abs(q[c]) > 1e-3 && (dep < 0 || std::abs(q[c]) > std::abs(q[dep]))) dep = c;
-      if (dep < 0) throw SolverError("CalculiX deck: no free component for the constraint at node " + std::to_string(v));
+      if (dep < 0) throw SolverInputError("CalculiX deck: no free component for the constraint at node " + std::to_string(v));
       taken[dep] = true;
       int terms = 0;
       std::string row;

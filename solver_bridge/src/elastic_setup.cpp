@@ -42,7 +42,7 @@ Vec3 plane_normal(const Mesh& mesh, std::int32_t tag) {
       }
   }
   const double len = std::sqrt(dot(n, n));
-  if (!(len > 0)) throw SolverError("sliding " + tag_label(mesh, tag) + " has no area");
+  if (!(len > 0)) throw SolverInputError("sliding " + tag_label(mesh, tag) + " has no area");
   for (double& c : n) c /= len;
   for (double& c : n)
     if (std::abs(c) < 1e-12) c = 0;
@@ -57,7 +57,7 @@ Vec3 plane_normal(const Mesh& mesh, std::int32_t tag) {
       const Vec3 p = point(mesh, mesh.bface[3 * f + i]);
       const double off = dot({p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]}, n);
       if (std::abs(off) > tol)
-        throw SolverError("sliding " + tag_label(mesh, tag) + " is not planar: node " +
+        throw SolverInputError("sliding " + tag_label(mesh, tag) + " is not planar: node " +
                           std::to_string(mesh.bface[3 * f + i]) + " lies " + std::to_string(off) +
                           " m off the plane of its triangles; sliding needs one plane per tag");
     }
@@ -93,7 +93,7 @@ void build_frame(const Mesh& mesh, std::uint32_t v, const Constraint* c, std::si
         const Vec3 x = point(mesh, v);
         char where[96];
         std::snprintf(where, sizeof where, " (%.6g, %.6g, %.6g)", x[0], x[1], x[2]);
-        throw SolverError("contradictory displacement constraints at node " + std::to_string(v) + where +
+        throw SolverInputError("contradictory displacement constraints at node " + std::to_string(v) + where +
                           ": a sliding plane or a fixed component asks for another value than the others");
       }
       continue;
@@ -153,7 +153,7 @@ std::vector<double> tet_temperature_change(const Mesh& mesh, const Thermoelastic
 check_finite(params.delta_t, "temperature change");
 if (!params.temperature.empty()) {
   if (params.temperature.size() != nn)
-    throw SolverError("the temperature field has " + std::to_string(params.temperature.size()) +
+    throw SolverInputError("the temperature field has " + std::to_string(params.temperature.size()) +
                       " values for " + std::to_string(nn) + " nodes");
   check_finite(params.reference_temperature, "reference temperature");
   for (std::size_t t = 0; t < nt; ++t) {
@@ -161,7 +161,7 @@ if (!params.temperature.empty()) {
     for (int a = 0; a < 4; ++a) {
       const std::uint32_t v = mesh.tet[4 * t + a];
       if (!std::isfinite(params.temperature[v]))
-        throw SolverError("the temperature of node " + std::to_string(v) + " (used by tet " +
+        throw SolverInputError("the temperature of node " + std::to_string(v) + " (used by tet " +
                           std::to_string(t) + ") is not a finite number");
       s += params.temperature[v];
     }
@@ -177,10 +177,10 @@ NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& para
   std::map<std::int32_t, int> bc_kind;  // 1 fixed, 2 sliding
   auto claim = [&](std::int32_t tag, int kind, const char* name) {
     if (!std::binary_search(tags.begin(), tags.end(), tag))
-      throw SolverError(std::string(name) + " condition on " + tag_label(mesh, tag) +
+      throw SolverInputError(std::string(name) + " condition on " + tag_label(mesh, tag) +
                         ", which tags no boundary triangle");
     if (!bc_kind.emplace(tag, kind).second)
-      throw SolverError(tag_label(mesh, tag) + " has more than one boundary condition");
+      throw SolverInputError(tag_label(mesh, tag) + " has more than one boundary condition");
   };
   std::map<std::int32_t, const FixedDisplacement*> fixed_by_tag;
   for (const FixedDisplacement& f : params.fixed) {

@@ -171,23 +171,23 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
 
   const std::size_t ne = electrodes.size(), nn = mesh.node_count(), nt = mesh.tet_count();
   if (ne == 0)
-    throw SolverError("ill-posed " + problem + ": no " + kind +
+    throw SolverInputError("ill-posed " + problem + ": no " + kind +
                       " is given, so the potential is undetermined; name at least one");
   const std::vector<std::int32_t> tags = boundary_tag_list(mesh);
   std::map<std::int32_t, FixedTag> fixed_tags;
   for (std::size_t e = 0; e < ne; ++e) {
     const Electrode& el = electrodes[e];
-    if (el.tags.empty()) throw SolverError(kind + " '" + el.name + "' has no boundary tags");
+    if (el.tags.empty()) throw SolverInputError(kind + " '" + el.name + "' has no boundary tags");
     for (std::size_t f = 0; f < e; ++f)
       if (electrodes[f].name == el.name && !el.name.empty())
-        throw SolverError("two " + kind + "s are named '" + el.name + "'");
+        throw SolverInputError("two " + kind + "s are named '" + el.name + "'");
     for (std::int32_t tag : el.tags) {
       if (!std::binary_search(tags.begin(), tags.end(), tag))
-        throw SolverError(kind + " '" + el.name + "' is on " + tag_label(mesh, tag) +
+        throw SolverInputError(kind + " '" + el.name + "' is on " + tag_label(mesh, tag) +
                           ", which tags no boundary triangle");
       auto [it, inserted] = fixed_tags.emplace(tag, FixedTag{static_cast<double>(e), e});
       if (!inserted && it->second.slot != e)
-        throw SolverError(tag_label(mesh, tag) + " belongs to two " + kind + "s ('" +
+        throw SolverInputError(tag_label(mesh, tag) + " belongs to two " + kind + "s ('" +
                           electrodes[it->second.slot].name + "' and '" + el.name + "')");
     }
   }
@@ -203,7 +203,7 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   std::vector<std::uint32_t> owner(nn, UINT32_MAX);
   for (const Dirichlet::Share& sh : d.shares) {
     if (owner[sh.node] != UINT32_MAX && owner[sh.node] != sh.slot)
-      throw SolverError(kind + "s '" + electrodes[owner[sh.node]].name + "' and '" + electrodes[sh.slot].name +
+      throw SolverInputError(kind + "s '" + electrodes[owner[sh.node]].name + "' and '" + electrodes[sh.slot].name +
                         "' touch (node " + std::to_string(sh.node) +
                         " is on both): they would be one electrode; merge them or separate them");
     owner[sh.node] = sh.slot;
@@ -228,7 +228,7 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
       if (owner[v] == UINT32_MAX) continue;
       if (it->second == UINT32_MAX) it->second = owner[v];
       if (it->second != owner[v])
-        throw SolverError("conductors '" + electrodes[it->second].name + "' and '" + electrodes[owner[v]].name +
+        throw SolverInputError("conductors '" + electrodes[it->second].name + "' and '" + electrodes[owner[v]].name +
                           "' are joined by metal (the body containing node " + std::to_string(v) +
                           "): they are one conductor; merge them, or make the metal a dielectric");
     }
@@ -402,7 +402,7 @@ ElectrostaticReport solve_electrostatic(Mesh& mesh, const ElectrostaticParams& p
   for (const Electrode& e : params.conductors) {
     detail::check_finite(e.voltage, "voltage of conductor '" + e.name + "'");
     if (e.fixed_current)
-      throw SolverError("conductor '" + e.name + "': a fixed current has no meaning in electrostatics");
+      throw SolverInputError("conductor '" + e.name + "': a fixed current has no meaning in electrostatics");
   }
   auto is_metal = [&](std::int32_t id) {
     for (const RegionCoefficient& c : params.permittivity)
@@ -471,7 +471,7 @@ CurrentReport solve_current(Mesh& mesh, const CurrentParams& params) {
     any_voltage = any_voltage || !e.fixed_current;
   }
   if (!params.terminals.empty() && !any_voltage)
-    throw SolverError(
+    throw SolverInputError(
         "ill-posed DC conduction problem: every terminal has a fixed current, so the potential is determined "
         "only up to a constant; give one terminal a fixed voltage (e.g. 0 V)");
   const ElectrodeSolve s = solve_electrodes(

@@ -165,12 +165,12 @@ namespace {
 void require_finite_input(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs) {
   for (double v : a.val)
     if (!std::isfinite(v))
-      throw SolverError("the system matrix holds NaN or infinity (mesh geometry or coefficients beyond the "
+      throw SolverInputError("the system matrix holds NaN or infinity (mesh geometry or coefficients beyond the "
                         "range of double)");
   for (const std::vector<double>& b : bs)
     for (double v : b)
       if (!std::isfinite(v))
-        throw SolverError("the right-hand side holds NaN or infinity (loads or geometry beyond the range of "
+        throw SolverInputError("the right-hand side holds NaN or infinity (loads or geometry beyond the range of "
                           "double)");
 }
 
@@ -214,7 +214,7 @@ SpdSolver::SpdSolver(const SymmetricCsr& a, const LinearSolverOptions& options, 
           s.weight[i] = 1.0 / a.val[static_cast<std::size_t>(k)];
     for (double w : s.weight)
       if (!(w > 0) || !std::isfinite(w))
-        throw SolverError("the matrix has a non-positive diagonal (a non-positive coefficient?)");
+        throw SolverInputError("the matrix has a non-positive diagonal (a non-positive coefficient?)");
   }
   s.kind = options.kind;
   if (s.kind == LinearSolverKind::automatic)

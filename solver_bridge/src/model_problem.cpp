@@ -14,7 +14,7 @@ std::vector<std::int32_t> surface_tags(const BoundaryCondition& c, const Mesh& m
     for (const Boundary& b : mesh.boundaries)
       if (b.name == s) found = &b;
     if (found == nullptr)
-      throw SolverError(std::string(condition_kind_name(c.kind)) + " condition (line " + std::to_string(c.line) +
+      throw SolverInputError(std::string(condition_kind_name(c.kind)) + " condition (line " + std::to_string(c.line) +
                         "): the mesh has no boundary named '" + s + "'");
     tags.push_back(found->tag);
   }
@@ -101,7 +101,7 @@ ThermoelasticParams thermoelastic_params_from_model(const Model& model, const Me
     for (std::size_t i = 0; i < model.parts.size(); ++i) {
       if (!l.part.empty() && model.parts[i].name != l.part) continue;
       if (!std::isnan(part_dt[i]) && part_dt[i] != l.value)
-        throw SolverError("temperature_change load (line " + std::to_string(l.line) + "): part '" +
+        throw SolverInputError("temperature_change load (line " + std::to_string(l.line) + "): part '" +
                           model.parts[i].name + "' already has a temperature change of " +
                           std::to_string(part_dt[i]) + " K");
       part_dt[i] = l.value;
@@ -110,7 +110,7 @@ ThermoelasticParams thermoelastic_params_from_model(const Model& model, const Me
   if (first_line == 0) return p;
   for (std::size_t i = 0; i < model.parts.size(); ++i)
     if (std::isnan(part_dt[i]) || part_dt[i] != part_dt[0])
-      throw SolverError("temperature_change load (line " + std::to_string(first_line) +
+      throw SolverInputError("temperature_change load (line " + std::to_string(first_line) +
                         "): the thermal stress solver takes one uniform temperature change; part '" +
                         model.parts[i].name + "' has " +
                         (std::isnan(part_dt[i]) ? std::string("none") : std::to_string(part_dt[i]) + " K") +

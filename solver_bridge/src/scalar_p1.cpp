@@ -20,7 +20,7 @@ std::string tag_label(const Mesh& mesh, std::int32_t tag) {
 }
 
 void check_finite(double v, const std::string& what) {
-  if (!std::isfinite(v)) throw SolverError(what + " is not a finite number");
+  if (!std::isfinite(v)) throw SolverInputError(what + " is not a finite number");
 }
 
 void set_field(Mesh& mesh, Field field) {
@@ -34,8 +34,8 @@ void set_field(Mesh& mesh, Field field) {
 
 void check_mesh(const Mesh& mesh) {
   if (std::string problem = check_sizes(mesh); !problem.empty())
-    throw SolverError("inconsistent mesh: " + problem);
-  if (mesh.tet_count() == 0) throw SolverError("the mesh has no tetrahedra");
+    throw SolverInputError("inconsistent mesh: " + problem);
+  if (mesh.tet_count() == 0) throw SolverInputError("the mesh has no tetrahedra");
 }
 
 void report_progress(const LinearSolverOptions& options, std::string_view stage, double fraction) {
@@ -84,16 +84,16 @@ std::vector<double> region_values(const Mesh& mesh, const RegionTable& regions,
   for (const auto& [id, value] : overrides) {
     const std::size_t i = regions.index(id);
     if (i == SIZE_MAX)
-      throw SolverError(what + " given for " + region_label(mesh, id) + ", which has no tets");
+      throw SolverInputError(what + " given for " + region_label(mesh, id) + ", which has no tets");
     c[i] = value;
   }
   for (std::size_t i = 0; i < nr; ++i) {
     if (std::isnan(c[i]))
-      throw SolverError(region_label(mesh, regions.ids[i]) + " has no " + what +
+      throw SolverInputError(region_label(mesh, regions.ids[i]) + " has no " + what +
                         ": its material gives none; set it in " + hint + " " +
                         std::to_string(regions.ids[i]) + "=VALUE)");
     if (!valid(c[i]))
-      throw SolverError(what + " of " + region_label(mesh, regions.ids[i]) + " must be " + requirement +
+      throw SolverInputError(what + " of " + region_label(mesh, regions.ids[i]) + " must be " + requirement +
                         ", not " + std::to_string(c[i]));
   }
   return c;
@@ -116,7 +116,7 @@ std::vector<double> tet_volumes(const Mesh& mesh, const RegionTable& regions, un
     for (unsigned th = 0; th < threads; ++th) region_volume[i] += part[th][i];
   for (std::size_t t = 0; t < nt; ++t)
     if (!(vol[t] > 0) || !std::isfinite(vol[t]))
-      throw SolverError("tet " + std::to_string(t) + " has " +
+      throw SolverInputError("tet " + std::to_string(t) + " has " +
                         (vol[t] > 0 ? "a volume beyond the range of double (" + std::to_string(vol[t]) +
                                           "; rescale the coordinates)"
                                     : "non-positive volume " + std::to_string(vol[t]) +
@@ -227,7 +227,7 @@ void check_anchored(const Mesh& mesh, const std::vector<char>& anchored_node, co
     if (anchored_node[v]) anchored[part[v]] = 1;
   for (std::size_t t = 0; t < nt; ++t)
     if (!anchored[part[mesh.tet[4 * t]]])
-      throw SolverError(problem + ": the connected part containing tet " + std::to_string(t) + " (" +
+      throw SolverInputError(problem + ": the connected part containing tet " + std::to_string(t) + " (" +
                         region_label(mesh, mesh.region_of(t)) + ") " + what);
 }
 

@@ -53,15 +53,15 @@ void check_probe(const Mesh& mesh, const ThermalProbe& probe, const detail::Regi
   const std::string what = std::string("thermal resistance: the ") + probe_name(probe.kind) + " of ";
   if (is_region_probe(probe.kind)) {
     if (regions.index(probe.id) == SIZE_MAX)
-      throw SolverError(what + region_label(mesh, probe.id) + ", which has no tets");
+      throw SolverInputError(what + region_label(mesh, probe.id) + ", which has no tets");
     return;
   }
   if (!std::binary_search(tags.begin(), tags.end(), probe.id))
-    throw SolverError(what + tag_label(mesh, probe.id) + ", which tags no boundary triangle");
+    throw SolverInputError(what + tag_label(mesh, probe.id) + ", which tags no boundary triangle");
   if (probe.kind == ThermalProbeKind::ambient) {
     auto it = bc.find(probe.id);
     if (it == bc.end() || it->second.kind != BcKind::convection)
-      throw SolverError(what + tag_label(mesh, probe.id) + ": it has no convection condition");
+      throw SolverInputError(what + tag_label(mesh, probe.id) + ": it has no convection condition");
   }
 }
 
@@ -149,11 +149,11 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
   std::map<std::int32_t, TagBc>& bc = sys.bc;
   auto add_bc = [&](std::int32_t tag, BcKind kind, double a, double b, const char* kind_name) {
     if (!std::binary_search(tags.begin(), tags.end(), tag))
-      throw SolverError(std::string(kind_name) + " condition on " + tag_label(mesh, tag) +
+      throw SolverInputError(std::string(kind_name) + " condition on " + tag_label(mesh, tag) +
                         ", which tags no boundary triangle");
     TagBc& t = bc[tag];
     if (t.kind != BcKind::none)
-      throw SolverError(tag_label(mesh, tag) + " has more than one boundary condition");
+      throw SolverInputError(tag_label(mesh, tag) + " has more than one boundary condition");
     t = {kind, a, b, 0};
   };
   for (const FixedTemperature& f : params.fixed) {
@@ -168,13 +168,13 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
   for (const Convection& c : params.convection) {
     check_finite(c.ambient, "ambient temperature on " + tag_label(mesh, c.tag));
     if (!(c.h > 0) || !std::isfinite(c.h))
-      throw SolverError("convection coefficient h on " + tag_label(mesh, c.tag) +
+      throw SolverInputError("convection coefficient h on " + tag_label(mesh, c.tag) +
                         " must be positive and finite");
     add_bc(c.tag, BcKind::convection, c.h, c.ambient, "convection");
     has_convection = true;
   }
   if (require_anchor && params.fixed.empty() && !has_convection)
-    throw SolverError(
+    throw SolverInputError(
         "ill-posed thermal problem: no boundary has a fixed temperature or convection, so the "
         "temperature is determined only up to a constant (and a net heat input has no way out); "
         "fix a temperature or add convection on at least one boundary tag");
@@ -207,9 +207,9 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
   for (const HeatSource& s : params.sources) {
     const std::size_t i = region_index(s.region);
     if (i == SIZE_MAX)
-      throw SolverError("heat source given for " + region_label(mesh, s.region) + ", which has no tets");
+      throw SolverInputError("heat source given for " + region_label(mesh, s.region) + ", which has no tets");
     check_finite(s.value, "heat source of " + region_label(mesh, s.region));
-    if (source_given[i]) throw SolverError(region_label(mesh, s.region) + " has more than one heat source");
+    if (source_given[i]) throw SolverInputError(region_label(mesh, s.region) + " has more than one heat source");
     source_given[i] = true;
     region_q[i] = s.total ? s.value / rep.regions[i].volume : s.value;
   }
@@ -262,7 +262,7 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
           for (int j = 0; j < 3; ++j) {
             const std::size_t pos = pat.find(v[i], v[j]);
             if (pos == SIZE_MAX)
-              throw SolverError("boundary triangle " + std::to_string(f) + " (" +
+              throw SolverInputError("boundary triangle " + std::to_string(f) + " (" +
                                 tag_label(mesh, mesh.bface_tag[f]) + ") is not a face of any tet");
             kval[pos] +=
                 params.convection_centroid_rule ? t.a * area / 9 : t.a * area / 12 * (i == j ? 2.0 : 1.0);

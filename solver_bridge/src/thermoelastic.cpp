@@ -109,7 +109,7 @@ void check_rigid_modes(const Mesh& mesh, const detail::NodeFrames& fr, const std
     if (left == 0) continue;
     std::size_t tet = 0;
     while (root(mesh.tet[4 * tet]) != r) ++tet;
-    throw SolverError("ill-posed thermoelastic problem: the connected part containing tet " + std::to_string(tet) +
+    throw SolverInputError("ill-posed thermoelastic problem: the connected part containing tet " + std::to_string(tet) +
                       " (" + region_label(mesh, mesh.region_of(tet)) + ") can still move rigidly, " +
                       std::to_string(left) + " rigid-body mode" + (left > 1 ? "s" : "") + " left (" + modes +
                       "); fix displacements or add sliding planes that hold it");
@@ -407,7 +407,7 @@ ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& p
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();
   if (params.order != 1 && params.order != 2)
-    throw SolverError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
+    throw SolverInputError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
   detail::check_mesh(mesh);
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   const unsigned threads = detail::thread_count(params.solver.threads);

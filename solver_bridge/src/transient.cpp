@@ -102,15 +102,15 @@ void check_waveform(const Mesh& mesh, const TransientPower& p) {
     case PowerWaveform::Kind::pulse:
       detail::check_finite(w.power, what);
       if (!(w.period > 0) || !std::isfinite(w.period) || !(w.width > 0) || !(w.width <= w.period))
-        throw SolverError(what + ": a pulse needs 0 < width <= period, finite");
+        throw SolverInputError(what + ": a pulse needs 0 < width <= period, finite");
       break;
     case PowerWaveform::Kind::table:
-      if (w.table.empty()) throw SolverError(what + ": the power table is empty");
+      if (w.table.empty()) throw SolverInputError(what + ": the power table is empty");
       for (std::size_t i = 0; i < w.table.size(); ++i) {
         detail::check_finite(w.table[i].first, what + " (table time)");
         detail::check_finite(w.table[i].second, what + " (table power)");
         if (i > 0 && !(w.table[i].first > w.table[i - 1].first))
-          throw SolverError(what + ": the table's times must increase");
+          throw SolverInputError(what + ": the table's times must increase");
       }
       break;
   }
@@ -137,8 +137,8 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();
   if (!(params.end_time > 0) || !std::isfinite(params.end_time))
-    throw SolverError("transient: the end time must be positive and finite");
-  if (params.steps == 0) throw SolverError("transient: the number of steps must be positive");
+    throw SolverInputError("transient: the end time must be positive and finite");
+  if (params.steps == 0) throw SolverInputError("transient: the number of steps must be positive");
   TransientReport out;
   out.scheme = params.scheme;
   ThermalReport& rep = out.final;
@@ -165,8 +165,8 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
   for (const TransientPower& p : params.power) {
     const std::size_t r = sys.regions.index(p.region);
     if (r == SIZE_MAX)
-      throw SolverError("power given for " + detail::region_label(mesh, p.region) + ", which has no tets");
-    if (region_has_power[r]) throw SolverError(detail::region_label(mesh, p.region) + " has more than one power");
+      throw SolverInputError("power given for " + detail::region_label(mesh, p.region) + ", which has no tets");
+    if (region_has_power[r]) throw SolverInputError(detail::region_label(mesh, p.region) + " has more than one power");
     region_has_power[r] = 1;
     check_waveform(mesh, p);
     std::vector<double> u(nn, 0.0);
@@ -178,7 +178,7 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
   std::vector<std::vector<std::uint32_t>> junction_nodes;
   for (std::int32_t id : params.junctions) {
     const std::size_t r = sys.regions.index(id);
-    if (r == SIZE_MAX) throw SolverError("junction " + detail::region_label(mesh, id) + " has no tets");
+    if (r == SIZE_MAX) throw SolverInputError("junction " + detail::region_label(mesh, id) + " has no tets");
     std::vector<std::uint32_t> nodes;
     for (std::size_t t = 0; t < nt; ++t)
       if (tet_rix[t] == r) nodes.insert(nodes.end(), &mesh.tet[4 * t], &mesh.tet[4 * t] + 4);

@@ -205,4 +205,22 @@ value = "0.1 W"
       << r.out;
 }
 
+// A problem the solver cannot pose is bad input (exit 3), not a failure of the work (exit 1): the
+// model has no conductor for electrostatics (refused by the model's conditions), and its mesh solved
+// with a heat source but no fixed boundary is ill-posed (refused by the solver itself).
+TEST(SolveUnitsCli, IllPosedProblemIsBadInput) {
+  TempDir dir;
+  test::write_text(dir / "cube.toml", kCube);
+  const Result r = solve(dir, "--physics electrostatic");
+  EXPECT_EQ(r.rc, 3) << r.out;
+  EXPECT_NE(r.out.find("voltage or ground"), std::string::npos) << r.out;
+  const std::string mesh = (dir / "cube.vtu").string();
+  ASSERT_EQ(test::run_cli("mesh '" + (dir / "cube.toml").string() + "' -o '" + mesh + "'", dir / "mesh.txt"), 0);
+  EXPECT_EQ(test::run_cli("solve '" + mesh + "' --k 1=1 --power 1=1W", dir / "ill.txt"), 3);
+  const std::string ill = test::read_text(dir / "ill.txt");
+  EXPECT_NE(ill.find("error: ill-posed thermal problem"), std::string::npos) << ill;
+  EXPECT_EQ(test::run_cli("solve '" + mesh + "' --k 1=1 --power 1=1W --fix 1=300K", dir / "ok.txt"), 0)
+      << test::read_text(dir / "ok.txt");
+}
+
 }  // namespace

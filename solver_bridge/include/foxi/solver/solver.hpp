@@ -22,6 +22,14 @@ struct FOXI_API SolverError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The problem as given is wrong (a missing or non-positive coefficient, an unknown or doubly constrained
+// tag, a load on an empty region, ill-posed conditions, geometry beyond the range of doubles): the input
+// must change. A SolverError that is not a SolverInputError is a failure of the solve itself (no
+// convergence, a failed factorization, a size limit); the CLI exits 3 for the one and 1 for the other.
+struct FOXI_API SolverInputError : SolverError {
+  using SolverError::SolverError;
+};
+
 // The progress callback returned false (a foxi::Cancelled too).
 struct FOXI_API SolverCancelled : SolverError, Cancelled {
   using SolverError::SolverError;
