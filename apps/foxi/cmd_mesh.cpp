@@ -40,7 +40,7 @@ const char* kMeshUsage =
     "  Lengths H take a unit (\"0.2 mm\"); a bare number is in the model's length unit (metres for .poly).\n"
     "  --set NAME=VALUE   overrides a model parameter\n"
     "  --max-size H       target edge length everywhere (TetGen -a with the regular tet's volume)\n"
-    "  --quality Q        radius-edge bound (default 1.414; 0: no quality refinement)\n"
+    "  --quality Q        radius-edge bound (default and least 1.414; 0: no quality refinement)\n"
     "  --min-dihedral D   TetGen's dihedral bound in degrees (not guaranteed without optimisation)\n"
     "  --max-volume V     largest tet volume in m^3 (or the .poly's units cubed)\n"
     "  --region-size R=H  target edge length in region R (its id; a model's part i has id i+1)\n"
@@ -118,6 +118,11 @@ int cmd_mesh(Args args) {
   const std::string min_dihedral = args.option("--min-dihedral", "");
   params.radius_edge = quality.empty() ? 1.414 : number(quality, "--quality");
   params.min_dihedral = min_dihedral.empty() ? 0 : number(min_dihedral, "--min-dihedral");
+  if (!(params.radius_edge == 0 || params.radius_edge >= kMinRadiusEdgeBound))
+    throw UsageError("--quality takes 0 (no quality refinement) or a radius-edge bound of at least 1.414, not '" +
+                     quality + "' (TetGen's refinement does not finish below it on thin layers)");
+  if (!(params.min_dihedral >= 0 && params.min_dihedral < 30))
+    throw UsageError("--min-dihedral takes 0 to 30 degrees (larger bounds do not terminate), not '" + min_dihedral + "'");
   params.optimize = args.flag("--optimize");
   const bool conform = !args.flag("--no-conform") && !params.optimize;
   args.flag("--check-delaunay");  // the certificate is always part of the report now

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -221,6 +222,10 @@ std::string format_number(double v) {
 
 Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (!(params.radius_edge == 0 || (params.radius_edge >= kMinRadiusEdgeBound && std::isfinite(params.radius_edge))))
+    throw MesherError(10, "the radius-edge bound must be 0 (no quality refinement) or at least " +
+                              format_number(kMinRadiusEdgeBound) + ", not " + format_number(params.radius_edge) +
+                              " (TetGen's refinement does not finish below it on thin layers)");
   if (plc.point_count() < 4) throw MesherError(10, "a PLC needs at least 4 points");
   if (plc.facet_count() < 4) throw MesherError(10, "a PLC needs at least 4 facets");
   for (std::uint32_t v : plc.polygon_vertices)

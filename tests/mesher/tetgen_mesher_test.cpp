@@ -185,6 +185,17 @@ TEST(TetgenMesher, BrokenInputGivesTypedErrors) {
       EXPECT_NE(what.find("(0.2, 0.2, -0.5)"), std::string::npos) << what;
     }
   }
+
+  // A radius-edge bound below sqrt(2) ran TetGen for minutes (1.0 never finished on a model of a die on
+  // a substrate): refused before TetGen starts, with the bound named.
+  MeshParams tight;
+  tight.radius_edge = 1.1;
+  try {
+    mesh_plc(plc, tight);
+    FAIL() << "no error";
+  } catch (const MesherError& e) {
+    EXPECT_NE(std::string(e.what()).find("at least 1.414"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
