@@ -239,6 +239,7 @@ int cmd_info(Args args) {
          ", \"out_of_range\": " + std::to_string(report.out_of_range) +
          ", \"duplicate_tets\": " + std::to_string(report.duplicate_tets) +
          ", \"duplicate_nodes\": " + std::to_string(report.duplicate_nodes) +
+         ", \"overlapping\": " + std::to_string(report.overlapping) +
          ", \"no_tets\": " + std::string(report.no_tets ? "true" : "false") +
          ", \"unused_nodes\": " + std::to_string(report.unused_nodes) + ", \"messages\": [";
     for (std::size_t i = 0; i < report.messages.size(); ++i)

@@ -110,15 +110,11 @@ bool geometry_in_range(const double* a, const double* b, const double* c, const 
 ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
   ValidationReport r;
   r.size_problem = check_sizes(mesh);
-  if (!r.size_problem.empty()) {
-    note(r, r.size_problem);
-    return r;
-  }
+  // size_problem and no_tets are listed by describe(); messages carry only the per-element details,
+  // so a caller printing both does not say the same thing twice.
+  if (!r.size_problem.empty()) return r;
   const std::size_t nv = mesh.node_count();
-  if (mesh.tet_count() == 0) {
-    r.no_tets = true;
-    note(r, "no tets: not a volume mesh (nothing to order, draw or solve)");
-  }
+  if (mesh.tet_count() == 0) r.no_tets = true;
   std::vector<std::uint8_t> finite(nv, 1);
   for (std::size_t v = 0; v < nv; ++v) {
     const double* p = &mesh.xyz[3 * v];
@@ -285,7 +281,7 @@ std::vector<std::string> describe(const ValidationReport& r) {
     if (n) out.push_back(std::to_string(n) + " " + (n == 1 ? one : many) + tail);
   };
   if (!r.size_problem.empty()) out.push_back(r.size_problem);
-  if (r.no_tets) out.push_back("no tets: not a volume mesh");
+  if (r.no_tets) out.push_back("no tets: not a volume mesh (nothing to order, draw or solve)");
   add(r.index_out_of_range, "element", "elements", " with a node index out of range");
   add(r.repeated_vertex, "element", "elements", " naming one node twice");
   add(r.nonfinite_nodes, "node", "nodes", " with NaN or infinite coordinates");
