@@ -19,7 +19,6 @@
 #include "field_options.hpp"
 #include "mesh_input.hpp"
 #include "foxi/model/cleanup.hpp"
-#include "foxi/model/delaunay.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/animation.hpp"
@@ -182,9 +181,6 @@ int cmd_movie(Args args) {
     }
   }
   mp.render = options.params;
-  if (!delaunay_certificate(mesh).delaunay)
-    throw InputError(path + " fails the Delaunay certificate: it has no visibility order to make a "
-                             "movie with (foxi render --zbuffer draws it)");
   const SphereTable table = compute_spheres(mesh);
 
   AnimationParams ap;
@@ -238,7 +234,9 @@ int cmd_movie(Args args) {
 
   std::size_t index = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  const MovieStats stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
+  MovieStats stats;
+  try {
+    stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
                                       [&](const Framebuffer& scene) {
                                         const Framebuffer* fb = &scene;
                                         if (framed.width > 0) {  // the scene beside the legend
@@ -256,6 +254,10 @@ int cmd_movie(Args args) {
                                         }
                                         ++index;
                                       });
+  } catch (const UncertifiedMeshError&) {  // thrown before the first frame: nothing written
+    throw InputError(path + " fails the Delaunay certificate: it has no visibility order to make a "
+                            "movie with (foxi render --zbuffer draws it)");
+  }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (writer) writer->finish();
   if (!writer) commit_together(frames);  // numbered frames, or ffmpeg's input

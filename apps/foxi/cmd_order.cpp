@@ -11,6 +11,7 @@
 #include "mesh_input.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/viz/picture.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/visibility_order.hpp"
 
@@ -135,7 +136,7 @@ int cmd_order(Args args) {
   const SphereTable table = compute_spheres(mesh);
   auto t2 = std::chrono::steady_clock::now();
   std::string use = method;
-  if (use == "auto") use = cert.delaunay ? "power" : "mpvo";
+  if (use == "auto") use = safe_order_method(cert) == OrderMethod::power ? "power" : "mpvo";
   std::printf("mesh        %s: %zu tets, %zu ordered\n", path.c_str(), mesh.tet_count(),
               subset.empty() ? mesh.tet_count() : subset.size());
   std::printf("certificate %s (%zu of %zu tets violated, %.1f ms)\n",

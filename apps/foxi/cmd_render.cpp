@@ -14,14 +14,12 @@
 #include "mesh_input.hpp"
 #include "render_options.hpp"
 #include "foxi/model/durable_file.hpp"
-#include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/depth_stop.hpp"
 #include "foxi/viz/png.hpp"
-#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/picture.hpp"
 #include "foxi/viz/spheres.hpp"
-#include "foxi/viz/visibility_order.hpp"
 
 namespace foxi::cli {
 
@@ -107,30 +105,19 @@ int cmd_render(Args args) {
   const Camera& camera = picture.camera;
 
   auto t0 = std::chrono::steady_clock::now();
-  const DelaunayCertificate& cert = delaunay_certificate(mesh);
-  const double cert_ms = ms_since(t0);
-  t0 = std::chrono::steady_clock::now();
   const SphereTable table = compute_spheres(mesh);
   const double spheres_ms = ms_since(t0);
-  const View view = view_of(camera);
-  t0 = std::chrono::steady_clock::now();
-  std::vector<std::uint32_t> order;
-  std::size_t cycles = 0;
-  if (cert.delaunay)
-    order = visibility_order(mesh, table, view, subset);
-  else
-    order = mpvo_order(mesh, table, view, subset, &cycles);
-  const double order_ms = ms_since(t0);
-  std::size_t count = std::min(order.size(), std::size_t(std::floor(stop * double(order.size()) + 1e-9)));
-  if (!depth_s.empty()) count = std::min(count, count_deeper(table, camera, order, depth_stop));
-
-  params.depth_buffer = zbuffer || !cert.delaunay;
-  t0 = std::chrono::steady_clock::now();
+  PictureParams pp;
+  pp.render = params;
+  pp.render.depth_buffer = zbuffer;
+  pp.subset = subset;
+  pp.stop_fraction = stop;
+  pp.stop_depth = depth_stop;
   width = options.width;
-  Framebuffer fb(width, height, params.depth_buffer);
-  TetRasterizer raster(mesh, camera, width, height, params);
-  raster.draw(fb, std::span<const std::uint32_t>(order).first(count));
-  const double draw_ms = ms_since(t0);
+  Framebuffer fb(width, height);
+  const PictureReport report = draw_picture(mesh, table, camera, fb, pp);
+  const bool delaunay = report.delaunay;
+  const std::size_t count = report.tets_drawn;
   MarkerReport markers;
   if (field.paint && field_options.markers) {
     if (!text) text = std::make_unique<TextRenderer>(find_font_file());
@@ -140,9 +127,9 @@ int cmd_render(Args args) {
 
   std::size_t covered = 0;
   for (std::uint32_t id : fb.id) covered += id != kNone;
-  std::printf("mesh        %s: %zu tets, %zu selected\n", path.c_str(), mesh.tet_count(), order.size());
+  std::printf("mesh        %s: %zu tets, %zu selected\n", path.c_str(), mesh.tet_count(), report.tets_ordered);
   std::printf("certificate %s (%.1f ms); spheres %.1f ms\n",
-              cert.delaunay ? "Delaunay" : "NOT Delaunay: picture drawn with the depth buffer", cert_ms,
+              delaunay ? "Delaunay" : "NOT Delaunay: picture drawn with the depth buffer", report.certificate_ms,
               spheres_ms);
   if (camera.perspective)
     std::printf("camera      perspective eye (%g, %g, %g) at (%g, %g, %g) up (%g, %g, %g) fov %g\n",
@@ -151,15 +138,17 @@ int cmd_render(Args args) {
   else
     std::printf("camera      orthographic along (%g, %g, %g), height %g\n", camera.at[0] - camera.eye[0],
                 camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2], camera.ortho_height);
-  std::printf("order       %s, %.1f ms%s\n", cert.delaunay ? "power (visibility order)" : "MPVO", order_ms,
-              cert.delaunay ? "" : (", " + std::to_string(cycles) + " cycles broken").c_str());
+  const bool mpvo = report.method == OrderMethod::mpvo;
+  std::printf("order       %s, %.1f ms%s\n", mpvo ? "MPVO" : "power (visibility order)", report.order_ms,
+              mpvo ? (", " + std::to_string(report.cycles_broken) + " cycles broken").c_str() : "");
   std::printf("drawn       %zu of %zu tets (%.0f%%) in %s mode, %.1f ms, %dx%d, %.1f%% of pixels covered",
-              count, order.size(), order.empty() ? 0.0 : 100.0 * double(count) / double(order.size()),
-              params.depth_buffer ? "depth-buffer" : "painter", draw_ms, width, height,
+              count, report.tets_ordered,
+              report.tets_ordered == 0 ? 0.0 : 100.0 * double(count) / double(report.tets_ordered),
+              report.depth_buffer ? "depth-buffer" : "painter", report.draw_ms, width, height,
               100.0 * double(covered) / double(fb.id.size()));
   if (!depth_s.empty() && count > 0)
-    std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop, tet_depth(table, camera, order[count - 1]));
-  if (raster.stats().tets_behind > 0) std::printf(", %zu tets behind the eye", raster.stats().tets_behind);
+    std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop, tet_depth(table, camera, report.last_drawn));
+  if (report.raster.tets_behind > 0) std::printf(", %zu tets behind the eye", report.raster.tets_behind);
   if (field.paint) {
     const DisplayUnit& u = field.legend.unit;
     const ColorScale& sc = field.legend.scale;

@@ -7,12 +7,10 @@
 #include <memory>
 
 #include "field_options.hpp"
-#include "foxi/model/delaunay.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/png.hpp"
-#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/picture.hpp"
 #include "foxi/viz/spheres.hpp"
-#include "foxi/viz/visibility_order.hpp"
 
 namespace foxi::cli {
 
@@ -107,27 +105,19 @@ ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
   // flat structures (packages) fill the picture better seen from lower down
   const double dir[3] = {-0.55, 1, -0.55}, up[3] = {0, 0, 1};
   const Camera camera = fit_camera(lo, hi, dir, up, true, 30, double(width) / p.height, 0.95);
-  const DelaunayCertificate& cert = delaunay_certificate(mesh);
   const SphereTable table = compute_spheres(mesh);
-  const View view = view_of(camera);
-  std::vector<std::uint32_t> order;
-  if (cert.delaunay) {
-    order = visibility_order(mesh, table, view, subset);
-  } else {
-    std::size_t cycles = 0;
-    order = mpvo_order(mesh, table, view, subset, &cycles);
-  }
+  PictureParams pp;
+  pp.render = rp;
+  pp.subset = subset;
   if (p.view == ModelView::interior) {
-    order.resize(order.size() * 6 / 10);
-    if (!rp.field) rp.shrink = 0.85;
+    pp.stop_fraction = 0.6;
+    if (!rp.field) pp.render.shrink = 0.85;
   }
-  out.delaunay = cert.delaunay;
-  rp.depth_buffer = !cert.delaunay;
-  Framebuffer fb(width, p.height, rp.depth_buffer);
-  TetRasterizer raster(mesh, camera, width, p.height, rp);
-  raster.draw(fb, order);
+  Framebuffer fb(width, p.height);
+  const PictureReport report = draw_picture(mesh, table, camera, fb, pp);
+  out.delaunay = report.delaunay;
   write_png(path, text ? with_legend(fb, *text, field, panel) : fb);
-  out.tets_drawn = order.size();
+  out.tets_drawn = report.tets_drawn;
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "foxi/model/delaunay.hpp"
 #include "foxi/viz/visibility_order.hpp"
 
 namespace foxi {
@@ -24,6 +25,8 @@ MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& 
     throw std::invalid_argument("movie: needs at least 2 frames per cycle and 1 cycle");
   if (!(params.from >= 0 && params.from <= params.to && params.to <= 1))
     throw std::invalid_argument("movie: needs 0 <= from <= to <= 1");
+  // The painter's picture of an uncertified mesh may be wrong, and undraw has no depth-buffer mode.
+  if (!delaunay_certificate(mesh).delaunay) throw UncertifiedMeshError();
   MovieStats stats;
   const std::size_t total = std::size_t(params.frames) * std::size_t(params.cycles);
   auto emit = [&](const Framebuffer& fb) {

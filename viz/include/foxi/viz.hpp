@@ -1,6 +1,8 @@
 // foxi/viz.hpp: the visibility order of tets and the software painter (foxi::viz), in one include.
 // The entry points, one a line (declared in the topic headers below, which say more):
 //
+//   draw_picture(mesh, table, camera, fb)     a safe picture: painter if certified, else MPVO + depth buffer (picture.hpp)
+//   safe_order(mesh, table, view, subset)      the back-to-front order draw_picture uses (picture.hpp)
 //   compute_spheres(mesh)                      per-mesh precompute of the power order (spheres.hpp)
 //   visibility_order(mesh, table, view, subset) back-to-front order for one view; Delaunay meshes (visibility_order.hpp)
 //   ProgressiveOrder                           the same handed out batch by batch (visibility_order.hpp)
@@ -28,6 +30,7 @@
 #include "foxi/viz/framebuffer.hpp"
 #include "foxi/viz/legend.hpp"
 #include "foxi/viz/movie.hpp"
+#include "foxi/viz/picture.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"

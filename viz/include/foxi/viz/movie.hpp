@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <stdexcept>
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
@@ -41,13 +42,21 @@ struct FOXI_API MovieCancelled : std::runtime_error, Cancelled {
   MovieCancelled() : std::runtime_error("movie cancelled") {}
 };
 
+// Thrown by make_movie for a mesh that fails the Delaunay certificate: the painter has no
+// visibility order to draw it in, and undrawing needs the painter (picture.hpp draws such a mesh
+// with the depth buffer instead).
+struct FOXI_API UncertifiedMeshError : std::invalid_argument {
+  UncertifiedMeshError()
+      : std::invalid_argument("the mesh fails the Delaunay certificate: it has no visibility order to make a movie with") {}
+};
+
 // Calls frame(fb) for each frame, in order. Back-and-forth frame k of a cycle of F frames shows the
 // first round(n (from + (to - from) k / h)) tets of the order for k <= h = F / 2, then undraws
 // back (the undrawn picture equals drawing that prefix afresh, see TetRasterizer::undraw): a cycle
 // starts and ends at `from`, so it loops seamlessly. Rotate frame k turns the camera by
-// turn_deg k / F. subset: tets to show (empty = all). Meshes without a visibility-order guarantee
-// should not be given (the painter's picture would be wrong; the caller checks the certificate).
-// Throws std::invalid_argument for bad parameters, MovieCancelled when progress returns false.
+// turn_deg k / F. subset: tets to show (empty = all). Throws UncertifiedMeshError before any frame for a mesh
+// without the visibility-order guarantee (delaunay.hpp's cached certificate), std::invalid_argument
+// for bad parameters, MovieCancelled when progress returns false.
 FOXI_API MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& camera, int width, int height,
                       std::span<const std::uint32_t> subset, const MovieParams& params,
                       const std::function<void(const Framebuffer&)>& frame, const ProgressFn& progress = {});

@@ -1,0 +1,74 @@
+// One safe picture of a mesh in one call: the rule "a mesh that passes the Delaunay certificate is
+// drawn by the painter in the power order (no depth buffer, seed paper Theorem 1); any other mesh has
+// no guaranteed visibility order and is drawn in MPVO order with the depth buffer" lives here, so the
+// CLI, the viewer and a host program draw alike. The MPVO order still puts the far part first, so a
+// stop takes the far part of an uncertified mesh too.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "foxi/api.hpp"
+#include "foxi/model/delaunay.hpp"
+#include "foxi/model/mesh.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/view.hpp"
+
+namespace foxi {
+
+// How a back-to-front order was made.
+enum class OrderMethod : std::uint8_t {
+  power,  // the power-function visibility order (a visibility order for a certified mesh)
+  mpvo,   // MPVO's face-adjacency sort seeded by the power order (cycles broken, reported)
+};
+
+// The order method a mesh with this certificate is drawn with: power when it is Delaunay (or
+// regular), MPVO otherwise.
+inline OrderMethod safe_order_method(const DelaunayCertificate& cert) {
+  return cert.delaunay ? OrderMethod::power : OrderMethod::mpvo;
+}
+
+// The back-to-front order of `subset` (empty: all tets) seen from `view` by the method the mesh's
+// (cached) certificate calls for; the method used and the MPVO cycles broken are stored where asked.
+FOXI_API std::vector<std::uint32_t> safe_order(const Mesh& mesh, const SphereTable& table, const View& view,
+                                               std::span<const std::uint32_t> subset = {},
+                                               OrderMethod* method = nullptr, std::size_t* cycles = nullptr);
+
+struct PictureParams {
+  // Colours, edges, shrink, field, threads. render.depth_buffer = true asks for the depth buffer
+  // on a certified mesh too (the oracle); an uncertified mesh always gets it. undoable is ignored.
+  RenderParams render;
+  std::span<const std::uint32_t> subset;  // tets to draw (each at most once); empty: all
+  // Draw only the first floor(stop_fraction n + 1e-9) tets of the back-to-front order of n tets, in [0, 1].
+  double stop_fraction = 1;
+  // And stop before the first tet whose depth (depth_stop.hpp) is below this; -infinity: no depth stop.
+  double stop_depth = -std::numeric_limits<double>::infinity();
+};
+
+struct PictureReport {
+  bool delaunay = false;  // the mesh passed the certificate
+  OrderMethod method = OrderMethod::power;
+  bool depth_buffer = false;       // drawn with the depth buffer (uncertified, or asked for)
+  std::size_t tets_ordered = 0;    // the tets selected (the subset, or all)
+  std::size_t tets_drawn = 0;      // the prefix of the order drawn (after the stops)
+  std::size_t cycles_broken = 0;   // MPVO only
+  std::uint32_t last_drawn = kNone;  // the last tet drawn (the nearest), kNone if none
+  RasterStats raster;              // tets behind the eye, faces clipped
+  double certificate_ms = 0;       // 0 when the mesh's certificate was already cached
+  double order_ms = 0, draw_ms = 0;
+};
+
+// Draws the picture into fb: fb keeps its width and height (both >= 1) and is cleared to white, with a
+// depth buffer exactly when the depth buffer is used. Throws std::invalid_argument for a stop
+// fraction outside [0, 1], a NaN stop depth, an empty framebuffer, a table of another mesh, and what
+// TetRasterizer throws (degenerate camera).
+FOXI_API PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera, Framebuffer& fb,
+                                    const PictureParams& params = {});
+
+}  // namespace foxi
