@@ -9,6 +9,7 @@ enum ExitCode : int {
   kExitUsage = 2,       // the command line is wrong (unknown option, missing value, bad syntax)
   kExitBadInput = 3,    // an input file, model or parameter is invalid (the message names it)
   kExitUnreliable = 4,  // a result was computed but failed its own checks (figures printed)
+  kExitHangup = 129,       // stopped by SIGHUP (the terminal closed); nothing partial left behind
   kExitInterrupted = 130,  // stopped by SIGINT (Ctrl-C); nothing partial left behind
   kExitTerminated = 143,   // stopped by SIGTERM; nothing partial left behind
 };

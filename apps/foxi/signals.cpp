@@ -27,6 +27,7 @@ sigset_t stop_signals() {
   sigemptyset(&set);
   sigaddset(&set, SIGINT);
   sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGHUP);  // the terminal went away: stop as cleanly as on SIGTERM
   return set;
 }
 
@@ -48,12 +49,12 @@ void handle_stop_signals(const std::string& command) {
     while (sigwait(&set, &sig) != 0) {
     }
     g_stopping = true;
-    const bool term = sig == SIGTERM;
+    const char* name = sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
     std::fprintf(stderr, "\nfoxi %s: stopped by %s; helper processes killed, unfinished files removed\n",
-                 command.c_str(), term ? "SIGTERM" : "SIGINT (Ctrl-C)");
+                 command.c_str(), name);
     cleanup::interrupt();
     std::fflush(stderr);
-    ::_exit(term ? kExitTerminated : kExitInterrupted);
+    ::_exit(sig == SIGTERM ? kExitTerminated : sig == SIGHUP ? kExitHangup : kExitInterrupted);
   }).detach();
 }
 

@@ -1,5 +1,6 @@
-// SIGINT and SIGTERM for the foxi program: a stop leaves no helper process and no temporary file,
-// only outputs that were complete, and exits 130 (SIGINT) or 143 (SIGTERM) with a message.
+// SIGINT, SIGTERM and SIGHUP for the foxi program: a stop leaves no helper process and no temporary
+// file, only outputs that were complete, and exits 130 (SIGINT), 143 (SIGTERM) or 129 (SIGHUP) with a
+// message.
 #pragma once
 
 #include <string>
@@ -7,7 +8,7 @@
 
 namespace foxi::cli {
 
-// Call first in main, before any thread starts. Blocks SIGINT and SIGTERM in this thread and so in
+// Call first in main, before any thread starts. Blocks SIGINT, SIGTERM and SIGHUP in this thread and so in
 // every thread and child started later (children are killed by foxi instead, so a terminal's Ctrl-C
 // cannot make a child's death look like a mesher failure), and waits for them in a thread of its
 // own. On one, that thread prints "foxi COMMAND: stopped by SIGINT ..." on stderr, kills the child

@@ -1,5 +1,5 @@
-// SIGINT and SIGTERM at random moments of foxi mesh, solve, render, movie and convert: the exit
-// status is 0 (the run finished first) or 130 (SIGINT) / 143 (SIGTERM), no process of the run is
+// SIGINT, SIGTERM and SIGHUP at random moments of foxi mesh, solve, render, movie and convert: the exit
+// status is 0 (the run finished first) or 130 (SIGINT) / 143 (SIGTERM) / 129 (SIGHUP), no process of the run is
 // left (the TetGen/CGAL children and ffmpeg included), no temporary file is left, and each output
 // is either absent or complete and valid (read back by foxi's readers and libpng; a TetGen set is
 // all three files or none; numbered movie frames are all there or none).
@@ -190,7 +190,7 @@ class SignalsCliSlow : public ::testing::Test {
   }
   static fs::path big() { return dir_->path() / "big.vtu"; }
 
-  // Runs `c` once to time it, then `trials` times with SIGINT or SIGTERM (alternating) after a
+  // Runs `c` once to time it, then `trials` times with SIGINT, SIGTERM or SIGHUP (in turn) after a
   // random delay up to 1.2 times that time.
   void trials(const Case& c, int count) {
     std::uint64_t seed = std::random_device{}();
@@ -206,19 +206,20 @@ class SignalsCliSlow : public ::testing::Test {
     std::uniform_real_distribution<double> delay(0.0, 1.2 * full.seconds);
     int stopped = 0;
     for (int k = 0; k < count; ++k) {
-      const int sig = k % 2 == 0 ? SIGINT : SIGTERM;
+      const int sig = k % 3 == 0 ? SIGINT : k % 3 == 1 ? SIGTERM : SIGHUP;
+      const char* sig_name = sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGHUP";
       const double d = delay(rng);
-      SCOPED_TRACE(c.name + " trial " + std::to_string(k) + ": " + (sig == SIGINT ? "SIGINT" : "SIGTERM") +
+      SCOPED_TRACE(c.name + " trial " + std::to_string(k) + ": " + sig_name +
                    " after " + std::to_string(d) + " s of " + std::to_string(full.seconds) + " s, seed " +
                    std::to_string(seed));
       const fs::path out = dir_->path() / (c.name + "-" + std::to_string(k));
       fs::create_directories(out);
       const Outcome o = run_foxi(with_out(c.args, out), dir_->path() / (c.name + "-" + std::to_string(k) + ".log"), sig, d);
-      const int stop_status = sig == SIGINT ? 130 : 143;
+      const int stop_status = 128 + sig;
       EXPECT_TRUE(o.status == 0 || o.status == stop_status) << "exit status " << o.status << "\n" << o.log;
       if (o.status == stop_status) {
         ++stopped;
-        EXPECT_NE(o.log.find(sig == SIGINT ? "stopped by SIGINT" : "stopped by SIGTERM"), std::string::npos) << o.log;
+        EXPECT_NE(o.log.find(std::string("stopped by ") + sig_name), std::string::npos) << o.log;
       }
       EXPECT_EQ(processes_mentioning(out.string()), std::vector<std::string>{});
       EXPECT_EQ(leftovers(out), std::vector<std::string>{});
