@@ -63,5 +63,6 @@ int cmd_solve(Args args);
 int cmd_model(Args args);
 int cmd_demo(Args args);
 int cmd_sweep(Args args);
+int cmd_fields(Args args);
 
 }  // namespace foxi::cli
