@@ -195,7 +195,8 @@ void FrdParser::read_results() {
   if (!have_step_) fail("a result block (-4) without its step header (100C)");
   if (src_.node_id.empty()) fail("a result block before the node block (2C)");
   // " -4  NAME    ncomps irtype"
-  std::string name(line_.substr(5, std::min<std::size_t>(8, line_.size() > 5 ? line_.size() - 5 : 0)));
+  std::string name(line_.size() > 5 ? line_.substr(5, 8) : std::string_view{});
+  while (!name.empty() && name.front() == ' ') name.erase(0, 1);
   while (!name.empty() && name.back() == ' ') name.pop_back();
   if (name.empty()) fail("a result block without a name");
   const std::int64_t declared = int_at(13, 5, "component count");
