@@ -34,7 +34,8 @@ const char* kFieldsUsage =
     "    --by location  another mesh of the same domain: each node located in FILE's tets and\n"
     "                   interpolated linearly, cell values taken at the tet centroid; inside the same\n"
     "                   region where both meshes have regions (--no-regions: ignore them)\n"
-    "    (default: id when FILE has MESH's node and tet counts or is keyed by ids, else location)\n"
+    "    (default: id when FILE is keyed by ids, or has MESH's node and tet counts and proves to be\n"
+    "    the same mesh; else location)\n"
     "    --outside      what a point in no source tet gets: nan (default, drawn in the 'no value'\n"
     "                   colour) or nearest (the nearest source node's or centroid's value)\n"
     "  Counts of points outside, nodes without a value and NaN values are printed. OUT is written\n"
@@ -104,14 +105,23 @@ int fields_import(Args& args) {
   const auto t1 = std::chrono::steady_clock::now();
   if (by.empty()) {
     const bool same = src.key != SourceKey::position ||
-                      (src.mesh.node_count() == mesh.node_count() && src.mesh.tet == mesh.tet);
+                      (src.mesh.node_count() == mesh.node_count() && src.mesh.tet_count() == mesh.tet_count());
     params.by = same ? MatchBy::id : MatchBy::location;
   } else {
     params.by = by == "id" ? MatchBy::id : MatchBy::location;
   }
   TransferReport rep;
   try {
-    rep = transfer_fields(src, mesh, params);
+    try {
+      rep = transfer_fields(src, mesh, params);
+    } catch (const FieldError& e) {
+      // The default with equal counts is a guess: another mesh with the same counts (other
+      // coordinates or tets) goes by location, and says so.
+      if (!by.empty() || src.key != SourceKey::position || params.by != MatchBy::id || src.mesh.tet_count() == 0) throw;
+      std::fprintf(stderr, "foxi fields: note: not the same mesh (%s): matching by location\n", e.what());
+      params.by = MatchBy::location;
+      rep = transfer_fields(src, mesh, params);
+    }
   } catch (const FieldError& e) {
     throw InputError(e.what());
   }

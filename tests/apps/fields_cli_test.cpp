@@ -64,6 +64,17 @@ TEST_F(FieldsCli, ImportByLocationIsExactAndRenders) {
   ASSERT_EQ(foxi("fields import " + p("out.vtu") + " " + p("out.vtu") + " -o " + p("again.vtu"), &log), 0) << log;
   EXPECT_NE(log.find("by id"), std::string::npos) << log;
   EXPECT_EQ(read_mesh(dir_ / "again.vtu").find_field("temperature")->values, t->values);
+  // Another mesh with the target's counts (other jitter): the default goes by location and says so.
+  Mesh twin = bench::kuhn_grid_mesh(5, 0.2, 99);
+  Field tt{"temperature", FieldLocation::node, 1, "K", {}, {}};
+  for (std::size_t i = 0; i < twin.node_count(); ++i) tt.values.push_back(linear(&twin.xyz[3 * i]));
+  twin.fields = {tt};
+  write_mesh(twin, dir_ / "twin.vtu");
+  ASSERT_EQ(foxi("fields import " + p("target.vtu") + " " + p("twin.vtu") + " -o " + p("t2.vtu"), &log), 0) << log;
+  EXPECT_NE(log.find("matching by location"), std::string::npos) << log;
+  const Mesh t2 = read_mesh(dir_ / "t2.vtu");
+  for (std::size_t i = 0; i < t2.node_count(); ++i)
+    EXPECT_NEAR(t2.find_field("temperature")->values[i], linear(&t2.xyz[3 * i]), 1e-11);
 }
 
 TEST_F(FieldsCli, CsvAndOutsidePoints) {

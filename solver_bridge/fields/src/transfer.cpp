@@ -75,6 +75,20 @@ void copy_entity(const Field& f, std::size_t from, std::size_t n_from, Field& g,
     std::copy_n(f.values.data() + (s * n_from + from) * c, c, g.values.data() + (s * n_to + to) * c);
 }
 
+// The same tets in the same order, each as a set of nodes (a reader or a command may have
+// re-oriented inverted tets of one of them).
+bool same_tets(const Mesh& a, const Mesh& b) {
+  if (a.tet.size() != b.tet.size()) return false;
+  for (std::size_t t = 0; t < a.tet.size(); t += 4) {
+    std::array<std::uint32_t, 4> p{a.tet[t], a.tet[t + 1], a.tet[t + 2], a.tet[t + 3]};
+    std::array<std::uint32_t, 4> q{b.tet[t], b.tet[t + 1], b.tet[t + 2], b.tet[t + 3]};
+    std::sort(p.begin(), p.end());
+    std::sort(q.begin(), q.end());
+    if (p != q) return false;
+  }
+  return true;
+}
+
 void check_coordinates(const FieldSource& src, const Mesh& target, const std::vector<std::uint32_t>& node_of,
                        const TransferParams& params) {
   if (src.mesh.xyz.empty()) return;  // a CSV keyed by id alone: nothing to compare
@@ -114,7 +128,7 @@ void transfer_by_id(const FieldSource& src, const Mesh& target, const std::vecto
       node_of.resize(nn);
       std::iota(node_of.begin(), node_of.end(), 0u);
       check_coordinates(src, target, node_of, params);
-      if (src.mesh.tet != target.tet)
+      if (!same_tets(src.mesh, target))
         throw FieldError(src.path + " has the target's nodes but other tets: a field over a different mesh (use --by location)");
       cell_of = node_of;
       cell_of.resize(nt);
