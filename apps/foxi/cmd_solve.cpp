@@ -263,6 +263,7 @@ int print_checks(const std::vector<BalanceCheck>& checks) {
 
 int cmd_solve(Args args) {
   const std::string physics = args.option("--physics", "thermal");
+  if (args.has_option("--with")) return cmd_solve_with(std::move(args), physics);
   if (args.has_option("--convergence")) return cmd_solve_convergence(std::move(args), physics);
   if (physics == "thermoelastic") return cmd_solve_thermoelastic(std::move(args));
   if (physics == "transient") return cmd_solve_transient(std::move(args));

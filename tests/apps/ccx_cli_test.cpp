@@ -1,0 +1,89 @@
+// foxi solve MODEL --with ccx and foxi export-ccx, end to end: ccx's temperatures come back on foxi's
+// mesh and agree with foxi's own solve (recomputed here from the written fields, not taken from the
+// printout); a failing ccx (a stand-in script) or a missing one exits 1 with ccx's own text and the
+// work folder kept; --solver with --with ccx is a usage error.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "foxi/model/mesh_io.hpp"
+#include "test_util.hpp"
+
+namespace foxi {
+namespace {
+
+
+class CcxCli : public ::testing::Test {
+ protected:
+  int foxi(const std::string& args, std::string* out = nullptr, const std::string& env = "") {
+    const int status = test::run(env + "'" + test::cli_path() + "' " + args, dir_ / "log.txt");
+    if (out) *out = test::read_text(dir_ / "log.txt");
+    return status;
+  }
+  std::string model() const { return "'" + test::models_dir() + "die_on_substrate.toml'"; }
+  test::TempDir dir_;
+};
+
+TEST_F(CcxCli, SolveWithCcxAgreesWithFoxi) {
+  if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
+  std::string log;
+  const std::string out = (dir_ / "out.vtu").string();
+  ASSERT_EQ(foxi("solve " + model() + " --physics thermal --with ccx --compare -o '" + out + "'", &log), 0) << log;
+  EXPECT_NE(log.find("agree to ccx's output precision"), std::string::npos) << log;
+  const Mesh m = read_mesh(out);
+  const Field* ccx = m.find_field("temperature");
+  const Field* own = m.find_field("temperature_foxi");
+  ASSERT_NE(ccx, nullptr);
+  ASSERT_NE(own, nullptr);
+  EXPECT_EQ(ccx->unit, "K");
+  double diff = 0, hi = 0;
+  for (std::size_t i = 0; i < m.node_count(); ++i) {
+    diff = std::max(diff, std::abs(ccx->values[i] - own->values[i]));
+    hi = std::max(hi, ccx->values[i]);
+  }
+  EXPECT_GT(hi, 310);  // heated above the 300 K it is held at
+  EXPECT_LT(diff / hi, 1e-5);
+  char max_text[64];
+  std::snprintf(max_text, sizeof max_text, "max temperature %.6g K", hi);
+  EXPECT_NE(log.find(max_text), std::string::npos) << log;
+}
+
+TEST_F(CcxCli, ExportWritesTheDeck) {
+  std::string log;
+  const std::string deck = (dir_ / "deck.inp").string();
+  ASSERT_EQ(foxi("export-ccx " + model() + " -o '" + deck + "'", &log), 0) << log;
+  const std::string text = test::read_text(deck);
+  EXPECT_NE(text.find("*NODE"), std::string::npos);
+  EXPECT_NE(text.find("*FILM"), std::string::npos);
+  EXPECT_NE(text.find("*END STEP"), std::string::npos);
+  if (!test::have_program("ccx")) return;
+  // ccx runs the exported deck as it is.
+  ASSERT_EQ(test::run("cd '" + dir_.path().string() + "' && OMP_NUM_THREADS=1 ccx -i deck", dir_ / "ccx.log"), 0);
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "deck.frd"));
+}
+
+TEST_F(CcxCli, FailingOrMissingCcxExitsOneWithItsText) {
+  std::string log;
+  const std::filesystem::path bin = dir_ / "bin";
+  std::filesystem::create_directories(bin);
+  test::write_text(bin / "ccx", "#!/bin/sh\necho ' *ERROR reading *NODE: something ccx-specific'\nexit 201\n");
+  std::filesystem::permissions(bin / "ccx", std::filesystem::perms::owner_all);
+  const std::string out = (dir_ / "never.vtu").string();
+  EXPECT_EQ(foxi("solve " + model() + " --with ccx -o '" + out + "'", &log, "PATH='" + bin.string() + "':\"$PATH\" "), 1);
+  EXPECT_NE(log.find("something ccx-specific"), std::string::npos) << log;
+  const std::size_t at = log.find("kept in ");
+  ASSERT_NE(at, std::string::npos) << log;
+  const std::string kept = log.substr(at + 8, log.find('\n', at) - at - 8);
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(kept) / "heat.inp")) << kept;
+  std::filesystem::remove_all(kept);
+  EXPECT_FALSE(std::filesystem::exists(out));
+  std::filesystem::remove(bin / "ccx");
+  EXPECT_EQ(foxi("solve " + model() + " --with ccx", &log, "PATH='" + bin.string() + "' "), 1);
+  EXPECT_NE(log.find("ccx (CalculiX) is not installed"), std::string::npos) << log;
+  EXPECT_EQ(foxi("solve " + model() + " --with ccx --solver direct", &log), 2);
+  EXPECT_EQ(foxi("solve " + model() + " --with abaqus", &log), 2);
+}
+
+}  // namespace
+}  // namespace foxi
