@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "foxi/solver/calculix.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "foxi/solver/thermoelastic.hpp"
 #include "mesh_input.hpp"
 #include "model_run.hpp"
 #include "signals.hpp"
@@ -40,27 +42,30 @@ const char* kExportUsage =
     "  mesh is ccx node i + 1. DECK is written whole or not at all. (thermoelastic: not yet.)";
 
 const char* kSolveCcxUsage =
-    "foxi solve MODEL.toml --physics thermal --with ccx [--set NAME=VALUE]... [--compare] [--keep]\n"
-    "                      [-o OUT]\n"
-    "  The model's steady heat problem solved by CalculiX: the deck (as foxi export-ccx writes it) is\n"
-    "  run by ccx in a work folder; its temperatures (the .frd's NDTEMP) come back as the field\n"
-    "  'temperature' (K) on foxi's mesh. Prints the maximum temperature and where, and each region's\n"
-    "  maximum. --compare also solves with foxi (with ccx's centroid rule for *FILM) and prints the\n"
-    "  largest difference, relative to the largest temperature (about 1e-6: ccx's .frd prints 6\n"
-    "  digits; exit 4 above 1e-5). OUT gets 'temperature' and, with --compare, 'temperature_foxi'.\n"
+    "foxi solve MODEL.toml --physics thermal|thermoelastic --with ccx [--set NAME=VALUE]...\n"
+    "                      [--temperature-from-thermal] [--compare] [--keep] [-o OUT]\n"
+    "  The model's problem solved by CalculiX: the deck (as foxi export-ccx writes it) is run by ccx in\n"
+    "  a work folder and its results come back as foxi fields on foxi's mesh (node i = ccx node i + 1).\n"
+    "  thermal: the .frd's NDTEMP as 'temperature' (K); prints the maximum and where, each region's\n"
+    "  maximum. thermoelastic (C3D4, the model's displacement conditions and temperature_change, or\n"
+    "  with --temperature-from-thermal ccx's steady temperatures of the model's thermal problem):\n"
+    "  DISP as 'displacement' (m), ccx's nodal STRESS (its element values averaged at the nodes) as\n"
+    "  'stress_nodal' (Pa, xx yy zz xy yz xz); prints the largest |u| and where, the largest nodal von\n"
+    "  Mises stress. --compare also solves with foxi on the same mesh and temperatures (thermal: with\n"
+    "  ccx's centroid rule for *FILM) and prints the largest difference of the temperature or the\n"
+    "  displacement, relative to its largest value (about 1e-6: ccx's .frd prints 6 digits; exit 4\n"
+    "  above 1e-5); OUT then also holds foxi's 'temperature_foxi' or 'displacement_foxi'.\n"
     "  The work folder is removed after a successful run (--keep keeps it) and kept, with ccx's\n"
-    "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here.\n"
+    "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here;\n"
+    "  --order 2 (C3D10) is not yet supported with ccx.\n"
     "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model, 4 --compare off.";
 
-MeshedModel model_for_ccx(Args& args, const char* usage, const char* command) {
+MeshedModel model_for_ccx(Args& args, const char* usage, const char* command, const std::string& physics) {
   const std::vector<std::string> sets = all_options(args, "--set");
-  const std::string physics = args.option("--physics", "thermal");
-  if (physics != "thermal")
-    throw UsageError(std::string(command) + " --physics takes thermal (thermoelastic with ccx: not yet)");
   const auto files = args.positional(1, 1, usage);
   if (!is_model_path(files[0]))
     throw UsageError("give a model file (MODEL.toml): ccx needs its conditions, which a mesh file does not hold");
-  MeshedModel run = mesh_model_for_solve(files[0], sets, "thermal");
+  MeshedModel run = mesh_model_for_solve(files[0], sets, physics);
   require_usable(run.mesh, files[0], command);
   return run;
 }
@@ -98,6 +103,63 @@ std::string tail_of(const fs::path& p, std::size_t lines) {
   return s.substr(pos);
 }
 
+// Runs ccx on WORK/JOB.inp. Throws (exit 1) when ccx is not installed; returns false, with ccx's
+// output printed and the folder kept, when it fails.
+bool run_ccx(const fs::path& work, const std::string& job) {
+  const int status = run_program({"/bin/sh", "-c", "cd '" + work.string() + "' && OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} exec ccx -i " + job},
+                                 (work / (job + ".log")).string());
+  const std::string log_tail = tail_of(work / (job + ".log"), 15);
+  if (status == 127) {
+    std::error_code ec;
+    fs::remove_all(work, ec);
+    throw std::runtime_error("ccx (CalculiX) is not installed: no 'ccx' in PATH (Debian: apt-get install calculix-ccx)");
+  }
+  if (status != 0 || log_tail.find("*ERROR") != std::string::npos || !fs::exists(work / (job + ".frd"))) {
+    std::fprintf(stderr, "foxi solve: ccx failed (exit status %d); its last output:\n%s\n", status, log_tail.c_str());
+    std::fprintf(stderr, "foxi solve: the deck and ccx's files are kept in %s\n", work.c_str());
+    return false;
+  }
+  return true;
+}
+
+// The nodal block `block` of WORK/JOB.frd on `mesh` (by node id, coordinates checked), renamed;
+// nullopt (message printed, folder kept) when it does not fit the mesh or leaves nodes without a value.
+std::optional<Field> ccx_field(const fs::path& work, const std::string& job, const Mesh& mesh, const char* block,
+                               const char* name, const char* unit) {
+  const FieldSource frd = read_frd_source(work / (job + ".frd"));
+  TransferParams tp;
+  tp.by = MatchBy::id;
+  tp.names = {block};
+  TransferReport rep;
+  try {
+    rep = transfer_fields(frd, mesh, tp);
+  } catch (const FieldError& e) {
+    std::fprintf(stderr, "foxi solve: ccx's results do not fit the mesh (%s); files kept in %s\n", e.what(), work.c_str());
+    return std::nullopt;
+  }
+  if (rep.nan_values > 0) {
+    std::fprintf(stderr, "foxi solve: ccx's %s has no value for %zu entries; files kept in %s\n", block, rep.nan_values,
+                 work.c_str());
+    return std::nullopt;
+  }
+  Field f = std::move(rep.fields[0]);
+  f.name = name;
+  f.unit = unit;
+  f.values.resize(mesh.node_count() * f.components);  // a static run has one step: its values
+  f.step_values.clear();
+  return f;
+}
+
+// max_i |a_i - b_i| over max_i |a_i|, and the former.
+std::pair<double, double> largest_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double diff = 0, scale = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff = std::max(diff, std::abs(a[i] - b[i]));
+    scale = std::max(scale, std::abs(a[i]));
+  }
+  return {diff, scale > 0 ? diff / scale : diff};
+}
+
 }  // namespace
 
 int cmd_export_ccx(Args args) {
@@ -108,7 +170,9 @@ int cmd_export_ccx(Args args) {
   const std::string out = args.option("-o");
   if (out.empty()) throw UsageError("give the deck: -o DECK.inp");
   check_output_path(out);
-  MeshedModel run = model_for_ccx(args, kExportUsage, "export-ccx");
+  const std::string physics = args.option("--physics", "thermal");
+  if (physics != "thermal") throw UsageError("export-ccx --physics takes thermal (thermoelastic: not yet)");
+  MeshedModel run = model_for_ccx(args, kExportUsage, "export-ccx", physics);
   const ThermalParams params = thermal_params_from_model(run.model, run.mesh);
   // Written beside nothing of the user's, then copied through a durable file: whole or not at all.
   const fs::path work = make_work_folder();
@@ -140,7 +204,13 @@ int cmd_solve_with(Args args, const std::string& physics) {
   if (with != "ccx") throw UsageError("--with takes ccx (CalculiX), not '" + with + "'");
   if (args.has_option("--solver") || args.has_option("--tol"))
     throw UsageError("--solver and --tol choose foxi's linear solver: not with --with ccx");
-  if (physics != "thermal") throw UsageError("--with ccx solves --physics thermal (thermoelastic: not yet)");
+  if (physics != "thermal" && physics != "thermoelastic")
+    throw UsageError("--with ccx solves --physics thermal or thermoelastic, not '" + physics + "'");
+  if (args.has_option("--order") && args.option("--order") != "1")
+    throw UsageError("--order 2 (C3D10) with ccx: not yet");
+  const bool stress = physics == "thermoelastic";
+  const bool from_thermal = args.flag("--temperature-from-thermal");
+  if (from_thermal && !stress) throw UsageError("--temperature-from-thermal is for --physics thermoelastic");
   const bool compare = args.flag("--compare");
   const bool keep = args.flag("--keep");
   const std::string out = args.option("-o");
@@ -148,84 +218,99 @@ int cmd_solve_with(Args args, const std::string& physics) {
     (void)format_from_path(out);
     check_output_path(out);
   }
-  MeshedModel run = model_for_ccx(args, kSolveCcxUsage, "solve");
+  MeshedModel run = model_for_ccx(args, kSolveCcxUsage, "solve", stress ? physics_name(Physics::thermal_stress) : "thermal");
   Mesh& mesh = run.mesh;
-  ThermalParams params = thermal_params_from_model(run.model, mesh);
-
   const fs::path work = make_work_folder();
-  const auto t0 = std::chrono::steady_clock::now();
-  write_calculix_thermal(mesh, params, work / "heat.inp");
-  const int status = run_program({"/bin/sh", "-c", "cd '" + work.string() + "' && OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} exec ccx -i heat"},
-                                 (work / "ccx.log").string());
-  const auto t1 = std::chrono::steady_clock::now();
-  const std::string log_tail = tail_of(work / "ccx.log", 15);
-  const bool ccx_error = log_tail.find("*ERROR") != std::string::npos;
-  if (status == 127) {
-    fs::remove_all(work);
-    throw std::runtime_error("ccx (CalculiX) is not installed: no 'ccx' in PATH (Debian: apt-get install calculix-ccx)");
-  }
-  if (status != 0 || ccx_error || !fs::exists(work / "heat.frd")) {
-    std::fprintf(stderr, "foxi solve: ccx failed (exit status %d); its last output:\n%s\n", status, log_tail.c_str());
-    std::fprintf(stderr, "foxi solve: the deck and ccx's files are kept in %s\n", work.c_str());
-    return kExitFailure;
-  }
-  const FieldSource frd = read_frd_source(work / "heat.frd");
-  TransferParams tp;
-  tp.by = MatchBy::id;
-  tp.names = {"NDTEMP"};
-  TransferReport rep;
-  try {
-    rep = transfer_fields(frd, mesh, tp);
-  } catch (const FieldError& e) {
-    std::fprintf(stderr, "foxi solve: ccx's results do not fit the mesh (%s); files kept in %s\n", e.what(), work.c_str());
-    return kExitFailure;
-  }
-  Field t = std::move(rep.fields[0]);
-  t.name = "temperature";
-  t.unit = "K";
-  t.step_values.clear();
-  t.values.resize(mesh.node_count());  // the one step of a steady run
-  if (rep.nan_values > 0) {
-    std::fprintf(stderr, "foxi solve: ccx gave no temperature for %zu nodes; files kept in %s\n", rep.nan_values, work.c_str());
-    return kExitUnreliable;
-  }
-  std::size_t arg = 0;
-  for (std::size_t i = 0; i < t.values.size(); ++i)
-    if (t.values[i] > t.values[arg]) arg = i;
-  std::printf("ccx: %zu nodes, %zu C3D4 elements, %.3f s; max temperature %.6g K at (%.6g, %.6g, %.6g) m\n",
-              mesh.node_count(), mesh.tet_count(), std::chrono::duration<double>(t1 - t0).count(), t.values[arg],
-              mesh.xyz[3 * arg], mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2]);
-  for (const Region& r : mesh.regions) {
-    double hi = -INFINITY;
-    for (std::size_t e = 0; e < mesh.tet_count(); ++e)
-      if (mesh.region_of(e) == r.id)
-        for (int j = 0; j < 4; ++j) hi = std::max(hi, t.values[mesh.tet[4 * e + j]]);
-    if (std::isfinite(hi)) std::printf("  region %-16s max %.6g K\n", region_label(mesh, r.id).c_str(), hi);
-  }
   int result = kExitOk;
-  mesh.fields.erase(std::remove_if(mesh.fields.begin(), mesh.fields.end(),
-                                   [](const Field& f) { return f.name == "temperature" || f.name == "temperature_foxi"; }),
-                    mesh.fields.end());
-  if (compare) {
-    Mesh own = mesh;
-    params.convection_centroid_rule = true;  // ccx's *FILM rule, so that the two agree to its print precision
-    solve_thermal(own, params);
-    const Field* f = own.find_field("temperature");
-    double diff = 0, scale = 0;
-    for (std::size_t i = 0; i < t.values.size(); ++i) {
-      diff = std::max(diff, std::abs(f->values[i] - t.values[i]));
-      scale = std::max(scale, std::abs(t.values[i]));
-    }
-    const double rel = diff / scale;
-    std::printf("compare: largest |T_ccx - T_foxi| %.3g K, %.3g of the largest temperature (%s)\n", diff, rel,
+  std::vector<Field> fields;  // written to OUT in this order
+  const auto clock = [t0 = std::chrono::steady_clock::now()] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  auto report_compare = [&](const char* what, const std::vector<double>& ccx, const std::vector<double>& own,
+                            const char* unit) {
+    const auto [diff, rel] = largest_difference(ccx, own);
+    std::printf("compare: largest |%s_ccx - %s_foxi| %.3g %s, %.3g of the largest (%s)\n", what, what, diff, unit, rel,
                 rel <= 1e-5 ? "agree to ccx's output precision" : "MORE than ccx's output precision explains");
-    Field g = *f;
-    g.name = "temperature_foxi";
-    mesh.fields.push_back(std::move(g));
     if (!(rel <= 1e-5)) result = kExitUnreliable;
+  };
+
+  std::vector<double> temperature;
+  if (!stress || from_thermal) {
+    ThermalParams params = thermal_params_from_model(run.model, mesh);
+    write_calculix_thermal(mesh, params, work / "heat.inp");
+    if (!run_ccx(work, "heat")) return kExitFailure;
+    std::optional<Field> t = ccx_field(work, "heat", mesh, "NDTEMP", "temperature", "K");
+    if (!t) return kExitFailure;
+    temperature = t->values;
+    std::size_t arg = 0;
+    for (std::size_t i = 0; i < temperature.size(); ++i)
+      if (temperature[i] > temperature[arg]) arg = i;
+    std::printf("ccx heat: %zu nodes, %zu C3D4 elements, %.3f s; max temperature %.6g K at (%.6g, %.6g, %.6g) m\n",
+                mesh.node_count(), mesh.tet_count(), clock(), temperature[arg], mesh.xyz[3 * arg],
+                mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2]);
+    for (const Region& r : mesh.regions) {
+      double hi = -INFINITY;
+      for (std::size_t e = 0; e < mesh.tet_count(); ++e)
+        if (mesh.region_of(e) == r.id)
+          for (int j = 0; j < 4; ++j) hi = std::max(hi, temperature[mesh.tet[4 * e + j]]);
+      if (std::isfinite(hi)) std::printf("  region %-16s max %.6g K\n", region_label(mesh, r.id).c_str(), hi);
+    }
+    if (compare && !stress) {
+      Mesh own = mesh;
+      params.convection_centroid_rule = true;  // ccx's *FILM rule, so that the two agree to its print precision
+      solve_thermal(own, params);
+      Field g = *own.find_field("temperature");
+      report_compare("T", temperature, g.values, "K");
+      g.name = "temperature_foxi";
+      fields.push_back(std::move(*t));
+      fields.push_back(std::move(g));
+    } else {
+      fields.push_back(std::move(*t));
+    }
   }
-  mesh.fields.insert(mesh.fields.begin(), std::move(t));
+  if (stress) {
+    ThermoelasticParams ep = thermoelastic_params_from_model(run.model, mesh);
+    if (from_thermal) {
+      ep.temperature = temperature;
+      ep.delta_t = 0;
+    }
+    write_calculix_thermoelastic(mesh, ep, work / "stress.inp");
+    if (!run_ccx(work, "stress")) return kExitFailure;
+    std::optional<Field> u = ccx_field(work, "stress", mesh, "DISP", "displacement", "m");
+    std::optional<Field> sn = ccx_field(work, "stress", mesh, "STRESS", "stress_nodal", "Pa");
+    if (!u || !sn) return kExitFailure;
+    std::size_t arg = 0;
+    double umax = 0, vm_max = 0;
+    for (std::size_t i = 0; i < mesh.node_count(); ++i) {
+      const double* v = &u->values[3 * i];
+      const double m = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      if (m > umax) umax = m, arg = i;
+      const double* s6 = &sn->values[6 * i];
+      const double vm = std::sqrt(0.5 * ((s6[0] - s6[1]) * (s6[0] - s6[1]) + (s6[1] - s6[2]) * (s6[1] - s6[2]) +
+                                         (s6[2] - s6[0]) * (s6[2] - s6[0])) +
+                                  3 * (s6[3] * s6[3] + s6[4] * s6[4] + s6[5] * s6[5]));
+      vm_max = std::max(vm_max, vm);
+    }
+    std::printf("ccx stress: %.3f s; largest |u| %.6g m at (%.6g, %.6g, %.6g) m; largest nodal von Mises %.6g Pa\n",
+                clock(), umax, mesh.xyz[3 * arg], mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2], vm_max);
+    if (compare) {
+      Mesh own = mesh;
+      solve_thermoelastic(own, ep);
+      Field g = *own.find_field("displacement");
+      report_compare("u", u->values, g.values, "m");
+      g.name = "displacement_foxi";
+      fields.push_back(std::move(*u));
+      fields.push_back(std::move(g));
+    } else {
+      fields.push_back(std::move(*u));
+    }
+    fields.push_back(std::move(*sn));
+  }
   if (!out.empty()) {
+    for (Field& f : fields) {
+      std::erase_if(mesh.fields, [&](const Field& g) { return g.name == f.name; });
+      mesh.fields.push_back(std::move(f));
+    }
     write_mesh(mesh, out);
     std::printf("wrote %s\n", out.c_str());
   }

@@ -1,5 +1,5 @@
-// foxi solve MODEL --with ccx and foxi export-ccx, end to end: ccx's temperatures come back on foxi's
-// mesh and agree with foxi's own solve (recomputed here from the written fields, not taken from the
+// foxi solve MODEL --with ccx and foxi export-ccx, end to end: ccx's temperatures (and displacements,
+// nodal stresses) come back on foxi's mesh and agree with foxi's own solve (recomputed here from the written fields, not taken from the
 // printout); a failing ccx (a stand-in script) or a missing one exits 1 with ccx's own text and the
 // work folder kept; --solver with --with ccx is a usage error.
 #include <gtest/gtest.h>
@@ -49,6 +49,34 @@ TEST_F(CcxCli, SolveWithCcxAgreesWithFoxi) {
   EXPECT_NE(log.find(max_text), std::string::npos) << log;
 }
 
+TEST_F(CcxCli, ThermoelasticWithCcxAgreesWithFoxiAndRenders) {
+  if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
+  std::string log;
+  const std::string out = (dir_ / "s.vtu").string();
+  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --temperature-from-thermal --compare -o '" +
+                     out + "'",
+                 &log),
+            0)
+      << log;
+  const Mesh m = read_mesh(out);
+  const Field* u = m.find_field("displacement");
+  const Field* own = m.find_field("displacement_foxi");
+  const Field* s = m.find_field("stress_nodal");
+  ASSERT_TRUE(u && own && s && m.find_field("temperature"));
+  EXPECT_EQ(u->components, 3u);
+  EXPECT_EQ(s->components, 6u);
+  double diff = 0, hi = 0;
+  for (std::size_t i = 0; i < u->values.size(); ++i) {
+    diff = std::max(diff, std::abs(u->values[i] - own->values[i]));
+    hi = std::max(hi, std::abs(u->values[i]));
+  }
+  EXPECT_GT(hi, 1e-8);
+  EXPECT_LT(diff / hi, 1e-5);
+  const std::string png = (dir_ / "s.png").string();
+  ASSERT_EQ(foxi("render '" + out + "' --field stress_nodal --size 480x320 -o '" + png + "'", &log), 0) << log;
+  EXPECT_TRUE(std::filesystem::exists(png));
+}
+
 TEST_F(CcxCli, ExportWritesTheDeck) {
   std::string log;
   const std::string deck = (dir_ / "deck.inp").string();
@@ -83,6 +111,7 @@ TEST_F(CcxCli, FailingOrMissingCcxExitsOneWithItsText) {
   EXPECT_NE(log.find("ccx (CalculiX) is not installed"), std::string::npos) << log;
   EXPECT_EQ(foxi("solve " + model() + " --with ccx --solver direct", &log), 2);
   EXPECT_EQ(foxi("solve " + model() + " --with abaqus", &log), 2);
+  EXPECT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --order 2", &log), 2);
 }
 
 }  // namespace
