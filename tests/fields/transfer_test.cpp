@@ -222,6 +222,12 @@ TEST(FieldTransfer, ValuesStayInTheirRegion) {
   EXPECT_GT(expect_cells, 0u);
   EXPECT_GE(rep.cells_outside, expect_cells);
   EXPECT_LE(rep.cells_outside, expect_cells + ties);
+  // A node of no target tet keeps to no region: located wherever it lies.
+  Mesh loose = target;
+  loose.xyz.insert(loose.xyz.end(), {0.5, 0.5, 0.4});
+  const TransferReport lr = transfer_fields(source_of(src), loose, p);
+  EXPECT_EQ(lr.nodes_outside, expect_nodes);
+  EXPECT_NEAR(lr.fields[0].values[loose.node_count() - 1], linear(&loose.xyz[loose.xyz.size() - 3]), 1e-13);
   // Without the region rule every node is inside (one box).
   p.match_regions = false;
   EXPECT_EQ(transfer_fields(source_of(src), target, p).nodes_outside, 0u);

@@ -249,7 +249,10 @@ void transfer_by_location(const FieldSource& src, const Mesh& target, const std:
     node_bary.assign(4 * nn, 0);
     detail::parallel_for(nn, threads, [&](std::size_t b, std::size_t e, unsigned) {
       for (std::size_t v = b; v < e; ++v) {
-        auto ok = [&](std::uint32_t t) { return !regions || contains(allowed.of(v), sm.tet_region[t]); };
+        // A node of no target tet has no region to keep to.
+        auto ok = [&](std::uint32_t t) {
+          return !regions || allowed.of(v).empty() || contains(allowed.of(v), sm.tet_region[t]);
+        };
         node_tet[v] = grid.locate(&target.xyz[3 * v], params.barycentric_tolerance, ok, &node_bary[4 * v]);
       }
     }, 2048);
@@ -260,7 +263,7 @@ void transfer_by_location(const FieldSource& src, const Mesh& target, const std:
       for (std::size_t v = 0; v < nn; ++v) {
         if (node_tet[v] != kNone) continue;
         node_near[v] = pts.nearest(&target.xyz[3 * v], [&](std::uint32_t s) {
-          if (!regions) return true;
+          if (!regions || allowed.of(v).empty()) return true;
           for (std::int32_t id : source_regions.of(s))
             if (contains(allowed.of(v), id)) return true;
           return false;
