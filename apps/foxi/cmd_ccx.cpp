@@ -43,12 +43,13 @@ const char* kExportUsage =
 
 const char* kSolveCcxUsage =
     "foxi solve MODEL.toml --physics thermal|thermoelastic --with ccx [--set NAME=VALUE]...\n"
-    "                      [--temperature-from-thermal] [--compare] [--keep] [-o OUT]\n"
+    "                      [--temperature-from-thermal] [--order 1|2] [--compare] [--keep] [-o OUT]\n"
     "  The model's problem solved by CalculiX: the deck (as foxi export-ccx writes it) is run by ccx in\n"
     "  a work folder and its results come back as foxi fields on foxi's mesh (node i = ccx node i + 1).\n"
     "  thermal: the .frd's NDTEMP as 'temperature' (K); prints the maximum and where, each region's\n"
-    "  maximum. thermoelastic (C3D4, the model's displacement conditions and temperature_change, or\n"
-    "  with --temperature-from-thermal ccx's steady temperatures of the model's thermal problem):\n"
+    "  maximum. thermoelastic (C3D4, or C3D10 with --order 2; the model's displacement conditions and\n"
+    "  temperature_change, or with --temperature-from-thermal ccx's steady temperatures of the model's\n"
+    "  thermal problem):\n"
     "  DISP as 'displacement' (m), ccx's nodal STRESS (its element values averaged at the nodes) as\n"
     "  'stress_nodal' (Pa, xx yy zz xy yz xz); prints the largest |u| and where, the largest nodal von\n"
     "  Mises stress. --compare also solves with foxi on the same mesh and temperatures (thermal: with\n"
@@ -56,8 +57,7 @@ const char* kSolveCcxUsage =
     "  displacement, relative to its largest value (about 1e-6: ccx's .frd prints 6 digits; exit 4\n"
     "  above 1e-5); OUT then also holds foxi's 'temperature_foxi' or 'displacement_foxi'.\n"
     "  The work folder is removed after a successful run (--keep keeps it) and kept, with ccx's\n"
-    "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here;\n"
-    "  --order 2 (C3D10) is not yet supported with ccx.\n"
+    "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here.\n"
     "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model, 4 --compare off.";
 
 MeshedModel model_for_ccx(Args& args, const char* usage, const char* command, const std::string& physics) {
@@ -122,11 +122,40 @@ bool run_ccx(const fs::path& work, const std::string& job) {
   return true;
 }
 
+// Drops the nodes with ids beyond n (the deck's C3D10 mid-edge nodes, numbered after the mesh's) from
+// a source keyed by node id, with their values; the tets go too (they would name dropped nodes).
+void drop_nodes_beyond(FieldSource& s, std::size_t n) {
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < s.node_id.size(); ++i)
+    if (s.node_id[i] <= n) keep.push_back(i);
+  if (keep.size() == s.node_id.size()) return;
+  const std::size_t old_n = s.node_id.size();
+  std::vector<std::uint64_t> ids;
+  std::vector<double> xyz;
+  for (std::size_t i : keep) {
+    ids.push_back(s.node_id[i]);
+    xyz.insert(xyz.end(), s.mesh.xyz.begin() + 3 * i, s.mesh.xyz.begin() + 3 * i + 3);
+  }
+  for (Field& f : s.mesh.fields) {
+    std::vector<double> v;
+    for (std::size_t st = 0; st < f.step_count(); ++st)
+      for (std::size_t i : keep)
+        v.insert(v.end(), f.values.begin() + (st * old_n + i) * f.components,
+                 f.values.begin() + (st * old_n + i + 1) * f.components);
+    f.values = std::move(v);
+  }
+  s.node_id = std::move(ids);
+  s.mesh.xyz = std::move(xyz);
+  s.mesh.tet.clear();
+  s.mesh.tet_region.clear();
+}
+
 // The nodal block `block` of WORK/JOB.frd on `mesh` (by node id, coordinates checked), renamed;
 // nullopt (message printed, folder kept) when it does not fit the mesh or leaves nodes without a value.
 std::optional<Field> ccx_field(const fs::path& work, const std::string& job, const Mesh& mesh, const char* block,
                                const char* name, const char* unit) {
-  const FieldSource frd = read_frd_source(work / (job + ".frd"));
+  FieldSource frd = read_frd_source(work / (job + ".frd"));
+  drop_nodes_beyond(frd, mesh.node_count());
   TransferParams tp;
   tp.by = MatchBy::id;
   tp.names = {block};
@@ -206,9 +235,10 @@ int cmd_solve_with(Args args, const std::string& physics) {
     throw UsageError("--solver and --tol choose foxi's linear solver: not with --with ccx");
   if (physics != "thermal" && physics != "thermoelastic")
     throw UsageError("--with ccx solves --physics thermal or thermoelastic, not '" + physics + "'");
-  if (args.has_option("--order") && args.option("--order") != "1")
-    throw UsageError("--order 2 (C3D10) with ccx: not yet");
+  const std::string order = args.option("--order", "1");
+  if (order != "1" && order != "2") throw UsageError("--order takes 1 or 2, not '" + order + "'");
   const bool stress = physics == "thermoelastic";
+  if (order == "2" && !stress) throw UsageError("--order 2 is for --physics thermoelastic");
   const bool from_thermal = args.flag("--temperature-from-thermal");
   if (from_thermal && !stress) throw UsageError("--temperature-from-thermal is for --physics thermoelastic");
   const bool compare = args.flag("--compare");
@@ -270,6 +300,7 @@ int cmd_solve_with(Args args, const std::string& physics) {
   }
   if (stress) {
     ThermoelasticParams ep = thermoelastic_params_from_model(run.model, mesh);
+    ep.order = order == "2" ? 2 : 1;
     if (from_thermal) {
       ep.temperature = temperature;
       ep.delta_t = 0;
@@ -291,8 +322,8 @@ int cmd_solve_with(Args args, const std::string& physics) {
                                   3 * (s6[3] * s6[3] + s6[4] * s6[4] + s6[5] * s6[5]));
       vm_max = std::max(vm_max, vm);
     }
-    std::printf("ccx stress: %.3f s; largest |u| %.6g m at (%.6g, %.6g, %.6g) m; largest nodal von Mises %.6g Pa\n",
-                clock(), umax, mesh.xyz[3 * arg], mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2], vm_max);
+    std::printf("ccx stress (%s): %.3f s; largest |u| %.6g m at (%.6g, %.6g, %.6g) m; largest nodal von Mises %.6g Pa\n",
+                ep.order == 2 ? "C3D10" : "C3D4", clock(), umax, mesh.xyz[3 * arg], mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2], vm_max);
     if (compare) {
       Mesh own = mesh;
       solve_thermoelastic(own, ep);
