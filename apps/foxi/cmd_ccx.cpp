@@ -35,11 +35,15 @@ namespace {
 namespace fs = std::filesystem;
 
 const char* kExportUsage =
-    "foxi export-ccx MODEL.toml [--set NAME=VALUE]... [--physics thermal] -o DECK.inp\n"
-    "  Meshes the model and writes its steady heat problem as a CalculiX deck: *NODE, C3D4 elements\n"
-    "  in one ELSET per region, *CONDUCTIVITY per region, the model's fixed temperatures (*BOUNDARY),\n"
-    "  heat fluxes (*DFLUX S), convection (*FILM) and sources (*DFLUX BF), *NODE FILE NT. Node i of the\n"
-    "  mesh is ccx node i + 1. DECK is written whole or not at all. (thermoelastic: not yet.)";
+    "foxi export-ccx MODEL.toml [--set NAME=VALUE]... [--physics thermal|thermoelastic] [--order 1|2]\n"
+    "                -o DECK.inp\n"
+    "  Meshes the model and writes its problem as a CalculiX deck, node i of the mesh ccx node i + 1.\n"
+    "  thermal: *NODE, C3D4 elements in one ELSET per region, *CONDUCTIVITY per region, the model's\n"
+    "  fixed temperatures (*BOUNDARY), heat fluxes (*DFLUX S), convection (*FILM) and sources\n"
+    "  (*DFLUX BF), *NODE FILE NT. thermoelastic: C3D4 (C3D10 with --order 2), *ELASTIC and\n"
+    "  *EXPANSION per region, the model's displacement conditions, its temperature_change as\n"
+    "  *INITIAL CONDITIONS and *TEMPERATURE, *NODE FILE U, *EL FILE S. DECK is written whole or not\n"
+    "  at all.";
 
 const char* kSolveCcxUsage =
     "foxi solve MODEL.toml --physics thermal|thermoelastic --with ccx [--set NAME=VALUE]...\n"
@@ -200,13 +204,31 @@ int cmd_export_ccx(Args args) {
   if (out.empty()) throw UsageError("give the deck: -o DECK.inp");
   check_output_path(out);
   const std::string physics = args.option("--physics", "thermal");
-  if (physics != "thermal") throw UsageError("export-ccx --physics takes thermal (thermoelastic: not yet)");
-  MeshedModel run = model_for_ccx(args, kExportUsage, "export-ccx", physics);
-  const ThermalParams params = thermal_params_from_model(run.model, run.mesh);
-  // Written beside nothing of the user's, then copied through a durable file: whole or not at all.
+  if (physics != "thermal" && physics != "thermoelastic")
+    throw UsageError("export-ccx --physics takes thermal or thermoelastic, not '" + physics + "'");
+  const bool stress = physics == "thermoelastic";
+  const std::string order = args.option("--order", "1");
+  if (order != "1" && order != "2") throw UsageError("--order takes 1 or 2, not '" + order + "'");
+  if (order == "2" && !stress) throw UsageError("--order 2 is for --physics thermoelastic");
+  MeshedModel run =
+      model_for_ccx(args, kExportUsage, "export-ccx", stress ? physics_name(Physics::thermal_stress) : "thermal");
+  // Written in a work folder, then copied through a durable file: whole or not at all.
   const fs::path work = make_work_folder();
+  std::string summary;
   try {
-    write_calculix_thermal(run.mesh, params, work / "deck.inp");
+    if (stress) {
+      ThermoelasticParams ep = thermoelastic_params_from_model(run.model, run.mesh);
+      ep.order = order == "2" ? 2 : 1;
+      write_calculix_thermoelastic(run.mesh, ep, work / "deck.inp");
+      summary = std::string(ep.order == 2 ? "C3D10" : "C3D4") + " elements; " + std::to_string(ep.fixed.size()) +
+                " displacement and " + std::to_string(ep.sliding.size()) + " sliding conditions";
+    } else {
+      const ThermalParams params = thermal_params_from_model(run.model, run.mesh);
+      write_calculix_thermal(run.mesh, params, work / "deck.inp");
+      summary = "C3D4 elements; " + std::to_string(params.fixed.size()) + " fixed, " +
+                std::to_string(params.flux.size()) + " flux, " + std::to_string(params.convection.size()) +
+                " convection conditions, " + std::to_string(params.sources.size()) + " sources";
+    }
     DurableFile file(out);
     file.write(read_text(work / "deck.inp"));
     file.commit();
@@ -217,10 +239,8 @@ int cmd_export_ccx(Args args) {
   }
   std::error_code ec;
   fs::remove_all(work, ec);
-  std::printf("wrote %s: %zu nodes, %zu C3D4 elements, %zu regions; %zu fixed, %zu flux, %zu convection "
-              "conditions, %zu sources\n",
-              out.c_str(), run.mesh.node_count(), run.mesh.tet_count(), run.mesh.regions.size(), params.fixed.size(),
-              params.flux.size(), params.convection.size(), params.sources.size());
+  std::printf("wrote %s: %zu nodes, %zu tets as %s, %zu regions\n", out.c_str(), run.mesh.node_count(),
+              run.mesh.tet_count(), summary.c_str(), run.mesh.regions.size());
   return kExitOk;
 }
 

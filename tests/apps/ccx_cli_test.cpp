@@ -110,6 +110,15 @@ TEST_F(CcxCli, ExportWritesTheDeck) {
   // ccx runs the exported deck as it is.
   ASSERT_EQ(test::run("cd '" + dir_.path().string() + "' && OMP_NUM_THREADS=1 ccx -i deck", dir_ / "ccx.log"), 0);
   EXPECT_TRUE(std::filesystem::exists(dir_ / "deck.frd"));
+  // The thermal-stress deck too: ccx runs it and writes displacements and stresses.
+  const std::string stress = (dir_ / "stress.inp").string();
+  ASSERT_EQ(foxi("export-ccx " + model() + " --physics thermoelastic -o '" + stress + "'", &log), 0) << log;
+  EXPECT_NE(test::read_text(stress).find("*EXPANSION"), std::string::npos);
+  ASSERT_EQ(test::run("cd '" + dir_.path().string() + "' && OMP_NUM_THREADS=1 ccx -i stress", dir_ / "ccx.log"), 0);
+  const std::string frd = test::read_text(dir_ / "stress.frd");
+  EXPECT_NE(frd.find("DISP"), std::string::npos);
+  EXPECT_NE(frd.find("STRESS"), std::string::npos);
+  EXPECT_EQ(foxi("export-ccx " + model() + " --order 2 -o '" + stress + "'", &log), 2);
 }
 
 TEST_F(CcxCli, FailingOrMissingCcxExitsOneWithItsText) {
