@@ -5,12 +5,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli.hpp"
@@ -60,7 +62,8 @@ const char* kSolveCcxUsage =
     "  ccx's centroid rule for *FILM) and prints the largest difference of the temperature or the\n"
     "  displacement, relative to its largest value (about 1e-6: ccx's .frd prints 6 digits; exit 4\n"
     "  above 1e-5); OUT then also holds foxi's 'temperature_foxi' or 'displacement_foxi'.\n"
-    "  The work folder is removed after a successful run (--keep keeps it) and kept, with ccx's\n"
+    "  On a terminal ccx's increments and Newton iterations show as it runs (stderr). The work\n"
+    "  folder is removed after a successful run (--keep keeps it) and kept, with ccx's\n"
     "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here.\n"
     "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model, 4 --compare off.";
 
@@ -107,11 +110,51 @@ std::string tail_of(const fs::path& p, std::size_t lines) {
   return s.substr(pos);
 }
 
+// While `running`, prints on stderr (a terminal only) the lines of ccx's output `log` that say
+// where it is: its increments, Newton iterations and their convergence, the end.
+void show_ccx_progress(const fs::path& log, const std::atomic<bool>& running) {
+  std::size_t done = 0;
+  std::string pending;
+  auto scan = [&] {
+    std::FILE* f = std::fopen(log.c_str(), "rb");
+    if (!f) return;
+    if (std::fseek(f, long(done), SEEK_SET) == 0) {
+      char buf[4096];
+      for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) {
+        pending.append(buf, n);
+        done += n;
+      }
+    }
+    std::fclose(f);
+    for (std::size_t nl; (nl = pending.find('\n')) != std::string::npos; pending.erase(0, nl + 1)) {
+      const std::size_t b = pending.find_first_not_of(' ');
+      const std::size_t e = nl == 0 ? std::string::npos : pending.find_last_not_of(" \r", nl - 1);
+      const std::string line = b < nl && e != std::string::npos && e >= b ? pending.substr(b, e - b + 1) : std::string();
+      // (ccx's Fortran and C parts buffer their output apart, so "STEP" lines come out of order.)
+      for (const char* key : {"increment ", "iteration ", "convergence", "no convergence", "Job finished"})
+        if (line.rfind(key, 0) == 0 && (key[0] != 'i' || key[1] != 'n' || line.find("attempt") != std::string::npos)) {
+          std::fprintf(stderr, "ccx: %s\n", line.c_str());
+          break;
+        }
+    }
+  };
+  while (running.load()) {
+    scan();
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  scan();
+}
+
 // Runs ccx on WORK/JOB.inp. Throws (exit 1) when ccx is not installed; returns false, with ccx's
 // output printed and the folder kept, when it fails.
 bool run_ccx(const fs::path& work, const std::string& job) {
+  std::atomic<bool> running{true};
+  std::thread progress;
+  if (::isatty(2)) progress = std::thread(show_ccx_progress, work / (job + ".log"), std::cref(running));
   const int status = run_program({"/bin/sh", "-c", "cd '" + work.string() + "' && OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} exec ccx -i " + job},
                                  (work / (job + ".log")).string());
+  running = false;
+  if (progress.joinable()) progress.join();
   const std::string log_tail = tail_of(work / (job + ".log"), 15);
   if (status == 127) {
     std::error_code ec;

@@ -55,6 +55,21 @@ TEST_F(CcxCli, SolveWithCcxAgreesWithFoxi) {
   EXPECT_NE(log.find(max_text), std::string::npos) << log;
 }
 
+// On a terminal (script(1) gives it one) ccx's progress shows as it runs.
+TEST_F(CcxCli, ProgressOnATerminal) {
+  if (!test::have_program("ccx") || !test::have_program("script")) GTEST_SKIP() << "ccx or script not installed";
+  const int rc = test::run("script -qec \"'" + test::cli_path() + "' solve " + model() + " --with ccx\" /dev/null",
+                           dir_ / "tty.txt");
+  const std::string log = test::read_text(dir_ / "tty.txt");
+  ASSERT_EQ(rc, 0) << log;
+  EXPECT_NE(log.find("ccx: iteration 1"), std::string::npos) << log;
+  EXPECT_NE(log.find("ccx: Job finished"), std::string::npos) << log;
+  // Not on a pipe or file: the printout stays as it was.
+  std::string plain;
+  ASSERT_EQ(foxi("solve " + model() + " --with ccx", &plain), 0) << plain;
+  EXPECT_EQ(plain.find("ccx: iteration"), std::string::npos) << plain;
+}
+
 TEST_F(CcxCli, ThermoelasticWithCcxAgreesWithFoxiAndRenders) {
   if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
   std::string log;
