@@ -18,6 +18,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "foxi/fields.hpp"
+#include "foxi/model/cleanup.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/mesh_io.hpp"
@@ -77,12 +78,28 @@ MeshedModel model_for_ccx(Args& args, const char* usage, const char* command, co
   return run;
 }
 
-// A fresh folder under the system temp folder.
-fs::path make_work_folder() {
-  std::string tmpl = (fs::temp_directory_path() / "foxi-ccx-XXXXXX").string();
-  if (::mkdtemp(tmpl.data()) == nullptr) throw IoError(tmpl, 0, IoError::kNoOffset, "cannot create the work folder");
-  return tmpl;
-}
+// A fresh folder under the system temp folder, recorded for removal if foxi is stopped
+// (foxi/model/cleanup.hpp); removed when this goes out of scope unless `keep` was set.
+struct WorkFolder {
+  fs::path path;
+  bool keep = false;
+  WorkFolder() {
+    std::string tmpl = (fs::temp_directory_path() / "foxi-ccx-XXXXXX").string();
+    cleanup::with_lock([&] {
+      if (::mkdtemp(tmpl.data()) == nullptr) return;
+      path = tmpl;
+      cleanup::track(path, true);
+    });
+    if (path.empty()) throw IoError(tmpl, 0, IoError::kNoOffset, "cannot create the work folder");
+  }
+  ~WorkFolder() {
+    cleanup::untrack(path);
+    std::error_code ec;
+    if (!keep) fs::remove_all(path, ec);
+  }
+  WorkFolder(const WorkFolder&) = delete;
+  WorkFolder& operator=(const WorkFolder&) = delete;
+};
 
 std::string read_text(const fs::path& p) {
   std::FILE* f = std::fopen(p.c_str(), "rb");
@@ -147,7 +164,8 @@ void show_ccx_progress(const fs::path& log, const std::atomic<bool>& running) {
 
 // Runs ccx on WORK/JOB.inp. Throws (exit 1) when ccx is not installed; returns false, with ccx's
 // output printed and the folder kept, when it fails.
-bool run_ccx(const fs::path& work, const std::string& job) {
+bool run_ccx(WorkFolder& folder, const std::string& job) {
+  const fs::path& work = folder.path;
   std::atomic<bool> running{true};
   std::thread progress;
   if (::isatty(2)) progress = std::thread(show_ccx_progress, work / (job + ".log"), std::cref(running));
@@ -156,14 +174,12 @@ bool run_ccx(const fs::path& work, const std::string& job) {
   running = false;
   if (progress.joinable()) progress.join();
   const std::string log_tail = tail_of(work / (job + ".log"), 15);
-  if (status == 127) {
-    std::error_code ec;
-    fs::remove_all(work, ec);
+  if (status == 127)
     throw std::runtime_error("ccx (CalculiX) is not installed: no 'ccx' in PATH (Debian: apt-get install calculix-ccx)");
-  }
   if (status != 0 || log_tail.find("*ERROR") != std::string::npos || !fs::exists(work / (job + ".frd"))) {
     std::fprintf(stderr, "foxi solve: ccx failed (exit status %d); its last output:\n%s\n", status, log_tail.c_str());
     std::fprintf(stderr, "foxi solve: the deck and ccx's files are kept in %s\n", work.c_str());
+    folder.keep = true;
     return false;
   }
   return true;
@@ -199,8 +215,9 @@ void drop_nodes_beyond(FieldSource& s, std::size_t n) {
 
 // The nodal block `block` of WORK/JOB.frd on `mesh` (by node id, coordinates checked), renamed;
 // nullopt (message printed, folder kept) when it does not fit the mesh or leaves nodes without a value.
-std::optional<Field> ccx_field(const fs::path& work, const std::string& job, const Mesh& mesh, const char* block,
+std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const Mesh& mesh, const char* block,
                                const char* name, const char* unit) {
+  const fs::path& work = folder.path;
   FieldSource frd = read_frd_source(work / (job + ".frd"));
   drop_nodes_beyond(frd, mesh.node_count());
   TransferParams tp;
@@ -211,11 +228,13 @@ std::optional<Field> ccx_field(const fs::path& work, const std::string& job, con
     rep = transfer_fields(frd, mesh, tp);
   } catch (const FieldError& e) {
     std::fprintf(stderr, "foxi solve: ccx's results do not fit the mesh (%s); files kept in %s\n", e.what(), work.c_str());
+    folder.keep = true;
     return std::nullopt;
   }
   if (rep.nan_values > 0) {
     std::fprintf(stderr, "foxi solve: ccx's %s has no value for %zu entries; files kept in %s\n", block, rep.nan_values,
                  work.c_str());
+    folder.keep = true;
     return std::nullopt;
   }
   Field f = std::move(rep.fields[0]);
@@ -256,32 +275,24 @@ int cmd_export_ccx(Args args) {
   MeshedModel run =
       model_for_ccx(args, kExportUsage, "export-ccx", stress ? physics_name(Physics::thermal_stress) : "thermal");
   // Written in a work folder, then copied through a durable file: whole or not at all.
-  const fs::path work = make_work_folder();
+  const WorkFolder work;
   std::string summary;
-  try {
-    if (stress) {
-      ThermoelasticParams ep = thermoelastic_params_from_model(run.model, run.mesh);
-      ep.order = order == "2" ? 2 : 1;
-      write_calculix_thermoelastic(run.mesh, ep, work / "deck.inp");
-      summary = std::string(ep.order == 2 ? "C3D10" : "C3D4") + " elements; " + std::to_string(ep.fixed.size()) +
-                " displacement and " + std::to_string(ep.sliding.size()) + " sliding conditions";
-    } else {
-      const ThermalParams params = thermal_params_from_model(run.model, run.mesh);
-      write_calculix_thermal(run.mesh, params, work / "deck.inp");
-      summary = "C3D4 elements; " + std::to_string(params.fixed.size()) + " fixed, " +
-                std::to_string(params.flux.size()) + " flux, " + std::to_string(params.convection.size()) +
-                " convection conditions, " + std::to_string(params.sources.size()) + " sources";
-    }
-    DurableFile file(out);
-    file.write(read_text(work / "deck.inp"));
-    file.commit();
-  } catch (...) {
-    std::error_code ec;
-    fs::remove_all(work, ec);
-    throw;
+  if (stress) {
+    ThermoelasticParams ep = thermoelastic_params_from_model(run.model, run.mesh);
+    ep.order = order == "2" ? 2 : 1;
+    write_calculix_thermoelastic(run.mesh, ep, work.path / "deck.inp");
+    summary = std::string(ep.order == 2 ? "C3D10" : "C3D4") + " elements; " + std::to_string(ep.fixed.size()) +
+              " displacement and " + std::to_string(ep.sliding.size()) + " sliding conditions";
+  } else {
+    const ThermalParams params = thermal_params_from_model(run.model, run.mesh);
+    write_calculix_thermal(run.mesh, params, work.path / "deck.inp");
+    summary = "C3D4 elements; " + std::to_string(params.fixed.size()) + " fixed, " +
+              std::to_string(params.flux.size()) + " flux, " + std::to_string(params.convection.size()) +
+              " convection conditions, " + std::to_string(params.sources.size()) + " sources";
   }
-  std::error_code ec;
-  fs::remove_all(work, ec);
+  DurableFile file(out);
+  file.write(read_text(work.path / "deck.inp"));
+  file.commit();
   std::printf("wrote %s: %zu nodes, %zu tets as %s, %zu regions\n", out.c_str(), run.mesh.node_count(),
               run.mesh.tet_count(), summary.c_str(), run.mesh.regions.size());
   return kExitOk;
@@ -313,7 +324,7 @@ int cmd_solve_with(Args args, const std::string& physics) {
   }
   MeshedModel run = model_for_ccx(args, kSolveCcxUsage, "solve", stress ? physics_name(Physics::thermal_stress) : "thermal");
   Mesh& mesh = run.mesh;
-  const fs::path work = make_work_folder();
+  WorkFolder work;
   int result = kExitOk;
   std::vector<Field> fields;  // written to OUT in this order
   const auto clock = [t0 = std::chrono::steady_clock::now()] {
@@ -330,7 +341,7 @@ int cmd_solve_with(Args args, const std::string& physics) {
   std::vector<double> temperature;
   if (!stress || from_thermal) {
     ThermalParams params = thermal_params_from_model(run.model, mesh);
-    write_calculix_thermal(mesh, params, work / "heat.inp");
+    write_calculix_thermal(mesh, params, work.path / "heat.inp");
     if (!run_ccx(work, "heat")) return kExitFailure;
     std::optional<Field> t = ccx_field(work, "heat", mesh, "NDTEMP", "temperature", "K");
     if (!t) return kExitFailure;
@@ -368,7 +379,7 @@ int cmd_solve_with(Args args, const std::string& physics) {
       ep.temperature = temperature;
       ep.delta_t = 0;
     }
-    write_calculix_thermoelastic(mesh, ep, work / "stress.inp");
+    write_calculix_thermoelastic(mesh, ep, work.path / "stress.inp");
     if (!run_ccx(work, "stress")) return kExitFailure;
     std::optional<Field> u = ccx_field(work, "stress", mesh, "DISP", "displacement", "m");
     std::optional<Field> sn = ccx_field(work, "stress", mesh, "STRESS", "stress_nodal", "Pa");
@@ -409,10 +420,8 @@ int cmd_solve_with(Args args, const std::string& physics) {
     std::printf("wrote %s\n", out.c_str());
   }
   if (keep) {
-    std::printf("ccx's work folder: %s\n", work.c_str());
-  } else {
-    std::error_code ec;
-    fs::remove_all(work, ec);
+    std::printf("ccx's work folder: %s\n", work.path.c_str());
+    work.keep = true;
   }
   return result;
 }

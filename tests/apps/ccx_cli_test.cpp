@@ -113,6 +113,25 @@ TEST_F(CcxCli, QuadraticThermoelasticWithCcxAgreesWithFoxi) {
   EXPECT_LT(rel, 1e-5);
 }
 
+// Ctrl-C while ccx runs: exit 130, ccx killed, the work folder (under TMPDIR) removed, no output.
+TEST_F(CcxCli, InterruptStopsCcxAndRemovesTheWorkFolder) {
+  if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
+  const auto tmp = dir_ / "tmp";
+  std::filesystem::create_directories(tmp);
+  test::write_text(dir_ / "stop.sh",
+                   "TMPDIR='" + tmp.string() + "' '" + test::cli_path() + "' solve " + model() +
+                       " --physics thermoelastic --with ccx --order 2 -o '" + (dir_ / "never.vtu").string() +
+                       "' &\npid=$!\n"
+                       "for i in $(seq 600); do ls '" + tmp.string() + "'/*/stress.inp > /dev/null 2>&1 && break; sleep 0.05; done\n"
+                       "sleep 0.5\nkill -INT $pid\nwait $pid\necho $?\n");
+  ASSERT_EQ(test::run("bash '" + (dir_ / "stop.sh").string() + "'", dir_ / "stop.log"), 0);
+  const std::string log = test::read_text(dir_ / "stop.log");
+  EXPECT_NE(log.find("stopped by SIGINT"), std::string::npos) << log;
+  EXPECT_NE(log.find("\n130\n"), std::string::npos) << log;
+  EXPECT_TRUE(std::filesystem::is_empty(tmp)) << log;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "never.vtu"));
+}
+
 TEST_F(CcxCli, ExportWritesTheDeck) {
   std::string log;
   const std::string deck = (dir_ / "deck.inp").string();
