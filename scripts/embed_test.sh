@@ -57,11 +57,12 @@ project(foxi_all_targets LANGUAGES CXX)
 find_package(foxi 0.1 REQUIRED)
 add_executable(all_targets main.cpp)
 target_compile_features(all_targets PRIVATE cxx_std_20)
-target_link_libraries(all_targets PRIVATE foxi::model foxi::structure foxi::mesher foxi::solver foxi::viz)
+target_link_libraries(all_targets PRIVATE foxi::model foxi::structure foxi::mesher foxi::solver foxi::viz foxi::fields)
 CMAKE
 cat > "$work/all_targets.src/main.cpp" <<'CPP'
 #include <cmath>
 #include <cstdio>
+#include "foxi/fields.hpp"
 #include "foxi/mesher.hpp"
 #include "foxi/model.hpp"
 #include "foxi/solver.hpp"
@@ -72,10 +73,13 @@ int main() {
   // Addresses of the heavy entry points make the linker resolve their dependencies (TetGen, CGAL).
   void* volatile entry[] = {reinterpret_cast<void*>(&foxi::mesh_plc), reinterpret_cast<void*>(&foxi::mesh_plc_cgal),
                             reinterpret_cast<void*>(&foxi::solve_thermal), reinterpret_cast<void*>(&foxi::load_model),
-                            reinterpret_cast<void*>(&foxi::compute_spheres)};
+                            reinterpret_cast<void*>(&foxi::compute_spheres),
+                            reinterpret_cast<void*>(&foxi::read_field_source)};
   const double mm = foxi::evaluate_in("2 mm + 500 um", "m");       // structure
   const double v = foxi::regular_tet_volume(1.0);                   // mesher
-  const bool ok = entry[0] != nullptr && std::abs(mm - 2.5e-3) < 1e-15 && std::abs(v - std::sqrt(2.0) / 12) < 1e-15;
+  const foxi::FieldSource csv = foxi::parse_csv_source("id,t [K]\n1,300\n", "host.csv");  // fields
+  const bool ok = entry[0] != nullptr && std::abs(mm - 2.5e-3) < 1e-15 && std::abs(v - std::sqrt(2.0) / 12) < 1e-15 &&
+                  csv.mesh.fields.size() == 1 && csv.mesh.fields[0].unit == "K";
   std::printf("all_targets: foxi %s, 2 mm + 500 um = %g m, regular tet volume %.6f: %s\n", FOXI_VERSION_STRING, mm, v,
               ok ? "ok" : "WRONG");
   return ok ? 0 : 1;

@@ -28,7 +28,8 @@ namespace {
 const char* kSolveUsage =
     "foxi solve MODEL.toml --physics thermal|electrostatic|current [--set NAME=VALUE]... [options below]\n"
     "  (--physics thermoelastic: see 'foxi solve --physics thermoelastic --help';\n"
-    "   --physics transient: see 'foxi solve --physics transient --help')\n"
+    "   --physics transient: see 'foxi solve --physics transient --help';\n"
+    "   --with ccx, the model solved by CalculiX: see 'foxi solve --with ccx --help')\n"
     "  Meshes the model (TetGen, its [mesh] controls) and solves with its [[conditions]] and [[loads]];\n"
     "  the options below add to them, boundaries and regions named as in 'foxi model check'.\n"
     "  Values take units as model files write them: --fix top=300K, --fix 'top=25 degC', --power die=3W,\n"
@@ -263,6 +264,7 @@ int print_checks(const std::vector<BalanceCheck>& checks) {
 
 int cmd_solve(Args args) {
   const std::string physics = args.option("--physics", "thermal");
+  if (args.has_option("--with")) return cmd_solve_with(std::move(args), physics);
   if (args.has_option("--convergence")) return cmd_solve_convergence(std::move(args), physics);
   if (physics == "thermoelastic") return cmd_solve_thermoelastic(std::move(args));
   if (physics == "transient") return cmd_solve_transient(std::move(args));

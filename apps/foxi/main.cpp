@@ -75,6 +75,8 @@ int main(int argc, char** argv) {
     if (command == "model") return foxi::cli::cmd_model(std::move(rest));
     if (command == "demo") return foxi::cli::cmd_demo(std::move(rest));
     if (command == "sweep") return foxi::cli::cmd_sweep(std::move(rest));
+    if (command == "fields") return foxi::cli::cmd_fields(std::move(rest));
+    if (command == "export-ccx") return foxi::cli::cmd_export_ccx(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return kExitUsage;
   } catch (const UsageError& e) {

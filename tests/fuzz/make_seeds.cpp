@@ -77,7 +77,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path out = argv[1], data = FOXI_TEST_DATA_DIR, root = FOXI_SOURCE_DIR;
-  for (const char* t : {"gmsh", "vtu", "vtk", "medit", "tetgen", "poly", "model", "expression", "mesh_pipeline"})
+  for (const char* t : {"gmsh", "vtu", "vtk", "medit", "tetgen", "poly", "model", "expression", "mesh_pipeline",
+                        "frd", "csv"})
     fs::create_directories(out / t);
 
   for (std::uint32_t n : {1u, 2u}) {
@@ -119,6 +120,10 @@ int main(int argc, char** argv) {
     }
     write_file(out / "tetgen" / (base.filename().string() + ".tetgen"), joined);
   }
+  // The field importer's readers: a CalculiX result file (two steps, DISP NDTEMP STRESS ERROR,
+  // elements) and CSV tables of each key.
+  copy_matching(data / "fields", out / "frd", {".frd"});
+  copy_matching(data / "fields", out / "csv", {".csv", ".tsv"});
   copy_matching(root / "examples", out / "poly", {".poly"});
   copy_matching(data / "cdt", out / "poly", {".poly"});
   copy_matching(root / "models", out / "model", {".toml"});

@@ -1,0 +1,429 @@
+// foxi export-ccx MODEL -o deck.inp and foxi solve MODEL --physics thermal --with ccx: a model's
+// steady heat problem as a CalculiX deck (foxi::solver's writer), run by ccx as a child process, its
+// .frd read back as foxi fields (foxi::fields) and, with --compare, checked against foxi's own solve.
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli.hpp"
+#include "exit_codes.hpp"
+#include "foxi/fields.hpp"
+#include "foxi/model/cleanup.hpp"
+#include "foxi/model/durable_file.hpp"
+#include "foxi/model/io_error.hpp"
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/solver/calculix.hpp"
+#include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/thermal.hpp"
+#include "foxi/solver/thermoelastic.hpp"
+#include "mesh_input.hpp"
+#include "model_run.hpp"
+#include "signals.hpp"
+#include "solve_options.hpp"
+
+namespace foxi::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kExportUsage =
+    "foxi export-ccx MODEL.toml [--set NAME=VALUE]... [--physics thermal|thermoelastic] [--order 1|2]\n"
+    "                -o DECK.inp\n"
+    "  Meshes the model and writes its problem as a CalculiX deck, node i of the mesh ccx node i + 1.\n"
+    "  thermal: *NODE, C3D4 elements in one ELSET per region, *CONDUCTIVITY per region, the model's\n"
+    "  fixed temperatures (*BOUNDARY), heat fluxes (*DFLUX S), convection (*FILM) and sources\n"
+    "  (*DFLUX BF), *NODE FILE NT. thermoelastic: C3D4 (C3D10 with --order 2), *ELASTIC and\n"
+    "  *EXPANSION per region, the model's displacement conditions, its temperature_change as\n"
+    "  *INITIAL CONDITIONS and *TEMPERATURE, *NODE FILE U, *EL FILE S. DECK is written whole or not\n"
+    "  at all.";
+
+const char* kSolveCcxUsage =
+    "foxi solve MODEL.toml --physics thermal|thermoelastic --with ccx [--set NAME=VALUE]...\n"
+    "                      [--temperature-from-thermal] [--order 1|2] [--compare] [--keep] [-o OUT]\n"
+    "  The model's problem solved by CalculiX: the deck (as foxi export-ccx writes it) is run by ccx in\n"
+    "  a work folder and its results come back as foxi fields on foxi's mesh (node i = ccx node i + 1).\n"
+    "  thermal: the .frd's NDTEMP as 'temperature' (K); prints the maximum and where, each region's\n"
+    "  maximum. thermoelastic (C3D4, or C3D10 with --order 2; the model's displacement conditions and\n"
+    "  temperature_change, or with --temperature-from-thermal ccx's steady temperatures of the model's\n"
+    "  thermal problem):\n"
+    "  DISP as 'displacement' (m), ccx's nodal STRESS (its element values averaged at the nodes) as\n"
+    "  'stress_nodal' (Pa, xx yy zz xy yz xz); prints the largest |u| and where, the largest nodal von\n"
+    "  Mises stress. --compare also solves with foxi on the same mesh and temperatures (thermal: with\n"
+    "  ccx's centroid rule for *FILM) and prints the largest difference of the temperature or the\n"
+    "  displacement, relative to its largest value (about 1e-6: ccx's .frd prints 6 digits; exit 4\n"
+    "  above 1e-5); OUT then also holds foxi's 'temperature_foxi' or 'displacement_foxi'.\n"
+    "  On a terminal ccx's increments and Newton iterations show as it runs (stderr). The work\n"
+    "  folder is removed after a successful run (--keep keeps it) and kept, with ccx's\n"
+    "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here.\n"
+    "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model, 4 --compare off.";
+
+MeshedModel model_for_ccx(Args& args, const char* usage, const char* command, const std::string& physics) {
+  const std::vector<std::string> sets = all_options(args, "--set");
+  const auto files = args.positional(1, 1, usage);
+  if (!is_model_path(files[0]))
+    throw UsageError("give a model file (MODEL.toml): ccx needs its conditions, which a mesh file does not hold");
+  MeshedModel run = mesh_model_for_solve(files[0], sets, physics);
+  require_usable(run.mesh, files[0], command);
+  return run;
+}
+
+// A fresh folder under the system temp folder, recorded for removal if foxi is stopped
+// (foxi/model/cleanup.hpp); removed when this goes out of scope unless `keep` was set.
+struct WorkFolder {
+  fs::path path;
+  bool keep = false;
+  WorkFolder() {
+    std::string tmpl = (fs::temp_directory_path() / "foxi-ccx-XXXXXX").string();
+    cleanup::with_lock([&] {
+      if (::mkdtemp(tmpl.data()) == nullptr) return;
+      path = tmpl;
+      cleanup::track(path, true);
+    });
+    if (path.empty()) throw IoError(tmpl, 0, IoError::kNoOffset, "cannot create the work folder");
+  }
+  ~WorkFolder() {
+    cleanup::untrack(path);
+    std::error_code ec;
+    if (!keep) fs::remove_all(path, ec);
+  }
+  WorkFolder(const WorkFolder&) = delete;
+  WorkFolder& operator=(const WorkFolder&) = delete;
+};
+
+std::string read_text(const fs::path& p) {
+  std::FILE* f = std::fopen(p.c_str(), "rb");
+  if (!f) throw IoError(p.string(), 0, IoError::kNoOffset, "cannot open");
+  std::string s;
+  char buf[65536];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) s.append(buf, n);
+  std::fclose(f);
+  return s;
+}
+
+// The last lines of a text file (ccx's output on failure).
+std::string tail_of(const fs::path& p, std::size_t lines) {
+  std::string s;
+  try {
+    s = read_text(p);
+  } catch (const IoError&) {
+    return {};
+  }
+  std::size_t pos = s.size();
+  for (std::size_t k = 0; k <= lines && pos > 0; ++k) {
+    const std::size_t nl = s.rfind('\n', pos - 1);
+    pos = nl == std::string::npos ? 0 : nl;
+  }
+  return s.substr(pos);
+}
+
+// While `running`, prints on stderr (a terminal only) the lines of ccx's output `log` that say
+// where it is: its increments, Newton iterations and their convergence, the end.
+void show_ccx_progress(const fs::path& log, const std::atomic<bool>& running) {
+  std::size_t done = 0;
+  std::string pending;
+  auto scan = [&] {
+    std::FILE* f = std::fopen(log.c_str(), "rb");
+    if (!f) return;
+    if (std::fseek(f, long(done), SEEK_SET) == 0) {
+      char buf[4096];
+      for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) {
+        pending.append(buf, n);
+        done += n;
+      }
+    }
+    std::fclose(f);
+    for (std::size_t nl; (nl = pending.find('\n')) != std::string::npos; pending.erase(0, nl + 1)) {
+      const std::size_t b = pending.find_first_not_of(' ');
+      const std::size_t e = nl == 0 ? std::string::npos : pending.find_last_not_of(" \r", nl - 1);
+      const std::string line = b < nl && e != std::string::npos && e >= b ? pending.substr(b, e - b + 1) : std::string();
+      // (ccx's Fortran and C parts buffer their output apart, so "STEP" lines come out of order.)
+      for (const char* key : {"increment ", "iteration ", "convergence", "no convergence", "Job finished"})
+        if (line.rfind(key, 0) == 0 && (key[0] != 'i' || key[1] != 'n' || line.find("attempt") != std::string::npos)) {
+          std::fprintf(stderr, "ccx: %s\n", line.c_str());
+          break;
+        }
+    }
+  };
+  while (running.load()) {
+    scan();
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  scan();
+}
+
+// Runs ccx on WORK/JOB.inp. Throws (exit 1) when ccx is not installed; returns false, with ccx's
+// output printed and the folder kept, when it fails.
+bool run_ccx(WorkFolder& folder, const std::string& job) {
+  const fs::path& work = folder.path;
+  std::atomic<bool> running{true};
+  std::thread progress;
+  if (::isatty(2)) progress = std::thread(show_ccx_progress, work / (job + ".log"), std::cref(running));
+  const int status = run_program({"/bin/sh", "-c", "cd '" + work.string() + "' && OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} exec ccx -i " + job},
+                                 (work / (job + ".log")).string());
+  running = false;
+  if (progress.joinable()) progress.join();
+  const std::string log_tail = tail_of(work / (job + ".log"), 15);
+  if (status == 127)
+    throw std::runtime_error("ccx (CalculiX) is not installed: no 'ccx' in PATH (Debian: apt-get install calculix-ccx)");
+  if (status != 0 || log_tail.find("*ERROR") != std::string::npos || !fs::exists(work / (job + ".frd"))) {
+    std::fprintf(stderr, "foxi solve: ccx failed (exit status %d); its last output:\n%s\n", status, log_tail.c_str());
+    std::fprintf(stderr, "foxi solve: the deck and ccx's files are kept in %s\n", work.c_str());
+    folder.keep = true;
+    return false;
+  }
+  return true;
+}
+
+// Drops the nodes with ids beyond n (the deck's C3D10 mid-edge nodes, numbered after the mesh's) from
+// a source keyed by node id, with their values; the tets go too (they would name dropped nodes).
+void drop_nodes_beyond(FieldSource& s, std::size_t n) {
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < s.node_id.size(); ++i)
+    if (s.node_id[i] <= n) keep.push_back(i);
+  if (keep.size() == s.node_id.size()) return;
+  const std::size_t old_n = s.node_id.size();
+  std::vector<std::uint64_t> ids;
+  std::vector<double> xyz;
+  for (std::size_t i : keep) {
+    ids.push_back(s.node_id[i]);
+    xyz.insert(xyz.end(), s.mesh.xyz.begin() + 3 * i, s.mesh.xyz.begin() + 3 * i + 3);
+  }
+  for (Field& f : s.mesh.fields) {
+    std::vector<double> v;
+    for (std::size_t st = 0; st < f.step_count(); ++st)
+      for (std::size_t i : keep)
+        v.insert(v.end(), f.values.begin() + (st * old_n + i) * f.components,
+                 f.values.begin() + (st * old_n + i + 1) * f.components);
+    f.values = std::move(v);
+  }
+  s.node_id = std::move(ids);
+  s.mesh.xyz = std::move(xyz);
+  s.mesh.tet.clear();
+  s.mesh.tet_region.clear();
+}
+
+// The nodal block `block` of WORK/JOB.frd on `mesh` (by node id, coordinates checked), renamed;
+// nullopt (message printed, folder kept) when it does not fit the mesh or leaves nodes without a value.
+std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const Mesh& mesh, const char* block,
+                               const char* name, const char* unit) {
+  const fs::path& work = folder.path;
+  FieldSource frd = read_frd_source(work / (job + ".frd"));
+  drop_nodes_beyond(frd, mesh.node_count());
+  TransferParams tp;
+  tp.by = MatchBy::id;
+  tp.names = {block};
+  TransferReport rep;
+  try {
+    rep = transfer_fields(frd, mesh, tp);
+  } catch (const FieldError& e) {
+    std::fprintf(stderr, "foxi solve: ccx's results do not fit the mesh (%s); files kept in %s\n", e.what(), work.c_str());
+    folder.keep = true;
+    return std::nullopt;
+  }
+  if (rep.nan_values > 0) {
+    std::fprintf(stderr, "foxi solve: ccx's %s has no value for %zu entries; files kept in %s\n", block, rep.nan_values,
+                 work.c_str());
+    folder.keep = true;
+    return std::nullopt;
+  }
+  Field f = std::move(rep.fields[0]);
+  f.name = name;
+  f.unit = unit;
+  f.values.resize(mesh.node_count() * f.components);  // a static run has one step: its values
+  f.step_values.clear();
+  return f;
+}
+
+// max_i |a_i - b_i| over max_i |a_i|, and the former.
+std::pair<double, double> largest_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double diff = 0, scale = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff = std::max(diff, std::abs(a[i] - b[i]));
+    scale = std::max(scale, std::abs(a[i]));
+  }
+  return {diff, scale > 0 ? diff / scale : diff};
+}
+
+}  // namespace
+
+int cmd_export_ccx(Args args) {
+  if (args.flag("--help") || args.flag("-h")) {
+    std::puts(kExportUsage);
+    return kExitOk;
+  }
+  const std::string out = args.option("-o");
+  if (out.empty()) throw UsageError("give the deck: -o DECK.inp");
+  check_output_path(out);
+  const std::string physics = args.option("--physics", "thermal");
+  if (physics != "thermal" && physics != "thermoelastic")
+    throw UsageError("export-ccx --physics takes thermal or thermoelastic, not '" + physics + "'");
+  const bool stress = physics == "thermoelastic";
+  const std::string order = args.option("--order", "1");
+  if (order != "1" && order != "2") throw UsageError("--order takes 1 or 2, not '" + order + "'");
+  if (order == "2" && !stress) throw UsageError("--order 2 is for --physics thermoelastic");
+  MeshedModel run =
+      model_for_ccx(args, kExportUsage, "export-ccx", stress ? physics_name(Physics::thermal_stress) : "thermal");
+  // Written in a work folder, then copied through a durable file: whole or not at all.
+  const WorkFolder work;
+  std::string summary;
+  if (stress) {
+    ThermoelasticParams ep = thermoelastic_params_from_model(run.model, run.mesh);
+    ep.order = order == "2" ? 2 : 1;
+    write_calculix_thermoelastic(run.mesh, ep, work.path / "deck.inp");
+    summary = std::string(ep.order == 2 ? "C3D10" : "C3D4") + " elements; " + std::to_string(ep.fixed.size()) +
+              " displacement and " + std::to_string(ep.sliding.size()) + " sliding conditions";
+  } else {
+    const ThermalParams params = thermal_params_from_model(run.model, run.mesh);
+    write_calculix_thermal(run.mesh, params, work.path / "deck.inp");
+    summary = "C3D4 elements; " + std::to_string(params.fixed.size()) + " fixed, " +
+              std::to_string(params.flux.size()) + " flux, " + std::to_string(params.convection.size()) +
+              " convection conditions, " + std::to_string(params.sources.size()) + " sources";
+  }
+  DurableFile file(out);
+  file.write(read_text(work.path / "deck.inp"));
+  file.commit();
+  std::printf("wrote %s: %zu nodes, %zu tets as %s, %zu regions\n", out.c_str(), run.mesh.node_count(),
+              run.mesh.tet_count(), summary.c_str(), run.mesh.regions.size());
+  return kExitOk;
+}
+
+int cmd_solve_with(Args args, const std::string& physics) {
+  if (args.flag("--help") || args.flag("-h")) {
+    std::puts(kSolveCcxUsage);
+    return kExitOk;
+  }
+  const std::string with = args.option("--with");
+  if (with != "ccx") throw UsageError("--with takes ccx (CalculiX), not '" + with + "'");
+  if (args.has_option("--solver") || args.has_option("--tol"))
+    throw UsageError("--solver and --tol choose foxi's linear solver: not with --with ccx");
+  if (physics != "thermal" && physics != "thermoelastic")
+    throw UsageError("--with ccx solves --physics thermal or thermoelastic, not '" + physics + "'");
+  const std::string order = args.option("--order", "1");
+  if (order != "1" && order != "2") throw UsageError("--order takes 1 or 2, not '" + order + "'");
+  const bool stress = physics == "thermoelastic";
+  if (order == "2" && !stress) throw UsageError("--order 2 is for --physics thermoelastic");
+  const bool from_thermal = args.flag("--temperature-from-thermal");
+  if (from_thermal && !stress) throw UsageError("--temperature-from-thermal is for --physics thermoelastic");
+  const bool compare = args.flag("--compare");
+  const bool keep = args.flag("--keep");
+  const std::string out = args.option("-o");
+  if (!out.empty()) {
+    (void)format_from_path(out);
+    check_output_path(out);
+  }
+  MeshedModel run = model_for_ccx(args, kSolveCcxUsage, "solve", stress ? physics_name(Physics::thermal_stress) : "thermal");
+  Mesh& mesh = run.mesh;
+  WorkFolder work;
+  int result = kExitOk;
+  std::vector<Field> fields;  // written to OUT in this order
+  const auto clock = [t0 = std::chrono::steady_clock::now()] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  auto report_compare = [&](const char* what, const std::vector<double>& ccx, const std::vector<double>& own,
+                            const char* unit) {
+    const auto [diff, rel] = largest_difference(ccx, own);
+    std::printf("compare: largest |%s_ccx - %s_foxi| %.3g %s, %.3g of the largest (%s)\n", what, what, diff, unit, rel,
+                rel <= 1e-5 ? "agree to ccx's output precision" : "MORE than ccx's output precision explains");
+    if (!(rel <= 1e-5)) result = kExitUnreliable;
+  };
+
+  std::vector<double> temperature;
+  if (!stress || from_thermal) {
+    ThermalParams params = thermal_params_from_model(run.model, mesh);
+    write_calculix_thermal(mesh, params, work.path / "heat.inp");
+    if (!run_ccx(work, "heat")) return kExitFailure;
+    std::optional<Field> t = ccx_field(work, "heat", mesh, "NDTEMP", "temperature", "K");
+    if (!t) return kExitFailure;
+    temperature = t->values;
+    std::size_t arg = 0;
+    for (std::size_t i = 0; i < temperature.size(); ++i)
+      if (temperature[i] > temperature[arg]) arg = i;
+    std::printf("ccx heat: %zu nodes, %zu C3D4 elements, %.3f s; max temperature %.6g K at (%.6g, %.6g, %.6g) m\n",
+                mesh.node_count(), mesh.tet_count(), clock(), temperature[arg], mesh.xyz[3 * arg],
+                mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2]);
+    for (const Region& r : mesh.regions) {
+      double hi = -INFINITY;
+      for (std::size_t e = 0; e < mesh.tet_count(); ++e)
+        if (mesh.region_of(e) == r.id)
+          for (int j = 0; j < 4; ++j) hi = std::max(hi, temperature[mesh.tet[4 * e + j]]);
+      if (std::isfinite(hi)) std::printf("  region %-16s max %.6g K\n", region_label(mesh, r.id).c_str(), hi);
+    }
+    if (compare && !stress) {
+      Mesh own = mesh;
+      params.convection_centroid_rule = true;  // ccx's *FILM rule, so that the two agree to its print precision
+      solve_thermal(own, params);
+      Field g = *own.find_field("temperature");
+      report_compare("T", temperature, g.values, "K");
+      g.name = "temperature_foxi";
+      fields.push_back(std::move(*t));
+      fields.push_back(std::move(g));
+    } else {
+      fields.push_back(std::move(*t));
+    }
+  }
+  if (stress) {
+    ThermoelasticParams ep = thermoelastic_params_from_model(run.model, mesh);
+    ep.order = order == "2" ? 2 : 1;
+    if (from_thermal) {
+      ep.temperature = temperature;
+      ep.delta_t = 0;
+    }
+    write_calculix_thermoelastic(mesh, ep, work.path / "stress.inp");
+    if (!run_ccx(work, "stress")) return kExitFailure;
+    std::optional<Field> u = ccx_field(work, "stress", mesh, "DISP", "displacement", "m");
+    std::optional<Field> sn = ccx_field(work, "stress", mesh, "STRESS", "stress_nodal", "Pa");
+    if (!u || !sn) return kExitFailure;
+    std::size_t arg = 0;
+    double umax = 0, vm_max = 0;
+    for (std::size_t i = 0; i < mesh.node_count(); ++i) {
+      const double* v = &u->values[3 * i];
+      const double m = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      if (m > umax) umax = m, arg = i;
+      const double* s6 = &sn->values[6 * i];
+      const double vm = std::sqrt(0.5 * ((s6[0] - s6[1]) * (s6[0] - s6[1]) + (s6[1] - s6[2]) * (s6[1] - s6[2]) +
+                                         (s6[2] - s6[0]) * (s6[2] - s6[0])) +
+                                  3 * (s6[3] * s6[3] + s6[4] * s6[4] + s6[5] * s6[5]));
+      vm_max = std::max(vm_max, vm);
+    }
+    std::printf("ccx stress (%s): %.3f s; largest |u| %.6g m at (%.6g, %.6g, %.6g) m; largest nodal von Mises %.6g Pa\n",
+                ep.order == 2 ? "C3D10" : "C3D4", clock(), umax, mesh.xyz[3 * arg], mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2], vm_max);
+    if (compare) {
+      Mesh own = mesh;
+      solve_thermoelastic(own, ep);
+      Field g = *own.find_field("displacement");
+      report_compare("u", u->values, g.values, "m");
+      g.name = "displacement_foxi";
+      fields.push_back(std::move(*u));
+      fields.push_back(std::move(g));
+    } else {
+      fields.push_back(std::move(*u));
+    }
+    fields.push_back(std::move(*sn));
+  }
+  if (!out.empty()) {
+    for (Field& f : fields) {
+      std::erase_if(mesh.fields, [&](const Field& g) { return g.name == f.name; });
+      mesh.fields.push_back(std::move(f));
+    }
+    write_mesh(mesh, out);
+    std::printf("wrote %s\n", out.c_str());
+  }
+  if (keep) {
+    std::printf("ccx's work folder: %s\n", work.path.c_str());
+    work.keep = true;
+  }
+  return result;
+}
+
+}  // namespace foxi::cli

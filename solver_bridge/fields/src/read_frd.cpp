@@ -1,0 +1,295 @@
+// CalculiX .frd results (ASCII) as a field source. Format: CalculiX GraphiX manual, "Result Format":
+// "    2C" node block (" -1" id x y z), "    3C" element block (" -1" id type group material, then
+// " -2" records of node ids), "  100C" result header (value = step time, I2 format flag at its end),
+// " -4" NAME ncomps, " -5" one line per component (iexist 1: computed by the reader, not in the
+// file), " -1" id + values, " -2" continuation values, " -3" block end, " 9999" file end. Fixed
+// columns (trailing blanks ignored): ids are I5 (short format 0) or I10 (long format 1), values E12.5 back to back (a minus
+// sign may touch the previous value); format 2 and 3 are binary.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <string>
+#include <unordered_map>
+
+#include "foxi/fields/field_source.hpp"
+#include "foxi/model/io_error.hpp"
+#include "io_util.hpp"
+
+namespace foxi {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Nodes per element of CalculiX's element types 1..12 (C3D8, C3D6, C3D4, C3D20, C3D15, C3D10, S3,
+// S6, S4, S8, B21, B32).
+constexpr int kElementNodes[] = {0, 8, 6, 4, 20, 15, 10, 3, 6, 4, 8, 2, 3};
+
+class FrdParser {
+ public:
+  FrdParser(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+
+  FieldSource parse();
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const { throw IoError(name_, line_no_, IoError::kNoOffset, why); }
+
+  bool next_line() {
+    if (pos_ >= text_.size()) return false;
+    const char* start = text_.data() + pos_;
+    const void* nl = std::memchr(start, '\n', text_.size() - pos_);
+    std::size_t end = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text_.data()) : text_.size();
+    line_ = text_.substr(pos_, end - pos_);
+    while (!line_.empty() && (line_.back() == '\r' || line_.back() == ' ')) line_.remove_suffix(1);
+    pos_ = end + 1;
+    ++line_no_;
+    return true;
+  }
+  bool starts(std::string_view key) const { return line_.substr(0, key.size()) == key; }
+
+  // An integer in columns [from, from + width) (blanks around it allowed).
+  std::int64_t int_at(std::size_t from, std::size_t width, const char* what) const {
+    if (from >= line_.size()) fail(std::string("the record ends before its ") + what);
+    std::string_view f = line_.substr(from, width);
+    while (!f.empty() && f.front() == ' ') f.remove_prefix(1);
+    while (!f.empty() && f.back() == ' ') f.remove_suffix(1);
+    std::int64_t v = 0;
+    auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
+    if (f.empty() || ec != std::errc() || p != f.data() + f.size())
+      fail(std::string("expected an integer (") + what + ") in columns " + std::to_string(from + 1) + "-" +
+           std::to_string(from + width) + ", found '" + std::string(f) + "'");
+    return v;
+  }
+  // The last blank-separated integer of the line (the format flag of 2C, 3C and 100C records).
+  int trailing_int() const {
+    std::size_t e = line_.size();
+    while (e > 0 && line_[e - 1] == ' ') --e;
+    std::size_t b = e;
+    while (b > 0 && line_[b - 1] != ' ') --b;
+    int v = -1;
+    std::from_chars(line_.data() + b, line_.data() + e, v);
+    return v;
+  }
+  // The 12-column values from `from` to the end of the line, appended to out; returns how many.
+  std::size_t values_from(std::size_t from, double* out, std::size_t max) const {
+    std::size_t n = 0;
+    for (std::size_t p = from; p < line_.size(); p += 12) {
+      if (n == max) fail("more values than the block declares");
+      const char* b = line_.data() + p;
+      const char* e = line_.data() + std::min(p + 12, line_.size());
+      while (b < e && *b == ' ') ++b;
+      double v = 0;
+      auto [q, ec] = std::from_chars(b, e, v);
+      if (b == e || (ec != std::errc() && ec != std::errc::result_out_of_range) || q != e)
+        fail("expected a number in columns " + std::to_string(p + 1) + "-" + std::to_string(p + 12) + ", found '" +
+             std::string(line_.substr(p, 12)) + "'");
+      out[n++] = v;
+    }
+    return n;
+  }
+  std::size_t id_width(int format) const { return format == 0 ? 5 : 10; }
+  void check_ascii(int format, const char* block) const {
+    if (format == 2 || format == 3)
+      fail(std::string("binary .frd ") + block + " (format " + std::to_string(format) +
+           "): only ASCII .frd files are read; ask ccx for them with *NODE FILE / *EL FILE without OUTPUT=BINARY");
+    if (format != 0 && format != 1) fail(std::string("unknown .frd format flag in the ") + block + " header");
+  }
+  std::uint32_t node_index(std::int64_t id) const {
+    if (id > 0 && static_cast<std::uint64_t>(id) < dense_.size() && dense_[id] != kNone) return dense_[id];
+    if (!sparse_.empty()) {
+      auto it = sparse_.find(static_cast<std::uint64_t>(id));
+      if (it != sparse_.end()) return it->second;
+    }
+    fail("node " + std::to_string(id) + " is not in the file's node block");
+  }
+
+  void read_nodes();
+  void read_elements();
+  void read_results();
+
+  std::string_view text_;
+  const std::string& name_;
+  std::size_t pos_ = 0;
+  std::string_view line_;
+  std::uint64_t line_no_ = 0;
+  FieldSource src_;
+  std::vector<std::uint32_t> dense_;                       // node id -> index (ids up to a few times the count)
+  std::unordered_map<std::uint64_t, std::uint32_t> sparse_;  // the others
+  double step_value_ = 0;
+  bool have_step_ = false;
+  int format_ = 1;                                         // of the current result block
+  std::map<std::string, std::size_t> field_of_;            // block name -> index in src_.mesh.fields
+};
+
+void FrdParser::read_nodes() {
+  if (!src_.mesh.xyz.empty() || !src_.node_id.empty()) fail("a second node block (2C)");
+  const int format = trailing_int();
+  check_ascii(format, "node block");
+  const std::size_t w = id_width(format);
+  const std::int64_t declared = int_at(6, 30, "node count");
+  if (declared < 0 || static_cast<std::uint64_t>(declared) > text_.size() / 40 + 1)
+    fail("a node count of " + std::to_string(declared) + " that the file is too short to hold");
+  src_.mesh.xyz.reserve(3 * declared);
+  src_.node_id.reserve(declared);
+  while (true) {
+    if (!next_line()) fail("the file ends inside the node block");
+    if (starts(" -3")) break;
+    if (!starts(" -1")) fail("expected a node record (' -1') or the block end (' -3')");
+    const std::int64_t id = int_at(3, w, "node id");
+    if (id <= 0) fail("node id " + std::to_string(id) + " is not positive");
+    double x[3];
+    if (values_from(3 + w, x, 3) != 3) fail("a node record without its 3 coordinates");
+    src_.node_id.push_back(static_cast<std::uint64_t>(id));
+    src_.mesh.xyz.insert(src_.mesh.xyz.end(), x, x + 3);
+  }
+  if (src_.node_id.size() != static_cast<std::size_t>(declared))
+    fail("the node block declares " + std::to_string(declared) + " nodes and holds " +
+         std::to_string(src_.node_id.size()));
+  // Ids to indices: a table where the ids are dense enough, a hash map for the rest.
+  const std::uint64_t max_id = src_.node_id.empty() ? 0 : *std::max_element(src_.node_id.begin(), src_.node_id.end());
+  const bool dense = max_id <= 4 * src_.node_id.size() + 1024;
+  if (dense) dense_.assign(max_id + 1, kNone);
+  for (std::size_t i = 0; i < src_.node_id.size(); ++i) {
+    const std::uint64_t id = src_.node_id[i];
+    const bool fresh = dense ? dense_[id] == kNone : sparse_.emplace(id, std::uint32_t(i)).second;
+    if (!fresh) fail("node id " + std::to_string(id) + " appears twice in the node block");
+    if (dense) dense_[id] = static_cast<std::uint32_t>(i);
+  }
+}
+
+void FrdParser::read_elements() {
+  if (src_.node_id.empty()) fail("an element block (3C) before the node block (2C)");
+  const int format = trailing_int();
+  check_ascii(format, "element block");
+  const std::size_t w = id_width(format);
+  Mesh& m = src_.mesh;
+  if (!next_line()) fail("the file ends inside the element block");
+  while (!starts(" -3")) {
+    if (!starts(" -1")) fail("expected an element record (' -1') or the block end (' -3')");
+    const std::int64_t type = int_at(3 + w, 5, "element type");
+    if (type < 1 || type > 12) fail("unknown element type " + std::to_string(type));
+    const int want = kElementNodes[type];
+    std::uint32_t nodes[20];
+    int got = 0;
+    while (true) {
+      if (!next_line()) fail("the file ends inside the element block");
+      if (!starts(" -2")) break;
+      for (std::size_t p = 3; p < line_.size(); p += w) {
+        if (got == want) fail("an element with more nodes than its type " + std::to_string(type) + " has");
+        nodes[got++] = node_index(int_at(p, w, "element node"));
+      }
+    }
+    if (got != want)
+      fail("an element of type " + std::to_string(type) + " with " + std::to_string(got) + " nodes, not " +
+           std::to_string(want));
+    if (type == 3 || type == 6) {  // C3D4, C3D10: the 4 corners come first
+      m.tet.insert(m.tet.end(), nodes, nodes + 4);
+    }
+  }
+}
+
+void FrdParser::read_results() {
+  if (!have_step_) fail("a result block (-4) without its step header (100C)");
+  if (src_.node_id.empty()) fail("a result block before the node block (2C)");
+  // " -4  NAME    ncomps irtype"
+  std::string name(line_.size() > 5 ? line_.substr(5, 8) : std::string_view{});
+  while (!name.empty() && name.front() == ' ') name.erase(0, 1);
+  while (!name.empty() && name.back() == ' ') name.pop_back();
+  if (name.empty()) fail("a result block without a name");
+  const std::int64_t declared = int_at(13, 5, "component count");
+  if (declared < 1 || declared > 64) fail("a component count of " + std::to_string(declared));
+  // " -5" component lines; iexist (columns 34-38) 1 marks a component the file does not hold.
+  std::vector<std::string> comp_names;
+  std::size_t comps = 0;
+  for (std::int64_t c = 0; c < declared; ++c) {
+    if (!next_line() || !starts(" -5")) fail("expected " + std::to_string(declared) + " component lines (' -5')");
+    const std::int64_t iexist = line_.size() >= 38 ? int_at(33, 5, "component flag") : 0;
+    if (iexist != 1) ++comps;
+  }
+  const std::size_t w = id_width(format_);
+  const std::size_t n = src_.node_id.size();
+  auto it = field_of_.find(name);
+  Field* f;
+  if (it == field_of_.end()) {
+    field_of_.emplace(name, src_.mesh.fields.size());
+    src_.mesh.fields.push_back(Field{name, FieldLocation::node, static_cast<std::uint32_t>(comps), "", {}, {}});
+    f = &src_.mesh.fields.back();
+  } else {
+    f = &src_.mesh.fields[it->second];
+    if (f->components != comps)
+      fail("block " + name + " has " + std::to_string(comps) + " components here and " +
+           std::to_string(f->components) + " in an earlier step");
+  }
+  const std::size_t step = f->step_values.size();
+  f->step_values.push_back(step_value_);
+  f->values.resize((step + 1) * n * comps, kNaN);
+  double* base = f->values.data() + step * n * comps;
+  std::vector<bool> seen(n, false);
+  while (true) {
+    if (!next_line()) fail("the file ends inside result block " + name);
+    if (starts(" -3")) break;
+    if (!starts(" -1")) fail("expected a node record (' -1') or the block end (' -3') in block " + name);
+    const std::uint32_t i = node_index(int_at(3, w, "node id"));
+    if (seen[i]) fail("node " + std::to_string(src_.node_id[i]) + " appears twice in block " + name);
+    seen[i] = true;
+    double* out = base + std::size_t(i) * comps;
+    std::size_t got = values_from(3 + w, out, comps);
+    // Values beyond one line continue on " -2" records (6 per line).
+    while (got < comps) {
+      if (!next_line() || !starts(" -2")) fail("node " + std::to_string(src_.node_id[i]) + " of block " + name +
+                                              " has " + std::to_string(got) + " values, not " + std::to_string(comps));
+      got += values_from(3 + w, out + got, comps - got);
+    }
+  }
+}
+
+FieldSource FrdParser::parse() {
+  src_.path = name_;
+  src_.format = "frd";
+  src_.key = SourceKey::node_id;
+  bool ended = false;
+  while (next_line()) {
+    if (starts("    2C")) {
+      read_nodes();
+    } else if (starts("    3C")) {
+      read_elements();
+    } else if (starts("  100C")) {
+      format_ = trailing_int();
+      check_ascii(format_, "result block");
+      double v = 0;
+      std::string_view f = line_.size() >= 24 ? line_.substr(12, 12) : std::string_view{};
+      while (!f.empty() && f.front() == ' ') f.remove_prefix(1);
+      auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
+      if (f.empty() || ec != std::errc() || p != f.data() + f.size()) fail("expected the step value in columns 13-24");
+      step_value_ = v;
+      have_step_ = true;
+    } else if (starts(" -4")) {
+      read_results();
+    } else if (starts(" 9999") || starts("9999")) {
+      ended = true;
+      break;
+    } else if (starts(" -1") || starts(" -2") || starts(" -5")) {
+      fail("a record outside any block");
+    }
+    // Other records (1C, 1U user text, 1P parameters, blank lines) carry nothing foxi uses.
+  }
+  if (!ended) fail("the file ends without its end record (9999): truncated?");
+  if (src_.node_id.empty()) fail("no node block (2C)");
+  // No regions: the file's material and group numbers are not foxi's region ids, and a region
+  // restriction on the wrong ids would be worse than none.
+  return std::move(src_);
+}
+
+}  // namespace
+
+FieldSource parse_frd_source(std::string_view bytes, const std::string& name) { return FrdParser(bytes, name).parse(); }
+
+FieldSource read_frd_source(const std::filesystem::path& path) {
+  const std::string bytes = io::read_file(path);
+  return parse_frd_source(bytes, path.string());
+}
+
+}  // namespace foxi
