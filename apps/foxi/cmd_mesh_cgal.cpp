@@ -1,7 +1,6 @@
 // foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT: the CGAL Mesh_3 path of `foxi mesh` (options in cmd_mesh.cpp's
 // usage text): meshes, writes, and prints counts, time, dihedral angles, each region's volume against the
 // PLC's and the weighted certificate. A mesh that fails either check is written but refused (exit 4).
-#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -23,9 +22,6 @@
 namespace foxi::cli {
 
 namespace {
-
-volatile std::sig_atomic_t g_interrupted = 0;
-extern "C" void on_interrupt(int) { g_interrupted = 1; }
 
 double non_negative(const std::string& s, const char* what) {
   char* end = nullptr;
@@ -119,19 +115,16 @@ int mesh_with_cgal(Args& args) {
                        is_model ? std::span<const double>(structure.part_volume) : std::span<const double>(),
                        max_tets);
   }
-  g_interrupted = 0;
-  auto* previous = std::signal(SIGINT, on_interrupt);
-  params.progress = [](std::string_view, double) { return g_interrupted == 0; };
+  // A stop (SIGINT, SIGTERM, SIGHUP) is handled by signals.hpp's thread: it kills the mesher's child
+  // process and exits, so the mesher needs no progress function for it.
   CgalMeshReport report;
   Mesh mesh;
   try {
     mesh = mesh_plc_cgal(plc, params, &report);
   } catch (const MesherError& e) {
-    std::signal(SIGINT, previous);
     std::fprintf(stderr, "foxi mesh: error: %s: %s: %s\n", in.c_str(), failure_name(e.failure()), e.what());
     return exit_code(e.failure());
   }
-  std::signal(SIGINT, previous);
   if (is_model) name_mesh(model, structure, mesh);
   write_mesh(mesh, out);
   const QualitySummary q = summarize_quality(mesh);

@@ -3,6 +3,8 @@
 // freedom 11 is the temperature), *DFLUX (S<face> surface flux into the body, BF body flux per
 // volume), *FILM (F<face>, sink temperature, film coefficient); .frd result format (ASCII: " -4"
 // block header, " -1" node records with 12-character values, " -2" continuations, " -3" block end).
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/solver/calculix.hpp"
 #include "elastic_setup.hpp"
@@ -31,20 +34,28 @@ struct FileCloser {
 
 std::string elset_name(std::size_t region_index) { return "R" + std::to_string(region_index + 1); }
 
-// A deck being written: IoError naming the file when it cannot be opened or written.
+// A deck being written, durably (durable_file.hpp): a temporary beside the target, written through a
+// stdio stream on a duplicate of its descriptor, and renamed over the target by close(); an error or
+// an exception before that leaves the target as it was and no temporary. IoError names the file.
 class DeckFile {
  public:
-  explicit DeckFile(const std::filesystem::path& path) : path_(path), file_(std::fopen(path.string().c_str(), "w")) {
-    if (!file_) throw IoError(path_.string(), 0, IoError::kNoOffset, "cannot open for writing");
+  explicit DeckFile(const std::filesystem::path& path) : path_(path), durable_(path) {
+    const int fd = ::dup(durable_.fd());
+    if (fd < 0 || !(file_ = std::unique_ptr<std::FILE, FileCloser>(::fdopen(fd, "w")))) {
+      if (fd >= 0) ::close(fd);
+      throw IoError(path_.string(), 0, IoError::kNoOffset, "cannot open for writing");
+    }
   }
   std::FILE* get() const { return file_.get(); }
   void close() {
     if (std::ferror(file_.get()) || std::fclose(file_.release()) != 0)
       throw IoError(path_.string(), 0, IoError::kNoOffset, "write failed");
+    durable_.commit();
   }
 
  private:
   std::filesystem::path path_;
+  DurableFile durable_;
   std::unique_ptr<std::FILE, FileCloser> file_;
 };
 
