@@ -36,7 +36,7 @@ struct IsoPainter::Impl {
   IsoParams params;
   std::vector<double> values;  // ascending
   bool depth = false;
-  double near = 0;
+  double near_given = 0;  // RenderParams::near
   double light[3] = {0, 0, -1};
   float lut[256][3] = {};
   std::optional<TetRasterizer> solid;  // cap mode: the whole tets
@@ -51,6 +51,13 @@ struct IsoPainter::Impl {
     // Near-plane clip (perspective): keep depth >= near.
     Vert clipped[kMaxPoly];
     if (proj.perspective) {
+      // The tet painter's rule (rasterizer.cpp) on the polygon's own points: at depth >= near, a point
+      // no farther than dmax from the eye projects within kMaxPixel of the centre.
+      double dmax = 0;
+      for (int i = 0; i < n; ++i)
+        dmax = std::max(dmax, std::sqrt(v[i].c[0] * v[i].c[0] + v[i].c[1] * v[i].c[1] + v[i].c[2] * v[i].c[2]));
+      double near = std::max(near_given, dmax * proj.focal / kMaxPixel);
+      if (!(near > 0)) near = 1e-300;
       int m = 0;
       for (int i = 0; i < n; ++i) {
         const Vert& a = v[i];
@@ -279,10 +286,11 @@ IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int he
     const std::uint32_t e = color_map_entry(params.scale.map, i);
     for (int k = 0; k < 3; ++k) s.lut[i][k] = float((e >> (8 * k)) & 255u);
   }
-  // The near plane and fixed-point range as the tet painter has them (it checks the camera).
-  TetRasterizer r(mesh, camera, width, height, tet_params);
-  s.near = r.near_plane();
-  if (params.cap && !s.values.empty()) s.solid.emplace(std::move(r));
+  // Cap mode draws whole tets with the tet painter (its setup projects every node); the polygons alone
+  // need no per-mesh setup, so a new isovalue or view costs only the tets it crosses: their near plane
+  // is chosen per polygon (draw_polygon).
+  s.near_given = tet_params.near;
+  if (params.cap && !s.values.empty()) s.solid.emplace(mesh, camera, width, height, tet_params);
 }
 
 IsoPainter::~IsoPainter() = default;
