@@ -18,6 +18,7 @@
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/visibility_order.hpp"
 #include "mesh_factory.hpp"
+#include "pixel_ray.hpp"
 #include "random_cameras.hpp"
 #include "test_util.hpp"
 
@@ -183,25 +184,6 @@ TEST(TetIntervals, CrossingEqualsBruteForceScan) {
   }
 }
 
-// The camera-frame ray of pixel centre (x, y), as field_render_test has it.
-void pixel_ray(const Projector& p, int x, int y, double o[3], double d[3]) {
-  double p0[2], px[2], py[2];
-  const double c0[3] = {0, 0, 1}, cx[3] = {1, 0, 1}, cy[3] = {0, 1, 1};
-  p.camera_to_pixel(c0, p0);
-  p.camera_to_pixel(cx, px);
-  p.camera_to_pixel(cy, py);
-  const double a11 = px[0] - p0[0], a12 = py[0] - p0[0], a21 = px[1] - p0[1], a22 = py[1] - p0[1];
-  const double det = a11 * a22 - a12 * a21, bx = x + 0.5 - p0[0], by = y + 0.5 - p0[1];
-  const double a = (bx * a22 - a12 * by) / det, b = (a11 * by - a21 * bx) / det;
-  if (p.perspective) {
-    o[0] = o[1] = o[2] = 0;
-    d[0] = a, d[1] = b, d[2] = 1;
-  } else {
-    o[0] = a, o[1] = b, o[2] = 0;
-    d[0] = d[1] = 0, d[2] = 1;
-  }
-}
-
 double sphere_field(const double* p) {
   const double c[3] = {0.52, 0.47, 0.5};
   return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
@@ -274,7 +256,7 @@ TEST(IsoPainter, PainterEqualsDepthBufferAndRayCast) {
       for (int y = 0; y < kH; y += 3)
         for (int x = 0; x < kW; x += 3) {
           double o[3], d[3];
-          pixel_ray(pr, x, y, o, d);
+          test::pixel_ray(pr, x, y, o, d);
           double best = 1e300;
           std::uint32_t best_tet = kNone;
           bool near_edge = false;
