@@ -10,13 +10,17 @@
 // (the phases, wall clock, per iteration; clear_ms: clearing the 1920x1080 picture, counted in the
 // time but not in the phases or the per-tet figures), ns_per_crossing_tet and ns_per_mesh_tet (the whole
 // iteration over the tets crossed, and over all the mesh's tets), build_ms (the interval tree, once).
-// The camera turns by 7 degrees per iteration, so no frame repeats.
+// iso_pruned also draws the full pass of each view outside its timing: full_ms (its query + order + clear
+// + draw), ratio (pruned / full, wall clock, clearing included in both) and differ_px (pixels, colour
+// or id, where the two pictures differ; 0 expected). Time columns: wall clock and process CPU time (all
+// threads). The camera turns by 7 degrees per iteration, so no frame repeats.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <string>
 
 #include "bench_meshes.hpp"
 #include "foxi/viz/camera.hpp"
@@ -100,6 +104,47 @@ Case& get_case() {
   return *c;
 }
 
+struct Phases {
+  double query_ms = 0, order_ms = 0, clear_ms = 0, draw_ms = 0;
+  std::size_t polygons = 0;
+  double total() const { return query_ms + order_ms + clear_ms + draw_ms; }
+};
+
+// One frame of the isovalues `ip` for `cam` into fb, pruned or the full pass; adds its phases' times.
+void frame(Case& c, const IsoParams& ip, const Camera& cam, bool pruned, Framebuffer& fb,
+           std::vector<std::uint32_t>& subset, std::vector<std::uint32_t>& order, Phases& ph) {
+  auto t0 = std::chrono::steady_clock::now();
+  subset.clear();
+  if (pruned) {
+    c.tree.crossing_any(ip.values, subset);
+  } else {
+    for (double v : ip.values) {
+      const std::vector<std::uint32_t> s = crossing_scan(c.corner, v);
+      subset.insert(subset.end(), s.begin(), s.end());
+    }
+  }
+  ph.query_ms += ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  if (pruned) {
+    visibility_order_into(order, c.mesh, c.table, view_of(cam), subset);
+  } else {
+    visibility_order_into(order, c.mesh, c.table, view_of(cam));
+  }
+  ph.order_ms += ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  fb.clear();
+  ph.clear_ms += ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  IsoPainter painter(c.mesh, cam, kWidth, kHeight, c.corner, ip);
+  painter.draw(fb, order);
+  ph.polygons = painter.polygons_drawn();
+  benchmark::DoNotOptimize(fb.rgba.data());
+  ph.draw_ms += ms_since(t0);
+}
+
+// The pruned frame timed; with `baseline`, each iteration also draws the full pass of the same view
+// outside the timing (full_ms, ratio = pruned / full wall clock, and differ_px: pixels, colour or id,
+// in which the two pictures differ: 0).
 void run(benchmark::State& state, bool pruned) {
   Case& c = get_case();
   const int f = int(state.range(0));
@@ -107,51 +152,37 @@ void run(benchmark::State& state, bool pruned) {
   ip.values = c.values[f];
   ip.scale.lo = c.lo;
   ip.scale.hi = c.hi;
-  Framebuffer fb(kWidth, kHeight);
-  std::vector<std::uint32_t> subset, order;
-  double query_ms = 0, order_ms = 0, clear_ms = 0, draw_ms = 0;
-  std::size_t i = 0, polygons = 0;
+  Framebuffer fb(kWidth, kHeight), full(kWidth, kHeight);
+  std::vector<std::uint32_t> subset, order, subset2, order2;
+  Phases ph, base;
+  std::size_t i = 0, differ = 0;
   for (auto _ : state) {
     const Camera cam = orbit(c.camera, 7.0 * double(i++), 0);
-    auto t0 = std::chrono::steady_clock::now();
-    subset.clear();
+    frame(c, ip, cam, pruned, fb, subset, order, ph);
     if (pruned) {
-      c.tree.crossing_any(ip.values, subset);
-    } else {
-      for (double v : ip.values) {
-        const std::vector<std::uint32_t> s = crossing_scan(c.corner, v);
-        subset.insert(subset.end(), s.begin(), s.end());
-      }
+      state.PauseTiming();
+      frame(c, ip, cam, false, full, subset2, order2, base);
+      for (std::size_t p = 0; p < fb.rgba.size(); ++p) differ += fb.rgba[p] != full.rgba[p] || fb.id[p] != full.id[p];
+      state.ResumeTiming();
     }
-    query_ms += ms_since(t0);
-    t0 = std::chrono::steady_clock::now();
-    if (pruned) {
-      visibility_order_into(order, c.mesh, c.table, view_of(cam), subset);
-    } else {
-      visibility_order_into(order, c.mesh, c.table, view_of(cam));
-    }
-    order_ms += ms_since(t0);
-    t0 = std::chrono::steady_clock::now();
-    fb.clear();
-    clear_ms += ms_since(t0);
-    t0 = std::chrono::steady_clock::now();
-    IsoPainter painter(c.mesh, cam, kWidth, kHeight, c.corner, ip);
-    painter.draw(fb, order);
-    polygons = painter.polygons_drawn();
-    benchmark::DoNotOptimize(fb.rgba.data());
-    draw_ms += ms_since(t0);
   }
   const double iters = double(state.iterations());
+  state.counters["values"] = double(ip.values.size());
   state.counters["crossing"] = double(c.crossing[f]);
-  state.counters["polygons"] = double(polygons);
-  state.counters["query_ms"] = query_ms / iters;
-  state.counters["order_ms"] = order_ms / iters;
-  state.counters["draw_ms"] = draw_ms / iters;
-  state.counters["clear_ms"] = clear_ms / iters;
-  const double total_ns = (query_ms + order_ms + draw_ms) * 1e6 / iters;
+  state.counters["polygons"] = double(ph.polygons);
+  state.counters["query_ms"] = ph.query_ms / iters;
+  state.counters["order_ms"] = ph.order_ms / iters;
+  state.counters["draw_ms"] = ph.draw_ms / iters;
+  state.counters["clear_ms"] = ph.clear_ms / iters;
+  const double total_ns = (ph.query_ms + ph.order_ms + ph.draw_ms) * 1e6 / iters;
   state.counters["ns_per_crossing_tet"] = total_ns / double(c.crossing[f]);
   state.counters["ns_per_mesh_tet"] = total_ns / double(c.mesh.tet_count());
   state.counters["build_ms"] = c.build_ms;
+  if (pruned) {
+    state.counters["full_ms"] = base.total() / iters;
+    state.counters["ratio"] = ph.total() / base.total();
+    state.counters["differ_px"] = double(differ);
+  }
   state.SetLabel(f == 0 ? "0.1%" : f == 1 ? "1%" : "10%");
 }
 
@@ -160,7 +191,7 @@ void BM_iso_full_scan(benchmark::State& state) { run(state, false); }
 
 }  // namespace
 
-BENCHMARK(BM_iso_pruned)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_iso_full_scan)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_iso_pruned)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_iso_full_scan)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -102,7 +102,7 @@ struct IsoParams {
 // its tet's place, so the picture is right without a depth buffer, and the order may be handed over in
 // batches (progressive; stop at any batch). The polygons of one tet are drawn far to near. RenderParams:
 // depth_buffer switches to the depth-buffer mode (the test oracle: nearest wins; fb needs a depth
-// buffer); the rest is for the whole tets of cap mode. Polygons are clipped at the near plane. Each
+// buffer); the rest is for the whole tets of cap mode. Polygons are drawn on the calling thread. Polygons are clipped at the near plane. Each
 // pixel's id is the tet whose polygon it shows. No undraw for iso polygons (the tet painter's undraw
 // covers whole-tet subsets: threshold, clip). The mesh and the value spans are lent and must outlive it.
 class FOXI_API IsoPainter {
