@@ -409,6 +409,55 @@ TEST(IsoPainter, CapAndSliceEqualTheDepthBuffer) {
   EXPECT_EQ(total_differ, 0u);
 }
 
+TEST(IsoPainter, UndrawEqualsDrawingTheRestAfresh) {
+  test::TempDir dir;
+  Mesh m = test::random_delaunay(dir, 1500, 17);
+  const SphereTable table = compute_spheres(m);
+  const std::vector<double> corner = corner_values_of(m, nodal_of(m, sphere_field));
+  const TetIntervals tree(corner);
+  for (int cap = 0; cap < 2; ++cap) {
+    IsoParams ip;
+    ip.values = cap ? std::vector<double>{0.3} : std::vector<double>{0.2, 0.3, 0.4};
+    ip.scale.lo = 0;
+    ip.scale.hi = 0.8;
+    ip.cap = cap == 1;
+    std::vector<std::uint32_t> tets;
+    if (cap)
+      tree.reaching(0.3, tets);
+    else
+      tree.crossing_any(ip.values, tets);
+    for (const Camera& cam : test::random_cameras(m, 3, 31 + unsigned(cap), double(kW) / kH)) {
+      const std::vector<std::uint32_t> order = visibility_order(m, table, view_of(cam), tets);
+      RenderParams rp;
+      rp.undoable = true;
+      IsoPainter painter(m, cam, kW, kH, corner, ip, rp);
+      Framebuffer fb(kW, kH);
+      for (std::size_t i = 0; i < order.size(); i += 50)
+        painter.draw(fb, std::span<const std::uint32_t>(order).subspan(i, std::min<std::size_t>(50, order.size() - i)));
+      std::size_t left = order.size();
+      for (std::size_t k : {std::size_t(1), std::size_t(37), order.size() / 3, std::size_t(5)}) {
+        k = std::min(k, left);
+        painter.undraw(fb, k);
+        left -= k;
+        ASSERT_EQ(painter.drawn_tets(), left);
+        Framebuffer fresh(kW, kH);
+        IsoPainter again(m, cam, kW, kH, corner, ip);
+        again.draw(fresh, std::span<const std::uint32_t>(order).first(left));
+        std::size_t differ = 0;
+        for (std::size_t p = 0; p < fb.rgba.size(); ++p) differ += fb.rgba[p] != fresh.rgba[p] || fb.id[p] != fresh.id[p];
+        EXPECT_EQ(differ, 0u) << (cap ? "cap" : "surfaces") << ", " << left << " tets left";
+      }
+      EXPECT_THROW(painter.undraw(fb, left + 1), std::out_of_range);
+    }
+  }
+  IsoParams ip;
+  ip.values = {0.3};
+  Camera cam = test::random_cameras(m, 1, 3, 1.0)[0];
+  IsoPainter plain(m, cam, kW, kH, corner, ip);
+  Framebuffer fb(kW, kH);
+  EXPECT_THROW(plain.undraw(fb, 0), std::logic_error);
+}
+
 TEST(FieldSubset, ThresholdAndClipSelectByValueAndCentroid) {
   Mesh m = test::grid_mesh(5, 4, 3, 0.2, 0.25, 1.0 / 3, 6);
   std::vector<double> value(m.tet_count());

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -41,6 +42,31 @@ struct IsoPainter::Impl {
   float lut[256][3] = {};
   std::optional<TetRasterizer> solid;  // cap mode: the whole tets
   std::size_t polygons = 0;
+  // Undoable (RenderParams::undoable): per tet handed to draw(), in order, a step: a tet drawn here
+  // with the pixels its polygons overwrote (their index, colour and id before, in writing order), or
+  // a run of whole tets drawn by `solid` (its own undo keeps those).
+  bool undoable = false;
+  struct Step {
+    bool solid = false;
+    std::size_t count = 1;       // tets (a solid run's), else 1
+    std::size_t save_begin = 0;  // the first saved pixel of a tet drawn here
+  };
+  std::vector<Step> steps;
+  std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;
+  std::size_t drawn = 0;
+  void begin_tet() {
+    ++drawn;
+    if (undoable) steps.push_back({false, 1, saved_pixel.size()});
+  }
+  void solid_run(Framebuffer& fb, std::span<const std::uint32_t> run) {
+    solid->draw(fb, run);
+    drawn += run.size();
+    if (!undoable) return;
+    if (!steps.empty() && steps.back().solid)
+      steps.back().count += run.size();
+    else
+      steps.push_back({true, run.size(), 0});
+  }
 
   Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
 
@@ -122,6 +148,11 @@ struct IsoPainter::Impl {
           if (depth) {
             if (!(z > fb.depth[p])) continue;
             fb.depth[p] = z;
+          }
+          if (undoable) {
+            saved_pixel.push_back(std::uint32_t(p));
+            saved_rgba.push_back(fb.rgba[p]);
+            saved_id.push_back(fb.id[p]);
           }
           const float* c = rgb;
           float nan_rgb[3];
@@ -279,6 +310,8 @@ IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int he
   std::sort(s.values.begin(), s.values.end());
   s.values.erase(std::unique(s.values.begin(), s.values.end()), s.values.end());
   s.depth = tet_params.depth_buffer;
+  s.undoable = tet_params.undoable;
+  if (s.undoable && s.depth) throw std::invalid_argument("isosurface: undoable drawing is the painter's, not the depth buffer's");
   const double l[3] = {-0.3, 0.45, -1};  // the tet painter's light (rasterizer.cpp)
   const double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
   for (int k = 0; k < 3; ++k) s.light[k] = l[k] / ln;
@@ -290,7 +323,7 @@ IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int he
   // need no per-mesh setup, so a new isovalue or view costs only the tets it crosses: their near plane
   // is chosen per polygon (draw_polygon).
   s.near_given = tet_params.near;
-  if (params.cap && !s.values.empty()) s.solid.emplace(mesh, camera, width, height, tet_params);
+  if (params.cap) s.solid.emplace(mesh, camera, width, height, tet_params);
 }
 
 IsoPainter::~IsoPainter() = default;
@@ -303,9 +336,12 @@ void IsoPainter::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
     throw std::invalid_argument("isosurface: framebuffer size differs from the painter's");
   if (s.depth && fb.depth.size() != fb.rgba.size())
     throw std::invalid_argument("isosurface: depth-buffer mode needs a framebuffer with a depth buffer");
-  if (s.values.empty()) return;
   for (std::uint32_t t : tets)
     if (t >= s.mesh->tet_count()) throw std::invalid_argument("isosurface: tet index out of range");
+  if (s.values.empty()) {  // nothing to draw; the tets still count as drawn (undraw)
+    for (std::size_t i = 0; i < tets.size(); ++i) s.begin_tet();
+    return;
+  }
   if (!s.params.cap) {
     // One thread: splitting the rows between two (the tet painter's bands) doubled the CPU time for
     // no gain in wall time (bench_iso, 1%: each thread repeats every polygon's setup, which costs
@@ -324,6 +360,7 @@ void IsoPainter::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
           const std::uint32_t* nv = &s.mesh->tet[4 * std::size_t(tets[i + 8])];
           for (int k = 0; k < 4; ++k) __builtin_prefetch(&s.mesh->xyz[3 * std::size_t(nv[k])]);
         }
+        s.begin_tet();
         s.draw_surfaces(fb, tets[i], rows);
       }
     }
@@ -336,12 +373,46 @@ void IsoPainter::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
     const double* c = &s.corner[4 * std::size_t(tets[i])];
     const double lo = std::min({c[0], c[1], c[2], c[3]});
     if (lo >= v) continue;  // whole (a NaN corner compares false: cut, drawn by its finite part)
-    if (i > run) s.solid->draw(fb, tets.subspan(run, i - run));
+    if (i > run) s.solid_run(fb, tets.subspan(run, i - run));
     run = i + 1;
+    s.begin_tet();
     if (std::max({c[0], c[1], c[2], c[3]}) >= v) s.draw_cut(fb, tets[i]);
   }
-  if (tets.size() > run) s.solid->draw(fb, tets.subspan(run));
+  if (tets.size() > run) s.solid_run(fb, tets.subspan(run));
 }
+
+void IsoPainter::undraw(Framebuffer& fb, std::size_t count) {
+  Impl& s = *impl_;
+  if (!s.undoable) throw std::logic_error("isosurface: undraw needs RenderParams::undoable");
+  if (count > s.drawn)
+    throw std::out_of_range("isosurface: undraw of " + std::to_string(count) + " tets, " + std::to_string(s.drawn) +
+                            " drawn");
+  while (count > 0) {
+    Impl::Step& st = s.steps.back();
+    if (st.solid) {
+      const std::size_t m = std::min(count, st.count);
+      s.solid->undraw(fb, m);
+      st.count -= m;
+      count -= m;
+      s.drawn -= m;
+      if (st.count == 0) s.steps.pop_back();
+      continue;
+    }
+    // Restored in reverse writing order: each pixel ends as it was before the tet's first write.
+    for (std::size_t i = s.saved_pixel.size(); i-- > st.save_begin;) {
+      fb.rgba[s.saved_pixel[i]] = s.saved_rgba[i];
+      fb.id[s.saved_pixel[i]] = s.saved_id[i];
+    }
+    s.saved_pixel.resize(st.save_begin);
+    s.saved_rgba.resize(st.save_begin);
+    s.saved_id.resize(st.save_begin);
+    s.steps.pop_back();
+    --count;
+    --s.drawn;
+  }
+}
+
+std::size_t IsoPainter::drawn_tets() const { return impl_->drawn; }
 
 std::size_t IsoPainter::polygons_drawn() const { return impl_->polygons; }
 

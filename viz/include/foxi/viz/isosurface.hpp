@@ -103,8 +103,11 @@ struct IsoParams {
 // batches (progressive; stop at any batch). The polygons of one tet are drawn far to near. RenderParams:
 // depth_buffer switches to the depth-buffer mode (the test oracle: nearest wins; fb needs a depth
 // buffer); the rest is for the whole tets of cap mode. Polygons are drawn on the calling thread. Polygons are clipped at the near plane. Each
-// pixel's id is the tet whose polygon it shows. No undraw for iso polygons (the tet painter's undraw
-// covers whole-tet subsets: threshold, clip). The mesh and the value spans are lent and must outlive it.
+// pixel's id is the tet whose polygon it shows. Undoable (RenderParams::undoable, painter mode only):
+// undraw(fb, k) takes back the last k tets handed to draw(), leaving fb pixel for pixel as it was before
+// they were drawn (fb must not be changed in between); each tet drawn here keeps the pixels its
+// polygons overwrote (12 bytes a pixel write), the whole tets of cap mode are undrawn by the tet
+// painter's own undo. The mesh and the value spans are lent and must outlive it.
 class FOXI_API IsoPainter {
  public:
   // corner: 4 values per tet of the field the isovalues apply to; attr: 4 per tet colouring the
@@ -116,6 +119,10 @@ class FOXI_API IsoPainter {
   IsoPainter& operator=(IsoPainter&&) noexcept;
 
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
+  // Undoable: takes back the last `count` tets handed to draw() (std::logic_error if not undoable,
+  // std::out_of_range if more than drawn_tets()).
+  void undraw(Framebuffer& fb, std::size_t count);
+  std::size_t drawn_tets() const;  // tets handed to draw() and not undrawn
   std::size_t polygons_drawn() const;
 
  private:
