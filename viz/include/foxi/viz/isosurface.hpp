@@ -130,4 +130,11 @@ class FOXI_API IsoPainter {
   std::unique_ptr<Impl> impl_;
 };
 
+// What draw_picture (picture.hpp) needs to draw iso polygons or a slice instead of whole tets: the
+// IsoPainter's inputs (the spans lent).
+struct IsoDrawing {
+  std::span<const double> corner, attr;
+  IsoParams params;
+};
+
 }  // namespace foxi
