@@ -10,6 +10,7 @@
 // (the phases, wall clock, per iteration; clear_ms: clearing the 1920x1080 picture, counted in the
 // time but not in the phases or the per-tet figures), ns_per_crossing_tet and ns_per_mesh_tet (the whole
 // iteration over the tets crossed, and over all the mesh's tets), build_ms (the interval tree, once).
+//   iso_draw/F       the draw phase alone, one view (process CPU time = the drawing thread's)
 // iso_pruned also draws the full pass of each view outside its timing: full_ms (its query + order + clear
 // + draw), ratio (pruned / full, wall clock, clearing included in both) and differ_px (pixels, colour
 // or id, where the two pictures differ; 0 expected). Time columns: wall clock and process CPU time (all
@@ -186,11 +187,50 @@ void run(benchmark::State& state, bool pruned) {
   state.SetLabel(f == 0 ? "0.1%" : f == 1 ? "1%" : "10%");
 }
 
+// The draw phase alone (one view, its pruned order made once): IsoPainter setup + draw of the crossing
+// tets' polygons, the picture cleared outside the timing; counters pixels (pixel writes per frame, from
+// the undo record) and ns_per_polygon.
+void BM_iso_draw(benchmark::State& state) {
+  Case& c = get_case();
+  const int f = int(state.range(0));
+  IsoParams ip;
+  ip.values = c.values[f];
+  ip.scale.lo = c.lo;
+  ip.scale.hi = c.hi;
+  std::vector<std::uint32_t> subset;
+  c.tree.crossing_any(ip.values, subset);
+  const std::vector<std::uint32_t> order = visibility_order(c.mesh, c.table, view_of(c.camera), subset);
+  Framebuffer fb(kWidth, kHeight);
+  std::size_t polygons = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    fb.clear();
+    state.ResumeTiming();
+    IsoPainter painter(c.mesh, c.camera, kWidth, kHeight, c.corner, ip);
+    painter.draw(fb, order);
+    polygons = painter.polygons_drawn();
+    benchmark::DoNotOptimize(fb.rgba.data());
+  }
+  RenderParams rp;
+  rp.undoable = true;
+  IsoPainter counting(c.mesh, c.camera, kWidth, kHeight, c.corner, ip, rp);
+  fb.clear();
+  counting.draw(fb, order);
+  std::size_t covered = 0;
+  for (std::uint32_t id : fb.id) covered += id != kNone;
+  state.counters["polygons"] = double(polygons);
+  state.counters["covered_px"] = double(covered);
+  state.counters["ns_per_polygon"] =
+      benchmark::Counter(double(polygons), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.SetLabel(f == 0 ? "0.1%" : f == 1 ? "1%" : "10%");
+}
+
 void BM_iso_pruned(benchmark::State& state) { run(state, true); }
 void BM_iso_full_scan(benchmark::State& state) { run(state, false); }
 
 }  // namespace
 
+BENCHMARK(BM_iso_draw)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_iso_pruned)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_iso_full_scan)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
