@@ -14,6 +14,7 @@
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/field_subset.hpp"
 #include "foxi/viz/isosurface.hpp"
+#include "foxi/viz/picture.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/visibility_order.hpp"
@@ -456,6 +457,36 @@ TEST(IsoPainter, UndrawEqualsDrawingTheRestAfresh) {
   IsoPainter plain(m, cam, kW, kH, corner, ip);
   Framebuffer fb(kW, kH);
   EXPECT_THROW(plain.undraw(fb, 0), std::logic_error);
+}
+
+TEST(IsoPainter, DrawPictureDrawsIsoPolygonsAndAnExactEmptySubset) {
+  test::TempDir dir;
+  Mesh m = test::random_delaunay(dir, 800, 23);
+  const SphereTable table = compute_spheres(m);
+  const std::vector<double> corner = corner_values_of(m, nodal_of(m, sphere_field));
+  IsoDrawing iso{corner, {}, {}};
+  iso.params.values = {0.25, 0.4};
+  iso.params.scale.hi = 0.8;
+  std::vector<std::uint32_t> tets;
+  TetIntervals(corner).crossing_any(iso.params.values, tets);
+  const Camera cam = test::random_cameras(m, 1, 2, double(kW) / kH)[0];
+  PictureParams pp;
+  pp.subset = tets;
+  pp.subset_exact = true;
+  pp.iso = &iso;
+  Framebuffer a(kW, kH);
+  const PictureReport r = draw_picture(m, table, cam, a, pp);
+  EXPECT_EQ(r.tets_ordered, tets.size());
+  Framebuffer b(kW, kH);
+  IsoPainter painter(m, cam, kW, kH, corner, iso.params);
+  painter.draw(b, visibility_order(m, table, view_of(cam), tets));
+  EXPECT_EQ(a.rgba, b.rgba);
+  EXPECT_EQ(a.id, b.id);
+  // An exact empty selection draws nothing (not the whole mesh).
+  pp.subset = {};
+  const PictureReport none = draw_picture(m, table, cam, a, pp);
+  EXPECT_EQ(none.tets_ordered, 0u);
+  for (std::uint32_t id : a.id) ASSERT_EQ(id, kNone);
 }
 
 TEST(FieldSubset, ThresholdAndClipSelectByValueAndCentroid) {
