@@ -190,8 +190,8 @@ double sphere_field(const double* p) {
   return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
 }
 
-// Draws the polygons of `tets` for `params` in painter mode in visibility order (in batches of 37) and in
-// depth mode in a shuffled order.
+// Draws the polygons of `tets` for `params` in painter mode in the progressive visibility order of the
+// subset (in batches) and in depth mode in a shuffled order.
 std::pair<Framebuffer, Framebuffer> painter_and_depth(const Mesh& m, const SphereTable& table, const Camera& cam,
                                                       std::span<const double> corner, const IsoParams& params,
                                                       const std::vector<std::uint32_t>& tets,
@@ -200,9 +200,12 @@ std::pair<Framebuffer, Framebuffer> painter_and_depth(const Mesh& m, const Spher
   rp.edges = false;
   Framebuffer a(kW, kH);
   IsoPainter painter(m, cam, kW, kH, corner, params, rp, attr);
-  const std::vector<std::uint32_t> order = visibility_order(m, table, view_of(cam), tets);
-  for (std::size_t i = 0; i < order.size(); i += 37)
-    painter.draw(a, std::span<const std::uint32_t>(order).subspan(i, std::min<std::size_t>(37, order.size() - i)));
+  // Progressively: the ordering engine's subset mode hands out batches, each drawn in turn (and split
+  // further into batches of 37, as a viewer stopping at any point would).
+  ProgressiveOrder order(m, table, view_of(cam), tets);
+  for (auto batch = order.next(); !batch.empty(); batch = order.next())
+    for (std::size_t i = 0; i < batch.size(); i += 37)
+      painter.draw(a, batch.subspan(i, std::min<std::size_t>(37, batch.size() - i)));
   rp.depth_buffer = true;
   Framebuffer b(kW, kH, true);
   IsoPainter depth(m, cam, kW, kH, corner, params, rp, attr);
