@@ -413,6 +413,39 @@ TEST(IsoPainter, CapAndSliceEqualTheDepthBuffer) {
   EXPECT_EQ(total_differ, 0u);
 }
 
+TEST(IsoPainter, SeveralValuesInOneTetAreDrawnFarToNear) {
+  // One cube of 6 tets, f = z: the levels 0.3 and 0.6 cross every tet, one above the other. From
+  // above (looking down, the hot side) the 0.6 level is nearer; from below (the cold side) the 0.3.
+  Mesh m = test::grid_mesh(1, 1, 1, 1, 1, 1, 6);
+  const std::vector<double> corner = corner_values_of(m, nodal_of(m, [](const double* p) { return p[2]; }));
+  IsoParams ip;
+  ip.values = {0.6, 0.3};
+  ip.scale.map = ColorMapId::coolwarm;
+  std::vector<std::uint32_t> all(m.tet_count());
+  for (std::uint32_t t = 0; t < all.size(); ++t) all[t] = t;
+  const SphereTable table = compute_spheres(m);
+  double lo[3], hi[3];
+  mesh_bounds(m, lo, hi);
+  for (int below = 0; below < 2; ++below) {
+    // Straight down or up, in perspective: the nearer level's square hides the farther one's.
+    const double dir[3] = {0, 0, below ? 1.0 : -1.0}, up[3] = {0, 1, 0};
+    const Camera cam = fit_camera(lo, hi, dir, up, true, 30, double(kW) / kH);
+    auto [a, b] = painter_and_depth(m, table, cam, corner, ip, all);
+    EXPECT_EQ(a.rgba, b.rgba);
+    EXPECT_EQ(a.id, b.id);
+    const std::uint32_t colour = ip.scale.color(below ? 0.3 : 0.6);
+    std::size_t covered = 0, right = 0;
+    for (std::size_t p = 0; p < a.rgba.size(); ++p) {
+      if (a.id[p] == kNone) continue;
+      ++covered;
+      right += below ? scaled_from(a.rgba[p], colour, ip.cold_side * ip.shade_min, ip.cold_side)
+                     : scaled_from(a.rgba[p], colour, ip.shade_min, 1);
+    }
+    EXPECT_GT(covered, 3000u);
+    EXPECT_EQ(right, covered) << (below ? "from below" : "from above");
+  }
+}
+
 TEST(IsoPainter, UndrawEqualsDrawingTheRestAfresh) {
   test::TempDir dir;
   Mesh m = test::random_delaunay(dir, 1500, 17);

@@ -19,7 +19,6 @@ namespace foxi {
 namespace {
 
 constexpr int kMaxPoly = 10;
-constexpr int kMaxLevels = 16;  // isovalues drawn in one tet (IsoParams)
 
 // A polygon vertex on its way to the screen: world, camera coordinates and the attribute (the
 // scale position for graded colour).
@@ -211,29 +210,24 @@ struct IsoPainter::Impl {
     auto last = std::upper_bound(values.begin(), values.end(), hi);   // v <= hi
     if (first == last) return;
     const double* a = attr.empty() ? nullptr : &attr[4 * std::size_t(t)];
-    IsoPolygon polys[kMaxLevels];
-    double level[kMaxLevels];
-    int count = 0;
-    for (auto it = first; it != last && count < kMaxLevels; ++it) {
-      polys[count] = iso_polygon(*mesh, t, c, *it, a);
-      level[count] = *it;
-      if (polys[count].count > 0) ++count;
-    }
-    if (count == 0) return;
     // Levels of one linear field are parallel planes: if the eye sees their hot side the higher
-    // values are nearer, so ascending values go far to near; else descending.
+    // values are nearer, so ascending values go far to near; else descending. (An eye between two
+    // of them sees them on disjoint pixels: their order does not matter.)
+    IsoPolygon p = iso_polygon(*mesh, t, c, *first, a);
     Vert v0;
-    proj.to_camera(polys[0].xyz[0], v0.c);
-    const bool hot_seen = faces_eye(polys[0].hot, v0.c);
-    for (int k = 0; k < count; ++k) {
-      const IsoPolygon& p = polys[hot_seen ? k : count - 1 - k];
+    proj.to_camera(p.xyz[0], v0.c);
+    const bool ascending = faces_eye(p.hot, v0.c);
+    const std::ptrdiff_t n = last - first;
+    for (std::ptrdiff_t k = 0; k < n; ++k) {
+      const double value = ascending ? first[k] : first[n - 1 - k];
+      if (k > 0 || !ascending) p = iso_polygon(*mesh, t, c, value, a);
+      if (p.count == 0) continue;
       Vert v[4];
       for (int i = 0; i < p.count; ++i) {
         proj.to_camera(p.xyz[i], v[i].c);
         v[i].pos = a != nullptr ? params.scale.position(p.attr[i]) : 0;
       }
-      float rgb[3];
-      const double value = level[hot_seen ? k : count - 1 - k];
+      float rgb[3] = {0, 0, 0};
       if (a == nullptr) entry_rgb(value, rgb);
       float f = shade(p.hot, v[0].c);
       if (!faces_eye(p.hot, v[0].c)) f *= float(params.cold_side);

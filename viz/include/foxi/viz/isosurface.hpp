@@ -81,7 +81,7 @@ FOXI_API std::vector<std::uint32_t> crossing_scan(std::span<const double> corner
 
 // How iso polygons are drawn.
 struct IsoParams {
-  std::vector<double> values;  // the isovalues (SI), any order; at most 16 are drawn in any one tet
+  std::vector<double> values;  // the isovalues (SI), any order
   // Each isovalue's colour is scale.color(v); with an attribute (IsoPainter's attr) the polygon is
   // coloured per pixel by the attribute's position on the scale instead (a slice coloured by a field).
   ColorScale scale;
