@@ -11,6 +11,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "field_options.hpp"
+#include "iso_options.hpp"
 #include "mesh_input.hpp"
 #include "render_options.hpp"
 #include "foxi/model/durable_file.hpp"
@@ -29,11 +30,12 @@ const std::string kRenderUsage = std::string(
     "foxi render MESH [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z] [--size WxH]\n"
     "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges]\n"
     "                 [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
-    "                 [--legend on|off] [--markers]] -o OUT.png\n"
+    "                 [--legend on|off] [--markers] [--iso v1,v2,... [--iso-only]] [--threshold a,b]\n"
+    "                 [--clip px,py,pz,nx,ny,nz] [--slice px,py,pz,nx,ny,nz]] -o OUT.png\n"
     "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
     "  faces flat-shaded in its region's colour (or a field's) with the mesh edges darkened (no depth\n"
     "  buffer).\n") +
-    kPictureOptionsHelp + kFieldOptionsHelp +
+    kPictureOptionsHelp + kFieldOptionsHelp + kIsoOptionsHelp +
     "  (--size defaults to 1280x960)\n"
     "  --stop P%       draw only the first P percent of the back-to-front order (the far part)\n"
     "  --depth d       stop at the first tet whose power distance from the eye, sqrt(|eye-c|^2-r^2)\n"
@@ -63,6 +65,7 @@ int cmd_render(Args args) {
   const bool zbuffer = args.flag("--zbuffer");
   PictureOptions options = take_picture_options(args, "1280x960");
   const FieldOptions field_options = take_field_options(args);
+  const IsoOptions iso_options = take_iso_options(args, field_options);
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
   check_output_path(out);
@@ -101,7 +104,14 @@ int cmd_render(Args args) {
       picture = resolve_picture(options, mesh);
     }
   }
-  const std::vector<std::uint32_t>& subset = picture.subset;
+  // Isosurfaces, slices and subsets by the field: the tets to order instead of the picture's subset.
+  IsoPicture iso;
+  if (iso_options.any()) {
+    iso = resolve_iso(iso_options, mesh, field, picture.subset);
+    field.legend.marks = iso.iso_si;
+  }
+  const std::vector<std::uint32_t>& subset = iso_options.any() ? iso.subset : picture.subset;
+  const IsoDrawing iso_drawing{iso.corner, iso.attr, iso.params};
   const Camera& camera = picture.camera;
 
   auto t0 = std::chrono::steady_clock::now();
@@ -111,6 +121,8 @@ int cmd_render(Args args) {
   pp.render = params;
   pp.render.depth_buffer = zbuffer;
   pp.subset = subset;
+  pp.subset_exact = iso_options.any();
+  if (iso.polygons) pp.iso = &iso_drawing;
   pp.stop_fraction = stop;
   pp.stop_depth = depth_stop;
   width = options.width;
@@ -166,6 +178,24 @@ int cmd_render(Args args) {
                 : field.range_centred ? " (symmetric about 0 for the diverging map)"
                                       : "");
     if (field.no_value > 0) std::printf(", %zu values NaN (grey)", field.no_value);
+    if (!iso_options.iso.empty()) {
+      std::printf("\niso         ");
+      for (std::size_t i = 0; i < iso.iso_si.size(); ++i) std::printf("%s%s", i ? ", " : "", shown(iso.iso_si[i]).c_str());
+      std::printf(": %zu tets crossed (interval tree %.1f ms, query %.2f ms), %s", iso.crossing, iso.build_ms,
+                  iso.query_ms,
+                  iso.params.cap ? "drawn as the solid above the lowest value, cut at its isosurface"
+                                 : "isosurfaces alone, the side toward higher values brighter");
+    }
+    if (iso_options.has_threshold)
+      std::printf("\nthreshold   values in [%g, %g] %s", iso_options.threshold[0], iso_options.threshold[1], u.symbol.c_str());
+    if (iso_options.clip)
+      std::printf("\nclip        whole tets behind the plane through (%g, %g, %g), normal (%g, %g, %g)",
+                  iso_options.clip->p[0], iso_options.clip->p[1], iso_options.clip->p[2], iso_options.clip->n[0],
+                  iso_options.clip->n[1], iso_options.clip->n[2]);
+    if (iso_options.slice)
+      std::printf("\nslice       plane through (%g, %g, %g), normal (%g, %g, %g): %zu tets cut",
+                  iso_options.slice->p[0], iso_options.slice->p[1], iso_options.slice->p[2], iso_options.slice->n[0],
+                  iso_options.slice->n[1], iso_options.slice->n[2], iso.crossing);
     if (field_options.legend)
       std::printf("\nlegend      %d pixels at the right, font %s", panel, text->font_file().c_str());
     if (field_options.markers)

@@ -102,5 +102,37 @@ TEST(Legend, TooSmallAnAreaIsRefused) {
   EXPECT_THROW(draw_color_legend(low, text, l, PixelRect{0, 0, w - 1, h - 2}), std::invalid_argument);
 }
 
+TEST(Legend, MarksCrossTheBarAtTheirValuesRow) {
+  const TextRenderer text(find_font_file());
+  ColorLegend l;
+  l.title = "temperature";
+  l.unit = *display_unit("K", "degC");
+  l.scale.lo = 300;
+  l.scale.hi = 380;
+  l.marks = {320, 350.5, 290, 379};  // 290 is outside the range: left out
+  const int w = legend_width(text, l);
+  Framebuffer fb(w, 400);
+  const LegendReport r = draw_color_legend(fb, text, l, PixelRect{0, 0, w - 1, 399});
+  ASSERT_EQ(r.mark_rows.size(), 3u);
+  const double in_range[3] = {320, 350.5, 379};
+  for (int i = 0; i < 3; ++i) {
+    // The row a mark crosses is the bar's row of the value's colour, within one row.
+    const double t = l.scale.position(in_range[i]);
+    EXPECT_NEAR(r.mark_rows[std::size_t(i)], r.bar.y1 - t * (r.bar.y1 - r.bar.y0), 1.0);
+    for (int x = r.bar.x0; x <= r.bar.x1; ++x)
+      EXPECT_EQ(fb.rgba[fb.index(x, r.mark_rows[std::size_t(i)])], pack_rgba(0, 0, 0));
+    EXPECT_EQ(fb.rgba[fb.index(r.bar.x0 - 2, r.mark_rows[std::size_t(i)])], pack_rgba(0, 0, 0));  // the pointer
+  }
+  // Rows away from marks and ticks keep the map's colour.
+  int plain = 0;
+  for (int y = r.bar.y0; y <= r.bar.y1; ++y) {
+    bool near_mark = false;
+    for (int m : r.mark_rows) near_mark |= std::abs(m - y) <= 3;
+    if (!near_mark && fb.rgba[fb.index(r.bar.x0, y)] == l.scale.color_at(double(r.bar.y1 - y) / (r.bar.y1 - r.bar.y0)))
+      ++plain;
+  }
+  EXPECT_GT(plain, (r.bar.y1 - r.bar.y0) * 3 / 4);
+}
+
 }  // namespace
 }  // namespace foxi

@@ -141,6 +141,21 @@ LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const 
     // The label centred on its tick: baseline half the digits' height below it.
     r.labels.push_back(text.draw(fb, s, r.bar.x1 + 7, row + (e.ascent + 1) / 2, fs, p.text_color));
   }
+  // Marks: a line across the bar and a pointer in the margin at its left, at the value's row (the
+  // bar's row of position t is the one that shows t's colour).
+  for (double v : l.marks) {
+    const double t = l.scale.position(v);
+    if (!(t >= 0 && t <= 1)) continue;
+    const int row = bar_bottom - int(std::lround(t * double(bar_h - 1)));
+    r.mark_rows.push_back(row);
+    for (int k = r.bar.x0; k <= r.bar.x1; ++k) fb.rgba[fb.index(k, row)] = p.text_color;
+    for (int dy = -3; dy <= 3; ++dy) {
+      const int yy = row + dy;
+      if (yy < area.y0 || yy > area.y1) continue;
+      for (int k = r.bar.x0 - 2 - (3 - std::abs(dy)); k <= r.bar.x0 - 2; ++k)
+        if (k >= area.x0) fb.rgba[fb.index(k, yy)] = p.text_color;
+    }
+  }
   y = bar_bottom + fs / 2 + line;
   text.draw(fb, range_line(l), x, y, fs, p.text_color);
   text.draw(fb, map_line(l), x, y + line, fs, pack_rgba(90, 90, 90));

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "foxi/viz/depth_stop.hpp"
+#include "foxi/viz/isosurface.hpp"
 #include "foxi/viz/visibility_order.hpp"
 
 namespace foxi {
@@ -48,8 +49,10 @@ PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Cam
   report.certificate_ms = ms_since(t0);
 
   t0 = std::chrono::steady_clock::now();
+  const bool none = params.subset_exact && params.subset.empty();
   const std::vector<std::uint32_t> order =
-      safe_order(mesh, table, view_of(camera), params.subset, &report.method, &report.cycles_broken);
+      none ? std::vector<std::uint32_t>()
+           : safe_order(mesh, table, view_of(camera), params.subset, &report.method, &report.cycles_broken);
   report.order_ms = ms_since(t0);
   report.tets_ordered = order.size();
   std::size_t count =
@@ -67,10 +70,16 @@ PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Cam
   report.depth_buffer = rp.depth_buffer;
   t0 = std::chrono::steady_clock::now();
   fb.resize(fb.width, fb.height, rp.depth_buffer);
-  TetRasterizer raster(mesh, camera, fb.width, fb.height, rp);
-  raster.draw(fb, std::span<const std::uint32_t>(order).first(count));
+  if (params.iso != nullptr) {  // each tet's iso polygons (or slice) at its place in the order
+    IsoPainter painter(mesh, camera, fb.width, fb.height, params.iso->corner, params.iso->params, rp,
+                       params.iso->attr);
+    painter.draw(fb, std::span<const std::uint32_t>(order).first(count));
+  } else {
+    TetRasterizer raster(mesh, camera, fb.width, fb.height, rp);
+    raster.draw(fb, std::span<const std::uint32_t>(order).first(count));
+    report.raster = raster.stats();
+  }
   report.draw_ms = ms_since(t0);
-  report.raster = raster.stats();
   return report;
 }
 

@@ -19,6 +19,9 @@ struct ColorLegend {
   std::string title;  // the field ("temperature")
   DisplayUnit unit;   // ticks and range are shown in it
   ColorScale scale;   // SI, as the picture uses it
+  // Values marked on the bar (SI; the isovalues of a picture): a dark line across the bar with a pointer
+  // at its left; values outside the range are left out.
+  std::vector<double> marks;
 };
 
 struct LegendParams {
@@ -34,6 +37,7 @@ struct LegendReport {
   std::vector<int> tick_rows;     // the row of each tick on the bar
   std::vector<PixelRect> labels;  // each tick label's ink box
   PixelRect bar;                  // the bar's pixels
+  std::vector<int> mark_rows;     // the row of each mark drawn (ColorLegend::marks in the range), in order
   PixelRect rect;                 // all the legend drew (its area)
 };
 

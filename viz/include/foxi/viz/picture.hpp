@@ -22,6 +22,8 @@
 
 namespace foxi {
 
+struct IsoDrawing;  // isosurface.hpp
+
 // How a back-to-front order was made.
 enum class OrderMethod : std::uint8_t {
   power,  // the power-function visibility order (a visibility order for a certified mesh)
@@ -45,6 +47,12 @@ struct PictureParams {
   // on a certified mesh too (the oracle); an uncertified mesh always gets it. undoable is ignored.
   RenderParams render;
   std::span<const std::uint32_t> subset;  // tets to draw (each at most once); empty: all
+  // The subset is the selection even when empty: an empty one then orders and draws nothing (a
+  // threshold or an isovalue that selects no tet).
+  bool subset_exact = false;
+  // Iso polygons or a slice (isosurface.hpp) instead of whole tets: the ordered tets are handed to an
+  // IsoPainter with these inputs (lent, must outlive the call); null: the tet painter.
+  const IsoDrawing* iso = nullptr;
   // Draw only the first floor(stop_fraction n + 1e-9) tets of the back-to-front order of n tets, in [0, 1].
   double stop_fraction = 1;
   // And stop before the first tet whose depth (depth_stop.hpp) is below this; -infinity: no depth stop.
