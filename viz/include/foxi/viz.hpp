@@ -20,10 +20,12 @@
 //   ColorScale, color_map_entry, nice_ticks    colour maps, ranges, colour-bar ticks (colormap.hpp)
 //   TextRenderer, find_font_file               text in pictures with FreeType (text.hpp)
 //   draw_color_legend, legend_width            a colour-bar legend drawn into a picture (legend.hpp)
+//   draw_chart, Chart, axis_ticks              line charts: series, log axes, legend (chart.hpp)
 #pragma once
 
 #include "foxi/viz/animation.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/chart.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/depth_stop.hpp"
 #include "foxi/viz/field_paint.hpp"
