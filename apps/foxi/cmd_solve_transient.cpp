@@ -1,6 +1,7 @@
 // foxi solve MODEL --physics transient ...: transient heat conduction (foxi/solver/transient.hpp);
 // the temperature of every written step as OUT_NNNN.vtu with the OUT.pvd collection, and the
-// junction temperatures and Zth(t) against time as OUT_junction.csv.
+// junction temperatures and Zth(t) against time as OUT_junction.csv, drawn as OUT_zth.png, and the
+// structure function (transient_charts.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,6 +22,7 @@
 #include "model_run.hpp"
 #include "run_results.hpp"
 #include "solve_options.hpp"
+#include "transient_charts.hpp"
 
 namespace foxi::cli {
 
@@ -39,7 +41,13 @@ const char* kTransientUsage =
     "  --time. A table is CSV 'time_s,power_W' (linear between rows).\n"
     "  Writes OUT_NNNN.vtu every K steps (and the last; default K = steps / 100, at least 1) with\n"
     "  OUT.pvd, and OUT_junction.csv: time, power and per powered region (a junction) its maximum\n"
-    "  temperature and, for a step power, Zth(t) = (Tj(t) - Tj(0)) / P in K/W.";
+    "  temperature and, for a step power, Zth(t) = (Tj(t) - Tj(0)) / P in K/W; OUT_zth.png draws\n"
+    "  Zth against log time and Tj against time (OUT_tj.png, Tj alone, when no power is a step: Zth\n"
+    "  is defined for a step only). With one powered region and a step, the cumulative structure\n"
+    "  function (JESD51-14: Zth fitted by a time-constant spectrum, Foster -> Cauer ladder; cumulative\n"
+    "  thermal capacitance against cumulative thermal resistance from the junction) goes to\n"
+    "  OUT_structure.csv (stage, R, C, cumulative R, cumulative C) and OUT_structure.png. Run to the\n"
+    "  steady state (--time several times the slowest time constant) for the whole heat path.";
 
 PowerWaveform parse_waveform(const std::string& text) {
   const auto colon = text.find(':');
@@ -138,6 +146,7 @@ int cmd_solve_transient(Args args) {
   const bool from_model = is_model_path(files[0]);
   if (!from_model && !sets.empty()) throw UsageError("--set is for model files (MODEL.toml)");
   silence_text_for_json(json);
+  const TextRenderer text(find_font_file());  // before the work: a missing font fails at once
   const auto t0 = std::chrono::steady_clock::now();
   MeshedModel model_run;
   if (from_model) model_run = mesh_model_for_solve(files[0], sets, "thermal");
@@ -252,6 +261,16 @@ int cmd_solve_transient(Args args) {
     f.write(csv);
     f.commit();
   }
+  std::vector<JunctionCurve> curves;
+  for (std::size_t j = 0; j < params.junctions.size(); ++j) {
+    const PowerWaveform& w = params.power[j].power;
+    curves.push_back({region_name(mesh, params.junctions[j]),
+                      w.kind == PowerWaveform::Kind::step    ? "step"
+                      : w.kind == PowerWaveform::Kind::pulse ? "pulse"
+                                                             : "table",
+                      w.kind == PowerWaveform::Kind::step ? w.power : 0.0, r.junction_temperature[j]});
+  }
+  const std::vector<BalanceCheck> chart_checks = write_transient_charts(stem, r.times, curves, text);
   {
     std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
     for (const auto& [time, path] : written)
@@ -273,6 +292,7 @@ int cmd_solve_transient(Args args) {
   res.model = files[0];
   res.parameters = run_parameters(sets);
   res.checks = r.checks;
+  res.checks.insert(res.checks.end(), chart_checks.begin(), chart_checks.end());
   res.status = all_passed(r.checks) ? RunStatus::ok : RunStatus::unreliable;
   for (std::size_t j = 0; j < params.junctions.size(); ++j) {
     const std::string n = region_name(mesh, params.junctions[j]);

@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <sstream>
 #include <string>
+
+#include "foxi/viz/png.hpp"
 
 #include "test_util.hpp"
 
@@ -68,6 +71,58 @@ TEST(TransientCli, MissingTimeIsAUsageError) {
   EXPECT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --steps 4 -o " +
                               (dir / "r.pvd").string(), dir / "log"),
             kUsage);
+}
+
+// The charts and the structure function: OUT_zth.png two charts high, OUT_structure.csv whose
+// cumulative sums add up its stages and whose total resistance is the Zth at the end of the CSV
+// (the run reaches the steady state) to 1 %; a pulse gets no Zth, no structure function and says so.
+TEST(TransientCli, ZthChartAndStructureFunction) {
+  test::TempDir dir;
+  const std::string out = (dir / "run.pvd").string();
+  ASSERT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 100s "
+                          "--steps 200 --write-every 200 -o " + out, dir / "solve.log"), 0)
+      << test::read_text(dir / "solve.log");
+  const Framebuffer png = read_png(dir / "run_zth.png");
+  EXPECT_EQ(png.height, 2 * 440);
+  std::istringstream junction(test::read_text(dir / "run_junction.csv")), structure(test::read_text(dir / "run_structure.csv"));
+  std::string line, last;
+  std::getline(junction, line);
+  EXPECT_EQ(line, "time_s,power_W,Tj[die]_K,Zth[die]_K/W");
+  while (std::getline(junction, line)) last = line;
+  const double zth_end = std::stod(last.substr(last.rfind(',') + 1));
+  std::getline(structure, line);
+  EXPECT_EQ(line, "stage,R_K/W,C_J/K,cumulative_R_K/W,cumulative_C_J/K");
+  double sum_r = 0, sum_c = 0;
+  int stages = 0;
+  while (std::getline(structure, line)) {
+    double v[5];
+    std::istringstream row(line);
+    for (double& x : v) {
+      std::string field;
+      std::getline(row, field, ',');
+      x = std::stod(field);
+    }
+    EXPECT_EQ(v[0], ++stages);
+    EXPECT_GT(v[1], 0);
+    EXPECT_GT(v[2], 0);
+    sum_r += v[1], sum_c += v[2];
+    EXPECT_NEAR(v[3], sum_r, 1e-6 * sum_r);
+    EXPECT_NEAR(v[4], sum_c, 1e-6 * sum_c);
+  }
+  EXPECT_GE(stages, 2);
+  EXPECT_NEAR(sum_r, zth_end, 0.01 * zth_end);
+  const std::string log = test::read_text(dir / "solve.log");
+  EXPECT_NE(log.find("check Zth fit        ok"), std::string::npos) << log;
+
+  ASSERT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 4s "
+                          "--steps 8 --power die=pulse:1W,1s,2s -o " + (dir / "p.pvd").string(), dir / "pulse.log"), 0)
+      << test::read_text(dir / "pulse.log");
+  const std::string plog = test::read_text(dir / "pulse.log");
+  EXPECT_NE(plog.find("Zth(t) of die: not computed: Zth is defined for a step of power, and its power is a pulse"),
+            std::string::npos) << plog;
+  EXPECT_TRUE(std::filesystem::exists(dir / "p_tj.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "p_zth.png"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "p_structure.csv"));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 //   joule_heat_sources(report)                 the Joule heat of a current solve, for thermal (electric.hpp)
 //   solve_transient_thermal(mesh, params)      transient heat: BDF2/Euler steps, junction T(t) (transient.hpp)
 //   read_power_table(path)                     a CSV power waveform (time, W) (transient.hpp)
+//   structure_function(t, zth)                 Zth(t) -> Foster fit -> Cauer ladder, cumulative R, C (structure_function.hpp)
 //   solve_thermoelastic(mesh, params)          thermal stress: displacements, stresses (thermoelastic.hpp)
 //   thermal_params_from_model(model, mesh)     a model's conditions as solver parameters; also
 //     electrostatic_, current_, thermoelastic_params_from_model (model_problem.hpp)
@@ -21,6 +22,7 @@
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/solver/solver.hpp"
+#include "foxi/solver/structure_function.hpp"
 #include "foxi/solver/thermal.hpp"
 #include "foxi/solver/thermoelastic.hpp"
 #include "foxi/solver/transient.hpp"

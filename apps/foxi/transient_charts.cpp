@@ -1,0 +1,136 @@
+// See transient_charts.hpp.
+#include "transient_charts.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "foxi/model/durable_file.hpp"
+#include "foxi/solver/structure_function.hpp"
+#include "foxi/viz/chart.hpp"
+#include "foxi/viz/png.hpp"
+
+namespace foxi::cli {
+
+namespace {
+
+constexpr int kChartWidth = 820, kChartHeight = 440;
+
+std::string number(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+}  // namespace
+
+std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const std::vector<double>& times,
+                                                 const std::vector<JunctionCurve>& junctions,
+                                                 const TextRenderer& text) {
+  std::vector<BalanceCheck> checks;
+  Chart zth, tj;
+  zth.title = "Thermal impedance Zth(t) = (Tj(t) - Tj(0)) / P";
+  zth.x = {"time", "s", true};
+  zth.y = {"Zth", "K/W"};
+  tj.title = "Junction temperature";
+  tj.x = {"time", "s"};
+  tj.y = {"Tj (max over the region)", "K"};
+  std::vector<const JunctionCurve*> stepped;
+  for (std::size_t j = 0; j < junctions.size(); ++j) {
+    const JunctionCurve& c = junctions[j];
+    tj.series.push_back({c.name, times, c.tj, chart_color(j)});
+    if (c.waveform == "step" && c.step_power != 0) {
+      ChartSeries s{c.name, {}, {}, chart_color(j)};
+      for (std::size_t i = 1; i < times.size(); ++i) {  // t = 0 has no place on a log axis
+        s.x.push_back(times[i]);
+        s.y.push_back((c.tj[i] - c.tj[0]) / c.step_power);
+      }
+      zth.series.push_back(std::move(s));
+      stepped.push_back(&c);
+    } else {
+      std::printf("Zth(t) of %s: not computed: Zth is defined for a step of power, and its power is %s\n",
+                  c.name.c_str(), c.waveform == "step" ? "zero" : ("a " + c.waveform).c_str());
+    }
+  }
+  const bool with_zth = !zth.series.empty();
+  const std::string picture = stem + (with_zth ? "_zth.png" : "_tj.png");
+  {
+    Framebuffer fb(kChartWidth, with_zth ? 2 * kChartHeight : kChartHeight);
+    int top = 0;
+    if (with_zth) {
+      draw_chart(fb, text, zth, PixelRect{0, 0, kChartWidth - 1, kChartHeight - 1});
+      top = kChartHeight;
+    }
+    draw_chart(fb, text, tj, PixelRect{0, top, kChartWidth - 1, top + kChartHeight - 1});
+    write_png(picture, fb);
+  }
+  std::printf("wrote %s (%s)\n", picture.c_str(),
+              with_zth ? "Zth against log time, Tj against time" : "Tj against time");
+
+  if (stepped.empty()) return checks;
+  if (junctions.size() != 1) {
+    std::printf("structure function: not computed: %zu regions are powered (it describes the heat path of "
+                "one source; each heats the others' junctions)\n",
+                junctions.size());
+    return checks;
+  }
+  const JunctionCurve& c = *stepped.front();
+  std::vector<double> t, z;
+  for (std::size_t i = 1; i < times.size(); ++i) {
+    t.push_back(times[i]);
+    z.push_back((c.tj[i] - c.tj[0]) / c.step_power);
+  }
+  if (t.size() < 3) {
+    std::printf("structure function: not computed: %zu time steps (at least 3 are needed)\n", t.size());
+    return checks;
+  }
+  const StructureFunction sf = structure_function(t, z);
+  const double zend = std::abs(z.back());
+  checks.push_back(make_check("Zth fit", "largest error of the Foster fit of Zth(t), relative to Zth(end)",
+                              zend > 0 ? sf.fit.max_error / zend : NAN, 0.01));
+  {
+    std::string csv = "stage,R_K/W,C_J/K,cumulative_R_K/W,cumulative_C_J/K\n";
+    for (std::size_t i = 0; i < sf.cauer.size(); ++i)
+      csv += std::to_string(i + 1) + ',' + number(sf.cauer[i].r) + ',' + number(sf.cauer[i].c) + ',' +
+             number(sf.cumulative_r[i]) + ',' + number(sf.cumulative_c[i]) + '\n';
+    DurableFile f(stem + "_structure.csv");
+    f.write(csv);
+    f.commit();
+  }
+  {
+    // The staircase: C_sum(R) is cumulative_c[i] on [cumulative_r[i-1], cumulative_r[i]).
+    Chart s;
+    s.title = "Cumulative structure function of " + c.name;
+    s.x = {"cumulative thermal resistance", "K/W"};
+    s.y = {"cumulative thermal capacitance", "J/K", true};
+    ChartSeries st{"", {}, {}, chart_color(0)};
+    for (std::size_t i = 0; i < sf.cumulative_r.size(); ++i) {
+      st.x.push_back(i == 0 ? 0.0 : sf.cumulative_r[i - 1]);
+      st.y.push_back(sf.cumulative_c[i]);
+      st.x.push_back(sf.cumulative_r[i]);
+      st.y.push_back(sf.cumulative_c[i]);
+    }
+    s.series.push_back(std::move(st));
+    Framebuffer fb(kChartWidth, kChartHeight + 60);
+    draw_chart(fb, text, s, PixelRect{0, 0, kChartWidth - 1, kChartHeight + 59});
+    write_png(stem + "_structure.png", fb);
+  }
+  std::printf("structure function of %s: %zu Cauer stages from %zu Foster terms (time constants %.3g s to "
+              "%.3g s), total R %.6g K/W against Zth(end) %.6g K/W, C at the junction %.4g J/K; Foster fit "
+              "error %.3g K/W at most (%.2g %% of Zth(end))\n",
+              c.name.c_str(), sf.cauer.size(), sf.fit.terms.size(),
+              sf.fit.terms.empty() ? NAN : sf.fit.terms.front().tau,
+              sf.fit.terms.empty() ? NAN : sf.fit.terms.back().tau,
+              sf.cumulative_r.empty() ? NAN : sf.cumulative_r.back(), z.back(),
+              sf.cauer.empty() ? NAN : sf.cauer.front().c, sf.fit.max_error,
+              zend > 0 ? 100 * sf.fit.max_error / zend : NAN);
+  if (sf.settled > 0.01)
+    std::printf("note: Zth still rose %.1f %% over the last tenth of the log time: the heat has not reached the "
+                "ambient, so the structure function ends early (its last stages stand for what is beyond); "
+                "run longer (--time) for the whole path\n",
+                100 * sf.settled);
+  std::printf("wrote %s_structure.csv and %s_structure.png (cumulative C against cumulative R)\n", stem.c_str(),
+              stem.c_str());
+  return checks;
+}
+
+}  // namespace foxi::cli

@@ -1,0 +1,31 @@
+// The charts and the structure function of foxi solve --physics transient (issue 18): Zth(t) on a
+// log time axis and Tj(t) as OUT_zth.png, and, for one junction heated by a step of power, the
+// cumulative structure function (foxi/solver/structure_function.hpp) as OUT_structure.csv and
+// OUT_structure.png.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "foxi/solver/solver.hpp"
+#include "foxi/viz/text.hpp"
+
+namespace foxi::cli {
+
+struct JunctionCurve {
+  std::string name;          // the region
+  std::string waveform;      // "step", "pulse", "table"
+  double step_power = 0;     // W, for a step (else 0)
+  std::vector<double> tj;    // K at each time
+};
+
+// Zth is (Tj(t) - Tj(0)) / P for a step of P != 0 only: a junction with another waveform gets no
+// Zth (a line says so) and, when no junction has a step, the picture is OUT_tj.png with Tj(t) alone.
+// The structure function needs exactly one powered junction with a step (several sources heat each
+// other's junctions, so no single path is described; a line says so). Prints what it wrote and
+// returns the check of the Foster fit (its largest error against Zth(end)) when it made one.
+std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const std::vector<double>& times,
+                                                 const std::vector<JunctionCurve>& junctions,
+                                                 const TextRenderer& text);
+
+}  // namespace foxi::cli
