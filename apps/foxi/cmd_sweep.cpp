@@ -1,5 +1,6 @@
-// foxi sweep MODEL --vary NAME=LO:HI:N [--vary ...] --physics P [--jobs N] -o sweep.csv [--json [FILE]]:
-// the model solved at every combination of parameter values, one CSV row per run.
+// foxi sweep MODEL --vary NAME=LO:HI:N [--vary ...] --physics P [--jobs N] -o sweep.csv [--plot sweep.png]
+// [--json [FILE]]: the model solved at every combination of parameter values, one CSV row per run, and
+// the key results drawn against the first varied parameter.
 //
 // Each run is a `foxi solve MODEL --set NAME=VALUE ... --json FILE` child process: runs are isolated
 // (a crash or an exhausted memory is that run's failed row, not the sweep's end), run in parallel up
@@ -10,6 +11,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -21,6 +25,8 @@
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/units.hpp"
+#include "foxi/viz/chart.hpp"
+#include "foxi/viz/png.hpp"
 #include "model_run.hpp"
 #include "run_results.hpp"
 #include "solve_options.hpp"
@@ -31,7 +37,8 @@ namespace {
 
 const char* kSweepUsage =
     "foxi sweep MODEL.toml --vary NAME=LO:HI:N [--vary ...] [--physics thermal|electrostatic|current|\n"
-    "           thermoelastic] [--jobs N] -o SWEEP.csv [--json [FILE.json]] [--set NAME=VALUE]...\n"
+    "           thermoelastic] [--jobs N] -o SWEEP.csv [--plot SWEEP.png] [--json [FILE.json]]\n"
+    "           [--set NAME=VALUE]...\n"
     "           [--theta J:R]... [--solver S] [--tol REL] [--max-tets N] [--threads N]\n"
     "           [-- FOXI SOLVE OPTIONS...]\n"
     "  Solves the model at every combination of the varied parameters (a grid: the product of the\n"
@@ -45,6 +52,10 @@ const char* kSweepUsage =
     "                       NAME=V1,V2,... (die_w=2mm,3mm,5mm). NAME is one of the model's [parameters].\n"
     "  --jobs N             runs at once (default: the cores); each run's solver gets cores / N\n"
     "                       threads unless --threads says otherwise\n"
+    "  --plot SWEEP.png     one chart per key result (the CSV's result columns, in their order; two\n"
+    "                       charts to a row, each 600 x 380 pixels) against the first varied\n"
+    "                       parameter, in its unit; with more --vary, one series per combination of\n"
+    "                       the others; a failed run's point is left out\n"
     "  --json [FILE.json]   every run's whole record (foxi solve --json) as one JSON array, on stdout\n"
     "                       or in FILE\n"
     "  --set, --theta, --solver, --tol, --max-tets, --threads go to every run as in foxi solve, and\n"
@@ -57,6 +68,8 @@ struct Varied {
   std::vector<std::string> texts;  // as given to --set
   std::vector<double> si;          // their SI values
   std::string si_unit;             // "m", "W", "" (dimensionless)
+  std::string unit;                // the unit the values are written in ("mm"; the first value's)
+  double unit_si = 1;              // its SI value
 };
 
 // The SI value and unit text of a value with units ("2mm" -> 0.002, "m").
@@ -104,6 +117,7 @@ Varied parse_vary(const std::string& spec) {
     const double unit_si = unit.empty() ? 1 : quantity("1 " + unit, option).value;
     if (!(unit_si != 0) || !std::isfinite(unit_si))
       throw UsageError(option + ": cannot write values in '" + unit + "'");
+    v.unit = unit, v.unit_si = unit_si;
     for (std::int32_t i = 0; i < n; ++i) {
       const double si = n == 1 ? lo.value : lo.value + (hi.value - lo.value) * i / (n - 1);
       char text[64];
@@ -128,6 +142,16 @@ Varied parse_vary(const std::string& spec) {
       at = comma + 1;
     }
     v.si_unit = dims_to_string(dims);
+    // The chart's unit: the first value's, when it converts (else SI).
+    const std::string unit = unit_suffix(v.texts.front());
+    double unit_si = 1;
+    try {
+      unit_si = unit.empty() ? 1 : quantity("1 " + unit, option).value;
+    } catch (const UsageError&) {
+      unit_si = 0;
+    }
+    if (unit_si != 0 && std::isfinite(unit_si)) v.unit = unit, v.unit_si = unit_si;
+    else v.unit = v.si_unit;
   }
   if (v.si_unit == "1") v.si_unit.clear();
   return v;
@@ -146,6 +170,51 @@ std::string number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
+}
+
+constexpr int kPlotWidth = 600, kPlotHeight = 380;  // one chart (the usage text says so)
+
+// The sweep's charts: one per result column, against the first varied parameter.
+void write_sweep_plot(const std::string& path, const TextRenderer& text, const std::vector<Varied>& varied,
+                      const std::vector<std::pair<std::string, std::string>>& columns,
+                      const std::vector<RunResults>& results,
+                      const std::function<std::vector<std::size_t>(std::size_t)>& combination) {
+  const std::size_t charts = std::max<std::size_t>(1, columns.size()), across = charts > 1 ? 2 : 1;
+  const std::size_t rows = (charts + across - 1) / across;
+  Framebuffer fb(int(across) * kPlotWidth, int(rows) * kPlotHeight);
+  const Varied& x = varied.front();
+  // The other parameters' combinations: one series each (one unnamed series for a single --vary).
+  std::size_t others = 1;
+  for (std::size_t i = 1; i < varied.size(); ++i) others *= varied[i].texts.size();
+  for (std::size_t k = 0; k < charts; ++k) {
+    Chart c;
+    if (!columns.empty()) {
+      c.title = columns[k].first;
+      c.y = {columns[k].first, columns[k].second};
+    } else {
+      c.title = "no results";
+    }
+    c.x = {x.name, x.unit};
+    c.series.resize(others);
+    for (std::size_t run = 0; run < results.size(); ++run) {
+      const auto idx = combination(run);
+      std::size_t series = 0;
+      std::string name;
+      for (std::size_t i = 1; i < varied.size(); ++i) {
+        series = series * varied[i].texts.size() + idx[i];
+        name += (i > 1 ? ", " : "") + varied[i].name + "=" + varied[i].texts[idx[i]];
+      }
+      ChartSeries& s = c.series[series];
+      s.name = name;
+      s.markers = true;
+      s.x.push_back(x.si[idx[0]] / x.unit_si);
+      const ResultValue* v = columns.empty() ? nullptr : results[run].find(columns[k].first);
+      s.y.push_back(v != nullptr && results[run].status != RunStatus::failed ? v->value : NAN);
+    }
+    const int x0 = int(k % across) * kPlotWidth, y0 = int(k / across) * kPlotHeight;
+    draw_chart(fb, text, c, PixelRect{x0, y0, x0 + kPlotWidth - 1, y0 + kPlotHeight - 1});
+  }
+  write_png(path, fb);
 }
 
 }  // namespace
@@ -177,6 +246,9 @@ int cmd_sweep(Args args) {
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
   if (out.empty()) throw UsageError("foxi sweep needs -o SWEEP.csv");
+  const std::string plot = args.option("--plot", "");
+  if (!plot.empty() && std::filesystem::path(plot).extension() != ".png")
+    throw UsageError("--plot writes a PNG picture: give --plot FILE.png, not '" + plot + "'");
   JsonOutput json = json_option(args);
   // passed to every run as given
   std::vector<std::string> pass;
@@ -196,6 +268,10 @@ int cmd_sweep(Args args) {
   if (!is_model_path(model))
     throw UsageError("foxi sweep takes a model file (MODEL.toml), not '" + model + "'");
   check_output_path(out);
+  if (!plot.empty()) check_output_path(plot);
+  // Before the runs: a missing font fails at once.
+  std::unique_ptr<TextRenderer> text;
+  if (!plot.empty()) text = std::make_unique<TextRenderer>(find_font_file());
 
   // Every combination, the last --vary fastest.
   std::size_t total = 1;
@@ -277,40 +353,45 @@ int cmd_sweep(Args args) {
       if (v.key &&
           std::none_of(columns.begin(), columns.end(), [&](const auto& c) { return c.first == v.name; }))
         columns.emplace_back(v.name, v.unit);
-  std::string text = "run";
+  std::string table = "run";
   for (const Varied& v : varied)
-    text += "," + csv(v.name) + "," + csv(v.name + " (" + (v.si_unit.empty() ? "1" : v.si_unit) + ")");
-  text += ",status,nodes,tets,mesh_s,solve_s,wall_s,error_indicator";
-  for (const auto& [name, unit] : columns) text += "," + csv(unit.empty() ? name : name + " (" + unit + ")");
-  text += ",failed_checks,error\n";
+    table += "," + csv(v.name) + "," + csv(v.name + " (" + (v.si_unit.empty() ? "1" : v.si_unit) + ")");
+  table += ",status,nodes,tets,mesh_s,solve_s,wall_s,error_indicator";
+  for (const auto& [name, unit] : columns) table += "," + csv(unit.empty() ? name : name + " (" + unit + ")");
+  table += ",failed_checks,error\n";
   std::size_t ok = 0, unreliable = 0, failed = 0;
   for (std::size_t run = 0; run < total; ++run) {
     const RunResults& r = results[run];
     (r.status == RunStatus::ok ? ok : r.status == RunStatus::unreliable ? unreliable : failed)++;
-    text += std::to_string(run + 1);
+    table += std::to_string(run + 1);
     const auto idx = combination(run);
     for (std::size_t i = 0; i < varied.size(); ++i)
-      text += "," + csv(varied[i].texts[idx[i]]) + "," + number(varied[i].si[idx[i]]);
-    text += std::string(",") + run_status_name(r.status);
+      table += "," + csv(varied[i].texts[idx[i]]) + "," + number(varied[i].si[idx[i]]);
+    table += std::string(",") + run_status_name(r.status);
     const bool has = r.status != RunStatus::failed;
-    text += "," + (has ? std::to_string(r.nodes) : "") + "," + (has ? std::to_string(r.tets) : "");
-    text += "," + (has ? number(r.mesh_seconds) : "") + "," + (has ? number(r.solve_seconds) : "") + "," +
+    table += "," + (has ? std::to_string(r.nodes) : "") + "," + (has ? std::to_string(r.tets) : "");
+    table += "," + (has ? number(r.mesh_seconds) : "") + "," + (has ? number(r.solve_seconds) : "") + "," +
             number(r.wall_seconds) + "," + (has ? number(r.error_indicator) : "");
     for (const auto& c : columns) {
       const ResultValue* v = r.find(c.first);
-      text += "," + (v ? number(v->value) : "");
+      table += "," + (v ? number(v->value) : "");
     }
     std::string bad;
     for (const BalanceCheck& c : r.checks)
       if (!c.passed)
         bad += (bad.empty() ? "" : "; ") + c.name + " " + number(c.figure) + " > " + number(c.tolerance);
-    text += "," + csv(bad) + "," + csv(r.error) + "\n";
+    table += "," + csv(bad) + "," + csv(r.error) + "\n";
   }
   DurableFile file(out);
-  file.write(text);
+  file.write(table);
   file.commit();
   std::fprintf(stderr, "foxi sweep: %zu runs in %.2f s (%zu ok, %zu unreliable, %zu failed); wrote %s\n",
                total, wall, ok, unreliable, failed, out.c_str());
+  if (text) {
+    write_sweep_plot(plot, *text, varied, columns, results, combination);
+    std::fprintf(stderr, "foxi sweep: wrote %s (%zu chart%s against %s)\n", plot.c_str(),
+                 std::max<std::size_t>(1, columns.size()), columns.size() == 1 ? "" : "s", varied.front().name.c_str());
+  }
   if (json.enabled) {
     std::string o = "[\n";
     for (std::size_t run = 0; run < total; ++run) {

@@ -10,6 +10,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <regex>
@@ -17,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "foxi/viz/chart.hpp"
+#include "foxi/viz/png.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -246,6 +250,79 @@ TEST(Sweep, ThetaFallsWithDieWidthAndRowsEqualSeparateSolves) {
     EXPECT_NEAR(std::stod(r[theta]), number_after(text, "theta"), 1e-5 * t) << r[w];
     EXPECT_EQ(std::stod(r[tets]), number_after(text, R"(nodes, )"));
   }
+}
+
+// --plot: one chart per result column, two to a row of 600 x 380 pixels (the usage text's layout).
+// Read back from the PNG as far as is robust: the markers (7 x 7 squares of the series' colour, found
+// as the 3 x 3 centres whose 5 x 5 neighbourhood is all that colour: the 2-pixel lines have none).
+// Each chart has one marker per run, their columns evenly spaced as die_w is, and their rows an affine
+// function of the CSV's values (within a pixel), higher values higher up.
+TEST(Sweep, PlotMarkersAreTheCsvValues) {
+  TempDir dir;
+  const auto csv = dir / "sweep.csv", png = dir / "sweep.png", log = dir / "sweep.txt";
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:6mm:5 --theta "
+                          "die:substrate.bottom --jobs 2 -o '" + csv.string() + "' --plot '" + png.string() + "'",
+                          log),
+            0)
+      << test::read_text(log);
+  const auto rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 6u);
+  const auto& h = rows[0];
+  const std::size_t first = column(h, "error_indicator") + 1, last = column(h, "failed_checks");
+  const std::size_t charts = last - first;
+  ASSERT_GE(charts, 3u);
+  const foxi::Framebuffer fb = foxi::read_png(png);
+  EXPECT_EQ(fb.width, 1200);
+  EXPECT_EQ(fb.height, int((charts + 1) / 2) * 380);
+  const std::uint32_t blue = foxi::chart_color(0);
+  auto is_blue = [&](int x, int y) { return x >= 0 && y >= 0 && x < fb.width && y < fb.height && fb.rgba[fb.index(x, y)] == blue; };
+  for (std::size_t k = 0; k < charts; ++k) {
+    const int x0 = int(k % 2) * 600, y0 = int(k / 2) * 380;
+    // marker centres: cores grouped by proximity
+    std::vector<std::array<double, 3>> marks;  // sum x, sum y, count
+    for (int y = y0; y < y0 + 380; ++y)
+      for (int x = x0; x < x0 + 600; ++x) {
+        bool core = true;
+        for (int dy = -2; dy <= 2 && core; ++dy)
+          for (int dx = -2; dx <= 2 && core; ++dx) core = is_blue(x + dx, y + dy);
+        if (!core) continue;
+        bool placed = false;
+        for (auto& m : marks)
+          if (std::abs(m[0] / m[2] - x) <= 3 && std::abs(m[1] / m[2] - y) <= 3) {
+            m[0] += x, m[1] += y, m[2] += 1, placed = true;
+            break;
+          }
+        if (!placed) marks.push_back({double(x), double(y), 1.0});
+      }
+    ASSERT_EQ(marks.size(), 5u) << "chart " << k << " (" << h[first + k] << ")";
+    std::sort(marks.begin(), marks.end(), [](const auto& a, const auto& b) { return a[0] / a[2] < b[0] / b[2]; });
+    std::vector<double> col, row, value;
+    for (std::size_t i = 0; i < 5; ++i) {
+      EXPECT_EQ(marks[i][2], 9.0);  // the 3 x 3 centre of a 7 x 7 marker
+      col.push_back(marks[i][0] / marks[i][2]);
+      row.push_back(marks[i][1] / marks[i][2]);
+      value.push_back(std::stod(rows[i + 1][first + k]));
+    }
+    const double spacing = (col[4] - col[0]) / 4;
+    EXPECT_GT(spacing, 50);
+    for (std::size_t i = 0; i < 5; ++i) EXPECT_NEAR(col[i], col[0] + spacing * double(i), 1.0) << h[first + k];
+    const auto [lo, hi] = std::minmax_element(value.begin(), value.end());
+    if (*hi - *lo <= 1e-12 * std::abs(*hi)) {
+      for (double r : row) EXPECT_EQ(r, row[0]);
+      continue;
+    }
+    // least-squares row = a + b value; every marker within a pixel of it, b < 0 (up is more)
+    double mv = 0, mr = 0, svv = 0, svr = 0;
+    for (std::size_t i = 0; i < 5; ++i) mv += value[i] / 5, mr += row[i] / 5;
+    for (std::size_t i = 0; i < 5; ++i) svv += (value[i] - mv) * (value[i] - mv), svr += (value[i] - mv) * (row[i] - mr);
+    const double b = svr / svv, a = mr - b * mv;
+    EXPECT_LT(b, 0) << h[first + k];
+    for (std::size_t i = 0; i < 5; ++i) EXPECT_NEAR(row[i], a + b * value[i], 1.0) << h[first + k] << " run " << i + 1;
+  }
+  // A plot that is not a PNG is a usage error, before any run.
+  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:6mm:2 -o '" + csv.string() +
+                          "' --plot '" + (dir / "p.jpg").string() + "'", log),
+            2);
 }
 
 // Two --vary make a grid, the last one fastest; each row's parameters reach its run.
