@@ -53,7 +53,8 @@ const char* kSolveUsage =
     "  number or name, REGION a region id or name; SI units: T and Tinf in K, q in W/m^2 (into the\n"
     "  body), h in W/(m^2 K), k in W/(m K) (default: the region's material). Boundaries with no\n"
     "  condition are insulated; at least one --fix or --convect is needed. --power gives a region's\n"
-    "  total heat in W, --power-density in W/m^3. Prints the maximum temperature and where, per-region\n"
+    "  total heat in W, --power-density in W/m^3 (either replaces a model's load on the region, said\n"
+    "  on a line). Prints the maximum temperature and where, per-region\n"
     "  maximum and mean, heat through each boundary and its mean surface temperature, the energy\n"
     "  balance (sources + boundary heat, ~0), and the solver's work; OUT (any mesh format,\n"
     "  .vtu for ParaView) gets the fields 'temperature' (K, nodes) and 'heat_flux' (W/m^2, cells).\n"
@@ -462,15 +463,29 @@ int cmd_solve(Args args) {
     params.convection.push_back({boundary_tag(mesh, k, "--convect"), parse_value(h, "--convect", "W/(m^2*K)"),
                                  parse_temperature(tinf, "--convect", TemperatureKind::absolute)});
   }
-  for (const std::string& s : power) {
-    auto [k, v] = split_assignment(s, "--power");
-    params.sources.push_back({region_id(mesh, k, "--power"), parse_value(v, "--power", "W"), true});
-  }
-  for (const std::string& s : density) {
-    auto [k, v] = split_assignment(s, "--power-density");
-    params.sources.push_back(
-        {region_id(mesh, k, "--power-density"), parse_value(v, "--power-density", "W/m^3"), false});
-  }
+  // --power and --power-density replace the model's load on their region (said on a line); a region
+  // given twice on the command line is a usage error.
+  const std::size_t model_sources = params.sources.size();
+  std::vector<bool> replaced(model_sources, false);
+  auto add_source = [&](const std::string& s, const char* option, const char* unit, bool total) {
+    auto [k, v] = split_assignment(s, option);
+    const HeatSource source{region_id(mesh, k, option), parse_value(v, option, unit), total};
+    for (std::size_t i = model_sources; i < params.sources.size(); ++i)
+      if (params.sources[i].region == source.region)
+        throw UsageError(std::string(option) + " " + k + ": the region has a --power or --power-density already");
+    for (std::size_t i = 0; i < model_sources; ++i)
+      if (params.sources[i].region == source.region && !replaced[i]) {
+        const HeatSource& old = params.sources[i];
+        std::printf("%s %s replaces the model's load on %s (%.6g %s)\n", option, s.c_str(),
+                    region_label(mesh, old.region).c_str(), old.value, old.total ? "W" : "W/m^3");
+        replaced[i] = true;
+      }
+    params.sources.push_back(source);
+  };
+  for (const std::string& s : power) add_source(s, "--power", "W", true);
+  for (const std::string& s : density) add_source(s, "--power-density", "W/m^3", false);
+  for (std::size_t i = model_sources; i-- > 0;)
+    if (replaced[i]) params.sources.erase(params.sources.begin() + std::ptrdiff_t(i));
   for (const std::string& s : cond) {
     auto [k, v] = split_assignment(s, "--k");
     params.conductivity.push_back({region_id(mesh, k, "--k"), parse_value(v, "--k", "W/(m*K)")});

@@ -115,6 +115,28 @@ TEST(SolveUnitsCli, PowerInWattsAndMilliwatts) {
   }
 }
 
+// --power on a model that loads the region already replaces the model's load and says so: the
+// temperature rise over the held bottom is linear in the power, so 3 W instead of the model's 1 W
+// gives three times the rise; the same region twice on the command line is a usage error.
+TEST(SolveUnitsCli, PowerReplacesTheModelsLoad) {
+  TempDir dir;
+  test::write_text(dir / "cube.toml", std::string(kCube) + "[[loads]]\ntype = \"power\"\npart = \"cube\"\nvalue = \"1 W\"\n");
+  const Result model = solve(dir, "--physics thermal");
+  ASSERT_EQ(model.rc, 0) << model.out;
+  EXPECT_EQ(number_after(line(model.out, "energy balance"), "sources"), 1) << model.out;
+  for (const char* option : {"--power cube=3W", "--power-density 'cube=3 W/mm^3'"}) {
+    const Result r = solve(dir, std::string("--physics thermal ") + option);
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("replaces the model's load on"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(1 W)"), std::string::npos) << r.out;
+    EXPECT_EQ(number_after(line(r.out, "energy balance"), "sources"), 3) << r.out;
+    const double rise1 = number_after(model.out, "max temperature") - 273.15,
+                 rise3 = number_after(r.out, "max temperature") - 273.15;
+    EXPECT_NEAR(rise3, 3 * rise1, 1e-5 * rise3) << r.out;
+  }
+  EXPECT_EQ(solve(dir, "--physics thermal --power cube=3W --power cube=2W").rc, 2);
+}
+
 TEST(SolveUnitsCli, WrongDimensionAndNegativeKelvinAreUsageErrors) {
   TempDir dir;
   test::write_text(dir / "cube.toml", kCube);
