@@ -2,7 +2,9 @@
 # The sweep's parallel efficiency (issue 18, "Performance"): a 7-point sweep of the flip chip at its
 # default mesh against T1, one run on one thread, measured in the same run of this script. The
 # target: sweep wall time <= 1.2 x max(T1, 7 T1 / cores). Prints T1, the sweep's wall time, the bound
-# and their ratio. Usage: bench/sweep_scaling.sh [FOXI] [JOBS]   (FOXI: build/apps/foxi/foxi)
+# and their ratio, with the load average before and after: the bound only means something on a quiet
+# machine (load below 1 beside this script), since T1 and the sweep compete with whatever else runs.
+# Usage: bench/sweep_scaling.sh [FOXI] [JOBS]   (FOXI: build/apps/foxi/foxi)
 set -eu
 foxi=${1:-build/apps/foxi/foxi}
 cores=$(nproc)
@@ -11,6 +13,8 @@ model=$(dirname "$0")/../models/flip_chip.toml
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 now() { date +%s.%N; }
+load() { cut -d' ' -f1-3 /proc/loadavg; }
+load_before=$(load)
 # T1: the median of three single-threaded runs of the middle point (die_w = 6 mm, the default)
 t1s=""
 for i in 1 2 3; do
@@ -25,3 +29,5 @@ wall=$(echo "$b - $a" | bc -l)
 bound=$(echo "t = 7 * $t1 / $cores; if (t < $t1) t = $t1; 1.2 * t" | bc -l)
 printf 'cores %s, jobs %s: T1 %.3f s, 7-point sweep %.3f s, bound 1.2 max(T1, 7 T1/cores) %.3f s, ratio %.2f (<= 1 meets it)\n' \
   "$cores" "$jobs" "$t1" "$wall" "$bound" "$(echo "$wall / $bound" | bc -l)"
+printf 'load average (1, 5, 15 min) before: %s, after: %s%s\n' "$load_before" "$(load)" \
+  "$(awk -v l="${load_before%% *}" 'BEGIN { if (l > 1) print " (a busy machine: the ratio is not the target'"'"'s measure)" }')"
