@@ -2,6 +2,7 @@
 // mesh sizes divided by R once more, and per key result the observed order and the Richardson
 // extrapolation (foxi/solver/results.hpp). Each level is a `foxi solve --size-scale S` child process,
 // so that a level is exactly what a user's `foxi solve` gives, and a stop kills it.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -50,6 +51,11 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
     std::snprintf(scale, sizeof scale, "%.17g", std::pow(ratio, -k));
     a.insert(a.end(), {"--size-scale", scale});
     const std::string n = std::to_string(k);
+    // A transient level writes its series into the scratch folder: the last step only.
+    if (physics == "transient")
+      a.insert(a.end(), {"-o", (scratch / ("level" + n + ".pvd")).string()});
+    if (physics == "transient" && std::find(pass.begin(), pass.end(), "--write-every") == pass.end())
+      a.insert(a.end(), {"--write-every", "1000000000"});
     RunResults r = run_solve_child(a, scratch / ("level" + n + ".json"), scratch / ("level" + n + ".log"));
     if (r.status == RunStatus::failed) {
       std::fprintf(stderr, "foxi solve: error: level %d (size scale %s) failed: %s\n", k, scale,

@@ -37,7 +37,7 @@ namespace {
 
 const char* kSweepUsage =
     "foxi sweep MODEL.toml --vary NAME=LO:HI:N [--vary ...] [--physics thermal|electrostatic|current|\n"
-    "           thermoelastic] [--jobs N] -o SWEEP.csv [--plot SWEEP.png] [--json [FILE.json]]\n"
+    "           thermoelastic|transient] [--jobs N] -o SWEEP.csv [--plot SWEEP.png] [--json [FILE.json]]\n"
     "           [--set NAME=VALUE]...\n"
     "           [--theta J:R]... [--solver S] [--tol REL] [--max-tets N] [--threads N]\n"
     "           [-- FOXI SOLVE OPTIONS...]\n"
@@ -46,7 +46,9 @@ const char* kSweepUsage =
     "  unreliable: a balance check failed, failed: no result), mesh size, times, the ZZ error\n"
     "  indicator, the key results (max and mean temperature per part and theta values for thermal,\n"
     "  R and the conductance matrix for current, the capacitance matrix for electrostatic, max von\n"
-    "  Mises per part for thermoelastic; a column per result, its unit in the header), the checks\n"
+    "  Mises per part for thermoelastic, the junction temperature at the end and Zth(end) (theta_JA once\n"
+    "  the run reaches the steady state) per powered region for transient, whose --time and --steps go\n"
+    "  after '--'; a column per result, its unit in the header), the checks\n"
     "  that failed and the error of a failed run. A failed run does not stop the sweep.\n"
     "  --vary NAME=LO:HI:N  N values from LO to HI evenly, in LO's unit (die_w=2mm:8mm:7); or a list\n"
     "                       NAME=V1,V2,... (die_w=2mm,3mm,5mm). NAME is one of the model's [parameters].\n"
@@ -228,9 +230,11 @@ int cmd_sweep(Args args) {
   const std::vector<std::string> solve_options = args.take_after("--");
   const std::string physics = args.option("--physics", "thermal");
   if (physics != "thermal" && physics != "electrostatic" && physics != "current" &&
-      physics != "thermoelastic")
-    throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics +
-                     "'");
+      physics != "thermoelastic" && physics != "transient")
+    throw UsageError("--physics takes thermal, electrostatic, current, thermoelastic or transient, not '" +
+                     physics + "'");
+  if (physics == "transient" && std::find(solve_options.begin(), solve_options.end(), "--time") == solve_options.end())
+    throw UsageError("--physics transient: give the runs' time stepping after '--' (-- --time 10s --steps 100)");
   std::vector<Varied> varied;
   for (const std::string& s : all_options(args, "--vary")) varied.push_back(parse_vary(s));
   if (varied.empty())
@@ -316,6 +320,11 @@ int cmd_sweep(Args args) {
       // --set of a varied name replaces the sweep's own (the later --set wins in load_model)
       a.insert(a.end(), pass.begin(), pass.end());
       const std::string n = std::to_string(run);
+      // A transient run writes its series into the scratch folder: the last step only.
+      if (physics == "transient")
+        a.insert(a.end(), {"-o", (scratch / ("run" + n + ".pvd")).string()});
+      if (physics == "transient" && std::find(pass.begin(), pass.end(), "--write-every") == pass.end())
+        a.insert(a.end(), {"--write-every", "1000000000"});
       const auto start = std::chrono::steady_clock::now();
       RunResults r = run_solve_child(a, scratch / ("run" + n + ".json"), scratch / ("run" + n + ".log"));
       if (r.status == RunStatus::failed)

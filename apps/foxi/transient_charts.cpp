@@ -1,6 +1,7 @@
 // See transient_charts.hpp.
 #include "transient_charts.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -14,6 +15,7 @@ namespace foxi::cli {
 namespace {
 
 constexpr int kChartWidth = 820, kChartHeight = 440;
+constexpr double kFitTolerance = 0.01;  // the Foster fit's largest error against Zth(end)
 
 std::string number(double v) {
   char buf[40];
@@ -23,10 +25,8 @@ std::string number(double v) {
 
 }  // namespace
 
-std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const std::vector<double>& times,
-                                                 const std::vector<JunctionCurve>& junctions,
-                                                 const TextRenderer& text) {
-  std::vector<BalanceCheck> checks;
+void write_transient_charts(const std::string& stem, const std::vector<double>& times,
+                            const std::vector<JunctionCurve>& junctions, const TextRenderer& text) {
   Chart zth, tj;
   zth.title = "Thermal impedance Zth(t) = (Tj(t) - Tj(0)) / P";
   zth.x = {"time", "s", true};
@@ -66,12 +66,12 @@ std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const 
   std::printf("wrote %s (%s)\n", picture.c_str(),
               with_zth ? "Zth against log time, Tj against time" : "Tj against time");
 
-  if (stepped.empty()) return checks;
+  if (stepped.empty()) return;
   if (junctions.size() != 1) {
     std::printf("structure function: not computed: %zu regions are powered (it describes the heat path of "
                 "one source; each heats the others' junctions)\n",
                 junctions.size());
-    return checks;
+    return;
   }
   const JunctionCurve& c = *stepped.front();
   std::vector<double> t, z;
@@ -81,12 +81,35 @@ std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const 
   }
   if (t.size() < 3) {
     std::printf("structure function: not computed: %zu time steps (at least 3 are needed)\n", t.size());
-    return checks;
+    return;
   }
   const StructureFunction sf = structure_function(t, z);
   const double zend = std::abs(z.back());
-  checks.push_back(make_check("Zth fit", "largest error of the Foster fit of Zth(t), relative to Zth(end)",
-                              zend > 0 ? sf.fit.max_error / zend : NAN, 0.01));
+  const double fit_error = zend > 0 ? sf.fit.max_error / zend : NAN;
+  // The structure function is only as good as the fit it comes from: refused past 1 % of Zth(end).
+  if (!(fit_error <= kFitTolerance)) {
+    // A step response is monotone; a discrete one that falls somewhere is the time stepping's
+    // (BDF2 overshoots at steps long against the time constants), which no sum of rising
+    // exponentials fits.
+    double peak = z.front(), drop = 0, drop_at = 0;
+    for (std::size_t i = 0; i < z.size(); ++i) {
+      if (peak - z[i] > drop) drop = peak - z[i], drop_at = t[i];
+      peak = std::max(peak, z[i]);
+    }
+    std::string why = std::to_string(t.size()) + " time steps do not resolve it; use more --steps";
+    if (drop > 0) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "Zth(t) falls by %.3g K/W by t = %.4g s, which a step response does not (the time "
+                    "stepping's overshoot: use more --steps, or --scheme euler)",
+                    drop, drop_at);
+      why = buf;
+    }
+    std::printf("structure function of %s: not written: the Foster fit misses Zth(t) by %.3g K/W, %.2g %% of "
+                "Zth(end) (more than %g %%): %s\n",
+                c.name.c_str(), sf.fit.max_error, 100 * fit_error, 100 * kFitTolerance, why.c_str());
+    return;
+  }
   {
     std::string csv = "stage,R_K/W,C_J/K,cumulative_R_K/W,cumulative_C_J/K\n";
     for (std::size_t i = 0; i < sf.cauer.size(); ++i)
@@ -116,13 +139,13 @@ std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const 
   }
   std::printf("structure function of %s: %zu Cauer stages from %zu Foster terms (time constants %.3g s to "
               "%.3g s), total R %.6g K/W against Zth(end) %.6g K/W, C at the junction %.4g J/K; Foster fit "
-              "error %.3g K/W at most (%.2g %% of Zth(end))\n",
+              "error %.3g K/W at most (%.2g %% of Zth(end), within %g %%)\n",
               c.name.c_str(), sf.cauer.size(), sf.fit.terms.size(),
               sf.fit.terms.empty() ? NAN : sf.fit.terms.front().tau,
               sf.fit.terms.empty() ? NAN : sf.fit.terms.back().tau,
               sf.cumulative_r.empty() ? NAN : sf.cumulative_r.back(), z.back(),
               sf.cauer.empty() ? NAN : sf.cauer.front().c, sf.fit.max_error,
-              zend > 0 ? 100 * sf.fit.max_error / zend : NAN);
+              100 * fit_error, 100 * kFitTolerance);
   if (sf.settled > 0.01)
     std::printf("note: Zth still rose %.1f %% over the last tenth of the log time: the heat has not reached the "
                 "ambient, so the structure function ends early (its last stages stand for what is beyond); "
@@ -130,7 +153,7 @@ std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const 
                 100 * sf.settled);
   std::printf("wrote %s_structure.csv and %s_structure.png (cumulative C against cumulative R)\n", stem.c_str(),
               stem.c_str());
-  return checks;
+  return;
 }
 
 }  // namespace foxi::cli

@@ -22,10 +22,9 @@ struct JunctionCurve {
 // Zth is (Tj(t) - Tj(0)) / P for a step of P != 0 only: a junction with another waveform gets no
 // Zth (a line says so) and, when no junction has a step, the picture is OUT_tj.png with Tj(t) alone.
 // The structure function needs exactly one powered junction with a step (several sources heat each
-// other's junctions, so no single path is described; a line says so). Prints what it wrote and
-// returns the check of the Foster fit (its largest error against Zth(end)) when it made one.
-std::vector<BalanceCheck> write_transient_charts(const std::string& stem, const std::vector<double>& times,
-                                                 const std::vector<JunctionCurve>& junctions,
-                                                 const TextRenderer& text);
+// other's junctions, so no single path is described; a line says so), and a Foster fit within 1 %
+// of Zth(end) (else a line says it is not written and why: too few steps). Prints what it wrote.
+void write_transient_charts(const std::string& stem, const std::vector<double>& times,
+                            const std::vector<JunctionCurve>& junctions, const TextRenderer& text);
 
 }  // namespace foxi::cli

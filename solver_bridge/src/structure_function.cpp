@@ -82,7 +82,7 @@ FosterFit fit_foster(std::span<const double> t, std::span<const double> z, const
   check_samples(t, z);
   if (p.per_decade < 1 || p.per_decade > 100)
     throw std::invalid_argument("Zth fit: per_decade must be 1 to 100");
-  const double lo = p.tau_min > 0 ? p.tau_min : t.front() / 3, hi = p.tau_max > 0 ? p.tau_max : t.back() * 3;
+  const double lo = p.tau_min > 0 ? p.tau_min : t.front() / 30, hi = p.tau_max > 0 ? p.tau_max : t.back() * 3;
   if (!(lo < hi)) throw std::invalid_argument("Zth fit: the time-constant range is empty");
   const int count = std::max(2, int(std::ceil(std::log10(hi / lo) * p.per_decade)) + 1);
   std::vector<double> tau(static_cast<std::size_t>(count));

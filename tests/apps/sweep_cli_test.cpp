@@ -325,6 +325,47 @@ TEST(Sweep, PlotMarkersAreTheCsvValues) {
             2);
 }
 
+// --physics transient: each row's Tj_end and Zth_end equal the last line of a separate transient
+// solve's junction CSV; without --time after '--' the sweep is a usage error; --convergence runs the
+// transient on refined meshes and tabulates Tj_end.
+TEST(Sweep, TransientRowsEqualSeparateSolvesAndConvergenceRuns) {
+  TempDir dir;
+  const auto csv = dir / "t.csv", log = dir / "t.txt";
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --physics transient --vary die_w=3mm,5mm "
+                          "--jobs 2 -o '" + csv.string() + "' -- --time 20s --steps 10",
+                          log),
+            0)
+      << test::read_text(log);
+  const auto rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 3u);
+  const std::size_t tj = column(rows[0], "Tj_end[die] (K)"), zth = column(rows[0], "Zth_end[die] (K/W)"),
+                    w = column(rows[0], "die_w");
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const auto one = dir / ("one" + std::to_string(i));
+    ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --physics transient --time 20s --steps 10 "
+                            "--set die_w=" + rows[i][w] + " -o '" + one.string() + ".pvd'",
+                            dir / "one.txt"),
+              0)
+        << test::read_text(dir / "one.txt");
+    const auto junction = read_csv(one.string() + "_junction.csv");
+    const auto& last = junction.back();
+    EXPECT_NEAR(std::stod(rows[i][tj]), std::stod(last[2]), 1e-6 * std::stod(last[2])) << rows[i][w];
+    EXPECT_NEAR(std::stod(rows[i][zth]), std::stod(last[3]), 1e-6 * std::stod(last[3])) << rows[i][w];
+  }
+  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --physics transient --vary die_w=3mm,5mm -o '" +
+                          csv.string() + "'", log),
+            2);
+  const auto conv = dir / "conv.txt";
+  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --physics transient --time 20s --steps 10 "
+                          "--convergence 3",
+                          conv),
+            0)
+      << test::read_text(conv);
+  const std::string text = test::read_text(conv);
+  EXPECT_NE(text.find("level 2:"), std::string::npos) << text;
+  EXPECT_NE(text.find("Tj_end[die]"), std::string::npos) << text;
+}
+
 // Two --vary make a grid, the last one fastest; each row's parameters reach its run.
 TEST(Sweep, TwoVariedParametersMakeAGrid) {
   TempDir dir;

@@ -38,7 +38,8 @@ struct CauerStage {
 
 struct FosterFitParams {
   int per_decade = 10;  // time constants a decade
-  // The grid's range (s); 0: from the first sample / 3 to the last sample * 3.
+  // The grid's range (s); 0: from the first sample / 30 (what is faster than the first sample
+  // shows as a term that has settled by then) to the last sample * 3.
   double tau_min = 0, tau_max = 0;
 };
 
