@@ -9,7 +9,10 @@
 //                         and the same 100 fixed increments (*HEAT TRANSFER, DIRECT), writing NT
 //                         every 10th increment (FOXI_BENCH_CCX=1; skipped otherwise): ccx_s and
 //                         x_ccx = transient_s / ccx_s
-//                       counters also: tets, CG iterations of the transient (all steps) and the
+//                       counters also: tets, CG iterations of the transient (all steps), its energy
+//                       check's figure (the run is an error when the check fails), CPU seconds of
+//                       the process for each (steady_cpu_s, transient_cpu_s, x_steady_cpu: steadier
+//                       than wall time on a loaded machine) and the
 //                       1-minute load average when the run started (load_1min), which the figures
 //                       must be read with on a shared machine.
 // Sizes: the Kuhn grid of bench_thermal.cpp (two regions, k 1 and 10 W/(m K), fixed 300 K at z = 0,
@@ -131,18 +134,22 @@ void transient(benchmark::State& state, std::uint32_t n) {
     write_vtu(frame, dir / name);
     return true;
   };
-  double steady_s = 0, transient_s = 0;
+  double steady_s = 0, transient_s = 0, steady_cpu = 0, transient_cpu = 0;
   TransientReport r;
   for (auto _ : state) {
+    double c0 = bench::process_cpu_seconds();
     auto t0 = std::chrono::steady_clock::now();
     const ThermalReport s = solve_thermal(mesh, steady);
     auto t1 = std::chrono::steady_clock::now();
+    steady_cpu = bench::process_cpu_seconds() - c0;
     benchmark::DoNotOptimize(s.max_temperature);
     steady_s = std::chrono::duration<double>(t1 - t0).count();
     written = 0;
+    c0 = bench::process_cpu_seconds();
     t0 = std::chrono::steady_clock::now();
     r = solve_transient_thermal(mesh, tp);
     t1 = std::chrono::steady_clock::now();
+    transient_cpu = bench::process_cpu_seconds() - c0;
     transient_s = std::chrono::duration<double>(t1 - t0).count();
     state.SetIterationTime(transient_s);
   }
@@ -150,9 +157,16 @@ void transient(benchmark::State& state, std::uint32_t n) {
   state.counters["steady_s"] = steady_s;
   state.counters["transient_s"] = transient_s;
   state.counters["x_steady"] = transient_s / steady_s;
+  state.counters["steady_cpu_s"] = steady_cpu;
+  state.counters["transient_cpu_s"] = transient_cpu;
+  state.counters["x_steady_cpu"] = transient_cpu / steady_cpu;
   state.counters["cg_iterations"] = double(r.iterations);
   state.counters["files"] = double(written);
   state.counters["Tj_end"] = r.junction_temperature[0].back();
+  // The solver's own energy check (heat in against stored energy): a fast wrong run is no figure.
+  for (const BalanceCheck& c : r.checks)
+    if (c.name == "energy") state.counters["energy_check"] = c.figure;
+  if (!all_passed(r.checks)) state.SkipWithError("the transient's energy check failed");
   if (std::getenv("FOXI_BENCH_CCX") != nullptr && std::system("command -v ccx > /dev/null 2>&1") == 0) {
     write_calculix_thermal(mesh, steady, dir / "steady.inp");
     std::ostringstream steady_text;

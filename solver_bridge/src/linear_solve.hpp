@@ -60,7 +60,12 @@ class SpdSolver {
   ~SpdSolver();
   SpdSolver(const SpdSolver&) = delete;
   SpdSolver& operator=(const SpdSolver&) = delete;
-  LinearSolveResult solve(const std::vector<double>& b, std::vector<double>& x);
+  // With `reference`, the goal is |r| <= tol max(|b|, |reference|) and the relative residual is
+  // measured against that: a time step that solves for its increment b = rhs - A x0 passes its full
+  // right-hand side, so that each step meets the accuracy of a solve of A x = rhs from zero (the
+  // increment alone would be reduced by tol at every step, however small it is).
+  LinearSolveResult solve(const std::vector<double>& b, std::vector<double>& x,
+                          const std::vector<double>* reference = nullptr);
   const std::string& name() const;
   std::size_t levels() const;
 

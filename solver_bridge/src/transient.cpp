@@ -293,7 +293,8 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
       if (sysm->dof[v] >= 0) x0[static_cast<std::size_t>(sysm->dof[v])] = temp[v];
     detail::multiply(sysm->a, x0.data(), r.data(), threads);
     for (std::size_t i = 0; i < r.size(); ++i) r[i] = rhs[i] - r[i];
-    const detail::LinearSolveResult lin = solver->solve(r, x);
+    // The goal relative to the step's whole right-hand side, as a solve from zero would have it.
+    const detail::LinearSolveResult lin = solver->solve(r, x, &rhs);
     out.iterations += lin.iterations;
     out.relative_residual = std::max(out.relative_residual, lin.relative_residual);
     for (std::size_t i = 0; i < x.size(); ++i) x[i] += x0[i];

@@ -15,7 +15,9 @@
 // as oscillations of the junction temperature at short times, where Zth matters most. The matrix
 // (c0 M/dt + K) is the same at every step (c0 = 1 Euler, 3/2 BDF2), so its factorization or AMG
 // hierarchy is built once (twice for BDF2: its Euler first step has its own) and reused; each step's
-// CG starts from the previous temperature (it solves for the increment).
+// CG starts from the previous temperature (it solves for the increment) and stops at the relative
+// tolerance of the step's whole right-hand side, as a solve from zero would: not of the increment,
+// which would ask ever more digits of it as the temperature settles.
 //
 // Power: sum over TransientPower of P_r(t) W spread uniformly over region r's volume, evaluated at
 // the end of each step (implicit), on top of ThermalParams::sources (constant).
@@ -121,7 +123,7 @@ struct TransientReport {
   std::string solver;
   std::size_t unknowns = 0;
   std::size_t iterations = 0;       // CG iterations over all steps
-  double relative_residual = 0;     // largest over the steps
+  double relative_residual = 0;     // largest over the steps, each against its step's whole right-hand side
   double setup_seconds = 0, solve_seconds = 0;
 };
 
