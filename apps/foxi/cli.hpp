@@ -64,6 +64,8 @@ int cmd_model(Args args);
 int cmd_demo(Args args);
 int cmd_sweep(Args args);
 int cmd_fields(Args args);
+int cmd_probe(Args args);
+int cmd_plot(Args args);
 int cmd_export_ccx(Args args);
 // foxi solve ... --with ccx (cmd_ccx.cpp), from cmd_solve.
 int cmd_solve_with(Args args, const std::string& physics);

@@ -38,6 +38,8 @@ const char* kUsage =
     "                 in parallel, one CSV row per run with its key results (-o SWEEP.csv)\n"
     "  render MESH    a PNG picture of the interior (painter, visibility order); -o OUT.png;\n"
     "                 --field NAME colours it by a field (flat or --graded) with a legend\n"
+    "  probe RESULT   a field's value at points (--field NAME --at x,y,z): tet, region, value, units\n"
+    "  plot RESULT    a field along a segment (--field NAME --line A:B -o PLOT.csv)\n"
     "  movie MESH     draw/undraw back and forth, or turn the view: -o OUT.gif|.apng|.mp4|frames\n"
     "\n"
     "mesh formats: .msh (Gmsh 2.2/4.1, ASCII/binary), .vtu (VTK XML), .vtk (VTK legacy),\n"
@@ -76,6 +78,8 @@ int main(int argc, char** argv) {
     if (command == "demo") return foxi::cli::cmd_demo(std::move(rest));
     if (command == "sweep") return foxi::cli::cmd_sweep(std::move(rest));
     if (command == "fields") return foxi::cli::cmd_fields(std::move(rest));
+    if (command == "probe") return foxi::cli::cmd_probe(std::move(rest));
+    if (command == "plot") return foxi::cli::cmd_plot(std::move(rest));
     if (command == "export-ccx") return foxi::cli::cmd_export_ccx(std::move(rest));
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return kExitUsage;

@@ -206,6 +206,20 @@ std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& cho
   return out;
 }
 
+double field_value_in_tet(const Mesh& mesh, const FieldChoice& choice, std::size_t t, const double bary[4],
+                          std::size_t step) {
+  const Field& f = *choice.field;
+  const std::span<const double> v = step_values(mesh, f, step);
+  const std::uint32_t n = f.components;
+  if (f.location == FieldLocation::cell) return scalar_of(choice.scalar, &v[t * n], n);
+  std::vector<double> c(n, 0.0);
+  for (int k = 0; k < 4; ++k) {
+    const double* p = &v[std::size_t(mesh.tet[4 * t + std::size_t(k)]) * n];
+    for (std::uint32_t i = 0; i < n; ++i) c[i] += bary[k] * p[i];
+  }
+  return scalar_of(choice.scalar, c.data(), n);
+}
+
 std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step) {
   const Field& f = *choice.field;
   std::vector<double> out(4 * mesh.tet_count());

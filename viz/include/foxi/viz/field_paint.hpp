@@ -56,6 +56,13 @@ FOXI_API std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldCh
 // components, then the scalar), so values never blend across a material interface.
 FOXI_API std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
 
+// The scalar at one point of tet `t` with barycentric coordinates bary[0..4) (its corners in the
+// tet's node order; foxi::locate_points gives them): a node field's components interpolated linearly
+// before taking the scalar (exact for a component of a field linear over the tet), a cell field the
+// tet's own value. NaN where a value it uses is NaN. For probes and line plots.
+FOXI_API double field_value_in_tet(const Mesh& mesh, const FieldChoice& choice, std::size_t t, const double bary[4],
+                                   std::size_t step = 0);
+
 // Display units: value_display = (value_SI - offset) * factor. "degC" / "°C" from K, "MPa" / "kPa" /
 // "GPa" from Pa, "mm" / "um" / "µm" / "nm" from m, "mV" / "kV" from V, "mW" from W; the SI unit
 // itself (factor 1). Nothing if `display` does not apply to `si_unit`.
