@@ -20,7 +20,8 @@ namespace {
 
 const char* kProbeUsage =
     "foxi probe RESULT --field NAME[:COMPONENT] --at x,y,z [--at x,y,z ...] [--step k]\n"
-    "  For each point (metres, as the mesh): the tet that holds it, its region (id and name) and the\n"
+    "  For each point (metres, as the mesh): the tet that holds it (its index from 0, as foxi solve\n"
+    "  and ParaView number tets), its region (id and name) and the\n"
     "  field's value there: a node field interpolated linearly (barycentric) in that tet, a cell\n"
     "  field the tet's value; in SI and in the field's usual display unit (°C for K, MPa for Pa, ...).\n"
     "  A point on a face shared by two tets takes one of them (the value is the same for a node field).\n"
@@ -35,7 +36,7 @@ const char* kPlotUsage =
     "          -o PLOT.csv\n"
     "  The field along the segment at N equally spaced samples (default 101, ends included), each\n"
     "  located and interpolated as foxi probe does. CSV columns: s (distance from the start, m),\n"
-    "  x, y, z (m), tet (1-based; empty outside), region, and the value in SI (its unit in the\n"
+    "  x, y, z (m), tet (index from 0; empty outside), region, and the value in SI (its unit in the\n"
     "  header); a sample outside the mesh has an empty tet and region and the value nan (a gap).\n"
     "  Exit status: 0 written, 2 usage error, 3 unreadable or unusable file, or no sample in the mesh.";
 
@@ -119,7 +120,7 @@ int cmd_probe(Args args) {
     }
     ++inside;
     const double v = field_value_in_tet(mesh, sel.choice, t, &loc.bary[4 * i], sel.step);
-    std::printf("tet %u, region %s, %s = ", t + 1, region_text(mesh, t).c_str(), sel.choice.label.c_str());
+    std::printf("tet %u, region %s, %s = ", t, region_text(mesh, t).c_str(), sel.choice.label.c_str());
     if (std::isnan(v)) {
       std::printf("no value (NaN)\n");
       continue;
@@ -192,7 +193,7 @@ int cmd_plot(Args args) {
       continue;
     }
     ++inside;
-    text += "," + std::to_string(t + 1) + "," + std::to_string(mesh.region_of(t)) + "," +
+    text += "," + std::to_string(t) + "," + std::to_string(mesh.region_of(t)) + "," +
             number(field_value_in_tet(mesh, sel.choice, t, &loc.bary[4 * i], sel.step)) + "\n";
   }
   if (inside == 0) {

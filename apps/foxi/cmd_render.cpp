@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/depth_stop.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/picture.hpp"
 #include "foxi/viz/spheres.hpp"
@@ -31,7 +33,8 @@ const std::string kRenderUsage = std::string(
     "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges]\n"
     "                 [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
     "                 [--legend on|off] [--markers] [--iso v1,v2,... [--iso-only]] [--threshold a,b]\n"
-    "                 [--clip px,py,pz,nx,ny,nz] [--slice px,py,pz,nx,ny,nz]] -o OUT.png\n"
+    "                 [--clip px,py,pz,nx,ny,nz] [--slice px,py,pz,nx,ny,nz]] [--deform NAME:SCALE]\n"
+    "                 -o OUT.png\n"
     "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
     "  faces flat-shaded in its region's colour (or a field's) with the mesh edges darkened (no depth\n"
     "  buffer).\n") +
@@ -45,8 +48,33 @@ const std::string kRenderUsage = std::string(
     "  --zbuffer       draw with a depth buffer instead (the oracle; order irrelevant)\n"
     "  Meshes that fail the Delaunay certificate have no guaranteed order: their picture is drawn\n"
     "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.\n"
+  "  --deform NAME:SCALE  the deformed shape: every node moved by SCALE times the 3-component node\n"
+  "                  field NAME (a displacement, its last step), before the camera is fitted. A\n"
+  "                  deformed mesh is certified again: in general it is not Delaunay and is drawn\n"
+  "                  in MPVO order with the depth buffer (the 'deformed' line says which)\n"
   "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused\n"
   "  with exit status 3, and no picture is written.";
+
+struct DeformOption {
+  std::string name;
+  double scale = 0;
+};
+// --deform NAME:SCALE (the last colon splits, so a field name may hold one).
+std::optional<DeformOption> take_deform_option(Args& args) {
+  const std::string text = args.option("--deform");
+  if (text.empty()) return std::nullopt;
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0)
+    throw UsageError("--deform takes NAME:SCALE (a displacement field and a factor), not '" + text + "'");
+  DeformOption d;
+  d.name = text.substr(0, colon);
+  const std::string scale = text.substr(colon + 1);
+  char* end = nullptr;
+  d.scale = std::strtod(scale.c_str(), &end);
+  if (scale.empty() || *end != 0 || !std::isfinite(d.scale))
+    throw UsageError("--deform NAME:SCALE: the scale must be a finite number, not '" + scale + "'");
+  return d;
+}
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -66,6 +94,7 @@ int cmd_render(Args args) {
   PictureOptions options = take_picture_options(args, "1280x960");
   const FieldOptions field_options = take_field_options(args);
   const IsoOptions iso_options = take_iso_options(args, field_options);
+  const std::optional<DeformOption> deform = take_deform_option(args);
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
   check_output_path(out);
@@ -88,7 +117,18 @@ int cmd_render(Args args) {
   }
   RenderParams params = options.params;
 
-  const Mesh mesh = read_usable_mesh(path, "render");
+  Mesh read = read_usable_mesh(path, "render");
+  double moved = 0;
+  if (deform) {
+    try {
+      moved = deform_by_field(read, deform->name, deform->scale);
+    } catch (const FieldSelectError& e) {
+      throw UsageError(path + ": --deform: " + e.what());
+    }
+    // Large factors fold tets over: re-oriented (a note says so) or, flat, refused.
+    require_usable(read, path + " deformed by " + deform->name + " x " + std::to_string(deform->scale), "render");
+  }
+  const Mesh& mesh = read;
   Picture picture = resolve_picture(options, mesh);
   // Colour by a field: the legend's panel is taken from the picture's width, the camera fitted to the rest.
   FieldPicture field;
@@ -151,6 +191,10 @@ int cmd_render(Args args) {
     std::printf("camera      orthographic along (%g, %g, %g), height %g\n", camera.at[0] - camera.eye[0],
                 camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2], camera.ortho_height);
   const bool mpvo = report.method == OrderMethod::mpvo;
+  if (deform)
+    std::printf("deformed    by %s x %g: nodes moved up to %g; drawn %s\n", deform->name.c_str(), deform->scale, moved,
+                mpvo ? "in MPVO order with the depth buffer (the deformed mesh is not Delaunay)"
+                     : "by the painter in the power order (the deformed mesh is still Delaunay)");
   std::printf("order       %s, %.1f ms%s\n", mpvo ? "MPVO" : "power (visibility order)", report.order_ms,
               mpvo ? (", " + std::to_string(report.cycles_broken) + " cycles broken").c_str() : "");
   std::printf("drawn       %zu of %zu tets (%.0f%%) in %s mode, %.1f ms, %dx%d, %.1f%% of pixels covered",

@@ -110,12 +110,11 @@ TEST_F(ProbeCli, LinearFieldAtRandomPointsIsTheAnalyticValueInAHoldingTet) {
     const std::size_t eq = lines[i].find("temperature = ");
     ASSERT_NE(eq, std::string::npos) << lines[i];
     ASSERT_EQ(std::sscanf(lines[i].c_str() + eq, "temperature = %lf K", &value), 1) << lines[i];
-    ASSERT_GE(tet, 1u);
-    ASSERT_LE(tet, mesh_.tet_count());
+    ASSERT_LT(tet, mesh_.tet_count());
     double b[4];
-    bary_of(mesh_, tet - 1, pts[i].data(), b);
+    bary_of(mesh_, tet, pts[i].data(), b);
     for (double x : b) EXPECT_GE(x, -1e-9) << "tet " << tet << " does not hold point " << i;
-    EXPECT_EQ(region, mesh_.tet_region[tet - 1]) << lines[i];
+    EXPECT_EQ(region, mesh_.tet_region[tet]) << lines[i];
     EXPECT_NEAR(value, linear(pts[i].data()), 1e-9 * 400) << lines[i];
     // The display unit: °C from K.
     double celsius = 0;
@@ -162,10 +161,11 @@ TEST_F(ProbeCli, CellFieldIsTheHoldingTetsValue) {
     ASSERT_EQ(std::sscanf(lines[i].c_str() + at, ": tet %u", &tet), 1) << lines[i];
     const std::size_t eq = lines[i].find(" = ");
     ASSERT_EQ(std::sscanf(lines[i].c_str() + eq, " = %lf Pa", &v), 1) << lines[i];
+    ASSERT_LT(tet, mesh_.tet_count());
     double b[4];
-    bary_of(mesh_, tet - 1, pts[i], b);
+    bary_of(mesh_, tet, pts[i], b);
     for (double x : b) EXPECT_GE(x, -1e-9) << lines[i];
-    EXPECT_EQ(v, 1e3 * double(tet)) << lines[i];  // the file's value of that tet, exactly
+    EXPECT_EQ(v, 1e3 * double(tet + 1)) << lines[i];  // the file's value of that tet, exactly
   }
 }
 
@@ -244,9 +244,9 @@ TEST_F(ProbeCli, PlotCsvOfALinearFieldIsTheAnalyticLineWithGapsOutside) {
     } else {
       ASSERT_NE(col[4], "") << row;
       double bc[4];
-      bary_of(mesh_, std::stoul(col[4]) - 1, p, bc);
+      bary_of(mesh_, std::stoul(col[4]), p, bc);
       for (double x : bc) EXPECT_GE(x, -1e-9) << row;
-      EXPECT_EQ(std::stoi(col[5]), mesh_.tet_region[std::stoul(col[4]) - 1]) << row;
+      EXPECT_EQ(std::stoi(col[5]), mesh_.tet_region[std::stoul(col[4])]) << row;
       EXPECT_NEAR(std::stod(col[6]), linear(p), 1e-9 * 400) << row;
     }
   }

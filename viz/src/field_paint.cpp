@@ -220,6 +220,40 @@ double field_value_in_tet(const Mesh& mesh, const FieldChoice& choice, std::size
   return scalar_of(choice.scalar, c.data(), n);
 }
 
+double deform_by_field(Mesh& mesh, std::string_view name, double scale, long step) {
+  const Field* f = mesh.find_field(name);
+  if (!f) {
+    std::string have;
+    for (const Field& g : mesh.fields)
+      if (g.location == FieldLocation::node && g.components == 3) have += (have.empty() ? "" : ", ") + g.name;
+    throw FieldSelectError("no field '" + std::string(name) + "' to deform by (3-component node fields: " +
+                           (have.empty() ? "none" : have) + ")");
+  }
+  if (f->location != FieldLocation::node || f->components != 3)
+    throw FieldSelectError("field '" + f->name + "' is not a displacement: deforming needs a node field of 3 components, it is a " +
+                           (f->location == FieldLocation::node ? "node" : "cell") + " field of " +
+                           std::to_string(f->components));
+  if (!std::isfinite(scale)) throw FieldSelectError("the deformation scale must be a finite number");
+  const std::size_t s = step < 0 ? f->step_count() - 1 : std::size_t(step);
+  const std::span<const double> u = step_values(mesh, *f, s);
+  for (std::size_t i = 0; i < u.size(); ++i)
+    if (std::isnan(u[i]))
+      throw FieldSelectError("field '" + f->name + "' has no value (NaN) at node " + std::to_string(i / 3 + 1) +
+                             ": that node cannot be moved");
+  double largest = 0;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = scale * u[3 * n + std::size_t(k)];
+      mesh.xyz[3 * n + std::size_t(k)] += d;
+      d2 += d * d;
+    }
+    largest = std::max(largest, std::sqrt(d2));
+  }
+  invalidate_derived(mesh);
+  return largest;
+}
+
 std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step) {
   const Field& f = *choice.field;
   std::vector<double> out(4 * mesh.tet_count());

@@ -63,6 +63,13 @@ FOXI_API std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoi
 FOXI_API double field_value_in_tet(const Mesh& mesh, const FieldChoice& choice, std::size_t t, const double bary[4],
                                    std::size_t step = 0);
 
+// The deformed shape: moves each node of `mesh` by scale x the 3-component node field `name` (a
+// displacement) in step `step` (-1: the last), and drops the mesh's derived data, its certificate
+// among them (a deformed mesh is in general no longer Delaunay). Returns the largest distance a node
+// moved. Throws FieldSelectError for no such field, one that is not a 3-component node field, a step
+// out of range, a non-finite scale or a NaN value (that node would have no place).
+FOXI_API double deform_by_field(Mesh& mesh, std::string_view name, double scale, long step = -1);
+
 // Display units: value_display = (value_SI - offset) * factor. "degC" / "°C" from K, "MPa" / "kPa" /
 // "GPa" from Pa, "mm" / "um" / "µm" / "nm" from m, "mV" / "kV" from V, "mW" from W; the SI unit
 // itself (factor 1). Nothing if `display` does not apply to `si_unit`.
