@@ -1,8 +1,11 @@
 // foxi probe RESULT --field NAME --at x,y,z: the value of a field at points; foxi plot RESULT --field
-// NAME --line A:B: the field along a segment, as CSV. Both locate their points through foxi::fields'
+// NAME --line A:B: the field along a segment, as CSV or a line chart (PNG). Both locate their points through foxi::fields'
 // uniform grid (locate_points) and interpolate with field_value_in_tet, so a probe and a plot sample
 // agree with each other and with the field transfer.
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -11,8 +14,12 @@
 #include "exit_codes.hpp"
 #include "foxi/fields/transfer.hpp"
 #include "foxi/model/durable_file.hpp"
+#include "foxi/viz/chart.hpp"
 #include "foxi/viz/field_paint.hpp"
+#include "foxi/viz/png.hpp"
+#include "foxi/viz/text.hpp"
 #include "mesh_input.hpp"
+#include "render_options.hpp"
 
 namespace foxi::cli {
 
@@ -21,9 +28,9 @@ namespace {
 const char* kProbeUsage =
     "foxi probe RESULT --field NAME[:COMPONENT] --at x,y,z [--at x,y,z ...] [--step k]\n"
     "  For each point (metres, as the mesh): the tet that holds it (its index from 0, as foxi solve\n"
-    "  and ParaView number tets), its region (id and name) and the\n"
-    "  field's value there: a node field interpolated linearly (barycentric) in that tet, a cell\n"
-    "  field the tet's value; in SI and in the field's usual display unit (°C for K, MPa for Pa, ...).\n"
+    "  and ParaView number tets), its region (id and name) and the field's value there: a node field\n"
+    "  interpolated linearly (barycentric) in that tet, a cell field the tet's value; in SI and in the\n"
+    "  field's usual display unit (°C for K, MPa for Pa, ...).\n"
     "  A point on a face shared by two tets takes one of them (the value is the same for a node field).\n"
     "  COMPONENT as foxi render --field: an index, x y z, mag, xx .. xz, vm, p1 p2 p3.\n"
     "  --step k  the field's step k (0-based; default the last)\n"
@@ -33,11 +40,14 @@ const char* kProbeUsage =
 
 const char* kPlotUsage =
     "foxi plot RESULT --field NAME[:COMPONENT] --line x0,y0,z0:x1,y1,z1 [--samples N] [--step k]\n"
-    "          -o PLOT.csv\n"
+    "          [--size WxH] -o PLOT.csv|PLOT.png\n"
     "  The field along the segment at N equally spaced samples (default 101, ends included), each\n"
     "  located and interpolated as foxi probe does. CSV columns: s (distance from the start, m),\n"
     "  x, y, z (m), tet (index from 0; empty outside), region, and the value in SI (its unit in the\n"
     "  header); a sample outside the mesh has an empty tet and region and the value nan (a gap).\n"
+    "  PNG: a line chart of the value (display units, as foxi render's legend) against the distance\n"
+    "  along the segment, with axes, ticks and units; samples outside the mesh break the line.\n"
+    "  --size WxH  the PNG's size in pixels (default 800x500)\n"
     "  Exit status: 0 written, 2 usage error, 3 unreadable or unusable file, or no sample in the mesh.";
 
 std::string number(double v) {
@@ -84,6 +94,40 @@ std::string region_text(const Mesh& mesh, std::uint32_t t) {
   const std::int32_t id = mesh.region_of(t);
   const Region* r = mesh.find_region(id);
   return std::to_string(id) + (r && !r->name.empty() ? " (" + r->name + ")" : "");
+}
+
+// The chart of foxi plot: the value in its display unit against the distance along the segment (mm
+// below a metre, else m); NaN values (outside the mesh) break the line.
+Framebuffer line_chart(const TextRenderer& text, const Selection& sel, const Field& f, const std::vector<double>& a,
+                       const std::vector<double>& b, const std::vector<double>& along, const std::vector<double>& value,
+                       int width, int height) {
+  double max_abs = 0;
+  for (double v : value)
+    if (std::isfinite(v)) max_abs = std::max(max_abs, std::abs(v));
+  const DisplayUnit u = default_display_unit(f.unit, max_abs);
+  const bool mm = along.back() < 1;
+  Chart chart;
+  char title[256];
+  std::snprintf(title, sizeof title, "%s from (%g, %g, %g) to (%g, %g, %g)", sel.choice.label.c_str(), a[0], a[1], a[2],
+                b[0], b[1], b[2]);
+  chart.title = title;
+  chart.x.label = "distance along the line";
+  chart.x.unit = mm ? "mm" : "m";
+  chart.y.label = sel.choice.label;
+  chart.y.unit = u.symbol;
+  ChartSeries series;
+  for (std::size_t i = 0; i < along.size(); ++i) {
+    series.x.push_back(mm ? along[i] * 1e3 : along[i]);
+    series.y.push_back(std::isnan(value[i]) ? value[i] : u.to_display(value[i]));
+  }
+  chart.series.push_back(std::move(series));
+  Framebuffer fb(width, height);
+  try {
+    draw_chart(fb, text, chart, PixelRect{0, 0, width - 1, height - 1});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("cannot draw the chart: ") + e.what() + " (a larger --size?)");
+  }
+  return fb;
 }
 
 }  // namespace
@@ -157,11 +201,18 @@ int cmd_plot(Args args) {
     throw UsageError("--samples takes a whole number from 2 to 10000000, not '" + samples_text + "'");
   const std::string out = args.option("-o");
   if (out.empty()) throw UsageError("-o PLOT.csv is required\n" + std::string(kPlotUsage));
-  if (!(out.size() > 4 && out.compare(out.size() - 4, 4, ".csv") == 0))
-    throw UsageError("-o takes a .csv file (a PNG chart is not available yet), not '" + out + "'");
+  auto ends_with = [&](const char* ext) { return out.size() > 4 && out.compare(out.size() - 4, 4, ext) == 0; };
+  const bool png = ends_with(".png");
+  if (!png && !ends_with(".csv")) throw UsageError("-o takes a .csv or .png file, not '" + out + "'");
+  const std::string size_text = args.option("--size");
+  if (!size_text.empty() && !png) throw UsageError("--size is for a PNG chart (-o PLOT.png)");
+  int width = 800, height = 500;
+  if (!size_text.empty()) parse_size(size_text, width, height);
   const std::string step_text = args.option("--step");
   const std::string path = args.positional(1, 1, kPlotUsage)[0];
   check_output_path(out);
+  std::unique_ptr<TextRenderer> font;
+  if (png) font = std::make_unique<TextRenderer>(find_font_file());  // a missing font fails before the work
 
   Mesh mesh = read_usable_mesh(path, "plot");
   const Selection sel = select_field(mesh, spec, step_text, path);
@@ -182,28 +233,34 @@ int cmd_plot(Args args) {
     for (char c : label) q += c == '"' ? std::string("\"\"") : std::string(1, c);
     label = q + "\"";
   }
-  std::string text = "s [m],x [m],y [m],z [m],tet,region," + label + "\n";
+  std::string csv = "s [m],x [m],y [m],z [m],tet,region," + label + "\n";
   std::size_t inside = 0;
+  std::vector<double> along(n), value(n, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t t = loc.tet[i];
-    text += number(length * double(i) / double(n - 1));
-    for (int k = 0; k < 3; ++k) text += "," + number(xyz[3 * i + k]);
+    along[i] = length * double(i) / double(n - 1);
+    csv += number(along[i]);
+    for (int k = 0; k < 3; ++k) csv += "," + number(xyz[3 * i + k]);
     if (t == kNone) {
-      text += ",,,nan\n";
+      csv += ",,,nan\n";
       continue;
     }
     ++inside;
-    text += "," + std::to_string(t) + "," + std::to_string(mesh.region_of(t)) + "," +
-            number(field_value_in_tet(mesh, sel.choice, t, &loc.bary[4 * i], sel.step)) + "\n";
+    value[i] = field_value_in_tet(mesh, sel.choice, t, &loc.bary[4 * i], sel.step);
+    csv += "," + std::to_string(t) + "," + std::to_string(mesh.region_of(t)) + "," + number(value[i]) + "\n";
   }
   if (inside == 0) {
     std::fprintf(stderr, "foxi plot: error: no sample of the line lies in the mesh of %s; nothing written\n",
                  path.c_str());
     return kExitBadInput;
   }
-  DurableFile file(out);
-  file.write(text);
-  file.commit();
+  if (png) {
+    write_png(out, line_chart(*font, sel, f, a, b, along, value, width, height));
+  } else {
+    DurableFile file(out);
+    file.write(csv);
+    file.commit();
+  }
   std::fprintf(stderr, "foxi plot: %zu samples over %.6g m, %zu in the mesh, %zu outside; wrote %s\n", n, length,
                inside, n - inside, out.c_str());
   return kExitOk;

@@ -25,6 +25,19 @@ void triple(const std::string& s, const char* what, double out[3]) {
 
 }  // namespace
 
+void parse_size(const std::string& size_s, int& width, int& height) {
+  std::size_t x = size_s.find('x');
+  char* e1 = nullptr;
+  char* e2 = nullptr;
+  std::string w = size_s.substr(0, x), h = x == std::string::npos ? "" : size_s.substr(x + 1);
+  long lw = std::strtol(w.c_str(), &e1, 10), lh = std::strtol(h.c_str(), &e2, 10);
+  if (x == std::string::npos || w.empty() || h.empty() || *e1 != 0 || *e2 != 0 || lw < 1 || lh < 1 ||
+      lw > 16384 || lh > 16384)
+    throw UsageError("--size takes WxH with 1 <= W, H <= 16384, not '" + size_s + "'");
+  width = int(lw);
+  height = int(lh);
+}
+
 PictureOptions take_picture_options(Args& args, const char* default_size) {
   PictureOptions o;
   const std::string eye_s = args.option("--eye"), at_s = args.option("--at"), up_s = args.option("--up");
@@ -34,18 +47,7 @@ PictureOptions take_picture_options(Args& args, const char* default_size) {
   o.params.edges = !args.flag("--no-edges");
   if (!dir_s.empty() && (!eye_s.empty() || !fov_s.empty()))
     throw UsageError("--dir (orthographic) cannot be combined with --eye or --fov");
-  {
-    std::size_t x = size_s.find('x');
-    char* e1 = nullptr;
-    char* e2 = nullptr;
-    std::string w = size_s.substr(0, x), h = x == std::string::npos ? "" : size_s.substr(x + 1);
-    long lw = std::strtol(w.c_str(), &e1, 10), lh = std::strtol(h.c_str(), &e2, 10);
-    if (x == std::string::npos || w.empty() || h.empty() || *e1 != 0 || *e2 != 0 || lw < 1 || lh < 1 ||
-        lw > 16384 || lh > 16384)
-      throw UsageError("--size takes WxH with 1 <= W, H <= 16384, not '" + size_s + "'");
-    o.width = int(lw);
-    o.height = int(lh);
-  }
+  parse_size(size_s, o.width, o.height);
   {
     char* end = nullptr;
     o.params.shrink = std::strtod(shrink_s.c_str(), &end);

@@ -26,6 +26,9 @@ struct PictureOptions {
   std::string regions;
 };
 
+// --size WxH (1..16384 each) into width and height; UsageError otherwise.
+void parse_size(const std::string& size_s, int& width, int& height);
+
 // Takes the options out of args; UsageError for malformed ones.
 PictureOptions take_picture_options(Args& args, const char* default_size);
 

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/viz/chart.hpp"
+#include "foxi/viz/png.hpp"
 #include "test_util.hpp"
 #include "viz/mesh_factory.hpp"
 
@@ -184,6 +186,10 @@ TEST_F(ProbeCli, PointsOutsideTheMesh) {
 
 TEST_F(ProbeCli, BadOptionsExit2BadFilesExit3) {
   std::string log;
+  EXPECT_EQ(foxi("probe --help", &log), 0) << log;
+  EXPECT_NE(log.find("foxi probe RESULT"), std::string::npos) << log;
+  EXPECT_EQ(foxi("plot --help", &log), 0) << log;
+  EXPECT_NE(log.find("foxi plot RESULT"), std::string::npos) << log;
   EXPECT_EQ(foxi("probe " + file() + " --at 1,1,1", &log), 2) << log;                          // no --field
   EXPECT_EQ(foxi("probe " + file() + " --field temperature", &log), 2) << log;                  // no --at
   EXPECT_EQ(foxi("probe " + file() + " --field temperature --at 1,1", &log), 2) << log;         // two numbers
@@ -259,6 +265,48 @@ TEST_F(ProbeCli, PlotCsvOfALinearFieldIsTheAnalyticLineWithGapsOutside) {
             3)
       << log;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "none.csv"));
+}
+
+TEST_F(ProbeCli, PlotPngIsALineChartOfTheAskedSize) {
+  const auto png = dir_ / "plot.png";
+  std::string log;
+  ASSERT_EQ(foxi("plot " + file() + " --field temperature --line -1,1.3,0.7:9,2.9,1.1 --samples 201 --size 640x400 -o '" +
+                     png.string() + "'",
+                 &log),
+            0)
+      << log;
+  const Framebuffer fb = read_png(png);
+  ASSERT_EQ(fb.width, 640);
+  ASSERT_EQ(fb.height, 400);
+  // The series' pixels (the palette's first colour): a rising line (the field grows along it), with
+  // the gaps outside the mesh at both ends: it starts right of the first series column a full line
+  // would have and ends left of the last.
+  const std::uint32_t c = chart_color(0);
+  int left = fb.width, right = -1, left_row = 0, right_row = 0;
+  std::size_t count = 0;
+  for (int y = 0; y < fb.height; ++y)
+    for (int x = 0; x < fb.width; ++x)
+      if ((fb.rgba[std::size_t(y) * std::size_t(fb.width) + std::size_t(x)] & 0xffffffu) == (c & 0xffffffu)) {
+        ++count;
+        if (x < left) left = x, left_row = y;
+        if (x > right) right = x, right_row = y;
+      }
+  ASSERT_GT(count, 100u);
+  EXPECT_GT(left_row, right_row + 100) << "the line does not rise from " << left << " to " << right;
+  EXPECT_GT(right - left, 300);
+  EXPECT_NE(log.find("wrote"), std::string::npos) << log;
+  // --size is for PNGs only; a chart too small for its labels is a usage error, nothing written.
+  EXPECT_EQ(foxi("plot " + file() + " --field temperature --line 0,0,0:8,4,2 --size 640x400 -o '" +
+                     (dir_ / "p.csv").string() + "'",
+                 &log),
+            2)
+      << log;
+  EXPECT_EQ(foxi("plot " + file() + " --field temperature --line 0,0,0:8,4,2 --size 40x30 -o '" +
+                     (dir_ / "small.png").string() + "'",
+                 &log),
+            2)
+      << log;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "small.png"));
 }
 
 }  // namespace
