@@ -55,6 +55,75 @@ TEST_F(CcxCli, SolveWithCcxAgreesWithFoxi) {
   EXPECT_NE(log.find(max_text), std::string::npos) << log;
 }
 
+// The same conditions on a mesh file, solved by foxi and by ccx: the same report lines and the same
+// --json record (parsed by python3), every value to ccx's precision (heats relative to the heat that
+// flows), apart from where the nearly isothermal die's maximum sits and the solver's own figures.
+TEST_F(CcxCli, MeshWithCliConditionsGivesFoxisReport) {
+  if (!test::have_program("ccx") || !test::have_program("/usr/bin/python3")) GTEST_SKIP() << "ccx or python3 missing";
+  std::string log, ccx_log;
+  const std::string mesh = (dir_ / "d.vtu").string();
+  ASSERT_EQ(foxi("mesh " + model() + " -o '" + mesh + "'", &log), 0) << log;
+  const std::string conditions = " --fix substrate.bottom=300K --flux die.top=2000 --power die=0.3W --k substrate=0.5";
+  ASSERT_EQ(foxi("solve '" + mesh + "'" + conditions + " --json '" + (dir_ / "a.json").string() + "'", &log), 0) << log;
+  ASSERT_EQ(foxi("solve '" + mesh + "' --with ccx" + conditions + " --json '" + (dir_ / "b.json").string() + "'",
+                 &ccx_log),
+            0)
+      << ccx_log;
+  for (const char* line : {"max temperature ", "\nregions ", "  2 (die)  ", "\nboundaries ", "  1 (substrate.bottom)   fixed",
+                           "  4 (die.top)            flux", "energy balance: sources 0.3 W", "check energy         ok"})
+    EXPECT_NE(ccx_log.find(line), std::string::npos) << line << "\n" << ccx_log;
+  test::write_text(dir_ / "cmp.py", R"(import json, sys
+a = json.load(open(sys.argv[1])); b = json.load(open(sys.argv[2]))
+assert b["solver"] == "ccx" and b["status"] == "ok" and b["physics"] == "thermal", b
+av = {v["name"]: v for v in a["values"]}; bv = {v["name"]: v for v in b["values"]}
+assert set(av) == set(bv), set(av) ^ set(bv)
+assert a["texts"] == b["texts"] or [t for t in a["texts"] if t["name"] != "T_max_region"] == [t for t in b["texts"] if t["name"] != "T_max_region"]
+assert [c["name"] for c in b["checks"]] == ["energy"] and b["checks"][0]["passed"]
+flow = av["heat_flow"]["value"]
+worst = 0
+for n, v in av.items():
+    if n.startswith("T_max_") or n in ("nonzeros", "unknowns", "iterations", "relative_residual"): continue
+    assert v["unit"] == bv[n]["unit"] and v["key"] == bv[n]["key"], n
+    x, y = v["value"], bv[n]["value"]
+    scale = flow if v["unit"] == "W" else max(abs(x), 1e-300)
+    worst = max(worst, abs(x - y) / scale)
+    assert abs(x - y) <= 1e-5 * scale, (n, x, y)
+print("compared", len(av), "worst", worst)
+)");
+  ASSERT_EQ(test::run("/usr/bin/python3 '" + (dir_ / "cmp.py").string() + "' '" + (dir_ / "a.json").string() + "' '" +
+                          (dir_ / "b.json").string() + "'",
+                      dir_ / "cmp.txt"),
+            0)
+      << test::read_text(dir_ / "cmp.txt");
+  EXPECT_NE(test::read_text(dir_ / "cmp.txt").find("compared"), std::string::npos);
+  // Without a --fix or --convect ccx is not run: a usage error; a thermoelastic mesh needs a model.
+  EXPECT_EQ(foxi("solve '" + mesh + "' --with ccx --power die=1W", &log), 2) << log;
+  EXPECT_EQ(foxi("solve '" + mesh + "' --with ccx --physics thermoelastic", &log), 2) << log;
+  EXPECT_EQ(foxi("solve '" + mesh + "' --with ccx --fix nowhere=300", &log), 2) << log;
+}
+
+// ccx's temperatures that do not balance the heat foxi puts in (a stand-in ccx that lowers the
+// deck's source before running the real one): the energy check fails, exit 4 with the figures.
+TEST_F(CcxCli, UnbalancedCcxResultIsUnreliable) {
+  if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
+  std::string real;
+  ASSERT_EQ(test::run("command -v ccx > '" + (dir_ / "which.txt").string() + "'"), 0);
+  real = test::read_text(dir_ / "which.txt");
+  real.erase(real.find_last_not_of("\n") + 1);
+  const std::filesystem::path bin = dir_ / "bin";
+  std::filesystem::create_directories(bin);
+  test::write_text(bin / "ccx", "#!/bin/sh\nsed -i 's/, BF, .*/, BF, 4e7/' \"$2.inp\"\nexec '" + real + "' \"$@\"\n");
+  std::filesystem::permissions(bin / "ccx", std::filesystem::perms::owner_all);
+  std::string log;
+  const std::string json = (dir_ / "u.json").string();
+  EXPECT_EQ(foxi("solve " + model() + " --with ccx --json '" + json + "'", &log, "PATH='" + bin.string() + "':\"$PATH\" "),
+            4)
+      << log;
+  EXPECT_NE(log.find("check energy         FAIL"), std::string::npos) << log;
+  EXPECT_NE(log.find("UNRELIABLE"), std::string::npos) << log;
+  EXPECT_NE(test::read_text(json).find("\"status\": \"unreliable\""), std::string::npos) << test::read_text(json);
+}
+
 // On a terminal (script(1) gives it one) ccx's progress shows as it runs.
 TEST_F(CcxCli, ProgressOnATerminal) {
   if (!test::have_program("ccx") || !test::have_program("script")) GTEST_SKIP() << "ccx or script not installed";
