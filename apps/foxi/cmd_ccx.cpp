@@ -260,6 +260,35 @@ std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const
   return f;
 }
 
+// The values of nodal block `block` of WORK/JOB.frd at the deck's C3D10 mid-edge nodes (ids after the
+// mesh's `n` nodes, every one from n + 1 on, in order); nullopt (message printed, folder kept) when
+// the block is missing or leaves one out.
+std::optional<std::vector<double>> ccx_mid_edge_values(WorkFolder& folder, const std::string& job, std::size_t n,
+                                                       const char* block) {
+  const FieldSource frd = read_frd_source(folder.path / (job + ".frd"));
+  const Field* f = nullptr;
+  for (const Field& g : frd.mesh.fields)
+    if (g.name == block && g.location == FieldLocation::node) f = &g;
+  std::size_t mid = 0;
+  for (std::uint64_t id : frd.node_id) mid += id > n;
+  std::vector<double> v(f ? mid * f->components : 0, NAN);
+  std::size_t found = 0;
+  for (std::size_t i = 0; f && i < frd.node_id.size(); ++i) {
+    const std::uint64_t id = frd.node_id[i];
+    if (id <= n || id > n + mid) continue;
+    ++found;
+    std::copy_n(f->values.begin() + std::ptrdiff_t(i * f->components), f->components,
+                v.begin() + std::ptrdiff_t((id - n - 1) * f->components));
+  }
+  if (!f || found != mid || std::any_of(v.begin(), v.end(), [](double x) { return !std::isfinite(x); })) {
+    std::fprintf(stderr, "foxi solve: ccx's %s does not give every mid-edge node a value; files kept in %s\n", block,
+                 folder.path.c_str());
+    folder.keep = true;
+    return std::nullopt;
+  }
+  return v;
+}
+
 // max_i |a_i - b_i| over max_i |a_i|, and the former.
 std::pair<double, double> largest_difference(const std::vector<double>& a, const std::vector<double>& b) {
   double diff = 0, scale = 0;
@@ -414,20 +443,34 @@ int cmd_solve_with(Args args, const std::string& physics) {
     std::optional<Field> u = ccx_field(work, "stress", mesh, "DISP", "displacement", "m");
     std::optional<Field> sn = ccx_field(work, "stress", mesh, "STRESS", "stress_nodal", "Pa");
     if (!u || !sn) return kExitFailure;
-    std::size_t arg = 0;
-    double umax = 0, vm_max = 0;
+    // foxi's report of ccx's displacements (with C3D10 the mid-edge nodes' too): stress, von Mises
+    // and principal stress per tet, the maxima per region and interface, as foxi solve prints them.
+    std::vector<double> solver_u = u->values;
+    if (ep.order == 2) {
+      const std::optional<std::vector<double>> mid = ccx_mid_edge_values(work, "stress", mesh.node_count(), "DISP");
+      if (!mid) return kExitFailure;
+      solver_u.insert(solver_u.end(), mid->begin(), mid->end());
+    }
+    const double ccx_seconds = clock() - mesh_seconds;
+    ThermoelasticReport rep = thermoelastic_report(mesh, ep, std::move(solver_u));
+    rep.solver = "ccx";
+    rep.solve_seconds = ccx_seconds;
+    double vm_max = 0;
     for (std::size_t i = 0; i < mesh.node_count(); ++i) {
-      const double* v = &u->values[3 * i];
-      const double m = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      if (m > umax) umax = m, arg = i;
       const double* s6 = &sn->values[6 * i];
       const double vm = std::sqrt(0.5 * ((s6[0] - s6[1]) * (s6[0] - s6[1]) + (s6[1] - s6[2]) * (s6[1] - s6[2]) +
                                          (s6[2] - s6[0]) * (s6[2] - s6[0])) +
                                   3 * (s6[3] * s6[3] + s6[4] * s6[4] + s6[5] * s6[5]));
       vm_max = std::max(vm_max, vm);
     }
-    std::printf("ccx stress (%s): %.3f s; largest |u| %.6g m at (%.6g, %.6g, %.6g) m; largest nodal von Mises %.6g Pa\n",
-                ep.order == 2 ? "C3D10" : "C3D4", clock(), umax, mesh.xyz[3 * arg], mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2], vm_max);
+    std::printf("%s: %zu nodes, %zu tets; linear thermoelasticity by ccx (%s), %.3f s\n", files[0].c_str(),
+                mesh.node_count(), mesh.tet_count(), ep.order == 2 ? "C3D10" : "C3D4", ccx_seconds);
+    print_thermoelastic_report(mesh, rep);
+    std::printf("largest von Mises of ccx's nodal stress (its element values averaged at the nodes) %.6g Pa\n",
+                vm_max);
+    RunResults elastic = thermoelastic_results(mesh, rep);
+    elastic.checks.insert(elastic.checks.begin(), results.checks.begin(), results.checks.end());  // the thermal run's
+    results = std::move(elastic);
     if (compare) {
       Mesh own = mesh;
       solve_thermoelastic(own, ep);
@@ -441,16 +484,16 @@ int cmd_solve_with(Args args, const std::string& physics) {
     }
     fields.push_back(std::move(*sn));
   }
-  if (!stress || from_thermal) {
-    results.model = files[0];
-    results.parameters = run_parameters(sets);
-    results.mesh_seconds = mesh_seconds;
-    results.wall_seconds = clock();
+  results.model = files[0];
+  results.parameters = run_parameters(sets);
+  results.mesh_seconds = mesh_seconds;
+  results.wall_seconds = clock();
+  if (!stress) {
     results.error_indicator = error_indicator(mesh, "temperature");
     print_error_indicator(results.error_indicator, "temperature");
-    if (print_checks(results.checks) != kExitOk) result = kExitUnreliable;
-    if (result == kExitUnreliable) results.status = RunStatus::unreliable;
   }
+  if (print_checks(results.checks) != kExitOk) result = kExitUnreliable;
+  if (result == kExitUnreliable) results.status = RunStatus::unreliable;
   if (!out.empty()) {
     for (Field& f : fields) {
       std::erase_if(mesh.fields, [&](const Field& g) { return g.name == f.name; });

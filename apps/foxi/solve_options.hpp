@@ -11,6 +11,7 @@
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/units.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "foxi/solver/thermoelastic.hpp"
 
 namespace foxi::cli {
 
@@ -64,6 +65,10 @@ void add_thermal_options(const Mesh& mesh, const ThermalOptions& options, Therma
 // The thermal report's lines: max temperature and where, the region and boundary tables, the energy
 // balance, the thermal resistances (foxi solve and foxi solve --with ccx print the same).
 void print_thermal_report(const Mesh& mesh, const ThermalReport& report);
+
+// The thermoelastic report's lines: the largest von Mises stress and displacement and where, per
+// region and per material interface (foxi solve and foxi solve --with ccx print the same).
+void print_thermoelastic_report(const Mesh& mesh, const ThermoelasticReport& report);
 
 int cmd_solve_thermoelastic(Args args);
 // foxi solve MODEL --physics transient ...: transient heat conduction, a .pvd series and Zth(t).
