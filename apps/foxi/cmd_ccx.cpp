@@ -28,6 +28,7 @@
 #include "foxi/solver/thermoelastic.hpp"
 #include "mesh_input.hpp"
 #include "model_run.hpp"
+#include "run_results.hpp"
 #include "signals.hpp"
 #include "solve_options.hpp"
 
@@ -36,6 +37,9 @@ namespace foxi::cli {
 namespace {
 
 namespace fs = std::filesystem;
+
+// ccx's ASCII .frd prints values as E12.5: 6 significant digits, rounded to half a unit of the last.
+constexpr double kFrdPrecision = 5e-6;
 
 const char* kExportUsage =
     "foxi export-ccx MODEL.toml [--set NAME=VALUE]... [--physics thermal|thermoelastic] [--order 1|2]\n"
@@ -49,14 +53,24 @@ const char* kExportUsage =
     "  at all.";
 
 const char* kSolveCcxUsage =
-    "foxi solve MODEL.toml --physics thermal|thermoelastic --with ccx [--set NAME=VALUE]...\n"
-    "                      [--temperature-from-thermal] [--order 1|2] [--compare] [--keep] [-o OUT]\n"
-    "  The model's problem solved by CalculiX: the deck (as foxi export-ccx writes it) is run by ccx in\n"
+    "foxi solve MODEL.toml|MESH --physics thermal|thermoelastic --with ccx [--set NAME=VALUE]...\n"
+    "                      [--fix TAG=T] [--flux TAG=q] [--convect TAG=h,Tinf] [--power REGION=W]\n"
+    "                      [--power-density REGION=W/m3] [--k REGION=k] [--theta JUNCTION:REFERENCE]\n"
+    "                      [--temperature-from-thermal] [--order 1|2] [--compare] [--keep]\n"
+    "                      [--json [FILE.json]] [-o OUT]\n"
+    "  The problem solved by CalculiX: the deck (as foxi export-ccx writes it) is run by ccx in\n"
     "  a work folder and its results come back as foxi fields on foxi's mesh (node i = ccx node i + 1).\n"
-    "  thermal: the .frd's NDTEMP as 'temperature' (K); prints the maximum and where, each region's\n"
-    "  maximum. thermoelastic (C3D4, or C3D10 with --order 2; the model's displacement conditions and\n"
-    "  temperature_change, or with --temperature-from-thermal ccx's steady temperatures of the model's\n"
-    "  thermal problem):\n"
+    "  thermal: a model's conditions and loads and the thermal options of 'foxi solve --help' added to\n"
+    "  them (a MESH file: those options alone; at least one --fix or --convect). The .frd's NDTEMP\n"
+    "  becomes 'temperature' (K) and foxi prints what its own solve prints, computed by foxi from ccx's\n"
+    "  temperatures: the maximum and where, per-region maximum and mean, heat through each boundary\n"
+    "  (the P1 reactions of ccx's temperatures at fixed nodes) and its mean temperature, the energy\n"
+    "  balance, thermal resistances, the error indicator; OUT also gets 'heat_flux'. The energy\n"
+    "  check's tolerance takes in what ccx's 6 printed digits can unbalance; a failed check is exit 4.\n"
+    "  --json writes the record foxi solve --json writes (solver \"ccx\", its solver figures 0).\n"
+    "  thermoelastic (a model file; C3D4, or C3D10 with --order 2; the model's displacement conditions\n"
+    "  and temperature_change, or with --temperature-from-thermal ccx's steady temperatures of the\n"
+    "  model's thermal problem):\n"
     "  DISP as 'displacement' (m), ccx's nodal STRESS (its element values averaged at the nodes) as\n"
     "  'stress_nodal' (Pa, xx yy zz xy yz xz); prints the largest |u| and where, the largest nodal von\n"
     "  Mises stress. --compare also solves with foxi on the same mesh and temperatures (thermal: with\n"
@@ -66,7 +80,8 @@ const char* kSolveCcxUsage =
     "  On a terminal ccx's increments and Newton iterations show as it runs (stderr). The work\n"
     "  folder is removed after a successful run (--keep keeps it) and kept, with ccx's\n"
     "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here.\n"
-    "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model, 4 --compare off.";
+    "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model or mesh, 4 a failed\n"
+    "  check or --compare off.";
 
 MeshedModel model_for_ccx(Args& args, const char* usage, const char* command, const std::string& physics) {
   const std::vector<std::string> sets = all_options(args, "--set");
@@ -245,6 +260,35 @@ std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const
   return f;
 }
 
+// The values of nodal block `block` of WORK/JOB.frd at the deck's C3D10 mid-edge nodes (ids after the
+// mesh's `n` nodes, every one from n + 1 on, in order); nullopt (message printed, folder kept) when
+// the block is missing or leaves one out.
+std::optional<std::vector<double>> ccx_mid_edge_values(WorkFolder& folder, const std::string& job, std::size_t n,
+                                                       const char* block) {
+  const FieldSource frd = read_frd_source(folder.path / (job + ".frd"));
+  const Field* f = nullptr;
+  for (const Field& g : frd.mesh.fields)
+    if (g.name == block && g.location == FieldLocation::node) f = &g;
+  std::size_t mid = 0;
+  for (std::uint64_t id : frd.node_id) mid += id > n;
+  std::vector<double> v(f ? mid * f->components : 0, NAN);
+  std::size_t found = 0;
+  for (std::size_t i = 0; f && i < frd.node_id.size(); ++i) {
+    const std::uint64_t id = frd.node_id[i];
+    if (id <= n || id > n + mid) continue;
+    ++found;
+    std::copy_n(f->values.begin() + std::ptrdiff_t(i * f->components), f->components,
+                v.begin() + std::ptrdiff_t((id - n - 1) * f->components));
+  }
+  if (!f || found != mid || std::any_of(v.begin(), v.end(), [](double x) { return !std::isfinite(x); })) {
+    std::fprintf(stderr, "foxi solve: ccx's %s does not give every mid-edge node a value; files kept in %s\n", block,
+                 folder.path.c_str());
+    folder.keep = true;
+    return std::nullopt;
+  }
+  return v;
+}
+
 // max_i |a_i - b_i| over max_i |a_i|, and the former.
 std::pair<double, double> largest_difference(const std::vector<double>& a, const std::vector<double>& b) {
   double diff = 0, scale = 0;
@@ -322,14 +366,31 @@ int cmd_solve_with(Args args, const std::string& physics) {
     (void)format_from_path(out);
     check_output_path(out);
   }
-  MeshedModel run = model_for_ccx(args, kSolveCcxUsage, "solve", stress ? physics_name(Physics::thermal_stress) : "thermal");
+  JsonOutput json = json_option(args);
+  const ThermalOptions cli_conditions = thermal_options(args);
+  if (stress && !cli_conditions.empty())
+    throw UsageError("--fix, --flux, --convect, --power, --power-density, --k and --theta are for --physics thermal");
+  const std::vector<std::string> sets = all_options(args, "--set");
+  const auto files = args.positional(1, 1, kSolveCcxUsage);
+  const bool from_model = is_model_path(files[0]);
+  if (!from_model && stress)
+    throw UsageError("--physics thermoelastic --with ccx needs a model file (MODEL.toml): its displacement conditions");
+  if (!from_model && !sets.empty()) throw UsageError("--set is for model files (MODEL.toml)");
+  silence_text_for_json(json);
+  const auto t0 = std::chrono::steady_clock::now();
+  MeshedModel run;
+  if (from_model)
+    run = mesh_model_for_solve(files[0], sets, stress ? physics_name(Physics::thermal_stress) : "thermal");
+  else
+    run.mesh = read_mesh(files[0]);
   Mesh& mesh = run.mesh;
+  require_usable(mesh, files[0], "solve");
+  const double mesh_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  RunResults results;  // the record of the run (--json)
   WorkFolder work;
   int result = kExitOk;
   std::vector<Field> fields;  // written to OUT in this order
-  const auto clock = [t0 = std::chrono::steady_clock::now()] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  };
+  const auto clock = [t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   auto report_compare = [&](const char* what, const std::vector<double>& ccx, const std::vector<double>& own,
                             const char* unit) {
     const auto [diff, rel] = largest_difference(ccx, own);
@@ -340,36 +401,34 @@ int cmd_solve_with(Args args, const std::string& physics) {
 
   std::vector<double> temperature;
   if (!stress || from_thermal) {
-    ThermalParams params = thermal_params_from_model(run.model, mesh);
+    ThermalParams params;
+    if (from_model) params = thermal_params_from_model(run.model, mesh);
+    add_thermal_options(mesh, cli_conditions, params);
+    if (params.fixed.empty() && params.convection.empty())
+      throw UsageError("give at least one --fix or --convect: the temperature is otherwise undetermined");
     write_calculix_thermal(mesh, params, work.path / "heat.inp");
     if (!run_ccx(work, "heat")) return kExitFailure;
     std::optional<Field> t = ccx_field(work, "heat", mesh, "NDTEMP", "temperature", "K");
     if (!t) return kExitFailure;
     temperature = t->values;
-    std::size_t arg = 0;
-    for (std::size_t i = 0; i < temperature.size(); ++i)
-      if (temperature[i] > temperature[arg]) arg = i;
-    std::printf("ccx heat: %zu nodes, %zu C3D4 elements, %.3f s; max temperature %.6g K at (%.6g, %.6g, %.6g) m\n",
-                mesh.node_count(), mesh.tet_count(), clock(), temperature[arg], mesh.xyz[3 * arg],
-                mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2]);
-    for (const Region& r : mesh.regions) {
-      double hi = -INFINITY;
-      for (std::size_t e = 0; e < mesh.tet_count(); ++e)
-        if (mesh.region_of(e) == r.id)
-          for (int j = 0; j < 4; ++j) hi = std::max(hi, temperature[mesh.tet[4 * e + j]]);
-      if (std::isfinite(hi)) std::printf("  region %-16s max %.6g K\n", region_label(mesh, r.id).c_str(), hi);
-    }
+    const double ccx_seconds = clock() - mesh_seconds;
+    // foxi's report of ccx's temperatures (stored, with the heat flux, on the mesh): the lines and
+    // the record foxi solve prints, the energy check's tolerance widened to ccx's 6 digits.
+    params.convection_centroid_rule = true;  // ccx's *FILM rule: the heat balance of its solution
+    ThermalReport rep = thermal_report(mesh, params, temperature, kFrdPrecision);
+    rep.solver = "ccx";
+    rep.solve_seconds = ccx_seconds;
+    std::printf("%s: %zu nodes, %zu tets; steady heat conduction by ccx (C3D4), %.3f s\n", files[0].c_str(),
+                mesh.node_count(), mesh.tet_count(), ccx_seconds);
+    print_thermal_report(mesh, rep);
+    results = thermal_results(mesh, rep);
     if (compare && !stress) {
       Mesh own = mesh;
-      params.convection_centroid_rule = true;  // ccx's *FILM rule, so that the two agree to its print precision
       solve_thermal(own, params);
       Field g = *own.find_field("temperature");
       report_compare("T", temperature, g.values, "K");
       g.name = "temperature_foxi";
-      fields.push_back(std::move(*t));
       fields.push_back(std::move(g));
-    } else {
-      fields.push_back(std::move(*t));
     }
   }
   if (stress) {
@@ -384,20 +443,34 @@ int cmd_solve_with(Args args, const std::string& physics) {
     std::optional<Field> u = ccx_field(work, "stress", mesh, "DISP", "displacement", "m");
     std::optional<Field> sn = ccx_field(work, "stress", mesh, "STRESS", "stress_nodal", "Pa");
     if (!u || !sn) return kExitFailure;
-    std::size_t arg = 0;
-    double umax = 0, vm_max = 0;
+    // foxi's report of ccx's displacements (with C3D10 the mid-edge nodes' too): stress, von Mises
+    // and principal stress per tet, the maxima per region and interface, as foxi solve prints them.
+    std::vector<double> solver_u = u->values;
+    if (ep.order == 2) {
+      const std::optional<std::vector<double>> mid = ccx_mid_edge_values(work, "stress", mesh.node_count(), "DISP");
+      if (!mid) return kExitFailure;
+      solver_u.insert(solver_u.end(), mid->begin(), mid->end());
+    }
+    const double ccx_seconds = clock() - mesh_seconds;
+    ThermoelasticReport rep = thermoelastic_report(mesh, ep, std::move(solver_u));
+    rep.solver = "ccx";
+    rep.solve_seconds = ccx_seconds;
+    double vm_max = 0;
     for (std::size_t i = 0; i < mesh.node_count(); ++i) {
-      const double* v = &u->values[3 * i];
-      const double m = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      if (m > umax) umax = m, arg = i;
       const double* s6 = &sn->values[6 * i];
       const double vm = std::sqrt(0.5 * ((s6[0] - s6[1]) * (s6[0] - s6[1]) + (s6[1] - s6[2]) * (s6[1] - s6[2]) +
                                          (s6[2] - s6[0]) * (s6[2] - s6[0])) +
                                   3 * (s6[3] * s6[3] + s6[4] * s6[4] + s6[5] * s6[5]));
       vm_max = std::max(vm_max, vm);
     }
-    std::printf("ccx stress (%s): %.3f s; largest |u| %.6g m at (%.6g, %.6g, %.6g) m; largest nodal von Mises %.6g Pa\n",
-                ep.order == 2 ? "C3D10" : "C3D4", clock(), umax, mesh.xyz[3 * arg], mesh.xyz[3 * arg + 1], mesh.xyz[3 * arg + 2], vm_max);
+    std::printf("%s: %zu nodes, %zu tets; linear thermoelasticity by ccx (%s), %.3f s\n", files[0].c_str(),
+                mesh.node_count(), mesh.tet_count(), ep.order == 2 ? "C3D10" : "C3D4", ccx_seconds);
+    print_thermoelastic_report(mesh, rep);
+    std::printf("largest von Mises of ccx's nodal stress (its element values averaged at the nodes) %.6g Pa\n",
+                vm_max);
+    RunResults elastic = thermoelastic_results(mesh, rep);
+    elastic.checks.insert(elastic.checks.begin(), results.checks.begin(), results.checks.end());  // the thermal run's
+    results = std::move(elastic);
     if (compare) {
       Mesh own = mesh;
       solve_thermoelastic(own, ep);
@@ -411,6 +484,16 @@ int cmd_solve_with(Args args, const std::string& physics) {
     }
     fields.push_back(std::move(*sn));
   }
+  results.model = files[0];
+  results.parameters = run_parameters(sets);
+  results.mesh_seconds = mesh_seconds;
+  results.wall_seconds = clock();
+  if (!stress) {
+    results.error_indicator = error_indicator(mesh, "temperature");
+    print_error_indicator(results.error_indicator, "temperature");
+  }
+  if (print_checks(results.checks) != kExitOk) result = kExitUnreliable;
+  if (result == kExitUnreliable) results.status = RunStatus::unreliable;
   if (!out.empty()) {
     for (Field& f : fields) {
       std::erase_if(mesh.fields, [&](const Field& g) { return g.name == f.name; });
@@ -423,6 +506,7 @@ int cmd_solve_with(Args args, const std::string& physics) {
     std::printf("ccx's work folder: %s\n", work.path.c_str());
     work.keep = true;
   }
+  write_json(json, results_json(results));
   return result;
 }
 

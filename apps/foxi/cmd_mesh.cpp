@@ -226,6 +226,9 @@ int cmd_mesh(Args args) {
       field = size_field_from_error(solved, *f, number(target_error, "--target-error"), 0, controls.max_size);
       std::printf("refine from %s: field '%s', relative gradient error %.3g (Zienkiewicz-Zhu), target %s\n",
                   refine_from.c_str(), f->name.c_str(), e.relative_error(), target_error.c_str());
+      if (e.tets_without_value > 0)
+        std::printf("  %zu of its %zu tets have a node without a value (NaN): left out of the error, they keep their size\n",
+                    e.tets_without_value, solved.tet_count());
     } else if (!controls.boxes.empty()) {
       check_tet_estimate(in, plc, params, volumes, max_tets);  // box_size_field meshes with params first
       field = box_size_field(plc, params, controls);

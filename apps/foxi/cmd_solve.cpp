@@ -263,6 +263,126 @@ int print_checks(const std::vector<BalanceCheck>& checks) {
   return status;
 }
 
+ThermalOptions thermal_options(Args& args) {
+  ThermalOptions o;
+  o.fix = all_options(args, "--fix"), o.flux = all_options(args, "--flux");
+  o.convect = all_options(args, "--convect"), o.power = all_options(args, "--power");
+  o.density = all_options(args, "--power-density"), o.cond = all_options(args, "--k");
+  o.theta = all_options(args, "--theta");
+  auto values = [](const std::vector<std::string>& list, const char* option, const char* unit) {
+    for (const std::string& s : list) (void)parse_value(split_assignment(s, option).second, option, unit);
+  };
+  for (const std::string& s : o.fix)
+    (void)parse_temperature(split_assignment(s, "--fix").second, "--fix", TemperatureKind::absolute);
+  for (const std::string& s : o.convect) {
+    const auto [h, tinf] = split_pair(split_assignment(s, "--convect").second, "--convect", "TAG=h,Tinf");
+    (void)parse_value(h, "--convect", "W/(m^2*K)");
+    (void)parse_temperature(tinf, "--convect", TemperatureKind::absolute);
+  }
+  values(o.flux, "--flux", "W/m^2");
+  values(o.power, "--power", "W");
+  values(o.density, "--power-density", "W/m^3");
+  values(o.cond, "--k", "W/(m*K)");
+  return o;
+}
+
+void add_thermal_options(const Mesh& mesh, const ThermalOptions& o, ThermalParams& params) {
+  for (const std::string& s : o.fix) {
+    auto [k, v] = split_assignment(s, "--fix");
+    params.fixed.push_back(
+        {boundary_tag(mesh, k, "--fix"), parse_temperature(v, "--fix", TemperatureKind::absolute)});
+  }
+  for (const std::string& s : o.flux) {
+    auto [k, v] = split_assignment(s, "--flux");
+    params.flux.push_back({boundary_tag(mesh, k, "--flux"), parse_value(v, "--flux", "W/m^2")});
+  }
+  for (const std::string& s : o.convect) {
+    auto [k, v] = split_assignment(s, "--convect");
+    const auto [h, tinf] = split_pair(v, "--convect", "TAG=h,Tinf");
+    params.convection.push_back({boundary_tag(mesh, k, "--convect"), parse_value(h, "--convect", "W/(m^2*K)"),
+                                 parse_temperature(tinf, "--convect", TemperatureKind::absolute)});
+  }
+  // --power and --power-density replace the model's load on their region (said on a line); a region
+  // given twice on the command line is a usage error.
+  const std::size_t model_sources = params.sources.size();
+  std::vector<bool> replaced(model_sources, false);
+  auto add_source = [&](const std::string& s, const char* option, const char* unit, bool total) {
+    auto [k, v] = split_assignment(s, option);
+    const HeatSource source{region_id(mesh, k, option), parse_value(v, option, unit), total};
+    for (std::size_t i = model_sources; i < params.sources.size(); ++i)
+      if (params.sources[i].region == source.region)
+        throw UsageError(std::string(option) + " " + k + ": the region has a --power or --power-density already");
+    for (std::size_t i = 0; i < model_sources; ++i)
+      if (params.sources[i].region == source.region && !replaced[i]) {
+        const HeatSource& old = params.sources[i];
+        std::printf("%s %s replaces the model's load on %s (%.6g %s)\n", option, s.c_str(),
+                    region_label(mesh, old.region).c_str(), old.value, old.total ? "W" : "W/m^3");
+        replaced[i] = true;
+      }
+    params.sources.push_back(source);
+  };
+  for (const std::string& s : o.power) add_source(s, "--power", "W", true);
+  for (const std::string& s : o.density) add_source(s, "--power-density", "W/m^3", false);
+  for (std::size_t i = model_sources; i-- > 0;)
+    if (replaced[i]) params.sources.erase(params.sources.begin() + std::ptrdiff_t(i));
+  for (const std::string& s : o.cond) {
+    auto [k, v] = split_assignment(s, "--k");
+    params.conductivity.push_back({region_id(mesh, k, "--k"), parse_value(v, "--k", "W/(m*K)")});
+  }
+  for (const std::string& s : o.theta) {
+    const auto colon = s.find(':');
+    if (colon == std::string::npos || s.find(':', colon + 1) != std::string::npos)
+      throw UsageError("--theta takes JUNCTION:REFERENCE, not '" + s + "'");
+    params.resistances.push_back({theta_probe(mesh, s.substr(0, colon), ThermalProbeKind::region_max),
+                                  theta_probe(mesh, s.substr(colon + 1), ThermalProbeKind::boundary_mean)});
+  }
+}
+
+void print_thermal_report(const Mesh& mesh, const ThermalReport& r) {
+  const double* p = &mesh.xyz[3 * std::size_t{r.max_node}];
+  std::printf("max temperature %.6g K (%.6g C) at node %u (%.6g, %.6g, %.6g)\n", r.max_temperature,
+              r.max_temperature - 273.15, r.max_node, p[0], p[1], p[2]);
+  std::printf("%-24s %12s %12s %12s %10s %12s %12s\n", "regions", "k W/(m K)", "power W", "max T K",
+              "max T C", "mean T K", "volume m^3");
+  for (const RegionTemperature& t : r.regions)
+    std::printf("  %-22s %12.4g %12.4g %12.6g %10.4g %12.6g %12.4g\n", region_label(mesh, t.region).c_str(),
+                t.conductivity, t.power, t.max_temperature, t.max_temperature - 273.15, t.mean_temperature,
+                t.volume);
+  std::printf("%-24s %-10s %12s %14s %12s\n", "boundaries", "condition", "area m^2", "heat in W", "mean T K");
+  double boundary_heat = 0;
+  for (const BoundaryHeat& b : r.boundaries) {
+    std::printf("  %-22s %-10s %12.4g %14.6g %12.6g\n", boundary_label(mesh, b.tag).c_str(), b.kind.c_str(),
+                b.area, b.heat_in, b.mean_temperature);
+    boundary_heat += b.heat_in;
+  }
+  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W", r.total_power,
+              boundary_heat, r.imbalance);
+  if (r.heat_flow > 0) std::printf(" (%.2g of the %.6g W that flow)", std::abs(r.imbalance) / r.heat_flow, r.heat_flow);
+  std::printf("\n");
+  for (const ThermalResistance& t : r.resistances) {
+    auto side = [&](const ThermalProbe& probe) {
+      switch (probe.kind) {
+        case ThermalProbeKind::region_max:
+          return "max of region " + region_label(mesh, probe.id);
+        case ThermalProbeKind::region_mean:
+          return "mean of region " + region_label(mesh, probe.id);
+        case ThermalProbeKind::boundary_mean:
+          return "surface mean of boundary " + boundary_label(mesh, probe.id);
+        case ThermalProbeKind::ambient:
+          return "ambient of boundary " + boundary_label(mesh, probe.id);
+      }
+      return std::string();
+    };
+    std::printf("thermal resistance %s %.6g K -> %s %.6g K: dT %.6g K, P %.6g W, theta %.6g K/W; ",
+                side(t.spec.junction).c_str(), t.junction_temperature, side(t.spec.reference).c_str(),
+                t.reference_temperature, t.delta_t, t.power, t.theta);
+    if (std::isnan(t.reference_heat_out))
+      std::printf("no boundary heat at a region reference\n");
+    else
+      std::printf("heat out there %.6g W, dT/heat %.6g K/W\n", t.reference_heat_out, t.path_theta);
+  }
+}
+
 int cmd_solve(Args args) {
   const std::string physics = args.option("--physics", "thermal");
   if (args.has_option("--with")) return cmd_solve_with(std::move(args), physics);
@@ -279,11 +399,7 @@ int cmd_solve(Args args) {
                                  eps = all_options(args, "--eps"), terminal = all_options(args, "--terminal"),
                                  terminal_current = all_options(args, "--terminal-current"),
                                  sigma = all_options(args, "--sigma");
-  const std::vector<std::string> fix = all_options(args, "--fix"), flux = all_options(args, "--flux"),
-                                 convect = all_options(args, "--convect"),
-                                 power = all_options(args, "--power"),
-                                 density = all_options(args, "--power-density"),
-                                 cond = all_options(args, "--k"), theta = all_options(args, "--theta");
+  const ThermalOptions thermal = thermal_options(args);
   const LinearSolverOptions solver_options = parse_solver_options(args);
   std::string out = args.option("-o", "");
   if (out.empty()) out = args.option("--output", "");
@@ -303,17 +419,6 @@ int cmd_solve(Args args) {
   auto values = [](const std::vector<std::string>& list, const char* option, const char* unit) {
     for (const std::string& s : list) (void)parse_value(split_assignment(s, option).second, option, unit);
   };
-  for (const std::string& s : fix)
-    (void)parse_temperature(split_assignment(s, "--fix").second, "--fix", TemperatureKind::absolute);
-  for (const std::string& s : convect) {
-    const auto [h, tinf] = split_pair(split_assignment(s, "--convect").second, "--convect", "TAG=h,Tinf");
-    (void)parse_value(h, "--convect", "W/(m^2*K)");
-    (void)parse_temperature(tinf, "--convect", TemperatureKind::absolute);
-  }
-  values(flux, "--flux", "W/m^2");
-  values(power, "--power", "W");
-  values(density, "--power-density", "W/m^3");
-  values(cond, "--k", "W/(m*K)");
   values(terminal, "--terminal", "V");
   values(terminal_current, "--terminal-current", "A");
   values(sigma, "--sigma", "S/m");
@@ -342,8 +447,7 @@ int cmd_solve(Args args) {
   };
 
   if (physics != "thermal") {
-    if (!fix.empty() || !flux.empty() || !convect.empty() || !power.empty() || !density.empty() ||
-        !cond.empty() || !theta.empty())
+    if (!thermal.empty())
       throw UsageError(
           "--fix, --flux, --convect, --power, --power-density, --k and --theta are for --physics "
           "thermal");
@@ -448,103 +552,14 @@ int cmd_solve(Args args) {
     params.fixed = mp.fixed, params.flux = mp.flux, params.convection = mp.convection;
     params.sources = mp.sources;
   }
-  for (const std::string& s : fix) {
-    auto [k, v] = split_assignment(s, "--fix");
-    params.fixed.push_back(
-        {boundary_tag(mesh, k, "--fix"), parse_temperature(v, "--fix", TemperatureKind::absolute)});
-  }
-  for (const std::string& s : flux) {
-    auto [k, v] = split_assignment(s, "--flux");
-    params.flux.push_back({boundary_tag(mesh, k, "--flux"), parse_value(v, "--flux", "W/m^2")});
-  }
-  for (const std::string& s : convect) {
-    auto [k, v] = split_assignment(s, "--convect");
-    const auto [h, tinf] = split_pair(v, "--convect", "TAG=h,Tinf");
-    params.convection.push_back({boundary_tag(mesh, k, "--convect"), parse_value(h, "--convect", "W/(m^2*K)"),
-                                 parse_temperature(tinf, "--convect", TemperatureKind::absolute)});
-  }
-  // --power and --power-density replace the model's load on their region (said on a line); a region
-  // given twice on the command line is a usage error.
-  const std::size_t model_sources = params.sources.size();
-  std::vector<bool> replaced(model_sources, false);
-  auto add_source = [&](const std::string& s, const char* option, const char* unit, bool total) {
-    auto [k, v] = split_assignment(s, option);
-    const HeatSource source{region_id(mesh, k, option), parse_value(v, option, unit), total};
-    for (std::size_t i = model_sources; i < params.sources.size(); ++i)
-      if (params.sources[i].region == source.region)
-        throw UsageError(std::string(option) + " " + k + ": the region has a --power or --power-density already");
-    for (std::size_t i = 0; i < model_sources; ++i)
-      if (params.sources[i].region == source.region && !replaced[i]) {
-        const HeatSource& old = params.sources[i];
-        std::printf("%s %s replaces the model's load on %s (%.6g %s)\n", option, s.c_str(),
-                    region_label(mesh, old.region).c_str(), old.value, old.total ? "W" : "W/m^3");
-        replaced[i] = true;
-      }
-    params.sources.push_back(source);
-  };
-  for (const std::string& s : power) add_source(s, "--power", "W", true);
-  for (const std::string& s : density) add_source(s, "--power-density", "W/m^3", false);
-  for (std::size_t i = model_sources; i-- > 0;)
-    if (replaced[i]) params.sources.erase(params.sources.begin() + std::ptrdiff_t(i));
-  for (const std::string& s : cond) {
-    auto [k, v] = split_assignment(s, "--k");
-    params.conductivity.push_back({region_id(mesh, k, "--k"), parse_value(v, "--k", "W/(m*K)")});
-  }
-  for (const std::string& s : theta) {
-    const auto colon = s.find(':');
-    if (colon == std::string::npos || s.find(':', colon + 1) != std::string::npos)
-      throw UsageError("--theta takes JUNCTION:REFERENCE, not '" + s + "'");
-    params.resistances.push_back({theta_probe(mesh, s.substr(0, colon), ThermalProbeKind::region_max),
-                                  theta_probe(mesh, s.substr(colon + 1), ThermalProbeKind::boundary_mean)});
-  }
+  add_thermal_options(mesh, thermal, params);
 
   const ThermalReport r = solve_thermal(mesh, params);
   auto t2 = std::chrono::steady_clock::now();
 
   std::printf("%s: %zu nodes, %zu tets; steady heat conduction, %zu unknowns\n", files[0].c_str(),
               mesh.node_count(), mesh.tet_count(), r.unknowns);
-  const double* p = &mesh.xyz[3 * std::size_t{r.max_node}];
-  std::printf("max temperature %.6g K (%.6g C) at node %u (%.6g, %.6g, %.6g)\n", r.max_temperature,
-              r.max_temperature - 273.15, r.max_node, p[0], p[1], p[2]);
-  std::printf("%-24s %12s %12s %12s %10s %12s %12s\n", "regions", "k W/(m K)", "power W", "max T K",
-              "max T C", "mean T K", "volume m^3");
-  for (const RegionTemperature& t : r.regions)
-    std::printf("  %-22s %12.4g %12.4g %12.6g %10.4g %12.6g %12.4g\n", region_label(mesh, t.region).c_str(),
-                t.conductivity, t.power, t.max_temperature, t.max_temperature - 273.15, t.mean_temperature,
-                t.volume);
-  std::printf("%-24s %-10s %12s %14s %12s\n", "boundaries", "condition", "area m^2", "heat in W", "mean T K");
-  double boundary_heat = 0;
-  for (const BoundaryHeat& b : r.boundaries) {
-    std::printf("  %-22s %-10s %12.4g %14.6g %12.6g\n", boundary_label(mesh, b.tag).c_str(), b.kind.c_str(),
-                b.area, b.heat_in, b.mean_temperature);
-    boundary_heat += b.heat_in;
-  }
-  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W", r.total_power,
-              boundary_heat, r.imbalance);
-  if (r.heat_flow > 0) std::printf(" (%.2g of the %.6g W that flow)", std::abs(r.imbalance) / r.heat_flow, r.heat_flow);
-  std::printf("\n");
-  for (const ThermalResistance& t : r.resistances) {
-    auto side = [&](const ThermalProbe& probe) {
-      switch (probe.kind) {
-        case ThermalProbeKind::region_max:
-          return "max of region " + region_label(mesh, probe.id);
-        case ThermalProbeKind::region_mean:
-          return "mean of region " + region_label(mesh, probe.id);
-        case ThermalProbeKind::boundary_mean:
-          return "surface mean of boundary " + boundary_label(mesh, probe.id);
-        case ThermalProbeKind::ambient:
-          return "ambient of boundary " + boundary_label(mesh, probe.id);
-      }
-      return std::string();
-    };
-    std::printf("thermal resistance %s %.6g K -> %s %.6g K: dT %.6g K, P %.6g W, theta %.6g K/W; ",
-                side(t.spec.junction).c_str(), t.junction_temperature, side(t.spec.reference).c_str(),
-                t.reference_temperature, t.delta_t, t.power, t.theta);
-    if (std::isnan(t.reference_heat_out))
-      std::printf("no boundary heat at a region reference\n");
-    else
-      std::printf("heat out there %.6g W, dT/heat %.6g K/W\n", t.reference_heat_out, t.path_theta);
-  }
+  print_thermal_report(mesh, r);
   std::printf(
       "solver %s, %zu nonzeros, %zu iterations, relative residual %.3g; read %.3f s, assemble %.3f s, "
       "solve %.3f s\n",

@@ -106,6 +106,31 @@ std::vector<double> read_temperature(const Mesh& mesh, const std::string& spec) 
 
 }  // namespace
 
+void print_thermoelastic_report(const Mesh& mesh, const ThermoelasticReport& r) {
+  auto centroid = [&](std::uint32_t t) {
+    double c[3] = {0, 0, 0};
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i) c[i] += 0.25 * mesh.xyz[3 * std::size_t{mesh.tet[4 * t + a]} + i];
+    char text[96];
+    std::snprintf(text, sizeof text, "tet %u at (%.6g, %.6g, %.6g)", t, c[0], c[1], c[2]);
+    return std::string(text);
+  };
+  std::printf("max von Mises stress %.6g Pa in %s, %s\n", r.max_von_mises, centroid(r.max_tet).c_str(),
+              ("region " + region_label(mesh, mesh.region_of(r.max_tet))).c_str());
+  const double* p = &mesh.xyz[3 * std::size_t{r.max_displacement_node}];
+  std::printf("max displacement %.6g m at node %u (%.6g, %.6g, %.6g)\n", r.max_displacement,
+              r.max_displacement_node, p[0], p[1], p[2]);
+  std::printf("regions:\n");
+  for (const RegionStress& s : r.regions)
+    std::printf("  %-20s E %-10.4g Pa  nu %-6.4g  alpha %-10.4g 1/K  max von Mises %.6g Pa in %s\n",
+                region_label(mesh, s.region).c_str(), s.youngs_modulus, s.poisson_ratio, s.thermal_expansion,
+                s.max_von_mises, centroid(s.max_tet).c_str());
+  if (!r.interfaces.empty()) std::printf("material interfaces (tets touching them):\n");
+  for (const InterfaceStress& s : r.interfaces)
+    std::printf("  %s / %s  area %.4g m^2  max von Mises %.6g Pa in %s\n", region_label(mesh, s.region_a).c_str(),
+                region_label(mesh, s.region_b).c_str(), s.area, s.max_von_mises, centroid(s.max_tet).c_str());
+}
+
 int cmd_solve_thermoelastic(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
     std::puts(kThermoelasticUsage);
@@ -205,31 +230,10 @@ int cmd_solve_thermoelastic(Args args) {
   const auto t1 = std::chrono::steady_clock::now();
 
   const ThermoelasticReport r = solve_thermoelastic(mesh, params);
-  auto centroid = [&](std::uint32_t t) {
-    double c[3] = {0, 0, 0};
-    for (int a = 0; a < 4; ++a)
-      for (int i = 0; i < 3; ++i) c[i] += 0.25 * mesh.xyz[3 * std::size_t{mesh.tet[4 * t + a]} + i];
-    char text[96];
-    std::snprintf(text, sizeof text, "tet %u at (%.6g, %.6g, %.6g)", t, c[0], c[1], c[2]);
-    return std::string(text);
-  };
   std::printf("%s: %zu nodes, %zu tets; linear thermoelasticity (P%d), %zu unknowns, %zu constrained nodes\n",
               files[0].c_str(), mesh.node_count(), mesh.tet_count(), params.order, r.unknowns,
               r.constrained_nodes);
-  std::printf("max von Mises stress %.6g Pa in %s, %s\n", r.max_von_mises, centroid(r.max_tet).c_str(),
-              ("region " + region_label(mesh, mesh.region_of(r.max_tet))).c_str());
-  const double* p = &mesh.xyz[3 * std::size_t{r.max_displacement_node}];
-  std::printf("max displacement %.6g m at node %u (%.6g, %.6g, %.6g)\n", r.max_displacement,
-              r.max_displacement_node, p[0], p[1], p[2]);
-  std::printf("regions:\n");
-  for (const RegionStress& s : r.regions)
-    std::printf("  %-20s E %-10.4g Pa  nu %-6.4g  alpha %-10.4g 1/K  max von Mises %.6g Pa in %s\n",
-                region_label(mesh, s.region).c_str(), s.youngs_modulus, s.poisson_ratio, s.thermal_expansion,
-                s.max_von_mises, centroid(s.max_tet).c_str());
-  if (!r.interfaces.empty()) std::printf("material interfaces (tets touching them):\n");
-  for (const InterfaceStress& s : r.interfaces)
-    std::printf("  %s / %s  area %.4g m^2  max von Mises %.6g Pa in %s\n", region_label(mesh, s.region_a).c_str(),
-                region_label(mesh, s.region_b).c_str(), s.area, s.max_von_mises, centroid(s.max_tet).c_str());
+  print_thermoelastic_report(mesh, r);
   std::printf(
       "solver %s, %zu nonzeros, %zu iterations, relative residual %.3g; read %.3f s, assemble %.3f s, "
       "solve %.3f s\n",

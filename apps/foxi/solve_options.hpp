@@ -11,6 +11,7 @@
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/units.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "foxi/solver/thermoelastic.hpp"
 
 namespace foxi::cli {
 
@@ -47,6 +48,27 @@ double size_scale_option(Args& args);
 // One line per check; a failed one is a loud UNRELIABLE line (on stdout with the figures, and on
 // stderr). Returns the exit status: kExitUnreliable when a check failed.
 int print_checks(const std::vector<BalanceCheck>& checks);
+
+// The thermal conditions of `foxi solve MESH --physics thermal` (--fix, --flux, --convect, --power,
+// --power-density, --k, --theta), taken out of args with their values checked (before the meshing:
+// tags and regions need the mesh, so add_thermal_options looks them up and appends to `params`; a
+// --power or --power-density replaces a load already in `params` on its region, with a line saying so).
+struct ThermalOptions {
+  std::vector<std::string> fix, flux, convect, power, density, cond, theta;
+  bool empty() const {
+    return fix.empty() && flux.empty() && convect.empty() && power.empty() && density.empty() && cond.empty() &&
+           theta.empty();
+  }
+};
+ThermalOptions thermal_options(Args& args);
+void add_thermal_options(const Mesh& mesh, const ThermalOptions& options, ThermalParams& params);
+// The thermal report's lines: max temperature and where, the region and boundary tables, the energy
+// balance, the thermal resistances (foxi solve and foxi solve --with ccx print the same).
+void print_thermal_report(const Mesh& mesh, const ThermalReport& report);
+
+// The thermoelastic report's lines: the largest von Mises stress and displacement and where, per
+// region and per material interface (foxi solve and foxi solve --with ccx print the same).
+void print_thermoelastic_report(const Mesh& mesh, const ThermoelasticReport& report);
 
 int cmd_solve_thermoelastic(Args args);
 // foxi solve MODEL --physics transient ...: transient heat conduction, a .pvd series and Zth(t).

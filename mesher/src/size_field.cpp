@@ -105,8 +105,18 @@ ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field) {
   std::vector<double> u(nn);
   for (std::size_t n = 0; n < nn; ++n) u[n] = field.values[n * field.components];
   std::vector<double> grad(3 * nt), vol(nt), rec(3 * nn, 0), wsum(nn, 0);
+  // A tet with a node of no value (NaN: an imported field outside its source) has no gradient: it
+  // takes no part in the recovery or the norms, and its error is NaN.
+  std::vector<char> valued(nt, 1);
+  ErrorIndicator e;
   for (std::size_t t = 0; t < nt; ++t) {
+    for (int i = 0; i < 4; ++i)
+      if (!std::isfinite(u[mesh.tet[4 * t + std::size_t(i)]])) valued[t] = 0;
     vol[t] = tet_gradient(mesh, t, u.data(), &grad[3 * t]);
+    if (!valued[t]) {
+      ++e.tets_without_value;
+      continue;
+    }
     for (int i = 0; i < 4; ++i) {
       const std::uint32_t v = mesh.tet[4 * t + std::size_t(i)];
       wsum[v] += vol[t];
@@ -116,10 +126,13 @@ ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field) {
   for (std::size_t n = 0; n < nn; ++n)
     if (wsum[n] > 0)
       for (int k = 0; k < 3; ++k) rec[3 * n + std::size_t(k)] /= wsum[n];
-  ErrorIndicator e;
   e.tet_error.resize(nt);
   double sum2 = 0, g2 = 0;
   for (std::size_t t = 0; t < nt; ++t) {
+    if (!valued[t]) {
+      e.tet_error[t] = NAN;
+      continue;
+    }
     double d2 = 0, gg = 0;
     for (int k = 0; k < 3; ++k) {
       double c = 0;
@@ -142,14 +155,18 @@ SizeField size_field_from_error(const Mesh& mesh, const Field& field, double tar
   if (!(target_error > 0)) throw MesherError(10, "the target error must be > 0");
   const ErrorIndicator e = zz_error_indicator(mesh, field);
   const std::size_t nt = mesh.tet_count();
-  const double per_tet = nt ? target_error * e.gradient_norm / std::sqrt(double(nt)) : 0;
+  if (nt > 0 && e.tets_without_value == nt)
+    throw MesherError(10, "field '" + field.name + "' has no value (NaN) at a node of every tet: no error to refine by");
+  const std::size_t valued = nt - e.tets_without_value;
+  const double per_tet = valued ? target_error * e.gradient_norm / std::sqrt(double(valued)) : 0;
   SizeField f;
   f.xyz = mesh.xyz;
   f.tet = mesh.tet;
   f.size.assign(mesh.node_count(), std::numeric_limits<double>::infinity());
   for (std::size_t t = 0; t < nt; ++t) {
     const double h = longest_edge(mesh, t);
-    double ratio = e.tet_error[t] > 0 ? per_tet / e.tet_error[t] : 2.0;
+    // no value: no error known, the tet keeps its size
+    double ratio = std::isnan(e.tet_error[t]) ? 1.0 : e.tet_error[t] > 0 ? per_tet / e.tet_error[t] : 2.0;
     ratio = std::clamp(ratio, 0.25, 2.0);
     double target = h * ratio;
     if (max_size > 0) target = std::min(target, max_size);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/fields.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/solver/calculix.hpp"
@@ -315,59 +316,29 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
   file.close();
 }
 
+// One reader of .frd files in foxi: foxi::fields' (which checks the node block, the record lengths,
+// every number, the steps); its fields here as the blocks of the file, step by step.
 std::vector<FrdBlock> read_frd(const std::filesystem::path& frd) {
-  std::ifstream in(frd, std::ios::binary);
-  if (!in) throw IoError(frd.string(), 0, IoError::kNoOffset, "cannot open");
+  const FieldSource src = read_frd_source(frd);
+  std::size_t steps = 0;
+  for (const Field& f : src.mesh.fields) steps = std::max(steps, f.step_count());
   std::vector<FrdBlock> blocks;
-  FrdBlock* cur = nullptr;
-  std::string line;
-  std::uint64_t line_no = 0;
-  auto fail = [&](const std::string& why) { throw IoError(frd.string(), line_no, IoError::kNoOffset, why); };
-  auto parse_values = [&](const std::string& s, std::size_t from, std::vector<double>& out) {
-    for (std::size_t p = from; p + 12 <= s.size(); p += 12) {
-      const std::string field = s.substr(p, 12);
-      char* end = nullptr;
-      const double v = std::strtod(field.c_str(), &end);
-      if (end == field.c_str()) fail("expected a number in '" + field + "'");
-      out.push_back(v);
+  const std::size_t n = src.node_id.size();
+  for (std::size_t st = 0; st < steps; ++st)
+    for (const Field& f : src.mesh.fields) {
+      if (f.location != FieldLocation::node || st >= f.step_count()) continue;
+      FrdBlock b;
+      b.name = f.name;
+      b.components = f.components;
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto v = f.values.begin() + std::ptrdiff_t((st * n + i) * f.components);
+        // a node the block leaves out has no values (NaN) in the source: not one of the block's
+        if (std::all_of(v, v + f.components, [](double x) { return std::isnan(x); })) continue;
+        b.node.push_back(static_cast<std::uint32_t>(src.node_id[i]));
+        b.values.insert(b.values.end(), v, v + f.components);
+      }
+      blocks.push_back(std::move(b));
     }
-  };
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.size() >= 3 && line.compare(0, 3, " -4") == 0) {
-      blocks.emplace_back();
-      cur = &blocks.back();
-      std::size_t p = 3;
-      while (p < line.size() && line[p] == ' ') ++p;
-      std::size_t e = p;
-      while (e < line.size() && line[e] != ' ') ++e;
-      cur->name = line.substr(p, e - p);
-    } else if (cur && line.size() >= 3 && line.compare(0, 3, " -1") == 0) {
-      // Long format: node in columns 4-13, values from 14; short format: node in 4-8, values from 9.
-      std::size_t from = (line.size() >= 13 && (line.size() - 13) % 12 == 0) ? 13
-                         : (line.size() >= 8 && (line.size() - 8) % 12 == 0) ? 8
-                                                                             : 0;
-      if (from == 0) fail("a node record of unexpected length " + std::to_string(line.size()));
-      char* end = nullptr;
-      const std::string node = line.substr(3, from - 3);
-      const unsigned long id = std::strtoul(node.c_str(), &end, 10);
-      if (end == node.c_str()) fail("expected a node number");
-      cur->node.push_back(static_cast<std::uint32_t>(id));
-      const std::size_t before = cur->values.size();
-      parse_values(line, from, cur->values);
-      if (cur->node.size() == 1) cur->components = static_cast<std::uint32_t>(cur->values.size() - before);
-    } else if (cur && line.size() >= 3 && line.compare(0, 3, " -2") == 0) {
-      if (cur->node.empty()) fail("a continuation record before any node");
-      const std::size_t before = cur->values.size();
-      parse_values(line, (line.size() - 13) % 12 == 0 ? 13 : 8, cur->values);
-      if (cur->node.size() == 1) cur->components += static_cast<std::uint32_t>(cur->values.size() - before);
-    } else if (line.size() >= 3 && line.compare(0, 3, " -3") == 0) {
-      if (cur && cur->components && cur->values.size() != cur->node.size() * cur->components)
-        fail("block " + cur->name + " has an uneven number of values per node");
-      cur = nullptr;
-    }
-  }
   return blocks;
 }
 

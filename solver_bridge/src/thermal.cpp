@@ -116,6 +116,49 @@ ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceS
   return r;
 }
 
+// Energy balance against the heat that flows (what enters, or what leaves if more): with no sources
+// the net boundary heat is ~0 and no scale for itself. `precision` > 0: the temperatures were given
+// rounded to that relative precision (another program's printout), and the tolerance takes in the
+// largest imbalance that rounding can make (each temperature off by precision |T|: the fixed nodes'
+// reactions by sum |K_vj| precision |T_j|, a convection tag's heat by h A precision |T|).
+void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std::vector<double>& temp, double solver_tolerance,
+                  double precision, ThermalReport& rep) {
+  const detail::CsrPattern& pat = sys.stiff.pat;
+  const std::vector<double>& kval = sys.stiff.val;
+  const std::vector<char>& fixed = sys.dir.fixed;
+  double in = std::max(0.0, rep.total_power), out = std::max(0.0, -rep.total_power);
+  rep.imbalance = rep.total_power;
+  for (const BoundaryHeat& b : rep.boundaries) {
+    rep.imbalance += b.heat_in;
+    (b.heat_in > 0 ? in : out) += std::abs(b.heat_in);
+  }
+  rep.heat_flow = std::max(in, out);
+  // Where (next to) nothing flows, the reactions are round-off of terms K_vv T_v: measure against
+  // 1e-9 of those, so that a body held at one temperature balances.
+  double terms = 0, rounding = 0;
+  for (std::size_t v = 0; v < fixed.size(); ++v)
+    if (fixed[v]) {
+      const auto n = static_cast<std::uint32_t>(v);
+      terms += std::abs(kval[pat.find(n, n)] * temp[v]);
+      if (precision > 0)
+        for (std::size_t e = pat.row_start[n]; e < pat.row_start[n + 1]; ++e)
+          rounding += std::abs(kval[e]) * precision * std::abs(temp[pat.col[e]]);
+    }
+  if (precision > 0)
+    for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
+      const auto it = sys.bc.find(mesh.bface_tag[f]);
+      if (it == sys.bc.end() || it->second.kind != detail::BcKind::convection) continue;
+      const std::uint32_t* v = &mesh.bface[3 * f];
+      const double t = std::max({std::abs(temp[v[0]]), std::abs(temp[v[1]]), std::abs(temp[v[2]])});
+      rounding += it->second.a * sys.bface_area[f] * precision * t;
+    }
+  const double scale = std::max(rep.heat_flow, 1e-9 * terms);
+  double tolerance = std::max(1e-6, 100 * solver_tolerance);
+  if (precision > 0 && scale > 0) tolerance = std::max(tolerance, rounding / scale);
+  rep.checks.push_back(make_check("energy", "|sources + boundary heat in| / the heat that flows through the body",
+                                  scale > 0 ? std::abs(rep.imbalance) / scale : 0.0, tolerance));
+}
+
 }  // namespace
 
 namespace detail {
@@ -393,8 +436,6 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   };
   const unsigned threads = sys.threads;
   const detail::P1Stiffness& stiff = sys.stiff;
-  const detail::CsrPattern& pat = stiff.pat;
-  const std::vector<double>& kval = stiff.val;
   const std::vector<double>& load = sys.load;
   const std::vector<char>& fixed = sys.dir.fixed;
   std::vector<double> temp = sys.dir.value;
@@ -419,33 +460,31 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   detail::boundary_heat(mesh, sys, load, temp, rep.boundaries);
   Field flux_field = detail::region_results(mesh, params, sys, temp, rep);
 
-  // Energy balance against the heat that flows (what enters, or what leaves if more): with no sources
-  // the net boundary heat is ~0 and no scale for itself.
-  {
-    double in = std::max(0.0, rep.total_power), out = std::max(0.0, -rep.total_power);
-    rep.imbalance = rep.total_power;
-    for (const BoundaryHeat& b : rep.boundaries) {
-      rep.imbalance += b.heat_in;
-      (b.heat_in > 0 ? in : out) += std::abs(b.heat_in);
-    }
-    rep.heat_flow = std::max(in, out);
-    // Where (next to) nothing flows, the reactions are round-off of terms K_vv T_v: measure against
-    // 1e-9 of those, so that a body held at one temperature balances.
-    double terms = 0;
-    for (std::size_t v = 0; v < fixed.size(); ++v)
-      if (fixed[v]) {
-        const auto n = static_cast<std::uint32_t>(v);
-        terms += std::abs(kval[pat.find(n, n)] * temp[v]);
-      }
-    const double scale = std::max(rep.heat_flow, 1e-9 * terms);
-    rep.checks.push_back(make_check(
-        "energy", "|sources + boundary heat in| / the heat that flows through the body",
-        scale > 0 ? std::abs(rep.imbalance) / scale : 0.0, std::max(1e-6, 100 * params.solver.relative_tolerance)));
-  }
+  energy_check(mesh, sys, temp, params.solver.relative_tolerance, 0, rep);
 
   detail::store_temperature(mesh, std::move(temp), std::move(flux_field));
   rep.assembly_seconds = std::chrono::duration<double>(t_assembled - t_start).count();
   rep.solve_seconds = std::chrono::duration<double>(t_solved - t_assembled).count();
+  return rep;
+}
+
+ThermalReport thermal_report(Mesh& mesh, const ThermalParams& params, std::vector<double> temperature,
+                             double precision) {
+  const auto t_start = std::chrono::steady_clock::now();
+  ThermalReport rep;
+  const detail::ThermalSystem sys = detail::assemble_thermal(mesh, params, rep);
+  if (temperature.size() != mesh.node_count())
+    throw SolverError("thermal_report: " + std::to_string(temperature.size()) + " temperatures for " +
+                      std::to_string(mesh.node_count()) + " nodes");
+  for (std::size_t t = 0; t < mesh.tet.size(); ++t)
+    if (!std::isfinite(temperature[mesh.tet[t]]))
+      throw SolverError("thermal_report: node " + std::to_string(mesh.tet[t]) + " of a tet has no temperature");
+  detail::boundary_heat(mesh, sys, sys.load, temperature, rep.boundaries);
+  Field flux_field = detail::region_results(mesh, params, sys, temperature, rep);
+  energy_check(mesh, sys, temperature, params.solver.relative_tolerance, precision, rep);
+  detail::store_temperature(mesh, std::move(temperature), std::move(flux_field));
+  rep.solver = "given";
+  rep.assembly_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
   return rep;
 }
 

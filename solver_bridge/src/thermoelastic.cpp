@@ -401,61 +401,30 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
   return u;
 }
 
-}  // namespace
+// Lame's lambda and mu per region from E and nu.
+std::pair<std::vector<double>, std::vector<double>> lame_parameters(const std::vector<double>& young,
+                                                                    const std::vector<double>& poisson) {
+  std::vector<double> lambda(young.size()), mu(young.size());
+  for (std::size_t i = 0; i < young.size(); ++i) {
+    mu[i] = young[i] / (2 * (1 + poisson[i]));
+    lambda[i] = young[i] * poisson[i] / ((1 + poisson[i]) * (1 - 2 * poisson[i]));
+  }
+  return {lambda, mu};
+}
 
-ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params) {
-  using clock = std::chrono::steady_clock;
-  const auto t_start = clock::now();
-  if (params.order != 1 && params.order != 2)
-    throw SolverInputError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
-  detail::check_mesh(mesh);
+// The displacement `u` (3 per solver node: the mesh's, then for order 2 the mid-edge nodes of
+// `edges`) into the report: the largest displacement, stress, von Mises and principal stresses per
+// tet, per-region and per-interface maxima; stores the fields.
+void finish_report(Mesh& mesh, const ThermoelasticParams& params, const detail::TetEdges& edges,
+                   const detail::ElasticMaterials& mat, const std::vector<double>& tet_dt,
+                   const std::vector<char>& used, std::vector<double> u, unsigned threads, ThermoelasticReport& rep) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
-  const unsigned threads = detail::thread_count(params.solver.threads);
-  detail::report_progress(params.solver, "assemble", 0.0);
-
-  const detail::ElasticMaterials mat = detail::elastic_materials(mesh, params);
   const detail::RegionTable& regions = mat.regions;
   const std::vector<double>&young = mat.young, &poisson = mat.poisson, &expansion = mat.expansion;
   const std::size_t nr = regions.size();
-  std::vector<double> lame_lambda(nr), lame_mu(nr);
-  for (std::size_t i = 0; i < nr; ++i) {
-    lame_mu[i] = young[i] / (2 * (1 + poisson[i]));
-    lame_lambda[i] = young[i] * poisson[i] / ((1 + poisson[i]) * (1 - 2 * poisson[i]));
-  }
-  const std::vector<double> tet_dt = detail::tet_temperature_change(mesh, params);
-  {
-    std::vector<double> region_volume;
-    (void)detail::tet_volumes(mesh, regions, threads, region_volume);  // rejects flat and inverted tets
-  }
-  const ElasticCoefficients co{lame_lambda, lame_mu, expansion, regions.tet_rix};
-
-  // Node-block stiffness with the thermal load; the constraints per solver node (fixed components and
-  // sliding normals, orthonormalised into node frames; for P2 from the boundary split through the
-  // mid-edge nodes, so a mid-edge node gets the constraints of the tagged triangles it lies on).
-  BlockSystem sys;
-  detail::NodeFrames fr;
-  detail::TetEdges edges;
-  if (params.order == 1) {
-    sys = assemble_p1(mesh, co, tet_dt, threads);
-    detail::report_progress(params.solver, "assemble", 0.4);
-    fr = detail::displacement_frames(mesh, params, sys.used);
-  } else {
-    edges = detail::tet_edges(mesh);
-    std::vector<double> node_dt(nn, params.delta_t);
-    if (!params.temperature.empty())  // sizes and values on used nodes checked by tet_temperature_change
-      for (std::size_t v = 0; v < nn; ++v) node_dt[v] = params.temperature[v] - params.reference_temperature;
-    sys = assemble_p2(mesh, edges, co, node_dt, params.solver, threads);
-    detail::report_progress(params.solver, "assemble", 0.4);
-    fr = detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, sys.used);
-  }
-  check_rigid_modes(mesh, fr, sys.used);  // the mesh's nodes come first among the solver nodes
-  ThermoelasticReport rep;
-  std::vector<double> u = solve_blocks(sys, fr, params.solver, threads, rep);
-  // Assembly: everything before the linear solve, the elimination of the constraints included.
-  rep.assembly_seconds =
-      std::max(0.0, std::chrono::duration<double>(clock::now() - t_start).count() - rep.solve_seconds);
+  const auto [lame_lambda, lame_mu] = lame_parameters(young, poisson);
   for (std::size_t v = 0; v < nn; ++v) {
-    if (!sys.used[v]) continue;
+    if (!used[v]) continue;
     const double len = std::sqrt(u[3 * v] * u[3 * v] + u[3 * v + 1] * u[3 * v + 1] + u[3 * v + 2] * u[3 * v + 2]);
     if (len >= rep.max_displacement) {
       rep.max_displacement = len;
@@ -566,6 +535,90 @@ ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& p
   detail::set_field(mesh, std::move(mises));
   detail::set_field(mesh, std::move(principal));
 
+}
+
+}  // namespace
+
+ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params) {
+  using clock = std::chrono::steady_clock;
+  const auto t_start = clock::now();
+  if (params.order != 1 && params.order != 2)
+    throw SolverInputError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
+  detail::check_mesh(mesh);
+  const std::size_t nn = mesh.node_count();
+  const unsigned threads = detail::thread_count(params.solver.threads);
+  detail::report_progress(params.solver, "assemble", 0.0);
+
+  const detail::ElasticMaterials mat = detail::elastic_materials(mesh, params);
+  const detail::RegionTable& regions = mat.regions;
+  const std::vector<double>&young = mat.young, &poisson = mat.poisson, &expansion = mat.expansion;
+  const auto [lame_lambda, lame_mu] = lame_parameters(young, poisson);
+  const std::vector<double> tet_dt = detail::tet_temperature_change(mesh, params);
+  {
+    std::vector<double> region_volume;
+    (void)detail::tet_volumes(mesh, regions, threads, region_volume);  // rejects flat and inverted tets
+  }
+  const ElasticCoefficients co{lame_lambda, lame_mu, expansion, regions.tet_rix};
+
+  // Node-block stiffness with the thermal load; the constraints per solver node (fixed components and
+  // sliding normals, orthonormalised into node frames; for P2 from the boundary split through the
+  // mid-edge nodes, so a mid-edge node gets the constraints of the tagged triangles it lies on).
+  BlockSystem sys;
+  detail::NodeFrames fr;
+  detail::TetEdges edges;
+  if (params.order == 1) {
+    sys = assemble_p1(mesh, co, tet_dt, threads);
+    detail::report_progress(params.solver, "assemble", 0.4);
+    fr = detail::displacement_frames(mesh, params, sys.used);
+  } else {
+    edges = detail::tet_edges(mesh);
+    std::vector<double> node_dt(nn, params.delta_t);
+    if (!params.temperature.empty())  // sizes and values on used nodes checked by tet_temperature_change
+      for (std::size_t v = 0; v < nn; ++v) node_dt[v] = params.temperature[v] - params.reference_temperature;
+    sys = assemble_p2(mesh, edges, co, node_dt, params.solver, threads);
+    detail::report_progress(params.solver, "assemble", 0.4);
+    fr = detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, sys.used);
+  }
+  check_rigid_modes(mesh, fr, sys.used);  // the mesh's nodes come first among the solver nodes
+  ThermoelasticReport rep;
+  std::vector<double> u = solve_blocks(sys, fr, params.solver, threads, rep);
+  // Assembly: everything before the linear solve, the elimination of the constraints included.
+  rep.assembly_seconds =
+      std::max(0.0, std::chrono::duration<double>(clock::now() - t_start).count() - rep.solve_seconds);
+  finish_report(mesh, params, edges, mat, tet_dt, sys.used, std::move(u), threads, rep);
+  return rep;
+}
+
+ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& params,
+                                         std::vector<double> displacement) {
+  if (params.order != 1 && params.order != 2)
+    throw SolverInputError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
+  detail::check_mesh(mesh);
+  const std::size_t nn = mesh.node_count();
+  const unsigned threads = detail::thread_count(params.solver.threads);
+  const detail::ElasticMaterials mat = detail::elastic_materials(mesh, params);
+  const std::vector<double> tet_dt = detail::tet_temperature_change(mesh, params);
+  {
+    std::vector<double> region_volume;
+    (void)detail::tet_volumes(mesh, mat.regions, threads, region_volume);  // rejects flat and inverted tets
+  }
+  detail::TetEdges edges;
+  if (params.order == 2) edges = detail::tet_edges(mesh);
+  const std::size_t solver_nodes = nn + edges.size();
+  if (displacement.size() != 3 * solver_nodes)
+    throw SolverInputError("thermoelastic_report: " + std::to_string(displacement.size()) + " displacement values for " +
+                           std::to_string(solver_nodes) + " nodes of 3 components");
+  std::vector<char> used(solver_nodes, 0);
+  for (std::uint32_t v : mesh.tet) used[v] = 1;
+  for (std::size_t e = 0; e < edges.size(); ++e) used[nn + e] = 1;
+  for (std::size_t v = 0; v < solver_nodes; ++v)
+    if (used[v])
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(displacement[3 * v + c]))
+          throw SolverInputError("thermoelastic_report: node " + std::to_string(v) + " of a tet has no displacement");
+  ThermoelasticReport rep;
+  rep.solver = "given";
+  finish_report(mesh, params, edges, mat, tet_dt, used, std::move(displacement), threads, rep);
   return rep;
 }
 

@@ -26,6 +26,39 @@ std::pair<double, double> relative_difference(const Field& a, const Field& b) {
 
 class CcxCli : public ::testing::Test {
  protected:
+  // The records of foxi solve --json by foxi (a) and by ccx (b) hold the same names, units and key
+  // marks, and every value agrees to 1e-5 (python3 reads them): relative to the value itself, the
+  // heats (W) relative to the heat that flows and the stresses (Pa) relative to the largest von
+  // Mises stress (both derivatives of ccx's 6-digit printout: its rounding of T or u, amplified by
+  // k / h or E / h, shows there first). Not compared: where a maximum sits (the nearly isothermal
+  // die has ties at ccx's precision) and the linear solver's own figures.
+  void compare_records(const std::filesystem::path& a, const std::filesystem::path& b, const char* physics) {
+    test::write_text(dir_ / "cmp.py", R"(import json, sys
+a = json.load(open(sys.argv[1])); b = json.load(open(sys.argv[2]))
+assert b["solver"] == "ccx" and b["status"] == "ok" and a["physics"] == b["physics"] == sys.argv[3], b
+av = {v["name"]: v for v in a["values"]}; bv = {v["name"]: v for v in b["values"]}
+assert set(av) == set(bv), set(av) ^ set(bv)
+strip = lambda texts: [t for t in texts if t["name"] != "T_max_region"]
+assert strip(a["texts"]) == strip(b["texts"]), (a["texts"], b["texts"])
+assert [c["name"] for c in a["checks"]] == [c["name"] for c in b["checks"]] and all(c["passed"] for c in b["checks"])
+scales = {"W": av.get("heat_flow", {}).get("value"), "Pa": av.get("von_mises_max", {}).get("value")}
+worst = 0
+for n, v in av.items():
+    if n.startswith("T_max_") or n in ("nonzeros", "unknowns", "iterations", "relative_residual"): continue
+    assert v["unit"] == bv[n]["unit"] and v["key"] == bv[n]["key"], n
+    x, y = v["value"], bv[n]["value"]
+    scale = scales.get(v["unit"]) or max(abs(x), 1e-300)
+    worst = max(worst, abs(x - y) / scale)
+    assert abs(x - y) <= 1e-5 * scale, (n, x, y)
+print("compared", len(av), "values, worst", worst)
+)");
+    ASSERT_EQ(test::run("/usr/bin/python3 '" + (dir_ / "cmp.py").string() + "' '" + a.string() + "' '" + b.string() +
+                            "' " + physics,
+                        dir_ / "cmp.txt"),
+              0)
+        << test::read_text(dir_ / "cmp.txt");
+    EXPECT_NE(test::read_text(dir_ / "cmp.txt").find("compared"), std::string::npos);
+  }
   int foxi(const std::string& args, std::string* out = nullptr, const std::string& env = "") {
     const int status = test::run(env + "'" + test::cli_path() + "' " + args, dir_ / "log.txt");
     if (out) *out = test::read_text(dir_ / "log.txt");
@@ -53,6 +86,52 @@ TEST_F(CcxCli, SolveWithCcxAgreesWithFoxi) {
   char max_text[64];
   std::snprintf(max_text, sizeof max_text, "max temperature %.6g K", hi);
   EXPECT_NE(log.find(max_text), std::string::npos) << log;
+}
+
+// The same conditions on a mesh file, solved by foxi and by ccx: the same report lines and the same
+// --json record (parsed by python3), every value to ccx's precision (heats relative to the heat that
+// flows), apart from where the nearly isothermal die's maximum sits and the solver's own figures.
+TEST_F(CcxCli, MeshWithCliConditionsGivesFoxisReport) {
+  if (!test::have_program("ccx") || !test::have_program("/usr/bin/python3")) GTEST_SKIP() << "ccx or python3 missing";
+  std::string log, ccx_log;
+  const std::string mesh = (dir_ / "d.vtu").string();
+  ASSERT_EQ(foxi("mesh " + model() + " -o '" + mesh + "'", &log), 0) << log;
+  const std::string conditions = " --fix substrate.bottom=300K --flux die.top=2000 --power die=0.3W --k substrate=0.5";
+  ASSERT_EQ(foxi("solve '" + mesh + "'" + conditions + " --json '" + (dir_ / "a.json").string() + "'", &log), 0) << log;
+  ASSERT_EQ(foxi("solve '" + mesh + "' --with ccx" + conditions + " --json '" + (dir_ / "b.json").string() + "'",
+                 &ccx_log),
+            0)
+      << ccx_log;
+  for (const char* line : {"max temperature ", "\nregions ", "  2 (die)  ", "\nboundaries ", "  1 (substrate.bottom)   fixed",
+                           "  4 (die.top)            flux", "energy balance: sources 0.3 W", "check energy         ok"})
+    EXPECT_NE(ccx_log.find(line), std::string::npos) << line << "\n" << ccx_log;
+  compare_records(dir_ / "a.json", dir_ / "b.json", "thermal");
+  // Without a --fix or --convect ccx is not run: a usage error; a thermoelastic mesh needs a model.
+  EXPECT_EQ(foxi("solve '" + mesh + "' --with ccx --power die=1W", &log), 2) << log;
+  EXPECT_EQ(foxi("solve '" + mesh + "' --with ccx --physics thermoelastic", &log), 2) << log;
+  EXPECT_EQ(foxi("solve '" + mesh + "' --with ccx --fix nowhere=300", &log), 2) << log;
+}
+
+// ccx's temperatures that do not balance the heat foxi puts in (a stand-in ccx that lowers the
+// deck's source before running the real one): the energy check fails, exit 4 with the figures.
+TEST_F(CcxCli, UnbalancedCcxResultIsUnreliable) {
+  if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
+  std::string real;
+  ASSERT_EQ(test::run("command -v ccx > '" + (dir_ / "which.txt").string() + "'"), 0);
+  real = test::read_text(dir_ / "which.txt");
+  real.erase(real.find_last_not_of("\n") + 1);
+  const std::filesystem::path bin = dir_ / "bin";
+  std::filesystem::create_directories(bin);
+  test::write_text(bin / "ccx", "#!/bin/sh\nsed -i 's/, BF, .*/, BF, 4e7/' \"$2.inp\"\nexec '" + real + "' \"$@\"\n");
+  std::filesystem::permissions(bin / "ccx", std::filesystem::perms::owner_all);
+  std::string log;
+  const std::string json = (dir_ / "u.json").string();
+  EXPECT_EQ(foxi("solve " + model() + " --with ccx --json '" + json + "'", &log, "PATH='" + bin.string() + "':\"$PATH\" "),
+            4)
+      << log;
+  EXPECT_NE(log.find("check energy         FAIL"), std::string::npos) << log;
+  EXPECT_NE(log.find("UNRELIABLE"), std::string::npos) << log;
+  EXPECT_NE(test::read_text(json).find("\"status\": \"unreliable\""), std::string::npos) << test::read_text(json);
 }
 
 // On a terminal (script(1) gives it one) ccx's progress shows as it runs.
@@ -94,6 +173,23 @@ TEST_F(CcxCli, ThermoelasticWithCcxAgreesWithFoxiAndRenders) {
   EXPECT_TRUE(std::filesystem::exists(png));
 }
 
+// The model's thermal stress by foxi and by ccx: the same report lines and record (von Mises per
+// region and interface from ccx's displacements).
+TEST_F(CcxCli, ThermoelasticWithCcxGivesFoxisReport) {
+  if (!test::have_program("ccx") || !test::have_program("/usr/bin/python3")) GTEST_SKIP() << "ccx or python3 missing";
+  std::string log;
+  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --json '" + (dir_ / "a.json").string() + "'", &log), 0)
+      << log;
+  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --json '" + (dir_ / "b.json").string() + "'",
+                 &log),
+            0)
+      << log;
+  for (const char* line : {"linear thermoelasticity by ccx (C3D4)", "\nmax von Mises stress ", "\nmax displacement ",
+                           "\nregions:\n  1 (substrate)        E 2.2e+10", "material interfaces (tets touching them):"})
+    EXPECT_NE(log.find(line), std::string::npos) << line << "\n" << log;
+  compare_records(dir_ / "a.json", dir_ / "b.json", "thermoelastic");
+}
+
 // C3D10: the deck's mid-edge nodes are dropped on reading; the corners' displacements agree with
 // foxi's P2 solve.
 TEST_F(CcxCli, QuadraticThermoelasticWithCcxAgreesWithFoxi) {
@@ -102,7 +198,8 @@ TEST_F(CcxCli, QuadraticThermoelasticWithCcxAgreesWithFoxi) {
   const std::string out = (dir_ / "q.vtu").string();
   ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --order 2 --compare -o '" + out + "'", &log), 0)
       << log;
-  EXPECT_NE(log.find("C3D10"), std::string::npos) << log;
+  EXPECT_NE(log.find("linear thermoelasticity by ccx (C3D10)"), std::string::npos) << log;
+  EXPECT_NE(log.find("\nmax von Mises stress "), std::string::npos) << log;  // from the mid-edge nodes too
   const Mesh m = read_mesh(out);
   const Field* u = m.find_field("displacement");
   const Field* own = m.find_field("displacement_foxi");

@@ -171,6 +171,41 @@ TEST(SizeField, ErrorIndicatorVanishesForALinearField) {
   // Recovery reproduces a linear field's constant gradient exactly: no error anywhere.
   EXPECT_NEAR(e.gradient_norm, std::sqrt(14.0 * summarize_quality(m).total_volume), 1e-9);
   EXPECT_LT(e.total_error, 1e-9 * e.gradient_norm);
+  EXPECT_EQ(e.tets_without_value, 0u);
+  // Without a value (NaN, as an imported field outside its source) for the nodes with x beyond the
+  // middle: the tets touching them are counted and left out, the rest is still the exact gradient
+  // (over the valued tets' volume) and no error; their sizes stay their own.
+  Field part = f;
+  std::size_t expect_nan = 0;
+  double valued_volume = 0;
+  const double mid = 0.5 * 10e-3;
+  for (std::size_t n = 0; n < m.node_count(); ++n)
+    if (m.xyz[3 * n] > mid) part.values[n] = NAN;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    bool nan = false;
+    for (int i = 0; i < 4; ++i) nan = nan || m.xyz[3 * m.tet[4 * t + std::size_t(i)]] > mid;
+    if (nan) {
+      ++expect_nan;
+    } else {
+      double p[4][3];
+      for (int i = 0; i < 4; ++i)
+        for (int k = 0; k < 3; ++k) p[i][k] = m.xyz[3 * m.tet[4 * t + std::size_t(i)] + std::size_t(k)];
+      double a[3], b[3], c[3];
+      for (int k = 0; k < 3; ++k) a[k] = p[1][k] - p[0][k], b[k] = p[2][k] - p[0][k], c[k] = p[3][k] - p[0][k];
+      valued_volume += std::abs(a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                                a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+    }
+  }
+  ASSERT_GT(expect_nan, 0u);
+  ASSERT_LT(expect_nan, m.tet_count());
+  const ErrorIndicator ep = zz_error_indicator(m, part);
+  EXPECT_EQ(ep.tets_without_value, expect_nan);
+  EXPECT_NEAR(ep.gradient_norm, std::sqrt(14.0 * valued_volume), 1e-9);
+  EXPECT_LT(ep.total_error, 1e-9 * ep.gradient_norm);
+  const SizeField sf = size_field_from_error(m, part, 0.1);
+  for (double h : sf.size) EXPECT_TRUE(std::isfinite(h) && h > 0);
+  std::fill(part.values.begin(), part.values.end(), NAN);
+  EXPECT_THROW(size_field_from_error(m, part, 0.1), MesherError);
   f.location = FieldLocation::cell;
   EXPECT_THROW(zz_error_indicator(m, f), MesherError);
   EXPECT_THROW(size_field_from_error(m, Field{}, 0.1), MesherError);

@@ -250,8 +250,12 @@ TEST(FrdReader, RejectsMalformedFiles) {
   test::write_text(dir / "bad.frd", "    1C\n -4  NDTEMP      1    1\n -1         1 3.0000\n -3\n");
   EXPECT_THROW(read_frd(dir / "bad.frd"), IoError);
   test::write_text(dir / "ok.frd",
-                   "    1C\n -4  NDTEMP      1    1\n -5  T           1    1    0    0\n"
-                   " -1         1 3.00000E+02\n -1         2-1.25000E+01\n -3\n");
+                   "    1C\n    2C                             2                                     1\n"
+                   " -1         1 0.00000E+00 0.00000E+00 0.00000E+00\n"
+                   " -1         2 1.00000E+00 0.00000E+00 0.00000E+00\n -3\n"
+                   "  100CL  101 1.000000000           2                     0    1           1\n"
+                   " -4  NDTEMP      1    1\n -5  T           1    1    0    0\n"
+                   " -1         1 3.00000E+02\n -1         2-1.25000E+01\n -3\n9999\n");
   const auto blocks = read_frd(dir / "ok.frd");
   ASSERT_EQ(blocks.size(), 1u);
   EXPECT_EQ(blocks[0].name, "NDTEMP");

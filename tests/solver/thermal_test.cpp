@@ -261,6 +261,53 @@ TEST_F(ThermalTest, ConvectionBoundaryMatchesRobinSolution) {
   EXPECT_NEAR(heat_of(r, 1).mean_temperature, t0, 1e-12 * t0);
 }
 
+// thermal_report on temperatures from elsewhere (here the analytic Robin profile, which P1 holds
+// exactly): the boundary heats are the analytic ones, the fields stored; rounded to 6 digits as
+// ccx prints them, the check passes within the rounding tolerance; a wrong profile fails it.
+TEST_F(ThermalTest, ReportOfGivenTemperaturesMatchesTheAnalyticHeat) {
+  Mesh m = box_mesh(0.002);
+  const double k = 4, h = 10, t0 = 300, tinf = 500;
+  ThermalParams p;
+  p.conductivity = {{1, k}};
+  p.fixed = {{1, t0}};
+  p.convection = {{2, h, tinf}};
+  p.convection_centroid_rule = true;  // a linear field: the centroid rule is exact on it too
+  const double flux = (tinf - t0) / (kL / k + 1 / h);
+  auto profile = [&](double slope_factor, bool rounded) {
+    std::vector<double> t(m.node_count());
+    for (std::size_t v = 0; v < t.size(); ++v) {
+      t[v] = t0 + slope_factor * flux * x_of(m, v) / k;
+      if (rounded) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.5E", t[v]);
+        t[v] = std::strtod(text, nullptr);
+      }
+    }
+    return t;
+  };
+  const ThermalReport r = thermal_report(m, p, profile(1, false));
+  EXPECT_NEAR(heat_of(r, 2).heat_in, flux * kArea, 1e-9 * flux * kArea);
+  EXPECT_NEAR(heat_of(r, 1).heat_in, -flux * kArea, 1e-9 * flux * kArea);
+  EXPECT_NEAR(r.max_temperature, t0 + flux * kL / k, 1e-9 * tinf);
+  EXPECT_NEAR(region_of(r, 1).mean_temperature, t0 + flux * kL / (2 * k), 1e-9 * tinf);
+  ASSERT_EQ(r.checks.size(), 1u);
+  EXPECT_TRUE(r.checks[0].passed);
+  EXPECT_LT(r.checks[0].figure, 1e-9);
+  EXPECT_EQ(r.solver, "given");
+  ASSERT_NE(m.find_field("heat_flux"), nullptr);
+  EXPECT_NEAR(m.find_field("heat_flux")->values[0], -flux, 1e-8 * flux);
+  const ThermalReport rounded = thermal_report(m, p, profile(1, true), 5e-6);
+  EXPECT_TRUE(rounded.checks[0].passed) << rounded.checks[0].figure << " " << rounded.checks[0].tolerance;
+  EXPECT_GT(rounded.checks[0].tolerance, 1e-6);
+  EXPECT_LT(rounded.checks[0].tolerance, 0.1);
+  const ThermalReport wrong = thermal_report(m, p, profile(1.05, false), 5e-6);
+  EXPECT_FALSE(wrong.checks[0].passed) << wrong.checks[0].figure << " " << wrong.checks[0].tolerance;
+  EXPECT_THROW(thermal_report(m, p, std::vector<double>(3, t0)), SolverError);
+  std::vector<double> nan = profile(1, false);
+  nan[m.tet[0]] = NAN;
+  EXPECT_THROW(thermal_report(m, p, nan), SolverError);
+}
+
 // Convection only (no fixed temperature) with a source: T at the cooled end is Tinf + P / (h A).
 TEST_F(ThermalTest, ConvectionAloneMakesItWellPosed) {
   Mesh m = box_mesh(0.002);

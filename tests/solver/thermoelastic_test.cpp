@@ -125,6 +125,36 @@ TEST_F(ThermoelasticTest, BarHeldAtBothEnds) {
   EXPECT_NEAR(pr->values[2], -s, 1e-7 * s);
 }
 
+// thermoelastic_report on the bar's analytic displacement (given, not solved): the analytic stress
+// and von Mises, as solve_thermoelastic reports them; a wrong size or a NaN is refused.
+TEST_F(ThermoelasticTest, ReportOfGivenDisplacementIsTheAnalyticStress) {
+  Mesh m = test::layered_box_mesh(0.2, 0.2, {0, 1.0}, 0.0005);
+  ThermoelasticParams p = one_material(kDt);
+  p.sliding = {{1}, {3}, {5}, {6}};
+  const double s = kE * kAlpha * kDt, lateral = kAlpha * (1 + kNu) * kDt;
+  std::vector<double> u(3 * m.node_count());
+  for (std::size_t v = 0; v < m.node_count(); ++v) {
+    u[3 * v] = lateral * m.xyz[3 * v];
+    u[3 * v + 1] = lateral * m.xyz[3 * v + 1];
+  }
+  const ThermoelasticReport r = thermoelastic_report(m, p, u);
+  const double want[6] = {0, 0, -s, 0, 0, 0};
+  EXPECT_LT(max_stress_error(m, want, s), 1e-8);
+  EXPECT_NEAR(r.max_von_mises, s, 1e-8 * s);
+  ASSERT_EQ(r.regions.size(), 1u);
+  EXPECT_NEAR(r.regions[0].max_von_mises, s, 1e-8 * s);
+  EXPECT_NEAR(r.max_displacement, lateral * std::sqrt(0.2 * 0.2 + 0.2 * 0.2), 1e-12);
+  EXPECT_EQ(r.solver, "given");
+  ASSERT_NE(m.find_field("von_mises"), nullptr);
+  EXPECT_EQ(m.find_field("displacement")->values, u);
+  EXPECT_THROW(thermoelastic_report(m, p, std::vector<double>(6, 0.0)), SolverError);
+  p.order = 2;  // the mid-edge nodes' values are missing
+  EXPECT_THROW(thermoelastic_report(m, p, u), SolverError);
+  p.order = 1;
+  u[3 * m.tet[0] + 2] = NAN;
+  EXPECT_THROW(thermoelastic_report(m, p, u), SolverError);
+}
+
 // Every face fixed: u = 0, hydrostatic sigma = -E alpha dT / (1 - 2 nu).
 TEST_F(ThermoelasticTest, FullyConstrainedBlock) {
   Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.004);

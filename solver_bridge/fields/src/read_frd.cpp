@@ -94,7 +94,9 @@ class FrdParser {
   void check_ascii(int format, const char* block) const {
     if (format == 2 || format == 3)
       fail(std::string("binary .frd ") + block + " (format " + std::to_string(format) +
-           "): only ASCII .frd files are read; ask ccx for them with *NODE FILE / *EL FILE without OUTPUT=BINARY");
+           "): only ASCII .frd files are read (ccx writes ASCII unless built with its '-o bin' option, which "
+           "CalculiX deactivated in 2020; 2.20 has no way to ask for binary, so there is no binary file to "
+           "test a reader against)");
     if (format != 0 && format != 1) fail(std::string("unknown .frd format flag in the ") + block + " header");
   }
   std::uint32_t node_index(std::int64_t id) const {

@@ -7,6 +7,7 @@
 // refines until edges are about that long). Boxes and solved fields become background meshes.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -64,10 +65,13 @@ FOXI_API SizeField box_size_field(const Plc& plc, const MeshParams& params, cons
 // recovered gradient at each node is the volume-weighted mean of the gradients of the tets around it;
 // a tet's error is the L2 norm over the tet of (recovered gradient, linear) - (tet gradient,
 // constant), estimated from the recovered gradient at the tet's centroid: |G*(c) - grad_T| sqrt(|T|).
+// A tet with a node of no value (NaN, e.g. an imported field outside its source mesh) is left out
+// of the recovery and the norms; its error is NaN, and counted.
 struct ErrorIndicator {
-  std::vector<double> tet_error;   // 1 per tet
+  std::vector<double> tet_error;   // 1 per tet (NaN: no value)
   double total_error = 0;          // sqrt of the sum of squares
   double gradient_norm = 0;        // || grad u ||_L2 over the mesh
+  std::size_t tets_without_value = 0;
   double relative_error() const { return gradient_norm > 0 ? total_error / gradient_norm : 0; }
 };
 FOXI_API ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field);
@@ -75,9 +79,10 @@ FOXI_API ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field)
 // Target sizes for a relative error `target_error` (total_error / gradient_norm), spread evenly over
 // the tets (each gets target_error * gradient_norm / sqrt(tet count)): a tet's size h (its longest
 // edge) becomes h * (target / error)^(1/1), for P1 elements (the gradient error goes as h), clamped
-// to [h / 4, 2 h] and to [min_size, max_size] when those are > 0; a node takes the smallest size
-// among its tets. The mesh itself is the background mesh. Throws MesherError(10) if the field is not
-// a node field of this mesh or target_error <= 0.
+// to [h / 4, 2 h] and to [min_size, max_size] when those are > 0; a tet without a value keeps h; a
+// node takes the smallest size among its tets. The mesh itself is the background mesh. Throws
+// MesherError(10) if the field is not a node field of this mesh, has no value on any tet, or
+// target_error <= 0.
 FOXI_API SizeField size_field_from_error(const Mesh& mesh, const Field& field, double target_error, double min_size = 0,
                                 double max_size = 0);
 

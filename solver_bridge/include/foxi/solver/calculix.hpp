@@ -48,8 +48,9 @@ struct FrdBlock {
   std::vector<double> values;       // components per node
 };
 
-// Reads every nodal result block of an ASCII .frd file (the last step's blocks come last). Throws
-// IoError (file and line) on a malformed or binary file.
+// Reads every nodal result block of an ASCII .frd file (the last step's blocks come last), through
+// foxi::fields' reader (read_frd_source: the one .frd reader, which also checks the node block and
+// the end record). Throws IoError (file and line) on a malformed, truncated or binary file.
 FOXI_API std::vector<FrdBlock> read_frd(const std::filesystem::path& frd);
 
 }  // namespace foxi

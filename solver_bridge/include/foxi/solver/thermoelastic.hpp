@@ -109,4 +109,13 @@ struct ThermoelasticReport {
 // fails or CG does not converge; SolverCancelled when the progress callback returns false.
 FOXI_API ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params);
 
+// The report of solve_thermoelastic for displacements solved elsewhere (CalculiX): the same stress,
+// von Mises and principal stress per tet from `displacement` (3 per node: the mesh's nodes, then for
+// order 2 the mid-edge nodes in the order of the CalculiX deck's C3D10 nodes), the same maxima per
+// region and interface, the same fields stored. The solver figures stay 0, `solver` is "given".
+// Throws SolverError as solve_thermoelastic does for `params`, and when `displacement` has the wrong
+// size or a non-finite value at a node of a tet.
+FOXI_API ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& params,
+                                                  std::vector<double> displacement);
+
 }  // namespace foxi
