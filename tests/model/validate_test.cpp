@@ -24,7 +24,10 @@ Mesh two_tets() {
   return m;
 }
 
+// Whether what a user is shown (describe's summary lines, then the per-element messages) says `text`.
 bool mentions(const ValidationReport& r, const std::string& text) {
+  for (const auto& m : describe(r))
+    if (m.find(text) != std::string::npos) return true;
   for (const auto& m : r.messages)
     if (m.find(text) != std::string::npos) return true;
   return false;
