@@ -144,7 +144,7 @@ int cmd_mesh(Args args) {
   Plc plc;
   double unit_scale = 1;
   if (is_model) {
-    model = load_model(in, sets);
+    model = load_model(in, sets, "--set");
     structure = build_structure(model);
     plc = structure.plc;
     unit_scale = model.length_scale;

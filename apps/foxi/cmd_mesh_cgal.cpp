@@ -99,7 +99,7 @@ int mesh_with_cgal(Args& args) {
   Structure structure;
   Plc plc;
   if (is_model) {
-    model = load_model(in, sets);
+    model = load_model(in, sets, "--set");
     structure = build_structure(model);
     plc = structure.plc;
     const ModelMeshParams mp = mesh_params_from_model(model, plc);

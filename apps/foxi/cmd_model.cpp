@@ -163,7 +163,7 @@ int cmd_model(Args args) {
       throw UsageError("--size takes WxH, 16 to 8192 pixels each, not '" + size + "'");
     pp.width = static_cast<int>(wh[0]);
     pp.height = static_cast<int>(wh[1]);
-    const MeshedModel m = mesh_model(file, sets, std::nullopt, true, max_tets);
+    const MeshedModel m = mesh_model_from_sets(file, sets, {.coarse = true, .max_tets = max_tets});
     const ModelPicture pic = render_model_picture(m, out, pp);
     std::printf("%s: %zu parts, coarse mesh %zu nodes, %zu tets (TetGen %s); drew %zu tets (%s) -> %s\n",
                 file.c_str(), m.model.parts.size(), m.mesh.node_count(), m.mesh.tet_count(),
@@ -174,7 +174,7 @@ int cmd_model(Args args) {
     return kExitOk;
   }
 
-  const Model model = load_model(file, sets);
+  const Model model = load_model(file, sets, "--set");
   const Structure s = build_structure(model);
   if (action == "plc") {
     write_poly(s.plc, out);

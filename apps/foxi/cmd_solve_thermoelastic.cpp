@@ -173,7 +173,7 @@ int cmd_solve_thermoelastic(Args args) {
   silence_text_for_json(json);
   const auto t0 = std::chrono::steady_clock::now();
   // the thermal conditions are checked before meshing, as mesh_model checks the stress conditions
-  if (from_thermal) check_physics(load_model(files[0], sets), Physics::thermal);
+  if (from_thermal) check_physics(load_model(files[0], sets, "--set"), Physics::thermal);
   MeshedModel run;
   if (from_model)
     run = mesh_model_for_solve(files[0], sets, physics_name(Physics::thermal_stress), size_scale, max_tets);

@@ -300,9 +300,9 @@ int cmd_sweep(Args args) {
   for (const Varied& v : varied) {
     std::vector<std::string> one = sets;
     one.push_back(v.name + "=" + v.texts.front());
-    (void)load_model(model, one);
+    (void)load_model(model, one, "--set");
   }
-  (void)load_model(model, run_sets(0));
+  (void)load_model(model, run_sets(0), "--set");
   silence_text_for_json(json);
 
   ScratchFolder scratch("foxi-sweep");

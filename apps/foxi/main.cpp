@@ -6,6 +6,8 @@
 
 #include "cli.hpp"
 #include "exit_codes.hpp"
+#include "model_run.hpp"
+#include "foxi/mesher/model_mesh.hpp"
 #include "foxi/solver/solver.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/progress.hpp"
@@ -88,6 +90,9 @@ int main(int argc, char** argv) {
     return kExitUsage;
   } catch (const InputError& e) {
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
+    return kExitBadInput;
+  } catch (const foxi::TetLimitError& e) {  // a mesh estimated past --max-tets, refused before meshing
+    std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), tet_limit_message(e).c_str());
     return kExitBadInput;
   } catch (const foxi::IoError& e) {
     // Files that cannot be read or are not what they claim, model files and their parameters.

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/model/diagnostics.hpp"
 #include "foxi/model/io_error.hpp"
 
@@ -21,73 +20,26 @@ double max_tets_option(Args& args) {
   return v;
 }
 
-void check_tet_estimate(const std::string& input, const Plc& plc, const MeshParams& params,
-                        std::span<const double> region_volume, double max_tets) {
-  const double est = estimate_tet_count(plc, params, region_volume);
-  if (est <= max_tets) return;
+std::string tet_limit_message(const TetLimitError& e) {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "the mesh would have about %.3g tets (from the volumes and the size bounds), over the limit "
                 "of %.0f; use a larger size, or --max-tets to raise the limit",
-                est, max_tets);
-  throw IoError(input, 0, IoError::kNoOffset, buf);
+                e.estimate(), e.limit());
+  return IoError(e.file(), e.line(), IoError::kNoOffset, buf).what();
+}
+
+std::vector<ParameterOverride> set_overrides(const std::string& file, std::span<const std::string> sets) {
+  return split_overrides(file, sets, "--set");
 }
 
 bool is_model_path(const std::string& path) {
   return path.size() > 5 && path.compare(path.size() - 5, 5, ".toml") == 0;
 }
 
-MeshedModel mesh_model(const std::string& file, std::span<const std::string> sets,
-                       std::optional<Physics> physics, bool coarse, double max_tets, double size_scale) {
-  MeshedModel m;
-  m.model = load_model(file, sets);
-  if (physics) check_physics(m.model, *physics);
-  m.structure = build_structure(m.model);
-  Plc plc = m.structure.plc;
-  // coarse (a picture of the parts): no sizes, no quality refinement and no conforming rounds, so the
-  // tets follow the PLC's points and TetGen's boundary recovery alone; the picture takes the power
-  // order where that mesh is Delaunay, else a depth buffer (model_picture.cpp). With the quality
-  // bounds, power_module's thin solders took 612k tets and 44 s; the conforming rounds alone, 185k
-  // tets and 90 s; this way 377 tets in 0.1 s.
-  Model controls = m.model;
-  if (coarse) controls.mesh = {.max_size = 0, .quality = 0, .min_dihedral = 0, .part_sizes = {}, .refine = {}};
-  if (size_scale != 1 && !coarse) {
-    if (controls.mesh.max_size <= 0) {
-      double d2 = 0;
-      for (int i = 0; i < 3; ++i) {
-        double lo = INFINITY, hi = -INFINITY;
-        for (std::size_t p = 0; p < plc.point_count(); ++p) {
-          lo = std::min(lo, plc.points[3 * p + i]);
-          hi = std::max(hi, plc.points[3 * p + i]);
-        }
-        d2 += (hi - lo) * (hi - lo);
-      }
-      controls.mesh.max_size = std::sqrt(d2) / 10;
-    }
-    controls.mesh.max_size *= size_scale;
-    for (PartSize& p : controls.mesh.part_sizes) p.max_size *= size_scale;
-    for (RefineBox& b : controls.mesh.refine) b.max_size *= size_scale;
-  }
-  const ModelMeshParams mp = mesh_params_from_model(controls, plc);
-  MeshParams params = mp.params;
-  check_tet_estimate(file, plc, params, m.structure.part_volume, max_tets);
-  // The model's refinement boxes as a size field, as `foxi mesh` applies them.
-  SizeField boxes;
-  if (!controls.mesh.refine.empty()) {
-    boxes = box_size_field(plc, params, size_controls_from_model(controls));
-    params.size_field = &boxes;
-    check_tet_estimate(file, plc, params, m.structure.part_volume, max_tets);
-  }
-  // The same conforming Delaunay path as `foxi mesh` (thin layers included), so that the mesh the
-  // solver gets is certified and the viewer's order is exact.
-  if (coarse) {
-    m.mesh = mesh_plc(plc, params, &m.conforming.tetgen);
-  } else {
-    m.mesh = mesh_conforming(plc, params, {}, &m.conforming);
-  }
-  m.report = m.conforming.tetgen;
-  name_mesh(m.model, m.structure, m.mesh);
-  return m;
+MeshedModel mesh_model_from_sets(const std::string& file, std::span<const std::string> sets, ModelMeshOptions options) {
+  options.override_origin = "--set";
+  return foxi::mesh_model(file, set_overrides(file, sets), options);
 }
 
 MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::string> sets,
@@ -95,7 +47,11 @@ MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::s
   std::optional<Physics> ph;
   for (Physics p : {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress})
     if (physics == physics_name(p)) ph = p;
-  MeshedModel m = mesh_model(file, sets, ph, false, max_tets, size_scale);
+  ModelMeshOptions options;
+  options.physics = ph;
+  options.max_tets = max_tets;
+  options.size_scale = size_scale;
+  MeshedModel m = mesh_model_from_sets(file, sets, options);
   // the model's warnings before the work (foxi model check prints the same)
   if (ph)
     for (const ModelWarning& w : warnings_for(diagnose_model(m.model, m.structure), *ph))

@@ -205,8 +205,8 @@ constexpr Dims kConductivity = {1, 1, -3, -1, 0}, kElectrical = {-3, -1, 3, 0, 2
 
 class Loader {
  public:
-  Loader(std::filesystem::path path, std::span<const std::string> overrides)
-      : path_(std::move(path)), overrides_(overrides) {}
+  Loader(std::filesystem::path path, std::span<const ParameterOverride> overrides, std::string_view origin)
+      : path_(std::move(path)), overrides_(overrides), origin_(origin) {}
 
   Model load() {
     model_.file = path_.string();
@@ -359,13 +359,10 @@ class Loader {
       if (!it->second.is_table()) throw Located{line_of(it->second), "'parameters' must be a table"};
       flatten("", it->second);
     }
-    for (const std::string& o : overrides_) {
-      const auto eq = o.find('=');
-      if (eq == std::string::npos || eq == 0) throw Located{0, "--set '" + o + "': expected name=value"};
-      const std::string name = o.substr(0, eq);
-      auto p = params_.find(name);
-      if (p == params_.end()) throw Located{0, "--set: unknown parameter '" + name + "'"};
-      p->second.param.expression = o.substr(eq + 1);
+    for (const ParameterOverride& o : overrides_) {
+      auto p = params_.find(o.name);
+      if (p == params_.end()) throw Located{0, origin_ + ": unknown parameter '" + o.name + "'"};
+      p->second.param.expression = o.expression;
       p->second.param.overridden = true;
     }
   }
@@ -390,7 +387,7 @@ class Loader {
     } catch (const ExpressionError& x) {
       throw Located{
           e.param.overridden ? 0 : e.line,
-          "parameter '" + name + "'" + (e.param.overridden ? " (from --set)" : "") + ": " + x.what()};
+          "parameter '" + name + "'" + (e.param.overridden ? " (from " + origin_ + ")" : "") + ": " + x.what()};
     }
     e.state = 2;
     return e.param.value;
@@ -837,7 +834,8 @@ class Loader {
   }
 
   std::filesystem::path path_;
-  std::span<const std::string> overrides_;
+  std::span<const ParameterOverride> overrides_;
+  std::string origin_;  // where the overrides came from, for messages
   Value root_;
   Model model_;
   std::map<std::string, ParamEntry> params_;
@@ -848,8 +846,26 @@ class Loader {
 
 }  // namespace
 
-Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides) {
-  return Loader(path, overrides).load();
+Model load_model(const std::filesystem::path& path, std::span<const ParameterOverride> overrides,
+                 std::string_view origin) {
+  return Loader(path, overrides, origin).load();
+}
+
+std::vector<ParameterOverride> split_overrides(const std::filesystem::path& path, std::span<const std::string> texts,
+                                               std::string_view origin) {
+  std::vector<ParameterOverride> out;
+  for (const std::string& o : texts) {
+    const auto eq = o.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw IoError(path.string(), 0, IoError::kNoOffset, std::string(origin) + " '" + o + "': expected name=value");
+    out.push_back({o.substr(0, eq), o.substr(eq + 1)});
+  }
+  return out;
+}
+
+Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides, std::string_view origin) {
+  const std::vector<ParameterOverride> split = split_overrides(path, overrides, origin);
+  return load_model(path, split, origin);
 }
 
 }  // namespace foxi

@@ -162,9 +162,9 @@ TEST(ModelLimits, DeeplyNestedExpressionIsRefused) {
   EXPECT_THROW(eval(std::string(5000, '1')), foxi::ExpressionError);
   EXPECT_THROW(eval("(m^20)^20"), foxi::ExpressionError);
   EXPECT_THROW(eval("m^20*m^20*m^20*m^20*m^20*m^20*m^20"), foxi::ExpressionError);
-  // in a model, through --set, with the parameter named
+  // in a model, through an override, with the parameter named
   const foxi::IoError e = error_of(kModels + "die_on_substrate.toml", {"die_w=" + deep});
-  EXPECT_TRUE(has(e, "parameter 'die_w' (from --set)")) << e.what();
+  EXPECT_TRUE(has(e, "parameter 'die_w' (from an override)")) << e.what();
 }
 
 // A chain of parameters, each needing the next, recursed once per link.

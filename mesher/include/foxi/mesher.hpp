@@ -1,6 +1,7 @@
 // foxi/mesher.hpp: tetrahedral meshing of a PLC (foxi::mesher), in one include. The entry points,
 // one a line (declared in the topic headers below, which say more):
 //
+//   mesh_model(file, overrides, options)       a model file to a certified, named mesh (model_mesh.hpp)
 //   mesh_plc(plc, params)                      TetGen's quality mesh of a PLC (tetgen_mesher.hpp)
 //   mesh_conforming(plc, params, conforming)   a conforming Delaunay mesh, certified (conforming.hpp)
 //   mesh_plc_cgal(plc, params)                 CGAL Mesh_3's mesh of a PLC (cgal_mesher.hpp)
@@ -16,6 +17,7 @@
 #include "foxi/mesher/cgal_mesher.hpp"
 #include "foxi/mesher/conforming.hpp"
 #include "foxi/mesher/mesher.hpp"
+#include "foxi/mesher/model_mesh.hpp"
 #include "foxi/mesher/model_mesh_params.hpp"
 #include "foxi/mesher/quality_report.hpp"
 #include "foxi/mesher/size_field.hpp"

@@ -2,7 +2,7 @@
 // PLC for the mesher (foxi::structure), in one include. The entry points, one a line (declared in
 // the topic headers below, which keep their foxi/model/ paths and say more):
 //
-//   load_model(path)                           a model file as plain data in SI units (model_file.hpp)
+//   load_model(path, overrides)                a model file as plain data in SI units, ParameterOverride (model_file.hpp)
 //   build_structure(model, progress)           parts -> one conforming PLC, regions, surfaces (structure.hpp)
 //   name_mesh(model, structure, mesh)          region, material and boundary names on a mesh (structure.hpp)
 //   StructureCancelled                         building was cancelled (structure.hpp)

@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "foxi/api.hpp"
@@ -79,7 +80,7 @@ struct Part {
 
 struct Parameter {
   std::string name;
-  std::string expression;  // as written (or as given by --set)
+  std::string expression;  // as written (or as given by an override)
   Quantity value;
   bool overridden = false;
 };
@@ -97,8 +98,16 @@ struct Model {
   ModelMeshControls mesh;                      // [mesh]
 };
 
-// Loads a model file. `overrides` are "name=expression" (from --set) and replace parameters of that
-// name. Throws IoError (file, line when known, and a reason naming the entity: parameter, part,
+// A parameter replaced from outside the model file (a host's input, a command-line option): the
+// parameter's name and the expression that replaces the file's (units included, as the file would
+// write it, e.g. "8 mm" or "2 * die_w").
+struct ParameterOverride {
+  std::string name;
+  std::string expression;
+};
+
+// Loads a model file. `overrides` replace the parameters of their names; `origin` names where they
+// came from in messages ("parameter 'w' (from ORIGIN): ...", "ORIGIN: unknown parameter 'w'"). Throws IoError (file, line when known, and a reason naming the entity: parameter, part,
 // material) for TOML syntax errors, unknown parameters, unit mismatches, circular expressions,
 // sizes that are not positive, unknown materials, and unknown shapes or keys; for conditions and
 // loads: unknown types, units that do not fit the type, surfaces that name no part face, interface or
@@ -106,6 +115,16 @@ struct Model {
 // (degenerate geometry included: a feature below kMinFeature of the model's extent). Referenced files
 // (library, STL) are named relative to the model's folder, must be regular files of the expected kind,
 // and their content is never quoted in an error.
-FOXI_API Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides = {});
+FOXI_API Model load_model(const std::filesystem::path& path, std::span<const ParameterOverride> overrides,
+                          std::string_view origin = "an override");
+// The same with the overrides written "name=expression" (IoError, line 0, for one without a name
+// and '=').
+FOXI_API Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides = {},
+                          std::string_view origin = "an override");
+// Splits "name=expression" texts into overrides of the model file `path`; IoError (line 0) naming
+// `origin` and the text for one without a name and '='.
+FOXI_API std::vector<ParameterOverride> split_overrides(const std::filesystem::path& path,
+                                                        std::span<const std::string> texts,
+                                                        std::string_view origin = "an override");
 
 }  // namespace foxi
