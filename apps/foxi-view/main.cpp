@@ -12,6 +12,7 @@
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
+#include "foxi/viz/view_options.hpp"
 #include "viewer.hpp"
 #include "x11_window.hpp"
 
@@ -98,25 +99,15 @@ int main(int argc, char** argv) {
     }
     if (mesh_path.empty()) throw Usage("give a mesh file");
     int width = 0, height = 0;
-    {
-      char* e1 = nullptr;
-      char* e2 = nullptr;
-      const std::size_t x = size.find('x');
-      const std::string w = size.substr(0, x), h = x == std::string::npos ? "" : size.substr(x + 1);
-      long lw = std::strtol(w.c_str(), &e1, 10), lh = std::strtol(h.c_str(), &e2, 10);
-      if (x == std::string::npos || w.empty() || h.empty() || *e1 != 0 || *e2 != 0 || lw < 1 || lh < 1 ||
-          lw > 16384 || lh > 16384)
-        throw Usage("--size takes WxH with 1 <= W, H <= 16384, not '" + size + "'");
-      width = int(lw);
-      height = int(lh);
-    }
     foxi::RenderParams params;
     params.undoable = !no_undo;
-    if (!shrink.empty()) {
-      char* end = nullptr;
-      params.shrink = std::strtod(shrink.c_str(), &end);
-      if (*end != 0 || !(params.shrink > 0 && params.shrink <= 1))
-        throw Usage("--shrink takes a factor in (0, 1]");
+    try {
+      const foxi::ImageSize image = foxi::parse_image_size(size);
+      width = image.width;
+      height = image.height;
+      if (!shrink.empty()) params.shrink = foxi::parse_shrink(shrink);
+    } catch (const foxi::OptionError& e) {
+      throw Usage(e.what());
     }
     foxi::Mesh mesh = foxi::read_mesh(mesh_path);
     {
@@ -134,7 +125,10 @@ int main(int argc, char** argv) {
     }
     foxi::Camera camera;
     try {
-      camera = foxi::view::default_camera(mesh, width, height, eye, at, up, fov, dir);
+      // The same rules as foxi render (view_options.hpp), so both give the same picture.
+      double lo[3], hi[3];
+      foxi::mesh_bounds(mesh, lo, hi);
+      camera = foxi::camera_for(foxi::parse_camera_options(eye, at, up, fov, dir), lo, hi, double(width) / height);
     } catch (const std::invalid_argument& e) {
       throw Usage(e.what());
     }

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "foxi/viz/view_options.hpp"
+
 namespace foxi::cli {
 
 bool Args::flag(std::string_view name) {
@@ -73,20 +75,11 @@ std::vector<std::string> Args::positional(std::size_t min, std::size_t max, std:
 }
 
 std::vector<double> parse_numbers(const std::string& s, const char* what) {
-  std::vector<double> v;
-  std::size_t pos = 0;
-  while (pos <= s.size()) {
-    std::size_t comma = s.find(',', pos);
-    std::string part = s.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
-    char* end = nullptr;
-    double x = std::strtod(part.c_str(), &end);
-    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(x))
-      throw UsageError(std::string(what) + " takes comma-separated numbers, not '" + s + "'");
-    v.push_back(x);
-    if (comma == std::string::npos) break;
-    pos = comma + 1;
+  try {
+    return parse_number_list(s, what);
+  } catch (const OptionError& e) {
+    throw UsageError(e.what());
   }
-  return v;
 }
 
 std::string json_string(std::string_view s) {

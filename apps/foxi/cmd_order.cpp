@@ -13,6 +13,7 @@
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/picture.hpp"
 #include "foxi/viz/spheres.hpp"
+#include "foxi/viz/view_options.hpp"
 #include "foxi/viz/visibility_order.hpp"
 
 namespace foxi::cli {
@@ -99,36 +100,7 @@ int cmd_order(Args args) {
   }
 
   std::vector<std::uint32_t> subset;
-  if (!subset_s.empty()) {
-    std::string kind = subset_s.substr(0, subset_s.find(':'));
-    std::string rest = subset_s.find(':') == std::string::npos ? "" : subset_s.substr(subset_s.find(':') + 1);
-    if (kind == "regions") {
-      auto ids = parse_numbers(rest, "--subset regions:");
-      for (std::size_t t = 0; t < mesh.tet_count(); ++t)
-        for (double id : ids)
-          if (mesh.region_of(t) == static_cast<std::int32_t>(id)) subset.push_back(static_cast<std::uint32_t>(t));
-    } else if (kind == "random") {
-      double f = parse_numbers(rest, "--subset random:")[0];
-      std::mt19937 rng(seed + 7);
-      std::uniform_real_distribution<double> u(0, 1);
-      for (std::size_t t = 0; t < mesh.tet_count(); ++t)
-        if (u(rng) < f) subset.push_back(static_cast<std::uint32_t>(t));
-    } else if (kind == "box") {
-      auto b = parse_numbers(rest, "--subset box:");
-      if (b.size() != 6) throw UsageError("--subset box: takes x0,y0,z0,x1,y1,z1");
-      for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
-        double c[3] = {0, 0, 0};
-        for (int k = 0; k < 4; ++k)
-          for (int j = 0; j < 3; ++j) c[j] += 0.25 * mesh.xyz[3 * std::size_t(mesh.tet[4 * t + k]) + j];
-        bool in = true;
-        for (int j = 0; j < 3; ++j) in = in && c[j] >= b[j] && c[j] <= b[3 + j];
-        if (in) subset.push_back(static_cast<std::uint32_t>(t));
-      }
-    } else {
-      throw UsageError("--subset takes regions:..., random:... or box:...");
-    }
-    if (subset.empty()) throw UsageError("the subset '" + subset_s + "' selects no tets");
-  }
+  if (!subset_s.empty()) subset = parse_subset(mesh, subset_s, seed + 7);
 
   auto t0 = std::chrono::steady_clock::now();
   const DelaunayCertificate cert = compute_delaunay_certificate(mesh);

@@ -115,10 +115,7 @@ bool parse_int(const std::string& s, std::int32_t& out) {
 }
 
 std::int32_t boundary_tag(const Mesh& mesh, const std::string& key, const std::string& option) {
-  std::int32_t tag = 0;
-  if (parse_int(key, tag)) return tag;
-  for (const Boundary& b : mesh.boundaries)
-    if (b.name == key) return b.tag;
+  if (const auto tag = boundary_tag_of(mesh, key)) return *tag;
   std::string names;
   for (const Boundary& b : mesh.boundaries)
     if (!b.name.empty()) names += (names.empty() ? "" : ", ") + b.name;
@@ -127,10 +124,7 @@ std::int32_t boundary_tag(const Mesh& mesh, const std::string& key, const std::s
 }
 
 std::int32_t region_id(const Mesh& mesh, const std::string& key, const std::string& option) {
-  std::int32_t id = 0;
-  if (parse_int(key, id)) return id;
-  for (const Region& r : mesh.regions)
-    if (r.name == key) return r.id;
+  if (const auto id = region_id_of(mesh, key)) return *id;
   throw UsageError(option + ": no region named '" + key + "'");
 }
 

@@ -10,6 +10,7 @@
 #include "foxi/mesher/model_mesh.hpp"
 #include "foxi/solver/solver.hpp"
 #include "foxi/model/io_error.hpp"
+#include "foxi/viz/view_options.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/units.hpp"
 #include "foxi/version.hpp"
@@ -86,6 +87,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "foxi: unknown command '%s'\n\n%s", command.c_str(), kUsage);
     return kExitUsage;
   } catch (const UsageError& e) {
+    std::fprintf(stderr, "foxi %s: %s\n", command.c_str(), e.what());
+    return kExitUsage;
+  } catch (const foxi::OptionError& e) {  // a malformed picture option (view_options.hpp)
     std::fprintf(stderr, "foxi %s: %s\n", command.c_str(), e.what());
     return kExitUsage;
   } catch (const InputError& e) {

@@ -10,10 +10,6 @@
 
 namespace foxi::cli {
 
-// RGBA (pack_rgba) of a material: familiar colours for the library's materials (copper, silicon,
-// solder, FR-4, ...), else entry `index` of a fixed palette.
-std::uint32_t material_color(const std::string& name, std::size_t index);
-
 enum class ModelView : std::uint8_t {
   exploded,  // each part lifted in z by its index times a gap: every part shows whole
   cut,       // only tets with centroids at y >= the middle: the inside shows (jagged at the cut)

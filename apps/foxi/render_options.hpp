@@ -11,6 +11,7 @@
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/view_options.hpp"
 
 namespace foxi::cli {
 
@@ -20,16 +21,14 @@ extern const char* const kPictureOptionsHelp;
 struct PictureOptions {
   int width = 0, height = 0;
   RenderParams params;  // edges, shrink
-  bool has_eye = false, has_at = false, has_up = false, has_dir = false;
-  double eye[3] = {0, 0, 0}, at[3] = {0, 0, 0}, up[3] = {0, 0, 1}, dir[3] = {0, 0, 1};
-  double fov = 0;  // 0: default
+  CameraOptions camera;  // as given (view_options.hpp), fitted by resolve_picture
   std::string regions;
 };
 
-// --size WxH (1..16384 each) into width and height; UsageError otherwise.
+// --size WxH (1..16384 each) into width and height; UsageError otherwise (parse_image_size).
 void parse_size(const std::string& size_s, int& width, int& height);
 
-// Takes the options out of args; UsageError for malformed ones.
+// Takes the options out of args; OptionError (view_options.hpp) for malformed ones.
 PictureOptions take_picture_options(Args& args, const char* default_size);
 
 struct Picture {

@@ -1,5 +1,8 @@
 #include "foxi/model/mesh.hpp"
 
+#include <cstdlib>
+#include <string>
+
 #include "derived.hpp"
 
 namespace foxi {
@@ -62,6 +65,38 @@ std::string check_sizes(const Mesh& mesh) {
       return "field '" + f.name + "' has " + std::to_string(f.values.size()) + " values, expected " + std::to_string(want);
   }
   return {};
+}
+
+namespace {
+
+// A whole number as strtol reads it, the whole key consumed (the CLI's reading before this moved).
+bool whole_number(std::string_view key, std::int32_t& out) {
+  const std::string s(key);
+  char* end = nullptr;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  if (s.empty() || end != s.c_str() + s.size()) return false;
+  out = static_cast<std::int32_t>(v);
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::int32_t> region_id_of(const Mesh& mesh, std::string_view key) {
+  std::int32_t id = 0;
+  if (whole_number(key, id)) return id;
+  if (key.empty()) return std::nullopt;  // not the unnamed regions
+  for (const Region& r : mesh.regions)
+    if (r.name == key) return r.id;
+  return std::nullopt;
+}
+
+std::optional<std::int32_t> boundary_tag_of(const Mesh& mesh, std::string_view key) {
+  std::int32_t tag = 0;
+  if (whole_number(key, tag)) return tag;
+  if (key.empty()) return std::nullopt;
+  for (const Boundary& b : mesh.boundaries)
+    if (b.name == key) return b.tag;
+  return std::nullopt;
 }
 
 }  // namespace foxi

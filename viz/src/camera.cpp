@@ -65,6 +65,24 @@ void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]) {
   }
 }
 
+void tets_bounds(const Mesh& mesh, std::span<const std::uint32_t> subset, double lo[3], double hi[3]) {
+  if (subset.empty()) {
+    mesh_bounds(mesh, lo, hi);
+    return;
+  }
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::numeric_limits<double>::infinity();
+    hi[k] = -std::numeric_limits<double>::infinity();
+  }
+  for (std::uint32_t t : subset)
+    for (int v = 0; v < 4; ++v)
+      for (int k = 0; k < 3; ++k) {
+        const double x = mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + v]) + k];
+        lo[k] = std::min(lo[k], x);
+        hi[k] = std::max(hi[k], x);
+      }
+}
+
 Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
                   bool perspective, double fov_deg, double aspect, double fill) {
   Camera cam;

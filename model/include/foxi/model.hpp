@@ -3,6 +3,7 @@
 //
 //   Mesh, Region, Boundary, Material, Field    the mesh database: plain arrays, SI units (mesh.hpp)
 //   check_sizes(mesh)                          the array sizes agree with each other (mesh.hpp)
+//   region_id_of, boundary_tag_of              a region or boundary by name or number (mesh.hpp)
 //   invalidate_derived(mesh)                   drop cached adjacency, spheres, certificate (mesh.hpp)
 //   validate(mesh), validate_and_repair(mesh)  indices, flat, inverted, duplicate tets... (validate.hpp)
 //   describe(report)                           a validation report as lines for a user (validate.hpp)

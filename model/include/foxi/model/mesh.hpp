@@ -15,8 +15,10 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "foxi/api.hpp"
@@ -124,5 +126,11 @@ FOXI_API std::size_t field_entity_count(const Mesh& mesh, const Field& field);
 // Checks the sizes of every array against each other (xyz % 3, tet % 4, tet_region, bface_tag,
 // weight, field value counts). Returns an empty string when consistent, else the first problem.
 FOXI_API std::string check_sizes(const Mesh& mesh);
+
+// Name-or-number lookups, as a user names a region or a boundary: `key` written as a whole number
+// (decimal, optional sign) is that id or tag as it is (it need not be listed); otherwise the id of the
+// region, the tag of the boundary, with that name (an empty key names none). nullopt when neither.
+FOXI_API std::optional<std::int32_t> region_id_of(const Mesh& mesh, std::string_view key);
+FOXI_API std::optional<std::int32_t> boundary_tag_of(const Mesh& mesh, std::string_view key);
 
 }  // namespace foxi

@@ -7,6 +7,9 @@
 // z along `forward` (from the eye into the scene); z is the depth.
 #pragma once
 
+#include <cstdint>
+#include <span>
+
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/view.hpp"
@@ -24,6 +27,9 @@ struct Camera {
 
 // Axis-aligned bounds of the nodes used by tets (all nodes if there are no tets). lo > hi if none.
 FOXI_API void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
+// Axis-aligned bounds of the corners of the tets in `subset` (tet indices < tet_count); an empty
+// subset: mesh_bounds. What a camera is fitted to when only part of a mesh is drawn.
+FOXI_API void tets_bounds(const Mesh& mesh, std::span<const std::uint32_t> subset, double lo[3], double hi[3]);
 
 // A camera looking along `dir` (from the eye into the scene) at the centre of the box [lo, hi], far
 // enough that the box's 8 corners project within `fill` (0..1] of the half-width and half-height of
