@@ -3,6 +3,9 @@
 //
 //   draw_picture(mesh, table, camera, fb)     a safe picture: painter if certified, else MPVO + depth buffer (picture.hpp)
 //   safe_order(mesh, table, view, subset)      the back-to-front order draw_picture uses (picture.hpp)
+//   InteractiveView                            camera, regions of interest, progressive draw/undraw, damage, pick (interactive_view.hpp)
+//   material_color, exploded_mesh              colours of materials, parts lifted apart (palette.hpp)
+//   parse_camera_options, parse_subset, ...    the front ends' picture options read from text (view_options.hpp)
 //   compute_spheres(mesh)                      per-mesh precompute of the power order (spheres.hpp)
 //   visibility_order(mesh, table, view, subset) back-to-front order for one view; Delaunay meshes (visibility_order.hpp)
 //   ProgressiveOrder                           the same handed out batch by batch (visibility_order.hpp)
@@ -14,6 +17,7 @@
 //   render_tets(mesh, camera, w, h, tets)      a fresh framebuffer with tets drawn (rasterizer.hpp)
 //   Framebuffer, pack_rgba                     RGBA8 pixels, tet ids, depth (framebuffer.hpp)
 //   write_png(path, fb), read_png(path)        PNG files of a framebuffer (png.hpp)
+//   tets_bounds(mesh, subset, lo, hi)         bounds of a subset, to fit a camera to (camera.hpp)
 //   tet_depth, count_deeper                    the painter's depth stop (depth_stop.hpp)
 //   make_movie(...)                            movies of the painter: APNG, GIF (movie.hpp, animation.hpp)
 //   choose_field, tet_corner_values, FieldPaint colour by a field: flat or graded (field_paint.hpp, RenderParams::field)
@@ -30,12 +34,15 @@
 #include "foxi/viz/depth_stop.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/legend.hpp"
 #include "foxi/viz/movie.hpp"
+#include "foxi/viz/palette.hpp"
 #include "foxi/viz/picture.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/text.hpp"
 #include "foxi/viz/view.hpp"
+#include "foxi/viz/view_options.hpp"
 #include "foxi/viz/visibility_order.hpp"

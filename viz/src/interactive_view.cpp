@@ -1,0 +1,250 @@
+// The window-free interactive view (interactive_view.hpp).
+#include "foxi/viz/interactive_view.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <utility>
+
+#include "foxi/model/delaunay.hpp"
+#include "foxi/viz/picture.hpp"
+#include "foxi/viz/png.hpp"
+
+namespace foxi {
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+// MPVO orders (non-Delaunay meshes) are drawn in chunks of this many tets, at least.
+constexpr std::size_t kMpvoChunk = 4096;
+
+}  // namespace
+
+InteractiveView::InteractiveView(const Mesh& mesh, const Camera& camera, int width, int height, const RenderParams& params)
+    : mesh_(mesh), params_(params), camera_(camera), width_(width), height_(height) {
+  if (mesh.tet_count() == 0) throw std::invalid_argument("the mesh has no tets");
+  delaunay_ = safe_order_method(delaunay_certificate(mesh)) == OrderMethod::power;
+  table_ = compute_spheres(mesh);
+  params_.depth_buffer = !delaunay_;
+  params_.undoable = delaunay_ && params.undoable;  // the painter can undraw, if asked to record
+  fb_.resize(width_, height_, params_.depth_buffer);
+  damage_all();
+}
+
+InteractiveView::~InteractiveView() = default;
+
+constexpr int kDamageBand = 16;  // rows
+
+void InteractiveView::add_damage(std::span<const PixelRect> rects) {
+  damage_.resize(std::size_t((height_ + kDamageBand - 1) / kDamageBand));
+  for (const PixelRect& r : rects) {
+    if (r.x0 > r.x1 || r.y0 > r.y1) continue;
+    for (int band = std::max(r.y0, 0) / kDamageBand; band <= std::min(r.y1, height_ - 1) / kDamageBand; ++band) {
+      PixelRect& d = damage_[std::size_t(band)];
+      const int y0 = std::max(r.y0, band * kDamageBand), y1 = std::min(r.y1, band * kDamageBand + kDamageBand - 1);
+      d = d.x0 > d.x1 ? PixelRect{r.x0, y0, r.x1, y1}
+                      : PixelRect{std::min(d.x0, r.x0), std::min(d.y0, y0), std::max(d.x1, r.x1), std::max(d.y1, y1)};
+    }
+  }
+}
+
+void InteractiveView::damage_all() {
+  damage_.clear();
+  const PixelRect all{0, 0, width_ - 1, height_ - 1};
+  add_damage(std::span<const PixelRect>(&all, 1));
+}
+
+std::vector<PixelRect> InteractiveView::take_damage() {
+  std::vector<PixelRect> rects;
+  for (PixelRect& d : damage_) {
+    if (d.x0 <= d.x1) {
+      if (!rects.empty() && rects.back().x0 == d.x0 && rects.back().x1 == d.x1 && rects.back().y1 + 1 == d.y0)
+        rects.back().y1 = d.y1;  // whole bands of the same extent as one
+      else
+        rects.push_back(d);
+    }
+    d = PixelRect{};
+  }
+  return rects;
+}
+
+std::span<const std::uint32_t> InteractiveView::current_subset() const {
+  if (stack_.empty()) return {};
+  return stack_.back();
+}
+
+void InteractiveView::begin_draw() {
+  // A degenerate camera (e.g. zoomed through `at`) throws here; the caller keeps the old picture.
+  const auto t0 = std::chrono::steady_clock::now();
+  auto raster = std::make_unique<TetRasterizer>(mesh_, camera_, width_, height_, params_);
+  raster_ = std::move(raster);
+  order_.reset();
+  mpvo_.clear();
+  mpvo_pos_ = 0;
+  const View v = view_of(camera_);
+  if (delaunay_)
+    order_.emplace(mesh_, table_, v, current_subset());
+  else
+    mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
+  fb_.resize(width_, height_, params_.depth_buffer);
+  damage_all();
+  drawn_.clear();
+  handed_.clear();
+  done_ = false;
+  undrawing_ = false;
+  started_ = true;
+  ++generation_;
+  frame_ms_ = ms_since(t0);  // ordering set-up (MPVO: the whole order) counts
+}
+
+void InteractiveView::restart() { begin_draw(); }
+
+bool InteractiveView::step() {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (undrawing_) {
+    const std::size_t n = undraw(std::max<std::size_t>(1, total() / 64));
+    step_ms_ = ms_since(t0);
+    frame_ms_ += step_ms_;
+    return n > 0;
+  }
+  if (done_) return false;
+  std::span<const std::uint32_t> batch;
+  if (drawn_.size() < handed_.size()) {  // drawing on after an undraw: the order is known
+    const std::size_t n = std::min(handed_.size() - drawn_.size(), std::max<std::size_t>(1, total() / 64));
+    batch = std::span<const std::uint32_t>(handed_).subspan(drawn_.size(), n);
+  } else if (order_) {
+    batch = order_->next();
+    handed_.insert(handed_.end(), batch.begin(), batch.end());
+    batch = std::span<const std::uint32_t>(handed_).last(batch.size());
+  } else {
+    std::size_t n = std::min(mpvo_.size() - mpvo_pos_, std::max(kMpvoChunk, mpvo_.size() / 64));
+    batch = std::span<const std::uint32_t>(mpvo_).subspan(mpvo_pos_, n);
+    mpvo_pos_ += n;
+  }
+  if (batch.empty()) {
+    done_ = true;
+    step_ms_ = ms_since(t0);
+    frame_ms_ += step_ms_;
+    return false;
+  }
+  raster_->draw(fb_, batch);
+  add_damage(raster_->changed_rects());
+  drawn_.insert(drawn_.end(), batch.begin(), batch.end());
+  step_ms_ = ms_since(t0);
+  frame_ms_ += step_ms_;
+  if (drawn_.size() >= total()) {
+    done_ = true;
+    order_.reset();  // stops its sorting thread
+  }
+  return true;
+}
+
+bool InteractiveView::set_undrawing(bool on) {
+  if (on && !params_.undoable) return false;
+  undrawing_ = on;
+  return true;
+}
+
+std::size_t InteractiveView::undraw(std::size_t count) {
+  if (!params_.undoable || !raster_) return 0;
+  const std::size_t n = std::min(count, drawn_.size());
+  raster_->undraw(fb_, n);
+  add_damage(raster_->changed_rects());
+  drawn_.resize(drawn_.size() - n);
+  if (n > 0) done_ = false;
+  return n;
+}
+
+bool InteractiveView::step(std::chrono::steady_clock::duration budget) {
+  const auto end = std::chrono::steady_clock::now() + budget;
+  bool changed = false;
+  do {
+    if (!step()) break;
+    changed = true;
+  } while (std::chrono::steady_clock::now() < end);
+  return changed;
+}
+
+std::uint32_t InteractiveView::pick(int x, int y) const {
+  if (x < 0 || y < 0 || x >= fb_.width || y >= fb_.height) return kNone;
+  return fb_.id[fb_.index(x, y)];
+}
+
+void InteractiveView::finish() {
+  while (step()) {
+  }
+}
+
+std::size_t InteractiveView::total() const {
+  if (!stack_.empty()) return stack_.back().size();
+  return mesh_.tet_count();
+}
+
+bool InteractiveView::push_region() {
+  if (drawn_.empty()) return false;
+  std::vector<std::uint32_t> subset = drawn_;
+  std::sort(subset.begin(), subset.end());
+  stack_.push_back(std::move(subset));
+  begin_draw();
+  return true;
+}
+
+bool InteractiveView::pop_region() {
+  if (stack_.empty()) return false;
+  stack_.pop_back();
+  begin_draw();
+  return true;
+}
+
+void InteractiveView::set_camera(const Camera& camera) {
+  const Camera old = camera_;
+  camera_ = camera;
+  try {
+    begin_draw();
+  } catch (const std::invalid_argument&) {
+    camera_ = old;  // a degenerate camera: keep the previous one
+    begin_draw();
+  }
+}
+
+void InteractiveView::orbit(double yaw_deg, double pitch_deg) { set_camera(foxi::orbit(camera_, yaw_deg, pitch_deg)); }
+void InteractiveView::zoom(double factor) { set_camera(foxi::zoom(camera_, factor)); }
+void InteractiveView::pan(double dx, double dy) { set_camera(foxi::pan(camera_, dx, dy)); }
+
+void InteractiveView::resize(int width, int height) {
+  width_ = std::max(1, width);
+  height_ = std::max(1, height);
+  begin_draw();
+}
+
+std::string InteractiveView::status() const {
+  char buf[256];
+  const std::size_t n = drawn_.size(), t = total();
+  const char* state = undrawing_ ? (n == 0 ? "undrawn" : "undrawing") : done_ ? "drawn" : "drawing";
+  std::snprintf(buf, sizeof buf, "%s %zu / %zu tets (%.1f%%), %.1f ms, %.2f ms/frame%s, region %zu%s", state, n,
+                t, t ? 100.0 * double(n) / double(t) : 0.0, frame_ms_, step_ms_,
+                started_ && !running_ && (undrawing_ ? n > 0 : !done_) ? " [stopped]" : "", stack_.size(),
+                delaunay_ ? "" : "  NOT Delaunay: depth-buffer drawing");
+  return buf;
+}
+
+std::string InteractiveView::camera_options() const {
+  char buf[512];
+  if (camera_.perspective)
+    std::snprintf(buf, sizeof buf,
+                  "--eye %.17g,%.17g,%.17g --at %.17g,%.17g,%.17g --up %.17g,%.17g,%.17g --fov %.17g",
+                  camera_.eye[0], camera_.eye[1], camera_.eye[2], camera_.at[0], camera_.at[1], camera_.at[2],
+                  camera_.up[0], camera_.up[1], camera_.up[2], camera_.fov_deg);
+  else
+    std::snprintf(buf, sizeof buf, "--dir %.17g,%.17g,%.17g", camera_.at[0] - camera_.eye[0],
+                  camera_.at[1] - camera_.eye[1], camera_.at[2] - camera_.eye[2]);
+  return buf;
+}
+
+void InteractiveView::save_png(const std::filesystem::path& path) const { write_png(path, fb_); }
+
+}  // namespace foxi
