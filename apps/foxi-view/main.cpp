@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../foxi/exit_codes.hpp"
+#include "../foxi/signals.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/validate.hpp"
@@ -53,6 +54,9 @@ struct BadInput : std::runtime_error {
 
 int main(int argc, char** argv) {
   using namespace foxi::cli;
+  // SIGINT, SIGTERM, SIGHUP: exit 130/143/129 with a message, a save under way left unfinished and
+  // its temporary removed (the durable writers' cleanup list).
+  handle_stop_signals("foxi-view");
   try {
     std::vector<std::string> args(argv + 1, argv + argc);
     std::string mesh_path, size = "800x600", eye, at, up, fov, dir, shrink, save = "foxi-view", script;

@@ -66,7 +66,9 @@ int cmd_demo(Args args) {
 
   std::printf("1. model %s\n", file.c_str());
   auto t = std::chrono::steady_clock::now();
-  MeshedModel m = mesh_model_from_sets(file, sets, {.physics = Physics::thermal});
+  ModelMeshOptions options;
+  options.physics = Physics::thermal;
+  MeshedModel m = mesh_model_from_sets(file, sets, options);
   for (std::size_t i = 0; i < m.model.parts.size(); ++i)
     std::printf("   part %-14s %-14s %.4g mm^3\n", m.model.parts[i].name.c_str(), m.model.parts[i].material.c_str(),
                 m.structure.part_volume[i] * 1e9);

@@ -163,7 +163,10 @@ int cmd_model(Args args) {
       throw UsageError("--size takes WxH, 16 to 8192 pixels each, not '" + size + "'");
     pp.width = static_cast<int>(wh[0]);
     pp.height = static_cast<int>(wh[1]);
-    const MeshedModel m = mesh_model_from_sets(file, sets, {.coarse = true, .max_tets = max_tets});
+    ModelMeshOptions options;
+    options.coarse = true;
+    options.max_tets = max_tets;
+    const MeshedModel m = mesh_model_from_sets(file, sets, options);
     const ModelPicture pic = render_model_picture(m, out, pp);
     std::printf("%s: %zu parts, coarse mesh %zu nodes, %zu tets (TetGen %s); drew %zu tets (%s) -> %s\n",
                 file.c_str(), m.model.parts.size(), m.mesh.node_count(), m.mesh.tet_count(),

@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   std::string command = args[0];
-  foxi::cli::handle_stop_signals(command);  // SIGINT/SIGTERM: exit 130/143, nothing partial left
+  foxi::cli::handle_stop_signals("foxi " + command);  // SIGINT/SIGTERM: exit 130/143, nothing partial left
   foxi::cli::Args rest(std::vector<std::string>(args.begin() + 1, args.end()));
   try {
     if (command == "info") return foxi::cli::cmd_info(std::move(rest));

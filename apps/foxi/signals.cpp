@@ -40,18 +40,18 @@ extern "C" void wait_for_stop() {
 
 }  // namespace
 
-void handle_stop_signals(const std::string& command) {
+void handle_stop_signals(const std::string& program) {
   const sigset_t set = stop_signals();
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
   std::atexit(wait_for_stop);
-  std::thread([command, set] {
+  std::thread([program, set] {
     int sig = 0;
     while (sigwait(&set, &sig) != 0) {
     }
     g_stopping = true;
     const char* name = sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP" : "SIGINT (Ctrl-C)";
-    std::fprintf(stderr, "\nfoxi %s: stopped by %s; helper processes killed, unfinished files removed\n",
-                 command.c_str(), name);
+    std::fprintf(stderr, "\n%s: stopped by %s; helper processes killed, unfinished files removed\n",
+                 program.c_str(), name);
     cleanup::interrupt();
     std::fflush(stderr);
     ::_exit(sig == SIGTERM ? kExitTerminated : sig == SIGHUP ? kExitHangup : kExitInterrupted);

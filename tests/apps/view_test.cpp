@@ -370,5 +370,39 @@ exit 0
   }
 }
 
+// SIGTERM and SIGHUP to the window (a job scheduler, a closed terminal): the viewer stops with exit
+// 143 / 129 and says so, as the foxi commands do, leaving nothing in its save folder.
+TEST_F(ViewTest, WindowStopsCleanlyOnSigtermAndSighup) {
+  if (!test::have_program("xvfb-run")) GTEST_SKIP() << "xvfb-run is missing (scripts/install-deps.sh installs it)";
+  const std::string driver = R"SH(set -u
+V=$1; M=$2; D=$3; S=$4
+"$V" "$M" --size 320x240 --save "$D/x" > "$D/stop.log" 2>&1 &
+pid=$!
+i=0; while [ $i -lt 200 ] && ! grep -q '^done' "$D/stop.log"; do kill -0 $pid 2>/dev/null || exit 4; sleep 0.1; i=$((i+1)); done
+grep -q '^done' "$D/stop.log" || { kill -9 $pid; exit 5; }
+kill -s "$S" $pid
+wait $pid
+exit $?
+)SH";
+  test::write_text(dir_ / "stop.sh", driver);
+  for (const auto& [sig, status] : {std::pair<std::string, int>{"TERM", 143}, std::pair<std::string, int>{"HUP", 129}}) {
+    SCOPED_TRACE("SIG" + sig);
+    const std::filesystem::path d = dir_ / ("stop-" + sig);
+    std::filesystem::create_directories(d);
+    std::string out;
+    EXPECT_EQ(run_logged("xvfb-run -a sh " + q(dir_ / "stop.sh") + " " + q(view_path()) + " " + q(mesh_path_) + " " +
+                             q(d) + " " + sig,
+                         dir_ / "stop-run.log", &out),
+              status)
+        << out << test::read_text(d / "stop.log");
+    EXPECT_NE(test::read_text(d / "stop.log").find("foxi-view: stopped by SIG" + sig), std::string::npos)
+        << test::read_text(d / "stop.log");
+    std::vector<std::string> left;
+    for (const auto& e : std::filesystem::directory_iterator(d))
+      if (e.path().filename() != "stop.log") left.push_back(e.path().filename().string());
+    EXPECT_TRUE(left.empty()) << left.front();
+  }
+}
+
 }  // namespace
 }  // namespace foxi

@@ -62,8 +62,11 @@ TEST(ModelMesh, OverrideGivesACertifiedNamedMeshOfTheRightVolumes) {
   EXPECT_TRUE(named_die && named_substrate);
   EXPECT_FALSE(m.mesh.boundaries.empty()) << "boundaries named after the structure's surfaces";
   EXPECT_TRUE(m.model.parameters.size() > 0);
-  for (const Parameter& p : m.model.parameters)
-    if (p.name == "die_w") EXPECT_TRUE(p.overridden);
+  for (const Parameter& p : m.model.parameters) {
+    if (p.name == "die_w") {
+      EXPECT_TRUE(p.overridden);
+    }
+  }
   (void)progress_calls;  // TetGen may finish before the first 100 ms poll
 }
 
