@@ -72,7 +72,7 @@ cat > "$work/all_targets.src/main.cpp" <<'CPP'
 int main() {
   // Addresses of the heavy entry points make the linker resolve their dependencies (TetGen, CGAL).
   void* volatile entry[] = {reinterpret_cast<void*>(&foxi::mesh_plc), reinterpret_cast<void*>(&foxi::mesh_plc_cgal),
-                            reinterpret_cast<void*>(&foxi::solve_thermal), reinterpret_cast<void*>(&foxi::load_model),
+                            reinterpret_cast<void*>(&foxi::solve_thermal), reinterpret_cast<void*>(static_cast<foxi::Model (*)(const std::filesystem::path&, std::span<const foxi::ParameterOverride>, std::string_view)>(&foxi::load_model)),
                             reinterpret_cast<void*>(&foxi::compute_spheres),
                             reinterpret_cast<void*>(&foxi::read_field_source)};
   const double mm = foxi::evaluate_in("2 mm + 500 um", "m");       // structure
