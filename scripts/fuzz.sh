@@ -27,7 +27,7 @@ build=build-fuzz
 if [ ! -f "$build/build.ninja" ]; then
   CMAKE_CXX_COMPILER_LAUNCHER=$(command -v ccache || true) \
   cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Fuzz \
-    -DFOXI_BUILD_FUZZERS=ON -DFOXI_BUILD_TESTS=OFF -DFOXI_BUILD_BENCH=OFF -DFOXI_WITH_QT=OFF -DFOXI_WITH_X11=OFF \
+    -DFOXI_BUILD_FUZZERS=ON -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DFOXI_BUILD_TESTS=OFF -DFOXI_BUILD_BENCH=OFF -DFOXI_WITH_QT=OFF -DFOXI_WITH_X11=OFF \
     > "$build.log" 2>&1 || { cat "$build.log"; exit 1; }
 fi
 [ "${FUZZ_NO_BUILD:-0}" = "1" ] || nice -n "$nice_level" ninja -C "$build" -j2 foxi_fuzzers

@@ -2,10 +2,11 @@
 # Runs every test on a fresh machine: installs what is missing, builds (Release), runs all tests
 # with CTest, installs foxi into a temporary prefix and builds and runs examples/embed against it
 # (scripts/embed_test.sh); then builds every test with AddressSanitizer + UndefinedBehaviorSanitizer
-# and runs them again, less those labelled `slow` (whole-model meshing and signal trials: minutes each in Release,
-# too long under the sanitizers for CI's budget) and the CGAL Mesh_3 model tests (40-90 s each in
-# Debug with the sanitizers; they run in Release, and the PLC side is fuzzed), so readers on broken
-# files never crash.
+# and runs them again, less those labelled `slow` (whole-model meshing and solving of every shipped model,
+# signal trials: minutes each in Release, too long under the sanitizers for CI's budget) and the CGAL
+# Mesh_3 model tests (40-90 s each in Debug with the sanitizers; they run in Release, and the PLC side
+# is fuzzed), so readers on broken files never crash. The sanitizer build keeps line tables only (-g1: what its stack traces need) and
+# links with lld (half ld.bfd's CPU per program, and it links about a hundred): CI's budget.
 # Set FOXI_SKIP_SANITIZE=1 to skip the second.
 # Last, the fuzz targets (clang, libFuzzer, build-fuzz) run about FOXI_FUZZ_SECONDS each (default 20),
 # two at a time, from a fixed seed (FOXI_FUZZ_SEED, default 1: the same inputs on every run, so a
@@ -21,6 +22,7 @@ ctest --test-dir build --output-on-failure -j2 --timeout 900
 bash scripts/embed_test.sh build
 if [ "${FOXI_SKIP_SANITIZE:-0}" != "1" ]; then
   cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DFOXI_SANITIZE=ON -DFOXI_BUILD_BENCH=OFF \
+    -DCMAKE_CXX_FLAGS_DEBUG=-g1 -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld \
     > build-asan.log 2>&1 || { cat build-asan.log; exit 1; }
   ninja -C build-asan
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$PWD/tests/lsan.supp \
