@@ -128,5 +128,22 @@ TEST(Camera, DegenerateCamerasAreRejected) {
   EXPECT_THROW(fit_camera(lo, hi, zero, up), std::invalid_argument);
 }
 
+// Looking straight down (eye above the target) with no --up given: the default +z would be parallel
+// to the line of sight, so another axis is taken and the point below the eye projects to the centre;
+// an up the user gave is kept and refused by the projector.
+TEST(Camera, StraightDownWithoutAnUpIsNotDegenerate) {
+  const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, eye[3] = {0.5, 0.5, 3}, at[3] = {0.5, 0.5, 0.2};
+  const Camera c = camera_from_options(lo, hi, 1.0, eye, at, nullptr, 30, nullptr);
+  const Projector p(c, 100, 100);
+  double s[2];
+  const double below[3] = {0.5, 0.5, 0.5};
+  ASSERT_TRUE(p.project(below, s));
+  EXPECT_NEAR(s[0], 50, 1e-9);
+  EXPECT_NEAR(s[1], 50, 1e-9);
+  const double up[3] = {0, 0, 1};
+  EXPECT_THROW(Projector(camera_from_options(lo, hi, 1.0, eye, at, up, 30, nullptr), 100, 100),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace foxi

@@ -37,6 +37,15 @@ bool basis(const Camera& c, double right[3], double up[3], double fwd[3]) {
   return normalize(up);
 }
 
+// The coordinate axis least aligned with d: the up of a view along the default up. Ties go to y,
+// then z, then x, so that a view straight down (along z) has +y up: the plan view of a drawing.
+int least_aligned_axis(const double d[3]) {
+  int axis = 1;
+  for (int k : {2, 0})
+    if (std::abs(d[k]) < std::abs(d[axis])) axis = k;
+  return axis;
+}
+
 // Rotates v about the unit axis by angle (radians), Rodrigues' formula.
 void rotate(double v[3], const double axis[3], double angle) {
   double c = std::cos(angle), s = std::sin(angle), kv[3], d = dot(axis, v);
@@ -104,11 +113,8 @@ Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], c
   double u[3] = {up[0], up[1], up[2]}, r[3];
   cross(d, u, r);
   if (!(norm(r) > 1e-6 * norm(u))) {
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (std::abs(d[k]) < std::abs(d[axis])) axis = k;
     u[0] = u[1] = u[2] = 0;
-    u[axis] = 1;
+    u[least_aligned_axis(d)] = 1;
   }
   for (int k = 0; k < 3; ++k) {
     cam.at[k] = centre[k];
@@ -270,6 +276,15 @@ Camera camera_from_options(const double lo[3], const double hi[3], double aspect
     for (int k = 0; k < 3; ++k) camera.eye[k] = camera.at[k] + (fitted_eye[k] - centre[k]);
   }
   for (int k = 0; k < 3; ++k) camera.up[k] = up[k];
+  // A default up (+z) along the given eye-to-target line (looking straight down or up) would be a
+  // degenerate camera: take the axis least aligned with the line instead, as fit_camera does. An up
+  // the user gave is kept, and Projector refuses it if it is parallel.
+  double line[3] = {camera.at[0] - camera.eye[0], camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2]}, r[3];
+  cross(line, camera.up, r);
+  if (up_given == nullptr && norm(line) > 0 && !(norm(r) > 1e-6 * norm(line))) {
+    camera.up[0] = camera.up[1] = camera.up[2] = 0;
+    camera.up[least_aligned_axis(line)] = 1;
+  }
   return camera;
 }
 
