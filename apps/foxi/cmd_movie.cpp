@@ -17,12 +17,15 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "field_options.hpp"
+#include "iso_options.hpp"
+#include "movie_sweep.hpp"
 #include "mesh_input.hpp"
 #include "foxi/model/cleanup.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/animation.hpp"
 #include "foxi/viz/movie.hpp"
+#include "foxi/viz/picture.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "render_options.hpp"
@@ -36,15 +39,29 @@ const std::string kMovieUsage = std::string(
     "foxi movie MESH [camera and picture options] [--mode backforth|rotate] [--frames N]\n"
     "                [--cycles C] [--from P%] [--to P%] [--turn deg] [--fps F]\n"
     "                [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
-    "                [--legend on|off]]\n"
-    "                -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png\n"
+    "                [--legend on|off] [--threshold a,b] [--clip px,py,pz,nx,ny,nz]\n"
+    "                [--sweep iso:a,b [--iso-only] | --sweep threshold:a,b | --sweep steps [--iso v,...]]]\n"
+    "                [--deform NAME:SCALE] -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png\n"
     "  A movie of the painter. backforth (the default): the tets drawn back to front in the\n"
     "  visibility order from --from to --to percent of the order (default 0% to 100%), then\n"
     "  undrawn front to back (the seed paper's undraw: back faces repainted as the neighbour's\n"
     "  front face, or restored from saved pixels), N frames per cycle, looping seamlessly.\n"
     "  rotate: the camera turned --turn degrees (default 360) about its up axis through --at over\n"
-    "  N frames, each frame the first --to percent of its own order.\n") +
-    kPictureOptionsHelp + kFieldOptionsHelp +
+    "  N frames, each frame the first --to percent of its own order.\n"
+    "  --sweep (in place of --mode) a field movie, each frame the picture foxi render draws with the\n"
+    "  same options and the frame's value, in one colour range (--range, or the field's own range):\n"
+    "    iso:a,b        the isosurface at v_k = a + (b - a) k / (N - 1), k = 0..N-1 (display units;\n"
+    "                   N = --frames, default 48), as foxi render --iso v_k [--iso-only] draws it: only\n"
+    "                   the tets v_k crosses (or reaches, for the solid) are ordered and drawn, found\n"
+    "                   by an interval tree built once, so a frame costs what its isosurface holds\n"
+    "    threshold:a,b  a growing threshold: frame k the tets with values in [a, v_k]\n"
+    "                   (foxi render --threshold a,v_k)\n"
+    "    steps          one frame per step of the field (a transient's .pvd, a multi-step .vtu or\n"
+    "                   .msh), as foxi render --step k; the range is the union over all steps unless\n"
+    "                   --range is given, so colours compare across frames; --iso draws each step's\n"
+    "                   isosurfaces\n"
+    "  --threshold and --clip select tets in every movie; --iso and --slice only with --sweep.\n") +
+    kPictureOptionsHelp + kFieldOptionsHelp + kIsoOptionsHelp + kDeformOptionHelp +
     "  (--size defaults to 640x480; with --field the colour range is the same in every frame)\n"
     "  --frames N      frames per cycle (default 48), --cycles C cycles (default 1)\n"
     "  --fps F         frames per second of the animated file (default 12)\n"
@@ -117,18 +134,30 @@ int cmd_movie(Args args) {
     std::puts(kMovieUsage.c_str());
     return kExitOk;
   }
-  const std::string mode = args.option("--mode", "backforth");
+  const Sweep sweep = parse_sweep(args.option("--sweep"));
+  const bool sweeping = sweep.kind != Sweep::Kind::none;
+  if (sweeping && args.has_option("--mode")) throw UsageError("--sweep is a kind of movie in place of --mode: give one");
+  // --iso-only belongs to the swept isovalue here, which take_iso_options does not see.
+  const bool sweep_iso_only = sweep.kind == Sweep::Kind::iso && args.flag("--iso-only");
+  const std::string mode = sweeping ? std::string("sweep") : args.option("--mode", "backforth");
   const std::string frames_s = args.option("--frames"), cycles_s = args.option("--cycles");
   const std::string from_s = args.option("--from"), to_s = args.option("--to"), turn_s = args.option("--turn");
   const std::string fps_s = args.option("--fps", "12");
   std::string out = args.option("-o");
   if (out.empty()) out = args.option("--output");
   PictureOptions options = take_picture_options(args, "640x480");
-  const FieldOptions field_options = take_field_options(args);
+  FieldOptions field_options = take_field_options(args);
   if (field_options.markers) throw UsageError("--markers marks a picture: foxi render takes it, foxi movie does not");
+  const IsoOptions iso_options = take_iso_options(args, field_options);
+  const std::optional<DeformOption> deform = take_deform_option(args);
   const std::string path = args.positional(1, 1, kMovieUsage)[0];
   if (out.empty()) throw UsageError("give the output with -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png");
-  if (mode != "backforth" && mode != "rotate") throw UsageError("--mode takes backforth or rotate");
+  if (mode != "backforth" && mode != "rotate" && mode != "sweep") throw UsageError("--mode takes backforth or rotate");
+  check_sweep_options(sweep, field_options, iso_options);
+  if (sweeping && !(cycles_s.empty() && from_s.empty() && to_s.empty() && turn_s.empty()))
+    throw UsageError("--cycles, --from, --to and --turn belong to --mode backforth|rotate, not to --sweep");
+  if (sweep.kind == Sweep::Kind::steps && !frames_s.empty())
+    throw UsageError("--sweep steps draws one frame per step of the field: leave out --frames");
   MovieParams mp;
   mp.rotate = mode == "rotate";
   mp.frames = int(whole(frames_s, "--frames", 48, 2, 100000));
@@ -163,28 +192,47 @@ int cmd_movie(Args args) {
   }
   if (kind != Kind::frames) check_output_path(out);  // before the work (frames: once their folder is made)
 
-  const Mesh mesh = read_usable_mesh(path, "movie");
+  Mesh read = read_usable_mesh(path, "movie");
+  const double moved = deform ? apply_deform(read, *deform, path, "movie") : 0;
+  const Mesh& mesh = read;
   Picture picture = resolve_picture(options, mesh);
-  // Colour by a field: one paint (one range) for the whole movie; the legend drawn once into a frame
-  // whose left part each movie frame fills.
+  // Colour by a field: one paint (one range) for the whole movie; the legend drawn beside each frame
+  // (a sweep's legend marks the frame's isovalue, so it is drawn per frame).
   FieldPicture field;
-  Framebuffer framed;
+  std::unique_ptr<TextRenderer> text;
+  int panel = 0;
+  std::size_t step_count = 1;
   if (!field_options.spec.empty()) {
+    if (sweep.kind == Sweep::Kind::steps) {
+      const SweepRange r = fixed_step_range(field_options, mesh, picture.subset, path);
+      step_count = r.steps;
+      field_options.has_si_range = true;
+      field_options.si_range[0] = r.lo;
+      field_options.si_range[1] = r.hi;
+      field_options.step = 0;
+    }
     field = resolve_field(field_options, mesh, picture.subset, path);
+    if (sweep.kind == Sweep::Kind::steps && step_count < 2)
+      throw UsageError(path + ": field '" + field.choice.field->name + "' has one step: --sweep steps needs several");
     options.params.field = field.paint;
     if (field_options.legend) {
-      const TextRenderer text(find_font_file());
-      const int panel = legend_panel(text, field, options.width, options.height);
-      framed = with_legend(Framebuffer(options.width - panel, options.height), text, field, panel);
+      text = std::make_unique<TextRenderer>(find_font_file());
+      panel = legend_panel(*text, field, options.width, options.height);
       options.width -= panel;
       picture = resolve_picture(options, mesh);
     }
+  }
+  // --threshold and --clip narrow the tets of every kind of movie.
+  if (!sweeping && iso_options.any()) {
+    IsoPicture sel = resolve_iso(iso_options, mesh, field, picture.subset);
+    if (sel.empty) throw UsageError("--threshold and --clip select no tets of " + path);
+    picture.subset = std::move(sel.subset);
   }
   mp.render = options.params;
   const SphereTable table = compute_spheres(mesh);
 
   AnimationParams ap;
-  ap.width = framed.width > 0 ? framed.width : options.width;
+  ap.width = options.width + panel;
   ap.height = options.height;
   ap.fps = fps;
   std::unique_ptr<AnimationWriter> writer;
@@ -233,30 +281,34 @@ int cmd_movie(Args args) {
   } forget_frames{frame_dir, true}, forget_created{created, true};
 
   std::size_t index = 0;
+  // One frame out: the scene, beside the legend of `legend_of` when there is one.
+  auto emit = [&](const Framebuffer& scene, const FieldPicture& legend_of) {
+    if (writer) {
+      writer->add(panel > 0 ? with_legend(scene, *text, legend_of, panel) : scene);
+    } else {
+      frames.emplace_back(frame_name(pattern, index), false);
+      write_png(frames.back(), panel > 0 ? with_legend(scene, *text, legend_of, panel) : scene);
+    }
+    ++index;
+  };
   const auto t0 = std::chrono::steady_clock::now();
   MovieStats stats;
-  try {
-    stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
-                                      [&](const Framebuffer& scene) {
-                                        const Framebuffer* fb = &scene;
-                                        if (framed.width > 0) {  // the scene beside the legend
-                                          for (int y = 0; y < scene.height; ++y)
-                                            std::copy_n(scene.rgba.begin() + std::ptrdiff_t(scene.index(0, y)),
-                                                        scene.width,
-                                                        framed.rgba.begin() + std::ptrdiff_t(framed.index(0, y)));
-                                          fb = &framed;
-                                        }
-                                        if (writer) {
-                                          writer->add(*fb);
-                                        } else {
-                                          frames.emplace_back(frame_name(pattern, index), false);
-                                          write_png(frames.back(), *fb);
-                                        }
-                                        ++index;
-                                      });
-  } catch (const UncertifiedMeshError&) {  // thrown before the first frame: nothing written
-    throw InputError(path + " fails the Delaunay certificate: it has no visibility order to make a "
-                            "movie with (foxi render --zbuffer draws it)");
+  SweepStats sweep_stats;
+  if (sweeping) {
+    SweepInputs in{mesh, table, picture.camera, options.width, options.height, options.params, picture.subset,
+                   field_options, field, iso_options, sweep, sweep_iso_only, mp.frames, step_count, path};
+    sweep_stats = run_sweep(in, emit);
+    stats.frames = sweep_stats.frames;
+  } else {
+    try {
+      stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
+                         [&](const Framebuffer& scene) { emit(scene, field); });
+    } catch (const UncertifiedMeshError&) {  // thrown before the first frame: nothing written
+      throw InputError(path + (deform ? " deformed by " + deform->name : std::string()) +
+                       " fails the Delaunay certificate: it has no visibility order to make a back-and-forth or "
+                       "rotating movie with (foxi render --zbuffer draws it; a --sweep draws each frame with the "
+                       "depth buffer)");
+    }
   }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (writer) writer->finish();
@@ -273,17 +325,24 @@ int cmd_movie(Args args) {
   }
   std::printf("mesh        %s: %zu tets, %zu shown\n", path.c_str(), mesh.tet_count(),
               picture.subset.empty() ? mesh.tet_count() : picture.subset.size());
+  if (deform) std::printf("deformed    by %s x %g: nodes moved up to %g\n", deform->name.c_str(), deform->scale, moved);
   std::printf("movie       %s, %zu frames of %dx%d, %.1f ms per frame (frames written included)\n", mode.c_str(),
               stats.frames, ap.width, options.height, ms / double(std::max<std::size_t>(1, stats.frames)));
-  std::printf("painter     %zu tets drawn, %zu undrawn, undraw memory at most %.1f MB\n", stats.tets_drawn,
-              stats.tets_undrawn, double(stats.max_undo_bytes) / 1e6);
+  if (sweeping) {
+    print_sweep(sweep_stats, sweep, field);
+  } else {
+    std::printf("painter     %zu tets drawn, %zu undrawn, undraw memory at most %.1f MB\n", stats.tets_drawn,
+                stats.tets_undrawn, double(stats.max_undo_bytes) / 1e6);
+  }
   if (field.paint) {
     const DisplayUnit& u = field.legend.unit;
-    std::printf("field       %s, step %zu, %s, %s%s, colours %.6g to %.6g%s%s in every frame%s\n",
-                field.legend.title.c_str(), field.step, field_options.graded ? "graded facets" : "flat per tet",
-                color_map_name(field.legend.scale.map), field.legend.scale.log ? " log" : "",
-                u.to_display(field.legend.scale.lo), u.to_display(field.legend.scale.hi), u.symbol.empty() ? "" : " ",
-                u.symbol.c_str(), framed.width > 0 ? ", legend at the right" : "");
+    std::printf("field       %s, %s, %s, %s%s, colours %.6g to %.6g%s%s in every frame%s\n", field.legend.title.c_str(),
+                sweep.kind == Sweep::Kind::steps ? ("steps 0 to " + std::to_string(step_count - 1)).c_str()
+                                                 : ("step " + std::to_string(field.step)).c_str(),
+                field_options.graded ? "graded facets" : "flat per tet", color_map_name(field.legend.scale.map),
+                field.legend.scale.log ? " log" : "", u.to_display(field.legend.scale.lo),
+                u.to_display(field.legend.scale.hi), u.symbol.empty() ? "" : " ", u.symbol.c_str(),
+                panel > 0 ? ", legend at the right" : "");
   }
   std::printf("wrote       %s\n", out.c_str());
   return kExitOk;

@@ -47,34 +47,10 @@ const std::string kRenderUsage = std::string(
     "                  --at across the view. With --stop, whichever stops first\n"
     "  --zbuffer       draw with a depth buffer instead (the oracle; order irrelevant)\n"
     "  Meshes that fail the Delaunay certificate have no guaranteed order: their picture is drawn\n"
-    "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.\n"
-  "  --deform NAME:SCALE  the deformed shape: every node moved by SCALE times the 3-component node\n"
-  "                  field NAME (a displacement, its last step), before the camera is fitted. A\n"
-  "                  deformed mesh is certified again: in general it is not Delaunay and is drawn\n"
-  "                  in MPVO order with the depth buffer (the 'deformed' line says which)\n"
+    "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.\n" +
+    kDeformOptionHelp +
   "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused\n"
   "  with exit status 3, and no picture is written.";
-
-struct DeformOption {
-  std::string name;
-  double scale = 0;
-};
-// --deform NAME:SCALE (the last colon splits, so a field name may hold one).
-std::optional<DeformOption> take_deform_option(Args& args) {
-  const std::string text = args.option("--deform");
-  if (text.empty()) return std::nullopt;
-  const std::size_t colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0)
-    throw UsageError("--deform takes NAME:SCALE (a displacement field and a factor), not '" + text + "'");
-  DeformOption d;
-  d.name = text.substr(0, colon);
-  const std::string scale = text.substr(colon + 1);
-  char* end = nullptr;
-  d.scale = std::strtod(scale.c_str(), &end);
-  if (scale.empty() || *end != 0 || !std::isfinite(d.scale))
-    throw UsageError("--deform NAME:SCALE: the scale must be a finite number, not '" + scale + "'");
-  return d;
-}
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -118,16 +94,7 @@ int cmd_render(Args args) {
   RenderParams params = options.params;
 
   Mesh read = read_usable_mesh(path, "render");
-  double moved = 0;
-  if (deform) {
-    try {
-      moved = deform_by_field(read, deform->name, deform->scale);
-    } catch (const FieldSelectError& e) {
-      throw UsageError(path + ": --deform: " + e.what());
-    }
-    // Large factors fold tets over: re-oriented (a note says so) or, flat, refused.
-    require_usable(read, path + " deformed by " + deform->name + " x " + std::to_string(deform->scale), "render");
-  }
+  const double moved = deform ? apply_deform(read, *deform, path, "render") : 0;
   const Mesh& mesh = read;
   Picture picture = resolve_picture(options, mesh);
   // Colour by a field: the legend's panel is taken from the picture's width, the camera fitted to the rest.
@@ -151,7 +118,7 @@ int cmd_render(Args args) {
     field.legend.marks = iso.iso_si;
   }
   const std::vector<std::uint32_t>& subset = iso_options.any() ? iso.subset : picture.subset;
-  const IsoDrawing iso_drawing{iso.corner, iso.attr, iso.params};
+  const IsoDrawing iso_drawing = iso.drawing();
   const Camera& camera = picture.camera;
 
   auto t0 = std::chrono::steady_clock::now();

@@ -140,9 +140,9 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
   ColorScale& s = f.legend.scale;
   s.map = o.map;
   s.log = o.log;
-  if (o.has_range) {
-    s.lo = f.legend.unit.to_si(o.range[0]);
-    s.hi = f.legend.unit.to_si(o.range[1]);
+  if (o.has_range || o.has_si_range) {
+    s.lo = o.has_si_range ? o.si_range[0] : f.legend.unit.to_si(o.range[0]);
+    s.hi = o.has_si_range ? o.si_range[1] : f.legend.unit.to_si(o.range[1]);
     if (s.lo > s.hi) std::swap(s.lo, s.hi);
     if (o.log && !(s.lo > 0))
       throw UsageError("--log needs a range above 0 in SI (" + field.unit + "), not " + std::to_string(s.lo));

@@ -29,6 +29,10 @@ struct FieldOptions {
   bool markers = false;  // --markers: mark the drawn maximum and minimum, with their values
   std::string units;     // --units; empty: the field's usual display unit (°C for K, MPa for Pa, ...)
   long step = -1;        // --step; -1: the last
+  // A colour range in SI that replaces --range and the automatic one (a movie's range, fixed over
+  // its time steps, is found in SI: converting it to a display unit and back would not round-trip).
+  bool has_si_range = false;
+  double si_range[2] = {0, 0};
 };
 
 // Takes the options out of args; UsageError for malformed ones.

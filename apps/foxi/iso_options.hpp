@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -36,17 +37,31 @@ struct IsoPicture {
   std::vector<std::uint32_t> subset;  // the tets to order (empty and `empty` set: none)
   bool empty = false;                 // the subset is empty (an empty vector alone means "all tets")
   bool polygons = false;              // draw with an IsoPainter (iso or slice), not the tet painter alone
-  std::vector<double> corner, attr;   // the painter's level values and colouring attribute, 4 per tet
+  // The painter's level values and colouring attribute, 4 per tet (shared with an IsoCache: a sweep's
+  // frames do not copy them).
+  std::shared_ptr<const std::vector<double>> corner, attr;
   IsoParams params;
   std::vector<double> iso_si;         // the isovalues, SI (the legend's marks)
   std::size_t crossing = 0;           // tets the isovalues cross (or the slice's plane cuts)
-  double query_ms = 0;                // building the interval tree and answering the query
-  double build_ms = 0;
+  double query_ms = 0;                // answering the query
+  double build_ms = 0;                // building the interval tree (0 when an IsoCache had it)
+  // draw_picture's iso input, lending corner and attr (the IsoPicture must outlive it).
+  IsoDrawing drawing() const;
+};
+
+// What resolve_iso derives from the field alone (corner and centroid values, the interval tree),
+// kept between calls for the same field, step and mesh: a sweep of isovalues or threshold ranges
+// then costs each frame the query, O(log n + answer), not a pass over the mesh.
+struct IsoCache {
+  std::shared_ptr<const std::vector<double>> corner;  // tet_corner_values
+  std::vector<double> centroid;                       // tet_centroid_values
+  std::unique_ptr<TetIntervals> tree;
 };
 
 // The tets of `base` (all when empty) that the options select, and the painter's inputs. The field's
 // scale colours the polygons; isovalues and the threshold are converted from the display unit.
+// `cache`: null, or kept by the caller across calls with the same field choice and step.
 IsoPicture resolve_iso(const IsoOptions& options, const Mesh& mesh, const FieldPicture& field,
-                       std::span<const std::uint32_t> base);
+                       std::span<const std::uint32_t> base, IsoCache* cache = nullptr);
 
 }  // namespace foxi::cli

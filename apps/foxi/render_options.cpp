@@ -1,5 +1,11 @@
 #include "render_options.hpp"
 
+#include <cmath>
+#include <cstdlib>
+
+#include "foxi/viz/field_paint.hpp"
+#include "mesh_input.hpp"
+
 namespace foxi::cli {
 
 const char* const kPictureOptionsHelp =
@@ -49,6 +55,40 @@ Picture resolve_picture(const PictureOptions& o, const Mesh& mesh) {
   const double aspect = double(o.width) / o.height;
   p.camera = camera_for(o.camera, lo, hi, aspect);
   return p;
+}
+
+const char* const kDeformOptionHelp =
+    "  --deform NAME:SCALE  the deformed shape: every node moved by SCALE times the 3-component node\n"
+    "                  field NAME (a displacement, its last step), before the camera is fitted. A\n"
+    "                  deformed mesh is certified again: in general it is not Delaunay and is drawn\n"
+    "                  in MPVO order with the depth buffer (the 'deformed' line says which)\n";
+
+std::optional<DeformOption> take_deform_option(Args& args) {
+  const std::string text = args.option("--deform");
+  if (text.empty()) return std::nullopt;
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0)
+    throw UsageError("--deform takes NAME:SCALE (a displacement field and a factor), not '" + text + "'");
+  DeformOption d;
+  d.name = text.substr(0, colon);
+  const std::string scale = text.substr(colon + 1);
+  char* end = nullptr;
+  d.scale = std::strtod(scale.c_str(), &end);
+  if (scale.empty() || *end != 0 || !std::isfinite(d.scale))
+    throw UsageError("--deform NAME:SCALE: the scale must be a finite number, not '" + scale + "'");
+  return d;
+}
+
+double apply_deform(Mesh& mesh, const DeformOption& deform, const std::string& path, const char* command) {
+  double moved = 0;
+  try {
+    moved = deform_by_field(mesh, deform.name, deform.scale);
+  } catch (const FieldSelectError& e) {
+    throw UsageError(path + ": --deform: " + e.what());
+  }
+  // Large factors fold tets over: re-oriented (a note says so) or, flat, refused.
+  require_usable(mesh, path + " deformed by " + deform.name + " x " + std::to_string(deform.scale), command);
+  return moved;
 }
 
 }  // namespace foxi::cli

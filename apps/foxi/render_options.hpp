@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,5 +39,18 @@ struct Picture {
 
 // The selected tets (UsageError if --regions selects none) and the camera fitted to them.
 Picture resolve_picture(const PictureOptions& options, const Mesh& mesh);
+
+// --deform NAME:SCALE, the deformed shape (foxi render and foxi movie).
+extern const char* const kDeformOptionHelp;
+struct DeformOption {
+  std::string name;
+  double scale = 0;
+};
+// Takes --deform out of args (the last colon splits, so a field name may hold one); UsageError if malformed.
+std::optional<DeformOption> take_deform_option(Args& args);
+// Moves mesh's nodes by the displacement (UsageError naming `path` for a field that is not one) and
+// checks the moved mesh as `command` does a read one (require_usable: folded tets re-oriented, flat
+// ones refused); returns the largest node movement.
+double apply_deform(Mesh& mesh, const DeformOption& deform, const std::string& path, const char* command);
 
 }  // namespace foxi::cli
