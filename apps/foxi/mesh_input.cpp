@@ -1,8 +1,10 @@
 #include "mesh_input.hpp"
 
 #include <cstdio>
+#include <filesystem>
 
 #include "cli.hpp"
+#include "foxi/fields/field_source.hpp"
 #include "foxi/model/mesh_io.hpp"
 
 namespace foxi::cli {
@@ -22,7 +24,9 @@ ValidationReport require_usable(Mesh& mesh, const std::string& name, const char*
 }
 
 Mesh read_usable_mesh(const std::string& path, const char* command) {
-  Mesh mesh = read_mesh(path);
+  // A ParaView collection (foxi solve --physics transient's output) is one mesh whose fields have a
+  // step per data set: read through the field importer, which checks that the sets agree.
+  Mesh mesh = std::filesystem::path(path).extension() == ".pvd" ? read_field_source(path).mesh : read_mesh(path);
   require_usable(mesh, path, command);
   return mesh;
 }

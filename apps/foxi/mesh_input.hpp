@@ -14,7 +14,7 @@ namespace foxi::cli {
 // flat or duplicate tets, coincident nodes). Returns the report (as found, before the repair).
 ValidationReport require_usable(Mesh& mesh, const std::string& name, const char* command);
 
-// read_mesh(path), then require_usable.
+// read_mesh(path) (a .pvd collection: the field importer's mesh, every data set a step), then require_usable.
 Mesh read_usable_mesh(const std::string& path, const char* command);
 
 }  // namespace foxi::cli
