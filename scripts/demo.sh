@@ -40,12 +40,14 @@ echo
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.msh"
 "$foxi" info "$out/die_on_substrate.msh" --json > "$out/die_on_substrate.json"
 echo
-# Another example end to end in one command (the flip chip: mesh, certificate, heat, pictures).
+# Another example end to end in one command (the flip chip: mesh, certificate, heat, pictures, then
+# an isotherm, the isotherm swept as a movie, and von Mises stress on the deformed shape).
 "$foxi" demo -o "$out"
 "$foxi" model show models/power_module.toml --view exploded -o "$out/power_module_parts.png" --set solder_h=0.5mm \
   --set cu_h=0.5mm --set ceramic_h=0.6mm
 echo
-echo "demo: wrote $out/flip_chip.png, $out/flip_chip_parts.png and $out/flip_chip_temperature.png (foxi demo),"
+echo "demo: wrote $out/flip_chip.png, $out/flip_chip_parts.png, $out/flip_chip_temperature.png,"
+echo "      $out/flip_chip_isotherm.png, $out/flip_chip_isotherms.gif and $out/flip_chip_von_mises.png (foxi demo),"
 echo "      $out/power_module_parts.png, $out/die_on_substrate_temperature.png (the solved temperature inside),"
 echo "demo: wrote $out/die_on_substrate.png (the mesh inside), $out/die_on_substrate_thermal.vtu (temperature and"
 echo "      heat flux, for ParaView), $out/die_on_substrate.vtu and .msh (the mesh), $out/die_on_substrate.json"

@@ -1,10 +1,14 @@
 // foxi demo [MODEL.toml]: one example end to end -- model, mesh, Delaunay certificate, steady heat,
 // a picture of the inside -- with what each step found.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "cli.hpp"
@@ -12,10 +16,13 @@
 #include "mesh_input.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/delaunay.hpp"
+#include "foxi/model/io_error.hpp"
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/model/physics.hpp"
 #include "foxi/model/quality.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/solver/model_problem.hpp"
+#include "foxi/viz/camera.hpp"
 #include "model_picture.hpp"
 #include "model_run.hpp"
 
@@ -31,7 +38,12 @@ const char* kDemoUsage =
     "  (default out/demo): MODEL.vtu (mesh, temperature, heat flux; for ParaView), MODEL.png (the far\n"
     "  60 % of the visibility order drawn by the painter, parts in their materials' colours),\n"
     "  MODEL_parts.png (the parts, exploded) and MODEL_temperature.png (the same far 60 % coloured by\n"
-    "  the solved temperature, graded facets, with a colour-bar legend in degrees Celsius).";
+    "  the solved temperature, graded facets, with a colour-bar legend in degrees Celsius). Then, through\n"
+    "  the commands themselves: MODEL_isotherm.png (foxi render --iso at the middle of the range: the\n"
+    "  solid hotter than it, cut at the isotherm), MODEL_isotherms.gif (foxi movie --sweep iso: the\n"
+    "  isotherm swept from the coolest to the hottest), MODEL_stress.vtu (foxi solve --physics\n"
+    "  thermoelastic) and MODEL_von_mises.png (von Mises stress on the deformed shape, the displacement\n"
+    "  scaled so that it reaches 2 % of the model's size).";
 
 // The folder of the example models: $FOXI_MODELS_DIR if set, else FOXI_MODELS_RELATIVE_DIR next to
 // this program (share/foxi/models of an installed foxi; the build tree has a link to models/ there),
@@ -41,6 +53,28 @@ std::filesystem::path models_dir() {
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   return (ec ? std::filesystem::path(".") : exe.parent_path()) / FOXI_MODELS_RELATIVE_DIR;
+}
+
+// A 1-2-5 factor that moves the nodes of `mesh` by `field` (a displacement) by at most `fraction` of
+// the diagonal of its bounding box (1 when the field is zero).
+double deform_scale_for(const Mesh& mesh, const std::string& field, double fraction) {
+  const Field* f = nullptr;
+  for (const Field& g : mesh.fields)
+    if (g.name == field && g.location == FieldLocation::node && g.components == 3) f = &g;
+  if (f == nullptr) throw std::runtime_error("the thermoelastic result has no 3-component node field '" + field + "'");
+  double lo[3], hi[3];
+  mesh_bounds(mesh, lo, hi);
+  const double diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  const std::span<const double> u = f->step(f->step_count() - 1, mesh.node_count());
+  double umax = 0;
+  for (std::size_t n = 0; n < mesh.node_count(); ++n)
+    umax = std::max(umax, std::hypot(u[3 * n], u[3 * n + 1], u[3 * n + 2]));
+  if (!(umax > 0) || !std::isfinite(umax)) return 1;
+  const double want = fraction * diag / umax;
+  const double decade = std::pow(10.0, std::floor(std::log10(want)));
+  for (double m : {5.0, 2.0, 1.0})
+    if (m * decade <= want) return m * decade;
+  return decade;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -121,8 +155,62 @@ int cmd_demo(Args args) {
   std::printf("6. temperature picture: the far 60 %% coloured by temperature (graded facets, viridis), %.2f to %.2f %s, "
               "legend at the right, %.2f s\n",
               tp.field_lo, tp.field_hi, tp.field_unit.c_str(), seconds_since(t));
-  std::printf("wrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature)\n", vtu.c_str(), png.c_str(),
-              parts.c_str(), temp_png.c_str());
+
+  // The rest through the commands themselves (their reports printed as they are), so that the demo
+  // shows what a user's command line gives: an isotherm, its sweep as a movie, the stress.
+  // 7. The isotherm half way up the temperature range, as the cut face of the solid hotter than it.
+  const double iso = std::round(5 * (tp.field_lo + tp.field_hi)) / 10;  // to 0.1 degree
+  char iso_s[32];
+  std::snprintf(iso_s, sizeof iso_s, "%g", iso);
+  const std::string iso_png = (dir / (stem + "_isotherm.png")).string();
+  const std::string gif = (dir / (stem + "_isotherms.gif")).string();
+  std::printf("7. isotherm at %s %s: foxi render %s --field temperature --graded --iso %s -o %s\n", iso_s,
+              tp.field_unit.c_str(), vtu.c_str(), iso_s, iso_png.c_str());
+  std::fflush(stdout);
+  int status = cmd_render(Args({vtu, "--field", "temperature", "--graded", "--iso", iso_s, "-o", iso_png}));
+  if (status != kExitOk) return status;
+  char sweep[96];
+  std::snprintf(sweep, sizeof sweep, "iso:%.6g,%.6g", tp.field_lo, tp.field_hi);
+  std::printf("\n8. the isotherm swept from the coolest to the hottest: foxi movie %s --field temperature --graded "
+              "--sweep %s --frames 24 -o %s\n",
+              vtu.c_str(), sweep, gif.c_str());
+  std::fflush(stdout);
+  status = cmd_movie(Args({vtu, "--field", "temperature", "--graded", "--sweep", sweep, "--frames", "24", "-o", gif}));
+  if (status != kExitOk) return status;
+  // 9. Thermal stress (the same model, thermoelastic), von Mises on the shape deformed by a factor that
+  // moves the nodes by at most 2 % of the model's size: the warpage visible, the tets not folded.
+  // A model without mechanical supports or properties has no stress to show: said, and the rest skipped.
+  try {
+    check_physics(m.model, Physics::thermal_stress);
+  } catch (const IoError& e) {
+    std::printf("\n9. thermal stress: skipped, the model is not ready for it: %s\n", e.what());
+    std::printf("\nwrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature), %s (isotherm), %s "
+                "(isotherm movie)\n",
+                vtu.c_str(), png.c_str(), parts.c_str(), temp_png.c_str(), iso_png.c_str(), gif.c_str());
+    return kExitOk;
+  }
+  const std::string te_vtu = (dir / (stem + "_stress.vtu")).string();
+  const std::string vm_png = (dir / (stem + "_von_mises.png")).string();
+  std::vector<std::string> solve = {file, "--physics", "thermoelastic", "-o", te_vtu};
+  for (const std::string& set : sets) solve.insert(solve.end(), {"--set", set});
+  std::printf("\n9. thermal stress: foxi solve %s --physics thermoelastic -o %s\n", file.c_str(), te_vtu.c_str());
+  std::fflush(stdout);
+  status = cmd_solve(Args(solve));
+  if (status != kExitOk) return status;
+  const Mesh te = read_mesh(te_vtu);
+  const double scale = deform_scale_for(te, "displacement", 0.02);
+  char scale_s[32];
+  std::snprintf(scale_s, sizeof scale_s, "displacement:%g", scale);
+  std::printf("\n10. von Mises on the deformed shape: foxi render %s --field von_mises --graded --deform %s --stop 60%% "
+              "-o %s\n",
+              te_vtu.c_str(), scale_s, vm_png.c_str());
+  std::fflush(stdout);
+  status = cmd_render(Args({te_vtu, "--field", "von_mises", "--graded", "--deform", scale_s, "--stop", "60%", "-o", vm_png}));
+  if (status != kExitOk) return status;
+  std::printf("\nwrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature), %s (isotherm), %s "
+              "(isotherm movie), %s (stress), %s (von Mises, deformed)\n",
+              vtu.c_str(), png.c_str(), parts.c_str(), temp_png.c_str(), iso_png.c_str(), gif.c_str(), te_vtu.c_str(),
+              vm_png.c_str());
   return kExitOk;
 }
 

@@ -176,7 +176,42 @@ TEST(ModelCli, DemoRunsAModelEndToEnd) {
   const std::string out = test::read_text(dir / "out.txt");
   for (const char* s : {"1. model", "2. mesh", "3. certificate", "4. steady heat", "5. picture"})
     EXPECT_NE(out.find(s), std::string::npos) << s << " missing in:\n" << out;
-  for (const char* f : {"trench.vtu", "trench.png", "trench_parts.png"})
+  for (const char* f : {"trench.vtu", "trench.png", "trench_parts.png", "trench_isotherm.png", "trench_isotherms.gif"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "d" / f)) << f;
+  // The trench has no mechanical supports: the stress steps are skipped with the reason, not failed.
+  EXPECT_NE(out.find("9. thermal stress: skipped, the model is not ready for it"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "d" / "trench_von_mises.png"));
+}
+
+// The flip chip has supports: the demo shows the isotherm at the middle of the temperature range (its
+// render's isovalue is that middle), the sweep as a movie, and von Mises on the deformed shape, the
+// displacement scaled (1-2-5) so that the nodes move by 0.8 % to 2 % of the model's diagonal.
+TEST(ModelCli, DemoShowsIsothermAndStressOnTheDeformedShape) {
+  TempDir dir;
+  ASSERT_EQ(foxi_cli("demo '" + kModels + "flip_chip.toml' -o '" + (dir / "d").string() + "'", dir / "out.txt"), 0)
+      << test::read_text(dir / "out.txt");
+  const std::string out = test::read_text(dir / "out.txt");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("\\(graded facets, viridis\\), ([0-9.]+) to ([0-9.]+) °C")))
+      << out;
+  const double lo = std::stod(m[1]), hi = std::stod(m[2]);
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("iso         ([0-9.]+) °C: ([0-9]+) tets crossed"))) << out;
+  EXPECT_NEAR(std::stod(m[1]), (lo + hi) / 2, 0.051);
+  EXPECT_GT(std::stoul(m[2]), 0u);
+  EXPECT_NE(out.find("sweep       isovalue of temperature, 24 frames"), std::string::npos) << out;
+  const foxi::Mesh te = foxi::read_mesh(dir / "d" / "flip_chip_stress.vtu");
+  double lo3[3] = {1e300, 1e300, 1e300}, hi3[3] = {-1e300, -1e300, -1e300};
+  for (std::size_t n = 0; n < te.node_count(); ++n)
+    for (int k = 0; k < 3; ++k)
+      lo3[k] = std::min(lo3[k], te.xyz[3 * n + std::size_t(k)]), hi3[k] = std::max(hi3[k], te.xyz[3 * n + std::size_t(k)]);
+  const double diag = std::hypot(hi3[0] - lo3[0], hi3[1] - lo3[1], hi3[2] - lo3[2]);
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("deformed    by displacement x ([0-9.e+-]+): nodes moved up to ([0-9.e+-]+)")))
+      << out;
+  const double moved = std::stod(m[2]);
+  EXPECT_LE(moved, 0.02 * diag * (1 + 1e-5));
+  EXPECT_GE(moved, 0.008 * diag);
+  EXPECT_NE(out.find("field       von_mises"), std::string::npos) << out;
+  for (const char* f : {"flip_chip_isotherm.png", "flip_chip_isotherms.gif", "flip_chip_von_mises.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "d" / f)) << f;
 }
 
