@@ -21,14 +21,20 @@ namespace {
 
 const char* kUsage =
     "foxi-view MESH [--size WxH] [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z]\n"
-    "               [--shrink f] [--no-undo] [--save PREFIX] [--script \"COMMANDS\" [--dump-ids]]\n"
+    "               [--shrink f] [--no-undo] [--field NAME[:C] [--graded] [--cmap M]] [--save PREFIX]\n"
+    "               [--script \"COMMANDS\" [--dump-ids]]\n"
     "  Opens a window and draws the mesh back to front in the power-function visibility order,\n"
     "  batch by batch, with a status line (tets drawn / total, %, ms for the draw so far, ms per frame).\n"
     "  Mouse: left-drag orbits, right-drag or wheel zooms, middle-drag pans (each redraws).\n"
     "  Keys: d draw from the back, space stop/continue, n one batch (or one undraw step), u undraw\n"
     "  front to back (1/64 of the set a frame; u again draws on), r region of interest (the tets\n"
     "  drawn so far become the displayed set, re-ordered for each new view), b back up the regions,\n"
-    "  s save the picture as PREFIX-NNN.png (default PREFIX foxi-view), q or Escape quit.\n"
+    "  f the next field (the mesh's fields in turn, then region colours), m the next colour map\n"
+    "  (viridis, cividis, coolwarm, rainbow), s save the picture as PREFIX-NNN.png (default PREFIX\n"
+    "  foxi-view), q or Escape quit. The status line shows the field's range and, under the mouse,\n"
+    "  the point the pixel shows, its tet and region, and the field's value there.\n"
+    "  --field NAME[:C] colour by a field from the start (as foxi render: C a component, mag, vm, p1..p3;\n"
+    "  its last step, its automatic range); --graded graded facets; --cmap the colour map.\n"
     "  Camera options as foxi render (same defaults, so the pictures agree); --size default 800x600.\n"
     "  Meshes that fail the Delaunay certificate are drawn with a depth buffer (MPVO order).\n"
     "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused.\n"
@@ -37,6 +43,8 @@ const char* kUsage =
     "     d (draw all)  c (restart, draw nothing)  n (one batch)  f (finish, drawing on)\n"
     "     u (undraw all)  u:N (undraw N tets)  r  b  s\n"
     "     orbit:YAW,PITCH (degrees)  zoom:F  pan:DX,DY (fractions of the height)\n"
+    "     field  map (the keys f and m; each restarts without drawing)\n"
+    "     probe:X,Y (prints the status line's value under pixel X,Y, 9 digits)\n"
     "  e.g. --script \"d r orbit:30,0 d s\"; --dump-ids also writes PREFIX-NNN.ids (the id buffer,\n"
     "  uint32 little-endian) and PREFIX-NNN.tets (the drawn tets, in drawing order).\n"
     "  Environment: FOXI_VIEW_NO_SHM=1 uses plain XPutImage even where XShm is available.\n"
@@ -60,7 +68,8 @@ int main(int argc, char** argv) {
   try {
     std::vector<std::string> args(argv + 1, argv + argc);
     std::string mesh_path, size = "800x600", eye, at, up, fov, dir, shrink, save = "foxi-view", script;
-    bool script_mode = false, dump = false, no_undo = false;
+    std::string field_spec, cmap;
+    bool script_mode = false, dump = false, no_undo = false, graded = false;
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string& a = args[i];
       auto value = [&]() -> std::string {
@@ -91,6 +100,12 @@ int main(int argc, char** argv) {
         script_mode = true;
       } else if (a == "--dump-ids") {
         dump = true;
+      } else if (a == "--field") {
+        field_spec = value();
+      } else if (a == "--cmap") {
+        cmap = value();
+      } else if (a == "--graded") {
+        graded = true;
       } else if (a == "--no-undo") {
         no_undo = true;
       } else if (a.rfind("-", 0) == 0) {
@@ -136,15 +151,29 @@ int main(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       throw Usage(e.what());
     }
+    if (field_spec.empty() && (graded || !cmap.empty())) throw Usage("--graded and --cmap colour by a field: give --field NAME");
+    foxi::ColorMapId map = foxi::ColorMapId::viridis;
+    if (!cmap.empty()) {
+      const auto m = foxi::parse_color_map(cmap);
+      if (!m) throw Usage("--cmap takes viridis, cividis, coolwarm or rainbow, not '" + cmap + "'");
+      map = *m;
+    }
+    foxi::view::ViewField field;
+    try {
+      field = foxi::view::view_field(mesh, field_spec, graded, map);
+    } catch (const foxi::FieldSelectError& e) {
+      throw Usage(mesh_path + ": " + e.what());
+    }
     foxi::view::Viewer viewer(mesh, camera, width, height, params);
+    if (!field_spec.empty()) foxi::view::apply_field(viewer, field);
     if (!viewer.delaunay())
       std::printf("note: %s fails the Delaunay certificate: drawn with the depth buffer (MPVO order)\n",
                   mesh_path.c_str());
     if (script_mode) {
-      foxi::view::run_script(viewer, script, save, dump);
+      foxi::view::run_script(viewer, field, script, save, dump);
       return kExitOk;
     }
-    return foxi::view::run_window(viewer, save);
+    return foxi::view::run_window(viewer, field, save);
   } catch (const Usage& e) {
     std::fprintf(stderr, "foxi-view: %s\nusage: %s\n", e.what(), kUsage);
     return kExitUsage;

@@ -42,7 +42,98 @@ std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix,
   return png;
 }
 
-void run_script(Viewer& viewer, const std::string& script, const std::string& prefix, bool dump) {
+ViewField view_field(const Mesh& mesh, const std::string& spec, bool graded, ColorMapId map) {
+  ViewField f;
+  f.specs.push_back("");
+  for (const Field& field : mesh.fields) f.specs.push_back(field.name);
+  f.graded = graded;
+  f.map = map;
+  if (!spec.empty()) {
+    choose_field(mesh, spec);  // throws FieldSelectError for one that is not there
+    const auto it = std::find(f.specs.begin(), f.specs.end(), spec);
+    if (it == f.specs.end()) f.specs.push_back(spec);
+    f.current = std::size_t(std::find(f.specs.begin(), f.specs.end(), spec) - f.specs.begin());
+  }
+  return f;
+}
+
+void apply_field(Viewer& viewer, ViewField& f) {
+  const std::string& spec = f.specs[f.current];
+  if (spec.empty()) {
+    viewer.set_field(nullptr);
+    return;
+  }
+  const Mesh& mesh = viewer.mesh();
+  f.choice = choose_field(mesh, spec);
+  f.step = f.choice.field->step_count() - 1;
+  const std::vector<double> values =
+      f.graded ? tet_corner_values(mesh, f.choice, f.step) : tet_centroid_values(mesh, f.choice, f.step);
+  auto [lo, hi] = finite_range(values, false);
+  if (std::isnan(lo)) lo = 0, hi = 1;  // no finite value: all drawn in the no-value grey
+  if (!(lo < hi)) {                    // a constant shows mid-map
+    const double d = lo != 0 ? std::abs(lo) * 0.01 : 1;
+    lo -= d;
+    hi += d;
+  }
+  f.scale = ColorScale{};
+  f.scale.map = f.map;
+  f.scale.lo = lo;
+  f.scale.hi = hi;
+  f.unit = default_display_unit(f.choice.field->unit, std::max(std::abs(lo), std::abs(hi)));
+  viewer.set_field(std::make_shared<const FieldPaint>(f.graded ? graded_field_paint(values, f.scale)
+                                                               : flat_field_paint(values, f.scale)));
+}
+
+void next_field(Viewer& viewer, ViewField& f) {
+  f.current = (f.current + 1) % f.specs.size();
+  apply_field(viewer, f);
+}
+
+void next_map(Viewer& viewer, ViewField& f) {
+  const ColorMapId maps[] = {ColorMapId::viridis, ColorMapId::cividis, ColorMapId::coolwarm, ColorMapId::rainbow};
+  std::size_t i = 0;
+  while (i < 4 && maps[i] != f.map) ++i;
+  f.map = maps[(i + 1) % 4];
+  if (!f.specs[f.current].empty()) apply_field(viewer, f);
+}
+
+std::string value_under(const Viewer& viewer, const ViewField& f, int x, int y, int digits) {
+  const std::uint32_t t = viewer.pick(x, y);
+  if (t == kNone) return "background";
+  const Mesh& mesh = viewer.mesh();
+  const Framebuffer& fb = viewer.framebuffer();
+  double b[4];
+  char buf[256];
+  const std::uint32_t region = mesh.tet_region.empty() ? 0 : mesh.tet_region[t];
+  if (!pixel_point_in_tet(mesh, viewer.camera(), fb.width, fb.height, t, x, y, b)) {
+    std::snprintf(buf, sizeof buf, "tet %u, region %u", t, region);
+    return buf;
+  }
+  double p[3] = {0, 0, 0};
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k) p[k] += b[i] * mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(i)]) + std::size_t(k)];
+  std::string value;
+  if (!f.specs[f.current].empty()) {
+    const double v = field_value_in_tet(mesh, f.choice, t, b, f.step);
+    std::snprintf(buf, sizeof buf, "%s %.*g%s%s ", f.choice.label.c_str(), digits, f.unit.to_display(v),
+                  f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
+    value = buf;
+  }
+  std::snprintf(buf, sizeof buf, "at (%.*g, %.*g, %.*g), tet %u, region %u", digits, p[0], digits, p[1], digits, p[2], t,
+                region);
+  return value + buf;
+}
+
+std::string field_status(const ViewField& f) {
+  if (f.specs[f.current].empty()) return "";
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%s, %s%s, %.4g to %.4g%s%s", f.choice.label.c_str(), color_map_name(f.map),
+                f.graded ? ", graded" : "", f.unit.to_display(f.scale.lo), f.unit.to_display(f.scale.hi),
+                f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
+  return buf;
+}
+
+void run_script(Viewer& viewer, ViewField& field, const std::string& script, const std::string& prefix, bool dump) {
   std::istringstream in(script);
   std::string cmd;
   while (in >> cmd) {
@@ -89,12 +180,20 @@ void run_script(Viewer& viewer, const std::string& script, const std::string& pr
       auto v = args(1);
       if (!(v[0] > 0)) throw std::invalid_argument("zoom takes a factor > 0");
       viewer.zoom(v[0]);
+    } else if (name == "probe") {
+      auto v = args(2);
+      std::printf("probe %g,%g: %s\n", v[0], v[1], value_under(viewer, field, int(v[0]), int(v[1]), 9).c_str());
+      std::fflush(stdout);
+    } else if (cmd == "field") {
+      next_field(viewer, field);
+    } else if (cmd == "map") {
+      next_map(viewer, field);
     } else if (name == "pan") {
       auto v = args(2);
       viewer.pan(v[0], v[1]);
     } else {
       throw std::invalid_argument("unknown script command '" + cmd +
-                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y)");
+                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map)");
     }
   }
 }

@@ -5,14 +5,49 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include "foxi/viz/colormap.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/interactive_view.hpp"
 
 namespace foxi::view {
 
 using Viewer = InteractiveView;
 
+// The field the view is coloured by (--field, --graded, --cmap; keys f and m) and what the status
+// line says under the mouse.
+struct ViewField {
+  std::vector<std::string> specs;  // "" (region colours), then each field of the mesh by name
+  std::size_t current = 0;         // index into specs
+  ColorMapId map = ColorMapId::viridis;
+  bool graded = false;
+  // Resolved by apply_field for specs[current] (its last step), when that is not "":
+  FieldChoice choice;
+  std::size_t step = 0;
+  ColorScale scale;
+  DisplayUnit unit;
+};
+
+// The specs of `mesh` ("" and its fields' names), `current` set to `spec` (NAME[:component], added
+// if it names a component); std::invalid_argument (FieldSelectError) for a field not in the mesh.
+ViewField view_field(const Mesh& mesh, const std::string& spec, bool graded, ColorMapId map);
+// Colours the viewer by field.specs[field.current] (its automatic range, the display unit an
+// engineer reads it in) and restarts the draw.
+void apply_field(Viewer& viewer, ViewField& field);
+// 'f': the next field (after the last, region colours again); 'm': the next colour map.
+void next_field(Viewer& viewer, ViewField& field);
+void next_map(Viewer& viewer, ViewField& field);
+// "temperature 53.2 °C at (x, y, z), tet 12, region 3" for pixel (x, y): the tet pick() shows there,
+// the point its front face shows at the pixel's centre (pixel_point_in_tet) and the field's value
+// there (field_value_in_tet); "background" where no tet shows. `digits`: significant digits.
+std::string value_under(const Viewer& viewer, const ViewField& field, int x, int y, int digits = 4);
+// The field, map and range for the status line ("" with region colours).
+std::string field_status(const ViewField& field);
+
 // Runs a script of whitespace-separated commands on the viewer (the headless mode):
+//   probe:X,Y    print "probe X,Y: " and value_under(X, Y) (9 digits)
+//   field / map  the keys f and m
 //   d            restart and draw to completion      c      restart without drawing
 //   n            draw one batch                      f      finish the current draw
 //   r / b        push the drawn tets as region / back up   (each restarts without drawing)
@@ -20,7 +55,7 @@ using Viewer = InteractiveView;
 //   s            save the picture as PREFIX-NNN.png (and with dump, PREFIX-NNN.ids: the id buffer as
 //                little-endian uint32, and PREFIX-NNN.tets: the drawn tets, one a line)
 // Prints one line per save ("saved NAME ...") on stdout. Throws std::invalid_argument on a bad command.
-void run_script(Viewer& viewer, const std::string& script, const std::string& prefix, bool dump);
+void run_script(Viewer& viewer, ViewField& field, const std::string& script, const std::string& prefix, bool dump);
 
 // Saves the picture under the next free name PREFIX-NNN.png; prints "saved NAME camera ..." and
 // returns the path. With dump, also writes the id buffer and the drawn tets beside it.

@@ -152,7 +152,7 @@ class Screen {
 
 }  // namespace
 
-int run_window(Viewer& viewer, const std::string& save_prefix) {
+int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix) {
   Display* dpy = XOpenDisplay(nullptr);
   if (!dpy)
     throw std::runtime_error("cannot open the X display (DISPLAY unset?); --script runs without a window");
@@ -190,18 +190,22 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
 
   std::printf(
       "foxi-view: %zu tets, %s, %s; keys: d draw, space stop/continue, n step, u undraw/draw on, r region, "
-      "b back, s save, "
+      "b back, f field, m colour map, s save, "
       "q quit; mouse: left orbit, right/wheel zoom, middle pan\n",
       viewer.mesh().tet_count(),
       viewer.delaunay() ? "Delaunay (painter, no depth buffer)" : "NOT Delaunay (depth-buffer drawing)",
       screen.shm() ? "XShm" : "XPutImage");
   std::fflush(stdout);
 
+  int mouse_x = -1, mouse_y = -1;  // the pointer over the picture (-1: elsewhere)
   auto draw_status = [&] {
     XSetForeground(dpy, gc, grey);
     XFillRectangle(dpy, win, gc, 0, height, unsigned(width), kStatusHeight);
     XSetForeground(dpy, gc, white);
     std::string s = viewer.status();
+    const std::string fs = field_status(field);
+    if (!fs.empty()) s += "  |  " + fs;
+    if (mouse_x >= 0) s += "  |  " + value_under(viewer, field, mouse_x, mouse_y);
     const int base = height + kStatusHeight - 5;
     XDrawString(dpy, win, gc, 4, base, s.c_str(), int(s.size()));
   };
@@ -273,7 +277,15 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
           if (int(ev.xbutton.button) == button) button = 0;
           break;
         case MotionNotify: {
-          if (!button) break;
+          if (!button) {  // the value under the mouse on the status line
+            while (XCheckTypedWindowEvent(dpy, win, MotionNotify, &ev)) {
+            }
+            const bool inside = ev.xmotion.x >= 0 && ev.xmotion.y >= 0 && ev.xmotion.x < width && ev.xmotion.y < height;
+            mouse_x = inside ? ev.xmotion.x : -1;
+            mouse_y = inside ? ev.xmotion.y : -1;
+            changed = true;
+            break;
+          }
           while (XCheckTypedWindowEvent(dpy, win, MotionNotify, &ev)) {
           }  // only the latest position matters
           const int dx = ev.xmotion.x - last_x, dy = ev.xmotion.y - last_y;
@@ -319,6 +331,14 @@ int run_window(Viewer& viewer, const std::string& save_prefix) {
               break;
             case XK_b:
               if (viewer.pop_region()) viewer.set_running(true);
+              break;
+            case XK_f:
+              next_field(viewer, field);
+              viewer.set_running(true);
+              break;
+            case XK_m:
+              next_map(viewer, field);
+              viewer.set_running(true);
               break;
             case XK_s:
               try {

@@ -10,6 +10,7 @@ namespace foxi::view {
 
 // Opens the window and runs the event loop until q / Escape / the window is closed. Returns the exit
 // status; throws std::runtime_error if the display cannot be opened.
-int run_window(Viewer& viewer, const std::string& save_prefix);
+// `field`: the colouring (keys f and m change it); the status line shows the value under the mouse.
+int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix);
 
 }  // namespace foxi::view

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -117,6 +119,58 @@ TEST_F(ViewTest, ScriptDrawEqualsFoxiRender) {
             0)
       << out;
   EXPECT_EQ(differing_pixels(read_png(dir_ / "o-001.png"), read_png(dir_ / "ro.png")), 0u);
+}
+
+// Fields in the viewer: --field colours as foxi render --field --legend off does (pixel for pixel, the
+// same automatic range); the value the status line reads under the mouse (script probe:X,Y) equals
+// foxi probe's at the point it names; the key f cycles to the next field.
+TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
+  Mesh m = two_region_grid();
+  Field u{"u", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < m.node_count(); ++n)
+    u.values.push_back(1 + m.xyz[3 * n] * m.xyz[3 * n + 1] + std::sin(m.xyz[3 * n + 2]));
+  Field w{"w", FieldLocation::node, 1, "", {}, {}};
+  w.values.assign(m.node_count(), 2.0);
+  m.fields = {u, w};
+  write_mesh(m, dir_ / "f.vtu");
+  std::string out;
+  const int px[][2] = {{160, 120}, {100, 90}, {200, 150}, {140, 170}, {230, 100}, {5, 5}};
+  std::string script = "d s";
+  for (const auto& p : px) script += " probe:" + std::to_string(p[0]) + "," + std::to_string(p[1]);
+  script += " field d probe:160,120";
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize + " --field u --graded --save " +
+                           q(dir_ / "fv") + " --script '" + script + "'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  const std::string view_log = out;
+  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(dir_ / "f.vtu") + " " + kSize +
+                           " --field u --graded --legend off -o " + q(dir_ / "fr.png"),
+                       dir_ / "render.log", &out),
+            0)
+      << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "fv-001.png"), read_png(dir_ / "fr.png")), 0u);
+  std::istringstream lines(view_log);
+  std::string line;
+  int probed = 0;
+  const std::regex value("^probe ([0-9]+),([0-9]+): u ([-0-9.e+]+) at \\(([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\), tet ([0-9]+)");
+  while (std::getline(lines, line)) {
+    std::smatch mm;
+    if (line.rfind("probe 5,5:", 0) == 0) EXPECT_NE(line.find("background"), std::string::npos) << line;
+    if (!std::regex_search(line, mm, value)) continue;
+    ++probed;
+    const std::string at = std::string(mm[4]) + "," + std::string(mm[5]) + "," + std::string(mm[6]);
+    ASSERT_EQ(run_logged(q(test::cli_path()) + " probe " + q(dir_ / "f.vtu") + " --field u --at " + at,
+                         dir_ / "probe.log", &out),
+              0)
+        << out;
+    std::smatch pm;
+    ASSERT_TRUE(std::regex_search(out, pm, std::regex("tet ([0-9]+), .*u = ([-0-9.e+]+)"))) << out;
+    EXPECT_NEAR(std::stod(pm[2]), std::stod(mm[3]), 1e-6 * std::abs(std::stod(mm[3]))) << line << "\n" << out;
+  }
+  EXPECT_EQ(probed, 5) << view_log;
+  // After f: the next field (w, a constant 2).
+  EXPECT_NE(view_log.find("probe 160,120: w 2 at"), std::string::npos) << view_log;
 }
 
 // Undraw in the viewer's state machine: draw all, undraw 360 of the 720 tets, and the picture (and

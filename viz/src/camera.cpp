@@ -288,4 +288,80 @@ Camera camera_from_options(const double lo[3], const double hi[3], double aspect
   return camera;
 }
 
+namespace {
+
+// Barycentric coordinates of q in the tet with corners c (4 x 3): b[0] = 1 - b[1] - b[2] - b[3].
+bool barycentric(const double c[4][3], const double q[3], double b[4]) {
+  double e[3][3], r[3];
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 3; ++j) e[j][k] = c[j + 1][k] - c[0][k];
+    r[k] = q[k] - c[0][k];
+  }
+  // Cramer's rule on the columns e[0], e[1], e[2].
+  auto det = [](const double* a, const double* b2, const double* c2) {
+    return a[0] * (b2[1] * c2[2] - b2[2] * c2[1]) - a[1] * (b2[0] * c2[2] - b2[2] * c2[0]) +
+           a[2] * (b2[0] * c2[1] - b2[1] * c2[0]);
+  };
+  const double d = det(e[0], e[1], e[2]);
+  if (!(d != 0) || !std::isfinite(d)) return false;
+  b[1] = det(r, e[1], e[2]) / d;
+  b[2] = det(e[0], r, e[2]) / d;
+  b[3] = det(e[0], e[1], r) / d;
+  b[0] = 1 - b[1] - b[2] - b[3];
+  return true;
+}
+
+}  // namespace
+
+bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height, std::uint32_t t, int x, int y,
+                        double bary[4]) {
+  if (t >= mesh.tet_count()) return false;
+  Projector p = [&] {
+    try {
+      return Projector(camera, width, height);
+    } catch (const std::invalid_argument&) {
+      return Projector(Camera{}, 1, 1);
+    }
+  }();
+  if (p.width != width) return false;  // degenerate camera
+  // The ray through the pixel's centre, in world coordinates (camera_to_pixel inverted).
+  const double u = x + 0.5 - p.cx, v = p.cy - (y + 0.5);
+  double o[3], d[3];
+  for (int k = 0; k < 3; ++k) {
+    if (p.perspective) {
+      o[k] = p.eye[k];
+      d[k] = p.right[k] * u / p.focal + p.up[k] * v / p.focal + p.forward[k];
+    } else {
+      o[k] = p.eye[k] + p.right[k] * u / p.scale + p.up[k] * v / p.scale;
+      d[k] = p.forward[k];
+    }
+  }
+  double c[4][3];
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k) c[i][k] = mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(i)]) + std::size_t(k)];
+  const double od[3] = {o[0] + d[0], o[1] + d[1], o[2] + d[2]};
+  double b0[4], b1[4];
+  if (!barycentric(c, o, b0) || !barycentric(c, od, b1)) return false;
+  // Inside where every b_i(s) = b0_i + s (b1_i - b0_i) >= 0: an interval of s; the entry is its start.
+  double lo = p.perspective ? 0.0 : -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 4; ++i) {
+    const double db = b1[i] - b0[i];
+    if (db > 0) lo = std::max(lo, -b0[i] / db);
+    if (db < 0) hi = std::min(hi, -b0[i] / db);
+  }
+  if (p.perspective && hi < 0) return false;  // behind the eye
+  double s = lo;
+  if (!(lo <= hi)) s = std::isfinite(hi) && std::isfinite(lo) ? 0.5 * (lo + hi) : (std::isfinite(hi) ? hi : lo);
+  if (!std::isfinite(s)) return false;
+  double sum = 0;
+  for (int i = 0; i < 4; ++i) {
+    bary[i] = std::max(0.0, b0[i] + s * (b1[i] - b0[i]));
+    sum += bary[i];
+  }
+  if (!(sum > 0)) return false;
+  for (int i = 0; i < 4; ++i) bary[i] /= sum;
+  return true;
+}
+
 }  // namespace foxi

@@ -103,6 +103,11 @@ void InteractiveView::begin_draw() {
 
 void InteractiveView::restart() { begin_draw(); }
 
+void InteractiveView::set_field(std::shared_ptr<const FieldPaint> field) {
+  params_.field = std::move(field);
+  begin_draw();
+}
+
 bool InteractiveView::step() {
   const auto t0 = std::chrono::steady_clock::now();
   if (undrawing_) {

@@ -77,6 +77,14 @@ struct FOXI_API Projector {
   bool project(const double p[3], double px[2], double* depth = nullptr) const;
 };
 
+// Where the ray through the centre of pixel (x, y) (row 0 at the top) of a width x height image
+// enters tet `t` of `mesh` (for a perspective eye inside the tet: the eye): its barycentric
+// coordinates in the tet's node order, the point the pixel shows of that tet (unshrunk). The ray is
+// clamped to the tet where it passes just outside it (a pixel centre past an edge the tet was
+// rasterized on). False if the camera is degenerate or the ray runs the other way.
+FOXI_API bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height, std::uint32_t t,
+                                 int x, int y, double bary[4]);
+
 // The ordering viewpoint of a camera: perspective -> View::at(eye), orthographic -> View::along(at - eye).
 FOXI_API View view_of(const Camera& camera);
 

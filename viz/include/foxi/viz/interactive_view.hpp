@@ -80,6 +80,9 @@ class FOXI_API InteractiveView {
 
   // The tet shown at pixel (x, y) (row 0 at the top), kNone for the background or outside the image.
   std::uint32_t pick(int x, int y) const;
+  // Colours by `field` (null: by region) from now on: the same camera and regions, redrawn from the back.
+  void set_field(std::shared_ptr<const FieldPaint> field);
+  const std::shared_ptr<const FieldPaint>& field() const { return params_.field; }
 
   const Camera& camera() const { return camera_; }
   const Framebuffer& framebuffer() const { return fb_; }
