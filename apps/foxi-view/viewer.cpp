@@ -85,8 +85,56 @@ void apply_field(Viewer& viewer, ViewField& f) {
 }
 
 void next_field(Viewer& viewer, ViewField& f) {
+  if (f.iso_on) {  // the isosurface belongs to the field it was of
+    viewer.set_iso(nullptr, {});
+    f.iso_on = false;
+  }
+  f.corner.clear();
+  f.tree.reset();
   f.current = (f.current + 1) % f.specs.size();
   apply_field(viewer, f);
+}
+
+bool set_iso(Viewer& viewer, ViewField& f, double value, bool iso_only) {
+  if (f.specs[f.current].empty()) return false;
+  if (!f.tree) {
+    f.corner = tet_corner_values(viewer.mesh(), f.choice, f.step);
+    f.tree = std::make_shared<const TetIntervals>(f.corner);
+  }
+  f.iso_on = true;
+  f.iso_only = iso_only;
+  f.iso_value = f.unit.to_si(value);
+  f.drawing = IsoDrawing{};
+  f.drawing.corner = f.corner;
+  f.drawing.params.values = {f.iso_value};
+  f.drawing.params.scale = f.scale;
+  f.drawing.params.cap = !iso_only;
+  std::vector<std::uint32_t> tets;  // as foxi render --iso: the crossing tets, or the solid's
+  if (iso_only)
+    f.tree->crossing(f.iso_value, tets);
+  else
+    f.tree->reaching(f.iso_value, tets);
+  viewer.set_iso(&f.drawing, std::move(tets));
+  return true;
+}
+
+void toggle_iso(Viewer& viewer, ViewField& f) {
+  if (f.iso_on) {
+    viewer.set_iso(nullptr, {});
+    f.iso_on = false;
+    return;
+  }
+  set_iso(viewer, f, f.unit.to_display(0.5 * (f.scale.lo + f.scale.hi)), f.iso_only);
+}
+
+void toggle_iso_only(Viewer& viewer, ViewField& f) {
+  if (f.iso_on) set_iso(viewer, f, f.unit.to_display(f.iso_value), !f.iso_only);
+}
+
+void move_iso(Viewer& viewer, ViewField& f, double steps) {
+  if (!f.iso_on) return;
+  const double v = std::clamp(f.iso_value + steps * (f.scale.hi - f.scale.lo) / 20, f.scale.lo, f.scale.hi);
+  set_iso(viewer, f, f.unit.to_display(v), f.iso_only);
 }
 
 void next_map(Viewer& viewer, ViewField& f) {
@@ -130,7 +178,13 @@ std::string field_status(const ViewField& f) {
   std::snprintf(buf, sizeof buf, "%s, %s%s, %.4g to %.4g%s%s", f.choice.label.c_str(), color_map_name(f.map),
                 f.graded ? ", graded" : "", f.unit.to_display(f.scale.lo), f.unit.to_display(f.scale.hi),
                 f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
-  return buf;
+  std::string s = buf;
+  if (f.iso_on) {
+    std::snprintf(buf, sizeof buf, ", %s %.4g%s%s", f.iso_only ? "isosurface" : "solid above", f.unit.to_display(f.iso_value),
+                  f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
+    s += buf;
+  }
+  return s;
 }
 
 void run_script(Viewer& viewer, ViewField& field, const std::string& script, const std::string& prefix, bool dump) {
@@ -184,6 +238,11 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       auto v = args(2);
       std::printf("probe %g,%g: %s\n", v[0], v[1], value_under(viewer, field, int(v[0]), int(v[1]), 9).c_str());
       std::fflush(stdout);
+    } else if (name == "iso" || name == "iso-only") {
+      if (!set_iso(viewer, field, args(1)[0], name == "iso-only"))
+        throw std::invalid_argument("script: '" + cmd + "' draws a field's isosurface: give --field or 'field' first");
+    } else if (cmd == "noiso") {
+      if (field.iso_on) toggle_iso(viewer, field);
     } else if (cmd == "field") {
       next_field(viewer, field);
     } else if (cmd == "map") {
@@ -193,7 +252,7 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       viewer.pan(v[0], v[1]);
     } else {
       throw std::invalid_argument("unknown script command '" + cmd +
-                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map)");
+                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map iso:V iso-only:V noiso)");
     }
   }
 }

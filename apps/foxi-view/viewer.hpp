@@ -4,12 +4,14 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/interactive_view.hpp"
+#include "foxi/viz/isosurface.hpp"
 
 namespace foxi::view {
 
@@ -27,6 +29,12 @@ struct ViewField {
   std::size_t step = 0;
   ColorScale scale;
   DisplayUnit unit;
+  // The isosurface (keys i, o, [ and ]): at iso_value (SI), the solid above it or (iso_only) the surface.
+  bool iso_on = false, iso_only = false;
+  double iso_value = 0;
+  std::vector<double> corner;  // the field's corner values (the IsoPainter's, lent to the view)
+  std::shared_ptr<const TetIntervals> tree;
+  IsoDrawing drawing;
 };
 
 // The specs of `mesh` ("" and its fields' names), `current` set to `spec` (NAME[:component], added
@@ -38,6 +46,14 @@ void apply_field(Viewer& viewer, ViewField& field);
 // 'f': the next field (after the last, region colours again); 'm': the next colour map.
 void next_field(Viewer& viewer, ViewField& field);
 void next_map(Viewer& viewer, ViewField& field);
+// The isosurface at `value` (display units) of the current field, drawn as the solid above it or
+// (iso_only) the surface alone; false (nothing changes) with region colours.
+bool set_iso(Viewer& viewer, ViewField& field, double value, bool iso_only);
+// 'i': the isosurface on (at the middle of the range) or off; 'o': solid / surface alone;
+// '[' and ']': the isovalue down or up by 1/20 of the colour range.
+void toggle_iso(Viewer& viewer, ViewField& field);
+void toggle_iso_only(Viewer& viewer, ViewField& field);
+void move_iso(Viewer& viewer, ViewField& field, double steps);
 // "temperature 53.2 °C at (x, y, z), tet 12, region 3" for pixel (x, y): the tet pick() shows there,
 // the point its front face shows at the pixel's centre (pixel_point_in_tet) and the field's value
 // there (field_value_in_tet); "background" where no tet shows. `digits`: significant digits.
@@ -48,6 +64,8 @@ std::string field_status(const ViewField& field);
 // Runs a script of whitespace-separated commands on the viewer (the headless mode):
 //   probe:X,Y    print "probe X,Y: " and value_under(X, Y) (9 digits)
 //   field / map  the keys f and m
+//   iso:V        the isosurface at V (display units) as the solid above it; iso-only:V the surface;
+//                noiso whole tets again (each restarts without drawing)
 //   d            restart and draw to completion      c      restart without drawing
 //   n            draw one batch                      f      finish the current draw
 //   r / b        push the drawn tets as region / back up   (each restarts without drawing)

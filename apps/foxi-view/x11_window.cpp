@@ -190,7 +190,7 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
 
   std::printf(
       "foxi-view: %zu tets, %s, %s; keys: d draw, space stop/continue, n step, u undraw/draw on, r region, "
-      "b back, f field, m colour map, s save, "
+      "b back, f field, m colour map, i isosurface, o solid/surface, [ ] isovalue, s save, "
       "q quit; mouse: left orbit, right/wheel zoom, middle pan\n",
       viewer.mesh().tet_count(),
       viewer.delaunay() ? "Delaunay (painter, no depth buffer)" : "NOT Delaunay (depth-buffer drawing)",
@@ -338,6 +338,19 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
               break;
             case XK_m:
               next_map(viewer, field);
+              viewer.set_running(true);
+              break;
+            case XK_i:
+              toggle_iso(viewer, field);
+              viewer.set_running(true);
+              break;
+            case XK_o:
+              toggle_iso_only(viewer, field);
+              viewer.set_running(true);
+              break;
+            case XK_bracketleft:
+            case XK_bracketright:
+              move_iso(viewer, field, sym == XK_bracketright ? 1 : -1);
               viewer.set_running(true);
               break;
             case XK_s:

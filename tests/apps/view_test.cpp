@@ -123,7 +123,8 @@ TEST_F(ViewTest, ScriptDrawEqualsFoxiRender) {
 
 // Fields in the viewer: --field colours as foxi render --field --legend off does (pixel for pixel, the
 // same automatic range); the value the status line reads under the mouse (script probe:X,Y) equals
-// foxi probe's at the point it names; the key f cycles to the next field.
+// foxi probe's at the point it names; the key f cycles to the next field; the isosurface keys draw
+// what foxi render --iso draws.
 TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
   Mesh m = two_region_grid();
   Field u{"u", FieldLocation::node, 1, "", {}, {}};
@@ -171,6 +172,25 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
   EXPECT_EQ(probed, 5) << view_log;
   // After f: the next field (w, a constant 2).
   EXPECT_NE(view_log.find("probe 160,120: w 2 at"), std::string::npos) << view_log;
+
+  // The isosurface keys' script forms: the solid above u = 6 and the surface alone equal foxi render
+  // --iso 6 [--iso-only], pixel for pixel; 'noiso' gives the whole tets back.
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize + " --field u --graded --save " +
+                           q(dir_ / "iv") + " --script 'iso:6 d s iso-only:6 d s noiso d s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  for (const char* only : {"", " --iso-only"}) {
+    ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(dir_ / "f.vtu") + " " + kSize +
+                             " --field u --graded --legend off --iso 6" + only + " -o " + q(dir_ / "ir.png"),
+                         dir_ / "render.log", &out),
+              0)
+        << out;
+    EXPECT_EQ(differing_pixels(read_png(dir_ / (*only ? "iv-002.png" : "iv-001.png")), read_png(dir_ / "ir.png")), 0u)
+        << (*only ? "surface" : "solid");
+  }
+  EXPECT_NE(differing_pixels(read_png(dir_ / "iv-001.png"), read_png(dir_ / "iv-002.png")), 0u);
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "iv-003.png"), read_png(dir_ / "fr.png")), 0u);
 }
 
 // Undraw in the viewer's state machine: draw all, undraw 360 of the 720 tets, and the picture (and

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <stdexcept>
 #include <utility>
 
@@ -73,6 +74,7 @@ std::vector<PixelRect> InteractiveView::take_damage() {
 }
 
 std::span<const std::uint32_t> InteractiveView::current_subset() const {
+  if (iso_) return iso_subset_;
   if (stack_.empty()) return {};
   return stack_.back();
 }
@@ -81,20 +83,36 @@ void InteractiveView::begin_draw() {
   // A degenerate camera (e.g. zoomed through `at`) throws here; the caller keeps the old picture.
   const auto t0 = std::chrono::steady_clock::now();
   auto raster = std::make_unique<TetRasterizer>(mesh_, camera_, width_, height_, params_);
+  std::unique_ptr<IsoPainter> iso_painter;
+  if (iso_) {
+    iso_painter = std::make_unique<IsoPainter>(mesh_, camera_, width_, height_, iso_->corner, iso_->params, params_,
+                                               iso_->attr);
+    // The iso tets within the region of interest.
+    iso_subset_.clear();
+    if (stack_.empty())
+      iso_subset_ = iso_tets_;
+    else
+      std::set_intersection(iso_tets_.begin(), iso_tets_.end(), stack_.back().begin(), stack_.back().end(),
+                            std::back_inserter(iso_subset_));
+  }
   raster_ = std::move(raster);
+  iso_painter_ = std::move(iso_painter);
   order_.reset();
   mpvo_.clear();
   mpvo_pos_ = 0;
   const View v = view_of(camera_);
-  if (delaunay_)
+  if (iso_ && iso_subset_.empty()) {
+    // Nothing crosses: an empty subset would mean the whole mesh to the orders.
+  } else if (delaunay_) {
     order_.emplace(mesh_, table_, v, current_subset());
-  else
+  } else {
     mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
+  }
   fb_.resize(width_, height_, params_.depth_buffer);
   damage_all();
   drawn_.clear();
   handed_.clear();
-  done_ = false;
+  done_ = iso_ && iso_subset_.empty();
   undrawing_ = false;
   started_ = true;
   ++generation_;
@@ -102,6 +120,14 @@ void InteractiveView::begin_draw() {
 }
 
 void InteractiveView::restart() { begin_draw(); }
+
+void InteractiveView::set_iso(const IsoDrawing* drawing, std::vector<std::uint32_t> tets) {
+  iso_ = drawing;
+  iso_tets_ = drawing ? std::move(tets) : std::vector<std::uint32_t>{};
+  std::sort(iso_tets_.begin(), iso_tets_.end());
+  iso_subset_.clear();
+  begin_draw();
+}
 
 void InteractiveView::set_field(std::shared_ptr<const FieldPaint> field) {
   params_.field = std::move(field);
@@ -136,8 +162,13 @@ bool InteractiveView::step() {
     frame_ms_ += step_ms_;
     return false;
   }
-  raster_->draw(fb_, batch);
-  add_damage(raster_->changed_rects());
+  if (iso_painter_) {
+    iso_painter_->draw(fb_, batch);
+    damage_all();  // the iso painter keeps no changed rectangles
+  } else {
+    raster_->draw(fb_, batch);
+    add_damage(raster_->changed_rects());
+  }
   drawn_.insert(drawn_.end(), batch.begin(), batch.end());
   step_ms_ = ms_since(t0);
   frame_ms_ += step_ms_;
@@ -157,8 +188,13 @@ bool InteractiveView::set_undrawing(bool on) {
 std::size_t InteractiveView::undraw(std::size_t count) {
   if (!params_.undoable || !raster_) return 0;
   const std::size_t n = std::min(count, drawn_.size());
-  raster_->undraw(fb_, n);
-  add_damage(raster_->changed_rects());
+  if (iso_painter_) {
+    iso_painter_->undraw(fb_, n);
+    damage_all();
+  } else {
+    raster_->undraw(fb_, n);
+    add_damage(raster_->changed_rects());
+  }
   drawn_.resize(drawn_.size() - n);
   if (n > 0) done_ = false;
   return n;
@@ -185,6 +221,7 @@ void InteractiveView::finish() {
 }
 
 std::size_t InteractiveView::total() const {
+  if (iso_) return iso_subset_.size();
   if (!stack_.empty()) return stack_.back().size();
   return mesh_.tet_count();
 }

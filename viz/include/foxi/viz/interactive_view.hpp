@@ -25,6 +25,7 @@
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/isosurface.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/visibility_order.hpp"
@@ -80,6 +81,12 @@ class FOXI_API InteractiveView {
 
   // The tet shown at pixel (x, y) (row 0 at the top), kNone for the background or outside the image.
   std::uint32_t pick(int x, int y) const;
+  // Iso polygons instead of whole tets (isosurface.hpp; the isovalue's surfaces, or in cap mode the
+  // solid above it): `drawing` the IsoPainter's inputs (lent with its spans: they must outlive the
+  // view or the next set_iso), `tets` the tets it crosses (cap mode: reaches; TetIntervals gives
+  // them), narrowed by the region stack. Null: whole tets again. Redraws from the back.
+  void set_iso(const IsoDrawing* drawing, std::vector<std::uint32_t> tets);
+  bool iso() const { return iso_ != nullptr; }
   // Colours by `field` (null: by region) from now on: the same camera and regions, redrawn from the back.
   void set_field(std::shared_ptr<const FieldPaint> field);
   const std::shared_ptr<const FieldPaint>& field() const { return params_.field; }
@@ -124,6 +131,10 @@ class FOXI_API InteractiveView {
   std::vector<std::uint32_t> mpvo_;                // otherwise: the MPVO order, drawn in chunks
   std::size_t mpvo_pos_ = 0;
   std::unique_ptr<TetRasterizer> raster_;
+  const IsoDrawing* iso_ = nullptr;
+  std::vector<std::uint32_t> iso_tets_;    // sorted
+  std::vector<std::uint32_t> iso_subset_;  // iso_tets_ within the region on top of the stack
+  std::unique_ptr<IsoPainter> iso_painter_;
   Framebuffer fb_;
   std::vector<PixelRect> damage_;  // see take_damage: per band of 16 rows (x0 > x1: none)
   void add_damage(std::span<const PixelRect> rects);
