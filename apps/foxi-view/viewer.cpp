@@ -15,7 +15,7 @@
 
 namespace foxi::view {
 
-std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix, bool dump) {
+std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix, bool dump, const ViewField* field) {
   std::string base;
   for (int i = 1;; ++i) {
     char num[16];
@@ -24,7 +24,10 @@ std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix,
     if (!std::filesystem::exists(base + ".png")) break;
   }
   const std::filesystem::path png = base + ".png";
-  viewer.save_png(png);
+  if (field && field->legend)
+    write_png(png, presented(viewer, *field));
+  else
+    viewer.save_png(png);
   if (dump) {
     const Framebuffer& fb = viewer.framebuffer();
     std::ofstream ids(base + ".ids", std::ios::binary);
@@ -57,10 +60,62 @@ ViewField view_field(const Mesh& mesh, const std::string& spec, bool graded, Col
   return f;
 }
 
+namespace {
+
+ColorLegend legend_of(const ViewField& f) {
+  ColorLegend l;
+  l.title = f.choice.label;
+  l.unit = f.unit;
+  l.scale = f.scale;
+  if (f.iso_on) l.marks = {f.iso_value};
+  return l;
+}
+
+// The scene's width for the legend as it is now: the panel taken from the full width, or all of it.
+void fit_legend(Viewer& viewer, ViewField& f) {
+  const int height = viewer.framebuffer().height;
+  int panel = 0;
+  if (f.legend && !f.specs[f.current].empty()) {
+    panel = legend_width(*f.text, legend_of(f));
+    if (f.full_width - panel < 64 || height < legend_min_height()) panel = 0;  // no room: no legend
+  }
+  f.legend = panel > 0;
+  if (panel != f.panel || viewer.framebuffer().width != f.full_width - panel) {
+    f.panel = panel;
+    viewer.resize(f.full_width - panel, height);
+  }
+}
+
+}  // namespace
+
+bool toggle_legend(Viewer& viewer, ViewField& f) {
+  if (f.specs[f.current].empty()) return false;
+  if (!f.text) f.text = std::make_shared<const TextRenderer>(find_font_file());
+  if (!f.legend) f.full_width = viewer.framebuffer().width;
+  f.legend = !f.legend;
+  fit_legend(viewer, f);
+  return true;
+}
+
+Framebuffer presented(const Viewer& viewer, const ViewField& f) {
+  const Framebuffer& scene = viewer.framebuffer();
+  if (!f.legend || f.panel <= 0) return scene;
+  Framebuffer out(scene.width + f.panel, scene.height);
+  for (int y = 0; y < scene.height; ++y) {
+    std::copy_n(scene.rgba.begin() + std::ptrdiff_t(scene.index(0, y)), scene.width,
+                out.rgba.begin() + std::ptrdiff_t(out.index(0, y)));
+    std::copy_n(scene.id.begin() + std::ptrdiff_t(scene.index(0, y)), scene.width,
+                out.id.begin() + std::ptrdiff_t(out.index(0, y)));
+  }
+  draw_color_legend(out, *f.text, legend_of(f), PixelRect{scene.width, 0, out.width - 1, out.height - 1});
+  return out;
+}
+
 void apply_field(Viewer& viewer, ViewField& f) {
   const std::string& spec = f.specs[f.current];
   if (spec.empty()) {
     viewer.set_field(nullptr);
+    if (f.legend) fit_legend(viewer, f);  // region colours: no legend
     return;
   }
   const Mesh& mesh = viewer.mesh();
@@ -82,6 +137,7 @@ void apply_field(Viewer& viewer, ViewField& f) {
   f.unit = default_display_unit(f.choice.field->unit, std::max(std::abs(lo), std::abs(hi)));
   viewer.set_field(std::make_shared<const FieldPaint>(f.graded ? graded_field_paint(values, f.scale)
                                                                : flat_field_paint(values, f.scale)));
+  if (f.legend) fit_legend(viewer, f);  // another field's labels may need another width
 }
 
 void next_field(Viewer& viewer, ViewField& f) {
@@ -226,7 +282,7 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
     } else if (cmd == "b") {
       viewer.pop_region();
     } else if (cmd == "s") {
-      save_next(viewer, prefix, dump);
+      save_next(viewer, prefix, dump, &field);
     } else if (name == "orbit") {
       auto v = args(2);
       viewer.orbit(v[0], v[1]);
@@ -241,6 +297,13 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
     } else if (name == "iso" || name == "iso-only") {
       if (!set_iso(viewer, field, args(1)[0], name == "iso-only"))
         throw std::invalid_argument("script: '" + cmd + "' draws a field's isosurface: give --field or 'field' first");
+    } else if (cmd == "legend") {
+      if (!toggle_legend(viewer, field)) throw std::invalid_argument("script: 'legend' needs a field: give --field");
+      if (field.legend)
+        std::printf("legend on, %d pixels at the right\n", field.panel);
+      else
+        std::printf("legend off\n");
+      std::fflush(stdout);
     } else if (cmd == "noiso") {
       if (field.iso_on) toggle_iso(viewer, field);
     } else if (cmd == "field") {
@@ -252,7 +315,7 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       viewer.pan(v[0], v[1]);
     } else {
       throw std::invalid_argument("unknown script command '" + cmd +
-                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map iso:V iso-only:V noiso)");
+                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map iso:V iso-only:V noiso legend)");
     }
   }
 }

@@ -12,6 +12,8 @@
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/isosurface.hpp"
+#include "foxi/viz/legend.hpp"
+#include "foxi/viz/text.hpp"
 
 namespace foxi::view {
 
@@ -35,6 +37,11 @@ struct ViewField {
   std::vector<double> corner;  // the field's corner values (the IsoPainter's, lent to the view)
   std::shared_ptr<const TetIntervals> tree;
   IsoDrawing drawing;
+  // The legend (key l): a panel of `panel` pixels at the right of a picture `full_width` wide, the
+  // scene narrowed by it (the camera kept).
+  bool legend = false;
+  int panel = 0, full_width = 0;
+  std::shared_ptr<const TextRenderer> text;
 };
 
 // The specs of `mesh` ("" and its fields' names), `current` set to `spec` (NAME[:component], added
@@ -54,6 +61,12 @@ bool set_iso(Viewer& viewer, ViewField& field, double value, bool iso_only);
 void toggle_iso(Viewer& viewer, ViewField& field);
 void toggle_iso_only(Viewer& viewer, ViewField& field);
 void move_iso(Viewer& viewer, ViewField& field, double steps);
+// 'l': the legend on or off (with region colours there is none: false, nothing changes). Finds the
+// font (find_font_file) the first time; throws std::runtime_error if there is none.
+bool toggle_legend(Viewer& viewer, ViewField& field);
+// The picture as shown: the scene, beside the legend (field, unit, ticks, range, map, the isovalue
+// marked) when it is on.
+Framebuffer presented(const Viewer& viewer, const ViewField& field);
 // "temperature 53.2 °C at (x, y, z), tet 12, region 3" for pixel (x, y): the tet pick() shows there,
 // the point its front face shows at the pixel's centre (pixel_point_in_tet) and the field's value
 // there (field_value_in_tet); "background" where no tet shows. `digits`: significant digits.
@@ -66,6 +79,7 @@ std::string field_status(const ViewField& field);
 //   field / map  the keys f and m
 //   iso:V        the isosurface at V (display units) as the solid above it; iso-only:V the surface;
 //                noiso whole tets again (each restarts without drawing)
+//   legend       the key l; prints "legend on, P pixels at the right" or "legend off"
 //   d            restart and draw to completion      c      restart without drawing
 //   n            draw one batch                      f      finish the current draw
 //   r / b        push the drawn tets as region / back up   (each restarts without drawing)
@@ -77,6 +91,8 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
 
 // Saves the picture under the next free name PREFIX-NNN.png; prints "saved NAME camera ..." and
 // returns the path. With dump, also writes the id buffer and the drawn tets beside it.
-std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix, bool dump);
+// With `field`, the picture as presented (the legend beside it when on).
+std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix, bool dump,
+                                const ViewField* field = nullptr);
 
 }  // namespace foxi::view

@@ -190,7 +190,7 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
 
   std::printf(
       "foxi-view: %zu tets, %s, %s; keys: d draw, space stop/continue, n step, u undraw/draw on, r region, "
-      "b back, f field, m colour map, i isosurface, o solid/surface, [ ] isovalue, s save, "
+      "b back, f field, m colour map, l legend, i isosurface, o solid/surface, [ ] isovalue, s save, "
       "q quit; mouse: left orbit, right/wheel zoom, middle pan\n",
       viewer.mesh().tet_count(),
       viewer.delaunay() ? "Delaunay (painter, no depth buffer)" : "NOT Delaunay (depth-buffer drawing)",
@@ -214,7 +214,10 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
     // Only what changed since the last show, unless the window needs all of it.
     const Framebuffer& fb = viewer.framebuffer();
     const std::vector<PixelRect> damage = viewer.take_damage();
-    if (exposed)
+    if (field.legend) {  // the scene beside the legend, put whole
+      const Framebuffer shown = presented(viewer, field);
+      screen.put(win, gc, shown, PixelRect{0, 0, shown.width - 1, shown.height - 1});
+    } else if (exposed)
       screen.put(win, gc, fb, PixelRect{0, 0, fb.width - 1, fb.height - 1});
     else
       for (const PixelRect& rect : damage) screen.put(win, gc, fb, rect);
@@ -251,7 +254,8 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
           if (w > 0 && h > 0 && (w != width || h != height)) {
             width = w;
             height = h;
-            viewer.resize(w, h);
+            field.full_width = w;
+            viewer.resize(field.legend ? w - field.panel : w, h);
             viewer.set_running(true);
             changed = exposed = true;
           }
@@ -280,7 +284,8 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
           if (!button) {  // the value under the mouse on the status line
             while (XCheckTypedWindowEvent(dpy, win, MotionNotify, &ev)) {
             }
-            const bool inside = ev.xmotion.x >= 0 && ev.xmotion.y >= 0 && ev.xmotion.x < width && ev.xmotion.y < height;
+            const bool inside = ev.xmotion.x >= 0 && ev.xmotion.y >= 0 && ev.xmotion.x < viewer.framebuffer().width &&
+                                ev.xmotion.y < height;
             mouse_x = inside ? ev.xmotion.x : -1;
             mouse_y = inside ? ev.xmotion.y : -1;
             changed = true;
@@ -340,6 +345,16 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
               next_map(viewer, field);
               viewer.set_running(true);
               break;
+            case XK_l:
+              try {
+                if (toggle_legend(viewer, field)) {
+                  viewer.set_running(true);
+                  exposed = true;
+                }
+              } catch (const std::exception& e) {
+                std::fprintf(stderr, "foxi-view: no legend: %s\n", e.what());
+              }
+              break;
             case XK_i:
               toggle_iso(viewer, field);
               viewer.set_running(true);
@@ -355,7 +370,7 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
               break;
             case XK_s:
               try {
-                save_next(viewer, save_prefix, false);
+                save_next(viewer, save_prefix, false, &field);
               } catch (const std::exception& e) {
                 std::fprintf(stderr, "foxi-view: %s\n", e.what());
               }

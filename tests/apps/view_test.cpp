@@ -191,6 +191,25 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
   }
   EXPECT_NE(differing_pixels(read_png(dir_ / "iv-001.png"), read_png(dir_ / "iv-002.png")), 0u);
   EXPECT_EQ(differing_pixels(read_png(dir_ / "iv-003.png"), read_png(dir_ / "fr.png")), 0u);
+
+  // The legend key's script form: the scene narrowed by the panel, the legend beside it with the
+  // isovalue marked, as foxi render --iso 6 with the legend draws it given the viewer's camera.
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize + " --field u --graded --save " +
+                           q(dir_ / "lv") + " --script 'legend iso:6 d s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  std::smatch cm;
+  ASSERT_TRUE(std::regex_search(out, cm, std::regex("legend on, ([0-9]+) pixels at the right"))) << out;
+  ASSERT_TRUE(std::regex_search(out, cm, std::regex("\\((--eye [^)]*)\\)"))) << out;
+  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(dir_ / "f.vtu") + " " + kSize + " " + std::string(cm[1]) +
+                           " --field u --graded --iso 6 -o " + q(dir_ / "lr.png"),
+                       dir_ / "render.log", &out),
+            0)
+      << out;
+  const Framebuffer lv = read_png(dir_ / "lv-001.png");
+  EXPECT_EQ(lv.width, 320);
+  EXPECT_EQ(differing_pixels(lv, read_png(dir_ / "lr.png")), 0u);
 }
 
 // Undraw in the viewer's state machine: draw all, undraw 360 of the 720 tets, and the picture (and
