@@ -184,6 +184,34 @@ TEST_F(MovieSweepCli, PvdCollectionStepsAreTheFrames) {
   for (int k = 0; k < 3; ++k) EXPECT_TRUE(same_rgb(frame("pvd", k), frame("vtu", k))) << "step " << k;
 }
 
+// --threshold narrows the back-and-forth movie too: its high point is foxi render --threshold's picture;
+// --deform with a sweep: each frame foxi render --deform --iso's (the deformed mesh drawn with the
+// depth buffer), while the back-and-forth movie, which needs the visibility order, refuses it.
+TEST_F(MovieSweepCli, ThresholdInBackAndForthAndDeformInSweeps) {
+  const std::string common = p("grid.vtu") + " --field temperature --size 200x150 --legend off";
+  std::string out;
+  ASSERT_EQ(foxi("movie " + common + " --threshold 40,70 --frames 6 -o " + p("bf/f_%d.png"), &out), 0) << out;
+  ASSERT_EQ(foxi("render " + common + " --threshold 40,70 -o " + p("r.png"), &out), 0) << out;
+  EXPECT_TRUE(same_rgb(frame("bf", 3), read_png(dir_ / "r.png")));
+  EXPECT_TRUE(blank(frame("bf", 0), 200));
+
+  Mesh m = mesh;  // a shear: u = (0.05 z, 0, 0)
+  Field d{"displacement", FieldLocation::node, 3, "m", {}, {}};
+  for (std::size_t n = 0; n < m.node_count(); ++n) d.values.insert(d.values.end(), {0.05 * m.xyz[3 * n + 2], 0, 0});
+  m.fields.push_back(d);
+  write_mesh(m, dir_ / "d.vtu");
+  const std::string dcommon = p("d.vtu") + " --field temperature --size 200x150 --legend off --deform displacement:2";
+  ASSERT_EQ(foxi("movie " + dcommon + " --sweep iso:40,90 --frames 3 -o " + p("dv/f_%d.png"), &out), 0) << out;
+  EXPECT_NE(out.find("with the depth buffer"), std::string::npos) << out;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_EQ(foxi("render " + dcommon + " --iso " + std::to_string(40 + 25 * k) + " -o " + p("r.png"), &out), 0) << out;
+    EXPECT_TRUE(same_rgb(frame("dv", k), read_png(dir_ / "r.png"))) << "frame " << k;
+  }
+  EXPECT_EQ(foxi("movie " + dcommon + " -o " + p("bfd.gif"), &out), 3) << out;
+  EXPECT_NE(out.find("fails the Delaunay certificate"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "bfd.gif"));
+}
+
 TEST_F(MovieSweepCli, BadSweepsAreUsageErrors) {
   const std::string g = p("grid.vtu") + " ";
   const std::string o = " -o " + p("m.gif");
