@@ -212,6 +212,28 @@ TEST_F(MovieSweepCli, ThresholdInBackAndForthAndDeformInSweeps) {
   EXPECT_FALSE(std::filesystem::exists(dir_ / "bfd.gif"));
 }
 
+// The transient solver's own output: one frame per data set of its .pvd, each foxi render --step k
+// of the same collection with the same --range.
+TEST_F(MovieSweepCli, TransientPvdOutputSteps) {
+  std::string out;
+  ASSERT_EQ(foxi("solve '" + test::models_dir() + "die_on_substrate.toml' --physics transient --time 1 --steps 4 -o " +
+                     p("run.pvd"),
+                 &out),
+            0)
+      << out;
+  const std::string common = p("run.pvd") + " --field temperature --graded --range 25,90 --size 240x160";
+  ASSERT_EQ(foxi("movie " + common + " --sweep steps -o " + p("tr/f_%d.png"), &out), 0) << out;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("steps of temperature, ([0-9]+) frames"))) << out;
+  const int n = std::stoi(m[1]);
+  EXPECT_EQ(n, 5) << "the start and 4 steps";
+  for (int k = 0; k < n; ++k) {
+    ASSERT_EQ(foxi("render " + common + " --step " + std::to_string(k) + " -o " + p("r.png"), &out), 0) << out;
+    EXPECT_TRUE(same_rgb(frame("tr", k), read_png(dir_ / "r.png"))) << "step " << k;
+  }
+  EXPECT_FALSE(same_rgb(frame("tr", 0), frame("tr", n - 1))) << "the die heats up";
+}
+
 TEST_F(MovieSweepCli, BadSweepsAreUsageErrors) {
   const std::string g = p("grid.vtu") + " ";
   const std::string o = " -o " + p("m.gif");
