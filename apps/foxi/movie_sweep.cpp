@@ -48,6 +48,8 @@ void check_sweep_options(const Sweep& sweep, const FieldOptions& field, const Is
                      "sweep them with --sweep iso:a,b or --sweep steps");
   if (sweep.kind == K::iso && (!iso.iso.empty() || iso.slice))
     throw UsageError("--sweep iso:a,b gives each frame its isovalue: leave out --iso and --slice");
+  if (sweep.kind == K::steps && field.step >= 0)
+    throw UsageError("--sweep steps draws every step of the field: leave out --step");
   if (sweep.kind == K::threshold && (iso.has_threshold || iso.slice))
     throw UsageError("--sweep threshold:a,b gives each frame its threshold: leave out --threshold and --slice");
 }

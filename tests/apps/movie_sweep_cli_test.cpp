@@ -250,6 +250,7 @@ TEST_F(MovieSweepCli, BadSweepsAreUsageErrors) {
   refused("--field temperature --sweep threshold:1,2 --threshold 0,3", "leave out --threshold");
   refused("--field temperature --sweep iso:1,2 --mode rotate", "in place of --mode");
   refused("--field u --sweep steps --frames 4", "leave out --frames");
+  refused("--field u --sweep steps --step 1", "leave out --step");
   refused("--field temperature --sweep steps", "has one step");
   refused("--field temperature --iso 50", "--sweep iso:a,b");
   refused("--field temperature --sweep iso:1,2 --cycles 2", "belong to --mode");
