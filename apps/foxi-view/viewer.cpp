@@ -304,6 +304,9 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       else
         std::printf("legend off\n");
       std::fflush(stdout);
+    } else if (cmd == "i") {  // the key: on at the middle of the range, or off
+      if (field.specs[field.current].empty()) throw std::invalid_argument("script: 'i' needs a field: give --field");
+      toggle_iso(viewer, field);
     } else if (cmd == "noiso") {
       if (field.iso_on) toggle_iso(viewer, field);
     } else if (cmd == "field") {
@@ -315,7 +318,7 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       viewer.pan(v[0], v[1]);
     } else {
       throw std::invalid_argument("unknown script command '" + cmd +
-                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map iso:V iso-only:V noiso legend)");
+                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map i iso:V iso-only:V noiso legend)");
     }
   }
 }

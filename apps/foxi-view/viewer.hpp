@@ -78,7 +78,7 @@ std::string field_status(const ViewField& field);
 //   probe:X,Y    print "probe X,Y: " and value_under(X, Y) (9 digits)
 //   field / map  the keys f and m
 //   iso:V        the isosurface at V (display units) as the solid above it; iso-only:V the surface;
-//                noiso whole tets again (each restarts without drawing)
+//                noiso whole tets again, i the key i (each restarts without drawing)
 //   legend       the key l; prints "legend on, P pixels at the right" or "legend off"
 //   d            restart and draw to completion      c      restart without drawing
 //   n            draw one batch                      f      finish the current draw

@@ -465,6 +465,68 @@ exit 0
 
 // SIGTERM and SIGHUP to the window (a job scheduler, a closed terminal): the viewer stops with exit
 // 143 / 129 and says so, as the foxi commands do, leaving nothing in its save folder.
+// The field keys in the real window: l (legend), i (isosurface at the middle of the range), m (next
+// colour map), s; the saved picture and the window's screenshot equal the headless script's
+// 'legend i map d s'.
+TEST_F(ViewTest, FieldKeysInTheWindowUnderXvfb) {
+  if (!test::have_program("xvfb-run") || !test::have_program("xdotool"))
+    GTEST_SKIP() << "xvfb-run or xdotool is missing (scripts/install-deps.sh installs them)";
+  Mesh m = two_region_grid();
+  Field u{"u", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < m.node_count(); ++n) u.values.push_back(m.xyz[3 * n] + 0.5 * m.xyz[3 * n + 2]);
+  m.fields = {u};
+  write_mesh(m, dir_ / "f.vtu");
+  const std::string driver = R"SH(set -u
+V=$1; M=$2; D=$3
+"$V" "$M" --size 320x240 --field u --graded --save "$D/k" > "$D/window.log" 2>&1 &
+pid=$!
+trap 'kill -9 $pid 2>/dev/null' EXIT
+wait_for() { i=0; while [ $i -lt 100 ]; do [ "$(grep -c "$1" "$D/window.log")" -ge "$2" ] && return 0; kill -0 $pid 2>/dev/null || return 1; sleep 0.1; i=$((i+1)); done; echo "timeout waiting for $1"; return 1; }
+wid=$(timeout 10 xdotool search --sync --name '^foxi-view$' | head -1)
+[ -n "$wid" ] || { echo "no window"; exit 3; }
+wait_for '^done' 1 || exit 4
+xdotool key --window "$wid" l
+wait_for '^done' 2 || exit 5
+xdotool key --window "$wid" i
+wait_for '^done' 3 || exit 5
+xdotool key --window "$wid" m
+wait_for '^done' 4 || exit 5
+xdotool key --window "$wid" s
+wait_for '^saved' 1 || exit 6
+if command -v xwd > /dev/null; then xwd -silent -id "$wid" > "$D/kshot.xwd" || exit 8; fi
+xdotool key --window "$wid" q 2>/dev/null
+i=0; while kill -0 $pid 2>/dev/null && [ $i -lt 50 ]; do sleep 0.1; i=$((i+1)); done
+kill -0 $pid 2>/dev/null && { echo "viewer did not quit"; exit 7; }
+wait $pid; rc=$?
+[ $rc -eq 0 ] || { echo "viewer exit status $rc"; cat "$D/window.log"; exit 9; }
+trap - EXIT
+exit 0
+)SH";
+  test::write_text(dir_ / "drive.sh", driver);
+  std::string out;
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " --size 320x240 --field u --graded --save " +
+                           q(dir_ / "h") + " --script 'legend i map d s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  const Framebuffer headless = read_png(dir_ / "h-001.png");
+  const int status = run_logged("timeout -k 5 40 xvfb-run -a -s '-screen 0 640x480x24' sh " + q(dir_ / "drive.sh") + " " +
+                                    q(view_path()) + " " + q(dir_ / "f.vtu") + " " + q(dir_.path()),
+                                dir_ / "xvfb.log", &out);
+  ASSERT_EQ(status, 0) << out << test::read_text(dir_ / "window.log");
+  ASSERT_TRUE(std::filesystem::exists(dir_ / "k-001.png")) << test::read_text(dir_ / "window.log");
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "k-001.png"), headless), 0u);
+  EXPECT_EQ(headless.width, 320);
+  if (!test::have_program("xwd")) GTEST_SKIP() << "xwd is missing: the screenshot comparison is skipped";
+  Framebuffer shot;
+  ASSERT_TRUE(read_xwd(dir_ / "kshot.xwd", shot)) << "cannot read the xwd screenshot";
+  ASSERT_EQ(shot.width, 320);
+  Framebuffer top(320, 240);
+  for (int y = 0; y < 240; ++y)
+    std::copy_n(shot.rgba.begin() + std::ptrdiff_t(y) * 320, 320, top.rgba.begin() + std::ptrdiff_t(y) * 320);
+  EXPECT_EQ(differing_pixels(top, headless), 0u) << "the window shows the scene beside the legend";
+}
+
 TEST_F(ViewTest, WindowStopsCleanlyOnSigtermAndSighup) {
   if (!test::have_program("xvfb-run")) GTEST_SKIP() << "xvfb-run is missing (scripts/install-deps.sh installs it)";
   const std::string driver = R"SH(set -u
