@@ -36,6 +36,11 @@ echo
 "$foxi" render "$out/die_on_substrate_thermal.vtu" --field temperature --graded --stop 60% --size 1280x960 \
   -o "$out/die_on_substrate_temperature.png"
 echo
+# Field movies: the solid hotter than an isotherm swept from 30 to 70 °C, cut at the isotherm (each
+# frame what foxi render --iso draws; only the tets the isovalue reaches are ordered and drawn).
+"$foxi" movie "$out/die_on_substrate_thermal.vtu" --field temperature --graded --sweep iso:30,70 --frames 12 \
+  --size 640x400 -o "$out/die_on_substrate_isotherms.gif"
+echo
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.vtu"
 "$foxi" convert "$out/die_on_substrate.node" "$out/die_on_substrate.msh"
 "$foxi" info "$out/die_on_substrate.msh" --json > "$out/die_on_substrate.json"
@@ -49,5 +54,6 @@ echo
 echo "demo: wrote $out/flip_chip.png, $out/flip_chip_parts.png, $out/flip_chip_temperature.png,"
 echo "      $out/flip_chip_isotherm.png, $out/flip_chip_isotherms.gif and $out/flip_chip_von_mises.png (foxi demo),"
 echo "      $out/power_module_parts.png, $out/die_on_substrate_temperature.png (the solved temperature inside),"
+echo "      $out/die_on_substrate_isotherms.gif (an isotherm swept as a movie),"
 echo "demo: wrote $out/die_on_substrate.png (the mesh inside), $out/die_on_substrate_thermal.vtu (temperature and"
 echo "      heat flux, for ParaView), $out/die_on_substrate.vtu and .msh (the mesh), $out/die_on_substrate.json"
