@@ -103,25 +103,9 @@ struct IsoPainter::Impl {
     }
     std::int64_t X[kMaxPoly], Y[kMaxPoly];
     double px[kMaxPoly][2], w[kMaxPoly];
-    for (int i = 0; i < n; ++i) {
-      proj.camera_to_pixel(v[i].c, px[i]);
-      X[i] = to_fixed(px[i][0]);
-      Y[i] = to_fixed(px[i][1]);
-      px[i][0] = double(X[i]) / double(kOne);  // interpolate from the snapped vertices
-      px[i][1] = double(Y[i]) / double(kOne);
-      w[i] = proj.perspective ? 1 / v[i].c[2] : -v[i].c[2];
-    }
+    snap_polygon(proj, n, [&](int i) { return v[i].c; }, X, Y, px, w);
     if (rows.thread == 0) ++polygons;
-    for (int i = 1; i + 1 < n; ++i) {
-      int idx[3] = {0, i, i + 1};
-      std::int64_t TX[3] = {X[0], X[i], X[i + 1]}, TY[3] = {Y[0], Y[i], Y[i + 1]};
-      const std::int64_t area = (TX[1] - TX[0]) * (TY[2] - TY[0]) - (TY[1] - TY[0]) * (TX[2] - TX[0]);
-      if (area == 0) continue;
-      if (area < 0) {
-        std::swap(TX[1], TX[2]);
-        std::swap(TY[1], TY[2]);
-        std::swap(idx[1], idx[2]);
-      }
+    for_each_fan_triangle(X, Y, n, [&](const std::int64_t* TX, const std::int64_t* TY, const int* idx) {
       // Affine functions on the screen: nearness, and position x nearness (perspective-correct).
       const double x0 = px[idx[0]][0], y0 = px[idx[0]][1];
       const double ax = px[idx[1]][0] - x0, ay = px[idx[1]][1] - y0;
@@ -170,7 +154,7 @@ struct IsoPainter::Impl {
           fb.id[p] = tet;
         }
       });
-    }
+    });
   }
 
   // Camera-frame direction of world direction d.

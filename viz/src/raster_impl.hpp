@@ -213,6 +213,42 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
   }
 }
 
+// Projects the n camera-frame points cam(i) (in front of the eye) of a polygon: their corners in
+// fixed point (X, Y), the snapped positions in pixels px (what the painters interpolate from) and
+// their nearness w (1 / depth perspective, -depth orthographic).
+template <class Cam>
+void snap_polygon(const Projector& proj, int n, Cam&& cam, std::int64_t* X, std::int64_t* Y, double (*px)[2],
+                  double* w) {
+  for (int i = 0; i < n; ++i) {
+    const double* c = cam(i);
+    proj.camera_to_pixel(c, px[i]);
+    X[i] = to_fixed(px[i][0]);
+    Y[i] = to_fixed(px[i][1]);
+    px[i][0] = double(X[i]) / double(kOne);  // interpolate from the snapped vertices
+    px[i][1] = double(Y[i]) / double(kOne);
+    w[i] = proj.perspective ? 1 / c[2] : -c[2];
+  }
+}
+
+// Calls fn(TX, TY, idx) for each triangle (0, i, i + 1) of the fan of a convex polygon of n vertices in
+// fixed point that has positive area on the screen, its corners reordered clockwise as raster_triangle
+// wants (idx: the polygon vertices they are). The iso and translucent painters draw polygons so.
+template <class Fn>
+void for_each_fan_triangle(const std::int64_t* X, const std::int64_t* Y, int n, Fn&& fn) {
+  for (int i = 1; i + 1 < n; ++i) {
+    int idx[3] = {0, i, i + 1};
+    std::int64_t TX[3] = {X[0], X[i], X[i + 1]}, TY[3] = {Y[0], Y[i], Y[i + 1]};
+    const std::int64_t area = (TX[1] - TX[0]) * (TY[2] - TY[0]) - (TY[1] - TY[0]) * (TX[2] - TX[0]);
+    if (area == 0) continue;
+    if (area < 0) {
+      std::swap(TX[1], TX[2]);
+      std::swap(TY[1], TY[2]);
+      std::swap(idx[1], idx[2]);
+    }
+    fn(TX, TY, idx);
+  }
+}
+
 struct PolyVertex {
   double c[3] = {0, 0, 0};  // camera coordinates (near-plane cuts only)
   std::int64_t X = 0, Y = 0;
