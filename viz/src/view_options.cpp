@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -125,6 +126,39 @@ std::vector<std::uint32_t> parse_subset(const Mesh& mesh, std::string_view spec_
   }
   if (subset.empty()) throw OptionError("the subset '" + spec + "' selects no tets");
   return subset;
+}
+
+double parse_opacity(std::string_view text, std::string_view what) {
+  const std::string s(text);
+  char* end = nullptr;
+  const double a = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || !(a >= 0 && a <= 1))
+    throw OptionError(std::string(what) + " takes an opacity from 0 (invisible) to 1 (opaque), not '" + s + "'");
+  return a;
+}
+
+std::vector<RegionOpacity> parse_region_opacity(const Mesh& mesh, std::string_view text) {
+  std::vector<RegionOpacity> out;
+  const std::string s(text);
+  std::size_t pos = 0;
+  while (pos <= s.size()) {
+    const std::size_t comma = s.find(',', pos);
+    const std::string part = s.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    // The last '=' splits, so a region name may hold one.
+    const std::size_t eq = part.rfind('=');
+    if (eq == std::string::npos || eq == 0)
+      throw OptionError("--region-opacity takes REGION=a,... (a region id or name and an opacity in [0, 1]), not '" +
+                        part + "'");
+    const std::string key = part.substr(0, eq);
+    const std::optional<std::int32_t> id = region_id_of(mesh, key);
+    if (!id) throw OptionError("--region-opacity: the mesh has no region '" + key + "'");
+    for (const RegionOpacity& r : out)
+      if (r.region == *id) throw OptionError("--region-opacity: region '" + key + "' given twice");
+    out.push_back({*id, parse_opacity(part.substr(eq + 1), "--region-opacity " + key + "=")});
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  return out;
 }
 
 }  // namespace foxi

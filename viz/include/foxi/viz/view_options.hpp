@@ -14,6 +14,7 @@
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/translucent.hpp"
 
 namespace foxi {
 
@@ -58,5 +59,12 @@ FOXI_API std::vector<std::uint32_t> tets_of_regions(const Mesh& mesh, std::strin
 // drawn with std::mt19937(seed)) or "box:x0,y0,z0,x1,y1,z1" (tets whose centroid lies in the box),
 // in index order; OptionError (naming --subset) for another form or a subset with no tets.
 FOXI_API std::vector<std::uint32_t> parse_subset(const Mesh& mesh, std::string_view spec, unsigned seed);
+
+// An opacity in [0, 1] (--iso-opacity); `what` names the option in the error.
+FOXI_API double parse_opacity(std::string_view text, std::string_view what);
+
+// "REGION=a,REGION=a,...": each REGION a region id or name of the mesh (region_id_of) and a an opacity
+// in [0, 1] (--region-opacity); OptionError for a malformed entry, an unknown name, a region given twice.
+FOXI_API std::vector<RegionOpacity> parse_region_opacity(const Mesh& mesh, std::string_view text);
 
 }  // namespace foxi

@@ -1,0 +1,116 @@
+// foxi render --region-opacity / --iso-opacity end to end. A slab of three regions along x seen from
+// above (orthographic): over a region of opacity a, a pixel shows its bottom face blended over the
+// white background and its top face over that (both flat, facing the eye, the same Lambert factor),
+// computed here by hand; an opaque region its shaded colour; a region of opacity 0 nothing. The
+// options take region ids or names; malformed ones and combinations it does not draw exit 2.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/viz/png.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "test_util.hpp"
+#include "viz/mesh_factory.hpp"
+
+namespace foxi {
+namespace {
+
+class TranslucentCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mesh = test::grid_mesh(9, 4, 2, 1, 1, 0.5, 6);
+    test::regions_along_x(mesh, 3, 6);
+    mesh.regions = {{1, "mould", kNone}, {2, "die", kNone}, {3, "substrate", kNone}};
+    Field t{"temperature", FieldLocation::node, 1, "K", {}, {}};
+    for (std::size_t n = 0; n < mesh.node_count(); ++n) t.values.push_back(300 + 10 * mesh.xyz[3 * n]);
+    mesh.fields = {t};
+    path_ = dir_ / "slab.vtu";
+    write_mesh(mesh, path_);
+  }
+  int foxi(const std::string& args, std::string* out = nullptr) {
+    const int status = test::run("'" + test::cli_path() + "' render '" + path_.string() + "' " + args, dir_ / "log.txt");
+    if (out) *out = test::read_text(dir_ / "log.txt");
+    return status;
+  }
+  Mesh mesh;
+  test::TempDir dir_;
+  std::filesystem::path path_;
+};
+
+// The painter's Lambert factor of a face whose normal points straight at an orthographic eye.
+double facing_shade() {
+  const double l[3] = {-0.3, 0.45, -1};
+  const double s = 1 / std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+  return 0.3 + 0.7 * s;
+}
+
+std::size_t count_near(const Framebuffer& fb, const double want[3]) {
+  std::size_t n = 0;
+  for (std::uint32_t p : fb.rgba) {
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) ok &= std::abs(double((p >> (8 * k)) & 255u) - want[k]) <= 1.0;
+    n += ok;
+  }
+  return n;
+}
+
+TEST_F(TranslucentCli, TopViewShowsHandBlendedLayers) {
+  const auto png = dir_ / "x.png";
+  std::string log;
+  ASSERT_EQ(foxi("--region-opacity mould=0.4,3=0 --dir 0,0,-1 --up 0,1,0 --size 180x120 -o '" + png.string() + "'", &log), 0)
+      << log;
+  EXPECT_NE(log.find("composited back to front in the power order"), std::string::npos) << log;
+  const Framebuffer fb = read_png(png);
+  const double shade = facing_shade();
+  double mould[3], die[3], white[3] = {255, 255, 255};
+  for (int k = 0; k < 3; ++k) {
+    const double c = double((region_color(1) >> (8 * k)) & 255u) * shade;
+    double x = 255;
+    x = c * 0.4 + x * 0.6;  // the bottom face
+    x = c * 0.4 + x * 0.6;  // the top face
+    mould[k] = x;
+    die[k] = double((region_color(2) >> (8 * k)) & 255u) * shade;
+  }
+  // The slab is 9 x 4 seen from above, fitted to 180x120: each third of it covers a block of pixels.
+  const std::size_t n_mould = count_near(fb, mould), n_die = count_near(fb, die), n_white = count_near(fb, white);
+  EXPECT_GT(n_mould, 1500u);
+  EXPECT_GT(n_die, 1500u);
+  EXPECT_GT(n_white, 1500u) << "the substrate is left out (opacity 0), the background shows";
+  // Nothing else but the edges between the blocks (a pixel column or two).
+  EXPECT_GT(n_mould + n_die + n_white, fb.rgba.size() - 3 * 120u);
+}
+
+TEST_F(TranslucentCli, TranslucentIsosurfacesAreDrawn) {
+  const auto png = dir_ / "iso.png";
+  std::string log;
+  ASSERT_EQ(foxi("--field temperature --iso 40,70 --iso-opacity 0.5 --legend off --size 160x120 -o '" +
+                     png.string() + "'",
+                 &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("isosurfaces opacity 0.5"), std::string::npos) << log;  // (display units: °C)
+  const Framebuffer fb = read_png(png);
+  std::size_t drawn = 0;
+  for (std::uint32_t p : fb.rgba) drawn += (p & 0xffffffu) != 0xffffffu;
+  EXPECT_GT(drawn, 500u);
+}
+
+TEST_F(TranslucentCli, BadOptionsExitWithUsage) {
+  const std::string out = " -o '" + (dir_ / "bad.png").string() + "'";
+  std::string log;
+  EXPECT_EQ(foxi("--region-opacity nosuch=0.5" + out, &log), 2);
+  EXPECT_NE(log.find("no region 'nosuch'"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--region-opacity die=1.5" + out, &log), 2);
+  EXPECT_NE(log.find("opacity from 0"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--region-opacity die" + out, &log), 2);
+  EXPECT_EQ(foxi("--region-opacity die=0.5,die=0.2" + out, &log), 2);
+  EXPECT_EQ(foxi("--iso-opacity 0.5" + out, &log), 2);
+  EXPECT_NE(log.find("give --iso"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--region-opacity die=0.5 --stop 50%" + out, &log), 2);
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
+}
+
+}  // namespace
+}  // namespace foxi
