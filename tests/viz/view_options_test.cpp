@@ -17,6 +17,30 @@
 namespace foxi {
 namespace {
 
+TEST(ViewOptions, RegionOpacitiesByIdOrName) {
+  Mesh m = test::grid_mesh(4, 3, 2, 1.0, 1.0, 1.0, 5);
+  test::regions_along_x(m, 1.0, 3.0);
+  m.regions = {{1, "mould", kNone}, {2, "die=2", kNone}, {3, "bumps", kNone}};
+  const std::vector<RegionOpacity> r = parse_region_opacity(m, "mould=0.25,3=1,die=2=0");
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[0].region, 1);
+  EXPECT_EQ(r[0].opacity, 0.25);
+  EXPECT_EQ(r[1].region, 3);
+  EXPECT_EQ(r[1].opacity, 1.0);
+  EXPECT_EQ(r[2].region, 2) << "the last '=' splits: a name may hold one";
+  EXPECT_EQ(r[2].opacity, 0.0);
+  EXPECT_THROW(parse_region_opacity(m, "mould"), OptionError);
+  EXPECT_THROW(parse_region_opacity(m, "=0.5"), OptionError);
+  EXPECT_THROW(parse_region_opacity(m, "nosuch=0.5"), OptionError);
+  EXPECT_THROW(parse_region_opacity(m, "mould=1.01"), OptionError);
+  EXPECT_THROW(parse_region_opacity(m, "mould=nan"), OptionError);
+  EXPECT_THROW(parse_region_opacity(m, "mould=0.5,1=0.2"), OptionError) << "region 1 twice";
+  EXPECT_THROW(parse_region_opacity(m, "mould=0.5,"), OptionError);
+  EXPECT_EQ(parse_opacity("0.5", "--iso-opacity"), 0.5);
+  EXPECT_THROW(parse_opacity("-0.1", "--iso-opacity"), OptionError);
+  EXPECT_THROW(parse_opacity("", "--iso-opacity"), OptionError);
+}
+
 TEST(ViewOptions, SubsetsOfAGrid) {
   Mesh m = test::grid_mesh(4, 3, 2, 1.0, 1.0, 1.0, 5);  // 24 unit cells, 5 tets each
   test::regions_along_x(m, 1.0, 3.0);                   // x in [0,1]: 1, [1,3]: 2, [3,4]: 3

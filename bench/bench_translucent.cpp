@@ -1,0 +1,162 @@
+// Translucent regions (issue 23 item 1) against the opaque frame, in the same run: TetGen's 0.97M-tet
+// box at 1920x1080, a new view per iteration (the camera turns by 7 degrees), wall clock per frame.
+//   opaque_frame          the whole mesh ordered (visibility_order_into) and drawn by the tet painter
+//                         (TetRasterizer, front faces, no blending): the picture foxi render draws
+//   translucent_frame/S   the tets owning a face to draw ordered (visibility_order_into of
+//                         TranslucentSurfaces::tets) and composited by TranslucentPainter, the picture
+//                         resolved to 8 bits; the surfaces themselves (view-independent) are found once
+//                         per mesh, outside the timing (surfaces_ms)
+// S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
+//        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
+//        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
+//        resolve), and on translucent_frame opaque_ms (the opaque frame of the same views, timed in the
+//        same iterations) and ratio (translucent / opaque).
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "bench_meshes.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/translucent.hpp"
+#include "foxi/viz/visibility_order.hpp"
+
+namespace {
+
+using namespace foxi;
+
+constexpr int kWidth = 1920, kHeight = 1080;
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct Case {
+  Mesh mesh[2];
+  SphereTable table;
+  Camera camera;
+  TranslucentParams params[2];
+  TranslucentSurfaces surfaces[2];
+  double surfaces_ms[2] = {};
+};
+
+Case& get_case() {
+  static std::unique_ptr<Case> c;
+  if (c) return *c;
+  c = std::make_unique<Case>();
+  Mesh box = bench::tetgen_box_mesh(2, 1, 1, 4e-6);
+  c->table = compute_spheres(box);
+  double lo[3], hi[3];
+  mesh_bounds(box, lo, hi);
+  const double dir[3] = {-1.0, 1.6, -0.9}, up[3] = {0, 0, 1};
+  c->camera = fit_camera(lo, hi, dir, up, true, 30, double(kWidth) / kHeight, 0.95);
+  const std::size_t n = box.tet_count();
+  for (int s = 0; s < 2; ++s) {
+    c->mesh[s] = box;
+    Mesh& m = c->mesh[s];
+    m.tet_region.assign(n, 1);
+    for (std::size_t t = 0; t < n; ++t) {
+      double x[3] = {0, 0, 0};
+      for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 3; ++j) x[j] += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * t + std::size_t(k)]) + std::size_t(j)];
+      if (s == 0) {
+        if (std::abs(x[0] - 1) < 0.35 && std::abs(x[1] - 0.5) < 0.25 && std::abs(x[2] - 0.5) < 0.08) m.tet_region[t] = 2;
+        for (int b = 0; b < 8; ++b) {
+          const double bx = 0.3 + 0.2 * b, by = b % 2 ? 0.2 : 0.8, bz = 0.25;
+          if ((x[0] - bx) * (x[0] - bx) + (x[1] - by) * (x[1] - by) + (x[2] - bz) * (x[2] - bz) < 0.01)
+            m.tet_region[t] = 3;
+        }
+      } else {
+        m.tet_region[t] = 1 + std::min(9, int(x[0] * 5));
+      }
+    }
+    TranslucentParams& p = c->params[s];
+    if (s == 0) {
+      p.region_opacity = {{1, 0.3}, {2, 1.0}, {3, 0.8}};
+    } else {
+      for (int r = 1; r <= 10; ++r) p.region_opacity.push_back({r, 0.05 + 0.09 * r});
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    c->surfaces[s] = translucent_surfaces(m, {}, p);
+    c->surfaces_ms[s] = ms_since(t0);
+  }
+  return *c;
+}
+
+struct Timing {
+  double order_ms = 0, draw_ms = 0;
+  double total() const { return order_ms + draw_ms; }
+};
+
+void opaque_frame(Case& c, const Camera& cam, Framebuffer& fb, std::vector<std::uint32_t>& order, Timing& t) {
+  auto t0 = std::chrono::steady_clock::now();
+  visibility_order_into(order, c.mesh[0], c.table, view_of(cam));
+  t.order_ms += ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  fb.clear();
+  TetRasterizer raster(c.mesh[0], cam, kWidth, kHeight);
+  raster.draw(fb, order);
+  t.draw_ms += ms_since(t0);
+}
+
+std::size_t translucent_frame(Case& c, int s, const Camera& cam, Framebuffer& fb, std::vector<std::uint32_t>& order,
+                              Timing& t) {
+  auto t0 = std::chrono::steady_clock::now();
+  visibility_order_into(order, c.mesh[s], c.table, view_of(cam), c.surfaces[s].tets);
+  t.order_ms += ms_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  TranslucentPainter painter(c.mesh[s], cam, kWidth, kHeight, c.surfaces[s], c.params[s]);
+  painter.draw(order);
+  painter.resolve(fb);
+  t.draw_ms += ms_since(t0);
+  return painter.fragment_count();
+}
+
+void BM_opaque_frame(benchmark::State& state) {
+  Case& c = get_case();
+  Framebuffer fb(kWidth, kHeight);
+  std::vector<std::uint32_t> order;
+  Timing t;
+  int i = 0;
+  for (auto _ : state) opaque_frame(c, orbit(c.camera, 7.0 * i++, 0), fb, order, t);
+  const double iters = double(state.iterations());
+  state.counters["order_ms"] = t.order_ms / iters;
+  state.counters["draw_ms"] = t.draw_ms / iters;
+  state.counters["tets"] = double(c.mesh[0].tet_count());
+}
+
+void BM_translucent_frame(benchmark::State& state) {
+  Case& c = get_case();
+  const int s = int(state.range(0));
+  Framebuffer fb(kWidth, kHeight), opaque(kWidth, kHeight);
+  std::vector<std::uint32_t> order;
+  Timing t, base;
+  std::size_t fragments = 0;
+  int i = 0;
+  for (auto _ : state) {
+    const Camera cam = orbit(c.camera, 7.0 * i++, 0);
+    fragments += translucent_frame(c, s, cam, fb, order, t);
+    state.PauseTiming();
+    opaque_frame(c, cam, opaque, order, base);
+    state.ResumeTiming();
+  }
+  const double iters = double(state.iterations());
+  state.counters["surface_tets"] = double(c.surfaces[s].tets.size());
+  state.counters["surfaces_ms"] = c.surfaces_ms[s];
+  state.counters["fragments"] = double(fragments) / iters;
+  state.counters["order_ms"] = t.order_ms / iters;
+  state.counters["draw_ms"] = t.draw_ms / iters;
+  state.counters["opaque_ms"] = base.total() / iters;
+  state.counters["ratio"] = t.total() / base.total();
+  state.SetLabel(s == 0 ? "package" : "10 slabs");
+}
+
+BENCHMARK(BM_opaque_frame)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_translucent_frame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+}  // namespace
+
+BENCHMARK_MAIN();
