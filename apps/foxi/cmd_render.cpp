@@ -59,7 +59,8 @@ const std::string kRenderUsage = std::string(
   "                  which is exact for a Delaunay mesh. A mesh without the certificate has no such\n"
   "                  order: its fragments are collected and sorted per pixel by depth instead (said\n"
   "                  so; memory grows with the fragments). With --iso, the isosurfaces translucent\n"
-  "                  inside. Not with --stop, --depth, --zbuffer, --threshold, --clip, --slice\n"
+  "                  inside. Not with --stop, --depth, --zbuffer, --threshold, --clip, --slice,\n"
+  "                  --shrink, --markers; a field colours only the isosurfaces\n"
   "  --iso-opacity a every isosurface of --iso translucent with opacity a, all nested ones seen at\n"
   "                  once (with --region-opacity inside the translucent regions, else alone)\n"
   "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused\n"
@@ -92,9 +93,12 @@ int cmd_render(Args args) {
     if (iso_options.iso.empty()) throw UsageError("--iso-opacity makes the isosurfaces of --iso translucent: give --iso");
   }
   if (translucent && (!stop_s.empty() || !depth_s.empty() || zbuffer || iso_options.has_threshold ||
-                      iso_options.clip || iso_options.slice))
+                      iso_options.clip || iso_options.slice || options.params.shrink != 1 || field_options.markers))
     throw UsageError("--region-opacity and --iso-opacity draw the whole picture translucent: leave out --stop, "
-                     "--depth, --zbuffer, --threshold, --clip and --slice");
+                     "--depth, --zbuffer, --threshold, --clip, --slice, --shrink and --markers");
+  if (translucent && !field_options.spec.empty() && iso_options.iso.empty())
+    throw UsageError("translucent regions are drawn in their regions' colours: --field serves only --iso there "
+                     "(give --iso v1,... --iso-opacity a, or leave out --field)");
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
   check_output_path(out);

@@ -109,6 +109,9 @@ TEST_F(TranslucentCli, BadOptionsExitWithUsage) {
   EXPECT_EQ(foxi("--iso-opacity 0.5" + out, &log), 2);
   EXPECT_NE(log.find("give --iso"), std::string::npos) << log;
   EXPECT_EQ(foxi("--region-opacity die=0.5 --stop 50%" + out, &log), 2);
+  EXPECT_EQ(foxi("--region-opacity die=0.5 --shrink 0.8" + out, &log), 2);
+  EXPECT_EQ(foxi("--region-opacity die=0.5 --field temperature" + out, &log), 2);
+  EXPECT_NE(log.find("--field serves only --iso"), std::string::npos) << log;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
 }
 
