@@ -213,6 +213,35 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
   }
 }
 
+// The near-plane clip of a convex polygon of n <= 8 points in camera coordinates (perspective): out
+// gets the part at depth >= near, near being near_given or, larger, the tet painter's rule (a point no
+// farther than dmax from the eye then projects within kMaxPixel of the centre). Returns its count,
+// 0 when fewer than 3 remain. Orthographic: a copy.
+inline int clip_near(const Projector& proj, double near_given, const double (*in)[3], int n, double (*out)[3]) {
+  if (!proj.perspective) {
+    for (int i = 0; i < n; ++i) std::copy(in[i], in[i] + 3, out[i]);
+    return n;
+  }
+  double dmax = 0;
+  for (int i = 0; i < n; ++i) dmax = std::max(dmax, std::sqrt(in[i][0] * in[i][0] + in[i][1] * in[i][1] + in[i][2] * in[i][2]));
+  double near = std::max(near_given, dmax * proj.focal / kMaxPixel);
+  if (!(near > 0)) near = 1e-300;
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    const double* a = in[i];
+    const double* b = in[(i + 1) % n];
+    const bool ina = a[2] >= near, inb = b[2] >= near;
+    if (ina) std::copy(a, a + 3, out[m++]);
+    if (ina != inb) {
+      const double t = (near - a[2]) / (b[2] - a[2]);
+      double* o = out[m++];
+      for (int k = 0; k < 3; ++k) o[k] = a[k] + t * (b[k] - a[k]);
+      o[2] = near;
+    }
+  }
+  return m >= 3 ? m : 0;
+}
+
 // Projects the n camera-frame points cam(i) (in front of the eye) of a polygon: their corners in
 // fixed point (X, Y), the snapped positions in pixels px (what the painters interpolate from) and
 // their nearness w (1 / depth perspective, -depth orthographic).

@@ -140,32 +140,9 @@ struct TranslucentPainter::Impl {
   // Blends (or collects) a convex polygon in camera coordinates with colour rgb and opacity alpha.
   void polygon(const double (*in)[3], int n, std::uint32_t tet, int face, const float rgb[3], float alpha,
                const Rows& rows, std::size_t& count) {
-    double clipped[kMaxPoly][3];
-    const double(*v)[3] = in;
-    if (proj.perspective) {
-      // The tet painter's rule: at depth >= near, a point no farther than dmax from the eye projects
-      // within kMaxPixel of the centre.
-      double dmax = 0;
-      for (int i = 0; i < n; ++i) dmax = std::max(dmax, std::sqrt(v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2]));
-      double near = std::max(params.near, dmax * proj.focal / kMaxPixel);
-      if (!(near > 0)) near = 1e-300;
-      int m = 0;
-      for (int i = 0; i < n; ++i) {
-        const double* a = v[i];
-        const double* b = v[(i + 1) % n];
-        const bool ina = a[2] >= near, inb = b[2] >= near;
-        if (ina && m < kMaxPoly) std::copy(a, a + 3, clipped[m++]);
-        if (ina != inb && m < kMaxPoly) {
-          const double t = (near - a[2]) / (b[2] - a[2]);
-          double* o = clipped[m++];
-          for (int k = 0; k < 3; ++k) o[k] = a[k] + t * (b[k] - a[k]);
-          o[2] = near;
-        }
-      }
-      if (m < 3) return;
-      v = clipped;
-      n = m;
-    }
+    double v[kMaxPoly][3];
+    n = clip_near(proj, params.near, in, n, v);
+    if (n == 0) return;
     std::int64_t X[kMaxPoly], Y[kMaxPoly];
     double px[kMaxPoly][2], w[kMaxPoly];
     snap_polygon(proj, n, [&](int i) { return v[i]; }, X, Y, px, w);
