@@ -1,0 +1,223 @@
+// Direct volume rendering by projected tetrahedra (volume.hpp): each tet's front faces rasterized with
+// the painter's fixed point and fill rule, the ray's segment through the tet found per pixel from the
+// tet's four planes, and the emission-absorption integral of the linear field over it blended back to
+// front.
+#include "foxi/viz/volume.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "raster_impl.hpp"
+
+namespace foxi {
+
+using namespace raster_detail;
+
+double volume_extinction(const VolumeParams& params, double v) {
+  const std::vector<OpacityPoint>& c = params.opacity_curve;
+  if (c.empty() || std::isnan(v)) return 0;
+  double a = 0;
+  if (v <= c.front().value) {
+    a = c.front().opacity;
+  } else if (v >= c.back().value) {
+    a = c.back().opacity;
+  } else {
+    const auto hi = std::upper_bound(c.begin(), c.end(), v, [](double x, const OpacityPoint& p) { return x < p.value; });
+    const auto lo = hi - 1;
+    const double t = (v - lo->value) / (hi->value - lo->value);
+    a = lo->opacity + t * (hi->opacity - lo->opacity);
+  }
+  return -std::log1p(-std::clamp(a, 0.0, 0.999999)) / params.unit_length;
+}
+
+void integrate_segment(const VolumeParams& params, double v_far, double v_near, double length, float c[3]) {
+  if (!(length > 0)) return;
+  // Steps of at most 1/64 of the colour scale and of optical depth at most 1/4 (the ends' and the
+  // middle's extinction), at most 256.
+  const double span = std::abs(params.scale.position(v_near) - params.scale.position(v_far));
+  const double tau_max = std::max({volume_extinction(params, v_far), volume_extinction(params, v_near),
+                               volume_extinction(params, 0.5 * (v_far + v_near))});
+  const double want = std::max(std::isfinite(span) ? span * 64 : 1.0, tau_max * length * 4);
+  const int steps = std::clamp(int(std::ceil(std::min(want, 256.0))), 1, 256);
+  const double dl = length / steps;
+  for (int k = 0; k < steps; ++k) {
+    const double v = v_far + (k + 0.5) / steps * (v_near - v_far);
+    const double tau = volume_extinction(params, v);
+    if (!(tau > 0)) continue;
+    const float a = float(-std::expm1(-tau * dl));
+    const std::uint32_t col = params.scale.color(v);
+    const float rgb[3] = {float(col & 255u), float((col >> 8) & 255u), float((col >> 16) & 255u)};
+    for (int j = 0; j < 3; ++j) c[j] = rgb[j] * a + c[j] * (1 - a);
+  }
+}
+
+struct VolumePainter::Impl {
+  const Mesh* mesh = nullptr;
+  Projector proj;
+  std::span<const double> corner;
+  VolumeParams params;
+  int lanes = 1;
+  std::vector<float> acc;
+  std::vector<std::uint32_t> front;
+  std::vector<std::size_t> lane_samples;
+
+  Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
+
+  void draw_tet(std::uint32_t t, const Rows& rows, std::size_t& count) {
+    const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
+    const double* cv = &corner[4 * std::size_t(t)];
+    double P[4][3];
+    for (int k = 0; k < 4; ++k) proj.to_camera(&mesh->xyz[3 * std::size_t(node[k])], P[k]);
+    // The field's gradient in the camera frame: (P[k] - P[0]) . g = cv[k] - cv[0], by Cramer's rule.
+    double e[3][3], df[3];
+    for (int k = 0; k < 3; ++k) {
+      for (int j = 0; j < 3; ++j) e[k][j] = P[k + 1][j] - P[0][j];
+      df[k] = cv[k + 1] - cv[0];
+    }
+    auto det3 = [](const double a[3], const double b[3], const double c[3]) {
+      return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    };
+    const double det = det3(e[0], e[1], e[2]);
+    if (!(std::abs(det) > 0)) return;  // flat
+    double g[3];
+    for (int j = 0; j < 3; ++j) {
+      double m[3][3];
+      for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 3; ++i) m[k][i] = i == j ? df[k] : e[k][i];
+      g[j] = det3(m[0], m[1], m[2]) / det;
+    }
+    // Outward planes n . x = h of the four faces.
+    double n[4][3], h[4];
+    bool facing[4];
+    int front_count = 0;
+    for (int f = 0; f < 4; ++f) {
+      const double* a = P[kFace[f][0]];
+      const double* b = P[kFace[f][1]];
+      const double* c = P[kFace[f][2]];
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      n[f][0] = u[1] * w[2] - u[2] * w[1];
+      n[f][1] = u[2] * w[0] - u[0] * w[2];
+      n[f][2] = u[0] * w[1] - u[1] * w[0];
+      const double* opp = P[f];
+      if (n[f][0] * (opp[0] - a[0]) + n[f][1] * (opp[1] - a[1]) + n[f][2] * (opp[2] - a[2]) > 0)
+        for (double& x : n[f]) x = -x;
+      h[f] = n[f][0] * a[0] + n[f][1] * a[1] + n[f][2] * a[2];
+      facing[f] = proj.perspective ? h[f] < 0 : n[f][2] < 0;  // the eye on its outer side
+      front_count += facing[f];
+    }
+    // The eye inside the tet (perspective, every plane's inner side): its back faces cover the screen
+    // where the rays start inside it.
+    const bool inside = front_count == 0;
+    const double near = proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
+    for (int f = 0; f < 4; ++f) {
+      if (facing[f] == inside) continue;
+      double tri[3][3], v[kMaxPolyVolume][3];
+      for (int k = 0; k < 3; ++k) std::copy(P[kFace[f][k]], P[kFace[f][k]] + 3, tri[k]);
+      const int m = clip_near(proj, params.near, tri, 3, v);
+      if (m == 0) continue;
+      std::int64_t X[kMaxPolyVolume], Y[kMaxPolyVolume];
+      double px[kMaxPolyVolume][2], w[kMaxPolyVolume];
+      snap_polygon(proj, m, [&](int i) { return v[i]; }, X, Y, px, w);
+      for_each_fan_triangle(X, Y, m, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
+        raster_triangle(TX, TY, proj.width, proj.height, rows, [&](int y, int lo, int hi) {
+          for (int x = lo; x <= hi; ++x) {
+            // The pixel's ray o + s d (camera frame; perspective: o = 0 and s is the depth).
+            double o[3] = {0, 0, 0}, d[3] = {0, 0, 1};
+            if (proj.perspective) {
+              d[0] = (x + 0.5 - proj.cx) / proj.focal;
+              d[1] = -(y + 0.5 - proj.cy) / proj.focal;
+            } else {
+              o[0] = (x + 0.5 - proj.cx) / proj.scale;
+              o[1] = -(y + 0.5 - proj.cy) / proj.scale;
+            }
+            double s_in = near, s_out = std::numeric_limits<double>::infinity();
+            for (int k = 0; k < 4; ++k) {
+              const double nd = n[k][0] * d[0] + n[k][1] * d[1] + n[k][2] * d[2];
+              const double s = (h[k] - (n[k][0] * o[0] + n[k][1] * o[1] + n[k][2] * o[2])) / nd;
+              if (nd < 0)
+                s_in = std::max(s_in, s);
+              else if (nd > 0)
+                s_out = std::min(s_out, s);
+            }
+            if (!(s_out > s_in)) continue;  // a snapped edge pixel the ray misses
+            auto value = [&](double s) {
+              return cv[0] + g[0] * (o[0] + s * d[0] - P[0][0]) + g[1] * (o[1] + s * d[1] - P[0][1]) +
+                     g[2] * (o[2] + s * d[2] - P[0][2]);
+            };
+            const double len = (s_out - s_in) * std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            const std::size_t p = std::size_t(y) * std::size_t(proj.width) + std::size_t(x);
+            integrate_segment(params, value(s_out), value(s_in), len, &acc[3 * p]);
+            front[p] = t;
+            ++count;
+          }
+        });
+      });
+    }
+  }
+  static constexpr int kMaxPolyVolume = 8;
+};
+
+VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, int height,
+                             std::span<const double> corner, const VolumeParams& params)
+    : impl_(std::make_unique<Impl>(mesh, camera, width, height)) {
+  Impl& s = *impl_;
+  if (corner.size() != mesh.tet.size())
+    throw std::invalid_argument("volume: " + std::to_string(corner.size()) + " corner values for a mesh of " +
+                                std::to_string(mesh.tet_count()) + " tets (4 per tet expected)");
+  if (!(params.unit_length > 0) || !std::isfinite(params.unit_length))
+    throw std::invalid_argument("volume: the unit length must be positive");
+  for (std::size_t i = 0; i < params.opacity_curve.size(); ++i) {
+    const OpacityPoint& p = params.opacity_curve[i];
+    if (!(p.opacity >= 0 && p.opacity < 1) || !std::isfinite(p.value))
+      throw std::invalid_argument("volume: opacity curve point " + std::to_string(i + 1) +
+                                  ": the opacity must be in [0, 1) and the value finite");
+    if (i > 0 && !(p.value > params.opacity_curve[i - 1].value))
+      throw std::invalid_argument("volume: the opacity curve's values must increase");
+  }
+  s.corner = corner;
+  s.params = params;
+  s.lanes = std::clamp(params.threads, 1, std::max(1, height >> kBandShift));
+  s.lane_samples.assign(std::size_t(s.lanes), 0);
+  const std::size_t pixels = std::size_t(width) * std::size_t(height);
+  s.acc.resize(3 * pixels);
+  const float bg[3] = {float(params.background & 255u), float((params.background >> 8) & 255u),
+                       float((params.background >> 16) & 255u)};
+  for (std::size_t p = 0; p < pixels; ++p) std::copy(bg, bg + 3, &s.acc[3 * p]);
+  s.front.assign(pixels, kNone);
+}
+
+VolumePainter::~VolumePainter() = default;
+VolumePainter::VolumePainter(VolumePainter&&) noexcept = default;
+VolumePainter& VolumePainter::operator=(VolumePainter&&) noexcept = default;
+
+void VolumePainter::draw(std::span<const std::uint32_t> tets) {
+  Impl& s = *impl_;
+  for (std::uint32_t t : tets)
+    if (t >= s.mesh->tet_count()) throw std::invalid_argument("volume: tet index out of range");
+  run_parts(s.lanes, [&](int lane) {
+    const Rows rows{lane, s.lanes};
+    std::size_t count = 0;
+    for (std::uint32_t t : tets) s.draw_tet(t, rows, count);
+    s.lane_samples[std::size_t(lane)] += count;
+  });
+}
+
+void VolumePainter::resolve(Framebuffer& fb) const {
+  const Impl& s = *impl_;
+  fb.resize(s.proj.width, s.proj.height, false, s.params.background);
+  auto to8 = [](float c) { return std::uint32_t(std::clamp(c, 0.0f, 255.0f) + 0.5f); };
+  for (std::size_t p = 0; p < fb.rgba.size(); ++p) {
+    fb.rgba[p] = pack_rgba(to8(s.acc[3 * p]), to8(s.acc[3 * p + 1]), to8(s.acc[3 * p + 2]));
+    fb.id[p] = s.front[p];
+  }
+}
+
+std::size_t VolumePainter::samples() const {
+  std::size_t n = 0;
+  for (std::size_t c : impl_->lane_samples) n += c;
+  return n;
+}
+
+}  // namespace foxi
