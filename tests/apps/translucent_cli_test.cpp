@@ -2,13 +2,16 @@
 // above (orthographic): over a region of opacity a, a pixel shows its bottom face blended over the
 // white background and its top face over that (both flat, facing the eye, the same Lambert factor),
 // computed here by hand; an opaque region its shaded colour; a region of opacity 0 nothing. The
-// options take region ids or names; malformed ones and combinations it does not draw exit 2.
+// options take region ids or names; malformed ones and combinations it does not draw exit 2. --volume
+// of a field linear in x seen along z, with a constant opacity that accumulates 0.5 through the slab:
+// every pixel is half the colour map's colour of its x over white.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/viz/colormap.hpp"
 #include "foxi/viz/png.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "test_util.hpp"
@@ -97,6 +100,45 @@ TEST_F(TranslucentCli, TranslucentIsosurfacesAreDrawn) {
   EXPECT_GT(drawn, 500u);
 }
 
+TEST_F(TranslucentCli, VolumeOfALinearFieldIsHalfItsColourOverWhite) {
+  const auto png = dir_ / "vol.png";
+  std::string log;
+  // The slab is 1 thick in z; opacity 0.5 per 1 world unit at every value: each ray gains exactly 0.5.
+  ASSERT_EQ(foxi("--volume temperature --opacity-curve 0:0.5 --opacity-length 1 --legend off --dir 0,0,-1 --up 0,1,0 "
+                 "--size 180x120 -o '" + png.string() + "'",
+                 &log),
+            0)
+      << log;
+  EXPECT_NE(log.find("composited back to front in the power order"), std::string::npos) << log;
+  const Framebuffer fb = read_png(png);
+  // Unblended: u = 2 p - 255 must be an entry of viridis (to rounding); the image centre (x = 4.5,
+  // 345 K on the data range 300..390 K) entry 128.
+  auto distance_to_entry = [](const double u[3], int e) {
+    const std::uint32_t c = color_map_entry(ColorMapId::viridis, e);
+    double d = 0;
+    for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(u[k] - double((c >> (8 * k)) & 255u)));
+    return d;
+  };
+  std::size_t covered = 0, off_map = 0;
+  for (std::size_t p = 0; p < fb.rgba.size(); ++p) {
+    if ((fb.rgba[p] & 0xffffffu) == 0xffffffu) continue;
+    ++covered;
+    double u[3];
+    for (int k = 0; k < 3; ++k) u[k] = 2.0 * double((fb.rgba[p] >> (8 * k)) & 255u) - 255;
+    double best = 1e9;
+    for (int e = 0; e < 256; ++e) best = std::min(best, distance_to_entry(u, e));
+    off_map += best > 3;
+  }
+  EXPECT_GT(covered, 180u * 120u / 3);
+  EXPECT_LE(off_map, covered / 100) << "pixels not half a viridis colour over white (the slab's edges)";
+  const std::uint32_t centre = fb.rgba[fb.index(90, 60)];
+  double u[3];
+  for (int k = 0; k < 3; ++k) u[k] = 2.0 * double((centre >> (8 * k)) & 255u) - 255;
+  double best = 1e9;
+  for (int e = 124; e <= 132; ++e) best = std::min(best, distance_to_entry(u, e));
+  EXPECT_LE(best, 3.0);
+}
+
 TEST_F(TranslucentCli, BadOptionsExitWithUsage) {
   const std::string out = " -o '" + (dir_ / "bad.png").string() + "'";
   std::string log;
@@ -112,6 +154,11 @@ TEST_F(TranslucentCli, BadOptionsExitWithUsage) {
   EXPECT_EQ(foxi("--region-opacity die=0.5 --shrink 0.8" + out, &log), 2);
   EXPECT_EQ(foxi("--region-opacity die=0.5 --field temperature" + out, &log), 2);
   EXPECT_NE(log.find("--field serves only --iso"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--volume temperature" + out, &log), 2);
+  EXPECT_EQ(foxi("--volume temperature --opacity-curve 1:0.5,0:0.2" + out, &log), 2);
+  EXPECT_EQ(foxi("--volume temperature --opacity-curve 0:1" + out, &log), 2);
+  EXPECT_EQ(foxi("--volume temperature --opacity-curve 0:0.5 --iso 40" + out, &log), 2);
+  EXPECT_EQ(foxi("--volume temperature --field temperature --opacity-curve 0:0.5" + out, &log), 2);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
 }
 

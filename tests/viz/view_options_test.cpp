@@ -41,6 +41,18 @@ TEST(ViewOptions, RegionOpacitiesByIdOrName) {
   EXPECT_THROW(parse_opacity("", "--iso-opacity"), OptionError);
 }
 
+TEST(ViewOptions, OpacityCurve) {
+  const std::vector<OpacityPoint> c = parse_opacity_curve("20:0,45.5:0.25,60:0.9");
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_EQ(c[1].value, 45.5);
+  EXPECT_EQ(c[1].opacity, 0.25);
+  EXPECT_THROW(parse_opacity_curve("20"), OptionError);
+  EXPECT_THROW(parse_opacity_curve("20:1"), OptionError) << "opacity 1 has no finite extinction";
+  EXPECT_THROW(parse_opacity_curve("20:0.1,10:0.2"), OptionError);
+  EXPECT_THROW(parse_opacity_curve("20:0.1,20:0.2"), OptionError);
+  EXPECT_THROW(parse_opacity_curve("a:0.1"), OptionError);
+}
+
 TEST(ViewOptions, SubsetsOfAGrid) {
   Mesh m = test::grid_mesh(4, 3, 2, 1.0, 1.0, 1.0, 5);  // 24 unit cells, 5 tets each
   test::regions_along_x(m, 1.0, 3.0);                   // x in [0,1]: 1, [1,3]: 2, [3,4]: 3

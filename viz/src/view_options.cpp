@@ -161,4 +161,31 @@ std::vector<RegionOpacity> parse_region_opacity(const Mesh& mesh, std::string_vi
   return out;
 }
 
+std::vector<OpacityPoint> parse_opacity_curve(std::string_view text) {
+  std::vector<OpacityPoint> out;
+  const std::string s(text);
+  std::size_t pos = 0;
+  auto number = [](const std::string& part, double& x) {
+    char* end = nullptr;
+    x = std::strtod(part.c_str(), &end);
+    return !part.empty() && end == part.c_str() + part.size() && std::isfinite(x);
+  };
+  while (pos <= s.size()) {
+    const std::size_t comma = s.find(',', pos);
+    const std::string part = s.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    const std::size_t colon = part.find(':');
+    OpacityPoint p;
+    if (colon == std::string::npos || !number(part.substr(0, colon), p.value) || !number(part.substr(colon + 1), p.opacity))
+      throw OptionError("--opacity-curve takes v0:a0,v1:a1,... (values and opacities), not '" + part + "'");
+    if (!(p.opacity >= 0 && p.opacity < 1))
+      throw OptionError("--opacity-curve: opacity " + part.substr(colon + 1) + " is not in [0, 1)");
+    if (!out.empty() && !(p.value > out.back().value))
+      throw OptionError("--opacity-curve: the values must increase ('" + part + "')");
+    out.push_back(p);
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  return out;
+}
+
 }  // namespace foxi

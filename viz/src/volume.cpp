@@ -5,10 +5,13 @@
 #include "foxi/viz/volume.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
+#include "foxi/model/delaunay.hpp"
+#include "foxi/viz/visibility_order.hpp"
 #include "raster_impl.hpp"
 
 namespace foxi {
@@ -218,6 +221,35 @@ std::size_t VolumePainter::samples() const {
   std::size_t n = 0;
   for (std::size_t c : impl_->lane_samples) n += c;
   return n;
+}
+
+VolumeReport draw_volume_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera, Framebuffer& fb,
+                                 std::span<const std::uint32_t> subset, std::span<const double> corner,
+                                 const VolumeParams& params) {
+  if (fb.width < 1 || fb.height < 1) throw std::invalid_argument("draw_volume_picture: the framebuffer is empty");
+  if (table.tet_count() != mesh.tet_count())
+    throw std::invalid_argument("draw_volume_picture: the sphere table belongs to another mesh");
+  auto ms_since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  VolumeReport report;
+  auto t0 = std::chrono::steady_clock::now();
+  report.delaunay = delaunay_certificate(mesh).delaunay;
+  report.certificate_ms = ms_since(t0);
+  report.exact_order = report.delaunay;
+  t0 = std::chrono::steady_clock::now();
+  const std::vector<std::uint32_t> order = report.delaunay
+                                               ? visibility_order(mesh, table, view_of(camera), subset)
+                                               : mpvo_order(mesh, table, view_of(camera), subset, &report.cycles_broken);
+  report.order_ms = ms_since(t0);
+  report.tets = order.size();
+  t0 = std::chrono::steady_clock::now();
+  VolumePainter painter(mesh, camera, fb.width, fb.height, corner, params);
+  painter.draw(order);
+  painter.resolve(fb);
+  report.samples = painter.samples();
+  report.draw_ms = ms_since(t0);
+  return report;
 }
 
 }  // namespace foxi

@@ -15,6 +15,7 @@
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/translucent.hpp"
+#include "foxi/viz/volume.hpp"
 
 namespace foxi {
 
@@ -66,5 +67,9 @@ FOXI_API double parse_opacity(std::string_view text, std::string_view what);
 // "REGION=a,REGION=a,...": each REGION a region id or name of the mesh (region_id_of) and a an opacity
 // in [0, 1] (--region-opacity); OptionError for a malformed entry, an unknown name, a region given twice.
 FOXI_API std::vector<RegionOpacity> parse_region_opacity(const Mesh& mesh, std::string_view text);
+
+// "v0:a0,v1:a1,...": values (as given; the caller converts units) strictly increasing, opacities in
+// [0, 1) (--opacity-curve); OptionError otherwise.
+FOXI_API std::vector<OpacityPoint> parse_opacity_curve(std::string_view text);
 
 }  // namespace foxi

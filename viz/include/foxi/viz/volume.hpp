@@ -27,6 +27,7 @@
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/framebuffer.hpp"
+#include "foxi/viz/spheres.hpp"
 
 namespace foxi {
 
@@ -73,5 +74,22 @@ class FOXI_API VolumePainter {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+struct VolumeReport {
+  bool delaunay = false;
+  bool exact_order = false;       // composited in the power order (else MPVO's, with cycles broken)
+  std::size_t cycles_broken = 0;  // MPVO only
+  std::size_t tets = 0, samples = 0;
+  double certificate_ms = 0, order_ms = 0, draw_ms = 0;
+};
+
+// The safe volume picture: a mesh with the Delaunay certificate composited in the power order of
+// `subset` (empty: all tets); any other mesh cannot be composited exactly by this painter: it is
+// composited in MPVO order (face adjacency, cycles broken at the largest power key), which is right
+// where MPVO's order is a visibility order and wrong along rays through the cycles it broke, and the
+// report says so. fb keeps its size.
+FOXI_API VolumeReport draw_volume_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera,
+                                          Framebuffer& fb, std::span<const std::uint32_t> subset,
+                                          std::span<const double> corner, const VolumeParams& params);
 
 }  // namespace foxi
