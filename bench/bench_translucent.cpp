@@ -6,6 +6,9 @@
 //                         TranslucentSurfaces::tets) and composited by TranslucentPainter, the picture
 //                         resolved to 8 bits; the surfaces themselves (view-independent) are found once
 //                         per mesh, outside the timing (surfaces_ms)
+//   volume_frame          the whole mesh ordered and volume-rendered (VolumePainter: a smooth node field,
+//                         the integral along every pixel's ray through every tet), counters order_ms,
+//                         draw_ms, segments (pixel-tet segments integrated), opaque_ms and ratio
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
@@ -23,6 +26,7 @@
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/translucent.hpp"
 #include "foxi/viz/visibility_order.hpp"
+#include "foxi/viz/volume.hpp"
 
 namespace {
 
@@ -41,6 +45,8 @@ struct Case {
   TranslucentParams params[2];
   TranslucentSurfaces surfaces[2];
   double surfaces_ms[2] = {};
+  std::vector<double> corner;  // the smooth field of bench_render, 4 per tet
+  VolumeParams volume;
 };
 
 Case& get_case() {
@@ -54,6 +60,19 @@ Case& get_case() {
   const double dir[3] = {-1.0, 1.6, -0.9}, up[3] = {0, 0, 1};
   c->camera = fit_camera(lo, hi, dir, up, true, 30, double(kWidth) / kHeight, 0.95);
   const std::size_t n = box.tet_count();
+  {
+    std::vector<double> nodal(box.node_count());
+    for (std::size_t k = 0; k < nodal.size(); ++k) {
+      const double* p = &box.xyz[3 * k];
+      nodal[k] = std::sin(3 * p[0]) * std::cos(4 * p[1]) + p[2];
+    }
+    c->corner.resize(box.tet.size());
+    for (std::size_t i = 0; i < c->corner.size(); ++i) c->corner[i] = nodal[box.tet[i]];
+    c->volume.scale.lo = -1;
+    c->volume.scale.hi = 2;
+    c->volume.opacity_curve = {{-1, 0.02}, {0.5, 0.1}, {2, 0.6}};
+    c->volume.unit_length = 0.25;
+  }
   for (int s = 0; s < 2; ++s) {
     c->mesh[s] = box;
     Mesh& m = c->mesh[s];
@@ -154,8 +173,39 @@ void BM_translucent_frame(benchmark::State& state) {
   state.SetLabel(s == 0 ? "package" : "10 slabs");
 }
 
+void BM_volume_frame(benchmark::State& state) {
+  Case& c = get_case();
+  Framebuffer fb(kWidth, kHeight), opaque(kWidth, kHeight);
+  std::vector<std::uint32_t> order;
+  Timing t, base;
+  std::size_t segments = 0;
+  int i = 0;
+  for (auto _ : state) {
+    const Camera cam = orbit(c.camera, 7.0 * i++, 0);
+    auto t0 = std::chrono::steady_clock::now();
+    visibility_order_into(order, c.mesh[0], c.table, view_of(cam));
+    t.order_ms += ms_since(t0);
+    t0 = std::chrono::steady_clock::now();
+    VolumePainter painter(c.mesh[0], cam, kWidth, kHeight, c.corner, c.volume);
+    painter.draw(order);
+    painter.resolve(fb);
+    segments += painter.samples();
+    t.draw_ms += ms_since(t0);
+    state.PauseTiming();
+    opaque_frame(c, cam, opaque, order, base);
+    state.ResumeTiming();
+  }
+  const double iters = double(state.iterations());
+  state.counters["segments"] = double(segments) / iters;
+  state.counters["order_ms"] = t.order_ms / iters;
+  state.counters["draw_ms"] = t.draw_ms / iters;
+  state.counters["opaque_ms"] = base.total() / iters;
+  state.counters["ratio"] = t.total() / base.total();
+}
+
 BENCHMARK(BM_opaque_frame)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_translucent_frame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_volume_frame)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 }  // namespace
 

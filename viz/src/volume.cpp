@@ -35,25 +35,83 @@ double volume_extinction(const VolumeParams& params, double v) {
   return -std::log1p(-std::clamp(a, 0.0, 0.999999)) / params.unit_length;
 }
 
-void integrate_segment(const VolumeParams& params, double v_far, double v_near, double length, float c[3]) {
+namespace {
+
+// The integral over one segment with a transfer function tf (tau(v), position(v), rgb(v, out)).
+template <class Transfer>
+void integrate(const Transfer& tf, double v_far, double v_near, double length, float c[3]) {
   if (!(length > 0)) return;
   // Steps of at most 1/64 of the colour scale and of optical depth at most 1/4 (the ends' and the
   // middle's extinction), at most 256.
-  const double span = std::abs(params.scale.position(v_near) - params.scale.position(v_far));
-  const double tau_max = std::max({volume_extinction(params, v_far), volume_extinction(params, v_near),
-                               volume_extinction(params, 0.5 * (v_far + v_near))});
+  const double span = std::abs(tf.position(v_near) - tf.position(v_far));
+  const double tau_max = std::max({tf.tau(v_far), tf.tau(v_near), tf.tau(0.5 * (v_far + v_near))});
   const double want = std::max(std::isfinite(span) ? span * 64 : 1.0, tau_max * length * 4);
   const int steps = std::clamp(int(std::ceil(std::min(want, 256.0))), 1, 256);
   const double dl = length / steps;
   for (int k = 0; k < steps; ++k) {
     const double v = v_far + (k + 0.5) / steps * (v_near - v_far);
-    const double tau = volume_extinction(params, v);
+    const double tau = tf.tau(v);
     if (!(tau > 0)) continue;
     const float a = float(-std::expm1(-tau * dl));
-    const std::uint32_t col = params.scale.color(v);
-    const float rgb[3] = {float(col & 255u), float((col >> 8) & 255u), float((col >> 16) & 255u)};
+    float rgb[3];
+    tf.rgb(v, rgb);
     for (int j = 0; j < 3; ++j) c[j] = rgb[j] * a + c[j] * (1 - a);
   }
+}
+
+// The transfer function as given (each extinction from the curve, each colour from the scale).
+struct ExactTransfer {
+  const VolumeParams& p;
+  double tau(double v) const { return volume_extinction(p, v); }
+  double position(double v) const { return p.scale.position(v); }
+  void rgb(double v, float out[3]) const {
+    const std::uint32_t col = p.scale.color(v);
+    for (int j = 0; j < 3; ++j) out[j] = float((col >> (8 * j)) & 255u);
+  }
+};
+
+// The painter's: the extinction tabulated at 4097 values across the curve (constant beyond its ends)
+// and interpolated linearly, the colour map's 256 entries, so a sample costs no logarithm.
+struct TableTransfer {
+  static constexpr int kN = 4096;
+  const VolumeParams* p = nullptr;
+  double lo = 0, hi = 0, inv_step = 0;
+  std::vector<double> tau_at;
+  float lut[256][3] = {};
+  float nan_rgb[3] = {};
+  explicit TableTransfer(const VolumeParams& params) : p(&params) {
+    if (!params.opacity_curve.empty()) {
+      lo = params.opacity_curve.front().value;
+      hi = params.opacity_curve.back().value;
+    }
+    tau_at.resize(kN + 1);
+    for (int i = 0; i <= kN; ++i) tau_at[std::size_t(i)] = volume_extinction(params, lo + (hi - lo) * i / kN);
+    inv_step = hi > lo ? kN / (hi - lo) : 0;
+    for (int i = 0; i < 256; ++i) {
+      const std::uint32_t e = color_map_entry(params.scale.map, i);
+      for (int j = 0; j < 3; ++j) lut[i][j] = float((e >> (8 * j)) & 255u);
+    }
+    for (int j = 0; j < 3; ++j) nan_rgb[j] = float((params.scale.nan_color >> (8 * j)) & 255u);
+  }
+  double tau(double v) const {
+    if (std::isnan(v) || tau_at.empty()) return 0;
+    const double x = std::clamp((v - lo) * inv_step, 0.0, double(kN));
+    const int i = std::min(int(x), kN - 1);
+    const double f = x - i;
+    return tau_at[std::size_t(i)] + f * (tau_at[std::size_t(i) + 1] - tau_at[std::size_t(i)]);
+  }
+  double position(double v) const { return p->scale.position(v); }
+  void rgb(double v, float out[3]) const {
+    const double t = p->scale.position(v);
+    const float* c = std::isnan(t) ? nan_rgb : lut[int(std::clamp(t * 256, 0.0, 255.0))];
+    std::copy(c, c + 3, out);
+  }
+};
+
+}  // namespace
+
+void integrate_segment(const VolumeParams& params, double v_far, double v_near, double length, float c[3]) {
+  integrate(ExactTransfer{params}, v_far, v_near, length, c);
 }
 
 struct VolumePainter::Impl {
@@ -65,6 +123,7 @@ struct VolumePainter::Impl {
   std::vector<float> acc;
   std::vector<std::uint32_t> front;
   std::vector<std::size_t> lane_samples;
+  std::unique_ptr<TableTransfer> transfer;
 
   Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
 
@@ -151,7 +210,7 @@ struct VolumePainter::Impl {
             };
             const double len = (s_out - s_in) * std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             const std::size_t p = std::size_t(y) * std::size_t(proj.width) + std::size_t(x);
-            integrate_segment(params, value(s_out), value(s_in), len, &acc[3 * p]);
+            integrate(*transfer, value(s_out), value(s_in), len, &acc[3 * p]);
             front[p] = t;
             ++count;
           }
@@ -181,6 +240,7 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   }
   s.corner = corner;
   s.params = params;
+  s.transfer = std::make_unique<TableTransfer>(s.params);
   s.lanes = std::clamp(params.threads, 1, std::max(1, height >> kBandShift));
   s.lane_samples.assign(std::size_t(s.lanes), 0);
   const std::size_t pixels = std::size_t(width) * std::size_t(height);
