@@ -25,6 +25,8 @@
 //   TextRenderer, find_font_file               text in pictures with FreeType (text.hpp)
 //   draw_color_legend, legend_width            a colour-bar legend drawn into a picture (legend.hpp)
 //   draw_chart, Chart, axis_ticks              line charts: series, log axes, legend (chart.hpp)
+//   draw_translucent_picture, TranslucentPainter translucent regions and isosurfaces, exactly composited (translucent.hpp)
+//   draw_volume_picture, VolumePainter         volume rendering by projected tetrahedra, power order (volume.hpp)
 #pragma once
 
 #include "foxi/viz/animation.hpp"
@@ -43,6 +45,8 @@
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/text.hpp"
+#include "foxi/viz/translucent.hpp"
 #include "foxi/viz/view.hpp"
 #include "foxi/viz/view_options.hpp"
 #include "foxi/viz/visibility_order.hpp"
+#include "foxi/viz/volume.hpp"
