@@ -227,7 +227,7 @@ int cmd_render(Args args) {
     tp.regions = !region_opacity_s.empty();
     tp.region_colors = params.region_colors;
     if (!iso_options.iso.empty()) {
-      tp.corner = iso.corner;
+      tp.corner = *iso.corner;  // shared: lives as long as iso
       tp.iso = iso.params;
       tp.iso_opacity = iso_opacity;
     }
