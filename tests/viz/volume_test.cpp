@@ -200,6 +200,29 @@ TEST(Volume, NonConvexSubsetMatchesTheRayCaster) {
   check(m, subset, 6, 63, "random half");
 }
 
+TEST(Volume, SafePictureSaysWhichOrder) {
+  // Certified: the power order, the same picture as the painter fed it directly.
+  const Mesh grid = bench::cube_grid_mesh(4);
+  const SphereTable table = compute_spheres(grid);
+  const std::vector<double> corner = smooth_field(grid);
+  const VolumeParams p = params_for(grid);
+  const Camera cam = test::random_cameras(grid, 1, 71, double(kW) / kH)[0];
+  Framebuffer fb(kW, kH);
+  const VolumeReport r = draw_volume_picture(grid, table, cam, fb, {}, corner, p);
+  EXPECT_TRUE(r.delaunay);
+  EXPECT_TRUE(r.exact_order);
+  EXPECT_EQ(r.tets, grid.tet_count());
+  EXPECT_EQ(fb.rgba, paint(grid, cam, visibility_order(grid, table, view_of(cam)), corner, p).rgba);
+  // Uncertified (a jittered Kuhn grid): MPVO, and the report says it is not exact.
+  const Mesh jittered = bench::kuhn_grid_mesh(4, 0.15, 7);
+  ASSERT_FALSE(compute_delaunay_certificate(jittered).delaunay);
+  const SphereTable jt = compute_spheres(jittered);
+  const VolumeReport rj = draw_volume_picture(jittered, jt, cam, fb, {}, smooth_field(jittered), p);
+  EXPECT_FALSE(rj.delaunay);
+  EXPECT_FALSE(rj.exact_order);
+  EXPECT_EQ(rj.tets, jittered.tet_count());
+}
+
 TEST(Volume, TransferFunction) {
   VolumeParams p;
   p.unit_length = 2;
