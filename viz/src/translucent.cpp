@@ -24,7 +24,6 @@ using namespace raster_detail;
 namespace {
 
 constexpr int kMaxPoly = 10;
-constexpr std::uint8_t kBoundaryBits = 0x0f, kInterfaceBits = 0xf0;
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
