@@ -225,7 +225,185 @@ TEST(FieldSource, CalculixFrdHasTheAnalyticValues) {
   }
 }
 
-// Broken .frd files: every truncation, a garbled number, a binary block, an unknown node.
+// True when the file's node block header carries a binary format flag (2 or 3): the comparisons below
+// must not quietly compare an ASCII file with itself.
+bool frd_is_binary(const std::string& bytes) {
+  const std::size_t at = bytes.find("    2C");
+  if (at == std::string::npos) return false;
+  const std::size_t eol = bytes.find('\n', at);
+  const std::string head = bytes.substr(at, eol - at);
+  const std::size_t last = head.find_last_not_of(' ');
+  return last != std::string::npos && (head[last] == '2' || head[last] == '3');
+}
+
+// `bin` (a binary .frd) holds what `ascii` (the same results in ASCII) holds: the same node ids with
+// the same coordinates, the same tets, and each of `names`' values at each step. The ASCII file prints
+// 6 significant digits (E12.5), the binary one float32 values and float64 coordinates, so they agree
+// to 5e-6 of each value (a field's own largest value for values near zero).
+void expect_same_results(const FieldSource& bin, const FieldSource& ascii, const std::vector<std::string>& names) {
+  ASSERT_EQ(bin.node_id.size(), ascii.node_id.size());
+  std::vector<std::size_t> to_ascii(bin.node_id.size());
+  for (std::size_t i = 0; i < bin.node_id.size(); ++i) {
+    const auto it = std::find(ascii.node_id.begin(), ascii.node_id.end(), bin.node_id[i]);
+    ASSERT_NE(it, ascii.node_id.end()) << "node " << bin.node_id[i];
+    to_ascii[i] = static_cast<std::size_t>(it - ascii.node_id.begin());
+    for (int c = 0; c < 3; ++c) {
+      const double a = ascii.mesh.xyz[3 * to_ascii[i] + c], b = bin.mesh.xyz[3 * i + c];
+      EXPECT_NEAR(b, a, 5e-6 * std::max(1.0, std::abs(a))) << "node " << bin.node_id[i];
+    }
+  }
+  ASSERT_EQ(bin.mesh.tet.size(), ascii.mesh.tet.size());
+  for (std::size_t k = 0; k < bin.mesh.tet.size(); ++k)
+    EXPECT_EQ(ascii.node_id[to_ascii[bin.mesh.tet[k]]], ascii.node_id[ascii.mesh.tet[k]]) << "tet corner " << k;
+  for (const std::string& name : names) {
+    const Field* fb = bin.mesh.find_field(name);
+    const Field* fa = ascii.mesh.find_field(name);
+    ASSERT_NE(fb, nullptr) << name;
+    ASSERT_NE(fa, nullptr) << name;
+    ASSERT_EQ(fb->components, fa->components) << name;
+    ASSERT_EQ(fb->step_values, fa->step_values) << name;
+    ASSERT_EQ(fb->values.size(), fa->values.size()) << name;
+    double scale = 0;
+    for (double v : fa->values) scale = std::max(scale, std::abs(v));
+    const std::size_t n = bin.node_id.size(), nc = fb->components;
+    std::size_t compared = 0;
+    for (std::size_t s = 0; s < fb->step_count(); ++s)
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t c = 0; c < nc; ++c) {
+          const double b = fb->values[(s * n + i) * nc + c];
+          const double a = fa->values[(s * n + to_ascii[i]) * nc + c];
+          ASSERT_EQ(std::isnan(a), std::isnan(b)) << name << " node " << bin.node_id[i];
+          if (std::isnan(a)) continue;
+          EXPECT_NEAR(b, a, 5e-6 * std::max(std::abs(a), 1e-6 * scale)) << name << " step " << s << " node "
+                                                                          << bin.node_id[i] << " component " << c;
+          ++compared;
+        }
+    EXPECT_GT(compared, 0u) << name;
+  }
+}
+
+// A binary .frd written by another program: CalculiX 2.21 (github.com/wr1/frd2vtu's test files, see
+// tests/data/fields/README.md), against the ASCII file Debian's ccx 2.20 writes from the same deck.
+TEST(FieldSource, BinaryFrdFromCalculix221) {
+  const std::string dir = test::data_dir() + "/fields/";
+  const std::string bytes = test::read_text(dir + "ccx221_beam10psmooth_binary.frd");
+  ASSERT_TRUE(frd_is_binary(bytes));
+  const FieldSource bin = read_field_source(dir + "ccx221_beam10psmooth_binary.frd");
+  const FieldSource ascii = read_field_source(dir + "ccx220_beam10psmooth_ascii.frd");
+  ASSERT_FALSE(frd_is_binary(test::read_text(dir + "ccx220_beam10psmooth_ascii.frd")));
+  EXPECT_EQ(bin.node_id.size(), 90u);
+  EXPECT_EQ(bin.mesh.tet_count(), 31u);  // C3D10 elements, their corners
+  expect_same_results(bin, ascii, {"DISP", "STRESS"});
+  // 2.21 also writes the error estimate ccx 2.20 leaves out for this deck: one component per node, all
+  // of them given, and small (the load is uniform pressure on a straight beam).
+  const Field* err = bin.mesh.find_field("ERROR");
+  ASSERT_NE(err, nullptr);
+  EXPECT_EQ(err->components, 1u);
+  EXPECT_EQ(err->values.size(), bin.node_id.size());
+  for (double v : err->values) EXPECT_TRUE(std::isfinite(v) && v >= 0 && v < 1e-6) << v;
+}
+
+// Debian's ccx 2.20 writes binary too, for *NODE OUTPUT / *ELEMENT OUTPUT (not *NODE FILE): the same
+// decks both ways give the same nodes, tets and values, over two steps and scalar, vector and tensor
+// fields, and the analytic temperatures.
+TEST(FieldSource, BinaryFrdFromCcxAgreesWithAscii) {
+  if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
+  test::TempDir dir;
+  const Mesh m = bench::kuhn_grid_mesh(3, 0.2, 7);
+  const std::string heat = "*STEP\n*HEAT TRANSFER, STEADY STATE\n*BOUNDARY\n" + nodes_at(m, 0, 0, ", 11, 11, 300") +
+                           nodes_at(m, 0, 1, ", 11, 11, 400") + "*NODE FILE\nNT\n*EL FILE\nHFL\n*END STEP\n" +
+                           "*STEP\n*HEAT TRANSFER, STEADY STATE\n*BOUNDARY\n" + nodes_at(m, 0, 1, ", 11, 11, 500") +
+                           "*NODE FILE\nNT\n*EL FILE\nHFL\n*END STEP\n";
+  const std::string load = "*STEP\n*STATIC\n*BOUNDARY\n" + nodes_at(m, 2, 0, ", 1, 3, 0") +
+                           "*BOUNDARY\n" + nodes_at(m, 2, 1, ", 3, 3, 0.01") + "*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n";
+  const auto binary = [](std::string deck) {
+    for (const auto& [from, to] : {std::pair<std::string, std::string>{"*NODE FILE", "*NODE OUTPUT"},
+                                   {"*EL FILE", "*ELEMENT OUTPUT"}})
+      for (std::size_t at; (at = deck.find(from)) != std::string::npos;) deck.replace(at, from.size(), to);
+    return deck;
+  };
+  write_deck(m, dir / "heat_a.inp", heat);
+  write_deck(m, dir / "heat_b.inp", binary(heat));
+  write_deck(m, dir / "load_a.inp", load);
+  write_deck(m, dir / "load_b.inp", binary(load));
+  for (const char* job : {"heat_a", "heat_b", "load_a", "load_b"}) {
+    const int rc = test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i " + job, dir / "ccx.log");
+    ASSERT_EQ(rc, 0) << test::read_text(dir / "ccx.log");
+  }
+  ASSERT_TRUE(frd_is_binary(test::read_text(dir / "heat_b.frd")));
+  ASSERT_TRUE(frd_is_binary(test::read_text(dir / "load_b.frd")));
+  ASSERT_FALSE(frd_is_binary(test::read_text(dir / "heat_a.frd")));
+  const FieldSource heat_bin = read_field_source(dir / "heat_b.frd");
+  expect_same_results(heat_bin, read_field_source(dir / "heat_a.frd"), {"NDTEMP", "FLUX"});
+  expect_same_results(read_field_source(dir / "load_b.frd"), read_field_source(dir / "load_a.frd"),
+                      {"DISP", "STRESS"});
+  // The binary temperatures are the analytic ones (float32: 6e-8 relative).
+  EXPECT_EQ(heat_bin.mesh.tet_count(), m.tet_count());
+  const Field* nt = heat_bin.mesh.find_field("NDTEMP");
+  ASSERT_NE(nt, nullptr);
+  ASSERT_EQ(nt->step_count(), 2u);
+  const std::size_t n = m.node_count();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = heat_bin.node_id[k] - 1;
+    EXPECT_NEAR(nt->values[k], 300 + 100 * m.xyz[3 * i], 1e-4) << "node " << i + 1;
+    EXPECT_NEAR(nt->values[n + k], 300 + 200 * m.xyz[3 * i], 1e-4) << "node " << i + 1;
+  }
+}
+
+// Broken binary .frd files: every truncation and absurd counts give an IoError naming the file and
+// the byte offset, with no allocation sized by the counts.
+TEST(FieldSource, BrokenBinaryFrdFilesNameTheOffset) {
+  const std::string good = test::read_text(test::data_dir() + "/fields/ccx221_beam10psmooth_binary.frd");
+  const std::size_t nodes_at = good.find("    2C");
+  const std::size_t first_binary = good.find('\n', nodes_at) + 1;
+  ASSERT_NO_THROW(parse_frd_source(good, "ok.frd"));
+  for (std::size_t cut = 0; cut + 5 < good.size(); cut += (cut < first_binary ? 7 : 1)) {
+    try {
+      parse_frd_source(good.substr(0, cut), "cut.frd");
+      ADD_FAILURE() << "a binary .frd cut at byte " << cut << " was read";
+    } catch (const IoError& e) {
+      EXPECT_EQ(e.file(), "cut.frd");
+      // Where: a block's header line (its count does not fit), or a byte offset inside the file.
+      EXPECT_TRUE(cut == 0 || e.line() > 0 || e.byte_offset() <= cut) << e.what() << " (cut at " << cut << ")";
+    }
+  }
+  const auto reason = [](const std::string& text) -> std::string {
+    try {
+      parse_frd_source(text, "bad.frd");
+    } catch (const IoError& e) {
+      EXPECT_EQ(e.file(), "bad.frd");
+      return e.reason();
+    }
+    return "read";
+  };
+  // Absurd node, element and result counts: refused against the bytes left, before reserving.
+  for (const char* header : {"    2C", "    3C", "  100C"}) {
+    std::string huge = good;
+    const std::size_t at = huge.find(header);
+    const std::size_t col = std::string(header) == "  100C" ? 24 : 6;
+    const std::size_t width = std::string(header) == "  100C" ? 12 : 30;
+    std::string count(width, ' ');
+    count.replace(width - 10, 10, "2000000000");
+    huge.replace(at + col, width, count);
+    EXPECT_NE(reason(huge).find("bytes left"), std::string::npos) << header << ": " << reason(huge);
+  }
+  // An element that names a node the file does not have; a result record of an unknown node.
+  std::string unknown = good;
+  const std::size_t elements = unknown.find('\n', unknown.find("    3C")) + 1;
+  unknown.replace(elements + 16, 4, std::string("\x39\x30\x00\x00", 4));  // first corner: node 12345
+  EXPECT_NE(reason(unknown).find("12345"), std::string::npos) << reason(unknown);
+  std::string stranger = good;
+  const std::size_t values = stranger.find('\n', stranger.find(" -5  ALL")) + 1;
+  stranger.replace(values, 4, std::string("\x39\x30\x00\x00", 4));
+  EXPECT_NE(reason(stranger).find("12345"), std::string::npos) << reason(stranger);
+  // A result header asking for float64 values: refused by name, not read as float32.
+  std::string doubles = good;
+  const std::size_t step = doubles.find("  100C");
+  doubles[doubles.find('\n', step) - 1] = '3';
+  EXPECT_NE(reason(doubles).find("format 3"), std::string::npos) << reason(doubles);
+}
+
+// Broken .frd files: every truncation, a garbled number, a binary flag on ASCII records, an unknown node.
 TEST(FieldSource, BrokenFrdFilesNameTheLine) {
   const std::string good =
       "    1C\n    2C                             2                                     1\n"
@@ -259,14 +437,10 @@ TEST(FieldSource, BrokenFrdFilesNameTheLine) {
   std::string unknown = good;
   unknown.replace(unknown.find(" -1         2 3.2"), 13, " -1         9");
   EXPECT_EQ(line_of_error(unknown), 10u);
+  // A binary flag over ASCII records: the records are read as binary and refused (never a crash).
   std::string binary = good;
   binary.replace(binary.find("1\n -1         1 0.0"), 1, "2");
-  EXPECT_EQ(line_of_error(binary), 2u);
-  try {
-    parse_frd_source(binary, "bad.frd");
-  } catch (const IoError& e) {
-    EXPECT_NE(e.reason().find("binary"), std::string::npos) << e.what();
-  }
+  EXPECT_THROW(parse_frd_source(binary, "bad.frd"), IoError);
   std::string short_record = good;
   short_record.replace(short_record.find(" 1.00000E+00 0.00000E+00 0.00000E+00"), 36, " 1.00000E+00");
   EXPECT_EQ(line_of_error(short_record), 4u);

@@ -120,8 +120,8 @@ int main(int argc, char** argv) {
     }
     write_file(out / "tetgen" / (base.filename().string() + ".tetgen"), joined);
   }
-  // The field importer's readers: a CalculiX result file (two steps, DISP NDTEMP STRESS ERROR,
-  // elements) and CSV tables of each key.
+  // The field importer's readers: CalculiX result files (ASCII: two steps, DISP NDTEMP STRESS ERROR,
+  // elements; binary, written by ccx 2.21: C3D10 elements, DISP STRESS ERROR) and CSV tables of each key.
   copy_matching(data / "fields", out / "frd", {".frd"});
   copy_matching(data / "fields", out / "csv", {".csv", ".tsv"});
   copy_matching(root / "examples", out / "poly", {".poly"});

@@ -1,11 +1,17 @@
-// CalculiX .frd results (ASCII) as a field source. Format: CalculiX GraphiX manual, "Result Format":
+// CalculiX .frd results (ASCII and binary) as a field source. Format: CalculiX GraphiX manual, "Result Format":
 // "    2C" node block (" -1" id x y z), "    3C" element block (" -1" id type group material, then
-// " -2" records of node ids), "  100C" result header (value = step time, I2 format flag at its end),
-// " -4" NAME ncomps, " -5" one line per component (iexist 1: computed by the reader, not in the
-// file), " -1" id + values, " -2" continuation values, " -3" block end, " 9999" file end. Fixed
-// columns (trailing blanks ignored): ids are I5 (short format 0) or I10 (long format 1), values E12.5 back to back (a minus
-// sign may touch the previous value); format 2 and 3 are binary.
+// " -2" records of node ids), "  100C" result header (value = step time, node count in columns 25-36, I2
+// format flag at its end), " -4" NAME ncomps, " -5" one line per component (iexist 1: computed by the
+// reader, not in the file), " -1" id + values, " -2" continuation values, " -3" block end, " 9999" file
+// end. Fixed columns (trailing blanks ignored): ids are I5 (short format 0) or I10 (long format 1), values
+// E12.5 back to back (a minus sign may touch the previous value).
+// Binary (what ccx writes for *NODE OUTPUT / *ELEMENT OUTPUT): the header lines stay ASCII, each block's
+// records follow its header (or its last " -5" line) as raw little-endian data, with no " -3" end line:
+// nodes (format 2: int32 id + 3 float32, format 3: int32 id + 3 float64), elements (format 2: int32 id,
+// type, group, material, then the type's node ids as int32), results (format 2: for each of the 100C
+// header's nodes an int32 id + the stored components as float32). Binary errors name the byte offset.
 #include <algorithm>
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -35,7 +41,41 @@ class FrdParser {
   FieldSource parse();
 
  private:
-  [[noreturn]] void fail(const std::string& why) const { throw IoError(name_, line_no_, IoError::kNoOffset, why); }
+  // Past binary data, line numbers mean nothing (the data may hold newline bytes): the error names the
+  // byte offset of the record instead.
+  [[noreturn]] void fail(const std::string& why) const {
+    if (binary_seen_) throw IoError(name_, 0, line_start_, why);
+    throw IoError(name_, line_no_, IoError::kNoOffset, why);
+  }
+  [[noreturn]] void fail_at(std::size_t offset, const std::string& why) const { throw IoError(name_, 0, offset, why); }
+  // `bytes` raw bytes of a binary block at the read position (advanced past them).
+  const unsigned char* take(std::size_t bytes, const std::string& what) {
+    if (bytes > text_.size() - std::min(pos_, text_.size()))
+      fail_at(std::min(pos_, text_.size()), "the file ends inside the binary " + what + " (" + std::to_string(bytes) +
+                                                " bytes needed, " + std::to_string(text_.size() - std::min(pos_, text_.size())) +
+                                                " left): truncated?");
+    const auto* p = reinterpret_cast<const unsigned char*>(text_.data() + pos_);
+    pos_ += bytes;
+    binary_seen_ = true;
+    return p;
+  }
+  // Bytes of the binary blocks are little-endian (ccx's x86 builds); decoded byte by byte so that the
+  // reader is right on any host.
+  static std::uint32_t le32(const unsigned char* p) {
+    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+  }
+  static std::int32_t int32_at(const unsigned char* p) { return static_cast<std::int32_t>(le32(p)); }
+  static double float32_at(const unsigned char* p) { return static_cast<double>(std::bit_cast<float>(le32(p))); }
+  static double float64_at(const unsigned char* p) {
+    return std::bit_cast<double>(std::uint64_t(le32(p)) | std::uint64_t(le32(p + 4)) << 32);
+  }
+  // A declared record count that the bytes left cannot hold is refused before anything is reserved.
+  void check_fits(std::int64_t count, std::size_t min_record, const std::string& what) const {
+    const std::size_t left = text_.size() - std::min(pos_, text_.size());
+    if (count < 0 || static_cast<std::uint64_t>(count) > left / min_record)
+      fail("a binary " + what + " of " + std::to_string(count) + " records of at least " + std::to_string(min_record) +
+           " bytes, and " + std::to_string(left) + " bytes left in the file");
+  }
 
   bool next_line() {
     if (pos_ >= text_.size()) return false;
@@ -43,6 +83,7 @@ class FrdParser {
     const void* nl = std::memchr(start, '\n', text_.size() - pos_);
     std::size_t end = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text_.data()) : text_.size();
     line_ = text_.substr(pos_, end - pos_);
+    line_start_ = pos_;
     while (!line_.empty() && (line_.back() == '\r' || line_.back() == ' ')) line_.remove_suffix(1);
     pos_ = end + 1;
     ++line_no_;
@@ -91,47 +132,73 @@ class FrdParser {
     return n;
   }
   std::size_t id_width(int format) const { return format == 0 ? 5 : 10; }
-  void check_ascii(int format, const char* block) const {
-    if (format == 2 || format == 3)
-      fail(std::string("binary .frd ") + block + " (format " + std::to_string(format) +
-           "): only ASCII .frd files are read (ccx writes ASCII unless built with its '-o bin' option, which "
-           "CalculiX deactivated in 2020; 2.20 has no way to ask for binary, so there is no binary file to "
-           "test a reader against)");
-    if (format != 0 && format != 1) fail(std::string("unknown .frd format flag in the ") + block + " header");
+  // The header's format flag: 0 and 1 ASCII, 2 binary (3 too where `double_ok`: binary float64).
+  void check_format(int format, const char* block, bool double_ok) const {
+    if (format == 3 && !double_ok)
+      fail(std::string("binary float64 data (format 3) in the ") + block +
+           ": CalculiX writes binary results as float32 (format 2); format 3 is not read here");
+    if (format < 0 || format > 3) fail(std::string("unknown .frd format flag in the ") + block + " header");
   }
-  std::uint32_t node_index(std::int64_t id) const {
+  std::uint32_t node_lookup(std::int64_t id) const {
     if (id > 0 && static_cast<std::uint64_t>(id) < dense_.size() && dense_[id] != kNone) return dense_[id];
     if (!sparse_.empty()) {
       auto it = sparse_.find(static_cast<std::uint64_t>(id));
       if (it != sparse_.end()) return it->second;
     }
-    fail("node " + std::to_string(id) + " is not in the file's node block");
+    return kNone;
+  }
+  std::uint32_t node_index(std::int64_t id) const {
+    const std::uint32_t i = node_lookup(id);
+    if (i == kNone) fail("node " + std::to_string(id) + " is not in the file's node block");
+    return i;
   }
 
   void read_nodes();
   void read_elements();
   void read_results();
+  void index_nodes();
+  void add_element(std::int64_t type, const std::uint32_t* nodes);
 
   std::string_view text_;
   const std::string& name_;
   std::size_t pos_ = 0;
   std::string_view line_;
   std::uint64_t line_no_ = 0;
+  std::size_t line_start_ = 0;  // byte offset of line_
+  bool binary_seen_ = false;
   FieldSource src_;
   std::vector<std::uint32_t> dense_;                       // node id -> index (ids up to a few times the count)
   std::unordered_map<std::uint64_t, std::uint32_t> sparse_;  // the others
   double step_value_ = 0;
   bool have_step_ = false;
   int format_ = 1;                                         // of the current result block
+  std::int64_t step_nodes_ = 0;                            // the 100C header's node count (binary records)
   std::map<std::string, std::size_t> field_of_;            // block name -> index in src_.mesh.fields
 };
 
 void FrdParser::read_nodes() {
   if (!src_.mesh.xyz.empty() || !src_.node_id.empty()) fail("a second node block (2C)");
   const int format = trailing_int();
-  check_ascii(format, "node block");
-  const std::size_t w = id_width(format);
+  check_format(format, "node block", true);
   const std::int64_t declared = int_at(6, 30, "node count");
+  if (format >= 2) {
+    const std::size_t real = format == 2 ? 4 : 8;
+    check_fits(declared, 4 + 3 * real, "node block");
+    src_.mesh.xyz.reserve(3 * declared);
+    src_.node_id.reserve(declared);
+    for (std::int64_t k = 0; k < declared; ++k) {
+      const std::size_t at = pos_;
+      const unsigned char* r = take(4 + 3 * real, "node block");
+      const std::int32_t id = int32_at(r);
+      if (id <= 0) fail_at(at, "node id " + std::to_string(id) + " is not positive");
+      src_.node_id.push_back(static_cast<std::uint64_t>(id));
+      for (int c = 0; c < 3; ++c)
+        src_.mesh.xyz.push_back(real == 4 ? float32_at(r + 4 + 4 * c) : float64_at(r + 4 + 8 * c));
+    }
+    index_nodes();
+    return;
+  }
+  const std::size_t w = id_width(format);
   if (declared < 0 || static_cast<std::uint64_t>(declared) > text_.size() / 40 + 1)
     fail("a node count of " + std::to_string(declared) + " that the file is too short to hold");
   src_.mesh.xyz.reserve(3 * declared);
@@ -150,6 +217,10 @@ void FrdParser::read_nodes() {
   if (src_.node_id.size() != static_cast<std::size_t>(declared))
     fail("the node block declares " + std::to_string(declared) + " nodes and holds " +
          std::to_string(src_.node_id.size()));
+  index_nodes();
+}
+
+void FrdParser::index_nodes() {
   // Ids to indices: a table where the ids are dense enough, a hash map for the rest.
   const std::uint64_t max_id = src_.node_id.empty() ? 0 : *std::max_element(src_.node_id.begin(), src_.node_id.end());
   const bool dense = max_id <= 4 * src_.node_id.size() + 1024;
@@ -162,12 +233,37 @@ void FrdParser::read_nodes() {
   }
 }
 
+void FrdParser::add_element(std::int64_t type, const std::uint32_t* nodes) {
+  if (type == 3 || type == 6) {  // C3D4, C3D10: the 4 corners come first
+    src_.mesh.tet.insert(src_.mesh.tet.end(), nodes, nodes + 4);
+  }
+}
+
 void FrdParser::read_elements() {
   if (src_.node_id.empty()) fail("an element block (3C) before the node block (2C)");
   const int format = trailing_int();
-  check_ascii(format, "element block");
+  check_format(format, "element block", false);
+  if (format == 2) {
+    const std::int64_t declared = int_at(6, 30, "element count");
+    check_fits(declared, 4 * 4 + 4 * 2, "element block");  // id type group material + 2 nodes at least
+    for (std::int64_t k = 0; k < declared; ++k) {
+      const std::size_t at = pos_;
+      const std::int32_t type = int32_at(take(16, "element block") + 4);
+      if (type < 1 || type > 12) fail_at(at, "unknown element type " + std::to_string(type));
+      const int want = kElementNodes[type];
+      const unsigned char* r = take(4 * std::size_t(want), "element block");
+      std::uint32_t nodes[20];
+      for (int j = 0; j < want; ++j) {
+        const std::int32_t id = int32_at(r + 4 * j);
+        if (id <= 0 || node_lookup(id) == kNone)
+          fail_at(at, "element node " + std::to_string(id) + " is not in the file's node block");
+        nodes[j] = node_lookup(id);
+      }
+      add_element(type, nodes);
+    }
+    return;
+  }
   const std::size_t w = id_width(format);
-  Mesh& m = src_.mesh;
   if (!next_line()) fail("the file ends inside the element block");
   while (!starts(" -3")) {
     if (!starts(" -1")) fail("expected an element record (' -1') or the block end (' -3')");
@@ -187,9 +283,7 @@ void FrdParser::read_elements() {
     if (got != want)
       fail("an element of type " + std::to_string(type) + " with " + std::to_string(got) + " nodes, not " +
            std::to_string(want));
-    if (type == 3 || type == 6) {  // C3D4, C3D10: the 4 corners come first
-      m.tet.insert(m.tet.end(), nodes, nodes + 4);
-    }
+    add_element(type, nodes);
   }
 }
 
@@ -230,6 +324,22 @@ void FrdParser::read_results() {
   f->values.resize((step + 1) * n * comps, kNaN);
   double* base = f->values.data() + step * n * comps;
   std::vector<bool> seen(n, false);
+  if (format_ == 2) {
+    if (comps == 0) fail("binary result block " + name + " stores no component");
+    check_fits(step_nodes_, 4 + 4 * comps, "result block " + name);
+    for (std::int64_t k = 0; k < step_nodes_; ++k) {
+      const std::size_t at = pos_;
+      const unsigned char* r = take(4 + 4 * comps, "result block " + name);
+      const std::int32_t id = int32_at(r);
+      const std::uint32_t i = node_lookup(id);
+      if (i == kNone) fail_at(at, "node " + std::to_string(id) + " of block " + name + " is not in the file's node block");
+      if (seen[i]) fail_at(at, "node " + std::to_string(id) + " appears twice in block " + name);
+      seen[i] = true;
+      double* out = base + std::size_t(i) * comps;
+      for (std::size_t c = 0; c < comps; ++c) out[c] = float32_at(r + 4 + 4 * c);
+    }
+    return;
+  }
   while (true) {
     if (!next_line()) fail("the file ends inside result block " + name);
     if (starts(" -3")) break;
@@ -260,7 +370,8 @@ FieldSource FrdParser::parse() {
       read_elements();
     } else if (starts("  100C")) {
       format_ = trailing_int();
-      check_ascii(format_, "result block");
+      check_format(format_, "result block", false);
+      if (format_ == 2) step_nodes_ = int_at(24, 12, "node count");
       double v = 0;
       std::string_view f = line_.size() >= 24 ? line_.substr(12, 12) : std::string_view{};
       while (!f.empty() && f.front() == ' ') f.remove_prefix(1);
