@@ -58,7 +58,7 @@ void handle_stop_signals(const std::string& program) {
   }).detach();
 }
 
-int run_program(const std::vector<std::string>& argv, const std::string& output) {
+int run_program(const std::vector<std::string>& argv, const std::string& output, const std::string& stdout_to) {
   if (argv.empty()) return -1;
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
@@ -75,6 +75,11 @@ int run_program(const std::vector<std::string>& argv, const std::string& output)
       if (out < 0) ::_exit(127);
       ::dup2(out, 1);
       ::dup2(out, 2);
+    }
+    if (!stdout_to.empty()) {
+      const int out = ::open(stdout_to.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+      if (out < 0) ::_exit(127);
+      ::dup2(out, 1);
     }
     ::execvp(args[0], args.data());
     ::_exit(127);

@@ -23,7 +23,9 @@ void handle_stop_signals(const std::string& program);
 
 // Runs a program (argv[0] looked up in PATH) with stdin from /dev/null as a tracked child (killed
 // on a stop) and waits for it; returns its exit status, or -1 if it could not be run or died on a
-// signal. A non-empty `output` gets the program's stdout and stderr (created or truncated).
-int run_program(const std::vector<std::string>& argv, const std::string& output = {});
+// signal. A non-empty `output` gets the program's stdout and stderr (created or truncated); a
+// non-empty `stdout_to` then takes its stdout alone.
+int run_program(const std::vector<std::string>& argv, const std::string& output = {},
+                const std::string& stdout_to = {});
 
 }  // namespace foxi::cli
