@@ -7,7 +7,6 @@
 // to --jobs, and a stop (SIGINT/SIGTERM) kills them (signals.hpp) and removes the scratch folder; the
 // table is written once, durably, at the end, so an interrupted sweep leaves no partial CSV.
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -219,6 +218,81 @@ void write_sweep_plot(const std::string& path, const TextRenderer& text, const s
   write_png(path, fb);
 }
 
+// The order the runs start in: the longest first, so that the last runs to start are short and the
+// cores stay busy to the end (the flip chip's runs range from 0.7 to 1.5 times the default's, and
+// started smallest first the largest ran alone at the end). A run's length is not known before it
+// runs: it is predicted from the runs already started, weighted by 1 / (their distance in the grid
+// of parameter values, in steps): a finished run by its length, a running one by its time so far
+// (a lower bound). Before anything is known the runs start from both ends of the grid. This changes
+// nothing but the wall time: each run is its own process, its row is written in grid order. Past
+// kPredicted runs they start in grid order: a prediction costs a pass over the started runs per
+// waiting run, and over hundreds of runs the tail matters little.
+class RunOrder {
+ public:
+  using Clock = std::chrono::steady_clock;
+  static constexpr std::size_t kPredicted = 256;
+  RunOrder(std::size_t total, const std::function<std::vector<std::size_t>(std::size_t)>& index)
+      : total_(total), seconds_(total, -1), start_(total), started_(total, false) {
+    if (total_ <= kPredicted)
+      for (std::size_t run = 0; run < total_; ++run) index_.push_back(index(run));
+  }
+
+  // The next run to start, or `total` when every run has started.
+  std::size_t next() {
+    if (started_count_ == total_) return total_;
+    const Clock::time_point now = Clock::now();
+    std::size_t pick = total_;
+    if (total_ > kPredicted) {
+      pick = first_unstarted();
+    } else if (started_count_ == 0 || (finished_count_ == 0 && started_count_ < 2)) {
+      pick = started_count_ == 0 ? total_ - 1 : 0;  // the two ends
+      if (started_[pick]) pick = first_unstarted();
+    } else {
+      double longest = -1;
+      for (std::size_t run = 0; run < total_; ++run) {
+        if (started_[run]) continue;
+        const double predicted = predict(run, now);
+        if (predicted > longest) longest = predicted, pick = run;
+      }
+    }
+    started_[pick] = true;
+    start_[pick] = now;
+    ++started_count_;
+    return pick;
+  }
+  void finished(std::size_t run) {
+    seconds_[run] = std::chrono::duration<double>(Clock::now() - start_[run]).count();
+    ++finished_count_;
+  }
+
+ private:
+  std::size_t first_unstarted() {
+    while (cursor_ < total_ && started_[cursor_]) ++cursor_;
+    return cursor_;
+  }
+  double predict(std::size_t run, Clock::time_point now) const {
+    double sum = 0, weight = 0;
+    for (std::size_t other = 0; other < total_; ++other) {
+      if (!started_[other]) continue;
+      std::size_t d = 0;
+      for (std::size_t i = 0; i < index_[run].size(); ++i)
+        d += index_[run][i] > index_[other][i] ? index_[run][i] - index_[other][i] : index_[other][i] - index_[run][i];
+      const double length =
+          seconds_[other] >= 0 ? seconds_[other] : std::chrono::duration<double>(now - start_[other]).count();
+      sum += length / double(d), weight += 1 / double(d);
+    }
+    return sum / weight;
+  }
+
+  std::size_t total_;
+  std::vector<std::vector<std::size_t>> index_;  // each run's place in the grid (up to kPredicted runs)
+  std::vector<double> seconds_;                  // a finished run's length, else -1
+  std::vector<Clock::time_point> start_;
+  std::vector<bool> started_;
+  std::size_t started_count_ = 0, finished_count_ = 0;
+  std::size_t cursor_ = 0;  // no run before it is waiting
+};
+
 }  // namespace
 
 int cmd_sweep(Args args) {
@@ -307,14 +381,17 @@ int cmd_sweep(Args args) {
 
   ScratchFolder scratch("foxi-sweep");
   std::vector<RunResults> results(total);
-  std::atomic<std::size_t> next{0};
   std::size_t finished = 0;
-  std::mutex print;
+  std::mutex print;  // guards the progress lines and the scheduler below
+  RunOrder order(total, [&](std::size_t run) { return combination(run); });
   const auto t0 = std::chrono::steady_clock::now();
   std::fprintf(stderr, "foxi sweep: %zu runs of %s --physics %s, %d at a time\n", total, model.c_str(),
                physics.c_str(), std::min<int>(jobs, int(total)));
   auto worker = [&] {
-    for (std::size_t run; (run = next.fetch_add(1)) < total;) {
+    for (std::size_t run; (run = [&] {
+                             std::lock_guard lock(print);
+                             return order.next();
+                           }()) < total;) {
       std::vector<std::string> a{model, "--physics", physics};
       for (const std::string& s : run_sets(run)) a.insert(a.end(), {"--set", s});
       // --set of a varied name replaces the sweep's own (the later --set wins in load_model)
@@ -340,6 +417,7 @@ int cmd_sweep(Args args) {
           break;
         }
       std::lock_guard lock(print);
+      order.finished(run);
       ++finished;
       if (r.status == RunStatus::failed)
         std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: FAILED after %.2f s: %s\n", finished, total,
