@@ -2,9 +2,9 @@
 // [--json [FILE]]: the model solved at every combination of parameter values, one CSV row per run, and
 // the key results drawn against the first varied parameter.
 //
-// Each run is a `foxi solve MODEL --set NAME=VALUE ... --json FILE` child process: runs are isolated
-// (a crash or an exhausted memory is that run's failed row, not the sweep's end), run in parallel up
-// to --jobs, and a stop (SIGINT/SIGTERM) kills them (signals.hpp) and removes the scratch folder; the
+// Each run is a `foxi solve MODEL --set NAME=VALUE ... --json` child process (its record on stdout, into
+// a scratch file): runs are isolated (a crash or an exhausted memory is that run's failed row, not the
+// sweep's end), run in parallel up to --jobs, longest predicted first (RunOrder), and a stop (SIGINT/SIGTERM) kills them (signals.hpp) and removes the scratch folder; the
 // table is written once, durably, at the end, so an interrupted sweep leaves no partial CSV.
 #include <algorithm>
 #include <chrono>

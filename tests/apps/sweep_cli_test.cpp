@@ -443,6 +443,27 @@ print(len(d), [r["status"] for r in d], d[1]["parameters"][0]["text"])
   EXPECT_NE(py.find("3 ['ok', 'failed', 'ok'] -1mm"), std::string::npos) << py;
 }
 
+// The runs start from the ends of the grid (then longest predicted first), the rows stay in grid
+// order: with one job the progress lines come in start order.
+TEST(Sweep, RunsStartFromTheEndsRowsInGridOrder) {
+  TempDir dir;
+  const auto csv = dir / "sweep.csv", log = dir / "sweep.txt";
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:8mm:4 --jobs 1 -o '" +
+                              csv.string() + "'",
+                          log),
+            0)
+      << test::read_text(log);
+  const std::string progress = test::read_text(log);
+  const std::size_t first = progress.find("[1/4] die_w=8mm"), second = progress.find("[2/4] die_w=2mm");
+  EXPECT_NE(first, std::string::npos) << progress;
+  EXPECT_NE(second, std::string::npos) << progress;
+  const auto rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 5u);
+  const std::size_t w = column(rows[0], "die_w");
+  const std::vector<std::string> widths{rows[1][w], rows[2][w], rows[3][w], rows[4][w]};
+  EXPECT_EQ(widths, (std::vector<std::string>{"2mm", "4mm", "6mm", "8mm"}));
+}
+
 // A stop in the middle of a sweep: exit 130, no CSV, no scratch folder or child left.
 TEST(Sweep, InterruptLeavesNoPartialCsv) {
   TempDir dir;
