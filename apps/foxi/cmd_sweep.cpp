@@ -223,7 +223,8 @@ void write_sweep_plot(const std::string& path, const TextRenderer& text, const s
 // started smallest first the largest ran alone at the end). A run's length is not known before it
 // runs: it is predicted from the runs already started, weighted by 1 / (their distance in the grid
 // of parameter values, in steps): a finished run by its length, a running one by its time so far
-// (a lower bound). Before anything is known the runs start from both ends of the grid. This changes
+// (a lower bound) where that is more than the finished runs predict for it. Before anything is known
+// the runs start from both ends of the grid. This changes
 // nothing but the wall time: each run is its own process, its row is written in grid order. Past
 // kPredicted runs they start in grid order: a prediction costs a pass over the started runs per
 // waiting run, and over hundreds of runs the tail matters little.
@@ -251,7 +252,7 @@ class RunOrder {
       double longest = -1;
       for (std::size_t run = 0; run < total_; ++run) {
         if (started_[run]) continue;
-        const double predicted = predict(run, now);
+        const double predicted = predict(run, &now);
         if (predicted > longest) longest = predicted, pick = run;
       }
     }
@@ -270,18 +271,26 @@ class RunOrder {
     while (cursor_ < total_ && started_[cursor_]) ++cursor_;
     return cursor_;
   }
-  double predict(std::size_t run, Clock::time_point now) const {
+  std::size_t distance(std::size_t a, std::size_t b) const {
+    std::size_t d = 0;
+    for (std::size_t i = 0; i < index_[a].size(); ++i)
+      d += index_[a][i] > index_[b][i] ? index_[a][i] - index_[b][i] : index_[b][i] - index_[a][i];
+    return d;
+  }
+  // The 1 / distance weighted mean length of the finished runs (and, with `now`, of the running ones:
+  // each the longer of its time so far and its own prediction from the finished runs, as a run that
+  // has just started says nothing yet).
+  double predict(std::size_t run, const Clock::time_point* now) const {
     double sum = 0, weight = 0;
     for (std::size_t other = 0; other < total_; ++other) {
-      if (!started_[other]) continue;
-      std::size_t d = 0;
-      for (std::size_t i = 0; i < index_[run].size(); ++i)
-        d += index_[run][i] > index_[other][i] ? index_[run][i] - index_[other][i] : index_[other][i] - index_[run][i];
-      const double length =
-          seconds_[other] >= 0 ? seconds_[other] : std::chrono::duration<double>(now - start_[other]).count();
-      sum += length / double(d), weight += 1 / double(d);
+      if (!started_[other] || other == run || (seconds_[other] < 0 && now == nullptr)) continue;
+      const double length = seconds_[other] >= 0 ? seconds_[other]
+                                                 : std::max(std::chrono::duration<double>(*now - start_[other]).count(),
+                                                            predict(other, nullptr));
+      const double w = 1 / double(distance(run, other));
+      sum += length * w, weight += w;
     }
-    return sum / weight;
+    return weight > 0 ? sum / weight : 0;
   }
 
   std::size_t total_;
