@@ -27,6 +27,7 @@
 #include "foxi/viz/chart.hpp"
 #include "foxi/viz/png.hpp"
 #include "model_run.hpp"
+#include "run_order.hpp"
 #include "run_results.hpp"
 #include "solve_options.hpp"
 
@@ -218,90 +219,6 @@ void write_sweep_plot(const std::string& path, const TextRenderer& text, const s
   write_png(path, fb);
 }
 
-// The order the runs start in: the longest first, so that the last runs to start are short and the
-// cores stay busy to the end (the flip chip's runs range from 0.7 to 1.5 times the default's, and
-// started smallest first the largest ran alone at the end). A run's length is not known before it
-// runs: it is predicted from the runs already started, weighted by 1 / (their distance in the grid
-// of parameter values, in steps): a finished run by its length, a running one by its time so far
-// (a lower bound) where that is more than the finished runs predict for it. Before anything is known
-// the runs start from both ends of the grid. This changes
-// nothing but the wall time: each run is its own process, its row is written in grid order. Past
-// kPredicted runs they start in grid order: a prediction costs a pass over the started runs per
-// waiting run, and over hundreds of runs the tail matters little.
-class RunOrder {
- public:
-  using Clock = std::chrono::steady_clock;
-  static constexpr std::size_t kPredicted = 256;
-  RunOrder(std::size_t total, const std::function<std::vector<std::size_t>(std::size_t)>& index)
-      : total_(total), seconds_(total, -1), start_(total), started_(total, false) {
-    if (total_ <= kPredicted)
-      for (std::size_t run = 0; run < total_; ++run) index_.push_back(index(run));
-  }
-
-  // The next run to start, or `total` when every run has started.
-  std::size_t next() {
-    if (started_count_ == total_) return total_;
-    const Clock::time_point now = Clock::now();
-    std::size_t pick = total_;
-    if (total_ > kPredicted) {
-      pick = first_unstarted();
-    } else if (started_count_ == 0 || (finished_count_ == 0 && started_count_ < 2)) {
-      pick = started_count_ == 0 ? total_ - 1 : 0;  // the two ends
-      if (started_[pick]) pick = first_unstarted();
-    } else {
-      double longest = -1;
-      for (std::size_t run = 0; run < total_; ++run) {
-        if (started_[run]) continue;
-        const double predicted = predict(run, &now);
-        if (predicted > longest) longest = predicted, pick = run;
-      }
-    }
-    started_[pick] = true;
-    start_[pick] = now;
-    ++started_count_;
-    return pick;
-  }
-  void finished(std::size_t run) {
-    seconds_[run] = std::chrono::duration<double>(Clock::now() - start_[run]).count();
-    ++finished_count_;
-  }
-
- private:
-  std::size_t first_unstarted() {
-    while (cursor_ < total_ && started_[cursor_]) ++cursor_;
-    return cursor_;
-  }
-  std::size_t distance(std::size_t a, std::size_t b) const {
-    std::size_t d = 0;
-    for (std::size_t i = 0; i < index_[a].size(); ++i)
-      d += index_[a][i] > index_[b][i] ? index_[a][i] - index_[b][i] : index_[b][i] - index_[a][i];
-    return d;
-  }
-  // The 1 / distance weighted mean length of the finished runs (and, with `now`, of the running ones:
-  // each the longer of its time so far and its own prediction from the finished runs, as a run that
-  // has just started says nothing yet).
-  double predict(std::size_t run, const Clock::time_point* now) const {
-    double sum = 0, weight = 0;
-    for (std::size_t other = 0; other < total_; ++other) {
-      if (!started_[other] || other == run || (seconds_[other] < 0 && now == nullptr)) continue;
-      const double length = seconds_[other] >= 0 ? seconds_[other]
-                                                 : std::max(std::chrono::duration<double>(*now - start_[other]).count(),
-                                                            predict(other, nullptr));
-      const double w = 1 / double(distance(run, other));
-      sum += length * w, weight += w;
-    }
-    return weight > 0 ? sum / weight : 0;
-  }
-
-  std::size_t total_;
-  std::vector<std::vector<std::size_t>> index_;  // each run's place in the grid (up to kPredicted runs)
-  std::vector<double> seconds_;                  // a finished run's length, else -1
-  std::vector<Clock::time_point> start_;
-  std::vector<bool> started_;
-  std::size_t started_count_ = 0, finished_count_ = 0;
-  std::size_t cursor_ = 0;  // no run before it is waiting
-};
-
 }  // namespace
 
 int cmd_sweep(Args args) {
@@ -394,12 +311,13 @@ int cmd_sweep(Args args) {
   std::mutex print;  // guards the progress lines and the scheduler below
   RunOrder order(total, [&](std::size_t run) { return combination(run); });
   const auto t0 = std::chrono::steady_clock::now();
+  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   std::fprintf(stderr, "foxi sweep: %zu runs of %s --physics %s, %d at a time\n", total, model.c_str(),
                physics.c_str(), std::min<int>(jobs, int(total)));
   auto worker = [&] {
     for (std::size_t run; (run = [&] {
                              std::lock_guard lock(print);
-                             return order.next();
+                             return order.next(seconds());
                            }()) < total;) {
       std::vector<std::string> a{model, "--physics", physics};
       for (const std::string& s : run_sets(run)) a.insert(a.end(), {"--set", s});
@@ -426,7 +344,7 @@ int cmd_sweep(Args args) {
           break;
         }
       std::lock_guard lock(print);
-      order.finished(run);
+      order.finished(run, seconds());
       ++finished;
       if (r.status == RunStatus::failed)
         std::fprintf(stderr, "foxi sweep: [%zu/%zu] %s: FAILED after %.2f s: %s\n", finished, total,
