@@ -46,6 +46,10 @@ TEST_F(FieldsCli, ListNamesLocationComponentsStepsUnitsAndRanges) {
   EXPECT_NE(log.find("NDTEMP           node, 1 component, 2 steps (1 .. 2), unit -, values 310 .. 330, 0 NaN"),
             std::string::npos)
       << log;
+  // A binary .frd written by ccx 2.21 (tests/data/fields/README.md).
+  ASSERT_EQ(foxi("fields list '" + test::data_dir() + "/fields/ccx221_beam10psmooth_binary.frd'", &log), 0) << log;
+  EXPECT_NE(log.find("90 nodes, 31 tets, 3 fields"), std::string::npos) << log;
+  EXPECT_NE(log.find("STRESS           node, 6 components, 1 step"), std::string::npos) << log;
 }
 
 TEST_F(FieldsCli, ImportByLocationIsExactAndRenders) {
@@ -114,6 +118,12 @@ TEST_F(FieldsCli, MismatchesAndBrokenFilesExitThreeAndWriteNothing) {
   test::write_text(dir_ / "cut.frd", frd.substr(0, frd.size() / 2));
   EXPECT_EQ(foxi("fields list " + p("cut.frd"), &log), 3);
   EXPECT_NE(log.find("cut.frd:"), std::string::npos) << log;
+  // A truncated binary .frd: the byte where it ends.
+  const std::string bin = test::read_text(test::data_dir() + "/fields/ccx221_beam10psmooth_binary.frd");
+  test::write_text(dir_ / "cut_binary.frd", bin.substr(0, 5000));
+  EXPECT_EQ(foxi("fields list " + p("cut_binary.frd"), &log), 3);
+  EXPECT_NE(log.find("cut_binary.frd: byte 4985: the file ends inside the binary element block"), std::string::npos)
+      << log;
   // A field that is not there.
   EXPECT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --field nope -o " + p("x.vtu"), &log), 3);
   EXPECT_NE(log.find("no field 'nope'"), std::string::npos) << log;
