@@ -1,8 +1,9 @@
 // CalculiX deck writer and .frd reader (see calculix.hpp). Formats: CalculiX 2.20 manual, sections
 // *NODE, *ELEMENT (C3D4: faces 1 = 1-2-3, 2 = 1-4-2, 3 = 2-4-3, 4 = 3-4-1), *BOUNDARY (degree of
 // freedom 11 is the temperature), *DFLUX (S<face> surface flux into the body, BF body flux per
-// volume), *FILM (F<face>, sink temperature, film coefficient); .frd result format (ASCII: " -4"
-// block header, " -1" node records with 12-character values, " -2" continuations, " -3" block end).
+// volume), *FILM (F<face>, sink temperature, film coefficient), *NODE OUTPUT / *ELEMENT OUTPUT (the
+// same results as *NODE FILE / *EL FILE, but ccx writes the .frd binary: float32 values, about one
+// digit more than the ASCII file's E12.5); the .frd is read by foxi::fields (read_frd.cpp).
 #include <unistd.h>
 
 #include <algorithm>
@@ -217,7 +218,7 @@ void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const
     const auto [t, face] = element_face(f);
     std::fprintf(out, "%zu, F%d, %.17g, %.17g\n", t + 1, face, it->second.b, it->second.a);
   }
-  std::fprintf(out, "*NODE FILE\nNT\n*END STEP\n");
+  std::fprintf(out, "*NODE OUTPUT\nNT\n*END STEP\n");
   file.close();
 }
 
@@ -308,7 +309,7 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
       std::fprintf(out, "%zu, %.14g\n", nn + e + 1,
                    (params.temperature[edges.a[e]] + params.temperature[edges.b[e]]) / 2);
   }
-  std::fprintf(out, "*NODE FILE\nU\n*EL FILE\nS\n");
+  std::fprintf(out, "*NODE OUTPUT\nU\n*ELEMENT OUTPUT\nS\n");
   // C3D10: the stresses at the 4 integration points in the .dat (their mean is the centroid stress).
   for (std::size_t i = 0; quadratic && i < mat.regions.size(); ++i)
     std::fprintf(out, "*EL PRINT, ELSET=%s\nS\n", elset_name(i).c_str());

@@ -1,5 +1,5 @@
 // The bridge to CalculiX (ccx): the same mesh and thermal or thermal-stress problem as a CalculiX input deck, and the
-// nodal results of its ASCII .frd file read back, so that foxi's solvers can be checked against an
+// nodal results of its .frd file read back, so that foxi's solvers can be checked against an
 // independent code on the same P1 / C3D4 discretisation.
 #pragma once
 
@@ -19,7 +19,7 @@ namespace foxi {
 // elements in one ELSET per region (E<id>, ids shifted to be positive), *CONDUCTIVITY per region
 // (params first, then the region's material), fixed temperatures as *BOUNDARY (per node, the same
 // lumped-area mean that solve_thermal uses where fixed tags meet), heat flux as *DFLUX S<face>,
-// convection as *FILM F<face>, sources as *DFLUX BF on the region's elements, and *NODE FILE NT.
+// convection as *FILM F<face>, sources as *DFLUX BF on the region's elements, and *NODE OUTPUT NT (binary .frd, float32 values).
 // Node i of the mesh is CalculiX node i + 1, tet t element t + 1 (tets positively oriented, as
 // C3D4 needs). Throws SolverError for the problems solve_thermal rejects (missing conductivity,
 // unknown tags and regions, a boundary triangle that is no tet face) and IoError when the file
@@ -31,7 +31,7 @@ FOXI_API void write_calculix_thermal(const Mesh& mesh, const ThermalParams& para
 // constraints of solve_thermoelastic node by node (components along a coordinate axis as *BOUNDARY,
 // sliding normals of other orientations as homogeneous *EQUATION), the reference temperature as
 // *INITIAL CONDITIONS and the temperature (reference + delta_t, or the nodal field) as *TEMPERATURE,
-// *NODE FILE U and *EL FILE S. With params.order 2: C3D10 elements whose mid-edge nodes (edge e of
+// *NODE OUTPUT U and *ELEMENT OUTPUT S. With params.order 2: C3D10 elements whose mid-edge nodes (edge e of
 // detail::tet_edges is node node_count + e + 1) get the constraints and the linearly interpolated
 // temperature solve_thermoelastic gives them, and *EL PRINT S puts the integration-point stresses in
 // the .dat. Throws SolverError for what solve_thermoelastic rejects (except the
@@ -40,7 +40,7 @@ FOXI_API void write_calculix_thermal(const Mesh& mesh, const ThermalParams& para
 FOXI_API void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,
                                   const std::filesystem::path& inp);
 
-// One nodal result block of a CalculiX ASCII .frd file ("NDTEMP", "DISP", ...).
+// One nodal result block of a CalculiX .frd file ("NDTEMP", "DISP", ...).
 struct FrdBlock {
   std::string name;
   std::uint32_t components = 0;
@@ -48,9 +48,9 @@ struct FrdBlock {
   std::vector<double> values;       // components per node
 };
 
-// Reads every nodal result block of an ASCII .frd file (the last step's blocks come last), through
+// Reads every nodal result block of an ASCII or binary .frd file (the last step's blocks come last), through
 // foxi::fields' reader (read_frd_source: the one .frd reader, which also checks the node block and
-// the end record). Throws IoError (file and line) on a malformed, truncated or binary file.
+// the end record). Throws IoError (file and line or byte) on a malformed or truncated file.
 FOXI_API std::vector<FrdBlock> read_frd(const std::filesystem::path& frd);
 
 }  // namespace foxi
