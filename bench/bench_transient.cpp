@@ -89,8 +89,8 @@ std::string transient_deck(const std::string& steady, double dt, double end_time
       out << "*DFLUX, AMPLITUDE=ON\n";
       continue;
     }
-    if (line == "*NODE FILE") {
-      out << "*NODE FILE, FREQUENCY=" << kWriteEvery << "\n";
+    if (line == "*NODE OUTPUT" || line == "*NODE FILE") {  // the deck asks for binary results
+      out << line << ", FREQUENCY=" << kWriteEvery << "\n";
       continue;
     }
     out << line << "\n";
