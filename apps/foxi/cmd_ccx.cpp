@@ -48,10 +48,10 @@ const char* kExportUsage =
     "  Meshes the model and writes its problem as a CalculiX deck, node i of the mesh ccx node i + 1.\n"
     "  thermal: *NODE, C3D4 elements in one ELSET per region, *CONDUCTIVITY per region, the model's\n"
     "  fixed temperatures (*BOUNDARY), heat fluxes (*DFLUX S), convection (*FILM) and sources\n"
-    "  (*DFLUX BF), *NODE OUTPUT NT (a binary .frd). thermoelastic: C3D4 (C3D10 with --order 2), *ELASTIC and\n"
-    "  *EXPANSION per region, the model's displacement conditions, its temperature_change as\n"
-    "  *INITIAL CONDITIONS and *TEMPERATURE, *NODE OUTPUT U, *ELEMENT OUTPUT S. DECK is written whole or not\n"
-    "  at all.";
+    "  (*DFLUX BF), *NODE OUTPUT NT (ccx then writes a binary .frd, float32 values). thermoelastic:\n"
+    "  C3D4 (C3D10 with --order 2), *ELASTIC and *EXPANSION per region, the model's displacement\n"
+    "  conditions, its temperature_change as *INITIAL CONDITIONS and *TEMPERATURE, *NODE OUTPUT U,\n"
+    "  *ELEMENT OUTPUT S. DECK is written whole or not at all.";
 
 const char* kSolveCcxUsage =
     "foxi solve MODEL.toml|MESH --physics thermal|thermoelastic --with ccx [--set NAME=VALUE]...\n"

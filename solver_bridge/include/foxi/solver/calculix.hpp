@@ -19,7 +19,8 @@ namespace foxi {
 // elements in one ELSET per region (E<id>, ids shifted to be positive), *CONDUCTIVITY per region
 // (params first, then the region's material), fixed temperatures as *BOUNDARY (per node, the same
 // lumped-area mean that solve_thermal uses where fixed tags meet), heat flux as *DFLUX S<face>,
-// convection as *FILM F<face>, sources as *DFLUX BF on the region's elements, and *NODE OUTPUT NT (binary .frd, float32 values).
+// convection as *FILM F<face>, sources as *DFLUX BF on the region's elements, and *NODE OUTPUT NT
+// (a binary .frd: float32 values).
 // Node i of the mesh is CalculiX node i + 1, tet t element t + 1 (tets positively oriented, as
 // C3D4 needs). Throws SolverError for the problems solve_thermal rejects (missing conductivity,
 // unknown tags and regions, a boundary triangle that is no tet face) and IoError when the file
