@@ -4,8 +4,9 @@
 //
 // Each run is a `foxi solve MODEL --set NAME=VALUE ... --json` child process (its record on stdout, into
 // a scratch file): runs are isolated (a crash or an exhausted memory is that run's failed row, not the
-// sweep's end), run in parallel up to --jobs, longest predicted first (RunOrder), and a stop (SIGINT/SIGTERM) kills them (signals.hpp) and removes the scratch folder; the
-// table is written once, durably, at the end, so an interrupted sweep leaves no partial CSV.
+// sweep's end), run in parallel up to --jobs, longest predicted first (RunOrder), and a stop (SIGINT/SIGTERM)
+// kills them (signals.hpp) and removes the scratch folder; the table is written once, durably, at the end, so
+// an interrupted sweep leaves no partial CSV.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -311,14 +312,16 @@ int cmd_sweep(Args args) {
   std::mutex print;  // guards the progress lines and the scheduler below
   RunOrder order(total, [&](std::size_t run) { return combination(run); });
   const auto t0 = std::chrono::steady_clock::now();
-  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  const auto seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   std::fprintf(stderr, "foxi sweep: %zu runs of %s --physics %s, %d at a time\n", total, model.c_str(),
                physics.c_str(), std::min<int>(jobs, int(total)));
   auto worker = [&] {
     for (std::size_t run; (run = [&] {
-                             std::lock_guard lock(print);
-                             return order.next(seconds());
-                           }()) < total;) {
+                            std::lock_guard lock(print);
+                            return order.next(seconds());
+                          }()) < total;) {
       std::vector<std::string> a{model, "--physics", physics};
       for (const std::string& s : run_sets(run)) a.insert(a.end(), {"--set", s});
       // --set of a varied name replaces the sweep's own (the later --set wins in load_model)

@@ -50,8 +50,8 @@ ProgressFn terminal_progress(const LinearSolverOptions& options);
 std::string self_executable();
 
 // Runs `foxi solve ARGS --json` as a tracked child process (killed on a stop), its stdout (the
-// record) in `json`, its stderr in `log`, and reads the record. A run that wrote none is a record with status failed and
-// the child's error line ("foxi solve: error: ..." or its last line) as the error.
+// record) in `json`, its stderr in `log`, and reads the record. A run that wrote none is a record with status
+// failed and the child's error line ("foxi solve: error: ..." or its last line) as the error.
 RunResults run_solve_child(const std::vector<std::string>& args, const std::filesystem::path& json,
                            const std::filesystem::path& log);
 

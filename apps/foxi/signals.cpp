@@ -58,7 +58,8 @@ void handle_stop_signals(const std::string& program) {
   }).detach();
 }
 
-int run_program(const std::vector<std::string>& argv, const std::string& output, const std::string& stdout_to) {
+int run_program(const std::vector<std::string>& argv, const std::string& output,
+                const std::string& stdout_to) {
   if (argv.empty()) return -1;
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));

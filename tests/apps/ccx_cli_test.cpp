@@ -30,8 +30,8 @@ class CcxCli : public ::testing::Test {
   // marks, and every value agrees to 1e-6 (python3 reads them): relative to the value itself, the
   // heats (W) relative to the heat that flows and the stresses (Pa) relative to the largest von
   // Mises stress (both derivatives of ccx's float32 binary .frd: its rounding of T or u, amplified by
-  // k / h or E / h, shows there first; the ASCII .frd's 6 digits needed 1e-5). Not compared: where a maximum sits (the nearly isothermal
-  // die has ties at ccx's precision) and the linear solver's own figures.
+  // k / h or E / h, shows there first; the ASCII .frd's 6 digits needed 1e-5). Not compared: where a maximum
+  // sits (the nearly isothermal die has ties at ccx's precision) and the linear solver's own figures.
   void compare_records(const std::filesystem::path& a, const std::filesystem::path& b, const char* physics) {
     test::write_text(dir_ / "cmp.py", R"(import json, sys
 a = json.load(open(sys.argv[1])); b = json.load(open(sys.argv[2]))

@@ -47,7 +47,8 @@ TEST_F(FieldsCli, ListNamesLocationComponentsStepsUnitsAndRanges) {
             std::string::npos)
       << log;
   // A binary .frd written by ccx 2.21 (tests/data/fields/README.md).
-  ASSERT_EQ(foxi("fields list '" + test::data_dir() + "/fields/ccx221_beam10psmooth_binary.frd'", &log), 0) << log;
+  ASSERT_EQ(foxi("fields list '" + test::data_dir() + "/fields/ccx221_beam10psmooth_binary.frd'", &log), 0)
+      << log;
   EXPECT_NE(log.find("90 nodes, 31 tets, 3 fields"), std::string::npos) << log;
   EXPECT_NE(log.find("STRESS           node, 6 components, 1 step"), std::string::npos) << log;
 }
@@ -122,7 +123,8 @@ TEST_F(FieldsCli, MismatchesAndBrokenFilesExitThreeAndWriteNothing) {
   const std::string bin = test::read_text(test::data_dir() + "/fields/ccx221_beam10psmooth_binary.frd");
   test::write_text(dir_ / "cut_binary.frd", bin.substr(0, 5000));
   EXPECT_EQ(foxi("fields list " + p("cut_binary.frd"), &log), 3);
-  EXPECT_NE(log.find("cut_binary.frd: byte 4985: the file ends inside the binary element block"), std::string::npos)
+  EXPECT_NE(log.find("cut_binary.frd: byte 4985: the file ends inside the binary element block"),
+            std::string::npos)
       << log;
   // A field that is not there.
   EXPECT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --field nope -o " + p("x.vtu"), &log), 3);

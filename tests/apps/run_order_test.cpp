@@ -2,14 +2,14 @@
 // a simulated clock: every run starts once, and the sweep's makespan on 2 workers is compared with
 // the best possible one (a brute-force search over every split of the runs between the workers) and
 // with starting the runs in grid order.
+#include "../../apps/foxi/run_order.hpp"  // an app header: the test includes it by its path
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstddef>
 #include <numeric>
 #include <vector>
-
-#include "../../apps/foxi/run_order.hpp"  // an app header: the test includes it by its path
 
 namespace foxi::cli {
 namespace {
@@ -51,8 +51,9 @@ double with_run_order(const std::vector<double>& length, int jobs) {
 
 double in_grid_order(const std::vector<double>& length, int jobs) {
   std::size_t next = 0;
-  return makespan(length, jobs, [&](double) { return next < length.size() ? next++ : length.size(); },
-                  [](std::size_t, double) {});
+  return makespan(
+      length, jobs, [&](double) { return next < length.size() ? next++ : length.size(); },
+      [](std::size_t, double) {});
 }
 
 // The best 2-worker makespan: every split of the runs between the two.
@@ -71,7 +72,8 @@ double best_of_two(const std::vector<double>& length) {
 TEST(RunOrder, LongestRunsFirstOnAGrowingSweep) {
   // The flip chip's 7-point die_w sweep: run lengths in proportion to its tet counts.
   const std::vector<double> growing{10.8, 12.2, 13.6, 15.5, 18.9, 21.3, 23.9};
-  const double best = best_of_two(growing), ours = with_run_order(growing, 2), grid = in_grid_order(growing, 2);
+  const double best = best_of_two(growing), ours = with_run_order(growing, 2),
+               grid = in_grid_order(growing, 2);
   EXPECT_LE(ours, 1.05 * best) << "best " << best << ", grid order " << grid;
   EXPECT_GT(grid, 1.10 * best);  // what the order saves: the largest run no longer ends alone
   std::vector<double> shrinking(growing.rbegin(), growing.rend());
@@ -91,7 +93,8 @@ TEST(RunOrder, LongestRunsFirstOnAGrowingSweep) {
     const double total = std::accumulate(length.begin(), length.end(), 0.0);
     const double longest = *std::max_element(length.begin(), length.end());
     for (int jobs : {2, 3})
-      EXPECT_LE(with_run_order(length, jobs), total / jobs + longest * (1 - 1.0 / jobs) + 1e-9) << "trial " << trial;
+      EXPECT_LE(with_run_order(length, jobs), total / jobs + longest * (1 - 1.0 / jobs) + 1e-9)
+          << "trial " << trial;
   }
 }
 

@@ -448,8 +448,8 @@ print(len(d), [r["status"] for r in d], d[1]["parameters"][0]["text"])
 TEST(Sweep, RunsStartFromTheEndsRowsInGridOrder) {
   TempDir dir;
   const auto csv = dir / "sweep.csv", log = dir / "sweep.txt";
-  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:8mm:4 --jobs 1 -o '" +
-                              csv.string() + "'",
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
+                              "' --vary die_w=2mm:8mm:4 --jobs 1 -o '" + csv.string() + "'",
                           log),
             0)
       << test::read_text(log);

@@ -240,7 +240,8 @@ bool frd_is_binary(const std::string& bytes) {
 // the same coordinates, the same tets, and each of `names`' values at each step. The ASCII file prints
 // 6 significant digits (E12.5), the binary one float32 values and float64 coordinates, so they agree
 // to 5e-6 of each value (a field's own largest value for values near zero).
-void expect_same_results(const FieldSource& bin, const FieldSource& ascii, const std::vector<std::string>& names) {
+void expect_same_results(const FieldSource& bin, const FieldSource& ascii,
+                         const std::vector<std::string>& names) {
   ASSERT_EQ(bin.node_id.size(), ascii.node_id.size());
   std::vector<std::size_t> to_ascii(bin.node_id.size());
   for (std::size_t i = 0; i < bin.node_id.size(); ++i) {
@@ -254,7 +255,8 @@ void expect_same_results(const FieldSource& bin, const FieldSource& ascii, const
   }
   ASSERT_EQ(bin.mesh.tet.size(), ascii.mesh.tet.size());
   for (std::size_t k = 0; k < bin.mesh.tet.size(); ++k)
-    EXPECT_EQ(ascii.node_id[to_ascii[bin.mesh.tet[k]]], ascii.node_id[ascii.mesh.tet[k]]) << "tet corner " << k;
+    EXPECT_EQ(ascii.node_id[to_ascii[bin.mesh.tet[k]]], ascii.node_id[ascii.mesh.tet[k]])
+        << "tet corner " << k;
   for (const std::string& name : names) {
     const Field* fb = bin.mesh.find_field(name);
     const Field* fa = ascii.mesh.find_field(name);
@@ -274,8 +276,8 @@ void expect_same_results(const FieldSource& bin, const FieldSource& ascii, const
           const double a = fa->values[(s * n + to_ascii[i]) * nc + c];
           ASSERT_EQ(std::isnan(a), std::isnan(b)) << name << " node " << bin.node_id[i];
           if (std::isnan(a)) continue;
-          EXPECT_NEAR(b, a, 5e-6 * std::max(std::abs(a), 1e-6 * scale)) << name << " step " << s << " node "
-                                                                          << bin.node_id[i] << " component " << c;
+          EXPECT_NEAR(b, a, 5e-6 * std::max(std::abs(a), 1e-6 * scale))
+              << name << " step " << s << " node " << bin.node_id[i] << " component " << c;
           ++compared;
         }
     EXPECT_GT(compared, 0u) << name;
@@ -310,15 +312,16 @@ TEST(FieldSource, BinaryFrdFromCcxAgreesWithAscii) {
   if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
   test::TempDir dir;
   const Mesh m = bench::kuhn_grid_mesh(3, 0.2, 7);
-  const std::string heat = "*STEP\n*HEAT TRANSFER, STEADY STATE\n*BOUNDARY\n" + nodes_at(m, 0, 0, ", 11, 11, 300") +
-                           nodes_at(m, 0, 1, ", 11, 11, 400") + "*NODE FILE\nNT\n*EL FILE\nHFL\n*END STEP\n" +
-                           "*STEP\n*HEAT TRANSFER, STEADY STATE\n*BOUNDARY\n" + nodes_at(m, 0, 1, ", 11, 11, 500") +
-                           "*NODE FILE\nNT\n*EL FILE\nHFL\n*END STEP\n";
-  const std::string load = "*STEP\n*STATIC\n*BOUNDARY\n" + nodes_at(m, 2, 0, ", 1, 3, 0") +
-                           "*BOUNDARY\n" + nodes_at(m, 2, 1, ", 3, 3, 0.01") + "*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n";
+  const std::string heat = "*STEP\n*HEAT TRANSFER, STEADY STATE\n*BOUNDARY\n" +
+                           nodes_at(m, 0, 0, ", 11, 11, 300") + nodes_at(m, 0, 1, ", 11, 11, 400") +
+                           "*NODE FILE\nNT\n*EL FILE\nHFL\n*END STEP\n" +
+                           "*STEP\n*HEAT TRANSFER, STEADY STATE\n*BOUNDARY\n" +
+                           nodes_at(m, 0, 1, ", 11, 11, 500") + "*NODE FILE\nNT\n*EL FILE\nHFL\n*END STEP\n";
+  const std::string load = "*STEP\n*STATIC\n*BOUNDARY\n" + nodes_at(m, 2, 0, ", 1, 3, 0") + "*BOUNDARY\n" +
+                           nodes_at(m, 2, 1, ", 3, 3, 0.01") + "*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n";
   const auto binary = [](std::string deck) {
-    for (const auto& [from, to] : {std::pair<std::string, std::string>{"*NODE FILE", "*NODE OUTPUT"},
-                                   {"*EL FILE", "*ELEMENT OUTPUT"}})
+    for (const auto& [from, to] :
+         {std::pair<std::string, std::string>{"*NODE FILE", "*NODE OUTPUT"}, {"*EL FILE", "*ELEMENT OUTPUT"}})
       for (std::size_t at; (at = deck.find(from)) != std::string::npos;) deck.replace(at, from.size(), to);
     return deck;
   };
@@ -327,7 +330,8 @@ TEST(FieldSource, BinaryFrdFromCcxAgreesWithAscii) {
   write_deck(m, dir / "load_a.inp", load);
   write_deck(m, dir / "load_b.inp", binary(load));
   for (const char* job : {"heat_a", "heat_b", "load_a", "load_b"}) {
-    const int rc = test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i " + job, dir / "ccx.log");
+    const int rc =
+        test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i " + job, dir / "ccx.log");
     ASSERT_EQ(rc, 0) << test::read_text(dir / "ccx.log");
   }
   ASSERT_TRUE(frd_is_binary(test::read_text(dir / "heat_b.frd")));
@@ -364,7 +368,8 @@ TEST(FieldSource, BrokenBinaryFrdFilesNameTheOffset) {
     } catch (const IoError& e) {
       EXPECT_EQ(e.file(), "cut.frd");
       // Where: a block's header line (its count does not fit), or a byte offset inside the file.
-      EXPECT_TRUE(cut == 0 || e.line() > 0 || e.byte_offset() <= cut) << e.what() << " (cut at " << cut << ")";
+      EXPECT_TRUE(cut == 0 || e.line() > 0 || e.byte_offset() <= cut)
+          << e.what() << " (cut at " << cut << ")";
     }
   }
   const auto reason = [](const std::string& text) -> std::string {

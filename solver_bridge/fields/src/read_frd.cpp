@@ -1,5 +1,5 @@
-// CalculiX .frd results (ASCII and binary) as a field source. Format: CalculiX GraphiX manual, "Result Format":
-// "    2C" node block (" -1" id x y z), "    3C" element block (" -1" id type group material, then
+// CalculiX .frd results (ASCII and binary) as a field source. Format: CalculiX GraphiX manual, "Result
+// Format": "    2C" node block (" -1" id x y z), "    3C" element block (" -1" id type group material, then
 // " -2" records of node ids), "  100C" result header (value = step time, node count in columns 25-36, I2
 // format flag at its end), " -4" NAME ncomps, " -5" one line per component (iexist 1: computed by the
 // reader, not in the file), " -1" id + values, " -2" continuation values, " -3" block end, " 9999" file
@@ -47,13 +47,15 @@ class FrdParser {
     if (binary_seen_) throw IoError(name_, 0, line_start_, why);
     throw IoError(name_, line_no_, IoError::kNoOffset, why);
   }
-  [[noreturn]] void fail_at(std::size_t offset, const std::string& why) const { throw IoError(name_, 0, offset, why); }
+  [[noreturn]] void fail_at(std::size_t offset, const std::string& why) const {
+    throw IoError(name_, 0, offset, why);
+  }
   // `bytes` raw bytes of a binary block at the read position (advanced past them).
   const unsigned char* take(std::size_t bytes, const std::string& what) {
     if (bytes > text_.size() - std::min(pos_, text_.size()))
-      fail_at(std::min(pos_, text_.size()), "the file ends inside the binary " + what + " (" + std::to_string(bytes) +
-                                                " bytes needed, " + std::to_string(text_.size() - std::min(pos_, text_.size())) +
-                                                " left): truncated?");
+      fail_at(std::min(pos_, text_.size()),
+              "the file ends inside the binary " + what + " (" + std::to_string(bytes) + " bytes needed, " +
+                  std::to_string(text_.size() - std::min(pos_, text_.size())) + " left): truncated?");
     const auto* p = reinterpret_cast<const unsigned char*>(text_.data() + pos_);
     pos_ += bytes;
     binary_seen_ = true;
@@ -62,10 +64,13 @@ class FrdParser {
   // Bytes of the binary blocks are little-endian (ccx's x86 builds); decoded byte by byte so that the
   // reader is right on any host.
   static std::uint32_t le32(const unsigned char* p) {
-    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+    return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 |
+           std::uint32_t(p[3]) << 24;
   }
   static std::int32_t int32_at(const unsigned char* p) { return static_cast<std::int32_t>(le32(p)); }
-  static double float32_at(const unsigned char* p) { return static_cast<double>(std::bit_cast<float>(le32(p))); }
+  static double float32_at(const unsigned char* p) {
+    return static_cast<double>(std::bit_cast<float>(le32(p)));
+  }
   static double float64_at(const unsigned char* p) {
     return std::bit_cast<double>(std::uint64_t(le32(p)) | std::uint64_t(le32(p + 4)) << 32);
   }
@@ -73,8 +78,8 @@ class FrdParser {
   void check_fits(std::int64_t count, std::size_t min_record, const std::string& what) const {
     const std::size_t left = text_.size() - std::min(pos_, text_.size());
     if (count < 0 || static_cast<std::uint64_t>(count) > left / min_record)
-      fail("a binary " + what + " of " + std::to_string(count) + " records of at least " + std::to_string(min_record) +
-           " bytes, and " + std::to_string(left) + " bytes left in the file");
+      fail("a binary " + what + " of " + std::to_string(count) + " records of at least " +
+           std::to_string(min_record) + " bytes, and " + std::to_string(left) + " bytes left in the file");
   }
 
   bool next_line() {
@@ -332,7 +337,8 @@ void FrdParser::read_results() {
       const unsigned char* r = take(4 + 4 * comps, "result block " + name);
       const std::int32_t id = int32_at(r);
       const std::uint32_t i = node_lookup(id);
-      if (i == kNone) fail_at(at, "node " + std::to_string(id) + " of block " + name + " is not in the file's node block");
+      if (i == kNone)
+        fail_at(at, "node " + std::to_string(id) + " of block " + name + " is not in the file's node block");
       if (seen[i]) fail_at(at, "node " + std::to_string(id) + " appears twice in block " + name);
       seen[i] = true;
       double* out = base + std::size_t(i) * comps;

@@ -1,5 +1,5 @@
-// The bridge to CalculiX (ccx): the same mesh and thermal or thermal-stress problem as a CalculiX input deck, and the
-// nodal results of its .frd file read back, so that foxi's solvers can be checked against an
+// The bridge to CalculiX (ccx): the same mesh and thermal or thermal-stress problem as a CalculiX input deck,
+// and the nodal results of its .frd file read back, so that foxi's solvers can be checked against an
 // independent code on the same P1 / C3D4 discretisation.
 #pragma once
 

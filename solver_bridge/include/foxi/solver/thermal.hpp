@@ -149,9 +149,9 @@ FOXI_API ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params);
 // The report of solve_thermal for nodal temperatures solved elsewhere (CalculiX): the same boundary
 // heat (the P1 reactions of `temperature` at the fixed nodes), region maxima and means, resistances
 // and energy check, and the same fields stored. `precision` > 0: the temperatures are rounded to
-// that relative precision (ccx's binary .frd: float32, 6e-8; an ASCII one: 5e-6), and the energy check's tolerance takes in the
-// imbalance that rounding can make. The solver figures stay 0, `solver` is "given". Throws
-// SolverError as solve_thermal does for `params`, and when `temperature` has the wrong size or no
+// that relative precision (ccx's binary .frd: float32, 6e-8; an ASCII one: 5e-6), and the energy check's
+// tolerance takes in the imbalance that rounding can make. The solver figures stay 0, `solver` is "given".
+// Throws SolverError as solve_thermal does for `params`, and when `temperature` has the wrong size or no
 // finite value at a node of a tet.
 FOXI_API ThermalReport thermal_report(Mesh& mesh, const ThermalParams& params, std::vector<double> temperature,
                                       double precision = 0);

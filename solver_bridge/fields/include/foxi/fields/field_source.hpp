@@ -5,7 +5,8 @@
 //   .pvd             a ParaView collection of .vtu files (as foxi solve --physics transient writes
 //                    it): every data set one step (its timestep attribute the step value) of the
 //                    fields of the first; all data sets must have the same nodes and cells.
-//   .frd             CalculiX results, ASCII or binary (float32 values): the nodes (2C) and the tets among the elements (3C:
+//   .frd             CalculiX results, ASCII or binary (float32 values): the nodes (2C) and the tets among
+//   the elements (3C:
 //                    C3D4, C3D10 as its corners), every nodal result block (DISP, NDTEMP, STRESS,
 //                    FLUX, ERROR, ...) of every step; a block name seen again is a new step of the
 //                    same field (step value: the time of its 100C record). Components that ccx
