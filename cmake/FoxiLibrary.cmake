@@ -4,8 +4,13 @@
 #  - symbols hidden unless marked FOXI_API (foxi/api.hpp), so a shared libfoxi_*.so exports only the
 #    entry points of its public headers;
 #  - installed into the export set foxiTargets as foxi::EXPORT_NAME, and the alias foxi::EXPORT_NAME
-#    in the build tree, so code in the repository and a host spell the targets alike.
+#    in the build tree, so code in the repository and a host spell the targets alike. An optional
+#    third argument names another export set (foxi::qt: foxiQtTargets, loaded only where Qt5 is found).
 function(foxi_library target export_name)
+  set(export_set foxiTargets)
+  if(ARGC GREATER 2)
+    set(export_set ${ARGV2})
+  endif()
   add_library(foxi::${export_name} ALIAS ${target})
   target_include_directories(${target}
     PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
@@ -33,7 +38,7 @@ function(foxi_library target export_name)
     $<$<CXX_COMPILER_ID:GNU,Clang>:-fmacro-prefix-map=${PROJECT_SOURCE_DIR}/=>)
   # Warnings are for foxi's own build: a host linking a static foxi must not inherit them.
   target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:foxi_warnings>)
-  install(TARGETS ${target} EXPORT foxiTargets
+  install(TARGETS ${target} EXPORT ${export_set}
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
     RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

@@ -147,24 +147,13 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
     if (o.log && !(s.lo > 0))
       throw UsageError("--log needs a range above 0 in SI (" + field.unit + "), not " + std::to_string(s.lo));
   } else {
-    auto [lo, hi] = finite_range(drawn, o.log);
-    if (std::isnan(lo))
+    const std::optional<AutoScale> a = automatic_scale(drawn, o.map, o.log);
+    if (!a)
       throw UsageError(path + ": field '" + field.name + "' has no " + (o.log ? "positive" : "finite") +
                        " value on the tets drawn" + (o.log ? " (a log scale needs one)" : ""));
-    if (!(lo < hi)) {  // a constant: a range around it, so it shows mid-map
-      const double d = lo != 0 ? std::abs(lo) * (o.log ? 0.5 : 0.01) : 1;
-      lo -= d;
-      hi += d;
-      f.range_widened = true;
-    }
-    // A diverging map shows signed values about zero: its centre (white) at 0.
-    if (o.map == ColorMapId::coolwarm && !o.log && lo < 0 && hi > 0) {
-      hi = std::max(-lo, hi);
-      lo = -hi;
-      f.range_centred = true;
-    }
-    s.lo = lo;
-    s.hi = hi;
+    s = a->scale;
+    f.range_widened = a->widened;
+    f.range_centred = a->centred;
   }
   f.legend.title = f.choice.label;
   f.paint =

@@ -362,4 +362,28 @@ std::pair<double, double> finite_range(std::span<const double> values, bool posi
   return {lo, hi};
 }
 
+
+std::optional<AutoScale> automatic_scale(std::span<const double> values, ColorMapId map, bool log) {
+  auto [lo, hi] = finite_range(values, log);
+  if (std::isnan(lo)) return std::nullopt;
+  AutoScale a;
+  if (!(lo < hi)) {  // a constant: a range around it, so it shows mid-map
+    const double d = lo != 0 ? std::abs(lo) * (log ? 0.5 : 0.01) : 1;
+    lo -= d;
+    hi += d;
+    a.widened = true;
+  }
+  // A diverging map shows signed values about zero: its centre (white) at 0.
+  if (map == ColorMapId::coolwarm && !log && lo < 0 && hi > 0) {
+    hi = std::max(-lo, hi);
+    lo = -hi;
+    a.centred = true;
+  }
+  a.scale.map = map;
+  a.scale.log = log;
+  a.scale.lo = lo;
+  a.scale.hi = hi;
+  return a;
+}
+
 }  // namespace foxi

@@ -105,4 +105,14 @@ FOXI_API FieldPaint graded_field_paint(std::span<const double> corner_values, co
 // The finite range of values (min, max); NaN, NaN if none is finite. Log: only positive values.
 FOXI_API std::pair<double, double> finite_range(std::span<const double> values, bool positive_only = false);
 
+// The automatic scale of `values` on `map` (foxi render without --range, and the workbench): their
+// finite range (log: positive values only); a constant widened around it (1 %, log 50 %, 1 about
+// zero) so it shows mid-map; coolwarm over values of both signs made symmetric about 0 (its white
+// centre at 0). Nothing when no value qualifies. widened / centred say which rule applied.
+struct AutoScale {
+  ColorScale scale;
+  bool widened = false, centred = false;
+};
+FOXI_API std::optional<AutoScale> automatic_scale(std::span<const double> values, ColorMapId map, bool log = false);
+
 }  // namespace foxi
