@@ -362,7 +362,6 @@ std::pair<double, double> finite_range(std::span<const double> values, bool posi
   return {lo, hi};
 }
 
-
 std::optional<AutoScale> automatic_scale(std::span<const double> values, ColorMapId map, bool log) {
   auto [lo, hi] = finite_range(values, log);
   if (std::isnan(lo)) return std::nullopt;

@@ -1,0 +1,201 @@
+// foxi-workbench [MODEL.toml] [--headless ...]: the Qt5 workbench (workbench.hpp). With --headless it
+// runs the loop once without a user -- load, --set, mesh, solve, show, save -- for tests and scripts
+// (QT_QPA_PLATFORM=offscreen: no display needed).
+#include <QApplication>
+#include <QEventLoop>
+#include <QPixmap>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "../foxi/exit_codes.hpp"
+#include "foxi/model/mesh_io.hpp"
+#include "foxi/viz/view_options.hpp"
+#include "workbench.hpp"
+
+namespace {
+
+const char* kUsage =
+    "foxi-workbench [MODEL.toml]\n"
+    "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics thermal] [--field NAME]\n"
+    "               [--cmap viridis|cividis|coolwarm|rainbow] [--view-size WxH]\n"
+    "               [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh MESH.vtu]\n"
+    "  The window: open a model, edit its parameters (with units, checked as the model file would\n"
+    "  be), mesh and solve on worker threads (Cancel keeps the previous mesh), look inside with the\n"
+    "  painter (draw, stop, step, undraw, the drawn-fraction slider, regions of interest), colour by a\n"
+    "  field with a legend, and compare runs in the history.\n"
+    "  --headless runs the loop once without a user: loads MODEL, applies the --set values, meshes,\n"
+    "  solves (--physics thermal), shows --field (default temperature after a solve), draws the view\n"
+    "  completely and saves the window (--screenshot), the view's own picture (--save-picture: what\n"
+    "  foxi render draws for the same mesh, field and camera) and the mesh with its fields\n"
+    "  (--save-mesh). Prints the tets, the key results and the camera as foxi render options.\n"
+    "  Run it with QT_QPA_PLATFORM=offscreen where there is no display.\n"
+    "  Exit status: 0 ok, 1 failure, 2 usage, 3 bad model or parameter, 4 a result failed its checks.";
+
+struct Usage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Waits (serving events) for the workbench's running job; returns its outcome.
+bool wait_job(foxi::workbench::Workbench& w) {
+  if (!w.busy()) return false;
+  bool ok = false;
+  QEventLoop loop;
+  QObject::connect(&w, &foxi::workbench::Workbench::finished, &loop, [&](bool r) {
+    ok = r;
+    loop.quit();
+  });
+  loop.exec();
+  return ok;
+}
+
+int headless(foxi::workbench::Workbench& w, const std::string& model, const std::vector<std::string>& sets,
+             const std::string& physics, std::string field, const std::string& cmap, const std::string& screenshot,
+             const std::string& picture, const std::string& mesh_out) {
+  using namespace foxi::cli;
+  QString error;
+  if (!w.open_model(QString::fromStdString(model), &error)) {
+    std::fprintf(stderr, "foxi-workbench: error: %s\n", error.toUtf8().constData());
+    return kExitBadInput;
+  }
+  for (const std::string& s : sets) {
+    const std::size_t eq = s.find('=');
+    if (eq == std::string::npos || eq == 0) throw Usage("--set takes NAME=VALUE, not '" + s + "'");
+    if (!w.set_parameter(QString::fromStdString(s.substr(0, eq)), QString::fromStdString(s.substr(eq + 1)), &error)) {
+      std::fprintf(stderr, "foxi-workbench: error: %s\n", error.toUtf8().constData());
+      return kExitBadInput;
+    }
+  }
+  QApplication::processEvents();  // the window laid out: the view has its size before the picture is made
+  if (!w.start_mesh() || !wait_job(w)) {
+    std::fprintf(stderr, "foxi-workbench: error: meshing: %s\n", w.last_error().toUtf8().constData());
+    return kExitFailure;
+  }
+  if (!physics.empty()) {
+    if (!w.start_solve() || !wait_job(w)) {
+      std::fprintf(stderr, "foxi-workbench: error: solving: %s\n", w.last_error().toUtf8().constData());
+      return kExitFailure;
+    }
+    if (field.empty()) field = "temperature";
+  }
+  if (!field.empty() || cmap != "viridis") {
+    if (!w.set_field(QString::fromStdString(field), QString::fromStdString(cmap)) || !wait_job(w)) {
+      std::fprintf(stderr, "foxi-workbench: error: --field %s: %s\n", field.c_str(), w.last_error().toUtf8().constData());
+      return kExitBadInput;
+    }
+  }
+  foxi::qt::ViewWidget* view = w.view_widget();
+  view->finish_now();
+  QApplication::processEvents();
+  std::printf("mesh: %zu tets\n", w.mesh()->tet_count());
+  int status = kExitOk;
+  if (const foxi::RunResults* r = w.results()) {
+    for (const foxi::ResultValue& v : r->values)
+      if (v.key) std::printf("%s %.6g %s\n", v.name.c_str(), v.value, v.unit.c_str());
+    for (const foxi::BalanceCheck& c : r->checks)
+      std::printf("check %s %s %.3g (tolerance %.3g)\n", c.name.c_str(), c.passed ? "ok" : "FAILED", c.figure,
+                  c.tolerance);
+    if (r->status != foxi::RunStatus::ok) status = kExitUnreliable;
+  }
+  std::printf("view: %s\n", view->status_text().toUtf8().constData());
+  std::printf("camera: %s\n", view->camera_options().c_str());
+  if (!picture.empty()) {
+    if (!view->save_picture(QString::fromStdString(picture), &error)) {
+      std::fprintf(stderr, "foxi-workbench: error: %s: %s\n", picture.c_str(), error.toUtf8().constData());
+      return kExitFailure;
+    }
+    std::printf("wrote %s (%dx%d)\n", picture.c_str(), view->width(), view->height());
+  }
+  if (!screenshot.empty()) {
+    if (!w.grab().save(QString::fromStdString(screenshot))) {
+      std::fprintf(stderr, "foxi-workbench: error: cannot write %s\n", screenshot.c_str());
+      return kExitFailure;
+    }
+    std::printf("wrote %s\n", screenshot.c_str());
+  }
+  if (!mesh_out.empty()) {
+    foxi::write_mesh(*w.mesh(), mesh_out);
+    std::printf("wrote %s\n", mesh_out.c_str());
+  }
+  std::fflush(stdout);
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace foxi::cli;
+  try {
+    std::vector<std::string> args(argv + 1, argv + argc);
+    std::string model, physics, field, cmap = "viridis", screenshot, picture, mesh_out, view_size;
+    std::vector<std::string> sets;
+    bool is_headless = false;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+      const std::string& a = args[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= args.size()) throw Usage(a + " takes a value");
+        return args[++i];
+      };
+      if (a == "--help" || a == "-h") {
+        std::puts(kUsage);
+        return kExitOk;
+      } else if (a == "--headless") {
+        is_headless = true;
+      } else if (a == "--set") {
+        sets.push_back(value());
+      } else if (a == "--physics") {
+        physics = value();
+        if (physics != "thermal") throw Usage("--physics: the workbench solves thermal only so far, not '" + physics + "'");
+      } else if (a == "--field") {
+        field = value();
+      } else if (a == "--cmap") {
+        cmap = value();
+      } else if (a == "--screenshot") {
+        screenshot = value();
+      } else if (a == "--save-picture") {
+        picture = value();
+      } else if (a == "--save-mesh") {
+        mesh_out = value();
+      } else if (a == "--view-size") {
+        view_size = value();
+      } else if (a.rfind("-", 0) == 0 && a.size() > 1 && a.rfind("-platform", 0) != 0) {
+        throw Usage("unknown option " + a);
+      } else if (model.empty()) {
+        model = a;
+      } else {
+        throw Usage("one model file only");
+      }
+    }
+    if (is_headless && model.empty()) throw Usage("--headless needs a model file");
+    if (!is_headless && (!sets.empty() || !physics.empty() || !field.empty() || !screenshot.empty() ||
+                         !picture.empty() || !mesh_out.empty()))
+      throw Usage("--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
+    if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")
+      throw Usage("--cmap takes viridis, cividis, coolwarm or rainbow, not '" + cmap + "'");
+    foxi::ImageSize size{0, 0};
+    if (!view_size.empty()) {
+      try {
+        size = foxi::parse_image_size(view_size);
+      } catch (const std::exception& e) {
+        throw Usage(std::string("--view-size: ") + e.what());
+      }
+    }
+    QApplication app(argc, argv);
+    QApplication::setApplicationName("foxi-workbench");
+    QApplication::setOrganizationName("foxi");
+    foxi::workbench::Workbench w;
+    if (size.width > 0) w.view_widget()->setFixedSize(size.width, size.height);
+    w.show();
+    if (is_headless) return headless(w, model, sets, physics, field, cmap, screenshot, picture, mesh_out);
+    if (!model.empty()) w.open_model(QString::fromStdString(model));
+    return app.exec();
+  } catch (const Usage& e) {
+    std::fprintf(stderr, "foxi-workbench: %s\nusage: %s\n", e.what(), kUsage);
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "foxi-workbench: error: %s\n", e.what());
+    return kExitFailure;
+  }
+}

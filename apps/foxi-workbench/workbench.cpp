@@ -1,0 +1,624 @@
+// foxi-workbench's main window: see workbench.hpp.
+#include "workbench.hpp"
+
+#include <QApplication>
+#include <QComboBox>
+#include <QDockWidget>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFutureWatcher>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QImage>
+#include <QLabel>
+#include <QPainter>
+#include <QPlainTextEdit>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSlider>
+#include <QSplitter>
+#include <QStatusBar>
+#include <QTableWidget>
+#include <QTimer>
+#include <QToolBar>
+#include <QVBoxLayout>
+#include <QtConcurrent/QtConcurrentRun>
+#include <chrono>
+#include <cmath>
+#include <exception>
+
+#include "foxi/mesher/mesher.hpp"
+#include "foxi/mesher/model_mesh.hpp"
+#include "foxi/model/io_error.hpp"
+#include "foxi/model/progress.hpp"
+#include "foxi/model/units.hpp"
+#include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/thermal.hpp"
+#include "foxi/viz/colormap.hpp"
+#include "foxi/viz/field_paint.hpp"
+#include "foxi/viz/legend.hpp"
+#include "foxi/viz/interactive_view.hpp"
+#include "foxi/viz/rasterizer.hpp"
+
+namespace foxi::workbench {
+
+struct Outcome {
+  bool ok = false, cancelled = false;
+  QString error;
+  bool meshed = false, solved = false;
+  std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const Model> model;
+  std::vector<ParameterOverride> overrides;
+  std::unique_ptr<InteractiveView> view;
+  std::vector<double> probe;  // per tet, display unit
+  QString probe_unit, field_label;
+  ColorScale scale;
+  DisplayUnit unit;
+  bool has_scale = false;
+  RunResults results;
+  double seconds = 0;
+};
+
+struct Workbench::Job {
+  std::shared_ptr<std::atomic<bool>> cancel;
+  std::shared_ptr<std::atomic<int>> permille;
+  QFutureWatcher<std::shared_ptr<Outcome>> watcher;
+  QString what;
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The display of `mesh` on the worker: the field's flat paint on the automatic scale (as foxi
+// render --field NAME --cmap MAP draws it) and the view, built with `camera` (null: the default).
+void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const std::string& cmap, int w,
+                   int h, const Camera* camera) {
+  RenderParams params;
+  params.undoable = true;  // the workbench undraws
+  if (!field.empty()) {
+    const FieldChoice choice = choose_field(mesh, field);
+    const std::vector<double> values = tet_centroid_values(mesh, choice, choice.field->step_count() - 1);
+    const ColorMapId map = parse_color_map(cmap).value_or(ColorMapId::viridis);
+    const std::optional<AutoScale> a = automatic_scale(values, map);
+    if (!a) throw FieldSelectError("field '" + field + "' has no finite value");
+    params.field = std::make_shared<const FieldPaint>(flat_field_paint(values, a->scale));
+    out.scale = a->scale;
+    out.has_scale = true;
+    const auto [lo, hi] = finite_range(values);
+    out.unit = default_display_unit(choice.field->unit, std::max(std::abs(lo), std::abs(hi)));
+    out.probe.resize(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) out.probe[i] = out.unit.to_display(values[i]);
+    out.probe_unit = QString::fromStdString(out.unit.symbol);
+    out.field_label = QString::fromStdString(choice.label);
+  }
+  out.view = foxi::qt::make_view(mesh, params, w, h, camera);
+}
+
+QString what_of(const std::exception& e) { return QString::fromStdString(e.what()); }
+
+// A colour bar with ticks (colormap.hpp's entries and nice_ticks), in the field's display unit.
+QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QString& label, int height) {
+  const int w = 150, bar = 18, top = 24, bottom = 10, h = std::max(height, 120);
+  QImage img(w, h, QImage::Format_RGB32);
+  img.fill(Qt::white);
+  QPainter p(&img);
+  const int span = h - top - bottom;
+  for (int y = 0; y < span; ++y) {
+    const std::uint32_t c = s.color_at(1.0 - (y + 0.5) / span);
+    p.setPen(QColor(int(c & 255), int(c >> 8 & 255), int(c >> 16 & 255)));
+    p.drawLine(8, top + y, 8 + bar, top + y);
+  }
+  p.setPen(Qt::black);
+  p.drawRect(8, top, bar, span);
+  p.drawText(4, 16, label + " [" + QString::fromStdString(unit.symbol) + "]");
+  const double lo = unit.to_display(s.lo), hi = unit.to_display(s.hi);
+  const std::vector<double> ticks = nice_ticks(std::min(lo, hi), std::max(lo, hi), 6);
+  const double step = ticks.size() > 1 ? ticks[1] - ticks[0] : 1;
+  for (double t : ticks) {
+    const double pos = s.position(unit.to_si(t));
+    const int y = top + int(std::lround((1 - pos) * span));
+    p.drawLine(8 + bar, y, 8 + bar + 4, y);
+    p.drawText(8 + bar + 8, y + 5, QString::fromStdString(tick_label(t, step)));
+  }
+  return QPixmap::fromImage(img);
+}
+
+}  // namespace
+
+Workbench::Workbench(QWidget* parent) : QMainWindow(parent) {
+  build_ui();
+  poll_ = new QTimer(this);
+  poll_->setInterval(100);
+  connect(poll_, &QTimer::timeout, this, [this] {
+    if (job_) progress_->setValue(job_->permille->load());
+  });
+}
+
+Workbench::~Workbench() {
+  if (job_) {
+    job_->cancel->store(true);
+    job_->watcher.waitForFinished();
+  }
+}
+
+void Workbench::build_ui() {
+  setWindowTitle("foxi workbench");
+  view_ = new foxi::qt::ViewWidget;
+  view_->setMinimumSize(480, 360);
+
+  // The view and its controls.
+  auto* centre = new QWidget;
+  auto* cv = new QVBoxLayout(centre);
+  auto* bar = new QHBoxLayout;
+  auto button = [&](const QString& text, auto slot) {
+    auto* b = new QPushButton(text);
+    connect(b, &QPushButton::clicked, view_, slot);
+    bar->addWidget(b);
+    return b;
+  };
+  button(tr("Draw"), &foxi::qt::ViewWidget::draw);
+  button(tr("Stop"), &foxi::qt::ViewWidget::stop);
+  button(tr("Go on"), &foxi::qt::ViewWidget::resume);
+  button(tr("Step"), &foxi::qt::ViewWidget::step_once);
+  button(tr("Undraw"), &foxi::qt::ViewWidget::undraw);
+  button(tr("Region"), &foxi::qt::ViewWidget::push_region);
+  button(tr("Back"), &foxi::qt::ViewWidget::pop_region);
+  fraction_ = new QSlider(Qt::Horizontal);
+  fraction_->setRange(0, 1000);
+  fraction_->setValue(1000);
+  fraction_->setToolTip(tr("fraction of the displayed set drawn: drawing or undrawing follows it"));
+  connect(fraction_, &QSlider::sliderMoved, this, [this](int v) { view_->set_fraction(v / 1000.0); });
+  bar->addWidget(new QLabel(tr("drawn")));
+  bar->addWidget(fraction_, 1);
+  cv->addLayout(bar);
+  auto* fields = new QHBoxLayout;
+  field_box_ = new QComboBox;
+  cmap_box_ = new QComboBox;
+  for (const char* m : {"viridis", "cividis", "coolwarm", "rainbow"}) cmap_box_->addItem(m);
+  fields->addWidget(new QLabel(tr("field")));
+  fields->addWidget(field_box_, 1);
+  fields->addWidget(new QLabel(tr("colour map")));
+  fields->addWidget(cmap_box_);
+  cv->addLayout(fields);
+  auto* vrow = new QHBoxLayout;
+  vrow->addWidget(view_, 1);
+  legend_ = new QLabel;
+  legend_->setFixedWidth(150);
+  legend_->setAlignment(Qt::AlignTop);
+  vrow->addWidget(legend_);
+  cv->addLayout(vrow, 1);
+  auto pick_field = [this] {
+    if (filling_) return;
+    const QString f = field_box_->currentIndex() <= 0 ? QString() : field_box_->currentText();
+    set_field(f, cmap_box_->currentText());
+  };
+  connect(field_box_, qOverload<int>(&QComboBox::currentIndexChanged), this, pick_field);
+  connect(cmap_box_, qOverload<int>(&QComboBox::currentIndexChanged), this, pick_field);
+  setCentralWidget(centre);
+
+  // The model panel: open, parameters (editable), the model's parts and conditions.
+  auto* left = new QWidget;
+  auto* lv = new QVBoxLayout(left);
+  auto* open = new QPushButton(tr("Open model..."));
+  connect(open, &QPushButton::clicked, this, [this] {
+    const QString f = QFileDialog::getOpenFileName(this, tr("Open a model"), QString(), tr("Models (*.toml)"));
+    if (!f.isEmpty()) open_model(f);
+  });
+  lv->addWidget(open);
+  params_ = new QTableWidget(0, 3);
+  params_->setHorizontalHeaderLabels({tr("parameter"), tr("expression"), tr("value (SI)")});
+  params_->horizontalHeader()->setStretchLastSection(true);
+  params_->verticalHeader()->hide();
+  connect(params_, &QTableWidget::cellChanged, this, &Workbench::on_parameter_edited);
+  lv->addWidget(params_, 2);
+  param_error_ = new QLabel;
+  param_error_->setWordWrap(true);
+  param_error_->setStyleSheet("color: #b00000");
+  lv->addWidget(param_error_);
+  model_text_ = new QPlainTextEdit;
+  model_text_->setReadOnly(true);
+  lv->addWidget(model_text_, 1);
+  auto* jobs = new QHBoxLayout;
+  mesh_button_ = new QPushButton(tr("Mesh"));
+  solve_button_ = new QPushButton(tr("Solve (thermal)"));
+  cancel_button_ = new QPushButton(tr("Cancel"));
+  cancel_button_->setEnabled(false);
+  connect(mesh_button_, &QPushButton::clicked, this, [this] { start_mesh(); });
+  connect(solve_button_, &QPushButton::clicked, this, [this] { start_solve(); });
+  connect(cancel_button_, &QPushButton::clicked, this, &Workbench::cancel);
+  jobs->addWidget(mesh_button_);
+  jobs->addWidget(solve_button_);
+  jobs->addWidget(cancel_button_);
+  lv->addLayout(jobs);
+  progress_ = new QProgressBar;
+  progress_->setRange(0, 1000);
+  progress_->setValue(0);
+  lv->addWidget(progress_);
+  auto* model_dock = new QDockWidget(tr("Model"));
+  model_dock->setObjectName("model");
+  model_dock->setWidget(left);
+  addDockWidget(Qt::LeftDockWidgetArea, model_dock);
+
+  // Results and history.
+  results_table_ = new QTableWidget(0, 3);
+  results_table_->setHorizontalHeaderLabels({tr("result"), tr("value"), tr("unit / check")});
+  results_table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  results_table_->setMinimumWidth(330);
+  results_table_->verticalHeader()->hide();
+  results_table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  auto* results_dock = new QDockWidget(tr("Results"));
+  results_dock->setObjectName("results");
+  results_dock->setWidget(results_table_);
+  addDockWidget(Qt::RightDockWidgetArea, results_dock);
+  history_table_ = new QTableWidget(0, 5);
+  history_table_->setHorizontalHeaderLabels({tr("run"), tr("parameters"), tr("tets"), tr("key results"), tr("time")});
+  history_table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  history_table_->horizontalHeader()->setSectionResizeMode(3, QHeaderView::Stretch);
+  history_table_->verticalHeader()->hide();
+  history_table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  auto* history_dock = new QDockWidget(tr("Run history"));
+  history_dock->setObjectName("history");
+  history_dock->setWidget(history_table_);
+  addDockWidget(Qt::BottomDockWidgetArea, history_dock);
+
+  status_ = new QLabel;
+  probe_ = new QLabel;
+  statusBar()->addWidget(status_, 1);
+  statusBar()->addPermanentWidget(probe_);
+  connect(view_, &foxi::qt::ViewWidget::status_changed, status_, &QLabel::setText);
+  connect(view_, &foxi::qt::ViewWidget::probe_changed, probe_, &QLabel::setText);
+  connect(view_, &foxi::qt::ViewWidget::fraction_changed, this, [this](double f) {
+    if (!fraction_->isSliderDown()) fraction_->setValue(int(std::lround(f * 1000)));
+  });
+  resize(1280, 860);
+}
+
+void Workbench::show_error(const QString& text) {
+  last_error_ = text;
+  param_error_->setText(text);
+}
+
+bool Workbench::open_model(const QString& path, QString* error) {
+  try {
+    auto m = std::make_shared<const Model>(load_model(path.toStdString(), std::span<const ParameterOverride>{}));
+    model_path_ = path;
+    overrides_.clear();
+    model_ = std::move(m);
+    show_error({});
+    setWindowTitle("foxi workbench - " + QFileInfo(path).fileName());
+    refresh_model_panel();
+    return true;
+  } catch (const std::exception& e) {
+    show_error(what_of(e));
+    if (error) *error = what_of(e);
+    return false;
+  }
+}
+
+std::vector<ParameterOverride> Workbench::overrides() const {
+  std::vector<ParameterOverride> out;
+  for (const auto& [n, e] : overrides_) out.push_back({n, e});
+  return out;
+}
+
+bool Workbench::set_parameter(const QString& name, const QString& expression, QString* error) {
+  if (model_path_.isEmpty()) {
+    if (error) *error = tr("open a model first");
+    return false;
+  }
+  auto trial = overrides_;
+  trial[name.toStdString()] = expression.toStdString();
+  std::vector<ParameterOverride> list;
+  for (const auto& [n, e] : trial) list.push_back({n, e});
+  try {
+    // The model library's own check: units, expressions, geometry limits (a model file load).
+    auto m = std::make_shared<const Model>(load_model(model_path_.toStdString(), list, "the parameter table"));
+    overrides_ = std::move(trial);
+    model_ = std::move(m);
+    show_error({});
+    refresh_model_panel();
+    return true;
+  } catch (const std::exception& e) {
+    show_error(what_of(e));
+    if (error) *error = what_of(e);
+    refresh_model_panel();  // the cell shows the accepted expression again
+    return false;
+  }
+}
+
+void Workbench::on_parameter_edited(int row, int column) {
+  if (filling_ || column != 1) return;
+  const QString name = params_->item(row, 0)->text(), expr = params_->item(row, 1)->text();
+  QString error;
+  if (!set_parameter(name, expr, &error)) {
+    // The message next to the field at fault: the row is marked and the message shown under it.
+    params_->selectRow(row);
+    param_error_->setText(tr("%1: %2").arg(name, error));
+  }
+}
+
+void Workbench::refresh_model_panel() {
+  filling_ = true;
+  params_->setRowCount(0);
+  if (model_) {
+    params_->setRowCount(int(model_->parameters.size()));
+    int row = 0;
+    for (const Parameter& p : model_->parameters) {
+      auto* n = new QTableWidgetItem(QString::fromStdString(p.name));
+      n->setFlags(n->flags() & ~Qt::ItemIsEditable);
+      auto* v = new QTableWidgetItem(QString("%1 %2").arg(p.value.value, 0, 'g', 6).arg(QString::fromStdString(dims_to_string(p.value.dims))));
+      v->setFlags(v->flags() & ~Qt::ItemIsEditable);
+      auto* e = new QTableWidgetItem(QString::fromStdString(p.expression));
+      if (p.overridden) e->setBackground(QColor(255, 245, 200));
+      params_->setItem(row, 0, n);
+      params_->setItem(row, 1, e);
+      params_->setItem(row, 2, v);
+      ++row;
+    }
+    QString text;
+    text += tr("length unit %1\n").arg(QString::fromStdString(model_->length_unit));
+    for (const Part& p : model_->parts)
+      text += tr("part %1: %2, %3 (line %4)\n")
+                  .arg(QString::fromStdString(p.name), QString::fromStdString(p.shape),
+                       QString::fromStdString(p.material))
+                  .arg(p.line);
+    text += tr("%1 materials, %2 conditions, %3 loads\n")
+                .arg(model_->materials.size())
+                .arg(model_->conditions.size())
+                .arg(model_->loads.size());
+    model_text_->setPlainText(text);
+  }
+  filling_ = false;
+}
+
+void Workbench::launch(std::function<std::shared_ptr<Outcome>()> work, const QString& what,
+                       std::shared_ptr<std::atomic<bool>> cancel, std::shared_ptr<std::atomic<int>> permille) {
+  job_ = std::make_unique<Job>();
+  job_->what = what;
+  job_->cancel = std::move(cancel);
+  job_->permille = std::move(permille);
+  connect(&job_->watcher, &QFutureWatcher<std::shared_ptr<Outcome>>::finished, this, &Workbench::on_job_done);
+  job_->watcher.setFuture(QtConcurrent::run(std::move(work)));
+  mesh_button_->setEnabled(false);
+  solve_button_->setEnabled(false);
+  cancel_button_->setEnabled(true);
+  progress_->setValue(0);
+  poll_->start();
+  statusBar()->showMessage(what + "...");
+}
+
+bool Workbench::start_mesh() {
+  if (busy() || model_path_.isEmpty()) return false;
+  const std::string path = model_path_.toStdString();
+  const std::vector<ParameterOverride> ov = overrides();
+  const int w = view_->width(), h = view_->height();
+  // The camera stays across a remesh of the same model (the loop: compare before and after).
+  std::optional<Camera> cam;
+  if (view_->camera()) cam = *view_->camera();
+  auto job_cancel = std::make_shared<std::atomic<bool>>(false);
+  auto job_permille = std::make_shared<std::atomic<int>>(0);
+  auto work = [path, ov, w, h, cam, job_cancel, job_permille]() {
+    auto out = std::make_shared<Outcome>();
+    const auto t0 = Clock::now();
+    try {
+      ModelMeshOptions options;
+      options.override_origin = "the parameter table";
+      options.progress = [job_cancel, job_permille](std::string_view, double f) {
+        job_permille->store(int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
+        return !job_cancel->load();
+      };
+      MeshedModel mm = mesh_model(path, ov, options);
+      if (job_cancel->load()) throw MesherCancelled("cancelled");
+      auto mesh = std::make_shared<Mesh>(std::move(mm.mesh));
+      out->model = std::make_shared<const Model>(std::move(mm.model));
+      out->overrides = ov;
+      build_display(*out, *mesh, "", "viridis", w, h, cam ? &*cam : nullptr);
+      out->mesh = std::move(mesh);
+      out->meshed = true;
+      out->ok = true;
+    } catch (const Cancelled&) {
+      out->cancelled = true;
+      out->error = "cancelled";
+    } catch (const std::exception& e) {
+      out->error = what_of(e);
+    }
+    out->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return out;
+  };
+  launch(work, tr("meshing"), job_cancel, job_permille);
+  return true;
+}
+
+bool Workbench::start_solve() {
+  if (busy() || !mesh_ || !meshed_model_) return false;
+  std::shared_ptr<const Mesh> mesh = mesh_;
+  std::shared_ptr<const Model> model = meshed_model_;
+  const std::string path = model_path_.toStdString();
+  const std::vector<ParameterOverride> ov = meshed_overrides_;
+  const std::string field = "temperature", cmap = color_map_.toStdString();
+  const int w = view_->width(), h = view_->height();
+  std::optional<Camera> cam;
+  if (view_->camera()) cam = *view_->camera();
+  auto job_cancel = std::make_shared<std::atomic<bool>>(false);
+  auto job_permille = std::make_shared<std::atomic<int>>(0);
+  auto work = [mesh, model, path, ov, field, cmap, w, h, cam, job_cancel, job_permille]() {
+    auto out = std::make_shared<Outcome>();
+    const auto t0 = Clock::now();
+    try {
+      // The shown mesh stays as it is: the solve writes its fields into a copy.
+      auto m = std::make_shared<Mesh>(*mesh);
+      ThermalParams params = thermal_params_from_model(*model, *m);
+      params.solver.progress = [job_cancel, job_permille](std::string_view, double f) {
+        job_permille->store(int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
+        return !job_cancel->load();
+      };
+      const ThermalReport report = solve_thermal(*m, params);
+      out->results = thermal_results(*m, report);
+      out->results.model = path;
+      out->results.physics = "thermal";
+      for (const ParameterOverride& o : ov) out->results.parameters.push_back({o.name, o.expression});
+      build_display(*out, *m, field, cmap, w, h, cam ? &*cam : nullptr);
+      out->mesh = std::move(m);
+      out->model = model;
+      out->overrides = ov;
+      out->solved = true;
+      out->ok = true;
+    } catch (const Cancelled&) {
+      out->cancelled = true;
+      out->error = "cancelled";
+    } catch (const std::exception& e) {
+      out->error = what_of(e);
+    }
+    out->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return out;
+  };
+  launch(work, tr("solving"), job_cancel, job_permille);
+  return true;
+}
+
+bool Workbench::set_field(const QString& field, const QString& color_map) {
+  if (busy() || !mesh_) return false;
+  std::shared_ptr<const Mesh> mesh = mesh_;
+  const std::string f = field.toStdString(), cmap = color_map.toStdString();
+  const int w = view_->width(), h = view_->height();
+  std::optional<Camera> cam;
+  if (view_->camera()) cam = *view_->camera();
+  field_ = field;
+  color_map_ = color_map;
+  auto work = [mesh, f, cmap, w, h, cam]() {
+    auto out = std::make_shared<Outcome>();
+    try {
+      build_display(*out, *mesh, f, cmap, w, h, cam ? &*cam : nullptr);
+      out->mesh = mesh;
+      out->ok = true;
+    } catch (const std::exception& e) {
+      out->error = what_of(e);
+    }
+    return out;
+  };
+  launch(work, tr("colouring"), std::make_shared<std::atomic<bool>>(false), std::make_shared<std::atomic<int>>(0));
+  return true;
+}
+
+void Workbench::cancel() {
+  if (job_) job_->cancel->store(true);
+}
+
+void Workbench::on_job_done() {
+  std::shared_ptr<Outcome> out = job_->watcher.result();
+  const QString what = job_->what;
+  job_.reset();
+  poll_->stop();
+  mesh_button_->setEnabled(true);
+  solve_button_->setEnabled(true);
+  cancel_button_->setEnabled(false);
+  progress_->setValue(out && out->ok ? 1000 : 0);
+  if (!out || !out->ok) {
+    const QString why = out ? out->error : tr("no result");
+    last_error_ = why;
+    statusBar()->showMessage(what + ": " + why, 10000);
+    if (!out || !out->cancelled) param_error_->setText(why);
+    emit finished(false);
+    return;
+  }
+  last_error_.clear();
+  statusBar()->showMessage(what + tr(": done in %1 s").arg(out->seconds, 0, 'f', 2), 5000);
+  if (out->meshed) {
+    mesh_ = out->mesh;
+    meshed_model_ = out->model;
+    meshed_overrides_ = out->overrides;
+    mesh_seconds_ = out->seconds;
+    ++mesh_serial_;
+    has_results_ = false;
+    field_.clear();
+  }
+  if (out->solved) {
+    mesh_ = out->mesh;
+    results_ = out->results;
+    results_.mesh_seconds = mesh_seconds_;
+    results_.solve_seconds = out->seconds;
+    has_results_ = true;
+    field_ = "temperature";
+  }
+  if (!out->meshed && !out->solved) mesh_ = out->mesh;
+  view_->set_view(out->mesh, std::move(out->view));
+  view_->set_probe_values(std::move(out->probe), out->probe_unit);
+  if (out->has_scale)
+    legend_->setPixmap(legend_pixmap(out->scale, out->unit, out->field_label, view_->height()));
+  else
+    legend_->clear();
+  refresh_fields();
+  if (out->meshed) add_history(out->seconds);
+  if (out->solved) {
+    show_results();
+    add_history(mesh_seconds_ + out->seconds);  // the mesh's row gets the results
+  }
+  emit finished(true);
+}
+
+void Workbench::refresh_fields() {
+  filling_ = true;
+  field_box_->clear();
+  field_box_->addItem(tr("(regions)"));
+  if (mesh_)
+    for (const Field& f : mesh_->fields) field_box_->addItem(QString::fromStdString(f.name));
+  const int i = field_.isEmpty() ? 0 : field_box_->findText(field_);
+  field_box_->setCurrentIndex(std::max(i, 0));
+  cmap_box_->setCurrentText(color_map_);
+  filling_ = false;
+}
+
+void Workbench::show_results() {
+  const RunResults& r = results_;
+  results_table_->setRowCount(0);
+  auto add = [&](const QString& a, const QString& b, const QString& c) {
+    const int row = results_table_->rowCount();
+    results_table_->insertRow(row);
+    results_table_->setItem(row, 0, new QTableWidgetItem(a));
+    results_table_->setItem(row, 1, new QTableWidgetItem(b));
+    results_table_->setItem(row, 2, new QTableWidgetItem(c));
+  };
+  add(tr("status"), run_status_name(r.status), QString::fromStdString(r.error));
+  add(tr("nodes / tets"), QString("%1 / %2").arg(r.nodes).arg(r.tets), {});
+  for (const ResultValue& v : r.values)
+    add(QString::fromStdString(v.name) + (v.key ? " *" : ""), QString::number(v.value, 'g', 6),
+        QString::fromStdString(v.unit));
+  for (const BalanceCheck& c : r.checks)
+    add(tr("check ") + QString::fromStdString(c.name), QString::number(c.figure, 'g', 3),
+        (c.passed ? tr("ok, tolerance ") : tr("FAILED, tolerance ")) + QString::number(c.tolerance, 'g', 3));
+}
+
+void Workbench::add_history(double seconds) {
+  HistoryRow row;
+  row.parameters = meshed_overrides_;
+  row.mesh = mesh_serial_;
+  row.tets = mesh_ ? mesh_->tet_count() : 0;
+  if (has_results_) row.results = results_;
+  else row.results.status = RunStatus::failed, row.results.error = "meshed only";
+  row.seconds = seconds;
+  // A solve of the mesh the last row made completes that row (one row per model state).
+  const bool complete = has_results_ && !history_.empty() && history_.back().results.values.empty() &&
+                        history_.back().mesh == row.mesh;
+  int i = history_table_->rowCount();
+  if (complete) {
+    history_.back() = row;
+    --i;
+  } else {
+    history_.push_back(row);
+    history_table_->insertRow(i);
+  }
+  QString params;
+  for (const ParameterOverride& o : row.parameters)
+    params += QString::fromStdString(o.name + "=" + o.expression + " ");
+  QString key;
+  for (const ResultValue& v : row.results.values)
+    if (v.key) key += QString("%1 %2 %3; ").arg(QString::fromStdString(v.name)).arg(v.value, 0, 'g', 5).arg(QString::fromStdString(v.unit));
+  history_table_->setItem(i, 0, new QTableWidgetItem(QString::number(i + 1)));
+  history_table_->setItem(i, 1, new QTableWidgetItem(params.isEmpty() ? tr("(as in the file)") : params));
+  history_table_->setItem(i, 2, new QTableWidgetItem(QString::number(row.tets)));
+  history_table_->setItem(i, 3, new QTableWidgetItem(has_results_ ? key : tr("meshed only")));
+  history_table_->setItem(i, 4, new QTableWidgetItem(QString("%1 s").arg(seconds, 0, 'f', 2)));
+}
+
+}  // namespace foxi::workbench

@@ -1,0 +1,130 @@
+// foxi-workbench's main window: a model file's parameters edited with units (checked by the model
+// library's own load_model), the model meshed (mesh_model) and solved (thermal: solve_thermal, its
+// results record and balance checks) on worker threads with a progress bar and Cancel, the result
+// shown on the foxi::qt view with a field, a colour map and a legend, and a history of the runs.
+// Every operation that can take long runs on a worker (QtConcurrent); the GUI thread only presents,
+// and the previous mesh and picture stay shown until a new one is ready.
+#pragma once
+
+#include <QMainWindow>
+#include <QString>
+#include <QStringList>
+#include <atomic>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/model/model_file.hpp"
+#include "foxi/qt/view_widget.hpp"
+#include "foxi/solver/results.hpp"
+
+class QComboBox;
+class QLabel;
+class QProgressBar;
+class QPushButton;
+class QSlider;
+class QTableWidget;
+class QPlainTextEdit;
+class QTimer;
+
+namespace foxi::workbench {
+
+// One row of the run history.
+struct HistoryRow {
+  std::vector<ParameterOverride> parameters;  // the overrides of that run
+  std::size_t mesh = 0;  // which mesh (1, 2, ... in the session): a solve completes its mesh's row
+  std::size_t tets = 0;
+  RunResults results;  // status failed with no values: meshed only
+  double seconds = 0;  // mesh + solve wall time
+};
+
+// What a worker hands back (mesh, solve or a new field paint).
+struct Outcome;
+
+class Workbench : public QMainWindow {
+  Q_OBJECT
+
+ public:
+  explicit Workbench(QWidget* parent = nullptr);
+  ~Workbench() override;
+
+  // Loads the model file; false with the error (file:line: reason) in `error` and shown.
+  bool open_model(const QString& path, QString* error = nullptr);
+  // Sets parameter `name` to `expression` ("5 mm", "2 * die_w"), checked by loading the model with
+  // it: false (nothing changes) with the library's message (file:line: reason) for an unknown name,
+  // a unit of another dimension, a bad expression.
+  bool set_parameter(const QString& name, const QString& expression, QString* error = nullptr);
+  // The current overrides (name=expression), and the model as loaded with them.
+  std::vector<ParameterOverride> overrides() const;
+  const Model* model() const { return model_.get(); }
+
+  // Starts meshing / solving on a worker; false if busy or nothing to do. finished() comes after.
+  bool start_mesh();
+  bool start_solve();
+  // Asks the running job to stop; the previous mesh and picture stay.
+  void cancel();
+  bool busy() const { return job_ != nullptr; }
+
+  // The field shown ("" for regions) and its colour map; rebuilds the picture on a worker.
+  bool set_field(const QString& field, const QString& color_map = "viridis");
+
+  std::shared_ptr<const Mesh> mesh() const { return mesh_; }
+  const RunResults* results() const { return has_results_ ? &results_ : nullptr; }
+  const std::vector<HistoryRow>& history() const { return history_; }
+  foxi::qt::ViewWidget* view_widget() const { return view_; }
+  QString last_error() const { return last_error_; }
+
+ signals:
+  // A job ended: ok false with last_error() (cancelled: "cancelled").
+  void finished(bool ok);
+
+ private:
+  void build_ui();
+  void refresh_model_panel();
+  void on_parameter_edited(int row, int column);
+  void launch(std::function<std::shared_ptr<Outcome>()> work, const QString& what,
+              std::shared_ptr<std::atomic<bool>> cancel, std::shared_ptr<std::atomic<int>> permille);
+  void on_job_done();
+  void show_results();
+  void add_history(double seconds);
+  void refresh_fields();
+  void show_error(const QString& text);
+
+  QString model_path_;
+  std::map<std::string, std::string> overrides_;
+  std::shared_ptr<const Model> model_;         // as loaded with the overrides
+  std::shared_ptr<const Model> meshed_model_;  // the model the shown mesh came from
+  std::vector<ParameterOverride> meshed_overrides_;
+  std::shared_ptr<const Mesh> mesh_;
+  RunResults results_;
+  bool has_results_ = false;
+  double mesh_seconds_ = 0;
+  std::size_t mesh_serial_ = 0;
+  std::vector<HistoryRow> history_;
+  QString field_, color_map_ = "viridis";
+  QString last_error_;
+
+  // The running job: its cancel flag and progress, polled by a timer (no event per progress call).
+  struct Job;
+  std::unique_ptr<Job> job_;
+  QTimer* poll_ = nullptr;
+
+  foxi::qt::ViewWidget* view_ = nullptr;
+  QTableWidget* params_ = nullptr;
+  QLabel* param_error_ = nullptr;
+  QPlainTextEdit* model_text_ = nullptr;
+  QPushButton *mesh_button_ = nullptr, *solve_button_ = nullptr, *cancel_button_ = nullptr;
+  QProgressBar* progress_ = nullptr;
+  QTableWidget* results_table_ = nullptr;
+  QTableWidget* history_table_ = nullptr;
+  QComboBox *field_box_ = nullptr, *cmap_box_ = nullptr;
+  QLabel* legend_ = nullptr;
+  QSlider* fraction_ = nullptr;
+  QLabel *status_ = nullptr, *probe_ = nullptr;
+  bool filling_ = false;  // the tables being filled by the program, not edited
+};
+
+}  // namespace foxi::workbench

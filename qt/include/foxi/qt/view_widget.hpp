@@ -1,0 +1,115 @@
+// foxi::qt: a QWidget showing a tet mesh drawn by the painter (foxi::InteractiveView,
+// viz/interactive_view.hpp) progressively, in time slices from a QTimer so that the GUI thread never
+// stalls: a draw runs batch by batch, each slice a few milliseconds, and the widget repaints only
+// the damaged rectangles. Mouse: left-drag orbits, middle-drag (or shift + left) pans, right-drag or
+// the wheel zooms; each move restarts the draw from the back. Draw / Stop / Step / Undraw as slots,
+// and a target fraction (a slider): the picture follows it both ways, drawing or undrawing (the
+// seed paper's interaction). The safe-picture rule holds (picture.hpp): a mesh that fails the
+// Delaunay certificate is drawn in MPVO order with the depth buffer and cannot undraw (the widget
+// then redraws up to a lower fraction instead).
+#pragma once
+
+#include <QString>
+#include <QWidget>
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "foxi/api.hpp"
+
+namespace foxi {
+struct Mesh;
+struct Camera;
+struct RenderParams;
+class InteractiveView;
+}  // namespace foxi
+
+namespace foxi::qt {
+
+// The view of `mesh` for a width x height widget, with `camera`, or when null foxi render's default
+// camera for the mesh's bounds (view_options.hpp): what set_mesh builds. Safe on any thread (a host
+// builds it on a worker for a large mesh and hands it to ViewWidget::set_view).
+FOXI_API std::unique_ptr<InteractiveView> make_view(const Mesh& mesh, const RenderParams& params, int width,
+                                                    int height, const Camera* camera = nullptr);
+
+class FOXI_API ViewWidget : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit ViewWidget(QWidget* parent = nullptr);
+  ~ViewWidget() override;
+
+  // Shows `mesh` (kept alive while shown) with `params`: builds the view (the Delaunay certificate
+  // and the sphere table: O(n log n), so a host with a large mesh builds the view on a worker
+  // thread with make_view and hands it to set_view). keep_camera: the current camera stays (a
+  // remesh of the same model); otherwise the default camera for the mesh's bounds, as foxi render's.
+  void set_mesh(std::shared_ptr<const Mesh> mesh, const RenderParams& params, bool keep_camera = false);
+  // A view built elsewhere (any thread) for `mesh`, which it must be the view of; starts drawing.
+  void set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<InteractiveView> view);
+  // Forgets the mesh (a blank widget).
+  void clear();
+
+  bool has_view() const;
+  InteractiveView* view();
+  const InteractiveView* view() const;
+  std::shared_ptr<const Mesh> mesh() const;
+  // The current camera, or null without a view.
+  const Camera* camera() const;
+
+  // Values per tet shown under the mouse pointer (the tet's value as its colour shows it), with
+  // their unit; empty: the region and tet only.
+  void set_probe_values(std::vector<double> tet_values, QString unit);
+  // The text for the tet at widget pixel (x, y): "tet 12, region die, 45.2 °C" (empty: background).
+  QString probe_text(int x, int y) const;
+
+  // Milliseconds of painter work per timer slice (default 8).
+  void set_time_slice(std::chrono::milliseconds slice);
+
+  // The fraction of the displayed set drawn, in [0, 1].
+  double fraction_drawn() const;
+  // "drawn 1234 / 5000 tets (24.7%), 12.3 ms, 0.8 ms/frame, ... | power order, Delaunay certified".
+  QString status_text() const;
+  // The view's framebuffer as a PNG (exactly what foxi render draws for the same mesh, paint and
+  // camera); false with the reason in `error`.
+  bool save_picture(const QString& path, QString* error = nullptr) const;
+  // The camera as foxi render options (--eye ... --at ... --up ... --fov ...), exact.
+  std::string camera_options() const;
+  // Whether the painter still has work (drawing, undrawing or following a fraction).
+  bool busy() const;
+
+ public slots:
+  void draw();        // a new draw from the back
+  void stop();        // pause (the picture stays)
+  void resume();      // go on drawing (or undrawing)
+  void step_once();   // one batch, then paused
+  void undraw();      // undraw front to back (again: draw on)
+  void finish_now();  // draw all that is left, at once (blocking: for scripts and tests)
+  // The picture follows the fraction `f` of the displayed set: draws on or undraws to it.
+  void set_fraction(double f);
+  bool push_region();  // the drawn tets become the displayed set, camera re-framed on them
+  bool pop_region();
+
+ signals:
+  void status_changed(const QString& text);
+  void probe_changed(const QString& text);
+  void fraction_changed(double fraction);
+  void draw_finished();
+
+ protected:
+  void paintEvent(QPaintEvent* event) override;
+  void resizeEvent(QResizeEvent* event) override;
+  void mousePressEvent(QMouseEvent* event) override;
+  void mouseMoveEvent(QMouseEvent* event) override;
+  void mouseReleaseEvent(QMouseEvent* event) override;
+  void wheelEvent(QWheelEvent* event) override;
+
+ private:
+  void tick();
+  void kick();  // the timer on, if there is work
+  void present();
+  struct Impl;
+  std::unique_ptr<Impl> d_;
+};
+
+}  // namespace foxi::qt

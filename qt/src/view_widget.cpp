@@ -1,0 +1,362 @@
+// foxi::qt::ViewWidget: see view_widget.hpp.
+#include "foxi/qt/view_widget.hpp"
+
+#include <QImage>
+#include <QMouseEvent>
+#include <QPaintEvent>
+#include <QPainter>
+#include <QTimer>
+#include <QWheelEvent>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <optional>
+
+#include "foxi/model/mesh.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/interactive_view.hpp"
+#include "foxi/viz/rasterizer.hpp"
+#include "foxi/viz/view_options.hpp"
+
+namespace foxi::qt {
+
+struct ViewWidget::Impl {
+  std::shared_ptr<const Mesh> mesh;
+  std::unique_ptr<InteractiveView> view;
+  QTimer timer;
+  std::chrono::milliseconds slice{8};
+  bool camera_default = true;  // never moved by the user: re-fitted to a new aspect on resize
+  std::optional<std::size_t> target;  // following a fraction: the tet count to reach
+  std::vector<double> probe;
+  QString probe_unit;
+  QPoint last;  // the last mouse position of a drag
+  Qt::MouseButtons buttons;
+};
+
+namespace {
+
+// foxi render's camera for the mesh's bounds and this aspect (view_options.hpp: the same rule).
+Camera default_camera(const Mesh& mesh, int width, int height) {
+  double lo[3], hi[3];
+  mesh_bounds(mesh, lo, hi);
+  return camera_for(CameraOptions{}, lo, hi, double(width) / double(height));
+}
+
+}  // namespace
+
+ViewWidget::ViewWidget(QWidget* parent) : QWidget(parent), d_(std::make_unique<Impl>()) {
+  setMouseTracking(true);
+  setMinimumSize(64, 48);
+  setAttribute(Qt::WA_OpaquePaintEvent);
+  setFocusPolicy(Qt::StrongFocus);
+  // A zero-interval timer runs whenever the event loop is idle: one slice of painter work per
+  // event-loop pass, so input and repaints are served between slices.
+  d_->timer.setInterval(0);
+  connect(&d_->timer, &QTimer::timeout, this, &ViewWidget::tick);
+}
+
+ViewWidget::~ViewWidget() = default;
+
+std::unique_ptr<InteractiveView> make_view(const Mesh& mesh, const RenderParams& params, int width, int height,
+                                           const Camera* camera) {
+  const int w = std::max(1, width), h = std::max(1, height);
+  return std::make_unique<InteractiveView>(mesh, camera ? *camera : default_camera(mesh, w, h), w, h, params);
+}
+
+void ViewWidget::set_mesh(std::shared_ptr<const Mesh> mesh, const RenderParams& params, bool keep_camera) {
+  const bool keep = keep_camera && d_->view;
+  const Camera cam = keep ? d_->view->camera() : Camera{};
+  auto view = make_view(*mesh, params, width(), height(), keep ? &cam : nullptr);
+  if (!keep) d_->camera_default = true;
+  set_view(std::move(mesh), std::move(view));
+}
+
+void ViewWidget::set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<InteractiveView> view) {
+  // The old view goes before the mesh it was lent.
+  d_->view = std::move(view);
+  d_->mesh = std::move(mesh);
+  d_->target.reset();
+  d_->probe.clear();
+  if (d_->view && (d_->view->framebuffer().width != width() || d_->view->framebuffer().height != height()))
+    d_->view->resize(std::max(1, width()), std::max(1, height()));
+  draw();
+}
+
+void ViewWidget::clear() {
+  d_->timer.stop();
+  d_->view.reset();
+  d_->mesh.reset();
+  d_->probe.clear();
+  update();
+  emit status_changed(status_text());
+}
+
+bool ViewWidget::has_view() const { return d_->view != nullptr; }
+InteractiveView* ViewWidget::view() { return d_->view.get(); }
+const InteractiveView* ViewWidget::view() const { return d_->view.get(); }
+std::shared_ptr<const Mesh> ViewWidget::mesh() const { return d_->mesh; }
+const Camera* ViewWidget::camera() const { return d_->view ? &d_->view->camera() : nullptr; }
+
+void ViewWidget::set_probe_values(std::vector<double> tet_values, QString unit) {
+  d_->probe = std::move(tet_values);
+  d_->probe_unit = std::move(unit);
+}
+
+QString ViewWidget::probe_text(int x, int y) const {
+  if (!d_->view) return {};
+  const std::uint32_t t = d_->view->pick(x, y);
+  if (t == kNone) return {};
+  const Mesh& m = *d_->mesh;
+  QString text = QString("tet %1").arg(t);
+  if (!m.tet_region.empty()) {
+    const std::int32_t r = m.tet_region[t];
+    QString name = QString::number(r);
+    for (const Region& reg : m.regions)
+      if (reg.id == r && !reg.name.empty()) name = QString::fromStdString(reg.name);
+    text += ", region " + name;
+  }
+  if (t < d_->probe.size()) {
+    const double v = d_->probe[t];
+    text += std::isfinite(v) ? QString(", %1 %2").arg(v, 0, 'g', 6).arg(d_->probe_unit) : QString(", no value");
+  }
+  return text;
+}
+
+void ViewWidget::set_time_slice(std::chrono::milliseconds slice) { d_->slice = std::max(slice, std::chrono::milliseconds(1)); }
+
+double ViewWidget::fraction_drawn() const {
+  if (!d_->view || d_->view->total() == 0) return 0;
+  return double(d_->view->drawn().size()) / double(d_->view->total());
+}
+
+QString ViewWidget::status_text() const {
+  if (!d_->view) return tr("no mesh");
+  QString s = QString::fromStdString(d_->view->status());
+  s += d_->view->delaunay() ? tr("  |  power order, Delaunay certified")
+                            : tr("  |  MPVO order + depth buffer, certificate failed");
+  return s;
+}
+
+bool ViewWidget::save_picture(const QString& path, QString* error) const {
+  if (!d_->view) {
+    if (error) *error = tr("no picture to save");
+    return false;
+  }
+  try {
+    d_->view->save_png(path.toStdString());
+    return true;
+  } catch (const std::exception& e) {
+    if (error) *error = QString::fromStdString(e.what());
+    return false;
+  }
+}
+
+std::string ViewWidget::camera_options() const { return d_->view ? d_->view->camera_options() : std::string(); }
+
+bool ViewWidget::busy() const { return d_->view && (d_->target || d_->view->running()); }
+
+void ViewWidget::kick() {
+  if (busy() && !d_->timer.isActive()) d_->timer.start();
+}
+
+void ViewWidget::draw() {
+  if (!d_->view) return;
+  d_->target.reset();
+  d_->view->restart();
+  d_->view->set_running(true);
+  present();
+  kick();
+}
+
+void ViewWidget::stop() {
+  if (!d_->view) return;
+  d_->target.reset();
+  d_->view->set_running(false);
+  d_->timer.stop();
+  emit status_changed(status_text());
+}
+
+void ViewWidget::resume() {
+  if (!d_->view) return;
+  d_->view->set_running(true);
+  kick();
+}
+
+void ViewWidget::step_once() {
+  if (!d_->view) return;
+  d_->target.reset();
+  d_->view->set_running(false);
+  d_->timer.stop();
+  d_->view->step();
+  present();
+}
+
+void ViewWidget::undraw() {
+  if (!d_->view) return;
+  d_->target.reset();
+  if (!d_->view->set_undrawing(!d_->view->undrawing())) return;  // depth-buffer drawing: no undraw
+  d_->view->set_running(true);
+  kick();
+  emit status_changed(status_text());
+}
+
+void ViewWidget::finish_now() {
+  if (!d_->view) return;
+  d_->target.reset();
+  d_->view->set_undrawing(false);
+  d_->view->finish();
+  d_->timer.stop();
+  present();
+  emit draw_finished();
+}
+
+void ViewWidget::set_fraction(double f) {
+  if (!d_->view) return;
+  f = std::clamp(f, 0.0, 1.0);
+  d_->target = std::size_t(std::llround(f * double(d_->view->total())));
+  d_->view->set_running(false);
+  kick();
+}
+
+bool ViewWidget::push_region() {
+  if (!d_->view) return false;
+  const std::vector<std::uint32_t> region = d_->view->drawn();  // what becomes the displayed set
+  if (!d_->view->push_region()) return false;
+  // The camera re-framed on the region: the same direction and up, fitted to the region's bounds.
+  double lo[3], hi[3];
+  tets_bounds(*d_->mesh, region, lo, hi);
+  const Camera& c = d_->view->camera();
+  const double dir[3] = {c.at[0] - c.eye[0], c.at[1] - c.eye[1], c.at[2] - c.eye[2]};
+  d_->camera_default = false;
+  d_->view->set_camera(fit_camera(lo, hi, dir, c.up, c.perspective, c.fov_deg,
+                                  double(std::max(1, width())) / double(std::max(1, height()))));
+  draw();
+  return true;
+}
+
+bool ViewWidget::pop_region() {
+  if (!d_->view || !d_->view->pop_region()) return false;
+  draw();
+  return true;
+}
+
+void ViewWidget::tick() {
+  InteractiveView* v = d_->view.get();
+  if (!v) {
+    d_->timer.stop();
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  if (d_->target) {
+    const std::size_t goal = *d_->target;
+    while (std::chrono::steady_clock::now() - start < d_->slice) {
+      const std::size_t n = v->drawn().size();
+      if (n < goal) {
+        if (v->undrawing()) v->set_undrawing(false);
+        if (v->done() && n == v->total()) break;
+        if (!v->step()) {
+          if (v->done()) break;
+        }
+        // A batch may overshoot the goal: take the excess back (painter only).
+        if (v->drawn().size() > goal && v->set_undrawing(true)) {
+          v->undraw(v->drawn().size() - goal);
+          v->set_undrawing(false);
+        }
+      } else if (n > goal) {
+        if (v->set_undrawing(true)) {
+          v->undraw(std::min<std::size_t>(n - goal, std::max<std::size_t>(1, v->total() / 64)));
+          v->set_undrawing(false);
+        } else {
+          // Depth-buffer drawing cannot take tets back: draw again from the back to the goal.
+          v->restart();
+          v->set_running(false);
+        }
+      } else {
+        break;
+      }
+    }
+    const std::size_t n = v->drawn().size();
+    if (n == goal || (n < goal && v->done())) d_->target.reset();
+  } else if (v->running()) {
+    v->step(d_->slice);
+  }
+  present();
+  if (!busy()) {
+    d_->timer.stop();
+    if (v->done()) emit draw_finished();
+  }
+}
+
+void ViewWidget::present() {
+  if (!d_->view) return;
+  for (const PixelRect& r : d_->view->take_damage())
+    update(QRect(r.x0, r.y0, r.x1 - r.x0 + 1, r.y1 - r.y0 + 1));
+  emit status_changed(status_text());
+  emit fraction_changed(fraction_drawn());
+}
+
+void ViewWidget::paintEvent(QPaintEvent* event) {
+  QPainter p(this);
+  if (!d_->view) {
+    p.fillRect(event->rect(), Qt::white);
+    return;
+  }
+  const Framebuffer& fb = d_->view->framebuffer();
+  // pack_rgba is R, G, B, A in memory order: QImage's RGBA8888. No copy: the image wraps the pixels.
+  const QImage image(reinterpret_cast<const uchar*>(fb.rgba.data()), fb.width, fb.height, fb.width * 4,
+                     QImage::Format_RGBA8888);
+  p.fillRect(event->rect(), Qt::white);
+  p.drawImage(event->rect(), image, event->rect());
+}
+
+void ViewWidget::resizeEvent(QResizeEvent* event) {
+  QWidget::resizeEvent(event);
+  if (!d_->view) return;
+  const int w = std::max(1, width()), h = std::max(1, height());
+  d_->view->resize(w, h);
+  if (d_->camera_default) d_->view->set_camera(default_camera(*d_->mesh, w, h));
+  draw();
+}
+
+void ViewWidget::mousePressEvent(QMouseEvent* event) {
+  d_->last = event->pos();
+  d_->buttons = event->buttons();
+}
+
+void ViewWidget::mouseMoveEvent(QMouseEvent* event) {
+  if (!d_->view) return;
+  if (event->buttons() == Qt::NoButton) {
+    emit probe_changed(probe_text(event->pos().x(), event->pos().y()));
+    return;
+  }
+  const QPoint delta = event->pos() - d_->last;
+  d_->last = event->pos();
+  if (delta.isNull()) return;
+  const double h = std::max(1, height());
+  d_->camera_default = false;
+  if ((event->buttons() & Qt::MiddleButton) ||
+      ((event->buttons() & Qt::LeftButton) && (event->modifiers() & Qt::ShiftModifier))) {
+    d_->view->pan(-delta.x() / h, delta.y() / h);
+  } else if (event->buttons() & Qt::LeftButton) {
+    d_->view->orbit(-0.4 * delta.x(), -0.4 * delta.y());
+  } else if (event->buttons() & Qt::RightButton) {
+    d_->view->zoom(std::pow(1.01, -delta.y()));
+  }
+  d_->view->set_running(true);
+  present();
+  kick();
+}
+
+void ViewWidget::mouseReleaseEvent(QMouseEvent*) { d_->buttons = Qt::NoButton; }
+
+void ViewWidget::wheelEvent(QWheelEvent* event) {
+  if (!d_->view) return;
+  d_->camera_default = false;
+  d_->view->zoom(std::pow(1.1, event->angleDelta().y() / 120.0));
+  d_->view->set_running(true);
+  present();
+  kick();
+}
+
+}  // namespace foxi::qt
