@@ -409,7 +409,11 @@ bool Workbench::start_mesh() {
         return !job_cancel->load();
       };
       MeshedModel mm = mesh_model(path, ov, options);
-      if (job_cancel->load()) throw MesherCancelled("cancelled");
+      if (job_cancel->load()) {  // cancelled after TetGen's last progress call
+        out->cancelled = true;
+        out->error = "cancelled";
+        return out;
+      }
       auto mesh = std::make_shared<Mesh>(std::move(mm.mesh));
       out->model = std::make_shared<const Model>(std::move(mm.model));
       out->overrides = ov;
@@ -454,6 +458,13 @@ bool Workbench::start_solve() {
         return !job_cancel->load();
       };
       const ThermalReport report = solve_thermal(*m, params);
+      // A direct solve may not ask the progress function at all: a Cancel pressed meanwhile still
+      // discards the result (the previous state stays).
+      if (job_cancel->load()) {
+        out->cancelled = true;
+        out->error = "cancelled";
+        return out;
+      }
       out->results = thermal_results(*m, report);
       out->results.model = path;
       out->results.physics = "thermal";
