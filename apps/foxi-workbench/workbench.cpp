@@ -23,6 +23,9 @@
 #include <QToolBar>
 #include <QVBoxLayout>
 #include <QtConcurrent/QtConcurrentRun>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -379,7 +382,12 @@ void Workbench::launch(std::function<std::shared_ptr<Outcome>()> work, const QSt
   job_->cancel = std::move(cancel);
   job_->permille = std::move(permille);
   connect(&job_->watcher, &QFutureWatcher<std::shared_ptr<Outcome>>::finished, this, &Workbench::on_job_done);
-  job_->watcher.setFuture(QtConcurrent::run(std::move(work)));
+  job_->watcher.setFuture(QtConcurrent::run([work = std::move(work)] {
+    // The worker (and the threads it starts: TetGen, the solver's, which inherit it) niced, so
+    // that on a machine with few cores the GUI thread still gets the CPU when it needs it.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+    return work();
+  }));
   mesh_button_->setEnabled(false);
   solve_button_->setEnabled(false);
   cancel_button_->setEnabled(true);
