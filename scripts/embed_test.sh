@@ -118,4 +118,34 @@ PY
 "$work/field_buffer/field_buffer" "$work/field.ppm"
 step "field_buffer: run"
 "$work/all_targets/all_targets"
+
+# The Qt host (examples/qt): a window embedding foxi::qt, where foxi was built with Qt5. Offscreen:
+# it meshes the installed model, draws it in the widget and saves the widget's picture.
+if [ -f "$prefix/lib/cmake/foxi/foxiQtTargets.cmake" ] || ls "$prefix"/lib*/cmake/foxi/foxiQtTargets.cmake > /dev/null 2>&1; then
+  dir=$work/qt_window
+  cmake -S examples/qt -B "$dir" -G "$generator" -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF > "$dir.log" 2>&1 ||
+    { cat "$dir.log"; exit 1; }
+  found=$(sed -n 's/^foxi_DIR:PATH=//p' "$dir/CMakeCache.txt")
+  case "$found" in
+    "$prefix"/*) ;;
+    *) echo "embed test: qt_window found foxi at '$found', not in $prefix" >&2; exit 1 ;;
+  esac
+  cmake --build "$dir" > "$dir.log" 2>&1 || { cat "$dir.log"; exit 1; }
+  step "qt_window: configure, build"
+  QT_QPA_PLATFORM=offscreen "$dir/qt_window" "$prefix/share/foxi/models/die_on_substrate.toml" --save "$work/qt_window.png" \
+    2> "$dir.run.log" || { cat "$dir.run.log"; exit 1; }
+  step "qt_window: run"
+  python3 - "$work/qt_window.png" <<'PY'
+import struct, sys
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+w, h = struct.unpack('>II', data[16:24])
+assert w >= 640 and h >= 480, f'size {w} x {h}'
+assert len(data) > 20000, f'only {len(data)} bytes: blank?'
+print(f'  qt_window.png: {w} x {h}, {len(data)} bytes')
+PY
+else
+  echo "  (foxi built without Qt5: examples/qt not built)"
+fi
 echo "embed test: passed"
