@@ -106,6 +106,25 @@ TEST(WorkbenchHeadless, ViewPictureEqualsFoxiRenderDieOnSubstrate) {
 
 TEST(WorkbenchHeadless, ViewPictureEqualsFoxiRenderFlipChip) { check_headless("flip_chip.toml", "die_w=7mm", "T_max"); }
 
+// Once with a real X server (xvfb-run, Qt's xcb platform): the same view picture as offscreen.
+TEST(WorkbenchHeadless, UnderXvfbSamePictureAsOffscreen) {
+  if (!foxi::test::have_program("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (Debian xvfb)";
+  TempDir dir;
+  const std::string common = "'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
+                             "die_on_substrate.toml' --headless --physics thermal --view-size 240x180 --save-picture ";
+  const auto off = dir.path() / "off.png", x11 = dir.path() / "x11.png";
+  ASSERT_EQ(foxi::test::run("QT_QPA_PLATFORM=offscreen " + common + "'" + off.string() + "'", dir.path() / "off.log"), 0)
+      << foxi::test::read_text(dir.path() / "off.log");
+  ASSERT_EQ(foxi::test::run("QT_QPA_PLATFORM=xcb timeout 120 xvfb-run -a " + common + "'" + x11.string() + "'",
+                            dir.path() / "x11.log"),
+            0)
+      << foxi::test::read_text(dir.path() / "x11.log");
+  const foxi::Framebuffer a = foxi::read_png(off), b = foxi::read_png(x11);
+  ASSERT_EQ(a.width, 240);
+  ASSERT_EQ(b.width, 240);
+  EXPECT_TRUE(a.rgba == b.rgba);
+}
+
 TEST(WorkbenchHeadless, BadParameterExitsWithBadInput) {
   TempDir dir;
   const auto log = dir.path() / "wb.log";
