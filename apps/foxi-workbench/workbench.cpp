@@ -32,6 +32,7 @@
 
 #include "foxi/mesher/mesher.hpp"
 #include "foxi/mesher/model_mesh.hpp"
+#include "foxi/mesher/quality_report.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/units.hpp"
@@ -60,6 +61,7 @@ struct Outcome {
   bool has_scale = false;
   RunResults results;
   double seconds = 0;
+  std::optional<MeshQualityReport> quality;  // a new mesh's
 };
 
 struct Workbench::Job {
@@ -127,6 +129,27 @@ QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QStrin
   return QPixmap::fromImage(img);
 }
 
+// The minimum dihedral angle histogram of the quality report as a bar chart (5-degree bins).
+QPixmap histogram_pixmap(const MeshQualityReport& q) {
+  const int w = 300, h = 130, left = 8, bottom = 18, top = 16;
+  QImage img(w, h, QImage::Format_RGB32);
+  img.fill(Qt::white);
+  QPainter p(&img);
+  std::size_t most = 1;
+  for (std::size_t c : q.min_dihedral_histogram) most = std::max(most, c);
+  const int bins = int(q.min_dihedral_histogram.size()), bw = (w - 2 * left) / bins;
+  for (int i = 0; i < bins; ++i) {
+    const int bh = int(std::lround(double(q.min_dihedral_histogram[std::size_t(i)]) / double(most) * (h - top - bottom)));
+    p.fillRect(left + i * bw + 1, h - bottom - bh, bw - 2, bh, QColor(70, 110, 170));
+  }
+  p.setPen(Qt::black);
+  p.drawLine(left, h - bottom, left + bins * bw, h - bottom);
+  for (int deg = 0; deg <= 75; deg += 15)
+    p.drawText(left + deg / 5 * bw - 6, h - 3, QString::number(deg));
+  p.drawText(left, 12, QObject::tr("tets by minimum dihedral angle (degrees)"));
+  return QPixmap::fromImage(img);
+}
+
 }  // namespace
 
 Workbench::Workbench(QWidget* parent) : QMainWindow(parent) {
@@ -172,9 +195,11 @@ void Workbench::build_ui() {
   fraction_->setValue(1000);
   fraction_->setToolTip(tr("fraction of the displayed set drawn: drawing or undrawing follows it"));
   connect(fraction_, &QSlider::sliderMoved, this, [this](int v) { view_->set_fraction(v / 1000.0); });
-  bar->addWidget(new QLabel(tr("drawn")));
-  bar->addWidget(fraction_, 1);
   cv->addLayout(bar);
+  auto* slider_row = new QHBoxLayout;
+  slider_row->addWidget(new QLabel(tr("fraction drawn")));
+  slider_row->addWidget(fraction_, 1);
+  cv->addLayout(slider_row);
   auto* fields = new QHBoxLayout;
   field_box_ = new QComboBox;
   cmap_box_ = new QComboBox;
@@ -242,6 +267,21 @@ void Workbench::build_ui() {
   model_dock->setObjectName("model");
   model_dock->setWidget(left);
   addDockWidget(Qt::LeftDockWidgetArea, model_dock);
+
+  // The mesh's quality report and its dihedral-angle histogram.
+  auto* mesh_panel = new QWidget;
+  auto* mv = new QVBoxLayout(mesh_panel);
+  quality_text_ = new QPlainTextEdit;
+  quality_text_->setReadOnly(true);
+  quality_text_->setLineWrapMode(QPlainTextEdit::NoWrap);
+  histogram_ = new QLabel;
+  mv->addWidget(histogram_);
+  mv->addWidget(quality_text_, 1);
+  mesh_panel->setMinimumWidth(320);
+  auto* mesh_dock = new QDockWidget(tr("Mesh quality"));
+  mesh_dock->setObjectName("mesh");
+  mesh_dock->setWidget(mesh_panel);
+  addDockWidget(Qt::RightDockWidgetArea, mesh_dock);
 
   // Results and history.
   results_table_ = new QTableWidget(0, 3);
@@ -392,8 +432,8 @@ void Workbench::launch(std::function<std::shared_ptr<Outcome>()> work, const QSt
   solve_button_->setEnabled(false);
   cancel_button_->setEnabled(true);
   progress_->setValue(0);
+  progress_->setFormat(what + " %p%");
   poll_->start();
-  statusBar()->showMessage(what + "...");
 }
 
 bool Workbench::start_mesh() {
@@ -423,6 +463,7 @@ bool Workbench::start_mesh() {
         return out;
       }
       auto mesh = std::make_shared<Mesh>(std::move(mm.mesh));
+      out->quality = mesh_quality_report(*mesh, mm.conforming);
       out->model = std::make_shared<const Model>(std::move(mm.model));
       out->overrides = ov;
       build_display(*out, *mesh, "", "viridis", w, h, cam ? &*cam : nullptr);
@@ -536,19 +577,23 @@ void Workbench::on_job_done() {
   if (!out || !out->ok) {
     const QString why = out ? out->error : tr("no result");
     last_error_ = why;
-    statusBar()->showMessage(what + ": " + why, 10000);
+    progress_->setFormat(what + ": " + why);
     if (!out || !out->cancelled) param_error_->setText(why);
     emit finished(false);
     return;
   }
   last_error_.clear();
-  statusBar()->showMessage(what + tr(": done in %1 s").arg(out->seconds, 0, 'f', 2), 5000);
+  progress_->setFormat(what + tr(": done in %1 s").arg(out->seconds, 0, 'f', 2));
   if (out->meshed) {
     mesh_ = out->mesh;
     meshed_model_ = out->model;
     meshed_overrides_ = out->overrides;
     mesh_seconds_ = out->seconds;
     ++mesh_serial_;
+    if (out->quality) {
+      quality_text_->setPlainText(QString::fromStdString(format_quality_report(*out->quality)));
+      histogram_->setPixmap(histogram_pixmap(*out->quality));
+    }
     has_results_ = false;
     field_.clear();
   }

@@ -116,6 +116,8 @@ class Workbench : public QMainWindow {
   QTableWidget* params_ = nullptr;
   QLabel* param_error_ = nullptr;
   QPlainTextEdit* model_text_ = nullptr;
+  QPlainTextEdit* quality_text_ = nullptr;
+  QLabel* histogram_ = nullptr;
   QPushButton *mesh_button_ = nullptr, *solve_button_ = nullptr, *cancel_button_ = nullptr;
   QProgressBar* progress_ = nullptr;
   QTableWidget* results_table_ = nullptr;
