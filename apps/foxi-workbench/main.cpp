@@ -182,6 +182,9 @@ int main(int argc, char** argv) {
         throw Usage(std::string("--view-size: ") + e.what());
       }
     }
+    // High-DPI screens: Qt scales the widgets; the view's framebuffer is drawn at the widget's
+    // logical size and scaled up (sharp pictures there are future work: a framebuffer at device pixels).
+    QApplication::setAttribute(Qt::AA_EnableHighDpiScaling);
     QApplication app(argc, argv);
     QApplication::setApplicationName("foxi-workbench");
     QApplication::setOrganizationName("foxi");
@@ -189,6 +192,7 @@ int main(int argc, char** argv) {
     if (size.width > 0) w.view_widget()->setFixedSize(size.width, size.height);
     w.show();
     if (is_headless) return headless(w, model, sets, physics, field, cmap, screenshot, picture, mesh_out);
+    w.restore_settings();
     if (!model.empty()) w.open_model(QString::fromStdString(model));
     return app.exec();
   } catch (const Usage& e) {

@@ -16,6 +16,8 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSlider>
+#include <QSettings>
+#include <QShortcut>
 #include <QSplitter>
 #include <QStatusBar>
 #include <QTableWidget>
@@ -190,6 +192,13 @@ void Workbench::build_ui() {
   button(tr("Undraw"), &foxi::qt::ViewWidget::undraw);
   button(tr("Region"), &foxi::qt::ViewWidget::push_region);
   button(tr("Back"), &foxi::qt::ViewWidget::pop_region);
+  auto* save = new QPushButton(tr("Save picture..."));
+  connect(save, &QPushButton::clicked, this, [this] {
+    const QString f = QFileDialog::getSaveFileName(this, tr("Save the view's picture"), QString(), tr("PNG (*.png)"));
+    QString error;
+    if (!f.isEmpty() && !view_->save_picture(f, &error)) param_error_->setText(error);
+  });
+  bar->addWidget(save);
   fraction_ = new QSlider(Qt::Horizontal);
   fraction_->setRange(0, 1000);
   fraction_->setValue(1000);
@@ -230,8 +239,10 @@ void Workbench::build_ui() {
   auto* lv = new QVBoxLayout(left);
   auto* open = new QPushButton(tr("Open model..."));
   connect(open, &QPushButton::clicked, this, [this] {
-    const QString f = QFileDialog::getOpenFileName(this, tr("Open a model"), QString(), tr("Models (*.toml)"));
-    if (!f.isEmpty()) open_model(f);
+    QSettings settings;
+    const QString f = QFileDialog::getOpenFileName(this, tr("Open a model"), settings.value("last_model").toString(),
+                                                   tr("Models (*.toml)"));
+    if (!f.isEmpty() && open_model(f)) settings.setValue("last_model", f);
   });
   lv->addWidget(open);
   params_ = new QTableWidget(0, 3);
@@ -314,7 +325,35 @@ void Workbench::build_ui() {
   connect(view_, &foxi::qt::ViewWidget::fraction_changed, this, [this](double f) {
     if (!fraction_->isSliderDown()) fraction_->setValue(int(std::lround(f * 1000)));
   });
+  // Keyboard: the viewer's keys (foxi-view's), and the loop's.
+  auto key = [this](const QKeySequence& k, auto fn) {
+    connect(new QShortcut(k, this), &QShortcut::activated, this, fn);
+  };
+  key(QKeySequence("D"), [this] { view_->draw(); });
+  key(QKeySequence("Space"), [this] { view_->busy() ? view_->stop() : view_->resume(); });
+  key(QKeySequence("N"), [this] { view_->step_once(); });
+  key(QKeySequence("U"), [this] { view_->undraw(); });
+  key(QKeySequence("R"), [this] { view_->push_region(); });
+  key(QKeySequence("B"), [this] { view_->pop_region(); });
+  key(QKeySequence::Open, [open] { open->click(); });
+  key(QKeySequence("Ctrl+M"), [this] { start_mesh(); });
+  key(QKeySequence("Ctrl+R"), [this] { start_solve(); });
+  key(QKeySequence("Escape"), [this] { cancel(); });
+  key(QKeySequence::Save, [save] { save->click(); });
   resize(1280, 860);
+}
+
+void Workbench::restore_settings() {
+  QSettings settings;
+  restoreGeometry(settings.value("geometry").toByteArray());
+  restoreState(settings.value("window_state").toByteArray());
+}
+
+void Workbench::closeEvent(QCloseEvent* event) {
+  QSettings settings;
+  settings.setValue("geometry", saveGeometry());
+  settings.setValue("window_state", saveState());
+  QMainWindow::closeEvent(event);
 }
 
 void Workbench::show_error(const QString& text) {

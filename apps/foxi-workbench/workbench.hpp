@@ -51,6 +51,10 @@ class Workbench : public QMainWindow {
   explicit Workbench(QWidget* parent = nullptr);
   ~Workbench() override;
 
+  // The window's size and panels as the user left them (QSettings: ~/.config/foxi/foxi-workbench.conf;
+  // saved on close). Not in headless runs, whose pictures must not depend on a user's settings.
+  void restore_settings();
+
   // Loads the model file; false with the error (file:line: reason) in `error` and shown.
   bool open_model(const QString& path, QString* error = nullptr);
   // Sets parameter `name` to `expression` ("5 mm", "2 * die_w"), checked by loading the model with
@@ -80,6 +84,9 @@ class Workbench : public QMainWindow {
  signals:
   // A job ended: ok false with last_error() (cancelled: "cancelled").
   void finished(bool ok);
+
+ protected:
+  void closeEvent(QCloseEvent* event) override;
 
  private:
   void build_ui();

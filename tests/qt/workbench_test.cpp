@@ -232,6 +232,49 @@ TEST(ViewWidget, FractionDrawsAndUndraws) {
   EXPECT_TRUE(v->view()->framebuffer().id == quarter_ids) << "undrawn back to the same picture";
 }
 
+// The value under the mouse: the tet at the pixel (the id buffer) and its temperature in °C, against
+// the mean of its 4 nodes' temperatures computed here from the node field (flat paint: the tet's
+// colour shows its centroid value); the status names the order method and the certificate.
+TEST(ViewWidget, ValueUnderTheMouseAndStatus) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w));
+  foxi::qt::ViewWidget* v = w.view_widget();
+  v->finish_now();
+  EXPECT_NE(v->status_text().indexOf("power order, Delaunay certified"), -1) << v->status_text().toStdString();
+  const foxi::Mesh& m = *w.mesh();
+  const foxi::Field* temp = nullptr;
+  for (const foxi::Field& f : m.fields)
+    if (f.name == "temperature") temp = &f;
+  ASSERT_NE(temp, nullptr);
+  const foxi::Framebuffer& fb = v->view()->framebuffer();
+  int checked = 0;
+  for (int y = 10; y < fb.height; y += 23)
+    for (int x = 10; x < fb.width; x += 29) {
+      const std::uint32_t t = fb.id[std::size_t(y) * std::size_t(fb.width) + std::size_t(x)];
+      const QString text = v->probe_text(x, y);
+      if (t == foxi::kNone) {
+        EXPECT_TRUE(text.isEmpty());
+        continue;
+      }
+      double mean = 0;
+      for (int k = 0; k < 4; ++k) mean += 0.25 * temp->values[m.tet[4 * std::size_t(t) + std::size_t(k)]];
+      const std::regex re("^tet ([0-9]+), region [a-z]+, ([-0-9.e+]+) °C$");
+      std::smatch match;
+      const std::string s = text.toStdString();
+      ASSERT_TRUE(std::regex_match(s, match, re)) << s;
+      EXPECT_EQ(std::stoul(match[1]), t);
+      EXPECT_NEAR(std::stod(match[2]), mean - 273.15, 1e-3) << s;
+      ++checked;
+    }
+  EXPECT_GT(checked, 5);
+}
+
 // The GUI thread never stalls: a 10 ms timer's longest gap while the flip chip is meshed, solved
 // and drawn progressively (the widget's own time slices, no finish_now) stays within 100 ms.
 TEST(Workbench, HeartbeatDuringMeshSolveDraw) {
