@@ -62,7 +62,8 @@ struct Outcome {
   DisplayUnit unit;
   bool has_scale = false;
   RunResults results;
-  double seconds = 0;
+  double seconds = 0;        // meshing (or the solve when not meshed)
+  double solve_seconds = 0;  // the solve
   std::optional<MeshQualityReport> quality;  // a new mesh's
 };
 
@@ -103,6 +104,12 @@ void build_display(Outcome& out, const Mesh& mesh, const std::string& field, con
 }
 
 QString what_of(const std::exception& e) { return QString::fromStdString(e.what()); }
+
+bool same_overrides(const std::vector<ParameterOverride>& a, const std::vector<ParameterOverride>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const ParameterOverride& x, const ParameterOverride& y) {
+    return x.name == y.name && x.expression == y.expression;
+  });
+}
 
 // A colour bar with ticks (colormap.hpp's entries and nice_ticks), in the field's display unit.
 QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QString& label, int height) {
@@ -340,6 +347,8 @@ void Workbench::build_ui() {
   key(QKeySequence("Ctrl+R"), [this] { start_solve(); });
   key(QKeySequence("Escape"), [this] { cancel(); });
   key(QKeySequence::Save, [save] { save->click(); });
+  key(QKeySequence::Undo, [this] { undo(); });
+  key(QKeySequence::Redo, [this] { redo(); });
   resize(1280, 860);
 }
 
@@ -367,6 +376,8 @@ bool Workbench::open_model(const QString& path, QString* error) {
     model_path_ = path;
     overrides_.clear();
     model_ = std::move(m);
+    undo_.clear();
+    redo_.clear();
     show_error({});
     setWindowTitle("foxi workbench - " + QFileInfo(path).fileName());
     refresh_model_panel();
@@ -391,6 +402,14 @@ bool Workbench::set_parameter(const QString& name, const QString& expression, QS
   }
   auto trial = overrides_;
   trial[name.toStdString()] = expression.toStdString();
+  const auto before = overrides_;
+  if (!apply_overrides(std::move(trial), error)) return false;
+  undo_.push_back(before);
+  redo_.clear();
+  return true;
+}
+
+bool Workbench::apply_overrides(std::map<std::string, std::string> trial, QString* error) {
   std::vector<ParameterOverride> list;
   for (const auto& [n, e] : trial) list.push_back({n, e});
   try {
@@ -407,6 +426,24 @@ bool Workbench::set_parameter(const QString& name, const QString& expression, QS
     refresh_model_panel();  // the cell shows the accepted expression again
     return false;
   }
+}
+
+bool Workbench::undo() {
+  if (undo_.empty()) return false;
+  const auto now = overrides_;
+  if (!apply_overrides(undo_.back(), nullptr)) return false;  // the model file changed meanwhile
+  undo_.pop_back();
+  redo_.push_back(now);
+  return true;
+}
+
+bool Workbench::redo() {
+  if (redo_.empty()) return false;
+  const auto now = overrides_;
+  if (!apply_overrides(redo_.back(), nullptr)) return false;
+  redo_.pop_back();
+  undo_.push_back(now);
+  return true;
 }
 
 void Workbench::on_parameter_edited(int row, int column) {
@@ -475,106 +512,112 @@ void Workbench::launch(std::function<std::shared_ptr<Outcome>()> work, const QSt
   poll_->start();
 }
 
-bool Workbench::start_mesh() {
-  if (busy() || model_path_.isEmpty()) return false;
-  const std::string path = model_path_.toStdString();
-  const std::vector<ParameterOverride> ov = overrides();
-  const int w = view_->width(), h = view_->height();
-  // The camera stays across a remesh of the same model (the loop: compare before and after).
-  std::optional<Camera> cam;
-  if (view_->camera()) cam = *view_->camera();
-  auto job_cancel = std::make_shared<std::atomic<bool>>(false);
-  auto job_permille = std::make_shared<std::atomic<int>>(0);
-  auto work = [path, ov, w, h, cam, job_cancel, job_permille]() {
-    auto out = std::make_shared<Outcome>();
-    const auto t0 = Clock::now();
-    try {
+// What a mesh or solve job needs, copied from the GUI thread's state when it starts.
+struct JobInput {
+  std::string path;
+  std::vector<ParameterOverride> overrides;
+  bool mesh = true, solve = false;
+  std::shared_ptr<const Mesh> old_mesh;    // solve only: the mesh to solve on
+  std::shared_ptr<const Model> old_model;  // and the model it came from
+  int width = 1, height = 1;
+  std::optional<Camera> camera;  // the view's camera stays across a remesh (compare before and after)
+  std::string cmap;
+  std::shared_ptr<std::atomic<bool>> cancel;
+  std::shared_ptr<std::atomic<int>> permille;
+};
+
+namespace {
+
+// The worker's part: mesh (mesh_model) and/or solve (thermal) and the new picture's view.
+std::shared_ptr<Outcome> run_job(const JobInput& in) {
+  auto out = std::make_shared<Outcome>();
+  const auto t0 = Clock::now();
+  auto progress = [cancel = in.cancel, permille = in.permille](std::string_view, double f) {
+    permille->store(int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
+    return !cancel->load();
+  };
+  // Cancel pressed after the last progress call (a direct solve may not call it at all) still
+  // discards the result: the previous state stays.
+  auto cancelled = [&] {
+    if (!in.cancel->load()) return false;
+    out->cancelled = true;
+    out->error = "cancelled";
+    return true;
+  };
+  try {
+    std::shared_ptr<Mesh> mesh;
+    std::shared_ptr<const Model> model = in.old_model;
+    if (in.mesh) {
       ModelMeshOptions options;
       options.override_origin = "the parameter table";
-      options.progress = [job_cancel, job_permille](std::string_view, double f) {
-        job_permille->store(int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
-        return !job_cancel->load();
-      };
-      MeshedModel mm = mesh_model(path, ov, options);
-      if (job_cancel->load()) {  // cancelled after TetGen's last progress call
-        out->cancelled = true;
-        out->error = "cancelled";
-        return out;
-      }
-      auto mesh = std::make_shared<Mesh>(std::move(mm.mesh));
+      options.progress = progress;
+      MeshedModel mm = mesh_model(in.path, in.overrides, options);
+      if (cancelled()) return out;
+      mesh = std::make_shared<Mesh>(std::move(mm.mesh));
       out->quality = mesh_quality_report(*mesh, mm.conforming);
-      out->model = std::make_shared<const Model>(std::move(mm.model));
-      out->overrides = ov;
-      build_display(*out, *mesh, "", "viridis", w, h, cam ? &*cam : nullptr);
-      out->mesh = std::move(mesh);
+      model = std::make_shared<const Model>(std::move(mm.model));
       out->meshed = true;
-      out->ok = true;
-    } catch (const Cancelled&) {
-      out->cancelled = true;
-      out->error = "cancelled";
-    } catch (const std::exception& e) {
-      out->error = what_of(e);
+      out->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    } else {
+      // The shown mesh stays as it is: the solve writes its fields into a copy.
+      mesh = std::make_shared<Mesh>(*in.old_mesh);
     }
-    out->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return out;
-  };
-  launch(work, tr("meshing"), job_cancel, job_permille);
+    const auto t1 = Clock::now();
+    if (in.solve) {
+      ThermalParams params = thermal_params_from_model(*model, *mesh);
+      params.solver.progress = progress;
+      const ThermalReport report = solve_thermal(*mesh, params);
+      if (cancelled()) return out;
+      out->results = thermal_results(*mesh, report);
+      out->results.model = in.path;
+      out->results.physics = "thermal";
+      for (const ParameterOverride& o : in.overrides) out->results.parameters.push_back({o.name, o.expression});
+      out->solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+      out->solved = true;
+    }
+    build_display(*out, *mesh, in.solve ? "temperature" : "", in.cmap, in.width, in.height,
+                  in.camera ? &*in.camera : nullptr);
+    out->mesh = std::move(mesh);
+    out->model = std::move(model);
+    out->overrides = in.overrides;
+    out->ok = true;
+  } catch (const Cancelled&) {
+    out->cancelled = true;
+    out->error = "cancelled";
+  } catch (const std::exception& e) {
+    out->error = what_of(e);
+  }
+  return out;
+}
+
+}  // namespace
+
+bool Workbench::start_job(bool mesh, bool solve) {
+  if (busy() || model_path_.isEmpty()) return false;
+  JobInput in;
+  in.path = model_path_.toStdString();
+  in.overrides = overrides();
+  // Only what changed reruns: a solve remeshes first when the parameters changed since the mesh.
+  const bool stale = !mesh_ || !meshed_model_ || !same_overrides(in.overrides, meshed_overrides_);
+  in.mesh = mesh || stale;
+  in.solve = solve;
+  in.old_mesh = mesh_;
+  in.old_model = meshed_model_;
+  in.width = view_->width();
+  in.height = view_->height();
+  if (view_->camera()) in.camera = *view_->camera();
+  in.cmap = color_map_.toStdString();
+  in.cancel = std::make_shared<std::atomic<bool>>(false);
+  in.permille = std::make_shared<std::atomic<int>>(0);
+  const QString what = in.mesh && in.solve ? tr("meshing and solving") : in.mesh ? tr("meshing") : tr("solving");
+  auto cancel = in.cancel;
+  auto permille = in.permille;
+  launch([in = std::move(in)] { return run_job(in); }, what, cancel, permille);
   return true;
 }
 
-bool Workbench::start_solve() {
-  if (busy() || !mesh_ || !meshed_model_) return false;
-  std::shared_ptr<const Mesh> mesh = mesh_;
-  std::shared_ptr<const Model> model = meshed_model_;
-  const std::string path = model_path_.toStdString();
-  const std::vector<ParameterOverride> ov = meshed_overrides_;
-  const std::string field = "temperature", cmap = color_map_.toStdString();
-  const int w = view_->width(), h = view_->height();
-  std::optional<Camera> cam;
-  if (view_->camera()) cam = *view_->camera();
-  auto job_cancel = std::make_shared<std::atomic<bool>>(false);
-  auto job_permille = std::make_shared<std::atomic<int>>(0);
-  auto work = [mesh, model, path, ov, field, cmap, w, h, cam, job_cancel, job_permille]() {
-    auto out = std::make_shared<Outcome>();
-    const auto t0 = Clock::now();
-    try {
-      // The shown mesh stays as it is: the solve writes its fields into a copy.
-      auto m = std::make_shared<Mesh>(*mesh);
-      ThermalParams params = thermal_params_from_model(*model, *m);
-      params.solver.progress = [job_cancel, job_permille](std::string_view, double f) {
-        job_permille->store(int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
-        return !job_cancel->load();
-      };
-      const ThermalReport report = solve_thermal(*m, params);
-      // A direct solve may not ask the progress function at all: a Cancel pressed meanwhile still
-      // discards the result (the previous state stays).
-      if (job_cancel->load()) {
-        out->cancelled = true;
-        out->error = "cancelled";
-        return out;
-      }
-      out->results = thermal_results(*m, report);
-      out->results.model = path;
-      out->results.physics = "thermal";
-      for (const ParameterOverride& o : ov) out->results.parameters.push_back({o.name, o.expression});
-      build_display(*out, *m, field, cmap, w, h, cam ? &*cam : nullptr);
-      out->mesh = std::move(m);
-      out->model = model;
-      out->overrides = ov;
-      out->solved = true;
-      out->ok = true;
-    } catch (const Cancelled&) {
-      out->cancelled = true;
-      out->error = "cancelled";
-    } catch (const std::exception& e) {
-      out->error = what_of(e);
-    }
-    out->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    return out;
-  };
-  launch(work, tr("solving"), job_cancel, job_permille);
-  return true;
-}
+bool Workbench::start_mesh() { return start_job(true, false); }
+bool Workbench::start_solve() { return start_job(false, true); }
 
 bool Workbench::set_field(const QString& field, const QString& color_map) {
   if (busy() || !mesh_) return false;
@@ -622,7 +665,7 @@ void Workbench::on_job_done() {
     return;
   }
   last_error_.clear();
-  progress_->setFormat(what + tr(": done in %1 s").arg(out->seconds, 0, 'f', 2));
+  progress_->setFormat(what + tr(": done in %1 s").arg(out->seconds + out->solve_seconds, 0, 'f', 2));
   if (out->meshed) {
     mesh_ = out->mesh;
     meshed_model_ = out->model;
@@ -640,7 +683,7 @@ void Workbench::on_job_done() {
     mesh_ = out->mesh;
     results_ = out->results;
     results_.mesh_seconds = mesh_seconds_;
-    results_.solve_seconds = out->seconds;
+    results_.solve_seconds = out->solve_seconds;
     has_results_ = true;
     field_ = "temperature";
   }
@@ -652,10 +695,10 @@ void Workbench::on_job_done() {
   else
     legend_->clear();
   refresh_fields();
-  if (out->meshed) add_history(out->seconds);
+  if (out->meshed && !out->solved) add_history(out->seconds);
   if (out->solved) {
     show_results();
-    add_history(mesh_seconds_ + out->seconds);  // the mesh's row gets the results
+    add_history(mesh_seconds_ + out->solve_seconds);  // the mesh's row gets the results
   }
   emit finished(true);
 }

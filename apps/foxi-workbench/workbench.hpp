@@ -61,11 +61,16 @@ class Workbench : public QMainWindow {
   // it: false (nothing changes) with the library's message (file:line: reason) for an unknown name,
   // a unit of another dimension, a bad expression.
   bool set_parameter(const QString& name, const QString& expression, QString* error = nullptr);
+  // Undo / redo of parameter edits (Ctrl+Z, Ctrl+Shift+Z); false when there is nothing to undo or
+  // redo (or the model file no longer loads with those values).
+  bool undo();
+  bool redo();
   // The current overrides (name=expression), and the model as loaded with them.
   std::vector<ParameterOverride> overrides() const;
   const Model* model() const { return model_.get(); }
 
   // Starts meshing / solving on a worker; false if busy or nothing to do. finished() comes after.
+  // A solve meshes first when the parameters changed since the shown mesh was made.
   bool start_mesh();
   bool start_solve();
   // Asks the running job to stop; the previous mesh and picture stay.
@@ -92,6 +97,8 @@ class Workbench : public QMainWindow {
   void build_ui();
   void refresh_model_panel();
   void on_parameter_edited(int row, int column);
+  bool start_job(bool mesh, bool solve);
+  bool apply_overrides(std::map<std::string, std::string> trial, QString* error);
   void launch(std::function<std::shared_ptr<Outcome>()> work, const QString& what,
               std::shared_ptr<std::atomic<bool>> cancel, std::shared_ptr<std::atomic<int>> permille);
   void on_job_done();
@@ -102,6 +109,7 @@ class Workbench : public QMainWindow {
 
   QString model_path_;
   std::map<std::string, std::string> overrides_;
+  std::vector<std::map<std::string, std::string>> undo_, redo_;  // the overrides before each edit
   std::shared_ptr<const Model> model_;         // as loaded with the overrides
   std::shared_ptr<const Model> meshed_model_;  // the model the shown mesh came from
   std::vector<ParameterOverride> meshed_overrides_;

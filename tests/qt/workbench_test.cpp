@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 
+#include "foxi/mesher/model_mesh.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/png.hpp"
@@ -164,6 +165,60 @@ TEST(Workbench, ParameterEditingWithUnits) {
   // A die wider than the substrate is a model the library refuses? Not necessarily; a negative size is.
   EXPECT_FALSE(w.set_parameter("die_h", "-1 mm", &error));
   EXPECT_NEAR(value_of("die_d"), 0.003, 1e-15);
+}
+
+TEST(Workbench, UndoRedoOfParameterEdits) {
+  Workbench w;
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  auto value_of = [&](const std::string& name) {
+    for (const foxi::Parameter& p : w.model()->parameters)
+      if (p.name == name) return p.value.value;
+    return -1.0;
+  };
+  EXPECT_FALSE(w.undo());
+  ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
+  ASSERT_TRUE(w.set_parameter("die_d", "2 mm"));
+  EXPECT_FALSE(w.set_parameter("die_d", "2 K"));  // refused: not an edit to undo
+  EXPECT_TRUE(w.undo());
+  EXPECT_NEAR(value_of("die_d"), 0.003, 1e-15);
+  EXPECT_NEAR(value_of("die_w"), 0.005, 1e-15);
+  EXPECT_TRUE(w.undo());
+  EXPECT_NEAR(value_of("die_w"), 0.004, 1e-15);
+  EXPECT_TRUE(w.overrides().empty());
+  EXPECT_FALSE(w.undo());
+  EXPECT_TRUE(w.redo());
+  EXPECT_NEAR(value_of("die_w"), 0.005, 1e-15);
+  ASSERT_TRUE(w.set_parameter("sub_h", "2 mm"));  // a new edit: nothing left to redo
+  EXPECT_FALSE(w.redo());
+  EXPECT_NEAR(value_of("sub_h"), 0.002, 1e-15);
+}
+
+// Only what changed reruns: Solve after a parameter change remeshes first (the mesh of the new
+// parameters, as mesh_model gives it here), Solve again on the same parameters does not.
+TEST(Workbench, SolveRemeshesWhenParametersChanged) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  const std::string model = kModels + "die_on_substrate.toml";
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w));
+  const auto first = w.mesh();
+  ASSERT_TRUE(w.set_parameter("die_w", "7 mm"));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const std::vector<foxi::ParameterOverride> ov = {{"die_w", "7 mm"}};
+  const foxi::MeshedModel direct = foxi::mesh_model(model, ov);
+  EXPECT_EQ(w.mesh()->tet_count(), direct.mesh.tet_count());
+  EXPECT_TRUE(w.mesh()->xyz == direct.mesh.xyz);
+  ASSERT_NE(w.results(), nullptr);
+  ASSERT_EQ(w.history().size(), 2u);
+  EXPECT_EQ(w.history()[1].tets, direct.mesh.tet_count());
+  const auto second = w.mesh();
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w));
+  EXPECT_TRUE(w.mesh()->xyz == second->xyz) << "same parameters: solved on the same mesh";
+  EXPECT_EQ(w.history().size(), 3u);  // a solve of an already solved mesh: a row of its own
+  (void)first;
 }
 
 TEST(Workbench, CancelKeepsThePreviousMeshAndPicture) {
