@@ -20,7 +20,7 @@ namespace {
 const char* kUsage =
     "foxi-workbench [MODEL.toml]\n"
     "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics thermal] [--field NAME]\n"
-    "               [--cmap viridis|cividis|coolwarm|rainbow] [--view-size WxH]\n"
+    "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
     "               [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh MESH.vtu]\n"
     "  The window: open a model, edit its parameters (with units, checked as the model file would\n"
     "  be), mesh and solve on worker threads (Cancel keeps the previous mesh), look inside with the\n"
@@ -52,7 +52,7 @@ bool wait_job(foxi::workbench::Workbench& w) {
 }
 
 int headless(foxi::workbench::Workbench& w, const std::string& model, const std::vector<std::string>& sets,
-             const std::string& physics, std::string field, const std::string& cmap, const std::string& screenshot,
+             const std::string& physics, std::string field, const std::string& cmap, double shrink, const std::string& screenshot,
              const std::string& picture, const std::string& mesh_out) {
   using namespace foxi::cli;
   QString error;
@@ -68,6 +68,7 @@ int headless(foxi::workbench::Workbench& w, const std::string& model, const std:
       return kExitBadInput;
     }
   }
+  w.set_shrink(shrink);
   QApplication::processEvents();  // the window laid out: the view has its size before the picture is made
   if (!w.start_mesh() || !wait_job(w)) {
     std::fprintf(stderr, "foxi-workbench: error: meshing: %s\n", w.last_error().toUtf8().constData());
@@ -132,6 +133,7 @@ int main(int argc, char** argv) {
     std::string model, physics, field, cmap = "viridis", screenshot, picture, mesh_out, view_size;
     std::vector<std::string> sets;
     bool is_headless = false;
+    double shrink = 1;
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string& a = args[i];
       auto value = [&]() -> std::string {
@@ -158,6 +160,12 @@ int main(int argc, char** argv) {
         picture = value();
       } else if (a == "--save-mesh") {
         mesh_out = value();
+      } else if (a == "--shrink") {
+        try {
+          shrink = foxi::parse_shrink(value());
+        } catch (const std::exception& e) {
+          throw Usage(std::string("--shrink: ") + e.what());
+        }
       } else if (a == "--view-size") {
         view_size = value();
       } else if (a.rfind("-", 0) == 0 && a.size() > 1 && a.rfind("-platform", 0) != 0) {
@@ -191,7 +199,7 @@ int main(int argc, char** argv) {
     foxi::workbench::Workbench w;
     if (size.width > 0) w.view_widget()->setFixedSize(size.width, size.height);
     w.show();
-    if (is_headless) return headless(w, model, sets, physics, field, cmap, screenshot, picture, mesh_out);
+    if (is_headless) return headless(w, model, sets, physics, field, cmap, shrink, screenshot, picture, mesh_out);
     w.restore_settings();
     if (!model.empty()) w.open_model(QString::fromStdString(model));
     return app.exec();

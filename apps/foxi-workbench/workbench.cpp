@@ -3,6 +3,7 @@
 
 #include <QApplication>
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFileInfo>
@@ -17,6 +18,7 @@
 #include <QPushButton>
 #include <QSlider>
 #include <QSettings>
+#include <QSignalBlocker>
 #include <QShortcut>
 #include <QSplitter>
 #include <QStatusBar>
@@ -80,10 +82,11 @@ using Clock = std::chrono::steady_clock;
 
 // The display of `mesh` on the worker: the field's flat paint on the automatic scale (as foxi
 // render --field NAME --cmap MAP draws it) and the view, built with `camera` (null: the default).
-void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const std::string& cmap, int w,
-                   int h, const Camera* camera) {
+void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const std::string& cmap, double shrink,
+                   int w, int h, const Camera* camera) {
   RenderParams params;
   params.undoable = true;  // the workbench undraws
+  params.shrink = shrink;
   if (!field.empty()) {
     const FieldChoice choice = choose_field(mesh, field);
     const std::vector<double> values = tet_centroid_values(mesh, choice, choice.field->step_count() - 1);
@@ -224,6 +227,14 @@ void Workbench::build_ui() {
   fields->addWidget(field_box_, 1);
   fields->addWidget(new QLabel(tr("colour map")));
   fields->addWidget(cmap_box_);
+  shrink_box_ = new QDoubleSpinBox;
+  shrink_box_->setRange(0.1, 1.0);
+  shrink_box_->setSingleStep(0.05);
+  shrink_box_->setValue(1.0);
+  shrink_box_->setToolTip(tr("each tet scaled about its centroid: see between them"));
+  connect(shrink_box_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this](double v) { set_shrink(v); });
+  fields->addWidget(new QLabel(tr("shrink")));
+  fields->addWidget(shrink_box_);
   cv->addLayout(fields);
   auto* vrow = new QHBoxLayout;
   vrow->addWidget(view_, 1);
@@ -522,6 +533,7 @@ struct JobInput {
   int width = 1, height = 1;
   std::optional<Camera> camera;  // the view's camera stays across a remesh (compare before and after)
   std::string cmap;
+  double shrink = 1;
   std::shared_ptr<std::atomic<bool>> cancel;
   std::shared_ptr<std::atomic<int>> permille;
 };
@@ -575,7 +587,7 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
       out->solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
       out->solved = true;
     }
-    build_display(*out, *mesh, in.solve ? "temperature" : "", in.cmap, in.width, in.height,
+    build_display(*out, *mesh, in.solve ? "temperature" : "", in.cmap, in.shrink, in.width, in.height,
                   in.camera ? &*in.camera : nullptr);
     out->mesh = std::move(mesh);
     out->model = std::move(model);
@@ -607,6 +619,7 @@ bool Workbench::start_job(bool mesh, bool solve) {
   in.height = view_->height();
   if (view_->camera()) in.camera = *view_->camera();
   in.cmap = color_map_.toStdString();
+  in.shrink = shrink_;
   in.cancel = std::make_shared<std::atomic<bool>>(false);
   in.permille = std::make_shared<std::atomic<int>>(0);
   const QString what = in.mesh && in.solve ? tr("meshing and solving") : in.mesh ? tr("meshing") : tr("solving");
@@ -623,15 +636,16 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
   if (busy() || !mesh_) return false;
   std::shared_ptr<const Mesh> mesh = mesh_;
   const std::string f = field.toStdString(), cmap = color_map.toStdString();
+  const double shrink = shrink_;
   const int w = view_->width(), h = view_->height();
   std::optional<Camera> cam;
   if (view_->camera()) cam = *view_->camera();
   field_ = field;
   color_map_ = color_map;
-  auto work = [mesh, f, cmap, w, h, cam]() {
+  auto work = [mesh, f, cmap, shrink, w, h, cam]() {
     auto out = std::make_shared<Outcome>();
     try {
-      build_display(*out, *mesh, f, cmap, w, h, cam ? &*cam : nullptr);
+      build_display(*out, *mesh, f, cmap, shrink, w, h, cam ? &*cam : nullptr);
       out->mesh = mesh;
       out->ok = true;
     } catch (const std::exception& e) {
@@ -641,6 +655,16 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
   };
   launch(work, tr("colouring"), std::make_shared<std::atomic<bool>>(false), std::make_shared<std::atomic<int>>(0));
   return true;
+}
+
+bool Workbench::set_shrink(double shrink) {
+  if (!(shrink > 0 && shrink <= 1)) return false;
+  shrink_ = shrink;
+  if (shrink_box_->value() != shrink) {
+    const QSignalBlocker quiet(shrink_box_);
+    shrink_box_->setValue(shrink);
+  }
+  return !mesh_ || set_field(field_, color_map_);
 }
 
 void Workbench::cancel() {

@@ -22,6 +22,7 @@
 #include "foxi/solver/results.hpp"
 
 class QComboBox;
+class QDoubleSpinBox;
 class QLabel;
 class QProgressBar;
 class QPushButton;
@@ -80,6 +81,10 @@ class Workbench : public QMainWindow {
   // The field shown ("" for regions) and its colour map; rebuilds the picture on a worker.
   bool set_field(const QString& field, const QString& color_map = "viridis");
 
+  // Each tet drawn scaled about its centroid by `shrink` in (0, 1] (foxi render --shrink); false
+  // for a value outside or while a job runs.
+  bool set_shrink(double shrink);
+
   std::shared_ptr<const Mesh> mesh() const { return mesh_; }
   const RunResults* results() const { return has_results_ ? &results_ : nullptr; }
   const std::vector<HistoryRow>& history() const { return history_; }
@@ -120,6 +125,7 @@ class Workbench : public QMainWindow {
   std::size_t mesh_serial_ = 0;
   std::vector<HistoryRow> history_;
   QString field_, color_map_ = "viridis";
+  double shrink_ = 1;
   QString last_error_;
 
   // The running job: its cancel flag and progress, polled by a timer (no event per progress call).
@@ -138,6 +144,7 @@ class Workbench : public QMainWindow {
   QTableWidget* results_table_ = nullptr;
   QTableWidget* history_table_ = nullptr;
   QComboBox *field_box_ = nullptr, *cmap_box_ = nullptr;
+  QDoubleSpinBox* shrink_box_ = nullptr;
   QLabel* legend_ = nullptr;
   QSlider* fraction_ = nullptr;
   QLabel *status_ = nullptr, *probe_ = nullptr;
