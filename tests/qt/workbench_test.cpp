@@ -292,6 +292,40 @@ TEST(ViewWidget, FractionDrawsAndUndraws) {
   EXPECT_TRUE(v->view()->framebuffer().id == quarter_ids) << "undrawn back to the same picture";
 }
 
+// A region of interest: the tets drawn become the displayed set and the camera is re-framed on them
+// (looking at the centre of their bounds, computed here from their corners); Back restores all.
+TEST(ViewWidget, RegionOfInterestReframes) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w));
+  foxi::qt::ViewWidget* v = w.view_widget();
+  v->finish_now();
+  v->set_fraction(0.2);
+  for (int i = 0; i < 100000 && v->busy(); ++i) QApplication::processEvents();
+  const std::vector<std::uint32_t> region = v->view()->drawn();
+  ASSERT_FALSE(region.empty());
+  const foxi::Mesh& m = *w.mesh();
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (std::uint32_t t : region)
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 3; ++j) {
+        const double x = m.xyz[3 * std::size_t(m.tet[4 * std::size_t(t) + std::size_t(k)]) + std::size_t(j)];
+        lo[j] = std::min(lo[j], x);
+        hi[j] = std::max(hi[j], x);
+      }
+  ASSERT_TRUE(v->push_region());
+  EXPECT_EQ(v->view()->total(), region.size());
+  for (int j = 0; j < 3; ++j) EXPECT_NEAR(v->camera()->at[j], 0.5 * (lo[j] + hi[j]), 1e-12);
+  v->finish_now();
+  EXPECT_EQ(v->view()->drawn().size(), region.size());
+  ASSERT_TRUE(v->pop_region());
+  EXPECT_EQ(v->view()->total(), m.tet_count());
+  EXPECT_FALSE(v->pop_region());
+}
+
 // The value under the mouse: the tet at the pixel (the id buffer) and its temperature in °C, against
 // the mean of its 4 nodes' temperatures computed here from the node field (flat paint: the tet's
 // colour shows its centroid value); the status names the order method and the certificate.
