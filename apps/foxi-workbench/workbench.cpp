@@ -264,12 +264,14 @@ void Workbench::build_ui() {
   });
   lv->addWidget(open);
   params_ = new QTableWidget(0, 3);
+  params_->setObjectName("parameters");
   params_->setHorizontalHeaderLabels({tr("parameter"), tr("expression"), tr("value (SI)")});
   params_->horizontalHeader()->setStretchLastSection(true);
   params_->verticalHeader()->hide();
   connect(params_, &QTableWidget::cellChanged, this, &Workbench::on_parameter_edited);
   lv->addWidget(params_, 2);
   param_error_ = new QLabel;
+  param_error_->setObjectName("parameter_error");
   param_error_->setWordWrap(true);
   param_error_->setStyleSheet("color: #b00000");
   lv->addWidget(param_error_);
@@ -460,12 +462,15 @@ bool Workbench::redo() {
 void Workbench::on_parameter_edited(int row, int column) {
   if (filling_ || column != 1) return;
   const QString name = params_->item(row, 0)->text(), expr = params_->item(row, 1)->text();
-  QString error;
-  if (!set_parameter(name, expr, &error)) {
-    // The message next to the field at fault: the row is marked and the message shown under it.
-    params_->selectRow(row);
-    param_error_->setText(tr("%1: %2").arg(name, error));
-  }
+  // After the table's signal returns: the check refills the table, which deletes this cell's item.
+  QTimer::singleShot(0, this, [this, row, name, expr] {
+    QString error;
+    if (!set_parameter(name, expr, &error)) {
+      // The message next to the field at fault: the row is marked and the message shown under it.
+      params_->selectRow(row);
+      param_error_->setText(tr("%1: %2").arg(name, error));
+    }
+  });
 }
 
 void Workbench::refresh_model_panel() {

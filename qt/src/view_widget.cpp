@@ -31,7 +31,6 @@ struct ViewWidget::Impl {
   std::vector<double> probe;
   QString probe_unit;
   QPoint last;  // the last mouse position of a drag
-  Qt::MouseButtons buttons;
 };
 
 namespace {
@@ -284,7 +283,7 @@ void ViewWidget::tick() {
   present();
   if (!busy()) {
     d_->timer.stop();
-    if (v->done()) emit draw_finished();
+    if (v->done() && !v->undrawing()) emit draw_finished();
   }
 }
 
@@ -319,10 +318,7 @@ void ViewWidget::resizeEvent(QResizeEvent* event) {
   draw();
 }
 
-void ViewWidget::mousePressEvent(QMouseEvent* event) {
-  d_->last = event->pos();
-  d_->buttons = event->buttons();
-}
+void ViewWidget::mousePressEvent(QMouseEvent* event) { d_->last = event->pos(); }
 
 void ViewWidget::mouseMoveEvent(QMouseEvent* event) {
   if (!d_->view) return;
@@ -348,7 +344,7 @@ void ViewWidget::mouseMoveEvent(QMouseEvent* event) {
   kick();
 }
 
-void ViewWidget::mouseReleaseEvent(QMouseEvent*) { d_->buttons = Qt::NoButton; }
+void ViewWidget::mouseReleaseEvent(QMouseEvent*) {}
 
 void ViewWidget::wheelEvent(QWheelEvent* event) {
   if (!d_->view) return;

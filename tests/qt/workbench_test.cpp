@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <QApplication>
+#include <QLabel>
+#include <QTableWidget>
 #include <QEventLoop>
 #include <QTimer>
 #include <algorithm>
@@ -170,6 +172,33 @@ TEST(Workbench, ParameterEditingWithUnits) {
   // A die wider than the substrate is a model the library refuses? Not necessarily; a negative size is.
   EXPECT_FALSE(w.set_parameter("die_h", "-1 mm", &error));
   EXPECT_NEAR(value_of("die_d"), 0.003, 1e-15);
+}
+
+// Editing the table's cell as a user does: a refused value's message shows next to the table (the
+// label under it, the row selected) and the cell goes back to the accepted expression.
+TEST(Workbench, ParameterTableCellEdit) {
+  Workbench w;
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  QTableWidget* table = w.findChild<QTableWidget*>("parameters");
+  QLabel* message = w.findChild<QLabel*>("parameter_error");
+  ASSERT_NE(table, nullptr);
+  ASSERT_NE(message, nullptr);
+  int row = -1;
+  for (int r = 0; r < table->rowCount(); ++r)
+    if (table->item(r, 0)->text() == "die_w") row = r;
+  ASSERT_GE(row, 0);
+  table->item(row, 1)->setText("4 s");  // a time for a length
+  QApplication::processEvents();         // the edit is checked once the table's signal returns
+  EXPECT_TRUE(message->text().contains("die_w")) << message->text().toStdString();
+  EXPECT_EQ(table->item(row, 1)->text(), "4 mm");
+  EXPECT_TRUE(w.overrides().empty());
+  table->item(row, 1)->setText("4.5 mm");
+  QApplication::processEvents();
+  EXPECT_TRUE(message->text().isEmpty()) << message->text().toStdString();
+  ASSERT_EQ(w.overrides().size(), 1u);
+  EXPECT_EQ(w.overrides()[0].expression, "4.5 mm");
+  for (int r = 0; r < table->rowCount(); ++r)
+    if (table->item(r, 0)->text() == "die_w") EXPECT_EQ(table->item(r, 2)->text(), "0.0045 m");
 }
 
 TEST(Workbench, UndoRedoOfParameterEdits) {
