@@ -6,11 +6,14 @@
 
 #include <QApplication>
 #include <QLabel>
+#include <QMouseEvent>
+#include <QWheelEvent>
 #include <QTableWidget>
 #include <QEventLoop>
 #include <QTimer>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <regex>
@@ -353,6 +356,56 @@ TEST(ViewWidget, RegionOfInterestReframes) {
   ASSERT_TRUE(v->pop_region());
   EXPECT_EQ(v->view()->total(), m.tet_count());
   EXPECT_FALSE(v->pop_region());
+}
+
+// The mouse, as Qt delivers it: left-drag orbits (the eye turns about `at` at the same distance),
+// middle-drag pans (eye and `at` move together), the wheel and right-drag zoom (wheel forward and
+// right-drag up bring the eye closer); each restarts the draw.
+TEST(ViewWidget, MouseOrbitsPansZooms) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w));
+  foxi::qt::ViewWidget* v = w.view_widget();
+  auto dist = [](const foxi::Camera& c) {
+    return std::hypot(c.eye[0] - c.at[0], c.eye[1] - c.at[1], c.eye[2] - c.at[2]);
+  };
+  auto drag = [&](Qt::MouseButton button, QPoint from, QPoint to) {
+    QMouseEvent press(QEvent::MouseButtonPress, from, button, button, Qt::NoModifier);
+    QApplication::sendEvent(v, &press);
+    QMouseEvent move(QEvent::MouseMove, to, Qt::NoButton, button, Qt::NoModifier);
+    QApplication::sendEvent(v, &move);
+    QMouseEvent release(QEvent::MouseButtonRelease, to, button, Qt::NoButton, Qt::NoModifier);
+    QApplication::sendEvent(v, &release);
+  };
+  foxi::Camera c0 = *v->camera();
+  drag(Qt::LeftButton, {100, 75}, {130, 75});
+  foxi::Camera c1 = *v->camera();
+  EXPECT_GT(std::hypot(c1.eye[0] - c0.eye[0], c1.eye[1] - c0.eye[1], c1.eye[2] - c0.eye[2]), 1e-3 * dist(c0));
+  EXPECT_NEAR(dist(c1), dist(c0), 1e-12 * dist(c0));
+  for (int j = 0; j < 3; ++j) EXPECT_DOUBLE_EQ(c1.at[j], c0.at[j]);
+  EXPECT_TRUE(v->busy()) << "the move restarted the draw";
+
+  drag(Qt::MiddleButton, {100, 75}, {110, 90});
+  foxi::Camera c2 = *v->camera();
+  double moved = 0;
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_NEAR(c2.eye[j] - c2.at[j], c1.eye[j] - c1.at[j], 1e-12 * dist(c1));
+    moved += std::abs(c2.at[j] - c1.at[j]);
+  }
+  EXPECT_GT(moved, 1e-4 * dist(c1));
+
+  QWheelEvent wheel(QPointF(100, 75), v->mapToGlobal(QPoint(100, 75)), QPoint(), QPoint(0, 120), Qt::NoButton,
+                    Qt::NoModifier, Qt::NoScrollPhase, false);
+  QApplication::sendEvent(v, &wheel);
+  foxi::Camera c3 = *v->camera();
+  EXPECT_NEAR(dist(c3), dist(c2) / 1.1, 1e-9 * dist(c2));
+  drag(Qt::RightButton, {100, 75}, {100, 55});  // up: closer
+  EXPECT_LT(dist(*v->camera()), dist(c3));
+  v->finish_now();
+  EXPECT_EQ(v->view()->drawn().size(), w.mesh()->tet_count());
 }
 
 // The value under the mouse: the tet at the pixel (the id buffer) and its temperature in °C, against
