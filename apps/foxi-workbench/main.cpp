@@ -72,12 +72,12 @@ int headless(foxi::workbench::Workbench& w, const std::string& model, const std:
   QApplication::processEvents();  // the window laid out: the view has its size before the picture is made
   if (!w.start_mesh() || !wait_job(w)) {
     std::fprintf(stderr, "foxi-workbench: error: meshing: %s\n", w.last_error().toUtf8().constData());
-    return kExitFailure;
+    return w.last_error_bad_input() ? kExitBadInput : kExitFailure;
   }
   if (!physics.empty()) {
     if (!w.start_solve() || !wait_job(w)) {
       std::fprintf(stderr, "foxi-workbench: error: solving: %s\n", w.last_error().toUtf8().constData());
-      return kExitFailure;
+      return w.last_error_bad_input() ? kExitBadInput : kExitFailure;
     }
     if (field.empty()) field = "temperature";
   }

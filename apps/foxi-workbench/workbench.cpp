@@ -38,6 +38,7 @@
 #include "foxi/mesher/model_mesh.hpp"
 #include "foxi/mesher/quality_report.hpp"
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/physics.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/units.hpp"
 #include "foxi/solver/model_problem.hpp"
@@ -52,6 +53,7 @@ namespace foxi::workbench {
 
 struct Outcome {
   bool ok = false, cancelled = false;
+  bool bad_input = false;  // the error is the model's (IoError: file, line, reason)
   QString error;
   bool meshed = false, solved = false;
   std::shared_ptr<const Mesh> mesh;
@@ -568,6 +570,8 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
       ModelMeshOptions options;
       options.override_origin = "the parameter table";
       options.progress = progress;
+      // A solve to follow: the model's conditions and materials checked before meshing, as foxi solve does.
+      if (in.solve) options.physics = Physics::thermal;
       MeshedModel mm = mesh_model(in.path, in.overrides, options);
       if (cancelled()) return out;
       mesh = std::make_shared<Mesh>(std::move(mm.mesh));
@@ -581,6 +585,7 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
     }
     const auto t1 = Clock::now();
     if (in.solve) {
+      if (!in.mesh) check_physics(*model, Physics::thermal);
       ThermalParams params = thermal_params_from_model(*model, *mesh);
       params.solver.progress = progress;
       const ThermalReport report = solve_thermal(*mesh, params);
@@ -601,6 +606,9 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
   } catch (const Cancelled&) {
     out->cancelled = true;
     out->error = "cancelled";
+  } catch (const IoError& e) {
+    out->bad_input = true;
+    out->error = what_of(e);
   } catch (const std::exception& e) {
     out->error = what_of(e);
   }
@@ -688,12 +696,14 @@ void Workbench::on_job_done() {
   if (!out || !out->ok) {
     const QString why = out ? out->error : tr("no result");
     last_error_ = why;
+    last_error_bad_input_ = out && out->bad_input;
     progress_->setFormat(what + ": " + why);
     if (!out || !out->cancelled) param_error_->setText(why);
     emit finished(false);
     return;
   }
   last_error_.clear();
+  last_error_bad_input_ = false;
   progress_->setFormat(what + tr(": done in %1 s").arg(out->seconds + out->solve_seconds, 0, 'f', 2));
   if (out->meshed) {
     mesh_ = out->mesh;

@@ -90,6 +90,9 @@ class Workbench : public QMainWindow {
   const std::vector<HistoryRow>& history() const { return history_; }
   foxi::qt::ViewWidget* view_widget() const { return view_; }
   QString last_error() const { return last_error_; }
+  // The last job failed on the model itself (its file, a parameter, missing conditions): the
+  // message names the file and line; a headless run exits with status 3 then.
+  bool last_error_bad_input() const { return last_error_bad_input_; }
 
  signals:
   // A job ended: ok false with last_error() (cancelled: "cancelled").
@@ -127,6 +130,7 @@ class Workbench : public QMainWindow {
   QString field_, color_map_ = "viridis";
   double shrink_ = 1;
   QString last_error_;
+  bool last_error_bad_input_ = false;
 
   // The running job: its cancel flag and progress, polled by a timer (no event per progress call).
   struct Job;

@@ -144,6 +144,17 @@ TEST(WorkbenchHeadless, BadParameterExitsWithBadInput) {
                             log),
             3);
   EXPECT_NE(foxi::test::read_text(log).find("die_w"), std::string::npos) << foxi::test::read_text(log);
+  // A model with no thermal conditions: refused as bad input (3), as foxi solve refuses it, naming the file.
+  std::string text = foxi::test::read_text(kModels + "die_on_substrate.toml");
+  text = text.substr(0, text.find("[[conditions]]"));
+  foxi::test::write_text(dir.path() / "nocond.toml", text);
+  std::filesystem::copy_file(kModels + "materials.toml", dir.path() / "materials.toml");
+  EXPECT_EQ(foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + (dir.path() / "nocond.toml").string() +
+                                "' --headless --physics thermal",
+                            log),
+            3);
+  EXPECT_NE(foxi::test::read_text(log).find("nocond.toml"), std::string::npos) << foxi::test::read_text(log);
+  EXPECT_EQ(foxi::test::run_cli("solve '" + (dir.path() / "nocond.toml").string() + "' --physics thermal", log), 3);
 }
 
 TEST(Workbench, ParameterEditingWithUnits) {
