@@ -33,6 +33,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <iterator>
 
 #include "foxi/mesher/mesher.hpp"
 #include "foxi/mesher/model_mesh.hpp"
@@ -81,6 +82,17 @@ struct Workbench::Job {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The stages the libraries report (progress.hpp's ProgressFn), numbered for the progress value the
+// worker stores in one atomic: stage * 10000 + fraction in permille. 0: unknown.
+const char* const kStages[] = {"", "meshing", "conforming refinement", "assemble", "factorize", "solve"};
+int stage_index(std::string_view name) {
+  for (int i = 1; i < int(std::size(kStages)); ++i)
+    if (name == kStages[i]) return i;
+  return 0;
+}
+
+const char* progress_stage(int index) { return index > 0 && index < int(std::size(kStages)) ? kStages[index] : ""; }
 
 // The display of `mesh` on the worker: the field's flat paint on the automatic scale (as foxi
 // render --field NAME --cmap MAP draws it) and the view, built with `camera` (null: the default).
@@ -171,7 +183,11 @@ Workbench::Workbench(QWidget* parent) : QMainWindow(parent) {
   poll_ = new QTimer(this);
   poll_->setInterval(100);
   connect(poll_, &QTimer::timeout, this, [this] {
-    if (job_) progress_->setValue(job_->permille->load());
+    if (!job_) return;
+    const int v = job_->permille->load();
+    progress_->setValue(v % 10000);
+    const char* stage = progress_stage(v / 10000);
+    progress_->setFormat(job_->what + (*stage ? QString(" (%1)").arg(stage) : QString()) + " %p%");
   });
 }
 
@@ -551,8 +567,8 @@ namespace {
 std::shared_ptr<Outcome> run_job(const JobInput& in) {
   auto out = std::make_shared<Outcome>();
   const auto t0 = Clock::now();
-  auto progress = [cancel = in.cancel, permille = in.permille](std::string_view, double f) {
-    permille->store(int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
+  auto progress = [cancel = in.cancel, permille = in.permille](std::string_view stage, double f) {
+    permille->store(stage_index(stage) * 10000 + int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
     return !cancel->load();
   };
   // Cancel pressed after the last progress call (a direct solve may not call it at all) still
