@@ -52,8 +52,8 @@ bool wait_job(foxi::workbench::Workbench& w) {
 }
 
 int headless(foxi::workbench::Workbench& w, const std::string& model, const std::vector<std::string>& sets,
-             const std::string& physics, std::string field, const std::string& cmap, double shrink, const std::string& screenshot,
-             const std::string& picture, const std::string& mesh_out) {
+             const std::string& physics, std::string field, const std::string& cmap, double shrink,
+             const std::string& screenshot, const std::string& picture, const std::string& mesh_out) {
   using namespace foxi::cli;
   QString error;
   if (!w.open_model(QString::fromStdString(model), &error)) {
@@ -63,7 +63,8 @@ int headless(foxi::workbench::Workbench& w, const std::string& model, const std:
   for (const std::string& s : sets) {
     const std::size_t eq = s.find('=');
     if (eq == std::string::npos || eq == 0) throw Usage("--set takes NAME=VALUE, not '" + s + "'");
-    if (!w.set_parameter(QString::fromStdString(s.substr(0, eq)), QString::fromStdString(s.substr(eq + 1)), &error)) {
+    if (!w.set_parameter(QString::fromStdString(s.substr(0, eq)), QString::fromStdString(s.substr(eq + 1)),
+                         &error)) {
       std::fprintf(stderr, "foxi-workbench: error: %s\n", error.toUtf8().constData());
       return kExitBadInput;
     }
@@ -83,7 +84,8 @@ int headless(foxi::workbench::Workbench& w, const std::string& model, const std:
   }
   if (!field.empty() || cmap != "viridis") {
     if (!w.set_field(QString::fromStdString(field), QString::fromStdString(cmap)) || !wait_job(w)) {
-      std::fprintf(stderr, "foxi-workbench: error: --field %s: %s\n", field.c_str(), w.last_error().toUtf8().constData());
+      std::fprintf(stderr, "foxi-workbench: error: --field %s: %s\n", field.c_str(),
+                   w.last_error().toUtf8().constData());
       return kExitBadInput;
     }
   }
@@ -149,7 +151,8 @@ int main(int argc, char** argv) {
         sets.push_back(value());
       } else if (a == "--physics") {
         physics = value();
-        if (physics != "thermal") throw Usage("--physics: the workbench solves thermal only so far, not '" + physics + "'");
+        if (physics != "thermal")
+          throw Usage("--physics: the workbench solves thermal only so far, not '" + physics + "'");
       } else if (a == "--field") {
         field = value();
       } else if (a == "--cmap") {
@@ -179,7 +182,8 @@ int main(int argc, char** argv) {
     if (is_headless && model.empty()) throw Usage("--headless needs a model file");
     if (!is_headless && (!sets.empty() || !physics.empty() || !field.empty() || !screenshot.empty() ||
                          !picture.empty() || !mesh_out.empty()))
-      throw Usage("--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
+      throw Usage(
+          "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")
       throw Usage("--cmap takes viridis, cividis, coolwarm or rainbow, not '" + cmap + "'");
     foxi::ImageSize size{0, 0};
@@ -199,7 +203,8 @@ int main(int argc, char** argv) {
     foxi::workbench::Workbench w;
     if (size.width > 0) w.view_widget()->setFixedSize(size.width, size.height);
     w.show();
-    if (is_headless) return headless(w, model, sets, physics, field, cmap, shrink, screenshot, picture, mesh_out);
+    if (is_headless)
+      return headless(w, model, sets, physics, field, cmap, shrink, screenshot, picture, mesh_out);
     w.restore_settings();
     if (!model.empty()) w.open_model(QString::fromStdString(model));
     return app.exec();

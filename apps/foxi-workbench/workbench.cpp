@@ -1,10 +1,14 @@
 // foxi-workbench's main window: see workbench.hpp.
 #include "workbench.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <QApplication>
 #include <QComboBox>
-#include <QDoubleSpinBox>
 #include <QDockWidget>
+#include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFutureWatcher>
@@ -16,10 +20,10 @@
 #include <QPlainTextEdit>
 #include <QProgressBar>
 #include <QPushButton>
-#include <QSlider>
 #include <QSettings>
-#include <QSignalBlocker>
 #include <QShortcut>
+#include <QSignalBlocker>
+#include <QSlider>
 #include <QSplitter>
 #include <QStatusBar>
 #include <QTableWidget>
@@ -27,9 +31,6 @@
 #include <QToolBar>
 #include <QVBoxLayout>
 #include <QtConcurrent/QtConcurrentRun>
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -46,8 +47,8 @@
 #include "foxi/solver/thermal.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/field_paint.hpp"
-#include "foxi/viz/legend.hpp"
 #include "foxi/viz/interactive_view.hpp"
+#include "foxi/viz/legend.hpp"
 #include "foxi/viz/rasterizer.hpp"
 
 namespace foxi::workbench {
@@ -67,8 +68,8 @@ struct Outcome {
   DisplayUnit unit;
   bool has_scale = false;
   RunResults results;
-  double seconds = 0;        // meshing (or the solve when not meshed)
-  double solve_seconds = 0;  // the solve
+  double seconds = 0;                        // meshing (or the solve when not meshed)
+  double solve_seconds = 0;                  // the solve
   std::optional<MeshQualityReport> quality;  // a new mesh's
 };
 
@@ -92,12 +93,14 @@ int stage_index(std::string_view name) {
   return 0;
 }
 
-const char* progress_stage(int index) { return index > 0 && index < int(std::size(kStages)) ? kStages[index] : ""; }
+const char* progress_stage(int index) {
+  return index > 0 && index < int(std::size(kStages)) ? kStages[index] : "";
+}
 
 // The display of `mesh` on the worker: the field's flat paint on the automatic scale (as foxi
 // render --field NAME --cmap MAP draws it) and the view, built with `camera` (null: the default).
-void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const std::string& cmap, double shrink,
-                   int w, int h, const Camera* camera) {
+void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const std::string& cmap,
+                   double shrink, int w, int h, const Camera* camera) {
   RenderParams params;
   params.undoable = true;  // the workbench undraws
   params.shrink = shrink;
@@ -123,9 +126,10 @@ void build_display(Outcome& out, const Mesh& mesh, const std::string& field, con
 QString what_of(const std::exception& e) { return QString::fromStdString(e.what()); }
 
 bool same_overrides(const std::vector<ParameterOverride>& a, const std::vector<ParameterOverride>& b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const ParameterOverride& x, const ParameterOverride& y) {
-    return x.name == y.name && x.expression == y.expression;
-  });
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const ParameterOverride& x, const ParameterOverride& y) {
+                      return x.name == y.name && x.expression == y.expression;
+                    });
 }
 
 // A colour bar with ticks (colormap.hpp's entries and nice_ticks), in the field's display unit.
@@ -165,13 +169,13 @@ QPixmap histogram_pixmap(const MeshQualityReport& q) {
   for (std::size_t c : q.min_dihedral_histogram) most = std::max(most, c);
   const int bins = int(q.min_dihedral_histogram.size()), bw = (w - 2 * left) / bins;
   for (int i = 0; i < bins; ++i) {
-    const int bh = int(std::lround(double(q.min_dihedral_histogram[std::size_t(i)]) / double(most) * (h - top - bottom)));
+    const int bh = int(
+        std::lround(double(q.min_dihedral_histogram[std::size_t(i)]) / double(most) * (h - top - bottom)));
     p.fillRect(left + i * bw + 1, h - bottom - bh, bw - 2, bh, QColor(70, 110, 170));
   }
   p.setPen(Qt::black);
   p.drawLine(left, h - bottom, left + bins * bw, h - bottom);
-  for (int deg = 0; deg <= 75; deg += 15)
-    p.drawText(left + deg / 5 * bw - 6, h - 3, QString::number(deg));
+  for (int deg = 0; deg <= 75; deg += 15) p.drawText(left + deg / 5 * bw - 6, h - 3, QString::number(deg));
   p.drawText(left, 12, QObject::tr("tets by minimum dihedral angle (degrees)"));
   return QPixmap::fromImage(img);
 }
@@ -222,7 +226,8 @@ void Workbench::build_ui() {
   button(tr("Back"), &foxi::qt::ViewWidget::pop_region);
   auto* save = new QPushButton(tr("Save picture..."));
   connect(save, &QPushButton::clicked, this, [this] {
-    const QString f = QFileDialog::getSaveFileName(this, tr("Save the view's picture"), QString(), tr("PNG (*.png)"));
+    const QString f =
+        QFileDialog::getSaveFileName(this, tr("Save the view's picture"), QString(), tr("PNG (*.png)"));
     QString error;
     if (!f.isEmpty() && !view_->save_picture(f, &error)) param_error_->setText(error);
   });
@@ -250,7 +255,8 @@ void Workbench::build_ui() {
   shrink_box_->setSingleStep(0.05);
   shrink_box_->setValue(1.0);
   shrink_box_->setToolTip(tr("each tet scaled about its centroid: see between them"));
-  connect(shrink_box_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this](double v) { set_shrink(v); });
+  connect(shrink_box_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
+          [this](double v) { set_shrink(v); });
   fields->addWidget(new QLabel(tr("shrink")));
   fields->addWidget(shrink_box_);
   cv->addLayout(fields);
@@ -276,8 +282,8 @@ void Workbench::build_ui() {
   auto* open = new QPushButton(tr("Open model..."));
   connect(open, &QPushButton::clicked, this, [this] {
     QSettings settings;
-    const QString f = QFileDialog::getOpenFileName(this, tr("Open a model"), settings.value("last_model").toString(),
-                                                   tr("Models (*.toml)"));
+    const QString f = QFileDialog::getOpenFileName(
+        this, tr("Open a model"), settings.value("last_model").toString(), tr("Models (*.toml)"));
     if (!f.isEmpty() && open_model(f)) settings.setValue("last_model", f);
   });
   lv->addWidget(open);
@@ -344,7 +350,8 @@ void Workbench::build_ui() {
   results_dock->setWidget(results_table_);
   addDockWidget(Qt::RightDockWidgetArea, results_dock);
   history_table_ = new QTableWidget(0, 5);
-  history_table_->setHorizontalHeaderLabels({tr("run"), tr("parameters"), tr("tets"), tr("key results"), tr("time")});
+  history_table_->setHorizontalHeaderLabels(
+      {tr("run"), tr("parameters"), tr("tets"), tr("key results"), tr("time")});
   history_table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   history_table_->horizontalHeader()->setSectionResizeMode(3, QHeaderView::Stretch);
   history_table_->verticalHeader()->hide();
@@ -403,7 +410,8 @@ void Workbench::show_error(const QString& text) {
 
 bool Workbench::open_model(const QString& path, QString* error) {
   try {
-    auto m = std::make_shared<const Model>(load_model(path.toStdString(), std::span<const ParameterOverride>{}));
+    auto m =
+        std::make_shared<const Model>(load_model(path.toStdString(), std::span<const ParameterOverride>{}));
     model_path_ = path;
     overrides_.clear();
     model_ = std::move(m);
@@ -445,7 +453,8 @@ bool Workbench::apply_overrides(std::map<std::string, std::string> trial, QStrin
   for (const auto& [n, e] : trial) list.push_back({n, e});
   try {
     // The model library's own check: units, expressions, geometry limits (a model file load).
-    auto m = std::make_shared<const Model>(load_model(model_path_.toStdString(), list, "the parameter table"));
+    auto m =
+        std::make_shared<const Model>(load_model(model_path_.toStdString(), list, "the parameter table"));
     overrides_ = std::move(trial);
     model_ = std::move(m);
     show_error({});
@@ -500,7 +509,9 @@ void Workbench::refresh_model_panel() {
     for (const Parameter& p : model_->parameters) {
       auto* n = new QTableWidgetItem(QString::fromStdString(p.name));
       n->setFlags(n->flags() & ~Qt::ItemIsEditable);
-      auto* v = new QTableWidgetItem(QString("%1 %2").arg(p.value.value, 0, 'g', 6).arg(QString::fromStdString(dims_to_string(p.value.dims))));
+      auto* v = new QTableWidgetItem(QString("%1 %2")
+                                         .arg(p.value.value, 0, 'g', 6)
+                                         .arg(QString::fromStdString(dims_to_string(p.value.dims))));
       v->setFlags(v->flags() & ~Qt::ItemIsEditable);
       auto* e = new QTableWidgetItem(QString::fromStdString(p.expression));
       if (p.overridden) e->setBackground(QColor(255, 245, 200));
@@ -526,7 +537,8 @@ void Workbench::refresh_model_panel() {
 }
 
 void Workbench::launch(std::function<std::shared_ptr<Outcome>()> work, const QString& what,
-                       std::shared_ptr<std::atomic<bool>> cancel, std::shared_ptr<std::atomic<int>> permille) {
+                       std::shared_ptr<std::atomic<bool>> cancel,
+                       std::shared_ptr<std::atomic<int>> permille) {
   job_ = std::make_unique<Job>();
   job_->what = what;
   job_->cancel = std::move(cancel);
@@ -609,7 +621,8 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
       out->results = thermal_results(*mesh, report);
       out->results.model = in.path;
       out->results.physics = "thermal";
-      for (const ParameterOverride& o : in.overrides) out->results.parameters.push_back({o.name, o.expression});
+      for (const ParameterOverride& o : in.overrides)
+        out->results.parameters.push_back({o.name, o.expression});
       out->solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
       out->solved = true;
     }
@@ -651,7 +664,9 @@ bool Workbench::start_job(bool mesh, bool solve) {
   in.shrink = shrink_;
   in.cancel = std::make_shared<std::atomic<bool>>(false);
   in.permille = std::make_shared<std::atomic<int>>(0);
-  const QString what = in.mesh && in.solve ? tr("meshing and solving") : in.mesh ? tr("meshing") : tr("solving");
+  const QString what = in.mesh && in.solve ? tr("meshing and solving")
+                       : in.mesh           ? tr("meshing")
+                                           : tr("solving");
   auto cancel = in.cancel;
   auto permille = in.permille;
   launch([in = std::move(in)] { return run_job(in); }, what, cancel, permille);
@@ -682,7 +697,8 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
     }
     return out;
   };
-  launch(work, tr("colouring"), std::make_shared<std::atomic<bool>>(false), std::make_shared<std::atomic<int>>(0));
+  launch(work, tr("colouring"), std::make_shared<std::atomic<bool>>(false),
+         std::make_shared<std::atomic<int>>(0));
   return true;
 }
 
@@ -795,8 +811,10 @@ void Workbench::add_history(double seconds) {
   row.parameters = meshed_overrides_;
   row.mesh = mesh_serial_;
   row.tets = mesh_ ? mesh_->tet_count() : 0;
-  if (has_results_) row.results = results_;
-  else row.results.status = RunStatus::failed, row.results.error = "meshed only";
+  if (has_results_)
+    row.results = results_;
+  else
+    row.results.status = RunStatus::failed, row.results.error = "meshed only";
   row.seconds = seconds;
   // A solve of the mesh the last row made completes that row (one row per model state).
   const bool complete = has_results_ && !history_.empty() && history_.back().results.values.empty() &&
@@ -814,7 +832,11 @@ void Workbench::add_history(double seconds) {
     params += QString::fromStdString(o.name + "=" + o.expression + " ");
   QString key;
   for (const ResultValue& v : row.results.values)
-    if (v.key) key += QString("%1 %2 %3; ").arg(QString::fromStdString(v.name)).arg(v.value, 0, 'g', 5).arg(QString::fromStdString(v.unit));
+    if (v.key)
+      key += QString("%1 %2 %3; ")
+                 .arg(QString::fromStdString(v.name))
+                 .arg(v.value, 0, 'g', 5)
+                 .arg(QString::fromStdString(v.unit));
   history_table_->setItem(i, 0, new QTableWidgetItem(QString::number(i + 1)));
   history_table_->setItem(i, 1, new QTableWidgetItem(params.isEmpty() ? tr("(as in the file)") : params));
   history_table_->setItem(i, 2, new QTableWidgetItem(QString::number(row.tets)));

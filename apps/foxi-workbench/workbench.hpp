@@ -118,8 +118,8 @@ class Workbench : public QMainWindow {
   QString model_path_;
   std::map<std::string, std::string> overrides_;
   std::vector<std::map<std::string, std::string>> undo_, redo_;  // the overrides before each edit
-  std::shared_ptr<const Model> model_;         // as loaded with the overrides
-  std::shared_ptr<const Model> meshed_model_;  // the model the shown mesh came from
+  std::shared_ptr<const Model> model_;                           // as loaded with the overrides
+  std::shared_ptr<const Model> meshed_model_;                    // the model the shown mesh came from
   std::vector<ParameterOverride> meshed_overrides_;
   std::shared_ptr<const Mesh> mesh_;
   RunResults results_;

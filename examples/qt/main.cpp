@@ -41,9 +41,10 @@ int main(int argc, char** argv) {
   auto* bar = new QHBoxLayout;
   auto* view = new foxi::qt::ViewWidget;
   view->setMinimumSize(640, 480);
-  for (auto [text, slot] : {std::pair{"Draw", &foxi::qt::ViewWidget::draw}, std::pair{"Stop", &foxi::qt::ViewWidget::stop},
-                            std::pair{"Step", &foxi::qt::ViewWidget::step_once},
-                            std::pair{"Undraw", &foxi::qt::ViewWidget::undraw}}) {
+  for (auto [text, slot] :
+       {std::pair{"Draw", &foxi::qt::ViewWidget::draw}, std::pair{"Stop", &foxi::qt::ViewWidget::stop},
+        std::pair{"Step", &foxi::qt::ViewWidget::step_once},
+        std::pair{"Undraw", &foxi::qt::ViewWidget::undraw}}) {
     auto* b = new QPushButton(text);
     QObject::connect(b, &QPushButton::clicked, view, slot);
     bar->addWidget(b);
@@ -72,7 +73,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "qt_window: %s\n", error.toUtf8().constData());
       return 1;
     }
-    std::printf("qt_window: %s: %zu tets; %s\n", argv[3], mesh->tet_count(), view->status_text().toUtf8().constData());
+    std::printf("qt_window: %s: %zu tets; %s\n", argv[3], mesh->tet_count(),
+                view->status_text().toUtf8().constData());
     return 0;
   }
   return app.exec();

@@ -26,7 +26,7 @@ struct ViewWidget::Impl {
   std::unique_ptr<InteractiveView> view;
   QTimer timer;
   std::chrono::milliseconds slice{8};
-  bool camera_default = true;  // never moved by the user: re-fitted to a new aspect on resize
+  bool camera_default = true;         // never moved by the user: re-fitted to a new aspect on resize
   std::optional<std::size_t> target;  // following a fraction: the tet count to reach
   std::vector<double> probe;
   QString probe_unit;
@@ -57,8 +57,8 @@ ViewWidget::ViewWidget(QWidget* parent) : QWidget(parent), d_(std::make_unique<I
 
 ViewWidget::~ViewWidget() = default;
 
-std::unique_ptr<InteractiveView> make_view(const Mesh& mesh, const RenderParams& params, int width, int height,
-                                           const Camera* camera) {
+std::unique_ptr<InteractiveView> make_view(const Mesh& mesh, const RenderParams& params, int width,
+                                           int height, const Camera* camera) {
   const int w = std::max(1, width), h = std::max(1, height);
   return std::make_unique<InteractiveView>(mesh, camera ? *camera : default_camera(mesh, w, h), w, h, params);
 }
@@ -117,12 +117,15 @@ QString ViewWidget::probe_text(int x, int y) const {
   }
   if (t < d_->probe.size()) {
     const double v = d_->probe[t];
-    text += std::isfinite(v) ? QString(", %1 %2").arg(v, 0, 'g', 6).arg(d_->probe_unit) : QString(", no value");
+    text +=
+        std::isfinite(v) ? QString(", %1 %2").arg(v, 0, 'g', 6).arg(d_->probe_unit) : QString(", no value");
   }
   return text;
 }
 
-void ViewWidget::set_time_slice(std::chrono::milliseconds slice) { d_->slice = std::max(slice, std::chrono::milliseconds(1)); }
+void ViewWidget::set_time_slice(std::chrono::milliseconds slice) {
+  d_->slice = std::max(slice, std::chrono::milliseconds(1));
+}
 
 double ViewWidget::fraction_drawn() const {
   if (!d_->view || d_->view->total() == 0) return 0;
@@ -151,7 +154,9 @@ bool ViewWidget::save_picture(const QString& path, QString* error) const {
   }
 }
 
-std::string ViewWidget::camera_options() const { return d_->view ? d_->view->camera_options() : std::string(); }
+std::string ViewWidget::camera_options() const {
+  return d_->view ? d_->view->camera_options() : std::string();
+}
 
 bool ViewWidget::busy() const { return d_->view && (d_->target || d_->view->running()); }
 

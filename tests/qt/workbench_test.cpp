@@ -2,15 +2,17 @@
 // same mesh, field and camera (the CLI as the second renderer), its results against foxi solve's
 // record, parameter editing with units (refused values keep the state), Cancel keeping the previous
 // mesh, and a GUI heartbeat over meshing, solving and drawing (the window never stalls > 100 ms).
+#include "workbench.hpp"
+
 #include <gtest/gtest.h>
 
 #include <QApplication>
+#include <QEventLoop>
 #include <QLabel>
 #include <QMouseEvent>
-#include <QWheelEvent>
 #include <QTableWidget>
-#include <QEventLoop>
 #include <QTimer>
+#include <QWheelEvent>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,7 +27,6 @@
 #include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/png.hpp"
 #include "test_util.hpp"
-#include "workbench.hpp"
 
 namespace {
 
@@ -67,18 +68,20 @@ void check_headless(const std::string& model, const std::string& set, const std:
   const auto view = dir.path() / "view.png", mesh = dir.path() / "mesh.vtu", shot = dir.path() / "window.png",
              cli = dir.path() / "cli.png", log = dir.path() / "wb.log";
   const std::string args = "'" + kModels + model + "' --headless --set " + set +
-                           " --physics thermal --view-size 320x240" + shrink_option + " --save-picture '" + view.string() +
-                           "' --screenshot '" + shot.string() + "' --save-mesh '" + mesh.string() + "'";
+                           " --physics thermal --view-size 320x240" + shrink_option + " --save-picture '" +
+                           view.string() + "' --screenshot '" + shot.string() + "' --save-mesh '" +
+                           mesh.string() + "'";
   ASSERT_EQ(foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' " + args, log), 0)
       << foxi::test::read_text(log);
   const std::string out = foxi::test::read_text(log);
   const std::string camera = line_after(out, "camera: ");
   ASSERT_NE(camera.find("--eye"), std::string::npos) << out;
   EXPECT_TRUE(std::filesystem::file_size(shot) > 0);
-  ASSERT_EQ(foxi::test::run_cli("render '" + mesh.string() + "' --field temperature --legend off --size 320x240" +
-                                    shrink_option + " " + camera + " -o '" + cli.string() + "'",
-                                dir.path() / "render.log"),
-            0)
+  ASSERT_EQ(
+      foxi::test::run_cli("render '" + mesh.string() + "' --field temperature --legend off --size 320x240" +
+                              shrink_option + " " + camera + " -o '" + cli.string() + "'",
+                          dir.path() / "render.log"),
+      0)
       << foxi::test::read_text(dir.path() / "render.log");
   const foxi::Framebuffer a = foxi::read_png(view), b = foxi::read_png(cli);
   ASSERT_EQ(a.width, 320);
@@ -95,8 +98,8 @@ void check_headless(const std::string& model, const std::string& set, const std:
 
   // The same key result as foxi solve's JSON record of the model with the same --set.
   const auto json = dir.path() / "solve.json";
-  ASSERT_EQ(foxi::test::run_cli("solve '" + kModels + model + "' --physics thermal --set " + set + " --json '" +
-                                    json.string() + "'",
+  ASSERT_EQ(foxi::test::run_cli("solve '" + kModels + model + "' --physics thermal --set " + set +
+                                    " --json '" + json.string() + "'",
                                 dir.path() / "solve.log"),
             0)
       << foxi::test::read_text(dir.path() / "solve.log");
@@ -121,14 +124,18 @@ TEST(WorkbenchHeadless, ViewPictureEqualsFoxiRenderFlipChipShrunk) {
 TEST(WorkbenchHeadless, UnderXvfbSamePictureAsOffscreen) {
   if (!foxi::test::have_program("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (Debian xvfb)";
   TempDir dir;
-  const std::string common = "'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
-                             "die_on_substrate.toml' --headless --physics thermal --view-size 240x180 --save-picture ";
+  const std::string common =
+      "'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
+      "die_on_substrate.toml' --headless --physics thermal --view-size 240x180 --save-picture ";
   const auto off = dir.path() / "off.png", x11 = dir.path() / "x11.png";
-  ASSERT_EQ(foxi::test::run("QT_QPA_PLATFORM=offscreen " + common + "'" + off.string() + "'", dir.path() / "off.log"), 0)
-      << foxi::test::read_text(dir.path() / "off.log");
-  ASSERT_EQ(foxi::test::run("QT_QPA_PLATFORM=xcb timeout 120 xvfb-run -a " + common + "'" + x11.string() + "'",
-                            dir.path() / "x11.log"),
+  ASSERT_EQ(foxi::test::run("QT_QPA_PLATFORM=offscreen " + common + "'" + off.string() + "'",
+                            dir.path() / "off.log"),
             0)
+      << foxi::test::read_text(dir.path() / "off.log");
+  ASSERT_EQ(
+      foxi::test::run("QT_QPA_PLATFORM=xcb timeout 120 xvfb-run -a " + common + "'" + x11.string() + "'",
+                      dir.path() / "x11.log"),
+      0)
       << foxi::test::read_text(dir.path() / "x11.log");
   const foxi::Framebuffer a = foxi::read_png(off), b = foxi::read_png(x11);
   ASSERT_EQ(a.width, 240);
@@ -149,12 +156,13 @@ TEST(WorkbenchHeadless, BadParameterExitsWithBadInput) {
   text = text.substr(0, text.find("[[conditions]]"));
   foxi::test::write_text(dir.path() / "nocond.toml", text);
   std::filesystem::copy_file(kModels + "materials.toml", dir.path() / "materials.toml");
-  EXPECT_EQ(foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + (dir.path() / "nocond.toml").string() +
-                                "' --headless --physics thermal",
+  EXPECT_EQ(foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' '" +
+                                (dir.path() / "nocond.toml").string() + "' --headless --physics thermal",
                             log),
             3);
   EXPECT_NE(foxi::test::read_text(log).find("nocond.toml"), std::string::npos) << foxi::test::read_text(log);
-  EXPECT_EQ(foxi::test::run_cli("solve '" + (dir.path() / "nocond.toml").string() + "' --physics thermal", log), 3);
+  EXPECT_EQ(
+      foxi::test::run_cli("solve '" + (dir.path() / "nocond.toml").string() + "' --physics thermal", log), 3);
 }
 
 TEST(Workbench, ParameterEditingWithUnits) {
@@ -202,7 +210,7 @@ TEST(Workbench, ParameterTableCellEdit) {
     if (table->item(r, 0)->text() == "die_w") row = r;
   ASSERT_GE(row, 0);
   table->item(row, 1)->setText("4 s");  // a time for a length
-  QApplication::processEvents();         // the edit is checked once the table's signal returns
+  QApplication::processEvents();        // the edit is checked once the table's signal returns
   EXPECT_TRUE(message->text().contains("die_w")) << message->text().toStdString();
   EXPECT_EQ(table->item(row, 1)->text(), "4 mm");
   EXPECT_TRUE(w.overrides().empty());
@@ -433,7 +441,8 @@ TEST(ViewWidget, ValueUnderTheMouseAndStatus) {
   ASSERT_TRUE(wait_job(w));
   foxi::qt::ViewWidget* v = w.view_widget();
   v->finish_now();
-  EXPECT_NE(v->status_text().indexOf("power order, Delaunay certified"), -1) << v->status_text().toStdString();
+  EXPECT_NE(v->status_text().indexOf("power order, Delaunay certified"), -1)
+      << v->status_text().toStdString();
   const foxi::Mesh& m = *w.mesh();
   const foxi::Field* temp = nullptr;
   for (const foxi::Field& f : m.fields)
@@ -497,7 +506,8 @@ double longest_gap_ms() {
   beat.stop();
   EXPECT_FALSE(v->busy());
   EXPECT_EQ(v->view()->drawn().size(), w.mesh()->tet_count());
-  std::printf("longest GUI-thread gap %.1f ms over mesh + solve + draw of %zu tets\n", longest, w.mesh()->tet_count());
+  std::printf("longest GUI-thread gap %.1f ms over mesh + solve + draw of %zu tets\n", longest,
+              w.mesh()->tet_count());
   return longest;
 }
 

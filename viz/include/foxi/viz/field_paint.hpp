@@ -113,6 +113,7 @@ struct AutoScale {
   ColorScale scale;
   bool widened = false, centred = false;
 };
-FOXI_API std::optional<AutoScale> automatic_scale(std::span<const double> values, ColorMapId map, bool log = false);
+FOXI_API std::optional<AutoScale> automatic_scale(std::span<const double> values, ColorMapId map,
+                                                  bool log = false);
 
 }  // namespace foxi
