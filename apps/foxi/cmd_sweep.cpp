@@ -297,13 +297,25 @@ int cmd_sweep(Args args) {
       s.push_back(varied[i].name + "=" + varied[i].texts[idx[i]]);
     return s;
   };
-  // The parameters and the model are checked once here: a mistyped name fails before any run.
+  // The parameters and the model are checked once here: a mistyped name or unit, or a broken model,
+  // fails before any run (no value of that parameter loads). A value that only some geometry refuses
+  // (a die of 1e-30 mm) is that run's failure, a row with its error, and the sweep goes on.
   for (const Varied& v : varied) {
-    std::vector<std::string> one = sets;
-    one.push_back(v.name + "=" + v.texts.front());
-    (void)load_model(model, one, "--set");
+    for (std::size_t i = 0; i < v.texts.size(); ++i) {
+      std::vector<std::string> one = sets;
+      one.push_back(v.name + "=" + v.texts[i]);
+      try {
+        (void)load_model(model, one, "--set");
+        break;
+      } catch (const std::exception&) {
+        if (i + 1 == v.texts.size()) {  // none loads: the error of the first value, as it was
+          one.back() = v.name + "=" + v.texts.front();
+          (void)load_model(model, one, "--set");
+          throw;
+        }
+      }
+    }
   }
-  (void)load_model(model, run_sets(0), "--set");
   silence_text_for_json(json);
 
   ScratchFolder scratch("foxi-sweep");

@@ -35,7 +35,7 @@ class RunOrder {
     std::size_t pick = total_;
     if (total_ > kPredicted) {
       pick = first_unstarted();
-    } else if (started_count_ == 0 || (finished_count_ == 0 && started_count_ < 2)) {
+    } else if (started_count_ < 2) {  // (one finished run predicts the same length for all)
       pick = started_count_ == 0 ? total_ - 1 : 0;  // the two ends
       if (started_[pick]) pick = first_unstarted();
     } else {
@@ -43,7 +43,9 @@ class RunOrder {
       for (std::size_t run = 0; run < total_; ++run) {
         if (started_[run]) continue;
         const double predicted = predict(run, &now);
-        if (predicted > longest) longest = predicted, pick = run;
+        // Ties (to rounding: one finished run predicts its own length everywhere, in weights of
+        // 1/3 and 1/2 that round differently) go to the first run in the grid.
+        if (predicted > longest * (1 + 1e-9)) longest = predicted, pick = run;
       }
     }
     started_[pick] = true;

@@ -210,6 +210,13 @@ TEST(SolveJson, UsageErrors) {
             3);
   EXPECT_NE(test::read_text(log).find("nope"), std::string::npos) << test::read_text(log);
   EXPECT_FALSE(std::filesystem::exists(dir / "s.csv"));
+  // so is a value of the wrong dimension in every run (a length parameter given kelvins)
+  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2K,3K -o '" +
+                              (dir / "s.csv").string() + "'",
+                          log),
+            3);
+  EXPECT_NE(test::read_text(log).find("die_w"), std::string::npos) << test::read_text(log);
+  EXPECT_FALSE(std::filesystem::exists(dir / "s.csv"));
 }
 
 TEST(Sweep, ThetaFallsWithDieWidthAndRowsEqualSeparateSolves) {
@@ -416,9 +423,10 @@ TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {
   if (!test::have_program("/usr/bin/python3")) GTEST_SKIP() << "no python3";
   TempDir dir;
   const auto csv = dir / "sweep.csv", log = dir / "sweep.txt", json = dir / "sweep.json";
-  // die_w = -1 mm makes the model invalid in that run only (the first value is checked up front)
+  // die_w = -1 mm makes the model invalid in that run only; so does 1e-30 mm, first in the list (a
+  // value that breaks only some geometry is a failed row even when it comes first)
   EXPECT_EQ(
-      test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=4mm,-1mm,5mm --jobs 1 -o '" +
+      test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=1e-30mm,-1mm,5mm --jobs 1 -o '" +
                         csv.string() + "' --json '" + json.string() + "'",
                     log),
       1)
@@ -427,9 +435,10 @@ TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {
   ASSERT_EQ(rows.size(), 4u) << test::read_text(csv);
   const std::size_t st = column(rows[0], "status"), err = column(rows[0], "error"),
                     tmax = column(rows[0], "T_max (K)");
-  EXPECT_EQ(rows[1][st], "ok");
+  EXPECT_EQ(rows[1][st], "failed");
   EXPECT_EQ(rows[2][st], "failed");
   EXPECT_EQ(rows[3][st], "ok");
+  EXPECT_NE(rows[1][err].find("degenerate"), std::string::npos) << rows[1][err];
   EXPECT_NE(rows[2][err].find("not positive"), std::string::npos) << rows[2][err];
   EXPECT_TRUE(rows[2][tmax].empty());
   EXPECT_FALSE(rows[3][tmax].empty());
@@ -440,7 +449,7 @@ d = json.load(open(sys.argv[1]))
 print(len(d), [r["status"] for r in d], d[1]["parameters"][0]["text"])
 )PY",
                                 json);
-  EXPECT_NE(py.find("3 ['ok', 'failed', 'ok'] -1mm"), std::string::npos) << py;
+  EXPECT_NE(py.find("3 ['failed', 'failed', 'ok'] -1mm"), std::string::npos) << py;
 }
 
 // The runs start from the ends of the grid (then longest predicted first), the rows stay in grid
