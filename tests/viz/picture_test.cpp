@@ -20,6 +20,7 @@
 #include "foxi/viz/movie.hpp"
 #include "foxi/viz/visibility_order.hpp"
 #include "mesh_factory.hpp"
+#include "picture_diff.hpp"
 #include "random_cameras.hpp"
 #include "test_util.hpp"
 
@@ -37,18 +38,8 @@ Framebuffer shuffled_depth_picture(const Mesh& m, const Camera& cam, std::vector
   return render_tets(m, cam, kW, kH, tets, zp);
 }
 
-struct Compared {
-  std::size_t differing = 0, covered = 0;
-};
-
-Compared compare(const Framebuffer& a, const Framebuffer& b) {
-  Compared c;
-  for (std::size_t i = 0; i < a.rgba.size(); ++i) {
-    c.differing += a.rgba[i] != b.rgba[i] || a.id[i] != b.id[i];
-    c.covered += b.id[i] != kNone;
-  }
-  return c;
-}
+using Compared = test::PictureDiff;
+constexpr auto compare = test::compare_pictures;
 
 std::vector<std::uint32_t> all_tets(const Mesh& m) {
   std::vector<std::uint32_t> v(m.tet_count());
@@ -75,11 +66,11 @@ TEST(Picture, CertifiedMeshIsDrawnByThePainterAndEqualsTheDepthBuffer) {
     EXPECT_EQ(r.cycles_broken, 0u);
     const Compared c = compare(fb, shuffled_depth_picture(m, cam, all_tets(m), ++seed));
     total.differing += c.differing;
-    total.covered += c.covered;
+    total.shown += c.shown;
   }
-  EXPECT_GT(total.covered, 12u * kW * kH / 20) << "the views should show the mesh";
+  EXPECT_GT(total.shown, 12u * kW * kH / 20) << "the views should show the mesh";
   // Only depth ties on shared edges may differ (rasterizer_test classifies them one by one).
-  EXPECT_LE(total.differing, total.covered / 2000 + 10);
+  EXPECT_LE(total.differing, total.shown / 2000 + 10);
 
   // Asked for, the depth buffer is used on a certified mesh too (power order, depth test).
   const Camera cam = test::random_cameras(m, 1, 5, double(kW) / kH)[0];
@@ -113,13 +104,13 @@ TEST(Picture, UncertifiedMeshIsDrawnInMpvoOrderWithTheDepthBuffer) {
     const Framebuffer oracle = shuffled_depth_picture(m, cam, all_tets(m), ++seed);
     const Compared c = compare(fb, oracle);
     total.differing += c.differing;
-    total.covered += c.covered;
+    total.shown += c.shown;
     // What the rule prevents: the painter in the power order (no depth buffer) on this mesh.
     const auto power = visibility_order(m, table, view_of(cam));
     painter_differing += compare(render_tets(m, cam, kW, kH, power), oracle).differing;
   }
-  EXPECT_GT(total.covered, 12u * kW * kH / 20);
-  EXPECT_LE(total.differing, total.covered / 2000 + 10);
+  EXPECT_GT(total.shown, 12u * kW * kH / 20);
+  EXPECT_LE(total.differing, total.shown / 2000 + 10);
   EXPECT_GT(painter_differing, 10 * (total.differing + 10)) << "this mesh should need the depth buffer";
   std::printf("uncertified grid: %zu pixels differ from the shuffled depth buffer (safe picture), %zu for the "
               "painter in the power order\n",

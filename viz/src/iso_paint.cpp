@@ -13,6 +13,7 @@
 #include "foxi/viz/isosurface.hpp"
 #include "iso_detail.hpp"
 #include "raster_impl.hpp"
+#include "depth_tie.hpp"
 
 namespace foxi {
 
@@ -128,10 +129,7 @@ struct IsoPainter::Impl {
           const double dx = x + 0.5 - x0;
           const std::size_t p = fb.index(x, y);
           const double z = w0 + wa * dx + wb * dy;
-          if (depth) {
-            if (!(z > fb.depth[p])) continue;
-            fb.depth[p] = z;
-          }
+          if (depth && !depth_test(fb, p, z, wa, wb, std::abs(w0) + std::abs(wa * dx) + std::abs(wb * dy))) continue;
           if (undoable) {
             saved_pixel.push_back(std::uint32_t(p));
             saved_rgba.push_back(fb.rgba[p]);
@@ -314,6 +312,7 @@ void IsoPainter::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
     throw std::invalid_argument("isosurface: framebuffer size differs from the painter's");
   if (s.depth && fb.depth.size() != fb.rgba.size())
     throw std::invalid_argument("isosurface: depth-buffer mode needs a framebuffer with a depth buffer");
+  if (s.depth) ensure_depth_slopes(fb);
   for (std::uint32_t t : tets)
     if (t >= s.mesh->tet_count()) throw std::invalid_argument("isosurface: tet index out of range");
   if (s.values.empty()) {  // nothing to draw; the tets still count as drawn (undraw)

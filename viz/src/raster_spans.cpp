@@ -1,15 +1,15 @@
 // The painter's pixels (TetRasterizer::Impl, raster_impl.hpp): a polygon's rows, spans and edge-darkened
 // pixels (scalar and SSE2), written or recorded for undo.
 #include "raster_impl.hpp"
+#include "depth_tie.hpp"
 
 namespace foxi {
 
 inline void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
   const std::size_t p = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
   if (params.depth_buffer) {
-    const double z = fs.w0 + fs.da * (x + 0.5 - fs.x0) + fs.db * (y + 0.5 - fs.y0);
-    if (!(z > fb.depth[p])) return;
-    fb.depth[p] = z;
+    const double ta = fs.da * (x + 0.5 - fs.x0), tb = fs.db * (y + 0.5 - fs.y0);
+    if (!depth_test(fb, p, fs.w0 + ta + tb, fs.da, fs.db, std::abs(fs.w0) + std::abs(ta) + std::abs(tb))) return;
   }
   fb.rgba[p] = face_color(fs, x, y);
   fb.id[p] = fs.tet;

@@ -4,6 +4,7 @@
 // This file: TetRasterizer's construction, draw and draw_batch (the threads and bands), the
 // written-mask and the public functions; the other members are in the files raster_impl.hpp names.
 #include "raster_impl.hpp"
+#include "depth_tie.hpp"
 
 namespace foxi {
 
@@ -206,6 +207,7 @@ void TetRasterizer::Impl::check_framebuffer(const Framebuffer& fb) const {
 
 void TetRasterizer::Impl::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
   check_framebuffer(fb);
+  if (params.depth_buffer) ensure_depth_slopes(fb);
   const std::size_t tc = mesh->tet_count();
   for (std::uint32_t t : tets)
     if (t >= tc) throw std::out_of_range("render: tet index " + std::to_string(t) + " out of range");

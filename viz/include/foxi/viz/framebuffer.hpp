@@ -42,6 +42,9 @@ struct Framebuffer {
   std::vector<std::uint32_t> rgba;  // width * height, row-major, row 0 at the top
   std::vector<std::uint32_t> id;    // width * height: tet index, or kNone for background
   std::vector<double> depth;        // width * height in depth-buffer mode, else empty; larger = nearer
+  // Depth-buffer mode: the nearness slopes (per pixel in x, in y) of the face each pixel shows, 2 a
+  // pixel; they decide exact depth ties as the painter's fill rule does (the rasterizer sizes it).
+  std::vector<double> depth_slope;
 
   Framebuffer() = default;
   // A cleared framebuffer; with_depth allocates the depth buffer.
@@ -55,10 +58,13 @@ struct Framebuffer {
     detail::reserve_advised(id, std::size_t(w) * std::size_t(h));
     rgba.assign(std::size_t(w) * std::size_t(h), background);
     id.assign(std::size_t(w) * std::size_t(h), kNone);
-    if (with_depth)
+    if (with_depth) {
       depth.assign(std::size_t(w) * std::size_t(h), -std::numeric_limits<double>::infinity());
-    else
+      depth_slope.assign(2 * depth.size(), 0.0);
+    } else {
       depth.clear();
+      depth_slope.clear();
+    }
   }
   // Background colour everywhere, no tet, depth at infinity.
   void clear(std::uint32_t background = pack_rgba(255, 255, 255)) {
