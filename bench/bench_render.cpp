@@ -24,6 +24,12 @@
 //                     painter_draw of the same view in the same iteration, outside the timing) and
 //                     ratio = graded time / plain time, wall clock (issue 17 target: at most 1.5);
 //                     cpu_ratio the same in process CPU time
+//   field_recolor     (after an untimed draw of all tets with field_flat_draw's paint) recolour the
+//                     picture by another field (flat, coolwarm) through the id buffer
+//                     (TetRasterizer::recolor; issue 17 target: at most 10 ms); counters redraw_ms (a
+//                     full painter_draw with the other field's paint, the same view and iteration,
+//                     outside the timing), ratio = recolour / redraw wall clock, shown_tets (the tets
+//                     the picture shows) and differ_px (pixels, colour or id, unlike the redraw: 0)
 // Times are process CPU time (all threads) and real time.
 // Meshes: TetGen's -O0 mesh of a 2x1x1 box at a4e-5 (~100k tets) and a4e-6 (~0.97M tets). The camera
 // is fitted to the box from an oblique direction (the mesh fills about 90% of the image height) and
@@ -61,6 +67,7 @@ struct Case {
   SphereTable table;
   Camera camera;
   std::shared_ptr<const FieldPaint> flat, graded;  // a smooth field's paints (field_paint)
+  std::shared_ptr<const FieldPaint> other;         // another field, flat, coolwarm (field_recolor)
 };
 
 // A smooth node field over the box (a few periods of a product of sines), flat and graded paints.
@@ -70,12 +77,21 @@ void add_field(Case& c) {
     const double* p = &c.mesh.xyz[3 * n];
     f.values.push_back(std::sin(3 * p[0]) * std::cos(4 * p[1]) + p[2]);
   }
-  c.mesh.fields = {f};
+  Field g{"g", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < c.mesh.node_count(); ++n) {
+    const double* p = &c.mesh.xyz[3 * n];
+    g.values.push_back(std::cos(5 * p[0]) + p[1] * p[2]);
+  }
+  c.mesh.fields = {f, g};
   const FieldChoice choice = choose_field(c.mesh, "f");
   ColorScale scale;
   std::tie(scale.lo, scale.hi) = finite_range(c.mesh.fields[0].values);
   c.flat = std::make_shared<const FieldPaint>(flat_field_paint(tet_centroid_values(c.mesh, choice), scale));
   c.graded = std::make_shared<const FieldPaint>(graded_field_paint(tet_corner_values(c.mesh, choice), scale));
+  ColorScale other;
+  other.map = ColorMapId::coolwarm;
+  std::tie(other.lo, other.hi) = finite_range(c.mesh.fields[1].values);
+  c.other = std::make_shared<const FieldPaint>(flat_field_paint(tet_centroid_values(c.mesh, choose_field(c.mesh, "g")), other));
 }
 
 Case& get_case(int which) {
@@ -269,7 +285,58 @@ void run_field(benchmark::State& state, bool graded) {
   }
 }
 
+// The picture drawn with the flat paint (untimed), recoloured by the other field; the baseline is a
+// full redraw with the other paint.
+void run_recolor(benchmark::State& state) {
+  Case& c = get_case(int(state.range(0)));
+  RenderParams params, other;
+  params.field = c.flat;
+  other.field = c.other;
+  Framebuffer fb(kWidth, kHeight), redrawn(kWidth, kHeight);
+  std::size_t i = 0, differ = 0, shown = 0;
+  double recolor_ms = 0, redraw_ms = 0;
+  std::vector<std::uint32_t> order;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const Camera cam = orbit(c.camera, 7.0 * double(i++), 0);
+    order = visibility_order(c.mesh, c.table, view_of(cam));
+    {  // the baseline: a full redraw of the same view in the other field's colours
+      const auto w0 = std::chrono::steady_clock::now();
+      redrawn.clear();
+      TetRasterizer r(c.mesh, cam, kWidth, kHeight, other);
+      r.draw(redrawn, order);
+      benchmark::DoNotOptimize(redrawn.rgba.data());
+      redraw_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count();
+    }
+    fb.clear();
+    TetRasterizer r(c.mesh, cam, kWidth, kHeight, params);
+    r.draw(fb, order);
+    state.ResumeTiming();
+    const auto w0 = std::chrono::steady_clock::now();
+    r.recolor(fb, c.other);
+    benchmark::DoNotOptimize(fb.rgba.data());
+    recolor_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w0).count();
+    state.PauseTiming();
+    std::vector<bool> seen(c.mesh.tet_count());
+    for (std::size_t p = 0; p < fb.rgba.size(); ++p) {
+      differ += fb.rgba[p] != redrawn.rgba[p] || fb.id[p] != redrawn.id[p];
+      if (fb.id[p] != kNone && !seen[fb.id[p]]) {
+        seen[fb.id[p]] = true;
+        ++shown;
+      }
+    }
+    state.ResumeTiming();
+  }
+  counters(state, c);
+  const double iters = double(state.iterations());
+  state.counters["redraw_ms"] = redraw_ms / iters;
+  state.counters["ratio"] = recolor_ms / redraw_ms;
+  state.counters["shown_tets"] = double(shown) / iters;
+  state.counters["differ_px"] = double(differ);
+}
+
 void BM_painter_draw(benchmark::State& state) { run(state, false, false, 1); }
+void BM_field_recolor(benchmark::State& state) { run_recolor(state); }
 void BM_field_flat_draw(benchmark::State& state) { run_field(state, false); }
 void BM_field_graded_draw(benchmark::State& state) { run_field(state, true); }
 void BM_painter_draw_undoable(benchmark::State& state) { run_undo(state, false); }
@@ -289,6 +356,7 @@ BENCHMARK(BM_painter_draw_1thread)->DenseRange(0, 1)->Unit(benchmark::kMilliseco
 BENCHMARK(BM_painter_draw_undoable)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_field_flat_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_field_graded_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_field_recolor)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_undraw_front10)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
 
 BENCHMARK_MAIN();

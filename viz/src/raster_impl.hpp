@@ -374,6 +374,8 @@ struct TetRasterizer::Impl {
   std::vector<std::uint8_t> tile_full;
   // Whether painter drawing tests and sets the mask (off while undraw repaints neighbours' faces).
   bool use_mask = false;
+  // While recolor() runs: shade_row writes only the pixels whose id is the face's tet (recolor.cpp).
+  bool recoloring = false;
   // Undoable mode (params.undoable): the tets drawn so far in order, which tets are drawn (`kept`,
   // bit t of word t / 64; during undraw, less the tets being undrawn), each drawn tet's position in
   // the order (drawn_at, stale where the bit is clear: undraw leaves it), and the undraw stack of
@@ -695,6 +697,11 @@ struct TetRasterizer::Impl {
                  const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden);
 
   void check_framebuffer(const Framebuffer& fb) const;
+
+  // Recolouring a drawn picture through its id buffer (recolor.cpp).
+  void recolor(Framebuffer& fb, std::shared_ptr<const FieldPaint> paint);
+  void recolor_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t);
+  void recolor_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
 
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
 

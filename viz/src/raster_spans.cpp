@@ -43,6 +43,10 @@ inline std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d
 // One row run of a face. Painter mode: only the pixels not yet written (see `written`), then the
 // whole run is marked written.
 [[gnu::always_inline]] inline void TetRasterizer::Impl::shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
+  if (recoloring) [[unlikely]] {
+    recolor_row(fb, fs, y, lo, hi);
+    return;
+  }
   if (params.depth_buffer) {
     for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
     return;
@@ -361,6 +365,16 @@ template <bool kFourLines>
   std::fill(id + a, id + b + 1, fs.tet);
   for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
   edge_pixels(rgba, id, fs, e, b + 1, hi);
+}
+
+// Recolouring (recolor.cpp): the pixels of row y in [lo, hi] that show the face's tet take its colour
+// (face_color: the same bits as the painter's spans, see FaceSetup).
+void TetRasterizer::Impl::recolor_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+  const std::size_t row = std::size_t(y) * std::size_t(fb.width);
+  const std::uint32_t* id = &fb.id[row];
+  std::uint32_t* rgba = &fb.rgba[row];
+  for (int x = lo; x <= hi; ++x)
+    if (id[x] == fs.tet) rgba[x] = face_color(fs, x, y);
 }
 
 // Draws a convex polygon (positive area) as a fan from vertex 0.

@@ -435,6 +435,9 @@ const RasterStats& TetRasterizer::stats() const { return impl_->stats; }
 const Projector& TetRasterizer::projector() const { return impl_->proj; }
 double TetRasterizer::near_plane() const { return impl_->near; }
 void TetRasterizer::undraw(Framebuffer& fb, std::size_t count) { impl_->undraw(fb, count); }
+void TetRasterizer::recolor(Framebuffer& fb, std::shared_ptr<const FieldPaint> field) {
+  impl_->recolor(fb, std::move(field));
+}
 std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_->history; }
 std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_pixels(); }
 std::size_t TetRasterizer::undo_bytes() const { return impl_->undo_bytes(); }

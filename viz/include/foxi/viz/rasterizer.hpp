@@ -116,6 +116,16 @@ class FOXI_API TetRasterizer {
   // Undoable: forgets the tets drawn (call after clearing fb to start a new picture).
   void forget_drawn();
 
+  // Recolours the picture in fb by another field paint (null: region colours) without drawing it
+  // again: the tets its id buffer shows are found, and each one's front faces are rasterized anew in
+  // the new colours, writing only the pixels whose id is that tet (shading and edge darkening are
+  // recomputed from the geometry, so nothing beyond the id needs keeping). fb is then pixel for
+  // pixel what drawing the same tets with `field` gives (fb must be this rasterizer's picture, ids
+  // unchanged since). Cost: a pass over the ids plus the shown tets and their pixels, not the mesh.
+  // Later draw() calls use the new paint. Throws std::invalid_argument for a paint of another mesh
+  // (the old paint is kept) or a framebuffer of another size.
+  void recolor(Framebuffer& fb, std::shared_ptr<const FieldPaint> field);
+
   const RasterStats& stats() const;
   const Projector& projector() const;
   double near_plane() const;  // the near-plane distance in use (perspective)
