@@ -374,8 +374,6 @@ struct TetRasterizer::Impl {
   std::vector<std::uint8_t> tile_full;
   // Whether painter drawing tests and sets the mask (off while undraw repaints neighbours' faces).
   bool use_mask = false;
-  // While recolor() runs: shade_row writes only the pixels whose id is the face's tet (recolor.cpp).
-  bool recoloring = false;
   // Undoable mode (params.undoable): the tets drawn so far in order, which tets are drawn (`kept`,
   // bit t of word t / 64; during undraw, less the tets being undrawn), each drawn tet's position in
   // the order (drawn_at, stale where the bit is clear: undraw leaves it), and the undraw stack of
@@ -592,6 +590,9 @@ struct TetRasterizer::Impl {
   [[gnu::noinline]] void shade_long_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
 
   void raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n);
+  void recolor_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n);
+  template <bool kRecolor>
+  inline void raster_fan(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n);
 
   // A tet's corners as `corners` gives them (c may point into local). Filled by load_corners, not
   // initialized here: it is made for every tet of every batch.

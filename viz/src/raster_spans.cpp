@@ -43,10 +43,6 @@ inline std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d
 // One row run of a face. Painter mode: only the pixels not yet written (see `written`), then the
 // whole run is marked written.
 [[gnu::always_inline]] inline void TetRasterizer::Impl::shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
-  if (recoloring) [[unlikely]] {
-    recolor_row(fb, fs, y, lo, hi);
-    return;
-  }
   if (params.depth_buffer) {
     for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
     return;
@@ -367,18 +363,24 @@ template <bool kFourLines>
   edge_pixels(rgba, id, fs, e, b + 1, hi);
 }
 
-// Recolouring (recolor.cpp): the pixels of row y in [lo, hi] that show the face's tet take its colour
-// (face_color: the same bits as the painter's spans, see FaceSetup).
+// Recolouring (recolor.cpp): the runs of row y in [lo, hi] that show the face's tet are shaded again
+// as the painter shades a span (the same bits whatever the run's bounds, see FaceSetup).
 void TetRasterizer::Impl::recolor_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
-  const std::size_t row = std::size_t(y) * std::size_t(fb.width);
-  const std::uint32_t* id = &fb.id[row];
-  std::uint32_t* rgba = &fb.rgba[row];
-  for (int x = lo; x <= hi; ++x)
-    if (id[x] == fs.tet) rgba[x] = face_color(fs, x, y);
+  const std::uint32_t* id = &fb.id[std::size_t(y) * std::size_t(fb.width)];
+  for (int x = lo; x <= hi;) {
+    while (x <= hi && id[x] != fs.tet) ++x;
+    const int a = x;
+    while (x <= hi && id[x] == fs.tet) ++x;
+    if (a < x) shade_span(fb, fs, y, a, x - 1);
+  }
 }
 
 // Draws a convex polygon (positive area) as a fan from vertex 0.
-void TetRasterizer::Impl::raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) {
+// raster_polygon's work; kRecolor: recolor_row in place of shade_row (a template, so that the painter's
+// rows stay as they were, without a test of the mode).
+template <bool kRecolor>
+[[gnu::always_inline]] inline void TetRasterizer::Impl::raster_fan(Framebuffer& fb, const Rows& rows, FaceSetup& fs,
+                                                                   const PolyVertex* poly, int n) {
   for (int q = 1; q + 1 < n; ++q) {
     const int i = reverse ? n - 1 - q : q;  // painter mode draws the fan back to front too
     std::int64_t X[3] = {poly[0].X, poly[i].X, poly[i + 1].X}, Y[3] = {poly[0].Y, poly[i].Y, poly[i + 1].Y};
@@ -422,9 +424,21 @@ void TetRasterizer::Impl::raster_polygon(Framebuffer& fb, const Rows& rows, Face
       fs.ha = ((h[1] - h[0]) * y2 - (h[2] - h[0]) * y1) * inv;
       fs.hb = (x1 * (h[2] - h[0]) - x2 * (h[1] - h[0])) * inv;
     }
-    raster_triangle(X, Y, fb.width, fb.height, rows,
-                    [&](int y, int lo, int hi) { shade_row(fb, fs, y, lo, hi); });
+    raster_triangle(X, Y, fb.width, fb.height, rows, [&](int y, int lo, int hi) {
+      if constexpr (kRecolor)
+        recolor_row(fb, fs, y, lo, hi);
+      else
+        shade_row(fb, fs, y, lo, hi);
+    });
   }
+}
+
+void TetRasterizer::Impl::raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) {
+  raster_fan<false>(fb, rows, fs, poly, n);
+}
+
+void TetRasterizer::Impl::recolor_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) {
+  raster_fan<true>(fb, rows, fs, poly, n);
 }
 
 }  // namespace foxi

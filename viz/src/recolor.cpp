@@ -30,7 +30,7 @@ void TetRasterizer::Impl::recolor_tet(Framebuffer& fb, const Rows& rows, std::ui
     const std::uint32_t node[3] = {k.tv[face[0]], k.tv[face[1]], k.tv[face[2]]};
     FaceSetup fs;
     setup_face(fs, t, v, node, poly, n);
-    raster_polygon(fb, rows, fs, poly, n);
+    recolor_polygon(fb, rows, fs, poly, n);
   }
 }
 
@@ -45,36 +45,28 @@ void TetRasterizer::Impl::recolor(Framebuffer& fb, std::shared_ptr<const FieldPa
     setup_field();
     throw;
   }
-  // The tets shown, each once (a bit per mesh tet: 125 kB at 1M tets), in the order first seen.
+  // The tets visible, each once (a bit per mesh tet: 125 kB at 1M tets), in the order first seen.
   const std::size_t tc = mesh->tet_count();
   std::vector<std::uint64_t> seen((tc + 63) / 64, 0);
-  std::vector<std::uint32_t> shown;
+  std::vector<std::uint32_t> visible;
   for (const std::uint32_t t : fb.id) {
     if (t >= tc) continue;  // background (kNone)
     std::uint64_t& word = seen[t >> 6];
     const std::uint64_t bit = std::uint64_t(1) << (t & 63);
     if ((word & bit) == 0) {
       word |= bit;
-      shown.push_back(t);
+      visible.push_back(t);
     }
   }
-  const int count = shown.size() < 256 ? 1 : std::min(params.threads, std::max(1, fb.height >> kBandShift));
-  const bool mask = use_mask;
-  recoloring = true;
-  use_mask = false;
-  try {
-    run_parts(count, [&](int part) {
-      const Rows rows{part, count};
-      for (const std::uint32_t t : shown) recolor_tet(fb, rows, t);
-    });
-  } catch (...) {
-    recoloring = false;
-    use_mask = mask;
-    throw;
-  }
-  recoloring = false;
-  use_mask = mask;
-  changed = shown.empty() ? PixelRect{} : PixelRect{0, 0, fb.width - 1, fb.height - 1};
+  // Threads take parts of the visible tets (not bands of rows, as drawing does: each tet's setup would be
+  // repeated by every thread); they write disjoint pixels, those whose id is one of their tets.
+  const int count = visible.size() < 256 ? 1 : std::max(1, params.threads);
+  run_parts(count, [&](int part) {
+    const std::size_t begin = visible.size() * std::size_t(part) / std::size_t(count);
+    const std::size_t end = visible.size() * std::size_t(part + 1) / std::size_t(count);
+    for (std::size_t i = begin; i < end; ++i) recolor_tet(fb, Rows{}, visible[i]);
+  });
+  changed = visible.empty() ? PixelRect{} : PixelRect{0, 0, fb.width - 1, fb.height - 1};
   changed_is_one_rect();
 }
 
