@@ -15,6 +15,8 @@
 // + draw), ratio (pruned / full, wall clock, clearing included in both) and differ_px (pixels, colour
 // or id, where the two pictures differ; 0 expected). Time columns: wall clock and process CPU time (all
 // threads). The camera turns by 7 degrees per iteration, so no frame repeats.
+// The outside anchor, VTK's vtkContourFilter on the same mesh, field and isovalues (a full pass that only
+// makes the triangles: no order, no picture), is bench/peers/iso_vtk_contour.py, run beside this.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
