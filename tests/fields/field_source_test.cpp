@@ -449,6 +449,21 @@ TEST(FieldSource, BrokenFrdFilesNameTheLine) {
   std::string short_record = good;
   short_record.replace(short_record.find(" 1.00000E+00 0.00000E+00 0.00000E+00"), 36, " 1.00000E+00");
   EXPECT_EQ(line_of_error(short_record), 4u);
+  // A block whose every component is flagged as not in the file (iexist 1, columns 34-38) would be a
+  // field of 0 components: refused at its component line.
+  std::string all_computed = good;
+  all_computed.replace(all_computed.find(" -5  T           1    1    0    0"), 33,
+                       " -5  T           1    1    0    0    1");
+  EXPECT_EQ(line_of_error(all_computed), 8u);
+  // The fuzz input that found it (a mutated ccx file, tests/data/bad/fuzz/frd/zero_components).
+  try {
+    read_frd_source(test::data_dir() + "/bad/fuzz/frd/zero_components");
+    ADD_FAILURE() << "zero_components was read";
+  } catch (const IoError& e) {
+    EXPECT_NE(e.reason().find("0 component"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("zero_components"), std::string::npos) << e.what();
+    EXPECT_GT(e.line(), 0u);
+  }
 }
 
 TEST(FieldSource, CsvTables) {

@@ -384,6 +384,22 @@ struct TetRasterizer::Impl {
   std::vector<std::uint32_t> drawn_at;
   std::vector<std::uint64_t> kept;
   bool is_kept(std::uint32_t t) const { return kept[t >> 6] >> (t & 63) & 1; }
+  // Undoable: the tets of inverted pairs. A pair is inverted when a tet has a front face (on the
+  // snapped pixels) shared with a tet drawn before it: in the picture it lies behind that tet across
+  // the face yet was drawn after it. A face seen edge-on makes it so after snapping (the order, from
+  // the exact geometry, may put either side first), as does an order that is not a visibility order.
+  // The later tet then covers pixels of the earlier one's front faces, so that the picture before a
+  // tet need not show a shared neighbour across its back face (what earlier_neighbour assumes): a
+  // back face shared with a tainted tet, and every back face of one, is saved as if unshared. Found
+  // by fuzzing (tests/data/bad/fuzz/mesh_pipeline/undraw_edge_on_face). `any_tainted` spares the
+  // common case the bit reads.
+  std::vector<std::uint64_t> tainted;
+  bool any_tainted = false;
+  bool is_tainted(std::uint32_t t) const { return tainted[t >> 6] >> (t & 63) & 1; }
+  void taint(std::uint32_t t) {
+    tainted[t >> 6] |= std::uint64_t(1) << (t & 63);
+    any_tainted = true;
+  }
   struct Save {
     std::uint32_t at = 0;    // position in history
     std::size_t offset = 0;  // first saved pixel (in its lane)
@@ -719,7 +735,13 @@ struct TetRasterizer::Impl {
   // --- Undraw (seed paper, section 6.2) ---
   // A back face of a drawn tet is shared when the tet across it was drawn before it (with unshrunk
   // tets only): in the picture of the tets before t, its pixels show that neighbour's front face.
+  // Neither of them may be tainted (see `tainted`); earlier_kept is the same without that test.
   std::uint32_t earlier_neighbour(std::uint32_t t, int f) const {
+    const std::uint32_t nb = earlier_kept(t, f);
+    if (nb == kNone || (any_tainted && (is_tainted(t) || is_tainted(nb >> 2)))) return kNone;
+    return nb;
+  }
+  std::uint32_t earlier_kept(std::uint32_t t, int f) const {
     if (params.shrink != 1) return kNone;
     const std::uint32_t nb = adjacency->neighbour[4 * std::size_t(t) + std::size_t(f)];
     if (nb == kNone || !is_kept(nb >> 2) || drawn_at[nb >> 2] >= drawn_at[t]) return kNone;
@@ -732,7 +754,10 @@ struct TetRasterizer::Impl {
   template <class Fn>
   inline void for_each_back_face(std::uint32_t t, Fn&& fn) const;
 
-  inline bool has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach) const;
+  inline bool has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach,
+                                     bool& inverted) const;
+
+  void taint_inverted(std::span<const std::uint32_t> tets);
 
   void request_saves(const Framebuffer& fb, const Rows& rows, std::uint32_t t);
 

@@ -50,6 +50,7 @@ TetRasterizer::Impl::Impl(const Mesh& m, const Camera& c, int w, int h, const Re
     adjacency = &face_adjacency(m);
     drawn_at.assign(m.tet_count(), 0);
     kept.assign((m.tet_count() + 63) / 64, 0);
+    tainted.assign(kept.size(), 0);
     const std::size_t pixels = std::size_t(w) * std::size_t(h);
     shown.assign(std::size_t(mask_words) * std::size_t(h), 0);
     slot.assign(pixels, kNone);
@@ -230,6 +231,7 @@ void TetRasterizer::Impl::draw(Framebuffer& fb, std::span<const std::uint32_t> t
     }
     kept[tets[i] >> 6] |= std::uint64_t(1) << (tets[i] & 63);
     drawn_at[tets[i]] = std::uint32_t(start + i);
+    if (any_tainted) tainted[tets[i] >> 6] &= ~(std::uint64_t(1) << (tets[i] & 63));  // drawn afresh
   }
   history.insert(history.end(), tets.begin(), tets.end());
   drawn_box.resize(history.size(), SmallBox{0, 0, -1, -1});  // "unknown" until draw_batch finds them
@@ -279,21 +281,27 @@ inline void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
 // Whether drawn tet t has a back face covering pixels that is not shared (see earlier_neighbour);
 // for every tet of an undoable batch, so the facing of an unclipped face is read off the sign of
 // its projected area (as face_polygon does) without building its polygon; k: its corners (finite).
-// reach: t's repaint reach (see drawn_reach).
-inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach) const {
+// reach: t's repaint reach (see drawn_reach). inverted: t has a front face shared with a tet drawn
+// before it (see `tainted`).
+inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach,
+                                                        bool& inverted) const {
   bool unshared = false;
   std::uint32_t least = drawn_at[t];
   const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
   for (int f = 0; f < 4; ++f) {
-    bool back;
+    bool back, front;
     if (unclipped) {
       const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
-      back = (k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]) > 0;
+      const std::int64_t area = (k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]);
+      back = area > 0;
+      front = area < 0;
     } else {
       PolyVertex poly[4];
       bool clipped = false;
       back = face_polygon(k, f, true, poly, &clipped) > 0;
+      front = !back && face_polygon(k, f, false, poly, &clipped) > 0;
     }
+    if (front && earlier_kept(t, f) != kNone) inverted = true;
     if (!back) continue;
     const std::uint32_t nb = earlier_neighbour(t, f);
     if (nb == kNone)
@@ -303,6 +311,30 @@ inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const T
   }
   reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
   return unshared;
+}
+
+// Undoable, a batch with an inverted pair (rare: a face seen edge-on): taints the pairs' tets (see
+// `tainted`), then finds again, in drawing order, which tets file saves and their reach (a tet's
+// back face shared with a tet tainted earlier in the batch is now unshared).
+void TetRasterizer::Impl::taint_inverted(std::span<const std::uint32_t> tets) {
+  for (std::size_t i = 0; i < tets.size(); ++i) {
+    if (boxes[i].x0 > boxes[i].x1) continue;
+    TetCorners k;
+    load_corners(tets[i], k);
+    bool inverted = false;
+    std::uint16_t reach = 0;
+    need_save[i] = has_unshared_back_face(tets[i], k, reach, inverted);
+    if (inverted) {
+      // Taint t and the earlier tets in front of it, then file t's saves for every back face.
+      for (int f = 0; f < 4; ++f) {
+        const std::uint32_t nb = earlier_kept(tets[i], f);
+        if (nb != kNone) taint(nb >> 2);
+      }
+      taint(tets[i]);
+      need_save[i] = has_unshared_back_face(tets[i], k, reach, inverted);
+    }
+    batch_reach[i] = reach;
+  }
 }
 
 // Painter or depth-buffer drawing of a batch (see draw); the written-pixel mask is all zero before
@@ -320,7 +352,7 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
     tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
   }
   boxes.resize(tets.size());
-  auto find_boxes = [&](std::size_t begin, std::size_t end) {
+  auto find_boxes = [&](std::size_t begin, std::size_t end, bool& inverted) {
     constexpr std::size_t kAhead = 8;
     for (std::size_t i = begin; i < end; ++i) {
       if (i + kAhead < end) prefetch_tet(tets[i + kAhead]);
@@ -335,7 +367,7 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
       if (recording) {
         need_save[i] = false;
         batch_reach[i] = 0;
-        if (boxes[i].x0 <= boxes[i].x1) need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i]);
+        if (boxes[i].x0 <= boxes[i].x1) need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted);
       }
     }
   };
@@ -364,12 +396,14 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
     need_save.resize(tets.size());
     batch_reach.resize(tets.size());
   }
+  bool inverted[2] = {false, false};
   if (!spawn || tets.size() < 4096) {
-    find_boxes(0, tets.size());
+    find_boxes(0, tets.size(), inverted[0]);
   } else {
     const std::size_t half = tets.size() / 2;
-    run_parts(2, [&](int k) { k == 0 ? find_boxes(0, half) : find_boxes(half, tets.size()); });
+    run_parts(2, [&](int k) { k == 0 ? find_boxes(0, half, inverted[0]) : find_boxes(half, tets.size(), inverted[1]); });
   }
+  if (recording && (inverted[0] || inverted[1])) taint_inverted(tets);
   if (recording) {  // the batch is the end of the history
     SmallBox* kept_box = drawn_box.data() + (drawn_box.size() - tets.size());
     for (std::size_t i = 0; i < tets.size(); ++i)

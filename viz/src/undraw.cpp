@@ -396,6 +396,8 @@ inline std::vector<int> TetRasterizer::Impl::split_rows(const std::vector<double
 
 void TetRasterizer::Impl::forget() {
   std::fill(kept.begin(), kept.end(), 0);
+  std::fill(tainted.begin(), tainted.end(), 0);
+  any_tainted = false;
   history.clear();
   drawn_box.clear();
   drawn_reach.clear();

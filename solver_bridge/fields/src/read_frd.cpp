@@ -310,6 +310,11 @@ void FrdParser::read_results() {
     const std::int64_t iexist = line_.size() >= 38 ? int_at(33, 5, "component flag") : 0;
     if (iexist != 1) ++comps;
   }
+  // Every component marked as computed by the reader leaves the block nothing to hold: refused, as a
+  // field of 0 components would have no values to show (found by fuzzing, tests/data/bad/fuzz/frd).
+  if (comps == 0)
+    fail("block " + name + " has 0 components in the file: its " + std::to_string(declared) +
+         " component line(s) are all flagged as not in the file (1 in columns 34-38)");
   const std::size_t w = id_width(format_);
   const std::size_t n = src_.node_id.size();
   auto it = field_of_.find(name);
