@@ -388,13 +388,21 @@ struct TetRasterizer::Impl {
   // snapped pixels) shared with a tet drawn before it: in the picture it lies behind that tet across
   // the face yet was drawn after it. A face seen edge-on makes it so after snapping (the order, from
   // the exact geometry, may put either side first), as does an order that is not a visibility order.
-  // The later tet then covers pixels of the earlier one's front faces, so that the picture before a
-  // tet need not show a shared neighbour across its back face (what earlier_neighbour assumes): a
-  // back face shared with a tainted tet, and every back face of one, is saved as if unshared. Found
-  // by fuzzing (tests/data/bad/fuzz/mesh_pipeline/undraw_edge_on_face). `any_tainted` spares the
-  // common case the bit reads.
-  std::vector<std::uint64_t> tainted;
+  // Where that face covers pixels (`risky`, one bit per pixel like `shown`), the later tet covers
+  // pixels of the earlier one's front faces, so that the picture before a tet need not show the
+  // neighbour across its back face there (what earlier_neighbour assumes): a back face shared with a
+  // tainted tet, and every back face of one, also saves its risky pixels. Found by fuzzing
+  // (tests/data/bad/fuzz/mesh_pipeline/undraw_edge_on_face). `any_tainted` spares the common case
+  // the bit reads.
+  std::vector<std::uint64_t> tainted, risky;
   bool any_tainted = false;
+  bool is_risky(int x, int y) const {
+    return risky[std::size_t(y) * std::size_t(mask_words) + std::size_t(x >> 6)] >> (x & 63) & 1;
+  }
+  // Whether back face f of t, shared with earlier tet nb, saves its risky pixels.
+  bool saves_risky(std::uint32_t t, std::uint32_t nb) const {
+    return any_tainted && (is_tainted(t) || is_tainted(nb >> 2));
+  }
   bool is_tainted(std::uint32_t t) const { return tainted[t >> 6] >> (t & 63) & 1; }
   void taint(std::uint32_t t) {
     tainted[t >> 6] |= std::uint64_t(1) << (t & 63);
@@ -735,13 +743,7 @@ struct TetRasterizer::Impl {
   // --- Undraw (seed paper, section 6.2) ---
   // A back face of a drawn tet is shared when the tet across it was drawn before it (with unshrunk
   // tets only): in the picture of the tets before t, its pixels show that neighbour's front face.
-  // Neither of them may be tainted (see `tainted`); earlier_kept is the same without that test.
   std::uint32_t earlier_neighbour(std::uint32_t t, int f) const {
-    const std::uint32_t nb = earlier_kept(t, f);
-    if (nb == kNone || (any_tainted && (is_tainted(t) || is_tainted(nb >> 2)))) return kNone;
-    return nb;
-  }
-  std::uint32_t earlier_kept(std::uint32_t t, int f) const {
     if (params.shrink != 1) return kNone;
     const std::uint32_t nb = adjacency->neighbour[4 * std::size_t(t) + std::size_t(f)];
     if (nb == kNone || !is_kept(nb >> 2) || drawn_at[nb >> 2] >= drawn_at[t]) return kNone;

@@ -301,16 +301,18 @@ inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const T
       back = face_polygon(k, f, true, poly, &clipped) > 0;
       front = !back && face_polygon(k, f, false, poly, &clipped) > 0;
     }
-    if (front && earlier_kept(t, f) != kNone) inverted = true;
+    if (front && earlier_neighbour(t, f) != kNone) inverted = true;
     if (!back) continue;
     const std::uint32_t nb = earlier_neighbour(t, f);
-    if (nb == kNone)
+    if (nb == kNone) {
       unshared = true;
-    else
+    } else {
       least = std::min(least, drawn_at[nb >> 2]);
+      if (saves_risky(t, nb)) unshared = true;  // it files saves (of its risky pixels only)
+    }
   }
   reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
-  return unshared;
+  return unshared || !unclipped;  // a tet cut by the near plane saves its front faces too (request_saves)
 }
 
 // Undoable, a batch with an inverted pair (rare: a face seen edge-on): taints the pairs' tets (see
@@ -325,13 +327,35 @@ void TetRasterizer::Impl::taint_inverted(std::span<const std::uint32_t> tets) {
     std::uint16_t reach = 0;
     need_save[i] = has_unshared_back_face(tets[i], k, reach, inverted);
     if (inverted) {
-      // Taint t and the earlier tets in front of it, then file t's saves for every back face.
+      // Where the front face shared with an earlier tet covers pixels (after snapping, a sliver that
+      // seldom holds a pixel centre), they become risky, and t and that tet tainted.
+      const Rows all{0, 1, 0, proj.height - 1};
+      bool covers = false;
       for (int f = 0; f < 4; ++f) {
-        const std::uint32_t nb = earlier_kept(tets[i], f);
-        if (nb != kNone) taint(nb >> 2);
+        const std::uint32_t nb = earlier_neighbour(tets[i], f);
+        if (nb == kNone) continue;
+        PolyVertex poly[4];
+        bool clipped = false;
+        const int n = face_polygon(k, f, false, poly, &clipped);
+        bool pixels = false;
+        for (int q = 1; q + 1 < n; ++q) {  // its fan triangles, as for_each_run walks them
+          const std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X}, Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
+          if ((X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]) <= 0) continue;
+          raster_triangle(X, Y, proj.width, proj.height, all, [&](int y, int lo, int hi) {
+            if (risky.empty()) risky.assign(shown.size(), 0);
+            for (int x = lo; x <= hi; ++x)
+              risky[std::size_t(y) * std::size_t(mask_words) + std::size_t(x >> 6)] |= std::uint64_t(1) << (x & 63);
+            pixels = true;
+          });
+        }
+        if (!pixels) continue;
+        taint(nb >> 2);
+        covers = true;
       }
-      taint(tets[i]);
-      need_save[i] = has_unshared_back_face(tets[i], k, reach, inverted);
+      if (covers) {
+        taint(tets[i]);
+        need_save[i] = has_unshared_back_face(tets[i], k, reach, inverted);
+      }
     }
     batch_reach[i] = reach;
   }

@@ -38,13 +38,13 @@ void TetRasterizer::Impl::request_saves(const Framebuffer& fb, const Rows& rows,
   Lane& lane = lanes[std::size_t(rows.thread)];
   std::vector<std::uint32_t>& saved_pixel = lane.saved_pixel;
   lane.saves.push_back(Save{drawn_at[t], saved_pixel.size()});
-  for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
-    if (earlier_neighbour(t, f) != kNone) return;
+  auto request = [&](const PolyVertex* poly, int n, bool risky_only) {
     for_each_run(poly, n, rows, [&](int y, int lo, int hi) {
       const std::size_t row = std::size_t(y) * std::size_t(fb.width);
       std::uint64_t* done = &written[std::size_t(y) * std::size_t(mask_words)];
       const std::uint64_t* shown_row = &shown[std::size_t(y) * std::size_t(mask_words)];
       for (int x = lo; x <= hi; ++x) {
+        if (risky_only && !is_risky(x, y)) continue;
         const std::uint32_t k = std::uint32_t(saved_pixel.size()), p = std::uint32_t(row + std::size_t(x));
         if (!(shown_row[x >> 6] >> (x & 63) & 1)) lane.unshown_requests = true;
         if (slot[p] != kNone) lane.aliases.emplace_back(slot[p], k);
@@ -54,7 +54,26 @@ void TetRasterizer::Impl::request_saves(const Framebuffer& fb, const Rows& rows,
         tile_full[std::size_t(y >> kBandShift) * std::size_t(mask_words) + std::size_t(x >> 6)] = 0;
       }
     });
+  };
+  for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
+    const std::uint32_t nb = earlier_neighbour(t, f);
+    if (nb == kNone)
+      request(poly, n, false);
+    else if (saves_risky(t, nb))
+      request(poly, n, true);
   });
+  // A tet cut by the near plane also saves its front faces' pixels: its clipped back faces need not
+  // cover every pixel its clipped front faces drew (with the eye in the plane of one of its faces,
+  // a line of them; found by fuzzing, tests/data/bad/fuzz/mesh_pipeline/undraw_eye_in_face_plane).
+  TetCorners k;
+  if (load_corners(t, k) && k.st[0] + k.st[1] + k.st[2] + k.st[3] != 0) {
+    PolyVertex poly[4];
+    for (int f = 0; f < 4; ++f) {
+      bool clipped = false;
+      const int n = face_polygon(k, f, false, poly, &clipped);
+      if (n > 0) request(poly, n, false);
+    }
+  }
   lane.saved_rgba.resize(saved_pixel.size());
   lane.saved_id.resize(saved_pixel.size());
 }
@@ -397,6 +416,7 @@ inline std::vector<int> TetRasterizer::Impl::split_rows(const std::vector<double
 void TetRasterizer::Impl::forget() {
   std::fill(kept.begin(), kept.end(), 0);
   std::fill(tainted.begin(), tainted.end(), 0);
+  risky.clear();
   any_tainted = false;
   history.clear();
   drawn_box.clear();
