@@ -5,11 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 
+#include "foxi/model/durable_file.hpp"
 #include "foxi/viz/view_options.hpp"
 #include "foxi/viz/png.hpp"
 
@@ -29,16 +29,21 @@ std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix,
   else
     viewer.save_png(png);
   if (dump) {
+    // Durably, like every output (foxi/model/durable_file.hpp), and the two together: a stop
+    // leaves both or neither, never a partial file or a temporary.
     const Framebuffer& fb = viewer.framebuffer();
-    std::ofstream ids(base + ".ids", std::ios::binary);
-    for (std::uint32_t id : fb.id) {
-      unsigned char b[4] = {static_cast<unsigned char>(id), static_cast<unsigned char>(id >> 8),
-                            static_cast<unsigned char>(id >> 16), static_cast<unsigned char>(id >> 24)};
-      ids.write(reinterpret_cast<const char*>(b), 4);
-    }
-    std::ofstream tets(base + ".tets");
-    for (std::uint32_t t : viewer.drawn()) tets << t << '\n';
-    if (!ids || !tets) throw std::runtime_error("cannot write " + base + ".ids/.tets");
+    std::vector<DurableFile> files;
+    files.emplace_back(base + ".ids");
+    files.emplace_back(base + ".tets");
+    std::string ids;
+    ids.reserve(4 * fb.id.size());
+    for (std::uint32_t id : fb.id)
+      for (int k = 0; k < 4; ++k) ids.push_back(static_cast<char>(id >> (8 * k)));  // little-endian
+    files[0].write(ids);
+    std::string tets;
+    for (std::uint32_t t : viewer.drawn()) tets += std::to_string(t) + '\n';
+    files[1].write(tets);
+    commit_together(files);
   }
   std::printf("saved %s  %s  (%s)\n", png.c_str(), viewer.status().c_str(), viewer.camera_options().c_str());
   std::fflush(stdout);

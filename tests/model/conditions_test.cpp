@@ -361,6 +361,9 @@ TEST(ModelConditionsBadInput, UnknownTypesPartsAndKeys) {
   // Below sqrt(2) TetGen's refinement ran for minutes on thin layers: refused with the bound named.
   EXPECT_NE(build_error(replaced(kModel, "quality = 1.5", "quality = 1.2")).reason().find("at least 1.414"),
             std::string::npos);
+  // The issue's own case (past 120 s on die_on_substrate before the bound).
+  EXPECT_NE(build_error(replaced(kModel, "quality = 1.5", "quality = 1.0")).reason().find("at least 1.414"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -221,6 +221,21 @@ TEST(Validate, GeometryBeyondDoubleRangeIsRefused) {
   EXPECT_EQ(scaled_volume(1e-300), 0.0);
 }
 
+// Coordinates above 1e60 (issue 22's audit): a mesh moved far from the origin keeps finite, positive
+// volumes, but at 1e60 doubles are 1e44 apart, so no tet there is smaller than that, and its
+// circumsphere reaches past the 1e24 the order's error bounds hold: refused, whatever the offset.
+TEST(Validate, CoordinatesAbove1e60AreRefusedEvenWithFiniteVolumes) {
+  for (const auto& [offset, size] : {std::pair{1e60, 1e50}, std::pair{1e60, 1e45}, std::pair{1e61, 1e61},
+                                     std::pair{-1e100, 1e90}}) {
+    Mesh m = two_tets();
+    for (double& x : m.xyz) x = offset + size * x;
+    const ValidationReport r = validate(m);
+    EXPECT_FALSE(r.ok()) << offset << " " << size;
+    EXPECT_TRUE(mentions(r, "beyond the range")) << offset << " " << size;
+    EXPECT_TRUE(std::isfinite(size * size * size)) << "the volumes themselves do not overflow";
+  }
+}
+
 TEST(Validate, AcceptedGeometryHasFiniteExactlyScaledVolumes) {
   // For every power of ten that validation accepts, the double volume is finite, positive and
   // equals s^3 / 6 (the analytic volume of the scaled corner tet) to rounding. The accepted powers
