@@ -312,7 +312,9 @@ inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const T
     }
   }
   reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
-  return unshared || !unclipped;  // a tet cut by the near plane saves its front faces too (request_saves)
+  // A tet cut by the near plane (not wholly behind it) saves its front faces too (request_saves).
+  const int behind = k.st[0] + k.st[1] + k.st[2] + k.st[3];
+  return unshared || (behind > 0 && behind < 4);
 }
 
 // Undoable, a batch with an inverted pair (rare: a face seen edge-on): taints the pairs' tets (see

@@ -66,7 +66,7 @@ void TetRasterizer::Impl::request_saves(const Framebuffer& fb, const Rows& rows,
   // cover every pixel its clipped front faces drew (with the eye in the plane of one of its faces,
   // a line of them; found by fuzzing, tests/data/bad/fuzz/mesh_pipeline/undraw_eye_in_face_plane).
   TetCorners k;
-  if (load_corners(t, k) && k.st[0] + k.st[1] + k.st[2] + k.st[3] != 0) {
+  if (load_corners(t, k) && k.st[0] + k.st[1] + k.st[2] + k.st[3] != 0) {  // (not wholly behind: need_save)
     PolyVertex poly[4];
     for (int f = 0; f < 4; ++f) {
       bool clipped = false;
