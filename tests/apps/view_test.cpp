@@ -242,7 +242,7 @@ TEST_F(ViewTest, UndrawEqualsRenderingFewerTets) {
   EXPECT_EQ(differing_pixels(read_png(dir_ / "u-004.png"), read_png(dir_ / "u-001.png")), 0u);
   EXPECT_EQ(read_ids(dir_ / "u-004.ids"), read_ids(dir_ / "u-001.ids"));
   // The dumps are written durably (DurableFile, committed together): no temporary is left beside them.
-  for (const auto& e : std::filesystem::directory_iterator(dir_))
+  for (const auto& e : std::filesystem::directory_iterator(dir_.path()))
     EXPECT_EQ(e.path().filename().string().find(".foxi-tmp-"), std::string::npos) << e.path();
   // The region after undrawing 100: the first 620 tets of the order, nothing drawn yet.
   const std::string log = test::read_text(dir_ / "view.log");
