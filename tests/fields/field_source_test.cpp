@@ -466,6 +466,53 @@ TEST(FieldSource, BrokenFrdFilesNameTheLine) {
   }
 }
 
+// A block of a few lines stands for every node, so a small file can ask for much memory: the
+// values all blocks keep are bounded by the file (FrdLimits). A file of 400 nodes and blocks of 64
+// components whose lines list no node: within a budget of 100,000 values the first 3 blocks fit
+// (25,600 values each) and the fourth is refused, naming its line; the default budget reads it all
+// with NaN for the missing values. (The outside case: 200,000 nodes and 400 such blocks, 11 MB, took
+// 13 GB before this bound and ended in "out of memory".)
+TEST(FieldSource, FrdMemoryIsBoundedByTheFile) {
+  std::string text = "    1C\n    2C                           400                                     1\n";
+  char line[96];
+  for (int i = 1; i <= 400; ++i) {
+    std::snprintf(line, sizeof line, " -1%10d%12.5E%12.5E%12.5E\n", i, i * 1e-3, 0.0, 0.0);
+    text += line;
+  }
+  text += " -3\n";
+  std::vector<std::uint64_t> block_line;
+  std::uint64_t lines = 403;
+  for (int b = 0; b < 5; ++b) {
+    text += "  100CL  101 1.000000000         400                     0    1           1\n -4  BIG        64    1\n";
+    block_line.push_back(lines + 2);
+    for (int c = 0; c < 64; ++c) {
+      std::snprintf(line, sizeof line, " -5  C%-2d         1    1    0    0\n", c);
+      text += line;
+    }
+    text += " -3\n";
+    lines += 67;
+  }
+  text += " 9999\n";
+  const FieldSource all = parse_frd_source(text, "big.frd");
+  ASSERT_EQ(all.mesh.fields.size(), 1u);
+  EXPECT_EQ(all.mesh.fields[0].step_values.size(), 5u);
+  EXPECT_EQ(all.mesh.fields[0].values.size(), 5u * 400 * 64);
+  EXPECT_TRUE(std::isnan(all.mesh.fields[0].values.back()));
+  FrdLimits small;
+  small.min_values = 100000;
+  small.values_per_byte = 0;
+  try {
+    parse_frd_source(text, "big.frd", small);
+    ADD_FAILURE() << "a file past its value budget was read";
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.line(), block_line[3]) << e.what();
+    EXPECT_NE(e.reason().find("BIG"), std::string::npos) << e.what();
+    EXPECT_NE(e.reason().find("at most 100000"), std::string::npos) << e.what();
+  }
+  small.values_per_byte = 16;  // the file's bytes (about 46 KB) allow 16 values a byte: all of it
+  EXPECT_EQ(parse_frd_source(text, "big.frd", small).mesh.fields[0].step_values.size(), 5u);
+}
+
 TEST(FieldSource, CsvTables) {
   const FieldSource a = parse_csv_source(
       "# exported\n\"id\";temperature [K];u:0 [m];u:1 [m];u:2 [m];q_x;q_y;q_z\n"

@@ -36,7 +36,8 @@ constexpr int kElementNodes[] = {0, 8, 6, 4, 20, 15, 10, 3, 6, 4, 8, 2, 3};
 
 class FrdParser {
  public:
-  FrdParser(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+  FrdParser(std::string_view text, const std::string& name, const FrdLimits& limits)
+      : text_(text), name_(name), limits_(limits) {}
 
   FieldSource parse();
 
@@ -167,6 +168,8 @@ class FrdParser {
   std::string_view text_;
   const std::string& name_;
   std::size_t pos_ = 0;
+  std::size_t values_kept_ = 0;  // doubles held by the fields' value arrays so far
+  FrdLimits limits_;
   std::string_view line_;
   std::uint64_t line_no_ = 0;
   std::size_t line_start_ = 0;  // byte offset of line_
@@ -300,6 +303,7 @@ void FrdParser::read_results() {
   while (!name.empty() && name.front() == ' ') name.erase(0, 1);
   while (!name.empty() && name.back() == ' ') name.pop_back();
   if (name.empty()) fail("a result block without a name");
+  const std::uint64_t header_line = line_no_;
   const std::int64_t declared = int_at(13, 5, "component count");
   if (declared < 1 || declared > 64) fail("a component count of " + std::to_string(declared));
   // " -5" component lines; iexist (columns 34-38) 1 marks a component the file does not hold.
@@ -329,6 +333,18 @@ void FrdParser::read_results() {
       fail("block " + name + " has " + std::to_string(comps) + " components here and " +
            std::to_string(f->components) + " in an earlier step");
   }
+  // Memory is bounded by the file (FrdLimits): a mutated file could declare a 64-component block for
+  // every node in 3 KB and ask for gigabytes.
+  const std::size_t budget = std::max(limits_.min_values, limits_.values_per_byte * text_.size());
+  if (n * comps > budget - std::min(budget, values_kept_)) {
+    line_no_ = header_line;  // the error names the block's own line
+    fail("result block " + name + " would make the fields keep " + std::to_string(values_kept_ + n * comps) +
+         " values (" + std::to_string((values_kept_ + n * comps) * sizeof(double) >> 20) + " MB, " +
+         std::to_string(n) + " nodes x " + std::to_string(comps) + " components a block) for a file of " +
+         std::to_string(text_.size()) + " bytes; foxi keeps at most " + std::to_string(budget) +
+         " (blocks that list few of the nodes each stand for all of them)");
+  }
+  values_kept_ += n * comps;
   const std::size_t step = f->step_values.size();
   f->step_values.push_back(step_value_);
   f->values.resize((step + 1) * n * comps, kNaN);
@@ -409,11 +425,13 @@ FieldSource FrdParser::parse() {
 
 }  // namespace
 
-FieldSource parse_frd_source(std::string_view bytes, const std::string& name) { return FrdParser(bytes, name).parse(); }
+FieldSource parse_frd_source(std::string_view bytes, const std::string& name, const FrdLimits& limits) {
+  return FrdParser(bytes, name, limits).parse();
+}
 
-FieldSource read_frd_source(const std::filesystem::path& path) {
+FieldSource read_frd_source(const std::filesystem::path& path, const FrdLimits& limits) {
   const std::string bytes = io::read_file(path);
-  return parse_frd_source(bytes, path.string());
+  return parse_frd_source(bytes, path.string(), limits);
 }
 
 }  // namespace foxi

@@ -75,8 +75,18 @@ struct FieldSource {
 FOXI_API FieldSource read_field_source(const std::filesystem::path& path);
 
 // The readers by format; `name` is used in error messages.
-FOXI_API FieldSource read_frd_source(const std::filesystem::path& path);
-FOXI_API FieldSource parse_frd_source(std::string_view bytes, const std::string& name);
+// The .frd reader keeps node values dense (NaN where a block has no line for a node), and a block of
+// a few lines stands for every node (ccx's *NODE FILE with an NSET writes a few nodes an increment),
+// so its memory is bounded by the file: all blocks together keep at most max(min_values,
+// values_per_byte x the file's bytes) values, else IoError naming the block. The defaults: 2^27
+// values (1 GB), or 128 bytes of memory per byte of file (a dense ASCII block holds about one value
+// per 12 bytes, a binary one one per 4).
+struct FrdLimits {
+  std::size_t min_values = std::size_t(1) << 27;
+  std::size_t values_per_byte = 16;
+};
+FOXI_API FieldSource read_frd_source(const std::filesystem::path& path, const FrdLimits& limits = {});
+FOXI_API FieldSource parse_frd_source(std::string_view bytes, const std::string& name, const FrdLimits& limits = {});
 FOXI_API FieldSource read_csv_source(const std::filesystem::path& path);
 FOXI_API FieldSource parse_csv_source(std::string_view bytes, const std::string& name);
 FOXI_API FieldSource read_pvd_source(const std::filesystem::path& path);
