@@ -4,7 +4,10 @@
 #include <QApplication>
 #include <QEventLoop>
 #include <QPixmap>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <string>
@@ -21,6 +24,7 @@ const char* kUsage =
     "foxi-workbench [MODEL.toml]\n"
     "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics thermal] [--field NAME]\n"
     "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
+    "               [--iso v [--iso-only]] [--threshold a,b] [--clip px,py,pz,nx,ny,nz]\n"
     "               [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh MESH.vtu]\n"
     "  The window: open a model, edit its parameters (with units, checked as the model file would\n"
     "  be), mesh and solve on worker threads (Cancel keeps the previous mesh), look inside with the\n"
@@ -31,6 +35,8 @@ const char* kUsage =
     "  completely and saves the window (--screenshot), the view's own picture (--save-picture: what\n"
     "  foxi render draws for the same mesh, field and camera) and the mesh with its fields\n"
     "  (--save-mesh). Prints the tets, the key results and the camera as foxi render options.\n"
+    "  --iso, --iso-only, --threshold and --clip set the view's field tools as foxi render's options\n"
+    "  of the same names draw them (values in the field's display unit, as the legend shows it).\n"
     "  Run it with QT_QPA_PLATFORM=offscreen where there is no display.\n"
     "  Exit status: 0 ok, 1 failure, 2 usage, 3 bad model or parameter, 4 a result failed its checks.";
 
@@ -51,9 +57,37 @@ bool wait_job(foxi::workbench::Workbench& w) {
   return ok;
 }
 
-int headless(foxi::workbench::Workbench& w, const std::string& model, const std::vector<std::string>& sets,
-             const std::string& physics, std::string field, const std::string& cmap, double shrink,
-             const std::string& screenshot, const std::string& picture, const std::string& mesh_out) {
+// "a,b,c": finite numbers, exactly `count` of them (0: any number, at least one).
+std::vector<double> parse_list(const std::string& s, const char* what, std::size_t count) {
+  std::vector<double> v;
+  std::size_t at = 0;
+  while (at <= s.size()) {
+    const std::size_t comma = std::min(s.find(',', at), s.size());
+    const std::string item = s.substr(at, comma - at);
+    char* end = nullptr;
+    const double x = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != 0 || !std::isfinite(x))
+      throw Usage(std::string(what) + " takes finite numbers separated by commas, not '" + s + "'");
+    v.push_back(x);
+    at = comma + 1;
+  }
+  if (count ? v.size() != count : v.empty())
+    throw Usage(std::string(what) + " takes " + std::to_string(count) + " numbers, not '" + s + "'");
+  return v;
+}
+
+// The field tools of the headless options, in the field's display unit.
+struct ToolOptions {
+  std::vector<double> iso;
+  bool iso_only = false;
+  std::vector<double> threshold, clip;
+  bool any() const { return !iso.empty() || !threshold.empty() || !clip.empty(); }
+};
+
+int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std::string& model,
+             const std::vector<std::string>& sets, const std::string& physics, std::string field,
+             const std::string& cmap, double shrink, const std::string& screenshot,
+             const std::string& picture, const std::string& mesh_out) {
   using namespace foxi::cli;
   QString error;
   if (!w.open_model(QString::fromStdString(model), &error)) {
@@ -87,6 +121,24 @@ int headless(foxi::workbench::Workbench& w, const std::string& model, const std:
       std::fprintf(stderr, "foxi-workbench: error: --field %s: %s\n", field.c_str(),
                    w.last_error().toUtf8().constData());
       return kExitBadInput;
+    }
+  }
+  if (tools.any()) {
+    const foxi::DisplayUnit& u = w.display_unit();
+    foxi::FieldSelection s;
+    for (double v : tools.iso) s.iso.push_back(u.to_si(v));
+    s.iso_only = tools.iso_only;
+    if (!tools.threshold.empty()) s.threshold = {u.to_si(tools.threshold[0]), u.to_si(tools.threshold[1])};
+    if (!tools.clip.empty()) {
+      foxi::Plane p;
+      for (int k = 0; k < 3; ++k)
+        p.p[k] = tools.clip[std::size_t(k)], p.n[k] = tools.clip[std::size_t(k) + 3];
+      s.clip = p;
+    }
+    if (!w.set_selection(s, &error)) {
+      std::fprintf(stderr, "foxi-workbench: error: --iso/--threshold/--clip: %s\n",
+                   error.toUtf8().constData());
+      return kExitUsage;
     }
   }
   foxi::qt::ViewWidget* view = w.view_widget();
@@ -135,6 +187,7 @@ int main(int argc, char** argv) {
     std::string model, physics, field, cmap = "viridis", screenshot, picture, mesh_out, view_size;
     std::vector<std::string> sets;
     bool is_headless = false;
+    ToolOptions tools;
     double shrink = 1;
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string& a = args[i];
@@ -169,6 +222,15 @@ int main(int argc, char** argv) {
         } catch (const std::exception& e) {
           throw Usage(std::string("--shrink: ") + e.what());
         }
+      } else if (a == "--iso") {
+        tools.iso = parse_list(value(), "--iso", 0);
+      } else if (a == "--iso-only") {
+        tools.iso_only = true;
+      } else if (a == "--threshold") {
+        tools.threshold = parse_list(value(), "--threshold", 2);
+        if (!(tools.threshold[0] <= tools.threshold[1])) throw Usage("--threshold takes a,b with a <= b");
+      } else if (a == "--clip") {
+        tools.clip = parse_list(value(), "--clip", 6);
       } else if (a == "--view-size") {
         view_size = value();
       } else if (a.rfind("-", 0) == 0 && a.size() > 1 && a.rfind("-platform", 0) != 0) {
@@ -180,8 +242,10 @@ int main(int argc, char** argv) {
       }
     }
     if (is_headless && model.empty()) throw Usage("--headless needs a model file");
-    if (!is_headless && (!sets.empty() || !physics.empty() || !field.empty() || !screenshot.empty() ||
-                         !picture.empty() || !mesh_out.empty()))
+    if (tools.iso_only && tools.iso.empty())
+      throw Usage("--iso-only draws the isosurface of --iso: give --iso");
+    if (!is_headless && (tools.any() || !sets.empty() || !physics.empty() || !field.empty() ||
+                         !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
       throw Usage(
           "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")
@@ -204,7 +268,7 @@ int main(int argc, char** argv) {
     if (size.width > 0) w.view_widget()->setFixedSize(size.width, size.height);
     w.show();
     if (is_headless)
-      return headless(w, model, sets, physics, field, cmap, shrink, screenshot, picture, mesh_out);
+      return headless(w, tools, model, sets, physics, field, cmap, shrink, screenshot, picture, mesh_out);
     w.restore_settings();
     if (!model.empty()) w.open_model(QString::fromStdString(model));
     return app.exec();

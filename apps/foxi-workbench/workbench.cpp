@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <QApplication>
+#include <QCheckBox>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
@@ -34,7 +35,9 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <initializer_list>
 #include <iterator>
+#include <tuple>
 
 #include "foxi/mesher/mesher.hpp"
 #include "foxi/mesher/model_mesh.hpp"
@@ -45,6 +48,7 @@
 #include "foxi/model/units.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "foxi/viz/camera.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/interactive_view.hpp"
@@ -67,6 +71,10 @@ struct Outcome {
   ColorScale scale;
   DisplayUnit unit;
   bool has_scale = false;
+  std::optional<FieldChoice> choice;  // the field shown, for the field tools
+  std::size_t step = 0;
+  std::shared_ptr<IsoCache> iso_cache;  // built here, on the worker: the tools then only query
+  double corner_lo = 0, corner_hi = 0;  // the corner values' range, SI
   RunResults results;
   double seconds = 0;                        // meshing (or the solve when not meshed)
   double solve_seconds = 0;                  // the solve
@@ -106,7 +114,8 @@ void build_display(Outcome& out, const Mesh& mesh, const std::string& field, con
   params.shrink = shrink;
   if (!field.empty()) {
     const FieldChoice choice = choose_field(mesh, field);
-    const std::vector<double> values = tet_centroid_values(mesh, choice, choice.field->step_count() - 1);
+    const std::size_t step = choice.field->step_count() - 1;
+    const std::vector<double> values = tet_centroid_values(mesh, choice, step);
     const ColorMapId map = parse_color_map(cmap).value_or(ColorMapId::viridis);
     const std::optional<AutoScale> a = automatic_scale(values, map);
     if (!a) throw FieldSelectError("field '" + field + "' has no finite value");
@@ -119,6 +128,10 @@ void build_display(Outcome& out, const Mesh& mesh, const std::string& field, con
     for (std::size_t i = 0; i < values.size(); ++i) out.probe[i] = out.unit.to_display(values[i]);
     out.probe_unit = QString::fromStdString(out.unit.symbol);
     out.field_label = QString::fromStdString(choice.label);
+    out.choice = choice;
+    out.step = step;
+    out.iso_cache = std::make_shared<IsoCache>(make_iso_cache(mesh, choice, step));
+    std::tie(out.corner_lo, out.corner_hi) = finite_range(*out.iso_cache->corner);
   }
   out.view = foxi::qt::make_view(mesh, params, w, h, camera);
 }
@@ -260,6 +273,50 @@ void Workbench::build_ui() {
   fields->addWidget(new QLabel(tr("shrink")));
   fields->addWidget(shrink_box_);
   cv->addLayout(fields);
+  // The field tools: isosurface, threshold, clip (by the field shown; disabled without one).
+  auto* tools = new QHBoxLayout;
+  iso_on_ = new QCheckBox(tr("isosurface"));
+  iso_on_->setToolTip(tr("the solid where the field is at least the isovalue, cut at the isosurface"));
+  iso_slider_ = new QSlider(Qt::Horizontal);
+  iso_slider_->setRange(0, 1000);
+  iso_slider_->setValue(500);
+  iso_value_ = new QLabel;
+  iso_value_->setMinimumWidth(80);
+  iso_only_ = new QCheckBox(tr("surface only"));
+  threshold_on_ = new QCheckBox(tr("threshold"));
+  threshold_on_->setToolTip(tr("only the tets whose value (at the centroid) lies in the range"));
+  threshold_lo_ = new QDoubleSpinBox;
+  threshold_hi_ = new QDoubleSpinBox;
+  for (QDoubleSpinBox* b : {threshold_lo_, threshold_hi_}) {
+    b->setDecimals(3);
+    b->setRange(-1e12, 1e12);
+    b->setKeyboardTracking(false);
+  }
+  clip_on_ = new QCheckBox(tr("clip"));
+  clip_on_->setToolTip(tr("only the whole tets behind the plane (normal along +axis)"));
+  clip_axis_ = new QComboBox;
+  for (const char* a : {"x", "y", "z"}) clip_axis_->addItem(a);
+  clip_slider_ = new QSlider(Qt::Horizontal);
+  clip_slider_->setRange(0, 1000);
+  clip_slider_->setValue(500);
+  tools->addWidget(iso_on_);
+  tools->addWidget(iso_slider_, 2);
+  tools->addWidget(iso_value_);
+  tools->addWidget(iso_only_);
+  tools->addWidget(threshold_on_);
+  tools->addWidget(threshold_lo_);
+  tools->addWidget(threshold_hi_);
+  tools->addWidget(clip_on_);
+  tools->addWidget(clip_axis_);
+  tools->addWidget(clip_slider_, 1);
+  cv->addLayout(tools);
+  for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_})
+    connect(c, &QCheckBox::toggled, this, [this] { apply_field_tools(); });
+  connect(iso_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
+  connect(clip_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
+  connect(clip_axis_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] { apply_field_tools(); });
+  for (QDoubleSpinBox* b : {threshold_lo_, threshold_hi_})
+    connect(b, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this] { apply_field_tools(); });
   auto* vrow = new QHBoxLayout;
   vrow->addWidget(view_, 1);
   legend_ = new QLabel;
@@ -761,6 +818,22 @@ void Workbench::on_job_done() {
   if (!out->meshed && !out->solved) mesh_ = out->mesh;
   view_->set_view(out->mesh, std::move(out->view));
   view_->set_probe_values(std::move(out->probe), out->probe_unit);
+  mesh_bounds(*out->mesh, bounds_lo_, bounds_hi_);
+  if (out->has_scale && out->choice) {
+    view_->set_field_source(*out->choice, out->step, out->scale, out->iso_cache);
+    unit_ = out->unit;
+    field_lo_ = out->corner_lo;
+    field_hi_ = out->corner_hi;
+    // The same field (a new colour map, shrink or solve): its tools stay; another field: they go.
+    if (selection_field_ != field_) selection_ = {};
+    selection_field_ = field_;
+    QString why;
+    if (selection_.any() && !view_->set_selection(selection_, &why)) selection_ = {};
+  } else {
+    selection_ = {};
+    selection_field_.clear();
+  }
+  show_selection();
   if (out->has_scale)
     legend_->setPixmap(legend_pixmap(out->scale, out->unit, out->field_label, view_->height()));
   else
@@ -772,6 +845,79 @@ void Workbench::on_job_done() {
     add_history(mesh_seconds_ + out->solve_seconds);  // the mesh's row gets the results
   }
   emit finished(true);
+}
+
+bool Workbench::set_selection(const FieldSelection& selection, QString* error) {
+  if (!view_->set_selection(selection, error)) return false;
+  selection_ = selection;
+  selection_field_ = field_;
+  show_selection();
+  return true;
+}
+
+void Workbench::show_selection() {
+  filling_ = true;
+  const bool field = !selection_field_.isEmpty() && view_->has_view() && field_hi_ >= field_lo_;
+  for (QWidget* w :
+       std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_only_, threshold_on_, threshold_lo_,
+                                       threshold_hi_, clip_on_, clip_axis_, clip_slider_})
+    w->setEnabled(field);
+  const FieldSelection& s = selection_;
+  const QSignalBlocker b1(iso_on_), b2(iso_slider_), b3(iso_only_), b4(threshold_on_), b5(threshold_lo_),
+      b6(threshold_hi_), b7(clip_on_), b8(clip_axis_), b9(clip_slider_);
+  iso_on_->setChecked(!s.iso.empty());
+  iso_only_->setChecked(s.iso_only);
+  const double span = field_hi_ - field_lo_;
+  if (!s.iso.empty() && span > 0)
+    iso_slider_->setValue(int(std::lround(1000 * (s.iso.front() - field_lo_) / span)));
+  const double iso = s.iso.empty() ? field_lo_ + span * iso_slider_->value() / 1000.0 : s.iso.front();
+  iso_value_->setText(
+      field ? QString("%1 %2").arg(unit_.to_display(iso), 0, 'g', 5).arg(QString::fromStdString(unit_.symbol))
+            : QString());
+  threshold_on_->setChecked(s.threshold.has_value());
+  if (field && !s.threshold) {
+    threshold_lo_->setValue(unit_.to_display(field_lo_));
+    threshold_hi_->setValue(unit_.to_display(field_hi_));
+  } else if (s.threshold) {
+    threshold_lo_->setValue(unit_.to_display(s.threshold->first));
+    threshold_hi_->setValue(unit_.to_display(s.threshold->second));
+  }
+  clip_on_->setChecked(s.clip.has_value());
+  if (s.clip) {
+    // An axis plane of the slider's: its axis and position; any other plane leaves the controls.
+    for (int k = 0; k < 3; ++k)
+      if (s.clip->n[k] > 0 && s.clip->n[(k + 1) % 3] == 0 && s.clip->n[(k + 2) % 3] == 0 &&
+          bounds_hi_[k] > bounds_lo_[k]) {
+        clip_axis_->setCurrentIndex(k);
+        clip_slider_->setValue(
+            int(std::lround(1000 * (s.clip->p[k] - bounds_lo_[k]) / (bounds_hi_[k] - bounds_lo_[k]))));
+      }
+  }
+  filling_ = false;
+}
+
+void Workbench::apply_field_tools() {
+  if (filling_ || selection_field_.isEmpty()) return;
+  FieldSelection s;
+  const double span = field_hi_ - field_lo_;
+  if (iso_on_->isChecked()) {
+    s.iso = {field_lo_ + span * iso_slider_->value() / 1000.0};
+    s.iso_only = iso_only_->isChecked();
+  }
+  if (threshold_on_->isChecked())
+    s.threshold = {unit_.to_si(threshold_lo_->value()), unit_.to_si(threshold_hi_->value())};
+  if (clip_on_->isChecked()) {
+    Plane p;
+    const int k = clip_axis_->currentIndex();
+    for (int j = 0; j < 3; ++j) {
+      p.p[j] = 0.5 * (bounds_lo_[j] + bounds_hi_[j]);
+      p.n[j] = j == k ? 1 : 0;
+    }
+    p.p[k] = bounds_lo_[k] + (bounds_hi_[k] - bounds_lo_[k]) * clip_slider_->value() / 1000.0;
+    s.clip = p;
+  }
+  QString why;
+  if (!set_selection(s, &why)) param_error_->setText(why);
 }
 
 void Workbench::refresh_fields() {

@@ -20,7 +20,10 @@
 #include "foxi/model/model_file.hpp"
 #include "foxi/qt/view_widget.hpp"
 #include "foxi/solver/results.hpp"
+#include "foxi/viz/field_paint.hpp"
+#include "foxi/viz/field_selection.hpp"
 
+class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
@@ -85,6 +88,18 @@ class Workbench : public QMainWindow {
   // for a value outside or while a job runs.
   bool set_shrink(double shrink);
 
+  // The view's field tools (field_selection.hpp, SI values): an isosurface (the solid above it, or the
+  // surface only), a threshold on the tets' values and a clip plane, by the field shown. The controls
+  // follow. False (nothing changes) with the reason: no field shown, a slice, a zero clip normal.
+  bool set_selection(const FieldSelection& selection, QString* error = nullptr);
+  // The field shown's display unit (the legend's, the probe's) and its corner values' range, SI: the
+  // range the isovalue slider spans.
+  const DisplayUnit& display_unit() const { return unit_; }
+  double field_lo() const { return field_lo_; }
+  double field_hi() const { return field_hi_; }
+  // The isovalue slider (0 .. 1000 over [field_lo, field_hi]): moving it moves the isosurface.
+  QSlider* iso_slider() const { return iso_slider_; }
+
   std::shared_ptr<const Mesh> mesh() const { return mesh_; }
   const RunResults* results() const { return has_results_ ? &results_ : nullptr; }
   const std::vector<HistoryRow>& history() const { return history_; }
@@ -114,6 +129,8 @@ class Workbench : public QMainWindow {
   void add_history(double seconds);
   void refresh_fields();
   void show_error(const QString& text);
+  void apply_field_tools();  // the controls' selection to the view
+  void show_selection();     // the controls to the selection
 
   QString model_path_;
   std::map<std::string, std::string> overrides_;
@@ -129,6 +146,11 @@ class Workbench : public QMainWindow {
   std::vector<HistoryRow> history_;
   QString field_, color_map_ = "viridis";
   double shrink_ = 1;
+  FieldSelection selection_;  // of selection_field_ (SI)
+  QString selection_field_;
+  DisplayUnit unit_;
+  double field_lo_ = 0, field_hi_ = 0;
+  double bounds_lo_[3] = {0, 0, 0}, bounds_hi_[3] = {0, 0, 0};  // the mesh's, for the clip slider
   QString last_error_;
   bool last_error_bad_input_ = false;
 
@@ -151,6 +173,11 @@ class Workbench : public QMainWindow {
   QDoubleSpinBox* shrink_box_ = nullptr;
   QLabel* legend_ = nullptr;
   QSlider* fraction_ = nullptr;
+  QCheckBox *iso_on_ = nullptr, *iso_only_ = nullptr, *threshold_on_ = nullptr, *clip_on_ = nullptr;
+  QSlider *iso_slider_ = nullptr, *clip_slider_ = nullptr;
+  QLabel* iso_value_ = nullptr;
+  QDoubleSpinBox *threshold_lo_ = nullptr, *threshold_hi_ = nullptr;
+  QComboBox* clip_axis_ = nullptr;
   QLabel *status_ = nullptr, *probe_ = nullptr;
   bool filling_ = false;  // the tables being filled by the program, not edited
 };

@@ -36,15 +36,6 @@ Plane parse_plane(const std::string& s, const char* what) {
   return p;
 }
 
-double ms_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
-
-// Keeps the tets of `set` that `keep` marks.
-void intersect(std::vector<std::uint32_t>& set, const std::vector<std::uint8_t>& keep) {
-  set.erase(std::remove_if(set.begin(), set.end(), [&](std::uint32_t t) { return keep[t] == 0; }), set.end());
-}
-
 }  // namespace
 
 IsoOptions take_iso_options(Args& args, const FieldOptions& field) {
@@ -76,84 +67,17 @@ IsoOptions take_iso_options(Args& args, const FieldOptions& field) {
   return o;
 }
 
-IsoDrawing IsoPicture::drawing() const {
-  IsoDrawing d;
-  if (corner) d.corner = *corner;
-  if (attr) d.attr = *attr;
-  d.params = params;
-  return d;
-}
-
 IsoPicture resolve_iso(const IsoOptions& options, const Mesh& mesh, const FieldPicture& field,
                        std::span<const std::uint32_t> base, IsoCache* cache) {
-  IsoPicture r;
-  IsoCache local;
-  IsoCache& c = cache ? *cache : local;
-  const std::size_t n = mesh.tet_count();
+  // The options are in the field's display unit; the library's rule takes SI.
   const DisplayUnit& unit = field.legend.unit;
-  // Membership of the tets selected so far (all, or base), built only when something narrows it: an
-  // isovalue alone over all tets then costs its query, not a pass over the mesh.
-  const bool narrows = !base.empty() || options.has_threshold || options.clip;
-  std::vector<std::uint8_t> keep;
-  if (narrows) {
-    keep.assign(n, base.empty() ? 1 : 0);
-    for (std::uint32_t t : base) keep[t] = 1;
-  }
-  auto narrow = [&](const std::vector<std::uint32_t>& set) {
-    std::vector<std::uint8_t> in(n, 0);
-    for (std::uint32_t t : set) in[t] = 1;
-    for (std::size_t t = 0; t < n; ++t) keep[t] &= in[t];
-  };
-  auto corners = [&] {
-    if (!c.corner)
-      c.corner = std::make_shared<const std::vector<double>>(tet_corner_values(mesh, field.choice, field.step));
-    return c.corner;
-  };
-  if (options.has_threshold) {
-    if (c.centroid.empty()) c.centroid = tet_centroid_values(mesh, field.choice, field.step);
-    narrow(threshold_tets(c.centroid, std::min(unit.to_si(options.threshold[0]), unit.to_si(options.threshold[1])),
-                          std::max(unit.to_si(options.threshold[0]), unit.to_si(options.threshold[1]))));
-  }
-  if (options.clip) narrow(clip_tets(mesh, *options.clip));
-  r.params.scale = field.legend.scale;
-  if (options.slice) {
-    r.polygons = true;
-    const auto plane = std::make_shared<const std::vector<double>>(plane_corner_values(mesh, *options.slice));
-    r.corner = plane;
-    r.attr = corners();
-    r.params.values = {0};
-    r.params.cold_side = 1;
-    const auto t0 = std::chrono::steady_clock::now();
-    r.subset = crossing_scan(*plane, 0);  // one plane, one pass: no tree to amortise
-    r.query_ms = ms_since(t0);
-    if (narrows) intersect(r.subset, keep);
-    r.crossing = r.subset.size();
-  } else if (!options.iso.empty()) {
-    r.polygons = true;
-    r.corner = corners();
-    for (double v : options.iso) r.iso_si.push_back(unit.to_si(v));
-    r.params.values = r.iso_si;
-    r.params.cap = !options.iso_only;
-    auto t0 = std::chrono::steady_clock::now();
-    if (!c.tree) {
-      c.tree = std::make_unique<TetIntervals>(*r.corner);
-      r.build_ms = ms_since(t0);
-    }
-    t0 = std::chrono::steady_clock::now();
-    c.tree->crossing_any(r.iso_si, r.subset);
-    r.crossing = r.subset.size();
-    if (r.params.cap) {
-      r.subset.clear();
-      c.tree->reaching(*std::min_element(r.iso_si.begin(), r.iso_si.end()), r.subset);
-    }
-    r.query_ms = ms_since(t0);
-    if (narrows) intersect(r.subset, keep);
-  } else {
-    for (std::size_t t = 0; t < n; ++t)
-      if (!narrows || keep[t]) r.subset.push_back(std::uint32_t(t));
-  }
-  r.empty = r.subset.empty();
-  return r;
+  FieldSelection s;
+  for (double v : options.iso) s.iso.push_back(unit.to_si(v));
+  s.iso_only = options.iso_only;
+  if (options.has_threshold) s.threshold = {unit.to_si(options.threshold[0]), unit.to_si(options.threshold[1])};
+  s.clip = options.clip;
+  s.slice = options.slice;
+  return select_field_tets(s, mesh, field.choice, field.step, field.legend.scale, base, cache);
 }
 
 }  // namespace foxi::cli

@@ -31,6 +31,18 @@ struct ViewWidget::Impl {
   std::vector<double> probe;
   QString probe_unit;
   QPoint last;  // the last mouse position of a drag
+  // The field tools: the source they select by, the selection and what it resolved to (the view
+  // borrows `drawing`'s spans, which borrow `picked`'s values: both live until the next selection).
+  struct Source {
+    FieldChoice choice;
+    std::size_t step = 0;
+    ColorScale scale;
+    std::shared_ptr<IsoCache> cache;
+  };
+  std::optional<Source> source;
+  FieldSelection selection;
+  std::unique_ptr<TetSelection> picked;
+  std::unique_ptr<IsoDrawing> drawing;
 };
 
 namespace {
@@ -72,8 +84,12 @@ void ViewWidget::set_mesh(std::shared_ptr<const Mesh> mesh, const RenderParams& 
 }
 
 void ViewWidget::set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<InteractiveView> view) {
-  // The old view goes before the mesh it was lent.
+  // The old view goes before the mesh it was lent (and the selection it borrowed).
   d_->view = std::move(view);
+  d_->source.reset();
+  d_->selection = {};
+  d_->drawing.reset();
+  d_->picked.reset();
   d_->mesh = std::move(mesh);
   d_->target.reset();
   d_->probe.clear();
@@ -85,6 +101,10 @@ void ViewWidget::set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<Inte
 void ViewWidget::clear() {
   d_->timer.stop();
   d_->view.reset();
+  d_->source.reset();
+  d_->selection = {};
+  d_->drawing.reset();
+  d_->picked.reset();
   d_->mesh.reset();
   d_->probe.clear();
   update();
@@ -121,6 +141,65 @@ QString ViewWidget::probe_text(int x, int y) const {
         std::isfinite(v) ? QString(", %1 %2").arg(v, 0, 'g', 6).arg(d_->probe_unit) : QString(", no value");
   }
   return text;
+}
+
+void ViewWidget::set_field_source(FieldChoice choice, std::size_t step, ColorScale scale,
+                                  std::shared_ptr<IsoCache> cache) {
+  if (d_->view && d_->selection.any()) {
+    d_->view->set_subset(std::nullopt);
+    draw();
+  }
+  d_->selection = {};
+  d_->drawing.reset();
+  d_->picked.reset();
+  d_->source = Impl::Source{std::move(choice), step, scale, std::move(cache)};
+}
+
+bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) {
+  auto fail = [&](const QString& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!d_->view) return fail(tr("no mesh shown"));
+  if (!selection.any()) {
+    d_->view->set_subset(std::nullopt);
+    d_->selection = {};
+    d_->drawing.reset();
+    d_->picked.reset();
+    draw();
+    return true;
+  }
+  if (!d_->source)
+    return fail(tr("colour by a field first: the isosurface, threshold and clip select by it"));
+  if (selection.slice) return fail(tr("a slice is not drawn in the view yet (foxi render --slice draws it)"));
+  std::unique_ptr<TetSelection> picked;
+  try {
+    const Impl::Source& s = *d_->source;
+    picked = std::make_unique<TetSelection>(
+        select_field_tets(selection, *d_->mesh, s.choice, s.step, s.scale, {}, s.cache.get()));
+  } catch (const std::exception& e) {
+    return fail(QString::fromStdString(e.what()));
+  }
+  std::unique_ptr<IsoDrawing> drawing;
+  if (picked->polygons) {
+    drawing = std::make_unique<IsoDrawing>(picked->drawing());
+    d_->view->set_iso(drawing.get(), picked->subset);
+  } else {
+    d_->view->set_subset(picked->subset);
+  }
+  // The view now borrows the new drawing: the old one may go.
+  d_->drawing = std::move(drawing);
+  d_->picked = std::move(picked);
+  d_->selection = selection;
+  draw();
+  return true;
+}
+
+const FieldSelection& ViewWidget::selection() const { return d_->selection; }
+
+std::size_t ViewWidget::selected_tets() const {
+  if (d_->picked) return d_->picked->subset.size();
+  return d_->mesh ? d_->mesh->tet_count() : 0;
 }
 
 void ViewWidget::set_time_slice(std::chrono::milliseconds slice) {

@@ -19,11 +19,13 @@
 #include <cstdlib>
 #include <fstream>
 #include <regex>
+#include <span>
 #include <sstream>
 #include <string>
 
 #include "foxi/mesher/model_mesh.hpp"
 #include "foxi/solver/results.hpp"
+#include "foxi/viz/field_selection.hpp"
 #include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/png.hpp"
 #include "test_util.hpp"
@@ -61,9 +63,11 @@ std::string line_after(const std::string& text, const std::string& key) {
 // The headless loop on a shipped model: the view's saved picture equals foxi render's picture of
 // the mesh the workbench saved, with the camera it printed, pixel for pixel; its key result equals
 // foxi solve's record of the same model and --set values.
+// `tools`: the field tools' options (--iso, --threshold, --clip), given to both programs alike.
 void check_headless(const std::string& model, const std::string& set, const std::string& result,
-                    const std::string& shrink = "") {
-  const std::string shrink_option = shrink.empty() ? "" : " --shrink " + shrink;
+                    const std::string& shrink = "", const std::string& tools = "") {
+  const std::string shrink_option =
+      (shrink.empty() ? "" : " --shrink " + shrink) + (tools.empty() ? "" : " " + tools);
   TempDir dir;
   const auto view = dir.path() / "view.png", mesh = dir.path() / "mesh.vtu", shot = dir.path() / "window.png",
              cli = dir.path() / "cli.png", log = dir.path() / "wb.log";
@@ -94,7 +98,20 @@ void check_headless(const std::string& model, const std::string& set, const std:
     coloured += a.rgba[i] != foxi::pack_rgba(255, 255, 255);
   }
   EXPECT_EQ(differ, 0u);
-  EXPECT_GT(coloured, a.rgba.size() / 10) << "the picture shows the model";
+  // The tools draw part of the model: a small picture, but not an empty one.
+  EXPECT_GT(coloured, a.rgba.size() / (tools.empty() ? 10 : 100)) << "the picture shows the model";
+  if (!tools.empty()) {
+    // The same tets drawn as foxi render reports ("drawn N of M tets").
+    std::smatch m;
+    const std::string render_log = foxi::test::read_text(dir.path() / "render.log");
+    const std::regex cli_drawn("drawn +([0-9]+) of ([0-9]+) tets"),
+        view_drawn("view: drawn ([0-9]+) / ([0-9]+) tets");
+    ASSERT_TRUE(std::regex_search(render_log, m, cli_drawn)) << render_log;
+    const std::string cli_n = m[1], cli_total = m[2];
+    ASSERT_TRUE(std::regex_search(out, m, view_drawn)) << out;
+    EXPECT_EQ(m[1].str(), cli_n);
+    EXPECT_EQ(m[2].str(), cli_total);
+  }
 
   // The same key result as foxi solve's JSON record of the model with the same --set.
   const auto json = dir.path() / "solve.json";
@@ -118,6 +135,24 @@ TEST(WorkbenchHeadless, ViewPictureEqualsFoxiRenderDieOnSubstrate) {
 // The flip chip with the tets shrunk (the inside shows between them): foxi render --shrink 0.7.
 TEST(WorkbenchHeadless, ViewPictureEqualsFoxiRenderFlipChipShrunk) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "0.7");
+}
+
+// The view's field tools against foxi render's options of the same names: the solid above an
+// isotherm, the isotherm alone, a threshold, a clip plane, and an isotherm within a clip.
+TEST(WorkbenchHeadless, IsoPictureEqualsFoxiRender) {
+  check_headless("die_on_substrate.toml", "die_w=5mm", "T_max", "", "--iso 60");
+}
+TEST(WorkbenchHeadless, IsoOnlyPictureEqualsFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--iso 50 --iso-only");
+}
+TEST(WorkbenchHeadless, ThresholdPictureEqualsFoxiRender) {
+  check_headless("die_on_substrate.toml", "die_w=5mm", "T_max", "", "--threshold 30,50");
+}
+TEST(WorkbenchHeadless, ClipPictureEqualsFoxiRender) {
+  check_headless("die_on_substrate.toml", "die_w=5mm", "T_max", "", "--clip 0.005,0.004,0.0007,1,0.2,0");
+}
+TEST(WorkbenchHeadless, IsoWithinClipEqualsFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "0.8", "--iso 48 --clip 0.005,0.005,0,0,1,0");
 }
 
 // Once with a real X server (xvfb-run, Qt's xcb platform): the same view picture as offscreen.
@@ -313,6 +348,71 @@ TEST(Workbench, CancelKeepsThePreviousMeshAndPicture) {
   EXPECT_NE(w.history()[1].results.find("T_max"), nullptr);
   ASSERT_EQ(w.history()[1].parameters.size(), 1u);
   EXPECT_EQ(w.history()[1].parameters[0].expression, "6 mm");
+}
+
+// The isovalue slider moves the isotherm both ways: each position draws the solid above its value,
+// which holds the tets with a corner at or above it (counted here from the mesh's node values), and
+// moving back gives the same picture again.
+TEST(Workbench, IsoSliderMovesTheIsovalueBothWays) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(w.iso_slider()->isEnabled()) << "the temperature is shown: the tools are on";
+  const foxi::Mesh& mesh = *w.mesh();
+  const foxi::Field* t = nullptr;
+  for (const foxi::Field& f : mesh.fields)
+    if (f.name == "temperature") t = &f;
+  ASSERT_NE(t, nullptr);
+  ASSERT_EQ(t->location, foxi::FieldLocation::node);
+  const std::span<const double> node = t->step(t->step_count() - 1, mesh.node_count());
+  double lo = INFINITY, hi = -INFINITY;
+  for (double v : node) lo = std::min(lo, v), hi = std::max(hi, v);
+  EXPECT_DOUBLE_EQ(w.field_lo(), lo);
+  EXPECT_DOUBLE_EQ(w.field_hi(), hi);
+  auto reaching = [&](double v) {
+    std::size_t n = 0;
+    for (std::size_t e = 0; e < mesh.tet_count(); ++e) {
+      bool any = false;
+      for (int k = 0; k < 4; ++k) any |= node[mesh.tet[4 * e + std::size_t(k)]] >= v;
+      n += any;
+    }
+    return n;
+  };
+  foxi::FieldSelection s;
+  s.iso = {0.5 * (lo + hi)};
+  ASSERT_TRUE(w.set_selection(s));
+  EXPECT_EQ(w.iso_slider()->value(), 500);
+  foxi::qt::ViewWidget* v = w.view_widget();
+  auto at = [&](int pos) {
+    w.iso_slider()->setValue(pos);
+    const double iso = lo + (hi - lo) * pos / 1000.0;
+    EXPECT_EQ(v->selection().iso.size(), 1u);
+    EXPECT_DOUBLE_EQ(v->selection().iso.at(0), iso);
+    EXPECT_EQ(v->selected_tets(), reaching(iso)) << "slider at " << pos;
+    v->finish_now();
+    EXPECT_EQ(v->view()->drawn().size(), reaching(iso));
+    return v->view()->framebuffer().id;
+  };
+  const auto low = at(200);
+  const std::size_t low_count = v->selected_tets();
+  at(800);
+  EXPECT_LT(v->selected_tets(), low_count) << "a hotter isotherm: a smaller solid";
+  EXPECT_GT(v->selected_tets(), 0u);
+  EXPECT_TRUE(at(200) == low) << "back down: the same picture";
+  // Off again: all tets.
+  ASSERT_TRUE(w.set_selection({}));
+  v->finish_now();
+  EXPECT_EQ(v->view()->drawn().size(), mesh.tet_count());
+  // Refused: a slice (not in the view yet), a zero clip normal; the selection stays as it was.
+  foxi::FieldSelection bad;
+  bad.clip = foxi::Plane{{0, 0, 0}, {0, 0, 0}};
+  QString why;
+  EXPECT_FALSE(w.set_selection(bad, &why));
+  EXPECT_FALSE(why.isEmpty());
+  EXPECT_FALSE(v->selection().any());
 }
 
 // The view follows the fraction slider both ways: drawing on to it and undrawing back to it; a

@@ -74,7 +74,7 @@ std::vector<PixelRect> InteractiveView::take_damage() {
 }
 
 std::span<const std::uint32_t> InteractiveView::current_subset() const {
-  if (iso_) return iso_subset_;
+  if (selecting_) return iso_subset_;
   if (stack_.empty()) return {};
   return stack_.back();
 }
@@ -84,10 +84,11 @@ void InteractiveView::begin_draw() {
   const auto t0 = std::chrono::steady_clock::now();
   auto raster = std::make_unique<TetRasterizer>(mesh_, camera_, width_, height_, params_);
   std::unique_ptr<IsoPainter> iso_painter;
-  if (iso_) {
+  if (iso_)
     iso_painter = std::make_unique<IsoPainter>(mesh_, camera_, width_, height_, iso_->corner, iso_->params, params_,
                                                iso_->attr);
-    // The iso tets within the region of interest.
+  if (selecting_) {
+    // The iso (or selected) tets within the region of interest.
     iso_subset_.clear();
     if (stack_.empty())
       iso_subset_ = iso_tets_;
@@ -101,7 +102,7 @@ void InteractiveView::begin_draw() {
   mpvo_.clear();
   mpvo_pos_ = 0;
   const View v = view_of(camera_);
-  if (iso_ && iso_subset_.empty()) {
+  if (selecting_ && iso_subset_.empty()) {
     // Nothing crosses: an empty subset would mean the whole mesh to the orders.
   } else if (delaunay_) {
     order_.emplace(mesh_, table_, v, current_subset());
@@ -112,7 +113,7 @@ void InteractiveView::begin_draw() {
   damage_all();
   drawn_.clear();
   handed_.clear();
-  done_ = iso_ && iso_subset_.empty();
+  done_ = selecting_ && iso_subset_.empty();
   undrawing_ = false;
   started_ = true;
   ++generation_;
@@ -123,7 +124,17 @@ void InteractiveView::restart() { begin_draw(); }
 
 void InteractiveView::set_iso(const IsoDrawing* drawing, std::vector<std::uint32_t> tets) {
   iso_ = drawing;
+  selecting_ = drawing != nullptr;
   iso_tets_ = drawing ? std::move(tets) : std::vector<std::uint32_t>{};
+  std::sort(iso_tets_.begin(), iso_tets_.end());
+  iso_subset_.clear();
+  begin_draw();
+}
+
+void InteractiveView::set_subset(std::optional<std::vector<std::uint32_t>> tets) {
+  iso_ = nullptr;
+  selecting_ = tets.has_value();
+  iso_tets_ = tets ? std::move(*tets) : std::vector<std::uint32_t>{};
   std::sort(iso_tets_.begin(), iso_tets_.end());
   iso_subset_.clear();
   begin_draw();
@@ -221,7 +232,7 @@ void InteractiveView::finish() {
 }
 
 std::size_t InteractiveView::total() const {
-  if (iso_) return iso_subset_.size();
+  if (selecting_) return iso_subset_.size();
   if (!stack_.empty()) return stack_.back().size();
   return mesh_.tet_count();
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "foxi/api.hpp"
+#include "foxi/viz/field_selection.hpp"
 
 namespace foxi {
 struct Mesh;
@@ -62,6 +63,21 @@ class FOXI_API ViewWidget : public QWidget {
   void set_probe_values(std::vector<double> tet_values, QString unit);
   // The text for the tet at widget pixel (x, y): "tet 12, region die, 45.2 °C" (empty: background).
   QString probe_text(int x, int y) const;
+
+  // The field tools (isosurface, threshold, clip) select by `choice` at `step`, its isosurfaces
+  // coloured on `scale`; `cache` is make_iso_cache's for them (O(n log n): a host builds it on a
+  // worker). Lifts the current selection. The view must show the mesh the choice belongs to.
+  void set_field_source(FieldChoice choice, std::size_t step, ColorScale scale,
+                        std::shared_ptr<IsoCache> cache);
+  // Draws what `selection` selects (field_selection.hpp, the rule of foxi render's --iso, --iso-only,
+  // --threshold and --clip: the same picture for the same camera), redrawn from the back; an empty
+  // selection draws all tets again. Costs the interval tree's query and, for a threshold or clip, a
+  // pass over the tets. False (nothing changes) with the reason in `error`: no view or no field
+  // source, a slice (not drawn here yet), a clip plane with a zero normal.
+  bool set_selection(const FieldSelection& selection, QString* error = nullptr);
+  const FieldSelection& selection() const;
+  // The tets the current selection draws (0 for none), or the whole mesh's count without one.
+  std::size_t selected_tets() const;
 
   // Milliseconds of painter work per timer slice (default 8).
   void set_time_slice(std::chrono::milliseconds slice);

@@ -87,6 +87,9 @@ class FOXI_API InteractiveView {
   // them), narrowed by the region stack. Null: whole tets again. Redraws from the back.
   void set_iso(const IsoDrawing* drawing, std::vector<std::uint32_t> tets);
   bool iso() const { return iso_ != nullptr; }
+  // Whole tets, only `tets` (a threshold or clip: field_selection.hpp; empty: none drawn), narrowed by
+  // the region stack; nullopt: all tets again. Ends iso drawing. Redraws from the back.
+  void set_subset(std::optional<std::vector<std::uint32_t>> tets);
   // Colours by `field` (null: by region) from now on: the same camera and regions, redrawn from the back.
   void set_field(std::shared_ptr<const FieldPaint> field);
   const std::shared_ptr<const FieldPaint>& field() const { return params_.field; }
@@ -132,6 +135,7 @@ class FOXI_API InteractiveView {
   std::size_t mpvo_pos_ = 0;
   std::unique_ptr<TetRasterizer> raster_;
   const IsoDrawing* iso_ = nullptr;
+  bool selecting_ = false;                 // set_iso or set_subset: only iso_tets_ are drawn
   std::vector<std::uint32_t> iso_tets_;    // sorted
   std::vector<std::uint32_t> iso_subset_;  // iso_tets_ within the region on top of the stack
   std::unique_ptr<IsoPainter> iso_painter_;
