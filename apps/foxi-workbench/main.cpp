@@ -24,7 +24,8 @@ const char* kUsage =
     "foxi-workbench [MODEL.toml]\n"
     "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics thermal] [--field NAME]\n"
     "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
-    "               [--iso v [--iso-only]] [--threshold a,b] [--clip px,py,pz,nx,ny,nz]\n"
+    "               [--regions ID,...] [--graded] [--range a,b] [--iso v [--iso-only]] [--threshold a,b] "
+    "[--clip px,py,pz,nx,ny,nz]\n"
     "               [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh MESH.vtu]\n"
     "  The window: open a model, edit its parameters (with units, checked as the model file would\n"
     "  be), mesh and solve on worker threads (Cancel keeps the previous mesh), look inside with the\n"
@@ -35,7 +36,8 @@ const char* kUsage =
     "  completely and saves the window (--screenshot), the view's own picture (--save-picture: what\n"
     "  foxi render draws for the same mesh, field and camera) and the mesh with its fields\n"
     "  (--save-mesh). Prints the tets, the key results and the camera as foxi render options.\n"
-    "  --iso, --iso-only, --threshold and --clip set the view's field tools as foxi render's options\n"
+    "  --regions, --graded, --range, --iso, --iso-only, --threshold and --clip set the view's field tools as "
+    "foxi render's options\n"
     "  of the same names draw them (values in the field's display unit, as the legend shows it).\n"
     "  Run it with QT_QPA_PLATFORM=offscreen where there is no display.\n"
     "  Exit status: 0 ok, 1 failure, 2 usage, 3 bad model or parameter, 4 a result failed its checks.";
@@ -82,6 +84,8 @@ struct ToolOptions {
   bool iso_only = false;
   std::vector<double> threshold, clip;
   bool any() const { return !iso.empty() || !threshold.empty() || !clip.empty(); }
+  bool graded = false;
+  std::vector<double> range, regions;
 };
 
 int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std::string& model,
@@ -104,6 +108,11 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     }
   }
   w.set_shrink(shrink);
+  if (tools.graded || !tools.range.empty()) {
+    std::optional<std::pair<double, double>> r;
+    if (!tools.range.empty()) r = std::pair(tools.range[0], tools.range[1]);
+    w.set_colouring(tools.graded, r);
+  }
   QApplication::processEvents();  // the window laid out: the view has its size before the picture is made
   if (!w.start_mesh() || !wait_job(w)) {
     std::fprintf(stderr, "foxi-workbench: error: meshing: %s\n", w.last_error().toUtf8().constData());
@@ -120,6 +129,16 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     if (!w.set_field(QString::fromStdString(field), QString::fromStdString(cmap)) || !wait_job(w)) {
       std::fprintf(stderr, "foxi-workbench: error: --field %s: %s\n", field.c_str(),
                    w.last_error().toUtf8().constData());
+      return kExitBadInput;
+    }
+  }
+  if (!tools.regions.empty()) {
+    std::vector<std::int32_t> hidden;
+    for (const foxi::Region& r : w.mesh()->regions)
+      if (std::find(tools.regions.begin(), tools.regions.end(), double(r.id)) == tools.regions.end())
+        hidden.push_back(r.id);
+    if (!w.set_hidden_regions(hidden) || !wait_job(w)) {
+      std::fprintf(stderr, "foxi-workbench: error: --regions: %s\n", w.last_error().toUtf8().constData());
       return kExitBadInput;
     }
   }
@@ -224,6 +243,13 @@ int main(int argc, char** argv) {
         }
       } else if (a == "--iso") {
         tools.iso = parse_list(value(), "--iso", 0);
+      } else if (a == "--regions") {
+        tools.regions = parse_list(value(), "--regions", 0);
+      } else if (a == "--graded") {
+        tools.graded = true;
+      } else if (a == "--range") {
+        tools.range = parse_list(value(), "--range", 2);
+        if (!(tools.range[0] < tools.range[1])) throw Usage("--range takes a,b with a < b");
       } else if (a == "--iso-only") {
         tools.iso_only = true;
       } else if (a == "--threshold") {
@@ -244,8 +270,9 @@ int main(int argc, char** argv) {
     if (is_headless && model.empty()) throw Usage("--headless needs a model file");
     if (tools.iso_only && tools.iso.empty())
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
-    if (!is_headless && (tools.any() || !sets.empty() || !physics.empty() || !field.empty() ||
-                         !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
+    if (!is_headless &&
+        (tools.any() || tools.graded || !tools.range.empty() || !tools.regions.empty() || !sets.empty() ||
+         !physics.empty() || !field.empty() || !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
       throw Usage(
           "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")

@@ -17,6 +17,7 @@
 #include <QHeaderView>
 #include <QImage>
 #include <QLabel>
+#include <QListWidget>
 #include <QPainter>
 #include <QPlainTextEdit>
 #include <QProgressBar>
@@ -71,6 +72,7 @@ struct Outcome {
   ColorScale scale;
   DisplayUnit unit;
   bool has_scale = false;
+  std::vector<std::uint32_t> base;    // the tets of the regions shown (empty: all)
   std::optional<FieldChoice> choice;  // the field shown, for the field tools
   std::size_t step = 0;
   std::shared_ptr<IsoCache> iso_cache;  // built here, on the worker: the tools then only query
@@ -105,10 +107,20 @@ const char* progress_stage(int index) {
   return index > 0 && index < int(std::size(kStages)) ? kStages[index] : "";
 }
 
-// The display of `mesh` on the worker: the field's flat paint on the automatic scale (as foxi
-// render --field NAME --cmap MAP draws it) and the view, built with `camera` (null: the default).
-void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const std::string& cmap,
+// The display of `mesh` on the worker: the field's paint, flat or graded, on the automatic scale or
+// the user's range (as foxi render --field NAME --cmap MAP [--graded] [--range a,b] draws it) and the
+// view, built with `camera` (null: the default).
+void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const Colouring& colouring,
                    double shrink, int w, int h, const Camera* camera) {
+  // The regions shown: the tets of the others left out (foxi render --regions); the automatic colour
+  // range is that of the tets shown, as there.
+  if (!colouring.hidden.empty()) {
+    for (std::size_t t = 0; t < mesh.tet_count(); ++t)
+      if (std::find(colouring.hidden.begin(), colouring.hidden.end(), mesh.region_of(t)) ==
+          colouring.hidden.end())
+        out.base.push_back(std::uint32_t(t));
+    if (out.base.empty()) throw std::runtime_error("every region is hidden: nothing to show");
+  }
   RenderParams params;
   params.undoable = true;  // the workbench undraws
   params.shrink = shrink;
@@ -116,21 +128,40 @@ void build_display(Outcome& out, const Mesh& mesh, const std::string& field, con
     const FieldChoice choice = choose_field(mesh, field);
     const std::size_t step = choice.field->step_count() - 1;
     const std::vector<double> values = tet_centroid_values(mesh, choice, step);
-    const ColorMapId map = parse_color_map(cmap).value_or(ColorMapId::viridis);
-    const std::optional<AutoScale> a = automatic_scale(values, map);
-    if (!a) throw FieldSelectError("field '" + field + "' has no finite value");
-    params.field = std::make_shared<const FieldPaint>(flat_field_paint(values, a->scale));
-    out.scale = a->scale;
+    out.iso_cache = std::make_shared<IsoCache>(make_iso_cache(mesh, choice, step));
+    // The values drawn: per tet, or per tet corner (graded); the unit and automatic range are theirs.
+    const std::vector<double>& all = colouring.graded ? *out.iso_cache->corner : values;
+    std::vector<double> shown;
+    const std::size_t per = colouring.graded ? 4 : 1;
+    for (std::uint32_t t : out.base)
+      shown.insert(shown.end(), all.begin() + std::ptrdiff_t(per * t),
+                   all.begin() + std::ptrdiff_t(per * (t + 1)));
+    const std::vector<double>& drawn = out.base.empty() ? all : shown;
+    const ColorMapId map = parse_color_map(colouring.cmap).value_or(ColorMapId::viridis);
+    const auto [lo, hi] = finite_range(drawn);
+    out.unit = default_display_unit(choice.field->unit,
+                                    std::isfinite(lo) ? std::max(std::abs(lo), std::abs(hi)) : 0);
+    ColorScale scale;
+    if (colouring.range) {
+      scale.map = map;
+      scale.lo = out.unit.to_si(colouring.range->first);
+      scale.hi = out.unit.to_si(colouring.range->second);
+      if (scale.lo > scale.hi) std::swap(scale.lo, scale.hi);
+    } else {
+      const std::optional<AutoScale> a = automatic_scale(drawn, map);
+      if (!a) throw FieldSelectError("field '" + field + "' has no finite value");
+      scale = a->scale;
+    }
+    params.field = std::make_shared<const FieldPaint>(colouring.graded ? graded_field_paint(all, scale)
+                                                                       : flat_field_paint(all, scale));
+    out.scale = scale;
     out.has_scale = true;
-    const auto [lo, hi] = finite_range(values);
-    out.unit = default_display_unit(choice.field->unit, std::max(std::abs(lo), std::abs(hi)));
     out.probe.resize(values.size());
     for (std::size_t i = 0; i < values.size(); ++i) out.probe[i] = out.unit.to_display(values[i]);
     out.probe_unit = QString::fromStdString(out.unit.symbol);
     out.field_label = QString::fromStdString(choice.label);
     out.choice = choice;
     out.step = step;
-    out.iso_cache = std::make_shared<IsoCache>(make_iso_cache(mesh, choice, step));
     std::tie(out.corner_lo, out.corner_hi) = finite_range(*out.iso_cache->corner);
   }
   out.view = foxi::qt::make_view(mesh, params, w, h, camera);
@@ -270,6 +301,31 @@ void Workbench::build_ui() {
   shrink_box_->setToolTip(tr("each tet scaled about its centroid: see between them"));
   connect(shrink_box_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
           [this](double v) { set_shrink(v); });
+  graded_box_ = new QCheckBox(tr("graded"));
+  graded_box_->setToolTip(tr("each face's colour interpolated from its corners (foxi render --graded)"));
+  range_on_ = new QCheckBox(tr("range"));
+  range_on_->setToolTip(tr("the colour range in the legend's unit (otherwise the values' own range)"));
+  range_lo_ = new QDoubleSpinBox;
+  range_hi_ = new QDoubleSpinBox;
+  for (QDoubleSpinBox* b : {range_lo_, range_hi_}) {
+    b->setDecimals(3);
+    b->setRange(-1e12, 1e12);
+    b->setKeyboardTracking(false);
+  }
+  range_hi_->setValue(1);
+  auto recolour = [this] {
+    std::optional<std::pair<double, double>> r;
+    if (range_on_->isChecked()) r = std::pair(range_lo_->value(), range_hi_->value());
+    if (!set_colouring(graded_box_->isChecked(), r)) param_error_->setText(tr("the range needs low < high"));
+  };
+  connect(graded_box_, &QCheckBox::toggled, this, recolour);
+  connect(range_on_, &QCheckBox::toggled, this, recolour);
+  connect(range_lo_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, recolour);
+  connect(range_hi_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, recolour);
+  fields->addWidget(graded_box_);
+  fields->addWidget(range_on_);
+  fields->addWidget(range_lo_);
+  fields->addWidget(range_hi_);
   fields->addWidget(new QLabel(tr("shrink")));
   fields->addWidget(shrink_box_);
   cv->addLayout(fields);
@@ -310,6 +366,22 @@ void Workbench::build_ui() {
   tools->addWidget(clip_axis_);
   tools->addWidget(clip_slider_, 1);
   cv->addLayout(tools);
+  regions_ = new QListWidget;
+  regions_->setFlow(QListView::LeftToRight);
+  regions_->setMaximumHeight(32);
+  regions_->setToolTip(tr("the regions shown (foxi render --regions)"));
+  connect(regions_, &QListWidget::itemChanged, this, [this] {
+    if (filling_) return;
+    std::vector<std::int32_t> hidden;
+    for (int i = 0; i < regions_->count(); ++i)
+      if (regions_->item(i)->checkState() != Qt::Checked)
+        hidden.push_back(regions_->item(i)->data(Qt::UserRole).toInt());
+    set_hidden_regions(hidden);
+  });
+  auto* region_row = new QHBoxLayout;
+  region_row->addWidget(new QLabel(tr("regions shown")));
+  region_row->addWidget(regions_, 1);
+  cv->addLayout(region_row);
   for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_})
     connect(c, &QCheckBox::toggled, this, [this] { apply_field_tools(); });
   connect(iso_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
@@ -624,7 +696,7 @@ struct JobInput {
   std::shared_ptr<const Model> old_model;  // and the model it came from
   int width = 1, height = 1;
   std::optional<Camera> camera;  // the view's camera stays across a remesh (compare before and after)
-  std::string cmap;
+  Colouring colouring;
   double shrink = 1;
   std::shared_ptr<std::atomic<bool>> cancel;
   std::shared_ptr<std::atomic<int>> permille;
@@ -683,7 +755,7 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
       out->solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
       out->solved = true;
     }
-    build_display(*out, *mesh, in.solve ? "temperature" : "", in.cmap, in.shrink, in.width, in.height,
+    build_display(*out, *mesh, in.solve ? "temperature" : "", in.colouring, in.shrink, in.width, in.height,
                   in.camera ? &*in.camera : nullptr);
     out->mesh = std::move(mesh);
     out->model = std::move(model);
@@ -717,7 +789,7 @@ bool Workbench::start_job(bool mesh, bool solve) {
   in.width = view_->width();
   in.height = view_->height();
   if (view_->camera()) in.camera = *view_->camera();
-  in.cmap = color_map_.toStdString();
+  in.colouring = colouring();
   in.shrink = shrink_;
   in.cancel = std::make_shared<std::atomic<bool>>(false);
   in.permille = std::make_shared<std::atomic<int>>(0);
@@ -736,17 +808,17 @@ bool Workbench::start_solve() { return start_job(false, true); }
 bool Workbench::set_field(const QString& field, const QString& color_map) {
   if (busy() || !mesh_) return false;
   std::shared_ptr<const Mesh> mesh = mesh_;
-  const std::string f = field.toStdString(), cmap = color_map.toStdString();
+  const std::string f = field.toStdString();
   const double shrink = shrink_;
   const int w = view_->width(), h = view_->height();
   std::optional<Camera> cam;
   if (view_->camera()) cam = *view_->camera();
   field_ = field;
   color_map_ = color_map;
-  auto work = [mesh, f, cmap, shrink, w, h, cam]() {
+  auto work = [mesh, f, c = colouring(), shrink, w, h, cam]() {
     auto out = std::make_shared<Outcome>();
     try {
-      build_display(*out, *mesh, f, cmap, shrink, w, h, cam ? &*cam : nullptr);
+      build_display(*out, *mesh, f, c, shrink, w, h, cam ? &*cam : nullptr);
       out->mesh = mesh;
       out->ok = true;
     } catch (const std::exception& e) {
@@ -757,6 +829,32 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
   launch(work, tr("colouring"), std::make_shared<std::atomic<bool>>(false),
          std::make_shared<std::atomic<int>>(0));
   return true;
+}
+
+Colouring Workbench::colouring() const {
+  return Colouring{color_map_.toStdString(), graded_, range_, hidden_};
+}
+
+bool Workbench::set_hidden_regions(std::vector<std::int32_t> hidden) {
+  hidden_ = std::move(hidden);
+  return !mesh_ || set_field(field_, color_map_);
+}
+
+bool Workbench::set_colouring(bool graded, std::optional<std::pair<double, double>> range) {
+  if (range && !(range->first < range->second && std::isfinite(range->first) && std::isfinite(range->second)))
+    return false;
+  graded_ = graded;
+  range_ = range;
+  {
+    const QSignalBlocker q1(graded_box_), q2(range_on_), q3(range_lo_), q4(range_hi_);
+    graded_box_->setChecked(graded);
+    range_on_->setChecked(range.has_value());
+    if (range) {
+      range_lo_->setValue(range->first);
+      range_hi_->setValue(range->second);
+    }
+  }
+  return !mesh_ || field_.isEmpty() || set_field(field_, color_map_);
 }
 
 bool Workbench::set_shrink(double shrink) {
@@ -819,6 +917,7 @@ void Workbench::on_job_done() {
   view_->set_view(out->mesh, std::move(out->view));
   view_->set_probe_values(std::move(out->probe), out->probe_unit);
   mesh_bounds(*out->mesh, bounds_lo_, bounds_hi_);
+  view_->set_base(std::move(out->base));
   if (out->has_scale && out->choice) {
     view_->set_field_source(*out->choice, out->step, out->scale, out->iso_cache);
     unit_ = out->unit;
@@ -929,6 +1028,17 @@ void Workbench::refresh_fields() {
   const int i = field_.isEmpty() ? 0 : field_box_->findText(field_);
   field_box_->setCurrentIndex(std::max(i, 0));
   cmap_box_->setCurrentText(color_map_);
+  regions_->clear();
+  if (mesh_)
+    for (const Region& r : mesh_->regions) {
+      auto* item =
+          new QListWidgetItem(r.name.empty() ? QString::number(r.id) : QString::fromStdString(r.name));
+      item->setData(Qt::UserRole, r.id);
+      item->setFlags(item->flags() | Qt::ItemIsUserCheckable);
+      item->setCheckState(std::find(hidden_.begin(), hidden_.end(), r.id) == hidden_.end() ? Qt::Checked
+                                                                                           : Qt::Unchecked);
+      regions_->addItem(item);
+    }
   filling_ = false;
 }
 

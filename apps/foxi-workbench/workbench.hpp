@@ -13,7 +13,9 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "foxi/model/mesh.hpp"
@@ -27,6 +29,7 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
+class QListWidget;
 class QProgressBar;
 class QPushButton;
 class QSlider;
@@ -43,6 +46,14 @@ struct HistoryRow {
   std::size_t tets = 0;
   RunResults results;  // status failed with no values: meshed only
   double seconds = 0;  // mesh + solve wall time
+};
+
+// How the field is coloured: the map, flat or graded, the automatic range or the user's (display unit).
+struct Colouring {
+  std::string cmap = "viridis";
+  bool graded = false;
+  std::optional<std::pair<double, double>> range;
+  std::vector<std::int32_t> hidden;  // regions hidden
 };
 
 // What a worker hands back (mesh, solve or a new field paint).
@@ -83,6 +94,13 @@ class Workbench : public QMainWindow {
 
   // The field shown ("" for regions) and its colour map; rebuilds the picture on a worker.
   bool set_field(const QString& field, const QString& color_map = "viridis");
+
+  // Graded colouring (foxi render --graded) and a colour range in the field's display unit (--range
+  // a,b; nullopt: the values' own); recolours on a worker. False for a range without low < high.
+  bool set_colouring(bool graded, std::optional<std::pair<double, double>> range);
+  Colouring colouring() const;
+  // The regions not shown (by id; foxi render --regions shows the others); redraws on a worker.
+  bool set_hidden_regions(std::vector<std::int32_t> hidden);
 
   // Each tet drawn scaled about its centroid by `shrink` in (0, 1] (foxi render --shrink); false
   // for a value outside or while a job runs.
@@ -146,6 +164,9 @@ class Workbench : public QMainWindow {
   std::vector<HistoryRow> history_;
   QString field_, color_map_ = "viridis";
   double shrink_ = 1;
+  bool graded_ = false;
+  std::optional<std::pair<double, double>> range_;
+  std::vector<std::int32_t> hidden_;
   FieldSelection selection_;  // of selection_field_ (SI)
   QString selection_field_;
   DisplayUnit unit_;
@@ -171,6 +192,8 @@ class Workbench : public QMainWindow {
   QTableWidget* history_table_ = nullptr;
   QComboBox *field_box_ = nullptr, *cmap_box_ = nullptr;
   QDoubleSpinBox* shrink_box_ = nullptr;
+  QCheckBox *graded_box_ = nullptr, *range_on_ = nullptr;
+  QDoubleSpinBox *range_lo_ = nullptr, *range_hi_ = nullptr;
   QLabel* legend_ = nullptr;
   QSlider* fraction_ = nullptr;
   QCheckBox *iso_on_ = nullptr, *iso_only_ = nullptr, *threshold_on_ = nullptr, *clip_on_ = nullptr;
@@ -178,6 +201,7 @@ class Workbench : public QMainWindow {
   QLabel* iso_value_ = nullptr;
   QDoubleSpinBox *threshold_lo_ = nullptr, *threshold_hi_ = nullptr;
   QComboBox* clip_axis_ = nullptr;
+  QListWidget* regions_ = nullptr;
   QLabel *status_ = nullptr, *probe_ = nullptr;
   bool filling_ = false;  // the tables being filled by the program, not edited
 };

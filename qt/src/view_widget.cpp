@@ -40,6 +40,7 @@ struct ViewWidget::Impl {
     std::shared_ptr<IsoCache> cache;
   };
   std::optional<Source> source;
+  std::vector<std::uint32_t> base;  // the regions shown (empty: all)
   FieldSelection selection;
   std::unique_ptr<TetSelection> picked;
   std::unique_ptr<IsoDrawing> drawing;
@@ -87,6 +88,7 @@ void ViewWidget::set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<Inte
   // The old view goes before the mesh it was lent (and the selection it borrowed).
   d_->view = std::move(view);
   d_->source.reset();
+  d_->base.clear();
   d_->selection = {};
   d_->drawing.reset();
   d_->picked.reset();
@@ -102,6 +104,7 @@ void ViewWidget::clear() {
   d_->timer.stop();
   d_->view.reset();
   d_->source.reset();
+  d_->base.clear();
   d_->selection = {};
   d_->drawing.reset();
   d_->picked.reset();
@@ -146,7 +149,7 @@ QString ViewWidget::probe_text(int x, int y) const {
 void ViewWidget::set_field_source(FieldChoice choice, std::size_t step, ColorScale scale,
                                   std::shared_ptr<IsoCache> cache) {
   if (d_->view && d_->selection.any()) {
-    d_->view->set_subset(std::nullopt);
+    d_->view->set_subset(d_->base.empty() ? std::nullopt : std::optional(d_->base));
     draw();
   }
   d_->selection = {};
@@ -162,7 +165,7 @@ bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) 
   };
   if (!d_->view) return fail(tr("no mesh shown"));
   if (!selection.any()) {
-    d_->view->set_subset(std::nullopt);
+    d_->view->set_subset(d_->base.empty() ? std::nullopt : std::optional(d_->base));
     d_->selection = {};
     d_->drawing.reset();
     d_->picked.reset();
@@ -176,7 +179,7 @@ bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) 
   try {
     const Impl::Source& s = *d_->source;
     picked = std::make_unique<TetSelection>(
-        select_field_tets(selection, *d_->mesh, s.choice, s.step, s.scale, {}, s.cache.get()));
+        select_field_tets(selection, *d_->mesh, s.choice, s.step, s.scale, d_->base, s.cache.get()));
   } catch (const std::exception& e) {
     return fail(QString::fromStdString(e.what()));
   }
@@ -195,10 +198,18 @@ bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) 
   return true;
 }
 
+void ViewWidget::set_base(std::vector<std::uint32_t> tets) {
+  d_->base = std::move(tets);
+  if (!d_->view) return;
+  const FieldSelection s = d_->selection;
+  if (!set_selection(s)) set_selection({});
+}
+
 const FieldSelection& ViewWidget::selection() const { return d_->selection; }
 
 std::size_t ViewWidget::selected_tets() const {
   if (d_->picked) return d_->picked->subset.size();
+  if (!d_->base.empty()) return d_->base.size();
   return d_->mesh ? d_->mesh->tet_count() : 0;
 }
 

@@ -154,6 +154,21 @@ TEST(WorkbenchHeadless, ClipPictureEqualsFoxiRender) {
 TEST(WorkbenchHeadless, IsoWithinClipEqualsFoxiRender) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "0.8", "--iso 48 --clip 0.005,0.005,0,0,1,0");
 }
+// Graded colouring and a user's colour range (foxi render --graded --range), alone and under an isotherm.
+TEST(WorkbenchHeadless, GradedRangePictureEqualsFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--graded --range 46,52");
+}
+TEST(WorkbenchHeadless, GradedIsoPictureEqualsFoxiRender) {
+  check_headless("die_on_substrate.toml", "die_w=5mm", "T_max", "", "--graded --iso 50");
+}
+// Regions hidden: the others shown as foxi render --regions shows them (the colour range theirs),
+// alone and narrowing an isotherm.
+TEST(WorkbenchHeadless, RegionsShownEqualFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--regions 1,3");
+}
+TEST(WorkbenchHeadless, RegionsShownWithIsoEqualFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--regions 1 --iso 49");
+}
 
 // Once with a real X server (xvfb-run, Qt's xcb platform): the same view picture as offscreen.
 TEST(WorkbenchHeadless, UnderXvfbSamePictureAsOffscreen) {

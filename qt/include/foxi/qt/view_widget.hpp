@@ -76,6 +76,9 @@ class FOXI_API ViewWidget : public QWidget {
   // source, a slice (not drawn here yet), a clip plane with a zero normal.
   bool set_selection(const FieldSelection& selection, QString* error = nullptr);
   const FieldSelection& selection() const;
+  // The tets shown without a selection and that a selection narrows: those of the regions shown
+  // (foxi render --regions); empty: all. Redraws from the back; kept until the next view.
+  void set_base(std::vector<std::uint32_t> tets);
   // The tets the current selection draws (0 for none), or the whole mesh's count without one.
   std::size_t selected_tets() const;
 
