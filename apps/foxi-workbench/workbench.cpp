@@ -288,6 +288,8 @@ void Workbench::build_ui() {
   cv->addLayout(slider_row);
   auto* fields = new QHBoxLayout;
   field_box_ = new QComboBox;
+  field_box_->setMinimumContentsLength(12);
+  field_box_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
   cmap_box_ = new QComboBox;
   for (const char* m : {"viridis", "cividis", "coolwarm", "rainbow"}) cmap_box_->addItem(m);
   fields->addWidget(new QLabel(tr("field")));
@@ -301,17 +303,21 @@ void Workbench::build_ui() {
   shrink_box_->setToolTip(tr("each tet scaled about its centroid: see between them"));
   connect(shrink_box_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
           [this](double v) { set_shrink(v); });
+  // A value in the field's display unit (a range's end), taken when typed in full.
+  auto value_box = [] {
+    auto* b = new QDoubleSpinBox;
+    b->setDecimals(3);
+    b->setRange(-1e12, 1e12);
+    b->setKeyboardTracking(false);
+    b->setMaximumWidth(110);
+    return b;
+  };
   graded_box_ = new QCheckBox(tr("graded"));
   graded_box_->setToolTip(tr("each face's colour interpolated from its corners (foxi render --graded)"));
   range_on_ = new QCheckBox(tr("range"));
   range_on_->setToolTip(tr("the colour range in the legend's unit (otherwise the values' own range)"));
-  range_lo_ = new QDoubleSpinBox;
-  range_hi_ = new QDoubleSpinBox;
-  for (QDoubleSpinBox* b : {range_lo_, range_hi_}) {
-    b->setDecimals(3);
-    b->setRange(-1e12, 1e12);
-    b->setKeyboardTracking(false);
-  }
+  range_lo_ = value_box();
+  range_hi_ = value_box();
   range_hi_->setValue(1);
   auto recolour = [this] {
     std::optional<std::pair<double, double>> r;
@@ -341,22 +347,19 @@ void Workbench::build_ui() {
   iso_only_ = new QCheckBox(tr("surface only"));
   threshold_on_ = new QCheckBox(tr("threshold"));
   threshold_on_->setToolTip(tr("only the tets whose value (at the centroid) lies in the range"));
-  threshold_lo_ = new QDoubleSpinBox;
-  threshold_hi_ = new QDoubleSpinBox;
-  for (QDoubleSpinBox* b : {threshold_lo_, threshold_hi_}) {
-    b->setDecimals(3);
-    b->setRange(-1e12, 1e12);
-    b->setKeyboardTracking(false);
-  }
+  threshold_lo_ = value_box();
+  threshold_hi_ = value_box();
   clip_on_ = new QCheckBox(tr("clip"));
-  clip_on_->setToolTip(tr("only the whole tets behind the plane (normal along +axis)"));
+  clip_on_->setToolTip(
+      tr("only the whole tets behind the plane (its normal, along the axis chosen, points to "
+         "the part cut away)"));
   clip_axis_ = new QComboBox;
-  for (const char* a : {"x", "y", "z"}) clip_axis_->addItem(a);
+  for (const char* a : {"+x", "+y", "+z", "-x", "-y", "-z"}) clip_axis_->addItem(a);
   clip_slider_ = new QSlider(Qt::Horizontal);
   clip_slider_->setRange(0, 1000);
   clip_slider_->setValue(500);
   tools->addWidget(iso_on_);
-  tools->addWidget(iso_slider_, 2);
+  tools->addWidget(iso_slider_, 3);
   tools->addWidget(iso_value_);
   tools->addWidget(iso_only_);
   tools->addWidget(threshold_on_);
@@ -364,7 +367,7 @@ void Workbench::build_ui() {
   tools->addWidget(threshold_hi_);
   tools->addWidget(clip_on_);
   tools->addWidget(clip_axis_);
-  tools->addWidget(clip_slider_, 1);
+  tools->addWidget(clip_slider_, 2);
   cv->addLayout(tools);
   regions_ = new QListWidget;
   regions_->setFlow(QListView::LeftToRight);
@@ -920,6 +923,11 @@ void Workbench::on_job_done() {
   view_->set_base(std::move(out->base));
   if (out->has_scale && out->choice) {
     view_->set_field_source(*out->choice, out->step, out->scale, out->iso_cache);
+    if (!range_) {  // the range boxes start from the automatic range
+      const QSignalBlocker q1(range_lo_), q2(range_hi_);
+      range_lo_->setValue(out->unit.to_display(out->scale.lo));
+      range_hi_->setValue(out->unit.to_display(out->scale.hi));
+    }
     unit_ = out->unit;
     field_lo_ = out->corner_lo;
     field_hi_ = out->corner_hi;
@@ -983,11 +991,11 @@ void Workbench::show_selection() {
   }
   clip_on_->setChecked(s.clip.has_value());
   if (s.clip) {
-    // An axis plane of the slider's: its axis and position; any other plane leaves the controls.
+    // An axis plane of the slider's: its axis, side and position; any other plane leaves the controls.
     for (int k = 0; k < 3; ++k)
-      if (s.clip->n[k] > 0 && s.clip->n[(k + 1) % 3] == 0 && s.clip->n[(k + 2) % 3] == 0 &&
+      if (s.clip->n[k] != 0 && s.clip->n[(k + 1) % 3] == 0 && s.clip->n[(k + 2) % 3] == 0 &&
           bounds_hi_[k] > bounds_lo_[k]) {
-        clip_axis_->setCurrentIndex(k);
+        clip_axis_->setCurrentIndex(s.clip->n[k] > 0 ? k : k + 3);
         clip_slider_->setValue(
             int(std::lround(1000 * (s.clip->p[k] - bounds_lo_[k]) / (bounds_hi_[k] - bounds_lo_[k]))));
       }
@@ -1007,10 +1015,10 @@ void Workbench::apply_field_tools() {
     s.threshold = {unit_.to_si(threshold_lo_->value()), unit_.to_si(threshold_hi_->value())};
   if (clip_on_->isChecked()) {
     Plane p;
-    const int k = clip_axis_->currentIndex();
+    const int k = clip_axis_->currentIndex() % 3;
     for (int j = 0; j < 3; ++j) {
       p.p[j] = 0.5 * (bounds_lo_[j] + bounds_hi_[j]);
-      p.n[j] = j == k ? 1 : 0;
+      p.n[j] = j == k ? (clip_axis_->currentIndex() < 3 ? 1 : -1) : 0;
     }
     p.p[k] = bounds_lo_[k] + (bounds_hi_[k] - bounds_lo_[k]) * clip_slider_->value() / 1000.0;
     s.clip = p;
