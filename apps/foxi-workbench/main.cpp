@@ -4,6 +4,7 @@
 #include <QApplication>
 #include <QEventLoop>
 #include <QPixmap>
+#include <QStandardPaths>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -297,6 +298,8 @@ int main(int argc, char** argv) {
     if (is_headless)
       return headless(w, tools, model, sets, physics, field, cmap, shrink, screenshot, picture, mesh_out);
     w.restore_settings();
+    // Until a project is saved or opened, the session autosaves here (reopen it with Open project).
+    w.set_autosave_folder(QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/autosave");
     if (!model.empty()) w.open_model(QString::fromStdString(model));
     return app.exec();
   } catch (const Usage& e) {

@@ -8,6 +8,7 @@
 #include <QApplication>
 #include <QCheckBox>
 #include <QComboBox>
+#include <QDir>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QFileDialog>
@@ -16,8 +17,12 @@
 #include <QHBoxLayout>
 #include <QHeaderView>
 #include <QImage>
+#include <QJsonArray>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QLabel>
 #include <QListWidget>
+#include <QMenu>
 #include <QPainter>
 #include <QPlainTextEdit>
 #include <QProgressBar>
@@ -43,7 +48,9 @@
 #include "foxi/mesher/mesher.hpp"
 #include "foxi/mesher/model_mesh.hpp"
 #include "foxi/mesher/quality_report.hpp"
+#include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/mesh_io.hpp"
 #include "foxi/model/physics.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/units.hpp"
@@ -228,6 +235,13 @@ QPixmap histogram_pixmap(const MeshQualityReport& q) {
 
 Workbench::Workbench(QWidget* parent) : QMainWindow(parent) {
   build_ui();
+  // Autosave: 2 s after the first change since the last one (a burst of edits is one save), on a
+  // worker: a crash loses at most the last few seconds.
+  autosave_timer_ = new QTimer(this);
+  autosave_timer_->setSingleShot(true);
+  autosave_timer_->setInterval(2000);
+  connect(autosave_timer_, &QTimer::timeout, this, &Workbench::autosave);
+  connect(view_, &foxi::qt::ViewWidget::draw_finished, this, &Workbench::changed);  // the camera moved
   poll_ = new QTimer(this);
   poll_->setInterval(100);
   connect(poll_, &QTimer::timeout, this, [this] {
@@ -240,6 +254,7 @@ Workbench::Workbench(QWidget* parent) : QMainWindow(parent) {
 }
 
 Workbench::~Workbench() {
+  wait_autosave();
   if (job_) {
     job_->cancel->store(true);
     job_->watcher.waitForFinished();
@@ -419,6 +434,50 @@ void Workbench::build_ui() {
     if (!f.isEmpty() && open_model(f)) settings.setValue("last_model", f);
   });
   lv->addWidget(open);
+  // Projects: save and reopen the whole state; the folder is then autosaved; the recent ones listed.
+  auto* projects = new QHBoxLayout;
+  auto* save_p = new QPushButton(tr("Save project..."));
+  auto* open_p = new QPushButton(tr("Open project..."));
+  auto* recent = new QPushButton(tr("Recent"));
+  auto* recent_menu = new QMenu(recent);
+  recent->setMenu(recent_menu);
+  // After a save or an open of `folder`: it heads the recent list (QSettings) and is autosaved.
+  auto adopt = [this](bool ok, const QString& folder, const QString& why) {
+    if (!ok) {
+      show_error(why);
+      return;
+    }
+    QSettings settings;
+    QStringList list = settings.value("recent_projects").toStringList();
+    list.removeAll(folder);
+    list.prepend(folder);
+    while (list.size() > 8) list.removeLast();
+    settings.setValue("recent_projects", list);
+    set_autosave_folder(folder);
+  };
+  auto open_folder = [this, adopt](const QString& folder) {
+    QString why;
+    adopt(open_project(folder, &why), folder, why);
+  };
+  connect(save_p, &QPushButton::clicked, this, [this, adopt] {
+    const QString f = QFileDialog::getExistingDirectory(this, tr("Save the project into a folder"));
+    if (f.isEmpty()) return;
+    QString why;
+    adopt(save_project(f, &why), f, why);
+  });
+  connect(open_p, &QPushButton::clicked, this, [this, open_folder] {
+    const QString f = QFileDialog::getExistingDirectory(this, tr("Open a project folder"));
+    if (!f.isEmpty()) open_folder(f);
+  });
+  connect(recent_menu, &QMenu::aboutToShow, this, [recent_menu, open_folder] {
+    recent_menu->clear();
+    for (const QString& f : QSettings().value("recent_projects").toStringList())
+      recent_menu->addAction(f, [open_folder, f] { open_folder(f); });
+  });
+  projects->addWidget(save_p);
+  projects->addWidget(open_p);
+  projects->addWidget(recent);
+  lv->addLayout(projects);
   params_ = new QTableWidget(0, 3);
   params_->setObjectName("parameters");
   params_->setHorizontalHeaderLabels({tr("parameter"), tr("expression"), tr("value (SI)")});
@@ -589,6 +648,7 @@ bool Workbench::apply_overrides(std::map<std::string, std::string> trial, QStrin
         std::make_shared<const Model>(load_model(model_path_.toStdString(), list, "the parameter table"));
     overrides_ = std::move(trial);
     model_ = std::move(m);
+    changed();
     show_error({});
     refresh_model_panel();
     return true;
@@ -816,6 +876,7 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
   const int w = view_->width(), h = view_->height();
   std::optional<Camera> cam;
   if (view_->camera()) cam = *view_->camera();
+  if (pending_camera_) cam = std::exchange(pending_camera_, std::nullopt);
   field_ = field;
   color_map_ = color_map;
   auto work = [mesh, f, c = colouring(), shrink, w, h, cam]() {
@@ -832,6 +893,277 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
   launch(work, tr("colouring"), std::make_shared<std::atomic<bool>>(false),
          std::make_shared<std::atomic<int>>(0));
   return true;
+}
+
+namespace {
+
+QJsonArray numbers(const double* v, int n) {
+  QJsonArray a;
+  for (int i = 0; i < n; ++i) a.append(v[i]);
+  return a;
+}
+
+void read_numbers(const QJsonValue& v, double* out, int n) {
+  const QJsonArray a = v.toArray();
+  if (a.size() != n)
+    throw std::runtime_error("a camera vector of " + std::to_string(n) + " numbers expected");
+  for (int i = 0; i < n; ++i) out[i] = a[i].toDouble();
+}
+
+QJsonArray overrides_json(const std::vector<ParameterOverride>& ov) {
+  QJsonArray a;
+  for (const ParameterOverride& o : ov)
+    a.append(QJsonArray{QString::fromStdString(o.name), QString::fromStdString(o.expression)});
+  return a;
+}
+
+std::vector<ParameterOverride> overrides_of(const QJsonValue& v) {
+  std::vector<ParameterOverride> ov;
+  for (const QJsonValue& e : v.toArray())
+    ov.push_back({e.toArray().at(0).toString().toStdString(), e.toArray().at(1).toString().toStdString()});
+  return ov;
+}
+
+}  // namespace
+
+// What a save writes, taken on the GUI thread (the state may change meanwhile) and written on any thread.
+struct ProjectSnapshot {
+  std::filesystem::path dir;
+  QJsonObject json;
+  std::shared_ptr<const Mesh> mesh;
+};
+
+namespace {
+
+// Writes the mesh under a new name, then project.json naming it (both DurableFile: each whole or
+// not at all), then removes the mesh file the previous project.json named.
+void write_project(ProjectSnapshot snap) {
+  const std::filesystem::path& dir = snap.dir;
+  std::filesystem::create_directories(dir);
+  std::filesystem::path old_mesh;
+  if (std::filesystem::exists(dir / "project.json")) {
+    QFile f(QString::fromStdString((dir / "project.json").string()));
+    if (f.open(QIODevice::ReadOnly)) {
+      const QString m = QJsonDocument::fromJson(f.readAll()).object()["mesh"].toString();
+      if (!m.isEmpty()) old_mesh = dir / m.toStdString();
+    }
+  }
+  if (snap.mesh) {
+    // A new name each save: the previous project.json names a whole mesh until the new one is in.
+    std::string name;
+    for (int i = 1;; ++i) {
+      name = "mesh-" + std::to_string(i) + ".vtu";
+      if (!std::filesystem::exists(dir / name) && dir / name != old_mesh) break;
+    }
+    write_mesh(*snap.mesh, dir / name);
+    snap.json["mesh"] = QString::fromStdString(name);
+  }
+  DurableFile out(dir / "project.json");
+  out.write(QJsonDocument(snap.json).toJson().toStdString());
+  out.commit();
+  if (!old_mesh.empty() && old_mesh.filename().string() != snap.json["mesh"].toString().toStdString() &&
+      old_mesh.filename().string().rfind("mesh-", 0) == 0)
+    std::filesystem::remove(old_mesh);
+}
+
+}  // namespace
+
+ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
+  if (model_path_.isEmpty()) throw std::runtime_error("no model to save");
+  ProjectSnapshot snap;
+  snap.dir = folder.toStdString();
+  snap.mesh = mesh_;
+  QJsonObject& p = snap.json;
+  p["format"] = "foxi-workbench project 1";
+  p["model"] = QFileInfo(model_path_).absoluteFilePath();
+  p["overrides"] = overrides_json(overrides());
+  p["field"] = field_;
+  p["color_map"] = color_map_;
+  p["graded"] = graded_;
+  if (range_) p["range"] = QJsonArray{range_->first, range_->second};
+  QJsonArray hidden;
+  for (std::int32_t r : hidden_) hidden.append(r);
+  p["hidden_regions"] = hidden;
+  p["shrink"] = shrink_;
+  if (const Camera* c = view_->camera()) {
+    QJsonObject cam;
+    cam["perspective"] = c->perspective;
+    cam["eye"] = numbers(c->eye, 3);
+    cam["at"] = numbers(c->at, 3);
+    cam["up"] = numbers(c->up, 3);
+    cam["fov_deg"] = c->fov_deg;
+    cam["ortho_height"] = c->ortho_height;
+    p["camera"] = cam;
+  }
+  QJsonArray history;
+  for (const HistoryRow& h : history_) {
+    QJsonObject row;
+    row["parameters"] = overrides_json(h.parameters);
+    row["mesh"] = double(h.mesh);
+    row["tets"] = double(h.tets);
+    row["seconds"] = h.seconds;
+    row["results"] = QString::fromStdString(results_json(h.results));
+    history.append(row);
+  }
+  p["history"] = history;
+  if (has_results_) p["results"] = QString::fromStdString(results_json(results_));
+  p["mesh_overrides"] = overrides_json(meshed_overrides_);
+  if (selection_.any()) {
+    QJsonObject sel;
+    QJsonArray iso;
+    for (double v : selection_.iso) iso.append(v);
+    sel["iso"] = iso;
+    sel["iso_only"] = selection_.iso_only;
+    if (selection_.threshold)
+      sel["threshold"] = QJsonArray{selection_.threshold->first, selection_.threshold->second};
+    if (selection_.clip) {
+      QJsonArray c = numbers(selection_.clip->p, 3);
+      for (int k = 0; k < 3; ++k) c.append(selection_.clip->n[k]);
+      sel["clip"] = c;
+    }
+    p["selection"] = sel;
+  }
+  return snap;
+}
+
+bool Workbench::save_project(const QString& folder, QString* error) {
+  try {
+    if (busy()) throw std::runtime_error("a job is running: save when it ends");
+    if (autosaving_.isRunning()) autosaving_.waitForFinished();
+    write_project(project_snapshot(folder));
+    return true;
+  } catch (const std::exception& e) {
+    if (error) *error = QString::fromStdString(e.what());
+    return false;
+  }
+}
+
+void Workbench::set_autosave_folder(const QString& folder) {
+  autosave_folder_ = folder;
+  if (folder.isEmpty()) autosave_timer_->stop();
+}
+
+void Workbench::changed() {
+  if (!autosave_folder_.isEmpty() && !model_path_.isEmpty() && !autosave_timer_->isActive())
+    autosave_timer_->start();
+}
+
+void Workbench::autosave() {
+  // Not while a job runs (its result is the next change) or the previous autosave still writes.
+  if (busy() || autosaving_.isRunning()) {
+    autosave_timer_->start();
+    return;
+  }
+  try {
+    ProjectSnapshot snap = project_snapshot(autosave_folder_);
+    autosaving_ = QtConcurrent::run([snap = std::move(snap)]() -> QString {
+      try {
+        write_project(snap);
+        return {};
+      } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+      }
+    });
+    ++autosaves_;
+  } catch (const std::exception& e) {
+    progress_->setFormat(tr("autosave: %1").arg(QString::fromStdString(e.what())));
+  }
+}
+
+void Workbench::wait_autosave() {
+  if (autosaving_.isRunning()) autosaving_.waitForFinished();
+}
+
+bool Workbench::open_project(const QString& folder, QString* error) {
+  try {
+    if (busy()) throw std::runtime_error("a job is running");
+    const std::filesystem::path dir = folder.toStdString();
+    QFile f(QString::fromStdString((dir / "project.json").string()));
+    if (!f.open(QIODevice::ReadOnly))
+      throw std::runtime_error((dir / "project.json").string() + ": cannot read");
+    QJsonParseError perr;
+    const QJsonDocument doc = QJsonDocument::fromJson(f.readAll(), &perr);
+    if (doc.isNull())
+      throw std::runtime_error((dir / "project.json").string() + ": " + perr.errorString().toStdString());
+    const QJsonObject p = doc.object();
+    if (p["format"].toString() != "foxi-workbench project 1")
+      throw std::runtime_error((dir / "project.json").string() + ": not a foxi-workbench project");
+    QString why;
+    if (!open_model(p["model"].toString(), &why)) throw std::runtime_error(why.toStdString());
+    std::map<std::string, std::string> trial;
+    for (const ParameterOverride& o : overrides_of(p["overrides"])) trial[o.name] = o.expression;
+    if (!apply_overrides(trial, &why)) throw std::runtime_error(why.toStdString());
+    field_ = p["field"].toString();
+    color_map_ = p["color_map"].toString("viridis");
+    graded_ = p["graded"].toBool();
+    range_.reset();
+    if (p.contains("range"))
+      range_ = std::pair(p["range"].toArray().at(0).toDouble(), p["range"].toArray().at(1).toDouble());
+    hidden_.clear();
+    for (const QJsonValue& v : p["hidden_regions"].toArray()) hidden_.push_back(v.toInt());
+    shrink_ = p["shrink"].toDouble(1);
+    history_.clear();
+    for (const QJsonValue& v : p["history"].toArray()) {
+      const QJsonObject o = v.toObject();
+      HistoryRow h;
+      h.parameters = overrides_of(o["parameters"]);
+      h.mesh = std::size_t(o["mesh"].toDouble());
+      h.tets = std::size_t(o["tets"].toDouble());
+      h.seconds = o["seconds"].toDouble();
+      h.results = parse_results_json(o["results"].toString().toStdString());
+      history_.push_back(std::move(h));
+    }
+    has_results_ = p.contains("results");
+    if (has_results_) results_ = parse_results_json(p["results"].toString().toStdString());
+    if (!p["mesh"].toString().isEmpty()) {
+      mesh_ = std::make_shared<const Mesh>(read_mesh(dir / p["mesh"].toString().toStdString()));
+      meshed_model_ = model_;
+      meshed_overrides_ = overrides_of(p["mesh_overrides"]);
+      mesh_serial_ = history_.empty() ? 1 : history_.back().mesh;
+    }
+    if (p.contains("camera")) {
+      const QJsonObject c = p["camera"].toObject();
+      Camera cam;
+      cam.perspective = c["perspective"].toBool(true);
+      read_numbers(c["eye"], cam.eye, 3);
+      read_numbers(c["at"], cam.at, 3);
+      read_numbers(c["up"], cam.up, 3);
+      cam.fov_deg = c["fov_deg"].toDouble(30);
+      cam.ortho_height = c["ortho_height"].toDouble(1);
+      pending_camera_ = cam;
+    }
+    selection_ = {};
+    if (p.contains("selection")) {
+      const QJsonObject sel = p["selection"].toObject();
+      for (const QJsonValue& v : sel["iso"].toArray()) selection_.iso.push_back(v.toDouble());
+      selection_.iso_only = sel["iso_only"].toBool();
+      if (sel.contains("threshold"))
+        selection_.threshold = std::pair(sel["threshold"].toArray().at(0).toDouble(),
+                                         sel["threshold"].toArray().at(1).toDouble());
+      if (sel.contains("clip")) {
+        double c[6];
+        read_numbers(sel["clip"], c, 6);
+        Plane pl;
+        for (int k = 0; k < 3; ++k) pl.p[k] = c[k], pl.n[k] = c[k + 3];
+        selection_.clip = pl;
+      }
+    }
+    selection_field_ = field_;  // the display that follows applies it
+    {
+      const QSignalBlocker q1(graded_box_), q2(range_on_), q3(range_lo_), q4(range_hi_), q5(shrink_box_);
+      graded_box_->setChecked(graded_);
+      range_on_->setChecked(range_.has_value());
+      if (range_) range_lo_->setValue(range_->first), range_hi_->setValue(range_->second);
+      shrink_box_->setValue(shrink_);
+    }
+    if (has_results_) show_results();
+    refresh_history();
+    if (mesh_) set_field(field_, color_map_);
+    return true;
+  } catch (const std::exception& e) {
+    if (error) *error = QString::fromStdString(e.what());
+    return false;
+  }
 }
 
 Colouring Workbench::colouring() const {
@@ -951,11 +1283,13 @@ void Workbench::on_job_done() {
     show_results();
     add_history(mesh_seconds_ + out->solve_seconds);  // the mesh's row gets the results
   }
+  changed();
   emit finished(true);
 }
 
 bool Workbench::set_selection(const FieldSelection& selection, QString* error) {
   if (!view_->set_selection(selection, error)) return false;
+  changed();
   selection_ = selection;
   selection_field_ = field_;
   show_selection();
@@ -1091,6 +1425,10 @@ void Workbench::add_history(double seconds) {
     history_.push_back(row);
     history_table_->insertRow(i);
   }
+  fill_history_row(i, row);
+}
+
+void Workbench::fill_history_row(int i, const HistoryRow& row) {
   QString params;
   for (const ParameterOverride& o : row.parameters)
     params += QString::fromStdString(o.name + "=" + o.expression + " ");
@@ -1104,8 +1442,13 @@ void Workbench::add_history(double seconds) {
   history_table_->setItem(i, 0, new QTableWidgetItem(QString::number(i + 1)));
   history_table_->setItem(i, 1, new QTableWidgetItem(params.isEmpty() ? tr("(as in the file)") : params));
   history_table_->setItem(i, 2, new QTableWidgetItem(QString::number(row.tets)));
-  history_table_->setItem(i, 3, new QTableWidgetItem(has_results_ ? key : tr("meshed only")));
-  history_table_->setItem(i, 4, new QTableWidgetItem(QString("%1 s").arg(seconds, 0, 'f', 2)));
+  history_table_->setItem(i, 3, new QTableWidgetItem(row.results.values.empty() ? tr("meshed only") : key));
+  history_table_->setItem(i, 4, new QTableWidgetItem(QString("%1 s").arg(row.seconds, 0, 'f', 2)));
+}
+
+void Workbench::refresh_history() {
+  history_table_->setRowCount(int(history_.size()));
+  for (std::size_t i = 0; i < history_.size(); ++i) fill_history_row(int(i), history_[i]);
 }
 
 }  // namespace foxi::workbench

@@ -6,6 +6,7 @@
 // and the previous mesh and picture stay shown until a new one is ready.
 #pragma once
 
+#include <QFuture>
 #include <QMainWindow>
 #include <QString>
 #include <QStringList>
@@ -22,6 +23,7 @@
 #include "foxi/model/model_file.hpp"
 #include "foxi/qt/view_widget.hpp"
 #include "foxi/solver/results.hpp"
+#include "foxi/viz/camera.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/field_selection.hpp"
 
@@ -58,6 +60,7 @@ struct Colouring {
 
 // What a worker hands back (mesh, solve or a new field paint).
 struct Outcome;
+struct ProjectSnapshot;
 
 class Workbench : public QMainWindow {
   Q_OBJECT
@@ -118,6 +121,22 @@ class Workbench : public QMainWindow {
   // The isovalue slider (0 .. 1000 over [field_lo, field_hi]): moving it moves the isosurface.
   QSlider* iso_slider() const { return iso_slider_; }
 
+  // A project folder: project.json (the model file's absolute path, so its material library and STL
+  // references stay valid; the parameter overrides, the colouring, the camera, the history, the
+  // results) and the mesh with its fields as mesh-N.vtu. Each file is written to a temporary and
+  // renamed (DurableFile); project.json last, naming the new mesh file, so a save killed half way
+  // leaves the previous project whole. False with the reason in `error`.
+  bool save_project(const QString& folder, QString* error = nullptr);
+  // Reopens a saved project: the model with its overrides, the mesh and results as saved, the view
+  // with the saved camera and colouring (drawn on a worker: finished() follows). False with the reason.
+  bool open_project(const QString& folder, QString* error = nullptr);
+
+  // Autosave into `folder` (a project folder; empty: off) within 5 s of a change (2 s after the
+  // first change of a burst, written on a worker as save_project writes). autosaves(): started so far.
+  void set_autosave_folder(const QString& folder);
+  int autosaves() const { return autosaves_; }
+  void wait_autosave();  // the running autosave written (for tests and quitting)
+
   std::shared_ptr<const Mesh> mesh() const { return mesh_; }
   const RunResults* results() const { return has_results_ ? &results_ : nullptr; }
   const std::vector<HistoryRow>& history() const { return history_; }
@@ -145,8 +164,13 @@ class Workbench : public QMainWindow {
   void on_job_done();
   void show_results();
   void add_history(double seconds);
+  void fill_history_row(int i, const HistoryRow& row);
+  void refresh_history();
   void refresh_fields();
   void show_error(const QString& text);
+  void changed();  // something a project holds changed: autosave soon
+  void autosave();
+  ProjectSnapshot project_snapshot(const QString& folder) const;
   void apply_field_tools();  // the controls' selection to the view
   void show_selection();     // the controls to the selection
 
@@ -167,6 +191,11 @@ class Workbench : public QMainWindow {
   bool graded_ = false;
   std::optional<std::pair<double, double>> range_;
   std::vector<std::int32_t> hidden_;
+  std::optional<Camera> pending_camera_;
+  QString autosave_folder_;
+  QTimer* autosave_timer_ = nullptr;
+  QFuture<QString> autosaving_;
+  int autosaves_ = 0;         // a reopened project's, for the next display
   FieldSelection selection_;  // of selection_field_ (SI)
   QString selection_field_;
   DisplayUnit unit_;

@@ -430,6 +430,102 @@ TEST(Workbench, IsoSliderMovesTheIsovalueBothWays) {
   EXPECT_FALSE(v->selection().any());
 }
 
+// A project saved and reopened in a new window: the same parameters, mesh (counts, coordinates),
+// results, history, camera and picture; a save killed half way (its temporaries left behind: a
+// partial project.json temporary, a mesh file project.json does not name) leaves the saved project
+// readable and the same.
+TEST(Workbench, ProjectSaveReopenAndKilledSave) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "proj").string());
+  std::vector<std::uint32_t> ids;
+  std::vector<double> xyz;
+  std::size_t tets = 0;
+  double t_max = 0;
+  std::string camera;
+  {
+    Workbench w;
+    w.view_widget()->setFixedSize(200, 150);
+    w.show();
+    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+    ASSERT_TRUE(w.set_parameter("die_w", "6 mm"));
+    ASSERT_TRUE(w.start_solve());
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    w.view_widget()->view()->orbit(20, 10);  // a camera of the user's, not the default
+    foxi::FieldSelection sel;                // and an isotherm in the middle of the range
+    sel.iso = {0.5 * (w.field_lo() + w.field_hi())};
+    ASSERT_TRUE(w.set_selection(sel));
+    w.view_widget()->finish_now();
+    QString why;
+    ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
+    ids = w.view_widget()->view()->framebuffer().id;
+    xyz = w.mesh()->xyz;
+    tets = w.mesh()->tet_count();
+    t_max = w.results()->find("T_max")->value;
+    camera = w.view_widget()->camera_options();
+  }
+  auto reopen = [&](const char* when) {
+    Workbench w;
+    w.view_widget()->setFixedSize(200, 150);
+    w.show();
+    QString why;
+    ASSERT_TRUE(w.open_project(folder, &why)) << when << ": " << why.toStdString();
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    ASSERT_EQ(w.overrides().size(), 1u) << when;
+    EXPECT_EQ(w.overrides()[0].name, "die_w");
+    EXPECT_EQ(w.overrides()[0].expression, "6 mm");
+    ASSERT_TRUE(w.mesh());
+    EXPECT_EQ(w.mesh()->tet_count(), tets);
+    EXPECT_TRUE(w.mesh()->xyz == xyz) << when << ": the coordinates as saved";
+    ASSERT_NE(w.results(), nullptr);
+    EXPECT_EQ(w.results()->find("T_max")->value, t_max);
+    ASSERT_EQ(w.history().size(), 1u);
+    EXPECT_EQ(w.history()[0].tets, tets);
+    EXPECT_EQ(w.view_widget()->camera_options(), camera) << when;
+    ASSERT_EQ(w.view_widget()->selection().iso.size(), 1u) << when << ": the isotherm as saved";
+    w.view_widget()->finish_now();
+    EXPECT_TRUE(w.view_widget()->view()->framebuffer().id == ids) << when << ": the same picture";
+  };
+  reopen("after the save");
+  // What a save killed while writing leaves: a temporary of project.json cut short (its writer's
+  // process gone) and the next mesh file written but not yet named by project.json.
+  const auto p = dir.path() / "proj";
+  {
+    std::ofstream(p / "project.json.foxi-tmp-999999999-killed") << "{\"format\": \"foxi-workbench proj";
+    std::ofstream(p / "mesh-9.vtu") << "<?xml version=\"1.0\"?><VTKFile";
+  }
+  reopen("after a killed save");
+}
+
+// Autosave: within 5 s of a parameter change the autosave folder holds a project with it (written on
+// a worker), which reopens with that value.
+TEST(Workbench, AutosaveWithinFiveSeconds) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "auto").string());
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.set_autosave_folder(folder);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(w.set_parameter("die_w", "4 mm"));
+  const auto json = dir.path() / "auto" / "project.json";
+  auto has_value = [&] {
+    return std::filesystem::exists(json) && foxi::test::read_text(json).find("4 mm") != std::string::npos;
+  };
+  while (!has_value() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(6)) {
+    QApplication::processEvents(QEventLoop::AllEvents, 50);
+    w.wait_autosave();
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(has_value()) << "no autosave within 6 s";
+  EXPECT_LT(s, 5.0);
+  EXPECT_GE(w.autosaves(), 1);
+  Workbench again;
+  QString why;
+  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
+  ASSERT_EQ(again.overrides().size(), 1u);
+  EXPECT_EQ(again.overrides()[0].expression, "4 mm");
+}
+
 // The view follows the fraction slider both ways: drawing on to it and undrawing back to it; a
 // fraction's picture equals a draw of that many tets from scratch (InteractiveView's undraw rule).
 TEST(ViewWidget, FractionDrawsAndUndraws) {
