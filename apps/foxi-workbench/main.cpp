@@ -27,7 +27,8 @@ const char* kUsage =
     "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
     "               [--regions ID,...] [--graded] [--range a,b] [--iso v [--iso-only]] [--threshold a,b] "
     "[--clip px,py,pz,nx,ny,nz]\n"
-    "               [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh MESH.vtu]\n"
+    "               [--save-project FOLDER] [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh "
+    "MESH.vtu]\n"
     "  The window: open a model, edit its parameters (with units, checked as the model file would\n"
     "  be), mesh and solve on worker threads (Cancel keeps the previous mesh), look inside with the\n"
     "  painter (draw, stop, step, undraw, the drawn-fraction slider, regions of interest), colour by a\n"
@@ -37,6 +38,7 @@ const char* kUsage =
     "  completely and saves the window (--screenshot), the view's own picture (--save-picture: what\n"
     "  foxi render draws for the same mesh, field and camera) and the mesh with its fields\n"
     "  (--save-mesh). Prints the tets, the key results and the camera as foxi render options.\n"
+    "  --save-project writes the project folder (Save project in the window).\n"
     "  --regions, --graded, --range, --iso, --iso-only, --threshold and --clip set the view's field tools as "
     "foxi render's options\n"
     "  of the same names draw them (values in the field's display unit, as the legend shows it).\n"
@@ -87,6 +89,7 @@ struct ToolOptions {
   bool any() const { return !iso.empty() || !threshold.empty() || !clip.empty(); }
   bool graded = false;
   std::vector<double> range, regions;
+  std::string project;  // --save-project
 };
 
 int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std::string& model,
@@ -190,6 +193,14 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     }
     std::printf("wrote %s\n", screenshot.c_str());
   }
+  if (!tools.project.empty()) {
+    if (!w.save_project(QString::fromStdString(tools.project), &error)) {
+      std::fprintf(stderr, "foxi-workbench: error: %s: %s\n", tools.project.c_str(),
+                   error.toUtf8().constData());
+      return kExitFailure;
+    }
+    std::printf("wrote project %s\n", tools.project.c_str());
+  }
   if (!mesh_out.empty()) {
     foxi::write_mesh(*w.mesh(), mesh_out);
     std::printf("wrote %s\n", mesh_out.c_str());
@@ -244,6 +255,8 @@ int main(int argc, char** argv) {
         }
       } else if (a == "--iso") {
         tools.iso = parse_list(value(), "--iso", 0);
+      } else if (a == "--save-project") {
+        tools.project = value();
       } else if (a == "--regions") {
         tools.regions = parse_list(value(), "--regions", 0);
       } else if (a == "--graded") {
@@ -271,9 +284,9 @@ int main(int argc, char** argv) {
     if (is_headless && model.empty()) throw Usage("--headless needs a model file");
     if (tools.iso_only && tools.iso.empty())
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
-    if (!is_headless &&
-        (tools.any() || tools.graded || !tools.range.empty() || !tools.regions.empty() || !sets.empty() ||
-         !physics.empty() || !field.empty() || !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
+    if (!is_headless && (tools.any() || tools.graded || !tools.range.empty() || !tools.regions.empty() ||
+                         !tools.project.empty() || !sets.empty() || !physics.empty() || !field.empty() ||
+                         !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
       throw Usage(
           "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")

@@ -496,6 +496,44 @@ TEST(Workbench, ProjectSaveReopenAndKilledSave) {
   reopen("after a killed save");
 }
 
+// A save killed while it writes (SIGKILL at staggered moments of a headless run that saves a
+// project over an existing one): the folder always opens, as the old project or the new one whole.
+TEST(WorkbenchHeadless, KilledSaveLeavesAProjectThatOpens) {
+  TempDir dir;
+  const auto folder = dir.path() / "proj";
+  const std::string base =
+      "'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
+      "die_on_substrate.toml' --headless --physics thermal --view-size 160x120 --save-project '" +
+      folder.string() + "' --set ";
+  ASSERT_EQ(foxi::test::run(base + "die_w=5mm", dir.path() / "first.log"), 0)
+      << foxi::test::read_text(dir.path() / "first.log");
+  const auto run_time = std::chrono::steady_clock::now();
+  ASSERT_EQ(foxi::test::run(base + "die_w=6mm", dir.path() / "second.log"), 0);
+  const double full = std::chrono::duration<double>(std::chrono::steady_clock::now() - run_time).count();
+  for (int i = 1; i <= 6; ++i) {
+    // Killed at i/6 of a whole run's time (the save is at its end), alternating the two states.
+    const std::string set = i % 2 ? "die_w=5mm" : "die_w=6mm";
+    const std::string cmd = "timeout -s KILL " + std::to_string(full * i / 6.0) + " " + base + set;
+    foxi::test::run(cmd, dir.path() / "killed.log");
+    Workbench w;
+    w.view_widget()->setFixedSize(160, 120);
+    QString why;
+    ASSERT_TRUE(w.open_project(QString::fromStdString(folder.string()), &why))
+        << "kill " << i << ": " << why.toStdString();
+    if (w.busy()) {
+      ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    }
+    ASSERT_EQ(w.overrides().size(), 1u);
+    const std::string v = w.overrides()[0].expression;
+    EXPECT_TRUE(v == "5mm" || v == "6mm") << v;
+    ASSERT_TRUE(w.mesh());
+    // The mesh is the one of those parameters (die_w = 5 mm and 6 mm mesh to different counts).
+    const std::vector<foxi::ParameterOverride> ov = {{"die_w", v}};
+    const foxi::MeshedModel direct = foxi::mesh_model(kModels + "die_on_substrate.toml", ov);
+    EXPECT_EQ(w.mesh()->tet_count(), direct.mesh.tet_count()) << "kill " << i;
+  }
+}
+
 // Autosave: within 5 s of a parameter change the autosave folder holds a project with it (written on
 // a worker), which reopens with that value.
 TEST(Workbench, AutosaveWithinFiveSeconds) {
