@@ -17,6 +17,7 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <memory>
 
@@ -53,7 +54,9 @@ Case& get_case() {
   static std::unique_ptr<Case> c;
   if (c) return *c;
   c = std::make_unique<Case>();
-  Mesh box = bench::tetgen_box_mesh(2, 1, 1, 4e-6);
+  // FOXI_BENCH_BOX_VOLUME: another maximum tet volume (a smaller mesh, for profiling).
+  const char* env = std::getenv("FOXI_BENCH_BOX_VOLUME");
+  Mesh box = bench::tetgen_box_mesh(2, 1, 1, env ? std::atof(env) : 4e-6);
   c->table = compute_spheres(box);
   double lo[3], hi[3];
   mesh_bounds(box, lo, hi);
