@@ -177,28 +177,32 @@ struct TableTransfer {
 // segment's own far part by its near part: the weights e^-(D-u) against A/D (u the optical depth from
 // the far end) differ by at most D/2, so the colour errs by at most dc D^2 / 4, dc the colour's spread
 // along the segment (at most lut_step per colour map entry crossed). Used where that bound is under
-// 1/4 of a level and the segment spans at least 2 grid cells (else the table's cell averaging shows);
-// false otherwise: the caller steps.
+// 1/4 of a level, the optical depth at most 1 and the segment spans at least 2 grid cells (else the
+// table's cell averaging shows); false otherwise: the caller steps.
 bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double length, float c[3]) {
   if (!tf.pre) return false;
   const double dv = v_near - v_far;
   if (!(std::abs(dv) * tf.g_inv >= 2)) return false;  // also NaN
+  const double inv_dv = 1 / dv;  // independent of the lookups: its latency overlaps theirs
   double a[4], b[4];
   tf.antiderivative(v_far, a);
   tf.antiderivative(v_near, b);
   const double dT = b[0] - a[0];
-  const double D = length * dT / dv;
+  const double inv_dT = 1 / dT;
+  const double D = length * dT * inv_dv;
   if (!(D > 0)) return D == 0;  // no extinction anywhere on the segment: nothing to blend
   const double spread = std::min(255.0, (std::abs(dv) * tf.pos_scale * 256 + 1) * tf.lut_step);
   if (D > 1 || spread * D * D > 1) return false;
-  // 1 - e^-D by its Taylor series to D^9 (the error is under D^10 / 10! < 3e-7 for D <= 1), cheaper
-  // than expm1.
-  constexpr double kInv[10] = {0, 1, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7, 1.0 / 8, 1.0 / 9};
-  double A = 0;
-  for (int k = 9; k >= 1; --k) A = D * kInv[k] * (1 - A);
-
-  const double w = A / dT;
-  for (int j = 0; j < 3; ++j) c[j] = float((b[j + 1] - a[j + 1]) * w + c[j] * (1 - A));
+  // e^-D as (e^-x)^8, x = D/8 <= 1/8, e^-x by its Taylor series to x^5 (error under x^6 / 720 < 5e-9,
+  // 4e-8 after the squarings), evaluated in a short dependency chain: cheaper than expm1.
+  const double x = 0.125 * D, x2 = x * x;
+  double e = (1 - x) + x2 * (0.5 - x * (1.0 / 6)) + x2 * x2 * (1.0 / 24 - x * (1.0 / 120));
+  e *= e;
+  e *= e;
+  e *= e;
+  const double A = 1 - e;
+  const double w = A * inv_dT;
+  for (int j = 0; j < 3; ++j) c[j] = float((b[j + 1] - a[j + 1]) * w + c[j] * e);
   return true;
 }
 
