@@ -230,6 +230,21 @@ struct VolumePainter::Impl {
     const double* cv = &corner[4 * std::size_t(t)];
     double P[4][3];
     for (int k = 0; k < 4; ++k) proj.to_camera(&mesh->xyz[3 * std::size_t(node[k])], P[k]);
+    {
+      // The tet's pixel rows (a bound, one pixel wider): every lane sees every tet, and most fall in
+      // another lane's band, so this is checked before the setup (a tet reaching the near plane is
+      // not culled here).
+      double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
+      bool cull = true;
+      for (int k = 0; k < 4 && cull; ++k) {
+        if (proj.perspective && !(P[k][2] > std::max(params.near, 0.0) && P[k][2] > 0)) cull = false;
+        const double y = proj.perspective ? proj.cy - proj.focal * P[k][1] / P[k][2] : proj.cy - proj.scale * P[k][1];
+        y_lo = std::min(y_lo, y);
+        y_hi = std::max(y_hi, y);
+      }
+      if (cull && (y_hi < -1 || y_lo > proj.height + 1 || !rows.any(int(std::floor(y_lo)) - 1, int(std::ceil(y_hi)) + 1)))
+        return;
+    }
     // The field's gradient in the camera frame: (P[k] - P[0]) . g = cv[k] - cv[0], by Cramer's rule.
     double e[3][3], df[3];
     for (int k = 0; k < 3; ++k) {
