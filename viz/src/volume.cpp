@@ -220,12 +220,12 @@ struct VolumePainter::Impl {
   int lanes = 1;
   std::vector<float> acc;
   std::vector<std::uint32_t> front;
-  std::vector<std::size_t> lane_samples;
+  std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
 
   Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
 
-  void draw_tet(std::uint32_t t, const Rows& rows, std::size_t& count) {
+  void draw_tet(std::uint32_t t, const Rows& rows, std::size_t& count, std::size_t& fast) {
     const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
     const double* cv = &corner[4 * std::size_t(t)];
     double P[4][3];
@@ -338,7 +338,9 @@ struct VolumePainter::Impl {
             const double len = (s_out - s_in) * std::sqrt(dx * dx + dyz);
             const double v_far = v0 + s_out * gd, v_near = v0 + s_in * gd;
             const std::size_t p = std::size_t(y) * std::size_t(proj.width) + std::size_t(x);
-            if (!integrate_fast(*transfer, v_far, v_near, len, &acc[3 * p]))
+            if (integrate_fast(*transfer, v_far, v_near, len, &acc[3 * p]))
+              ++fast;
+            else
               integrate(*transfer, v_far, v_near, len, &acc[3 * p]);
             front[p] = t;
             ++count;
@@ -372,6 +374,7 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   s.transfer = std::make_unique<TableTransfer>(s.params);
   s.lanes = std::clamp(params.threads, 1, std::max(1, height >> kBandShift));
   s.lane_samples.assign(std::size_t(s.lanes), 0);
+  s.lane_fast.assign(std::size_t(s.lanes), 0);
   const std::size_t pixels = std::size_t(width) * std::size_t(height);
   s.acc.resize(3 * pixels);
   const float bg[3] = {float(params.background & 255u), float((params.background >> 8) & 255u),
@@ -390,9 +393,10 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
     if (t >= s.mesh->tet_count()) throw std::invalid_argument("volume: tet index out of range");
   run_parts(s.lanes, [&](int lane) {
     const Rows rows{lane, s.lanes};
-    std::size_t count = 0;
-    for (std::uint32_t t : tets) s.draw_tet(t, rows, count);
+    std::size_t count = 0, fast = 0;
+    for (std::uint32_t t : tets) s.draw_tet(t, rows, count, fast);
     s.lane_samples[std::size_t(lane)] += count;
+    s.lane_fast[std::size_t(lane)] += fast;
   });
 }
 
@@ -404,6 +408,12 @@ void VolumePainter::resolve(Framebuffer& fb) const {
     fb.rgba[p] = pack_rgba(to8(s.acc[3 * p]), to8(s.acc[3 * p + 1]), to8(s.acc[3 * p + 2]));
     fb.id[p] = s.front[p];
   }
+}
+
+std::size_t VolumePainter::pre_integrated() const {
+  std::size_t n = 0;
+  for (std::size_t c : impl_->lane_fast) n += c;
+  return n;
 }
 
 std::size_t VolumePainter::samples() const {

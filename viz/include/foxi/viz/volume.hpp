@@ -68,7 +68,8 @@ class FOXI_API VolumePainter {
   // The picture so far into fb (resized, no depth buffer): colours rounded to 8 bits, ids the nearest
   // tet blended at each pixel (kNone where none).
   void resolve(Framebuffer& fb) const;
-  std::size_t samples() const;  // pixel segments integrated
+  std::size_t samples() const;         // pixel segments integrated
+  std::size_t pre_integrated() const;  // of those, the ones taken in closed form (see volume.cpp)
 
  private:
   struct Impl;
