@@ -220,6 +220,7 @@ struct VolumePainter::Impl {
   int lanes = 1;
   std::vector<float> acc;
   std::vector<std::uint32_t> front;
+  std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
 
@@ -229,7 +230,7 @@ struct VolumePainter::Impl {
     const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
     const double* cv = &corner[4 * std::size_t(t)];
     double P[4][3];
-    for (int k = 0; k < 4; ++k) proj.to_camera(&mesh->xyz[3 * std::size_t(node[k])], P[k]);
+    for (int k = 0; k < 4; ++k) std::copy_n(&cam_xyz[3 * std::size_t(node[k])], 3, P[k]);
     {
       // The tet's pixel rows (a bound, one pixel wider): every lane sees every tet, and most fall in
       // another lane's band, so this is checked before the setup (a tet reaching the near plane is
@@ -371,6 +372,8 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   }
   s.corner = corner;
   s.params = params;
+  s.cam_xyz.resize(mesh.xyz.size());
+  for (std::size_t k = 0; k < mesh.node_count(); ++k) s.proj.to_camera(&mesh.xyz[3 * k], &s.cam_xyz[3 * k]);
   s.transfer = std::make_unique<TableTransfer>(s.params);
   s.lanes = std::clamp(params.threads, 1, std::max(1, height >> kBandShift));
   s.lane_samples.assign(std::size_t(s.lanes), 0);
