@@ -183,13 +183,13 @@ bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double
   if (!tf.pre) return false;
   const double dv = v_near - v_far;
   if (!(std::abs(dv) * tf.g_inv >= 2)) return false;  // also NaN
+  const double inv_dv = 1 / dv;  // independent of the lookups: its latency overlaps theirs
   double a[4], b[4];
   tf.antiderivative(v_far, a);
   tf.antiderivative(v_near, b);
   const double dT = b[0] - a[0];
-  const double r = 1 / (dv * dT);  // one division for 1/dv and 1/dT
-  const double inv_dT = dv * r;
-  const double D = length * dT * dT * r;
+  const double inv_dT = 1 / dT;
+  const double D = length * dT * inv_dv;
   if (!(D > 0)) return D == 0;  // no extinction anywhere on the segment: nothing to blend
   const double spread = std::min(255.0, (std::abs(dv) * tf.pos_scale * 256 + 1) * tf.lut_step);
   if (D > 1 || spread * D * D > 1) return false;
@@ -324,22 +324,15 @@ struct VolumePainter::Impl {
           const double dyz = d0[1] * d0[1] + d0[2] * d0[2];
           for (int x = lo; x <= hi; ++x) {
             const double xf = x;
-            // The entry is the largest num/nd over the planes with nd < 0, the exit the smallest over
-            // nd > 0: compared as fractions (cross-multiplied, the denominators' signs known), so
-            // two divisions instead of four.
-            double in_num = 0, in_nd = 0, out_num = 0, out_nd = 0;  // none yet: nd == 0
+            double s_in = near, s_out = std::numeric_limits<double>::infinity();
             for (int k = 0; k < 4; ++k) {
               const double nd = ndA[k] + xf * ndB[k];
-              const double num = numA[k] + xf * numB[k];
-              if (nd < 0) {
-                // num/nd > in_num/in_nd with nd, in_nd < 0: num * in_nd > in_num * nd.
-                if (in_nd == 0 || num * in_nd > in_num * nd) in_num = num, in_nd = nd;
-              } else if (nd > 0) {
-                if (out_nd == 0 || num * out_nd < out_num * nd) out_num = num, out_nd = nd;
-              }
+              const double sk = (numA[k] + xf * numB[k]) / nd;
+              if (nd < 0)
+                s_in = std::max(s_in, sk);
+              else if (nd > 0)
+                s_out = std::min(s_out, sk);
             }
-            const double s_in = in_nd == 0 ? near : std::max(near, in_num / in_nd);
-            const double s_out = out_nd == 0 ? std::numeric_limits<double>::infinity() : out_num / out_nd;
             if (!(s_out > s_in)) continue;  // a snapped edge pixel the ray misses
             const double v0 = vA + xf * vB, gd = gdA + xf * gdB;
             const double dx = d0[0] + xf * d1[0];
