@@ -181,7 +181,7 @@ void BM_volume_frame(benchmark::State& state) {
   Framebuffer fb(kWidth, kHeight), opaque(kWidth, kHeight);
   std::vector<std::uint32_t> order;
   Timing t, base;
-  std::size_t segments = 0;
+  std::size_t segments = 0, pre_integrated = 0;
   int i = 0;
   for (auto _ : state) {
     const Camera cam = orbit(c.camera, 7.0 * i++, 0);
@@ -193,6 +193,7 @@ void BM_volume_frame(benchmark::State& state) {
     painter.draw(order);
     painter.resolve(fb);
     segments += painter.samples();
+    pre_integrated += painter.pre_integrated();
     t.draw_ms += ms_since(t0);
     state.PauseTiming();
     opaque_frame(c, cam, opaque, order, base);
@@ -200,6 +201,7 @@ void BM_volume_frame(benchmark::State& state) {
   }
   const double iters = double(state.iterations());
   state.counters["segments"] = double(segments) / iters;
+  state.counters["pre_integrated"] = double(pre_integrated) / iters;
   state.counters["order_ms"] = t.order_ms / iters;
   state.counters["draw_ms"] = t.draw_ms / iters;
   state.counters["opaque_ms"] = base.total() / iters;

@@ -177,32 +177,74 @@ struct TableTransfer {
 // segment's own far part by its near part: the weights e^-(D-u) against A/D (u the optical depth from
 // the far end) differ by at most D/2, so the colour errs by at most dc D^2 / 4, dc the colour's spread
 // along the segment (at most lut_step per colour map entry crossed). Used where that bound is under
-// 1/4 of a level, the optical depth at most 1 and the segment spans at least 2 grid cells (else the
-// table's cell averaging shows); false otherwise: the caller steps.
-bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double length, float c[3]) {
-  if (!tf.pre) return false;
-  const double dv = v_near - v_far;
-  if (!(std::abs(dv) * tf.g_inv >= 2)) return false;  // also NaN
-  const double inv_dv = 1 / dv;  // independent of the lookups: its latency overlaps theirs
-  double a[4], b[4];
-  tf.antiderivative(v_far, a);
-  tf.antiderivative(v_near, b);
-  const double dT = b[0] - a[0];
-  const double inv_dT = 1 / dT;
-  const double D = length * dT * inv_dv;
-  if (!(D > 0)) return D == 0;  // no extinction anywhere on the segment: nothing to blend
-  const double spread = std::min(255.0, (std::abs(dv) * tf.pos_scale * 256 + 1) * tf.lut_step);
-  if (D > 1 || spread * D * D > 1) return false;
-  // e^-D as (e^-x)^8, x = D/8 <= 1/8, e^-x by its Taylor series to x^5 (error under x^6 / 720 < 5e-9,
-  // 4e-8 after the squarings), evaluated in a short dependency chain: cheaper than expm1.
+// 1/4 of a level and the optical depth at most 1; a thicker or more colourful segment is cut into
+// pieces that meet it. A segment under 2 grid cells (where the table's cell averaging would show)
+// takes its midpoint. False (the caller steps) for a log colour scale, NaN, a thin but optically thick
+// segment.
+// e^-D for 0 <= D <= 1 as (e^-x)^8, x = D/8 <= 1/8, e^-x by its Taylor series to x^5 (error under
+// x^6 / 720 < 5e-9, 4e-8 after the squarings), in a short dependency chain: cheaper than exp.
+double exp_neg_small(double D) {
   const double x = 0.125 * D, x2 = x * x;
   double e = (1 - x) + x2 * (0.5 - x * (1.0 / 6)) + x2 * x2 * (1.0 / 24 - x * (1.0 / 120));
   e *= e;
   e *= e;
-  e *= e;
-  const double A = 1 - e;
-  const double w = A * inv_dT;
+  return e * e;
+}
+
+// One piece in closed form, given the antiderivatives at its ends (a: far, b: near): false where the
+// bound above does not hold.
+bool closed_piece(const TableTransfer& tf, const double a[4], const double b[4], double dv, double length, float c[3]) {
+  const double dT = b[0] - a[0];
+  const double D = length * dT / dv;
+  if (!(D > 0)) return D == 0;  // no extinction anywhere on the piece: nothing to blend
+  const double spread = std::min(255.0, (std::abs(dv) * tf.pos_scale * 256 + 1) * tf.lut_step);
+  if (D > 1 || spread * D * D > 1) return false;
+  const double e = exp_neg_small(D);
+  const double w = (1 - e) / dT;
   for (int j = 0; j < 3; ++j) c[j] = float((b[j + 1] - a[j + 1]) * w + c[j] * e);
+  return true;
+}
+
+bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double length, float c[3]) {
+  if (!tf.pre) return false;
+  const double dv = v_near - v_far;
+  const double cells = std::abs(dv) * tf.g_inv;
+  if (!(cells >= 2)) {
+    // Under 2 grid cells (1/16 of a colour map entry): the value's midpoint, as the steps would
+    // take it (one step: the spread is under one entry), unless the piece is optically thick.
+    if (!(cells >= 0)) return false;  // NaN
+    const double vm = 0.5 * (v_far + v_near);
+    const double D = tf.tau(vm) * length;
+    if (!(D <= 1)) return false;
+    float rgb[3];
+    tf.rgb(vm, rgb);
+    const double e = exp_neg_small(D);
+    for (int j = 0; j < 3; ++j) c[j] = float(rgb[j] * (1 - e) + c[j] * e);
+    return true;
+  }
+  double a[4], b[4];
+  tf.antiderivative(v_far, a);
+  tf.antiderivative(v_near, b);
+  if (closed_piece(tf, a, b, dv, length, c)) return true;
+  // Too thick or too colourful for one piece: n equal pieces of the value (each at least 2 grid
+  // cells), enough that the average piece meets the bound; a piece that still does not is stepped.
+  const double D = length * (b[0] - a[0]) / dv;
+  const double spread = std::min(255.0, (std::abs(dv) * tf.pos_scale * 256 + 1) * tf.lut_step);
+  const int n = std::clamp(int(std::ceil(std::max(D, std::sqrt(spread) * D) * 1.25)), 2,
+                           std::max(2, std::min(64, int(cells / 2))));
+  if (!(std::isfinite(D)) || cells < 4) return false;
+  double lo[4];
+  std::copy(a, a + 4, lo);
+  for (int i = 0; i < n; ++i) {
+    const double v0 = v_far + dv * i / n, v1 = i + 1 == n ? v_near : v_far + dv * (i + 1) / n;
+    double hi[4];
+    if (i + 1 == n)
+      std::copy(b, b + 4, hi);
+    else
+      tf.antiderivative(v1, hi);
+    if (!closed_piece(tf, lo, hi, v1 - v0, length / n, c)) integrate(tf, v0, v1, length / n, c);
+    std::copy(hi, hi + 4, lo);
+  }
   return true;
 }
 
