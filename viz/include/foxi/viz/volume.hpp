@@ -5,9 +5,14 @@
 // along the ray) and the emission-absorption integral over that segment give a colour and an opacity,
 // blended over what the farther tets left. The transfer function is a colour scale (colormap.hpp) and an
 // opacity curve: opacity a(v) is what a ray accumulates through `unit_length` of constant value v, so
-// the extinction is tau(v) = -ln(1 - a(v)) / unit_length (per world unit). The integral is evaluated
-// with the segment cut into steps of at most 1/64 of the colour scale and an optical depth of at most
-// 1/4 each (midpoint rule in the value; each step's colour and extinction constant), at most 256.
+// the extinction is tau(v) = -ln(1 - a(v)) / unit_length (per world unit). integrate_segment evaluates
+// the integral with the segment cut into steps of at most 1/64 of the colour scale and an optical
+// depth of at most 1/4 each (midpoint rule in the value; each step's colour and extinction constant),
+// at most 256. The painter, with a linear colour scale, pre-integrates instead: tabulated
+// antiderivatives of tau and of the tau-weighted colour over the value give a segment's opacity (to
+// the tables' accuracy) and its colour within 1/4 of a level more (pieces where one would not do;
+// volume.cpp says why);
+// with a log scale it steps.
 //
 // Why the order makes it exact: each pixel's ray meets tets in interior-disjoint segments, and the power
 // order of a Delaunay mesh puts the farther of any two tets one ray meets first (seed paper, Theorem
