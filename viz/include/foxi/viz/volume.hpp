@@ -11,8 +11,7 @@
 // at most 256. The painter, with a linear colour scale, pre-integrates instead: tabulated
 // antiderivatives of tau and of the tau-weighted colour over the value give a segment's opacity (to
 // the tables' accuracy) and its colour within 1/4 of a level more (pieces where one would not do;
-// volume.cpp says why);
-// with a log scale it steps.
+// volume.cpp says why); with a log scale it steps.
 //
 // Why the order makes it exact: each pixel's ray meets tets in interior-disjoint segments, and the power
 // order of a Delaunay mesh puts the farther of any two tets one ray meets first (seed paper, Theorem
