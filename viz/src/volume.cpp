@@ -260,8 +260,13 @@ struct VolumePainter::Impl {
   std::span<const double> corner;
   VolumeParams params;
   int lanes = 1;
-  std::vector<float> acc;
-  std::vector<std::uint32_t> front;
+  // Per pixel the colour so far and the nearest tet blended, side by side (16 bytes): a tet's row of
+  // pixels touches one run of cache lines, not two.
+  struct Pixel {
+    float c[3];
+    std::uint32_t front;
+  };
+  std::vector<Pixel> acc;
   std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
@@ -381,11 +386,12 @@ struct VolumePainter::Impl {
             const double len = (s_out - s_in) * std::sqrt(dx * dx + dyz);
             const double v_far = v0 + s_out * gd, v_near = v0 + s_in * gd;
             const std::size_t p = std::size_t(y) * std::size_t(proj.width) + std::size_t(x);
-            if (integrate_fast(*transfer, v_far, v_near, len, &acc[3 * p]))
+            Pixel& px = acc[p];
+            if (integrate_fast(*transfer, v_far, v_near, len, px.c))
               ++fast;
             else
-              integrate(*transfer, v_far, v_near, len, &acc[3 * p]);
-            front[p] = t;
+              integrate(*transfer, v_far, v_near, len, px.c);
+            px.front = t;
             ++count;
           }
         });
@@ -421,11 +427,10 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   s.lane_samples.assign(std::size_t(s.lanes), 0);
   s.lane_fast.assign(std::size_t(s.lanes), 0);
   const std::size_t pixels = std::size_t(width) * std::size_t(height);
-  s.acc.resize(3 * pixels);
+  s.acc.resize(pixels);
   const float bg[3] = {float(params.background & 255u), float((params.background >> 8) & 255u),
                        float((params.background >> 16) & 255u)};
-  for (std::size_t p = 0; p < pixels; ++p) std::copy(bg, bg + 3, &s.acc[3 * p]);
-  s.front.assign(pixels, kNone);
+  for (Impl::Pixel& p : s.acc) p = {{bg[0], bg[1], bg[2]}, kNone};
 }
 
 VolumePainter::~VolumePainter() = default;
@@ -450,8 +455,8 @@ void VolumePainter::resolve(Framebuffer& fb) const {
   fb.resize(s.proj.width, s.proj.height, false, s.params.background);
   auto to8 = [](float c) { return std::uint32_t(std::clamp(c, 0.0f, 255.0f) + 0.5f); };
   for (std::size_t p = 0; p < fb.rgba.size(); ++p) {
-    fb.rgba[p] = pack_rgba(to8(s.acc[3 * p]), to8(s.acc[3 * p + 1]), to8(s.acc[3 * p + 2]));
-    fb.id[p] = s.front[p];
+    fb.rgba[p] = pack_rgba(to8(s.acc[p].c[0]), to8(s.acc[p].c[1]), to8(s.acc[p].c[2]));
+    fb.id[p] = s.acc[p].front;
   }
 }
 
