@@ -8,7 +8,10 @@
 //                         per mesh, outside the timing (surfaces_ms)
 //   volume_frame          the whole mesh ordered and volume-rendered (VolumePainter: a smooth node field,
 //                         the integral along every pixel's ray through every tet), counters order_ms,
-//                         draw_ms, segments (pixel-tet segments integrated), opaque_ms and ratio
+//                         draw_ms, segments (pixel-tet segments integrated), pre_integrated (of those,
+//                         the ones in closed form), opaque_ms and ratio. The outside anchor, VTK's
+//                         projected tetrahedra on the same mesh and view: bench/peers/volume_vtk.py.
+//                         FOXI_BENCH_BOX_VOLUME=4e-5 (a maximum tet volume): a smaller box, to profile.
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
