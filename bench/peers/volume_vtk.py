@@ -88,6 +88,7 @@ def main():
     grab = vtk.vtkWindowToImageFilter()
     grab.SetInput(win)
     grab.ReadFrontBufferOff()
+    grab.ShouldRerenderOff()  # read what Render() drew, do not render a second time
 
     def frame():
         win.Render()
