@@ -71,7 +71,8 @@ struct Data {
     std::fprintf(f.get(), "    1C\n    1UPGM               CalculiX\n");
     std::fprintf(f.get(), "    2C%30zu%37d\n", m.node_count(), 1);
     for (std::size_t i = 0; i < m.node_count(); ++i)
-      std::fprintf(f.get(), " -1%10zu%12.5E%12.5E%12.5E\n", i + 1, m.xyz[3 * i], m.xyz[3 * i + 1], m.xyz[3 * i + 2]);
+      std::fprintf(f.get(), " -1%10zu%12.5E%12.5E%12.5E\n", i + 1, m.xyz[3 * i], m.xyz[3 * i + 1],
+                   m.xyz[3 * i + 2]);
     std::fprintf(f.get(), " -3\n    3C%30zu%37d\n", m.tet_count(), 1);
     for (std::size_t t = 0; t < m.tet_count(); ++t)
       std::fprintf(f.get(), " -1%10zu%5d%5d%5d\n -2%10u%10u%10u%10u\n", t + 1, 3, 0, 1, m.tet[4 * t] + 1,
@@ -82,12 +83,15 @@ struct Data {
     for (int b = 0; b < 3; ++b) {
       const foxi::Field& fld = m.fields[b];
       std::fprintf(f.get(), "    1PSTEP%25d%12d%12d\n", b + 1, 1, 1);
-      std::fprintf(f.get(), "  100CL  101 1.000000000%12zu                     0    1           1\n", m.node_count());
+      std::fprintf(f.get(), "  100CL  101 1.000000000%12zu                     0    1           1\n",
+                   m.node_count());
       std::fprintf(f.get(), " -4  %-8s%5u    1\n", names[b], fld.components);
-      for (unsigned c = 0; c < fld.components; ++c) std::fprintf(f.get(), " -5  %-8s%5d%5d%5u%5d\n", comps[b][c], 1, 1, c + 1, 0);
+      for (unsigned c = 0; c < fld.components; ++c)
+        std::fprintf(f.get(), " -5  %-8s%5d%5d%5u%5d\n", comps[b][c], 1, 1, c + 1, 0);
       for (std::size_t i = 0; i < m.node_count(); ++i) {
         std::fprintf(f.get(), " -1%10zu", i + 1);
-        for (unsigned c = 0; c < fld.components; ++c) std::fprintf(f.get(), "%12.5E", fld.values[i * fld.components + c]);
+        for (unsigned c = 0; c < fld.components; ++c)
+          std::fprintf(f.get(), "%12.5E", fld.values[i * fld.components + c]);
         std::fputc('\n', f.get());
       }
       std::fprintf(f.get(), " -3\n");
@@ -118,8 +122,9 @@ void transfer_by_location(benchmark::State& state) {
   if (outside != 0 || !(worst < 1e-9)) state.SkipWithError("the transfer of a linear field is not exact");
   state.counters["source_tets"] = double(d.source.mesh.tet_count());
   state.counters["target_nodes"] = double(d.target.node_count());
-  state.counters["ns_per_node"] = benchmark::Counter(double(d.target.node_count()),
-                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_node"] =
+      benchmark::Counter(double(d.target.node_count()),
+                         benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["max_error"] = worst;
 }
 BENCHMARK(transfer_by_location)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
@@ -127,12 +132,14 @@ BENCHMARK(transfer_by_location)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->
 // scipy.interpolate.LinearNDInterpolator(source points, T)(target points), timed inside Python.
 void transfer_scipy(benchmark::State& state) {
   Data& d = data();
-  const std::string cmd =
-      "cd '" + d.dir.path.string() +
-      "' && /usr/bin/python3 -c \"import time, numpy as np; from scipy.interpolate import LinearNDInterpolator as L; "
-      "s = np.fromfile('src_xyz.bin').reshape(-1, 3); v = np.fromfile('src_t.bin'); q = np.fromfile('tgt_xyz.bin').reshape(-1, 3); "
-      "t = time.perf_counter(); r = L(s, v)(q); t = time.perf_counter() - t; "
-      "e = np.nanmax(np.abs(r - (300 + 20 * q[:, 0] - 30 * q[:, 1] + 5 * q[:, 2]))); print(t, e)\" 2>/dev/null";
+  const std::string cmd = "cd '" + d.dir.path.string() +
+                          "' && /usr/bin/python3 -c \"import time, numpy as np; from scipy.interpolate "
+                          "import LinearNDInterpolator as L; "
+                          "s = np.fromfile('src_xyz.bin').reshape(-1, 3); v = np.fromfile('src_t.bin'); q = "
+                          "np.fromfile('tgt_xyz.bin').reshape(-1, 3); "
+                          "t = time.perf_counter(); r = L(s, v)(q); t = time.perf_counter() - t; "
+                          "e = np.nanmax(np.abs(r - (300 + 20 * q[:, 0] - 30 * q[:, 1] + 5 * q[:, 2]))); "
+                          "print(t, e)\" 2>/dev/null";
   double err = -1;
   for (auto _ : state) {
     std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
@@ -144,8 +151,9 @@ void transfer_scipy(benchmark::State& state) {
     state.SetIterationTime(seconds);
   }
   state.counters["max_error"] = err;
-  state.counters["ns_per_node"] = benchmark::Counter(double(d.target.node_count()),
-                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_node"] =
+      benchmark::Counter(double(d.target.node_count()),
+                         benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(transfer_scipy)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1);
 
@@ -163,9 +171,18 @@ void read_source(benchmark::State& state, const char* name) {
   state.SetBytesProcessed(bytes * state.iterations());
   state.counters["file_MB"] = double(bytes) / 1e6;
 }
-BENCHMARK_CAPTURE(read_source, frd_ascii, "big.frd")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2);
-BENCHMARK_CAPTURE(read_source, vtu_ascii, "ascii.vtu")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2);
-BENCHMARK_CAPTURE(read_source, vtu_appended_raw, "raw.vtu")->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2);
+BENCHMARK_CAPTURE(read_source, frd_ascii, "big.frd")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2);
+BENCHMARK_CAPTURE(read_source, vtu_ascii, "ascii.vtu")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2);
+BENCHMARK_CAPTURE(read_source, vtu_appended_raw, "raw.vtu")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2);
 
 }  // namespace
 

@@ -165,7 +165,8 @@ void run(benchmark::State& state, bool pruned) {
     if (pruned) {
       state.PauseTiming();
       frame(c, ip, cam, false, full, subset2, order2, base);
-      for (std::size_t p = 0; p < fb.rgba.size(); ++p) differ += fb.rgba[p] != full.rgba[p] || fb.id[p] != full.id[p];
+      for (std::size_t p = 0; p < fb.rgba.size(); ++p)
+        differ += fb.rgba[p] != full.rgba[p] || fb.id[p] != full.id[p];
       state.ResumeTiming();
     }
   }
@@ -222,8 +223,8 @@ void BM_iso_draw(benchmark::State& state) {
   for (std::uint32_t id : fb.id) covered += id != kNone;
   state.counters["polygons"] = double(polygons);
   state.counters["covered_px"] = double(covered);
-  state.counters["ns_per_polygon"] =
-      benchmark::Counter(double(polygons), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_polygon"] = benchmark::Counter(
+      double(polygons), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.SetLabel(f == 0 ? "0.1%" : f == 1 ? "1%" : "10%");
 }
 
@@ -232,8 +233,20 @@ void BM_iso_full_scan(benchmark::State& state) { run(state, false); }
 
 }  // namespace
 
-BENCHMARK(BM_iso_draw)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_iso_pruned)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_iso_full_scan)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_iso_draw)
+    ->DenseRange(0, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_iso_pruned)
+    ->DenseRange(0, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_iso_full_scan)
+    ->DenseRange(0, 2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -43,7 +43,8 @@ void BM_TetgenProgram(benchmark::State& state) {
   const fs::path dir = fs::temp_directory_path() / ("foxi-bench-mesh-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   foxi::write_poly(flip_chip(), dir / "fc.poly");
-  const std::string cmd = "tetgen -pzAq1.414a2.6e-13O0Q '" + (dir / "fc.poly").string() + "' > /dev/null 2>&1";
+  const std::string cmd =
+      "tetgen -pzAq1.414a2.6e-13O0Q '" + (dir / "fc.poly").string() + "' > /dev/null 2>&1";
   struct Cleanup {
     fs::path p;
     ~Cleanup() {
@@ -55,7 +56,8 @@ void BM_TetgenProgram(benchmark::State& state) {
     const double c0 = cpu_ms();
     const auto t0 = std::chrono::steady_clock::now();
     if (std::system(cmd.c_str()) != 0) return state.SkipWithError("the tetgen program failed or is missing");
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     state.SetIterationTime(ms * 1e-3);
     state.counters["ms"] = ms;
     state.counters["cpu_ms"] = cpu_ms() - c0;
@@ -70,14 +72,16 @@ void BM_FoxiConforming(benchmark::State& state) {
     const auto t0 = std::chrono::steady_clock::now();
     foxi::ConformingReport r;
     const foxi::Mesh m = foxi::mesh_conforming(flip_chip(), params, {}, &r);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     state.SetIterationTime(ms * 1e-3);
     state.counters["ms"] = ms;
     state.counters["cpu_ms"] = cpu_ms() - c0;
     state.counters["tets"] = double(m.tet_count());
     state.counters["points"] = double(m.node_count());
     state.counters["added"] = double(r.added_points);
-    state.counters["overhead_pct"] = r.first_mesh_points ? 100.0 * double(r.added_points) / double(r.first_mesh_points) : 0;
+    state.counters["overhead_pct"] =
+        r.first_mesh_points ? 100.0 * double(r.added_points) / double(r.first_mesh_points) : 0;
     state.counters["iterations"] = double(r.iterations);
     state.counters["delaunay"] = r.delaunay;
     state.counters["certificate_ms"] = r.certificate_seconds * 1e3;

@@ -73,8 +73,8 @@ bool skip(benchmark::State& state, int which) {
 
 void per_tet(benchmark::State& state, std::size_t tets) {
   state.counters["tets"] = double(tets);
-  state.counters["ns_per_tet"] =
-      benchmark::Counter(double(tets), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_tet"] = benchmark::Counter(
+      double(tets), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.SetLabel(case_name(static_cast<int>(state.range(0))));
 }
 

@@ -91,7 +91,8 @@ void add_field(Case& c) {
   ColorScale other;
   other.map = ColorMapId::coolwarm;
   std::tie(other.lo, other.hi) = finite_range(c.mesh.fields[1].values);
-  c.other = std::make_shared<const FieldPaint>(flat_field_paint(tet_centroid_values(c.mesh, choose_field(c.mesh, "g")), other));
+  c.other = std::make_shared<const FieldPaint>(
+      flat_field_paint(tet_centroid_values(c.mesh, choose_field(c.mesh, "g")), other));
 }
 
 Case& get_case(int which) {
@@ -202,7 +203,8 @@ void run_undo(benchmark::State& state, bool undraw) {
           for (const PixelRect& rect : r->changed_rects())
             presented += std::size_t(rect.x1 - rect.x0 + 1) * std::size_t(rect.y1 - rect.y0 + 1);
           const PixelRect all = r->changed_rect();
-          if (all.x0 <= all.x1) union_px += std::size_t(all.x1 - all.x0 + 1) * std::size_t(all.y1 - all.y0 + 1);
+          if (all.x0 <= all.x1)
+            union_px += std::size_t(all.x1 - all.x0 + 1) * std::size_t(all.y1 - all.y0 + 1);
           for (std::size_t p = 0; p < fb.id.size(); ++p) {
             changed += fb.id[p] != before.id[p] || fb.rgba[p] != before.rgba[p];
             mismatch += fb.rgba[p] != shown.rgba[p];
@@ -212,7 +214,8 @@ void run_undo(benchmark::State& state, bool undraw) {
         }
         if (timed) {
           undraw_cpu_ms += process_cpu_ms() - c0;
-          undraw_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+          undraw_ms +=
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
           benchmark::DoNotOptimize(shown.rgba.data());
           state.PauseTiming();
         }
@@ -348,15 +351,55 @@ void BM_painter_draw_1thread(benchmark::State& state) { run(state, false, false,
 
 }  // namespace
 
-BENCHMARK(BM_painter_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_zbuffer_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_painter_frame)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_painter_shrink)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_painter_draw_1thread)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_painter_draw_undoable)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_field_flat_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_field_graded_draw)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_field_recolor)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
-BENCHMARK(BM_undraw_front10)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_painter_draw)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_zbuffer_draw)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_painter_frame)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_painter_shrink)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_painter_draw_1thread)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_painter_draw_undoable)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_field_flat_draw)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_field_graded_draw)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_field_recolor)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_undraw_front10)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -91,13 +91,14 @@ Mesh* tetgen_mesh(benchmark::State& state, const std::string& which) {
   }
   bool failed = false;
   Mesh& m = cached_mesh("tetgen-" + which, [&] {
-    const std::filesystem::path dir =
-        std::filesystem::temp_directory_path() / ("foxi-bench-tetgen-" + std::to_string(std::random_device{}()));
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                      ("foxi-bench-tetgen-" + std::to_string(std::random_device{}()));
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "in.poly") << (which == "box" ? kBoxPoly : kBoardPoly);
     const char* volume = which == "box" ? "0.00042" : "0.00022";
     Mesh out;
-    if (std::system(("tetgen -Qpq1.414AO0a" + std::string(volume) + " '" + (dir / "in.poly").string() + "'").c_str()) == 0)
+    if (std::system(("tetgen -Qpq1.414AO0a" + std::string(volume) + " '" + (dir / "in.poly").string() + "'")
+                        .c_str()) == 0)
       out = read_tetgen(dir / "in.1");
     else
       failed = true;
@@ -195,8 +196,12 @@ void tetgen_ccx(benchmark::State& state, const char* which) {
   Mesh* m = tetgen_mesh(state, which);
   if (!m) return;
   bench::time_ccx(
-      state, "heat", [&](const std::filesystem::path& inp) { write_calculix_thermal(*m, tetgen_params(which, LinearSolverKind::automatic), inp); },
-      std::getenv("FOXI_BENCH_CCX") != nullptr, "set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
+      state, "heat",
+      [&](const std::filesystem::path& inp) {
+        write_calculix_thermal(*m, tetgen_params(which, LinearSolverKind::automatic), inp);
+      },
+      std::getenv("FOXI_BENCH_CCX") != nullptr,
+      "set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
   state.counters["tets"] = static_cast<double>(m->tet_count());
 }
 
@@ -295,8 +300,12 @@ void eigen_cg_jacobi(benchmark::State& state) {
 void ccx_1M(benchmark::State& state) {
   Mesh& m = grid(57);
   bench::time_ccx(
-      state, "heat", [&](const std::filesystem::path& inp) { write_calculix_thermal(m, params(LinearSolverKind::automatic), inp); },
-      std::getenv("FOXI_BENCH_CCX") != nullptr, "set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
+      state, "heat",
+      [&](const std::filesystem::path& inp) {
+        write_calculix_thermal(m, params(LinearSolverKind::automatic), inp);
+      },
+      std::getenv("FOXI_BENCH_CCX") != nullptr,
+      "set FOXI_BENCH_CCX=1 (and install calculix-ccx) to time ccx");
   state.counters["tets"] = static_cast<double>(m.tet_count());
 }
 
@@ -329,7 +338,10 @@ BENCHMARK_CAPTURE(tetgen_thermal, ichol_box_948k, LinearSolverKind::cg_ichol, "b
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(2);
-BENCHMARK_CAPTURE(tetgen_ccx, board_1M, "board")->UseManualTime()->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tetgen_ccx, board_1M, "board")
+    ->UseManualTime()
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(tetgen_thermal, amg_board_1M, LinearSolverKind::cg_amg, "board")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()

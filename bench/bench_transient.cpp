@@ -120,15 +120,16 @@ void transient(benchmark::State& state, std::uint32_t n) {
   tp.steps = kSteps;
   tp.initial_temperature = 300;
   tp.junctions = {2};
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("foxi-bench-transient-" + std::to_string(std::random_device{}()));
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("foxi-bench-transient-" + std::to_string(std::random_device{}()));
   std::filesystem::create_directories(dir);
   Mesh frame = mesh;
   frame.fields.clear();
   std::size_t written = 0;
   tp.on_step = [&](std::size_t step, double, std::span<const double> temperature) {
     if (step % kWriteEvery != 0 || step == 0) return true;
-    frame.fields = {Field{"temperature", FieldLocation::node, 1, "K", {}, {temperature.begin(), temperature.end()}}};
+    frame.fields = {
+        Field{"temperature", FieldLocation::node, 1, "K", {}, {temperature.begin(), temperature.end()}}};
     char name[32];
     std::snprintf(name, sizeof name, "run_%04zu.vtu", written++);
     write_vtu(frame, dir / name);
@@ -171,7 +172,8 @@ void transient(benchmark::State& state, std::uint32_t n) {
     write_calculix_thermal(mesh, steady, dir / "steady.inp");
     std::ostringstream steady_text;
     steady_text << std::ifstream(dir / "steady.inp").rdbuf();
-    std::ofstream(dir / "heat.inp") << transient_deck(steady_text.str(), tp.end_time / double(kSteps), tp.end_time);
+    std::ofstream(dir / "heat.inp") << transient_deck(steady_text.str(), tp.end_time / double(kSteps),
+                                                      tp.end_time);
     const auto t0 = std::chrono::steady_clock::now();
     const int rc = std::system(("cd '" + dir.string() + "' && ccx -i heat > ccx.log 2>&1").c_str());
     const double ccx_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -86,9 +86,11 @@ Case& get_case() {
     for (std::size_t t = 0; t < n; ++t) {
       double x[3] = {0, 0, 0};
       for (int k = 0; k < 4; ++k)
-        for (int j = 0; j < 3; ++j) x[j] += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * t + std::size_t(k)]) + std::size_t(j)];
+        for (int j = 0; j < 3; ++j)
+          x[j] += 0.25 * m.xyz[3 * std::size_t(m.tet[4 * t + std::size_t(k)]) + std::size_t(j)];
       if (s == 0) {
-        if (std::abs(x[0] - 1) < 0.35 && std::abs(x[1] - 0.5) < 0.25 && std::abs(x[2] - 0.5) < 0.08) m.tet_region[t] = 2;
+        if (std::abs(x[0] - 1) < 0.35 && std::abs(x[1] - 0.5) < 0.25 && std::abs(x[2] - 0.5) < 0.08)
+          m.tet_region[t] = 2;
         for (int b = 0; b < 8; ++b) {
           const double bx = 0.3 + 0.2 * b, by = b % 2 ? 0.2 : 0.8, bz = 0.25;
           if ((x[0] - bx) * (x[0] - bx) + (x[1] - by) * (x[1] - by) + (x[2] - bz) * (x[2] - bz) < 0.01)
@@ -127,8 +129,8 @@ void opaque_frame(Case& c, const Camera& cam, Framebuffer& fb, std::vector<std::
   t.draw_ms += ms_since(t0);
 }
 
-std::size_t translucent_frame(Case& c, int s, const Camera& cam, Framebuffer& fb, std::vector<std::uint32_t>& order,
-                              Timing& t) {
+std::size_t translucent_frame(Case& c, int s, const Camera& cam, Framebuffer& fb,
+                              std::vector<std::uint32_t>& order, Timing& t) {
   auto t0 = std::chrono::steady_clock::now();
   visibility_order_into(order, c.mesh[s], c.table, view_of(cam), c.surfaces[s].tets);
   t.order_ms += ms_since(t0);

@@ -20,6 +20,8 @@ packages=(
   # the sanitizer build links with lld: about half the CPU of ld.bfd per test program (measured 1.5 s
   # against 3.1 s), and it links about a hundred of them
   lld
+  # scripts/check_format.sh (in test.sh): the one C++ format, .clang-format
+  clang-format-14
   # outside programs the tests use as oracles
   gmsh tetgen calculix-ccx python3-meshio python3-numpy
   # optional: foxi movie writes MP4 through it, and the movie tests decode APNG/GIF/MP4 with it

@@ -18,6 +18,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
+bash scripts/check_format.sh  # every C++ source as .clang-format says (clang-format-14)
 bash scripts/build.sh
 bash scripts/check_exports.sh build  # what the programs and tests call is FOXI_API (shared builds link)
 ctest --test-dir build --output-on-failure -j2 --timeout 900

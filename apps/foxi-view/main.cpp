@@ -30,7 +30,8 @@ const char* kUsage =
     "  front to back (1/64 of the set a frame; u again draws on), r region of interest (the tets\n"
     "  drawn so far become the displayed set, re-ordered for each new view), b back up the regions,\n"
     "  f the next field (the mesh's fields in turn, then region colours), m the next colour map\n"
-    "  (viridis, cividis, coolwarm, rainbow), l the legend at the right on or off, i the isosurface at the middle of the range (the solid\n"
+    "  (viridis, cividis, coolwarm, rainbow), l the legend at the right on or off, i the isosurface at the "
+    "middle of the range (the solid\n"
     "  above it, as foxi render --iso) on or off, o the surface alone or the solid, [ and ] the\n"
     "  isovalue down or up by 1/20 of the range (only the tets it crosses or reaches are ordered and\n"
     "  drawn), s save the picture as PREFIX-NNN.png (default PREFIX\n"
@@ -151,11 +152,13 @@ int main(int argc, char** argv) {
       // The same rules as foxi render (view_options.hpp), so both give the same picture.
       double lo[3], hi[3];
       foxi::mesh_bounds(mesh, lo, hi);
-      camera = foxi::camera_for(foxi::parse_camera_options(eye, at, up, fov, dir), lo, hi, double(width) / height);
+      camera =
+          foxi::camera_for(foxi::parse_camera_options(eye, at, up, fov, dir), lo, hi, double(width) / height);
     } catch (const std::invalid_argument& e) {
       throw Usage(e.what());
     }
-    if (field_spec.empty() && (graded || !cmap.empty())) throw Usage("--graded and --cmap colour by a field: give --field NAME");
+    if (field_spec.empty() && (graded || !cmap.empty()))
+      throw Usage("--graded and --cmap colour by a field: give --field NAME");
     foxi::ColorMapId map = foxi::ColorMapId::viridis;
     if (!cmap.empty()) {
       const auto m = foxi::parse_color_map(cmap);

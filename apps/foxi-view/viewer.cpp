@@ -15,7 +15,8 @@
 
 namespace foxi::view {
 
-std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix, bool dump, const ViewField* field) {
+std::filesystem::path save_next(const Viewer& viewer, const std::string& prefix, bool dump,
+                                const ViewField* field) {
   std::string base;
   for (int i = 1;; ++i) {
     char num[16];
@@ -199,7 +200,8 @@ void move_iso(Viewer& viewer, ViewField& f, double steps) {
 }
 
 void next_map(Viewer& viewer, ViewField& f) {
-  const ColorMapId maps[] = {ColorMapId::viridis, ColorMapId::cividis, ColorMapId::coolwarm, ColorMapId::rainbow};
+  const ColorMapId maps[] = {ColorMapId::viridis, ColorMapId::cividis, ColorMapId::coolwarm,
+                             ColorMapId::rainbow};
   std::size_t i = 0;
   while (i < 4 && maps[i] != f.map) ++i;
   f.map = maps[(i + 1) % 4];
@@ -220,7 +222,9 @@ std::string value_under(const Viewer& viewer, const ViewField& f, int x, int y, 
   }
   double p[3] = {0, 0, 0};
   for (int i = 0; i < 4; ++i)
-    for (int k = 0; k < 3; ++k) p[k] += b[i] * mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(i)]) + std::size_t(k)];
+    for (int k = 0; k < 3; ++k)
+      p[k] +=
+          b[i] * mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(i)]) + std::size_t(k)];
   std::string value;
   if (!f.specs[f.current].empty()) {
     const double v = field_value_in_tet(mesh, f.choice, t, b, f.step);
@@ -228,8 +232,8 @@ std::string value_under(const Viewer& viewer, const ViewField& f, int x, int y, 
                   f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
     value = buf;
   }
-  std::snprintf(buf, sizeof buf, "at (%.*g, %.*g, %.*g), tet %u, region %u", digits, p[0], digits, p[1], digits, p[2], t,
-                region);
+  std::snprintf(buf, sizeof buf, "at (%.*g, %.*g, %.*g), tet %u, region %u", digits, p[0], digits, p[1],
+                digits, p[2], t, region);
   return value + buf;
 }
 
@@ -241,14 +245,15 @@ std::string field_status(const ViewField& f) {
                 f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
   std::string s = buf;
   if (f.iso_on) {
-    std::snprintf(buf, sizeof buf, ", %s %.4g%s%s", f.iso_only ? "isosurface" : "solid above", f.unit.to_display(f.iso_value),
-                  f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
+    std::snprintf(buf, sizeof buf, ", %s %.4g%s%s", f.iso_only ? "isosurface" : "solid above",
+                  f.unit.to_display(f.iso_value), f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
     s += buf;
   }
   return s;
 }
 
-void run_script(Viewer& viewer, ViewField& field, const std::string& script, const std::string& prefix, bool dump) {
+void run_script(Viewer& viewer, ViewField& field, const std::string& script, const std::string& prefix,
+                bool dump) {
   std::istringstream in(script);
   std::string cmd;
   while (in >> cmd) {
@@ -273,7 +278,8 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       viewer.set_undrawing(false);
       viewer.finish();
     } else if (name == "u") {
-      if (!viewer.set_undrawing(true)) throw std::invalid_argument("script: 'u' needs the painter (a Delaunay mesh) and no --no-undo");
+      if (!viewer.set_undrawing(true))
+        throw std::invalid_argument("script: 'u' needs the painter (a Delaunay mesh) and no --no-undo");
       if (arg.empty()) {
         while (viewer.step()) {
         }
@@ -297,20 +303,24 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       viewer.zoom(v[0]);
     } else if (name == "probe") {
       auto v = args(2);
-      std::printf("probe %g,%g: %s\n", v[0], v[1], value_under(viewer, field, int(v[0]), int(v[1]), 9).c_str());
+      std::printf("probe %g,%g: %s\n", v[0], v[1],
+                  value_under(viewer, field, int(v[0]), int(v[1]), 9).c_str());
       std::fflush(stdout);
     } else if (name == "iso" || name == "iso-only") {
       if (!set_iso(viewer, field, args(1)[0], name == "iso-only"))
-        throw std::invalid_argument("script: '" + cmd + "' draws a field's isosurface: give --field or 'field' first");
+        throw std::invalid_argument("script: '" + cmd +
+                                    "' draws a field's isosurface: give --field or 'field' first");
     } else if (cmd == "legend") {
-      if (!toggle_legend(viewer, field)) throw std::invalid_argument("script: 'legend' needs a field: give --field");
+      if (!toggle_legend(viewer, field))
+        throw std::invalid_argument("script: 'legend' needs a field: give --field");
       if (field.legend)
         std::printf("legend on, %d pixels at the right\n", field.panel);
       else
         std::printf("legend off\n");
       std::fflush(stdout);
     } else if (cmd == "i") {  // the key: on at the middle of the range, or off
-      if (field.specs[field.current].empty()) throw std::invalid_argument("script: 'i' needs a field: give --field");
+      if (field.specs[field.current].empty())
+        throw std::invalid_argument("script: 'i' needs a field: give --field");
       toggle_iso(viewer, field);
     } else if (cmd == "noiso") {
       if (field.iso_on) toggle_iso(viewer, field);
@@ -323,7 +333,8 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       viewer.pan(v[0], v[1]);
     } else {
       throw std::invalid_argument("unknown script command '" + cmd +
-                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map i iso:V iso-only:V noiso legend)");
+                                  "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map i "
+                                  "iso:V iso-only:V noiso legend)");
     }
   }
 }

@@ -87,7 +87,8 @@ std::string field_status(const ViewField& field);
 //   s            save the picture as PREFIX-NNN.png (and with dump, PREFIX-NNN.ids: the id buffer as
 //                little-endian uint32, and PREFIX-NNN.tets: the drawn tets, one a line)
 // Prints one line per save ("saved NAME ...") on stdout. Throws std::invalid_argument on a bad command.
-void run_script(Viewer& viewer, ViewField& field, const std::string& script, const std::string& prefix, bool dump);
+void run_script(Viewer& viewer, ViewField& field, const std::string& script, const std::string& prefix,
+                bool dump);
 
 // Saves the picture under the next free name PREFIX-NNN.png; prints "saved NAME camera ..." and
 // returns the path. With dump, also writes the id buffer and the drawn tets beside it.

@@ -284,8 +284,8 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
           if (!button) {  // the value under the mouse on the status line
             while (XCheckTypedWindowEvent(dpy, win, MotionNotify, &ev)) {
             }
-            const bool inside = ev.xmotion.x >= 0 && ev.xmotion.y >= 0 && ev.xmotion.x < viewer.framebuffer().width &&
-                                ev.xmotion.y < height;
+            const bool inside = ev.xmotion.x >= 0 && ev.xmotion.y >= 0 &&
+                                ev.xmotion.x < viewer.framebuffer().width && ev.xmotion.y < height;
             mouse_x = inside ? ev.xmotion.x : -1;
             mouse_y = inside ? ev.xmotion.y : -1;
             changed = true;

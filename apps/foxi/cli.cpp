@@ -20,7 +20,8 @@ bool Args::flag(std::string_view name) {
 }
 
 bool Args::has_option(std::string_view name) const {
-  for (const std::string& a : args_) if (a == name) return true;
+  for (const std::string& a : args_)
+    if (a == name) return true;
   return false;
 }
 
@@ -65,10 +66,12 @@ std::string Args::option(std::string_view name, std::string fallback) {
 
 std::vector<std::string> Args::positional(std::size_t min, std::size_t max, std::string_view usage) {
   for (const std::string& a : args_) {
-    if (a.size() > 1 && a[0] == '-' && a[1] == '-') throw UsageError("unknown option " + a + "\nusage: " + std::string(usage));
+    if (a.size() > 1 && a[0] == '-' && a[1] == '-')
+      throw UsageError("unknown option " + a + "\nusage: " + std::string(usage));
   }
   if (args_.size() < min || args_.size() > max) {
-    throw UsageError("expected " + (min == max ? std::to_string(min) : std::to_string(min) + " to " + std::to_string(max)) +
+    throw UsageError("expected " +
+                     (min == max ? std::to_string(min) : std::to_string(min) + " to " + std::to_string(max)) +
                      " arguments, got " + std::to_string(args_.size()) + "\nusage: " + std::string(usage));
   }
   return args_;
@@ -86,11 +89,21 @@ std::string json_string(std::string_view s) {
   std::string out = "\"";
   for (char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];

@@ -88,7 +88,8 @@ MeshedModel model_for_ccx(Args& args, const char* usage, const char* command, co
   const std::vector<std::string> sets = all_options(args, "--set");
   const auto files = args.positional(1, 1, usage);
   if (!is_model_path(files[0]))
-    throw UsageError("give a model file (MODEL.toml): ccx needs its conditions, which a mesh file does not hold");
+    throw UsageError(
+        "give a model file (MODEL.toml): ccx needs its conditions, which a mesh file does not hold");
   MeshedModel run = mesh_model_for_solve(files[0], sets, physics);
   require_usable(run.mesh, files[0], command);
   return run;
@@ -162,10 +163,12 @@ void show_ccx_progress(const fs::path& log, const std::atomic<bool>& running) {
     for (std::size_t nl; (nl = pending.find('\n')) != std::string::npos; pending.erase(0, nl + 1)) {
       const std::size_t b = pending.find_first_not_of(' ');
       const std::size_t e = nl == 0 ? std::string::npos : pending.find_last_not_of(" \r", nl - 1);
-      const std::string line = b < nl && e != std::string::npos && e >= b ? pending.substr(b, e - b + 1) : std::string();
+      const std::string line =
+          b < nl && e != std::string::npos && e >= b ? pending.substr(b, e - b + 1) : std::string();
       // (ccx's Fortran and C parts buffer their output apart, so "STEP" lines come out of order.)
       for (const char* key : {"increment ", "iteration ", "convergence", "no convergence", "Job finished"})
-        if (line.rfind(key, 0) == 0 && (key[0] != 'i' || key[1] != 'n' || line.find("attempt") != std::string::npos)) {
+        if (line.rfind(key, 0) == 0 &&
+            (key[0] != 'i' || key[1] != 'n' || line.find("attempt") != std::string::npos)) {
           std::fprintf(stderr, "ccx: %s\n", line.c_str());
           break;
         }
@@ -185,15 +188,19 @@ bool run_ccx(WorkFolder& folder, const std::string& job) {
   std::atomic<bool> running{true};
   std::thread progress;
   if (::isatty(2)) progress = std::thread(show_ccx_progress, work / (job + ".log"), std::cref(running));
-  const int status = run_program({"/bin/sh", "-c", "cd '" + work.string() + "' && OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} exec ccx -i " + job},
-                                 (work / (job + ".log")).string());
+  const int status =
+      run_program({"/bin/sh", "-c",
+                   "cd '" + work.string() + "' && OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} exec ccx -i " + job},
+                  (work / (job + ".log")).string());
   running = false;
   if (progress.joinable()) progress.join();
   const std::string log_tail = tail_of(work / (job + ".log"), 15);
   if (status == 127)
-    throw std::runtime_error("ccx (CalculiX) is not installed: no 'ccx' in PATH (Debian: apt-get install calculix-ccx)");
+    throw std::runtime_error(
+        "ccx (CalculiX) is not installed: no 'ccx' in PATH (Debian: apt-get install calculix-ccx)");
   if (status != 0 || log_tail.find("*ERROR") != std::string::npos || !fs::exists(work / (job + ".frd"))) {
-    std::fprintf(stderr, "foxi solve: ccx failed (exit status %d); its last output:\n%s\n", status, log_tail.c_str());
+    std::fprintf(stderr, "foxi solve: ccx failed (exit status %d); its last output:\n%s\n", status,
+                 log_tail.c_str());
     std::fprintf(stderr, "foxi solve: the deck and ccx's files are kept in %s\n", work.c_str());
     folder.keep = true;
     return false;
@@ -231,8 +238,8 @@ void drop_nodes_beyond(FieldSource& s, std::size_t n) {
 
 // The nodal block `block` of WORK/JOB.frd on `mesh` (by node id, coordinates checked), renamed;
 // nullopt (message printed, folder kept) when it does not fit the mesh or leaves nodes without a value.
-std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const Mesh& mesh, const char* block,
-                               const char* name, const char* unit) {
+std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const Mesh& mesh,
+                               const char* block, const char* name, const char* unit) {
   const fs::path& work = folder.path;
   FieldSource frd = read_frd_source(work / (job + ".frd"));
   drop_nodes_beyond(frd, mesh.node_count());
@@ -243,13 +250,14 @@ std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const
   try {
     rep = transfer_fields(frd, mesh, tp);
   } catch (const FieldError& e) {
-    std::fprintf(stderr, "foxi solve: ccx's results do not fit the mesh (%s); files kept in %s\n", e.what(), work.c_str());
+    std::fprintf(stderr, "foxi solve: ccx's results do not fit the mesh (%s); files kept in %s\n", e.what(),
+                 work.c_str());
     folder.keep = true;
     return std::nullopt;
   }
   if (rep.nan_values > 0) {
-    std::fprintf(stderr, "foxi solve: ccx's %s has no value for %zu entries; files kept in %s\n", block, rep.nan_values,
-                 work.c_str());
+    std::fprintf(stderr, "foxi solve: ccx's %s has no value for %zu entries; files kept in %s\n", block,
+                 rep.nan_values, work.c_str());
     folder.keep = true;
     return std::nullopt;
   }
@@ -264,8 +272,8 @@ std::optional<Field> ccx_field(WorkFolder& folder, const std::string& job, const
 // The values of nodal block `block` of WORK/JOB.frd at the deck's C3D10 mid-edge nodes (ids after the
 // mesh's `n` nodes, every one from n + 1 on, in order); nullopt (message printed, folder kept) when
 // the block is missing or leaves one out.
-std::optional<std::vector<double>> ccx_mid_edge_values(WorkFolder& folder, const std::string& job, std::size_t n,
-                                                       const char* block) {
+std::optional<std::vector<double>> ccx_mid_edge_values(WorkFolder& folder, const std::string& job,
+                                                       std::size_t n, const char* block) {
   const FieldSource frd = read_frd_source(folder.path / (job + ".frd"));
   const Field* f = nullptr;
   for (const Field& g : frd.mesh.fields)
@@ -282,8 +290,8 @@ std::optional<std::vector<double>> ccx_mid_edge_values(WorkFolder& folder, const
                 v.begin() + std::ptrdiff_t((id - n - 1) * f->components));
   }
   if (!f || found != mid || std::any_of(v.begin(), v.end(), [](double x) { return !std::isfinite(x); })) {
-    std::fprintf(stderr, "foxi solve: ccx's %s does not give every mid-edge node a value; files kept in %s\n", block,
-                 folder.path.c_str());
+    std::fprintf(stderr, "foxi solve: ccx's %s does not give every mid-edge node a value; files kept in %s\n",
+                 block, folder.path.c_str());
     folder.keep = true;
     return std::nullopt;
   }
@@ -317,8 +325,8 @@ int cmd_export_ccx(Args args) {
   const std::string order = args.option("--order", "1");
   if (order != "1" && order != "2") throw UsageError("--order takes 1 or 2, not '" + order + "'");
   if (order == "2" && !stress) throw UsageError("--order 2 is for --physics thermoelastic");
-  MeshedModel run =
-      model_for_ccx(args, kExportUsage, "export-ccx", stress ? physics_name(Physics::thermal_stress) : "thermal");
+  MeshedModel run = model_for_ccx(args, kExportUsage, "export-ccx",
+                                  stress ? physics_name(Physics::thermal_stress) : "thermal");
   // Written in a work folder, then copied through a durable file: whole or not at all.
   const WorkFolder work;
   std::string summary;
@@ -326,8 +334,9 @@ int cmd_export_ccx(Args args) {
     ThermoelasticParams ep = thermoelastic_params_from_model(run.model, run.mesh);
     ep.order = order == "2" ? 2 : 1;
     write_calculix_thermoelastic(run.mesh, ep, work.path / "deck.inp");
-    summary = std::string(ep.order == 2 ? "C3D10" : "C3D4") + " elements; " + std::to_string(ep.fixed.size()) +
-              " displacement and " + std::to_string(ep.sliding.size()) + " sliding conditions";
+    summary = std::string(ep.order == 2 ? "C3D10" : "C3D4") + " elements; " +
+              std::to_string(ep.fixed.size()) + " displacement and " + std::to_string(ep.sliding.size()) +
+              " sliding conditions";
   } else {
     const ThermalParams params = thermal_params_from_model(run.model, run.mesh);
     write_calculix_thermal(run.mesh, params, work.path / "deck.inp");
@@ -370,12 +379,14 @@ int cmd_solve_with(Args args, const std::string& physics) {
   JsonOutput json = json_option(args);
   const ThermalOptions cli_conditions = thermal_options(args);
   if (stress && !cli_conditions.empty())
-    throw UsageError("--fix, --flux, --convect, --power, --power-density, --k and --theta are for --physics thermal");
+    throw UsageError(
+        "--fix, --flux, --convect, --power, --power-density, --k and --theta are for --physics thermal");
   const std::vector<std::string> sets = all_options(args, "--set");
   const auto files = args.positional(1, 1, kSolveCcxUsage);
   const bool from_model = is_model_path(files[0]);
   if (!from_model && stress)
-    throw UsageError("--physics thermoelastic --with ccx needs a model file (MODEL.toml): its displacement conditions");
+    throw UsageError(
+        "--physics thermoelastic --with ccx needs a model file (MODEL.toml): its displacement conditions");
   if (!from_model && !sets.empty()) throw UsageError("--set is for model files (MODEL.toml)");
   silence_text_for_json(json);
   const auto t0 = std::chrono::steady_clock::now();
@@ -391,12 +402,15 @@ int cmd_solve_with(Args args, const std::string& physics) {
   WorkFolder work;
   int result = kExitOk;
   std::vector<Field> fields;  // written to OUT in this order
-  const auto clock = [t0] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  const auto clock = [t0] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   auto report_compare = [&](const char* what, const std::vector<double>& ccx, const std::vector<double>& own,
                             const char* unit) {
     const auto [diff, rel] = largest_difference(ccx, own);
-    std::printf("compare: largest |%s_ccx - %s_foxi| %.3g %s, %.3g of the largest (%s)\n", what, what, diff, unit, rel,
-                rel <= 1e-5 ? "agree to ccx's output precision" : "MORE than ccx's output precision explains");
+    std::printf(
+        "compare: largest |%s_ccx - %s_foxi| %.3g %s, %.3g of the largest (%s)\n", what, what, diff, unit,
+        rel, rel <= 1e-5 ? "agree to ccx's output precision" : "MORE than ccx's output precision explains");
     if (!(rel <= 1e-5)) result = kExitUnreliable;
   };
 
@@ -448,7 +462,8 @@ int cmd_solve_with(Args args, const std::string& physics) {
     // and principal stress per tet, the maxima per region and interface, as foxi solve prints them.
     std::vector<double> solver_u = u->values;
     if (ep.order == 2) {
-      const std::optional<std::vector<double>> mid = ccx_mid_edge_values(work, "stress", mesh.node_count(), "DISP");
+      const std::optional<std::vector<double>> mid =
+          ccx_mid_edge_values(work, "stress", mesh.node_count(), "DISP");
       if (!mid) return kExitFailure;
       solver_u.insert(solver_u.end(), mid->begin(), mid->end());
     }
@@ -459,18 +474,21 @@ int cmd_solve_with(Args args, const std::string& physics) {
     double vm_max = 0;
     for (std::size_t i = 0; i < mesh.node_count(); ++i) {
       const double* s6 = &sn->values[6 * i];
-      const double vm = std::sqrt(0.5 * ((s6[0] - s6[1]) * (s6[0] - s6[1]) + (s6[1] - s6[2]) * (s6[1] - s6[2]) +
-                                         (s6[2] - s6[0]) * (s6[2] - s6[0])) +
-                                  3 * (s6[3] * s6[3] + s6[4] * s6[4] + s6[5] * s6[5]));
+      const double vm =
+          std::sqrt(0.5 * ((s6[0] - s6[1]) * (s6[0] - s6[1]) + (s6[1] - s6[2]) * (s6[1] - s6[2]) +
+                           (s6[2] - s6[0]) * (s6[2] - s6[0])) +
+                    3 * (s6[3] * s6[3] + s6[4] * s6[4] + s6[5] * s6[5]));
       vm_max = std::max(vm_max, vm);
     }
     std::printf("%s: %zu nodes, %zu tets; linear thermoelasticity by ccx (%s), %.3f s\n", files[0].c_str(),
                 mesh.node_count(), mesh.tet_count(), ep.order == 2 ? "C3D10" : "C3D4", ccx_seconds);
     print_thermoelastic_report(mesh, rep);
-    std::printf("largest von Mises of ccx's nodal stress (its element values averaged at the nodes) %.6g Pa\n",
-                vm_max);
+    std::printf(
+        "largest von Mises of ccx's nodal stress (its element values averaged at the nodes) %.6g Pa\n",
+        vm_max);
     RunResults elastic = thermoelastic_results(mesh, rep);
-    elastic.checks.insert(elastic.checks.begin(), results.checks.begin(), results.checks.end());  // the thermal run's
+    elastic.checks.insert(elastic.checks.begin(), results.checks.begin(),
+                          results.checks.end());  // the thermal run's
     results = std::move(elastic);
     if (compare) {
       Mesh own = mesh;

@@ -21,7 +21,8 @@ const char* kConvertUsage =
     "  .node/.ele/.face .mesh). Regions, boundary tags, vertex weights and fields are carried\n"
     "  where the output format can hold them. Inverted tets are re-oriented (and counted) unless\n"
     "  --keep-orientation. A mesh that validation calls unusable (see foxi info) is refused (exit\n"
-    "  status 3) unless --keep-invalid, which converts it as it is, with a warning. OUT is written to a temporary file and renamed, so a failure leaves\n"
+    "  status 3) unless --keep-invalid, which converts it as it is, with a warning. OUT is written to a "
+    "temporary file and renamed, so a failure leaves\n"
     "  no partial file. Defaults: binary, Gmsh 4.1, appended raw .vtu.";
 
 }  // namespace
@@ -37,16 +38,24 @@ int cmd_convert(Args args) {
   if (ascii && binary) throw UsageError("--ascii and --binary exclude each other");
   options.binary = !ascii;
   const std::string version = args.option("--msh-version", "4.1");
-  if (version == "4.1" || version == "4") options.gmsh_version = 41;
-  else if (version == "2.2" || version == "2") options.gmsh_version = 22;
-  else throw UsageError("--msh-version takes 2.2 or 4.1, not '" + version + "'");
+  if (version == "4.1" || version == "4")
+    options.gmsh_version = 41;
+  else if (version == "2.2" || version == "2")
+    options.gmsh_version = 22;
+  else
+    throw UsageError("--msh-version takes 2.2 or 4.1, not '" + version + "'");
   const bool encoding_given = args.has_option("--vtu-encoding");
   const std::string encoding = args.option("--vtu-encoding", "raw");
-  if (encoding == "raw" || encoding == "appended") options.vtu_encoding = VtuEncoding::appended_raw;
-  else if (encoding == "zlib") options.vtu_encoding = VtuEncoding::zlib;
-  else if (encoding == "base64") options.vtu_encoding = VtuEncoding::base64;
-  else if (encoding == "ascii") options.vtu_encoding = VtuEncoding::ascii;
-  else throw UsageError("--vtu-encoding takes raw, zlib, base64 or ascii, not '" + encoding + "'");
+  if (encoding == "raw" || encoding == "appended")
+    options.vtu_encoding = VtuEncoding::appended_raw;
+  else if (encoding == "zlib")
+    options.vtu_encoding = VtuEncoding::zlib;
+  else if (encoding == "base64")
+    options.vtu_encoding = VtuEncoding::base64;
+  else if (encoding == "ascii")
+    options.vtu_encoding = VtuEncoding::ascii;
+  else
+    throw UsageError("--vtu-encoding takes raw, zlib, base64 or ascii, not '" + encoding + "'");
   if (ascii && !encoding_given) options.vtu_encoding = VtuEncoding::ascii;
   const bool keep_orientation = args.flag("--keep-orientation");
   const bool keep_invalid = args.flag("--keep-invalid");
@@ -64,7 +73,8 @@ int cmd_convert(Args args) {
   if (keep_invalid) {
     report = keep_orientation ? validate(mesh) : validate_and_repair(mesh);
     if (!report.ok()) {
-      std::fprintf(stderr, "foxi convert: warning: %s is not a usable mesh (converted as it is, --keep-invalid):\n",
+      std::fprintf(stderr,
+                   "foxi convert: warning: %s is not a usable mesh (converted as it is, --keep-invalid):\n",
                    files[0].c_str());
       for (const std::string& m : describe(report)) std::fprintf(stderr, "  %s\n", m.c_str());
       for (const std::string& m : report.messages) std::fprintf(stderr, "  %s\n", m.c_str());
@@ -77,11 +87,12 @@ int cmd_convert(Args args) {
   }
   write_mesh(mesh, files[1], options);
   auto t2 = std::chrono::steady_clock::now();
-  std::printf("%s (%s) -> %s (%s): %zu nodes, %zu tets, %zu boundary triangles, %zu fields; read %.3f s, "
-              "write %.3f s\n",
-              files[0].c_str(), format_name(in_format), files[1].c_str(), format_name(out_format),
-              mesh.node_count(), mesh.tet_count(), mesh.bface_count(), mesh.fields.size(),
-              std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count());
+  std::printf(
+      "%s (%s) -> %s (%s): %zu nodes, %zu tets, %zu boundary triangles, %zu fields; read %.3f s, "
+      "write %.3f s\n",
+      files[0].c_str(), format_name(in_format), files[1].c_str(), format_name(out_format), mesh.node_count(),
+      mesh.tet_count(), mesh.bface_count(), mesh.fields.size(),
+      std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count());
   if (report.inverted > 0) {
     std::printf("%zu inverted tets %s\n", report.inverted,
                 keep_orientation ? "kept as they were (--keep-orientation)" : "re-oriented");

@@ -61,7 +61,8 @@ double deform_scale_for(const Mesh& mesh, const std::string& field, double fract
   const Field* f = nullptr;
   for (const Field& g : mesh.fields)
     if (g.name == field && g.location == FieldLocation::node && g.components == 3) f = &g;
-  if (f == nullptr) throw std::runtime_error("the thermoelastic result has no 3-component node field '" + field + "'");
+  if (f == nullptr)
+    throw std::runtime_error("the thermoelastic result has no 3-component node field '" + field + "'");
   double lo[3], hi[3];
   mesh_bounds(mesh, lo, hi);
   const double diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
@@ -92,7 +93,8 @@ int cmd_demo(Args args) {
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
   const std::filesystem::path dir = args.option("-o", "out/demo");
   const auto pos = args.positional(0, 1, kDemoUsage);
-  const std::string file = pos.empty() ? (models_dir() / "flip_chip.toml").lexically_normal().string() : pos[0];
+  const std::string file =
+      pos.empty() ? (models_dir() / "flip_chip.toml").lexically_normal().string() : pos[0];
   if (!is_model_path(file)) throw UsageError("foxi demo takes a model file (.toml), not '" + file + "'");
   const std::string stem = std::filesystem::path(file).stem().string();
   std::filesystem::create_directories(dir);
@@ -104,12 +106,14 @@ int cmd_demo(Args args) {
   options.physics = Physics::thermal;
   MeshedModel m = mesh_model_from_sets(file, sets, options);
   for (std::size_t i = 0; i < m.model.parts.size(); ++i)
-    std::printf("   part %-14s %-14s %.4g mm^3\n", m.model.parts[i].name.c_str(), m.model.parts[i].material.c_str(),
-                m.structure.part_volume[i] * 1e9);
+    std::printf("   part %-14s %-14s %.4g mm^3\n", m.model.parts[i].name.c_str(),
+                m.model.parts[i].material.c_str(), m.structure.part_volume[i] * 1e9);
   print_model_conditions(m.model);
-  std::printf("2. mesh: PLC %zu points, %zu facets -> %zu nodes, %zu tets, %zu boundary triangles (TetGen %s, %.2f s)\n",
-              m.structure.plc.point_count(), m.structure.plc.facet_count(), m.mesh.node_count(),
-              m.mesh.tet_count(), m.mesh.bface_count(), m.report.switches.c_str(), seconds_since(t));
+  std::printf(
+      "2. mesh: PLC %zu points, %zu facets -> %zu nodes, %zu tets, %zu boundary triangles (TetGen %s, %.2f "
+      "s)\n",
+      m.structure.plc.point_count(), m.structure.plc.facet_count(), m.mesh.node_count(), m.mesh.tet_count(),
+      m.mesh.bface_count(), m.report.switches.c_str(), seconds_since(t));
   const QualitySummary q = summarize_quality(m.mesh);
   std::printf("   radius-edge max %.3g, min dihedral %.3g deg, %zu slivers below 5 deg\n", q.radius_edge.max,
               q.min_dihedral_deg.min, q.slivers);
@@ -125,10 +129,11 @@ int cmd_demo(Args args) {
   const ThermalReport r = solve_thermal(m.mesh, thermal_params_from_model(m.model, m.mesh));
   double out = 0;
   for (const BoundaryHeat& b : r.boundaries) out -= b.heat_in;
-  std::printf("4. steady heat: max temperature %.2f K (%.2f C); %.4g W in, %.4g W out through the boundaries "
-              "(balance %.2g W); solver %s, %.2f s\n",
-              r.max_temperature, r.max_temperature - 273.15, r.total_power, out, r.total_power - out,
-              r.solver.c_str(), r.assembly_seconds + r.solve_seconds);
+  std::printf(
+      "4. steady heat: max temperature %.2f K (%.2f C); %.4g W in, %.4g W out through the boundaries "
+      "(balance %.2g W); solver %s, %.2f s\n",
+      r.max_temperature, r.max_temperature - 273.15, r.total_power, out, r.total_power - out,
+      r.solver.c_str(), r.assembly_seconds + r.solve_seconds);
   for (const RegionTemperature& rt : r.regions) {
     const Region* reg = m.mesh.find_region(rt.region);
     std::printf("   %-14s max %.2f K, mean %.2f K\n", reg ? reg->name.c_str() : "?", rt.max_temperature,
@@ -152,9 +157,11 @@ int cmd_demo(Args args) {
   pp.view = ModelView::interior;
   pp.field = "temperature";
   const ModelPicture tp = render_model_picture(m, temp_png, pp);
-  std::printf("6. temperature picture: the far 60 %% coloured by temperature (graded facets, viridis), %.2f to %.2f %s, "
-              "legend at the right, %.2f s\n",
-              tp.field_lo, tp.field_hi, tp.field_unit.c_str(), seconds_since(t));
+  std::printf(
+      "6. temperature picture: the far 60 %% coloured by temperature (graded facets, viridis), %.2f to %.2f "
+      "%s, "
+      "legend at the right, %.2f s\n",
+      tp.field_lo, tp.field_hi, tp.field_unit.c_str(), seconds_since(t));
 
   // The rest through the commands themselves (their reports printed as they are), so that the demo
   // shows what a user's command line gives: an isotherm, its sweep as a movie, the stress.
@@ -171,11 +178,13 @@ int cmd_demo(Args args) {
   if (status != kExitOk) return status;
   char sweep[96];
   std::snprintf(sweep, sizeof sweep, "iso:%.6g,%.6g", tp.field_lo, tp.field_hi);
-  std::printf("\n8. the isotherm swept from the coolest to the hottest: foxi movie %s --field temperature --graded "
-              "--sweep %s --frames 24 -o %s\n",
-              vtu.c_str(), sweep, gif.c_str());
+  std::printf(
+      "\n8. the isotherm swept from the coolest to the hottest: foxi movie %s --field temperature --graded "
+      "--sweep %s --frames 24 -o %s\n",
+      vtu.c_str(), sweep, gif.c_str());
   std::fflush(stdout);
-  status = cmd_movie(Args({vtu, "--field", "temperature", "--graded", "--sweep", sweep, "--frames", "24", "-o", gif}));
+  status = cmd_movie(
+      Args({vtu, "--field", "temperature", "--graded", "--sweep", sweep, "--frames", "24", "-o", gif}));
   if (status != kExitOk) return status;
   // 9. Thermal stress (the same model, thermoelastic), von Mises on the shape deformed by a factor that
   // moves the nodes by at most 2 % of the model's size: the warpage visible, the tets not folded.
@@ -184,16 +193,18 @@ int cmd_demo(Args args) {
     check_physics(m.model, Physics::thermal_stress);
   } catch (const IoError& e) {
     std::printf("\n9. thermal stress: skipped, the model is not ready for it: %s\n", e.what());
-    std::printf("\nwrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature), %s (isotherm), %s "
-                "(isotherm movie)\n",
-                vtu.c_str(), png.c_str(), parts.c_str(), temp_png.c_str(), iso_png.c_str(), gif.c_str());
+    std::printf(
+        "\nwrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature), %s (isotherm), %s "
+        "(isotherm movie)\n",
+        vtu.c_str(), png.c_str(), parts.c_str(), temp_png.c_str(), iso_png.c_str(), gif.c_str());
     return kExitOk;
   }
   const std::string te_vtu = (dir / (stem + "_stress.vtu")).string();
   const std::string vm_png = (dir / (stem + "_von_mises.png")).string();
   std::vector<std::string> solve = {file, "--physics", "thermoelastic", "-o", te_vtu};
   for (const std::string& set : sets) solve.insert(solve.end(), {"--set", set});
-  std::printf("\n9. thermal stress: foxi solve %s --physics thermoelastic -o %s\n", file.c_str(), te_vtu.c_str());
+  std::printf("\n9. thermal stress: foxi solve %s --physics thermoelastic -o %s\n", file.c_str(),
+              te_vtu.c_str());
   std::fflush(stdout);
   status = cmd_solve(Args(solve));
   if (status != kExitOk) return status;
@@ -201,16 +212,20 @@ int cmd_demo(Args args) {
   const double scale = deform_scale_for(te, "displacement", 0.02);
   char scale_s[32];
   std::snprintf(scale_s, sizeof scale_s, "displacement:%g", scale);
-  std::printf("\n10. von Mises on the deformed shape: foxi render %s --field von_mises --graded --deform %s --stop 60%% "
-              "-o %s\n",
-              te_vtu.c_str(), scale_s, vm_png.c_str());
+  std::printf(
+      "\n10. von Mises on the deformed shape: foxi render %s --field von_mises --graded --deform %s --stop "
+      "60%% "
+      "-o %s\n",
+      te_vtu.c_str(), scale_s, vm_png.c_str());
   std::fflush(stdout);
-  status = cmd_render(Args({te_vtu, "--field", "von_mises", "--graded", "--deform", scale_s, "--stop", "60%", "-o", vm_png}));
+  status = cmd_render(
+      Args({te_vtu, "--field", "von_mises", "--graded", "--deform", scale_s, "--stop", "60%", "-o", vm_png}));
   if (status != kExitOk) return status;
-  std::printf("\nwrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature), %s (isotherm), %s "
-              "(isotherm movie), %s (stress), %s (von Mises, deformed)\n",
-              vtu.c_str(), png.c_str(), parts.c_str(), temp_png.c_str(), iso_png.c_str(), gif.c_str(), te_vtu.c_str(),
-              vm_png.c_str());
+  std::printf(
+      "\nwrote %s (temperature, heat flux), %s (inside), %s (parts), %s (temperature), %s (isotherm), %s "
+      "(isotherm movie), %s (stress), %s (von Mises, deformed)\n",
+      vtu.c_str(), png.c_str(), parts.c_str(), temp_png.c_str(), iso_png.c_str(), gif.c_str(), te_vtu.c_str(),
+      vm_png.c_str());
   return kExitOk;
 }
 

@@ -25,7 +25,8 @@ const char* kFieldsUsage =
     "  FILE: .vtu .vtk (point and cell data), .pvd (a ParaView series of .vtu files, one step each),\n"
     "  .msh ($NodeData/$ElementData, every step), .frd (CalculiX results, ASCII or binary, every block\n"
     "  of every step), .csv (a header row: a key column 'id' (node ids, 1-based), 'cell' (tet ids,\n"
-    "  1-based) or 'x','y','z'; then field columns 'NAME', 'NAME [UNIT]', 'NAME:0'.. or 'NAME_x'.. for vectors).\n"
+    "  1-based) or 'x','y','z'; then field columns 'NAME', 'NAME [UNIT]', 'NAME:0'.. or 'NAME_x'.. for "
+    "vectors).\n"
     "  list: each field's name, location (node/cell), components, steps, unit, value range and NaNs.\n"
     "  import: the fields of FILE (all, or each --field NAME) carried onto MESH, written with MESH's\n"
     "  own fields to OUT (any mesh format; a field of the same name is replaced):\n"
@@ -45,10 +46,14 @@ const char* location_name(FieldLocation l) { return l == FieldLocation::node ? "
 
 const char* key_name(SourceKey k) {
   switch (k) {
-    case SourceKey::position: return "its own mesh";
-    case SourceKey::node_id: return "node ids";
-    case SourceKey::cell_id: return "tet ids";
-    case SourceKey::coordinates: return "coordinates";
+    case SourceKey::position:
+      return "its own mesh";
+    case SourceKey::node_id:
+      return "node ids";
+    case SourceKey::cell_id:
+      return "tet ids";
+    case SourceKey::coordinates:
+      return "coordinates";
   }
   return "?";
 }
@@ -63,16 +68,21 @@ int fields_list(Args& args) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     std::size_t nan = 0;
     for (double v : f.values) {
-      if (std::isnan(v)) ++nan;
-      else if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+      if (std::isnan(v))
+        ++nan;
+      else if (std::isfinite(v))
+        lo = std::min(lo, v), hi = std::max(hi, v);
     }
     std::string steps = std::to_string(f.step_count()) + (f.step_count() == 1 ? " step" : " steps");
     if (f.step_values.size() > 1)
       steps += " (" + json_number(f.step_values.front()) + " .. " + json_number(f.step_values.back()) + ")";
-    std::printf("  %-16s %s, %u component%s, %s, unit %s, ", f.name.c_str(), location_name(f.location), f.components,
-                f.components == 1 ? "" : "s", steps.c_str(), f.unit.empty() ? "-" : f.unit.c_str());
-    if (lo <= hi) std::printf("values %.6g .. %.6g", lo, hi);
-    else std::printf("no finite values");
+    std::printf("  %-16s %s, %u component%s, %s, unit %s, ", f.name.c_str(), location_name(f.location),
+                f.components, f.components == 1 ? "" : "s", steps.c_str(),
+                f.unit.empty() ? "-" : f.unit.c_str());
+    if (lo <= hi)
+      std::printf("values %.6g .. %.6g", lo, hi);
+    else
+      std::printf("no finite values");
     std::printf(", %zu NaN\n", nan);
   }
   return kExitOk;
@@ -81,11 +91,15 @@ int fields_list(Args& args) {
 int fields_import(Args& args) {
   TransferParams params;
   const std::string by = args.option("--by", "");
-  if (!by.empty() && by != "id" && by != "location") throw UsageError("--by takes id or location, not '" + by + "'");
+  if (!by.empty() && by != "id" && by != "location")
+    throw UsageError("--by takes id or location, not '" + by + "'");
   const std::string outside = args.option("--outside", "nan");
-  if (outside == "nan") params.outside = Outside::nan;
-  else if (outside == "nearest") params.outside = Outside::nearest;
-  else throw UsageError("--outside takes nan or nearest, not '" + outside + "'");
+  if (outside == "nan")
+    params.outside = Outside::nan;
+  else if (outside == "nearest")
+    params.outside = Outside::nearest;
+  else
+    throw UsageError("--outside takes nan or nearest, not '" + outside + "'");
   if (args.has_option("--tolerance")) {
     const std::vector<double> t = parse_numbers(args.option("--tolerance"), "--tolerance");
     if (t.size() != 1 || !(t[0] >= 0)) throw UsageError("--tolerance takes one number >= 0");
@@ -104,8 +118,8 @@ int fields_import(Args& args) {
   const FieldSource src = read_field_source(files[1]);
   const auto t1 = std::chrono::steady_clock::now();
   if (by.empty()) {
-    const bool same = src.key != SourceKey::position ||
-                      (src.mesh.node_count() == mesh.node_count() && src.mesh.tet_count() == mesh.tet_count());
+    const bool same = src.key != SourceKey::position || (src.mesh.node_count() == mesh.node_count() &&
+                                                         src.mesh.tet_count() == mesh.tet_count());
     params.by = same ? MatchBy::id : MatchBy::location;
   } else {
     params.by = by == "id" ? MatchBy::id : MatchBy::location;
@@ -117,7 +131,9 @@ int fields_import(Args& args) {
     } catch (const FieldError& e) {
       // The default with equal counts is a guess: another mesh with the same counts (other
       // coordinates or tets) goes by location, and says so.
-      if (!by.empty() || src.key != SourceKey::position || params.by != MatchBy::id || src.mesh.tet_count() == 0) throw;
+      if (!by.empty() || src.key != SourceKey::position || params.by != MatchBy::id ||
+          src.mesh.tet_count() == 0)
+        throw;
       std::fprintf(stderr, "foxi fields: note: not the same mesh (%s): matching by location\n", e.what());
       params.by = MatchBy::location;
       rep = transfer_fields(src, mesh, params);
@@ -140,13 +156,15 @@ int fields_import(Args& args) {
   const auto t3 = std::chrono::steady_clock::now();
   const auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   std::printf("%s -> %s: %zu field%s by %s onto %s (%zu nodes, %zu tets)\n", files[1].c_str(), out.c_str(),
-              rep.fields.size(), rep.fields.size() == 1 ? "" : "s", params.by == MatchBy::id ? "id" : "location",
-              files[0].c_str(), rep.target_nodes, rep.target_cells);
+              rep.fields.size(), rep.fields.size() == 1 ? "" : "s",
+              params.by == MatchBy::id ? "id" : "location", files[0].c_str(), rep.target_nodes,
+              rep.target_cells);
   if (params.by == MatchBy::location)
-    std::printf("  outside the source mesh: %zu nodes, %zu tet centroids (%s)\n", rep.nodes_outside, rep.cells_outside,
-                params.outside == Outside::nan ? "NaN" : "nearest value");
+    std::printf("  outside the source mesh: %zu nodes, %zu tet centroids (%s)\n", rep.nodes_outside,
+                rep.cells_outside, params.outside == Outside::nan ? "NaN" : "nearest value");
   else
-    std::printf("  without a source value: %zu nodes, %zu tets (NaN)\n", rep.nodes_missing, rep.cells_missing);
+    std::printf("  without a source value: %zu nodes, %zu tets (NaN)\n", rep.nodes_missing,
+                rep.cells_missing);
   std::printf("  NaN values: %zu; read %.3f s, transfer %.3f s, write %.3f s\n", rep.nan_values, sec(t0, t1),
               sec(t1, t2), sec(t2, t3));
   return kExitOk;

@@ -48,7 +48,8 @@ double tet_volume(const Mesh& m, std::size_t t) {
     c[k] = p[3][k] - p[0][k];
   }
   return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-          a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+          a[2] * (b[0] * c[1] - b[1] * c[0])) /
+         6.0;
 }
 
 const char* location_name(FieldLocation l) { return l == FieldLocation::node ? "node" : "cell"; }
@@ -71,7 +72,7 @@ FieldRange field_range(const Mesh& mesh, const Field& f) {
   }
   r.scalar = c.scalar.kind == FieldScalar::Kind::magnitude   ? "magnitude"
              : c.scalar.kind == FieldScalar::Kind::von_mises ? "von Mises"
-                                                            : "value";
+                                                             : "value";
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (std::size_t s = 0; s < f.step_count(); ++s)
     for (double v : field_scalar_values(mesh, c, s)) {
@@ -201,11 +202,12 @@ int cmd_info(Args args) {
       o += first ? "\n" : ",\n";
       first = false;
       const FieldRange range = field_range(mesh, f);
-      o += "    {\"name\": " + json_string(f.name) + ", \"location\": " + json_string(location_name(f.location)) +
-           ", \"components\": " + std::to_string(f.components) + ", \"steps\": " + std::to_string(f.step_count()) +
-           ", \"unit\": " + json_string(f.unit) + ", \"scalar\": " + json_string(range.scalar) +
-           ", \"min\": " + json_number(range.lo) + ", \"max\": " + json_number(range.hi) +
-           ", \"nan_values\": " + std::to_string(range.nan) + "}";
+      o += "    {\"name\": " + json_string(f.name) +
+           ", \"location\": " + json_string(location_name(f.location)) +
+           ", \"components\": " + std::to_string(f.components) +
+           ", \"steps\": " + std::to_string(f.step_count()) + ", \"unit\": " + json_string(f.unit) +
+           ", \"scalar\": " + json_string(range.scalar) + ", \"min\": " + json_number(range.lo) +
+           ", \"max\": " + json_number(range.hi) + ", \"nan_values\": " + std::to_string(range.nan) + "}";
     }
     o += first ? "],\n" : "\n  ],\n";
     if (quality && quality_ok) {
@@ -254,7 +256,8 @@ int cmd_info(Args args) {
   std::printf("tets                %zu\n", mesh.tet_count());
   std::printf("boundary triangles  %zu\n", mesh.bface_count());
   if (mesh.node_count() > 0)
-    std::printf("bounding box        [%g, %g, %g] .. [%g, %g, %g]\n", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+    std::printf("bounding box        [%g, %g, %g] .. [%g, %g, %g]\n", lo[0], lo[1], lo[2], hi[0], hi[1],
+                hi[2]);
   std::printf("volume              %.10g\n", volume);
   std::printf("regions             %zu\n", regions.size());
   for (auto& [id, s] : regions) {
@@ -280,8 +283,10 @@ int cmd_info(Args args) {
     }
     // SI, and in the unit an engineer reads it in when that differs (°C for K, MPa for Pa, ...).
     const DisplayUnit u = default_display_unit(f.unit, std::max(std::abs(r.lo), std::abs(r.hi)));
-    std::printf("  %-24s %s %.6g to %.6g%s%s", "", r.scalar.c_str(), r.lo, r.hi, f.unit.empty() ? "" : " ", f.unit.c_str());
-    if (u.symbol != f.unit) std::printf(" (%.6g to %.6g %s)", u.to_display(r.lo), u.to_display(r.hi), u.symbol.c_str());
+    std::printf("  %-24s %s %.6g to %.6g%s%s", "", r.scalar.c_str(), r.lo, r.hi, f.unit.empty() ? "" : " ",
+                f.unit.c_str());
+    if (u.symbol != f.unit)
+      std::printf(" (%.6g to %.6g %s)", u.to_display(r.lo), u.to_display(r.hi), u.symbol.c_str());
     if (f.step_count() > 1) std::printf(" over all steps");
     if (r.nan > 0) std::printf(", %zu values NaN", r.nan);
     std::printf("\n");
@@ -293,17 +298,18 @@ int cmd_info(Args args) {
                 q.min_dihedral_deg.min, q.min_dihedral_deg.mean, q.min_dihedral_deg.max, q.slivers);
   }
   if (have_adjacency)
-    std::printf("faces               %zu interior, %zu boundary, %zu non-manifold\n", adjacency.interior_faces,
-                adjacency.boundary_faces, adjacency.nonmanifold_faces);
+    std::printf("faces               %zu interior, %zu boundary, %zu non-manifold\n",
+                adjacency.interior_faces, adjacency.boundary_faces, adjacency.nonmanifold_faces);
   if (have_cert) {
     if (cert.delaunay)
       std::printf("delaunay            yes: every %s is empty (%zu tets, exact predicates)\n",
                   cert.weighted ? "orthosphere" : "circumsphere", cert.tets_checked);
     else
-      std::printf("delaunay            NO: %zu of %zu tets have a vertex inside their %s (deepest %.3g of the "
-                  "radius), %zu degenerate\n",
-                  cert.violating_tet_count, cert.tets_checked, cert.weighted ? "orthosphere" : "circumsphere",
-                  cert.max_relative_depth, cert.degenerate_tet_count);
+      std::printf(
+          "delaunay            NO: %zu of %zu tets have a vertex inside their %s (deepest %.3g of the "
+          "radius), %zu degenerate\n",
+          cert.violating_tet_count, cert.tets_checked, cert.weighted ? "orthosphere" : "circumsphere",
+          cert.max_relative_depth, cert.degenerate_tet_count);
   } else if (check_delaunay) {
     std::printf("delaunay            not checked: the mesh is invalid\n");
   }

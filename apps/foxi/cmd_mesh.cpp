@@ -30,7 +30,8 @@ namespace {
 
 const char* kMeshUsage =
     "foxi mesh MODEL.toml|PLC.poly -o OUT [--set NAME=VALUE]... [--max-size H] [--quality Q]\n"
-    "          [--min-dihedral DEG] [--max-volume V] [--region-size REGION=H]... [--refine-box X0,Y0,Z0,X1,Y1,Z1=H]...\n"
+    "          [--min-dihedral DEG] [--max-volume V] [--region-size REGION=H]... [--refine-box "
+    "X0,Y0,Z0,X1,Y1,Z1=H]...\n"
     "          [--refine-from RESULT.vtu [--field NAME] --target-error E] [--no-conform] [--optimize]\n"
     "          [--mesher tetgen|cgal] [--perturb] [--resample [--feature-angle DEG]] [--time-limit S]\n"
     "          [--max-tets N]\n"
@@ -51,8 +52,10 @@ const char* kMeshUsage =
     "  --max-tets N       refuse a mesh estimated (before meshing, from the volumes and the sizes) to\n"
     "                     have more than N tets (default 4000000)\n"
     "  --no-conform       TetGen's mesh as it is (may not be Delaunay)\n"
-    "  --optimize         TetGen's flips and smoothing (implies --no-conform: the mesh stops being Delaunay)\n"
-    "  --mesher cgal      CGAL Mesh_3 instead of TetGen (a model, with --set and its max_size and part sizes,\n"
+    "  --optimize         TetGen's flips and smoothing (implies --no-conform: the mesh stops being "
+    "Delaunay)\n"
+    "  --mesher cgal      CGAL Mesh_3 instead of TetGen (a model, with --set and its max_size and part "
+    "sizes,\n"
     "                     or a PLC.poly): every facet edge of the PLC protected (region volumes are the\n"
     "                     PLC's, checked to 0.1%), sliver exudation; the mesh is part of a regular\n"
     "                     triangulation, its vertex weights are written (point data 'weight' in .vtu)\n"
@@ -69,7 +72,8 @@ const char* kMeshUsage =
 double number(const std::string& s, const char* what) {
   char* end = nullptr;
   double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || end != s.c_str() + s.size() || !(v >= 0)) throw UsageError(std::string(what) + " takes a number >= 0, not '" + s + "'");
+  if (s.empty() || end != s.c_str() + s.size() || !(v >= 0))
+    throw UsageError(std::string(what) + " takes a number >= 0, not '" + s + "'");
   return v;
 }
 
@@ -81,19 +85,22 @@ double length(const std::string& s, double unit_scale, const char* what) {
   } catch (const ExpressionError& e) {
     throw UsageError(std::string(what) + ": " + e.what());
   }
-  if (q.dims == kDimensionless) q.value *= unit_scale;
-  else if (q.dims != kLength) throw UsageError(std::string(what) + " takes a length, not '" + s + "'");
-  if (!(q.value > 0) || !std::isfinite(q.value)) throw UsageError(std::string(what) + " must be > 0, not '" + s + "'");
+  if (q.dims == kDimensionless)
+    q.value *= unit_scale;
+  else if (q.dims != kLength)
+    throw UsageError(std::string(what) + " takes a length, not '" + s + "'");
+  if (!(q.value > 0) || !std::isfinite(q.value))
+    throw UsageError(std::string(what) + " must be > 0, not '" + s + "'");
   return q.value;
 }
 
 // "LHS=RHS" split at the last '='.
 std::pair<std::string, std::string> split_eq(const std::string& s, const char* what) {
   const auto eq = s.rfind('=');
-  if (eq == std::string::npos || eq == 0 || eq + 1 == s.size()) throw UsageError(std::string(what) + " takes A=B, not '" + s + "'");
+  if (eq == std::string::npos || eq == 0 || eq + 1 == s.size())
+    throw UsageError(std::string(what) + " takes A=B, not '" + s + "'");
   return {s.substr(0, eq), s.substr(eq + 1)};
 }
-
 
 }  // namespace
 
@@ -119,10 +126,12 @@ int cmd_mesh(Args args) {
   params.radius_edge = quality.empty() ? 1.414 : number(quality, "--quality");
   params.min_dihedral = min_dihedral.empty() ? 0 : number(min_dihedral, "--min-dihedral");
   if (!(params.radius_edge == 0 || params.radius_edge >= kMinRadiusEdgeBound))
-    throw UsageError("--quality takes 0 (no quality refinement) or a radius-edge bound of at least 1.414, not '" +
-                     quality + "' (TetGen's refinement does not finish below it on thin layers)");
+    throw UsageError(
+        "--quality takes 0 (no quality refinement) or a radius-edge bound of at least 1.414, not '" +
+        quality + "' (TetGen's refinement does not finish below it on thin layers)");
   if (!(params.min_dihedral >= 0 && params.min_dihedral < 30))
-    throw UsageError("--min-dihedral takes 0 to 30 degrees (larger bounds do not terminate), not '" + min_dihedral + "'");
+    throw UsageError("--min-dihedral takes 0 to 30 degrees (larger bounds do not terminate), not '" +
+                     min_dihedral + "'");
   params.optimize = args.flag("--optimize");
   const bool conform = !args.flag("--no-conform") && !params.optimize;
   args.flag("--check-delaunay");  // the certificate is always part of the report now
@@ -211,8 +220,8 @@ int cmd_mesh(Args args) {
   int status = kExitOk;
   try {
     plc = with_region_sizes(plc, controls);
-    const std::span<const double> volumes = is_model ? std::span<const double>(structure.part_volume)
-                                                      : std::span<const double>();
+    const std::span<const double> volumes =
+        is_model ? std::span<const double>(structure.part_volume) : std::span<const double>();
     if (!refine_from.empty()) {
       const Mesh solved = read_mesh(refine_from);
       const Field* f = nullptr;
@@ -221,14 +230,18 @@ int cmd_mesh(Args args) {
           f = &cand;
           break;
         }
-      if (!f) throw UsageError(refine_from + " has no node field" + (field_name.empty() ? "" : " named '" + field_name + "'"));
+      if (!f)
+        throw UsageError(refine_from + " has no node field" +
+                         (field_name.empty() ? "" : " named '" + field_name + "'"));
       const ErrorIndicator e = zz_error_indicator(solved, *f);
       field = size_field_from_error(solved, *f, number(target_error, "--target-error"), 0, controls.max_size);
       std::printf("refine from %s: field '%s', relative gradient error %.3g (Zienkiewicz-Zhu), target %s\n",
                   refine_from.c_str(), f->name.c_str(), e.relative_error(), target_error.c_str());
       if (e.tets_without_value > 0)
-        std::printf("  %zu of its %zu tets have a node without a value (NaN): left out of the error, they keep their size\n",
-                    e.tets_without_value, solved.tet_count());
+        std::printf(
+            "  %zu of its %zu tets have a node without a value (NaN): left out of the error, they keep their "
+            "size\n",
+            e.tets_without_value, solved.tet_count());
     } else if (!controls.boxes.empty()) {
       check_tet_estimate(in, plc, params, volumes, max_tets);  // box_size_field meshes with params first
       field = box_size_field(plc, params, controls);

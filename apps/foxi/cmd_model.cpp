@@ -125,7 +125,8 @@ void print_conductors(const Model& model, const Structure& s) {
   }
   for (std::size_t i = 0; i < np; ++i)
     if (metal[i] && owner[i] < 0)
-      std::printf("  floating metal   %s: one unknown potential, no net charge\n", model.parts[i].name.c_str());
+      std::printf("  floating metal   %s: one unknown potential, no net charge\n",
+                  model.parts[i].name.c_str());
 }
 
 }  // namespace
@@ -157,7 +158,8 @@ int cmd_model(Args args) {
       pp.view = ModelView::whole;
     else if (view != "exploded")
       throw UsageError("--view takes exploded, cut or whole, not '" + view + "'");
-    const auto wh = parse_numbers(size.substr(0, size.find('x')) + "," + size.substr(size.find('x') + 1), "--size");
+    const auto wh =
+        parse_numbers(size.substr(0, size.find('x')) + "," + size.substr(size.find('x') + 1), "--size");
     if (size.find('x') == std::string::npos || wh.size() != 2 || !(wh[0] >= 16 && wh[0] <= 8192) ||
         !(wh[1] >= 16 && wh[1] <= 8192) || wh[0] != std::floor(wh[0]) || wh[1] != std::floor(wh[1]))
       throw UsageError("--size takes WxH, 16 to 8192 pixels each, not '" + size + "'");
@@ -171,7 +173,8 @@ int cmd_model(Args args) {
     std::printf("%s: %zu parts, coarse mesh %zu nodes, %zu tets (TetGen %s); drew %zu tets (%s) -> %s\n",
                 file.c_str(), m.model.parts.size(), m.mesh.node_count(), m.mesh.tet_count(),
                 m.report.switches.c_str(), pic.tets_drawn,
-                pic.delaunay ? "painter, power order" : "not Delaunay: MPVO order, depth buffer", out.c_str());
+                pic.delaunay ? "painter, power order" : "not Delaunay: MPVO order, depth buffer",
+                out.c_str());
     std::printf("colours (part, material, RGB):\n");
     print_legend(m, pic);
     return kExitOk;
@@ -243,13 +246,12 @@ int cmd_model(Args args) {
     } catch (const IoError&) {
       thermal = false;
     }
-    std::printf(
-        "physics %s: ready (foxi solve MODEL --physics thermoelastic%s)%s\n", physics_name(ph),
-        load      ? ""
-        : thermal ? " --temperature-from-thermal, or --dT K"
-                  : " --dT K",
-        load ? (thermal ? "; or with the thermal run's temperatures: --temperature-from-thermal" : "")
-             : "; the model has no temperature_change load");
+    std::printf("physics %s: ready (foxi solve MODEL --physics thermoelastic%s)%s\n", physics_name(ph),
+                load      ? ""
+                : thermal ? " --temperature-from-thermal, or --dT K"
+                          : " --dT K",
+                load ? (thermal ? "; or with the thermal run's temperatures: --temperature-from-thermal" : "")
+                     : "; the model has no temperature_change load");
   }
   std::printf("PLC: %zu points, %zu facets, %zu region seeds\n", s.plc.point_count(), s.plc.facet_count(),
               s.plc.regions.size());

@@ -35,32 +35,35 @@ namespace foxi::cli {
 
 namespace {
 
-const std::string kMovieUsage = std::string(
-    "foxi movie MESH [camera and picture options] [--mode backforth|rotate] [--frames N]\n"
-    "                [--cycles C] [--from P%] [--to P%] [--turn deg] [--fps F]\n"
-    "                [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
-    "                [--legend on|off] [--threshold a,b] [--clip px,py,pz,nx,ny,nz]\n"
-    "                [--sweep iso:a,b [--iso-only] | --sweep threshold:a,b | --sweep steps [--iso v,...]]]\n"
-    "                [--deform NAME:SCALE] -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png\n"
-    "  A movie of the painter. backforth (the default): the tets drawn back to front in the\n"
-    "  visibility order from --from to --to percent of the order (default 0% to 100%), then\n"
-    "  undrawn front to back (the seed paper's undraw: back faces repainted as the neighbour's\n"
-    "  front face, or restored from saved pixels), N frames per cycle, looping seamlessly.\n"
-    "  rotate: the camera turned --turn degrees (default 360) about its up axis through --at over\n"
-    "  N frames, each frame the first --to percent of its own order.\n"
-    "  --sweep (in place of --mode) a field movie, each frame the picture foxi render draws with the\n"
-    "  same options and the frame's value, in one colour range (--range, or the field's own range):\n"
-    "    iso:a,b        the isosurface at v_k = a + (b - a) k / (N - 1), k = 0..N-1 (display units;\n"
-    "                   N = --frames, default 48), as foxi render --iso v_k [--iso-only] draws it: only\n"
-    "                   the tets v_k crosses (or reaches, for the solid) are ordered and drawn, found\n"
-    "                   by an interval tree built once, so a frame costs what its isosurface holds\n"
-    "    threshold:a,b  a growing threshold: frame k the tets with values in [a, v_k]\n"
-    "                   (foxi render --threshold a,v_k)\n"
-    "    steps          one frame per step of the field (a transient's .pvd, a multi-step .vtu or\n"
-    "                   .msh), as foxi render --step k; the range is the union over all steps unless\n"
-    "                   --range is given, so colours compare across frames; --iso draws each step's\n"
-    "                   isosurfaces\n"
-    "  --threshold and --clip select tets in every movie; --iso and --slice only with --sweep.\n") +
+const std::string kMovieUsage =
+    std::string(
+        "foxi movie MESH [camera and picture options] [--mode backforth|rotate] [--frames N]\n"
+        "                [--cycles C] [--from P%] [--to P%] [--turn deg] [--fps F]\n"
+        "                [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step "
+        "k]\n"
+        "                [--legend on|off] [--threshold a,b] [--clip px,py,pz,nx,ny,nz]\n"
+        "                [--sweep iso:a,b [--iso-only] | --sweep threshold:a,b | --sweep steps [--iso "
+        "v,...]]]\n"
+        "                [--deform NAME:SCALE] -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png\n"
+        "  A movie of the painter. backforth (the default): the tets drawn back to front in the\n"
+        "  visibility order from --from to --to percent of the order (default 0% to 100%), then\n"
+        "  undrawn front to back (the seed paper's undraw: back faces repainted as the neighbour's\n"
+        "  front face, or restored from saved pixels), N frames per cycle, looping seamlessly.\n"
+        "  rotate: the camera turned --turn degrees (default 360) about its up axis through --at over\n"
+        "  N frames, each frame the first --to percent of its own order.\n"
+        "  --sweep (in place of --mode) a field movie, each frame the picture foxi render draws with the\n"
+        "  same options and the frame's value, in one colour range (--range, or the field's own range):\n"
+        "    iso:a,b        the isosurface at v_k = a + (b - a) k / (N - 1), k = 0..N-1 (display units;\n"
+        "                   N = --frames, default 48), as foxi render --iso v_k [--iso-only] draws it: only\n"
+        "                   the tets v_k crosses (or reaches, for the solid) are ordered and drawn, found\n"
+        "                   by an interval tree built once, so a frame costs what its isosurface holds\n"
+        "    threshold:a,b  a growing threshold: frame k the tets with values in [a, v_k]\n"
+        "                   (foxi render --threshold a,v_k)\n"
+        "    steps          one frame per step of the field (a transient's .pvd, a multi-step .vtu or\n"
+        "                   .msh), as foxi render --step k; the range is the union over all steps unless\n"
+        "                   --range is given, so colours compare across frames; --iso draws each step's\n"
+        "                   isosurfaces\n"
+        "  --threshold and --clip select tets in every movie; --iso and --slice only with --sweep.\n") +
     kPictureOptionsHelp + kFieldOptionsHelp + kIsoOptionsHelp + kDeformOptionHelp +
     "  (--size defaults to 640x480; with --field the colour range is the same in every frame)\n"
     "  --frames N      frames per cycle (default 48), --cycles C cycles (default 1)\n"
@@ -87,7 +90,8 @@ long whole(const std::string& s, const char* what, long fallback, long lo, long 
   char* end = nullptr;
   const long v = std::strtol(s.c_str(), &end, 10);
   if (*end != 0 || v < lo || v > hi)
-    throw UsageError(std::string(what) + " takes a whole number in " + std::to_string(lo) + ".." + std::to_string(hi));
+    throw UsageError(std::string(what) + " takes a whole number in " + std::to_string(lo) + ".." +
+                     std::to_string(hi));
   return v;
 }
 
@@ -136,23 +140,27 @@ int cmd_movie(Args args) {
   }
   const Sweep sweep = parse_sweep(args.option("--sweep"));
   const bool sweeping = sweep.kind != Sweep::Kind::none;
-  if (sweeping && args.has_option("--mode")) throw UsageError("--sweep is a kind of movie in place of --mode: give one");
+  if (sweeping && args.has_option("--mode"))
+    throw UsageError("--sweep is a kind of movie in place of --mode: give one");
   // --iso-only belongs to the swept isovalue here, which take_iso_options does not see.
   const bool sweep_iso_only = sweep.kind == Sweep::Kind::iso && args.flag("--iso-only");
   const std::string mode = sweeping ? std::string("sweep") : args.option("--mode", "backforth");
   const std::string frames_s = args.option("--frames"), cycles_s = args.option("--cycles");
-  const std::string from_s = args.option("--from"), to_s = args.option("--to"), turn_s = args.option("--turn");
+  const std::string from_s = args.option("--from"), to_s = args.option("--to"),
+                    turn_s = args.option("--turn");
   const std::string fps_s = args.option("--fps", "12");
   std::string out = args.option("-o");
   if (out.empty()) out = args.option("--output");
   PictureOptions options = take_picture_options(args, "640x480");
   FieldOptions field_options = take_field_options(args);
-  if (field_options.markers) throw UsageError("--markers marks a picture: foxi render takes it, foxi movie does not");
+  if (field_options.markers)
+    throw UsageError("--markers marks a picture: foxi render takes it, foxi movie does not");
   const IsoOptions iso_options = take_iso_options(args, field_options);
   const std::optional<DeformOption> deform = take_deform_option(args);
   const std::string path = args.positional(1, 1, kMovieUsage)[0];
   if (out.empty()) throw UsageError("give the output with -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png");
-  if (mode != "backforth" && mode != "rotate" && mode != "sweep") throw UsageError("--mode takes backforth or rotate");
+  if (mode != "backforth" && mode != "rotate" && mode != "sweep")
+    throw UsageError("--mode takes backforth or rotate");
   check_sweep_options(sweep, field_options, iso_options);
   if (sweeping && !(cycles_s.empty() && from_s.empty() && to_s.empty() && turn_s.empty()))
     throw UsageError("--cycles, --from, --to and --turn belong to --mode backforth|rotate, not to --sweep");
@@ -177,7 +185,8 @@ int cmd_movie(Args args) {
   enum class Kind { frames, gif, apng, mp4 } kind;
   const std::string ext = std::filesystem::path(out).extension().string();
   if (out.find('%') != std::string::npos) {
-    if (!frame_pattern(out)) throw UsageError("-o " + out + ": a frame name needs one %d or %0Nd and no other %");
+    if (!frame_pattern(out))
+      throw UsageError("-o " + out + ": a frame name needs one %d or %0Nd and no other %");
     kind = Kind::frames;
   } else if (ext == ".gif") {
     kind = Kind::gif;
@@ -186,9 +195,12 @@ int cmd_movie(Args args) {
   } else if (ext == ".mp4") {
     kind = Kind::mp4;
     if (!have_ffmpeg())
-      throw UsageError("-o " + out + ": MP4 needs the ffmpeg program, which is not installed (write .gif, .apng or frames)");
+      throw UsageError(
+          "-o " + out +
+          ": MP4 needs the ffmpeg program, which is not installed (write .gif, .apng or frames)");
   } else {
-    throw UsageError("-o " + out + ": give .gif, .apng, .mp4 or a numbered frame name like dir/frame_%04d.png");
+    throw UsageError("-o " + out +
+                     ": give .gif, .apng, .mp4 or a numbered frame name like dir/frame_%04d.png");
   }
   if (kind != Kind::frames) check_output_path(out);  // before the work (frames: once their folder is made)
 
@@ -213,7 +225,8 @@ int cmd_movie(Args args) {
     }
     field = resolve_field(field_options, mesh, picture.subset, path);
     if (sweep.kind == Sweep::Kind::steps && step_count < 2)
-      throw UsageError(path + ": field '" + field.choice.field->name + "' has one step: --sweep steps needs several");
+      throw UsageError(path + ": field '" + field.choice.field->name +
+                       "' has one step: --sweep steps needs several");
     options.params.field = field.paint;
     if (field_options.legend) {
       text = std::make_unique<TextRenderer>(find_font_file());
@@ -295,8 +308,9 @@ int cmd_movie(Args args) {
   MovieStats stats;
   SweepStats sweep_stats;
   if (sweeping) {
-    SweepInputs in{mesh, table, picture.camera, options.width, options.height, options.params, picture.subset,
-                   field_options, field, iso_options, sweep, sweep_iso_only, mp.frames, step_count, path};
+    SweepInputs in{mesh,           table,          picture.camera, options.width, options.height,
+                   options.params, picture.subset, field_options,  field,         iso_options,
+                   sweep,          sweep_iso_only, mp.frames,      step_count,    path};
     sweep_stats = run_sweep(in, emit);
     stats.frames = sweep_stats.frames;
   } else {
@@ -304,30 +318,46 @@ int cmd_movie(Args args) {
       stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
                          [&](const Framebuffer& scene) { emit(scene, field); });
     } catch (const UncertifiedMeshError&) {  // thrown before the first frame: nothing written
-      throw InputError(path + (deform ? " deformed by " + deform->name : std::string()) +
-                       " fails the Delaunay certificate: it has no visibility order to make a back-and-forth or "
-                       "rotating movie with (foxi render --zbuffer draws it; a --sweep draws each frame with the "
-                       "depth buffer)");
+      throw InputError(
+          path + (deform ? " deformed by " + deform->name : std::string()) +
+          " fails the Delaunay certificate: it has no visibility order to make a back-and-forth or "
+          "rotating movie with (foxi render --zbuffer draws it; a --sweep draws each frame with the "
+          "depth buffer)");
     }
   }
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (writer) writer->finish();
-  if (!writer) commit_together(frames);  // numbered frames, or ffmpeg's input
+  if (!writer) commit_together(frames);                     // numbered frames, or ffmpeg's input
   if (kind == Kind::frames) forget_created.remove = false;  // the frames are in it now
   if (kind == Kind::mp4) {
     DurableFile video(out);
-    const std::vector<std::string> ffmpeg = {
-        "ffmpeg", "-y", "-loglevel", "error", "-framerate", std::to_string(fps), "-i",
-        (frame_dir / "frame_%06d.png").string(), "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p",
-        "-c:v", "libx264", "-f", "mp4", video.temp().string()};
+    const std::vector<std::string> ffmpeg = {"ffmpeg",
+                                             "-y",
+                                             "-loglevel",
+                                             "error",
+                                             "-framerate",
+                                             std::to_string(fps),
+                                             "-i",
+                                             (frame_dir / "frame_%06d.png").string(),
+                                             "-vf",
+                                             "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                             "-pix_fmt",
+                                             "yuv420p",
+                                             "-c:v",
+                                             "libx264",
+                                             "-f",
+                                             "mp4",
+                                             video.temp().string()};
     if (run_program(ffmpeg) != 0) throw std::runtime_error(out + ": ffmpeg failed to encode the frames");
     video.commit();
   }
   std::printf("mesh        %s: %zu tets, %zu shown\n", path.c_str(), mesh.tet_count(),
               picture.subset.empty() ? mesh.tet_count() : picture.subset.size());
-  if (deform) std::printf("deformed    by %s x %g: nodes moved up to %g\n", deform->name.c_str(), deform->scale, moved);
-  std::printf("movie       %s, %zu frames of %dx%d, %.1f ms per frame (frames written included)\n", mode.c_str(),
-              stats.frames, ap.width, options.height, ms / double(std::max<std::size_t>(1, stats.frames)));
+  if (deform)
+    std::printf("deformed    by %s x %g: nodes moved up to %g\n", deform->name.c_str(), deform->scale, moved);
+  std::printf("movie       %s, %zu frames of %dx%d, %.1f ms per frame (frames written included)\n",
+              mode.c_str(), stats.frames, ap.width, options.height,
+              ms / double(std::max<std::size_t>(1, stats.frames)));
   if (sweeping) {
     print_sweep(sweep_stats, sweep, field);
   } else {
@@ -336,13 +366,14 @@ int cmd_movie(Args args) {
   }
   if (field.paint) {
     const DisplayUnit& u = field.legend.unit;
-    std::printf("field       %s, %s, %s, %s%s, colours %.6g to %.6g%s%s in every frame%s\n", field.legend.title.c_str(),
+    std::printf("field       %s, %s, %s, %s%s, colours %.6g to %.6g%s%s in every frame%s\n",
+                field.legend.title.c_str(),
                 sweep.kind == Sweep::Kind::steps ? ("steps 0 to " + std::to_string(step_count - 1)).c_str()
                                                  : ("step " + std::to_string(field.step)).c_str(),
-                field_options.graded ? "graded facets" : "flat per tet", color_map_name(field.legend.scale.map),
-                field.legend.scale.log ? " log" : "", u.to_display(field.legend.scale.lo),
-                u.to_display(field.legend.scale.hi), u.symbol.empty() ? "" : " ", u.symbol.c_str(),
-                panel > 0 ? ", legend at the right" : "");
+                field_options.graded ? "graded facets" : "flat per tet",
+                color_map_name(field.legend.scale.map), field.legend.scale.log ? " log" : "",
+                u.to_display(field.legend.scale.lo), u.to_display(field.legend.scale.hi),
+                u.symbol.empty() ? "" : " ", u.symbol.c_str(), panel > 0 ? ", legend at the right" : "");
   }
   std::printf("wrote       %s\n", out.c_str());
   return kExitOk;

@@ -37,7 +37,6 @@ const char* kOrderUsage =
     "  The mesh is validated first: inverted tets are re-oriented (a note says so), an unusable\n"
     "  mesh (see foxi info) is refused with exit status 3.";
 
-
 }  // namespace
 
 int cmd_order(Args args) {
@@ -45,7 +44,8 @@ int cmd_order(Args args) {
     std::puts(kOrderUsage);
     return kExitOk;
   }
-  const std::string eye_s = args.option("--eye"), dir_s = args.option("--dir"), views_s = args.option("--views");
+  const std::string eye_s = args.option("--eye"), dir_s = args.option("--dir"),
+                    views_s = args.option("--views");
   const std::string subset_s = args.option("--subset"), method = args.option("--method", "auto");
   const unsigned seed = static_cast<unsigned>(std::stoul(args.option("--seed", "1")));
   const bool ftb = args.flag("--front-to-back"), check = args.flag("--check");
@@ -70,7 +70,8 @@ int cmd_order(Args args) {
     views.push_back(View::at(e[0], e[1], e[2]));
   } else if (!dir_s.empty()) {
     auto d = parse_numbers(dir_s, "--dir");
-    if (d.size() != 3 || (d[0] == 0 && d[1] == 0 && d[2] == 0)) throw UsageError("--dir takes a nonzero x,y,z");
+    if (d.size() != 3 || (d[0] == 0 && d[1] == 0 && d[2] == 0))
+      throw UsageError("--dir takes a nonzero x,y,z");
     views.push_back(View::along(d[0], d[1], d[2]));
   } else {
     int n = std::stoi(views_s);
@@ -113,15 +114,18 @@ int cmd_order(Args args) {
               subset.empty() ? mesh.tet_count() : subset.size());
   std::printf("certificate %s (%zu of %zu tets violated, %.1f ms)\n",
               cert.delaunay ? (cert.weighted ? "regular (weighted Delaunay)" : "Delaunay") : "NOT Delaunay",
-              cert.violating_tet_count, mesh.tet_count(), std::chrono::duration<double, std::milli>(t1 - t0).count());
-  std::printf("precompute  %.1f ms: %zu cospherical clusters holding %zu tets, %zu centres recomputed exactly, "
-              "%zu flat tets\n",
-              std::chrono::duration<double, std::milli>(t2 - t1).count(), table.cluster_count(),
-              table.cluster_tets.size(), table.recomputed_exactly, table.flat_count);
+              cert.violating_tet_count, mesh.tet_count(),
+              std::chrono::duration<double, std::milli>(t1 - t0).count());
+  std::printf(
+      "precompute  %.1f ms: %zu cospherical clusters holding %zu tets, %zu centres recomputed exactly, "
+      "%zu flat tets\n",
+      std::chrono::duration<double, std::milli>(t2 - t1).count(), table.cluster_count(),
+      table.cluster_tets.size(), table.recomputed_exactly, table.flat_count);
   std::printf("method      %s%s\n", use.c_str(),
               use == "mpvo" ? " (face-adjacency topological sort seeded by the power order)" : "");
   if (!cert.delaunay && use == "power")
-    std::printf("warning     the mesh is not Delaunay: the power order is not guaranteed to be a visibility order\n");
+    std::printf(
+        "warning     the mesh is not Delaunay: the power order is not guaranteed to be a visibility order\n");
 
   std::size_t total_violations = 0;
   double total_ms = 0;
@@ -152,7 +156,8 @@ int cmd_order(Args args) {
       std::printf("view %3zu  dir (%g, %g, %g)", i + 1, v.dir[0], v.dir[1], v.dir[2]);
     std::printf("  %zu violations of %zu face pairs  %.2f ms", r.violations, r.pairs_checked, ms);
     if (use == "power")
-      std::printf("  (%zu near-tie runs of %zu items, bound %.2g of the key range, %zu wide)", stats.near_tie_runs, stats.near_tie_items,
+      std::printf("  (%zu near-tie runs of %zu items, bound %.2g of the key range, %zu wide)",
+                  stats.near_tie_runs, stats.near_tie_items,
                   stats.key_range > 0 ? stats.key_bound / stats.key_range : 0.0, stats.wide_items);
     if (use == "mpvo") std::printf("  (%zu cycles broken)", cycles);
     std::printf("\n");

@@ -1,7 +1,7 @@
 // foxi probe RESULT --field NAME --at x,y,z: the value of a field at points; foxi plot RESULT --field
-// NAME --line A:B: the field along a segment, as CSV or a line chart (PNG). Both locate their points through foxi::fields'
-// uniform grid (locate_points) and interpolate with field_value_in_tet, so a probe and a plot sample
-// agree with each other and with the field transfer.
+// NAME --line A:B: the field along a segment, as CSV or a line chart (PNG). Both locate their points through
+// foxi::fields' uniform grid (locate_points) and interpolate with field_value_in_tet, so a probe and a plot
+// sample agree with each other and with the field transfer.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -75,7 +75,8 @@ Selection select_field(const Mesh& mesh, const std::string& spec, const std::str
   if (!step_text.empty()) {
     char* end = nullptr;
     step = std::strtol(step_text.c_str(), &end, 10);
-    if (*end != 0 || step < 0) throw UsageError("--step takes a step number 0, 1, ..., not '" + step_text + "'");
+    if (*end != 0 || step < 0)
+      throw UsageError("--step takes a step number 0, 1, ..., not '" + step_text + "'");
   }
   try {
     s.choice = choose_field(mesh, spec);
@@ -98,9 +99,10 @@ std::string region_text(const Mesh& mesh, std::uint32_t t) {
 
 // The chart of foxi plot: the value in its display unit against the distance along the segment (mm
 // below a metre, else m); NaN values (outside the mesh) break the line.
-Framebuffer line_chart(const TextRenderer& text, const Selection& sel, const Field& f, const std::vector<double>& a,
-                       const std::vector<double>& b, const std::vector<double>& along, const std::vector<double>& value,
-                       int width, int height) {
+Framebuffer line_chart(const TextRenderer& text, const Selection& sel, const Field& f,
+                       const std::vector<double>& a, const std::vector<double>& b,
+                       const std::vector<double>& along, const std::vector<double>& value, int width,
+                       int height) {
   double max_abs = 0;
   for (double v : value)
     if (std::isfinite(v)) max_abs = std::max(max_abs, std::abs(v));
@@ -108,8 +110,8 @@ Framebuffer line_chart(const TextRenderer& text, const Selection& sel, const Fie
   const bool mm = along.back() < 1;
   Chart chart;
   char title[256];
-  std::snprintf(title, sizeof title, "%s from (%g, %g, %g) to (%g, %g, %g)", sel.choice.label.c_str(), a[0], a[1], a[2],
-                b[0], b[1], b[2]);
+  std::snprintf(title, sizeof title, "%s from (%g, %g, %g) to (%g, %g, %g)", sel.choice.label.c_str(), a[0],
+                a[1], a[2], b[0], b[1], b[2]);
   chart.title = title;
   chart.x.label = "distance along the line";
   chart.x.unit = mm ? "mm" : "m";
@@ -201,7 +203,9 @@ int cmd_plot(Args args) {
     throw UsageError("--samples takes a whole number from 2 to 10000000, not '" + samples_text + "'");
   const std::string out = args.option("-o");
   if (out.empty()) throw UsageError("-o PLOT.csv is required\n" + std::string(kPlotUsage));
-  auto ends_with = [&](const char* ext) { return out.size() > 4 && out.compare(out.size() - 4, 4, ext) == 0; };
+  auto ends_with = [&](const char* ext) {
+    return out.size() > 4 && out.compare(out.size() - 4, 4, ext) == 0;
+  };
   const bool png = ends_with(".png");
   if (!png && !ends_with(".csv")) throw UsageError("-o takes a .csv or .png file, not '" + out + "'");
   const std::string size_text = args.option("--size");
@@ -261,8 +265,8 @@ int cmd_plot(Args args) {
     file.write(csv);
     file.commit();
   }
-  std::fprintf(stderr, "foxi plot: %zu samples over %.6g m, %zu in the mesh, %zu outside; wrote %s\n", n, length,
-               inside, n - inside, out.c_str());
+  std::fprintf(stderr, "foxi plot: %zu samples over %.6g m, %zu in the mesh, %zu outside; wrote %s\n", n,
+               length, inside, n - inside, out.c_str());
   return kExitOk;
 }
 

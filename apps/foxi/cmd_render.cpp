@@ -31,18 +31,20 @@ namespace foxi::cli {
 
 namespace {
 
-const std::string kRenderUsage = std::string(
-    "foxi render MESH [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z] [--size WxH]\n"
-    "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges]\n"
-    "                 [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step k]\n"
-    "                 [--legend on|off] [--markers] [--iso v1,v2,... [--iso-only]] [--threshold a,b]\n"
-    "                 [--clip px,py,pz,nx,ny,nz] [--slice px,py,pz,nx,ny,nz]] [--deform NAME:SCALE]\n"
-    "                 [--region-opacity REGION=a,... ] [--iso-opacity a]\n"
-    "                 [--volume NAME[:C] [--cmap M] [--range a,b] --opacity-curve v0:a0,v1:a1,...\n"
-    "                 [--opacity-length L]] -o OUT.png\n"
-    "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
-    "  faces flat-shaded in its region's colour (or a field's) with the mesh edges darkened (no depth\n"
-    "  buffer).\n") +
+const std::string kRenderUsage =
+    std::string(
+        "foxi render MESH [--eye x,y,z --at x,y,z --up x,y,z --fov deg | --dir x,y,z] [--size WxH]\n"
+        "                 [--stop P%] [--depth d] [--zbuffer] [--shrink f] [--regions a,b] [--no-edges]\n"
+        "                 [--field NAME[:C] [--graded] [--cmap M] [--range a,b] [--log] [--units U] [--step "
+        "k]\n"
+        "                 [--legend on|off] [--markers] [--iso v1,v2,... [--iso-only]] [--threshold a,b]\n"
+        "                 [--clip px,py,pz,nx,ny,nz] [--slice px,py,pz,nx,ny,nz]] [--deform NAME:SCALE]\n"
+        "                 [--region-opacity REGION=a,... ] [--iso-opacity a]\n"
+        "                 [--volume NAME[:C] [--cmap M] [--range a,b] --opacity-curve v0:a0,v1:a1,...\n"
+        "                 [--opacity-length L]] -o OUT.png\n"
+        "  Draws the tets back to front in the power-function visibility order, each showing its front\n"
+        "  faces flat-shaded in its region's colour (or a field's) with the mesh edges darkened (no depth\n"
+        "  buffer).\n") +
     kPictureOptionsHelp + kFieldOptionsHelp + kIsoOptionsHelp +
     "  (--size defaults to 1280x960)\n"
     "  --stop P%       draw only the first P percent of the back-to-front order (the far part)\n"
@@ -54,29 +56,29 @@ const std::string kRenderUsage = std::string(
     "  Meshes that fail the Delaunay certificate have no guaranteed order: their picture is drawn\n"
     "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.\n" +
     kDeformOptionHelp +
-  "  --region-opacity REGION=a,...  translucent regions (an \"x-ray\" view): REGION a region id or\n"
-  "                  name, a its opacity from 0 (left out) to 1 (opaque; regions not listed). Drawn\n"
-  "                  are the faces between regions of different opacity and the outer boundary of\n"
-  "                  what is drawn, one layer each (the picture does not depend on the mesh\n"
-  "                  density), blended back to front in the power order of the tets that own them,\n"
-  "                  which is exact for a Delaunay mesh. A mesh without the certificate has no such\n"
-  "                  order: its fragments are collected and sorted per pixel by depth instead (said\n"
-  "                  so; memory grows with the fragments). With --iso, the isosurfaces translucent\n"
-  "                  inside. Not with --stop, --depth, --zbuffer, --threshold, --clip, --slice,\n"
-  "                  --shrink, --markers; a field colours only the isosurfaces\n"
-  "  --iso-opacity a every isosurface of --iso translucent with opacity a, all nested ones seen at\n"
-  "                  once (with --region-opacity inside the translucent regions, else alone)\n"
-  "  --volume NAME[:C]  a volume rendering of the field (as --field takes it; --cmap, --range,\n"
-  "                  --units, --step, --legend apply): the emission-absorption integral of the\n"
-  "                  field, linear in each tet, along every pixel's ray, tets composited back to\n"
-  "                  front in the power order (exact for a Delaunay mesh; another mesh is\n"
-  "                  composited in MPVO order, not exact, and a note says so). Colour: the colour\n"
-  "                  map; opacity: --opacity-curve v0:a0,... (values in display units, ascending;\n"
-  "                  a in [0, 1): the opacity a ray gains through --opacity-length L world units of\n"
-  "                  that value, L by default a tenth of the drawn box's diagonal), linear between\n"
-  "                  the points, constant beyond. Not with the other drawing options\n"
-  "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused\n"
-  "  with exit status 3, and no picture is written.";
+    "  --region-opacity REGION=a,...  translucent regions (an \"x-ray\" view): REGION a region id or\n"
+    "                  name, a its opacity from 0 (left out) to 1 (opaque; regions not listed). Drawn\n"
+    "                  are the faces between regions of different opacity and the outer boundary of\n"
+    "                  what is drawn, one layer each (the picture does not depend on the mesh\n"
+    "                  density), blended back to front in the power order of the tets that own them,\n"
+    "                  which is exact for a Delaunay mesh. A mesh without the certificate has no such\n"
+    "                  order: its fragments are collected and sorted per pixel by depth instead (said\n"
+    "                  so; memory grows with the fragments). With --iso, the isosurfaces translucent\n"
+    "                  inside. Not with --stop, --depth, --zbuffer, --threshold, --clip, --slice,\n"
+    "                  --shrink, --markers; a field colours only the isosurfaces\n"
+    "  --iso-opacity a every isosurface of --iso translucent with opacity a, all nested ones seen at\n"
+    "                  once (with --region-opacity inside the translucent regions, else alone)\n"
+    "  --volume NAME[:C]  a volume rendering of the field (as --field takes it; --cmap, --range,\n"
+    "                  --units, --step, --legend apply): the emission-absorption integral of the\n"
+    "                  field, linear in each tet, along every pixel's ray, tets composited back to\n"
+    "                  front in the power order (exact for a Delaunay mesh; another mesh is\n"
+    "                  composited in MPVO order, not exact, and a note says so). Colour: the colour\n"
+    "                  map; opacity: --opacity-curve v0:a0,... (values in display units, ascending;\n"
+    "                  a in [0, 1): the opacity a ray gains through --opacity-length L world units of\n"
+    "                  that value, L by default a tenth of the drawn box's diagonal), linear between\n"
+    "                  the points, constant beyond. Not with the other drawing options\n"
+    "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused\n"
+    "  with exit status 3, and no picture is written.";
 
 double ms_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -97,7 +99,8 @@ int cmd_render(Args args) {
     rest.insert(rest.end(), {"--field", volume_field});
     args = Args(std::move(rest));
   }
-  const std::string curve_s = args.option("--opacity-curve"), opacity_length_s = args.option("--opacity-length");
+  const std::string curve_s = args.option("--opacity-curve"),
+                    opacity_length_s = args.option("--opacity-length");
   const std::string stop_s = args.option("--stop"), depth_s = args.option("--depth");
   std::string out = args.option("-o");
   if (out.empty()) out = args.option("--output");
@@ -106,17 +109,21 @@ int cmd_render(Args args) {
   const FieldOptions field_options = take_field_options(args);
   const IsoOptions iso_options = take_iso_options(args, field_options);
   const std::optional<DeformOption> deform = take_deform_option(args);
-  const std::string region_opacity_s = args.option("--region-opacity"), iso_opacity_s = args.option("--iso-opacity");
+  const std::string region_opacity_s = args.option("--region-opacity"),
+                    iso_opacity_s = args.option("--iso-opacity");
   const bool translucent = !region_opacity_s.empty() || !iso_opacity_s.empty();
   double iso_opacity = 0.5;
   if (!iso_opacity_s.empty()) {
     iso_opacity = parse_opacity(iso_opacity_s, "--iso-opacity");
-    if (iso_options.iso.empty()) throw UsageError("--iso-opacity makes the isosurfaces of --iso translucent: give --iso");
+    if (iso_options.iso.empty())
+      throw UsageError("--iso-opacity makes the isosurfaces of --iso translucent: give --iso");
   }
-  if (translucent && (!stop_s.empty() || !depth_s.empty() || zbuffer || iso_options.has_threshold ||
-                      iso_options.clip || iso_options.slice || options.params.shrink != 1 || field_options.markers))
-    throw UsageError("--region-opacity and --iso-opacity draw the whole picture translucent: leave out --stop, "
-                     "--depth, --zbuffer, --threshold, --clip, --slice, --shrink and --markers");
+  if (translucent &&
+      (!stop_s.empty() || !depth_s.empty() || zbuffer || iso_options.has_threshold || iso_options.clip ||
+       iso_options.slice || options.params.shrink != 1 || field_options.markers))
+    throw UsageError(
+        "--region-opacity and --iso-opacity draw the whole picture translucent: leave out --stop, "
+        "--depth, --zbuffer, --threshold, --clip, --slice, --shrink and --markers");
   const bool volume = !volume_field.empty();
   if (volume != !curve_s.empty() || (!opacity_length_s.empty() && !volume))
     throw UsageError("--volume NAME and --opacity-curve v0:a0,... go together (--opacity-length with them)");
@@ -128,16 +135,19 @@ int cmd_render(Args args) {
       char* end = nullptr;
       opacity_length = std::strtod(opacity_length_s.c_str(), &end);
       if (*end != 0 || !(opacity_length > 0) || !std::isfinite(opacity_length))
-        throw UsageError("--opacity-length takes a positive length (world units), not '" + opacity_length_s + "'");
+        throw UsageError("--opacity-length takes a positive length (world units), not '" + opacity_length_s +
+                         "'");
     }
     if (translucent || iso_options.any() || !stop_s.empty() || !depth_s.empty() || zbuffer ||
         options.params.shrink != 1 || field_options.markers)
-      throw UsageError("--volume draws the field alone: leave out --region-opacity, --iso-opacity, --iso, --threshold, "
-                       "--clip, --slice, --stop, --depth, --zbuffer, --shrink and --markers");
+      throw UsageError(
+          "--volume draws the field alone: leave out --region-opacity, --iso-opacity, --iso, --threshold, "
+          "--clip, --slice, --stop, --depth, --zbuffer, --shrink and --markers");
   }
   if (translucent && !field_options.spec.empty() && iso_options.iso.empty())
-    throw UsageError("translucent regions are drawn in their regions' colours: --field serves only --iso there "
-                     "(give --iso v1,... --iso-opacity a, or leave out --field)");
+    throw UsageError(
+        "translucent regions are drawn in their regions' colours: --field serves only --iso there "
+        "(give --iso v1,... --iso-opacity a, or leave out --field)");
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
   check_output_path(out);
@@ -194,11 +204,13 @@ int cmd_render(Args args) {
   if (volume) {
     VolumeParams vp;
     vp.scale = field.legend.scale;
-    for (const OpacityPoint& p : curve) vp.opacity_curve.push_back({field.legend.unit.to_si(p.value), p.opacity});
+    for (const OpacityPoint& p : curve)
+      vp.opacity_curve.push_back({field.legend.unit.to_si(p.value), p.opacity});
     double lo[3], hi[3];
     tets_bounds(mesh, picture.subset, lo, hi);
     vp.unit_length = opacity_length > 0 ? opacity_length
-                                        : 0.1 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                        : 0.1 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                                          (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
     const std::vector<double> corner = tet_corner_values(mesh, field.choice, field.step);
     Framebuffer fb(options.width, height);
@@ -208,16 +220,19 @@ int cmd_render(Args args) {
     std::printf("certificate %s (%.1f ms); spheres %.1f ms\n", report.delaunay ? "Delaunay" : "NOT Delaunay",
                 report.certificate_ms, spheres_ms);
     std::printf("volume      %s, %s, colours %.6g to %.6g %s; opacity over %g world units\n",
-                field.legend.title.c_str(), color_map_name(vp.scale.map), field.legend.unit.to_display(vp.scale.lo),
-                field.legend.unit.to_display(vp.scale.hi), field.legend.unit.symbol.c_str(), vp.unit_length);
+                field.legend.title.c_str(), color_map_name(vp.scale.map),
+                field.legend.unit.to_display(vp.scale.lo), field.legend.unit.to_display(vp.scale.hi),
+                field.legend.unit.symbol.c_str(), vp.unit_length);
     if (report.exact_order)
-      std::printf("composited back to front in the power order (exact for this Delaunay mesh), order %.1f ms, "
-                  "integration %.1f ms: %zu pixel segments, %dx%d\n",
-                  report.order_ms, report.draw_ms, report.samples, options.width, height);
+      std::printf(
+          "composited back to front in the power order (exact for this Delaunay mesh), order %.1f ms, "
+          "integration %.1f ms: %zu pixel segments, %dx%d\n",
+          report.order_ms, report.draw_ms, report.samples, options.width, height);
     else
-      std::printf("composited in MPVO order, NOT exact (no visibility order without the certificate; %zu cycles "
-                  "broken), order %.1f ms, integration %.1f ms: %zu pixel segments, %dx%d\n",
-                  report.cycles_broken, report.order_ms, report.draw_ms, report.samples, options.width, height);
+      std::printf(
+          "composited in MPVO order, NOT exact (no visibility order without the certificate; %zu cycles "
+          "broken), order %.1f ms, integration %.1f ms: %zu pixel segments, %dx%d\n",
+          report.cycles_broken, report.order_ms, report.draw_ms, report.samples, options.width, height);
     std::printf("wrote       %s\n", out.c_str());
     return kExitOk;
   }
@@ -241,16 +256,18 @@ int cmd_render(Args args) {
                 report.certificate_ms, spheres_ms);
     std::printf("translucent ");
     for (std::size_t i = 0; i < tp.region_opacity.size(); ++i)
-      std::printf("%sregion %d opacity %g", i ? ", " : "", tp.region_opacity[i].region, tp.region_opacity[i].opacity);
+      std::printf("%sregion %d opacity %g", i ? ", " : "", tp.region_opacity[i].region,
+                  tp.region_opacity[i].opacity);
     if (!tp.region_opacity.empty()) std::printf(" (others opaque); ");
     if (!iso_options.iso.empty()) std::printf("isosurfaces opacity %g; ", tp.iso_opacity);
     std::printf("%zu tets own a surface (%.1f ms)\n", report.tets_ordered, report.surfaces_ms);
-    std::printf("composited %s, order %.1f ms, blending %.1f ms: %zu fragments, %dx%d, %.1f%% of pixels covered\n",
-                report.exact_order ? "back to front in the power order (exact for this Delaunay mesh)"
-                                   : "by sorting each pixel's fragments by depth (no exact order without the "
-                                     "certificate)",
-                report.order_ms, report.draw_ms, report.fragments, options.width, height,
-                100.0 * double(covered) / double(fb.id.size()));
+    std::printf(
+        "composited %s, order %.1f ms, blending %.1f ms: %zu fragments, %dx%d, %.1f%% of pixels covered\n",
+        report.exact_order ? "back to front in the power order (exact for this Delaunay mesh)"
+                           : "by sorting each pixel's fragments by depth (no exact order without the "
+                             "certificate)",
+        report.order_ms, report.draw_ms, report.fragments, options.width, height,
+        100.0 * double(covered) / double(fb.id.size()));
     std::printf("wrote       %s\n", out.c_str());
     return kExitOk;
   }
@@ -276,10 +293,11 @@ int cmd_render(Args args) {
 
   std::size_t covered = 0;
   for (std::uint32_t id : fb.id) covered += id != kNone;
-  std::printf("mesh        %s: %zu tets, %zu selected\n", path.c_str(), mesh.tet_count(), report.tets_ordered);
+  std::printf("mesh        %s: %zu tets, %zu selected\n", path.c_str(), mesh.tet_count(),
+              report.tets_ordered);
   std::printf("certificate %s (%.1f ms); spheres %.1f ms\n",
-              delaunay ? "Delaunay" : "NOT Delaunay: picture drawn with the depth buffer", report.certificate_ms,
-              spheres_ms);
+              delaunay ? "Delaunay" : "NOT Delaunay: picture drawn with the depth buffer",
+              report.certificate_ms, spheres_ms);
   if (camera.perspective)
     std::printf("camera      perspective eye (%g, %g, %g) at (%g, %g, %g) up (%g, %g, %g) fov %g\n",
                 camera.eye[0], camera.eye[1], camera.eye[2], camera.at[0], camera.at[1], camera.at[2],
@@ -289,7 +307,8 @@ int cmd_render(Args args) {
                 camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2], camera.ortho_height);
   const bool mpvo = report.method == OrderMethod::mpvo;
   if (deform)
-    std::printf("deformed    by %s x %g: nodes moved up to %g; drawn %s\n", deform->name.c_str(), deform->scale, moved,
+    std::printf("deformed    by %s x %g: nodes moved up to %g; drawn %s\n", deform->name.c_str(),
+                deform->scale, moved,
                 mpvo ? "in MPVO order with the depth buffer (the deformed mesh is not Delaunay)"
                      : "by the painter in the power order (the deformed mesh is still Delaunay)");
   std::printf("order       %s, %.1f ms%s\n", mpvo ? "MPVO" : "power (visibility order)", report.order_ms,
@@ -300,7 +319,8 @@ int cmd_render(Args args) {
               report.depth_buffer ? "depth-buffer" : "painter", report.draw_ms, width, height,
               100.0 * double(covered) / double(fb.id.size()));
   if (!depth_s.empty() && count > 0)
-    std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop, tet_depth(table, camera, report.last_drawn));
+    std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop,
+                tet_depth(table, camera, report.last_drawn));
   if (report.raster.tets_behind > 0) std::printf(", %zu tets behind the eye", report.raster.tets_behind);
   if (field.paint) {
     const DisplayUnit& u = field.legend.unit;
@@ -312,37 +332,40 @@ int cmd_render(Args args) {
     };
     std::printf("\nfield       %s, step %zu of %zu, %s, %s%s: values %.6g to %s, colours %.6g to %s%s",
                 field.legend.title.c_str(), field.step, field.choice.field->step_count(),
-                field_options.graded ? "graded facets" : "flat per tet (centroid value)", color_map_name(sc.map),
-                sc.log ? " log" : "", u.to_display(field.data_lo), shown(field.data_hi).c_str(), u.to_display(sc.lo),
-                shown(sc.hi).c_str(),
-                field.range_widened    ? " (a constant: range widened around it)"
+                field_options.graded ? "graded facets" : "flat per tet (centroid value)",
+                color_map_name(sc.map), sc.log ? " log" : "", u.to_display(field.data_lo),
+                shown(field.data_hi).c_str(), u.to_display(sc.lo), shown(sc.hi).c_str(),
+                field.range_widened   ? " (a constant: range widened around it)"
                 : field.range_centred ? " (symmetric about 0 for the diverging map)"
                                       : "");
     if (field.no_value > 0) std::printf(", %zu values NaN (grey)", field.no_value);
     if (!iso_options.iso.empty()) {
       std::printf("\niso         ");
-      for (std::size_t i = 0; i < iso.iso_si.size(); ++i) std::printf("%s%s", i ? ", " : "", shown(iso.iso_si[i]).c_str());
+      for (std::size_t i = 0; i < iso.iso_si.size(); ++i)
+        std::printf("%s%s", i ? ", " : "", shown(iso.iso_si[i]).c_str());
       std::printf(": %zu tets crossed (interval tree %.1f ms, query %.2f ms), %s", iso.crossing, iso.build_ms,
                   iso.query_ms,
                   iso.params.cap ? "drawn as the solid above the lowest value, cut at its isosurface"
                                  : "isosurfaces alone, the side toward higher values brighter");
     }
     if (iso_options.has_threshold)
-      std::printf("\nthreshold   values in [%g, %g] %s", iso_options.threshold[0], iso_options.threshold[1], u.symbol.c_str());
+      std::printf("\nthreshold   values in [%g, %g] %s", iso_options.threshold[0], iso_options.threshold[1],
+                  u.symbol.c_str());
     if (iso_options.clip)
       std::printf("\nclip        whole tets behind the plane through (%g, %g, %g), normal (%g, %g, %g)",
-                  iso_options.clip->p[0], iso_options.clip->p[1], iso_options.clip->p[2], iso_options.clip->n[0],
-                  iso_options.clip->n[1], iso_options.clip->n[2]);
+                  iso_options.clip->p[0], iso_options.clip->p[1], iso_options.clip->p[2],
+                  iso_options.clip->n[0], iso_options.clip->n[1], iso_options.clip->n[2]);
     if (iso_options.slice)
       std::printf("\nslice       plane through (%g, %g, %g), normal (%g, %g, %g): %zu tets cut",
-                  iso_options.slice->p[0], iso_options.slice->p[1], iso_options.slice->p[2], iso_options.slice->n[0],
-                  iso_options.slice->n[1], iso_options.slice->n[2], iso.crossing);
+                  iso_options.slice->p[0], iso_options.slice->p[1], iso_options.slice->p[2],
+                  iso_options.slice->n[0], iso_options.slice->n[1], iso_options.slice->n[2], iso.crossing);
     if (field_options.legend)
       std::printf("\nlegend      %d pixels at the right, font %s", panel, text->font_file().c_str());
     if (field_options.markers)
-      std::printf("\nmarkers     max %s at (%g, %g, %g) %s; min %s at (%g, %g, %g) %s", shown(field.data_hi).c_str(),
-                  field.max_at[0], field.max_at[1], field.max_at[2], markers.max_shown ? "marked" : "hidden in this view",
-                  shown(field.data_lo).c_str(), field.min_at[0], field.min_at[1], field.min_at[2],
+      std::printf("\nmarkers     max %s at (%g, %g, %g) %s; min %s at (%g, %g, %g) %s",
+                  shown(field.data_hi).c_str(), field.max_at[0], field.max_at[1], field.max_at[2],
+                  markers.max_shown ? "marked" : "hidden in this view", shown(field.data_lo).c_str(),
+                  field.min_at[0], field.min_at[1], field.min_at[2],
                   markers.min_shown ? "marked" : "hidden in this view");
   }
   std::printf("\nwrote       %s\n", out.c_str());

@@ -305,7 +305,8 @@ void add_thermal_options(const Mesh& mesh, const ThermalOptions& o, ThermalParam
     const HeatSource source{region_id(mesh, k, option), parse_value(v, option, unit), total};
     for (std::size_t i = model_sources; i < params.sources.size(); ++i)
       if (params.sources[i].region == source.region)
-        throw UsageError(std::string(option) + " " + k + ": the region has a --power or --power-density already");
+        throw UsageError(std::string(option) + " " + k +
+                         ": the region has a --power or --power-density already");
     for (std::size_t i = 0; i < model_sources; ++i)
       if (params.sources[i].region == source.region && !replaced[i]) {
         const HeatSource& old = params.sources[i];
@@ -349,9 +350,10 @@ void print_thermal_report(const Mesh& mesh, const ThermalReport& r) {
                 b.area, b.heat_in, b.mean_temperature);
     boundary_heat += b.heat_in;
   }
-  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W", r.total_power,
-              boundary_heat, r.imbalance);
-  if (r.heat_flow > 0) std::printf(" (%.2g of the %.6g W that flow)", std::abs(r.imbalance) / r.heat_flow, r.heat_flow);
+  std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W",
+              r.total_power, boundary_heat, r.imbalance);
+  if (r.heat_flow > 0)
+    std::printf(" (%.2g of the %.6g W that flow)", std::abs(r.imbalance) / r.heat_flow, r.heat_flow);
   std::printf("\n");
   for (const ThermalResistance& t : r.resistances) {
     auto side = [&](const ThermalProbe& probe) {
@@ -388,7 +390,8 @@ int cmd_solve(Args args) {
     return kExitOk;
   }
   if (physics != "thermal" && physics != "electrostatic" && physics != "current")
-    throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics + "'");
+    throw UsageError("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics +
+                     "'");
   const std::vector<std::string> conductor = all_options(args, "--conductor"),
                                  eps = all_options(args, "--eps"), terminal = all_options(args, "--terminal"),
                                  terminal_current = all_options(args, "--terminal-current"),
@@ -407,7 +410,7 @@ int cmd_solve(Args args) {
   params.solver = solver_options;
   params.solver.progress = terminal_progress(params.solver);
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
-  if (!out.empty()) check_output_path(out);        // and so does a folder that cannot be written
+  if (!out.empty()) check_output_path(out);       // and so does a folder that cannot be written
 
   // The values are checked before the meshing, which may take long (tags and regions need the mesh).
   auto values = [](const std::vector<std::string>& list, const char* option, const char* unit) {

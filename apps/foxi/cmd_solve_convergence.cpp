@@ -52,8 +52,7 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
     a.insert(a.end(), {"--size-scale", scale});
     const std::string n = std::to_string(k);
     // A transient level writes its series into the scratch folder: the last step only.
-    if (physics == "transient")
-      a.insert(a.end(), {"-o", (scratch / ("level" + n + ".pvd")).string()});
+    if (physics == "transient") a.insert(a.end(), {"-o", (scratch / ("level" + n + ".pvd")).string()});
     if (physics == "transient" && std::find(pass.begin(), pass.end(), "--write-every") == pass.end())
       a.insert(a.end(), {"--write-every", "1000000000"});
     RunResults r = run_solve_child(a, scratch / ("level" + n + ".json"), scratch / ("level" + n + ".log"));

@@ -127,8 +127,9 @@ void print_thermoelastic_report(const Mesh& mesh, const ThermoelasticReport& r) 
                 s.max_von_mises, centroid(s.max_tet).c_str());
   if (!r.interfaces.empty()) std::printf("material interfaces (tets touching them):\n");
   for (const InterfaceStress& s : r.interfaces)
-    std::printf("  %s / %s  area %.4g m^2  max von Mises %.6g Pa in %s\n", region_label(mesh, s.region_a).c_str(),
-                region_label(mesh, s.region_b).c_str(), s.area, s.max_von_mises, centroid(s.max_tet).c_str());
+    std::printf("  %s / %s  area %.4g m^2  max von Mises %.6g Pa in %s\n",
+                region_label(mesh, s.region_a).c_str(), region_label(mesh, s.region_b).c_str(), s.area,
+                s.max_von_mises, centroid(s.max_tet).c_str());
 }
 
 int cmd_solve_thermoelastic(Args args) {
@@ -165,7 +166,7 @@ int cmd_solve_thermoelastic(Args args) {
   if (order != "1" && order != "2") throw UsageError("--order takes 1 or 2, not '" + order + "'");
   params.order = order == "2" ? 2 : 1;
   if (!out.empty()) (void)format_from_path(out);  // a bad extension fails before the work
-  if (!out.empty()) check_output_path(out);        // and so does a folder that cannot be written
+  if (!out.empty()) check_output_path(out);       // and so does a folder that cannot be written
 
   // the temperatures are checked before the meshing, which may take long
   if (!dt.empty()) (void)parse_temperature(dt, "--dT", TemperatureKind::difference);
@@ -226,7 +227,8 @@ int cmd_solve_thermoelastic(Args args) {
   material(alpha, "--alpha", "1/K", &RegionElasticity::thermal_expansion);
   if (!dt.empty()) params.delta_t = parse_temperature(dt, "--dT", TemperatureKind::difference);
   if (!temperature.empty()) params.temperature = read_temperature(mesh, temperature);
-  if (!tref.empty()) params.reference_temperature = parse_temperature(tref, "--tref", TemperatureKind::absolute);
+  if (!tref.empty())
+    params.reference_temperature = parse_temperature(tref, "--tref", TemperatureKind::absolute);
   const auto t1 = std::chrono::steady_clock::now();
 
   const ThermoelasticReport r = solve_thermoelastic(mesh, params);
@@ -248,7 +250,8 @@ int cmd_solve_thermoelastic(Args args) {
   write_json(json, results_json(res));
   if (!out.empty()) {
     write_mesh(mesh, out);
-    std::printf("wrote %s (fields displacement [m], stress, von_mises, principal_stress [Pa])\n", out.c_str());
+    std::printf("wrote %s (fields displacement [m], stress, von_mises, principal_stress [Pa])\n",
+                out.c_str());
   }
   return kExitOk;
 }

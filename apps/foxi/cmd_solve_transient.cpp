@@ -30,7 +30,8 @@ namespace {
 
 const char* kTransientUsage =
     "foxi solve MODEL.toml|MESH --physics transient --time T (--time-step DT | --steps N)\n"
-    "                [--power REGION=step:P | REGION=pulse:P,WIDTH,PERIOD[,COUNT] | REGION=table:FILE.csv]...\n"
+    "                [--power REGION=step:P | REGION=pulse:P,WIDTH,PERIOD[,COUNT] | "
+    "REGION=table:FILE.csv]...\n"
     "                [--scheme bdf2|euler] [--write-every K] [--initial T] [--set NAME=VALUE]...\n"
     "                [--fix TAG=T] [--convect TAG=h,Tinf] [--solver ...] [--json [FILE]] [--size-scale S]\n"
     "                [--max-tets N] -o OUT.pvd\n"
@@ -129,7 +130,8 @@ int cmd_solve_transient(Args args) {
     if (n > 1e7) throw UsageError("--time / --time-step is over 1e7 steps");
     steps = static_cast<std::size_t>(n);
   }
-  if (scheme != "bdf2" && scheme != "euler") throw UsageError("--scheme takes bdf2 or euler, not '" + scheme + "'");
+  if (scheme != "bdf2" && scheme != "euler")
+    throw UsageError("--scheme takes bdf2 or euler, not '" + scheme + "'");
   std::size_t every = std::max<std::size_t>(1, steps / 100);
   if (!every_text.empty()) {
     std::int32_t k = 0;
@@ -164,7 +166,8 @@ int cmd_solve_transient(Args args) {
   params.end_time = end_time;
   params.steps = steps;
   params.scheme = scheme == "euler" ? TimeScheme::euler : TimeScheme::bdf2;
-  if (!initial.empty()) params.initial_temperature = parse_temperature(initial, "--initial", TemperatureKind::absolute);
+  if (!initial.empty())
+    params.initial_temperature = parse_temperature(initial, "--initial", TemperatureKind::absolute);
   std::vector<HeatSource> model_sources;
   if (from_model) {
     ThermalParams mp = thermal_params_from_model(model_run.model, mesh);
@@ -187,7 +190,8 @@ int cmd_solve_transient(Args args) {
   // The model's loads: a step at t = 0 (W; a density times the region's volume) unless --power has
   // the region.
   for (const HeatSource& s : model_sources) {
-    if (std::any_of(params.power.begin(), params.power.end(), [&](const TransientPower& p) { return p.region == s.region; }))
+    if (std::any_of(params.power.begin(), params.power.end(),
+                    [&](const TransientPower& p) { return p.region == s.region; }))
       continue;
     double volume = 0;
     for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
@@ -197,12 +201,15 @@ int cmd_solve_transient(Args args) {
       double e[3][3];
       for (int a = 0; a < 3; ++a)
         for (int c = 0; c < 3; ++c) e[a][c] = p[a + 1][c] - p[0][c];
-      volume += (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6;
+      volume += (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                 e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+                6;
     }
     params.power.push_back({s.region, PowerWaveform::step_of(s.total ? s.value : s.value * volume)});
   }
-  if (params.power.empty()) throw UsageError("no power: give --power REGION=... (or a model with power loads)");
+  if (params.power.empty())
+    throw UsageError("no power: give --power REGION=... (or a model with power loads)");
   for (const TransientPower& p : params.power) params.junctions.push_back(p.region);
 
   // Each written step: OUT_NNNN.vtu, tracked so that a stop removes the whole series (until the
@@ -233,14 +240,16 @@ int cmd_solve_transient(Args args) {
     const TransientPower& p = params.power[j];
     const std::vector<double>& tj = r.junction_temperature[j];
     const bool step = p.power.kind == PowerWaveform::Kind::step && p.power.power != 0;
-    std::printf("  %-22s %12.4g %14.6g %14.6g %14.6g\n", region_label(mesh, p.region).c_str(), p.power.at(end_time),
-                tj.front(), tj.back(), step ? (tj.back() - tj.front()) / p.power.power : NAN);
+    std::printf("  %-22s %12.4g %14.6g %14.6g %14.6g\n", region_label(mesh, p.region).c_str(),
+                p.power.at(end_time), tj.front(), tj.back(),
+                step ? (tj.back() - tj.front()) / p.power.power : NAN);
   }
   // heat_in is the scheme's sum of dt * (heat in at each step's end): for BDF2 it differs from the
   // stored energy by O(dt) end terms (transient.hpp), so only the stored energy is printed as a figure.
   std::printf("energy: stored %.6g J (sum of rho c V dT over the run)\n", r.stored_energy);
-  std::printf("solver %s, %zu iterations in all, largest relative residual %.3g; setup %.3f s, steps %.3f s\n",
-              r.solver.c_str(), r.iterations, r.relative_residual, r.setup_seconds, r.solve_seconds);
+  std::printf(
+      "solver %s, %zu iterations in all, largest relative residual %.3g; setup %.3f s, steps %.3f s\n",
+      r.solver.c_str(), r.iterations, r.relative_residual, r.setup_seconds, r.solve_seconds);
 
   // CSV, then the .pvd last: its presence means the series is whole.
   {
@@ -257,7 +266,8 @@ int cmd_solve_transient(Args args) {
         const std::vector<double>& tj = r.junction_temperature[j];
         csv += ',' + csv_number(tj[i]);
         const PowerWaveform& w = params.power[j].power;
-        if (w.kind == PowerWaveform::Kind::step) csv += ',' + csv_number(w.power != 0 ? (tj[i] - tj[0]) / w.power : NAN);
+        if (w.kind == PowerWaveform::Kind::step)
+          csv += ',' + csv_number(w.power != 0 ? (tj[i] - tj[0]) / w.power : NAN);
       }
       csv += '\n';
     }
@@ -276,7 +286,8 @@ int cmd_solve_transient(Args args) {
   }
   write_transient_charts(stem, r.times, curves, text);
   {
-    std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+    std::string pvd =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
     for (const auto& [time, path] : written)
       pvd += "    <DataSet timestep=\"" + csv_number(time) + "\" part=\"0\" file=\"" +
              std::filesystem::path(path).filename().string() + "\"/>\n";

@@ -153,8 +153,10 @@ Varied parse_vary(const std::string& spec) {
     } catch (const UsageError&) {
       unit_si = 0;
     }
-    if (unit_si != 0 && std::isfinite(unit_si)) v.unit = unit, v.unit_si = unit_si;
-    else v.unit = v.si_unit;
+    if (unit_si != 0 && std::isfinite(unit_si))
+      v.unit = unit, v.unit_si = unit_si;
+    else
+      v.unit = v.si_unit;
   }
   if (v.si_unit == "1") v.si_unit.clear();
   return v;
@@ -234,8 +236,10 @@ int cmd_sweep(Args args) {
       physics != "thermoelastic" && physics != "transient")
     throw UsageError("--physics takes thermal, electrostatic, current, thermoelastic or transient, not '" +
                      physics + "'");
-  if (physics == "transient" && std::find(solve_options.begin(), solve_options.end(), "--time") == solve_options.end())
-    throw UsageError("--physics transient: give the runs' time stepping after '--' (-- --time 10s --steps 100)");
+  if (physics == "transient" &&
+      std::find(solve_options.begin(), solve_options.end(), "--time") == solve_options.end())
+    throw UsageError(
+        "--physics transient: give the runs' time stepping after '--' (-- --time 10s --steps 100)");
   std::vector<Varied> varied;
   for (const std::string& s : all_options(args, "--vary")) varied.push_back(parse_vary(s));
   if (varied.empty())
@@ -340,8 +344,7 @@ int cmd_sweep(Args args) {
       a.insert(a.end(), pass.begin(), pass.end());
       const std::string n = std::to_string(run);
       // A transient run writes its series into the scratch folder: the last step only.
-      if (physics == "transient")
-        a.insert(a.end(), {"-o", (scratch / ("run" + n + ".pvd")).string()});
+      if (physics == "transient") a.insert(a.end(), {"-o", (scratch / ("run" + n + ".pvd")).string()});
       if (physics == "transient" && std::find(pass.begin(), pass.end(), "--write-every") == pass.end())
         a.insert(a.end(), {"--write-every", "1000000000"});
       const auto start = std::chrono::steady_clock::now();
@@ -400,7 +403,7 @@ int cmd_sweep(Args args) {
     const bool has = r.status != RunStatus::failed;
     table += "," + (has ? std::to_string(r.nodes) : "") + "," + (has ? std::to_string(r.tets) : "");
     table += "," + (has ? number(r.mesh_seconds) : "") + "," + (has ? number(r.solve_seconds) : "") + "," +
-            number(r.wall_seconds) + "," + (has ? number(r.error_indicator) : "");
+             number(r.wall_seconds) + "," + (has ? number(r.error_indicator) : "");
     for (const auto& c : columns) {
       const ResultValue* v = r.find(c.first);
       table += "," + (v ? number(v->value) : "");
@@ -419,7 +422,8 @@ int cmd_sweep(Args args) {
   if (text) {
     write_sweep_plot(plot, *text, varied, columns, results, combination);
     std::fprintf(stderr, "foxi sweep: wrote %s (%zu chart%s against %s)\n", plot.c_str(),
-                 std::max<std::size_t>(1, columns.size()), columns.size() == 1 ? "" : "s", varied.front().name.c_str());
+                 std::max<std::size_t>(1, columns.size()), columns.size() == 1 ? "" : "s",
+                 varied.front().name.c_str());
   }
   if (json.enabled) {
     std::string o = "[\n";

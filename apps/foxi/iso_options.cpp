@@ -49,7 +49,8 @@ IsoOptions take_iso_options(Args& args, const FieldOptions& field) {
     for (double v : o.iso)
       if (!std::isfinite(v)) throw UsageError("--iso takes finite values, not '" + iso + "'");
   }
-  if (o.iso_only && o.iso.empty()) throw UsageError("--iso-only draws the isosurfaces of --iso v1,v2,...: give --iso");
+  if (o.iso_only && o.iso.empty())
+    throw UsageError("--iso-only draws the isosurfaces of --iso v1,v2,...: give --iso");
   if (!threshold.empty()) {
     const std::vector<double> r = parse_numbers(threshold, "--threshold");
     if (r.size() != 2 || !(r[0] <= r[1]))
@@ -61,7 +62,8 @@ IsoOptions take_iso_options(Args& args, const FieldOptions& field) {
   if (!clip.empty()) o.clip = parse_plane(clip, "--clip");
   if (!slice.empty()) o.slice = parse_plane(slice, "--slice");
   if (o.any() && field.spec.empty())
-    throw UsageError("--iso, --threshold, --clip and --slice select by a field or draw it: give --field NAME");
+    throw UsageError(
+        "--iso, --threshold, --clip and --slice select by a field or draw it: give --field NAME");
   if (o.slice && (!o.iso.empty() || o.has_threshold || o.clip))
     throw UsageError("--slice is drawn alone: leave out --iso, --threshold and --clip");
   return o;
@@ -74,7 +76,8 @@ IsoPicture resolve_iso(const IsoOptions& options, const Mesh& mesh, const FieldP
   FieldSelection s;
   for (double v : options.iso) s.iso.push_back(unit.to_si(v));
   s.iso_only = options.iso_only;
-  if (options.has_threshold) s.threshold = {unit.to_si(options.threshold[0]), unit.to_si(options.threshold[1])};
+  if (options.has_threshold)
+    s.threshold = {unit.to_si(options.threshold[0]), unit.to_si(options.threshold[1])};
   s.clip = options.clip;
   s.slice = options.slice;
   return select_field_tets(s, mesh, field.choice, field.step, field.legend.scale, base, cache);

@@ -18,15 +18,16 @@ ValidationReport require_usable(Mesh& mesh, const std::string& name, const char*
     throw InputError(why);
   }
   if (report.inverted > 0)
-    std::fprintf(stderr, "foxi %s: note: %s: %zu inverted tet%s (negative orientation) re-oriented\n", command,
-                 name.c_str(), report.inverted, report.inverted == 1 ? "" : "s");
+    std::fprintf(stderr, "foxi %s: note: %s: %zu inverted tet%s (negative orientation) re-oriented\n",
+                 command, name.c_str(), report.inverted, report.inverted == 1 ? "" : "s");
   return report;
 }
 
 Mesh read_usable_mesh(const std::string& path, const char* command) {
   // A ParaView collection (foxi solve --physics transient's output) is one mesh whose fields have a
   // step per data set: read through the field importer, which checks that the sets agree.
-  Mesh mesh = std::filesystem::path(path).extension() == ".pvd" ? read_field_source(path).mesh : read_mesh(path);
+  Mesh mesh =
+      std::filesystem::path(path).extension() == ".pvd" ? read_field_source(path).mesh : read_mesh(path);
   require_usable(mesh, path, command);
   return mesh;
 }

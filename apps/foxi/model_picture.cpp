@@ -15,12 +15,12 @@
 
 namespace foxi::cli {
 
-ModelPicture render_model_picture(const MeshedModel& m, const std::string& path, const ModelPictureParams& p) {
+ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
+                                  const ModelPictureParams& p) {
   double lo[3], hi[3];
   mesh_bounds(m.mesh, lo, hi);
   const double size = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  const Mesh exploded =
-      p.view == ModelView::exploded ? exploded_mesh(m.mesh, 0.12 * size) : Mesh{};
+  const Mesh exploded = p.view == ModelView::exploded ? exploded_mesh(m.mesh, 0.12 * size) : Mesh{};
   const Mesh& mesh = p.view == ModelView::exploded ? exploded : m.mesh;
   ModelPicture out;
   RenderParams rp;
@@ -83,8 +83,8 @@ ModelPicture render_model_picture(const MeshedModel& m, const std::string& path,
 void print_legend(const MeshedModel& m, const ModelPicture& picture) {
   for (std::size_t i = 0; i < m.model.parts.size(); ++i) {
     const std::uint32_t c = picture.part_color[i];
-    std::printf("  %-16s %-16s #%02x%02x%02x\n", m.model.parts[i].name.c_str(), m.model.parts[i].material.c_str(),
-                c & 255u, (c >> 8) & 255u, (c >> 16) & 255u);
+    std::printf("  %-16s %-16s #%02x%02x%02x\n", m.model.parts[i].name.c_str(),
+                m.model.parts[i].material.c_str(), c & 255u, (c >> 8) & 255u, (c >> 16) & 255u);
   }
 }
 

@@ -37,7 +37,8 @@ bool is_model_path(const std::string& path) {
   return path.size() > 5 && path.compare(path.size() - 5, 5, ".toml") == 0;
 }
 
-MeshedModel mesh_model_from_sets(const std::string& file, std::span<const std::string> sets, ModelMeshOptions options) {
+MeshedModel mesh_model_from_sets(const std::string& file, std::span<const std::string> sets,
+                                 ModelMeshOptions options) {
   options.override_origin = "--set";
   return foxi::mesh_model(file, set_overrides(file, sets), options);
 }
@@ -56,12 +57,13 @@ MeshedModel mesh_model_for_solve(const std::string& file, std::span<const std::s
   if (ph)
     for (const ModelWarning& w : warnings_for(diagnose_model(m.model, m.structure), *ph))
       std::fprintf(stderr, "foxi solve: warning: %s: %s\n", file.c_str(), describe(w, m.model).c_str());
-  std::printf("model %s: %zu parts, %zu conditions, %zu loads -> PLC %zu points, %zu facets -> %zu nodes, %zu tets "
-              "(TetGen %s, %.3f s; Delaunay %s%s)\n",
-              file.c_str(), m.model.parts.size(), m.model.conditions.size(), m.model.loads.size(),
-              m.structure.plc.point_count(), m.structure.plc.facet_count(), m.mesh.node_count(), m.mesh.tet_count(),
-              m.report.switches.c_str(), m.conforming.seconds, m.conforming.delaunay ? "certified" : "NOT certified",
-              m.conforming.thin_layers.empty() ? "" : ", thin layers meshed flat");
+  std::printf(
+      "model %s: %zu parts, %zu conditions, %zu loads -> PLC %zu points, %zu facets -> %zu nodes, %zu tets "
+      "(TetGen %s, %.3f s; Delaunay %s%s)\n",
+      file.c_str(), m.model.parts.size(), m.model.conditions.size(), m.model.loads.size(),
+      m.structure.plc.point_count(), m.structure.plc.facet_count(), m.mesh.node_count(), m.mesh.tet_count(),
+      m.report.switches.c_str(), m.conforming.seconds, m.conforming.delaunay ? "certified" : "NOT certified",
+      m.conforming.thin_layers.empty() ? "" : ", thin layers meshed flat");
   return m;
 }
 
@@ -82,19 +84,28 @@ void print_model_conditions(const Model& model) {
   for (const BoundaryCondition& c : model.conditions) {
     std::printf("  %-12s on %-28s ", condition_kind_name(c.kind), c.name.c_str());
     switch (c.kind) {
-      case ConditionKind::temperature: std::printf("%g K (%g C)", c.value, c.value - 273.15); break;
-      case ConditionKind::heat_flux: std::printf("%g W/m^2 into the body", c.value); break;
+      case ConditionKind::temperature:
+        std::printf("%g K (%g C)", c.value, c.value - 273.15);
+        break;
+      case ConditionKind::heat_flux:
+        std::printf("%g W/m^2 into the body", c.value);
+        break;
       case ConditionKind::convection:
         std::printf("h %g W/(m^2 K), ambient %g K (%g C)", c.h, c.ambient, c.ambient - 273.15);
         break;
       case ConditionKind::voltage:
         std::printf("%g V%s%s", c.value, c.physics.empty() ? "" : ", --physics ", c.physics.c_str());
         break;
-      case ConditionKind::current: std::printf("%g A into the body", c.value); break;
-      case ConditionKind::displacement:
-        std::printf("(%g, %g, %g) %s", c.displacement[0] / s, c.displacement[1] / s, c.displacement[2] / s, u);
+      case ConditionKind::current:
+        std::printf("%g A into the body", c.value);
         break;
-      case ConditionKind::sliding: std::printf("normal displacement 0"); break;
+      case ConditionKind::displacement:
+        std::printf("(%g, %g, %g) %s", c.displacement[0] / s, c.displacement[1] / s, c.displacement[2] / s,
+                    u);
+        break;
+      case ConditionKind::sliding:
+        std::printf("normal displacement 0");
+        break;
     }
     std::printf("\n");
   }

@@ -26,7 +26,8 @@ double max_tets_option(Args& args);
 std::vector<ParameterOverride> set_overrides(const std::string& file, std::span<const std::string> sets);
 
 // foxi::mesh_model (mesher/model_mesh.hpp) with the --set texts, messages naming --set.
-MeshedModel mesh_model_from_sets(const std::string& file, std::span<const std::string> sets, ModelMeshOptions options = {});
+MeshedModel mesh_model_from_sets(const std::string& file, std::span<const std::string> sets,
+                                 ModelMeshOptions options = {});
 
 // The message of a tet-limit refusal as the CLI says it (naming --max-tets).
 std::string tet_limit_message(const TetLimitError& e);

@@ -34,7 +34,8 @@ Sweep parse_sweep(const std::string& text) {
   if (v.size() != 2 || v[0] == v[1])
     throw UsageError("--sweep " + kind + ":a,b takes two different values, not '" + text + "'");
   if (s.kind == Sweep::Kind::threshold && !(v[0] < v[1]))
-    throw UsageError("--sweep threshold:a,b grows the range [a, v] from v = a to b: a < b, not '" + text + "'");
+    throw UsageError("--sweep threshold:a,b grows the range [a, v] from v = a to b: a < b, not '" + text +
+                     "'");
   s.a = v[0];
   s.b = v[1];
   return s;
@@ -42,16 +43,19 @@ Sweep parse_sweep(const std::string& text) {
 
 void check_sweep_options(const Sweep& sweep, const FieldOptions& field, const IsoOptions& iso) {
   using K = Sweep::Kind;
-  if (sweep.kind != K::none && field.spec.empty()) throw UsageError("--sweep draws a field: give --field NAME");
+  if (sweep.kind != K::none && field.spec.empty())
+    throw UsageError("--sweep draws a field: give --field NAME");
   if (sweep.kind == K::none && (!iso.iso.empty() || iso.slice))
-    throw UsageError("--iso and --slice draw polygons, which the back-and-forth and rotating movies do not: "
-                     "sweep them with --sweep iso:a,b or --sweep steps");
+    throw UsageError(
+        "--iso and --slice draw polygons, which the back-and-forth and rotating movies do not: "
+        "sweep them with --sweep iso:a,b or --sweep steps");
   if (sweep.kind == K::iso && (!iso.iso.empty() || iso.slice))
     throw UsageError("--sweep iso:a,b gives each frame its isovalue: leave out --iso and --slice");
   if (sweep.kind == K::steps && field.step >= 0)
     throw UsageError("--sweep steps draws every step of the field: leave out --step");
   if (sweep.kind == K::threshold && (iso.has_threshold || iso.slice))
-    throw UsageError("--sweep threshold:a,b gives each frame its threshold: leave out --threshold and --slice");
+    throw UsageError(
+        "--sweep threshold:a,b gives each frame its threshold: leave out --threshold and --slice");
 }
 
 double sweep_value(const Sweep& sweep, int k, int n) {
@@ -59,8 +63,8 @@ double sweep_value(const Sweep& sweep, int k, int n) {
   return sweep.a + (sweep.b - sweep.a) * double(k) / double(n - 1);
 }
 
-SweepRange fixed_step_range(const FieldOptions& options, const Mesh& mesh, std::span<const std::uint32_t> subset,
-                            const std::string& path) {
+SweepRange fixed_step_range(const FieldOptions& options, const Mesh& mesh,
+                            std::span<const std::uint32_t> subset, const std::string& path) {
   FieldOptions o = options;
   o.step = 0;
   SweepRange r;
@@ -159,14 +163,15 @@ void print_sweep(const SweepStats& st, const Sweep& sweep, const FieldPicture& f
     const auto [cmin, cmax] = std::minmax_element(st.crossing.begin(), st.crossing.end());
     std::printf("sweep       isovalue of %s, %zu frames: %s%s\n", field.legend.title.c_str(), st.frames,
                 list("%.6g").c_str(), unit.c_str());
-    std::printf("pruned      %zu to %zu tets crossed a frame, %zu to %zu ordered and drawn; interval tree built "
-                "once (%.1f ms), queries %.2f ms in all\n",
-                *cmin, *cmax, *dmin, *dmax, st.build_ms, st.query_ms);
+    std::printf(
+        "pruned      %zu to %zu tets crossed a frame, %zu to %zu ordered and drawn; interval tree built "
+        "once (%.1f ms), queries %.2f ms in all\n",
+        *cmin, *cmax, *dmin, *dmax, st.build_ms, st.query_ms);
   } else if (sweep.kind == K::threshold) {
     char a[64];
     std::snprintf(a, sizeof a, "%.6g", sweep.a);
-    std::printf("sweep       threshold [%s, v] of %s, %zu frames, v = %s%s\n", a, field.legend.title.c_str(), st.frames,
-                list("%.6g").c_str(), unit.c_str());
+    std::printf("sweep       threshold [%s, v] of %s, %zu frames, v = %s%s\n", a, field.legend.title.c_str(),
+                st.frames, list("%.6g").c_str(), unit.c_str());
     std::printf("selected    %zu to %zu tets a frame\n", *dmin, *dmax);
   } else {
     std::printf("sweep       steps of %s, %zu frames", field.legend.title.c_str(), st.frames);

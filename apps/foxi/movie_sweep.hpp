@@ -39,34 +39,34 @@ struct SweepRange {
   std::size_t steps = 1;
 };
 // The colour range of every step of the field together, as resolve_field would choose it for each.
-SweepRange fixed_step_range(const FieldOptions& options, const Mesh& mesh, std::span<const std::uint32_t> subset,
-                            const std::string& path);
+SweepRange fixed_step_range(const FieldOptions& options, const Mesh& mesh,
+                            std::span<const std::uint32_t> subset, const std::string& path);
 
 struct SweepInputs {
   const Mesh& mesh;
   const SphereTable& table;
   const Camera& camera;
-  int width, height;                      // the scene, without the legend's panel
-  const RenderParams& render;             // edges, shrink (the field's paint is set per frame)
-  std::span<const std::uint32_t> base;    // --regions (empty: all)
-  const FieldOptions& field_options;      // steps: resolved again per step (with the fixed range)
-  const FieldPicture& field;              // iso, threshold: the field as resolved once
-  const IsoOptions& iso_options;          // --threshold, --clip (and --iso, --slice with steps)
+  int width, height;                    // the scene, without the legend's panel
+  const RenderParams& render;           // edges, shrink (the field's paint is set per frame)
+  std::span<const std::uint32_t> base;  // --regions (empty: all)
+  const FieldOptions& field_options;    // steps: resolved again per step (with the fixed range)
+  const FieldPicture& field;            // iso, threshold: the field as resolved once
+  const IsoOptions& iso_options;        // --threshold, --clip (and --iso, --slice with steps)
   Sweep sweep;
   bool iso_only = false;
-  int frames = 48;                        // iso, threshold
-  std::size_t steps = 1;                  // steps
+  int frames = 48;        // iso, threshold
+  std::size_t steps = 1;  // steps
   const std::string& path;
 };
 
 struct SweepStats {
   std::size_t frames = 0;
-  std::vector<double> values;                    // each frame's value, display units (steps: step index)
-  std::vector<std::size_t> crossing, drawn;      // per frame: tets crossed (iso), tets drawn
+  std::vector<double> values;                      // each frame's value, display units (steps: step index)
+  std::vector<std::size_t> crossing, drawn;        // per frame: tets crossed (iso), tets drawn
   double build_ms = 0, query_ms = 0, draw_ms = 0;  // the interval tree (once), queries and drawing in all
-  bool depth_buffer = false;                     // some frame drawn with the depth buffer (uncertified)
-  std::string unit;                              // the display unit's symbol
-  std::vector<double> step_values;               // steps: the field's step times
+  bool depth_buffer = false;                       // some frame drawn with the depth buffer (uncertified)
+  std::string unit;                                // the display unit's symbol
+  std::vector<double> step_values;                 // steps: the field's step times
 };
 
 // Draws the frames in order and hands each, with the field picture its legend shows, to `frame`.

@@ -21,7 +21,7 @@ extern const char* const kPictureOptionsHelp;
 
 struct PictureOptions {
   int width = 0, height = 0;
-  RenderParams params;  // edges, shrink
+  RenderParams params;   // edges, shrink
   CameraOptions camera;  // as given (view_options.hpp), fitted by resolve_picture
   std::string regions;
 };

@@ -35,7 +35,7 @@ class RunOrder {
     std::size_t pick = total_;
     if (total_ > kPredicted) {
       pick = first_unstarted();
-    } else if (started_count_ < 2) {  // (one finished run predicts the same length for all)
+    } else if (started_count_ < 2) {                // (one finished run predicts the same length for all)
       pick = started_count_ == 0 ? total_ - 1 : 0;  // the two ends
       if (started_[pick]) pick = first_unstarted();
     } else {

@@ -11,8 +11,8 @@ double parse_value(const std::string& text, const std::string& option, const cha
   try {
     return evaluate_in(text, unit);
   } catch (const ExpressionError& e) {
-    throw UsageError(option + ": " + e.what() + " (expected a value in " + unit + "; a bare number is in " + unit +
-                     ")");
+    throw UsageError(option + ": " + e.what() + " (expected a value in " + unit + "; a bare number is in " +
+                     unit + ")");
   }
 }
 

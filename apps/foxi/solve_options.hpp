@@ -56,8 +56,8 @@ int print_checks(const std::vector<BalanceCheck>& checks);
 struct ThermalOptions {
   std::vector<std::string> fix, flux, convect, power, density, cond, theta;
   bool empty() const {
-    return fix.empty() && flux.empty() && convect.empty() && power.empty() && density.empty() && cond.empty() &&
-           theta.empty();
+    return fix.empty() && flux.empty() && convect.empty() && power.empty() && density.empty() &&
+           cond.empty() && theta.empty();
   }
 };
 ThermalOptions thermal_options(Args& args);

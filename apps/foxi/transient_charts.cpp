@@ -68,9 +68,10 @@ void write_transient_charts(const std::string& stem, const std::vector<double>& 
 
   if (stepped.empty()) return;
   if (junctions.size() != 1) {
-    std::printf("structure function: not computed: %zu regions are powered (it describes the heat path of "
-                "one source; each heats the others' junctions)\n",
-                junctions.size());
+    std::printf(
+        "structure function: not computed: %zu regions are powered (it describes the heat path of "
+        "one source; each heats the others' junctions)\n",
+        junctions.size());
     return;
   }
   const JunctionCurve& c = *stepped.front();
@@ -105,9 +106,10 @@ void write_transient_charts(const std::string& stem, const std::vector<double>& 
                     drop, drop_at);
       why = buf;
     }
-    std::printf("structure function of %s: not written: the Foster fit misses Zth(t) by %.3g K/W, %.2g %% of "
-                "Zth(end) (more than %g %%): %s\n",
-                c.name.c_str(), sf.fit.max_error, 100 * fit_error, 100 * kFitTolerance, why.c_str());
+    std::printf(
+        "structure function of %s: not written: the Foster fit misses Zth(t) by %.3g K/W, %.2g %% of "
+        "Zth(end) (more than %g %%): %s\n",
+        c.name.c_str(), sf.fit.max_error, 100 * fit_error, 100 * kFitTolerance, why.c_str());
     return;
   }
   {
@@ -137,22 +139,23 @@ void write_transient_charts(const std::string& stem, const std::vector<double>& 
     draw_chart(fb, text, s, PixelRect{0, 0, kChartWidth - 1, kChartHeight + 59});
     write_png(stem + "_structure.png", fb);
   }
-  std::printf("structure function of %s: %zu Cauer stages from %zu Foster terms (time constants %.3g s to "
-              "%.3g s), total R %.6g K/W against Zth(end) %.6g K/W, C at the junction %.4g J/K; Foster fit "
-              "error %.3g K/W at most (%.2g %% of Zth(end), within %g %%)\n",
-              c.name.c_str(), sf.cauer.size(), sf.fit.terms.size(),
-              sf.fit.terms.empty() ? NAN : sf.fit.terms.front().tau,
-              sf.fit.terms.empty() ? NAN : sf.fit.terms.back().tau,
-              sf.cumulative_r.empty() ? NAN : sf.cumulative_r.back(), z.back(),
-              sf.cauer.empty() ? NAN : sf.cauer.front().c, sf.fit.max_error,
-              100 * fit_error, 100 * kFitTolerance);
+  std::printf(
+      "structure function of %s: %zu Cauer stages from %zu Foster terms (time constants %.3g s to "
+      "%.3g s), total R %.6g K/W against Zth(end) %.6g K/W, C at the junction %.4g J/K; Foster fit "
+      "error %.3g K/W at most (%.2g %% of Zth(end), within %g %%)\n",
+      c.name.c_str(), sf.cauer.size(), sf.fit.terms.size(),
+      sf.fit.terms.empty() ? NAN : sf.fit.terms.front().tau,
+      sf.fit.terms.empty() ? NAN : sf.fit.terms.back().tau,
+      sf.cumulative_r.empty() ? NAN : sf.cumulative_r.back(), z.back(),
+      sf.cauer.empty() ? NAN : sf.cauer.front().c, sf.fit.max_error, 100 * fit_error, 100 * kFitTolerance);
   if (sf.settled > 0.01)
-    std::printf("note: Zth still rose %.1f %% over the last tenth of the log time: the heat has not reached the "
-                "ambient, so the structure function ends early (its last stages stand for what is beyond); "
-                "run longer (--time) for the whole path\n",
-                100 * sf.settled);
-  std::printf("wrote %s_structure.csv and %s_structure.png (cumulative C against cumulative R)\n", stem.c_str(),
-              stem.c_str());
+    std::printf(
+        "note: Zth still rose %.1f %% over the last tenth of the log time: the heat has not reached the "
+        "ambient, so the structure function ends early (its last stages stand for what is beyond); "
+        "run longer (--time) for the whole path\n",
+        100 * sf.settled);
+  std::printf("wrote %s_structure.csv and %s_structure.png (cumulative C against cumulative R)\n",
+              stem.c_str(), stem.c_str());
   return;
 }
 

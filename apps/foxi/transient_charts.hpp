@@ -13,10 +13,10 @@
 namespace foxi::cli {
 
 struct JunctionCurve {
-  std::string name;          // the region
-  std::string waveform;      // "step", "pulse", "table"
-  double step_power = 0;     // W, for a step (else 0)
-  std::vector<double> tj;    // K at each time
+  std::string name;        // the region
+  std::string waveform;    // "step", "pulse", "table"
+  double step_power = 0;   // W, for a step (else 0)
+  std::vector<double> tj;  // K at each time
 };
 
 // Zth is (Tj(t) - Tj(0)) / P for a step of P != 0 only: a junction with another waveform gets no

@@ -110,10 +110,13 @@ EdgeSize edge_size_field(const Domain& domain, double global) {
   std::sort(pts.begin(), pts.end());
   for (std::size_t i = 0; i < pts.size(); ++i) {
     double best = HUGE_VAL;
-    for (std::size_t j = i + 1; j < pts.size() && (pts[j][0] - pts[i][0]) * (pts[j][0] - pts[i][0]) < best; ++j)
-      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]), K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
+    for (std::size_t j = i + 1; j < pts.size() && (pts[j][0] - pts[i][0]) * (pts[j][0] - pts[i][0]) < best;
+         ++j)
+      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]),
+                                                   K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
     for (std::size_t j = i; j-- > 0 && (pts[i][0] - pts[j][0]) * (pts[i][0] - pts[j][0]) < best;)
-      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]), K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
+      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]),
+                                                   K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
     const double cap = std::min(global, std::isfinite(best) ? std::sqrt(best) / 3 : global);
     e.corner_size[pts[i]] = cap * (0.7 + 0.25 * (1 - hash01(pts[i])));
   }
@@ -145,7 +148,9 @@ std::vector<std::uint32_t> plane_regions(const detail::PlcSurface& s, const Plc&
       edge_tris[{std::min(a, b), std::max(a, b)}].push_back(t);
     }
   }
-  auto pt = [&](std::uint32_t v) { return K::Point_3(s.points[3 * v], s.points[3 * v + 1], s.points[3 * v + 2]); };
+  auto pt = [&](std::uint32_t v) {
+    return K::Point_3(s.points[3 * v], s.points[3 * v + 1], s.points[3 * v + 2]);
+  };
   auto cells = [&](std::uint32_t t) { return std::minmax(s.side_cell[2 * t], s.side_cell[2 * t + 1]); };
   for (const auto& [edge, tris] : edge_tris) {
     if (tris.size() != 2) continue;
@@ -154,7 +159,8 @@ std::vector<std::uint32_t> plane_regions(const detail::PlcSurface& s, const Plc&
     std::uint32_t apex = s.tri[3 * u];
     for (int i = 0; i < 3; ++i)
       if (s.tri[3 * u + i] != edge.first && s.tri[3 * u + i] != edge.second) apex = s.tri[3 * u + i];
-    if (CGAL::coplanar(pt(s.tri[3 * t]), pt(s.tri[3 * t + 1]), pt(s.tri[3 * t + 2]), pt(apex))) groups.unite(f, g);
+    if (CGAL::coplanar(pt(s.tri[3 * t]), pt(s.tri[3 * t + 1]), pt(s.tri[3 * t + 2]), pt(apex)))
+      groups.unite(f, g);
   }
   std::vector<std::uint32_t> root(plc.facet_count());
   for (std::uint32_t f = 0; f < root.size(); ++f) root[f] = groups.find(f);
@@ -166,7 +172,8 @@ Patches make_patches(const Plc& plc, const detail::PlcSurface& s, bool per_facet
   // Triangles of one facet (or marker) with the same cells on their sides: facets of one patch are
   // oriented alike (their normals point into the same cell), so the group is a consistently oriented surface.
   const std::vector<std::uint32_t> region = per_facet ? plane_regions(s, plc) : std::vector<std::uint32_t>{};
-  std::map<std::tuple<std::int32_t, std::uint32_t, std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
+  std::map<std::tuple<std::int32_t, std::uint32_t, std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>>
+      groups;
   for (std::uint32_t t = 0; t < s.tri_facet.size(); ++t) {
     const std::uint32_t front = s.side_cell[2 * t], back = s.side_cell[2 * t + 1];
     if (front == back) continue;
@@ -181,7 +188,8 @@ Patches make_patches(const Plc& plc, const detail::PlcSurface& s, bool per_facet
   Patches out;
   for (const auto& [key, tris] : groups) {
     const auto [marker, facet, back, front] = key;
-    const std::string which = per_facet ? "facet " + std::to_string(facet + 1) : "the facets of marker " + std::to_string(marker);
+    const std::string which =
+        per_facet ? "facet " + std::to_string(facet + 1) : "the facets of marker " + std::to_string(marker);
     std::vector<K::Point_3> pts;
     std::vector<std::vector<std::size_t>> polys;
     std::unordered_map<std::uint32_t, std::size_t> local;
@@ -199,13 +207,17 @@ Patches make_patches(const Plc& plc, const detail::PlcSurface& s, bool per_facet
     if (!PMP::is_polygon_soup_a_polygon_mesh(polys)) {
       const auto before = polys;
       PMP::orient_polygon_soup(pts, polys);  // splits non-manifold vertices; must not flip a triangle
-      if (polys.size() != before.size()) throw MesherError(MesherFailure::bad_input, which + (per_facet ? " overlaps itself" : " overlap"));
+      if (polys.size() != before.size())
+        throw MesherError(MesherFailure::bad_input, which + (per_facet ? " overlaps itself" : " overlap"));
       for (std::size_t i = 0; i < polys.size(); ++i) {
         const auto& a = before[i];
         const auto& b = polys[i];
-        const bool same = (pts[a[0]] == pts[b[0]] && pts[a[1]] == pts[b[1]]) || (pts[a[0]] == pts[b[1]] && pts[a[1]] == pts[b[2]]) ||
+        const bool same = (pts[a[0]] == pts[b[0]] && pts[a[1]] == pts[b[1]]) ||
+                          (pts[a[0]] == pts[b[1]] && pts[a[1]] == pts[b[2]]) ||
                           (pts[a[0]] == pts[b[2]] && pts[a[1]] == pts[b[0]]);
-        if (!same) throw MesherError(MesherFailure::bad_input, which + (per_facet ? " meets itself" : " meet") + " in a non-manifold way");
+        if (!same)
+          throw MesherError(MesherFailure::bad_input,
+                            which + (per_facet ? " meets itself" : " meet") + " in a non-manifold way");
       }
     }
     Polyhedron poly;
@@ -215,7 +227,8 @@ Patches make_patches(const Plc& plc, const detail::PlcSurface& s, bool per_facet
     out.marker.push_back(marker);
   }
   if (out.polyhedra.empty())
-    throw MesherError(MesherFailure::bad_input, "the PLC encloses no volume (no facet has different cells on its sides)");
+    throw MesherError(MesherFailure::bad_input,
+                      "the PLC encloses no volume (no facet has different cells on its sides)");
   if (per_facet) {
     std::vector<char> used(plc.facet_count(), 0);
     for (std::uint32_t f : s.tri_facet) used[f] = 1;
@@ -237,9 +250,11 @@ std::vector<double> cell_volumes(const detail::PlcSurface& s) {
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < 3; ++k) p[i][k] = s.points[3 * s.tri[3 * t + i] + k] - o[k];
     // The tet (origin, a, b, c): positive when the normal (right hand rule) points away from the origin.
-    const double v = (p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) - p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
-                      p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0])) / 6;
-    vol[back] += v;   // the normal points out of the cell behind it
+    const double v = (p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
+                      p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
+                      p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0])) /
+                     6;
+    vol[back] += v;  // the normal points out of the cell behind it
     vol[front] -= v;
   }
   return vol;
@@ -265,16 +280,19 @@ void put(std::vector<char>& out, const std::vector<T>& v) {
 template <class T>
 void get(const std::vector<char>& in, std::size_t& at, std::vector<T>& v) {
   std::uint64_t n = 0;
-  if (in.size() - at < sizeof n) throw MesherError(MesherFailure::internal_error, "CGAL's result was cut short");
+  if (in.size() - at < sizeof n)
+    throw MesherError(MesherFailure::internal_error, "CGAL's result was cut short");
   std::memcpy(&n, in.data() + at, sizeof n);
   at += sizeof n;
-  if (n > (in.size() - at) / sizeof(T)) throw MesherError(MesherFailure::internal_error, "CGAL's result was cut short");
+  if (n > (in.size() - at) / sizeof(T))
+    throw MesherError(MesherFailure::internal_error, "CGAL's result was cut short");
   v.resize(n);
   std::memcpy(v.data(), in.data() + at, sizeof(T) * n);
   at += sizeof(T) * n;
 }
 
-Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& patches, const std::vector<std::int32_t>& cell_region) {
+Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& patches,
+                      const std::vector<std::int32_t>& cell_region) {
   Result r;
   std::unordered_map<Tr::Vertex_handle, std::uint32_t, CGAL::Handle_hash_function> index;
   auto node = [&](Tr::Vertex_handle v) {
@@ -299,7 +317,8 @@ Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& pat
     const auto& p1 = c->vertex(1)->point();
     const auto& p2 = c->vertex(2)->point();
     const auto& p3 = c->vertex(3)->point();
-    const K::Point_3 centroid((p0.x() + p1.x() + p2.x() + p3.x()) / 4, (p0.y() + p1.y() + p2.y() + p3.y()) / 4,
+    const K::Point_3 centroid((p0.x() + p1.x() + p2.x() + p3.x()) / 4,
+                              (p0.y() + p1.y() + p2.y() + p3.y()) / 4,
                               (p0.z() + p1.z() + p2.z() + p3.z()) / 4);
     const auto where = locate(centroid);
     auto sd = static_cast<std::size_t>(c3t3.subdomain_index(c));
@@ -330,10 +349,12 @@ Result export_complex(const C3t3& c3t3, const Domain& domain, const Patches& pat
 using Clock = std::chrono::steady_clock;
 
 // Runs in the child process. `deadline` bounds the optimisers (the parent kills the child at it).
-std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s, const Plc& plc, const CgalMeshReport& sizes,
-                             const CgalMeshParams& params, Clock::time_point deadline) {
+std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s, const Plc& plc,
+                             const CgalMeshReport& sizes, const CgalMeshParams& params,
+                             Clock::time_point deadline) {
   namespace P = CGAL::parameters;
-  Domain domain(patches.polyhedra.begin(), patches.polyhedra.end(), patches.subdomains.begin(), patches.subdomains.end());
+  Domain domain(patches.polyhedra.begin(), patches.polyhedra.end(), patches.subdomains.begin(),
+                patches.subdomains.end());
   if (params.resample) {
     // Patch borders (marker or material changes) and edges where the facets turn by more than
     // feature_angle. A faceted cylinder's wall is then one smooth patch whose rims are curves: their
@@ -349,30 +370,37 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
   for (const RegionSeed& seed : plc.regions)
     if (seed.max_volume > 0)
       for (std::size_t c = 1; c < s.cell_count; ++c)
-        if (s.cell_region[c] == seed.id) cell_size.per_subdomain[c] = std::min(cell_size.per_subdomain[c], regular_tet_circumradius(seed.max_volume));
+        if (s.cell_region[c] == seed.id)
+          cell_size.per_subdomain[c] =
+              std::min(cell_size.per_subdomain[c], regular_tet_circumradius(seed.max_volume));
   // Facets keep their vertices on one patch (or its bounding features): without it a coarse mesh of a thin
-  // part takes facets that cut across its corners (the dual edge meets a patch, the facet does not lie in it).
+  // part takes facets that cut across its corners (the dual edge meets a patch, the facet does not lie in
+  // it).
   const EdgeSize edge_size = edge_size_field(domain, sizes.edge_size);
-  Criteria criteria(P::edge_size = edge_size, P::facet_angle = params.facet_angle, P::facet_size = sizes.facet_size,
+  Criteria criteria(P::edge_size = edge_size, P::facet_angle = params.facet_angle,
+                    P::facet_size = sizes.facet_size,
                     P::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH_WITH_ADJACENCY_CHECK,
-                    P::facet_distance = sizes.facet_distance,
-                    P::cell_radius_edge_ratio = params.radius_edge, P::cell_size = cell_size);
+                    P::facet_distance = sizes.facet_distance, P::cell_radius_edge_ratio = params.radius_edge,
+                    P::cell_size = cell_size);
   C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, P::no_perturb(), P::no_exude());
   // Each optimiser stops at its own limit or before the deadline with time left to export and send
   // the mesh, whichever is first (stopped, they leave a valid regular triangulation); with no time left
   // they are skipped.
   auto optimiser_limit = [&] {
-    const double left = std::chrono::duration<double>(deadline - Clock::now()).count() - std::max(2.0, 0.1 * params.time_limit);
+    const double left = std::chrono::duration<double>(deadline - Clock::now()).count() -
+                        std::max(2.0, 0.1 * params.time_limit);
     if (params.time_limit <= 0) return params.optimiser_seconds;
     return params.optimiser_seconds > 0 ? std::min(params.optimiser_seconds, left) : left;
   };
   if (params.perturb) {
     const double limit = optimiser_limit();
-    if (params.time_limit <= 0 || limit > 0) CGAL::perturb_mesh_3(c3t3, domain, P::time_limit = limit, P::sliver_bound = params.sliver_bound);
+    if (params.time_limit <= 0 || limit > 0)
+      CGAL::perturb_mesh_3(c3t3, domain, P::time_limit = limit, P::sliver_bound = params.sliver_bound);
   }
   if (params.exude) {
     const double limit = optimiser_limit();
-    if (params.time_limit <= 0 || limit > 0) CGAL::exude_mesh_3(c3t3, P::time_limit = limit, P::sliver_bound = params.sliver_bound);
+    if (params.time_limit <= 0 || limit > 0)
+      CGAL::exude_mesh_3(c3t3, P::time_limit = limit, P::sliver_bound = params.sliver_bound);
   }
 
   const Result r = export_complex(c3t3, domain, patches, s.cell_region);
@@ -398,13 +426,16 @@ std::vector<std::int32_t> distinct(std::vector<std::int32_t> v) {
 Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshReport* report) {
   const auto t0 = Clock::now();
   if (!(params.max_size >= 0 && params.facet_size >= 0 && params.edge_size >= 0 && params.radius_edge >= 0 &&
-        params.facet_angle >= 0 && params.facet_angle <= 30 && params.optimiser_seconds >= 0 && params.sliver_bound >= 0 &&
-        params.sliver_bound < 70 && params.facet_distance >= 0 && params.feature_angle >= 0 && params.feature_angle <= 180 &&
-        params.time_limit >= 0 && params.volume_tolerance > 0 && std::isfinite(params.max_size) && std::isfinite(params.facet_size) &&
-        std::isfinite(params.edge_size) && std::isfinite(params.facet_distance) && std::isfinite(params.radius_edge) &&
-        std::isfinite(params.optimiser_seconds) && std::isfinite(params.time_limit)))
+        params.facet_angle >= 0 && params.facet_angle <= 30 && params.optimiser_seconds >= 0 &&
+        params.sliver_bound >= 0 && params.sliver_bound < 70 && params.facet_distance >= 0 &&
+        params.feature_angle >= 0 && params.feature_angle <= 180 && params.time_limit >= 0 &&
+        params.volume_tolerance > 0 && std::isfinite(params.max_size) && std::isfinite(params.facet_size) &&
+        std::isfinite(params.edge_size) && std::isfinite(params.facet_distance) &&
+        std::isfinite(params.radius_edge) && std::isfinite(params.optimiser_seconds) &&
+        std::isfinite(params.time_limit)))
     throw MesherError(MesherFailure::bad_input,
-                      "CGAL mesh parameters out of range (finite sizes >= 0, facet angle in [0, 30], sliver bound in [0, 70), "
+                      "CGAL mesh parameters out of range (finite sizes >= 0, facet angle in [0, 30], sliver "
+                      "bound in [0, 70), "
                       "feature angle in [0, 180] degrees, time limit >= 0, volume tolerance > 0)");
   CgalMeshReport rep;
   rep.resampled = params.resample;
@@ -422,7 +453,8 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
     lo[i % 3] = std::min(lo[i % 3], s.points[i]);
     hi[i % 3] = std::max(hi[i % 3], s.points[i]);
   }
-  const double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  const double diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                (hi[2] - lo[2]) * (hi[2] - lo[2]));
   rep.max_size = params.max_size > 0 ? params.max_size : diag / 20;
   rep.facet_size = params.facet_size > 0 ? params.facet_size : rep.max_size;
   rep.edge_size = params.edge_size > 0 ? params.edge_size : rep.facet_size;
@@ -436,7 +468,8 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
 
   // The time limit: the parent asks `progress` every 100 ms while the child runs; past the deadline
   // it says stop (the child is killed) and the cancellation is reported as the time limit.
-  const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(params.time_limit));
+  const auto deadline =
+      t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(params.time_limit));
   bool timed_out = false;
   const ProgressFn progress = [&](std::string_view stage, double fraction) {
     if (params.time_limit > 0 && Clock::now() >= deadline) {
@@ -462,11 +495,14 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
     if (!timed_out) throw;
     char limit[64];
     std::snprintf(limit, sizeof limit, "%g", params.time_limit);
-    throw MesherError(MesherFailure::time_limit,
-                      std::string("CGAL Mesh_3 did not finish within the time limit of ") + limit +
-                          " s and was stopped. Mesh_3 has no bound of its own on its work: a part much thinner than it is wide "
-                          "(a die attach or solder layer) is sampled at its thickness all over, millions of tets at radius-edge 2. "
-                          "Raise the time limit, or mesh with TetGen (the default mesher), which grades thin layers");
+    throw MesherError(
+        MesherFailure::time_limit,
+        std::string("CGAL Mesh_3 did not finish within the time limit of ") + limit +
+            " s and was stopped. Mesh_3 has no bound of its own on its work: a part much thinner than it is "
+            "wide "
+            "(a die attach or solder layer) is sampled at its thickness all over, millions of tets at "
+            "radius-edge 2. "
+            "Raise the time limit, or mesh with TetGen (the default mesher), which grades thin layers");
   }
   Result r;
   std::size_t at = 0;
@@ -478,12 +514,14 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
   get(bytes, at, r.bface);
   get(bytes, at, r.bface_tag);
   const std::size_t nn = r.weight.size();
-  if (r.relabelled.size() != 1 || r.xyz.size() != 3 * nn || r.tet.size() != 4 * r.tet_region.size() || r.bface.size() != 3 * r.bface_tag.size())
+  if (r.relabelled.size() != 1 || r.xyz.size() != 3 * nn || r.tet.size() != 4 * r.tet_region.size() ||
+      r.bface.size() != 3 * r.bface_tag.size())
     throw MesherError(MesherFailure::internal_error, "CGAL's result is inconsistent");
   for (std::uint32_t v : r.tet)
     if (v >= nn) throw MesherError(MesherFailure::internal_error, "CGAL returned a tet index out of range");
   if (r.tet.empty())
-    throw MesherError(MesherFailure::internal_error, "CGAL Mesh_3 returned no tets (sizes too large for the PLC?)");
+    throw MesherError(MesherFailure::internal_error,
+                      "CGAL Mesh_3 returned no tets (sizes too large for the PLC?)");
 
   Mesh m;
   m.xyz = std::move(r.xyz);
@@ -511,7 +549,9 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
     const double c[3] = {p[3][0] - p[0][0], p[3][1] - p[0][1], p[3][2] - p[0][2]};
     CgalRegionVolume& v = volumes[m.tet_region[t]];
     v.region = m.tet_region[t];
-    v.mesh += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+    v.mesh += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+               a[2] * (b[0] * c[1] - b[1] * c[0])) /
+              6;
   }
   rep.volumes_match = true;
   for (const auto& [id, v] : volumes) {
@@ -524,20 +564,23 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
   // boundary triangles. A surface Mesh_3 did not recover (an interface inside a thin stack) is missing.
   std::map<std::int32_t, std::pair<double, double>> areas;  // marker -> (PLC, mesh)
   auto tri_area = [](const double* a, const double* b, const double* c) {
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     return 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   };
   for (std::size_t t = 0; t < s.tri_facet.size(); ++t)
     if (s.side_cell[2 * t] != s.side_cell[2 * t + 1])
-      areas[plc.facet_marker[s.tri_facet[t]]].first +=
-          tri_area(&s.points[3 * s.tri[3 * t]], &s.points[3 * s.tri[3 * t + 1]], &s.points[3 * s.tri[3 * t + 2]]);
+      areas[plc.facet_marker[s.tri_facet[t]]].first += tri_area(
+          &s.points[3 * s.tri[3 * t]], &s.points[3 * s.tri[3 * t + 1]], &s.points[3 * s.tri[3 * t + 2]]);
   for (std::size_t f = 0; f < m.bface_count(); ++f)
-    areas[m.bface_tag[f]].second += tri_area(&m.xyz[3 * m.bface[3 * f]], &m.xyz[3 * m.bface[3 * f + 1]], &m.xyz[3 * m.bface[3 * f + 2]]);
+    areas[m.bface_tag[f]].second +=
+        tri_area(&m.xyz[3 * m.bface[3 * f]], &m.xyz[3 * m.bface[3 * f + 1]], &m.xyz[3 * m.bface[3 * f + 2]]);
   rep.areas_match = true;
   for (const auto& [marker, a] : areas) {
     const double change = a.first > 0 ? std::abs(a.second / a.first - 1) : (a.second > 0 ? 1.0 : 0.0);
-    if (!(change <= params.volume_tolerance) && (rep.areas_match || change > rep.worst_area_change)) rep.worst_area_marker = marker;
+    if (!(change <= params.volume_tolerance) && (rep.areas_match || change > rep.worst_area_change))
+      rep.worst_area_marker = marker;
     if (!(change <= params.volume_tolerance)) rep.areas_match = false;
     rep.worst_area_change = std::max(rep.worst_area_change, change);
   }

@@ -111,7 +111,8 @@ std::vector<char> run_in_child(const std::function<std::vector<char>()>& work, c
   }
   std::memcpy(&code, reply.data(), sizeof code);
   reply.erase(reply.begin(), reply.begin() + sizeof code);
-  if (code != 0) throw_mesher_error(code, reply.empty() ? what + " failed" : std::string(reply.begin(), reply.end()));
+  if (code != 0)
+    throw_mesher_error(code, reply.empty() ? what + " failed" : std::string(reply.begin(), reply.end()));
   if (WIFSIGNALED(wstatus) || (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) != 0))
     throw MesherError(2, what + "'s result was cut short");
   return reply;

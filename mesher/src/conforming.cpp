@@ -43,8 +43,10 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
   if (conforming.surface_rescue) detail::merge_coplanar_facets(current);
   Mesh mesh;
   const std::vector<ThinLayer> layers =
-      conforming.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 || (params.size_field && !params.size_field->empty()) ||
-                                       std::any_of(plc.regions.begin(), plc.regions.end(), [](const RegionSeed& s) { return s.max_volume > 0; }))
+      conforming.thin_layer_aspect > 0 && (params.radius_edge > 0 || params.max_volume > 0 ||
+                                           (params.size_field && !params.size_field->empty()) ||
+                                           std::any_of(plc.regions.begin(), plc.regions.end(),
+                                                       [](const RegionSeed& s) { return s.max_volume > 0; }))
           ? find_thin_layers(plc, conforming.thin_layer_aspect, conforming.thin_layer_min_area)
           : std::vector<ThinLayer>{};
   RefinementRounds rounds(p, rep);
@@ -58,8 +60,8 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     // TetGen's own refinement answering a round's splits with new violations: the rounds are not
     // settling, and the surface rescue below settles faster from here.
     if (conforming.surface_rescue && it > 0 && rep.violations[it] >= rep.violations[it - 1]) break;
-    const double budget =
-        std::max(conforming.max_added_fraction * double(rep.first_mesh_points), double(conforming.min_added_budget));
+    const double budget = std::max(conforming.max_added_fraction * double(rep.first_mesh_points),
+                                   double(conforming.min_added_budget));
     if (double(rep.added_points) >= budget) break;
     if (params.progress &&
         !params.progress("conforming refinement", double(it + 1) / double(conforming.max_iterations + 1)))
@@ -97,7 +99,8 @@ Mesh mesh_conforming(const Plc& plc, const MeshParams& params, const ConformingP
     rep.radius_edge_bound = params.radius_edge;
     for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
       const std::uint32_t* v = &mesh.tet[4 * t];
-      const TetQuality q = tet_quality(&mesh.xyz[3 * v[0]], &mesh.xyz[3 * v[1]], &mesh.xyz[3 * v[2]], &mesh.xyz[3 * v[3]]);
+      const TetQuality q =
+          tet_quality(&mesh.xyz[3 * v[0]], &mesh.xyz[3 * v[1]], &mesh.xyz[3 * v[2]], &mesh.xyz[3 * v[3]]);
       rep.over_radius_edge += q.radius_edge > params.radius_edge * (1 + 1e-9);
     }
   }

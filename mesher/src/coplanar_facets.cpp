@@ -17,7 +17,9 @@ namespace {
 
 struct Facets {
   const Plc& plc;
-  std::size_t polygon_count(std::size_t f) const { return plc.facet_polygon_begin[f + 1] - plc.facet_polygon_begin[f]; }
+  std::size_t polygon_count(std::size_t f) const {
+    return plc.facet_polygon_begin[f + 1] - plc.facet_polygon_begin[f];
+  }
   std::pair<const std::uint32_t*, std::size_t> polygon(std::size_t g) const {
     const std::uint32_t b = plc.polygon_vertex_begin[g], e = plc.polygon_vertex_begin[g + 1];
     return {plc.polygon_vertices.data() + b, e - b};
@@ -42,7 +44,9 @@ struct Plane {
 // A point strictly inside the simple polygon `loop` (2D coordinates u, w of the 3D points): near its
 // leftmost vertex, which is convex.
 Vec inside_point(const Plc& plc, const std::vector<std::uint32_t>& loop, std::size_t u, std::size_t w) {
-  auto p2 = [&](std::uint32_t v) { return std::array<double, 2>{plc.points[3 * v + u], plc.points[3 * v + w]}; };
+  auto p2 = [&](std::uint32_t v) {
+    return std::array<double, 2>{plc.points[3 * v + u], plc.points[3 * v + w]};
+  };
   const std::size_t n = loop.size();
   std::size_t i = 0;
   for (std::size_t k = 1; k < n; ++k) {
@@ -51,7 +55,8 @@ Vec inside_point(const Plc& plc, const std::vector<std::uint32_t>& loop, std::si
   }
   const std::uint32_t va = loop[(i + n - 1) % n], vv = loop[i], vb = loop[(i + 1) % n];
   const auto A = p2(va), V = p2(vv), B = p2(vb);
-  auto orient = [](const std::array<double, 2>& p, const std::array<double, 2>& q, const std::array<double, 2>& r) {
+  auto orient = [](const std::array<double, 2>& p, const std::array<double, 2>& q,
+                   const std::array<double, 2>& r) {
     return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
   };
   const double s = orient(A, V, B) > 0 ? 1 : -1;
@@ -118,7 +123,9 @@ CoplanarMerge merge_coplanar_facets(Plc& plc, double relative_tol) {
   for (std::size_t f = 0; f < nf; ++f) {
     if (!segment_facet[f]) continue;
     bool redundant = true;
-    F.for_each_edge(f, [&](std::uint32_t a, std::uint32_t b) { redundant = redundant && polygon_edges.count(edge_key(a, b)); });
+    F.for_each_edge(f, [&](std::uint32_t a, std::uint32_t b) {
+      redundant = redundant && polygon_edges.count(edge_key(a, b));
+    });
     if (redundant) {
       keep[f] = 0;
       ++out.segment_facets_dropped;
@@ -185,7 +192,8 @@ CoplanarMerge merge_coplanar_facets(Plc& plc, double relative_tol) {
     std::vector<std::uint32_t> group{root};
     group.insert(group.end(), rest.begin(), rest.end());
     std::unordered_map<std::uint64_t, int> count;
-    for (std::uint32_t f : group) F.for_each_edge(f, [&](std::uint32_t a, std::uint32_t b) { ++count[edge_key(a, b)]; });
+    for (std::uint32_t f : group)
+      F.for_each_edge(f, [&](std::uint32_t a, std::uint32_t b) { ++count[edge_key(a, b)]; });
     std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> next;
     bool simple = true;
     MergedFacet m;
@@ -288,7 +296,8 @@ CoplanarMerge merge_coplanar_facets(Plc& plc, double relative_tol) {
         const auto [v, n] = F.polygon(g);
         add_polygon(v, n);
       }
-      next.facet_holes.insert(next.facet_holes.end(), plc.facet_holes.begin() + 3 * std::ptrdiff_t(plc.facet_hole_begin[f]),
+      next.facet_holes.insert(next.facet_holes.end(),
+                              plc.facet_holes.begin() + 3 * std::ptrdiff_t(plc.facet_hole_begin[f]),
                               plc.facet_holes.begin() + 3 * std::ptrdiff_t(plc.facet_hole_begin[f + 1]));
     }
     next.facet_polygon_begin.push_back(static_cast<std::uint32_t>(next.polygon_vertex_begin.size() - 1));

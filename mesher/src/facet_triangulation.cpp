@@ -40,11 +40,13 @@ std::size_t triangulate_facets(Plc& plc) {
   };
   auto copy_facet = [&](std::size_t f) {
     for (std::uint32_t g = plc.facet_polygon_begin[f]; g < plc.facet_polygon_begin[f + 1]; ++g) {
-      out.polygon_vertices.insert(out.polygon_vertices.end(), plc.polygon_vertices.begin() + plc.polygon_vertex_begin[g],
+      out.polygon_vertices.insert(out.polygon_vertices.end(),
+                                  plc.polygon_vertices.begin() + plc.polygon_vertex_begin[g],
                                   plc.polygon_vertices.begin() + plc.polygon_vertex_begin[g + 1]);
       out.polygon_vertex_begin.push_back(static_cast<std::uint32_t>(out.polygon_vertices.size()));
     }
-    out.facet_holes.insert(out.facet_holes.end(), plc.facet_holes.begin() + 3 * std::ptrdiff_t(plc.facet_hole_begin[f]),
+    out.facet_holes.insert(out.facet_holes.end(),
+                           plc.facet_holes.begin() + 3 * std::ptrdiff_t(plc.facet_hole_begin[f]),
                            plc.facet_holes.begin() + 3 * std::ptrdiff_t(plc.facet_hole_begin[f + 1]));
     close_facet(plc.facet_marker[f]);
   };
@@ -52,7 +54,8 @@ std::size_t triangulate_facets(Plc& plc) {
     const std::uint32_t g0 = plc.facet_polygon_begin[f], g1 = plc.facet_polygon_begin[f + 1];
     const bool plain = g1 == g0 + 1 && plc.polygon_vertex_begin[g0 + 1] - plc.polygon_vertex_begin[g0] == 3;
     bool area = false;
-    for (std::uint32_t g = g0; g < g1; ++g) area = area || plc.polygon_vertex_begin[g + 1] - plc.polygon_vertex_begin[g] >= 3;
+    for (std::uint32_t g = g0; g < g1; ++g)
+      area = area || plc.polygon_vertex_begin[g + 1] - plc.polygon_vertex_begin[g] >= 3;
     if (plain || !area) {
       copy_facet(f);
       continue;

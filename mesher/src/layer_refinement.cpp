@@ -93,10 +93,12 @@ class TetLocator {
   bool in_tet(std::uint32_t t, const Vec& p) const {
     const std::uint32_t* v = &mesh_.tet[4 * std::size_t(t)];
     const Vec d = at(mesh_.xyz, v[3]);
-    const Vec a = sub(at(mesh_.xyz, v[0]), d), b = sub(at(mesh_.xyz, v[1]), d), c = sub(at(mesh_.xyz, v[2]), d), q = sub(p, d);
+    const Vec a = sub(at(mesh_.xyz, v[0]), d), b = sub(at(mesh_.xyz, v[1]), d),
+              c = sub(at(mesh_.xyz, v[2]), d), q = sub(p, d);
     const double det = dot(a, cross(b, c));
     if (!(std::abs(det) > 0)) return false;
-    const double l0 = dot(q, cross(b, c)) / det, l1 = dot(a, cross(q, c)) / det, l2 = dot(a, cross(b, q)) / det;
+    const double l0 = dot(q, cross(b, c)) / det, l1 = dot(a, cross(q, c)) / det,
+                 l2 = dot(a, cross(b, q)) / det;
     const double eps = -1e-12;
     return l0 >= eps && l1 >= eps && l2 >= eps && 1 - l0 - l1 - l2 >= eps;
   }
@@ -109,7 +111,8 @@ class TetLocator {
 bool dihedral_below(const Vec& a0, const Vec& b0, const Vec& c0, const Vec& d, double cos_min) {
   const Vec a = sub(a0, d), b = sub(b0, d), c = sub(c0, d);
   // Gradients of the barycentric coordinates (up to the common factor 1/det).
-  const Vec g[4] = {cross(b, c), cross(c, a), cross(a, b), scale(add(add(cross(b, c), cross(c, a)), cross(a, b)), -1.0)};
+  const Vec g[4] = {cross(b, c), cross(c, a), cross(a, b),
+                    scale(add(add(cross(b, c), cross(c, a)), cross(a, b)), -1.0)};
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j)
       if (-dot(g[i], g[j]) > cos_min * std::sqrt(norm2(g[i]) * norm2(g[j]))) return true;
@@ -117,7 +120,8 @@ bool dihedral_below(const Vec& a0, const Vec& b0, const Vec& c0, const Vec& d, d
 }
 
 bool all_in(const ThinLayer& l, const Vec (&x)[4]) {
-  return l.contains(x[0].data()) && l.contains(x[1].data()) && l.contains(x[2].data()) && l.contains(x[3].data());
+  return l.contains(x[0].data()) && l.contains(x[1].data()) && l.contains(x[2].data()) &&
+         l.contains(x[3].data());
 }
 
 }  // namespace
@@ -182,14 +186,16 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
         over = h > 0 && (in_layer[t] ? longest2 : b.r2) > h * h;
       }
       if (!over && !in_layer[t])
-        over = (q2 > 0 && b.r2 > q2 * shortest2) || (cos_min >= -1 && dihedral_below(x[0], x[1], x[2], x[3], cos_min));
+        over = (q2 > 0 && b.r2 > q2 * shortest2) ||
+               (cos_min >= -1 && dihedral_below(x[0], x[1], x[2], x[3], cos_min));
       if (over) bad.push_back({b.r2, static_cast<std::uint32_t>(t)});
     }
     rep.quality_unmet = 0;
     for (const auto& [r2, t] : bad) rep.quality_unmet += !in_layer[t];
     if ((cert.delaunay && bad.empty()) || it >= conforming.max_layer_iterations) break;
-    if (params.progress && !params.progress(first_mesh ? "conforming refinement" : "refinement around thin layers",
-                                            double(it + 1) / double(conforming.max_layer_iterations + 1)))
+    if (params.progress &&
+        !params.progress(first_mesh ? "conforming refinement" : "refinement around thin layers",
+                         double(it + 1) / double(conforming.max_layer_iterations + 1)))
       throw MesherCancelled("meshing cancelled");
 
     const MeshSearch search(mesh);

@@ -24,7 +24,9 @@ std::string tet_limit_reason(double estimate, double limit) {
 }  // namespace
 
 TetLimitError::TetLimitError(const std::string& file, double estimate, double limit)
-    : IoError(file, 0, IoError::kNoOffset, tet_limit_reason(estimate, limit)), estimate_(estimate), limit_(limit) {}
+    : IoError(file, 0, IoError::kNoOffset, tet_limit_reason(estimate, limit)),
+      estimate_(estimate),
+      limit_(limit) {}
 
 void check_tet_estimate(const std::string& file, const Plc& plc, const MeshParams& params,
                         std::span<const double> region_volume, double max_tets) {

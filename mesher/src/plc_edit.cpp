@@ -8,7 +8,8 @@ namespace {
 
 double polygon_area2(const EditablePlc& e, const std::vector<std::uint32_t>& poly) {
   Vec n{0, 0, 0};
-  for (std::size_t i = 0; i < poly.size(); ++i) n = add(n, cross(e.point(poly[i]), e.point(poly[(i + 1) % poly.size()])));
+  for (std::size_t i = 0; i < poly.size(); ++i)
+    n = add(n, cross(e.point(poly[i]), e.point(poly[(i + 1) % poly.size()])));
   return norm2(n);
 }
 
@@ -106,7 +107,8 @@ MeshSearch::MeshSearch(const Mesh& m) : mesh(m), vertices(m.xyz, used_vertices(m
   const std::size_t nf = m.bface_count();
   face_ball.resize(nf);
   for (std::size_t f = 0; f < nf; ++f)
-    face_ball[f] = triangle_ball(at(m.xyz, m.bface[3 * f]), at(m.xyz, m.bface[3 * f + 1]), at(m.xyz, m.bface[3 * f + 2]));
+    face_ball[f] = triangle_ball(at(m.xyz, m.bface[3 * f]), at(m.xyz, m.bface[3 * f + 1]),
+                                 at(m.xyz, m.bface[3 * f + 2]));
   // Each triangle goes into the cells its ball's box covers; balls covering very many cells are
   // checked for every query instead.
   const std::size_t cells = vertices.dim[0] * vertices.dim[1] * vertices.dim[2];
@@ -114,8 +116,10 @@ MeshSearch::MeshSearch(const Mesh& m) : mesh(m), vertices(m.xyz, used_vertices(m
   auto cover = [&](std::uint32_t f, auto&& visit) {
     const Ball& b = face_ball[f];
     const double r = std::sqrt(b.r2);
-    const std::array<std::size_t, 3> lo{vertices.coord(b.c[0] - r, 0), vertices.coord(b.c[1] - r, 1), vertices.coord(b.c[2] - r, 2)};
-    const std::array<std::size_t, 3> hi{vertices.coord(b.c[0] + r, 0), vertices.coord(b.c[1] + r, 1), vertices.coord(b.c[2] + r, 2)};
+    const std::array<std::size_t, 3> lo{vertices.coord(b.c[0] - r, 0), vertices.coord(b.c[1] - r, 1),
+                                        vertices.coord(b.c[2] - r, 2)};
+    const std::array<std::size_t, 3> hi{vertices.coord(b.c[0] + r, 0), vertices.coord(b.c[1] + r, 1),
+                                        vertices.coord(b.c[2] + r, 2)};
     if ((hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1) > 512) return false;
     for (std::size_t z = lo[2]; z <= hi[2]; ++z)
       for (std::size_t y = lo[1]; y <= hi[1]; ++y)
@@ -143,7 +147,8 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
   for (std::uint32_t t : violating_tets) {
     if (t >= mesh.tet_count()) continue;
     const std::uint32_t* tv = &mesh.tet[4 * std::size_t(t)];
-    const Ball b = tet_ball(at(mesh.xyz, tv[0]), at(mesh.xyz, tv[1]), at(mesh.xyz, tv[2]), at(mesh.xyz, tv[3]));
+    const Ball b =
+        tet_ball(at(mesh.xyz, tv[0]), at(mesh.xyz, tv[1]), at(mesh.xyz, tv[2]), at(mesh.xyz, tv[3]));
     if (b.r2 < 0) continue;
     const double r = std::sqrt(b.r2);
     // The vertices inside; the certificate is exact, so if rounding hides them take the deepest one.
@@ -172,7 +177,9 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
         }
       });
     if (marked > 0) continue;
-    const Vec centroid = scale(add(add(at(mesh.xyz, tv[0]), at(mesh.xyz, tv[1])), add(at(mesh.xyz, tv[2]), at(mesh.xyz, tv[3]))), 0.25);
+    const Vec centroid = scale(
+        add(add(at(mesh.xyz, tv[0]), at(mesh.xyz, tv[1])), add(at(mesh.xyz, tv[2]), at(mesh.xyz, tv[3]))),
+        0.25);
     for (std::uint32_t q : inside)
       search.for_each_face_crossed(centroid, at(mesh.xyz, q), [&](std::uint32_t f) {
         const std::uint32_t* fv = &mesh.bface[3 * std::size_t(f)];
@@ -224,7 +231,8 @@ std::size_t snap_coordinates(Plc& plc, double relative_tol) {
   for (std::size_t k = 0; k < 3; ++k) {
     auto value = [&](std::uint32_t i) { return plc.points[3 * i + k]; };
     for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return value(a) < value(b); });
+    std::sort(order.begin(), order.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return value(a) < value(b); });
     const double tol = relative_tol * (std::abs(value(order.front())) + std::abs(value(order.back())) +
                                        (value(order.back()) - value(order.front())));
     // Clusters no wider than tol (no chaining along a dense run); the most common value wins.
@@ -267,7 +275,8 @@ std::size_t weld_coincident_points(Plc& plc, double relative_tol) {
   const double tol = relative_tol * std::sqrt(norm2(sub(hi, lo)));
   std::vector<std::uint32_t> order(n), target(n);
   for (std::uint32_t i = 0; i < n; ++i) order[i] = target[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return plc.points[3 * a] < plc.points[3 * b]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return plc.points[3 * a] < plc.points[3 * b]; });
   std::size_t merged = 0;
   for (std::size_t a = 0; a < n; ++a) {
     const std::uint32_t i = order[a];
@@ -291,7 +300,8 @@ std::size_t weld_coincident_points(Plc& plc, double relative_tol) {
   for (std::uint32_t i = 0; i < n; ++i)
     if (target[i] == i) {
       renumber[i] = static_cast<std::uint32_t>(kept.size() / 3);
-      kept.insert(kept.end(), plc.points.begin() + 3 * std::ptrdiff_t(i), plc.points.begin() + 3 * std::ptrdiff_t(i) + 3);
+      kept.insert(kept.end(), plc.points.begin() + 3 * std::ptrdiff_t(i),
+                  plc.points.begin() + 3 * std::ptrdiff_t(i) + 3);
     }
   for (std::uint32_t i = 0; i < n; ++i) target[i] = renumber[target[i]];
   plc.points = std::move(kept);
@@ -316,8 +326,9 @@ std::map<std::int32_t, double> region_volumes(const Mesh& mesh) {
   for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
     const std::uint32_t* n = &mesh.tet[4 * t];
     const Vec a = at(mesh.xyz, n[0]);
-    v[mesh.region_of(t)] +=
-        std::abs(dot(sub(at(mesh.xyz, n[1]), a), cross(sub(at(mesh.xyz, n[2]), a), sub(at(mesh.xyz, n[3]), a)))) / 6;
+    v[mesh.region_of(t)] += std::abs(dot(sub(at(mesh.xyz, n[1]), a),
+                                         cross(sub(at(mesh.xyz, n[2]), a), sub(at(mesh.xyz, n[3]), a)))) /
+                            6;
   }
   return v;
 }
@@ -332,8 +343,8 @@ bool same_region_volumes(const std::map<std::int32_t, double>& a, const std::map
 }
 
 bool NearPoints::near(const Vec& p, double r) const {
-  const std::int64_t x0 = cell_of(p[0] - r), x1 = cell_of(p[0] + r), y0 = cell_of(p[1] - r), y1 = cell_of(p[1] + r),
-                     z0 = cell_of(p[2] - r), z1 = cell_of(p[2] + r);
+  const std::int64_t x0 = cell_of(p[0] - r), x1 = cell_of(p[0] + r), y0 = cell_of(p[1] - r),
+                     y1 = cell_of(p[1] + r), z0 = cell_of(p[2] - r), z1 = cell_of(p[2] + r);
   const std::int64_t span = std::max({x1 - x0, y1 - y0, z1 - z0}) + 1;
   if (span > 16) {  // a huge ball: look at every point
     for (const auto& kv : cells_)
@@ -369,7 +380,8 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
   std::vector<std::uint32_t> order;
   for (std::uint32_t f = 0; f < split.size(); ++f)
     if (split[f]) order.push_back(f);
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return face_ball[a].r2 > face_ball[b].r2; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return face_ball[a].r2 > face_ball[b].r2; });
   for (std::uint32_t f : order) {
     const std::uint32_t* fv = &mesh.bface[3 * f];
     const Vec p[3] = {at(mesh.xyz, fv[0]), at(mesh.xyz, fv[1]), at(mesh.xyz, fv[2])};
@@ -389,8 +401,7 @@ std::size_t split_faces(const Mesh& mesh, const std::vector<Ball>& face_ball, co
       if (edit.surface) {
         a = fv[e];
         b = fv[(e + 1) % 3];
-        if (!edit.edge_facets.count(edge_key(a, b)) && !edit.split_at.count(edge_key(a, b)))
-          continue;
+        if (!edit.edge_facets.count(edge_key(a, b)) && !edit.split_at.count(edge_key(a, b))) continue;
       } else if (!edit.find_segment(u, v, a, b)) {
         continue;
       }

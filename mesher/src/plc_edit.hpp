@@ -19,7 +19,9 @@
 namespace foxi::detail {
 
 using Vec = Vec3;  // sub, add, scale, dot, cross, norm2: foxi/model/vec3.hpp
-inline Vec at(const std::vector<double>& xyz, std::uint32_t i) { return {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; }
+inline Vec at(const std::vector<double>& xyz, std::uint32_t i) {
+  return {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+}
 
 // An undirected edge as one integer (the smaller index in the high half).
 inline std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
@@ -29,7 +31,8 @@ inline std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
 
 // Adds the Newell normal of the closed polygon v[0..n) (twice its vector area; no need to choose
 // three vertices) to `normal`.
-inline void add_newell_normal(const std::vector<double>& xyz, const std::uint32_t* v, std::size_t n, Vec& normal) {
+inline void add_newell_normal(const std::vector<double>& xyz, const std::uint32_t* v, std::size_t n,
+                              Vec& normal) {
   for (std::size_t i = 0; i < n; ++i) {
     const Vec a = at(xyz, v[i]), b = at(xyz, v[i + 1 < n ? i + 1 : 0]);
     normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
@@ -48,7 +51,8 @@ inline Ball tet_ball(const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p3)
   const Vec a = sub(p1, p0), b = sub(p2, p0), c = sub(p3, p0);
   const double det = dot(a, cross(b, c));
   if (!(std::abs(det) > 0)) return {};
-  const Vec num = add(add(scale(cross(b, c), norm2(a)), scale(cross(c, a), norm2(b))), scale(cross(a, b), norm2(c)));
+  const Vec num =
+      add(add(scale(cross(b, c), norm2(a)), scale(cross(c, a), norm2(b))), scale(cross(a, b), norm2(c)));
   const Vec off = scale(num, 0.5 / det);
   return {add(p0, off), norm2(off)};
 }
@@ -70,7 +74,9 @@ struct PointGrid {
   std::array<std::size_t, 3> dim{1, 1, 1};
   std::vector<std::uint32_t> begin, items;
 
-  std::size_t index(const std::array<std::size_t, 3>& c) const { return (c[2] * dim[1] + c[1]) * dim[0] + c[0]; }
+  std::size_t index(const std::array<std::size_t, 3>& c) const {
+    return (c[2] * dim[1] + c[1]) * dim[0] + c[0];
+  }
   std::size_t coord(double v, int axis) const {
     const double k = std::floor((v - lo[std::size_t(axis)]) / cell);
     if (!(k > 0)) return 0;
@@ -88,8 +94,8 @@ struct PointGrid {
       }
     const Vec ext = sub(hi, lo);
     const double vol = std::max(ext[0], 1e-300) * std::max(ext[1], 1e-300) * std::max(ext[2], 1e-300);
-    cell = std::max({std::cbrt(vol / double(std::max<std::size_t>(vertices.size(), 1))), ext[0] / 256, ext[1] / 256,
-                     ext[2] / 256, 1e-300});
+    cell = std::max({std::cbrt(vol / double(std::max<std::size_t>(vertices.size(), 1))), ext[0] / 256,
+                     ext[1] / 256, ext[2] / 256, 1e-300});
     for (int k = 0; k < 3; ++k) dim[std::size_t(k)] = std::size_t(ext[std::size_t(k)] / cell) + 1;
     begin.assign(dim[0] * dim[1] * dim[2] + 1, 0);
     std::vector<std::size_t> slot(vertices.size());
@@ -135,14 +141,14 @@ inline Vec onto_layer_plane(const ThinLayer& l, const Vec& p, double level) {
 struct EditablePlc {
   Plc& plc;
   std::vector<std::vector<std::vector<std::uint32_t>>> facets;  // facet -> polygons (2+ vertices) -> vertices
-  std::vector<std::vector<std::uint32_t>> facet_points;         // facet -> its lone vertices (1-vertex polygons)
-  double tol = 0;                                               // "on a segment / plane", metres
+  std::vector<std::vector<std::uint32_t>> facet_points;  // facet -> its lone vertices (1-vertex polygons)
+  double tol = 0;                                        // "on a segment / plane", metres
   // Surface mode (index_surface()): the PLC is a mesh's surface (surface_plc), facet f is the mesh's
   // boundary triangle f and PLC point i its vertex i, and edges are found through these maps instead
   // of by scanning every facet, which is quadratic on a surface of 10^5 triangles.
   bool surface = false;
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> edge_facets;  // polygon edge -> facets
-  std::unordered_map<std::uint64_t, std::uint32_t> split_at;                   // split edge -> its new point
+  std::unordered_map<std::uint64_t, std::uint32_t> split_at;                  // split edge -> its new point
 
   void index_surface() {
     surface = true;
@@ -276,8 +282,6 @@ struct EditablePlc {
     }
   }
 
-
-
   // A new facet holding the single segment (a, b).
   void add_segment_facet(std::uint32_t a, std::uint32_t b, std::int32_t marker) {
     facets.push_back({{a, b}});
@@ -293,7 +297,6 @@ struct EditablePlc {
       if (plc.facet_marker[f] == marker && in_facet(f, p0, p1, p2, centroid)) return f;
     return facets.size();
   }
-
 
   // Whether p lies in the plane of the polygon and inside it (the triangle p0 p1 p2 gives the plane).
   bool in_polygon(const std::vector<std::uint32_t>& poly, const Vec& p0, const Vec& p1, const Vec& p2,
@@ -323,10 +326,10 @@ struct EditablePlc {
   // hole point). The triangle p0 p1 p2 gives the plane.
   bool in_facet(std::size_t f, const Vec& p0, const Vec& p1, const Vec& p2, const Vec& p) const;
 
-
   // The edge (a, b) of one of facet f's polygons nearest to p, if closer than `within` and p projects
   // inside it.
-  bool nearest_facet_edge(std::size_t f, const Vec& p, double within, std::uint32_t& a, std::uint32_t& b) const;
+  bool nearest_facet_edge(std::size_t f, const Vec& p, double within, std::uint32_t& a,
+                          std::uint32_t& b) const;
   // The facet whose plane and polygons hold p, or facets.size().
   std::size_t facet_at(const Vec& p) const;
   // Adds p to the PLC segment that holds it (splitting that segment in every polygon) or else, as a
@@ -399,7 +402,8 @@ struct MeshSearch {
     std::vector<std::size_t> cells;
     for (std::size_t i = 0; i <= steps; ++i) {
       const Vec x = add(p, scale(sub(q, p), double(i) / double(steps)));
-      const std::array<std::size_t, 3> c{vertices.coord(x[0], 0), vertices.coord(x[1], 1), vertices.coord(x[2], 2)};
+      const std::array<std::size_t, 3> c{vertices.coord(x[0], 0), vertices.coord(x[1], 1),
+                                         vertices.coord(x[2], 2)};
       for (std::size_t dz = 0; dz < 3; ++dz)
         for (std::size_t dy = 0; dy < 3; ++dy)
           for (std::size_t dx = 0; dx < 3; ++dx) {
@@ -427,7 +431,8 @@ struct MeshSearch {
       if (b.r2 > 0 && norm2(sub(p, b.c)) < b.r2 * (1 - 1e-12)) f(face);
     };
     for (std::uint32_t face : big_faces_) test(face);
-    const std::size_t cell = vertices.index({vertices.coord(p[0], 0), vertices.coord(p[1], 1), vertices.coord(p[2], 2)});
+    const std::size_t cell =
+        vertices.index({vertices.coord(p[0], 0), vertices.coord(p[1], 1), vertices.coord(p[2], 2)});
     for (std::uint32_t k = face_begin_[cell]; k < face_begin_[cell + 1]; ++k) test(face_items_[k]);
   }
 
@@ -448,9 +453,9 @@ void mark_faces_for_violations(const MeshSearch& search, const std::vector<std::
 
 // Merges PLC points closer than `relative_tol` times the PLC's bounding-box diagonal (a builder may
 // emit one corner twice for two parts). The merged copies are removed (points renumbered in order);
-// polygons are remapped and lose repeated consecutive vertices. A segment split by the refinement must be one segment for every
-// polygon that has it, which index-based splitting only sees when shared corners are one point.
-// Returns the number of points merged.
+// polygons are remapped and lose repeated consecutive vertices. A segment split by the refinement must be one
+// segment for every polygon that has it, which index-based splitting only sees when shared corners are one
+// point. Returns the number of points merged.
 std::size_t weld_coincident_points(Plc& plc, double relative_tol = 1e-12);
 
 // The mesh's constraint triangles as a PLC: every mesh vertex a point, every boundary/interface

@@ -25,20 +25,26 @@ using Point = K::Point_3;
 using Vec = K::Vector_3;
 using Proj = CGAL::Projection_traits_3<K>;
 using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::uint32_t, Proj>;
-using Fb = CGAL::Constrained_triangulation_face_base_2<Proj, CGAL::Triangulation_face_base_with_info_2<int, Proj>>;
+using Fb =
+    CGAL::Constrained_triangulation_face_base_2<Proj, CGAL::Triangulation_face_base_with_info_2<int, Proj>>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 // Crossing constraints would need new points: a PLC whose facet edges cross is rejected.
-using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Proj, Tds, CGAL::No_constraint_intersection_requiring_constructions_tag>;
+using Cdt =
+    CGAL::Constrained_Delaunay_triangulation_2<Proj, Tds,
+                                               CGAL::No_constraint_intersection_requiring_constructions_tag>;
 
 constexpr std::uint32_t kNoTri = 0xffffffffu;
 
 [[noreturn]] void reject(const std::string& why) { throw MesherError(10, why); }
 
-Point point(const std::vector<double>& xyz, std::uint32_t i) { return Point(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]); }
+Point point(const std::vector<double>& xyz, std::uint32_t i) {
+  return Point(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+}
 
 // A facet's polygons (point ids after merging duplicates), their edges split at every PLC point lying
 // strictly inside them, so that facets meeting at a T-junction share edges.
-std::vector<std::vector<std::uint32_t>> split_polygons(const Plc& plc, std::size_t f, const std::vector<std::uint32_t>& id,
+std::vector<std::vector<std::uint32_t>> split_polygons(const Plc& plc, std::size_t f,
+                                                       const std::vector<std::uint32_t>& id,
                                                        const std::vector<double>& xyz) {
   std::vector<std::vector<std::uint32_t>> out;
   const std::size_t n_points = xyz.size() / 3;
@@ -79,9 +85,11 @@ void triangulate_facet(const Plc& plc, std::size_t f, const std::vector<std::uin
     if (poly.size() < 3) continue;
     for (std::size_t i = 0; i < poly.size(); ++i) {
       const Point a = point(s.points, poly[i]), b = point(s.points, poly[(i + 1) % poly.size()]);
-      normal = normal + Vec((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()), (a.x() - b.x()) * (a.y() + b.y()));
+      normal = normal + Vec((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()),
+                            (a.x() - b.x()) * (a.y() + b.y()));
     }
-    if (normal.squared_length() > 0) break;  // the first polygon with an area fixes the plane; the others lie in it
+    if (normal.squared_length() > 0)
+      break;  // the first polygon with an area fixes the plane; the others lie in it
   }
   if (normal.squared_length() == 0) {
     // A polygon whose points are not all on one line but whose signed area is zero crosses itself.
@@ -140,9 +148,9 @@ void triangulate_facet(const Plc& plc, std::size_t f, const std::vector<std::uin
   }
 }
 
-
 Vec tri_normal(const PlcSurface& s, std::size_t t) {
-  const Point a = point(s.points, s.tri[3 * t]), b = point(s.points, s.tri[3 * t + 1]), c = point(s.points, s.tri[3 * t + 2]);
+  const Point a = point(s.points, s.tri[3 * t]), b = point(s.points, s.tri[3 * t + 1]),
+              c = point(s.points, s.tri[3 * t + 2]);
   return CGAL::cross_product(b - a, c - a);
 }
 
@@ -158,7 +166,8 @@ void join_sides_around_edges(const PlcSurface& s, UnionFind& uf) {
       edge_tris[a << 32 | b].push_back(t);
     }
   for (const auto& [key, tris] : edge_tris) {
-    const std::uint32_t u = static_cast<std::uint32_t>(key >> 32), v = static_cast<std::uint32_t>(key & 0xffffffffu);
+    const std::uint32_t u = static_cast<std::uint32_t>(key >> 32),
+                        v = static_cast<std::uint32_t>(key & 0xffffffffu);
     const Point pu = point(s.points, u);
     const Vec e = point(s.points, v) - pu;
     // An orthonormal frame (x, y) of the plane normal to the edge.
@@ -179,9 +188,11 @@ void join_sides_around_edges(const PlcSurface& s, UnionFind& uf) {
         if (s.tri[3 * t + i] != u && s.tri[3 * t + i] != v) w = s.tri[3 * t + i];
       const Vec r = point(s.points, w) - pu;
       const bool front_increasing = tri_normal(s, t) * CGAL::cross_product(e, r) > 0;
-      around.push_back({std::atan2(r * y, r * x), front_increasing ? 2 * t : 2 * t + 1, front_increasing ? 2 * t + 1 : 2 * t});
+      around.push_back({std::atan2(r * y, r * x), front_increasing ? 2 * t : 2 * t + 1,
+                        front_increasing ? 2 * t + 1 : 2 * t});
     }
-    std::sort(around.begin(), around.end(), [](const Around& a, const Around& b) { return a.angle < b.angle; });
+    std::sort(around.begin(), around.end(),
+              [](const Around& a, const Around& b) { return a.angle < b.angle; });
     for (std::size_t i = 0; i < around.size(); ++i)
       uf.unite(around[i].toward_increasing, around[(i + 1) % around.size()].toward_decreasing);
   }
@@ -199,7 +210,8 @@ RayHit shoot(const PlcSurface& s, const Point& origin, const Vec& dir, std::uint
   const std::size_t nt = s.tri.size() / 3;
   for (std::uint32_t t = 0; t < nt; ++t) {
     if (t == skip_tri) continue;
-    const Point a = point(s.points, s.tri[3 * t]), b = point(s.points, s.tri[3 * t + 1]), c = point(s.points, s.tri[3 * t + 2]);
+    const Point a = point(s.points, s.tri[3 * t]), b = point(s.points, s.tri[3 * t + 1]),
+                c = point(s.points, s.tri[3 * t + 2]);
     const Vec e1 = b - a, e2 = c - a, pv = CGAL::cross_product(dir, e2);
     const double det = e1 * pv;
     const double scale = std::sqrt(e1.squared_length() * pv.squared_length());
@@ -223,7 +235,8 @@ RayHit shoot(const PlcSurface& s, const Point& origin, const Vec& dir, std::uint
 const std::array<Vec, 4> kGeneric = {Vec(0.5773, 0.6180, 0.5345), Vec(-0.3217, 0.8123, 0.4866),
                                      Vec(0.7071, -0.1234, 0.6962), Vec(-0.4142, -0.5176, 0.7483)};
 
-RayHit shoot_generic(const PlcSurface& s, const Point& origin, const Vec& base, std::uint32_t skip_tri, double tol) {
+RayHit shoot_generic(const PlcSurface& s, const Point& origin, const Vec& base, std::uint32_t skip_tri,
+                     double tol) {
   RayHit h;
   for (const Vec& g : kGeneric) {
     h = shoot(s, origin, base + 0.1 * g, skip_tri, tol);
@@ -245,15 +258,18 @@ PlcSurface plc_surface(const Plc& plc) {
     id[i] = it->second;
   }
   for (std::uint32_t v : plc.polygon_vertices)
-    if (v >= plc.point_count()) reject("a facet names point " + std::to_string(v + 1) + " of " + std::to_string(plc.point_count()));
+    if (v >= plc.point_count())
+      reject("a facet names point " + std::to_string(v + 1) + " of " + std::to_string(plc.point_count()));
   for (std::size_t f = 0; f < plc.facet_count(); ++f) triangulate_facet(plc, f, id, s);
   const std::size_t nt = s.tri.size() / 3;
   if (nt == 0) reject("the PLC has no facet with an area");
 
   CGAL::Bbox_3 box;
-  for (std::size_t i = 0; i < s.points.size() / 3; ++i) box += point(s.points, static_cast<std::uint32_t>(i)).bbox();
-  const double diag = std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
-                                CGAL::square(box.zmax() - box.zmin()));
+  for (std::size_t i = 0; i < s.points.size() / 3; ++i)
+    box += point(s.points, static_cast<std::uint32_t>(i)).bbox();
+  const double diag =
+      std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
+                CGAL::square(box.zmax() - box.zmin()));
   const double tol = 1e-9 * diag;
 
   const std::uint32_t outside = static_cast<std::uint32_t>(2 * nt);
@@ -265,14 +281,16 @@ PlcSurface plc_surface(const Plc& plc) {
     if (uf.find(side) == side) shells.push_back(side);
   for (std::uint32_t side : shells) {
     const std::uint32_t t = side / 2;
-    const Point c = CGAL::centroid(point(s.points, s.tri[3 * t]), point(s.points, s.tri[3 * t + 1]), point(s.points, s.tri[3 * t + 2]));
+    const Point c = CGAL::centroid(point(s.points, s.tri[3 * t]), point(s.points, s.tri[3 * t + 1]),
+                                   point(s.points, s.tri[3 * t + 2]));
     Vec n = tri_normal(s, t);
     n = n / std::sqrt(n.squared_length());
     const RayHit h = shoot_generic(s, c, side % 2 == 0 ? n : -n, t, tol);
     uf.unite(side, h.hit ? h.side : outside);
   }
   for (std::size_t i = 0; i < plc.holes.size() / 3; ++i) {
-    const RayHit h = shoot_generic(s, point(plc.holes, static_cast<std::uint32_t>(i)), Vec(0, 0, 0), kNoTri, tol);
+    const RayHit h =
+        shoot_generic(s, point(plc.holes, static_cast<std::uint32_t>(i)), Vec(0, 0, 0), kNoTri, tol);
     if (h.hit) uf.unite(h.side, outside);
   }
   std::vector<std::uint32_t> cell_of_root(2 * nt + 1, kNoTri);
@@ -288,12 +306,15 @@ PlcSurface plc_surface(const Plc& plc) {
   std::vector<bool> seeded(s.cell_count, false);
   for (std::size_t k = 0; k < plc.regions.size(); ++k) {
     const RegionSeed& seed = plc.regions[k];
-    const RayHit h = shoot_generic(s, Point(seed.point[0], seed.point[1], seed.point[2]), Vec(0, 0, 0), kNoTri, tol);
-    const std::string name = "region seed " + std::to_string(k + 1) + " (region " + std::to_string(seed.id) + ")";
+    const RayHit h =
+        shoot_generic(s, Point(seed.point[0], seed.point[1], seed.point[2]), Vec(0, 0, 0), kNoTri, tol);
+    const std::string name =
+        "region seed " + std::to_string(k + 1) + " (region " + std::to_string(seed.id) + ")";
     if (!h.hit) reject(name + " lies outside every closed surface of the PLC");
     if (h.distance <= tol) reject(name + " lies on a facet");
     const std::uint32_t c = s.side_cell[h.side];
-    if (c == PlcSurface::kOutside || seeded[c]) continue;  // in a volume hole, or a second seed: the first wins
+    if (c == PlcSurface::kOutside || seeded[c])
+      continue;  // in a volume hole, or a second seed: the first wins
     seeded[c] = true;
     s.cell_region[c] = seed.id;
   }

@@ -12,15 +12,15 @@
 namespace foxi::detail {
 
 struct PlcSurface {
-  std::vector<double> points;               // 3 per point: the PLC's points, duplicates merged
-  std::vector<std::uint32_t> tri;           // 3 per triangle; each facet's triangles share one orientation
-  std::vector<std::uint32_t> tri_facet;     // the PLC facet of each triangle
+  std::vector<double> points;            // 3 per point: the PLC's points, duplicates merged
+  std::vector<std::uint32_t> tri;        // 3 per triangle; each facet's triangles share one orientation
+  std::vector<std::uint32_t> tri_facet;  // the PLC facet of each triangle
   // The cell on each side of each triangle: side_cell[2 t] on the side its normal (right hand rule)
   // points to, side_cell[2 t + 1] behind it. Cell kOutside is the unbounded one and every cell holding
   // a volume hole point.
   std::vector<std::uint32_t> side_cell;
-  std::size_t cell_count = 0;               // cells 0 .. cell_count-1, kOutside included
-  std::size_t facets_without_area = 0;      // facets of only segments, points or collinear polygons: left out
+  std::size_t cell_count = 0;           // cells 0 .. cell_count-1, kOutside included
+  std::size_t facets_without_area = 0;  // facets of only segments, points or collinear polygons: left out
   // The region id of each cell (from the first region seed inside it; 0 for an enclosed cell with no
   // seed, and for kOutside).
   std::vector<std::int32_t> cell_region;

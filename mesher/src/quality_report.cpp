@@ -44,8 +44,9 @@ MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& 
   }
   r.tetgen_steiner_points = conforming.tetgen.steiner_points;  // the added points were TetGen's input
   r.conforming_points = conforming.added_points;
-  r.conforming_overhead =
-      conforming.first_mesh_points ? double(conforming.added_points) / double(conforming.first_mesh_points) : 0;
+  r.conforming_overhead = conforming.first_mesh_points
+                              ? double(conforming.added_points) / double(conforming.first_mesh_points)
+                              : 0;
   r.iterations = conforming.iterations;
   r.thin_layers = conforming.thin_layers.size();
   r.quality_points = conforming.quality_points;
@@ -74,7 +75,8 @@ std::string format_quality_report(const MeshQualityReport& r) {
   put("mesh: %zu nodes, %zu tets, %zu boundary triangles", r.nodes, r.tets, r.boundary_triangles);
   put("radius-edge ratio: min %.3g, mean %.3g, max %.3g (regular tet 0.612)", r.shape.radius_edge.min,
       r.shape.radius_edge.mean, r.shape.radius_edge.max);
-  put("min dihedral angle: min %.3g, mean %.3g deg; %zu slivers below %g deg (kept: Delaunay refinement does not "
+  put("min dihedral angle: min %.3g, mean %.3g deg; %zu slivers below %g deg (kept: Delaunay refinement does "
+      "not "
       "remove slivers, flips or smoothing would break the Delaunay property)",
       r.shape.min_dihedral_deg.min, r.shape.min_dihedral_deg.mean, r.slivers, r.sliver_angle_deg);
   std::string hist = "min dihedral histogram (5 deg bins from 0):";
@@ -83,22 +85,28 @@ std::string format_quality_report(const MeshQualityReport& r) {
   put("tet volume: min %.4g, max %.4g m^3, total %.6g m^3", r.shape.volume.min, r.shape.volume.max,
       r.shape.total_volume);
   for (const RegionSize& rs : r.regions)
-    put("  region %d%s%s: %zu tets, %.6g m^3", rs.id, rs.name.empty() ? "" : " ", rs.name.c_str(), rs.tets, rs.volume);
+    put("  region %d%s%s: %zu tets, %.6g m^3", rs.id, rs.name.empty() ? "" : " ", rs.name.c_str(), rs.tets,
+        rs.volume);
   if (r.thin_layers == 0) {
-    put("Steiner points: %zu by TetGen, %zu for conformity (%.2f%% of the first -O0 mesh's points) in %zu iterations",
+    put("Steiner points: %zu by TetGen, %zu for conformity (%.2f%% of the first -O0 mesh's points) in %zu "
+        "iterations",
         r.tetgen_steiner_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
     if (r.over_radius_edge > 0)
-      put("radius-edge bound %g: %zu tets over it (TetGen leaves some near small input angles, the conformity "
+      put("radius-edge bound %g: %zu tets over it (TetGen leaves some near small input angles, the "
+          "conformity "
           "rounds some next to the boundary points they add; refining those did not settle on faceted curved "
           "surfaces)",
           r.radius_edge_bound, r.over_radius_edge);
   } else {
-    put("thin layers: %zu, exempt from the quality bounds: %zu tets in them; outside them radius-edge max %.3g, "
+    put("thin layers: %zu, exempt from the quality bounds: %zu tets in them; outside them radius-edge max "
+        "%.3g, "
         "%zu tets still over a bound",
         r.thin_layers, r.thin_layer_tets, r.max_radius_edge_outside_layers, r.quality_unmet);
-    put("Steiner points: %zu by TetGen, %zu by foxi's refinement for quality and size, %zu for conformity (%.2f%% "
+    put("Steiner points: %zu by TetGen, %zu by foxi's refinement for quality and size, %zu for conformity "
+        "(%.2f%% "
         "of the other points) in %zu iterations",
-        r.tetgen_steiner_points, r.quality_points, r.conforming_points, 100 * r.conforming_overhead, r.iterations);
+        r.tetgen_steiner_points, r.quality_points, r.conforming_points, 100 * r.conforming_overhead,
+        r.iterations);
   }
   if (r.delaunay)
     put("delaunay: yes, every circumsphere is empty (exact; the first -O0 mesh had %zu non-Delaunay tets)",
@@ -107,8 +115,10 @@ std::string format_quality_report(const MeshQualityReport& r) {
     put("delaunay: NO, %zu tets have a vertex inside their circumsphere (the first -O0 mesh had %zu)",
         r.violating_tets, r.first_mesh_violations);
   if (r.tetgen_failed)
-    put("refinement stopped early: TetGen failed on the refined PLC (or lost a region); this is the last good mesh");
-  put("time: %.3f s meshing and refinement, of which %.3f s certificates", r.mesh_seconds, r.certificate_seconds);
+    put("refinement stopped early: TetGen failed on the refined PLC (or lost a region); this is the last "
+        "good mesh");
+  put("time: %.3f s meshing and refinement, of which %.3f s certificates", r.mesh_seconds,
+      r.certificate_seconds);
   return s;
 }
 

@@ -8,7 +8,8 @@
 
 namespace foxi::detail {
 
-std::optional<DelaunayCertificate> RefinementRounds::run(std::size_t it, Plc& current, Mesh& mesh, bool mesh_given) {
+std::optional<DelaunayCertificate> RefinementRounds::run(std::size_t it, Plc& current, Mesh& mesh,
+                                                         bool mesh_given) {
   try {
     if (it > 0 || !mesh_given) {
       MeshParams p = params_;
@@ -17,10 +18,12 @@ std::optional<DelaunayCertificate> RefinementRounds::run(std::size_t it, Plc& cu
       if (it > 0) p.time_limit = std::max(30.0, 20 * first_seconds_);
       const auto t0 = std::chrono::steady_clock::now();
       mesh = mesh_plc(current, p, &rep_.tetgen);
-      if (it == 0) first_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (it == 0)
+        first_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     if (it == 0) first_volumes_ = region_volumes(mesh);
-    if (it > 0 && !same_region_volumes(first_volumes_, region_volumes(mesh))) throw MesherError(2, "regions lost");
+    if (it > 0 && !same_region_volumes(first_volumes_, region_volumes(mesh)))
+      throw MesherError(2, "regions lost");
   } catch (const MesherError& e) {
     if (it == 0 || e.tetgen_code() != 2) throw;
     current = std::move(previous_);

@@ -13,7 +13,8 @@ namespace foxi::detail {
 
 class RefinementRounds {
  public:
-  RefinementRounds(const MeshParams& tetgen_params, ConformingReport& rep) : params_(tetgen_params), rep_(rep) {}
+  RefinementRounds(const MeshParams& tetgen_params, ConformingReport& rep)
+      : params_(tetgen_params), rep_(rep) {}
 
   // Meshes `current` (round `it`, 0 first) into `mesh` and certifies it, filling the report's
   // violations, first-mesh figures and `delaunay`. A later round whose TetGen run fails (code 2) or

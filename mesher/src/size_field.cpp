@@ -52,7 +52,9 @@ double tet_gradient(const Mesh& m, std::size_t t, const double* u, double g[3]) 
 }  // namespace
 
 double regular_tet_volume(double edge) { return edge * edge * edge / (6 * std::sqrt(2.0)); }
-double regular_tet_circumradius(double volume) { return std::cbrt(6 * std::sqrt(2.0) * volume) * std::sqrt(6.0) / 4; }
+double regular_tet_circumradius(double volume) {
+  return std::cbrt(6 * std::sqrt(2.0) * volume) * std::sqrt(6.0) / 4;
+}
 
 Plc with_region_sizes(const Plc& plc, const SizeControls& controls) {
   Plc out = plc;
@@ -64,7 +66,9 @@ Plc with_region_sizes(const Plc& plc, const SizeControls& controls) {
         const double v = regular_tet_volume(controls.region_sizes[i]);
         s.max_volume = s.max_volume > 0 ? std::min(s.max_volume, v) : v;
       }
-    if (!found) throw MesherError(10, "no region " + std::to_string(controls.region_ids[i]) + " in the PLC for its size");
+    if (!found)
+      throw MesherError(10,
+                        "no region " + std::to_string(controls.region_ids[i]) + " in the PLC for its size");
   }
   return out;
 }
@@ -75,12 +79,14 @@ SizeField size_field_from_boxes(const Mesh& background, const SizeControls& cont
   f.tet = background.tet;
   double fallback = controls.max_size;
   if (!(fallback > 0))
-    for (std::size_t t = 0; t < background.tet_count(); ++t) fallback = std::max(fallback, longest_edge(background, t));
+    for (std::size_t t = 0; t < background.tet_count(); ++t)
+      fallback = std::max(fallback, longest_edge(background, t));
   f.size.assign(background.node_count(), fallback);
   for (std::size_t n = 0; n < background.node_count(); ++n) {
     const double* p = &background.xyz[3 * n];
     for (const RefinementBox& b : controls.boxes)
-      if (p[0] >= b.lo[0] && p[0] <= b.hi[0] && p[1] >= b.lo[1] && p[1] <= b.hi[1] && p[2] >= b.lo[2] && p[2] <= b.hi[2])
+      if (p[0] >= b.lo[0] && p[0] <= b.hi[0] && p[1] >= b.lo[1] && p[1] <= b.hi[1] && p[2] >= b.lo[2] &&
+          p[2] <= b.hi[2])
         f.size[n] = std::min(f.size[n], b.size);
   }
   return f;
@@ -100,7 +106,8 @@ SizeField box_size_field(const Plc& plc, const MeshParams& params, const SizeCon
 
 ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
-  if (field.location != FieldLocation::node || field.components < 1 || field.values.size() < nn * field.components)
+  if (field.location != FieldLocation::node || field.components < 1 ||
+      field.values.size() < nn * field.components)
     throw MesherError(10, "field '" + field.name + "' is not a node field of this mesh");
   std::vector<double> u(nn);
   for (std::size_t n = 0; n < nn; ++n) u[n] = field.values[n * field.components];
@@ -156,7 +163,8 @@ SizeField size_field_from_error(const Mesh& mesh, const Field& field, double tar
   const ErrorIndicator e = zz_error_indicator(mesh, field);
   const std::size_t nt = mesh.tet_count();
   if (nt > 0 && e.tets_without_value == nt)
-    throw MesherError(10, "field '" + field.name + "' has no value (NaN) at a node of every tet: no error to refine by");
+    throw MesherError(
+        10, "field '" + field.name + "' has no value (NaN) at a node of every tet: no error to refine by");
   const std::size_t valued = nt - e.tets_without_value;
   const double per_tet = valued ? target_error * e.gradient_norm / std::sqrt(double(valued)) : 0;
   SizeField f;

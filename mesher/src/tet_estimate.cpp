@@ -41,7 +41,8 @@ double estimate_tet_count(const Plc& plc, const MeshParams& params, std::span<co
         sized += kTetsPerBoundVolume * region_volume[static_cast<std::size_t>(id - 1)] / b;
   } else {
     double b = global;
-    if (b == 0 && !bound.empty() && std::all_of(bound.begin(), bound.end(), [](auto& x) { return x.second > 0; }))
+    if (b == 0 && !bound.empty() &&
+        std::all_of(bound.begin(), bound.end(), [](auto& x) { return x.second > 0; }))
       for (const auto& x : bound) b = std::max(b, x.second);
     if (b > 0 && plc.point_count() > 0) {
       double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

@@ -26,13 +26,20 @@ namespace {
 
 std::string tetgen_message(int code) {
   switch (code) {
-    case 1: return "TetGen ran out of memory";
-    case 2: return "TetGen met an internal error";
-    case 3: return "the PLC has self-intersecting facets";
-    case 4: return "the PLC has a feature smaller than TetGen's tolerance";
-    case 5: return "the PLC has two facets too close to each other";
-    case 10: return "TetGen rejected the input PLC";
-    default: return "TetGen failed with code " + std::to_string(code);
+    case 1:
+      return "TetGen ran out of memory";
+    case 2:
+      return "TetGen met an internal error";
+    case 3:
+      return "the PLC has self-intersecting facets";
+    case 4:
+      return "the PLC has a feature smaller than TetGen's tolerance";
+    case 5:
+      return "the PLC has two facets too close to each other";
+    case 10:
+      return "TetGen rejected the input PLC";
+    default:
+      return "TetGen failed with code " + std::to_string(code);
   }
 }
 
@@ -59,7 +66,8 @@ struct Result {
 // Runs TetGen in a child process: TetGen 1.5's library frees its memory twice when it stops on an
 // error (terminatetetgen() then the mesh destructor), which crashes the caller; in a child the crash
 // becomes an error message.
-Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const ProgressFn& progress, double time_limit) {
+Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const ProgressFn& progress,
+                    double time_limit) {
   int fds[2];
   if (::pipe(fds) != 0) throw MesherError(1, std::string("cannot create a pipe: ") + std::strerror(errno));
   std::fflush(nullptr);
@@ -127,7 +135,8 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
     if (time_limit > 0 &&
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > time_limit) {
       stop_child();
-      throw MesherError(2, "TetGen did not finish within " + std::to_string(int(time_limit)) + " s on this PLC");
+      throw MesherError(2,
+                        "TetGen did not finish within " + std::to_string(int(time_limit)) + " s on this PLC");
     }
     if (progress || time_limit > 0) {
       // TetGen reports no progress of its own: the callback is asked every 100 ms (fraction -1,
@@ -167,13 +176,15 @@ Result run_isolated(tetgenio& in, tetgenio* background, char* switches, const Pr
   }
   if (r.status != 0) return r;
   std::int64_t head[5];
-  if (!take(head, sizeof head) || head[2] != 4) throw MesherError(2, "TetGen returned an incomplete or unexpected mesh");
+  if (!take(head, sizeof head) || head[2] != 4)
+    throw MesherError(2, "TetGen returned an incomplete or unexpected mesh");
   r.points.resize(3 * std::size_t(head[0]));
   r.tets.resize(4 * std::size_t(head[1]));
   r.trifaces.resize(3 * std::size_t(head[3]));
   r.trimarkers.resize(std::size_t(head[3]));
   r.attributes.resize(std::size_t(head[1]));
-  if (!take(r.points.data(), sizeof(double) * r.points.size()) || !take(r.tets.data(), sizeof(int) * r.tets.size()) ||
+  if (!take(r.points.data(), sizeof(double) * r.points.size()) ||
+      !take(r.tets.data(), sizeof(int) * r.tets.size()) ||
       !take(r.trifaces.data(), sizeof(int) * r.trifaces.size()) ||
       !take(r.trimarkers.data(), sizeof(int) * r.trimarkers.size()) ||
       !take(r.attributes.data(), sizeof(double) * r.attributes.size()))
@@ -203,8 +214,8 @@ std::string intersections_found(tetgenio& in, const MeshParams& params) {
     for (int k = 0; k < 3; ++k) {
       const std::size_t v = std::size_t(r.trifaces[3 * f + std::size_t(k)]);
       if (v >= np) return std::string("(?)");
-      t += (k ? " (" : "(") + format_number(r.points[3 * v]) + ", " + format_number(r.points[3 * v + 1]) + ", " +
-           format_number(r.points[3 * v + 2]) + ")";
+      t += (k ? " (" : "(") + format_number(r.points[3 * v]) + ", " + format_number(r.points[3 * v + 1]) +
+           ", " + format_number(r.points[3 * v + 2]) + ")";
     }
     return t;
   };
@@ -222,14 +233,18 @@ std::string format_number(double v) {
 
 Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (!(params.radius_edge == 0 || (params.radius_edge >= kMinRadiusEdgeBound && std::isfinite(params.radius_edge))))
+  if (!(params.radius_edge == 0 ||
+        (params.radius_edge >= kMinRadiusEdgeBound && std::isfinite(params.radius_edge))))
     throw MesherError(10, "the radius-edge bound must be 0 (no quality refinement) or at least " +
-                              format_number(kMinRadiusEdgeBound) + ", not " + format_number(params.radius_edge) +
+                              format_number(kMinRadiusEdgeBound) + ", not " +
+                              format_number(params.radius_edge) +
                               " (TetGen's refinement does not finish below it on thin layers)");
   if (plc.point_count() < 4) throw MesherError(10, "a PLC needs at least 4 points");
   if (plc.facet_count() < 4) throw MesherError(10, "a PLC needs at least 4 facets");
   for (std::uint32_t v : plc.polygon_vertices)
-    if (v >= plc.point_count()) throw MesherError(10, "a facet names point " + std::to_string(v) + " of " + std::to_string(plc.point_count()));
+    if (v >= plc.point_count())
+      throw MesherError(
+          10, "a facet names point " + std::to_string(v) + " of " + std::to_string(plc.point_count()));
 
   // tetgenio owns its arrays and frees them with delete[]: fill it with new[] allocations.
   tetgenio in;
@@ -252,7 +267,8 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
       const std::uint32_t v0 = plc.polygon_vertex_begin[p], v1 = plc.polygon_vertex_begin[p + 1];
       pg.numberofvertices = static_cast<int>(v1 - v0);
       pg.vertexlist = new int[v1 - v0];
-      for (std::uint32_t v = v0; v < v1; ++v) pg.vertexlist[v - v0] = static_cast<int>(plc.polygon_vertices[v]);
+      for (std::uint32_t v = v0; v < v1; ++v)
+        pg.vertexlist[v - v0] = static_cast<int>(plc.polygon_vertices[v]);
     }
     const std::uint32_t h0 = plc.facet_hole_begin[f], h1 = plc.facet_hole_begin[f + 1];
     if (h1 > h0) {
@@ -312,21 +328,26 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
     background.numberoftetrahedra = static_cast<int>(sf.tet.size() / 4);
     background.numberofcorners = 4;
     background.tetrahedronlist = new int[sf.tet.size()];
-    for (std::size_t i = 0; i < sf.tet.size(); ++i) background.tetrahedronlist[i] = static_cast<int>(sf.tet[i]);
+    for (std::size_t i = 0; i < sf.tet.size(); ++i)
+      background.tetrahedronlist[i] = static_cast<int>(sf.tet[i]);
     sw += "m";
   }
   std::vector<char> switches(sw.begin(), sw.end());
   switches.push_back('\0');
   Result res;
   try {
-    res = run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress, params.time_limit);
+    res =
+        run_isolated(in, sized ? &background : nullptr, switches.data(), params.progress, params.time_limit);
   } catch (const MesherError& e) {
     // The child died (a signal; under a sanitizer, an exit after its report) without a result.
     const std::string_view what = e.what();
-    if (e.tetgen_code() != 2 || (what.find("crashed") == what.npos && what.find("without a result") == what.npos)) throw;
+    if (e.tetgen_code() != 2 ||
+        (what.find("crashed") == what.npos && what.find("without a result") == what.npos))
+      throw;
     throw MesherError(2, e.what() + intersections_found(in, params));
   }
-  if (res.status != 0) throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
+  if (res.status != 0)
+    throw MesherError(static_cast<int>(res.status), tetgen_message(static_cast<int>(res.status)));
 
   Mesh m;
   const std::size_t np = res.points.size() / 3;
@@ -334,7 +355,8 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   const std::size_t nt = res.tets.size() / 4;
   m.tet.resize(4 * nt);
   for (std::size_t i = 0; i < 4 * nt; ++i) {
-    if (res.tets[i] < 0 || std::size_t(res.tets[i]) >= np) throw MesherError(2, "TetGen returned a tet index out of range");
+    if (res.tets[i] < 0 || std::size_t(res.tets[i]) >= np)
+      throw MesherError(2, "TetGen returned a tet index out of range");
     m.tet[i] = static_cast<std::uint32_t>(res.tets[i]);
   }
   m.tet_region.assign(nt, 0);
@@ -343,7 +365,8 @@ Mesh mesh_plc(const Plc& plc, const MeshParams& params, MeshReport* report) {
   const std::size_t nf = res.trifaces.size() / 3;
   m.bface.resize(3 * nf);
   for (std::size_t i = 0; i < 3 * nf; ++i) {
-    if (res.trifaces[i] < 0 || std::size_t(res.trifaces[i]) >= np) throw MesherError(2, "TetGen returned a face index out of range");
+    if (res.trifaces[i] < 0 || std::size_t(res.trifaces[i]) >= np)
+      throw MesherError(2, "TetGen returned a face index out of range");
     m.bface[i] = static_cast<std::uint32_t>(res.trifaces[i]);
   }
   m.bface_tag.assign(res.trimarkers.begin(), res.trimarkers.end());

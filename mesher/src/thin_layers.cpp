@@ -103,7 +103,8 @@ std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect, doubl
       if (!(gap > 1e3 * tol)) continue;
       const double u0 = std::max(a.u_lo, b.u_lo), u1 = std::min(a.u_hi, b.u_hi);
       const double v0 = std::max(a.v_lo, b.v_lo), v1 = std::min(a.v_hi, b.v_hi);
-      if (u1 - u0 < min_aspect * gap || v1 - v0 < min_aspect * gap || (u1 - u0) * (v1 - v0) < min_area * gap * gap)
+      if (u1 - u0 < min_aspect * gap || v1 - v0 < min_aspect * gap ||
+          (u1 - u0) * (v1 - v0) < min_area * gap * gap)
         continue;
       ThinLayer l;
       l.normal = a.normal;
@@ -121,8 +122,8 @@ std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect, doubl
   // Drop layers inside others (the same slab is found from several facet pairs).
   auto inside = [](const ThinLayer& a, const ThinLayer& b) {  // a within b
     return dot(a.normal, b.normal) >= 1 - 1e-12 && a.lo >= b.lo - b.tolerance && a.hi <= b.hi + b.tolerance &&
-           a.u_lo >= b.u_lo - b.tolerance && a.u_hi <= b.u_hi + b.tolerance && a.v_lo >= b.v_lo - b.tolerance &&
-           a.v_hi <= b.v_hi + b.tolerance;
+           a.u_lo >= b.u_lo - b.tolerance && a.u_hi <= b.u_hi + b.tolerance &&
+           a.v_lo >= b.v_lo - b.tolerance && a.v_hi <= b.v_hi + b.tolerance;
   };
   std::vector<ThinLayer> kept;
   for (std::size_t i = 0; i < layers.size(); ++i) {
@@ -137,8 +138,8 @@ std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect, doubl
 bool tet_in_thin_layer(const Mesh& mesh, std::size_t t, const std::vector<ThinLayer>& layers) {
   const std::uint32_t* v = &mesh.tet[4 * t];
   for (const ThinLayer& l : layers)
-    if (l.contains(&mesh.xyz[3 * v[0]]) && l.contains(&mesh.xyz[3 * v[1]]) && l.contains(&mesh.xyz[3 * v[2]]) &&
-        l.contains(&mesh.xyz[3 * v[3]]))
+    if (l.contains(&mesh.xyz[3 * v[0]]) && l.contains(&mesh.xyz[3 * v[1]]) &&
+        l.contains(&mesh.xyz[3 * v[2]]) && l.contains(&mesh.xyz[3 * v[3]]))
       return true;
   return false;
 }

@@ -55,7 +55,8 @@ inline SortedTet sort_tet(const std::uint32_t* t) {
 // body(i) once on each of `threads` threads (thread i takes range(i)).
 template <class F>
 void parallel_for_threads(unsigned threads, F&& body) {
-  detail::parallel_for(threads, threads, [&](std::size_t, std::size_t, unsigned i) { body(i); }, 0);
+  detail::parallel_for(
+      threads, threads, [&](std::size_t, std::size_t, unsigned i) { body(i); }, 0);
 }
 
 struct Counts {

@@ -142,7 +142,8 @@ PointGrid build_grid(const Mesh& mesh, bool weighted) {
     double vol = 1;
     for (int d = 0; d < 3; ++d) vol *= std::max((hi[d] - lo[d]) / emax, 1e-3);
     double h = emax * std::cbrt(vol / static_cast<double>(m));
-    if (!(h > 0) || !std::isfinite(h)) h = std::numeric_limits<double>::infinity();  // extent overflows: one cell
+    if (!(h > 0) || !std::isfinite(h))
+      h = std::numeric_limits<double>::infinity();  // extent overflows: one cell
     for (int d = 0; d < 3; ++d) {
       const double n = std::ceil((hi[d] - lo[d]) / h);  // (NaN for an infinite extent: one cell)
       g.dims[d] = n >= 1 ? static_cast<std::int64_t>(std::min(n, 4096.0)) : 1;
@@ -322,8 +323,7 @@ class Checker {
       } else {
         const WPoint W[4] = {WPoint(P[0], wv[0]), WPoint(P[1], wv[1]), WPoint(P[2], wv[2]),
                              WPoint(P[3], wv[3])};
-        side = K().power_side_of_oriented_power_sphere_3_object()(W[0], W[1], W[s2], W[s3],
-                                                                  WPoint(pq, q->w));
+        side = K().power_side_of_oriented_power_sphere_3_object()(W[0], W[1], W[s2], W[s3], WPoint(pq, q->w));
       }
       if (side == CGAL::ON_POSITIVE_SIDE) {
         violated = true;
@@ -433,7 +433,8 @@ DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const Certifi
         cancel = true;
     }
   };
-  detail::parallel_for(threads, threads, [&](std::size_t, std::size_t, unsigned i) { work(i); }, 0);
+  detail::parallel_for(
+      threads, threads, [&](std::size_t, std::size_t, unsigned i) { work(i); }, 0);
 
   for (ThreadResult& r : results) {
     cert.tets_checked += r.checked + r.degenerate;

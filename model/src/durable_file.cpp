@@ -71,9 +71,11 @@ void check_output_path(const std::filesystem::path& path) {
   const std::filesystem::path folder = folder_of(path);
   const auto st = std::filesystem::status(folder, ec);
   if (!std::filesystem::exists(st))
-    throw IoError(path.string(), 0, IoError::kNoOffset, "cannot write: the folder " + folder.string() + " does not exist");
+    throw IoError(path.string(), 0, IoError::kNoOffset,
+                  "cannot write: the folder " + folder.string() + " does not exist");
   if (!std::filesystem::is_directory(st))
-    throw IoError(path.string(), 0, IoError::kNoOffset, "cannot write: " + folder.string() + " is not a folder");
+    throw IoError(path.string(), 0, IoError::kNoOffset,
+                  "cannot write: " + folder.string() + " is not a folder");
   if (::access(folder.c_str(), W_OK | X_OK) != 0)
     throw IoError(path.string(), 0, IoError::kNoOffset,
                   "cannot write in the folder " + folder.string() + ": " + std::strerror(errno));
@@ -90,7 +92,8 @@ std::size_t remove_stale(const std::filesystem::path& folder, const std::string*
     const std::string entry = it->path().filename().string();
     const std::size_t tag = name ? name->size() : entry.rfind(kTempTag);
     if (tag == std::string::npos || tag == 0) continue;
-    if (name && (entry.compare(0, name->size(), *name) != 0 || entry.compare(tag, kTempTag.size(), kTempTag) != 0))
+    if (name &&
+        (entry.compare(0, name->size(), *name) != 0 || entry.compare(tag, kTempTag.size(), kTempTag) != 0))
       continue;
     // PID-RANDOM after the tag; anything else is not foxi's and is left alone.
     const char* p = entry.data() + tag + kTempTag.size();
@@ -98,7 +101,8 @@ std::size_t remove_stale(const std::filesystem::path& folder, const std::string*
     long pid = 0;
     const auto [q, err] = std::from_chars(p, e, pid);
     if (err != std::errc() || q == p || q == e || *q != '-' || pid <= 0) continue;
-    if (pid == ::getpid() ? !cleanup::is_tracked(it->path()) : writer_gone(pid_t(pid))) stale.push_back(it->path());
+    if (pid == ::getpid() ? !cleanup::is_tracked(it->path()) : writer_gone(pid_t(pid)))
+      stale.push_back(it->path());
   }
   std::size_t removed = 0;
   for (const auto& p : stale) removed += std::filesystem::remove_all(p, ec) > 0 ? 1 : 0;
@@ -112,14 +116,16 @@ std::size_t remove_stale_temporaries(const std::filesystem::path& target) {
   return remove_stale(folder_of(target), &name);
 }
 
-std::size_t remove_stale_temporaries_in(const std::filesystem::path& folder) { return remove_stale(folder, nullptr); }
+std::size_t remove_stale_temporaries_in(const std::filesystem::path& folder) {
+  return remove_stale(folder, nullptr);
+}
 
 DurableFile::DurableFile(std::filesystem::path target, bool clean_stale) : target_(std::move(target)) {
   if (clean_stale) remove_stale_temporaries(target_);
   std::random_device rd;
   char suffix[64];
-  std::snprintf(suffix, sizeof suffix, "%.*s%ld-%08x", int(kTempTag.size()), kTempTag.data(), long(::getpid()),
-                static_cast<unsigned>(rd()));
+  std::snprintf(suffix, sizeof suffix, "%.*s%ld-%08x", int(kTempTag.size()), kTempTag.data(),
+                long(::getpid()), static_cast<unsigned>(rd()));
   temp_ = target_;
   temp_ += suffix;
   int err = 0;
@@ -139,8 +145,12 @@ DurableFile::DurableFile(std::filesystem::path target, bool clean_stale) : targe
 }
 
 DurableFile::DurableFile(DurableFile&& o) noexcept
-    : target_(std::move(o.target_)), temp_(std::move(o.temp_)), buffer_(std::move(o.buffer_)),
-      written_(o.written_), fd_(o.fd_), done_(o.done_) {
+    : target_(std::move(o.target_)),
+      temp_(std::move(o.temp_)),
+      buffer_(std::move(o.buffer_)),
+      written_(o.written_),
+      fd_(o.fd_),
+      done_(o.done_) {
   o.fd_ = -1;
   o.done_ = true;
 }
@@ -184,7 +194,8 @@ void DurableFile::write(const void* data, std::size_t bytes) {
     write_through(static_cast<const char*>(data), bytes);  // big pieces skip the copy
     return;
   }
-  if (buffer_.capacity() < kBufferBytes) buffer_.reserve(kBufferBytes);  // not before: a PNG writes through fd()
+  if (buffer_.capacity() < kBufferBytes)
+    buffer_.reserve(kBufferBytes);  // not before: a PNG writes through fd()
   buffer_.append(static_cast<const char*>(data), bytes);
 }
 
@@ -248,7 +259,8 @@ void DurableFile::commit() {
   });
   if (err != 0) {
     discard();
-    if (err == EISDIR) throw IoError(target_.string(), 0, IoError::kNoOffset, "is a folder, not a file to write");
+    if (err == EISDIR)
+      throw IoError(target_.string(), 0, IoError::kNoOffset, "is a folder, not a file to write");
     fail(target_, "cannot rename into place", err);
   }
   sync_folder(target_);

@@ -136,8 +136,6 @@ class TagMap {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> sorted_;
 };
 
-
-
 // Number of nodes of the element types foxi reads; -1 for any other type. Second-order tets and
 // triangles are read as their corner nodes (the first 4 or 3; the mid-edge nodes stay in the node
 // list, unused).

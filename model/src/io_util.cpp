@@ -21,7 +21,10 @@ static std::string compose(const std::string& file, std::uint64_t line, std::uin
 
 IoError::IoError(std::string file, std::uint64_t line, std::uint64_t byte_offset, std::string reason)
     : std::runtime_error(compose(file, line, byte_offset, reason)),
-      file_(std::move(file)), line_(line), byte_offset_(byte_offset), reason_(std::move(reason)) {}
+      file_(std::move(file)),
+      line_(line),
+      byte_offset_(byte_offset),
+      reason_(std::move(reason)) {}
 
 namespace io {
 

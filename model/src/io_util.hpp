@@ -34,7 +34,8 @@ FOXI_API std::uint64_t line_of(std::string_view text, std::size_t offset);
 [[noreturn]] FOXI_API void fail_text(const std::string& file, std::string_view text, std::size_t offset,
                                      const std::string& reason);
 // Throws IoError for a problem at byte `offset` of binary data (no line).
-[[noreturn]] FOXI_API void fail_binary(const std::string& file, std::size_t offset, const std::string& reason);
+[[noreturn]] FOXI_API void fail_binary(const std::string& file, std::size_t offset,
+                                       const std::string& reason);
 
 // Reads whitespace-separated tokens from a text held in memory. Whitespace is space, tab, '\r',
 // '\n', '\f', '\v', so files with mixed line endings read the same. Errors name the line.
@@ -46,7 +47,10 @@ class TextCursor {
   const std::string& file() const { return file_; }
   std::size_t pos() const { return pos_; }
   void set_pos(std::size_t p) { pos_ = p; }
-  bool at_end() { skip_space(); return pos_ >= text_.size(); }
+  bool at_end() {
+    skip_space();
+    return pos_ >= text_.size();
+  }
   std::size_t remaining() const { return text_.size() - pos_; }
 
   // Skips whitespace; if `comment` is not 0, also from that character to the end of its line.
@@ -136,7 +140,8 @@ class TextCursor {
 
   static std::string shorten(std::string_view t) {
     std::string s(t.substr(0, 40));
-    for (char& c : s) if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
+    for (char& c : s)
+      if (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126) c = '?';
     if (t.size() > 40) s += "...";
     return s;
   }

@@ -28,7 +28,6 @@ namespace {
 constexpr const char* kRegionNames[] = {"region", "gmsh:physical", "CellEntityIds", "medit:ref",
                                         "tetgen:ref"};
 
-
 const char* cell_type_name(std::int64_t t) {
   switch (t) {
     case 0:
@@ -90,26 +89,39 @@ std::map<std::int32_t, std::string> parse_names(std::string_view s) {
 // A material's properties in the order foxi_region_materials keeps them, as bit patterns (so that
 // NaN, "not set", compares equal to NaN).
 std::array<std::uint64_t, 8> material_values(const Material& m) {
-  const double v[8] = {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity,
-                       m.youngs_modulus,       m.poisson_ratio,           m.thermal_expansion,
-                       m.density,              m.specific_heat};
+  const double v[8] = {m.thermal_conductivity,
+                       m.electrical_conductivity,
+                       m.relative_permittivity,
+                       m.youngs_modulus,
+                       m.poisson_ratio,
+                       m.thermal_expansion,
+                       m.density,
+                       m.specific_heat};
   std::array<std::uint64_t, 8> bits{};
-  for (std::size_t i = 0; i < 8; ++i) bits[i] = std::isnan(v[i]) ? 0x7ff8000000000000ull : std::bit_cast<std::uint64_t>(v[i]);
+  for (std::size_t i = 0; i < 8; ++i)
+    bits[i] = std::isnan(v[i]) ? 0x7ff8000000000000ull : std::bit_cast<std::uint64_t>(v[i]);
   return bits;
 }
 
 // "name|k|sigma|eps|E|nu|alpha|rho|c" (name %-escaped, "nan" for a property not set; files written
-// before density and specific heat have the first seven only); nothing when it does not have that form (an attribute another writer put there is ignored, not an error).
+// before density and specific heat have the first seven only); nothing when it does not have that form (an
+// attribute another writer put there is ignored, not an error).
 std::optional<Material> parse_material(std::string_view s) {
   std::vector<std::string_view> parts;
-  for (std::size_t bar; (bar = s.find('|')) != std::string_view::npos; s = s.substr(bar + 1)) parts.push_back(s.substr(0, bar));
+  for (std::size_t bar; (bar = s.find('|')) != std::string_view::npos; s = s.substr(bar + 1))
+    parts.push_back(s.substr(0, bar));
   parts.push_back(s);
   if (parts.size() != 7 && parts.size() != 9) return std::nullopt;
   Material m;
   m.name = percent_decode(parts[0]);
-  double* v[8] = {&m.thermal_conductivity, &m.electrical_conductivity, &m.relative_permittivity,
-                  &m.youngs_modulus,       &m.poisson_ratio,           &m.thermal_expansion,
-                  &m.density,              &m.specific_heat};
+  double* v[8] = {&m.thermal_conductivity,
+                  &m.electrical_conductivity,
+                  &m.relative_permittivity,
+                  &m.youngs_modulus,
+                  &m.poisson_ratio,
+                  &m.thermal_expansion,
+                  &m.density,
+                  &m.specific_heat};
   for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
     const std::string_view t = parts[i + 1];
     if (t == "nan") continue;
@@ -209,8 +221,8 @@ void Assembler::add(Piece& p, std::size_t piece_index) {
   };
   p.conn = normalize_ints(std::move(p.conn), int_fail("connectivity"));
   p.offsets = normalize_ints(std::move(p.offsets), int_fail("offsets"));
-  ArrayData types = p.types.type == VType::u8 ? std::move(p.types)
-                                              : normalize_ints(std::move(p.types), int_fail("types"));
+  ArrayData types =
+      p.types.type == VType::u8 ? std::move(p.types) : normalize_ints(std::move(p.types), int_fail("types"));
   // Count tets and triangles, check types.
   // 0 skip, 1 tet, 2 triangle; quadratic tets (24) and triangles (22) are read as their corners
   // (the first 4 or 3 nodes; the mid-edge points stay, unused).
@@ -257,9 +269,8 @@ void Assembler::add(Piece& p, std::size_t piece_index) {
         std::int64_t end = static_cast<std::int64_t>(off[i]);
         if (end < prev || end > nconn) {
           fail("cell " + std::to_string(i) + ": offset " + std::to_string(end) +
-               (end < prev
-                    ? " is smaller than the previous offset " + std::to_string(prev)
-                    : " is past the end of the connectivity (" + std::to_string(nconn) + " entries)"));
+               (end < prev ? " is smaller than the previous offset " + std::to_string(prev)
+                           : " is past the end of the connectivity (" + std::to_string(nconn) + " entries)"));
         }
         std::uint8_t k = kind[i];
         if (k != 0) {
@@ -267,8 +278,8 @@ void Assembler::add(Piece& p, std::size_t piece_index) {
           const std::int64_t want = quadratic[i] ? (k == 1 ? 10 : 6) : corners;
           if (end - prev != want)
             fail("cell " + std::to_string(i) + " (" + (quadratic[i] ? "quadratic " : "") +
-                 (k == 1 ? "tetra" : "triangle") + ") has " + std::to_string(end - prev) + " nodes, expected " +
-                 std::to_string(want));
+                 (k == 1 ? "tetra" : "triangle") + ") has " + std::to_string(end - prev) +
+                 " nodes, expected " + std::to_string(want));
           std::uint32_t* d = k == 1 ? td : fd;
           for (std::int64_t j = 0; j < want; ++j) {
             auto v = static_cast<std::int64_t>(c[static_cast<std::size_t>(prev + j)]);
@@ -291,8 +302,7 @@ void Assembler::add(Piece& p, std::size_t piece_index) {
   int region_index = -1;
   for (const char* rn : kRegionNames) {
     for (std::size_t a = 0; a < p.cell_arrays.size() && region_index < 0; ++a)
-      if (p.cell_arrays[a].name == rn && p.cell_arrays[a].components == 1)
-        region_index = static_cast<int>(a);
+      if (p.cell_arrays[a].name == rn && p.cell_arrays[a].components == 1) region_index = static_cast<int>(a);
     if (region_index >= 0) break;
   }
   std::size_t tets_before = tet_at / 4;
@@ -417,7 +427,9 @@ Mesh Assembler::finish() {
       mesh_.regions.push_back({id, it == region_names_.end() ? std::string() : it->second, kNone});
       if (auto m = region_materials_.find(id); m != region_materials_.end()) {
         // Regions of one material share it (equal name and properties, NaN equal to NaN).
-        auto same = [&](const Material& a) { return a.name == m->second.name && material_values(a) == material_values(m->second); };
+        auto same = [&](const Material& a) {
+          return a.name == m->second.name && material_values(a) == material_values(m->second);
+        };
         auto at = std::find_if(mesh_.materials.begin(), mesh_.materials.end(), same);
         if (at == mesh_.materials.end()) at = mesh_.materials.insert(mesh_.materials.end(), m->second);
         mesh_.regions.back().material = static_cast<std::uint32_t>(at - mesh_.materials.begin());

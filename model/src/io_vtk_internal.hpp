@@ -136,10 +136,10 @@ struct NamedArray {
   ArrayData data;
   std::string unit;
   std::optional<double> step_value;
-  std::string region_names;    // foxi_region_names attribute (region array only)
+  std::string region_names;      // foxi_region_names attribute (region array only)
   std::string region_materials;  // foxi_region_materials attribute (region array only)
-  std::string boundary_names;  // foxi_boundary_names attribute
-  std::size_t at = 0;          // file offset of its declaration (for errors)
+  std::string boundary_names;    // foxi_boundary_names attribute
+  std::size_t at = 0;            // file offset of its declaration (for errors)
 };
 
 struct Piece {

@@ -74,8 +74,8 @@ std::string names_attribute(const std::vector<std::pair<std::int32_t, std::strin
 // parse_material's form: "name|k|sigma|eps|E|nu|alpha|rho|c", shortest round-trip numbers.
 std::string material_attribute(const Material& m) {
   std::string s = percent_encode(m.name, ";=|");
-  for (double v : {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity, m.youngs_modulus,
-                   m.poisson_ratio, m.thermal_expansion, m.density, m.specific_heat}) {
+  for (double v : {m.thermal_conductivity, m.electrical_conductivity, m.relative_permittivity,
+                   m.youngs_modulus, m.poisson_ratio, m.thermal_expansion, m.density, m.specific_heat}) {
     s += '|';
     if (std::isnan(v)) {
       s += "nan";
@@ -185,7 +185,8 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
     for (const Boundary& b : mesh.boundaries) bn.emplace_back(b.tag, b.name);
     std::vector<std::pair<std::int32_t, std::string>> rm;
     for (const Region& g : mesh.regions)
-      if (g.material < mesh.materials.size()) rm.emplace_back(g.id, material_attribute(mesh.materials[g.material]));
+      if (g.material < mesh.materials.size())
+        rm.emplace_back(g.id, material_attribute(mesh.materials[g.material]));
     std::string ra = names_attribute(rn), ba = names_attribute(bn), ma = names_attribute(rm);
     if (!ra.empty()) r.extra += " foxi_region_names=\"" + xml_escape(ra) + "\"";
     if (!ma.empty()) r.extra += " foxi_region_materials=\"" + xml_escape(ma) + "\"";

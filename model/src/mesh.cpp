@@ -29,15 +29,18 @@ DerivedData& derived_of(const Mesh& mesh) {
 void invalidate_derived(Mesh& mesh) { mesh.derived.clear(); }
 
 const Field* Mesh::find_field(std::string_view name) const {
-  for (const Field& f : fields) if (f.name == name) return &f;
+  for (const Field& f : fields)
+    if (f.name == name) return &f;
   return nullptr;
 }
 const Region* Mesh::find_region(std::int32_t id) const {
-  for (const Region& r : regions) if (r.id == id) return &r;
+  for (const Region& r : regions)
+    if (r.id == id) return &r;
   return nullptr;
 }
 const Boundary* Mesh::find_boundary(std::int32_t tag) const {
-  for (const Boundary& b : boundaries) if (b.tag == tag) return &b;
+  for (const Boundary& b : boundaries)
+    if (b.tag == tag) return &b;
   return nullptr;
 }
 
@@ -46,23 +49,31 @@ std::size_t field_entity_count(const Mesh& mesh, const Field& field) {
 }
 
 std::string check_sizes(const Mesh& mesh) {
-  if (mesh.xyz.size() % 3 != 0) return "xyz holds " + std::to_string(mesh.xyz.size()) + " values, not a multiple of 3";
-  if (mesh.tet.size() % 4 != 0) return "tet holds " + std::to_string(mesh.tet.size()) + " indices, not a multiple of 4";
-  if (mesh.bface.size() % 3 != 0) return "bface holds " + std::to_string(mesh.bface.size()) + " indices, not a multiple of 3";
+  if (mesh.xyz.size() % 3 != 0)
+    return "xyz holds " + std::to_string(mesh.xyz.size()) + " values, not a multiple of 3";
+  if (mesh.tet.size() % 4 != 0)
+    return "tet holds " + std::to_string(mesh.tet.size()) + " indices, not a multiple of 4";
+  if (mesh.bface.size() % 3 != 0)
+    return "bface holds " + std::to_string(mesh.bface.size()) + " indices, not a multiple of 3";
   if (!mesh.tet_region.empty() && mesh.tet_region.size() != mesh.tet_count())
-    return "tet_region has " + std::to_string(mesh.tet_region.size()) + " entries for " + std::to_string(mesh.tet_count()) + " tets";
+    return "tet_region has " + std::to_string(mesh.tet_region.size()) + " entries for " +
+           std::to_string(mesh.tet_count()) + " tets";
   if (mesh.bface_tag.size() != mesh.bface_count())
-    return "bface_tag has " + std::to_string(mesh.bface_tag.size()) + " entries for " + std::to_string(mesh.bface_count()) + " boundary triangles";
+    return "bface_tag has " + std::to_string(mesh.bface_tag.size()) + " entries for " +
+           std::to_string(mesh.bface_count()) + " boundary triangles";
   if (!mesh.weight.empty() && mesh.weight.size() != mesh.node_count())
-    return "weight has " + std::to_string(mesh.weight.size()) + " entries for " + std::to_string(mesh.node_count()) + " nodes";
+    return "weight has " + std::to_string(mesh.weight.size()) + " entries for " +
+           std::to_string(mesh.node_count()) + " nodes";
   for (const Region& r : mesh.regions)
     if (r.material != kNone && r.material >= mesh.materials.size())
-      return "region " + std::to_string(r.id) + " names material " + std::to_string(r.material) + " of " + std::to_string(mesh.materials.size());
+      return "region " + std::to_string(r.id) + " names material " + std::to_string(r.material) + " of " +
+             std::to_string(mesh.materials.size());
   for (const Field& f : mesh.fields) {
     if (f.components == 0) return "field '" + f.name + "' has 0 components";
     std::size_t want = f.step_count() * field_entity_count(mesh, f) * f.components;
     if (f.values.size() != want)
-      return "field '" + f.name + "' has " + std::to_string(f.values.size()) + " values, expected " + std::to_string(want);
+      return "field '" + f.name + "' has " + std::to_string(f.values.size()) + " values, expected " +
+             std::to_string(want);
   }
   return {};
 }

@@ -26,11 +26,16 @@ MeshFormat format_from_path(const std::filesystem::path& path) {
 
 const char* format_name(MeshFormat format) {
   switch (format) {
-    case MeshFormat::gmsh: return "Gmsh .msh";
-    case MeshFormat::vtu: return "VTK XML .vtu";
-    case MeshFormat::vtk_legacy: return "VTK legacy .vtk";
-    case MeshFormat::tetgen: return "TetGen .node/.ele";
-    case MeshFormat::medit: return "Medit .mesh";
+    case MeshFormat::gmsh:
+      return "Gmsh .msh";
+    case MeshFormat::vtu:
+      return "VTK XML .vtu";
+    case MeshFormat::vtk_legacy:
+      return "VTK legacy .vtk";
+    case MeshFormat::tetgen:
+      return "TetGen .node/.ele";
+    case MeshFormat::medit:
+      return "Medit .mesh";
   }
   return "?";
 }
@@ -47,11 +52,16 @@ static std::filesystem::path tetgen_base(const std::filesystem::path& path) {
 
 Mesh read_mesh(const std::filesystem::path& path) {
   switch (format_from_path(path)) {
-    case MeshFormat::gmsh: return read_gmsh(path);
-    case MeshFormat::vtu: return read_vtu(path);
-    case MeshFormat::vtk_legacy: return read_vtk_legacy(path);
-    case MeshFormat::tetgen: return read_tetgen(tetgen_base(path));
-    case MeshFormat::medit: return read_medit(path);
+    case MeshFormat::gmsh:
+      return read_gmsh(path);
+    case MeshFormat::vtu:
+      return read_vtu(path);
+    case MeshFormat::vtk_legacy:
+      return read_vtk_legacy(path);
+    case MeshFormat::tetgen:
+      return read_tetgen(tetgen_base(path));
+    case MeshFormat::medit:
+      return read_medit(path);
   }
   throw IoError(path.string(), 0, IoError::kNoOffset, "unknown mesh format");
 }
@@ -61,10 +71,18 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const Write
     case MeshFormat::gmsh:
       write_gmsh(mesh, path, GmshWriteOptions{options.gmsh_version, options.binary});
       return;
-    case MeshFormat::vtu: write_vtu(mesh, path, options.vtu_encoding); return;
-    case MeshFormat::vtk_legacy: write_vtk_legacy(mesh, path, options.binary); return;
-    case MeshFormat::tetgen: write_tetgen(mesh, tetgen_base(path)); return;
-    case MeshFormat::medit: write_medit(mesh, path); return;
+    case MeshFormat::vtu:
+      write_vtu(mesh, path, options.vtu_encoding);
+      return;
+    case MeshFormat::vtk_legacy:
+      write_vtk_legacy(mesh, path, options.binary);
+      return;
+    case MeshFormat::tetgen:
+      write_tetgen(mesh, tetgen_base(path));
+      return;
+    case MeshFormat::medit:
+      write_medit(mesh, path);
+      return;
   }
 }
 

@@ -50,7 +50,8 @@ Plc parse_poly(std::string_view text, const std::string& name) {
       if (idx != 0 && idx != 1) in.fail("the first point index must be 0 or 1, not " + std::to_string(idx));
       base = idx;
     } else if (idx != base + std::int64_t(i)) {
-      in.fail("point index " + std::to_string(idx) + " out of sequence (expected " + std::to_string(base + std::int64_t(i)) + ")");
+      in.fail("point index " + std::to_string(idx) + " out of sequence (expected " +
+              std::to_string(base + std::int64_t(i)) + ")");
     }
     for (int k = 0; k < 3; ++k) plc.points.push_back(real("coordinate"));
     for (std::int64_t a = 0; a < nattr + nmark; ++a) in.real("point attribute or marker", kComment);
@@ -58,7 +59,8 @@ Plc parse_poly(std::string_view text, const std::string& name) {
   auto vertex = [&]() {
     std::int64_t v = in.integer("vertex index", kComment) - base;
     if (v < 0 || std::uint64_t(v) >= np)
-      in.fail("vertex index " + std::to_string(v + base) + " out of range (" + std::to_string(np) + " points)");
+      in.fail("vertex index " + std::to_string(v + base) + " out of range (" + std::to_string(np) +
+              " points)");
     return static_cast<std::uint32_t>(v);
   };
   // Facets.
@@ -71,7 +73,8 @@ Plc parse_poly(std::string_view text, const std::string& name) {
     std::uint64_t nholes = 0;
     std::int32_t marker = 0;
     if (!in.at_line_end(kComment)) nholes = count("facet holes", 6);
-    if (fmark == 1 && !in.at_line_end(kComment)) marker = static_cast<std::int32_t>(in.integer("facet marker", kComment));
+    if (fmark == 1 && !in.at_line_end(kComment))
+      marker = static_cast<std::int32_t>(in.integer("facet marker", kComment));
     for (std::uint64_t p = 0; p < npoly; ++p) {
       const std::uint64_t nv = count("polygon vertices", 2);
       if (nv == 0) in.fail("a polygon needs at least one vertex");

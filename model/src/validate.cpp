@@ -154,8 +154,9 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
     if (mesh.tet_count() > 0 && extent < kMinExtent) {
       // Every tet is affected; counted as such, with one message for the mesh.
       tiny_mesh = true;
-      note(r, "geometry beyond the range foxi computes in: the mesh is " + num(extent) + " across, below the " +
-                  num(kMinExtent) + " that the visibility order's float error bounds hold (rescale the coordinates)");
+      note(r, "geometry beyond the range foxi computes in: the mesh is " + num(extent) +
+                  " across, below the " + num(kMinExtent) +
+                  " that the visibility order's float error bounds hold (rescale the coordinates)");
     }
   }
   std::vector<std::uint8_t> used(nv, 0);
@@ -211,8 +212,8 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
                            x + 3 * std::size_t(v[pos ? 2 : 3]), x + 3 * std::size_t(v[pos ? 3 : 2]), origin,
                            why)) {
       ++r.out_of_range;
-      note(r, "tet " + std::to_string(t) + " " + ids(v, 4) + ": geometry beyond the range foxi computes in: " + why +
-                  " (rescale the coordinates)");
+      note(r, "tet " + std::to_string(t) + " " + ids(v, 4) +
+                  ": geometry beyond the range foxi computes in: " + why + " (rescale the coordinates)");
     }
   }
   std::sort(keys.begin(), keys.end());
@@ -233,17 +234,17 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
       return std::array<double, 3>{mesh.xyz[3 * std::size_t(v)], mesh.xyz[3 * std::size_t(v) + 1],
                                    mesh.xyz[3 * std::size_t(v) + 2]};
     };
-    std::sort(pts.begin(), pts.end(), [&](std::uint32_t p, std::uint32_t q) {
-      return std::pair(at(p), p) < std::pair(at(q), q);
-    });
+    std::sort(pts.begin(), pts.end(),
+              [&](std::uint32_t p, std::uint32_t q) { return std::pair(at(p), p) < std::pair(at(q), q); });
     for (std::size_t i = 1; i < pts.size(); ++i)
       if (at(pts[i]) == at(pts[i - 1])) {
         ++r.duplicate_nodes;
         std::size_t first = i - 1;
         while (first > 0 && at(pts[first - 1]) == at(pts[i])) --first;
         const auto p = at(pts[i]);
-        note(r, "nodes " + std::to_string(pts[first]) + " and " + std::to_string(pts[i]) + ": the same point (" +
-                    num(p[0]) + ", " + num(p[1]) + ", " + num(p[2]) + "), both used by tets");
+        note(r, "nodes " + std::to_string(pts[first]) + " and " + std::to_string(pts[i]) +
+                    ": the same point (" + num(p[0]) + ", " + num(p[1]) + ", " + num(p[2]) +
+                    "), both used by tets");
       }
   }
   for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
@@ -286,9 +287,11 @@ std::vector<std::string> describe(const ValidationReport& r) {
   add(r.repeated_vertex, "element", "elements", " naming one node twice");
   add(r.nonfinite_nodes, "node", "nodes", " with NaN or infinite coordinates");
   add(r.zero_volume, "tet", "tets", " of zero volume");
-  add(r.out_of_range, "tet", "tets", " with geometry beyond the range foxi computes in (volumes, circumspheres, keys)");
+  add(r.out_of_range, "tet", "tets",
+      " with geometry beyond the range foxi computes in (volumes, circumspheres, keys)");
   add(r.duplicate_tets, "tet", "tets", " repeating an earlier tet's nodes");
-  add(r.overlapping, "place", "places", " where tets overlap (folded or crossing faces, or a tet inside another)");
+  add(r.overlapping, "place", "places",
+      " where tets overlap (folded or crossing faces, or a tet inside another)");
   add(r.duplicate_nodes, "node", "nodes", " at the point of another node (the mesh is torn there)");
   add(r.inverted, "inverted tet", "inverted tets", " (negative orientation; every command re-orients them)");
   add(r.unused_nodes, "node", "nodes", " used by no tet");

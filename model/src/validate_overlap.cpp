@@ -60,7 +60,8 @@ bool wedges_overlap(const Point& p, Point a, Point b, Point c, Point d) {
 }
 
 // Whether two boundary triangles meet in more than the vertices they share (exact).
-bool triangles_overlap(const Mesh& m, const std::array<std::uint32_t, 3>& a, const std::array<std::uint32_t, 3>& b) {
+bool triangles_overlap(const Mesh& m, const std::array<std::uint32_t, 3>& a,
+                       const std::array<std::uint32_t, 3>& b) {
   int shared = 0, sa[3] = {-1, -1, -1};  // sa[i]: index in b of a[i], or -1
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -71,7 +72,8 @@ bool triangles_overlap(const Mesh& m, const std::array<std::uint32_t, 3>& a, con
   const Point pa[3] = {point_of(m, a[0]), point_of(m, a[1]), point_of(m, a[2])};
   const Point pb[3] = {point_of(m, b[0]), point_of(m, b[1]), point_of(m, b[2])};
   if (shared == 3) return true;  // the same triangle twice on the boundary: two tets on one side
-  if (shared == 0) return CGAL::do_intersect(K::Triangle_3(pa[0], pa[1], pa[2]), K::Triangle_3(pb[0], pb[1], pb[2]));
+  if (shared == 0)
+    return CGAL::do_intersect(K::Triangle_3(pa[0], pa[1], pa[2]), K::Triangle_3(pb[0], pb[1], pb[2]));
   if (shared == 2) {
     // A shared edge pq: they overlap only if coplanar with the third vertices on one side of pq.
     int ia = 0;
@@ -169,7 +171,8 @@ OverlapReport check_overlap(const Mesh& mesh, std::size_t max_examples) {
   }
   CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& x, const Box& y) {
     const std::size_t fx = boundary[x.info()], fy = boundary[y.info()];
-    if (triangles_overlap(mesh, face_nodes(mesh, fx / 4, int(fx % 4)), face_nodes(mesh, fy / 4, int(fy % 4)))) {
+    if (triangles_overlap(mesh, face_nodes(mesh, fx / 4, int(fx % 4)),
+                          face_nodes(mesh, fy / 4, int(fy % 4)))) {
       ++r.crossing_boundary_faces;
       example("boundary faces of tets " + std::to_string(fx / 4) + " and " + std::to_string(fy / 4) +
               " cross (the tets overlap)");
@@ -211,12 +214,14 @@ OverlapReport check_overlap(const Mesh& mesh, std::size_t max_examples) {
       c[k] = 0.25 * (mesh.xyz[3 * std::size_t(v[0]) + k] + mesh.xyz[3 * std::size_t(v[1]) + k] +
                      mesh.xyz[3 * std::size_t(v[2]) + k] + mesh.xyz[3 * std::size_t(v[3]) + k]);
     const Point p(c[0], c[1], c[2]);
-    const Point q[4] = {point_of(mesh, v[0]), point_of(mesh, v[1]), point_of(mesh, v[2]), point_of(mesh, v[3])};
+    const Point q[4] = {point_of(mesh, v[0]), point_of(mesh, v[1]), point_of(mesh, v[2]),
+                        point_of(mesh, v[3])};
     bool strictly = true;
     for (int f = 0; f < 4; ++f) {
       Point s[4] = {q[0], q[1], q[2], q[3]};
       s[f] = p;
-      if (CGAL::orientation(s[0], s[1], s[2], s[3]) != CGAL::orientation(q[0], q[1], q[2], q[3])) strictly = false;
+      if (CGAL::orientation(s[0], s[1], s[2], s[3]) != CGAL::orientation(q[0], q[1], q[2], q[3]))
+        strictly = false;
     }
     if (!strictly) continue;
     probes.emplace_back(c, c, t);
@@ -246,7 +251,8 @@ OverlapReport check_overlap(const Mesh& mesh, std::size_t max_examples) {
       tet_box(t, lo, hi);
       for (std::size_t i = 0; i < probes.size(); ++i) {
         const Point& c = probe_points[i];
-        if (lo[0] <= c.x() && c.x() <= hi[0] && lo[1] <= c.y() && c.y() <= hi[1] && lo[2] <= c.z() && c.z() <= hi[2])
+        if (lo[0] <= c.x() && c.x() <= hi[0] && lo[1] <= c.y() && c.y() <= hi[1] && lo[2] <= c.z() &&
+            c.z() <= hi[2])
           covered(i, static_cast<std::uint32_t>(t));
       }
     }
@@ -263,10 +269,12 @@ OverlapReport check_overlap(const Mesh& mesh, std::size_t max_examples) {
   std::vector<std::pair<std::uint32_t, std::size_t>> probe_of;  // (tet, probe index)
   for (std::size_t i = 0; i < probes.size(); ++i) probe_of.emplace_back(probes[i].info(), i);
   std::sort(probe_of.begin(), probe_of.end());
-  CGAL::box_intersection_d(probes.begin(), probes.end(), tets.begin(), tets.end(), [&](const Box& p, const Box& t) {
-    covered(std::lower_bound(probe_of.begin(), probe_of.end(), std::pair(p.info(), std::size_t(0)))->second,
+  CGAL::box_intersection_d(
+      probes.begin(), probes.end(), tets.begin(), tets.end(), [&](const Box& p, const Box& t) {
+        covered(
+            std::lower_bound(probe_of.begin(), probe_of.end(), std::pair(p.info(), std::size_t(0)))->second,
             t.info());
-  });
+      });
   return r;
 }
 

@@ -18,7 +18,9 @@ struct OverlapReport {
   std::size_t boundary_pieces = 0;          // connected pieces of the boundary (through shared edges)
   std::vector<std::string> examples;        // the first few, with tet numbers
 
-  std::size_t problems() const { return nonmanifold_faces + folded_faces + crossing_boundary_faces + covered_twice; }
+  std::size_t problems() const {
+    return nonmanifold_faces + folded_faces + crossing_boundary_faces + covered_twice;
+  }
 };
 
 // Needs a mesh that passes validation's local checks (indices in range, no repeated vertex, finite,

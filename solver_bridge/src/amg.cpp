@@ -44,8 +44,8 @@ struct View {
 View view(const Csr& m) {
   FOXI_ASSERT(m.start.size() == m.rows + 1 && m.col.size() == m.val.size() &&
                   std::size_t(m.start.back()) == m.col.size(),
-              "CSR of " << m.rows << " rows: " << m.start.size() << " row starts, last " << m.start.back() << ", "
-                        << m.col.size() << " columns, " << m.val.size() << " values");
+              "CSR of " << m.rows << " rows: " << m.start.size() << " row starts, last " << m.start.back()
+                        << ", " << m.col.size() << " columns, " << m.val.size() << " values");
   return {m.rows, m.start.data(), m.col.data(), m.val.data()};
 }
 
@@ -109,7 +109,8 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row,
           const int first = out.start[i];
           int next = first;
           row(i, [&](int c, double v) {
-            FOXI_ASSERT(c >= 0 && static_cast<std::size_t>(c) < cols, "CSR row " << i << ": column " << c << " of " << cols);
+            FOXI_ASSERT(c >= 0 && static_cast<std::size_t>(c) < cols,
+                        "CSR row " << i << ": column " << c << " of " << cols);
             int& m = mark[static_cast<std::size_t>(c)];
             if (m < first) {
               m = next++;
@@ -119,7 +120,8 @@ Csr build_rows(std::size_t rows, std::size_t cols, unsigned threads, Row&& row,
               out.val[static_cast<std::size_t>(m)] += v;
             }
           });
-          FOXI_ASSERT(next == out.start[i + 1], "CSR row " << i << ": " << next - first << " columns filled of "
+          FOXI_ASSERT(next == out.start[i + 1], "CSR row " << i << ": " << next - first
+                                                           << " columns filled of "
                                                            << out.start[i + 1] - first << " counted");
         }
       },
@@ -178,7 +180,9 @@ void residual(const View& a, const double* c, const double* x, double* y, unsign
       serial_rows(a));
 }
 
-void spmv(const View& a, const double* x, double* y, unsigned threads) { residual(a, nullptr, x, y, threads); }
+void spmv(const View& a, const double* x, double* y, unsigned threads) {
+  residual(a, nullptr, x, y, threads);
+}
 
 // rho(D^-1 A) by a few power iterations (an estimate from below, padded by 5%). Each iteration is one
 // pass on threads: w = D^-1 A v and |w|^2 by slices (added in slice order: deterministic); no
@@ -377,7 +381,8 @@ std::vector<int> group_members(const std::vector<std::uint32_t>& group_of, std::
   for (std::size_t g = 0; g < groups; ++g) first[g + 1] += first[g];
   std::vector<int> members(group_of.size());
   std::vector<int> fill(first.begin(), first.end() - 1);
-  for (std::size_t i = 0; i < group_of.size(); ++i) members[static_cast<std::size_t>(fill[group_of[i]]++)] = static_cast<int>(i);
+  for (std::size_t i = 0; i < group_of.size(); ++i)
+    members[static_cast<std::size_t>(fill[group_of[i]]++)] = static_cast<int>(i);
   return members;
 }
 
@@ -462,7 +467,9 @@ Csr block_tentative(const View& a, NearNullSpace& ns) {
     }
   }
   p.cols = static_cast<std::size_t>(first_col[groups]);
-  for (std::size_t i = 0; i < n; ++i) p.start[i + 1] = checked_nonzeros(static_cast<std::size_t>(p.start[i]) + static_cast<std::size_t>(p.start[i + 1]));
+  for (std::size_t i = 0; i < n; ++i)
+    p.start[i + 1] =
+        checked_nonzeros(static_cast<std::size_t>(p.start[i]) + static_cast<std::size_t>(p.start[i + 1]));
   p.col.resize(static_cast<std::size_t>(p.start[n]));
   p.val.resize(p.col.size());
   for (std::size_t ag = 0; ag < groups; ++ag)
@@ -643,8 +650,7 @@ void AmgPreconditioner::Impl::factorize_coarsest() {
   Eigen::SparseMatrix<double> c(nl, nl);
   c.setFromTriplets(t.begin(), t.end());
   coarse.compute(c);
-  if (coarse.info() != Eigen::Success)
-    throw SolverError("AMG: the coarsest system could not be factorized");
+  if (coarse.info() != Eigen::Success) throw SolverError("AMG: the coarsest system could not be factorized");
 }
 
 AmgPreconditioner::~AmgPreconditioner() = default;
@@ -672,7 +678,8 @@ void AmgPreconditioner::apply(const double* r, double* z) {
 // One hybrid Gauss-Seidel sweep: each thread's block of rows in order (forward) or in reverse, values
 // of the other blocks taken from l.scratch (the values before the sweep; a `fresh` sweep starts from
 // x = 0, which it sets itself, so there they are zero and skipped).
-void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x, bool forward, bool fresh) const {
+void AmgPreconditioner::Impl::smooth(const Level& l, const double* b, double* x, bool forward,
+                                     bool fresh) const {
   const View& a = l.a;
   const double* before = l.scratch.data();
   parallel_for(

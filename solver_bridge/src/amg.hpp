@@ -6,14 +6,14 @@
 // coarsest level.
 //
 // Plain CSR arrays throughout (no sparse-matrix library in the setup): the products P^T (A P) run
-// row-parallel in two passes (count, then fill) so that nothing is built twice, and the work vectors of the cycle are allocated once. The smoother is "hybrid"
-// Gauss-Seidel: each thread sweeps its own contiguous block of rows and takes the values of the other
-// blocks from before the sweep, the backward sweep mirroring the forward one, so one cycle stays a
-// symmetric positive definite operator (and is plain symmetric Gauss-Seidel on one thread). The fine
-// matrix is first renumbered breadth-first (a copy, in the hierarchy), so that the threads' blocks are
-// compact bands of the mesh whatever the caller's node order: in a mesher's order (TetGen's Steiner
-// points) most couplings crossed blocks, and the board-and-block TetGen mesh of 1M tets on 2 threads
-// took 1,889 CG iterations instead of 35.
+// row-parallel in two passes (count, then fill) so that nothing is built twice, and the work vectors of the
+// cycle are allocated once. The smoother is "hybrid" Gauss-Seidel: each thread sweeps its own contiguous
+// block of rows and takes the values of the other blocks from before the sweep, the backward sweep mirroring
+// the forward one, so one cycle stays a symmetric positive definite operator (and is plain symmetric
+// Gauss-Seidel on one thread). The fine matrix is first renumbered breadth-first (a copy, in the hierarchy),
+// so that the threads' blocks are compact bands of the mesh whatever the caller's node order: in a mesher's
+// order (TetGen's Steiner points) most couplings crossed blocks, and the board-and-block TetGen mesh of 1M
+// tets on 2 threads took 1,889 CG iterations instead of 35.
 #pragma once
 
 #include <cstddef>

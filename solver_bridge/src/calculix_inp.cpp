@@ -248,8 +248,8 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
                quadratic ? "C3D10" : "C3D4");
   write_nodes_and_elements(out, mesh, mat.regions.ids, quadratic ? &edges : nullptr);
   for (std::size_t i = 0; i < mat.regions.size(); ++i) {
-    std::fprintf(out, "*MATERIAL, NAME=M%zu\n*ELASTIC\n%.14g, %.14g\n*EXPANSION\n%.14g\n", i + 1, mat.young[i],
-                 mat.poisson[i], mat.expansion[i]);
+    std::fprintf(out, "*MATERIAL, NAME=M%zu\n*ELASTIC\n%.14g, %.14g\n*EXPANSION\n%.14g\n", i + 1,
+                 mat.young[i], mat.poisson[i], mat.expansion[i]);
     std::fprintf(out, "*SOLID SECTION, ELSET=%s, MATERIAL=M%zu\n", elset_name(i).c_str(), i + 1);
   }
   // Values with 14 significant digits: ccx reads at most 20 characters per field.
@@ -270,18 +270,22 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
         continue;
       }
       taken[axis] = true;
-      std::snprintf(line, sizeof line, "%zu, %d, %d, %.14g\n", v + 1, axis + 1, axis + 1, q[axis] * fr.g[3 * v + a]);
+      std::snprintf(line, sizeof line, "%zu, %d, %d, %.14g\n", v + 1, axis + 1, axis + 1,
+                    q[axis] * fr.g[3 * v + a]);
       boundary += line;
     }
     for (int a : general) {
       const double* q = &fr.r[9 * v + 3 * a];
       if (fr.g[3 * v + a] != 0)
-        throw SolverInputError("CalculiX deck: node " + std::to_string(v) +
-                          " has a non-zero displacement prescribed along a direction that is no coordinate axis");
+        throw SolverInputError(
+            "CalculiX deck: node " + std::to_string(v) +
+            " has a non-zero displacement prescribed along a direction that is no coordinate axis");
       int dep = -1;
       for (int c = 0; c < 3; ++c)
         if (!taken[c] && std::abs(q[c]) > 1e-3 && (dep < 0 || std::abs(q[c]) > std::abs(q[dep]))) dep = c;
-      if (dep < 0) throw SolverInputError("CalculiX deck: no free component for the constraint at node " + std::to_string(v));
+      if (dep < 0)
+        throw SolverInputError("CalculiX deck: no free component for the constraint at node " +
+                               std::to_string(v));
       taken[dep] = true;
       int terms = 0;
       std::string row;
@@ -299,7 +303,8 @@ void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& p
   if (!equation.empty()) std::fprintf(out, "*EQUATION\n%s", equation.c_str());
   // Thermal strain alpha (T - T_initial): the reference temperature is the initial condition.
   const double tref = params.temperature.empty() ? 0.0 : params.reference_temperature;
-  std::fprintf(out, "*INITIAL CONDITIONS, TYPE=TEMPERATURE\nNALL, %.14g\n*STEP\n*STATIC\n*TEMPERATURE\n", tref);
+  std::fprintf(out, "*INITIAL CONDITIONS, TYPE=TEMPERATURE\nNALL, %.14g\n*STEP\n*STATIC\n*TEMPERATURE\n",
+               tref);
   if (params.temperature.empty()) {
     std::fprintf(out, "NALL, %.14g\n", tref + params.delta_t);
   } else {

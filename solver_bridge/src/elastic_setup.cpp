@@ -58,8 +58,8 @@ Vec3 plane_normal(const Mesh& mesh, std::int32_t tag) {
       const double off = dot({p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]}, n);
       if (std::abs(off) > tol)
         throw SolverInputError("sliding " + tag_label(mesh, tag) + " is not planar: node " +
-                          std::to_string(mesh.bface[3 * f + i]) + " lies " + std::to_string(off) +
-                          " m off the plane of its triangles; sliding needs one plane per tag");
+                               std::to_string(mesh.bface[3 * f + i]) + " lies " + std::to_string(off) +
+                               " m off the plane of its triangles; sliding needs one plane per tag");
     }
   }
   return n;
@@ -93,8 +93,9 @@ void build_frame(const Mesh& mesh, std::uint32_t v, const Constraint* c, std::si
         const Vec3 x = point(mesh, v);
         char where[96];
         std::snprintf(where, sizeof where, " (%.6g, %.6g, %.6g)", x[0], x[1], x[2]);
-        throw SolverInputError("contradictory displacement constraints at node " + std::to_string(v) + where +
-                          ": a sliding plane or a fixed component asks for another value than the others");
+        throw SolverInputError(
+            "contradictory displacement constraints at node " + std::to_string(v) + where +
+            ": a sliding plane or a fixed component asks for another value than the others");
       }
       continue;
     }
@@ -150,35 +151,36 @@ ElasticMaterials elastic_materials(const Mesh& mesh, const ThermoelasticParams& 
 std::vector<double> tet_temperature_change(const Mesh& mesh, const ThermoelasticParams& params) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   std::vector<double> tet_dt(nt, params.delta_t);
-check_finite(params.delta_t, "temperature change");
-if (!params.temperature.empty()) {
-  if (params.temperature.size() != nn)
-    throw SolverInputError("the temperature field has " + std::to_string(params.temperature.size()) +
-                      " values for " + std::to_string(nn) + " nodes");
-  check_finite(params.reference_temperature, "reference temperature");
-  for (std::size_t t = 0; t < nt; ++t) {
-    double s = 0;
-    for (int a = 0; a < 4; ++a) {
-      const std::uint32_t v = mesh.tet[4 * t + a];
-      if (!std::isfinite(params.temperature[v]))
-        throw SolverInputError("the temperature of node " + std::to_string(v) + " (used by tet " +
-                          std::to_string(t) + ") is not a finite number");
-      s += params.temperature[v];
+  check_finite(params.delta_t, "temperature change");
+  if (!params.temperature.empty()) {
+    if (params.temperature.size() != nn)
+      throw SolverInputError("the temperature field has " + std::to_string(params.temperature.size()) +
+                             " values for " + std::to_string(nn) + " nodes");
+    check_finite(params.reference_temperature, "reference temperature");
+    for (std::size_t t = 0; t < nt; ++t) {
+      double s = 0;
+      for (int a = 0; a < 4; ++a) {
+        const std::uint32_t v = mesh.tet[4 * t + a];
+        if (!std::isfinite(params.temperature[v]))
+          throw SolverInputError("the temperature of node " + std::to_string(v) + " (used by tet " +
+                                 std::to_string(t) + ") is not a finite number");
+        s += params.temperature[v];
+      }
+      tet_dt[t] = s / 4 - params.reference_temperature;
     }
-    tet_dt[t] = s / 4 - params.reference_temperature;
   }
-}
   return tet_dt;
 }
 
-NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& params, const std::vector<char>& used) {
+NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& params,
+                               const std::vector<char>& used) {
   const std::size_t nn = mesh.node_count(), nf = mesh.bface_count();
   const std::vector<std::int32_t> tags = boundary_tag_list(mesh);
   std::map<std::int32_t, int> bc_kind;  // 1 fixed, 2 sliding
   auto claim = [&](std::int32_t tag, int kind, const char* name) {
     if (!std::binary_search(tags.begin(), tags.end(), tag))
       throw SolverInputError(std::string(name) + " condition on " + tag_label(mesh, tag) +
-                        ", which tags no boundary triangle");
+                             ", which tags no boundary triangle");
     if (!bc_kind.emplace(tag, kind).second)
       throw SolverInputError(tag_label(mesh, tag) + " has more than one boundary condition");
   };

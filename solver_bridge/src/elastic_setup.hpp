@@ -42,7 +42,8 @@ struct NodeFrames {
 // of the values where fixed tags meet) and params.sliding (the tag's plane normal, value 0), Gram-
 // Schmidt orthonormalised per node. SolverError on an unknown tag, a tag with two conditions, a sliding
 // tag that is not planar, contradictory constraints at a node.
-NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& params, const std::vector<char>& used);
+NodeFrames displacement_frames(const Mesh& mesh, const ThermoelasticParams& params,
+                               const std::vector<char>& used);
 
 // The unique edges of the tets (the mid-edge nodes of 10-node tets): edge e joins nodes a[e] < b[e],
 // edges sorted by (a, b); tet t's k-th edge joins its corners kTetEdge[k] (the C3D10 order 01, 12, 20,

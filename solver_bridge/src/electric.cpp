@@ -23,9 +23,9 @@ struct ElectrodeSolve {
   std::vector<double> coefficient;  // per region, scaled (eps0 eps_r or sigma); 0 for metal
   std::vector<char> metal;          // per region (electrostatics)
   std::vector<double> region_volume;
-  std::vector<double> area;                 // per electrode
-  std::vector<std::vector<double>> unit;    // per electrode: nodal potential with 1 V on it
-  std::vector<std::vector<double>> matrix;  // M[i][j]: energy form a(u_i, u_j)
+  std::vector<double> area;                                // per electrode
+  std::vector<std::vector<double>> unit;                   // per electrode: nodal potential with 1 V on it
+  std::vector<std::vector<double>> matrix;                 // M[i][j]: energy form a(u_i, u_j)
   std::vector<std::vector<std::int32_t>> electrode_metal;  // per electrode: metal regions in it
   struct Floating {
     std::vector<std::int32_t> regions;
@@ -45,14 +45,16 @@ SymmetricCsr merged_system(const P1Stiffness& k, const std::vector<int>& dof, st
   const std::size_t nn = dof.size();
   std::vector<std::size_t> count(ndof + 1, 0);
   for (std::size_t v = 0; v < nn; ++v)
-    if (dof[v] >= 0) count[static_cast<std::size_t>(dof[v]) + 1] += k.pat.row_start[v + 1] - k.pat.row_start[v];
+    if (dof[v] >= 0)
+      count[static_cast<std::size_t>(dof[v]) + 1] += k.pat.row_start[v + 1] - k.pat.row_start[v];
   for (std::size_t i = 0; i < ndof; ++i) count[i + 1] += count[i];
   std::vector<std::pair<int, double>> entries(count[ndof]);
   std::vector<std::size_t> at(count.begin(), count.end() - 1);
   for (std::size_t v = 0; v < nn; ++v) {
     if (dof[v] < 0) continue;
     for (std::size_t p = k.pat.row_start[v]; p < k.pat.row_start[v + 1]; ++p)
-      if (const int c = dof[k.pat.col[p]]; c >= 0) entries[at[static_cast<std::size_t>(dof[v])]++] = {c, k.val[p]};
+      if (const int c = dof[k.pat.col[p]]; c >= 0)
+        entries[at[static_cast<std::size_t>(dof[v])]++] = {c, k.val[p]};
   }
   SymmetricCsr a;
   a.start.assign(ndof + 1, 0);
@@ -98,8 +100,8 @@ std::vector<std::vector<double>> energy_matrix(const Mesh& mesh, const RegionTab
       }
       for (std::size_t i = 0; i < ne; ++i)
         for (std::size_t j = 0; j <= i; ++j)
-          part[th][i * ne + j] +=
-              cv * (grad[3 * i] * grad[3 * j] + grad[3 * i + 1] * grad[3 * j + 1] + grad[3 * i + 2] * grad[3 * j + 2]);
+          part[th][i * ne + j] += cv * (grad[3 * i] * grad[3 * j] + grad[3 * i + 1] * grad[3 * j + 1] +
+                                        grad[3 * i + 2] * grad[3 * j + 2]);
     }
   });
   std::vector<std::vector<double>> m(ne, std::vector<double>(ne, 0.0));
@@ -134,7 +136,8 @@ std::vector<std::vector<double>> flattened(const Mesh& mesh, const std::vector<s
     // The value of each flat set: an electrode's where it touches one, else its root's.
     std::vector<double> value(nn, std::numeric_limits<double>::quiet_NaN());
     for (std::size_t v = 0; v < nn; ++v)
-      if (set[v] != UINT32_MAX && electrode_of[v] != UINT32_MAX) value[set[v]] = electrode_of[v] == j ? 1.0 : 0.0;
+      if (set[v] != UINT32_MAX && electrode_of[v] != UINT32_MAX)
+        value[set[v]] = electrode_of[v] == j ? 1.0 : 0.0;
     for (std::size_t v = 0; v < nn; ++v) {
       if (set[v] == UINT32_MAX) continue;
       if (std::isnan(value[set[v]])) value[set[v]] = u[set[v]];
@@ -172,7 +175,7 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   const std::size_t ne = electrodes.size(), nn = mesh.node_count(), nt = mesh.tet_count();
   if (ne == 0)
     throw SolverInputError("ill-posed " + problem + ": no " + kind +
-                      " is given, so the potential is undetermined; name at least one");
+                           " is given, so the potential is undetermined; name at least one");
   const std::vector<std::int32_t> tags = boundary_tag_list(mesh);
   std::map<std::int32_t, FixedTag> fixed_tags;
   for (std::size_t e = 0; e < ne; ++e) {
@@ -184,11 +187,11 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
     for (std::int32_t tag : el.tags) {
       if (!std::binary_search(tags.begin(), tags.end(), tag))
         throw SolverInputError(kind + " '" + el.name + "' is on " + tag_label(mesh, tag) +
-                          ", which tags no boundary triangle");
+                               ", which tags no boundary triangle");
       auto [it, inserted] = fixed_tags.emplace(tag, FixedTag{static_cast<double>(e), e});
       if (!inserted && it->second.slot != e)
         throw SolverInputError(tag_label(mesh, tag) + " belongs to two " + kind + "s ('" +
-                          electrodes[it->second.slot].name + "' and '" + el.name + "')");
+                               electrodes[it->second.slot].name + "' and '" + el.name + "')");
     }
   }
   std::vector<double> tet_c(nt);
@@ -203,9 +206,9 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
   std::vector<std::uint32_t> owner(nn, UINT32_MAX);
   for (const Dirichlet::Share& sh : d.shares) {
     if (owner[sh.node] != UINT32_MAX && owner[sh.node] != sh.slot)
-      throw SolverInputError(kind + "s '" + electrodes[owner[sh.node]].name + "' and '" + electrodes[sh.slot].name +
-                        "' touch (node " + std::to_string(sh.node) +
-                        " is on both): they would be one electrode; merge them or separate them");
+      throw SolverInputError(kind + "s '" + electrodes[owner[sh.node]].name + "' and '" +
+                             electrodes[sh.slot].name + "' touch (node " + std::to_string(sh.node) +
+                             " is on both): they would be one electrode; merge them or separate them");
     owner[sh.node] = sh.slot;
   }
   // Metal bodies: the connected sets of metal tets (through shared nodes).
@@ -228,9 +231,10 @@ ElectrodeSolve solve_electrodes(const Mesh& mesh, const std::vector<Electrode>& 
       if (owner[v] == UINT32_MAX) continue;
       if (it->second == UINT32_MAX) it->second = owner[v];
       if (it->second != owner[v])
-        throw SolverInputError("conductors '" + electrodes[it->second].name + "' and '" + electrodes[owner[v]].name +
-                          "' are joined by metal (the body containing node " + std::to_string(v) +
-                          "): they are one conductor; merge them, or make the metal a dielectric");
+        throw SolverInputError("conductors '" + electrodes[it->second].name + "' and '" +
+                               electrodes[owner[v]].name +
+                               "' are joined by metal (the body containing node " + std::to_string(v) +
+                               "): they are one conductor; merge them, or make the metal a dielectric");
     }
     for (std::size_t t = 0; t < nt; ++t)
       if (s.metal[s.regions.tet_rix[t]]) {
@@ -343,12 +347,13 @@ std::vector<BalanceCheck> maxwell_matrix_checks(const std::vector<std::vector<do
         sign = std::max(sign, m[i][j] / std::sqrt(m[i][i] * m[j][j]));
   }
   if (ne > 1)
-    checks.push_back(make_check("Kirchhoff", "largest |column sum| / largest |entry| of the matrix (" + flow +
-                                                 " into all electrodes with one at 1 V must add to 0)",
+    checks.push_back(make_check("Kirchhoff",
+                                "largest |column sum| / largest |entry| of the matrix (" + flow +
+                                    " into all electrodes with one at 1 V must add to 0)",
                                 kirchhoff, tolerance));
   checks.push_back(make_check("Maxwell signs",
-                              "largest positive off-diagonal M_ij / sqrt(M_ii M_jj) (inf: a diagonal <= 0)", sign,
-                              tolerance));
+                              "largest positive off-diagonal M_ij / sqrt(M_ii M_jj) (inf: a diagonal <= 0)",
+                              sign, tolerance));
   checks.push_back(make_check("residual", "largest |b - A x|_k / A_kk per volt applied, over the solves",
                               residual, tolerance));
   return checks;
@@ -364,7 +369,8 @@ std::vector<BalanceCheck> electrode_checks(const ElectrodeSolve& s, const Linear
   const double tol = std::max(1e-6, 100 * o.relative_tolerance);
   std::vector<BalanceCheck> checks = maxwell_matrix_checks(s.matrix, s.residual, tol, flow);
   scale = std::max(scale, field);
-  checks.push_back(make_check("energy", energy_what, scale > 0 ? std::abs(reported - field) / scale : 0.0, tol));
+  checks.push_back(
+      make_check("energy", energy_what, scale > 0 ? std::abs(reported - field) / scale : 0.0, tol));
   return checks;
 }
 
@@ -444,8 +450,9 @@ ElectrostaticReport solve_electrostatic(Mesh& mesh, const ElectrostaticParams& p
   (void)detail::cell_gradients(mesh, s.regions, s.coefficient, u, 1.0, threads, &e2);
   for (double v : e2) rep.field_energy += 0.5 * v;
   rep.residual = s.residual;
-  rep.checks = electrode_checks(s, params.solver, "the charges", "|1/2 sum Q V - field energy| / field energy",
-                                rep.energy, qv, rep.field_energy);
+  rep.checks =
+      electrode_checks(s, params.solver, "the charges", "|1/2 sum Q V - field energy| / field energy",
+                       rep.energy, qv, rep.field_energy);
   // In a metal body the field is zero (its tets have no coefficient): write that, not the gradient of
   // the round-off.
   std::vector<double> field = detail::cell_gradients(mesh, s.regions, one, u, -1.0, threads, nullptr);

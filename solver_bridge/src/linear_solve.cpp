@@ -46,8 +46,8 @@ double weighted_norm(const std::vector<double>& v, const std::vector<double>& w)
   return std::sqrt(s);
 }
 
-std::vector<double> residual(const SymmetricCsr& a, const std::vector<double>& b, const std::vector<double>& x,
-                             unsigned threads) {
+std::vector<double> residual(const SymmetricCsr& a, const std::vector<double>& b,
+                             const std::vector<double>& x, unsigned threads) {
   std::vector<double> r(b.size());
   multiply(a, x.data(), r.data(), threads);
   for (std::size_t i = 0; i < b.size(); ++i) r[i] = b[i] - r[i];
@@ -165,13 +165,15 @@ namespace {
 void require_finite_input(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs) {
   for (double v : a.val)
     if (!std::isfinite(v))
-      throw SolverInputError("the system matrix holds NaN or infinity (mesh geometry or coefficients beyond the "
-                        "range of double)");
+      throw SolverInputError(
+          "the system matrix holds NaN or infinity (mesh geometry or coefficients beyond the "
+          "range of double)");
   for (const std::vector<double>& b : bs)
     for (double v : b)
       if (!std::isfinite(v))
-        throw SolverInputError("the right-hand side holds NaN or infinity (loads or geometry beyond the range of "
-                          "double)");
+        throw SolverInputError(
+            "the right-hand side holds NaN or infinity (loads or geometry beyond the range of "
+            "double)");
 }
 
 void require_finite_output(const std::vector<std::vector<double>>& xs, const LinearSolveResult& result) {
@@ -198,7 +200,8 @@ struct SpdSolver::Impl {
   Impl(const SymmetricCsr& m, const LinearSolverOptions& o) : a(m), options(o) {}
 };
 
-SpdSolver::SpdSolver(const SymmetricCsr& a, const LinearSolverOptions& options, const NearNullSpace* near_null)
+SpdSolver::SpdSolver(const SymmetricCsr& a, const LinearSolverOptions& options,
+                     const NearNullSpace* near_null)
     : impl_(std::make_unique<Impl>(a, options)) {
   Impl& s = *impl_;
   const std::size_t n = a.rows();
@@ -330,7 +333,8 @@ namespace {
 
 LinearSolveResult solve_spd_many_unchecked(const SymmetricCsr& a, const std::vector<std::vector<double>>& bs,
                                            std::vector<std::vector<double>>& xs,
-                                           const LinearSolverOptions& options, const NearNullSpace* near_null) {
+                                           const LinearSolverOptions& options,
+                                           const NearNullSpace* near_null) {
   SpdSolver solver(a, options, near_null);
   LinearSolveResult result;
   result.solver = solver.name();

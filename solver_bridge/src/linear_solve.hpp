@@ -56,7 +56,8 @@ LinearSolveResult solve_spd_many(const SymmetricCsr& a, const std::vector<std::v
 // for NaN (the caller's results do).
 class SpdSolver {
  public:
-  SpdSolver(const SymmetricCsr& a, const LinearSolverOptions& options, const NearNullSpace* near_null = nullptr);
+  SpdSolver(const SymmetricCsr& a, const LinearSolverOptions& options,
+            const NearNullSpace* near_null = nullptr);
   ~SpdSolver();
   SpdSolver(const SpdSolver&) = delete;
   SpdSolver& operator=(const SpdSolver&) = delete;

@@ -14,8 +14,8 @@ std::vector<std::int32_t> surface_tags(const BoundaryCondition& c, const Mesh& m
     for (const Boundary& b : mesh.boundaries)
       if (b.name == s) found = &b;
     if (found == nullptr)
-      throw SolverInputError(std::string(condition_kind_name(c.kind)) + " condition (line " + std::to_string(c.line) +
-                        "): the mesh has no boundary named '" + s + "'");
+      throw SolverInputError(std::string(condition_kind_name(c.kind)) + " condition (line " +
+                             std::to_string(c.line) + "): the mesh has no boundary named '" + s + "'");
     tags.push_back(found->tag);
   }
   return tags;
@@ -36,7 +36,8 @@ ThermalParams thermal_params_from_model(const Model& model, const Mesh& mesh) {
   for (const Load& l : model.loads) {
     if (l.kind != LoadKind::power) continue;
     for (std::size_t i = 0; i < model.parts.size(); ++i)
-      if (model.parts[i].name == l.part) p.sources.push_back({static_cast<std::int32_t>(i + 1), l.value, l.total});
+      if (model.parts[i].name == l.part)
+        p.sources.push_back({static_cast<std::int32_t>(i + 1), l.value, l.total});
   }
   return p;
 }
@@ -46,7 +47,8 @@ namespace {
 std::vector<Electrode> electrodes(const Model& model, const Mesh& mesh, Physics physics) {
   std::vector<Electrode> out;
   for (const BoundaryCondition& c : model.conditions) {
-    if ((c.kind != ConditionKind::voltage && c.kind != ConditionKind::current) || !condition_applies(c, physics))
+    if ((c.kind != ConditionKind::voltage && c.kind != ConditionKind::current) ||
+        !condition_applies(c, physics))
       continue;
     Electrode e;
     e.name = c.name;
@@ -102,19 +104,19 @@ ThermoelasticParams thermoelastic_params_from_model(const Model& model, const Me
       if (!l.part.empty() && model.parts[i].name != l.part) continue;
       if (!std::isnan(part_dt[i]) && part_dt[i] != l.value)
         throw SolverInputError("temperature_change load (line " + std::to_string(l.line) + "): part '" +
-                          model.parts[i].name + "' already has a temperature change of " +
-                          std::to_string(part_dt[i]) + " K");
+                               model.parts[i].name + "' already has a temperature change of " +
+                               std::to_string(part_dt[i]) + " K");
       part_dt[i] = l.value;
     }
   }
   if (first_line == 0) return p;
   for (std::size_t i = 0; i < model.parts.size(); ++i)
     if (std::isnan(part_dt[i]) || part_dt[i] != part_dt[0])
-      throw SolverInputError("temperature_change load (line " + std::to_string(first_line) +
-                        "): the thermal stress solver takes one uniform temperature change; part '" +
-                        model.parts[i].name + "' has " +
-                        (std::isnan(part_dt[i]) ? std::string("none") : std::to_string(part_dt[i]) + " K") +
-                        ", part '" + model.parts[0].name + "' " + std::to_string(part_dt[0]) + " K");
+      throw SolverInputError(
+          "temperature_change load (line " + std::to_string(first_line) +
+          "): the thermal stress solver takes one uniform temperature change; part '" + model.parts[i].name +
+          "' has " + (std::isnan(part_dt[i]) ? std::string("none") : std::to_string(part_dt[i]) + " K") +
+          ", part '" + model.parts[0].name + "' " + std::to_string(part_dt[0]) + " K");
   p.delta_t = part_dt[0];
   return p;
 }

@@ -290,7 +290,8 @@ std::string results_json(const RunResults& r) {
   }
   o += "],\n \"texts\": [";
   for (std::size_t i = 0; i < r.texts.size(); ++i)
-    o += std::string(i ? ", " : "") + "{\"name\": " + jstr(r.texts[i].name) + ", \"text\": " + jstr(r.texts[i].text) + "}";
+    o += std::string(i ? ", " : "") + "{\"name\": " + jstr(r.texts[i].name) +
+         ", \"text\": " + jstr(r.texts[i].text) + "}";
   o += "],\n \"checks\": [";
   for (std::size_t i = 0; i < r.checks.size(); ++i) {
     const BalanceCheck& c = r.checks[i];

@@ -67,8 +67,8 @@ std::vector<double> region_coefficients(const Mesh& mesh, const RegionTable& reg
                                         const std::vector<std::pair<std::int32_t, double>>& overrides,
                                         const std::string& what, const std::string& hint) {
   return region_values(
-      mesh, regions, from_material, overrides, what, hint,
-      [](double v) { return v > 0 && std::isfinite(v); }, "positive and finite");
+      mesh, regions, from_material, overrides, what, hint, [](double v) { return v > 0 && std::isfinite(v); },
+      "positive and finite");
 }
 
 std::vector<double> region_values(const Mesh& mesh, const RegionTable& regions,
@@ -90,11 +90,11 @@ std::vector<double> region_values(const Mesh& mesh, const RegionTable& regions,
   for (std::size_t i = 0; i < nr; ++i) {
     if (std::isnan(c[i]))
       throw SolverInputError(region_label(mesh, regions.ids[i]) + " has no " + what +
-                        ": its material gives none; set it in " + hint + " " +
-                        std::to_string(regions.ids[i]) + "=VALUE)");
+                             ": its material gives none; set it in " + hint + " " +
+                             std::to_string(regions.ids[i]) + "=VALUE)");
     if (!valid(c[i]))
       throw SolverInputError(what + " of " + region_label(mesh, regions.ids[i]) + " must be " + requirement +
-                        ", not " + std::to_string(c[i]));
+                             ", not " + std::to_string(c[i]));
   }
   return c;
 }
@@ -116,11 +116,12 @@ std::vector<double> tet_volumes(const Mesh& mesh, const RegionTable& regions, un
     for (unsigned th = 0; th < threads; ++th) region_volume[i] += part[th][i];
   for (std::size_t t = 0; t < nt; ++t)
     if (!(vol[t] > 0) || !std::isfinite(vol[t]))
-      throw SolverInputError("tet " + std::to_string(t) + " has " +
-                        (vol[t] > 0 ? "a volume beyond the range of double (" + std::to_string(vol[t]) +
-                                          "; rescale the coordinates)"
-                                    : "non-positive volume " + std::to_string(vol[t]) +
-                                          " (inverted or flat; validate_and_repair() re-orients inverted tets)"));
+      throw SolverInputError(
+          "tet " + std::to_string(t) + " has " +
+          (vol[t] > 0 ? "a volume beyond the range of double (" + std::to_string(vol[t]) +
+                            "; rescale the coordinates)"
+                      : "non-positive volume " + std::to_string(vol[t]) +
+                            " (inverted or flat; validate_and_repair() re-orients inverted tets)"));
   return vol;
 }
 
@@ -183,7 +184,8 @@ Dirichlet dirichlet_from_tags(const Mesh& mesh, const P1Stiffness& k,
   return d;
 }
 
-std::vector<std::uint32_t> tet_set_components(const Mesh& mesh, const std::function<bool(std::size_t)>& keep) {
+std::vector<std::uint32_t> tet_set_components(const Mesh& mesh,
+                                              const std::function<bool(std::size_t)>& keep) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   std::vector<std::uint32_t> parent(nn);
   for (std::size_t v = 0; v < nn; ++v) parent[v] = static_cast<std::uint32_t>(v);
@@ -228,7 +230,7 @@ void check_anchored(const Mesh& mesh, const std::vector<char>& anchored_node, co
   for (std::size_t t = 0; t < nt; ++t)
     if (!anchored[part[mesh.tet[4 * t]]])
       throw SolverInputError(problem + ": the connected part containing tet " + std::to_string(t) + " (" +
-                        region_label(mesh, mesh.region_of(t)) + ") " + what);
+                             region_label(mesh, mesh.region_of(t)) + ") " + what);
 }
 
 ReducedSystem reduce(const P1Stiffness& k, const std::vector<char>& fixed, unsigned threads) {

@@ -58,8 +58,8 @@ Eigen::VectorXd nnls(const Eigen::MatrixXd& a, const Eigen::VectorXd& b) {
 
 void check_samples(std::span<const double> t, std::span<const double> z) {
   if (t.size() != z.size())
-    throw std::invalid_argument("Zth fit: " + std::to_string(t.size()) + " times and " + std::to_string(z.size()) +
-                                " values");
+    throw std::invalid_argument("Zth fit: " + std::to_string(t.size()) + " times and " +
+                                std::to_string(z.size()) + " values");
   if (t.size() < 3) throw std::invalid_argument("Zth fit: needs at least 3 samples");
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (!std::isfinite(t[i]) || !std::isfinite(z[i]))

@@ -121,8 +121,8 @@ ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceS
 // rounded to that relative precision (another program's printout), and the tolerance takes in the
 // largest imbalance that rounding can make (each temperature off by precision |T|: the fixed nodes'
 // reactions by sum |K_vj| precision |T_j|, a convection tag's heat by h A precision |T|).
-void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std::vector<double>& temp, double solver_tolerance,
-                  double precision, ThermalReport& rep) {
+void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std::vector<double>& temp,
+                  double solver_tolerance, double precision, ThermalReport& rep) {
   const detail::CsrPattern& pat = sys.stiff.pat;
   const std::vector<double>& kval = sys.stiff.val;
   const std::vector<char>& fixed = sys.dir.fixed;
@@ -155,7 +155,8 @@ void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std:
   const double scale = std::max(rep.heat_flow, 1e-9 * terms);
   double tolerance = std::max(1e-6, 100 * solver_tolerance);
   if (precision > 0 && scale > 0) tolerance = std::max(tolerance, rounding / scale);
-  rep.checks.push_back(make_check("energy", "|sources + boundary heat in| / the heat that flows through the body",
+  rep.checks.push_back(make_check("energy",
+                                  "|sources + boundary heat in| / the heat that flows through the body",
                                   scale > 0 ? std::abs(rep.imbalance) / scale : 0.0, tolerance));
 }
 
@@ -164,7 +165,7 @@ void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std:
 namespace detail {
 
 ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, ThermalReport& rep,
-                              bool require_anchor) {
+                               bool require_anchor) {
   check_mesh(mesh);
   ThermalSystem sys;
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), nf = mesh.bface_count();
@@ -193,7 +194,7 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
   auto add_bc = [&](std::int32_t tag, BcKind kind, double a, double b, const char* kind_name) {
     if (!std::binary_search(tags.begin(), tags.end(), tag))
       throw SolverInputError(std::string(kind_name) + " condition on " + tag_label(mesh, tag) +
-                        ", which tags no boundary triangle");
+                             ", which tags no boundary triangle");
     TagBc& t = bc[tag];
     if (t.kind != BcKind::none)
       throw SolverInputError(tag_label(mesh, tag) + " has more than one boundary condition");
@@ -212,7 +213,7 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
     check_finite(c.ambient, "ambient temperature on " + tag_label(mesh, c.tag));
     if (!(c.h > 0) || !std::isfinite(c.h))
       throw SolverInputError("convection coefficient h on " + tag_label(mesh, c.tag) +
-                        " must be positive and finite");
+                             " must be positive and finite");
     add_bc(c.tag, BcKind::convection, c.h, c.ambient, "convection");
     has_convection = true;
   }
@@ -252,7 +253,8 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
     if (i == SIZE_MAX)
       throw SolverInputError("heat source given for " + region_label(mesh, s.region) + ", which has no tets");
     check_finite(s.value, "heat source of " + region_label(mesh, s.region));
-    if (source_given[i]) throw SolverInputError(region_label(mesh, s.region) + " has more than one heat source");
+    if (source_given[i])
+      throw SolverInputError(region_label(mesh, s.region) + " has more than one heat source");
     source_given[i] = true;
     region_q[i] = s.total ? s.value / rep.regions[i].volume : s.value;
   }
@@ -306,7 +308,7 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
             const std::size_t pos = pat.find(v[i], v[j]);
             if (pos == SIZE_MAX)
               throw SolverInputError("boundary triangle " + std::to_string(f) + " (" +
-                                tag_label(mesh, mesh.bface_tag[f]) + ") is not a face of any tet");
+                                     tag_label(mesh, mesh.bface_tag[f]) + ") is not a face of any tet");
             kval[pos] +=
                 params.convection_centroid_rule ? t.a * area / 9 : t.a * area / 12 * (i == j ? 2.0 : 1.0);
           }
@@ -330,9 +332,8 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
       auto it = bc.find(mesh.bface_tag[f]);
       if (it != bc.end() && it->second.kind == BcKind::convection) anchored[mesh.bface[3 * f]] = 1;
     }
-    check_anchored(
-        mesh, anchored, "ill-posed thermal problem",
-        "touches no fixed-temperature or convection boundary, so its temperature is undetermined");
+    check_anchored(mesh, anchored, "ill-posed thermal problem",
+                   "touches no fixed-temperature or convection boundary, so its temperature is undetermined");
   }
   return sys;
 }
@@ -353,7 +354,6 @@ void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector
       boundaries[t.report].heat_in += t.a * (t.b - mean) * sys.bface_area[f];
     }
   }
-
 }
 
 void store_temperature(Mesh& mesh, std::vector<double> temp, Field flux) {
@@ -478,7 +478,8 @@ ThermalReport thermal_report(Mesh& mesh, const ThermalParams& params, std::vecto
                       std::to_string(mesh.node_count()) + " nodes");
   for (std::size_t t = 0; t < mesh.tet.size(); ++t)
     if (!std::isfinite(temperature[mesh.tet[t]]))
-      throw SolverError("thermal_report: node " + std::to_string(mesh.tet[t]) + " of a tet has no temperature");
+      throw SolverError("thermal_report: node " + std::to_string(mesh.tet[t]) +
+                        " of a tet has no temperature");
   detail::boundary_heat(mesh, sys, sys.load, temperature, rep.boundaries);
   Field flux_field = detail::region_results(mesh, params, sys, temperature, rep);
   energy_check(mesh, sys, temperature, params.solver.relative_tolerance, precision, rep);

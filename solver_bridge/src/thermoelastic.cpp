@@ -28,25 +28,27 @@ namespace foxi {
 
 namespace {
 
-using detail::parallel_for;
-using detail::region_label;
-using detail::Vec3;
 using detail::cross;
 using detail::dot;
+using detail::parallel_for;
 using detail::point;
+using detail::region_label;
+using detail::Vec3;
 
 // B <- R_left B R_right^T for 3x3 row-major blocks (either rotation may be null: identity).
 void rotate_block(double* b, const double* left, const double* right) {
   double t[9];
   if (left) {
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) t[3 * i + j] = left[3 * i] * b[j] + left[3 * i + 1] * b[3 + j] + left[3 * i + 2] * b[6 + j];
+      for (int j = 0; j < 3; ++j)
+        t[3 * i + j] = left[3 * i] * b[j] + left[3 * i + 1] * b[3 + j] + left[3 * i + 2] * b[6 + j];
     std::copy(t, t + 9, b);
   }
   if (right) {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
-        t[3 * i + j] = b[3 * i] * right[3 * j] + b[3 * i + 1] * right[3 * j + 1] + b[3 * i + 2] * right[3 * j + 2];
+        t[3 * i + j] =
+            b[3 * i] * right[3 * j] + b[3 * i + 1] * right[3 * j + 1] + b[3 * i + 2] * right[3 * j + 2];
     std::copy(t, t + 9, b);
   }
 }
@@ -102,17 +104,18 @@ void check_rigid_modes(const Mesh& mesh, const detail::NodeFrames& fr, const std
       for (double& c : dir)
         if (std::abs(c) < 1e-9) c = 0;
       char text[96];
-      std::snprintf(text, sizeof text, "%s (%.3g, %.3g, %.3g)", t >= w ? "translation along" : "rotation about",
-                    dir[0], dir[1], dir[2]);
+      std::snprintf(text, sizeof text, "%s (%.3g, %.3g, %.3g)",
+                    t >= w ? "translation along" : "rotation about", dir[0], dir[1], dir[2]);
       modes += (modes.empty() ? "" : "; ") + std::string(text);
     }
     if (left == 0) continue;
     std::size_t tet = 0;
     while (root(mesh.tet[4 * tet]) != r) ++tet;
-    throw SolverInputError("ill-posed thermoelastic problem: the connected part containing tet " + std::to_string(tet) +
-                      " (" + region_label(mesh, mesh.region_of(tet)) + ") can still move rigidly, " +
-                      std::to_string(left) + " rigid-body mode" + (left > 1 ? "s" : "") + " left (" + modes +
-                      "); fix displacements or add sliding planes that hold it");
+    throw SolverInputError("ill-posed thermoelastic problem: the connected part containing tet " +
+                           std::to_string(tet) + " (" + region_label(mesh, mesh.region_of(tet)) +
+                           ") can still move rigidly, " + std::to_string(left) + " rigid-body mode" +
+                           (left > 1 ? "s" : "") + " left (" + modes +
+                           "); fix displacements or add sliding planes that hold it");
   }
 }
 
@@ -308,7 +311,8 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
       }
       if (rv) {
         double f[3];
-        for (int i = 0; i < 3; ++i) f[i] = rv[3 * i] * load[3 * v] + rv[3 * i + 1] * load[3 * v + 1] + rv[3 * i + 2] * load[3 * v + 2];
+        for (int i = 0; i < 3; ++i)
+          f[i] = rv[3 * i] * load[3 * v] + rv[3 * i + 1] * load[3 * v + 1] + rv[3 * i + 2] * load[3 * v + 2];
         std::copy(f, f + 3, &load[3 * v]);
       }
     }
@@ -395,8 +399,9 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
     for (int c = 0; c < 3; ++c)
       local[c] = c < mv ? fr.g[3 * v + c] : x[static_cast<std::size_t>(base[v] + c - mv)];
     for (int i = 0; i < 3; ++i)
-      u[3 * v + i] = mv ? fr.r[9 * v + i] * local[0] + fr.r[9 * v + 3 + i] * local[1] + fr.r[9 * v + 6 + i] * local[2]
-                        : local[i];
+      u[3 * v + i] =
+          mv ? fr.r[9 * v + i] * local[0] + fr.r[9 * v + 3 + i] * local[1] + fr.r[9 * v + 6 + i] * local[2]
+             : local[i];
   }
   return u;
 }
@@ -417,7 +422,8 @@ std::pair<std::vector<double>, std::vector<double>> lame_parameters(const std::v
 // tet, per-region and per-interface maxima; stores the fields.
 void finish_report(Mesh& mesh, const ThermoelasticParams& params, const detail::TetEdges& edges,
                    const detail::ElasticMaterials& mat, const std::vector<double>& tet_dt,
-                   const std::vector<char>& used, std::vector<double> u, unsigned threads, ThermoelasticReport& rep) {
+                   const std::vector<char>& used, std::vector<double> u, unsigned threads,
+                   ThermoelasticReport& rep) {
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count();
   const detail::RegionTable& regions = mat.regions;
   const std::vector<double>&young = mat.young, &poisson = mat.poisson, &expansion = mat.expansion;
@@ -425,7 +431,8 @@ void finish_report(Mesh& mesh, const ThermoelasticParams& params, const detail::
   const auto [lame_lambda, lame_mu] = lame_parameters(young, poisson);
   for (std::size_t v = 0; v < nn; ++v) {
     if (!used[v]) continue;
-    const double len = std::sqrt(u[3 * v] * u[3 * v] + u[3 * v + 1] * u[3 * v + 1] + u[3 * v + 2] * u[3 * v + 2]);
+    const double len =
+        std::sqrt(u[3 * v] * u[3 * v] + u[3 * v + 1] * u[3 * v + 1] + u[3 * v + 2] * u[3 * v + 2]);
     if (len >= rep.max_displacement) {
       rep.max_displacement = len;
       rep.max_displacement_node = static_cast<std::uint32_t>(v);
@@ -534,7 +541,6 @@ void finish_report(Mesh& mesh, const ThermoelasticParams& params, const detail::
   detail::set_field(mesh, std::move(stress));
   detail::set_field(mesh, std::move(mises));
   detail::set_field(mesh, std::move(principal));
-
 }
 
 }  // namespace
@@ -606,8 +612,9 @@ ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& 
   if (params.order == 2) edges = detail::tet_edges(mesh);
   const std::size_t solver_nodes = nn + edges.size();
   if (displacement.size() != 3 * solver_nodes)
-    throw SolverInputError("thermoelastic_report: " + std::to_string(displacement.size()) + " displacement values for " +
-                           std::to_string(solver_nodes) + " nodes of 3 components");
+    throw SolverInputError("thermoelastic_report: " + std::to_string(displacement.size()) +
+                           " displacement values for " + std::to_string(solver_nodes) +
+                           " nodes of 3 components");
   std::vector<char> used(solver_nodes, 0);
   for (std::uint32_t v : mesh.tet) used[v] = 1;
   for (std::size_t e = 0; e < edges.size(); ++e) used[nn + e] = 1;
@@ -615,7 +622,8 @@ ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& 
     if (used[v])
       for (int c = 0; c < 3; ++c)
         if (!std::isfinite(displacement[3 * v + c]))
-          throw SolverInputError("thermoelastic_report: node " + std::to_string(v) + " of a tet has no displacement");
+          throw SolverInputError("thermoelastic_report: node " + std::to_string(v) +
+                                 " of a tet has no displacement");
   ThermoelasticReport rep;
   rep.solver = "given";
   finish_report(mesh, params, edges, mat, tet_dt, used, std::move(displacement), threads, rep);

@@ -165,8 +165,10 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
   for (const TransientPower& p : params.power) {
     const std::size_t r = sys.regions.index(p.region);
     if (r == SIZE_MAX)
-      throw SolverInputError("power given for " + detail::region_label(mesh, p.region) + ", which has no tets");
-    if (region_has_power[r]) throw SolverInputError(detail::region_label(mesh, p.region) + " has more than one power");
+      throw SolverInputError("power given for " + detail::region_label(mesh, p.region) +
+                             ", which has no tets");
+    if (region_has_power[r])
+      throw SolverInputError(detail::region_label(mesh, p.region) + " has more than one power");
     region_has_power[r] = 1;
     check_waveform(mesh, p);
     std::vector<double> u(nn, 0.0);
@@ -263,7 +265,8 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
     const double c0 = use_bdf2 ? 1.5 : 1.0;
     const detail::ReducedSystem* sysm = &euler;
     if (use_bdf2) {
-      if (!bdf2) bdf2 = std::make_unique<detail::ReducedSystem>(step_matrix(sys.stiff, mass, c0 / dt, fixed, threads));
+      if (!bdf2)
+        bdf2 = std::make_unique<detail::ReducedSystem>(step_matrix(sys.stiff, mass, c0 / dt, fixed, threads));
       sysm = bdf2.get();
     }
     if (current != (use_bdf2 ? 2u : 1u)) {
@@ -345,8 +348,8 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
   rep.relative_residual = out.relative_residual;
   detail::store_temperature(mesh, std::move(temp), std::move(flux));
   out.setup_seconds = setup_seconds;
-  out.solve_seconds = std::chrono::duration<double>(clock::now() - t_setup).count() - (setup_seconds -
-                      std::chrono::duration<double>(t_setup - t_start).count());
+  out.solve_seconds = std::chrono::duration<double>(clock::now() - t_setup).count() -
+                      (setup_seconds - std::chrono::duration<double>(t_setup - t_start).count());
   return out;
 }
 

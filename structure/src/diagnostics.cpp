@@ -137,12 +137,13 @@ class Diagnoser {
   }
 
   std::int32_t own_marker(std::size_t f) const {
-    return s_.facet_own_marker.size() == s_.plc.facet_count() ? s_.facet_own_marker[f] : s_.plc.facet_marker[f];
+    return s_.facet_own_marker.size() == s_.plc.facet_count() ? s_.facet_own_marker[f]
+                                                              : s_.plc.facet_marker[f];
   }
   const NameInfo* own_info(std::size_t f) const {
     const std::int32_t m = own_marker(f);
     return m >= 1 && static_cast<std::size_t>(m) <= names_.size() ? &names_[static_cast<std::size_t>(m - 1)]
-                                                                   : nullptr;
+                                                                  : nullptr;
   }
 
   // The parts a condition's surface lies on: the part of a face, both parts of an interface, the
@@ -257,7 +258,8 @@ class Diagnoser {
   }
   static double area(const Flat& f) {
     double a = 0;
-    for (std::size_t r = 0; r < f.rings.size(); ++r) a += (r == 0 ? 1 : -1) * std::abs(signed_area(f.rings[r].xy));
+    for (std::size_t r = 0; r < f.rings.size(); ++r)
+      a += (r == 0 ? 1 : -1) * std::abs(signed_area(f.rings[r].xy));
     return a;
   }
   static double area_inside(const Flat& f, const std::vector<double>& hull) {
@@ -294,8 +296,9 @@ class Diagnoser {
       for (const Flat& x : flats)
         if (const NameInfo* o = own_info(x.facet); o->a == part && o->bottom) levels.push_back(x.z);
       std::sort(levels.begin(), levels.end());
-      levels.erase(std::unique(levels.begin(), levels.end(), [&](double a, double b) { return b - a <= tol; }),
-                   levels.end());
+      levels.erase(
+          std::unique(levels.begin(), levels.end(), [&](double a, double b) { return b - a <= tol; }),
+          levels.end());
       for (double z : levels) {
         double exposed = 0, supported = 0, outside = 0;
         std::vector<double> contact;
@@ -352,10 +355,13 @@ class Diagnoser {
   static bool fixes(const BoundaryCondition& c, Physics ph) {
     if (!condition_applies(c, ph)) return false;
     switch (ph) {
-      case Physics::thermal: return c.kind == ConditionKind::temperature || c.kind == ConditionKind::convection;
+      case Physics::thermal:
+        return c.kind == ConditionKind::temperature || c.kind == ConditionKind::convection;
       case Physics::electrostatic:
-      case Physics::current: return c.kind == ConditionKind::voltage;
-      case Physics::thermal_stress: return c.kind == ConditionKind::displacement || c.kind == ConditionKind::sliding;
+      case Physics::current:
+        return c.kind == ConditionKind::voltage;
+      case Physics::thermal_stress:
+        return c.kind == ConditionKind::displacement || c.kind == ConditionKind::sliding;
     }
     return false;
   }
@@ -399,7 +405,8 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0) {
 
 }  // namespace
 
-ModelDiagnostics diagnose_model(const Model& model, const Structure& structure, const DiagnosticsParams& params) {
+ModelDiagnostics diagnose_model(const Model& model, const Structure& structure,
+                                const DiagnosticsParams& params) {
   return Diagnoser(model, structure, params).run();
 }
 
@@ -421,17 +428,18 @@ std::string describe(const ModelWarning& w, const Model& model) {
              "; an edge or a point of contact is none): no heat, current or force passes between " +
              (w.parts.size() == 1 ? "it" : "them") + " and the rest of the model";
     case ModelWarningKind::overhang:
-      return who + " overhangs what it sits on (" + quoted_list(w.supports) + ") at z = " +
-             format("%.6g ", w.z / s) + u + ": " + format("%.4g ", w.area / (s * s)) + u + "^2 (" +
-             format("%.3g%%", 100 * w.fraction) +
+      return who + " overhangs what it sits on (" + quoted_list(w.supports) +
+             ") at z = " + format("%.6g ", w.z / s) + u + ": " + format("%.4g ", w.area / (s * s)) + u +
+             "^2 (" + format("%.3g%%", 100 * w.fraction) +
              ") of its bottom there lies beyond the contact, exposed (insulated unless a condition is on it)";
     case ModelWarningKind::no_fixed_value: {
       const char* what = w.physics == Physics::thermal          ? "temperature or convection"
                          : w.physics == Physics::thermal_stress ? "displacement or sliding"
                                                                 : "voltage or ground";
       return std::string(physics_name(w.physics)) + ": " + who + " (" + vol +
-             (w.parts.size() == 1 ? ") has" : ", joined by interfaces) have") + " no path to a fixed value: no " +
-             what + " condition on any of " + (w.parts.size() == 1 ? "its" : "their") +
+             (w.parts.size() == 1 ? ") has" : ", joined by interfaces) have") +
+             " no path to a fixed value: no " + what + " condition on any of " +
+             (w.parts.size() == 1 ? "its" : "their") +
              " boundaries, so the solution there is fixed only up to a " +
              (w.physics == Physics::thermal_stress ? "rigid motion" : "constant");
     }

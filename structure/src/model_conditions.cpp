@@ -13,13 +13,20 @@ namespace foxi {
 
 const char* condition_kind_name(ConditionKind kind) {
   switch (kind) {
-    case ConditionKind::temperature: return "temperature";
-    case ConditionKind::heat_flux: return "heat_flux";
-    case ConditionKind::convection: return "convection";
-    case ConditionKind::voltage: return "voltage";
-    case ConditionKind::current: return "current";
-    case ConditionKind::displacement: return "displacement";
-    case ConditionKind::sliding: return "sliding";
+    case ConditionKind::temperature:
+      return "temperature";
+    case ConditionKind::heat_flux:
+      return "heat_flux";
+    case ConditionKind::convection:
+      return "convection";
+    case ConditionKind::voltage:
+      return "voltage";
+    case ConditionKind::current:
+      return "current";
+    case ConditionKind::displacement:
+      return "displacement";
+    case ConditionKind::sliding:
+      return "sliding";
   }
   return "?";
 }
@@ -114,7 +121,8 @@ class ConditionReader {
       fail(v, entity + ": expected a number or an expression string");
     if (q.dims == kDimensionless && want != kDimensionless) q = {q.value * bare_scale, want};
     if (q.dims != want)
-      fail(v, entity + ": unit mismatch: expected " + dims_to_string(want) + ", got " + dims_to_string(q.dims));
+      fail(v,
+           entity + ": unit mismatch: expected " + dims_to_string(want) + ", got " + dims_to_string(q.dims));
     if (!std::isfinite(q.value)) fail(v, entity + " is not finite");
     return q.value;
   }
@@ -142,7 +150,8 @@ class ConditionReader {
     const TemperatureKind kind = absolute ? TemperatureKind::absolute : TemperatureKind::difference;
     if (v.is_string()) {
       try {
-        return evaluate_temperature(v.as_string().str, kind, [&](std::string_view n) { return parameter(n); });
+        return evaluate_temperature(v.as_string().str, kind,
+                                    [&](std::string_view n) { return parameter(n); });
       } catch (const ExpressionError& x) {
         fail(v, entity + ": " + x.what());
       }
@@ -150,7 +159,8 @@ class ConditionReader {
     const double t = quantity(v, kTemperature, entity, 1);
     if (absolute && !(t > 0)) {
       char buf[96];
-      std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero (for Celsius write \"%g degC\")", t, t);
+      std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero (for Celsius write \"%g degC\")", t,
+                    t);
       fail(v, entity + buf);
     }
     return t;
@@ -230,7 +240,8 @@ class ConditionReader {
     if (surf.is_string()) {
       bc.surfaces.push_back(surface_name(surf, surf.as_string().str, who));
     } else if (surf.is_array() && !surf.as_array().empty()) {
-      for (const Value& s : surf.as_array()) bc.surfaces.push_back(surface_name(s, text(s, who + " surface"), who));
+      for (const Value& s : surf.as_array())
+        bc.surfaces.push_back(surface_name(s, text(s, who + " surface"), who));
     } else {
       fail(surf, who + ": surface must be a name or an array of names");
     }
@@ -327,8 +338,9 @@ class ConditionReader {
       // TetGen 1.5's refinement did not finish within 5 minutes below sqrt(2) (1.0 and 1.1 on
       // die_on_substrate, 1.2 and 1.3 on die_attach and power_module); mesh_plc refuses it too.
       if (!(mc.quality == 0 || mc.quality >= 1.414))
-        fail(*q, "mesh quality (a radius-edge bound) must be 0 (off) or at least 1.414 (TetGen's refinement "
-                 "does not finish below it on thin layers)");
+        fail(*q,
+             "mesh quality (a radius-edge bound) must be 0 (off) or at least 1.414 (TetGen's refinement "
+             "does not finish below it on thin layers)");
     }
     if (const Value* d = find(v, "min_dihedral")) {
       mc.min_dihedral = quantity(*d, kDimensionless, "mesh min_dihedral", 1);
@@ -339,7 +351,8 @@ class ConditionReader {
       if (!p->is_table()) fail(*p, "mesh parts must be a table { PART = max_size, ... }");
       for (const auto& [name, s] : p->as_table()) {
         if (part_index(name) == m_.parts.size()) fail(s, "mesh parts: unknown part '" + name + "'");
-        mc.part_sizes.push_back({name, positive_length(s, "mesh size of part '" + name + "'"), s.location().line()});
+        mc.part_sizes.push_back(
+            {name, positive_length(s, "mesh size of part '" + name + "'"), s.location().line()});
       }
     }
     if (const Value* r = find(v, "refine")) {

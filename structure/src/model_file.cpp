@@ -97,8 +97,8 @@ namespace lim = model_limits;
 // TOML (toml11 does that next).
 std::pair<std::uint64_t, std::string> toml_nesting(std::string_view s) {
   std::uint64_t line = 1;
-  std::size_t open = 0;  // [ and { of values not yet closed
-  std::vector<bool> inline_table;  // for each open one: a { (keys inside) or a [
+  std::size_t open = 0;             // [ and { of values not yet closed
+  std::vector<bool> inline_table;   // for each open one: a { (keys inside) or a [
   std::size_t header = 0, key = 0;  // dotted parts of the current [header] and of the key being read
   bool at_key = true;  // reading a key: at a line's start outside values, after { or , in an inline table
   auto deep = [&](std::size_t n) -> std::pair<std::uint64_t, std::string> {
@@ -200,8 +200,8 @@ std::uint64_t line_of(const Value& v) {
 }
 
 constexpr Dims kConductivity = {1, 1, -3, -1, 0}, kElectrical = {-3, -1, 3, 0, 2},
-               kModulus = {-1, 1, -2, 0, 0}, kExpansion = {0, 0, 0, -1, 0},
-               kDensity = {-3, 1, 0, 0, 0}, kSpecificHeat = {2, 0, -2, -1, 0};
+               kModulus = {-1, 1, -2, 0, 0}, kExpansion = {0, 0, 0, -1, 0}, kDensity = {-3, 1, 0, 0, 0},
+               kSpecificHeat = {2, 0, -2, -1, 0};
 
 class Loader {
  public:
@@ -237,8 +237,9 @@ class Loader {
                                   std::to_string(loc.column()) + ")"
                             : "TOML syntax: " + toml_summary(e.what()));
     } catch (const std::exception& e) {
-      throw IoError(p.string(), 0, IoError::kNoOffset,
-                    library ? std::string("not a TOML materials library") : "TOML: " + toml_summary(e.what()));
+      throw IoError(
+          p.string(), 0, IoError::kNoOffset,
+          library ? std::string("not a TOML materials library") : "TOML: " + toml_summary(e.what()));
     }
   }
 
@@ -254,9 +255,9 @@ class Loader {
       throw IoError(p.string(), 0, IoError::kNoOffset, "is not a regular file (a device, pipe or socket)");
     const std::uintmax_t size = std::filesystem::file_size(p, ec);
     if (!ec && size > limit)
-      throw IoError(p.string(), 0, IoError::kNoOffset,
-                    "the file has " + std::to_string(size) + " bytes, more than the limit of " +
-                        std::to_string(limit));
+      throw IoError(
+          p.string(), 0, IoError::kNoOffset,
+          "the file has " + std::to_string(size) + " bytes, more than the limit of " + std::to_string(limit));
     std::string data = io::read_file(p);
     if (data.size() > limit)  // it grew since
       throw IoError(p.string(), 0, IoError::kNoOffset,
@@ -385,9 +386,9 @@ class Loader {
     try {
       e.param.value = evaluate(e.param.expression, chain);
     } catch (const ExpressionError& x) {
-      throw Located{
-          e.param.overridden ? 0 : e.line,
-          "parameter '" + name + "'" + (e.param.overridden ? " (from " + origin_ + ")" : "") + ": " + x.what()};
+      throw Located{e.param.overridden ? 0 : e.line,
+                    "parameter '" + name + "'" + (e.param.overridden ? " (from " + origin_ + ")" : "") +
+                        ": " + x.what()};
     }
     e.state = 2;
     return e.param.value;
@@ -613,7 +614,8 @@ class Loader {
         throw Located{line_of(pts), who + " points: expected an array of at least 3 [x, y] points"};
       if (pts.as_array().size() > lim::kOutlinePoints)
         throw Located{line_of(pts), who + " points: " + std::to_string(pts.as_array().size()) +
-                                        " points, more than the limit of " + std::to_string(lim::kOutlinePoints)};
+                                        " points, more than the limit of " +
+                                        std::to_string(lim::kOutlinePoints)};
       std::size_t i = 0;
       for (const Value& q : pts.as_array()) {
         const auto xy = lengths(q, 2, who + " points[" + std::to_string(i++) + "]", false);
@@ -723,7 +725,8 @@ class Loader {
         const long ny = integer(cnt.as_array()[1], who + " count[1]", 1, lim::kArrayItems);
         if (nx * ny > lim::kArrayItems)
           throw Located{line_of(cnt), who + " count: " + std::to_string(nx) + " x " + std::to_string(ny) +
-                                          " items, more than the limit of " + std::to_string(lim::kArrayItems)};
+                                          " items, more than the limit of " +
+                                          std::to_string(lim::kArrayItems)};
         const auto pp = lengths(pitch, 2, who + " pitch", true);
         const Value& item = need(pv, "item", who);
         if (!item.is_table()) throw Located{line_of(item), who + " item must be a table"};
@@ -773,8 +776,9 @@ class Loader {
                               " outline vertices (all prisms and array items), more than the limit of " +
                               std::to_string(lim::kOutlineVertices)};
     if (surface_triangles_ > lim::kSurfaceTriangles)
-      throw Located{line, who + ": the balls and STL surfaces so far have " + std::to_string(surface_triangles_) +
-                              " triangles, more than the limit of " + std::to_string(lim::kSurfaceTriangles)};
+      throw Located{line, who + ": the balls and STL surfaces so far have " +
+                              std::to_string(surface_triangles_) + " triangles, more than the limit of " +
+                              std::to_string(lim::kSurfaceTriangles)};
   }
 
   // Degenerate geometry, refused before CGAL or the mesher see it: a model larger than kMaxLength or
@@ -805,9 +809,9 @@ class Loader {
     for (const Part& p : model_.parts) {
       auto refuse = [&](const std::string& what, double size) {
         throw Located{p.line, "part '" + p.name + "': " + what + " is " + short_number(size / u) + unit +
-                                  ", below the smallest feature foxi meshes, " + short_number(lim::kMinFeature) +
-                                  " of the model's extent (" + short_number(extent / u) + unit +
-                                  "): degenerate geometry"};
+                                  ", below the smallest feature foxi meshes, " +
+                                  short_number(lim::kMinFeature) + " of the model's extent (" +
+                                  short_number(extent / u) + unit + "): degenerate geometry"};
       };
       for (std::size_t k = 0; k < p.prisms.size(); ++k) {
         const Prism& q = p.prisms[k];
@@ -840,7 +844,7 @@ class Loader {
   Model model_;
   std::map<std::string, ParamEntry> params_;
   std::map<std::string, Material> materials_;
-  std::map<std::string, TriSurface> stl_;  // by file, read once
+  std::map<std::string, TriSurface> stl_;                     // by file, read once
   std::size_t outline_vertices_ = 0, surface_triangles_ = 0;  // of the parts so far
 };
 
@@ -851,19 +855,21 @@ Model load_model(const std::filesystem::path& path, std::span<const ParameterOve
   return Loader(path, overrides, origin).load();
 }
 
-std::vector<ParameterOverride> split_overrides(const std::filesystem::path& path, std::span<const std::string> texts,
-                                               std::string_view origin) {
+std::vector<ParameterOverride> split_overrides(const std::filesystem::path& path,
+                                               std::span<const std::string> texts, std::string_view origin) {
   std::vector<ParameterOverride> out;
   for (const std::string& o : texts) {
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw IoError(path.string(), 0, IoError::kNoOffset, std::string(origin) + " '" + o + "': expected name=value");
+      throw IoError(path.string(), 0, IoError::kNoOffset,
+                    std::string(origin) + " '" + o + "': expected name=value");
     out.push_back({o.substr(0, eq), o.substr(eq + 1)});
   }
   return out;
 }
 
-Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides, std::string_view origin) {
+Model load_model(const std::filesystem::path& path, std::span<const std::string> overrides,
+                 std::string_view origin) {
   const std::vector<ParameterOverride> split = split_overrides(path, overrides, origin);
   return load_model(path, split, origin);
 }

@@ -9,10 +9,14 @@ namespace foxi {
 
 const char* physics_name(Physics physics) {
   switch (physics) {
-    case Physics::thermal: return "thermal";
-    case Physics::electrostatic: return "electrostatic";
-    case Physics::current: return "current";
-    case Physics::thermal_stress: return "thermoelastic";  // the name foxi solve --physics takes
+    case Physics::thermal:
+      return "thermal";
+    case Physics::electrostatic:
+      return "electrostatic";
+    case Physics::current:
+      return "current";
+    case Physics::thermal_stress:
+      return "thermoelastic";  // the name foxi solve --physics takes
   }
   return "?";
 }
@@ -21,11 +25,15 @@ bool condition_applies(ConditionKind c, Physics physics) {
   switch (c) {
     case ConditionKind::temperature:
     case ConditionKind::heat_flux:
-    case ConditionKind::convection: return physics == Physics::thermal;
-    case ConditionKind::voltage: return physics == Physics::electrostatic || physics == Physics::current;
-    case ConditionKind::current: return physics == Physics::current;
+    case ConditionKind::convection:
+      return physics == Physics::thermal;
+    case ConditionKind::voltage:
+      return physics == Physics::electrostatic || physics == Physics::current;
+    case ConditionKind::current:
+      return physics == Physics::current;
     case ConditionKind::displacement:
-    case ConditionKind::sliding: return physics == Physics::thermal_stress;
+    case ConditionKind::sliding:
+      return physics == Physics::thermal_stress;
   }
   return false;
 }
@@ -41,9 +49,15 @@ void check_physics(const Model& model, Physics physics) {
   };
   std::vector<Need> needs;
   switch (physics) {
-    case Physics::thermal: needs = {{"thermal_conductivity", &Material::thermal_conductivity}}; break;
-    case Physics::electrostatic: needs = {{"relative_permittivity", &Material::relative_permittivity}}; break;
-    case Physics::current: needs = {{"electrical_conductivity", &Material::electrical_conductivity}}; break;
+    case Physics::thermal:
+      needs = {{"thermal_conductivity", &Material::thermal_conductivity}};
+      break;
+    case Physics::electrostatic:
+      needs = {{"relative_permittivity", &Material::relative_permittivity}};
+      break;
+    case Physics::current:
+      needs = {{"electrical_conductivity", &Material::electrical_conductivity}};
+      break;
     case Physics::thermal_stress:
       needs = {{"youngs_modulus", &Material::youngs_modulus},
                {"poisson_ratio", &Material::poisson_ratio},
@@ -65,8 +79,8 @@ void check_physics(const Model& model, Physics physics) {
                       (c.kind != ConditionKind::sliding || physics == Physics::thermal_stress));
   std::size_t electrodes = 0;
   for (const BoundaryCondition& c : model.conditions)
-    electrodes += (physics == Physics::electrostatic || physics == Physics::current) &&
-                  condition_applies(c, physics);
+    electrodes +=
+        (physics == Physics::electrostatic || physics == Physics::current) && condition_applies(c, physics);
   if (fixes && electrodes == 1)
     throw IoError(model.file, 0, IoError::kNoOffset,
                   std::string("--physics ") + physics_name(physics) +

@@ -57,7 +57,12 @@ bool inside_ring(std::size_t n, At at, double x, double y) {
 }
 
 bool inside_polygon(const std::vector<double>& xy, double x, double y) {  // 2 doubles per vertex
-  return inside_ring(xy.size() / 2, [&](std::size_t i) { return XY{xy[2 * i], xy[2 * i + 1]}; }, x, y);
+  return inside_ring(
+      xy.size() / 2,
+      [&](std::size_t i) {
+        return XY{xy[2 * i], xy[2 * i + 1]};
+      },
+      x, y);
 }
 
 // A planar subdivision by segments: vertices, edges (halfedge 2e runs u -> v, 2e + 1 back; each has
@@ -89,7 +94,8 @@ double cycle_area(const Plane& pl, const std::vector<std::uint32_t>& ring) {
 }
 
 bool in_ring(const Plane& pl, const std::vector<std::uint32_t>& ring, double x, double y) {
-  return inside_ring(ring.size(), [&](std::size_t i) { return pl.from(ring[i]); }, x, y);
+  return inside_ring(
+      ring.size(), [&](std::size_t i) { return pl.from(ring[i]); }, x, y);
 }
 
 void build_plane(Plane& pl, const std::vector<const Prism*>& prisms) {

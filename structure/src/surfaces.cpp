@@ -71,10 +71,10 @@ void tag_selected_surfaces(const Model& model, Structure& s) {
       ++taken;
     }
     if (taken == 0)
-      throw IoError(model.file, sel.line, IoError::kNoOffset,
-                    "surface '" + sel.name + "' picks no outer boundary facet (facets are taken whole: the " +
-                        (sel.plane ? "plane must hold whole part faces" : "box must contain whole part faces") +
-                        ")");
+      throw IoError(
+          model.file, sel.line, IoError::kNoOffset,
+          "surface '" + sel.name + "' picks no outer boundary facet (facets are taken whole: the " +
+              (sel.plane ? "plane must hold whole part faces" : "box must contain whole part faces") + ")");
   }
   // a boundary whose facets all went to selectors keeps its marker with no area
   for (double& a : s.boundary_area)
@@ -99,8 +99,9 @@ void check_conditions(const Model& model, const Structure& s) {
                           "' does not exist in the built structure (parts that do not touch have no "
                           "interface; a face covered entirely by other parts has no outer boundary)");
       if (!(a > 0))
-        throw IoError(model.file, c.line, IoError::kNoOffset,
-                      who + ": surface '" + name + "' has no facets left (a [surfaces] selector took them all)");
+        throw IoError(
+            model.file, c.line, IoError::kNoOffset,
+            who + ": surface '" + name + "' has no facets left (a [surfaces] selector took them all)");
       for (std::size_t j = 0; j < i; ++j) {
         const BoundaryCondition& d = model.conditions[j];
         const bool same_physics = std::any_of(std::begin(kGroups), std::end(kGroups), [&](Physics p) {

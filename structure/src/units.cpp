@@ -194,7 +194,8 @@ class Parser {
       if (n != e.value || std::abs(n) > 20) fail("a quantity with units takes only small integer exponents");
       for (auto& d : base.dims) {
         const int x = d * static_cast<int>(n);
-        if (std::abs(x) > kMaxUnitPower) fail("a unit raised past the power " + std::to_string(kMaxUnitPower));
+        if (std::abs(x) > kMaxUnitPower)
+          fail("a unit raised past the power " + std::to_string(kMaxUnitPower));
         d = static_cast<std::int8_t>(x);
       }
     }
@@ -235,8 +236,9 @@ class Parser {
         if (!uq) {
           p_ = at;
           if (u == "degC")  // an offset unit: only a whole absolute temperature may end with it
-            fail("degC is an absolute temperature with an offset: write it only at the end of a "
-                 "condition's temperature (\"25 degC\"); in expressions use K");
+            fail(
+                "degC is an absolute temperature with an offset: write it only at the end of a "
+                "condition's temperature (\"25 degC\"); in expressions use K");
           fail("unknown unit '" + std::string(u) + "'");
         }
         Quantity unit = *uq;
@@ -351,8 +353,8 @@ double evaluate_in(std::string_view text, std::string_view unit) {
   const Quantity q = evaluate_expression(text, no_names);
   if (q.dims == kDimensionless) return q.value * want.value;  // a bare number: SI
   if (q.dims != want.dims)
-    throw ExpressionError("unit mismatch: '" + std::string(text) + "' is " + dims_to_string(q.dims) + ", not " +
-                          std::string(unit) + " (" + dims_to_string(want.dims) + ")");
+    throw ExpressionError("unit mismatch: '" + std::string(text) + "' is " + dims_to_string(q.dims) +
+                          ", not " + std::string(unit) + " (" + dims_to_string(want.dims) + ")");
   return q.value;
 }
 
@@ -365,7 +367,8 @@ double evaluate_temperature(std::string_view text, TemperatureKind kind,
   while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
   double t = 0;
   bool celsius = false;
-  for (std::string_view suffix : {std::string_view("degC"), std::string_view("\xC2\xB0" "C")}) {
+  for (std::string_view suffix : {std::string_view("degC"), std::string_view("\xC2\xB0"
+                                                                             "C")}) {
     if (s.size() <= suffix.size() || s.substr(s.size() - suffix.size()) != suffix) continue;
     const std::string_view before = s.substr(0, s.size() - suffix.size());
     const Quantity q = evaluate_expression(before, names);
@@ -388,7 +391,8 @@ double evaluate_temperature(std::string_view text, TemperatureKind kind,
     if (celsius)
       std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero", t);
     else
-      std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero (for Celsius write \"%g degC\")", t, t);
+      std::snprintf(buf, sizeof buf, " = %g K is not above absolute zero (for Celsius write \"%g degC\")", t,
+                    t);
     throw ExpressionError("'" + std::string(s) + "'" + buf);
   }
   return t;

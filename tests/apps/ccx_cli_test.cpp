@@ -1,7 +1,7 @@
 // foxi solve MODEL --with ccx and foxi export-ccx, end to end: ccx's temperatures (and displacements,
-// nodal stresses) come back on foxi's mesh and agree with foxi's own solve (recomputed here from the written fields, not taken from the
-// printout); a failing ccx (a stand-in script) or a missing one exits 1 with ccx's own text and the
-// work folder kept; --solver with --with ccx is a usage error.
+// nodal stresses) come back on foxi's mesh and agree with foxi's own solve (recomputed here from the written
+// fields, not taken from the printout); a failing ccx (a stand-in script) or a missing one exits 1 with ccx's
+// own text and the work folder kept; --solver with --with ccx is a usage error.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +12,6 @@
 
 namespace foxi {
 namespace {
-
 
 // The largest |a - b| over the largest |a|, and the latter.
 std::pair<double, double> relative_difference(const Field& a, const Field& b) {
@@ -52,8 +51,8 @@ for n, v in av.items():
     assert abs(x - y) <= 1e-6 * scale, (n, x, y)
 print("compared", len(av), "values, worst", worst)
 )");
-    ASSERT_EQ(test::run("/usr/bin/python3 '" + (dir_ / "cmp.py").string() + "' '" + a.string() + "' '" + b.string() +
-                            "' " + physics,
+    ASSERT_EQ(test::run("/usr/bin/python3 '" + (dir_ / "cmp.py").string() + "' '" + a.string() + "' '" +
+                            b.string() + "' " + physics,
                         dir_ / "cmp.txt"),
               0)
         << test::read_text(dir_ / "cmp.txt");
@@ -72,7 +71,8 @@ TEST_F(CcxCli, SolveWithCcxAgreesWithFoxi) {
   if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
   std::string log;
   const std::string out = (dir_ / "out.vtu").string();
-  ASSERT_EQ(foxi("solve " + model() + " --physics thermal --with ccx --compare -o '" + out + "'", &log), 0) << log;
+  ASSERT_EQ(foxi("solve " + model() + " --physics thermal --with ccx --compare -o '" + out + "'", &log), 0)
+      << log;
   EXPECT_NE(log.find("agree to ccx's output precision"), std::string::npos) << log;
   const Mesh m = read_mesh(out);
   const Field* ccx = m.find_field("temperature");
@@ -92,18 +92,24 @@ TEST_F(CcxCli, SolveWithCcxAgreesWithFoxi) {
 // --json record (parsed by python3), every value to ccx's precision (heats relative to the heat that
 // flows), apart from where the nearly isothermal die's maximum sits and the solver's own figures.
 TEST_F(CcxCli, MeshWithCliConditionsGivesFoxisReport) {
-  if (!test::have_program("ccx") || !test::have_program("/usr/bin/python3")) GTEST_SKIP() << "ccx or python3 missing";
+  if (!test::have_program("ccx") || !test::have_program("/usr/bin/python3"))
+    GTEST_SKIP() << "ccx or python3 missing";
   std::string log, ccx_log;
   const std::string mesh = (dir_ / "d.vtu").string();
   ASSERT_EQ(foxi("mesh " + model() + " -o '" + mesh + "'", &log), 0) << log;
-  const std::string conditions = " --fix substrate.bottom=300K --flux die.top=2000 --power die=0.3W --k substrate=0.5";
-  ASSERT_EQ(foxi("solve '" + mesh + "'" + conditions + " --json '" + (dir_ / "a.json").string() + "'", &log), 0) << log;
-  ASSERT_EQ(foxi("solve '" + mesh + "' --with ccx" + conditions + " --json '" + (dir_ / "b.json").string() + "'",
-                 &ccx_log),
+  const std::string conditions =
+      " --fix substrate.bottom=300K --flux die.top=2000 --power die=0.3W --k substrate=0.5";
+  ASSERT_EQ(foxi("solve '" + mesh + "'" + conditions + " --json '" + (dir_ / "a.json").string() + "'", &log),
             0)
+      << log;
+  ASSERT_EQ(
+      foxi("solve '" + mesh + "' --with ccx" + conditions + " --json '" + (dir_ / "b.json").string() + "'",
+           &ccx_log),
+      0)
       << ccx_log;
-  for (const char* line : {"max temperature ", "\nregions ", "  2 (die)  ", "\nboundaries ", "  1 (substrate.bottom)   fixed",
-                           "  4 (die.top)            flux", "energy balance: sources 0.3 W", "check energy         ok"})
+  for (const char* line :
+       {"max temperature ", "\nregions ", "  2 (die)  ", "\nboundaries ", "  1 (substrate.bottom)   fixed",
+        "  4 (die.top)            flux", "energy balance: sources 0.3 W", "check energy         ok"})
     EXPECT_NE(ccx_log.find(line), std::string::npos) << line << "\n" << ccx_log;
   compare_records(dir_ / "a.json", dir_ / "b.json", "thermal");
   // Without a --fix or --convect ccx is not run: a usage error; a thermoelastic mesh needs a model.
@@ -122,23 +128,28 @@ TEST_F(CcxCli, UnbalancedCcxResultIsUnreliable) {
   real.erase(real.find_last_not_of("\n") + 1);
   const std::filesystem::path bin = dir_ / "bin";
   std::filesystem::create_directories(bin);
-  test::write_text(bin / "ccx", "#!/bin/sh\nsed -i 's/, BF, .*/, BF, 4e7/' \"$2.inp\"\nexec '" + real + "' \"$@\"\n");
+  test::write_text(bin / "ccx",
+                   "#!/bin/sh\nsed -i 's/, BF, .*/, BF, 4e7/' \"$2.inp\"\nexec '" + real + "' \"$@\"\n");
   std::filesystem::permissions(bin / "ccx", std::filesystem::perms::owner_all);
   std::string log;
   const std::string json = (dir_ / "u.json").string();
-  EXPECT_EQ(foxi("solve " + model() + " --with ccx --json '" + json + "'", &log, "PATH='" + bin.string() + "':\"$PATH\" "),
+  EXPECT_EQ(foxi("solve " + model() + " --with ccx --json '" + json + "'", &log,
+                 "PATH='" + bin.string() + "':\"$PATH\" "),
             4)
       << log;
   EXPECT_NE(log.find("check energy         FAIL"), std::string::npos) << log;
   EXPECT_NE(log.find("UNRELIABLE"), std::string::npos) << log;
-  EXPECT_NE(test::read_text(json).find("\"status\": \"unreliable\""), std::string::npos) << test::read_text(json);
+  EXPECT_NE(test::read_text(json).find("\"status\": \"unreliable\""), std::string::npos)
+      << test::read_text(json);
 }
 
 // On a terminal (script(1) gives it one) ccx's progress shows as it runs.
 TEST_F(CcxCli, ProgressOnATerminal) {
-  if (!test::have_program("ccx") || !test::have_program("script")) GTEST_SKIP() << "ccx or script not installed";
-  const int rc = test::run("script -qec \"'" + test::cli_path() + "' solve " + model() + " --with ccx\" /dev/null",
-                           dir_ / "tty.txt");
+  if (!test::have_program("ccx") || !test::have_program("script"))
+    GTEST_SKIP() << "ccx or script not installed";
+  const int rc =
+      test::run("script -qec \"'" + test::cli_path() + "' solve " + model() + " --with ccx\" /dev/null",
+                dir_ / "tty.txt");
   const std::string log = test::read_text(dir_ / "tty.txt");
   ASSERT_EQ(rc, 0) << log;
   EXPECT_NE(log.find("ccx: iteration 1"), std::string::npos) << log;
@@ -153,10 +164,11 @@ TEST_F(CcxCli, ThermoelasticWithCcxAgreesWithFoxiAndRenders) {
   if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
   std::string log;
   const std::string out = (dir_ / "s.vtu").string();
-  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --temperature-from-thermal --compare -o '" +
-                     out + "'",
-                 &log),
-            0)
+  ASSERT_EQ(
+      foxi("solve " + model() +
+               " --physics thermoelastic --with ccx --temperature-from-thermal --compare -o '" + out + "'",
+           &log),
+      0)
       << log;
   const Mesh m = read_mesh(out);
   const Field* u = m.find_field("displacement");
@@ -169,23 +181,29 @@ TEST_F(CcxCli, ThermoelasticWithCcxAgreesWithFoxiAndRenders) {
   EXPECT_GT(hi, 1e-8);
   EXPECT_LT(rel, 1e-5);
   const std::string png = (dir_ / "s.png").string();
-  ASSERT_EQ(foxi("render '" + out + "' --field stress_nodal --size 480x320 -o '" + png + "'", &log), 0) << log;
+  ASSERT_EQ(foxi("render '" + out + "' --field stress_nodal --size 480x320 -o '" + png + "'", &log), 0)
+      << log;
   EXPECT_TRUE(std::filesystem::exists(png));
 }
 
 // The model's thermal stress by foxi and by ccx: the same report lines and record (von Mises per
 // region and interface from ccx's displacements).
 TEST_F(CcxCli, ThermoelasticWithCcxGivesFoxisReport) {
-  if (!test::have_program("ccx") || !test::have_program("/usr/bin/python3")) GTEST_SKIP() << "ccx or python3 missing";
+  if (!test::have_program("ccx") || !test::have_program("/usr/bin/python3"))
+    GTEST_SKIP() << "ccx or python3 missing";
   std::string log;
-  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --json '" + (dir_ / "a.json").string() + "'", &log), 0)
+  ASSERT_EQ(
+      foxi("solve " + model() + " --physics thermoelastic --json '" + (dir_ / "a.json").string() + "'", &log),
+      0)
       << log;
-  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --json '" + (dir_ / "b.json").string() + "'",
+  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --json '" +
+                     (dir_ / "b.json").string() + "'",
                  &log),
             0)
       << log;
-  for (const char* line : {"linear thermoelasticity by ccx (C3D4)", "\nmax von Mises stress ", "\nmax displacement ",
-                           "\nregions:\n  1 (substrate)        E 2.2e+10", "material interfaces (tets touching them):"})
+  for (const char* line :
+       {"linear thermoelasticity by ccx (C3D4)", "\nmax von Mises stress ", "\nmax displacement ",
+        "\nregions:\n  1 (substrate)        E 2.2e+10", "material interfaces (tets touching them):"})
     EXPECT_NE(log.find(line), std::string::npos) << line << "\n" << log;
   compare_records(dir_ / "a.json", dir_ / "b.json", "thermoelastic");
 }
@@ -196,7 +214,10 @@ TEST_F(CcxCli, QuadraticThermoelasticWithCcxAgreesWithFoxi) {
   if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
   std::string log;
   const std::string out = (dir_ / "q.vtu").string();
-  ASSERT_EQ(foxi("solve " + model() + " --physics thermoelastic --with ccx --order 2 --compare -o '" + out + "'", &log), 0)
+  ASSERT_EQ(
+      foxi("solve " + model() + " --physics thermoelastic --with ccx --order 2 --compare -o '" + out + "'",
+           &log),
+      0)
       << log;
   EXPECT_NE(log.find("linear thermoelasticity by ccx (C3D10)"), std::string::npos) << log;
   EXPECT_NE(log.find("\nmax von Mises stress "), std::string::npos) << log;  // from the mid-edge nodes too
@@ -215,12 +236,14 @@ TEST_F(CcxCli, InterruptStopsCcxAndRemovesTheWorkFolder) {
   if (!test::have_program("ccx")) GTEST_SKIP() << "ccx not installed";
   const auto tmp = dir_ / "tmp";
   std::filesystem::create_directories(tmp);
-  test::write_text(dir_ / "stop.sh",
-                   "TMPDIR='" + tmp.string() + "' '" + test::cli_path() + "' solve " + model() +
-                       " --physics thermoelastic --with ccx --order 2 -o '" + (dir_ / "never.vtu").string() +
-                       "' &\npid=$!\n"
-                       "for i in $(seq 600); do ls '" + tmp.string() + "'/*/stress.inp > /dev/null 2>&1 && break; sleep 0.05; done\n"
-                       "sleep 0.5\nkill -INT $pid\nwait $pid\necho $?\n");
+  test::write_text(dir_ / "stop.sh", "TMPDIR='" + tmp.string() + "' '" + test::cli_path() + "' solve " +
+                                         model() + " --physics thermoelastic --with ccx --order 2 -o '" +
+                                         (dir_ / "never.vtu").string() +
+                                         "' &\npid=$!\n"
+                                         "for i in $(seq 600); do ls '" +
+                                         tmp.string() +
+                                         "'/*/stress.inp > /dev/null 2>&1 && break; sleep 0.05; done\n"
+                                         "sleep 0.5\nkill -INT $pid\nwait $pid\necho $?\n");
   ASSERT_EQ(test::run("bash '" + (dir_ / "stop.sh").string() + "'", dir_ / "stop.log"), 0);
   const std::string log = test::read_text(dir_ / "stop.log");
   EXPECT_NE(log.find("stopped by SIGINT"), std::string::npos) << log;
@@ -239,13 +262,15 @@ TEST_F(CcxCli, ExportWritesTheDeck) {
   EXPECT_NE(text.find("*END STEP"), std::string::npos);
   if (!test::have_program("ccx")) return;
   // ccx runs the exported deck as it is.
-  ASSERT_EQ(test::run("cd '" + dir_.path().string() + "' && OMP_NUM_THREADS=1 ccx -i deck", dir_ / "ccx.log"), 0);
+  ASSERT_EQ(test::run("cd '" + dir_.path().string() + "' && OMP_NUM_THREADS=1 ccx -i deck", dir_ / "ccx.log"),
+            0);
   EXPECT_TRUE(std::filesystem::exists(dir_ / "deck.frd"));
   // The thermal-stress deck too: ccx runs it and writes displacements and stresses.
   const std::string stress = (dir_ / "stress.inp").string();
   ASSERT_EQ(foxi("export-ccx " + model() + " --physics thermoelastic -o '" + stress + "'", &log), 0) << log;
   EXPECT_NE(test::read_text(stress).find("*EXPANSION"), std::string::npos);
-  ASSERT_EQ(test::run("cd '" + dir_.path().string() + "' && OMP_NUM_THREADS=1 ccx -i stress", dir_ / "ccx.log"), 0);
+  ASSERT_EQ(
+      test::run("cd '" + dir_.path().string() + "' && OMP_NUM_THREADS=1 ccx -i stress", dir_ / "ccx.log"), 0);
   const std::string frd = test::read_text(dir_ / "stress.frd");
   EXPECT_NE(frd.find("DISP"), std::string::npos);
   EXPECT_NE(frd.find("STRESS"), std::string::npos);
@@ -256,10 +281,13 @@ TEST_F(CcxCli, FailingOrMissingCcxExitsOneWithItsText) {
   std::string log;
   const std::filesystem::path bin = dir_ / "bin";
   std::filesystem::create_directories(bin);
-  test::write_text(bin / "ccx", "#!/bin/sh\necho ' *ERROR reading *NODE: something ccx-specific'\nexit 201\n");
+  test::write_text(bin / "ccx",
+                   "#!/bin/sh\necho ' *ERROR reading *NODE: something ccx-specific'\nexit 201\n");
   std::filesystem::permissions(bin / "ccx", std::filesystem::perms::owner_all);
   const std::string out = (dir_ / "never.vtu").string();
-  EXPECT_EQ(foxi("solve " + model() + " --with ccx -o '" + out + "'", &log, "PATH='" + bin.string() + "':\"$PATH\" "), 1);
+  EXPECT_EQ(foxi("solve " + model() + " --with ccx -o '" + out + "'", &log,
+                 "PATH='" + bin.string() + "':\"$PATH\" "),
+            1);
   EXPECT_NE(log.find("something ccx-specific"), std::string::npos) << log;
   const std::size_t at = log.find("kept in ");
   ASSERT_NE(at, std::string::npos) << log;

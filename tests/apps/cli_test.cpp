@@ -60,11 +60,15 @@ TEST(Cli, InfoCountsMatchGmsh) {
   if (!test::have_program("gmsh")) GTEST_SKIP();
   test::TempDir dir;
   test::write_text(dir / "b.geo", kTwoBoxes);
-  ASSERT_EQ(test::run("gmsh -3 '" + (dir / "b.geo").string() + "' -format msh41 -bin -o '" + (dir / "b.msh").string() + "'",
-                      dir / "gmsh.log"), 0);
+  ASSERT_EQ(test::run("gmsh -3 '" + (dir / "b.geo").string() + "' -format msh41 -bin -o '" +
+                          (dir / "b.msh").string() + "'",
+                      dir / "gmsh.log"),
+            0);
   // gmsh re-saves its own mesh as ASCII 2.2: the independent count.
   ASSERT_EQ(test::run("gmsh -nopopup '" + (dir / "b.msh").string() + "' -save -format msh22 -o '" +
-                          (dir / "g.msh").string() + "'", dir / "gmsh2.log"), 0);
+                          (dir / "g.msh").string() + "'",
+                      dir / "gmsh2.log"),
+            0);
   GmshCounts want = count_msh22(test::read_text(dir / "g.msh"));
   ASSERT_GT(want.tets, 100);
   Result r = foxi_cli("info --json '" + (dir / "b.msh").string() + "'", dir);
@@ -72,20 +76,24 @@ TEST(Cli, InfoCountsMatchGmsh) {
   // Python's JSON parser reads the output and prints the counts.
   test::write_text(dir / "info.json", r.out);
   const auto py = dir / "py.log";
-  ASSERT_EQ(test::run("/usr/bin/python3 -c \"import json; d = json.load(open('" + (dir / "info.json").string() +
-                          "')); print(d['nodes'], d['tets'], d['boundary_triangles'], round(d['volume'], 9), "
-                          "sorted(r['name'] for r in d['regions']))\"",
-                      py), 0);
+  ASSERT_EQ(
+      test::run("/usr/bin/python3 -c \"import json; d = json.load(open('" + (dir / "info.json").string() +
+                    "')); print(d['nodes'], d['tets'], d['boundary_triangles'], round(d['volume'], 9), "
+                    "sorted(r['name'] for r in d['regions']))\"",
+                py),
+      0);
   std::string got = test::read_text(py);
-  EXPECT_EQ(got, std::to_string(want.nodes) + " " + std::to_string(want.tets) + " " + std::to_string(want.triangles) +
-                     " 2.0 ['left', 'right']\n");
+  EXPECT_EQ(got, std::to_string(want.nodes) + " " + std::to_string(want.tets) + " " +
+                     std::to_string(want.triangles) + " 2.0 ['left', 'right']\n");
 }
 
 TEST(Cli, InfoCountsMatchTetgen) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
-  std::filesystem::copy(std::string(FOXI_TEST_DATA_DIR) + "/../../examples/die_on_substrate.poly", dir / "d.poly");
-  ASSERT_EQ(test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a2e-9AO0 d.poly", dir / "tetgen.log"), 0);
+  std::filesystem::copy(std::string(FOXI_TEST_DATA_DIR) + "/../../examples/die_on_substrate.poly",
+                        dir / "d.poly");
+  ASSERT_EQ(
+      test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a2e-9AO0 d.poly", dir / "tetgen.log"), 0);
   // TetGen prints its own statistics.
   std::string log = test::read_text(dir / "tetgen.log");
   std::smatch m;
@@ -105,19 +113,22 @@ TEST(Cli, ConvertRoundTripsThroughEveryFormat) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
   std::filesystem::copy(std::string(FOXI_TEST_DATA_DIR) + "/../../examples/trench.poly", dir / "t.poly");
-  ASSERT_EQ(test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a0.01O0 t.poly", dir / "tetgen.log"), 0);
+  ASSERT_EQ(
+      test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a0.01O0 t.poly", dir / "tetgen.log"), 0);
   Result base = foxi_cli("info --json '" + (dir / "t.1.ele").string() + "'", dir);
   ASSERT_EQ(base.status, 0) << base.out;
   auto counts = [](const std::string& json) {
     std::smatch m;
-    std::regex_search(json, m, std::regex("\"nodes\": (\\d+),\\s*\"tets\": (\\d+),\\s*\"boundary_triangles\": (\\d+)"));
+    std::regex_search(
+        json, m, std::regex("\"nodes\": (\\d+),\\s*\"tets\": (\\d+),\\s*\"boundary_triangles\": (\\d+)"));
     return m.str(0);
   };
   std::string want = counts(base.out);
   ASSERT_FALSE(want.empty());
   for (std::string out : {"a.msh", "b.vtu", "c.vtk", "d.mesh", "e.node"}) {
     std::string extra = out == "a.msh" ? "--msh-version 2.2 --ascii" : "";
-    Result c = foxi_cli("convert '" + (dir / "t.1.ele").string() + "' '" + (dir / out).string() + "' " + extra, dir);
+    Result c =
+        foxi_cli("convert '" + (dir / "t.1.ele").string() + "' '" + (dir / out).string() + "' " + extra, dir);
     ASSERT_EQ(c.status, 0) << out << ": " << c.out;
     Result i = foxi_cli("info --json '" + (dir / out).string() + "'", dir);
     ASSERT_EQ(i.status, 0) << out << ": " << i.out;
@@ -127,8 +138,10 @@ TEST(Cli, ConvertRoundTripsThroughEveryFormat) {
 
 TEST(Cli, BadInputNamesFileAndLineAndLeavesNoOutput) {
   test::TempDir dir;
-  test::write_text(dir / "bad.msh", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n3 1 0 2\n1\n2\n0 0 zero\n");
-  Result r = foxi_cli("convert '" + (dir / "bad.msh").string() + "' '" + (dir / "out.vtu").string() + "'", dir);
+  test::write_text(dir / "bad.msh",
+                   "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n3 1 0 2\n1\n2\n0 0 zero\n");
+  Result r =
+      foxi_cli("convert '" + (dir / "bad.msh").string() + "' '" + (dir / "out.vtu").string() + "'", dir);
   EXPECT_EQ(r.status, 3);
   EXPECT_NE(r.out.find("bad.msh:"), std::string::npos) << r.out;
   EXPECT_FALSE(std::filesystem::exists(dir / "out.vtu"));
@@ -157,11 +170,13 @@ TEST(Cli, OrderReportsZeroViolationsOnDelaunayMesh) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
   std::filesystem::copy(std::string(FOXI_TEST_DATA_DIR) + "/../../examples/trench.poly", dir / "t.poly");
-  ASSERT_EQ(test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a0.002O0 t.poly", dir / "tetgen.log"), 0);
+  ASSERT_EQ(
+      test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a0.002O0 t.poly", dir / "tetgen.log"), 0);
   Result r = foxi_cli("order '" + (dir / "t.1.ele").string() + "' --views 12 --check", dir);
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("total       0 violations over 12 views"), std::string::npos) << r.out;
-  Result s = foxi_cli("order '" + (dir / "t.1.ele").string() + "' --views 6 --subset box:0,0,0,1,1,0.6 --check", dir);
+  Result s = foxi_cli(
+      "order '" + (dir / "t.1.ele").string() + "' --views 6 --subset box:0,0,0,1,1,0.6 --check", dir);
   EXPECT_EQ(s.status, 0) << s.out;
   // The centroid baseline gets some wrong on the same mesh.
   Result c = foxi_cli("order '" + (dir / "t.1.ele").string() + "' --views 12 --method centroid --check", dir);

@@ -55,7 +55,8 @@ class DeformCli : public ::testing::Test {
   Framebuffer render(const std::filesystem::path& file, const std::string& args, const std::string& name,
                      std::string* log) {
     const auto png = dir_ / (name + ".png");
-    EXPECT_EQ(foxi("render '" + file.string() + "' " + args + " --size 320x200 -o '" + png.string() + "'", log), 0)
+    EXPECT_EQ(
+        foxi("render '" + file.string() + "' " + args + " --size 320x200 -o '" + png.string() + "'", log), 0)
         << *log;
     return read_png(png);
   }
@@ -97,7 +98,8 @@ TEST_F(DeformCli, UniformDisplacementIsTheCameraMovedBack) {
 TEST_F(DeformCli, ShearedMeshIsDrawnWithTheDepthBufferAsTheTestDeformsIt) {
   const std::string cam = "--eye -7,-9,8 --at 3,2,1 --up 0,0,1 --fov 40";
   std::string log;
-  const Framebuffer deformed = render(path_, cam + " --deform shear:1.5 --field temperature", "deformed", &log);
+  const Framebuffer deformed =
+      render(path_, cam + " --deform shear:1.5 --field temperature", "deformed", &log);
   EXPECT_NE(log.find("MPVO order with the depth buffer"), std::string::npos) << log;
   EXPECT_NE(log.find("NOT Delaunay"), std::string::npos) << log;
   // The same deformation done here, written, and drawn without --deform.

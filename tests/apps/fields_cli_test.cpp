@@ -43,8 +43,9 @@ TEST_F(FieldsCli, ListNamesLocationComponentsStepsUnitsAndRanges) {
   ASSERT_EQ(foxi("fields list '" + test::data_dir() + "/fields/ccx_two_steps.frd'", &log), 0) << log;
   EXPECT_NE(log.find("DISP             node, 3 components, 2 steps (1 .. 2)"), std::string::npos) << log;
   EXPECT_NE(log.find("STRESS           node, 6 components"), std::string::npos) << log;
-  EXPECT_NE(log.find("NDTEMP           node, 1 component, 2 steps (1 .. 2), unit -, values 310 .. 330, 0 NaN"),
-            std::string::npos)
+  EXPECT_NE(
+      log.find("NDTEMP           node, 1 component, 2 steps (1 .. 2), unit -, values 310 .. 330, 0 NaN"),
+      std::string::npos)
       << log;
   // A binary .frd written by ccx 2.21 (tests/data/fields/README.md).
   ASSERT_EQ(foxi("fields list '" + test::data_dir() + "/fields/ccx221_beam10psmooth_binary.frd'", &log), 0)
@@ -55,18 +56,22 @@ TEST_F(FieldsCli, ListNamesLocationComponentsStepsUnitsAndRanges) {
 
 TEST_F(FieldsCli, ImportByLocationIsExactAndRenders) {
   std::string log;
-  ASSERT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " -o " + p("out.vtu"), &log), 0) << log;
+  ASSERT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " -o " + p("out.vtu"), &log), 0)
+      << log;
   EXPECT_NE(log.find("by location"), std::string::npos) << log;
   EXPECT_NE(log.find("outside the source mesh: 0 nodes"), std::string::npos) << log;
   const Mesh out = read_mesh(dir_ / "out.vtu");
   const Field* t = out.find_field("temperature");
   ASSERT_NE(t, nullptr);
   EXPECT_EQ(t->unit, "K");
-  for (std::size_t i = 0; i < out.node_count(); ++i) EXPECT_NEAR(t->values[i], linear(&out.xyz[3 * i]), 1e-11);
-  ASSERT_EQ(foxi("render " + p("out.vtu") + " --field temperature --size 480x320 -o " + p("t.png"), &log), 0) << log;
+  for (std::size_t i = 0; i < out.node_count(); ++i)
+    EXPECT_NEAR(t->values[i], linear(&out.xyz[3 * i]), 1e-11);
+  ASSERT_EQ(foxi("render " + p("out.vtu") + " --field temperature --size 480x320 -o " + p("t.png"), &log), 0)
+      << log;
   EXPECT_TRUE(std::filesystem::file_size(dir_ / "t.png") > 1000);
   // The same mesh again: by id (the default when counts agree), bit for bit.
-  ASSERT_EQ(foxi("fields import " + p("out.vtu") + " " + p("out.vtu") + " -o " + p("again.vtu"), &log), 0) << log;
+  ASSERT_EQ(foxi("fields import " + p("out.vtu") + " " + p("out.vtu") + " -o " + p("again.vtu"), &log), 0)
+      << log;
   EXPECT_NE(log.find("by id"), std::string::npos) << log;
   EXPECT_EQ(read_mesh(dir_ / "again.vtu").find_field("temperature")->values, t->values);
   // Another mesh with the target's counts (other jitter): the default goes by location and says so.
@@ -75,7 +80,8 @@ TEST_F(FieldsCli, ImportByLocationIsExactAndRenders) {
   for (std::size_t i = 0; i < twin.node_count(); ++i) tt.values.push_back(linear(&twin.xyz[3 * i]));
   twin.fields = {tt};
   write_mesh(twin, dir_ / "twin.vtu");
-  ASSERT_EQ(foxi("fields import " + p("target.vtu") + " " + p("twin.vtu") + " -o " + p("t2.vtu"), &log), 0) << log;
+  ASSERT_EQ(foxi("fields import " + p("target.vtu") + " " + p("twin.vtu") + " -o " + p("t2.vtu"), &log), 0)
+      << log;
   EXPECT_NE(log.find("matching by location"), std::string::npos) << log;
   const Mesh t2 = read_mesh(dir_ / "t2.vtu");
   for (std::size_t i = 0; i < t2.node_count(); ++i)
@@ -86,18 +92,22 @@ TEST_F(FieldsCli, CsvAndOutsidePoints) {
   // Node ids 1..3 of the target, one unknown column layout; then the same table with an id beyond it.
   test::write_text(dir_ / "t.csv", "id,heat [W]\n1,5\n2,6\n3,7\n");
   std::string log;
-  ASSERT_EQ(foxi("fields import " + p("target.vtu") + " " + p("t.csv") + " -o " + p("o.vtu"), &log), 0) << log;
+  ASSERT_EQ(foxi("fields import " + p("target.vtu") + " " + p("t.csv") + " -o " + p("o.vtu"), &log), 0)
+      << log;
   const Mesh o = read_mesh(dir_ / "o.vtu");
   EXPECT_EQ(o.find_field("heat")->values[2], 7);
   const std::size_t missing = o.node_count() - 3;
-  EXPECT_NE(log.find("without a source value: " + std::to_string(missing) + " nodes"), std::string::npos) << log;
+  EXPECT_NE(log.find("without a source value: " + std::to_string(missing) + " nodes"), std::string::npos)
+      << log;
   EXPECT_NE(log.find("NaN values: " + std::to_string(missing)), std::string::npos) << log;
   // Nearest outside: a target reaching beyond the source box gets no NaN.
   Mesh big = bench::kuhn_grid_mesh(3, 0.0, 1);
   for (double& x : big.xyz) x = 1.4 * x - 0.2;
   write_mesh(big, dir_ / "big.vtu");
-  ASSERT_EQ(foxi("fields import " + p("big.vtu") + " " + p("source.vtu") + " --outside nearest -o " + p("n.vtu"), &log),
-            0)
+  ASSERT_EQ(
+      foxi("fields import " + p("big.vtu") + " " + p("source.vtu") + " --outside nearest -o " + p("n.vtu"),
+           &log),
+      0)
       << log;
   EXPECT_NE(log.find("NaN values: 0"), std::string::npos) << log;
   EXPECT_EQ(log.find("outside the source mesh: 0 nodes"), std::string::npos) << log;
@@ -106,7 +116,9 @@ TEST_F(FieldsCli, CsvAndOutsidePoints) {
 TEST_F(FieldsCli, MismatchesAndBrokenFilesExitThreeAndWriteNothing) {
   std::string log;
   // A field over another mesh with --by id.
-  EXPECT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --by id -o " + p("x.vtu"), &log), 3);
+  EXPECT_EQ(
+      foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --by id -o " + p("x.vtu"), &log),
+      3);
   EXPECT_NE(log.find("different mesh"), std::string::npos) << log;
   // An id the mesh lacks; a non-numeric cell; a truncated .frd.
   test::write_text(dir_ / "far.csv", "id,t\n1,2\n100000,3\n");
@@ -127,11 +139,16 @@ TEST_F(FieldsCli, MismatchesAndBrokenFilesExitThreeAndWriteNothing) {
             std::string::npos)
       << log;
   // A field that is not there.
-  EXPECT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --field nope -o " + p("x.vtu"), &log), 3);
+  EXPECT_EQ(
+      foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --field nope -o " + p("x.vtu"),
+           &log),
+      3);
   EXPECT_NE(log.find("no field 'nope'"), std::string::npos) << log;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.vtu"));
   // Usage mistakes.
-  EXPECT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --outside far -o " + p("x.vtu")), 2);
+  EXPECT_EQ(
+      foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " --outside far -o " + p("x.vtu")),
+      2);
   EXPECT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu")), 2);
   EXPECT_EQ(foxi("fields frobnicate"), 2);
   EXPECT_FALSE(std::filesystem::exists(dir_ / "x.vtu"));

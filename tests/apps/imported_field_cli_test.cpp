@@ -36,19 +36,22 @@ class ImportedFieldCli : public ::testing::Test {
 TEST_F(ImportedFieldCli, RefineFromAndMovieTakeAnImportedField) {
   std::string log;
   ASSERT_EQ(foxi("mesh " + model() + " -o " + p("c.vtu"), &log), 0) << log;
-  ASSERT_EQ(foxi("solve " + p("c.vtu") + " --fix substrate.bottom=300K --power die=0.5W -o " + p("s.vtu"), &log), 0)
+  ASSERT_EQ(
+      foxi("solve " + p("c.vtu") + " --fix substrate.bottom=300K --power die=0.5W -o " + p("s.vtu"), &log), 0)
       << log;
-  ASSERT_EQ(foxi("fields import " + p("c.vtu") + " " + p("s.vtu") + " --by id --field temperature -o " + p("i.vtu"), &log),
-            0)
+  ASSERT_EQ(
+      foxi("fields import " + p("c.vtu") + " " + p("s.vtu") + " --by id --field temperature -o " + p("i.vtu"),
+           &log),
+      0)
       << log;
   std::string from_solved, from_imported;
-  ASSERT_EQ(foxi("mesh " + model() + " --refine-from " + p("s.vtu") + " --field temperature --target-error 0.3 -o " +
-                     p("r1.vtu"),
+  ASSERT_EQ(foxi("mesh " + model() + " --refine-from " + p("s.vtu") +
+                     " --field temperature --target-error 0.3 -o " + p("r1.vtu"),
                  &from_solved),
             0)
       << from_solved;
-  ASSERT_EQ(foxi("mesh " + model() + " --refine-from " + p("i.vtu") + " --field temperature --target-error 0.3 -o " +
-                     p("r2.vtu"),
+  ASSERT_EQ(foxi("mesh " + model() + " --refine-from " + p("i.vtu") +
+                     " --field temperature --target-error 0.3 -o " + p("r2.vtu"),
                  &from_imported),
             0)
       << from_imported;
@@ -91,10 +94,14 @@ TEST_F(ImportedFieldCli, RefineFromAndMovieTakeAnImportedField) {
   EXPECT_LT(rel, 2) << err;
   EXPECT_TRUE(std::filesystem::exists(dir_ / "r3.vtu"));
 
-  ASSERT_EQ(foxi("movie " + p("part.vtu") + " --field temperature --frames 2 --size 320x240 -o " + p("m.gif"), &log), 0)
+  ASSERT_EQ(foxi("movie " + p("part.vtu") + " --field temperature --frames 2 --size 320x240 -o " + p("m.gif"),
+                 &log),
+            0)
       << log;
   EXPECT_GT(std::filesystem::file_size(dir_ / "m.gif"), 1000u);
-  ASSERT_EQ(foxi("render " + p("part.vtu") + " --field temperature --graded --size 320x240 -o " + p("p.png"), &log), 0)
+  ASSERT_EQ(
+      foxi("render " + p("part.vtu") + " --field temperature --graded --size 320x240 -o " + p("p.png"), &log),
+      0)
       << log;
   EXPECT_TRUE(std::filesystem::exists(dir_ / "p.png"));
 }

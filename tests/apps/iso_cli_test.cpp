@@ -24,14 +24,16 @@ class IsoCli : public ::testing::Test {
   void SetUp() override {
     mesh = test::grid_mesh(8, 4, 3, 1, 1, 1, 6);
     Field t{"temperature", FieldLocation::node, 1, "K", {}, {}};
-    for (std::size_t n = 0; n < mesh.node_count(); ++n) t.values.push_back(300 + 10 * mesh.xyz[3 * n]);  // 300..380 K
+    for (std::size_t n = 0; n < mesh.node_count(); ++n)
+      t.values.push_back(300 + 10 * mesh.xyz[3 * n]);  // 300..380 K
     mesh.fields = {t};
     path_ = dir_ / "grid.vtu";
     write_mesh(mesh, path_);
     for (std::size_t i = 0; i < mesh.tet.size(); ++i) corner.push_back(300 + 10 * mesh.xyz[3 * mesh.tet[i]]);
   }
   int foxi(const std::string& args, std::string* out = nullptr) {
-    const int status = test::run("'" + test::cli_path() + "' render '" + path_.string() + "' " + args, dir_ / "log.txt");
+    const int status =
+        test::run("'" + test::cli_path() + "' render '" + path_.string() + "' " + args, dir_ / "log.txt");
     if (out) *out = test::read_text(dir_ / "log.txt");
     return status;
   }
@@ -68,10 +70,11 @@ TEST_F(IsoCli, IsothermsSeenAlongTheGradientShowTheNearestValueHotOrCold) {
     const auto png = dir_ / "iso.png";
     std::string log;
     // 50 and 80 °C: the planes x = 2.315 and x = 5.315.
-    ASSERT_EQ(foxi("--field temperature --iso 50,80 --iso-only --range 20,110 --legend off --size 200x160 --dir " +
-                       std::string(from_hot ? "-1,0,0" : "1,0,0") + " -o '" + png.string() + "'",
-                   &log),
-              0)
+    ASSERT_EQ(
+        foxi("--field temperature --iso 50,80 --iso-only --range 20,110 --legend off --size 200x160 --dir " +
+                 std::string(from_hot ? "-1,0,0" : "1,0,0") + " -o '" + png.string() + "'",
+             &log),
+        0)
         << log;
     std::size_t want = 0;  // tets crossed by either value
     {

@@ -22,14 +22,20 @@ namespace {
 TEST(MeshCgalCli, ModelMeshedCertifiedOrderedAndWeightsReadByMeshio) {
   test::TempDir dir;
   const std::string foxi = test::cli_path(), models = test::data_dir() + "/../../models/";
-  ASSERT_EQ(test::run(foxi + " model plc " + models + "die_on_substrate.toml -o " + (dir / "d.poly").string(), dir / "plc.log"), 0);
-  ASSERT_EQ(test::run(foxi + " mesh " + (dir / "d.poly").string() + " --mesher cgal -o " + (dir / "d.vtu").string(), dir / "mesh.log"), 0)
+  ASSERT_EQ(test::run(foxi + " model plc " + models + "die_on_substrate.toml -o " + (dir / "d.poly").string(),
+                      dir / "plc.log"),
+            0);
+  ASSERT_EQ(
+      test::run(foxi + " mesh " + (dir / "d.poly").string() + " --mesher cgal -o " + (dir / "d.vtu").string(),
+                dir / "mesh.log"),
+      0)
       << test::read_text(dir / "mesh.log");
   const std::string log = test::read_text(dir / "mesh.log");
   EXPECT_NE(log.find("regular (weighted Delaunay): yes"), std::string::npos) << log;
   EXPECT_NE(log.find("dihedral min"), std::string::npos) << log;
 
-  ASSERT_EQ(test::run(foxi + " order " + (dir / "d.vtu").string() + " --views 12 --check", dir / "order.log"), 0);
+  ASSERT_EQ(test::run(foxi + " order " + (dir / "d.vtu").string() + " --views 12 --check", dir / "order.log"),
+            0);
   const std::string order = test::read_text(dir / "order.log");
   EXPECT_NE(order.find(" 0 violations over 12 views"), std::string::npos) << order;
 
@@ -57,10 +63,11 @@ TEST(MeshCgalCli, ModelMeshedCertifiedOrderedAndWeightsReadByMeshio) {
 TEST(MeshCgalCli, ModelFileWithSetKeepsPartVolumesAndNames) {
   test::TempDir dir;
   const std::string models = test::data_dir() + "/../../models/";
-  ASSERT_EQ(test::run(test::cli_path() + " mesh " + models + "die_on_substrate.toml --set die_w=3mm --mesher cgal -o " +
-                          (dir / "d.vtu").string(),
-                      dir / "mesh.log"),
-            0)
+  ASSERT_EQ(
+      test::run(test::cli_path() + " mesh " + models +
+                    "die_on_substrate.toml --set die_w=3mm --mesher cgal -o " + (dir / "d.vtu").string(),
+                dir / "mesh.log"),
+      0)
       << test::read_text(dir / "mesh.log");
   EXPECT_NE(test::read_text(dir / "mesh.log").find("regular (weighted Delaunay): yes"), std::string::npos);
   const Mesh m = read_mesh(dir / "d.vtu");
@@ -71,7 +78,8 @@ TEST(MeshCgalCli, ModelFileWithSetKeepsPartVolumesAndNames) {
     const double a[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
     const double b[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
     const double c[3] = {p[3][0] - p[0][0], p[3][1] - p[0][1], p[3][2] - p[0][2]};
-    const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+    const double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                       a[2] * (b[0] * c[1] - b[1] * c[0]);
     for (const Region& r : m.regions)
       if (r.id == m.region_of(t)) volume[r.name] += std::abs(det) / 6;
   }
@@ -81,8 +89,11 @@ TEST(MeshCgalCli, ModelFileWithSetKeepsPartVolumesAndNames) {
   EXPECT_NEAR(volume["substrate"], 10e-3 * 8e-3 * 1e-3, 1e-9 * 8e-8);
   // A model's [mesh] max_size of 1 mm bounds the cells: no tet is larger than the regular tet's 0.118 mm^3.
   double largest = 0;
-  for (std::size_t t = 0; t < m.tet_count(); ++t) largest = std::max(largest, std::abs(tet_quality(&m.xyz[3 * m.tet[4 * t]],
-      &m.xyz[3 * m.tet[4 * t + 1]], &m.xyz[3 * m.tet[4 * t + 2]], &m.xyz[3 * m.tet[4 * t + 3]]).volume));
+  for (std::size_t t = 0; t < m.tet_count(); ++t)
+    largest =
+        std::max(largest, std::abs(tet_quality(&m.xyz[3 * m.tet[4 * t]], &m.xyz[3 * m.tet[4 * t + 1]],
+                                               &m.xyz[3 * m.tet[4 * t + 2]], &m.xyz[3 * m.tet[4 * t + 3]])
+                                       .volume));
   EXPECT_LT(largest, 1e-9 / (6 * std::sqrt(2.0)) * 1.5);
 }
 
@@ -91,7 +102,8 @@ std::map<std::string, double> volumes_by_name(const Mesh& m) {
   std::map<std::string, double> volume;
   for (std::size_t t = 0; t < m.tet_count(); ++t) {
     const std::uint32_t* v = &m.tet[4 * t];
-    const double vol = tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume;
+    const double vol =
+        tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume;
     for (const Region& r : m.regions)
       if (r.id == m.region_of(t)) volume[r.name] += vol;
   }
@@ -100,7 +112,8 @@ std::map<std::string, double> volumes_by_name(const Mesh& m) {
 
 // The part volumes `foxi model check` prints: "  ID NAME SHAPE MATERIAL V m^3 (...)".
 std::map<std::string, double> model_check_volumes(const std::string& model, const test::TempDir& dir) {
-  EXPECT_EQ(test::run_cli("model check " + model, dir / "check.log"), 0) << test::read_text(dir / "check.log");
+  EXPECT_EQ(test::run_cli("model check " + model, dir / "check.log"), 0)
+      << test::read_text(dir / "check.log");
   std::istringstream in(test::read_text(dir / "check.log"));
   std::map<std::string, double> volume;
   std::string line;
@@ -128,11 +141,13 @@ void expect_cli_meshes_model(const std::string& name, const std::string& options
   const std::string model = test::models_dir() + name + ".toml";
   const std::map<std::string, double> want = model_check_volumes(model, dir);
   ASSERT_FALSE(want.empty());
-  const int status = test::run_cli("mesh " + model + " --mesher cgal " + options + " -o " + (dir / "m.vtu").string(), dir / "mesh.log");
+  const int status = test::run_cli(
+      "mesh " + model + " --mesher cgal " + options + " -o " + (dir / "m.vtu").string(), dir / "mesh.log");
   const std::string log = test::read_text(dir / "mesh.log");
   ASSERT_EQ(status, 0) << log;
   EXPECT_NE(log.find("regular (weighted Delaunay): yes"), std::string::npos) << log;
-  EXPECT_NE(log.find("region volumes against the PLC (every facet edge protected)"), std::string::npos) << log;
+  EXPECT_NE(log.find("region volumes against the PLC (every facet edge protected)"), std::string::npos)
+      << log;
   const auto got = volumes_by_name(read_mesh(dir / "m.vtu"));
   ASSERT_EQ(got.size(), want.size()) << log;
   for (const auto& [part, v] : want) {
@@ -142,21 +157,26 @@ void expect_cli_meshes_model(const std::string& name, const std::string& options
 }
 
 // The via (a 16-gon prism through a layer): it lost 1.7% of its volume when its wall was resampled.
-TEST(MeshCgalCli, ViaModelKeepsThePartVolumesModelCheckPrints) { expect_cli_meshes_model("via_in_dielectric"); }
+TEST(MeshCgalCli, ViaModelKeepsThePartVolumesModelCheckPrints) {
+  expect_cli_meshes_model("via_in_dielectric");
+}
 
 // The bga: a corefined triangle soup with segment facets; it failed with "facet 488 has no polygon
 // with an area" before.
 // (450k tets, 1.5 to 5 minutes: the limit three times the default, for shared test machines.)
-TEST(MeshCgalCliSlow, BgaModelKeepsThePartVolumesModelCheckPrints) { expect_cli_meshes_model("bga", "--time-limit 900"); }
+TEST(MeshCgalCliSlow, BgaModelKeepsThePartVolumesModelCheckPrints) {
+  expect_cli_meshes_model("bga", "--time-limit 900");
+}
 
 // die_attach (a 20 um layer under a 10 mm die) ran past 60 s: it now finishes (volumes checked) or
 // stops at --time-limit with exit 1 and a message naming the limit, well within the limit.
 TEST(MeshCgalCliSlow, DieAttachFinishesOrStopsWithinItsTimeLimit) {
   test::TempDir dir;
   const auto t0 = std::chrono::steady_clock::now();
-  const int status = test::run_cli("mesh " + test::models_dir() + "die_attach.toml --mesher cgal --time-limit 60 -o " +
-                                       (dir / "m.vtu").string(),
-                                   dir / "mesh.log");
+  const int status =
+      test::run_cli("mesh " + test::models_dir() + "die_attach.toml --mesher cgal --time-limit 60 -o " +
+                        (dir / "m.vtu").string(),
+                    dir / "mesh.log");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::string log = test::read_text(dir / "mesh.log");
   EXPECT_LT(seconds, 90) << log;
@@ -164,7 +184,9 @@ TEST(MeshCgalCliSlow, DieAttachFinishesOrStopsWithinItsTimeLimit) {
     EXPECT_NE(log.find("regular (weighted Delaunay): yes"), std::string::npos) << log;
   } else {
     EXPECT_EQ(status, 1) << log;
-    EXPECT_NE(log.find("time limit: CGAL Mesh_3 did not finish within the time limit of 60 s"), std::string::npos) << log;
+    EXPECT_NE(log.find("time limit: CGAL Mesh_3 did not finish within the time limit of 60 s"),
+              std::string::npos)
+        << log;
     EXPECT_FALSE(std::filesystem::exists(dir / "m.vtu"));
   }
   std::printf("die_attach with --mesher cgal --time-limit 60: exit %d after %.1f s\n", status, seconds);
@@ -175,7 +197,9 @@ TEST(MeshCgalCli, ResampleReportsTheViaVolumeChange) {
   test::TempDir dir;
   const std::string model = test::models_dir() + "via_in_dielectric.toml";
   const std::map<std::string, double> want = model_check_volumes(model, dir);
-  ASSERT_EQ(test::run_cli("mesh " + model + " --mesher cgal --resample -o " + (dir / "m.vtu").string(), dir / "mesh.log"), 0)
+  ASSERT_EQ(test::run_cli("mesh " + model + " --mesher cgal --resample -o " + (dir / "m.vtu").string(),
+                          dir / "mesh.log"),
+            0)
       << test::read_text(dir / "mesh.log");
   const std::string log = test::read_text(dir / "mesh.log");
   EXPECT_NE(log.find("region volumes against the PLC (facets resampled)"), std::string::npos) << log;
@@ -186,7 +210,9 @@ TEST(MeshCgalCli, ResampleReportsTheViaVolumeChange) {
     const auto at = log.find(tag);
     ASSERT_NE(at, std::string::npos) << log;
     double plc = 0, mesh = 0, change = 0;
-    ASSERT_EQ(std::sscanf(log.c_str() + at + tag.size(), "%lf, mesh %lf, change %lf%%", &plc, &mesh, &change), 3) << log;
+    ASSERT_EQ(std::sscanf(log.c_str() + at + tag.size(), "%lf, mesh %lf, change %lf%%", &plc, &mesh, &change),
+              3)
+        << log;
     EXPECT_NEAR(plc, v, 1e-5 * v) << part;
     EXPECT_NEAR(mesh, got.at(part), 1e-5 * got.at(part)) << part;
     EXPECT_NEAR(change, 100 * (got.at(part) / v - 1), 1e-3 + 1e-2 * std::abs(change)) << part;
@@ -197,26 +223,35 @@ TEST(MeshCgalCli, ResampleReportsTheViaVolumeChange) {
 
 TEST(MeshCgalCli, BadOptionsAndBadInputHaveTheirExitStatuses) {
   test::TempDir dir;
-  const std::string model = test::models_dir() + "die_on_substrate.toml", out = " -o " + (dir / "m.vtu").string();
+  const std::string model = test::models_dir() + "die_on_substrate.toml",
+                    out = " -o " + (dir / "m.vtu").string();
   EXPECT_EQ(test::run_cli("mesh " + model + " --mesher cgal --feature-angle 30" + out, dir / "log"), 2);
-  EXPECT_NE(test::read_text(dir / "log").find("--feature-angle needs --resample"), std::string::npos) << test::read_text(dir / "log");
+  EXPECT_NE(test::read_text(dir / "log").find("--feature-angle needs --resample"), std::string::npos)
+      << test::read_text(dir / "log");
   EXPECT_EQ(test::run_cli("mesh " + model + " --mesher cgal --time-limit -1" + out, dir / "log"), 2);
   // A region seed outside the PLC: bad input (3), the file and the seed named.
   std::FILE* f = std::fopen((dir / "out.poly").c_str(), "w");
   ASSERT_NE(f, nullptr);
-  std::fputs("8 3 0 0\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n6 1\n"
-             "1 0 1\n4 1 2 3 4\n1 0 2\n4 5 6 7 8\n1 0 3\n4 1 2 6 5\n1 0 4\n4 2 3 7 6\n1 0 5\n4 3 4 8 7\n1 0 6\n4 4 1 5 8\n"
-             "0\n1\n1 5 5 5 7 -1\n", f);
+  std::fputs(
+      "8 3 0 0\n1 0 0 0\n2 1 0 0\n3 1 1 0\n4 0 1 0\n5 0 0 1\n6 1 0 1\n7 1 1 1\n8 0 1 1\n6 1\n"
+      "1 0 1\n4 1 2 3 4\n1 0 2\n4 5 6 7 8\n1 0 3\n4 1 2 6 5\n1 0 4\n4 2 3 7 6\n1 0 5\n4 3 4 8 7\n1 0 6\n4 4 "
+      "1 5 8\n"
+      "0\n1\n1 5 5 5 7 -1\n",
+      f);
   std::fclose(f);
   EXPECT_EQ(test::run_cli("mesh " + (dir / "out.poly").string() + " --mesher cgal" + out, dir / "log"), 3);
   const std::string log = test::read_text(dir / "log");
-  EXPECT_NE(log.find("out.poly: bad input: region seed 1 (region 7) lies outside every closed surface"), std::string::npos) << log;
+  EXPECT_NE(log.find("out.poly: bad input: region seed 1 (region 7) lies outside every closed surface"),
+            std::string::npos)
+      << log;
   EXPECT_FALSE(std::filesystem::exists(dir / "m.vtu"));
 }
 
 TEST(MeshCgalCli, UnknownMesherIsAUsageError) {
   test::TempDir dir;
-  EXPECT_EQ(test::run(test::cli_path() + " mesh x.poly --mesher gmsh -o " + (dir / "x.vtu").string(), dir / "log"), 2);
+  EXPECT_EQ(
+      test::run(test::cli_path() + " mesh x.poly --mesher gmsh -o " + (dir / "x.vtu").string(), dir / "log"),
+      2);
   EXPECT_NE(test::read_text(dir / "log").find("--mesher takes tetgen or cgal"), std::string::npos);
 }
 

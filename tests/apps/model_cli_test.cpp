@@ -72,7 +72,9 @@ TEST(ModelCli, ErrorsAndUsage) {
 // die leaves through the boundaries, the fixed board temperature is what the model says (45 degC).
 TEST(ModelCli, SolveModelUsesItsConditionsAndLoads) {
   TempDir dir;
-  ASSERT_EQ(foxi_cli("solve '" + kModels + "flip_chip.toml' --physics thermal --set die_h=0.6mm", dir / "out.txt"), 0)
+  ASSERT_EQ(
+      foxi_cli("solve '" + kModels + "flip_chip.toml' --physics thermal --set die_h=0.6mm", dir / "out.txt"),
+      0)
       << test::read_text(dir / "out.txt");
   const std::string out = test::read_text(dir / "out.txt");
   for (const char* s : {"substrate.bottom", "fixed", "die.top", "convection", "sources 3 W"})
@@ -101,10 +103,13 @@ TEST(ModelCli, SolveAppliesTheModelsRefinementBoxes) {
     std::fclose(f);
   };
   write("plain.toml", model);
-  write("boxed.toml", model + "\n[[mesh.refine]]\nmin = [0, 0, 0]\nmax = [2, 2, 1]\nmax_size = \"0.25 mm\"\n");
-  auto nodes_in_box = [&](const std::string& name, const std::string& command = "solve", const std::string& args = " --physics thermal") {
+  write("boxed.toml",
+        model + "\n[[mesh.refine]]\nmin = [0, 0, 0]\nmax = [2, 2, 1]\nmax_size = \"0.25 mm\"\n");
+  auto nodes_in_box = [&](const std::string& name, const std::string& command = "solve",
+                          const std::string& args = " --physics thermal") {
     const auto out = dir / (name + command + ".vtu");
-    EXPECT_EQ(foxi_cli(command + " '" + (dir / (name + ".toml")).string() + "'" + args + " -o '" + out.string() + "'",
+    EXPECT_EQ(foxi_cli(command + " '" + (dir / (name + ".toml")).string() + "'" + args + " -o '" +
+                           out.string() + "'",
                        dir / "log.txt"),
               0)
         << test::read_text(dir / "log.txt");
@@ -124,12 +129,13 @@ TEST(ModelCli, SolveModelErrorsBeforeMeshing) {
   TempDir dir;
   // die_on_substrate has no electrodes
   EXPECT_EQ(foxi_cli("solve '" + kModels + "die_on_substrate.toml' --physics current", dir / "e1.txt"), 3);
-  EXPECT_NE(test::read_text(dir / "e1.txt").find("no [[conditions]] fix the current solution"), std::string::npos)
+  EXPECT_NE(test::read_text(dir / "e1.txt").find("no [[conditions]] fix the current solution"),
+            std::string::npos)
       << test::read_text(dir / "e1.txt");
   std::filesystem::copy(kModels + "materials.toml", dir / "materials.toml");
   test::write_text(dir / "bad.toml", test::read_text(kModels + "die_on_substrate.toml") +
-                                          "\n[[conditions]]\ntype = \"heat_flux\"\nsurface = \"die.bottom\"\n"
-                                          "value = \"1 W/m^2\"\n");
+                                         "\n[[conditions]]\ntype = \"heat_flux\"\nsurface = \"die.bottom\"\n"
+                                         "value = \"1 W/m^2\"\n");
   EXPECT_EQ(foxi_cli("solve '" + (dir / "bad.toml").string() + "' --physics thermal", dir / "e2.txt"), 3);
   const std::string e2 = test::read_text(dir / "e2.txt");
   EXPECT_NE(e2.find("bad.toml:"), std::string::npos) << e2;
@@ -141,7 +147,8 @@ TEST(ModelCli, SolveModelErrorsBeforeMeshing) {
 // Every part of the exploded picture shows: some pixel has the part's colour (up to shading).
 TEST(ModelCli, ShowDrawsEveryPartInItsColour) {
   TempDir dir;
-  ASSERT_EQ(foxi_cli("model show '" + kModels + "flip_chip.toml' --size 640x480 -o '" + (dir / "f.png").string() + "'",
+  ASSERT_EQ(foxi_cli("model show '" + kModels + "flip_chip.toml' --size 640x480 -o '" +
+                         (dir / "f.png").string() + "'",
                      dir / "out.txt"),
             0)
       << test::read_text(dir / "out.txt");
@@ -171,12 +178,14 @@ TEST(ModelCli, ShowDrawsEveryPartInItsColour) {
 
 TEST(ModelCli, DemoRunsAModelEndToEnd) {
   TempDir dir;
-  ASSERT_EQ(foxi_cli("demo '" + kModels + "trench.toml' -o '" + (dir / "d").string() + "'", dir / "out.txt"), 0)
+  ASSERT_EQ(foxi_cli("demo '" + kModels + "trench.toml' -o '" + (dir / "d").string() + "'", dir / "out.txt"),
+            0)
       << test::read_text(dir / "out.txt");
   const std::string out = test::read_text(dir / "out.txt");
   for (const char* s : {"1. model", "2. mesh", "3. certificate", "4. steady heat", "5. picture"})
     EXPECT_NE(out.find(s), std::string::npos) << s << " missing in:\n" << out;
-  for (const char* f : {"trench.vtu", "trench.png", "trench_parts.png", "trench_isotherm.png", "trench_isotherms.gif"})
+  for (const char* f :
+       {"trench.vtu", "trench.png", "trench_parts.png", "trench_isotherm.png", "trench_isotherms.gif"})
     EXPECT_TRUE(std::filesystem::exists(dir / "d" / f)) << f;
   // The trench has no mechanical supports: the stress steps are skipped with the reason, not failed.
   EXPECT_NE(out.find("9. thermal stress: skipped, the model is not ready for it"), std::string::npos) << out;
@@ -188,14 +197,17 @@ TEST(ModelCli, DemoRunsAModelEndToEnd) {
 // displacement scaled (1-2-5) so that the nodes move by 0.8 % to 2 % of the model's diagonal.
 TEST(ModelCli, DemoShowsIsothermAndStressOnTheDeformedShape) {
   TempDir dir;
-  ASSERT_EQ(foxi_cli("demo '" + kModels + "flip_chip.toml' -o '" + (dir / "d").string() + "'", dir / "out.txt"), 0)
+  ASSERT_EQ(
+      foxi_cli("demo '" + kModels + "flip_chip.toml' -o '" + (dir / "d").string() + "'", dir / "out.txt"), 0)
       << test::read_text(dir / "out.txt");
   const std::string out = test::read_text(dir / "out.txt");
   std::smatch m;
-  ASSERT_TRUE(std::regex_search(out, m, std::regex("\\(graded facets, viridis\\), ([0-9.]+) to ([0-9.]+) °C")))
+  ASSERT_TRUE(
+      std::regex_search(out, m, std::regex("\\(graded facets, viridis\\), ([0-9.]+) to ([0-9.]+) °C")))
       << out;
   const double lo = std::stod(m[1]), hi = std::stod(m[2]);
-  ASSERT_TRUE(std::regex_search(out, m, std::regex("iso         ([0-9.]+) °C: ([0-9]+) tets crossed"))) << out;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("iso         ([0-9.]+) °C: ([0-9]+) tets crossed")))
+      << out;
   EXPECT_NEAR(std::stod(m[1]), (lo + hi) / 2, 0.051);
   EXPECT_GT(std::stoul(m[2]), 0u);
   EXPECT_NE(out.find("sweep       isovalue of temperature, 24 frames"), std::string::npos) << out;
@@ -203,9 +215,11 @@ TEST(ModelCli, DemoShowsIsothermAndStressOnTheDeformedShape) {
   double lo3[3] = {1e300, 1e300, 1e300}, hi3[3] = {-1e300, -1e300, -1e300};
   for (std::size_t n = 0; n < te.node_count(); ++n)
     for (int k = 0; k < 3; ++k)
-      lo3[k] = std::min(lo3[k], te.xyz[3 * n + std::size_t(k)]), hi3[k] = std::max(hi3[k], te.xyz[3 * n + std::size_t(k)]);
+      lo3[k] = std::min(lo3[k], te.xyz[3 * n + std::size_t(k)]),
+      hi3[k] = std::max(hi3[k], te.xyz[3 * n + std::size_t(k)]);
   const double diag = std::hypot(hi3[0] - lo3[0], hi3[1] - lo3[1], hi3[2] - lo3[2]);
-  ASSERT_TRUE(std::regex_search(out, m, std::regex("deformed    by displacement x ([0-9.e+-]+): nodes moved up to ([0-9.e+-]+)")))
+  ASSERT_TRUE(std::regex_search(
+      out, m, std::regex("deformed    by displacement x ([0-9.e+-]+): nodes moved up to ([0-9.e+-]+)")))
       << out;
   const double moved = std::stod(m[2]);
   EXPECT_LE(moved, 0.02 * diag * (1 + 1e-5));
@@ -226,7 +240,8 @@ struct Outcome {
 Outcome timed(const std::string& args, const std::filesystem::path& log) {
   const auto t0 = std::chrono::steady_clock::now();
   const int status = foxi_cli(args, log);
-  return {status, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), test::read_text(log)};
+  return {status, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+          test::read_text(log)};
 }
 
 // The crashes (SIGSEGV in CGAL, SIGFPE in GMP and on nan, stack overflows in toml11 and in foxi's
@@ -240,11 +255,13 @@ TEST(ModelCli, CrashesAndHangsOfIssue22AreRefused) {
     return "'" + (dir / name).string() + "'";
   };
   const std::string board =
-      "[[parts]]\nname = \"board\"\nmaterial = \"fr4\"\nshape = \"box\"\norigin = [0, 0, 0]\nsize = [10, 10, 1]\n";
+      "[[parts]]\nname = \"board\"\nmaterial = \"fr4\"\nshape = \"box\"\norigin = [0, 0, 0]\nsize = [10, 10, "
+      "1]\n";
   std::string outline;
   for (int i = 0; i < 20000; ++i) {
     const double a = 2 * 3.141592653589793 * i / 20000;
-    outline += (i ? ",\n [" : "[") + std::to_string(5 + 2 * std::cos(a)) + ", " + std::to_string(5 + 2 * std::sin(a)) + "]";
+    outline += (i ? ",\n [" : "[") + std::to_string(5 + 2 * std::cos(a)) + ", " +
+               std::to_string(5 + 2 * std::sin(a)) + "]";
   }
   std::string deep;  // 100,000 levels in 200 KB, a thousand brackets a line
   for (int k = 0; k < 100; ++k) deep = std::string(1000, '[') + "\n" + deep + std::string(1000, ']') + "\n";
@@ -274,11 +291,15 @@ TEST(ModelCli, CrashesAndHangsOfIssue22AreRefused) {
                                  "center = [5, 5, 1]\nradius = 1\nheight = 1\nsegments = 1e6\n"),
        "cyl.toml", "must be an integer from 3 to 1000"},
       {"'" + bga + "' --set 'ball_tol=1e-6 mm'", "bga.toml", "below the limit of 0.001 times the radius"},
-      {model("outline.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
-                                     "points = [" + outline + "]\nz = 1\nheight = 1\n"),
+      {model("outline.toml", board +
+                                 "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
+                                 "points = [" +
+                                 outline + "]\nz = 1\nheight = 1\n"),
        "outline.toml", "20000 points, more than the limit of 2000"},
-      {model("line.toml", board + "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
-                                  "points = [" + one_line + "]\nz = 1\nheight = 1\n"),
+      {model("line.toml", board +
+                              "[[parts]]\nname = \"e\"\nmaterial = \"fr4\"\nshape = \"extrusion\"\n"
+                              "points = [" +
+                              one_line + "]\nz = 1\nheight = 1\n"),
        "line.toml", "more than the limit of 65536 (break long arrays over several lines)"},
   };
   for (const Case& c : cases) {
@@ -326,7 +347,8 @@ TEST(ModelCli, ReferencedFilesAreCheckedAndNeverQuoted) {
 // within a factor of 3 of the tets TetGen then makes.
 TEST(ModelCli, MeshRefusesAnEstimatePastMaxTets) {
   TempDir dir;
-  const std::string die = "'" + kModels + "die_on_substrate.toml'", out = "'" + (dir / "m.vtu").string() + "'";
+  const std::string die = "'" + kModels + "die_on_substrate.toml'",
+                    out = "'" + (dir / "m.vtu").string() + "'";
   Outcome o = timed("mesh " + die + " --max-size 0.01mm -o " + out, dir / "log.txt");
   EXPECT_EQ(o.status, kBadInput) << o.text;
   EXPECT_LT(o.seconds, 5 * test::kTimeScale);
@@ -339,7 +361,8 @@ TEST(ModelCli, MeshRefusesAnEstimatePastMaxTets) {
   std::smatch m;
   ASSERT_TRUE(std::regex_search(o.text, m, std::regex("about (\\S+) tets"))) << o.text;
   const double estimate = std::stod(m[1]);
-  ASSERT_EQ(foxi_cli("mesh " + die + " --max-size 0.4mm -o " + out, dir / "log.txt"), 0) << test::read_text(dir / "log.txt");
+  ASSERT_EQ(foxi_cli("mesh " + die + " --max-size 0.4mm -o " + out, dir / "log.txt"), 0)
+      << test::read_text(dir / "log.txt");
   const double tets = static_cast<double>(foxi::read_mesh(dir / "m.vtu").tet_count());
   EXPECT_GT(tets, estimate / 3) << estimate;
   EXPECT_LT(tets, estimate * 3) << estimate;
@@ -352,13 +375,16 @@ TEST(ModelCli, MeshRefusesAnEstimatePastMaxTets) {
 // is within a factor of 3 of what TetGen makes where it is allowed.
 TEST(ModelCli, RefineFromIsBoundedByTheEstimate) {
   TempDir dir;
-  const std::string die = "'" + kModels + "die_on_substrate.toml'", solved = "'" + (dir / "s.vtu").string() + "'";
+  const std::string die = "'" + kModels + "die_on_substrate.toml'",
+                    solved = "'" + (dir / "s.vtu").string() + "'";
   ASSERT_EQ(foxi_cli("solve " + die + " --physics thermal -o " + solved, dir / "log.txt"), 0)
       << test::read_text(dir / "log.txt");
   const double first = static_cast<double>(foxi::read_mesh(dir / "s.vtu").tet_count());
-  const std::string refine = "mesh " + die + " --refine-from " + solved + " -o '" + (dir / "r.vtu").string() + "'";
-  Outcome o = timed(refine + " --target-error 1e-9 --max-tets " + std::to_string(static_cast<long>(10 * first)),
-                    dir / "log.txt");
+  const std::string refine =
+      "mesh " + die + " --refine-from " + solved + " -o '" + (dir / "r.vtu").string() + "'";
+  Outcome o =
+      timed(refine + " --target-error 1e-9 --max-tets " + std::to_string(static_cast<long>(10 * first)),
+            dir / "log.txt");
   EXPECT_EQ(o.status, kBadInput) << o.text;
   EXPECT_LT(o.seconds, 10 * test::kTimeScale);
   std::smatch m;
@@ -379,16 +405,17 @@ TEST(ModelCli, RefineFromIsBoundedByTheEstimate) {
 // (44 s); now the tets follow the PLC's points, and every part still shows (its legend line).
 TEST(ModelCli, ShowMeshIsCoarse) {
   TempDir dir;
-  const Outcome o = timed("model show '" + kModels + "power_module.toml' --size 320x240 -o '" +
-                              (dir / "p.png").string() + "'",
-                          dir / "log.txt");
+  const Outcome o = timed(
+      "model show '" + kModels + "power_module.toml' --size 320x240 -o '" + (dir / "p.png").string() + "'",
+      dir / "log.txt");
   ASSERT_EQ(o.status, 0) << o.text;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(o.text, m, std::regex("coarse mesh (\\d+) nodes, (\\d+) tets"))) << o.text;
   EXPECT_LT(std::stod(m[2]), 5000) << o.text;
   EXPECT_NE(o.text.find("baseplate"), std::string::npos) << o.text;
   EXPECT_EQ(foxi::read_png(dir / "p.png").width, 320);
-  EXPECT_EQ(foxi_cli("model show '" + kModels + "power_module.toml' --max-tets 10 -o '" + (dir / "q.png").string() + "'",
+  EXPECT_EQ(foxi_cli("model show '" + kModels + "power_module.toml' --max-tets 10 -o '" +
+                         (dir / "q.png").string() + "'",
                      dir / "log2.txt"),
             kBadInput)
       << test::read_text(dir / "log2.txt");

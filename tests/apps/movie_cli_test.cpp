@@ -79,19 +79,23 @@ TEST_F(MovieCli, FramesApngGifAndMp4AgreeWithRender) {
     EXPECT_TRUE(same_rgb(read_png(dir_ / ("dec_" + std::to_string(k + 1) + ".png")), frames[std::size_t(k)]))
         << "APNG frame " << k;
   ASSERT_EQ(foxi("movie " + common + " --mode rotate -o " + p("m.mp4"), &out), 0) << out;
-  ASSERT_EQ(test::run("ffprobe -v error -count_frames -show_entries stream=nb_read_frames,width,height -of csv=p=0 " +
-                          p("m.mp4"),
-                      dir_ / "probe.txt"),
-            0);
+  ASSERT_EQ(
+      test::run(
+          "ffprobe -v error -count_frames -show_entries stream=nb_read_frames,width,height -of csv=p=0 " +
+              p("m.mp4"),
+          dir_ / "probe.txt"),
+      0);
   EXPECT_EQ(test::read_text(dir_ / "probe.txt"), "80,60,6\n");
 }
 
 TEST_F(MovieCli, RenderDepthStops) {
   std::string out;
   ASSERT_EQ(foxi("render " + p("grid.vtu") + " --size 80x60 -o " + p("full.png")), 0);
-  ASSERT_EQ(foxi("render " + p("grid.vtu") + " --size 80x60 --depth -1e9 -o " + p("all.png"), &out), 0) << out;
+  ASSERT_EQ(foxi("render " + p("grid.vtu") + " --size 80x60 --depth -1e9 -o " + p("all.png"), &out), 0)
+      << out;
   EXPECT_TRUE(same_rgb(read_png(dir_ / "all.png"), read_png(dir_ / "full.png")));
-  ASSERT_EQ(foxi("render " + p("grid.vtu") + " --size 80x60 --depth 1e9 -o " + p("none.png"), &out), 0) << out;
+  ASSERT_EQ(foxi("render " + p("grid.vtu") + " --size 80x60 --depth 1e9 -o " + p("none.png"), &out), 0)
+      << out;
   EXPECT_NE(out.find("drawn       0 of 360"), std::string::npos) << out;
   ASSERT_EQ(foxi("render " + p("grid.vtu") + " --size 80x60 --depth 12 -o " + p("some.png"), &out), 0) << out;
   EXPECT_NE(out.find("stopped at depth 12"), std::string::npos) << out;

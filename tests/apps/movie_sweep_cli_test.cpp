@@ -81,7 +81,8 @@ TEST_F(MovieSweepCli, IsoSweepFramesEqualRenderAtEachValue) {
     SCOPED_TRACE(extra);
     const std::string common = p("grid.vtu") + " --field temperature --size 240x160" + std::string(extra);
     std::string out;
-    ASSERT_EQ(foxi("movie " + common + " --sweep iso:20,80 --frames 6 -o " + p("iso/f_%d.png"), &out), 0) << out;
+    ASSERT_EQ(foxi("movie " + common + " --sweep iso:20,80 --frames 6 -o " + p("iso/f_%d.png"), &out), 0)
+        << out;
     EXPECT_NE(out.find("6 frames: 20, 32, 44, 56, 68, 80 °C"), std::string::npos) << out;
     std::size_t cmin = std::size_t(-1), cmax = 0;
     for (int k = 0; k < n; ++k) {
@@ -91,12 +92,14 @@ TEST_F(MovieSweepCli, IsoSweepFramesEqualRenderAtEachValue) {
       cmax = std::max(cmax, c);
       std::string rlog;
       ASSERT_EQ(foxi("render " + common + " --iso " + exact(v) + " -o " + p("r.png"), &rlog), 0) << rlog;
-      EXPECT_TRUE(same_rgb(frame("iso", k), read_png(dir_ / "r.png"))) << "frame " << k << " at " << v << " °C";
+      EXPECT_TRUE(same_rgb(frame("iso", k), read_png(dir_ / "r.png")))
+          << "frame " << k << " at " << v << " °C";
     }
     EXPECT_EQ(cmin, 0u) << "20 °C lies below every node";
     EXPECT_GT(cmax, 20u);
-    EXPECT_NE(out.find("pruned      " + std::to_string(cmin) + " to " + std::to_string(cmax) + " tets crossed"),
-              std::string::npos)
+    EXPECT_NE(
+        out.find("pruned      " + std::to_string(cmin) + " to " + std::to_string(cmax) + " tets crossed"),
+        std::string::npos)
         << out;
     EXPECT_FALSE(same_rgb(frame("iso", 2), frame("iso", 3))) << "the isosurface moves";
   }
@@ -107,11 +110,14 @@ TEST_F(MovieSweepCli, ThresholdSweepFramesEqualRenderOfTheGrowingRange) {
   std::string out;
   ASSERT_EQ(foxi("movie " + common + " --sweep threshold:30,110 --frames 5 -o " + p("thr/f_%d.png"), &out), 0)
       << out;
-  EXPECT_NE(out.find("threshold [30, v] of temperature, 5 frames, v = 30, 50, 70, 90, 110 °C"), std::string::npos)
+  EXPECT_NE(out.find("threshold [30, v] of temperature, 5 frames, v = 30, 50, 70, 90, 110 °C"),
+            std::string::npos)
       << out;
   for (int k = 0; k < 5; ++k) {
-    ASSERT_EQ(foxi("render " + common + " --threshold 30," + std::to_string(30 + 20 * k) + " -o " + p("r.png"), &out),
-              0)
+    ASSERT_EQ(
+        foxi("render " + common + " --threshold 30," + std::to_string(30 + 20 * k) + " -o " + p("r.png"),
+             &out),
+        0)
         << out;
     EXPECT_TRUE(same_rgb(frame("thr", k), read_png(dir_ / "r.png"))) << "frame " << k;
   }
@@ -120,7 +126,8 @@ TEST_F(MovieSweepCli, ThresholdSweepFramesEqualRenderOfTheGrowingRange) {
 }
 
 TEST_F(MovieSweepCli, StepsSweepKeepsOneRangeOverTheSteps) {
-  // The range the movie must fix: the union of every step's values as drawn (flat: the tets' centroid values).
+  // The range the movie must fix: the union of every step's values as drawn (flat: the tets' centroid
+  // values).
   double lo = 1e300, hi = -1e300;
   const FieldChoice choice = choose_field(mesh, "u");
   for (std::size_t s = 0; s < 3; ++s)
@@ -134,8 +141,8 @@ TEST_F(MovieSweepCli, StepsSweepKeepsOneRangeOverTheSteps) {
   EXPECT_NE(out.find(range), std::string::npos) << out;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "st/f_3.png"));
   for (int k = 0; k < 3; ++k) {
-    ASSERT_EQ(foxi("render " + common + " --step " + std::to_string(k) + " --range " + exact(lo) + "," + exact(hi) +
-                       " -o " + p("r.png"),
+    ASSERT_EQ(foxi("render " + common + " --step " + std::to_string(k) + " --range " + exact(lo) + "," +
+                       exact(hi) + " -o " + p("r.png"),
                    &out),
               0)
         << out;
@@ -149,10 +156,11 @@ TEST_F(MovieSweepCli, StepsSweepKeepsOneRangeOverTheSteps) {
   lo = 1e300, hi = -1e300;
   for (std::size_t s = 0; s < 3; ++s)
     for (double v : tet_corner_values(mesh, choice, s)) lo = std::min(lo, v), hi = std::max(hi, v);
-  ASSERT_EQ(foxi("movie " + common + " --graded --iso 1.5 --sweep steps -o " + p("sti/f_%d.png"), &out), 0) << out;
+  ASSERT_EQ(foxi("movie " + common + " --graded --iso 1.5 --sweep steps -o " + p("sti/f_%d.png"), &out), 0)
+      << out;
   for (int k = 1; k < 3; ++k) {
-    ASSERT_EQ(foxi("render " + common + " --graded --iso 1.5 --step " + std::to_string(k) + " --range " + exact(lo) +
-                       "," + exact(hi) + " -o " + p("r.png"),
+    ASSERT_EQ(foxi("render " + common + " --graded --iso 1.5 --step " + std::to_string(k) + " --range " +
+                       exact(lo) + "," + exact(hi) + " -o " + p("r.png"),
                    &out),
               0)
         << out;
@@ -177,9 +185,13 @@ TEST_F(MovieSweepCli, PvdCollectionStepsAreTheFrames) {
   }
   test::write_text(dir_ / "run.pvd", pvd + "</Collection>\n</VTKFile>\n");
   std::string out;
-  ASSERT_EQ(foxi("movie " + p("run.pvd") + " --field u --size 240x160 --sweep steps -o " + p("pvd/f_%d.png"), &out), 0)
+  ASSERT_EQ(
+      foxi("movie " + p("run.pvd") + " --field u --size 240x160 --sweep steps -o " + p("pvd/f_%d.png"), &out),
+      0)
       << out;
-  ASSERT_EQ(foxi("movie " + p("grid.vtu") + " --field u --size 240x160 --sweep steps -o " + p("vtu/f_%d.png"), &out), 0)
+  ASSERT_EQ(foxi("movie " + p("grid.vtu") + " --field u --size 240x160 --sweep steps -o " + p("vtu/f_%d.png"),
+                 &out),
+            0)
       << out;
   for (int k = 0; k < 3; ++k) EXPECT_TRUE(same_rgb(frame("pvd", k), frame("vtu", k))) << "step " << k;
 }
@@ -197,14 +209,19 @@ TEST_F(MovieSweepCli, ThresholdInBackAndForthAndDeformInSweeps) {
 
   Mesh m = mesh;  // a shear: u = (0.05 z, 0, 0)
   Field d{"displacement", FieldLocation::node, 3, "m", {}, {}};
-  for (std::size_t n = 0; n < m.node_count(); ++n) d.values.insert(d.values.end(), {0.05 * m.xyz[3 * n + 2], 0, 0});
+  for (std::size_t n = 0; n < m.node_count(); ++n)
+    d.values.insert(d.values.end(), {0.05 * m.xyz[3 * n + 2], 0, 0});
   m.fields.push_back(d);
   write_mesh(m, dir_ / "d.vtu");
-  const std::string dcommon = p("d.vtu") + " --field temperature --size 200x150 --legend off --deform displacement:2";
-  ASSERT_EQ(foxi("movie " + dcommon + " --sweep iso:40,90 --frames 3 -o " + p("dv/f_%d.png"), &out), 0) << out;
+  const std::string dcommon =
+      p("d.vtu") + " --field temperature --size 200x150 --legend off --deform displacement:2";
+  ASSERT_EQ(foxi("movie " + dcommon + " --sweep iso:40,90 --frames 3 -o " + p("dv/f_%d.png"), &out), 0)
+      << out;
   EXPECT_NE(out.find("with the depth buffer"), std::string::npos) << out;
   for (int k = 0; k < 3; ++k) {
-    ASSERT_EQ(foxi("render " + dcommon + " --iso " + std::to_string(40 + 25 * k) + " -o " + p("r.png"), &out), 0) << out;
+    ASSERT_EQ(foxi("render " + dcommon + " --iso " + std::to_string(40 + 25 * k) + " -o " + p("r.png"), &out),
+              0)
+        << out;
     EXPECT_TRUE(same_rgb(frame("dv", k), read_png(dir_ / "r.png"))) << "frame " << k;
   }
   EXPECT_EQ(foxi("movie " + dcommon + " -o " + p("bfd.gif"), &out), 3) << out;
@@ -216,8 +233,8 @@ TEST_F(MovieSweepCli, ThresholdInBackAndForthAndDeformInSweeps) {
 // of the same collection with the same --range.
 TEST_F(MovieSweepCli, TransientPvdOutputSteps) {
   std::string out;
-  ASSERT_EQ(foxi("solve '" + test::models_dir() + "die_on_substrate.toml' --physics transient --time 1 --steps 4 -o " +
-                     p("run.pvd"),
+  ASSERT_EQ(foxi("solve '" + test::models_dir() +
+                     "die_on_substrate.toml' --physics transient --time 1 --steps 4 -o " + p("run.pvd"),
                  &out),
             0)
       << out;
@@ -228,7 +245,8 @@ TEST_F(MovieSweepCli, TransientPvdOutputSteps) {
   const int n = std::stoi(m[1]);
   EXPECT_EQ(n, 5) << "the start and 4 steps";
   for (int k = 0; k < n; ++k) {
-    ASSERT_EQ(foxi("render " + common + " --step " + std::to_string(k) + " -o " + p("r.png"), &out), 0) << out;
+    ASSERT_EQ(foxi("render " + common + " --step " + std::to_string(k) + " -o " + p("r.png"), &out), 0)
+        << out;
     EXPECT_TRUE(same_rgb(frame("tr", k), read_png(dir_ / "r.png"))) << "step " << k;
   }
   EXPECT_FALSE(same_rgb(frame("tr", 0), frame("tr", n - 1))) << "the die heats up";

@@ -25,17 +25,21 @@ struct CliRun {
 CliRun run(const std::string& args, const fs::path& log) {
   const auto t0 = std::chrono::steady_clock::now();
   const int status = test::run_cli(args, log);
-  return {status, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), test::read_text(log)};
+  return {status, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+          test::read_text(log)};
 }
 
 TEST(OutputPathCli, UnwritableOutputsFailBeforeTheWork) {
   TempDir dir;
   const std::string model = test::models_dir() + "die_on_substrate.toml";
   // A small mesh to read.
-  ASSERT_EQ(test::run_cli("mesh '" + model + "' --max-size 1mm -o '" + (dir / "m.vtu").string() + "'", dir / "setup.log"), 0)
+  ASSERT_EQ(test::run_cli("mesh '" + model + "' --max-size 1mm -o '" + (dir / "m.vtu").string() + "'",
+                          dir / "setup.log"),
+            0)
       << test::read_text(dir / "setup.log");
   // Folders named like the outputs.
-  for (const char* ext : {".vtu", ".msh", ".png", ".gif", ".poly"}) fs::create_directories(dir / (std::string("folder") + ext));
+  for (const char* ext : {".vtu", ".msh", ".png", ".gif", ".poly"})
+    fs::create_directories(dir / (std::string("folder") + ext));
   test::write_text(dir / "file", "x");
   const std::string m = "'" + (dir / "m.vtu").string() + "'";
   struct Bad {
@@ -54,8 +58,7 @@ TEST(OutputPathCli, UnwritableOutputsFailBeforeTheWork) {
         // Meshing at 0.05 mm takes minutes: the check must come first.
         "mesh '" + model + "' --max-size 0.05mm -o " + q + ".vtu'",
         "convert " + m + " " + q + ".msh'",
-        "solve " + m + " --physics thermal --fix substrate.bottom=300 --power die=1 -o " + q +
-            ".vtu'",
+        "solve " + m + " --physics thermal --fix substrate.bottom=300 --power die=1 -o " + q + ".vtu'",
         "render " + m + " -o " + q + ".png'",
         "movie " + m + " --frames 2 -o " + q + ".gif'",
         "model plc '" + model + "' -o " + q + ".poly'",
@@ -72,7 +75,8 @@ TEST(OutputPathCli, UnwritableOutputsFailBeforeTheWork) {
   }
   // Nothing was written anywhere but the setup mesh and its log.
   std::vector<std::string> names;
-  for (const auto& e : fs::recursive_directory_iterator(dir.path())) names.push_back(e.path().filename().string());
+  for (const auto& e : fs::recursive_directory_iterator(dir.path()))
+    names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"file", "folder.gif", "folder.msh", "folder.png", "folder.poly",
                                              "folder.vtu", "log.txt", "m.vtu", "setup.log"}));

@@ -27,7 +27,8 @@ void bary_of(const Mesh& m, std::size_t t, const double* p, double out[4]) {
   auto vol = [](const double* a, const double* b, const double* c, const double* d) {
     double u[3], v[3], w[3];
     for (int k = 0; k < 3; ++k) u[k] = b[k] - a[k], v[k] = c[k] - a[k], w[k] = d[k] - a[k];
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0]);
   };
   const double* c[4];
   for (int j = 0; j < 4; ++j) c[j] = &m.xyz[3 * std::size_t(m.tet[4 * t + j])];
@@ -190,24 +191,31 @@ TEST_F(ProbeCli, BadOptionsExit2BadFilesExit3) {
   EXPECT_NE(log.find("foxi probe RESULT"), std::string::npos) << log;
   EXPECT_EQ(foxi("plot --help", &log), 0) << log;
   EXPECT_NE(log.find("foxi plot RESULT"), std::string::npos) << log;
-  EXPECT_EQ(foxi("probe " + file() + " --at 1,1,1", &log), 2) << log;                          // no --field
-  EXPECT_EQ(foxi("probe " + file() + " --field temperature", &log), 2) << log;                  // no --at
-  EXPECT_EQ(foxi("probe " + file() + " --field temperature --at 1,1", &log), 2) << log;         // two numbers
-  EXPECT_EQ(foxi("probe " + file() + " --field temperature --at 1,x,1", &log), 2) << log;       // not a number
-  EXPECT_EQ(foxi("probe " + file() + " --field pressure --at 1,1,1", &log), 2) << log;          // no such field
-  EXPECT_NE(log.find("temperature"), std::string::npos) << log;                                  // says what there is
-  EXPECT_EQ(foxi("probe " + file() + " --field temperature:q --at 1,1,1", &log), 2) << log;     // no such component
+  EXPECT_EQ(foxi("probe " + file() + " --at 1,1,1", &log), 2) << log;                      // no --field
+  EXPECT_EQ(foxi("probe " + file() + " --field temperature", &log), 2) << log;             // no --at
+  EXPECT_EQ(foxi("probe " + file() + " --field temperature --at 1,1", &log), 2) << log;    // two numbers
+  EXPECT_EQ(foxi("probe " + file() + " --field temperature --at 1,x,1", &log), 2) << log;  // not a number
+  EXPECT_EQ(foxi("probe " + file() + " --field pressure --at 1,1,1", &log), 2) << log;     // no such field
+  EXPECT_NE(log.find("temperature"), std::string::npos) << log;  // says what there is
+  EXPECT_EQ(foxi("probe " + file() + " --field temperature:q --at 1,1,1", &log), 2)
+      << log;  // no such component
   EXPECT_EQ(foxi("probe " + file() + " --field temperature --at 1,1,1 --step 3", &log), 2) << log;
   EXPECT_EQ(foxi("probe " + file() + " --field temperature --at 1,1,1 --bogus", &log), 2) << log;
   const std::string line = " --field temperature --line 0,0,0:8,4,2 -o '" + (dir_ / "p.csv").string() + "'";
-  EXPECT_EQ(foxi("plot " + file() + " --field temperature --line 0,0,0 -o '" + (dir_ / "p.csv").string() + "'", &log), 2) << log;
+  EXPECT_EQ(
+      foxi("plot " + file() + " --field temperature --line 0,0,0 -o '" + (dir_ / "p.csv").string() + "'",
+           &log),
+      2)
+      << log;
   EXPECT_EQ(foxi("plot " + file() + line + " --samples 1", &log), 2) << log;
   EXPECT_EQ(foxi("plot " + file() + " --field temperature --line 0,0,0:8,4,2", &log), 2) << log;  // no -o
   EXPECT_FALSE(std::filesystem::exists(dir_ / "p.csv"));
   // Files: missing, not a mesh.
-  EXPECT_EQ(foxi("probe '" + (dir_ / "missing.vtu").string() + "' --field temperature --at 1,1,1", &log), 3) << log;
+  EXPECT_EQ(foxi("probe '" + (dir_ / "missing.vtu").string() + "' --field temperature --at 1,1,1", &log), 3)
+      << log;
   test::write_text(dir_ / "junk.vtu", "<VTKFile this is not");
-  EXPECT_EQ(foxi("probe '" + (dir_ / "junk.vtu").string() + "' --field temperature --at 1,1,1", &log), 3) << log;
+  EXPECT_EQ(foxi("probe '" + (dir_ / "junk.vtu").string() + "' --field temperature --at 1,1,1", &log), 3)
+      << log;
   EXPECT_NE(log.find("junk.vtu"), std::string::npos) << log;
   EXPECT_EQ(foxi("plot '" + (dir_ / "junk.vtu").string() + "'" + line, &log), 3) << log;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "p.csv"));
@@ -260,7 +268,8 @@ TEST_F(ProbeCli, PlotCsvOfALinearFieldIsTheAnalyticLineWithGapsOutside) {
   EXPECT_EQ(gaps, 10);  // x = -1 + 0.2 i: i = 0..4 below 0, i = 46..50 above 8
   EXPECT_NE(log.find("51 samples"), std::string::npos) << log;
   // A line wholly outside: exit 3 and no file.
-  EXPECT_EQ(foxi("plot " + file() + " --field temperature --line 9,0,0:10,0,0 -o '" + (dir_ / "none.csv").string() + "'",
+  EXPECT_EQ(foxi("plot " + file() + " --field temperature --line 9,0,0:10,0,0 -o '" +
+                     (dir_ / "none.csv").string() + "'",
                  &log),
             3)
       << log;
@@ -270,7 +279,8 @@ TEST_F(ProbeCli, PlotCsvOfALinearFieldIsTheAnalyticLineWithGapsOutside) {
 TEST_F(ProbeCli, PlotPngIsALineChartOfTheAskedSize) {
   const auto png = dir_ / "plot.png";
   std::string log;
-  ASSERT_EQ(foxi("plot " + file() + " --field temperature --line -1,1.3,0.7:9,2.9,1.1 --samples 201 --size 640x400 -o '" +
+  ASSERT_EQ(foxi("plot " + file() +
+                     " --field temperature --line -1,1.3,0.7:9,2.9,1.1 --samples 201 --size 640x400 -o '" +
                      png.string() + "'",
                  &log),
             0)

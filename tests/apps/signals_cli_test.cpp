@@ -1,8 +1,8 @@
 // SIGINT, SIGTERM and SIGHUP at random moments of foxi mesh, solve, render, movie and convert: the exit
-// status is 0 (the run finished first) or 130 (SIGINT) / 143 (SIGTERM) / 129 (SIGHUP), no process of the run is
-// left (the TetGen/CGAL children and ffmpeg included), no temporary file is left, and each output
-// is either absent or complete and valid (read back by foxi's readers and libpng; a TetGen set is
-// all three files or none; numbered movie frames are all there or none).
+// status is 0 (the run finished first) or 130 (SIGINT) / 143 (SIGTERM) / 129 (SIGHUP), no process of the run
+// is left (the TetGen/CGAL children and ffmpeg included), no temporary file is left, and each output is
+// either absent or complete and valid (read back by foxi's readers and libpng; a TetGen set is all three
+// files or none; numbered movie frames are all there or none).
 //
 // The delays are drawn from a seeded generator (the seed is printed, FOXI_SIGNAL_SEED repeats a
 // run), uniform over the time a whole run takes on this machine, measured first.
@@ -62,8 +62,8 @@ Outcome run_foxi(const std::vector<std::string>& args, const fs::path& log, int 
     for (int i = 0; i < 5000; ++i) {
       const std::string st = test::read_text(status_file);
       const auto at = st.find("SigBlk:");
-      if (st.empty() || (at != std::string::npos &&
-                         (std::stoull(st.substr(at + 7), nullptr, 16) & 0x4002) == 0x4002))
+      if (st.empty() ||
+          (at != std::string::npos && (std::stoull(st.substr(at + 7), nullptr, 16) & 0x4002) == 0x4002))
         break;
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
@@ -118,7 +118,8 @@ std::vector<std::string> leftovers(const fs::path& dir) {
   std::vector<std::string> found;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     const std::string n = e.path().filename().string();
-    if (n.find(".foxi-tmp-") != std::string::npos || n.find(".tmp") != std::string::npos) found.push_back(e.path().string());
+    if (n.find(".foxi-tmp-") != std::string::npos || n.find(".tmp") != std::string::npos)
+      found.push_back(e.path().string());
   }
   return found;
 }
@@ -169,7 +170,8 @@ std::string png_ok(const fs::path& path, bool& exists, int w, int h) {
   }
   // The file ends with the IEND chunk (an APNG too: its frames come before it).
   const std::string bytes = test::read_text(path);
-  if (bytes.size() < 12 || bytes.compare(bytes.size() - 8, 4, "IEND") != 0) return path.string() + ": no IEND at the end";
+  if (bytes.size() < 12 || bytes.compare(bytes.size() - 8, 4, "IEND") != 0)
+    return path.string() + ": no IEND at the end";
   return "";
 }
 
@@ -179,9 +181,10 @@ class SignalsCliSlow : public ::testing::Test {
     dir_ = new TempDir;
     // A mesh (212k tets) big enough that solving, drawing and converting it take a noticeable time
     // (a second or so each on a shared 2-core machine).
-    const int rc = test::run_cli("mesh '" + test::models_dir() + "die_on_substrate.toml' --max-size 0.2mm -o '" +
-                                     (dir_->path() / "big.vtu").string() + "'",
-                                 dir_->path() / "setup.log");
+    const int rc =
+        test::run_cli("mesh '" + test::models_dir() + "die_on_substrate.toml' --max-size 0.2mm -o '" +
+                          (dir_->path() / "big.vtu").string() + "'",
+                      dir_->path() / "setup.log");
     ASSERT_EQ(rc, 0) << test::read_text(dir_->path() / "setup.log");
   }
   static void TearDownTestSuite() {
@@ -209,12 +212,12 @@ class SignalsCliSlow : public ::testing::Test {
       const int sig = k % 3 == 0 ? SIGINT : k % 3 == 1 ? SIGTERM : SIGHUP;
       const char* sig_name = sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "SIGHUP";
       const double d = delay(rng);
-      SCOPED_TRACE(c.name + " trial " + std::to_string(k) + ": " + sig_name +
-                   " after " + std::to_string(d) + " s of " + std::to_string(full.seconds) + " s, seed " +
-                   std::to_string(seed));
+      SCOPED_TRACE(c.name + " trial " + std::to_string(k) + ": " + sig_name + " after " + std::to_string(d) +
+                   " s of " + std::to_string(full.seconds) + " s, seed " + std::to_string(seed));
       const fs::path out = dir_->path() / (c.name + "-" + std::to_string(k));
       fs::create_directories(out);
-      const Outcome o = run_foxi(with_out(c.args, out), dir_->path() / (c.name + "-" + std::to_string(k) + ".log"), sig, d);
+      const Outcome o =
+          run_foxi(with_out(c.args, out), dir_->path() / (c.name + "-" + std::to_string(k) + ".log"), sig, d);
       const int stop_status = 128 + sig;
       EXPECT_TRUE(o.status == 0 || o.status == stop_status) << "exit status " << o.status << "\n" << o.log;
       if (o.status == stop_status) {
@@ -229,8 +232,8 @@ class SignalsCliSlow : public ::testing::Test {
         EXPECT_TRUE(wrote) << "exit status 0 without the output";
       }
     }
-    std::printf("%s: %d trials, %d stopped by the signal, %d finished first (a whole run %.2f s)\n", c.name.c_str(),
-                count, stopped, count - stopped, full.seconds);
+    std::printf("%s: %d trials, %d stopped by the signal, %d finished first (a whole run %.2f s)\n",
+                c.name.c_str(), count, stopped, count - stopped, full.seconds);
   }
 
   static TempDir* dir_;
@@ -251,8 +254,10 @@ TEST_F(SignalsCliSlow, MeshToTetgenSet) {
   trials({"mesh-tetgen",
           {"mesh", test::models_dir() + "die_on_substrate.toml", "--max-size", "0.3mm", "-o", "OUT/m.node"},
           [](const fs::path& d, bool& e) {
-            const int n = int(fs::exists(d / "m.node")) + int(fs::exists(d / "m.ele")) + int(fs::exists(d / "m.face"));
-            if (n != 0 && n != 3) return std::string("a partial TetGen set: ") + std::to_string(n) + " of 3 files";
+            const int n =
+                int(fs::exists(d / "m.node")) + int(fs::exists(d / "m.ele")) + int(fs::exists(d / "m.face"));
+            if (n != 0 && n != 3)
+              return std::string("a partial TetGen set: ") + std::to_string(n) + " of 3 files";
             return mesh_ok(d / "m.node", e);
           }},
          kTrials);
@@ -260,8 +265,8 @@ TEST_F(SignalsCliSlow, MeshToTetgenSet) {
 
 TEST_F(SignalsCliSlow, Solve) {
   trials({"solve",
-          {"solve", big().string(), "--physics", "thermal", "--fix", "substrate.bottom=300", "--power", "die=1", "-o",
-           "OUT/s.vtu"},
+          {"solve", big().string(), "--physics", "thermal", "--fix", "substrate.bottom=300", "--power",
+           "die=1", "-o", "OUT/s.vtu"},
           [](const fs::path& d, bool& e) { return mesh_ok(d / "s.vtu", e, "temperature"); }},
          kTrials);
 }
@@ -284,8 +289,10 @@ TEST_F(SignalsCliSlow, ConvertToTetgenSet) {
   trials({"convert-tetgen",
           {"convert", big().string(), "OUT/c.node"},
           [](const fs::path& d, bool& e) {
-            const int n = int(fs::exists(d / "c.node")) + int(fs::exists(d / "c.ele")) + int(fs::exists(d / "c.face"));
-            if (n != 0 && n != 3) return std::string("a partial TetGen set: ") + std::to_string(n) + " of 3 files";
+            const int n =
+                int(fs::exists(d / "c.node")) + int(fs::exists(d / "c.ele")) + int(fs::exists(d / "c.face"));
+            if (n != 0 && n != 3)
+              return std::string("a partial TetGen set: ") + std::to_string(n) + " of 3 files";
             return mesh_ok(d / "c.node", e);
           }},
          kTrials);

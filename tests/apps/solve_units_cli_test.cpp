@@ -107,8 +107,8 @@ TEST(SolveUnitsCli, PowerInWattsAndMilliwatts) {
   const Result w = solve(dir, "--physics thermal --power cube=3W");
   ASSERT_EQ(w.rc, 0) << w.out;
   EXPECT_EQ(number_after(line(w.out, "energy balance"), "sources"), 3) << w.out;
-  for (const char* same : {"--power cube=3000mW", "--power 'cube=3 W'", "--power cube=3",
-                           "--power-density 'cube=3 W/mm^3'"}) {
+  for (const char* same :
+       {"--power cube=3000mW", "--power 'cube=3 W'", "--power cube=3", "--power-density 'cube=3 W/mm^3'"}) {
     const Result r = solve(dir, std::string("--physics thermal ") + same);
     ASSERT_EQ(r.rc, 0) << same << "\n" << r.out;
     EXPECT_EQ(line(r.out, "max temperature"), line(w.out, "max temperature")) << same;
@@ -120,7 +120,8 @@ TEST(SolveUnitsCli, PowerInWattsAndMilliwatts) {
 // gives three times the rise; the same region twice on the command line is a usage error.
 TEST(SolveUnitsCli, PowerReplacesTheModelsLoad) {
   TempDir dir;
-  test::write_text(dir / "cube.toml", std::string(kCube) + "[[loads]]\ntype = \"power\"\npart = \"cube\"\nvalue = \"1 W\"\n");
+  test::write_text(dir / "cube.toml",
+                   std::string(kCube) + "[[loads]]\ntype = \"power\"\npart = \"cube\"\nvalue = \"1 W\"\n");
   const Result model = solve(dir, "--physics thermal");
   ASSERT_EQ(model.rc, 0) << model.out;
   EXPECT_EQ(number_after(line(model.out, "energy balance"), "sources"), 1) << model.out;
@@ -144,14 +145,14 @@ TEST(SolveUnitsCli, WrongDimensionAndNegativeKelvinAreUsageErrors) {
     const char* args;
     const char* says;
   };
-  for (const Bad& b : {Bad{"--power cube=3m", "--power: unit mismatch: '3m' is m, not W"},
-                       Bad{"--k cube=2W", "not W/(m*K)"},
-                       Bad{"--fix cube.top=5V", "--fix: unit mismatch: '5V'"},
-                       Bad{"--fix cube.top=-5", "not above absolute zero"},
-                       Bad{"--fix cube.top=-300degC", "not above absolute zero"},
-                       Bad{"--convect 'cube.top=10 W/(m^2*K),-1K'", "--convect: '-1K' = -1 K is not above"},
-                       Bad{"--convect 'cube.top=10 W/m^2,300K'", "--convect: unit mismatch"},
-                       Bad{"--flux cube.top=5W", "not W/m^2"}}) {
+  for (const Bad& b :
+       {Bad{"--power cube=3m", "--power: unit mismatch: '3m' is m, not W"}, Bad{"--k cube=2W", "not W/(m*K)"},
+        Bad{"--fix cube.top=5V", "--fix: unit mismatch: '5V'"},
+        Bad{"--fix cube.top=-5", "not above absolute zero"},
+        Bad{"--fix cube.top=-300degC", "not above absolute zero"},
+        Bad{"--convect 'cube.top=10 W/(m^2*K),-1K'", "--convect: '-1K' = -1 K is not above"},
+        Bad{"--convect 'cube.top=10 W/m^2,300K'", "--convect: unit mismatch"},
+        Bad{"--flux cube.top=5W", "not W/m^2"}}) {
     const Result r = solve(dir, std::string("--physics thermal ") + b.args);
     EXPECT_EQ(r.rc, 2) << b.args << "\n" << r.out;
     EXPECT_NE(r.out.find(b.says), std::string::npos) << b.args << "\n" << r.out;
@@ -163,10 +164,12 @@ TEST(SolveUnitsCli, WrongDimensionAndNegativeKelvinAreUsageErrors) {
   for (const char* bad : {"--physics thermal --fix cube.top=-1K", "--physics thermal --power cube=1m",
                           "--physics thermal --convect cube.top=1,2m", "--physics thermoelastic --dT 1m",
                           "--physics thermoelastic --temperature-from-thermal --tref -1"}) {
-    EXPECT_EQ(test::run("timeout 60 '" + test::cli_path() + "' solve '" + (dir / "huge.toml").string() + "' " + bad,
-                        dir / "huge.txt"),
-              2)
-        << bad << "\n" << test::read_text(dir / "huge.txt");
+    EXPECT_EQ(
+        test::run("timeout 60 '" + test::cli_path() + "' solve '" + (dir / "huge.toml").string() + "' " + bad,
+                  dir / "huge.txt"),
+        2)
+        << bad << "\n"
+        << test::read_text(dir / "huge.txt");
   }
   const Result v = solve(dir, "--physics thermoelastic --dT 5V");
   EXPECT_EQ(v.rc, 2) << v.out;
@@ -222,7 +225,8 @@ value = "0.1 W"
   EXPECT_NE(check.find("physics electrostatic: not ready: "), std::string::npos) << check;
   const Result r = solve(dir, "--physics thermal");
   EXPECT_EQ(r.rc, 0) << r.out;
-  EXPECT_NE(r.out.find("foxi solve: warning: " + (dir / "cube.toml").string() + ": part 'die' touches no other part"),
+  EXPECT_NE(r.out.find("foxi solve: warning: " + (dir / "cube.toml").string() +
+                       ": part 'die' touches no other part"),
             std::string::npos)
       << r.out;
 }
@@ -237,7 +241,8 @@ TEST(SolveUnitsCli, IllPosedProblemIsBadInput) {
   EXPECT_EQ(r.rc, 3) << r.out;
   EXPECT_NE(r.out.find("voltage or ground"), std::string::npos) << r.out;
   const std::string mesh = (dir / "cube.vtu").string();
-  ASSERT_EQ(test::run_cli("mesh '" + (dir / "cube.toml").string() + "' -o '" + mesh + "'", dir / "mesh.txt"), 0);
+  ASSERT_EQ(test::run_cli("mesh '" + (dir / "cube.toml").string() + "' -o '" + mesh + "'", dir / "mesh.txt"),
+            0);
   EXPECT_EQ(test::run_cli("solve '" + mesh + "' --k 1=1 --power 1=1W", dir / "ill.txt"), 3);
   const std::string ill = test::read_text(dir / "ill.txt");
   EXPECT_NE(ill.find("error: ill-posed thermal problem"), std::string::npos) << ill;

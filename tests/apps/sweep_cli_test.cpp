@@ -267,8 +267,10 @@ TEST(Sweep, ThetaFallsWithDieWidthAndRowsEqualSeparateSolves) {
 TEST(Sweep, PlotMarkersAreTheCsvValues) {
   TempDir dir;
   const auto csv = dir / "sweep.csv", png = dir / "sweep.png", log = dir / "sweep.txt";
-  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:6mm:5 --theta "
-                          "die:substrate.bottom --jobs 2 -o '" + csv.string() + "' --plot '" + png.string() + "'",
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
+                              "' --vary die_w=2mm:6mm:5 --theta "
+                              "die:substrate.bottom --jobs 2 -o '" +
+                              csv.string() + "' --plot '" + png.string() + "'",
                           log),
             0)
       << test::read_text(log);
@@ -282,7 +284,9 @@ TEST(Sweep, PlotMarkersAreTheCsvValues) {
   EXPECT_EQ(fb.width, 1200);
   EXPECT_EQ(fb.height, int((charts + 1) / 2) * 380);
   const std::uint32_t blue = foxi::chart_color(0);
-  auto is_blue = [&](int x, int y) { return x >= 0 && y >= 0 && x < fb.width && y < fb.height && fb.rgba[fb.index(x, y)] == blue; };
+  auto is_blue = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < fb.width && y < fb.height && fb.rgba[fb.index(x, y)] == blue;
+  };
   for (std::size_t k = 0; k < charts; ++k) {
     const int x0 = int(k % 2) * 600, y0 = int(k / 2) * 380;
     // marker centres: cores grouped by proximity
@@ -302,7 +306,8 @@ TEST(Sweep, PlotMarkersAreTheCsvValues) {
         if (!placed) marks.push_back({double(x), double(y), 1.0});
       }
     ASSERT_EQ(marks.size(), 5u) << "chart " << k << " (" << h[first + k] << ")";
-    std::sort(marks.begin(), marks.end(), [](const auto& a, const auto& b) { return a[0] / a[2] < b[0] / b[2]; });
+    std::sort(marks.begin(), marks.end(),
+              [](const auto& a, const auto& b) { return a[0] / a[2] < b[0] / b[2]; });
     std::vector<double> col, row, value;
     for (std::size_t i = 0; i < 5; ++i) {
       EXPECT_EQ(marks[i][2], 9.0);  // the 3 x 3 centre of a 7 x 7 marker
@@ -312,7 +317,8 @@ TEST(Sweep, PlotMarkersAreTheCsvValues) {
     }
     const double spacing = (col[4] - col[0]) / 4;
     EXPECT_GT(spacing, 50);
-    for (std::size_t i = 0; i < 5; ++i) EXPECT_NEAR(col[i], col[0] + spacing * double(i), 1.0) << h[first + k];
+    for (std::size_t i = 0; i < 5; ++i)
+      EXPECT_NEAR(col[i], col[0] + spacing * double(i), 1.0) << h[first + k];
     const auto [lo, hi] = std::minmax_element(value.begin(), value.end());
     if (*hi - *lo <= 1e-12 * std::abs(*hi)) {
       for (double r : row) EXPECT_EQ(r, row[0]);
@@ -321,14 +327,17 @@ TEST(Sweep, PlotMarkersAreTheCsvValues) {
     // least-squares row = a + b value; every marker within a pixel of it, b < 0 (up is more)
     double mv = 0, mr = 0, svv = 0, svr = 0;
     for (std::size_t i = 0; i < 5; ++i) mv += value[i] / 5, mr += row[i] / 5;
-    for (std::size_t i = 0; i < 5; ++i) svv += (value[i] - mv) * (value[i] - mv), svr += (value[i] - mv) * (row[i] - mr);
+    for (std::size_t i = 0; i < 5; ++i)
+      svv += (value[i] - mv) * (value[i] - mv), svr += (value[i] - mv) * (row[i] - mr);
     const double b = svr / svv, a = mr - b * mv;
     EXPECT_LT(b, 0) << h[first + k];
-    for (std::size_t i = 0; i < 5; ++i) EXPECT_NEAR(row[i], a + b * value[i], 1.0) << h[first + k] << " run " << i + 1;
+    for (std::size_t i = 0; i < 5; ++i)
+      EXPECT_NEAR(row[i], a + b * value[i], 1.0) << h[first + k] << " run " << i + 1;
   }
   // A plot that is not a PNG is a usage error, before any run.
-  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:6mm:2 -o '" + csv.string() +
-                          "' --plot '" + (dir / "p.jpg").string() + "'", log),
+  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm:6mm:2 -o '" +
+                              csv.string() + "' --plot '" + (dir / "p.jpg").string() + "'",
+                          log),
             2);
 }
 
@@ -338,8 +347,10 @@ TEST(Sweep, PlotMarkersAreTheCsvValues) {
 TEST(Sweep, TransientRowsEqualSeparateSolvesAndConvergenceRuns) {
   TempDir dir;
   const auto csv = dir / "t.csv", log = dir / "t.txt";
-  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --physics transient --vary die_w=3mm,5mm "
-                          "--jobs 2 -o '" + csv.string() + "' -- --time 20s --steps 10",
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
+                              "' --physics transient --vary die_w=3mm,5mm "
+                              "--jobs 2 -o '" +
+                              csv.string() + "' -- --time 20s --steps 10",
                           log),
             0)
       << test::read_text(log);
@@ -349,8 +360,10 @@ TEST(Sweep, TransientRowsEqualSeparateSolvesAndConvergenceRuns) {
                     w = column(rows[0], "die_w");
   for (std::size_t i = 1; i < rows.size(); ++i) {
     const auto one = dir / ("one" + std::to_string(i));
-    ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --physics transient --time 20s --steps 10 "
-                            "--set die_w=" + rows[i][w] + " -o '" + one.string() + ".pvd'",
+    ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") +
+                                "' --physics transient --time 20s --steps 10 "
+                                "--set die_w=" +
+                                rows[i][w] + " -o '" + one.string() + ".pvd'",
                             dir / "one.txt"),
               0)
         << test::read_text(dir / "one.txt");
@@ -359,12 +372,14 @@ TEST(Sweep, TransientRowsEqualSeparateSolvesAndConvergenceRuns) {
     EXPECT_NEAR(std::stod(rows[i][tj]), std::stod(last[2]), 1e-6 * std::stod(last[2])) << rows[i][w];
     EXPECT_NEAR(std::stod(rows[i][zth]), std::stod(last[3]), 1e-6 * std::stod(last[3])) << rows[i][w];
   }
-  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --physics transient --vary die_w=3mm,5mm -o '" +
-                          csv.string() + "'", log),
+  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
+                              "' --physics transient --vary die_w=3mm,5mm -o '" + csv.string() + "'",
+                          log),
             2);
   const auto conv = dir / "conv.txt";
-  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --physics transient --time 20s --steps 10 "
-                          "--convergence 3",
+  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") +
+                              "' --physics transient --time 20s --steps 10 "
+                              "--convergence 3",
                           conv),
             0)
       << test::read_text(conv);
@@ -402,13 +417,15 @@ TEST(Sweep, TwoVariedParametersMakeAGrid) {
 TEST(Sweep, OptionsAfterDashDashGoToEveryRun) {
   TempDir dir;
   const auto csv = dir / "k.csv", log = dir / "k.txt", one = dir / "one.txt", plain = dir / "plain.txt";
-  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=4mm:4mm:1 -o '" + csv.string() +
-                              "' -- --k 'substrate=4 W/(m*K)'",
+  ASSERT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=4mm:4mm:1 -o '" +
+                              csv.string() + "' -- --k 'substrate=4 W/(m*K)'",
                           log),
             0)
       << test::read_text(log);
-  ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --set die_w=4mm --k 'substrate=4 W/(m*K)'", one),
-            0);
+  ASSERT_EQ(
+      test::run_cli(
+          "solve '" + model("die_on_substrate.toml") + "' --set die_w=4mm --k 'substrate=4 W/(m*K)'", one),
+      0);
   ASSERT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --set die_w=4mm", plain), 0);
   const auto rows = read_csv(csv);
   ASSERT_EQ(rows.size(), 2u);
@@ -425,11 +442,11 @@ TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {
   const auto csv = dir / "sweep.csv", log = dir / "sweep.txt", json = dir / "sweep.json";
   // die_w = -1 mm makes the model invalid in that run only; so does 1e-30 mm, first in the list (a
   // value that breaks only some geometry is a failed row even when it comes first)
-  EXPECT_EQ(
-      test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=1e-30mm,-1mm,5mm --jobs 1 -o '" +
-                        csv.string() + "' --json '" + json.string() + "'",
-                    log),
-      1)
+  EXPECT_EQ(test::run_cli("sweep '" + model("die_on_substrate.toml") +
+                              "' --vary die_w=1e-30mm,-1mm,5mm --jobs 1 -o '" + csv.string() + "' --json '" +
+                              json.string() + "'",
+                          log),
+            1)
       << test::read_text(log);
   const auto rows = read_csv(csv);
   ASSERT_EQ(rows.size(), 4u) << test::read_text(csv);

@@ -20,8 +20,10 @@ TEST(TransientCli, DieOnSubstrateSeriesReadsBackInMeshio) {
   if (test::run("/usr/bin/python3 -c 'import meshio' > /dev/null 2>&1") != 0) GTEST_SKIP() << "no meshio";
   test::TempDir dir;
   const std::string out = (dir / "run.pvd").string();
-  const int status = test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 2s "
-                                   "--steps 20 --write-every 5 -o " + out + " --json " + (dir / "r.json").string(),
+  const int status = test::run_cli("solve " + test::models_dir() +
+                                       "die_on_substrate.toml --physics transient --time 2s "
+                                       "--steps 20 --write-every 5 -o " +
+                                       out + " --json " + (dir / "r.json").string(),
                                    dir / "solve.log");
   ASSERT_EQ(status, 0) << test::read_text(dir / "solve.log");
   const std::string script = R"PY(
@@ -50,16 +52,20 @@ assert any(c['name'] == 'energy' and c['passed'] for c in j['checks'])
 print('ok', z[-1])
 )PY";
   test::write_text(dir / "check.py", script);
-  ASSERT_EQ(test::run("/usr/bin/python3 " + (dir / "check.py").string() + " " + dir.path().string(), dir / "py.log"), 0)
+  ASSERT_EQ(test::run("/usr/bin/python3 " + (dir / "check.py").string() + " " + dir.path().string(),
+                      dir / "py.log"),
+            0)
       << test::read_text(dir / "py.log");
 }
 
 TEST(TransientCli, BadPowerTableRowIsNamedWithFileAndLine) {
   test::TempDir dir;
   test::write_text(dir / "p.csv", "time_s,power_W\n0,1\n0.5,oops\n");
-  const int status = test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 1s "
-                                   "--steps 4 --power die=table:" + (dir / "p.csv").string() + " -o " +
-                                   (dir / "r.pvd").string(), dir / "log");
+  const int status = test::run_cli("solve " + test::models_dir() +
+                                       "die_on_substrate.toml --physics transient --time 1s "
+                                       "--steps 4 --power die=table:" +
+                                       (dir / "p.csv").string() + " -o " + (dir / "r.pvd").string(),
+                                   dir / "log");
   EXPECT_EQ(status, kBadInput);
   const std::string log = test::read_text(dir / "log");
   EXPECT_NE(log.find("p.csv:3"), std::string::npos) << log;
@@ -68,9 +74,11 @@ TEST(TransientCli, BadPowerTableRowIsNamedWithFileAndLine) {
 
 TEST(TransientCli, MissingTimeIsAUsageError) {
   test::TempDir dir;
-  EXPECT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --steps 4 -o " +
-                              (dir / "r.pvd").string(), dir / "log"),
-            kUsage);
+  EXPECT_EQ(
+      test::run_cli("solve " + test::models_dir() +
+                        "die_on_substrate.toml --physics transient --steps 4 -o " + (dir / "r.pvd").string(),
+                    dir / "log"),
+      kUsage);
 }
 
 // The charts and the structure function: OUT_zth.png two charts high, OUT_structure.csv whose
@@ -79,12 +87,17 @@ TEST(TransientCli, MissingTimeIsAUsageError) {
 TEST(TransientCli, ZthChartAndStructureFunction) {
   test::TempDir dir;
   const std::string out = (dir / "run.pvd").string();
-  ASSERT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 100s "
-                          "--steps 200 --write-every 200 -o " + out, dir / "solve.log"), 0)
+  ASSERT_EQ(test::run_cli("solve " + test::models_dir() +
+                              "die_on_substrate.toml --physics transient --time 100s "
+                              "--steps 200 --write-every 200 -o " +
+                              out,
+                          dir / "solve.log"),
+            0)
       << test::read_text(dir / "solve.log");
   const Framebuffer png = read_png(dir / "run_zth.png");
   EXPECT_EQ(png.height, 2 * 440);
-  std::istringstream junction(test::read_text(dir / "run_junction.csv")), structure(test::read_text(dir / "run_structure.csv"));
+  std::istringstream junction(test::read_text(dir / "run_junction.csv")),
+      structure(test::read_text(dir / "run_structure.csv"));
   std::string line, last;
   std::getline(junction, line);
   EXPECT_EQ(line, "time_s,power_W,Tj[die]_K,Zth[die]_K/W");
@@ -114,27 +127,41 @@ TEST(TransientCli, ZthChartAndStructureFunction) {
   const std::string log = test::read_text(dir / "solve.log");
   EXPECT_NE(log.find("Foster fit error"), std::string::npos) << log;
 
-  ASSERT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 4s "
-                          "--steps 8 --power die=pulse:1W,1s,2s -o " + (dir / "p.pvd").string(), dir / "pulse.log"), 0)
+  ASSERT_EQ(test::run_cli("solve " + test::models_dir() +
+                              "die_on_substrate.toml --physics transient --time 4s "
+                              "--steps 8 --power die=pulse:1W,1s,2s -o " +
+                              (dir / "p.pvd").string(),
+                          dir / "pulse.log"),
+            0)
       << test::read_text(dir / "pulse.log");
   const std::string plog = test::read_text(dir / "pulse.log");
-  EXPECT_NE(plog.find("Zth(t) of die: not computed: Zth is defined for a step of power, and its power is a pulse"),
-            std::string::npos) << plog;
+  EXPECT_NE(
+      plog.find("Zth(t) of die: not computed: Zth is defined for a step of power, and its power is a pulse"),
+      std::string::npos)
+      << plog;
   EXPECT_TRUE(std::filesystem::exists(dir / "p_tj.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "p_zth.png"));
   EXPECT_FALSE(std::filesystem::exists(dir / "p_structure.csv"));
   // 10 BDF2 steps of 2 s overshoot (the die's Zth peaks at 16 s, then falls): no sum of rising
   // exponentials fits that within 1 %, so no structure function, and a line says why; the run is ok.
   // Backward Euler's 10 steps do not overshoot, and the structure function is written.
-  ASSERT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 20s "
-                          "--steps 10 -o " + (dir / "c.pvd").string(), dir / "coarse.log"), 0)
+  ASSERT_EQ(test::run_cli("solve " + test::models_dir() +
+                              "die_on_substrate.toml --physics transient --time 20s "
+                              "--steps 10 -o " +
+                              (dir / "c.pvd").string(),
+                          dir / "coarse.log"),
+            0)
       << test::read_text(dir / "coarse.log");
   const std::string clog = test::read_text(dir / "coarse.log");
   EXPECT_NE(clog.find("not written: the Foster fit misses Zth(t)"), std::string::npos) << clog;
   EXPECT_NE(clog.find("which a step response does not"), std::string::npos) << clog;
   EXPECT_TRUE(std::filesystem::exists(dir / "c_zth.png"));
-  ASSERT_EQ(test::run_cli("solve " + test::models_dir() + "die_on_substrate.toml --physics transient --time 20s "
-                          "--steps 10 --scheme euler -o " + (dir / "e.pvd").string(), dir / "euler.log"), 0)
+  ASSERT_EQ(test::run_cli("solve " + test::models_dir() +
+                              "die_on_substrate.toml --physics transient --time 20s "
+                              "--steps 10 --scheme euler -o " +
+                              (dir / "e.pvd").string(),
+                          dir / "euler.log"),
+            0)
       << test::read_text(dir / "euler.log");
   EXPECT_TRUE(std::filesystem::exists(dir / "e_structure.csv")) << test::read_text(dir / "euler.log");
   EXPECT_FALSE(std::filesystem::exists(dir / "c_structure.csv"));

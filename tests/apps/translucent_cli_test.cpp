@@ -33,7 +33,8 @@ class TranslucentCli : public ::testing::Test {
     write_mesh(mesh, path_);
   }
   int foxi(const std::string& args, std::string* out = nullptr) {
-    const int status = test::run("'" + test::cli_path() + "' render '" + path_.string() + "' " + args, dir_ / "log.txt");
+    const int status =
+        test::run("'" + test::cli_path() + "' render '" + path_.string() + "' " + args, dir_ / "log.txt");
     if (out) *out = test::read_text(dir_ / "log.txt");
     return status;
   }
@@ -62,7 +63,10 @@ std::size_t count_near(const Framebuffer& fb, const double want[3]) {
 TEST_F(TranslucentCli, TopViewShowsHandBlendedLayers) {
   const auto png = dir_ / "x.png";
   std::string log;
-  ASSERT_EQ(foxi("--region-opacity mould=0.4,3=0 --dir 0,0,-1 --up 0,1,0 --size 180x120 -o '" + png.string() + "'", &log), 0)
+  ASSERT_EQ(
+      foxi("--region-opacity mould=0.4,3=0 --dir 0,0,-1 --up 0,1,0 --size 180x120 -o '" + png.string() + "'",
+           &log),
+      0)
       << log;
   EXPECT_NE(log.find("composited back to front in the power order"), std::string::npos) << log;
   const Framebuffer fb = read_png(png);
@@ -77,7 +81,8 @@ TEST_F(TranslucentCli, TopViewShowsHandBlendedLayers) {
     die[k] = double((region_color(2) >> (8 * k)) & 255u) * shade;
   }
   // The slab is 9 x 4 seen from above, fitted to 180x120: each third of it covers a block of pixels.
-  const std::size_t n_mould = count_near(fb, mould), n_die = count_near(fb, die), n_white = count_near(fb, white);
+  const std::size_t n_mould = count_near(fb, mould), n_die = count_near(fb, die),
+                    n_white = count_near(fb, white);
   EXPECT_GT(n_mould, 1500u);
   EXPECT_GT(n_die, 1500u);
   EXPECT_GT(n_white, 1500u) << "the substrate is left out (opacity 0), the background shows";
@@ -104,8 +109,10 @@ TEST_F(TranslucentCli, VolumeOfALinearFieldIsHalfItsColourOverWhite) {
   const auto png = dir_ / "vol.png";
   std::string log;
   // The slab is 1 thick in z; opacity 0.5 per 1 world unit at every value: each ray gains exactly 0.5.
-  ASSERT_EQ(foxi("--volume temperature --opacity-curve 0:0.5 --opacity-length 1 --legend off --dir 0,0,-1 --up 0,1,0 "
-                 "--size 180x120 -o '" + png.string() + "'",
+  ASSERT_EQ(foxi("--volume temperature --opacity-curve 0:0.5 --opacity-length 1 --legend off --dir 0,0,-1 "
+                 "--up 0,1,0 "
+                 "--size 180x120 -o '" +
+                     png.string() + "'",
                  &log),
             0)
       << log;

@@ -42,7 +42,8 @@ TEST(ValidateCli, InvertedTetsAreReorientedBeforeOrderAndRender) {
   const Mesh good = bench::kuhn_grid_mesh(4, 0.0);  // exactly Delaunay, positively oriented
   Mesh bad = good;
   std::size_t inverted = 0;
-  for (std::size_t t = 0; t < bad.tet_count(); t += 3, ++inverted) std::swap(bad.tet[4 * t], bad.tet[4 * t + 1]);
+  for (std::size_t t = 0; t < bad.tet_count(); t += 3, ++inverted)
+    std::swap(bad.tet[4 * t], bad.tet[4 * t + 1]);
   write_mesh(good, dir / "good.vtu");
   write_mesh(bad, dir / "bad.vtu");
 
@@ -81,23 +82,41 @@ struct BadCase {
 
 TEST(ValidateCli, UnusableMeshesAreRefusedByEveryCommand) {
   const std::vector<BadCase> cases = {
-      {"duplicate_tet", [](Mesh& m) {
+      {"duplicate_tet",
+       [](Mesh& m) {
          m.tet.insert(m.tet.end(), {m.tet[3], m.tet[2], m.tet[1], m.tet[0]});
          m.tet_region.push_back(m.tet_region[0]);
-       }, "the same nodes as tet 0"},
-      {"coincident_nodes", [](Mesh& m) {
+       },
+       "the same nodes as tet 0"},
+      {"coincident_nodes",
+       [](Mesh& m) {
          // Tet 0's first node gets a copy of its own: tet 0 is torn off its neighbours.
          const std::uint32_t v = m.tet[0];
          m.xyz.insert(m.xyz.end(), {m.xyz[3 * v], m.xyz[3 * v + 1], m.xyz[3 * v + 2]});
          m.tet[0] = static_cast<std::uint32_t>(m.node_count() - 1);
-       }, "both used by tets"},
-      {"scaled_1e154", [](Mesh& m) { for (double& x : m.xyz) x *= 1e154; }, "beyond the range"},
-      {"scaled_1e300", [](Mesh& m) { for (double& x : m.xyz) x *= 1e300; }, "beyond the range"},
-      {"scaled_1e-300", [](Mesh& m) { for (double& x : m.xyz) x *= 1e-300; }, "beyond the range"},
-      {"no_tets", [](Mesh& m) {
+       },
+       "both used by tets"},
+      {"scaled_1e154",
+       [](Mesh& m) {
+         for (double& x : m.xyz) x *= 1e154;
+       },
+       "beyond the range"},
+      {"scaled_1e300",
+       [](Mesh& m) {
+         for (double& x : m.xyz) x *= 1e300;
+       },
+       "beyond the range"},
+      {"scaled_1e-300",
+       [](Mesh& m) {
+         for (double& x : m.xyz) x *= 1e-300;
+       },
+       "beyond the range"},
+      {"no_tets",
+       [](Mesh& m) {
          m.tet.clear();
          m.tet_region.clear();
-       }, "no tets"},
+       },
+       "no tets"},
   };
   test::TempDir dir;
   for (const BadCase& c : cases) {

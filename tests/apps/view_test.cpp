@@ -139,8 +139,8 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
   std::string script = "d s";
   for (const auto& p : px) script += " probe:" + std::to_string(p[0]) + "," + std::to_string(p[1]);
   script += " field d probe:160,120";
-  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize + " --field u --graded --save " +
-                           q(dir_ / "fv") + " --script '" + script + "'",
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize +
+                           " --field u --graded --save " + q(dir_ / "fv") + " --script '" + script + "'",
                        dir_ / "view.log", &out),
             0)
       << out;
@@ -154,7 +154,9 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
   std::istringstream lines(view_log);
   std::string line;
   int probed = 0;
-  const std::regex value("^probe ([0-9]+),([0-9]+): u ([-0-9.e+]+) at \\(([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\), tet ([0-9]+)");
+  const std::regex value(
+      "^probe ([0-9]+),([0-9]+): u ([-0-9.e+]+) at \\(([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\), tet "
+      "([0-9]+)");
   while (std::getline(lines, line)) {
     std::smatch mm;
     if (line.rfind("probe 5,5:", 0) == 0) EXPECT_NE(line.find("background"), std::string::npos) << line;
@@ -175,10 +177,11 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
 
   // The isosurface keys' script forms: the solid above u = 6 and the surface alone equal foxi render
   // --iso 6 [--iso-only], pixel for pixel; 'noiso' gives the whole tets back.
-  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize + " --field u --graded --save " +
-                           q(dir_ / "iv") + " --script 'iso:6 d s iso-only:6 d s noiso d s'",
-                       dir_ / "view.log", &out),
-            0)
+  ASSERT_EQ(
+      run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize + " --field u --graded --save " +
+                     q(dir_ / "iv") + " --script 'iso:6 d s iso-only:6 d s noiso d s'",
+                 dir_ / "view.log", &out),
+      0)
       << out;
   for (const char* only : {"", " --iso-only"}) {
     ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(dir_ / "f.vtu") + " " + kSize +
@@ -186,7 +189,9 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
                          dir_ / "render.log", &out),
               0)
         << out;
-    EXPECT_EQ(differing_pixels(read_png(dir_ / (*only ? "iv-002.png" : "iv-001.png")), read_png(dir_ / "ir.png")), 0u)
+    EXPECT_EQ(
+        differing_pixels(read_png(dir_ / (*only ? "iv-002.png" : "iv-001.png")), read_png(dir_ / "ir.png")),
+        0u)
         << (*only ? "surface" : "solid");
   }
   EXPECT_NE(differing_pixels(read_png(dir_ / "iv-001.png"), read_png(dir_ / "iv-002.png")), 0u);
@@ -194,16 +199,16 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
 
   // The legend key's script form: the scene narrowed by the panel, the legend beside it with the
   // isovalue marked, as foxi render --iso 6 with the legend draws it given the viewer's camera.
-  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize + " --field u --graded --save " +
-                           q(dir_ / "lv") + " --script 'legend iso:6 d s'",
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize +
+                           " --field u --graded --save " + q(dir_ / "lv") + " --script 'legend iso:6 d s'",
                        dir_ / "view.log", &out),
             0)
       << out;
   std::smatch cm;
   ASSERT_TRUE(std::regex_search(out, cm, std::regex("legend on, ([0-9]+) pixels at the right"))) << out;
   ASSERT_TRUE(std::regex_search(out, cm, std::regex("\\((--eye [^)]*)\\)"))) << out;
-  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(dir_ / "f.vtu") + " " + kSize + " " + std::string(cm[1]) +
-                           " --field u --graded --iso 6 -o " + q(dir_ / "lr.png"),
+  ASSERT_EQ(run_logged(q(test::cli_path()) + " render " + q(dir_ / "f.vtu") + " " + kSize + " " +
+                           std::string(cm[1]) + " --field u --graded --iso 6 -o " + q(dir_ / "lr.png"),
                        dir_ / "render.log", &out),
             0)
       << out;
@@ -218,8 +223,8 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
 // is exactly the tets left.
 TEST_F(ViewTest, UndrawEqualsRenderingFewerTets) {
   std::string out;
-  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --dump-ids --save " + q(dir_ / "u") +
-                           " --script 'd s u:360 s u s f s u:100 r s'",
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --dump-ids --save " +
+                           q(dir_ / "u") + " --script 'd s u:360 s u s f s u:100 r s'",
                        dir_ / "view.log", &out),
             0)
       << out;
@@ -255,8 +260,8 @@ TEST_F(ViewTest, UndrawEqualsRenderingFewerTets) {
 // pixel), and an undraw is refused with a message.
 TEST_F(ViewTest, NoUndoDrawsTheSamePictureAndRefusesUndraw) {
   std::string out;
-  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --no-undo --save " + q(dir_ / "n") +
-                           " --script 'd s'",
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --no-undo --save " +
+                           q(dir_ / "n") + " --script 'd s'",
                        dir_ / "view.log", &out),
             0)
       << out;
@@ -507,15 +512,17 @@ exit 0
 )SH";
   test::write_text(dir_ / "drive.sh", driver);
   std::string out;
-  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " --size 320x240 --field u --graded --save " +
-                           q(dir_ / "h") + " --script 'legend i map d s'",
-                       dir_ / "view.log", &out),
-            0)
+  ASSERT_EQ(
+      run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " --size 320x240 --field u --graded --save " +
+                     q(dir_ / "h") + " --script 'legend i map d s'",
+                 dir_ / "view.log", &out),
+      0)
       << out;
   const Framebuffer headless = read_png(dir_ / "h-001.png");
-  const int status = run_logged("timeout -k 5 40 xvfb-run -a -s '-screen 0 640x480x24' sh " + q(dir_ / "drive.sh") + " " +
-                                    q(view_path()) + " " + q(dir_ / "f.vtu") + " " + q(dir_.path()),
-                                dir_ / "xvfb.log", &out);
+  const int status =
+      run_logged("timeout -k 5 40 xvfb-run -a -s '-screen 0 640x480x24' sh " + q(dir_ / "drive.sh") + " " +
+                     q(view_path()) + " " + q(dir_ / "f.vtu") + " " + q(dir_.path()),
+                 dir_ / "xvfb.log", &out);
   ASSERT_EQ(status, 0) << out << test::read_text(dir_ / "window.log");
   ASSERT_TRUE(std::filesystem::exists(dir_ / "k-001.png")) << test::read_text(dir_ / "window.log");
   EXPECT_EQ(differing_pixels(read_png(dir_ / "k-001.png"), headless), 0u);
@@ -531,7 +538,8 @@ exit 0
 }
 
 TEST_F(ViewTest, WindowStopsCleanlyOnSigtermAndSighup) {
-  if (!test::have_program("xvfb-run")) GTEST_SKIP() << "xvfb-run is missing (scripts/install-deps.sh installs it)";
+  if (!test::have_program("xvfb-run"))
+    GTEST_SKIP() << "xvfb-run is missing (scripts/install-deps.sh installs it)";
   const std::string driver = R"SH(set -u
 V=$1; M=$2; D=$3; S=$4
 "$V" "$M" --size 320x240 --save "$D/x" > "$D/stop.log" 2>&1 &
@@ -543,13 +551,14 @@ wait $pid
 exit $?
 )SH";
   test::write_text(dir_ / "stop.sh", driver);
-  for (const auto& [sig, status] : {std::pair<std::string, int>{"TERM", 143}, std::pair<std::string, int>{"HUP", 129}}) {
+  for (const auto& [sig, status] :
+       {std::pair<std::string, int>{"TERM", 143}, std::pair<std::string, int>{"HUP", 129}}) {
     SCOPED_TRACE("SIG" + sig);
     const std::filesystem::path d = dir_ / ("stop-" + sig);
     std::filesystem::create_directories(d);
     std::string out;
-    EXPECT_EQ(run_logged("xvfb-run -a sh " + q(dir_ / "stop.sh") + " " + q(view_path()) + " " + q(mesh_path_) + " " +
-                             q(d) + " " + sig,
+    EXPECT_EQ(run_logged("xvfb-run -a sh " + q(dir_ / "stop.sh") + " " + q(view_path()) + " " +
+                             q(mesh_path_) + " " + q(d) + " " + sig,
                          dir_ / "stop-run.log", &out),
               status)
         << out << test::read_text(d / "stop.log");

@@ -61,9 +61,10 @@ class ExternalFiles : public ::testing::Test {
     if (test::run("/usr/bin/python3 -c 'import meshio, numpy' > /dev/null 2>&1") != 0)
       GTEST_SKIP() << "python3 with meshio and numpy not installed";
     test::write_text(dir_ / "make.py", kScript);
-    ASSERT_EQ(test::run("/usr/bin/python3 '" + (dir_ / "make.py").string() + "' '" + dir_.path().string() + "'",
-                        dir_ / "py.log"),
-              0)
+    ASSERT_EQ(
+        test::run("/usr/bin/python3 '" + (dir_ / "make.py").string() + "' '" + dir_.path().string() + "'",
+                  dir_ / "py.log"),
+        0)
         << test::read_text(dir_ / "py.log");
     f_ = read_numbers(dir_ / "f.txt");
     v_ = read_numbers(dir_ / "v.txt");
@@ -98,8 +99,9 @@ TEST_F(ExternalFiles, MeshioVtuVtkAndMshHoldWhatMeshioWrote) {
 TEST_F(ExternalFiles, GmshWrittenViewHoldsTheValues) {
   if (!test::have_program("gmsh")) GTEST_SKIP() << "gmsh not installed";
   // gmsh loads meshio's file and writes the view itself, as .msh 4.1 with the mesh ($NodeData).
-  test::write_text(dir_ / "resave.geo", "Merge \"meshio.msh\";\nPostProcessing.SaveMesh = 1;\n"
-                                        "Mesh.MshFileVersion = 4.1;\nSave View[0] \"gmsh.msh\";\n");
+  test::write_text(dir_ / "resave.geo",
+                   "Merge \"meshio.msh\";\nPostProcessing.SaveMesh = 1;\n"
+                   "Mesh.MshFileVersion = 4.1;\nSave View[0] \"gmsh.msh\";\n");
   ASSERT_EQ(test::run("cd '" + dir_.path().string() + "' && gmsh -0 resave.geo", dir_ / "gmsh.log"), 0)
       << test::read_text(dir_ / "gmsh.log");
   ASSERT_NE(test::read_text(dir_ / "gmsh.msh").find("$NodeData"), std::string::npos);
@@ -113,7 +115,8 @@ TEST_F(ExternalFiles, GmshWrittenViewHoldsTheValues) {
   p.names = {f.name};
   const TransferReport rep = transfer_fields(s, m.mesh, p);
   EXPECT_EQ(rep.nodes_outside, 0u);
-  for (std::size_t i = 0; i < f_.size(); ++i) EXPECT_NEAR(rep.fields[0].values[i], f_[i], 1e-14 * std::abs(f_[i]) + 1e-14);
+  for (std::size_t i = 0; i < f_.size(); ++i)
+    EXPECT_NEAR(rep.fields[0].values[i], f_[i], 1e-14 * std::abs(f_[i]) + 1e-14);
 }
 
 }  // namespace

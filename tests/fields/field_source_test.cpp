@@ -31,7 +31,8 @@ TransferParams by_id() {
 }
 
 bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
 
 Mesh mesh_with_fields() {
@@ -43,14 +44,16 @@ Mesh mesh_with_fields() {
   Field u{"u", FieldLocation::node, 3, "m", {}, {}};
   for (std::size_t i = 0; i < 3 * m.node_count(); ++i) u.values.push_back(std::sin(double(i)) * 1e-6);
   Field s{"stress", FieldLocation::cell, 6, "Pa", {1, 2}, {}};
-  for (std::size_t i = 0; i < 2 * 6 * m.tet_count(); ++i) s.values.push_back(std::exp(double(i % 97) / 7) * 1e5 / 3);
+  for (std::size_t i = 0; i < 2 * 6 * m.tet_count(); ++i)
+    s.values.push_back(std::exp(double(i % 97) / 7) * 1e5 / 3);
   m.fields = {t, u, s};
   return m;
 }
 
 // Reads `path` as a field source and carries it by id onto m (without its fields): every value of
 // every field and step must come back bit for bit.
-void expect_round_trip(const Mesh& m, const std::filesystem::path& path, bool keeps_units, bool keeps_step_values) {
+void expect_round_trip(const Mesh& m, const std::filesystem::path& path, bool keeps_units,
+                       bool keeps_step_values) {
   SCOPED_TRACE(path.filename().string());
   const FieldSource src = read_field_source(path);
   Mesh target = m;
@@ -82,8 +85,10 @@ void expect_round_trip(const Mesh& m, const std::filesystem::path& path, bool ke
 TEST(FieldSource, VtkAndGmshRoundTripsKeepEveryValueBitForBit) {
   test::TempDir dir;
   const Mesh m = mesh_with_fields();
-  for (auto [enc, name] : {std::pair{VtuEncoding::appended_raw, "raw"}, {VtuEncoding::ascii, "ascii"},
-                           {VtuEncoding::base64, "base64"}, {VtuEncoding::zlib, "zlib"}}) {
+  for (auto [enc, name] : {std::pair{VtuEncoding::appended_raw, "raw"},
+                           {VtuEncoding::ascii, "ascii"},
+                           {VtuEncoding::base64, "base64"},
+                           {VtuEncoding::zlib, "zlib"}}) {
     write_vtu(m, dir / (std::string(name) + ".vtu"), enc);
     expect_round_trip(m, dir / (std::string(name) + ".vtu"), true, true);
   }
@@ -103,7 +108,8 @@ TEST(FieldSource, PvdSeriesIsOneFieldWithSteps) {
   test::TempDir dir;
   Mesh m = bench::kuhn_grid_mesh(2, 0.2, 4);
   std::vector<double> all;
-  std::string pvd = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
+  std::string pvd =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
   const double times[] = {0, 0.25, 1e-3 / 3};
   for (int s = 0; s < 3; ++s) {
     Field t{"temperature", FieldLocation::node, 1, "K", {}, {}};
@@ -141,7 +147,8 @@ void write_deck(const Mesh& m, const std::filesystem::path& path, const std::str
   std::string s = "*NODE, NSET=NALL\n";
   char line[160];
   for (std::size_t i = 0; i < m.node_count(); ++i) {
-    std::snprintf(line, sizeof line, "%zu, %.17g, %.17g, %.17g\n", i + 1, m.xyz[3 * i], m.xyz[3 * i + 1], m.xyz[3 * i + 2]);
+    std::snprintf(line, sizeof line, "%zu, %.17g, %.17g, %.17g\n", i + 1, m.xyz[3 * i], m.xyz[3 * i + 1],
+                  m.xyz[3 * i + 2]);
     s += line;
   }
   s += "*ELEMENT, TYPE=C3D4, ELSET=EALL\n";
@@ -151,7 +158,8 @@ void write_deck(const Mesh& m, const std::filesystem::path& path, const std::str
     s += line;
   }
   s += "*MATERIAL, NAME=M\n*CONDUCTIVITY\n50\n*ELASTIC\n1e9, 0.3\n*EXPANSION\n1e-5\n"
-       "*SOLID SECTION, ELSET=EALL, MATERIAL=M\n" + body;
+       "*SOLID SECTION, ELSET=EALL, MATERIAL=M\n" +
+       body;
   test::write_text(path, s);
 }
 
@@ -186,7 +194,8 @@ TEST(FieldSource, CalculixFrdHasTheAnalyticValues) {
                  ", 1, 3, 0\n" + corner(1, 0) + ", 2, 3, 0\n" + corner(0, 1) +
                  ", 3, 3, 0\n*TEMPERATURE\nNALL, 400\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n");
   for (const char* job : {"heat", "expand"}) {
-    const int rc = test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i " + job, dir / "ccx.log");
+    const int rc =
+        test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i " + job, dir / "ccx.log");
     ASSERT_EQ(rc, 0) << test::read_text(dir / "ccx.log");
   }
   const FieldSource heat = read_field_source(dir / "heat.frd");
@@ -218,10 +227,13 @@ TEST(FieldSource, CalculixFrdHasTheAnalyticValues) {
   EXPECT_EQ(u->components, 3u);  // D1 D2 D3; "ALL" is computed by the reader, not in the file
   EXPECT_EQ(s->components, 6u);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t k = std::find(expand.node_id.begin(), expand.node_id.end(), i + 1) - expand.node_id.begin();
+    const std::size_t k =
+        std::find(expand.node_id.begin(), expand.node_id.end(), i + 1) - expand.node_id.begin();
     ASSERT_LT(k, n);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(u->values[3 * k + c], 1e-3 * m.xyz[3 * i + c], 1e-8) << "node " << i + 1;
-    for (int c = 0; c < 6; ++c) EXPECT_NEAR(s->values[6 * k + c], 0, 1.0) << "node " << i + 1;  // E alpha dT = 1e6 Pa
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(u->values[3 * k + c], 1e-3 * m.xyz[3 * i + c], 1e-8) << "node " << i + 1;
+    for (int c = 0; c < 6; ++c)
+      EXPECT_NEAR(s->values[6 * k + c], 0, 1.0) << "node " << i + 1;  // E alpha dT = 1e6 Pa
   }
 }
 
@@ -483,7 +495,9 @@ TEST(FieldSource, FrdMemoryIsBoundedByTheFile) {
   std::vector<std::uint64_t> block_line;
   std::uint64_t lines = 403;
   for (int b = 0; b < 5; ++b) {
-    text += "  100CL  101 1.000000000         400                     0    1           1\n -4  BIG        64    1\n";
+    text +=
+        "  100CL  101 1.000000000         400                     0    1           1\n -4  BIG        64    "
+        "1\n";
     block_line.push_back(lines + 2);
     for (int c = 0; c < 64; ++c) {
       std::snprintf(line, sizeof line, " -5  C%-2d         1    1    0    0\n", c);

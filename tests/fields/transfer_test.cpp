@@ -70,9 +70,11 @@ Mesh keep_tets(const Mesh& m, Keep keep) {
 // Brute force: is p in some tet of m (no barycentric coordinate below -tol), by signed volumes.
 bool inside_scan(const Mesh& m, const double* p, double tol) {
   auto det = [](const double* a, const double* b, const double* c, const double* d) {
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]},
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]},
                  w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0]);
   };
   for (std::size_t t = 0; t < m.tet_count(); ++t) {
     const double* q[4];
@@ -110,7 +112,11 @@ TEST(FieldTransfer, LinearFieldBetweenTwoMeshesOfABoxIsExact) {
     worst = std::max(worst, std::abs(f.values[i] - want));
     worst = std::max(worst, std::abs(f.values[n + i] - 10 * want) / 10);
     for (int k = 0; k < 3; ++k)
-      worst = std::max(worst, std::abs(rep.fields[1].values[3 * i + k] - (k == 0 ? 1 : k == 1 ? 2 : -1) * want) / 2);
+      worst = std::max(worst, std::abs(rep.fields[1].values[3 * i + k] - (k == 0   ? 1
+                                                                          : k == 1 ? 2
+                                                                                   : -1) *
+                                                                             want) /
+                                  2);
   }
   EXPECT_LT(worst, 1e-13) << "linear interpolation of a linear field must be exact to rounding";
 }
@@ -121,7 +127,8 @@ TEST(FieldTransfer, OutsideCountsOnNonConvexMeshesMatchABruteForceScan) {
   const double tol = 1e-9;
   Mesh box = bench::kuhn_grid_mesh(6, 0.25, 3);
   box.tet_region.clear();
-  Mesh ell = keep_tets(bench::kuhn_grid_mesh(7, 0.2, 5), [](const double* c) { return !(c[0] > 0.5 && c[1] > 0.5); });
+  Mesh ell = keep_tets(bench::kuhn_grid_mesh(7, 0.2, 5),
+                       [](const double* c) { return !(c[0] > 0.5 && c[1] > 0.5); });
   ell.tet_region.clear();
   for (int shifted = 0; shifted < 2; ++shifted) {
     Mesh src = shifted ? box : ell;
@@ -251,7 +258,8 @@ TEST(FieldTransfer, LocatePointsAgreesWithTheScan) {
     double q[3] = {0, 0, 0}, s = 0;  // the barycentric coordinates give the point back
     for (int j = 0; j < 4; ++j) {
       s += loc.bary[4 * i + j];
-      for (int k = 0; k < 3; ++k) q[k] += loc.bary[4 * i + j] * m.xyz[3 * std::size_t(m.tet[4 * loc.tet[i] + j]) + k];
+      for (int k = 0; k < 3; ++k)
+        q[k] += loc.bary[4 * i + j] * m.xyz[3 * std::size_t(m.tet[4 * loc.tet[i] + j]) + k];
     }
     EXPECT_NEAR(s, 1, 1e-14);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(q[k], pts[3 * i + k], 1e-14);
@@ -279,7 +287,8 @@ TEST(FieldTransfer, ByIdChecksTheMesh) {
   // A field that is not there, and a unit that differs from the target's field of that name.
   EXPECT_THROW(transfer_fields(source_of(m), target, by_id({"nope"})), FieldError);
   Mesh with_unit = target;
-  with_unit.fields.push_back(Field{"f", FieldLocation::node, 1, "degC", {}, std::vector<double>(m.node_count(), 0)});
+  with_unit.fields.push_back(
+      Field{"f", FieldLocation::node, 1, "degC", {}, std::vector<double>(m.node_count(), 0)});
   EXPECT_THROW(transfer_fields(source_of(m), with_unit, by_id()), FieldError);
 }
 
@@ -296,8 +305,9 @@ TEST(FieldTransfer, NanValuesAreKeptAndCounted) {
   const TransferReport loc = transfer_fields(source_of(m), target, names({"f"}));
   EXPECT_TRUE(std::isnan(loc.fields[0].values[5]));
   EXPECT_GE(loc.nan_values, 1u);
-  EXPECT_EQ(loc.nan_values, std::size_t(std::count_if(loc.fields[0].values.begin(), loc.fields[0].values.end(),
-                                                      [](double v) { return std::isnan(v); })));
+  EXPECT_EQ(loc.nan_values,
+            std::size_t(std::count_if(loc.fields[0].values.begin(), loc.fields[0].values.end(),
+                                      [](double v) { return std::isnan(v); })));
 }
 
 }  // namespace

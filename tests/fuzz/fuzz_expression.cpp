@@ -14,7 +14,8 @@ std::optional<foxi::Quantity> lookup(std::string_view name, int depth) {
   if (name == "k") return foxi::Quantity{150, {1, 1, -3, -1, 0}};
   // A parameter defined by another expression, which the lookup evaluates (nesting the parser).
   if (name == "r" && depth < 4)
-    return foxi::evaluate_expression("2 * w + r", [depth](std::string_view n) { return lookup(n, depth + 1); });
+    return foxi::evaluate_expression("2 * w + r",
+                                     [depth](std::string_view n) { return lookup(n, depth + 1); });
   return std::nullopt;
 }
 
@@ -22,7 +23,8 @@ std::optional<foxi::Quantity> lookup(std::string_view name, int depth) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    foxi::evaluate_expression(foxi::fuzz::as_text(data, size), [](std::string_view n) { return lookup(n, 0); });
+    foxi::evaluate_expression(foxi::fuzz::as_text(data, size),
+                              [](std::string_view n) { return lookup(n, 0); });
   } catch (const foxi::ExpressionError&) {
   }
   return 0;

@@ -80,8 +80,8 @@ std::size_t brute_force_violations(const foxi::Mesh& m) {
   for (std::size_t t = 0; t < m.tet_count(); ++t) {
     const std::uint32_t* q = &m.tet[4 * t];
     for (std::uint32_t v = 0; v < m.node_count(); ++v)
-      if (used[v] && CGAL::side_of_bounded_sphere(point(q[0]), point(q[1]), point(q[2]), point(q[3]), point(v)) ==
-                         CGAL::ON_BOUNDED_SIDE) {
+      if (used[v] && CGAL::side_of_bounded_sphere(point(q[0]), point(q[1]), point(q[2]), point(q[3]),
+                                                  point(v)) == CGAL::ON_BOUNDED_SIDE) {
         ++violating;
         break;
       }
@@ -97,8 +97,9 @@ void render_checks(const foxi::Mesh& m, const foxi::View& view, std::span<const 
   foxi::RenderParams params;
   params.undoable = visibility_order;
   try {
-    const foxi::Camera camera = foxi::camera_from_options(lo, hi, double(kW) / kH, view.perspective ? view.eye : nullptr,
-                                                          nullptr, nullptr, 30, view.perspective ? nullptr : view.dir);
+    const foxi::Camera camera =
+        foxi::camera_from_options(lo, hi, double(kW) / kH, view.perspective ? view.eye : nullptr, nullptr,
+                                  nullptr, 30, view.perspective ? nullptr : view.dir);
     foxi::TetRasterizer raster(m, camera, kW, kH, params);
     foxi::Framebuffer fb(kW, kH);
     raster.draw(fb, order);
@@ -107,9 +108,9 @@ void render_checks(const foxi::Mesh& m, const foxi::View& view, std::span<const 
     raster.undraw(fb, order.size() - half);
     foxi::RenderParams fresh_params;
     const foxi::Framebuffer fresh = foxi::render_tets(m, camera, kW, kH, order.first(half), fresh_params);
-    FOXI_FUZZ_CHECK(fresh.rgba == fb.rgba && fresh.id == fb.id,
-                    "undrawing to " + std::to_string(half) + " of " + std::to_string(order.size()) +
-                        " tets differs from drawing them afresh");
+    FOXI_FUZZ_CHECK(fresh.rgba == fb.rgba && fresh.id == fb.id, "undrawing to " + std::to_string(half) +
+                                                                    " of " + std::to_string(order.size()) +
+                                                                    " tets differs from drawing them afresh");
   } catch (const std::invalid_argument&) {
     // A degenerate camera (eye on the target point), bounds too large to fit a camera to, or one
     // zoomed past the fixed-point range: refused, which is the documented answer.
@@ -128,8 +129,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FOXI_FUZZ_CHECK(cert.tets_checked == m.tet_count(), "");
   if (m.weight.empty()) {
     const std::size_t expected = brute_force_violations(m);
-    FOXI_FUZZ_CHECK(cert.violating_tet_count == expected,
-                    std::to_string(cert.violating_tet_count) + " violating tets, brute force " + std::to_string(expected));
+    FOXI_FUZZ_CHECK(cert.violating_tet_count == expected, std::to_string(cert.violating_tet_count) +
+                                                              " violating tets, brute force " +
+                                                              std::to_string(expected));
     FOXI_FUZZ_CHECK(cert.delaunay == (expected == 0 && cert.degenerate_tet_count == 0), "");
   }
 
@@ -141,7 +143,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     order = foxi::visibility_order(m, table, view);
     check_permutation(order, all);
     const foxi::ViolationReport report = foxi::count_violations(m, view, order);
-    FOXI_FUZZ_CHECK(report.violations == 0, std::to_string(report.violations) + " face-adjacent pairs out of order");
+    FOXI_FUZZ_CHECK(report.violations == 0,
+                    std::to_string(report.violations) + " face-adjacent pairs out of order");
   } else {
     std::size_t cycles = 0;
     order = foxi::mpvo_order(m, table, view, {}, &cycles);

@@ -24,8 +24,8 @@ namespace foxi::fuzz {
   std::abort();
 }
 
-#define FOXI_FUZZ_CHECK(cond, detail) \
-  do {                                \
+#define FOXI_FUZZ_CHECK(cond, detail)               \
+  do {                                              \
     if (!(cond)) ::foxi::fuzz::fail(#cond, detail); \
   } while (0)
 

@@ -30,7 +30,8 @@ void write_file(const fs::path& p, const std::string& bytes) {
 }
 
 // Copies the files of `from` with one of the extensions (all if none given) into `to`.
-void copy_matching(const fs::path& from, const fs::path& to, const std::vector<std::string>& extensions = {}) {
+void copy_matching(const fs::path& from, const fs::path& to,
+                   const std::vector<std::string>& extensions = {}) {
   for (const auto& e : fs::directory_iterator(from)) {
     if (!e.is_regular_file()) continue;
     bool take = extensions.empty();
@@ -77,8 +78,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const fs::path out = argv[1], data = FOXI_TEST_DATA_DIR, root = FOXI_SOURCE_DIR;
-  for (const char* t : {"gmsh", "vtu", "vtk", "medit", "tetgen", "poly", "model", "expression", "mesh_pipeline",
-                        "frd", "csv"})
+  for (const char* t : {"gmsh", "vtu", "vtk", "medit", "tetgen", "poly", "model", "expression",
+                        "mesh_pipeline", "frd", "csv"})
     fs::create_directories(out / t);
 
   for (std::uint32_t n : {1u, 2u}) {
@@ -86,7 +87,8 @@ int main(int argc, char** argv) {
     const std::string k = "kuhn" + std::to_string(n);
     for (int version : {22, 41})
       for (bool binary : {false, true})
-        foxi::write_gmsh(m, out / "gmsh" / (k + "_" + std::to_string(version) + (binary ? "_bin" : "") + ".msh"),
+        foxi::write_gmsh(m,
+                         out / "gmsh" / (k + "_" + std::to_string(version) + (binary ? "_bin" : "") + ".msh"),
                          {version, binary});
     const std::pair<foxi::VtuEncoding, const char*> encodings[] = {{foxi::VtuEncoding::ascii, "ascii"},
                                                                    {foxi::VtuEncoding::base64, "base64"},
@@ -129,10 +131,26 @@ int main(int argc, char** argv) {
   copy_matching(root / "models", out / "model", {".toml"});
   copy_matching(data / "cdt", out / "model", {".toml"});
 
-  const char* expressions[] = {"4 mm", "w + 2 mm", "150 W/(m*K)", "sqrt(w * w)", "2.5um", "-(w - 1 mm) / 2",
-                               "min(w, 3 mm) + max(1 mm, w)", "n ^ 3 * w", "w ^ -2", "sin(pi / n) * exp(1)",
-                               "log(10) * abs(-k)", "1e-3 * k * w / (2 K)", "r * 2", "1 mm + 300 K", "((w))",
-                               "3 kV / mm", "20 ppm / K", "1 MPa * 2 mA", "cos(tan(0.5))", "1e308 * 10"};
+  const char* expressions[] = {"4 mm",
+                               "w + 2 mm",
+                               "150 W/(m*K)",
+                               "sqrt(w * w)",
+                               "2.5um",
+                               "-(w - 1 mm) / 2",
+                               "min(w, 3 mm) + max(1 mm, w)",
+                               "n ^ 3 * w",
+                               "w ^ -2",
+                               "sin(pi / n) * exp(1)",
+                               "log(10) * abs(-k)",
+                               "1e-3 * k * w / (2 K)",
+                               "r * 2",
+                               "1 mm + 300 K",
+                               "((w))",
+                               "3 kV / mm",
+                               "20 ppm / K",
+                               "1 MPa * 2 mA",
+                               "cos(tan(0.5))",
+                               "1e308 * 10"};
   int i = 0;
   for (const char* x : expressions) write_file(out / "expression" / ("e" + std::to_string(i++)), x);
 
@@ -148,7 +166,8 @@ int main(int argc, char** argv) {
   write_file(out / "mesh_pipeline" / "cube_weighted", encode_lattice(0x06, cube, kuhn, 0, {-40, 30, 20}));
   write_file(out / "mesh_pipeline" / "cube_inside", encode_lattice(0x24, cube, kuhn, 0, {8, 8, 8}));
   std::vector<int> pair = {0, 0, 0, 3, 0, 0, 0, 3, 0, 0, 0, 3, 2, 2, 2};
-  write_file(out / "mesh_pipeline" / "flip_pair", encode_lattice(0x04, pair, {0, 1, 2, 3, 1, 2, 3, 4}, 0, {30, 20, 10}));
+  write_file(out / "mesh_pipeline" / "flip_pair",
+             encode_lattice(0x04, pair, {0, 1, 2, 3, 1, 2, 3, 4}, 0, {30, 20, 10}));
   std::printf("fuzz_make_seeds: wrote %s\n", out.c_str());
   return 0;
 }

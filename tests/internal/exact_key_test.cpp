@@ -40,7 +40,8 @@ std::pair<Q, Q> oracle(const Tet& t, bool perspective, const P& x) {
     r[i] = n2i - n20 - (Q(t.w[i + 1]) - Q(t.w[0]));
   }
   auto det3 = [](Q a[3][3]) {
-    return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+    return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+           a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
            a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
   };
   const Q d = det3(m);
@@ -80,10 +81,10 @@ int oracle_compare(const Tet& a, const Tet& b, bool perspective, const P& x) {
 
 int foxi_compare(const Tet& a, const Tet& b, bool perspective, const P& x) {
   exact::PowerKey ka, kb;
-  ka.set(a.v[0].data(), a.v[1].data(), a.v[2].data(), a.v[3].data(), a.weighted ? a.w.data() : nullptr, perspective,
-         x.data());
-  kb.set(b.v[0].data(), b.v[1].data(), b.v[2].data(), b.v[3].data(), b.weighted ? b.w.data() : nullptr, perspective,
-         x.data());
+  ka.set(a.v[0].data(), a.v[1].data(), a.v[2].data(), a.v[3].data(), a.weighted ? a.w.data() : nullptr,
+         perspective, x.data());
+  kb.set(b.v[0].data(), b.v[1].data(), b.v[2].data(), b.v[3].data(), b.weighted ? b.w.data() : nullptr,
+         perspective, x.data());
   return ka.compare(kb);
 }
 
@@ -96,7 +97,8 @@ void expect_agree(const std::vector<Tet>& tets, std::mt19937& rng, int views, in
       for (std::size_t j = i + 1; j < tets.size(); ++j) {
         const int expect = oracle_compare(tets[i], tets[j], perspective, x);
         ASSERT_EQ(foxi_compare(tets[i], tets[j], perspective, x), expect)
-            << "tets " << i << ", " << j << (perspective ? " eye " : " dir ") << x[0] << " " << x[1] << " " << x[2];
+            << "tets " << i << ", " << j << (perspective ? " eye " : " dir ") << x[0] << " " << x[1] << " "
+            << x[2];
         ASSERT_EQ(foxi_compare(tets[j], tets[i], perspective, x), -expect);
         if (ties && expect == 0) ++*ties;
       }
@@ -116,9 +118,11 @@ TEST(ExactKey, CospherialCornersTieAndOneUlpApartDoNot) {
   // Tets on the corners of a 1 x 2 x 3 box share its circumsphere: equal keys from every point.
   const double X = 0.1, Y = 0.7, Z = 0.3;
   std::vector<P> corner;
-  for (int i = 0; i < 8; ++i) corner.push_back({X + (i & 1), Y + 2.0 * ((i >> 1) & 1), Z + 3.0 * ((i >> 2) & 1)});
+  for (int i = 0; i < 8; ++i)
+    corner.push_back({X + (i & 1), Y + 2.0 * ((i >> 1) & 1), Z + 3.0 * ((i >> 2) & 1)});
   std::vector<Tet> tets;
-  for (const auto& q : std::vector<std::array<int, 4>>{{0, 1, 2, 4}, {7, 6, 5, 3}, {1, 2, 4, 7}, {0, 3, 5, 6}, {0, 1, 3, 5}}) {
+  for (const auto& q : std::vector<std::array<int, 4>>{
+           {0, 1, 2, 4}, {7, 6, 5, 3}, {1, 2, 4, 7}, {0, 3, 5, 6}, {0, 1, 3, 5}}) {
     Tet t;
     for (int k = 0; k < 4; ++k) t.v[std::size_t(k)] = corner[std::size_t(q[std::size_t(k)])];
     tets.push_back(t);

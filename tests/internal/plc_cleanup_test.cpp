@@ -41,10 +41,12 @@ std::uint32_t point(Plc& plc, double x, double y, double z) {
 // and the interface (marker 6) as two triangles. Other faces: marker 1 (slab), 2 (block).
 Plc slab_and_block() {
   Plc plc;
-  const std::uint32_t s[8] = {point(plc, 0, 0, 0), point(plc, 4, 0, 0), point(plc, 4, 4, 0), point(plc, 0, 4, 0),
-                              point(plc, 0, 0, 1), point(plc, 4, 0, 1), point(plc, 4, 4, 1), point(plc, 0, 4, 1)};
-  const std::uint32_t b[8] = {point(plc, 1, 1, 1), point(plc, 3, 1, 1), point(plc, 3, 3, 1), point(plc, 1, 3, 1),
-                              point(plc, 1, 1, 2), point(plc, 3, 1, 2), point(plc, 3, 3, 2), point(plc, 1, 3, 2)};
+  const std::uint32_t s[8] = {point(plc, 0, 0, 0), point(plc, 4, 0, 0), point(plc, 4, 4, 0),
+                              point(plc, 0, 4, 0), point(plc, 0, 0, 1), point(plc, 4, 0, 1),
+                              point(plc, 4, 4, 1), point(plc, 0, 4, 1)};
+  const std::uint32_t b[8] = {point(plc, 1, 1, 1), point(plc, 3, 1, 1), point(plc, 3, 3, 1),
+                              point(plc, 1, 3, 1), point(plc, 1, 1, 2), point(plc, 3, 1, 2),
+                              point(plc, 3, 3, 2), point(plc, 1, 3, 2)};
   // Slab bottom and sides.
   plc.add_facet({s[0], s[1], s[2], s[3]}, 1);
   plc.add_facet({s[0], s[1], s[5], s[4]}, 1);
@@ -81,9 +83,9 @@ void expect_slab_and_block_geometry(const Mesh& m) {
 
 TEST(PlcCleanup, SnapMakesRoundingDifferencesEqualAndLeavesRealOnesAlone) {
   Plc plc = slab_and_block();
-  plc.points[3 * 4] = std::nextafter(0.0, 1.0);        // slab corner x: one rounding step off 0
-  plc.points[3 * 9 + 1] = std::nextafter(1.0, 2.0);    // block corner y: one step off 1
-  plc.points[3 * 10 + 2] = 1 + 1e-6;                   // a real offset: kept
+  plc.points[3 * 4] = std::nextafter(0.0, 1.0);      // slab corner x: one rounding step off 0
+  plc.points[3 * 9 + 1] = std::nextafter(1.0, 2.0);  // block corner y: one step off 1
+  plc.points[3 * 10 + 2] = 1 + 1e-6;                 // a real offset: kept
   EXPECT_EQ(detail::snap_coordinates(plc), 2u);
   EXPECT_EQ(plc.points[3 * 4], 0.0);
   EXPECT_EQ(plc.points[3 * 9 + 1], 1.0);

@@ -37,7 +37,8 @@ std::map<std::int32_t, double> region_volumes(const Mesh& m) {
   std::map<std::int32_t, double> v;
   for (std::size_t t = 0; t < m.tet_count(); ++t) {
     const std::uint32_t* n = &m.tet[4 * t];
-    const double vol = tet_quality(&m.xyz[3 * n[0]], &m.xyz[3 * n[1]], &m.xyz[3 * n[2]], &m.xyz[3 * n[3]]).volume;
+    const double vol =
+        tet_quality(&m.xyz[3 * n[0]], &m.xyz[3 * n[1]], &m.xyz[3 * n[2]], &m.xyz[3 * n[3]]).volume;
     EXPECT_GT(vol, 0) << "tet " << t << " is not positively oriented";
     v[m.region_of(t)] += vol;
   }
@@ -50,7 +51,8 @@ std::map<std::int32_t, double> tag_areas(const Mesh& m) {
     const double* p = &m.xyz[3 * m.bface[3 * f]];
     const double* q = &m.xyz[3 * m.bface[3 * f + 1]];
     const double* r = &m.xyz[3 * m.bface[3 * f + 2]];
-    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+    const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]},
+                 w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
     const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     area[m.bface_tag[f]] += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   }
@@ -96,7 +98,8 @@ std::vector<View> views_around(const Mesh& m, int n) {
   for (int i = 1; i < n; ++i) {
     const double z = 1 - 2 * (i + 0.5) / n, s = std::sqrt(1 - z * z), phi = i * 2.399963229728653;
     const double d[3] = {s * std::cos(phi), s * std::sin(phi), z};
-    views.push_back(i % 2 ? View::along(d[0], d[1], d[2]) : View::at(c[0] + r * d[0], c[1] + r * d[1], c[2] + r * d[2]));
+    views.push_back(i % 2 ? View::along(d[0], d[1], d[2])
+                          : View::at(c[0] + r * d[0], c[1] + r * d[1], c[2] + r * d[2]));
   }
   return views;
 }
@@ -143,7 +146,8 @@ TEST(CgalMesher, UnitBoxKeepsItsCornersTagsAndIsCertified) {
   for (std::size_t k = 0; k < 8; ++k) {
     bool found = false;
     for (std::size_t i = 0; i < m.node_count() && !found; ++i)
-      found = m.xyz[3 * i] == plc.points[3 * k] && m.xyz[3 * i + 1] == plc.points[3 * k + 1] && m.xyz[3 * i + 2] == plc.points[3 * k + 2];
+      found = m.xyz[3 * i] == plc.points[3 * k] && m.xyz[3 * i + 1] == plc.points[3 * k + 1] &&
+              m.xyz[3 * i + 2] == plc.points[3 * k + 2];
     EXPECT_TRUE(found) << "corner " << k;
   }
   expect_certified(m, 40);
@@ -188,11 +192,13 @@ TEST(CgalMesher, DieOnSubstrateModelMatchesThePartVolumesAndBeatsTetgenAngles) {
   const auto vol = region_volumes(m);
   ASSERT_EQ(vol.size(), st.part_volume.size());
   for (std::size_t p = 0; p < st.part_volume.size(); ++p)
-    EXPECT_NEAR(vol.at(static_cast<std::int32_t>(p + 1)), st.part_volume[p], 1e-9 * st.part_volume[p]) << "part " << p;
+    EXPECT_NEAR(vol.at(static_cast<std::int32_t>(p + 1)), st.part_volume[p], 1e-9 * st.part_volume[p])
+        << "part " << p;
   const auto area = tag_areas(m);
   ASSERT_EQ(area.size(), st.boundary_area.size());  // every named surface is covered
   for (std::size_t b = 0; b < st.boundary_area.size(); ++b)
-    EXPECT_NEAR(area.at(static_cast<std::int32_t>(b + 1)), st.boundary_area[b], 1e-8 * st.boundary_area[b]) << st.boundary_names[b];
+    EXPECT_NEAR(area.at(static_cast<std::int32_t>(b + 1)), st.boundary_area[b], 1e-8 * st.boundary_area[b])
+        << st.boundary_names[b];
   expect_certified(m, 30);
 
   // TetGen -O0 (no flips or smoothing) with a similar tet count: CGAL's exuded mesh has better angles.
@@ -202,8 +208,9 @@ TEST(CgalMesher, DieOnSubstrateModelMatchesThePartVolumesAndBeatsTetgenAngles) {
   tp.max_volume = 1.5 * total / static_cast<double>(m.tet_count());
   const Mesh t = mesh_plc(st.plc, tp);
   const double cgal_min = min_dihedral(m), tetgen_min = min_dihedral(t);
-  std::printf("die on substrate: CGAL %zu tets, min dihedral %.2f deg; TetGen -O0 %zu tets, min dihedral %.2f deg\n", m.tet_count(),
-              cgal_min, t.tet_count(), tetgen_min);
+  std::printf(
+      "die on substrate: CGAL %zu tets, min dihedral %.2f deg; TetGen -O0 %zu tets, min dihedral %.2f deg\n",
+      m.tet_count(), cgal_min, t.tet_count(), tetgen_min);
   EXPECT_GT(cgal_min, tetgen_min);
 }
 
@@ -213,8 +220,8 @@ TEST(CgalMesher, CylinderViaThroughALayerHasAnalyticVolumes) {
   params.max_size = 0.12;
   CgalMeshReport report;
   const Mesh m = mesh_plc_cgal(plc, params, &report);
-  const double via = 0.5 * 8 * 0.2 * 0.2 * std::sin(std::numbers::pi / 8);     // 16-gon prism, r 0.2, height 0.5
-  const double wall = 16 * 2 * 0.2 * std::sin(std::numbers::pi / 16) * 0.5;   // its side area
+  const double via = 0.5 * 8 * 0.2 * 0.2 * std::sin(std::numbers::pi / 8);  // 16-gon prism, r 0.2, height 0.5
+  const double wall = 16 * 2 * 0.2 * std::sin(std::numbers::pi / 16) * 0.5;  // its side area
   const auto vol = region_volumes(m);
   ASSERT_EQ(vol.size(), 3u);
   // Every facet edge is protected: the 16-gon's wall keeps its facets, so every volume and area is the
@@ -224,9 +231,9 @@ TEST(CgalMesher, CylinderViaThroughALayerHasAnalyticVolumes) {
   EXPECT_NEAR(vol.at(3), via, 1e-9 * via);
   const auto area = tag_areas(m);
   EXPECT_EQ(area.size(), 8u);
-  EXPECT_NEAR(area.at(1), 1.0, 1e-9);               // bottom
-  EXPECT_NEAR(area.at(7), 1.0 - 2 * via, 1e-9);     // dielectric top
-  EXPECT_NEAR(area.at(8), 2 * via, 1e-9);           // via top = its footprint
+  EXPECT_NEAR(area.at(1), 1.0, 1e-9);            // bottom
+  EXPECT_NEAR(area.at(7), 1.0 - 2 * via, 1e-9);  // dielectric top
+  EXPECT_NEAR(area.at(8), 2 * via, 1e-9);        // via top = its footprint
   EXPECT_NEAR(area.at(6), wall, 1e-9 * wall);
   // The report's PLC volumes (divergence theorem) are the analytic ones, its mesh volumes ours.
   ASSERT_EQ(report.volumes.size(), 3u);
@@ -239,8 +246,10 @@ TEST(CgalMesher, CylinderViaThroughALayerHasAnalyticVolumes) {
   MeshParams tp;
   tp.max_volume = 1.5 / static_cast<double>(m.tet_count());
   const Mesh t = mesh_plc(plc, tp);
-  std::printf("via: CGAL %zu tets, min dihedral %.2f deg, via volume error %.2e; TetGen -O0 %zu tets, min dihedral %.2f deg\n",
-              m.tet_count(), min_dihedral(m), vol.at(3) / via - 1, t.tet_count(), min_dihedral(t));
+  std::printf(
+      "via: CGAL %zu tets, min dihedral %.2f deg, via volume error %.2e; TetGen -O0 %zu tets, min dihedral "
+      "%.2f deg\n",
+      m.tet_count(), min_dihedral(m), vol.at(3) / via - 1, t.tet_count(), min_dihedral(t));
   EXPECT_GT(min_dihedral(m), min_dihedral(t));
 }
 
@@ -267,7 +276,8 @@ TEST(CgalMesher, ResamplingCutsTheViaAndReportsByHowMuch) {
   }
   EXPECT_NEAR(report.volumes[2].plc, via, 1e-12);
   EXPECT_NE(vol.at(3), via);  // resampled: the via really changed
-  EXPECT_NEAR(report.worst_volume_change, std::max(std::abs(vol.at(3) / via - 1), std::abs(vol.at(2) / (0.5 - via) - 1)), 1e-12);
+  EXPECT_NEAR(report.worst_volume_change,
+              std::max(std::abs(vol.at(3) / via - 1), std::abs(vol.at(2) / (0.5 - via) - 1)), 1e-12);
   std::printf("via resampled: volume change %+.3f%%\n", 100 * (vol.at(3) / via - 1));
   expect_certified(m, 10);
 }
@@ -310,13 +320,18 @@ void expect_model_meshes(const std::string& name, double time_limit = 900, bool 
     }
     worst_area = std::max(worst_area, std::abs(a / want - 1));
   }
-  EXPECT_EQ(report.volumes_match, worst <= 1e-3) << name << ": the report's volume check disagrees (worst change " << worst << ")";
-  EXPECT_EQ(report.areas_match, worst_area <= 1e-3) << name << ": the report's area check disagrees (worst change " << worst_area << ")";
-  std::printf("%s: CGAL %zu tets in %.1f s, %zu patches (%zu facets joined, %zu without area), %zu points welded, %zu tets "
-              "relabelled, worst part volume change %.2e, worst tag area change %.2e (tag %d), min dihedral %.2f deg%s\n",
-              name.c_str(), m.tet_count(), seconds, report.patches, report.facets_joined, report.facets_without_area,
-              report.points_welded, report.tets_relabelled, worst, worst_area, report.worst_area_marker, min_dihedral(m),
-              report.volumes_match && report.areas_match ? "" : " (refused)");
+  EXPECT_EQ(report.volumes_match, worst <= 1e-3)
+      << name << ": the report's volume check disagrees (worst change " << worst << ")";
+  EXPECT_EQ(report.areas_match, worst_area <= 1e-3)
+      << name << ": the report's area check disagrees (worst change " << worst_area << ")";
+  std::printf(
+      "%s: CGAL %zu tets in %.1f s, %zu patches (%zu facets joined, %zu without area), %zu points welded, "
+      "%zu tets "
+      "relabelled, worst part volume change %.2e, worst tag area change %.2e (tag %d), min dihedral %.2f "
+      "deg%s\n",
+      name.c_str(), m.tet_count(), seconds, report.patches, report.facets_joined, report.facets_without_area,
+      report.points_welded, report.tets_relabelled, worst, worst_area, report.worst_area_marker,
+      min_dihedral(m), report.volumes_match && report.areas_match ? "" : " (refused)");
   expect_certified(m, 6);
 }
 
@@ -327,7 +342,9 @@ TEST(CgalMesher, MultiChipModelKeepsItsVolumes) { expect_model_meshes("multi_chi
 // the 10 x 10 mm interface between the 0.1 mm die attach and the 0.12 mm die (no boundary triangle has
 // its tag; tets straddle it: 0.35% of the die's volume in the attach). Not solved: the report's checks
 // must say so (the command refuses the mesh with exit 4), and agree with the builder's volumes and areas.
-TEST(CgalMesherSlow, PowerModuleModelMeshesOrIsRefusedTruthfully) { expect_model_meshes("power_module", 900, true); }
+TEST(CgalMesherSlow, PowerModuleModelMeshesOrIsRefusedTruthfully) {
+  expect_model_meshes("power_module", 900, true);
+}
 TEST(CgalMesherSlow, FlipChipBumpsKeepTheirVolumes) { expect_model_meshes("flip_chip"); }
 // The bga's structure is a corefined triangle soup (balls cut by two boards); it failed with "facet
 // 488 has no polygon with an area" before.
@@ -365,8 +382,8 @@ TEST(CgalMesher, WeightsSurviveAVtuFileAndStillCertify) {
   Mesh bare = m;
   bare.weight.clear();
   const DelaunayCertificate c = compute_delaunay_certificate(bare);
-  std::printf("unit box without its weights: %zu of %zu tets have a vertex inside their circumsphere\n", c.violating_tet_count,
-              c.tets_checked);
+  std::printf("unit box without its weights: %zu of %zu tets have a vertex inside their circumsphere\n",
+              c.violating_tet_count, c.tets_checked);
 }
 
 TEST(CgalMesher, BadPlcsTimeLimitAndCancelGiveTypedMesherErrors) {
@@ -409,7 +426,8 @@ TEST(CgalMesher, BadPlcsTimeLimitAndCancelGiveTypedMesherErrors) {
     EXPECT_EQ(e.failure(), MesherFailure::time_limit) << e.what();
     EXPECT_NE(std::string(e.what()).find("time limit of 1 s"), std::string::npos) << e.what();
   }
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10 * test::kTimeScale);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+            10 * test::kTimeScale);
 
   CgalMeshParams params;
   params.max_size = 0.01;  // long enough to be cancelled

@@ -24,8 +24,8 @@ namespace foxi {
 namespace {
 
 struct ModelCase {
-  const char* path;     // relative to tests/data
-  double max_size;      // target edge length (m), 0: none
+  const char* path;  // relative to tests/data
+  double max_size;   // target edge length (m), 0: none
   double radius_edge;
 };
 
@@ -64,7 +64,8 @@ TEST_P(Models, ConformingMeshIsDelaunayWithExactRegionsAndBoundaries) {
     const double* p = &m.xyz[3 * m.bface[3 * f]];
     const double* a = &m.xyz[3 * m.bface[3 * f + 1]];
     const double* b = &m.xyz[3 * m.bface[3 * f + 2]];
-    const double u[3] = {a[0] - p[0], a[1] - p[1], a[2] - p[2]}, w[3] = {b[0] - p[0], b[1] - p[1], b[2] - p[2]};
+    const double u[3] = {a[0] - p[0], a[1] - p[1], a[2] - p[2]},
+                 w[3] = {b[0] - p[0], b[1] - p[1], b[2] - p[2]};
     const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
     area[m.bface_tag[f]] += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   }
@@ -114,8 +115,7 @@ INSTANTIATE_TEST_SUITE_P(
 // Labelled slow (the suite name): about 4 minutes under the sanitizers, so only the Release pass
 // runs it.
 INSTANTIATE_TEST_SUITE_P(ShippedSlow, Models,
-                         ::testing::Values(ModelCase{"../../models/bga.toml", 1e-3, 1.414}),
-                         model_case_name);
+                         ::testing::Values(ModelCase{"../../models/bga.toml", 1e-3, 1.414}), model_case_name);
 
 // The power module shrunk (its own [mesh] controls): the ceramic overhangs the copper under and over
 // it, and tets in the overhang have circumspheres reaching round the copper's edge to vertices hidden
@@ -156,7 +156,8 @@ TEST(Models, ThinDieAttachLayerDoesNotExplode) {
     const TetQuality q = tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]);
     // The layer by its region id and z range, not by the mesher's own layer test.
     bool in_layer = m.region_of(t) == 2;
-    for (int i = 0; i < 4; ++i) in_layer = in_layer && m.xyz[3 * v[i] + 2] >= 1e-3 - 1e-12 && m.xyz[3 * v[i] + 2] <= 1.02e-3 + 1e-12;
+    for (int i = 0; i < 4; ++i)
+      in_layer = in_layer && m.xyz[3 * v[i] + 2] >= 1e-3 - 1e-12 && m.xyz[3 * v[i] + 2] <= 1.02e-3 + 1e-12;
     if (in_layer) {
       ++layer;
       continue;
@@ -172,8 +173,8 @@ TEST(Models, ThinDieAttachLayerDoesNotExplode) {
   EXPECT_LE(worst_outside, 1.414 * (1 + 1e-6));
   EXPECT_EQ(flat_outside, 0u);
   EXPECT_EQ(report.quality_unmet, 0u);
-  std::printf("die attach: %zu tets, %zu in the layer, radius-edge max %.3f outside it, %zu rounds\n", m.tet_count(), layer,
-              worst_outside, report.iterations);
+  std::printf("die attach: %zu tets, %zu in the layer, radius-edge max %.3f outside it, %zu rounds\n",
+              m.tet_count(), layer, worst_outside, report.iterations);
 }
 
 }  // namespace

@@ -86,8 +86,10 @@ TEST_P(Corpus, RefinementMakesTheO0MeshDelaunay) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cdt, Corpus,
-                         ::testing::Values(Case{"tilted_facets_q1414.poly", 1.414}, Case{"floating_triangles_p.poly", 0},
-                                           Case{"floating_facets_p.poly", 0}, Case{"floating_facets_q1414.poly", 1.414},
+                         ::testing::Values(Case{"tilted_facets_q1414.poly", 1.414},
+                                           Case{"floating_triangles_p.poly", 0},
+                                           Case{"floating_facets_p.poly", 0},
+                                           Case{"floating_facets_q1414.poly", 1.414},
                                            Case{"floating_facets_q1414_a0002.poly", 1.414, 0.002}),
                          [](const ::testing::TestParamInfo<Case>& p) {
                            std::string n = p.param.file;
@@ -111,7 +113,8 @@ TEST(Conforming, SplitPointsLieOnTheEncroachedConstraints) {
   for (std::uint32_t k = static_cast<std::uint32_t>(plc.point_count()); k < refined.point_count(); ++k) {
     bool found = false;
     for (std::size_t f = 0; f < refined.facet_count() && !found; ++f)
-      for (std::uint32_t g = refined.facet_polygon_begin[f]; g < refined.facet_polygon_begin[f + 1] && !found; ++g)
+      for (std::uint32_t g = refined.facet_polygon_begin[f]; g < refined.facet_polygon_begin[f + 1] && !found;
+           ++g)
         for (std::uint32_t v = refined.polygon_vertex_begin[g]; v < refined.polygon_vertex_begin[g + 1]; ++v)
           if (refined.polygon_vertices[v] == k) found = true;
     EXPECT_TRUE(found) << "point " << k << " is in no facet";

@@ -28,7 +28,8 @@ double tet_volume(const Mesh& m, std::size_t t) {
     w[k] = p[3][k] - p[0][k];
   }
   return std::abs(u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                  u[2] * (v[0] * w[1] - v[1] * w[0])) / 6;
+                  u[2] * (v[0] * w[1] - v[1] * w[0])) /
+         6;
 }
 
 TEST(ModelMesh, OverrideGivesACertifiedNamedMeshOfTheRightVolumes) {
@@ -52,7 +53,7 @@ TEST(ModelMesh, OverrideGivesACertifiedNamedMeshOfTheRightVolumes) {
     ASSERT_TRUE(r == 1 || r == 2) << r;
     volume[r] += tet_volume(m.mesh, t);
   }
-  EXPECT_NEAR(volume[1], 10e-3 * 8e-3 * 1e-3, 1e-15);  // substrate 10 x 8 x 1 mm
+  EXPECT_NEAR(volume[1], 10e-3 * 8e-3 * 1e-3, 1e-15);   // substrate 10 x 8 x 1 mm
   EXPECT_NEAR(volume[2], 6e-3 * 3e-3 * 0.5e-3, 1e-15);  // die 6 (overridden from 4) x 3 x 0.5 mm
   bool named_die = false, named_substrate = false;
   for (const auto& r : m.mesh.regions) {

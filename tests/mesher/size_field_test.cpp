@@ -40,7 +40,8 @@ double density(const Mesh& m, double x0, double y0, double x1, double y1) {
     centroid(m, t, c);
     if (c[0] < x0 || c[0] > x1 || c[1] < y0 || c[1] > y1) continue;
     const std::uint32_t* v = &m.tet[4 * t];
-    vol += std::abs(tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume);
+    vol +=
+        std::abs(tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume);
     ++n;
   }
   return vol > 0 ? double(n) / vol : 0;
@@ -65,7 +66,8 @@ TEST(SizeField, RegionSizeShrinksOnlyThatRegion) {
   double vmax[3] = {0, 0, 0};
   for (std::size_t t = 0; t < m.tet_count(); ++t) {
     const std::uint32_t* v = &m.tet[4 * t];
-    const double vol = std::abs(tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume);
+    const double vol =
+        std::abs(tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume);
     vmax[m.region_of(t)] = std::max(vmax[m.region_of(t)], vol);
   }
   EXPECT_LE(vmax[2], regular_tet_volume(0.2e-3) * (1 + 1e-9));
@@ -125,13 +127,15 @@ TEST(SizeField, RefinementFromASolvedFieldFollowsTheGradient) {
       centroid(coarse, t, c);
       if (coarse.region_of(t) != 1 || c[0] < x0 || c[0] > x1 || c[1] < y0 || c[1] > y1) continue;
       const std::uint32_t* v = &coarse.tet[4 * t];
-      const double* p[4] = {&coarse.xyz[3 * v[0]], &coarse.xyz[3 * v[1]], &coarse.xyz[3 * v[2]], &coarse.xyz[3 * v[3]]};
+      const double* p[4] = {&coarse.xyz[3 * v[0]], &coarse.xyz[3 * v[1]], &coarse.xyz[3 * v[2]],
+                            &coarse.xyz[3 * v[3]]};
       // |q| = k |grad T| from the solver's heat_flux cell field: k is constant in the substrate.
       const double w = std::abs(tet_quality(p[0], p[1], p[2], p[3]).volume);
       double g2 = 0;
       for (const Field& f : coarse.fields)
         if (f.name == "heat_flux" && f.location == FieldLocation::cell)
-          for (int k = 0; k < 3; ++k) g2 += f.values[3 * t + std::size_t(k)] * f.values[3 * t + std::size_t(k)];
+          for (int k = 0; k < 3; ++k)
+            g2 += f.values[3 * t + std::size_t(k)] * f.values[3 * t + std::size_t(k)];
       sum += std::sqrt(g2) * w;
       vol += w;
     }
@@ -153,8 +157,9 @@ TEST(SizeField, RefinementFromASolvedFieldFollowsTheGradient) {
   const double before = density(coarse, 3e-3, 2.5e-3, 7e-3, 5.5e-3) / density(coarse, 0, 0, 2e-3, 2e-3);
   const double after = density(fine, 3e-3, 2.5e-3, 7e-3, 5.5e-3) / density(fine, 0, 0, 2e-3, 2e-3);
   // Measured: 0.79 before, 79 after (3,738 -> 30,915 tets); ask for a tenfold concentration.
-  EXPECT_GT(after, 10 * before) << "density ratio under the die / far corner: before " << before << ", after " << after
-                               << " (" << coarse.tet_count() << " -> " << fine.tet_count() << " tets)";
+  EXPECT_GT(after, 10 * before) << "density ratio under the die / far corner: before " << before << ", after "
+                                << after << " (" << coarse.tet_count() << " -> " << fine.tet_count()
+                                << " tets)";
 }
 
 TEST(SizeField, ErrorIndicatorVanishesForALinearField) {
@@ -166,7 +171,8 @@ TEST(SizeField, ErrorIndicatorVanishesForALinearField) {
   Field f;
   f.name = "linear";
   f.values.resize(m.node_count());
-  for (std::size_t n = 0; n < m.node_count(); ++n) f.values[n] = 3 * m.xyz[3 * n] - 2 * m.xyz[3 * n + 1] + m.xyz[3 * n + 2];
+  for (std::size_t n = 0; n < m.node_count(); ++n)
+    f.values[n] = 3 * m.xyz[3 * n] - 2 * m.xyz[3 * n + 1] + m.xyz[3 * n + 2];
   const ErrorIndicator e = zz_error_indicator(m, f);
   // Recovery reproduces a linear field's constant gradient exactly: no error anywhere.
   EXPECT_NEAR(e.gradient_norm, std::sqrt(14.0 * summarize_quality(m).total_volume), 1e-9);
@@ -191,9 +197,11 @@ TEST(SizeField, ErrorIndicatorVanishesForALinearField) {
       for (int i = 0; i < 4; ++i)
         for (int k = 0; k < 3; ++k) p[i][k] = m.xyz[3 * m.tet[4 * t + std::size_t(i)] + std::size_t(k)];
       double a[3], b[3], c[3];
-      for (int k = 0; k < 3; ++k) a[k] = p[1][k] - p[0][k], b[k] = p[2][k] - p[0][k], c[k] = p[3][k] - p[0][k];
+      for (int k = 0; k < 3; ++k)
+        a[k] = p[1][k] - p[0][k], b[k] = p[2][k] - p[0][k], c[k] = p[3][k] - p[0][k];
       valued_volume += std::abs(a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                                a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+                                a[2] * (b[0] * c[1] - b[1] * c[0])) /
+                       6;
     }
   }
   ASSERT_GT(expect_nan, 0u);

@@ -29,7 +29,9 @@ double tet_volume(const Mesh& m, std::size_t t) {
     b[k] = p[2][k] - p[0][k];
     c[k] = p[3][k] - p[0][k];
   }
-  return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) / 6;
+  return (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+          a[2] * (b[0] * c[1] - b[1] * c[0])) /
+         6;
 }
 
 double tri_area(const Mesh& m, std::size_t f) {
@@ -56,13 +58,13 @@ TEST(TetgenMesher, DieOnSubstrateRegionsAndBoundariesHaveAnalyticSizes) {
     volume[m.region_of(t)] += v;
   }
   for (std::size_t f = 0; f < m.bface_count(); ++f) area[m.bface_tag[f]] += tri_area(m, f);
-  EXPECT_NEAR(volume[1], 0.010 * 0.008 * 0.001, 1e-18);  // substrate
-  EXPECT_NEAR(volume[2], 0.004 * 0.003 * 0.0005, 1e-18); // die
-  EXPECT_NEAR(area[1], 0.010 * 0.008, 1e-15);            // substrate bottom
+  EXPECT_NEAR(volume[1], 0.010 * 0.008 * 0.001, 1e-18);        // substrate
+  EXPECT_NEAR(volume[2], 0.004 * 0.003 * 0.0005, 1e-18);       // die
+  EXPECT_NEAR(area[1], 0.010 * 0.008, 1e-15);                  // substrate bottom
   EXPECT_NEAR(area[3], 0.010 * 0.008 - 0.004 * 0.003, 1e-15);  // top ring around the die
-  EXPECT_NEAR(area[4], 0.004 * 0.003, 1e-15);            // die/substrate interface
-  EXPECT_NEAR(area[6], 0.004 * 0.003, 1e-15);            // die top
-  EXPECT_NEAR(area[5], 2 * (0.004 + 0.003) * 0.0005, 1e-15);  // die sides
+  EXPECT_NEAR(area[4], 0.004 * 0.003, 1e-15);                  // die/substrate interface
+  EXPECT_NEAR(area[6], 0.004 * 0.003, 1e-15);                  // die top
+  EXPECT_NEAR(area[5], 2 * (0.004 + 0.003) * 0.0005, 1e-15);   // die sides
   EXPECT_GT(report.steiner_points, 0u);
 }
 
@@ -155,8 +157,8 @@ TEST(TetgenMesher, BrokenInputGivesTypedErrors) {
   }
   // Two crossing facets: TetGen refuses, and foxi says why instead of crashing or exiting.
   Plc plc;
-  plc.points = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 1, 1, 1, 0, 1, 1,
-                0.5, -0.5, -0.5, 0.5, 1.5, -0.5, 0.5, 1.5, 1.5, 0.5, -0.5, 1.5};
+  plc.points = {0, 0, 0, 1, 0, 0, 1,   1,    0,    0,   1,   0,    0,   0,   1,   1,   0,    1,
+                1, 1, 1, 0, 1, 1, 0.5, -0.5, -0.5, 0.5, 1.5, -0.5, 0.5, 1.5, 1.5, 0.5, -0.5, 1.5};
   plc.add_facet({0, 1, 2, 3}, 1);
   plc.add_facet({4, 5, 6, 7}, 1);
   plc.add_facet({0, 1, 5, 4}, 1);

@@ -156,7 +156,6 @@ TEST(FaceAdjacency, RejectsAbsurdIndex) {
 
 // --- TetGen oracle ---------------------------------------------------------------------------------
 
-
 struct TetgenMesh {
   Mesh mesh;
   std::vector<std::int64_t> neigh;  // 4 per tet, 0-based tet index or -1
@@ -189,7 +188,6 @@ TetgenMesh read_tetgen_with_neigh(const std::filesystem::path& base) {
     }
   return r;
 }
-
 
 void check_against_tetgen(const std::string& poly_text, const std::string& switches) {
   if (!test::have_program("tetgen")) GTEST_SKIP() << "tetgen not installed";
@@ -224,7 +222,6 @@ void check_against_tetgen(const std::string& poly_text, const std::string& switc
 TEST(FaceAdjacency, MatchesTetgenNeighboursOnBox) {
   check_against_tetgen(test::box_poly(2, 1, 1), "-pq1.414a0.0005O0nQ");
 }
-
 
 TEST(FaceAdjacency, MatchesTetgenNeighboursOnTrench) {
   check_against_tetgen(test::trench_poly(), "-pq1.414a0.001nQ");

@@ -9,8 +9,9 @@ namespace {
 
 TEST(AssertDeathTest, BrokenInvariantAbortsNamingMessageConditionAndPlace) {
   const int counted = 3, filled = 2;
-  EXPECT_DEATH(FOXI_ASSERT(filled == counted, "row 7: " << filled << " of " << counted),
-               "internal invariant broken: row 7: 2 of 3 \\(filled == counted\\) at .*assert_test\\.cpp:[0-9]+");
+  EXPECT_DEATH(
+      FOXI_ASSERT(filled == counted, "row 7: " << filled << " of " << counted),
+      "internal invariant broken: row 7: 2 of 3 \\(filled == counted\\) at .*assert_test\\.cpp:[0-9]+");
 }
 
 TEST(Assert, HeldInvariantIsEvaluatedOnceAndPasses) {

@@ -238,7 +238,8 @@ TEST(ModelConditions, PhysicsNeedsItsMaterialProperties) {
   // no condition fixes the potential
   const foxi::Model n =
       load(dir, replaced(replaced(kModel, "type = \"ground\"", "type = \"current\"\nvalue = \"1 A\""),
-                         "thermal_conductivity = 10.0", "thermal_conductivity = 10.0\nelectrical_conductivity = 50.0"));
+                         "thermal_conductivity = 10.0",
+                         "thermal_conductivity = 10.0\nelectrical_conductivity = 50.0"));
   try {
     foxi::check_physics(n, foxi::Physics::current);
     ADD_FAILURE() << "no error";
@@ -250,7 +251,8 @@ TEST(ModelConditions, PhysicsNeedsItsMaterialProperties) {
 // A voltage or ground condition with `physics` applies to that physics only.
 TEST(ModelConditions, VoltageConditionForOnePhysics) {
   TempDir dir;
-  const std::string only = replaced(kModel, "type = \"ground\"", "type = \"ground\"\nphysics = \"electrostatic\"");
+  const std::string only =
+      replaced(kModel, "type = \"ground\"", "type = \"ground\"\nphysics = \"electrostatic\"");
   const foxi::Model m = load(dir, only);
   const foxi::BoundaryCondition* ground = nullptr;
   for (const foxi::BoundaryCondition& c : m.conditions)
@@ -273,7 +275,8 @@ TEST(ModelConditions, VoltageConditionForOnePhysics) {
     load(dir, bad);
     ADD_FAILURE() << "no error";
   } catch (const foxi::IoError& e) {
-    EXPECT_NE(e.reason().find("physics must be \"electrostatic\" or \"current\""), std::string::npos) << e.what();
+    EXPECT_NE(e.reason().find("physics must be \"electrostatic\" or \"current\""), std::string::npos)
+        << e.what();
     EXPECT_EQ(e.line(), line_of(bad, "physics = \"thermal\""));
   }
 }
@@ -302,7 +305,8 @@ TEST(ModelConditionsBadInput, UnitMismatchIsNamed) {
   EXPECT_EQ(e.line(), line_of(t, "h = \"10 W/m^2\""));
   const foxi::IoError v = build_error(replaced(kModel, "value = \"3e-3 A\"", "value = \"3 V\""));
   EXPECT_NE(v.reason().find("unit mismatch"), std::string::npos) << v.what();
-  const foxi::IoError d = build_error(replaced(kModel, "value = \"t_amb degC\"", "value = \"t_amb * 1 mm degC\""));
+  const foxi::IoError d =
+      build_error(replaced(kModel, "value = \"t_amb degC\"", "value = \"t_amb * 1 mm degC\""));
   EXPECT_NE(d.reason().find("before degC"), std::string::npos) << d.what();
 }
 
@@ -348,14 +352,18 @@ TEST(ModelConditionsBadInput, UnknownTypesPartsAndKeys) {
                 .reason()
                 .find("unknown condition type 'slipping'"),
             std::string::npos);
-  EXPECT_NE(build_error(replaced(kModel, "part = \"cube\"", "part = \"cub\"")).reason().find("unknown part 'cub'"),
-            std::string::npos);
-  EXPECT_NE(build_error(replaced(kModel, "parts = { cube", "parts = { cubes")).reason().find("unknown part 'cubes'"),
+  EXPECT_NE(
+      build_error(replaced(kModel, "part = \"cube\"", "part = \"cub\"")).reason().find("unknown part 'cub'"),
+      std::string::npos);
+  EXPECT_NE(build_error(replaced(kModel, "parts = { cube", "parts = { cubes"))
+                .reason()
+                .find("unknown part 'cubes'"),
             std::string::npos);
   EXPECT_NE(build_error(replaced(kModel, "h = \"10", "hh = 1\nh = \"10")).reason().find("unknown key 'hh'"),
             std::string::npos);
-  EXPECT_NE(build_error(replaced(kModel, "value = \"0.5 W\"", "value = \"0.5 K\"")).reason().find("unit mismatch"),
-            std::string::npos);
+  EXPECT_NE(
+      build_error(replaced(kModel, "value = \"0.5 W\"", "value = \"0.5 K\"")).reason().find("unit mismatch"),
+      std::string::npos);
   EXPECT_NE(build_error(replaced(kModel, "quality = 1.5", "quality = 0.5")).reason().find("mesh quality"),
             std::string::npos);
   // Below sqrt(2) TetGen's refinement ran for minutes on thin layers: refused with the bound named.

@@ -148,8 +148,6 @@ Mesh read_node_ele(const std::filesystem::path& base) {
   return m;
 }
 
-
-
 // Runs tetgen on a PLC; returns false (and the test skips) when tetgen is not installed.
 bool tetgen_mesh(const std::string& poly, const std::string& switches, Mesh& out) {
   if (!test::have_program("tetgen")) return false;

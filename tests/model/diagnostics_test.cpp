@@ -23,13 +23,13 @@ namespace {
 using foxi::ModelWarning;
 using foxi::ModelWarningKind;
 using foxi::Physics;
-using foxi::test::TempDir;
 using foxi::test::box;
 using foxi::test::kMm;
 using foxi::test::kMm2;
 using foxi::test::kMm3;
 using foxi::test::kModels;
 using foxi::test::ngon_area;
+using foxi::test::TempDir;
 
 struct Diagnosed {
   foxi::Model model;
@@ -86,7 +86,8 @@ std::string condition(const std::string& type, const std::string& surface, const
 
 TEST(ModelDiagnostics, FloatingDieIsIsolatedAndNamed) {
   // a 10 x 10 x 1 mm substrate, a 4 x 4 x 0.5 mm die 1 mm above it, cooled on top
-  const std::string text = kMaterials + box("substrate", 0, 0, 0, 10, 10, 1) + box("die", 3, 3, 2, 4, 4, 0.5) +
+  const std::string text = kMaterials + box("substrate", 0, 0, 0, 10, 10, 1) +
+                           box("die", 3, 3, 2, 4, 4, 0.5) +
                            condition("temperature", "substrate.bottom", "value = \"25 degC\"") +
                            condition("convection", "die.top", "h = 10\nambient = 300");
   const Diagnosed x = diagnose_text(text);
@@ -100,9 +101,9 @@ TEST(ModelDiagnostics, FloatingDieIsIsolatedAndNamed) {
   EXPECT_NE(foxi::describe(iso[0], x.model).find("part 'die' touches no other part"), std::string::npos);
 
   // on the substrate it is fine
-  const Diagnosed on = diagnose_text(kMaterials + box("substrate", 0, 0, 0, 10, 10, 1) +
-                                     box("die", 3, 3, 1, 4, 4, 0.5) +
-                                     condition("temperature", "substrate.bottom", "value = 300"));
+  const Diagnosed on =
+      diagnose_text(kMaterials + box("substrate", 0, 0, 0, 10, 10, 1) + box("die", 3, 3, 1, 4, 4, 0.5) +
+                    condition("temperature", "substrate.bottom", "value = 300"));
   EXPECT_TRUE(on.d.warnings.empty()) << all(on);
 }
 
@@ -118,8 +119,8 @@ TEST(ModelDiagnostics, ParkedAtAnEdgeTouchesNothing) {
 
 TEST(ModelDiagnostics, DieWiderThanItsAttachOverhangs) {
   // die 4 x 4 mm on a centred 2 x 2 mm attach: 16 - 4 = 12 mm^2 exposed, 3/4 of the die's bottom
-  const std::string text = kMaterials + box("substrate", 0, 0, 0, 10, 10, 1) + box("attach", 4, 4, 1, 2, 2, 0.1) +
-                           box("die", 3, 3, 1.1, 4, 4, 0.5) +
+  const std::string text = kMaterials + box("substrate", 0, 0, 0, 10, 10, 1) +
+                           box("attach", 4, 4, 1, 2, 2, 0.1) + box("die", 3, 3, 1.1, 4, 4, 0.5) +
                            condition("temperature", "substrate.bottom", "value = 300");
   const Diagnosed x = diagnose_text(text);
   const auto over = of_kind(x, ModelWarningKind::overhang);
@@ -158,8 +159,8 @@ TEST(ModelDiagnostics, DieOnAPillarOverhangsByTheSquareLessThePolygon) {
 TEST(ModelDiagnostics, BridgeBetweenTwoPostsIsNoOverhang) {
   // a 4 x 4 mm plate on two 1 x 4 mm posts at its ends: its bottom between them is inside the
   // contact's hull (a clip, a lid); with the plate 1 mm wider than the posts' span it overhangs 4 mm^2
-  const std::string posts = box("substrate", 0, 0, 0, 10, 10, 1) + box("p1", 3, 3, 1, 1, 4, 1) +
-                            box("p2", 6, 3, 1, 1, 4, 1);
+  const std::string posts =
+      box("substrate", 0, 0, 0, 10, 10, 1) + box("p1", 3, 3, 1, 1, 4, 1) + box("p2", 6, 3, 1, 1, 4, 1);
   const Diagnosed x = diagnose_text(kMaterials + posts + box("plate", 3, 3, 2, 4, 4, 0.5) +
                                     condition("temperature", "substrate.bottom", "value = 300"));
   EXPECT_TRUE(x.d.warnings.empty()) << all(x);
@@ -179,8 +180,7 @@ TEST(ModelDiagnostics, PathToAFixedValueDependsOnThePhysics) {
   std::string spacer = box("spacer", 0, 0, 1, 4, 4, 1);  // box() writes material "a"
   spacer.replace(spacer.find("material = \"a\""), 14, "material = \"ins\"");
   const std::string stack = box("base", 0, 0, 0, 4, 4, 1) + spacer + box("top", 0, 0, 2, 4, 4, 1);
-  const std::string model = kMaterials + stack +
-                            condition("voltage", "base.bottom", "value = \"1 V\"") +
+  const std::string model = kMaterials + stack + condition("voltage", "base.bottom", "value = \"1 V\"") +
                             condition("current", "top.top", "value = \"1 mA\"") +
                             condition("convection", "top.top", "h = 10\nambient = \"25 degC\"") +
                             condition("displacement", "base.bottom", "value = [0, 0, 0]");
@@ -214,14 +214,15 @@ TEST(ModelDiagnostics, IslandWithoutConditionsIsCutOffInEveryPhysics) {
   ASSERT_EQ(of_kind(x, ModelWarningKind::isolated).size(), 1u) << all(x);
   const auto unfixed = of_kind(x, ModelWarningKind::no_fixed_value);
   ASSERT_EQ(unfixed.size(), 4u) << all(x);
-  const Physics order[] = {Physics::thermal, Physics::electrostatic, Physics::current, Physics::thermal_stress};
+  const Physics order[] = {Physics::thermal, Physics::electrostatic, Physics::current,
+                           Physics::thermal_stress};
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(unfixed[i].physics, order[i]);
     EXPECT_EQ(unfixed[i].parts, std::vector<std::string>{"island"});
   }
-  const Diagnosed held = diagnose_text(
-      kMaterials + parts + "[surfaces.cold]\nbox = { min = [9, -1, 0.5], max = [12, 2, 1.5] }\n" + conditions +
-      condition("temperature", "cold", "value = 300"));
+  const Diagnosed held = diagnose_text(kMaterials + parts +
+                                       "[surfaces.cold]\nbox = { min = [9, -1, 0.5], max = [12, 2, 1.5] }\n" +
+                                       conditions + condition("temperature", "cold", "value = 300"));
   const auto left = of_kind(held, ModelWarningKind::no_fixed_value);
   ASSERT_EQ(left.size(), 3u) << all(held);
   for (const ModelWarning& w : left) EXPECT_NE(w.physics, Physics::thermal);

@@ -104,8 +104,8 @@ TEST(DurableFile, StaleTemporariesOfDeadWritersOnlyAreRemoved) {
   const std::string dead_tmp = "m.msh.foxi-tmp-" + std::to_string(dead) + "-0badf00d";
   const std::string live_tmp = "m.msh.foxi-tmp-" + std::to_string(live) + "-12345678";
   const std::vector<std::string> foreign = {
-      "m.msh.tmp1234abcd",               // the old naming: whose it is cannot be known
-      "m.msh.foxi-tmp-notapid-1",        // not foxi's pattern
+      "m.msh.tmp1234abcd",                                  // the old naming: whose it is cannot be known
+      "m.msh.foxi-tmp-notapid-1",                           // not foxi's pattern
       "other.msh.foxi-tmp-" + std::to_string(dead) + "-1",  // another target's
   };
   test::write_text(dir / dead_tmp, "left by a killed writer");
@@ -157,7 +157,9 @@ TEST(DurableFile, FsyncBeforeRenameAndTheFolderAfter) {
   TempDir dir;
   const fs::path out = dir / "d.txt";
   const std::string self = fs::read_symlink("/proc/self/exe").string();
-  const int rc = test::run("DURABLE_FILE_TARGET='" + out.string() + "' ASAN_OPTIONS=detect_leaks=0 strace -f -e trace=openat,fsync,rename,renameat,renameat2,unlink,unlinkat -o '" +
+  const int rc = test::run("DURABLE_FILE_TARGET='" + out.string() +
+                               "' ASAN_OPTIONS=detect_leaks=0 strace -f -e "
+                               "trace=openat,fsync,rename,renameat,renameat2,unlink,unlinkat -o '" +
                                (dir / "trace").string() + "' '" + self +
                                "' --gtest_filter=DurableFile.WriteOneFileForStrace",
                            dir / "log");
@@ -169,14 +171,17 @@ TEST(DurableFile, FsyncBeforeRenameAndTheFolderAfter) {
   while (std::getline(lines, line)) {
     const auto eq = line.rfind("= ");
     const std::string result = eq == std::string::npos ? "" : line.substr(eq + 2);
-    if (step == 0 && line.find("openat(") != std::string::npos && line.find("d.txt.foxi-tmp-") != std::string::npos) {
+    if (step == 0 && line.find("openat(") != std::string::npos &&
+        line.find("d.txt.foxi-tmp-") != std::string::npos) {
       tmp_fd = result;
       step = 1;
     } else if (step == 1 && line.find("fsync(" + tmp_fd + ")") != std::string::npos) {
       step = 2;
-    } else if (step == 2 && line.find("rename") != std::string::npos && line.find("d.txt\"") != std::string::npos) {
+    } else if (step == 2 && line.find("rename") != std::string::npos &&
+               line.find("d.txt\"") != std::string::npos) {
       step = 3;
-    } else if (step == 3 && line.find("openat(") != std::string::npos && line.find("O_DIRECTORY") != std::string::npos) {
+    } else if (step == 3 && line.find("openat(") != std::string::npos &&
+               line.find("O_DIRECTORY") != std::string::npos) {
       dir_fd = result;
       step = 4;
     } else if (step == 4 && line.find("fsync(" + dir_fd + ")") != std::string::npos) {
@@ -214,7 +219,8 @@ TEST(DurableFile, SetMarkerGoesFirstAndComesLast) {
   for (const char* ext : {".node", ".ele", ".face"}) test::write_text(dir / (std::string("s") + ext), "old");
   const std::string self = fs::read_symlink("/proc/self/exe").string();
   const int rc = test::run("DURABLE_FILE_SET=1 DURABLE_FILE_TARGET='" + base.string() +
-                               "' ASAN_OPTIONS=detect_leaks=0 strace -f -e trace=fsync,rename,renameat,renameat2,unlink,unlinkat -o '" +
+                               "' ASAN_OPTIONS=detect_leaks=0 strace -f -e "
+                               "trace=fsync,rename,renameat,renameat2,unlink,unlinkat -o '" +
                                (dir / "trace").string() + "' '" + self +
                                "' --gtest_filter=DurableFile.WriteOneFileForStrace",
                            dir / "log");
@@ -230,11 +236,14 @@ TEST(DurableFile, SetMarkerGoesFirstAndComesLast) {
       if (line.find("unlink") != std::string::npos) events.push_back(std::string("unlink ") + ext);
       if (line.find("rename") != std::string::npos) events.push_back(std::string("rename ") + ext);
     }
-    if (line.find("fsync(") != std::string::npos && !events.empty() && events.back() != "fsync") events.push_back("fsync");
+    if (line.find("fsync(") != std::string::npos && !events.empty() && events.back() != "fsync")
+      events.push_back("fsync");
   }
-  const std::vector<std::string> expected = {"unlink node", "fsync", "rename ele", "rename face", "fsync", "rename node", "fsync"};
+  const std::vector<std::string> expected = {"unlink node", "fsync",       "rename ele", "rename face",
+                                             "fsync",       "rename node", "fsync"};
   EXPECT_EQ(events, expected) << trace;
-  for (const char* ext : {".node", ".ele", ".face"}) EXPECT_EQ(test::read_text(dir / (std::string("s") + ext)), ext);
+  for (const char* ext : {".node", ".ele", ".face"})
+    EXPECT_EQ(test::read_text(dir / (std::string("s") + ext)), ext);
 }
 
 Mesh two_tets() {
@@ -361,7 +370,8 @@ TEST(Cleanup, TrackedChildDiesWithItsParent) {
   ::close(pipefd[1]);
   char buf[32] = {};
   ssize_t n = 0, got = 0;
-  while ((n = ::read(pipefd[0], buf + got, sizeof buf - 1 - std::size_t(got))) > 0 && buf[got + n - 1] != '\n')
+  while ((n = ::read(pipefd[0], buf + got, sizeof buf - 1 - std::size_t(got))) > 0 &&
+         buf[got + n - 1] != '\n')
     got += n;
   ::close(pipefd[0]);
   const pid_t child = pid_t(std::atoi(buf));

@@ -233,7 +233,8 @@ TEST(GmshRead, SecondOrderElementsReadAsCorners) {
   for (const char* variant : {"msh41", "msh41 -bin", "msh22", "msh22 -bin"}) {
     SCOPED_TRACE(variant);
     const std::string file = (dir / "p2.msh").string();
-    ASSERT_EQ(test::run("gmsh -3 -order 2 " + geo + " -format " + variant + " -o '" + file + "'", dir / "log"), 0);
+    ASSERT_EQ(
+        test::run("gmsh -3 -order 2 " + geo + " -format " + variant + " -o '" + file + "'", dir / "log"), 0);
     const std::string text = test::read_text(file);
     const Mesh m = read_gmsh(file);
     EXPECT_EQ(m.tet_count(), p1.tet_count());

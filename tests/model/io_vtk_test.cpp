@@ -273,7 +273,8 @@ print("corners|", " ".join(repr(x) for x in c.flatten()))
     for (int k = 0; k < 4; ++k)
       for (int j = 0; j < 3; ++j) corners.push_back(m.xyz[3 * m.tet[k] + j]);
     EXPECT_EQ(corners, want["corners"]);
-    EXPECT_EQ(std::vector<std::uint32_t>(m.bface.begin(), m.bface.end()), (std::vector<std::uint32_t>{0, 1, 2}));
+    EXPECT_EQ(std::vector<std::uint32_t>(m.bface.begin(), m.bface.end()),
+              (std::vector<std::uint32_t>{0, 1, 2}));
   }
 }
 
@@ -329,7 +330,7 @@ Mesh rich_mesh() {
   cu.youngs_modulus = 1.1e11;
   cu.poisson_ratio = 0.34;
   cu.thermal_expansion = 1.7e-5 / 3;  // not a short decimal
-  cu.density = 8960;  // specific_heat left unset
+  cu.density = 8960;                  // specific_heat left unset
   m.materials = {cu};
   m.regions[0].material = 0;
   m.regions[1].material = 0;
@@ -374,10 +375,11 @@ void expect_same_mesh(const Mesh& a, const Mesh& b, bool names) {
       if (!has) continue;
       const Material &x = a.materials[a.regions[i].material], &y = b.materials[b.regions[i].material];
       EXPECT_EQ(x.name, y.name);
-      EXPECT_TRUE(same_bits({x.thermal_conductivity, x.electrical_conductivity, x.relative_permittivity, x.youngs_modulus,
-                             x.poisson_ratio, x.thermal_expansion, x.density, x.specific_heat},
-                            {y.thermal_conductivity, y.electrical_conductivity, y.relative_permittivity, y.youngs_modulus,
-                             y.poisson_ratio, y.thermal_expansion, y.density, y.specific_heat}));
+      EXPECT_TRUE(
+          same_bits({x.thermal_conductivity, x.electrical_conductivity, x.relative_permittivity,
+                     x.youngs_modulus, x.poisson_ratio, x.thermal_expansion, x.density, x.specific_heat},
+                    {y.thermal_conductivity, y.electrical_conductivity, y.relative_permittivity,
+                     y.youngs_modulus, y.poisson_ratio, y.thermal_expansion, y.density, y.specific_heat}));
     }
   }
   if (names) {

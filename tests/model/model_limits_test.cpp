@@ -34,13 +34,16 @@ std::string part(const std::string& name, const std::string& shape, const std::s
 std::string sub() { return part("sub", "box", "origin = [0, 0, 0]\nsize = [10, 10, 1]"); }
 
 // The error of loading and building `path` (which must fail within `seconds`).
-foxi::IoError error_of(const std::filesystem::path& path, std::vector<std::string> sets = {}, double seconds = 5) {
+foxi::IoError error_of(const std::filesystem::path& path, std::vector<std::string> sets = {},
+                       double seconds = 5) {
   const auto t0 = std::chrono::steady_clock::now();
   try {
     const foxi::Model m = foxi::load_model(path, sets);
     foxi::build_structure(m);
   } catch (const foxi::IoError& e) {
-    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), seconds * foxi::test::kTimeScale) << e.what();
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+              seconds * foxi::test::kTimeScale)
+        << e.what();
     return e;
   }
   ADD_FAILURE() << "no error for " << path;
@@ -55,7 +58,9 @@ foxi::IoError text_error(const std::string& text, std::vector<std::string> sets 
   return e;
 }
 
-bool has(const foxi::IoError& e, const std::string& s) { return std::string(e.what()).find(s) != std::string::npos; }
+bool has(const foxi::IoError& e, const std::string& s) {
+  return std::string(e.what()).find(s) != std::string::npos;
+}
 
 std::uint64_t line_of(const std::string& text, const std::string& needle) {
   const auto at = text.find(needle);
@@ -83,7 +88,8 @@ TEST(ModelLimits, FeatureFarBelowTheStructureIsDegenerate) {
   EXPECT_TRUE(has(e, "1e-06 of the model's extent")) << e.what();
   EXPECT_GT(e.line(), 0u);
   // just above the bound it loads: 2e-5 mm against the 10 mm substrate (2e-6 of the extent)
-  const foxi::Model ok = foxi::load_model(kModels + "die_on_substrate.toml", std::vector<std::string>{"die_w=2e-5 mm"});
+  const foxi::Model ok =
+      foxi::load_model(kModels + "die_on_substrate.toml", std::vector<std::string>{"die_w=2e-5 mm"});
   EXPECT_EQ(ok.parts.size(), 2u);
 }
 
@@ -97,9 +103,9 @@ TEST(ModelLimits, HugeLengthIsBeyondTheBound) {
 // nan and inf (TOML floats) in an extrusion's outline crashed with SIGFPE.
 TEST(ModelLimits, NanAndInfinityInAnOutlineAreRefused) {
   for (const char* bad : {"nan", "inf", "-inf", "\"1e400 mm\""}) {
-    const std::string t = header() + sub() +
-                          part("e", "extrusion", std::string("points = [[0, 0], [") + bad +
-                                                     ", 0], [1, 1]]\nz = 1\nheight = 1");
+    const std::string t =
+        header() + sub() +
+        part("e", "extrusion", std::string("points = [[0, 0], [") + bad + ", 0], [1, 1]]\nz = 1\nheight = 1");
     const foxi::IoError e = text_error(t);
     EXPECT_TRUE(has(e, "part 'e' points[1][0]")) << bad << ": " << e.what();
     EXPECT_TRUE(has(e, "not a finite number") || has(e, "not finite")) << bad << ": " << e.what();
@@ -113,7 +119,8 @@ TEST(ModelLimits, NanAndInfinityInAnOutlineAreRefused) {
 TEST(ModelLimits, DeeplyNestedTomlIsRefusedBeforeParsing) {
   // 100,000 levels in 200 KB, a thousand brackets a line (lines have a limit of their own)
   std::string opening, closing;
-  for (int k = 0; k < 100; ++k) opening += std::string(1000, '[') + "\n", closing += std::string(1000, ']') + "\n";
+  for (int k = 0; k < 100; ++k)
+    opening += std::string(1000, '[') + "\n", closing += std::string(1000, ']') + "\n";
   const std::string t = header() + "x = " + opening + closing + sub();
   const foxi::IoError e = text_error(t);
   EXPECT_TRUE(has(e, "nest deeper than 32 levels")) << e.what();
@@ -128,8 +135,9 @@ TEST(ModelLimits, DeeplyNestedTomlIsRefusedBeforeParsing) {
   TempDir dir;
   foxi::test::write_text(dir / "ok.toml", "units.length = \"mm\" # " + std::string(100, '[') +
                                               "\n[parameters]\nw = \"10 mm\" # [[[[[\n[materials.a]\n"
-                                              "thermal_conductivity = 1\nnote = \"" + std::string(100, '{') +
-                                              "\\\"\"\nsource = '''\n" + std::string(100, '[') + "\n'''\n" + sub());
+                                              "thermal_conductivity = 1\nnote = \"" +
+                                              std::string(100, '{') + "\\\"\"\nsource = '''\n" +
+                                              std::string(100, '[') + "\n'''\n" + sub());
   EXPECT_NO_THROW(foxi::load_model(dir / "ok.toml"));
 }
 
@@ -139,8 +147,7 @@ TEST(ModelLimits, DeeplyNestedExpressionIsRefused) {
   EXPECT_THROW(eval(deep), foxi::ExpressionError);
   for (const std::string& nested :
        {std::string(2000, '(') + "1" + std::string(2000, ')'), std::string(2000, '-') + "1",
-        "2" + std::string(1000, '^') /* unterminated, but deep first */, std::string(1000, '+') + "1",
-        [] {
+        "2" + std::string(1000, '^') /* unterminated, but deep first */, std::string(1000, '+') + "1", [] {
           std::string s = "1";
           for (int i = 0; i < 100; ++i) s = "abs(" + s + ")";
           return s;
@@ -170,7 +177,8 @@ TEST(ModelLimits, DeeplyNestedExpressionIsRefused) {
 // A chain of parameters, each needing the next, recursed once per link.
 TEST(ModelLimits, LongParameterChainIsRefused) {
   std::string t = header() + "[parameters]\np0 = \"1 mm\"\n";
-  for (int i = 1; i <= 1000; ++i) t += "p" + std::to_string(i) + " = \"p" + std::to_string(i - 1) + " + 1 mm\"\n";
+  for (int i = 1; i <= 1000; ++i)
+    t += "p" + std::to_string(i) + " = \"p" + std::to_string(i - 1) + " + 1 mm\"\n";
   const foxi::IoError e = text_error(t + sub());
   EXPECT_TRUE(has(e, "more than 64 parameters")) << e.what();
 }
@@ -178,24 +186,28 @@ TEST(ModelLimits, LongParameterChainIsRefused) {
 // --- the hangs: values with no upper bound ---
 
 TEST(ModelLimits, HugeArrayCountIsRefused) {
-  const std::string t =
-      header() + sub() +
-      part("pins", "array",
-           "count = [100000, 1]\npitch = [1, 1]\nitem = { shape = \"box\", origin = [0, 0, 1], size = [0.5, 0.5, 1] }");
+  const std::string t = header() + sub() +
+                        part("pins", "array",
+                             "count = [100000, 1]\npitch = [1, 1]\nitem = { shape = \"box\", origin = [0, 0, "
+                             "1], size = [0.5, 0.5, 1] }");
   const foxi::IoError e = text_error(t);
   EXPECT_TRUE(has(e, "must be an integer from 1 to 10000")) << e.what();
-  EXPECT_TRUE(has(text_error(replaced(t, "[100000, 1]", "[200, 200]")), "200 x 200 items, more than the limit of 10000"));
+  EXPECT_TRUE(has(text_error(replaced(t, "[100000, 1]", "[200, 200]")),
+                  "200 x 200 items, more than the limit of 10000"));
   // the outline vertices of all items together: 100 x 100 cylinders of 16 segments
-  const std::string cyl = header() + sub() +
-                          part("vias", "array",
-                               "count = [100, 100]\npitch = [0.1, 0.1]\nitem = { shape = \"cylinder\", center = "
-                               "[0.05, 0.05, 1], radius = 0.01, height = 1 }");
-  EXPECT_TRUE(has(text_error(cyl), "outline vertices (all prisms and array items), more than the limit of 100000"));
+  const std::string cyl =
+      header() + sub() +
+      part("vias", "array",
+           "count = [100, 100]\npitch = [0.1, 0.1]\nitem = { shape = \"cylinder\", center = "
+           "[0.05, 0.05, 1], radius = 0.01, height = 1 }");
+  EXPECT_TRUE(
+      has(text_error(cyl), "outline vertices (all prisms and array items), more than the limit of 100000"));
 }
 
 TEST(ModelLimits, CylinderSegmentsAndOutlinePointsAreBounded) {
-  const std::string cyl = header() + sub() +
-                          part("c", "cylinder", "center = [5, 5, 1]\nradius = 1\nheight = 1\nsegments = 1000000");
+  const std::string cyl =
+      header() + sub() +
+      part("c", "cylinder", "center = [5, 5, 1]\nradius = 1\nheight = 1\nsegments = 1000000");
   const foxi::IoError e = text_error(cyl);
   EXPECT_TRUE(has(e, "part 'c' segments = 1e+06: must be an integer from 3 to 1000")) << e.what();
   EXPECT_EQ(e.line(), line_of(cyl, "segments ="));
@@ -206,7 +218,8 @@ TEST(ModelLimits, CylinderSegmentsAndOutlinePointsAreBounded) {
   std::string pts = "points = [";
   for (int i = 0; i < 20000; ++i) {
     const double a = 2 * 3.141592653589793 * i / 20000;
-    pts += (i ? ",\n [" : "[") + std::to_string(5 + 2 * std::cos(a)) + ", " + std::to_string(5 + 2 * std::sin(a)) + "]";
+    pts += (i ? ",\n [" : "[") + std::to_string(5 + 2 * std::cos(a)) + ", " +
+           std::to_string(5 + 2 * std::sin(a)) + "]";
   }
   const std::string ext = header() + sub() + part("e", "extrusion", pts + "]\nz = 1\nheight = 1");
   const foxi::IoError o = text_error(ext);
@@ -220,7 +233,8 @@ TEST(ModelLimits, CylinderSegmentsAndOutlinePointsAreBounded) {
 
 TEST(ModelLimits, BallToleranceIsBoundedByTheRadius) {
   const foxi::IoError e = error_of(kModels + "bga.toml", {"ball_tol=1e-6 mm"});
-  EXPECT_TRUE(has(e, "tolerance = 1e-06 mm is below the limit of 0.001 times the radius (0.38 mm)")) << e.what();
+  EXPECT_TRUE(has(e, "tolerance = 1e-06 mm is below the limit of 0.001 times the radius (0.38 mm)"))
+      << e.what();
   // at the bound a ball has about 10,000 triangles: one loads
   const std::string ball = header() + part("b", "ball", "center = [0, 0, 0]\nradius = 1\ntolerance = 0.001");
   TempDir dir;
@@ -230,16 +244,19 @@ TEST(ModelLimits, BallToleranceIsBoundedByTheRadius) {
   EXPECT_LT(m.parts[0].surface.triangle_count(), 20000u);
   // 25 of them pass the limit on all surface triangles
   const foxi::IoError many = text_error(
-      header() + part("bs", "array",
-                      "count = [5, 5]\npitch = [3, 3]\nitem = { shape = \"ball\", center = [0, 0, 0], radius = 1, "
-                      "tolerance = 0.001 }"));
+      header() +
+      part("bs", "array",
+           "count = [5, 5]\npitch = [3, 3]\nitem = { shape = \"ball\", center = [0, 0, 0], radius = 1, "
+           "tolerance = 0.001 }"));
   EXPECT_TRUE(has(many, "triangles, more than the limit of 200000")) << many.what();
 }
 
 TEST(ModelLimits, ModelExtentIsBounded) {
-  const foxi::IoError tiny = text_error(header() + part("t", "box", "origin = [0, 0, 0]\nsize = [\"1e-4 nm\", \"1e-4 nm\", \"1e-4 nm\"]"));
+  const foxi::IoError tiny = text_error(
+      header() + part("t", "box", "origin = [0, 0, 0]\nsize = [\"1e-4 nm\", \"1e-4 nm\", \"1e-4 nm\"]"));
   EXPECT_TRUE(has(tiny, "across, below the limit of 1e-09 m")) << tiny.what();
-  const foxi::IoError far = text_error(header() + sub() + part("far", "box", "origin = [\"999 m\", 0, 0]\nsize = [\"999 m\", 1, 1]"));
+  const foxi::IoError far = text_error(
+      header() + sub() + part("far", "box", "origin = [\"999 m\", 0, 0]\nsize = [\"999 m\", 1, 1]"));
   EXPECT_TRUE(has(far, "beyond the limit of 1000 m")) << far.what();
 }
 
@@ -255,10 +272,12 @@ TEST(ModelFiles, ReferencedFilesMustBeRegularFilesNamedRelatively) {
       {"library = \"\"\n" + header() + sub(), "library: the file name is empty"},
       {"library = \"folder\"\n" + header() + sub(), "library 'folder' is a directory, not a file"},
       {"library = \".\"\n" + header() + sub(), "is a directory, not a file"},
-      {"library = \"/etc/passwd\"\n" + header() + sub(), "is an absolute path: name it relative to the model file's folder"},
+      {"library = \"/etc/passwd\"\n" + header() + sub(),
+       "is an absolute path: name it relative to the model file's folder"},
       {"library = \"nothing.toml\"\n" + header() + sub(), "library 'nothing.toml': no such file"},
       {"library = \"zero\"\n" + header() + sub(), "library 'zero' is not a regular file"},
-      {header() + sub() + replaced(stl_part, "FILE", "folder"), "part 's' file 'folder' is a directory, not a file"},
+      {header() + sub() + replaced(stl_part, "FILE", "folder"),
+       "part 's' file 'folder' is a directory, not a file"},
       {header() + sub() + replaced(stl_part, "FILE", ""), "part 's' file: the file name is empty"},
       {"library = 3\n" + header() + sub(), "library must be a string"},
   };
@@ -308,14 +327,16 @@ TEST(ModelFiles, LibraryOutsideTheFolderByARelativePathLoads) {
 }
 
 TEST(ModelFiles, UnknownKeyErrorsListTheAllowedKeys) {
-  const foxi::IoError p = text_error(header() + part("b", "box", "origin = [0, 0, 0]\nsize = [1, 1, 1]\ncolour = 3"));
-  EXPECT_TRUE(has(p, "part 'b': unknown key 'colour' (expected name, shape, material, origin, size)")) << p.what();
+  const foxi::IoError p =
+      text_error(header() + part("b", "box", "origin = [0, 0, 0]\nsize = [1, 1, 1]\ncolour = 3"));
+  EXPECT_TRUE(has(p, "part 'b': unknown key 'colour' (expected name, shape, material, origin, size)"))
+      << p.what();
   const foxi::IoError u = text_error("units.lenght = \"mm\"\n" + header() + sub());
   EXPECT_TRUE(has(u, "(expected units.length)")) << u.what();
   const foxi::IoError m = text_error(header() + "[materials.b]\nconductivity = 1\n" + sub());
   EXPECT_TRUE(has(m, "(expected thermal_conductivity, electrical_conductivity")) << m.what();
-  const foxi::IoError c =
-      text_error(header() + sub() + "[[conditions]]\ntype = \"temperature\"\nsurface = \"sub.top\"\nvalu = 300\n");
+  const foxi::IoError c = text_error(
+      header() + sub() + "[[conditions]]\ntype = \"temperature\"\nsurface = \"sub.top\"\nvalu = 300\n");
   EXPECT_TRUE(has(c, "unknown key 'valu' (expected type, surface, value)")) << c.what();
   const foxi::IoError t = text_error("colour = 1\n" + header() + sub());
   EXPECT_TRUE(has(t, "(expected units, library, parameters")) << t.what();

@@ -20,8 +20,8 @@
 
 namespace {
 
-using foxi::test::Meshed;
-using foxi::test::TempDir;
+using foxi::test::box;
+using foxi::test::boxes_model;
 using foxi::test::expect_areas;
 using foxi::test::expect_near_rel;
 using foxi::test::expect_volumes;
@@ -29,12 +29,12 @@ using foxi::test::kMm;
 using foxi::test::kMm2;
 using foxi::test::kMm3;
 using foxi::test::kModels;
-using foxi::test::box;
-using foxi::test::boxes_model;
 using foxi::test::mesh_model;
 using foxi::test::mesh_text;
+using foxi::test::Meshed;
 using foxi::test::ngon_area;
 using foxi::test::ngon_perimeter;
+using foxi::test::TempDir;
 using foxi::test::tet_volume;
 using foxi::test::tri_area;
 
@@ -315,17 +315,20 @@ TEST(StructureBadInput, TheGoodModelLoads) {
 // dimension or a negative value is refused with its line.
 TEST(StructureBadInput, DensityAndSpecificHeatTakeUnits) {
   TempDir dir;
-  const std::string t = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"",
-                                 "thermal_conductivity = \"2 W/(m*K)\"\ndensity = \"8.96 g/cm^3\"\nspecific_heat = \"0.385 J/(g*K)\"");
+  const std::string t = replaced(
+      kGood, "thermal_conductivity = \"2 W/(m*K)\"",
+      "thermal_conductivity = \"2 W/(m*K)\"\ndensity = \"8.96 g/cm^3\"\nspecific_heat = \"0.385 J/(g*K)\"");
   foxi::test::write_text(dir / "u.toml", t);
   const foxi::Model m = foxi::load_model(dir / "u.toml");
   EXPECT_NEAR(m.materials[0].density, 8960, 1e-9);
   EXPECT_NEAR(m.materials[0].specific_heat, 385, 1e-9);
-  const std::string bad = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"", "thermal_conductivity = \"2 W/(m*K)\"\ndensity = \"3 kg/m^2\"");
+  const std::string bad = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"",
+                                   "thermal_conductivity = \"2 W/(m*K)\"\ndensity = \"3 kg/m^2\"");
   const foxi::IoError e = load_error(bad);
   EXPECT_NE(e.reason().find("unit mismatch"), std::string::npos) << e.what();
   EXPECT_EQ(e.line(), line_of(bad, "density ="));
-  const std::string neg = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"", "thermal_conductivity = \"2 W/(m*K)\"\nspecific_heat = -1");
+  const std::string neg = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"",
+                                   "thermal_conductivity = \"2 W/(m*K)\"\nspecific_heat = -1");
   const foxi::IoError n = load_error(neg);
   EXPECT_NE(n.reason().find("must not be negative"), std::string::npos) << n.what();
 }

@@ -76,11 +76,13 @@ TEST(Units, MismatchesAndUnknownNamesAreErrors) {
 TEST(Units, MinMaxMismatchNamesOnlyTheFunction) {
   const std::string text = "max(1, 2 mm)TRAILING";
   try {
-    foxi::evaluate_expression(std::string_view(text).substr(0, 12), [](std::string_view) { return std::nullopt; });
+    foxi::evaluate_expression(std::string_view(text).substr(0, 12),
+                              [](std::string_view) { return std::nullopt; });
     FAIL() << "no error";
   } catch (const foxi::ExpressionError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("unit mismatch: 1 (dimensionless) max m in 'max(1, 2 mm)'"), std::string::npos) << what;
+    EXPECT_NE(what.find("unit mismatch: 1 (dimensionless) max m in 'max(1, 2 mm)'"), std::string::npos)
+        << what;
     EXPECT_EQ(what.find("TRAILING"), std::string::npos) << what;
   }
 }
@@ -118,7 +120,10 @@ TEST(UnitsValue, TemperaturesAbsoluteAndDifferences) {
   EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("300K", abs), 300);
   EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("25 degC", abs), 298.15);
   EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("25degC", abs), 298.15);
-  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("25 \xC2\xB0" "C", abs), 298.15);
+  EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("25 \xC2\xB0"
+                                              "C",
+                                              abs),
+                   298.15);
   EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("-40 degC", abs), 233.15);
   // a difference: 5 degC is 5 K, never 278.15 K; negative differences are fine
   EXPECT_DOUBLE_EQ(foxi::evaluate_temperature("5 degC", diff), 5);
@@ -134,11 +139,13 @@ TEST(UnitsValue, TemperaturesAbsoluteAndDifferences) {
   const std::string k = thrown([&] { foxi::evaluate_temperature("-5", abs); });
   EXPECT_NE(k.find("not above absolute zero"), std::string::npos) << k;
   EXPECT_NE(k.find("-5 degC"), std::string::npos) << k;  // the hint for Celsius
-  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("-300 degC", abs); }).find("absolute zero"), std::string::npos);
+  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("-300 degC", abs); }).find("absolute zero"),
+            std::string::npos);
   EXPECT_NE(thrown([&] { foxi::evaluate_temperature("0 K", abs); }).find("absolute zero"), std::string::npos);
   EXPECT_NE(thrown([&] { foxi::evaluate_temperature("5 V", abs); }).find("not a temperature (K or degC)"),
             std::string::npos);
-  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("5 mm degC", diff); }).find("before degC"), std::string::npos);
+  EXPECT_NE(thrown([&] { foxi::evaluate_temperature("5 mm degC", diff); }).find("before degC"),
+            std::string::npos);
   EXPECT_FALSE(thrown([&] { foxi::evaluate_temperature("5 degC + 1 K", abs); }).empty());
 }
 

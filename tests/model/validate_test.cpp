@@ -202,7 +202,8 @@ TEST(Validate, CoincidentUsedNodesAreErrors) {
 double scaled_volume(double s) {
   const double B[3] = {s, 0, 0}, C[3] = {0, s, 0}, D[3] = {0, 0, s};
   return (B[0] * (C[1] * D[2] - C[2] * D[1]) - B[1] * (C[0] * D[2] - C[2] * D[0]) +
-          B[2] * (C[0] * D[1] - C[1] * D[0])) / 6;
+          B[2] * (C[0] * D[1] - C[1] * D[0])) /
+         6;
 }
 
 TEST(Validate, GeometryBeyondDoubleRangeIsRefused) {
@@ -225,8 +226,8 @@ TEST(Validate, GeometryBeyondDoubleRangeIsRefused) {
 // volumes, but at 1e60 doubles are 1e44 apart, so no tet there is smaller than that, and its
 // circumsphere reaches past the 1e24 the order's error bounds hold: refused, whatever the offset.
 TEST(Validate, CoordinatesAbove1e60AreRefusedEvenWithFiniteVolumes) {
-  for (const auto& [offset, size] : {std::pair{1e60, 1e50}, std::pair{1e60, 1e45}, std::pair{1e61, 1e61},
-                                     std::pair{-1e100, 1e90}}) {
+  for (const auto& [offset, size] :
+       {std::pair{1e60, 1e50}, std::pair{1e60, 1e45}, std::pair{1e61, 1e61}, std::pair{-1e100, 1e90}}) {
     Mesh m = two_tets();
     for (double& x : m.xyz) x = offset + size * x;
     const ValidationReport r = validate(m);
@@ -261,7 +262,6 @@ TEST(Validate, AcceptedGeometryHasFiniteExactlyScaledVolumes) {
   EXPECT_GE(accepted_lo, -12);  // 2 x 1e-13 across: refused
   EXPECT_LE(accepted_hi, 24);   // spheres reaching 1.7e24: refused
 }
-
 
 // Overlapping tets. Each mesh below passes every local check (indices, orientation, volume,
 // duplicates) and yet two of its tets cover the same space; each was found by fuzzing or is the

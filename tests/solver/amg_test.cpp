@@ -33,7 +33,8 @@ Mesh tetgen_o0_mesh(const std::string& poly, double max_volume) {
   std::ostringstream cmd;
   cmd.precision(17);
   cmd << "tetgen -pq1.414AO0Qa" << max_volume << " '" << (dir / "in.poly").string() << "'";
-  if (test::run(cmd.str(), dir / "log") != 0) throw std::runtime_error("tetgen failed: " + test::read_text(dir / "log"));
+  if (test::run(cmd.str(), dir / "log") != 0)
+    throw std::runtime_error("tetgen failed: " + test::read_text(dir / "log"));
   Mesh mesh = read_tetgen(dir / "in.1");
   validate_and_repair(mesh);
   return mesh;
@@ -148,7 +149,8 @@ TEST(Amg, BoardAndBlockAtContrast1e4MatchesTheDirectSolver) {
     EXPECT_EQ(direct.solver, "SimplicialLDLT");
     const std::vector<double>& t_direct = m.find_field("temperature")->values;
     double worst = 0;
-    for (std::size_t v = 0; v < m.node_count(); ++v) worst = std::max(worst, std::abs(t_amg[v] - t_direct[v]));
+    for (std::size_t v = 0; v < m.node_count(); ++v)
+      worst = std::max(worst, std::abs(t_amg[v] - t_direct[v]));
     EXPECT_LT(worst, 1e-6) << "largest nodal difference, K";
   }
 }

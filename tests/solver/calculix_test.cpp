@@ -96,8 +96,8 @@ TEST_F(CalculixTest, PackageTemperaturesAgreeWithCcx) {
 }
 
 // The nodal block `name` of ccx's .frd per mesh node (NaN where ccx gave none), `components` each.
-std::vector<double> frd_nodal(const std::filesystem::path& frd, const std::string& name, std::uint32_t components,
-                              std::size_t nodes) {
+std::vector<double> frd_nodal(const std::filesystem::path& frd, const std::string& name,
+                              std::uint32_t components, std::size_t nodes) {
   std::vector<double> out(components * nodes, std::nan(""));
   for (const FrdBlock& b : read_frd(frd)) {
     if (b.name != name) continue;
@@ -115,10 +115,11 @@ std::vector<double> frd_nodal(const std::filesystem::path& frd, const std::strin
 // Mises stress). ccx writes C3D4 stresses at the nodes as the mean over the elements around each
 // node, so foxi's constant tet stresses are averaged the same way.
 std::pair<double, double> thermal_stress_difference(const test::TempDir& dir, Mesh& m,
-                                                     const ThermoelasticParams& p) {
+                                                    const ThermoelasticParams& p) {
   const ThermoelasticReport r = solve_thermoelastic(m, p);
   write_calculix_thermoelastic(m, p, dir / "stress.inp");
-  const int rc = test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i stress", dir / "ccx.log");
+  const int rc =
+      test::run("cd '" + dir.path().string() + "' && OMP_NUM_THREADS=1 ccx -i stress", dir / "ccx.log");
   EXPECT_EQ(rc, 0) << test::read_text(dir / "ccx.log");
   const std::size_t nn = m.node_count();
   const std::vector<double> u_ccx = frd_nodal(dir / "stress.frd", "DISP", 3, nn);
@@ -139,12 +140,14 @@ std::pair<double, double> thermal_stress_difference(const test::TempDir& dir, Me
                                       ? HUGE_VAL
                                       : std::abs(u[3 * v + c] - u_ccx[3 * v + c]) / r.max_displacement);
     for (int c = 0; c < 6; ++c)
-      s_worst = std::max(s_worst, std::isnan(s_ccx[6 * v + c])
-                                      ? HUGE_VAL
-                                      : std::abs(s_node[6 * v + c] / count[v] - s_ccx[6 * v + c]) / r.max_von_mises);
+      s_worst = std::max(s_worst,
+                         std::isnan(s_ccx[6 * v + c])
+                             ? HUGE_VAL
+                             : std::abs(s_node[6 * v + c] / count[v] - s_ccx[6 * v + c]) / r.max_von_mises);
   }
-  std::printf("%zu nodes, max |u| %.4g m, max von Mises %.4g Pa; relative difference to ccx: u %.3g, stress %.3g\n",
-              nn, r.max_displacement, r.max_von_mises, u_worst, s_worst);
+  std::printf(
+      "%zu nodes, max |u| %.4g m, max von Mises %.4g Pa; relative difference to ccx: u %.3g, stress %.3g\n",
+      nn, r.max_displacement, r.max_von_mises, u_worst, s_worst);
   return {u_worst, s_worst};
 }
 

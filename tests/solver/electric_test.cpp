@@ -237,7 +237,8 @@ TEST(Electrostatic, ConcentricSpheresConverge) {
     const ElectrostaticReport r = solve_electrostatic(m, p);
     const double err = std::abs(r.capacitance[0][0] - exact) / exact;
     errors.push_back(err);
-    sizes.push_back(std::cbrt(4.0 / 3 * std::numbers::pi * (r2 * r2 * r2 - r1 * r1 * r1) / double(m.tet_count())));
+    sizes.push_back(
+        std::cbrt(4.0 / 3 * std::numbers::pi * (r2 * r2 * r2 - r1 * r1 * r1) / double(m.tet_count())));
     expect_checks_pass(r.checks);
     EXPECT_NEAR(r.capacitance[0][1], -r.capacitance[0][0], 1e-8 * exact);
     std::printf("[ spheres ] clscale %.2f: %zu tets, C = %.6e F (exact %.6e), relative error %.3e\n", scale,
@@ -609,8 +610,8 @@ TEST(Electric, MaxwellChecksCatchWrongMatrices) {
   };
   const auto good = maxwell_matrix_checks({{2e-3, -2e-3}, {-2e-3, 2e-3}}, 1e-12, 1e-6, "the currents");
   EXPECT_TRUE(passed(good, "Kirchhoff") && passed(good, "Maxwell signs") && passed(good, "residual"));
-  EXPECT_FALSE(passed(maxwell_matrix_checks({{1.5e-11, -5.1e-16}, {-5.1e-16, 5.1e-16}}, 0, 1e-6, "x"),
-                      "Kirchhoff"));
+  EXPECT_FALSE(
+      passed(maxwell_matrix_checks({{1.5e-11, -5.1e-16}, {-5.1e-16, 5.1e-16}}, 0, 1e-6, "x"), "Kirchhoff"));
   const auto same_sign = maxwell_matrix_checks({{1e-15, 2e-16}, {2e-16, 1e-15}}, 0, 1e-6, "x");
   EXPECT_FALSE(passed(same_sign, "Maxwell signs"));
   EXPECT_FALSE(passed(same_sign, "Kirchhoff"));

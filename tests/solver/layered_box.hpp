@@ -25,7 +25,8 @@ inline std::string layered_box_poly(double lx, double ly, const std::vector<doub
   s << 4 * nl << " 3 0 0\n";
   const double xy[4][2] = {{0, 0}, {lx, 0}, {lx, ly}, {0, ly}};
   for (std::size_t i = 0; i < nl; ++i)
-    for (int c = 0; c < 4; ++c) s << 4 * i + c + 1 << ' ' << xy[c][0] << ' ' << xy[c][1] << ' ' << levels[i] << '\n';
+    for (int c = 0; c < 4; ++c)
+      s << 4 * i + c + 1 << ' ' << xy[c][0] << ' ' << xy[c][1] << ' ' << levels[i] << '\n';
   const std::size_t slabs = nl - 1;
   s << nl + 4 * slabs << " 1\n";
   auto quad = [&](std::size_t a, std::size_t b, std::size_t c, std::size_t d, int marker) {

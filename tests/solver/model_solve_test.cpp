@@ -369,8 +369,7 @@ surface = ["south", "base"]
 
 // Coarser versions of shipped models whose realistic thin layers make large meshes.
 const std::map<std::string, std::vector<std::string>> kCoarse = {
-    {"power_module.toml",
-     {"solder_h=0.5mm", "cu_h=0.5mm", "ceramic_h=0.6mm", "die_h=0.5mm", "clip_h=1mm"}},
+    {"power_module.toml", {"solder_h=0.5mm", "cu_h=0.5mm", "ceramic_h=0.6mm", "die_h=0.5mm", "clip_h=1mm"}},
 };
 
 // Slow (every shipped model meshed and solved, about 5 minutes under the sanitizers): the Release
@@ -383,7 +382,8 @@ TEST(ModelSolveSlow, EveryShippedModelMeshesAndSolvesWithBalancedEnergy) {
     SCOPED_TRACE(name);
     ++models;
     const auto coarse = kCoarse.find(name);
-    Solved s = mesh_model(entry.path(), coarse == kCoarse.end() ? std::vector<std::string>{} : coarse->second);
+    Solved s =
+        mesh_model(entry.path(), coarse == kCoarse.end() ? std::vector<std::string>{} : coarse->second);
     EXPECT_LT(s.mesh.tet_count(), 120000u) << "too large a mesh for a unit test";
     // every part is its region, with the part's volume
     std::vector<double> volume(s.model.parts.size() + 1, 0);

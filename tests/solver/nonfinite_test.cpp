@@ -25,7 +25,8 @@ bool says_nonfinite(const SolverError& e) {
 }
 
 TEST(NonFinite, InfiniteVolumesAreRefused) {
-  for (LinearSolverKind kind : {LinearSolverKind::direct, LinearSolverKind::cg_amg, LinearSolverKind::cg_ichol}) {
+  for (LinearSolverKind kind :
+       {LinearSolverKind::direct, LinearSolverKind::cg_amg, LinearSolverKind::cg_ichol}) {
     Mesh m = bench::kuhn_grid_mesh(3, 0.0);
     for (double& x : m.xyz) x *= 1e154;
     ThermalParams p = hot_and_cold(1.0);
@@ -41,7 +42,8 @@ TEST(NonFinite, InfiniteVolumesAreRefused) {
 
 TEST(NonFinite, OverflowingStiffnessIsRefused) {
   // Finite volumes, but a conductivity of 1e308 on 10 m cells overflows the matrix entries.
-  for (LinearSolverKind kind : {LinearSolverKind::direct, LinearSolverKind::cg_amg, LinearSolverKind::cg_ichol}) {
+  for (LinearSolverKind kind :
+       {LinearSolverKind::direct, LinearSolverKind::cg_amg, LinearSolverKind::cg_ichol}) {
     Mesh m = bench::kuhn_grid_mesh(3, 0.0);
     for (double& x : m.xyz) x *= 10;
     ThermalParams p = hot_and_cold(1e308);

@@ -122,7 +122,8 @@ TEST_F(SolveCliTest, BadInputGivesClearErrors) {
 // thermal run (both ends at 350 K: uniform) read back with --temperature and --tref 300.
 TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) {
   test::write_text(dir_ / "box.poly", test::layered_box_poly(1.0, 0.6, {0, 0.4}));
-  ASSERT_EQ(test::run("tetgen -pq1.414AQa0.002 '" + (dir_ / "box.poly").string() + "'", dir_ / "tetgen.log"), 0);
+  ASSERT_EQ(test::run("tetgen -pq1.414AQa0.002 '" + (dir_ / "box.poly").string() + "'", dir_ / "tetgen.log"),
+            0);
   const std::string box = "'" + (dir_ / "box.1.node").string() + "'";
   const std::string material = " --E 1=70e9 --nu 1=0.3 --alpha 1=2e-5 --slide 1 --slide 3 --slide 5";
   const std::string out = (dir_ / "stress.vtu").string();
@@ -151,7 +152,9 @@ TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) 
   ASSERT_NE(m.find_field("principal_stress"), nullptr);
 
   const std::string temperature = (dir_ / "temperature.vtu").string();
-  ASSERT_EQ(foxi("solve " + box + " --physics thermal --fix 1=350 --fix 2=350 --k 1=1 -o '" + temperature + "'"), 0);
+  ASSERT_EQ(
+      foxi("solve " + box + " --physics thermal --fix 1=350 --fix 2=350 --k 1=1 -o '" + temperature + "'"),
+      0);
   ASSERT_EQ(foxi("solve " + box + " --physics thermoelastic --temperature '" + temperature + "' --tref 300" +
                  material + " -o '" + out + "'"),
             0)
@@ -168,10 +171,14 @@ TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) 
   // Bad input: no load (2), an unknown component (2), a body free to move (3, the modes named).
   EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic" + material), 2);
   EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic --dT 1 --fix 1=uw" + material), 2);
-  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic --dT 1 --slide 5 --E 1=1e9 --nu 1=0.3 --alpha 1=1e-5"), 3);
+  EXPECT_EQ(
+      foxi("solve " + box + " --physics thermoelastic --dT 1 --slide 5 --E 1=1e9 --nu 1=0.3 --alpha 1=1e-5"),
+      3);
   log = test::read_text(dir_ / "out.log");
   EXPECT_NE(log.find("3 rigid-body modes left"), std::string::npos) << log;
-  EXPECT_EQ(foxi("solve " + mesh() + " --physics thermoelastic --dT 1 --slide 3 --E 1=1e9 --nu 1=0.3 --alpha 1=1e-5"), 3);
+  EXPECT_EQ(foxi("solve " + mesh() +
+                 " --physics thermoelastic --dT 1 --slide 3 --E 1=1e9 --nu 1=0.3 --alpha 1=1e-5"),
+            3);
   log = test::read_text(dir_ / "out.log");
   EXPECT_NE(log.find("not planar"), std::string::npos) << log;
   EXPECT_EQ(foxi("solve --physics thermoelastic --help"), 0);

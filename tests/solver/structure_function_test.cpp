@@ -81,7 +81,8 @@ TEST(StructureFunction, ExactFosterOfTheLadderMatchesATimeIntegration) {
 }
 
 TEST(StructureFunction, FosterToCauerGivesTheLadderBack) {
-  for (const Ladder& l : {kLadder, Ladder{{1.0}, {0.5}}, Ladder{{0.1, 0.3, 0.2, 0.6, 1.5, 0.4}, {1e-5, 1e-4, 3e-3, 1e-2, 0.2, 4.0}}}) {
+  for (const Ladder& l : {kLadder, Ladder{{1.0}, {0.5}},
+                          Ladder{{0.1, 0.3, 0.2, 0.6, 1.5, 0.4}, {1e-5, 1e-4, 3e-3, 1e-2, 0.2, 4.0}}}) {
     const std::vector<CauerStage> cauer = foster_to_cauer(exact_foster(l));
     ASSERT_EQ(cauer.size(), l.r.size());
     for (std::size_t i = 0; i < cauer.size(); ++i) {
@@ -115,7 +116,8 @@ void expect_recovered(const StructureFunction& s, const Ladder& l, double r_tol,
     cum_c += l.c[i];
     const double mid = start + l.r[i] / 2;
     EXPECT_NEAR(c_sum_at(s, mid), cum_c, c_tol * cum_c) << "stage " << i << " at R_sum " << mid;
-    if (std::getenv("FOXI_TEST_VERBOSE")) std::printf("stage %zu: C_sum %.4g, recovered %.4g\n", i, cum_c, c_sum_at(s, mid));
+    if (std::getenv("FOXI_TEST_VERBOSE"))
+      std::printf("stage %zu: C_sum %.4g, recovered %.4g\n", i, cum_c, c_sum_at(s, mid));
     start += l.r[i];
   }
 }
@@ -147,8 +149,10 @@ TEST(StructureFunction, RecoveredFromSampledZth) {
   // Cut off before the last stage settles: the rise is reported.
   std::vector<double> tc(t.begin(), t.begin() + 20 * 6), zc(z.begin(), z.begin() + 20 * 6);
   EXPECT_GT(structure_function(tc, zc).settled, 0.01);
-  EXPECT_THROW(structure_function(std::vector<double>{1, 2}, std::vector<double>{1, 2}), std::invalid_argument);
-  EXPECT_THROW(structure_function(std::vector<double>{1, 1, 2}, std::vector<double>{1, 2, 3}), std::invalid_argument);
+  EXPECT_THROW(structure_function(std::vector<double>{1, 2}, std::vector<double>{1, 2}),
+               std::invalid_argument);
+  EXPECT_THROW(structure_function(std::vector<double>{1, 1, 2}, std::vector<double>{1, 2, 3}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -62,12 +62,14 @@ TEST_F(ThermoelasticTest, FreeExpansionOnSymmetryPlanesIsStressFree) {
   Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.4}, 0.002);
   ThermoelasticParams p = one_material(kDt);
   p.sliding = {{1}, {3}, {5}};
-  for (LinearSolverKind kind : {LinearSolverKind::direct, LinearSolverKind::cg_ichol, LinearSolverKind::cg_amg}) {
+  for (LinearSolverKind kind :
+       {LinearSolverKind::direct, LinearSolverKind::cg_ichol, LinearSolverKind::cg_amg}) {
     p.solver.kind = kind;
     const ThermoelasticReport r = solve_thermoelastic(m, p);
-    EXPECT_LT(max_displacement_error(m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); },
-                                     kAlpha * kDt),
-              1e-8)
+    EXPECT_LT(
+        max_displacement_error(
+            m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); }, kAlpha * kDt),
+        1e-8)
         << r.solver;
     const double zero[6] = {0, 0, 0, 0, 0, 0};
     EXPECT_LT(max_stress_error(m, zero, kE * kAlpha * kDt), 1e-7) << r.solver;
@@ -112,10 +114,11 @@ TEST_F(ThermoelasticTest, BarHeldAtBothEnds) {
   const double want[6] = {0, 0, -s, 0, 0, 0};
   EXPECT_LT(max_stress_error(m, want, s), 1e-8);
   const double lateral = kAlpha * (1 + kNu) * kDt;
-  EXPECT_LT(max_displacement_error(
-                m, [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(lateral * x[0], lateral * x[1], 0); },
-                kAlpha * kDt),
-            1e-8);
+  EXPECT_LT(
+      max_displacement_error(
+          m, [&](const Eigen::Vector3d& x) { return Eigen::Vector3d(lateral * x[0], lateral * x[1], 0); },
+          kAlpha * kDt),
+      1e-8);
   EXPECT_NEAR(r.max_von_mises, s, 1e-8 * s);
   ASSERT_EQ(r.regions.size(), 1u);
   EXPECT_NEAR(r.regions[0].max_von_mises, s, 1e-8 * s);
@@ -242,7 +245,8 @@ TEST_F(ThermoelasticTest, BimaterialStripBendsAsTimoshenkoSays) {
   EXPECT_NEAR(fine.fitted, kappa, 0.2 * kappa);
   const double ratio = std::pow(static_cast<double>(fine.tets) / static_cast<double>(coarse.tets), 2.0 / 3.0);
   const double extrapolated = (ratio * fine.fitted - coarse.fitted) / (ratio - 1);
-  std::printf("Richardson extrapolation %.5g 1/m (%+.2f%%)\n", extrapolated, 100 * (extrapolated / kappa - 1));
+  std::printf("Richardson extrapolation %.5g 1/m (%+.2f%%)\n", extrapolated,
+              100 * (extrapolated / kappa - 1));
   EXPECT_NEAR(extrapolated, kappa, 0.03 * kappa);
   EXPECT_GT(fine.report.amg_levels, 1u);  // AMG with the rigid-body modes: few iterations
   EXPECT_LT(fine.report.iterations, 60u);
@@ -350,8 +354,8 @@ TEST_F(ThermoelasticTest, NodalTemperatureFieldEqualsUniformChange) {
   p.reference_temperature = 300;
   p.temperature.assign(m.node_count(), 300 + kDt);
   solve_thermoelastic(m, p);
-  EXPECT_LT(max_displacement_error(m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); },
-                                   kAlpha * kDt),
+  EXPECT_LT(max_displacement_error(
+                m, [](const Eigen::Vector3d& x) { return Eigen::Vector3d(kAlpha * kDt * x); }, kAlpha * kDt),
             1e-8);
   p.temperature.pop_back();
   EXPECT_THROW(solve_thermoelastic(m, p), SolverError);
@@ -374,7 +378,8 @@ TEST_F(ThermoelasticTest, RigidMotionIsReportedNotSolved) {
   EXPECT_NE(three.find("3 rigid-body modes left"), std::string::npos) << three;
   EXPECT_NE(three.find("rotation about (0, 0, 1)"), std::string::npos) << three;
   p.sliding = {{5}, {1}};  // y translation remains
-  EXPECT_NE(message().find("1 rigid-body mode left (translation along (0, 1, 0))"), std::string::npos) << message();
+  EXPECT_NE(message().find("1 rigid-body mode left (translation along (0, 1, 0))"), std::string::npos)
+      << message();
   p.sliding = {{5}, {1}, {3}};
   EXPECT_EQ(message(), "");
 }

@@ -32,7 +32,8 @@ TransientParams base(const Mesh& m, double k, double rho_c) {
 
 void expect_balanced(const TransientReport& rep) {
   ASSERT_FALSE(rep.checks.empty());
-  for (const BalanceCheck& c : rep.checks) EXPECT_TRUE(c.passed) << c.name << " " << c.figure << " > " << c.tolerance;
+  for (const BalanceCheck& c : rep.checks)
+    EXPECT_TRUE(c.passed) << c.name << " " << c.figure << " > " << c.tolerance;
 }
 
 const std::vector<double>& temperature(const Mesh& m) {
@@ -90,7 +91,8 @@ TEST(Transient, ConvectivelyCooledBodyDecaysExponentially) {
     // its O(dt) end terms (TransientReport::heat_in), about 0.3% here.
     const double exact_loss = rho_c * L * L * L * (t0 - tinf) * (1 - std::exp(-1.0));
     EXPECT_NEAR(-r.stored_energy, exact_loss, 3e-3 * exact_loss);
-    EXPECT_NEAR(r.heat_in, r.stored_energy, (scheme == TimeScheme::euler ? 1e-6 : 1e-2) * std::abs(r.stored_energy));
+    EXPECT_NEAR(r.heat_in, r.stored_energy,
+                (scheme == TimeScheme::euler ? 1e-6 : 1e-2) * std::abs(r.stored_energy));
   }
 }
 
@@ -201,8 +203,11 @@ TEST(TransientBadInput, PowerTableRowsAreRefusedWithTheirLine) {
   const auto rows = read_power_table((dir / "ok.csv").string());
   ASSERT_EQ(rows.size(), 3u);
   EXPECT_EQ(rows[1].second, 2.0);
-  const std::pair<const char*, std::uint64_t> bad[] = {
-      {"0,1\n0.5,x\n", 2}, {"0,1\n0.5\n", 2}, {"0,1\n1,2\n1,3\n", 3}, {"0,1\n2,inf\n", 2}, {"# nothing\n", 1}};
+  const std::pair<const char*, std::uint64_t> bad[] = {{"0,1\n0.5,x\n", 2},
+                                                       {"0,1\n0.5\n", 2},
+                                                       {"0,1\n1,2\n1,3\n", 3},
+                                                       {"0,1\n2,inf\n", 2},
+                                                       {"# nothing\n", 1}};
   for (const auto& [text, line] : bad) {
     test::write_text(dir / "bad.csv", text);
     try {

@@ -50,8 +50,10 @@ inline Mesh kuhn_grid_mesh(std::uint32_t n, double jitter = 0.1, std::uint32_t s
           int ax0 = p[0] == 1 ? 0 : p[0] == 2 ? 1 : 2;
           int ax1 = (p[1] ^ p[0]) == 1 ? 0 : (p[1] ^ p[0]) == 2 ? 1 : 2;
           bool even = (ax1 - ax0 + 3) % 3 == 1;
-          if (even) m.tet.insert(m.tet.end(), {a, b, c, d});
-          else m.tet.insert(m.tet.end(), {a, c, b, d});
+          if (even)
+            m.tet.insert(m.tet.end(), {a, b, c, d});
+          else
+            m.tet.insert(m.tet.end(), {a, c, b, d});
           m.tet_region.push_back(k < n / 2 ? 1 : 2);
         }
       }
@@ -76,7 +78,10 @@ inline Mesh kuhn_grid_mesh(std::uint32_t n, double jitter = 0.1, std::uint32_t s
           m.bface_tag.push_back(tag);
           m.bface_tag.push_back(tag);
         }
-      m.boundaries.push_back({tag, std::string("xyz"[axis] == 'x' ? "x" : axis == 1 ? "y" : "z") + (side ? "max" : "min")});
+      m.boundaries.push_back({tag, std::string("xyz"[axis] == 'x' ? "x"
+                                               : axis == 1        ? "y"
+                                                                  : "z") +
+                                       (side ? "max" : "min")});
     }
   return m;
 }
@@ -103,7 +108,8 @@ inline Mesh tetgen_box_mesh(double sx, double sy, double sz, double max_volume) 
     std::fclose(f);
     char a[64];
     std::snprintf(a, sizeof a, "%g", max_volume);
-    const std::string cmd = "tetgen -pq1.414a" + std::string(a) + "O0Q '" + (dir / "box.poly").string() + "' > /dev/null 2>&1";
+    const std::string cmd =
+        "tetgen -pq1.414a" + std::string(a) + "O0Q '" + (dir / "box.poly").string() + "' > /dev/null 2>&1";
     if (std::system(cmd.c_str()) != 0) throw std::runtime_error("tetgen failed: " + cmd);
   }
   return read_tetgen(base);

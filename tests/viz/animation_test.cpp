@@ -65,7 +65,8 @@ std::vector<Framebuffer> read_apng(const std::filesystem::path& path, std::uint3
     const std::size_t stride = 1 + 3 * std::size_t(fw);
     std::vector<unsigned char> raw(stride * std::size_t(fh));
     uLongf size = uLongf(raw.size());
-    EXPECT_EQ(uncompress(raw.data(), &size, reinterpret_cast<const Bytef*>(data.data()), uLong(data.size())), Z_OK);
+    EXPECT_EQ(uncompress(raw.data(), &size, reinterpret_cast<const Bytef*>(data.data()), uLong(data.size())),
+              Z_OK);
     EXPECT_EQ(size, raw.size());
     std::vector<unsigned char> prev(3 * std::size_t(fw), 0), cur(3 * std::size_t(fw));
     for (int y = 0; y < fh; ++y) {
@@ -74,22 +75,31 @@ std::vector<Framebuffer> read_apng(const std::filesystem::path& path, std::uint3
         const int a = i >= 3 ? cur[i - 3] : 0, b = prev[i], c = i >= 3 ? prev[i - 3] : 0;
         int pred = 0;
         switch (r[0]) {
-          case 0: pred = 0; break;
-          case 1: pred = a; break;
-          case 2: pred = b; break;
-          case 3: pred = (a + b) / 2; break;
+          case 0:
+            pred = 0;
+            break;
+          case 1:
+            pred = a;
+            break;
+          case 2:
+            pred = b;
+            break;
+          case 3:
+            pred = (a + b) / 2;
+            break;
           case 4: {
             const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
             pred = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
             break;
           }
-          default: ADD_FAILURE() << "bad filter " << int(r[0]);
+          default:
+            ADD_FAILURE() << "bad filter " << int(r[0]);
         }
         cur[i] = static_cast<unsigned char>(r[1 + i] + pred);
       }
       for (int x = 0; x < fw; ++x)
-        canvas.rgba[canvas.index(fx + x, fy + y)] = pack_rgba(cur[3 * std::size_t(x)], cur[3 * std::size_t(x) + 1],
-                                                              cur[3 * std::size_t(x) + 2]);
+        canvas.rgba[canvas.index(fx + x, fy + y)] =
+            pack_rgba(cur[3 * std::size_t(x)], cur[3 * std::size_t(x) + 1], cur[3 * std::size_t(x) + 2]);
       std::swap(prev, cur);
     }
     frames.push_back(canvas);
@@ -98,7 +108,8 @@ std::vector<Framebuffer> read_apng(const std::filesystem::path& path, std::uint3
   while (at + 12 <= f.size()) {
     const std::uint32_t len = be32(f, at);
     const std::string type = f.substr(at + 4, 4), body = f.substr(at + 8, len);
-    const uLong crc = crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(f.data() + at + 4), uInt(len + 4));
+    const uLong crc =
+        crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(f.data() + at + 4), uInt(len + 4));
     EXPECT_EQ(be32(f, at + 8 + len), std::uint32_t(crc)) << type << " CRC";
     at += 12 + len;
     if (type == "IHDR") {
@@ -143,11 +154,13 @@ bool same_rgb(const Framebuffer& a, const Framebuffer& b) {
 }
 
 // All frames as ffmpeg decodes them (rgb24), or empty if ffmpeg is not installed.
-std::vector<Framebuffer> ffmpeg_frames(const test::TempDir& dir, const std::filesystem::path& file, int w, int h) {
+std::vector<Framebuffer> ffmpeg_frames(const test::TempDir& dir, const std::filesystem::path& file, int w,
+                                       int h) {
   std::vector<Framebuffer> out;
   if (!test::have_program("ffmpeg")) return out;
   const auto raw = dir / "frames.rgb";
-  EXPECT_EQ(test::run("ffmpeg -v error -y -i '" + file.string() + "' -f rawvideo -pix_fmt rgb24 '" + raw.string() + "'",
+  EXPECT_EQ(test::run("ffmpeg -v error -y -i '" + file.string() + "' -f rawvideo -pix_fmt rgb24 '" +
+                          raw.string() + "'",
                       dir / "ffmpeg.log"),
             0);
   const std::string bytes = test::read_text(raw);
@@ -185,7 +198,8 @@ TEST(Animation, ApngFramesReadBackExactly) {
   const auto ff = ffmpeg_frames(dir, dir / "a.apng", w, h);
   if (!ff.empty()) {
     ASSERT_EQ(ff.size(), frames.size());
-    for (std::size_t i = 0; i < frames.size(); ++i) EXPECT_TRUE(same_rgb(ff[i], frames[i])) << "ffmpeg frame " << i;
+    for (std::size_t i = 0; i < frames.size(); ++i)
+      EXPECT_TRUE(same_rgb(ff[i], frames[i])) << "ffmpeg frame " << i;
   }
 }
 

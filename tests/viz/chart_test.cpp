@@ -108,8 +108,8 @@ TEST(Chart, TicksSitWhereTheMappingSaysAndLabelsKeepApart) {
   for (int w : {300, 640, 1200}) {
     Framebuffer fb(w + 20, 400);
     const ChartReport r = draw_chart(fb, text, c, PixelRect{10, 0, w + 9, 399});
-    for (auto [ticks, lo, hi, data_lo, data_hi] :
-         {std::tuple{r.x_ticks, r.x_lo, r.x_hi, 0.3, 7.3}, std::tuple{r.y_ticks, r.y_lo, r.y_hi, -3.2, 12.6}}) {
+    for (auto [ticks, lo, hi, data_lo, data_hi] : {std::tuple{r.x_ticks, r.x_lo, r.x_hi, 0.3, 7.3},
+                                                   std::tuple{r.y_ticks, r.y_lo, r.y_hi, -3.2, 12.6}}) {
       ASSERT_GE(ticks.size(), 2u);
       const double step = ticks[1] - ticks[0];
       const double k = std::floor(std::log10(step) + 1e-9), m = step / std::pow(10.0, k);
@@ -126,7 +126,7 @@ TEST(Chart, TicksSitWhereTheMappingSaysAndLabelsKeepApart) {
     }
     for (std::size_t i = 0; i < r.x_ticks.size(); ++i) {
       EXPECT_EQ(r.x_tick_columns[i], std::lround(r.plot.x0 + (r.x_ticks[i] - r.x_lo) / (r.x_hi - r.x_lo) *
-                                                                  (r.plot.x1 - r.plot.x0)));
+                                                                 (r.plot.x1 - r.plot.x0)));
       if (i > 0) {
         EXPECT_FALSE(overlap(r.x_labels[i], r.x_labels[i - 1])) << w;
       }
@@ -136,7 +136,7 @@ TEST(Chart, TicksSitWhereTheMappingSaysAndLabelsKeepApart) {
     EXPECT_EQ(r.x_tick_columns.back(), r.plot.x1);
     for (std::size_t i = 0; i < r.y_ticks.size(); ++i) {
       EXPECT_EQ(r.y_tick_rows[i], std::lround(r.plot.y1 - (r.y_ticks[i] - r.y_lo) / (r.y_hi - r.y_lo) *
-                                                               (r.plot.y1 - r.plot.y0)));
+                                                              (r.plot.y1 - r.plot.y0)));
       if (i > 0) {
         EXPECT_FALSE(overlap(r.y_labels[i], r.y_labels[i - 1]));
       }
@@ -211,13 +211,15 @@ TEST(Chart, LogAxes) {
   for (std::size_t i = 0; i < r.x_ticks.size(); ++i) {
     const double k = std::floor(std::log10(r.x_ticks[i]) + 1e-9), m = r.x_ticks[i] / std::pow(10.0, k);
     EXPECT_TRUE(std::abs(m - 1) < 1e-9 || std::abs(m - 2) < 1e-9 || std::abs(m - 5) < 1e-9) << r.x_ticks[i];
-    EXPECT_EQ(r.x_tick_columns[i], std::lround(r.plot.x0 + (std::log10(r.x_ticks[i]) + 3) / 5 * (r.plot.x1 - r.plot.x0)));
+    EXPECT_EQ(r.x_tick_columns[i],
+              std::lround(r.plot.x0 + (std::log10(r.x_ticks[i]) + 3) / 5 * (r.plot.x1 - r.plot.x0)));
     if (i > 0) {
       EXPECT_FALSE(overlap(r.x_labels[i], r.x_labels[i - 1]));
     }
   }
   for (std::size_t i = 0; i < r.y_ticks.size(); ++i)
-    EXPECT_EQ(r.y_tick_rows[i], std::lround(r.plot.y1 - (std::log10(r.y_ticks[i]) + 6) / 10 * (r.plot.y1 - r.plot.y0)));
+    EXPECT_EQ(r.y_tick_rows[i],
+              std::lround(r.plot.y1 - (std::log10(r.y_ticks[i]) + 6) / 10 * (r.plot.y1 - r.plot.y0)));
   // y = x^2 is straight on log-log axes: the line from (1e-3, 1e-6) to (1e2, 1e4), the frame's diagonal.
   EXPECT_NEAR(r.column(1e-3), r.plot.x0, 1e-9);
   EXPECT_NEAR(r.row(1e4), r.plot.y0, 1e-9);

@@ -96,12 +96,14 @@ Count iso_painter_vs_depth(const Mesh& m, const SphereTable& table, const Camera
 }
 
 // The views: each axis both ways, grid lines on pixel centres and on pixel edges, then 2-3 degrees off.
-std::vector<std::pair<std::string, Camera>> axis_views(const Mesh& m, double ppu = kPixelsPerUnit, double step = 1) {
+std::vector<std::pair<std::string, Camera>> axis_views(const Mesh& m, double ppu = kPixelsPerUnit,
+                                                       double step = 1) {
   std::vector<std::pair<std::string, Camera>> views;
   for (int axis = 0; axis < 3; ++axis)
     for (double s : {1.0, -1.0})
       for (bool half : {true, false}) {
-        const std::string name = std::string(s > 0 ? "+" : "-") + "xyz"[axis] + (half ? " centres" : " edges");
+        const std::string name =
+            std::string(s > 0 ? "+" : "-") + "xyz"[axis] + (half ? " centres" : " edges");
         views.emplace_back(name, axis_camera(m, axis, s, half, 0, 0, ppu, step));
         views.emplace_back(name + ", 2.5 deg off", axis_camera(m, axis, s, half, 2.5, 0, ppu, step));
         views.emplace_back(name + ", 2 and 3 deg off", axis_camera(m, axis, s, half, 2, -3, ppu, step));
@@ -151,11 +153,13 @@ TEST(DepthTie, PainterEqualsDepthBufferWithFieldColoursOnGrids) {
   for (const char* field : {"c", "n"})
     for (bool graded : {false, true}) {
       const FieldChoice choice = choose_field(m, field);
-      const std::vector<double> values = graded ? tet_corner_values(m, choice) : tet_centroid_values(m, choice);
+      const std::vector<double> values =
+          graded ? tet_corner_values(m, choice) : tet_centroid_values(m, choice);
       ColorScale s;
       std::tie(s.lo, s.hi) = finite_range(values);
       RenderParams p;
-      p.field = std::make_shared<FieldPaint>(graded ? graded_field_paint(values, s) : flat_field_paint(values, s));
+      p.field =
+          std::make_shared<FieldPaint>(graded ? graded_field_paint(values, s) : flat_field_paint(values, s));
       for (const auto& [name, cam] : axis_views(m)) {
         const Count n = painter_vs_depth(m, table, cam, p, ++seed);
         EXPECT_EQ(n.differing, 0u) << field << (graded ? " graded" : " flat") << ", view " << name;
@@ -197,8 +201,8 @@ TEST(DepthTie, PainterEqualsDepthBufferOnRandomDelaunay) {
       for (int i = 0; i <= 8; ++i) {
         const bool corner = (i % 8 == 0) && (j % 8 == 0) && (k % 8 == 0);
         if (!corner && rng() % 3 != 0) continue;
-        text += std::to_string(++count) + " " + std::to_string(i / 8.0) + " " + std::to_string(j / 8.0) + " " +
-                std::to_string(k / 8.0) + "\n";
+        text += std::to_string(++count) + " " + std::to_string(i / 8.0) + " " + std::to_string(j / 8.0) +
+                " " + std::to_string(k / 8.0) + "\n";
       }
   test::write_text(dir / "lattice.node", std::to_string(count) + " 3 0 0\n" + text);
   test::run("cd '" + dir.path().string() + "' && tetgen -Q lattice.node", dir / "tetgen.log");

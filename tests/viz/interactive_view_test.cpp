@@ -61,7 +61,8 @@ TEST(InteractiveView, EventsDamageUndrawAndPick) {
         const std::size_t i = after.index(x, y);
         if (after.rgba[i] == before.rgba[i] && after.id[i] == before.id[i]) continue;
         bool inside = false;
-        for (const PixelRect& r : damage) inside = inside || (x >= r.x0 && x <= r.x1 && y >= r.y0 && y <= r.y1);
+        for (const PixelRect& r : damage)
+          inside = inside || (x >= r.x0 && x <= r.x1 && y >= r.y0 && y <= r.y1);
         ASSERT_TRUE(inside) << "pixel " << x << "," << y << " changed outside the damage";
       }
   }

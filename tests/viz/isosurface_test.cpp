@@ -87,9 +87,11 @@ TEST(MarchingTets, LinearFieldPolygonsLieOnThePlaneWithTheBoxCrossSectionArea) {
   auto f = [&](const double* p) { return g[0] * p[0] + g[1] * p[1] + g[2] * p[2]; };
   const double glen = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
   for (int mesh_kind = 0; mesh_kind < 2; ++mesh_kind) {
-    Mesh m = mesh_kind == 0 ? test::grid_mesh(7, 6, 5, 1.0 / 7, 1.0 / 6, 1.0 / 5, 6) : test::random_delaunay(dir, 600, 5);
+    Mesh m = mesh_kind == 0 ? test::grid_mesh(7, 6, 5, 1.0 / 7, 1.0 / 6, 1.0 / 5, 6)
+                            : test::random_delaunay(dir, 600, 5);
     const std::vector<double> corner = corner_values_of(m, nodal_of(m, f));
-    for (double v : mesh_kind == 0 ? std::vector<double>{0.11, 0.5, 0.8, 1.2, 1.47} : std::vector<double>{0.5, 0.8, 1.0}) {
+    for (double v : mesh_kind == 0 ? std::vector<double>{0.11, 0.5, 0.8, 1.2, 1.47}
+                                   : std::vector<double>{0.5, 0.8, 1.0}) {
       double area = 0;
       std::size_t polys = 0;
       for (std::uint32_t t = 0; t < m.tet_count(); ++t) {
@@ -120,11 +122,14 @@ TEST(MarchingTets, SphereAreaConvergesToFourPiRSquared) {
   double prev_err = 0;
   for (int n : {8, 16, 32}) {
     Mesh m = test::grid_mesh(n, n, n, 1.0 / n, 1.0 / n, 1.0 / n, 6);
-    const std::vector<double> corner = corner_values_of(m, nodal_of(m, [&](const double* p) {
-      return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
-    }));
+    const std::vector<double> corner =
+        corner_values_of(m, nodal_of(m, [&](const double* p) {
+                           return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
+                                            (p[2] - c[2]) * (p[2] - c[2]));
+                         }));
     double area = 0;
-    for (std::uint32_t t = 0; t < m.tet_count(); ++t) area += polygon_area(iso_polygon(m, t, &corner[4 * t], r));
+    for (std::uint32_t t = 0; t < m.tet_count(); ++t)
+      area += polygon_area(iso_polygon(m, t, &corner[4 * t], r));
     const double err = std::abs(area - want) / want;
     std::printf("n %d: area %.6f (4 pi r^2 %.6f), relative error %.2e%s\n", n, area, want, err,
                 prev_err > 0 ? (" rate " + std::to_string(std::log2(prev_err / err))).c_str() : "");
@@ -187,13 +192,15 @@ TEST(TetIntervals, CrossingEqualsBruteForceScan) {
 
 double sphere_field(const double* p) {
   const double c[3] = {0.52, 0.47, 0.5};
-  return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
+  return std::sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) +
+                   (p[2] - c[2]) * (p[2] - c[2]));
 }
 
 // Draws the polygons of `tets` for `params` in painter mode in the progressive visibility order of the
 // subset (in batches) and in depth mode in a shuffled order.
-std::pair<Framebuffer, Framebuffer> painter_and_depth(const Mesh& m, const SphereTable& table, const Camera& cam,
-                                                      std::span<const double> corner, const IsoParams& params,
+std::pair<Framebuffer, Framebuffer> painter_and_depth(const Mesh& m, const SphereTable& table,
+                                                      const Camera& cam, std::span<const double> corner,
+                                                      const IsoParams& params,
                                                       const std::vector<std::uint32_t>& tets,
                                                       std::span<const double> attr = {}) {
   RenderParams rp;
@@ -218,7 +225,8 @@ std::pair<Framebuffer, Framebuffer> painter_and_depth(const Mesh& m, const Spher
 TEST(IsoPainter, PainterEqualsDepthBufferAndRayCast) {
   test::TempDir dir;
   for (int mesh_kind = 0; mesh_kind < 2; ++mesh_kind) {
-    Mesh m = mesh_kind == 0 ? test::grid_mesh(7, 7, 7, 1.0 / 7, 1.0 / 7, 1.0 / 7, 6) : test::random_delaunay(dir, 1500, 21);
+    Mesh m = mesh_kind == 0 ? test::grid_mesh(7, 7, 7, 1.0 / 7, 1.0 / 7, 1.0 / 7, 6)
+                            : test::random_delaunay(dir, 1500, 21);
     const SphereTable table = compute_spheres(m);
     const std::vector<double> corner = corner_values_of(m, nodal_of(m, sphere_field));
     IsoParams ip;
@@ -273,11 +281,14 @@ TEST(IsoPainter, PainterEqualsDepthBufferAndRayCast) {
               pr.camera_to_pixel(tr.c[k], s[k]);
             }
             if (behind) continue;
-            const double det = (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[1][1] - s[0][1]) * (s[2][0] - s[0][0]);
+            const double det =
+                (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[1][1] - s[0][1]) * (s[2][0] - s[0][0]);
             if (std::abs(det) < 1e-12) continue;
             const double qx = x + 0.5, qy = y + 0.5;
-            const double l1 = ((qx - s[0][0]) * (s[2][1] - s[0][1]) - (qy - s[0][1]) * (s[2][0] - s[0][0])) / det;
-            const double l2 = ((s[1][0] - s[0][0]) * (qy - s[0][1]) - (s[1][1] - s[0][1]) * (qx - s[0][0])) / det;
+            const double l1 =
+                ((qx - s[0][0]) * (s[2][1] - s[0][1]) - (qy - s[0][1]) * (s[2][0] - s[0][0])) / det;
+            const double l2 =
+                ((s[1][0] - s[0][0]) * (qy - s[0][1]) - (s[1][1] - s[0][1]) * (qx - s[0][0])) / det;
             const double l0 = 1 - l1 - l2;
             if (l0 < -1e-9 || l1 < -1e-9 || l2 < -1e-9) continue;
             // Distance in pixels to the triangle's edges: barycentric times the opposite height.
@@ -307,8 +318,9 @@ TEST(IsoPainter, PainterEqualsDepthBufferAndRayCast) {
           EXPECT_EQ(a.id[a.index(x, y)], best_tet) << "pixel " << x << "," << y;
         }
     }
-    std::printf("mesh %d: %zu iso pixels compared with the depth buffer, %zu with the ray cast (%zu near edges)\n",
-                mesh_kind, compared, cast, skipped);
+    std::printf(
+        "mesh %d: %zu iso pixels compared with the depth buffer, %zu with the ray cast (%zu near edges)\n",
+        mesh_kind, compared, cast, skipped);
     EXPECT_GT(compared, 10000u);
   }
 }
@@ -406,8 +418,8 @@ TEST(IsoPainter, CapAndSliceEqualTheDepthBuffer) {
       slice_pixels += c.id[p] != kNone;
     }
   }
-  std::printf("cap: %zu pixels, %zu differ from the depth buffer; slice: %zu pixels\n", cap_pixels, total_differ,
-              slice_pixels);
+  std::printf("cap: %zu pixels, %zu differ from the depth buffer; slice: %zu pixels\n", cap_pixels,
+              total_differ, slice_pixels);
   EXPECT_GT(cap_pixels, 10000u);
   EXPECT_GT(slice_pixels, 5000u);
   EXPECT_EQ(total_differ, 0u);
@@ -470,7 +482,8 @@ TEST(IsoPainter, UndrawEqualsDrawingTheRestAfresh) {
       IsoPainter painter(m, cam, kW, kH, corner, ip, rp);
       Framebuffer fb(kW, kH);
       for (std::size_t i = 0; i < order.size(); i += 50)
-        painter.draw(fb, std::span<const std::uint32_t>(order).subspan(i, std::min<std::size_t>(50, order.size() - i)));
+        painter.draw(fb, std::span<const std::uint32_t>(order).subspan(
+                             i, std::min<std::size_t>(50, order.size() - i)));
       std::size_t left = order.size();
       for (std::size_t k : {std::size_t(1), std::size_t(37), order.size() / 3, std::size_t(5)}) {
         k = std::min(k, left);
@@ -481,7 +494,8 @@ TEST(IsoPainter, UndrawEqualsDrawingTheRestAfresh) {
         IsoPainter again(m, cam, kW, kH, corner, ip);
         again.draw(fresh, std::span<const std::uint32_t>(order).first(left));
         std::size_t differ = 0;
-        for (std::size_t p = 0; p < fb.rgba.size(); ++p) differ += fb.rgba[p] != fresh.rgba[p] || fb.id[p] != fresh.id[p];
+        for (std::size_t p = 0; p < fb.rgba.size(); ++p)
+          differ += fb.rgba[p] != fresh.rgba[p] || fb.id[p] != fresh.id[p];
         EXPECT_EQ(differ, 0u) << (cap ? "cap" : "surfaces") << ", " << left << " tets left";
       }
       EXPECT_THROW(painter.undraw(fb, left + 1), std::out_of_range);

@@ -121,14 +121,16 @@ TEST(Legend, MarksCrossTheBarAtTheirValuesRow) {
     EXPECT_NEAR(r.mark_rows[std::size_t(i)], r.bar.y1 - t * (r.bar.y1 - r.bar.y0), 1.0);
     for (int x = r.bar.x0; x <= r.bar.x1; ++x)
       EXPECT_EQ(fb.rgba[fb.index(x, r.mark_rows[std::size_t(i)])], pack_rgba(0, 0, 0));
-    EXPECT_EQ(fb.rgba[fb.index(r.bar.x0 - 2, r.mark_rows[std::size_t(i)])], pack_rgba(0, 0, 0));  // the pointer
+    EXPECT_EQ(fb.rgba[fb.index(r.bar.x0 - 2, r.mark_rows[std::size_t(i)])],
+              pack_rgba(0, 0, 0));  // the pointer
   }
   // Rows away from marks and ticks keep the map's colour.
   int plain = 0;
   for (int y = r.bar.y0; y <= r.bar.y1; ++y) {
     bool near_mark = false;
     for (int m : r.mark_rows) near_mark |= std::abs(m - y) <= 3;
-    if (!near_mark && fb.rgba[fb.index(r.bar.x0, y)] == l.scale.color_at(double(r.bar.y1 - y) / (r.bar.y1 - r.bar.y0)))
+    if (!near_mark &&
+        fb.rgba[fb.index(r.bar.x0, y)] == l.scale.color_at(double(r.bar.y1 - y) / (r.bar.y1 - r.bar.y0)))
       ++plain;
   }
   EXPECT_GT(plain, (r.bar.y1 - r.bar.y0) * 3 / 4);

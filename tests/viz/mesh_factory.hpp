@@ -25,7 +25,8 @@ inline double orient(const Mesh& m, std::uint32_t a, std::uint32_t b, std::uint3
     v[k] = r[k] - p[k];
     w[k] = s[k] - p[k];
   }
-  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+         u[2] * (v[0] * w[1] - v[1] * w[0]);
 }
 
 inline void push_tet(Mesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
@@ -36,7 +37,9 @@ inline void push_tet(Mesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c,
 // nx x ny x nz cuboids of size hx x hy x hz; tets_per_cell 5 or 6. Region 1 everywhere.
 inline Mesh grid_mesh(int nx, int ny, int nz, double hx, double hy, double hz, int tets_per_cell) {
   Mesh m;
-  auto id = [&](int i, int j, int k) { return static_cast<std::uint32_t>((k * (ny + 1) + j) * (nx + 1) + i); };
+  auto id = [&](int i, int j, int k) {
+    return static_cast<std::uint32_t>((k * (ny + 1) + j) * (nx + 1) + i);
+  };
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i) m.xyz.insert(m.xyz.end(), {i * hx, j * hy, k * hz});
@@ -80,7 +83,8 @@ inline void regions_along_x(Mesh& m, double x1, double x2) {
 
 // TetGen's Delaunay tetrahedralization of `n` random points in the box [0,sx]x[0,sy]x[0,sz]
 // (`tetgen` on a .node file, no PLC: the convex hull is meshed).
-inline Mesh random_delaunay(const TempDir& dir, int n, unsigned seed, double sx = 1, double sy = 1, double sz = 1) {
+inline Mesh random_delaunay(const TempDir& dir, int n, unsigned seed, double sx = 1, double sy = 1,
+                            double sz = 1) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::string text = std::to_string(n) + " 3 0 0\n";
@@ -121,7 +125,8 @@ inline Mesh integer_sphere_delaunay(const TempDir& dir, int r2) {
       for (int z = -r; z <= r; ++z)
         if (x * x + y * y + z * z == r2) {
           ++n;
-          body += std::to_string(n) + " " + std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) + "\n";
+          body += std::to_string(n) + " " + std::to_string(x) + " " + std::to_string(y) + " " +
+                  std::to_string(z) + "\n";
         }
   write_text(dir / "isph.node", std::to_string(n) + " 3 0 0\n" + body);
   run("cd '" + dir.path().string() + "' && tetgen -Q isph.node", dir / "tetgen.log");

@@ -105,7 +105,8 @@ TEST(MixedScales, CertificateAndOrderFinishAndAreRight) {
       EXPECT_EQ(order.size(), m.tet_count());
       EXPECT_EQ(count_violations(m, v, order).violations, 0u) << "kmax " << kmax;
     }
-    std::printf("kmax %d: %zu tets; certificate %.3f s, spheres %.3f s\n", kmax, m.tet_count(), cert_s, spheres_s);
+    std::printf("kmax %d: %zu tets; certificate %.3f s, spheres %.3f s\n", kmax, m.tet_count(), cert_s,
+                spheres_s);
   }
 }
 
@@ -173,7 +174,8 @@ TEST(MixedScales, CertificateMatchesBruteForce) {
     }
   ASSERT_TRUE(done);
   for (std::size_t t = 0; t < base.tet_count(); ++t)
-    if (t != skip0 && t != skip1) flipped.tet.insert(flipped.tet.end(), &base.tet[4 * t], &base.tet[4 * t + 4]);
+    if (t != skip0 && t != skip1)
+      flipped.tet.insert(flipped.tet.end(), &base.tet[4 * t], &base.tet[4 * t + 4]);
   flipped.tet_region.assign(flipped.tet_count(), 1);
   const ValidationReport r = validate(flipped);
   ASSERT_TRUE(r.ok()) << (r.messages.empty() ? "" : r.messages[0]);

@@ -42,7 +42,8 @@ TEST(Movie, BackAndForthFramesEqualFreshPrefixes) {
     p.from = 0.2;
     p.to = 0.9;
     std::vector<Framebuffer> frames;
-    const MovieStats s = make_movie(m, table, cam, kW, kH, subset, p, [&](const Framebuffer& fb) { frames.push_back(fb); });
+    const MovieStats s =
+        make_movie(m, table, cam, kW, kH, subset, p, [&](const Framebuffer& fb) { frames.push_back(fb); });
     ASSERT_EQ(frames.size(), 18u);
     EXPECT_EQ(s.frames, 18u);
     EXPECT_GT(s.tets_undrawn, 0u);
@@ -84,13 +85,15 @@ TEST(Movie, RotatingFramesEqualFreshPicturesAndProgressCancels) {
   }
   EXPECT_NE(frames[0].rgba, frames[5].rgba);
   int calls = 0;
-  EXPECT_THROW(make_movie(m, table, cam, kW, kH, {}, p, [](const Framebuffer&) {},
-                          [&](std::string_view, double) { return ++calls < 3; }),
+  EXPECT_THROW(make_movie(
+                   m, table, cam, kW, kH, {}, p, [](const Framebuffer&) {},
+                   [&](std::string_view, double) { return ++calls < 3; }),
                MovieCancelled);
   EXPECT_EQ(calls, 3);
   calls = 0;
-  EXPECT_THROW(make_movie(m, table, cam, kW, kH, {}, p, [](const Framebuffer&) {},
-                          [&](std::string_view, double) { return ++calls < 3; }),
+  EXPECT_THROW(make_movie(
+                   m, table, cam, kW, kH, {}, p, [](const Framebuffer&) {},
+                   [&](std::string_view, double) { return ++calls < 3; }),
                Cancelled);  // the one cancellation outcome of every library
   p.frames = 1;
   EXPECT_THROW(make_movie(m, table, cam, kW, kH, {}, p, [](const Framebuffer&) {}), std::invalid_argument);

@@ -112,9 +112,10 @@ TEST(Picture, UncertifiedMeshIsDrawnInMpvoOrderWithTheDepthBuffer) {
   EXPECT_GT(total.shown, 12u * kW * kH / 20);
   EXPECT_LE(total.differing, total.shown / 2000 + 10);
   EXPECT_GT(painter_differing, 10 * (total.differing + 10)) << "this mesh should need the depth buffer";
-  std::printf("uncertified grid: %zu pixels differ from the shuffled depth buffer (safe picture), %zu for the "
-              "painter in the power order\n",
-              total.differing, painter_differing);
+  std::printf(
+      "uncertified grid: %zu pixels differ from the shuffled depth buffer (safe picture), %zu for the "
+      "painter in the power order\n",
+      total.differing, painter_differing);
 }
 
 TEST(Picture, StopsDrawThePrefixTheReportNames) {
@@ -131,8 +132,7 @@ TEST(Picture, StopsDrawThePrefixTheReportNames) {
   const std::size_t n = std::size_t(std::floor(0.4 * double(order.size()) + 1e-9));
   EXPECT_EQ(r.tets_drawn, n);
   EXPECT_EQ(r.last_drawn, order[n - 1]);
-  const Framebuffer prefix =
-      render_tets(m, cam, kW, kH, std::span<const std::uint32_t>(order).first(n));
+  const Framebuffer prefix = render_tets(m, cam, kW, kH, std::span<const std::uint32_t>(order).first(n));
   EXPECT_EQ(fb.rgba, prefix.rgba);
   EXPECT_EQ(fb.id, prefix.id);
 

@@ -56,13 +56,15 @@ TEST(PixelPoint, ThePointAndValueUnderAPixelAreWhereItsRayEntersTheBox) {
           s_in = std::max(s_in, std::min(a, b));
           s_out = std::min(s_out, std::max(a, b));
         }
-        ASSERT_LE(s_in, s_out + 1e-9) << "pixel " << x << "," << y << " shows a tet but its ray misses the box";
+        ASSERT_LE(s_in, s_out + 1e-9)
+            << "pixel " << x << "," << y << " shows a tet but its ray misses the box";
         const double want[3] = {o[0] + s_in * d[0], o[1] + s_in * d[1], o[2] + s_in * d[2]};
         double b[4];
         ASSERT_TRUE(pixel_point_in_tet(mesh, cams[c], w, h, tet, x, y, b)) << x << "," << y;
         double got[3] = {0, 0, 0};
         for (int i = 0; i < 4; ++i)
-          for (int k = 0; k < 3; ++k) got[k] += b[i] * mesh.xyz[3 * std::size_t(mesh.tet[4 * tet + std::size_t(i)]) + std::size_t(k)];
+          for (int k = 0; k < 3; ++k)
+            got[k] += b[i] * mesh.xyz[3 * std::size_t(mesh.tet[4 * tet + std::size_t(i)]) + std::size_t(k)];
         // Exact to rounding, but for pixel centres the rasterizer (in floats) gives to a tet they lie a
         // hair outside of: clamped onto the tet, within a small part of a pixel (about 0.03 here).
         const double err = std::hypot(got[0] - want[0], got[1] - want[1], got[2] - want[2]);

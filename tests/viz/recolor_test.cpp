@@ -28,7 +28,8 @@ namespace {
 constexpr int kW = 160, kH = 120;
 
 struct Paints {
-  std::vector<std::shared_ptr<const FieldPaint>> all;  // flat a, graded a, flat b (coolwarm), graded b (rainbow)
+  std::vector<std::shared_ptr<const FieldPaint>>
+      all;  // flat a, graded a, flat b (coolwarm), graded b (rainbow)
 };
 
 // Two fields on m (a random cell field "a" and a smooth node field "b") and their paints.
@@ -51,17 +52,21 @@ Paints make_paints(Mesh& m) {
       ColorScale s;
       std::tie(s.lo, s.hi) = finite_range(v);
       if (name[0] == 'b') s.map = graded ? ColorMapId::rainbow : ColorMapId::coolwarm;
-      ps.all.push_back(std::make_shared<const FieldPaint>(graded ? graded_field_paint(v, s) : flat_field_paint(v, s)));
+      ps.all.push_back(
+          std::make_shared<const FieldPaint>(graded ? graded_field_paint(v, s) : flat_field_paint(v, s)));
     }
   return ps;
 }
 
-std::size_t differing(const Framebuffer& a, const Framebuffer& b) { return test::compare_pictures(a, b).differing; }
+std::size_t differing(const Framebuffer& a, const Framebuffer& b) {
+  return test::compare_pictures(a, b).differing;
+}
 
 // Draws `tets` with paint `from`, recolours with `to` and compares with a fresh draw with `to`; returns
 // the pixels the recolouring changed (so that a test sees it did something).
 std::size_t check(const Mesh& m, const Camera& cam, std::span<const std::uint32_t> tets, RenderParams p,
-                  std::shared_ptr<const FieldPaint> from, std::shared_ptr<const FieldPaint> to, const char* what) {
+                  std::shared_ptr<const FieldPaint> from, std::shared_ptr<const FieldPaint> to,
+                  const char* what) {
   p.field = from;
   TetRasterizer r(m, cam, kW, kH, p);
   Framebuffer fb(kW, kH);

@@ -46,7 +46,8 @@ void random_regions(Mesh& m, unsigned seed) {
 
 // The exact depth (camera z, larger = farther) where the pixel's ray meets the plane through a, b, c
 // (camera coordinates); NaN when the ray is parallel to it.
-double ray_plane_depth(const double o[3], const double d[3], const double a[3], const double b[3], const double c[3]) {
+double ray_plane_depth(const double o[3], const double d[3], const double a[3], const double b[3],
+                       const double c[3]) {
   const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
   const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
   const double nd = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
@@ -87,7 +88,8 @@ OracleResult per_pixel_oracle(const Mesh& m, const Camera& cam, const Translucen
     int count = 3;
     if (f.face >= 0) {
       for (int k = 0; k < 3; ++k)
-        proj.to_camera(&m.xyz[3 * std::size_t(m.tet[4 * std::size_t(f.tet) + std::size_t(kFaceOf[f.face][k])])], p[k]);
+        proj.to_camera(
+            &m.xyz[3 * std::size_t(m.tet[4 * std::size_t(f.tet) + std::size_t(kFaceOf[f.face][k])])], p[k]);
     } else {
       const double v = isovalues[std::size_t(-1 - f.face)];
       const IsoPolygon poly = iso_polygon(m, f.tet, &params.corner[4 * std::size_t(f.tet)], v);
@@ -134,7 +136,8 @@ OracleResult per_pixel_oracle(const Mesh& m, const Camera& cam, const Translucen
     auto& list = at[px];
     if (list.empty()) continue;
     ++r.pixels;
-    std::stable_sort(list.begin(), list.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::stable_sort(list.begin(), list.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
     bool tie = edge[px] != 0;
     for (std::size_t k = 1; k < list.size(); ++k)
       tie |= std::abs(list[k].first - list[k - 1].first) <= 1e-9 * std::abs(list[k].first) + 1e-12;
@@ -150,16 +153,18 @@ OracleResult per_pixel_oracle(const Mesh& m, const Camera& cam, const Translucen
     if (debug && differs && !tie && std::getenv("FOXI_TRANSLUCENT_DEBUG")) {
       std::printf("pixel %zu,%zu:\n", px % kW, px / kW);
       for (const auto& e : list)
-        std::printf("  depth %.17g tet %u face %d drawn #%zu alpha %g edge dist %g px\n", e.first, frags[e.second].tet,
-                    frags[e.second].face, e.second, frags[e.second].alpha, mindist[e.second]);
+        std::printf("  depth %.17g tet %u face %d drawn #%zu alpha %g edge dist %g px\n", e.first,
+                    frags[e.second].tet, frags[e.second].face, e.second, frags[e.second].alpha,
+                    mindist[e.second]);
     }
     if (differs) ++(tie ? r.tied_differing : r.differing);
   }
   return r;
 }
 
-Framebuffer composite(const Mesh& m, const Camera& cam, const TranslucentSurfaces& surf, const TranslucentParams& params,
-                      std::span<const std::uint32_t> order, std::size_t* fragments = nullptr) {
+Framebuffer composite(const Mesh& m, const Camera& cam, const TranslucentSurfaces& surf,
+                      const TranslucentParams& params, std::span<const std::uint32_t> order,
+                      std::size_t* fragments = nullptr) {
   TranslucentPainter painter(m, cam, kW, kH, surf, params);
   // In two batches: a progressive picture blends on where the last batch stopped.
   const std::size_t half = order.size() / 2;
@@ -190,8 +195,8 @@ struct Totals {
 
 // Power order against the oracle for several cameras (outside, inside, orthographic); the centroid
 // order for the same views, to show the order matters.
-Totals check_views(const Mesh& m, std::span<const std::uint32_t> subset, const TranslucentParams& params, int cameras,
-                   unsigned seed) {
+Totals check_views(const Mesh& m, std::span<const std::uint32_t> subset, const TranslucentParams& params,
+                   int cameras, unsigned seed) {
   const SphereTable table = compute_spheres(m);
   const TranslucentSurfaces surf = translucent_surfaces(m, subset, params);
   Totals t;
@@ -203,7 +208,8 @@ Totals check_views(const Mesh& m, std::span<const std::uint32_t> subset, const T
     EXPECT_EQ(blended, r.fragments) << "the same fragments blended as collected";
     t.add(t.power, r);
     const std::vector<std::uint32_t> centroid = centroid_order(m, view_of(cam), surf.tets);
-    t.add(t.centroid, per_pixel_oracle(m, cam, surf, params, centroid, composite(m, cam, surf, params, centroid)));
+    t.add(t.centroid,
+          per_pixel_oracle(m, cam, surf, params, centroid, composite(m, cam, surf, params, centroid)));
   }
   return t;
 }
@@ -215,10 +221,11 @@ void expect_exact(const Totals& t, const char* what) {
   // small, dense pictures) have no exact depth order for that fragment: they may differ, and do in
   // about 1 pixel of 3000 (seen: 0 to 11 of 33,000).
   EXPECT_LE(t.power.tied_differing, t.power.pixels / 1000 + 5) << what;
-  std::printf("%s: %zu pixels, %zu fragments, power order %zu differ (%zu tied, %zu of them differing); centroid "
-              "order %zu differ\n",
-              what, t.power.pixels, t.power.fragments, t.power.differing, t.power.tied, t.power.tied_differing,
-              t.centroid.differing);
+  std::printf(
+      "%s: %zu pixels, %zu fragments, power order %zu differ (%zu tied, %zu of them differing); centroid "
+      "order %zu differ\n",
+      what, t.power.pixels, t.power.fragments, t.power.differing, t.power.tied, t.power.tied_differing,
+      t.centroid.differing);
 }
 
 TEST(Translucent, RandomDelaunayRegionsMatchThePerPixelOracle) {
@@ -324,7 +331,8 @@ TEST(Translucent, SurfaceFragmentsAreTheRayCrossingsOfTheDrawnSurfaces) {
           const std::uint8_t mask = surf.mask[t];
           for (int f = 0; f < 4; ++f) {
             if (!(mask & (0x11u << f))) continue;
-            if (!(mask & (1u << f)) && adj.neighbour[4 * t + std::size_t(f)] / 4 < t) continue;  // interface once
+            if (!(mask & (1u << f)) && adj.neighbour[4 * t + std::size_t(f)] / 4 < t)
+              continue;  // interface once
             double c[3][3];
             std::uint32_t n[3];
             for (int k = 0; k < 3; ++k) {
@@ -339,7 +347,8 @@ TEST(Translucent, SurfaceFragmentsAreTheRayCrossingsOfTheDrawnSurfaces) {
               const double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
               const double w[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
               // sign of d . (w x e)
-              s[k] = d[0] * (w[1] * e[2] - w[2] * e[1]) + d[1] * (w[2] * e[0] - w[0] * e[2]) + d[2] * (w[0] * e[1] - w[1] * e[0]);
+              s[k] = d[0] * (w[1] * e[2] - w[2] * e[1]) + d[1] * (w[2] * e[0] - w[0] * e[2]) +
+                     d[2] * (w[0] * e[1] - w[1] * e[0]);
             }
             const double mag = std::abs(s[0]) + std::abs(s[1]) + std::abs(s[2]);
             const bool inside = (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0);
@@ -412,7 +421,8 @@ TEST(Translucent, CertifiedPictureIsThePowerOrderComposite) {
   none.default_opacity = 0;
   const TranslucentReport r0 = draw_translucent_picture(m, table, cam, fb, {}, none);
   EXPECT_EQ(r0.tets_ordered, 0u);
-  EXPECT_TRUE(std::all_of(fb.rgba.begin(), fb.rgba.end(), [](std::uint32_t c) { return c == pack_rgba(255, 255, 255); }));
+  EXPECT_TRUE(std::all_of(fb.rgba.begin(), fb.rgba.end(),
+                          [](std::uint32_t c) { return c == pack_rgba(255, 255, 255); }));
 }
 
 TEST(Translucent, BadOpacitiesAreRefused) {

@@ -76,7 +76,8 @@ void check_undraw(const Mesh& m, std::span<const std::uint32_t> subset, int view
     // Undraw everything: the background, and nothing saved any more.
     r.undraw(fb, order.size());
     EXPECT_TRUE(std::all_of(fb.id.begin(), fb.id.end(), [](std::uint32_t id) { return id == kNone; }));
-    EXPECT_TRUE(std::all_of(fb.rgba.begin(), fb.rgba.end(), [](std::uint32_t c) { return c == pack_rgba(255, 255, 255); }));
+    EXPECT_TRUE(std::all_of(fb.rgba.begin(), fb.rgba.end(),
+                            [](std::uint32_t c) { return c == pack_rgba(255, 255, 255); }));
     EXPECT_EQ(r.saved_pixels(), 0u);
   }
   EXPECT_GT(covered, std::size_t(views) * kW * kH / 20) << "the views should show the mesh";
@@ -129,12 +130,14 @@ TEST(Undraw, BatchesOnThreadsEqualOneTetAtATime) {
   const std::vector<Camera> cams = test::random_cameras(m, 6, 29, double(kBigW) / kBigH);
   std::size_t threaded = 0;
   for (std::size_t v = 0; v < cams.size(); ++v) {
-    const auto order = visibility_order(m, table, view_of(cams[v]), v % 2 == 0 ? std::span<const std::uint32_t>{} : subset);
+    const auto order =
+        visibility_order(m, table, view_of(cams[v]), v % 2 == 0 ? std::span<const std::uint32_t>{} : subset);
     const std::span<const std::uint32_t> all(order);
     const std::size_t j = order.size() / 5;  // undraw down to the back fifth
     const Framebuffer fresh = render_tets(m, cams[v], kBigW, kBigH, all.first(j));
     for (int threads : {1, 2, 5}) {
-      for (std::size_t batch : {std::size_t(1), std::size_t(97), std::size_t(300), std::size_t(1400), order.size()}) {
+      for (std::size_t batch :
+           {std::size_t(1), std::size_t(97), std::size_t(300), std::size_t(1400), order.size()}) {
         if (batch == 1 && threads != 2) continue;  // one tet at a time never spawns threads
         RenderParams p;
         p.undoable = true;
@@ -204,17 +207,20 @@ std::size_t changes_outside(const Framebuffer& before, const Framebuffer& after,
 // The changed pixels outside every rectangle of `rects`, checking that the rectangles are disjoint,
 // in row order and inside `bound`; `area` adds up theirs.
 std::size_t changes_outside_rects(const Framebuffer& before, const Framebuffer& after,
-                                  std::span<const PixelRect> rects, const PixelRect& bound, std::size_t& area) {
+                                  std::span<const PixelRect> rects, const PixelRect& bound,
+                                  std::size_t& area) {
   std::vector<std::uint8_t> covered(after.rgba.size(), 0);
   int last_y1 = -1;
   for (const PixelRect& r : rects) {
     EXPECT_TRUE(r.x0 <= r.x1 && r.y0 <= r.y1) << "an empty rectangle";
-    EXPECT_TRUE(r.x0 >= bound.x0 && r.x1 <= bound.x1 && r.y0 >= bound.y0 && r.y1 <= bound.y1) << "outside changed_rect";
+    EXPECT_TRUE(r.x0 >= bound.x0 && r.x1 <= bound.x1 && r.y0 >= bound.y0 && r.y1 <= bound.y1)
+        << "outside changed_rect";
     EXPECT_GT(r.y0, last_y1) << "rectangles overlap or are out of row order";
     last_y1 = r.y1;
     area += std::size_t(r.x1 - r.x0 + 1) * std::size_t(r.y1 - r.y0 + 1);
     for (int y = std::max(r.y0, 0); y <= std::min(r.y1, after.height - 1); ++y)
-      for (int x = std::max(r.x0, 0); x <= std::min(r.x1, after.width - 1); ++x) covered[after.index(x, y)] = 1;
+      for (int x = std::max(r.x0, 0); x <= std::min(r.x1, after.width - 1); ++x)
+        covered[after.index(x, y)] = 1;
   }
   std::size_t outside = 0;
   for (std::size_t i = 0; i < covered.size(); ++i)
@@ -253,11 +259,13 @@ TEST(Undraw, ChangedRectHoldsEveryChangedPixel) {
         }
         changed_calls += changed > 0;
         std::size_t area = 0;
-        EXPECT_EQ(changes_outside_rects(before, fb, r.changed_rects(), rect, area), 0u) << what << " mode " << mode;
+        EXPECT_EQ(changes_outside_rects(before, fb, r.changed_rects(), rect, area), 0u)
+            << what << " mode " << mode;
         if (rect.x0 > rect.x1) {
           EXPECT_TRUE(r.changed_rects().empty());
         }
-        if (rect.x0 <= rect.x1) tighter_calls += area < std::size_t(rect.x1 - rect.x0 + 1) * std::size_t(rect.y1 - rect.y0 + 1);
+        if (rect.x0 <= rect.x1)
+          tighter_calls += area < std::size_t(rect.x1 - rect.x0 + 1) * std::size_t(rect.y1 - rect.y0 + 1);
       };
       std::size_t at = 0;
       for (std::size_t s : random_cuts(order.size(), 1 + order.size() / 6, rng)) {
@@ -347,7 +355,8 @@ TEST(Undraw, EyeInsideATetWithBoundaryFaces) {
 
 // Draws `order` undoably, undraws every count of its last tets in turn (from a fresh drawing each
 // time) and counts the pixels that differ from the painter's fresh drawing of the tets kept.
-std::size_t undraw_differences(const Mesh& m, const Camera& cam, int w, int h, std::span<const std::uint32_t> order) {
+std::size_t undraw_differences(const Mesh& m, const Camera& cam, int w, int h,
+                               std::span<const std::uint32_t> order) {
   std::size_t differ = 0;
   for (std::size_t undrawn = 1; undrawn <= order.size(); ++undrawn) {
     RenderParams p;
@@ -357,7 +366,8 @@ std::size_t undraw_differences(const Mesh& m, const Camera& cam, int w, int h, s
     r.draw(fb, order);
     r.undraw(fb, undrawn);
     const Framebuffer fresh = render_tets(m, cam, w, h, order.first(order.size() - undrawn));
-    for (std::size_t i = 0; i < fresh.id.size(); ++i) differ += fresh.rgba[i] != fb.rgba[i] || fresh.id[i] != fb.id[i];
+    for (std::size_t i = 0; i < fresh.id.size(); ++i)
+      differ += fresh.rgba[i] != fb.rgba[i] || fresh.id[i] != fb.id[i];
   }
   return differ;
 }
@@ -369,8 +379,8 @@ std::size_t undraw_differences(const Mesh& m, const Camera& cam, int w, int h, s
 // Oracle: the painter's fresh drawing of the kept tets.
 TEST(Undraw, FaceSeenEdgeOnOrthographic) {
   Mesh m;
-  m.xyz = {0, 0, 0, 2000, 0, 0, 0, 2000, 0, 2000, 2000, -4000, 0, 0, 2000, 2000, -1750, 2000, 0, 2000, 2000,
-           -4000, -4000, -4000};
+  m.xyz = {0, 0, 0,    2000, 0,     0,    0, 2000, 0,    2000,  2000,  -4000,
+           0, 0, 2000, 2000, -1750, 2000, 0, 2000, 2000, -4000, -4000, -4000};
   m.tet = {3, 1, 0, 7, 0, 1, 5, 7, 0, 2, 3, 7, 0, 2, 6, 1, 7, 0, 4, 5, 7, 0, 6, 4};
   ASSERT_TRUE(validate_and_repair(m).ok());
   double lo[3], hi[3];

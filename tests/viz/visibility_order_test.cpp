@@ -45,14 +45,16 @@ std::vector<View> random_views(const Mesh& m, int n, unsigned seed) {
   return views;
 }
 
-std::size_t violations(const Mesh& m, const SphereTable& t, const View& v, std::span<const std::uint32_t> subset = {}) {
+std::size_t violations(const Mesh& m, const SphereTable& t, const View& v,
+                       std::span<const std::uint32_t> subset = {}) {
   auto order = visibility_order(m, t, v, subset);
   EXPECT_EQ(order.size(), subset.empty() ? m.tet_count() : subset.size());
   return count_violations(m, v, order).violations;
 }
 
 // Parameter interval [t0, t1] of the ray o + t d inside tet `tet` (t >= tmin); empty if t1 <= t0.
-std::pair<double, double> ray_interval(const Mesh& m, std::uint32_t tet, const double* o, const double* d, double tmin) {
+std::pair<double, double> ray_interval(const Mesh& m, std::uint32_t tet, const double* o, const double* d,
+                                       double tmin) {
   static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
   double t0 = tmin, t1 = 1e300;
   const std::uint32_t* v = &m.tet[4 * std::size_t(tet)];
@@ -312,9 +314,11 @@ TEST(VisibilityOrder, LargeGridSubsetsSplitAcrossThreadsAndBatches) {
   std::vector<std::uint32_t> order;
   for (const View& v : random_views(m, 3, 21)) {
     for (bool use_subset : {false, true}) {
-      std::span<const std::uint32_t> s = use_subset ? std::span<const std::uint32_t>(subset) : std::span<const std::uint32_t>();
+      std::span<const std::uint32_t> s =
+          use_subset ? std::span<const std::uint32_t>(subset) : std::span<const std::uint32_t>();
       visibility_order_into(order, m, t, v, s);
-      std::vector<std::uint32_t> sorted_order = order, expected = use_subset ? subset : std::vector<std::uint32_t>();
+      std::vector<std::uint32_t> sorted_order = order,
+                                 expected = use_subset ? subset : std::vector<std::uint32_t>();
       if (!use_subset)
         for (std::uint32_t i = 0; i < m.tet_count(); ++i) expected.push_back(i);
       std::sort(sorted_order.begin(), sorted_order.end());
@@ -322,7 +326,8 @@ TEST(VisibilityOrder, LargeGridSubsetsSplitAcrossThreadsAndBatches) {
       EXPECT_EQ(count_violations(m, v, order).violations, 0u);
       ProgressiveOrder progressive(m, t, v, s);
       std::vector<std::uint32_t> all;
-      for (auto b = progressive.next(); !b.empty(); b = progressive.next()) all.insert(all.end(), b.begin(), b.end());
+      for (auto b = progressive.next(); !b.empty(); b = progressive.next())
+        all.insert(all.end(), b.begin(), b.end());
       EXPECT_EQ(all, order);
     }
   }
@@ -460,7 +465,8 @@ TEST(VisibilityOrder, ProgressiveSortingAheadOnASecondThread) {
   for (const View& v : random_views(m, 6, 77)) {
     ProgressiveOrder progressive(m, t, v);
     std::vector<std::uint32_t> all;
-    for (auto b = progressive.next(); !b.empty(); b = progressive.next()) all.insert(all.end(), b.begin(), b.end());
+    for (auto b = progressive.next(); !b.empty(); b = progressive.next())
+      all.insert(all.end(), b.begin(), b.end());
     EXPECT_EQ(progressive.handed_out(), m.tet_count());
     EXPECT_EQ(all, visibility_order(m, t, v));
     EXPECT_EQ(count_violations(m, v, all).violations, 0u);
@@ -490,7 +496,8 @@ TEST(VisibilityOrder, FirstBatchFromKeyBlocksIsThePrefixOfTheWholeOrder) {
   for (std::uint32_t i = 0; i < n; ++i) shuffle[i] = i;
   std::shuffle(shuffle.begin(), shuffle.end(), std::mt19937(5));
   for (std::uint32_t t : shuffle)
-    m.tet.insert(m.tet.end(), tetgen_mesh.tet.begin() + 4 * std::ptrdiff_t(t), tetgen_mesh.tet.begin() + 4 * std::ptrdiff_t(t + 1));
+    m.tet.insert(m.tet.end(), tetgen_mesh.tet.begin() + 4 * std::ptrdiff_t(t),
+                 tetgen_mesh.tet.begin() + 4 * std::ptrdiff_t(t + 1));
   SphereTable t = compute_spheres(m);
   ASSERT_EQ(t.key_order.size(), t.fixed_keys.size());
   std::size_t compared = 0, keys_read = 0;
@@ -525,7 +532,8 @@ Mesh few_cubes_delaunay(const test::TempDir& dir, int points, int cubes, unsigne
   std::uniform_real_distribution<double> u(0, 1);
   const double radius = 0.03, half = radius / std::sqrt(3.0);
   std::vector<std::array<double, 3>> centres;
-  for (int k = 0; k < cubes; ++k) centres.push_back({0.15 + 0.7 * u(rng), 0.15 + 0.7 * u(rng), 0.15 + 0.7 * u(rng)});
+  for (int k = 0; k < cubes; ++k)
+    centres.push_back({0.15 + 0.7 * u(rng), 0.15 + 0.7 * u(rng), 0.15 + 0.7 * u(rng)});
   std::vector<std::array<double, 3>> xyz;
   while (xyz.size() < std::size_t(points)) {
     const std::array<double, 3> p = {u(rng), u(rng), u(rng)};
@@ -567,7 +575,8 @@ TEST(VisibilityOrder, AFewSplitClustersAreDrawnAsUnits) {
   // Each cube (6 tets here), and on each of its faces the two tets outside it that share the
   // face's square and an apex (2 tets on one sphere).
   std::size_t cubes = 0;
-  for (std::size_t k = 0; k < t.cluster_count(); ++k) cubes += t.cluster_begin[k + 1] - t.cluster_begin[k] >= 5;
+  for (std::size_t k = 0; k < t.cluster_count(); ++k)
+    cubes += t.cluster_begin[k + 1] - t.cluster_begin[k] >= 5;
   ASSERT_EQ(cubes, 4u);
   ASSERT_TRUE(t.clusters_split);
   ASSERT_EQ(t.all_items.size() + t.wide_items.size(), n);
@@ -593,7 +602,8 @@ TEST(VisibilityOrder, AFewSplitClustersAreDrawnAsUnits) {
       EXPECT_EQ(whole, visibility_order(m, t, v, every, ftb));
       ProgressiveOrder progressive(m, t, v, {}, ftb);
       std::vector<std::uint32_t> all;
-      for (auto b = progressive.next(); !b.empty(); b = progressive.next()) all.insert(all.end(), b.begin(), b.end());
+      for (auto b = progressive.next(); !b.empty(); b = progressive.next())
+        all.insert(all.end(), b.begin(), b.end());
       EXPECT_EQ(all, whole);
     }
   }
@@ -603,7 +613,8 @@ TEST(VisibilityOrder, NonDelaunayMeshIsReportedAndMpvoOrdersIt) {
   if (!test::have_program("tetgen")) GTEST_SKIP();
   test::TempDir dir;
   // TetGen with its mesh optimisation (flips, smoothing): not Delaunay, as measured in issue 6.
-  test::write_text(dir / "t.poly", test::read_text(std::string(FOXI_TEST_DATA_DIR) + "/../../examples/trench.poly"));
+  test::write_text(dir / "t.poly",
+                   test::read_text(std::string(FOXI_TEST_DATA_DIR) + "/../../examples/trench.poly"));
   ASSERT_EQ(test::run("cd '" + dir.path().string() + "' && tetgen -pq1.414a0.0005Q t.poly"), 0);
   Mesh m = read_tetgen(dir / "t.1");
   DelaunayCertificate cert = compute_delaunay_certificate(m);

@@ -45,17 +45,20 @@ VolumeParams params_for(const Mesh& m, double light = 1) {
   p.opacity_curve = {{-0.4, 0.1}, {0.5, 0.7}, {0.9, 0.2}, {1.7, 0.8}};
   double lo[3], hi[3];
   mesh_bounds(m, lo, hi);
-  p.unit_length = light * (hi[0] - lo[0]) / 25;  // dense: a tet's segment is strongly opaque, so the order shows
+  p.unit_length =
+      light * (hi[0] - lo[0]) / 25;  // dense: a tet's segment is strongly opaque, so the order shows
   return p;
 }
 
 // The ray caster: the picture of the tets `set` as the volume-rendering integral along each pixel's ray.
-Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint32_t> set, std::span<const double> corner,
-                     const VolumeParams& p) {
+Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint32_t> set,
+                     std::span<const double> corner, const VolumeParams& p) {
   const Projector proj(cam, kW, kH);
   std::vector<std::array<double, 12>> P(set.size());  // camera coordinates of the corners
   for (std::size_t i = 0; i < set.size(); ++i)
-    for (int k = 0; k < 4; ++k) proj.to_camera(&m.xyz[3 * std::size_t(m.tet[4 * std::size_t(set[i]) + std::size_t(k)])], &P[i][3 * std::size_t(k)]);
+    for (int k = 0; k < 4; ++k)
+      proj.to_camera(&m.xyz[3 * std::size_t(m.tet[4 * std::size_t(set[i]) + std::size_t(k)])],
+                     &P[i][3 * std::size_t(k)]);
   Framebuffer fb(kW, kH);
   struct Seg {
     double s0, s1, v0, v1;
@@ -77,7 +80,8 @@ Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint
           const double* a = c + 3 * q[0];
           const double* b = c + 3 * q[1];
           const double* e = c + 3 * q[2];
-          const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {e[0] - a[0], e[1] - a[1], e[2] - a[2]};
+          const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                       w[3] = {e[0] - a[0], e[1] - a[1], e[2] - a[2]};
           double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
           const double* pf = c + 3 * f;
           if (n[0] * (pf[0] - a[0]) + n[1] * (pf[1] - a[1]) + n[2] * (pf[2] - a[2]) < 0)
@@ -98,17 +102,19 @@ Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint
         auto value = [&](double s) {
           const double pt[3] = {o[0] + s * d[0], o[1] + s * d[1], o[2] + s * d[2]};
           auto vol = [](const double* a, const double* b, const double* cc, const double* dd) {
-            const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]},
+            const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                         v[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]},
                          w[3] = {dd[0] - a[0], dd[1] - a[1], dd[2] - a[2]};
-            return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
+            return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                   u[2] * (v[0] * w[1] - v[1] * w[0]);
           };
           const double* q0 = c;
           const double* q1 = c + 3;
           const double* q2 = c + 6;
           const double* q3 = c + 9;
           const double total = vol(q0, q1, q2, q3);
-          const double l[4] = {vol(pt, q1, q2, q3) / total, vol(q0, pt, q2, q3) / total, vol(q0, q1, pt, q3) / total,
-                               vol(q0, q1, q2, pt) / total};
+          const double l[4] = {vol(pt, q1, q2, q3) / total, vol(q0, pt, q2, q3) / total,
+                               vol(q0, q1, pt, q3) / total, vol(q0, q1, q2, pt) / total};
           double v = 0;
           for (int k = 0; k < 4; ++k) v += l[k] * corner[4 * std::size_t(set[i]) + std::size_t(k)];
           return v;
@@ -128,13 +134,15 @@ Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint
           for (int j = 0; j < 3; ++j) col[j] = double((rgb >> (8 * j)) & 255u) * a + col[j] * (1 - a);
         }
       }
-      fb.rgba[fb.index(x, y)] = pack_rgba(std::uint32_t(col[0] + 0.5), std::uint32_t(col[1] + 0.5), std::uint32_t(col[2] + 0.5));
+      fb.rgba[fb.index(x, y)] =
+          pack_rgba(std::uint32_t(col[0] + 0.5), std::uint32_t(col[1] + 0.5), std::uint32_t(col[2] + 0.5));
     }
   return fb;
 }
 
-Framebuffer paint(const Mesh& m, const Camera& cam, std::span<const std::uint32_t> order, std::span<const double> corner,
-                  const VolumeParams& p, std::size_t* samples = nullptr, std::size_t* pre_integrated = nullptr) {
+Framebuffer paint(const Mesh& m, const Camera& cam, std::span<const std::uint32_t> order,
+                  std::span<const double> corner, const VolumeParams& p, std::size_t* samples = nullptr,
+                  std::size_t* pre_integrated = nullptr) {
   VolumePainter painter(m, cam, kW, kH, corner, p);
   const std::size_t half = order.size() / 2;
   painter.draw(order.first(half));  // progressive: two batches
@@ -151,7 +159,8 @@ std::size_t differing(const Framebuffer& a, const Framebuffer& b, int tol, int* 
   std::size_t n = 0;
   for (std::size_t p = 0; p < a.rgba.size(); ++p) {
     int d = 0;
-    for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(int((a.rgba[p] >> (8 * k)) & 255u) - int((b.rgba[p] >> (8 * k)) & 255u)));
+    for (int k = 0; k < 3; ++k)
+      d = std::max(d, std::abs(int((a.rgba[p] >> (8 * k)) & 255u) - int((b.rgba[p] >> (8 * k)) & 255u)));
     if (worst) *worst = std::max(*worst, d);
     n += d > tol;
   }
@@ -173,13 +182,16 @@ void check(const Mesh& m, std::span<const std::uint32_t> subset, int cameras, un
   for (const Camera& cam : test::random_cameras(m, cameras, seed, double(kW) / kH)) {
     const Framebuffer want = ray_cast(m, cam, set, corner, p);
     for (std::uint32_t c : want.rgba) covered += c != pack_rgba(255, 255, 255);
-    power_bad += differing(paint(m, cam, visibility_order(m, table, view_of(cam), set), corner, p, &samples, &pre), want,
-                           2, &worst);
-    centroid_bad += differing(paint(m, cam, centroid_order(m, view_of(cam), set), corner, p), want, 2, nullptr);
+    power_bad +=
+        differing(paint(m, cam, visibility_order(m, table, view_of(cam), set), corner, p, &samples, &pre),
+                  want, 2, &worst);
+    centroid_bad +=
+        differing(paint(m, cam, centroid_order(m, view_of(cam), set), corner, p), want, 2, nullptr);
   }
-  std::printf("%s: %zu pixels covered; power order: %zu differ by more than 2/255 (worst %d; %zu of %zu segments "
-              "pre-integrated); centroid order: %zu\n",
-              what, covered, power_bad, worst, pre, samples, centroid_bad);
+  std::printf(
+      "%s: %zu pixels covered; power order: %zu differ by more than 2/255 (worst %d; %zu of %zu segments "
+      "pre-integrated); centroid order: %zu\n",
+      what, covered, power_bad, worst, pre, samples, centroid_bad);
   EXPECT_GT(covered, std::size_t(cameras) * kW * kH / 4) << what;
   EXPECT_EQ(power_bad, 0u) << what;
   if (light == 1) {

@@ -55,8 +55,8 @@ class ApngWriter final : public AnimationWriter {
     std::string ihdr;
     put32(ihdr, std::uint32_t(p_.width));
     put32(ihdr, std::uint32_t(p_.height));
-    ihdr += char(8);  // bit depth
-    ihdr += char(2);  // colour type: RGB
+    ihdr += char(8);               // bit depth
+    ihdr += char(2);               // colour type: RGB
     ihdr += std::string(3, '\0');  // compression, filter, interlace
     chunk("IHDR", ihdr);
     actl_at_ = file_.size();
@@ -135,7 +135,8 @@ class ApngWriter final : public AnimationWriter {
     put32(c, std::uint32_t(data.size()));
     c += type;
     c += data;
-    const uLong crc = crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(c.data() + 4), uInt(c.size() - 4));
+    const uLong crc =
+        crc32(crc32(0, nullptr, 0), reinterpret_cast<const Bytef*>(c.data() + 4), uInt(c.size() - 4));
     put32(c, std::uint32_t(crc));
     return c;
   }
@@ -191,7 +192,8 @@ class GifWriter final : public AnimationWriter {
     EGifSetGifVersion(gif_, true);
     if (EGifPutScreenDesc(gif_, p_.width, p_.height, 8, 0, nullptr) == GIF_ERROR) fail(gif_->Error);
     // NETSCAPE2.0: loop count.
-    unsigned char loop[3] = {1, static_cast<unsigned char>(p_.loops & 255), static_cast<unsigned char>(p_.loops >> 8)};
+    unsigned char loop[3] = {1, static_cast<unsigned char>(p_.loops & 255),
+                             static_cast<unsigned char>(p_.loops >> 8)};
     if (EGifPutExtensionLeader(gif_, APPLICATION_EXT_FUNC_CODE) == GIF_ERROR ||
         EGifPutExtensionBlock(gif_, 11, "NETSCAPE2.0") == GIF_ERROR ||
         EGifPutExtensionBlock(gif_, 3, loop) == GIF_ERROR || EGifPutExtensionTrailer(gif_) == GIF_ERROR)

@@ -251,7 +251,8 @@ View view_of(const Camera& camera) {
 
 Camera camera_from_options(const double lo[3], const double hi[3], double aspect, const double* eye,
                            const double* at, const double* up_given, double fov_deg, const double* dir) {
-  const double up[3] = {up_given ? up_given[0] : 0.0, up_given ? up_given[1] : 0.0, up_given ? up_given[2] : 1.0};
+  const double up[3] = {up_given ? up_given[0] : 0.0, up_given ? up_given[1] : 0.0,
+                        up_given ? up_given[2] : 1.0};
   Camera camera;
   if (dir != nullptr) {
     camera = fit_camera(lo, hi, dir, up, false, 30, aspect);
@@ -279,7 +280,8 @@ Camera camera_from_options(const double lo[3], const double hi[3], double aspect
   // A default up (+z) along the given eye-to-target line (looking straight down or up) would be a
   // degenerate camera: take the axis least aligned with the line instead, as fit_camera does. An up
   // the user gave is kept, and Projector refuses it if it is parallel.
-  double line[3] = {camera.at[0] - camera.eye[0], camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2]}, r[3];
+  double line[3] = {camera.at[0] - camera.eye[0], camera.at[1] - camera.eye[1], camera.at[2] - camera.eye[2]},
+         r[3];
   cross(line, camera.up, r);
   if (up_given == nullptr && norm(line) > 0 && !(norm(r) > 1e-6 * norm(line))) {
     camera.up[0] = camera.up[1] = camera.up[2] = 0;
@@ -313,8 +315,8 @@ bool barycentric(const double c[4][3], const double q[3], double b[4]) {
 
 }  // namespace
 
-bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height, std::uint32_t t, int x, int y,
-                        double bary[4]) {
+bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height, std::uint32_t t, int x,
+                        int y, double bary[4]) {
   if (t >= mesh.tet_count()) return false;
   Projector p = [&] {
     try {
@@ -338,7 +340,8 @@ bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int h
   }
   double c[4][3];
   for (int i = 0; i < 4; ++i)
-    for (int k = 0; k < 3; ++k) c[i][k] = mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(i)]) + std::size_t(k)];
+    for (int k = 0; k < 3; ++k)
+      c[i][k] = mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(i)]) + std::size_t(k)];
   const double od[3] = {o[0] + d[0], o[1] + d[1], o[2] + d[2]};
   double b0[4], b1[4];
   if (!barycentric(c, o, b0) || !barycentric(c, od, b1)) return false;
@@ -352,7 +355,8 @@ bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int h
   }
   if (p.perspective && hi < 0) return false;  // behind the eye
   double s = lo;
-  if (!(lo <= hi)) s = std::isfinite(hi) && std::isfinite(lo) ? 0.5 * (lo + hi) : (std::isfinite(hi) ? hi : lo);
+  if (!(lo <= hi))
+    s = std::isfinite(hi) && std::isfinite(lo) ? 0.5 * (lo + hi) : (std::isfinite(hi) ? hi : lo);
   if (!std::isfinite(s)) return false;
   double sum = 0;
   for (int i = 0; i < 4; ++i) {

@@ -42,7 +42,8 @@ std::pair<double, double> data_range(const Chart& c, bool x_axis) {
       hi = std::max(hi, w);
     }
   if (!(lo <= hi)) {
-    if (a.log && std::any_of(c.series.begin(), c.series.end(), [](const ChartSeries& s) { return !s.x.empty(); }))
+    if (a.log &&
+        std::any_of(c.series.begin(), c.series.end(), [](const ChartSeries& s) { return !s.x.empty(); }))
       throw std::invalid_argument("chart: the " + std::string(x_axis ? "x" : "y") +
                                   " axis is logarithmic and no point has a positive value there");
     lo = a.log ? 1 : 0, hi = a.log ? 10 : 1;  // no data: an empty frame
@@ -51,8 +52,10 @@ std::pair<double, double> data_range(const Chart& c, bool x_axis) {
   if (std::isfinite(a.hi)) hi = a.hi;
   if (lo == hi) {  // one value: a range around it
     const double d = lo == 0 ? 1 : std::abs(lo) * 0.1;
-    if (a.log) lo /= 2, hi *= 2;
-    else lo -= d, hi += d;
+    if (a.log)
+      lo /= 2, hi *= 2;
+    else
+      lo -= d, hi += d;
   }
   if (!(lo < hi)) throw std::invalid_argument("chart: an axis's range is empty");
   return {lo, hi};
@@ -122,8 +125,10 @@ void segment(Framebuffer& fb, double x0, double y0, double x1, double y1, PixelR
       continue;
     }
     const double r = q[i] / p[i];
-    if (p[i] < 0) t0 = std::max(t0, r);
-    else t1 = std::min(t1, r);
+    if (p[i] < 0)
+      t0 = std::max(t0, r);
+    else
+      t1 = std::min(t1, r);
   }
   if (t0 > t1) return;
   const double ax = x0 + t0 * dx, ay = y0 + t0 * dy, bx = x0 + t1 * dx, by = y0 + t1 * dy;
@@ -144,7 +149,7 @@ void segment(Framebuffer& fb, double x0, double y0, double x1, double y1, PixelR
 std::uint32_t chart_color(std::size_t i) {
   // Tableau's ten: distinct for the colour-blind in most pairs, and dark enough on white.
   static constexpr std::array<std::uint32_t, 10> palette{
-      pack_rgba(31, 119, 180),  pack_rgba(255, 127, 14), pack_rgba(44, 160, 44),  pack_rgba(214, 39, 40),
+      pack_rgba(31, 119, 180),  pack_rgba(255, 127, 14), pack_rgba(44, 160, 44),   pack_rgba(214, 39, 40),
       pack_rgba(148, 103, 189), pack_rgba(140, 86, 75),  pack_rgba(227, 119, 194), pack_rgba(127, 127, 127),
       pack_rgba(188, 189, 34),  pack_rgba(23, 190, 207)};
   return palette[i % palette.size()];
@@ -193,7 +198,9 @@ ChartReport draw_chart(Framebuffer& fb, const TextRenderer& text, const Chart& c
     bool apart = true;
     for (std::size_t i = 1; i < yt.ticks.size(); ++i)
       if (std::abs(ChartReport::fraction(yt.ticks[i], yt.lo, yt.hi, c.y.log) -
-                   ChartReport::fraction(yt.ticks[i - 1], yt.lo, yt.hi, c.y.log)) * plot_h < line)
+                   ChartReport::fraction(yt.ticks[i - 1], yt.lo, yt.hi, c.y.log)) *
+              plot_h <
+          line)
         apart = false;
     if (apart) break;
   }
@@ -206,7 +213,8 @@ ChartReport draw_chart(Framebuffer& fb, const TextRenderer& text, const Chart& c
 
   // Horizontal layout: the y labels, the plot, the legend.
   r.plot.x0 = area.x0 + p.margin + ylabel_w + 6;
-  const bool legend = std::any_of(c.series.begin(), c.series.end(), [](const ChartSeries& s) { return !s.name.empty(); });
+  const bool legend =
+      std::any_of(c.series.begin(), c.series.end(), [](const ChartSeries& s) { return !s.name.empty(); });
   int legend_w = 0;
   if (legend) {
     for (const ChartSeries& s : c.series) legend_w = std::max(legend_w, text.measure(s.name, fs).advance);
@@ -275,7 +283,8 @@ ChartReport draw_chart(Framebuffer& fb, const TextRenderer& text, const Chart& c
   if (!ytitle.empty()) text.draw(fb, ytitle, area.x0 + p.margin, ytitle_baseline, fs, p.text_color);
   if (!xtitle.empty()) {
     const TextExtent e = text.measure(xtitle, fs);
-    text.draw(fb, xtitle, (r.plot.x0 + r.plot.x1) / 2 - e.advance / 2, xlabel_baseline + line, fs, p.text_color);
+    text.draw(fb, xtitle, (r.plot.x0 + r.plot.x1) / 2 - e.advance / 2, xlabel_baseline + line, fs,
+              p.text_color);
   }
 
   // The series: lines first, markers over them.
@@ -323,7 +332,8 @@ ChartReport draw_chart(Framebuffer& fb, const TextRenderer& text, const Chart& c
       const ChartSeries& s = c.series[si];
       const std::uint32_t color = s.color != 0 ? s.color : chart_color(si);
       const int mid = row0 + 4 + int(si) * line + line / 2;
-      if (s.line) fill(fb, PixelRect{x0 + 6, mid - p.line_width / 2, x0 + 27, mid + (p.line_width - 1) / 2}, color);
+      if (s.line)
+        fill(fb, PixelRect{x0 + 6, mid - p.line_width / 2, x0 + 27, mid + (p.line_width - 1) / 2}, color);
       if (s.markers) fill(fb, PixelRect{x0 + 14, mid - 3, x0 + 20, mid + 3}, color);
       const TextExtent e = text.measure(s.name, fs);
       text.draw(fb, s.name, x0 + 34, mid + (e.ascent + 1) / 2, fs, p.text_color);

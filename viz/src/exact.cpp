@@ -56,7 +56,8 @@ bool centre_offset(const double* a, const double* b, const double* c, const doub
   // A NaN or infinity has no exact value (GMP raises SIGFPE converting it): no sphere, like a flat tet.
   for (const double* p : {a, b, c, d})
     if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) return false;
-  if (w != nullptr && !(std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]) && std::isfinite(w[3])))
+  if (w != nullptr &&
+      !(std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]) && std::isfinite(w[3])))
     return false;
   A = qv(a);
   QVec B = sub(qv(b), A), C = sub(qv(c), A), D = sub(qv(d), A);

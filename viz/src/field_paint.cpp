@@ -230,7 +230,8 @@ double deform_by_field(Mesh& mesh, std::string_view name, double scale, long ste
                            (have.empty() ? "none" : have) + ")");
   }
   if (f->location != FieldLocation::node || f->components != 3)
-    throw FieldSelectError("field '" + f->name + "' is not a displacement: deforming needs a node field of 3 components, it is a " +
+    throw FieldSelectError("field '" + f->name +
+                           "' is not a displacement: deforming needs a node field of 3 components, it is a " +
                            (f->location == FieldLocation::node ? "node" : "cell") + " field of " +
                            std::to_string(f->components));
   if (!std::isfinite(scale)) throw FieldSelectError("the deformation scale must be a finite number");
@@ -238,8 +239,8 @@ double deform_by_field(Mesh& mesh, std::string_view name, double scale, long ste
   const std::span<const double> u = step_values(mesh, *f, s);
   for (std::size_t i = 0; i < u.size(); ++i)
     if (std::isnan(u[i]))
-      throw FieldSelectError("field '" + f->name + "' has no value (NaN) at node " + std::to_string(i / 3 + 1) +
-                             ": that node cannot be moved");
+      throw FieldSelectError("field '" + f->name + "' has no value (NaN) at node " +
+                             std::to_string(i / 3 + 1) + ": that node cannot be moved");
   double largest = 0;
   for (std::size_t n = 0; n < mesh.node_count(); ++n) {
     double d2 = 0;

@@ -20,13 +20,16 @@ void check_plane(const Plane& plane) {
 }
 }  // namespace
 
-std::vector<std::uint32_t> clip_tets(const Mesh& mesh, const Plane& plane, std::span<const std::uint32_t> subset) {
+std::vector<std::uint32_t> clip_tets(const Mesh& mesh, const Plane& plane,
+                                     std::span<const std::uint32_t> subset) {
   check_plane(plane);
   std::vector<std::uint32_t> out;
   auto keep = [&](std::uint32_t t) {
     double c[3] = {0, 0, 0};
     for (int k = 0; k < 4; ++k)
-      for (int j = 0; j < 3; ++j) c[j] += 0.25 * mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(k)]) + std::size_t(j)];
+      for (int j = 0; j < 3; ++j)
+        c[j] +=
+            0.25 * mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(k)]) + std::size_t(j)];
     if (plane.signed_distance(c) <= 0) out.push_back(t);
   };
   if (subset.empty()) {
@@ -40,7 +43,8 @@ std::vector<std::uint32_t> clip_tets(const Mesh& mesh, const Plane& plane, std::
 std::vector<double> plane_corner_values(const Mesh& mesh, const Plane& plane) {
   check_plane(plane);
   std::vector<double> out(mesh.tet.size());
-  for (std::size_t i = 0; i < mesh.tet.size(); ++i) out[i] = plane.signed_distance(&mesh.xyz[3 * std::size_t(mesh.tet[i])]);
+  for (std::size_t i = 0; i < mesh.tet.size(); ++i)
+    out[i] = plane.signed_distance(&mesh.xyz[3 * std::size_t(mesh.tet[i])]);
   return out;
 }
 

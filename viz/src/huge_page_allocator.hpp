@@ -1,6 +1,6 @@
-// Internal: huge pages for big buffers. An allocator for the per-view sort buffers (tens of MB, reused from view to view) that
-// asks Linux for transparent huge pages. The first-level scatter writes at thousands of places a
-// few kB to MB apart at once; with 4 kB pages nearly every write is a TLB miss once the buffer
+// Internal: huge pages for big buffers. An allocator for the per-view sort buffers (tens of MB, reused from
+// view to view) that asks Linux for transparent huge pages. The first-level scatter writes at thousands of
+// places a few kB to MB apart at once; with 4 kB pages nearly every write is a TLB miss once the buffer
 // outgrows the TLB's reach (a few MB), with 2 MB pages none is. Small buffers use the plain heap.
 #pragma once
 
@@ -37,11 +37,15 @@ struct HugePageAllocator {
     return static_cast<T*>(p);
   }
   void deallocate(T* p, std::size_t n) noexcept {
-    if (n * sizeof(T) < kPage) std::allocator<T>().deallocate(p, n);
-    else std::free(p);
+    if (n * sizeof(T) < kPage)
+      std::allocator<T>().deallocate(p, n);
+    else
+      std::free(p);
   }
   template <class U>
-  bool operator==(const HugePageAllocator<U>&) const noexcept { return true; }
+  bool operator==(const HugePageAllocator<U>&) const noexcept {
+    return true;
+  }
 };
 
 // Asks for transparent huge pages on the 2 MB pages inside [p, p + bytes), for a buffer not yet

@@ -25,7 +25,8 @@ constexpr std::size_t kMpvoChunk = 4096;
 
 }  // namespace
 
-InteractiveView::InteractiveView(const Mesh& mesh, const Camera& camera, int width, int height, const RenderParams& params)
+InteractiveView::InteractiveView(const Mesh& mesh, const Camera& camera, int width, int height,
+                                 const RenderParams& params)
     : mesh_(mesh), params_(params), camera_(camera), width_(width), height_(height) {
   if (mesh.tet_count() == 0) throw std::invalid_argument("the mesh has no tets");
   delaunay_ = safe_order_method(delaunay_certificate(mesh)) == OrderMethod::power;
@@ -44,11 +45,14 @@ void InteractiveView::add_damage(std::span<const PixelRect> rects) {
   damage_.resize(std::size_t((height_ + kDamageBand - 1) / kDamageBand));
   for (const PixelRect& r : rects) {
     if (r.x0 > r.x1 || r.y0 > r.y1) continue;
-    for (int band = std::max(r.y0, 0) / kDamageBand; band <= std::min(r.y1, height_ - 1) / kDamageBand; ++band) {
+    for (int band = std::max(r.y0, 0) / kDamageBand; band <= std::min(r.y1, height_ - 1) / kDamageBand;
+         ++band) {
       PixelRect& d = damage_[std::size_t(band)];
-      const int y0 = std::max(r.y0, band * kDamageBand), y1 = std::min(r.y1, band * kDamageBand + kDamageBand - 1);
-      d = d.x0 > d.x1 ? PixelRect{r.x0, y0, r.x1, y1}
-                      : PixelRect{std::min(d.x0, r.x0), std::min(d.y0, y0), std::max(d.x1, r.x1), std::max(d.y1, y1)};
+      const int y0 = std::max(r.y0, band * kDamageBand),
+                y1 = std::min(r.y1, band * kDamageBand + kDamageBand - 1);
+      d = d.x0 > d.x1
+              ? PixelRect{r.x0, y0, r.x1, y1}
+              : PixelRect{std::min(d.x0, r.x0), std::min(d.y0, y0), std::max(d.x1, r.x1), std::max(d.y1, y1)};
     }
   }
 }
@@ -85,8 +89,8 @@ void InteractiveView::begin_draw() {
   auto raster = std::make_unique<TetRasterizer>(mesh_, camera_, width_, height_, params_);
   std::unique_ptr<IsoPainter> iso_painter;
   if (iso_)
-    iso_painter = std::make_unique<IsoPainter>(mesh_, camera_, width_, height_, iso_->corner, iso_->params, params_,
-                                               iso_->attr);
+    iso_painter = std::make_unique<IsoPainter>(mesh_, camera_, width_, height_, iso_->corner, iso_->params,
+                                               params_, iso_->attr);
   if (selecting_) {
     // The iso (or selected) tets within the region of interest.
     iso_subset_.clear();
@@ -264,7 +268,9 @@ void InteractiveView::set_camera(const Camera& camera) {
   }
 }
 
-void InteractiveView::orbit(double yaw_deg, double pitch_deg) { set_camera(foxi::orbit(camera_, yaw_deg, pitch_deg)); }
+void InteractiveView::orbit(double yaw_deg, double pitch_deg) {
+  set_camera(foxi::orbit(camera_, yaw_deg, pitch_deg));
+}
 void InteractiveView::zoom(double factor) { set_camera(foxi::zoom(camera_, factor)); }
 void InteractiveView::pan(double dx, double dy) { set_camera(foxi::pan(camera_, dx, dy)); }
 
@@ -278,8 +284,8 @@ std::string InteractiveView::status() const {
   char buf[256];
   const std::size_t n = drawn_.size(), t = total();
   const char* state = undrawing_ ? (n == 0 ? "undrawn" : "undrawing") : done_ ? "drawn" : "drawing";
-  std::snprintf(buf, sizeof buf, "%s %zu / %zu tets (%.1f%%), %.1f ms, %.2f ms/frame%s, region %zu%s", state, n,
-                t, t ? 100.0 * double(n) / double(t) : 0.0, frame_ms_, step_ms_,
+  std::snprintf(buf, sizeof buf, "%s %zu / %zu tets (%.1f%%), %.1f ms, %.2f ms/frame%s, region %zu%s", state,
+                n, t, t ? 100.0 * double(n) / double(t) : 0.0, frame_ms_, step_ms_,
                 started_ && !running_ && (undrawing_ ? n > 0 : !done_) ? " [stopped]" : "", stack_.size(),
                 delaunay_ ? "" : "  NOT Delaunay: depth-buffer drawing");
   return buf;

@@ -81,7 +81,8 @@ struct IsoPainter::Impl {
       // no farther than dmax from the eye projects within kMaxPixel of the centre.
       double dmax = 0;
       for (int i = 0; i < n; ++i)
-        dmax = std::max(dmax, std::sqrt(v[i].c[0] * v[i].c[0] + v[i].c[1] * v[i].c[1] + v[i].c[2] * v[i].c[2]));
+        dmax =
+            std::max(dmax, std::sqrt(v[i].c[0] * v[i].c[0] + v[i].c[1] * v[i].c[1] + v[i].c[2] * v[i].c[2]));
       double near = std::max(near_given, dmax * proj.focal / kMaxPixel);
       if (!(near > 0)) near = 1e-300;
       int m = 0;
@@ -104,7 +105,8 @@ struct IsoPainter::Impl {
     }
     std::int64_t X[kMaxPoly], Y[kMaxPoly];
     double px[kMaxPoly][2], w[kMaxPoly];
-    snap_polygon(proj, n, [&](int i) { return v[i].c; }, X, Y, px, w);
+    snap_polygon(
+        proj, n, [&](int i) { return v[i].c; }, X, Y, px, w);
     if (rows.thread == 0) ++polygons;
     for_each_fan_triangle(X, Y, n, [&](const std::int64_t* TX, const std::int64_t* TY, const int* idx) {
       // Affine functions on the screen: nearness, and position x nearness (perspective-correct).
@@ -129,7 +131,8 @@ struct IsoPainter::Impl {
           const double dx = x + 0.5 - x0;
           const std::size_t p = fb.index(x, y);
           const double z = w0 + wa * dx + wb * dy;
-          if (depth && !depth_test(fb, p, z, wa, wb, std::abs(w0) + std::abs(wa * dx) + std::abs(wb * dy))) continue;
+          if (depth && !depth_test(fb, p, z, wa, wb, std::abs(w0) + std::abs(wa * dx) + std::abs(wb * dy)))
+            continue;
           if (undoable) {
             saved_pixel.push_back(std::uint32_t(p));
             saved_rgba.push_back(fb.rgba[p]);
@@ -266,13 +269,15 @@ struct IsoPainter::Impl {
   }
 };
 
-IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int height, std::span<const double> corner,
-                       const IsoParams& params, const RenderParams& tet_params, std::span<const double> attr)
+IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int height,
+                       std::span<const double> corner, const IsoParams& params,
+                       const RenderParams& tet_params, std::span<const double> attr)
     : impl_(std::make_unique<Impl>(mesh, camera, width, height)) {
   Impl& s = *impl_;
   if (corner.size() != mesh.tet.size())
-    throw std::invalid_argument("isosurface: " + std::to_string(corner.size()) + " corner values for a mesh of " +
-                                std::to_string(mesh.tet_count()) + " tets (4 per tet expected)");
+    throw std::invalid_argument("isosurface: " + std::to_string(corner.size()) +
+                                " corner values for a mesh of " + std::to_string(mesh.tet_count()) +
+                                " tets (4 per tet expected)");
   if (!attr.empty() && attr.size() != mesh.tet.size())
     throw std::invalid_argument("isosurface: " + std::to_string(attr.size()) +
                                 " attribute values (4 per tet expected)");
@@ -287,7 +292,8 @@ IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int he
   s.values.erase(std::unique(s.values.begin(), s.values.end()), s.values.end());
   s.depth = tet_params.depth_buffer;
   s.undoable = tet_params.undoable;
-  if (s.undoable && s.depth) throw std::invalid_argument("isosurface: undoable drawing is the painter's, not the depth buffer's");
+  if (s.undoable && s.depth)
+    throw std::invalid_argument("isosurface: undoable drawing is the painter's, not the depth buffer's");
   const double l[3] = {-0.3, 0.45, -1};  // the tet painter's light (rasterizer.cpp)
   const double ln = std::sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
   for (int k = 0; k < 3; ++k) s.light[k] = l[k] / ln;
@@ -362,8 +368,8 @@ void IsoPainter::undraw(Framebuffer& fb, std::size_t count) {
   Impl& s = *impl_;
   if (!s.undoable) throw std::logic_error("isosurface: undraw needs RenderParams::undoable");
   if (count > s.drawn)
-    throw std::out_of_range("isosurface: undraw of " + std::to_string(count) + " tets, " + std::to_string(s.drawn) +
-                            " drawn");
+    throw std::out_of_range("isosurface: undraw of " + std::to_string(count) + " tets, " +
+                            std::to_string(s.drawn) + " drawn");
   while (count > 0) {
     Impl::Step& st = s.steps.back();
     if (st.solid) {

@@ -24,7 +24,8 @@ void edge_point(const Mesh& mesh, std::uint32_t tet, const double corner[4], dou
 
 }  // namespace iso_detail
 
-IsoPolygon iso_polygon(const Mesh& mesh, std::uint32_t tet, const double corner[4], double v, const double* attr) {
+IsoPolygon iso_polygon(const Mesh& mesh, std::uint32_t tet, const double corner[4], double v,
+                       const double* attr) {
   IsoPolygon p;
   int hot[4], cold[4], nh = 0, nc = 0;
   for (int k = 0; k < 4; ++k) {
@@ -89,7 +90,8 @@ TetIntervals::TetIntervals(std::span<const double> corner_values) : tet_count_(c
     max_sorted_.push_back({hi[t], std::uint32_t(t)});
     if (lo[t] < hi[t]) items.push_back(std::uint32_t(t));
   }
-  std::sort(max_sorted_.begin(), max_sorted_.end(), [](const Entry& a, const Entry& b) { return a.key < b.key; });
+  std::sort(max_sorted_.begin(), max_sorted_.end(),
+            [](const Entry& a, const Entry& b) { return a.key < b.key; });
   by_min_.reserve(items.size());
   by_max_.reserve(items.size());
   // Centred interval tree: a node's centre is the median of its intervals' midpoints; the intervals
@@ -117,8 +119,10 @@ TetIntervals::TetIntervals(std::span<const double> corner_values) : tet_count_(c
     }
     const std::uint32_t b = nodes_[node].begin, e = std::uint32_t(by_min_.size());
     nodes_[node].end = e;
-    std::sort(by_min_.begin() + b, by_min_.begin() + e, [](const Entry& x, const Entry& y) { return x.key < y.key; });
-    std::sort(by_max_.begin() + b, by_max_.begin() + e, [](const Entry& x, const Entry& y) { return x.key > y.key; });
+    std::sort(by_min_.begin() + b, by_min_.begin() + e,
+              [](const Entry& x, const Entry& y) { return x.key < y.key; });
+    std::sort(by_max_.begin() + b, by_max_.begin() + e,
+              [](const Entry& x, const Entry& y) { return x.key > y.key; });
     std::vector<std::uint32_t>().swap(set);
     const std::uint32_t l = self(self, left);
     const std::uint32_t r = self(self, right);

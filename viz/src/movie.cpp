@@ -62,7 +62,8 @@ MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& 
   for (int c = 0; c < params.cycles; ++c) {
     for (int k = 0; k < params.frames; ++k) {
       // Up for k = 0..half, down for the rest, back to the low point after the last frame.
-      const double t = k <= half ? double(k) / half : double(params.frames - k) / double(params.frames - half);
+      const double t =
+          k <= half ? double(k) / half : double(params.frames - k) / double(params.frames - half);
       const std::size_t want = prefix(order.size(), params.from + (params.to - params.from) * t);
       const std::size_t have = r.drawn_tets().size();
       if (want > have) {

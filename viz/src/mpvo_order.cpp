@@ -27,7 +27,8 @@ std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table
   }
   std::vector<std::uint8_t> member(n, 0);
   for (std::uint32_t t : tets) member[t] = 1;
-  const double e[3] = {view.eye[0] - table.origin[0], view.eye[1] - table.origin[1], view.eye[2] - table.origin[2]};
+  const double e[3] = {view.eye[0] - table.origin[0], view.eye[1] - table.origin[1],
+                       view.eye[2] - table.origin[2]};
   auto key = [&](std::uint32_t t) {
     const double* c = table.c.data() + 3 * std::size_t(t);
     return view.perspective ? table.s[t] - 2 * (c[0] * e[0] + c[1] * e[1] + c[2] * e[2])
@@ -44,7 +45,8 @@ std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table
       if (nb == kNone || !member[nb >> 2]) continue;
       std::uint32_t u = nb >> 2;
       if (u < t) continue;
-      int side = eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]), node(mesh, v[kFace[f][2]]));
+      int side =
+          eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]), node(mesh, v[kFace[f][2]]));
       if (side == 0) continue;
       // t's own vertex is on the negative side: side < 0 means the eye is on t's side (t in front).
       if (side < 0) {

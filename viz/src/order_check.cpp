@@ -14,7 +14,8 @@ namespace foxi {
 
 using namespace order_detail;
 
-std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view, std::span<const std::uint32_t> subset) {
+std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view,
+                                          std::span<const std::uint32_t> subset) {
   std::vector<std::uint32_t> tets;
   if (subset.empty()) {
     tets.resize(mesh.tet_count());
@@ -58,7 +59,8 @@ ViolationReport count_violations(const Mesh& mesh, const View& view, std::span<c
         if (nb == kNone) continue;
         std::uint32_t u = nb >> 2;
         if (u < t || pos[u] == kNone) continue;
-        int side = eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]), node(mesh, v[kFace[f][2]]));
+        int side = eye_side(view, node(mesh, v[kFace[f][0]]), node(mesh, v[kFace[f][1]]),
+                            node(mesh, v[kFace[f][2]]));
         if (side == 0) continue;
         ++checked[part];
         // side < 0: the eye is on t's side, t is in front and must come after u.

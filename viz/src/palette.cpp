@@ -16,11 +16,11 @@ std::uint32_t material_color(std::string_view name, std::size_t index) {
     std::uint32_t rgba;
   };
   static const Known kKnown[] = {
-      {"copper", pack_rgba(200, 117, 51)},        {"silicon", pack_rgba(96, 110, 160)},
-      {"polysilicon", pack_rgba(150, 100, 170)},  {"sac305", pack_rgba(175, 180, 185)},
-      {"fr4", pack_rgba(70, 140, 70)},            {"mold_compound", pack_rgba(80, 80, 85)},
-      {"underfill", pack_rgba(225, 190, 110)},    {"sio2", pack_rgba(150, 215, 230)},
-      {"aluminium", pack_rgba(210, 210, 215)},    {"alumina", pack_rgba(240, 235, 215)},
+      {"copper", pack_rgba(200, 117, 51)},       {"silicon", pack_rgba(96, 110, 160)},
+      {"polysilicon", pack_rgba(150, 100, 170)}, {"sac305", pack_rgba(175, 180, 185)},
+      {"fr4", pack_rgba(70, 140, 70)},           {"mold_compound", pack_rgba(80, 80, 85)},
+      {"underfill", pack_rgba(225, 190, 110)},   {"sio2", pack_rgba(150, 215, 230)},
+      {"aluminium", pack_rgba(210, 210, 215)},   {"alumina", pack_rgba(240, 235, 215)},
   };
   for (const Known& k : kKnown)
     if (name == k.name) return k.rgba;

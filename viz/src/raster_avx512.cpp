@@ -16,8 +16,9 @@ namespace foxi {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own _mm512_undefined_pd in its intrinsics
 #endif
-__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2"))) void TetRasterizer::Impl::repaint_triangle_avx512(
-    Framebuffer& fb, const Rows& rows, const FaceSetup& fs, const PolyVertex* poly) {
+__attribute__((target("avx512f,avx512vl,avx512bw,avx512dq,avx2"))) void
+TetRasterizer::Impl::repaint_triangle_avx512(Framebuffer& fb, const Rows& rows, const FaceSetup& fs,
+                                             const PolyVertex* poly) {
   const std::int64_t X[3] = {poly[0].X, poly[1].X, poly[2].X}, Y[3] = {poly[0].Y, poly[1].Y, poly[2].Y};
   if ((X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]) <= 0) return;
   const std::int64_t minx = std::min({X[0], X[1], X[2]}), maxx = std::max({X[0], X[1], X[2]});

@@ -9,7 +9,8 @@ namespace foxi {
 // in ascending node order (its sign from the permutation's parity), so the two tets sharing a face
 // get the same bits, each side with its sign: undraw shades a kept neighbour's face from the
 // undrawn tet's own corners, as drawing the neighbour did.
-FaceShade TetRasterizer::Impl::face_shade(std::uint32_t tet, const double* const v[3], const std::uint32_t node[3]) const {
+FaceShade TetRasterizer::Impl::face_shade(std::uint32_t tet, const double* const v[3],
+                                          const std::uint32_t node[3]) const {
   int s0 = 0, s1 = 1, s2 = 2;
   bool odd = false;
   auto swap_if = [&](int& i, int& j) {
@@ -35,7 +36,7 @@ FaceShade TetRasterizer::Impl::face_shade(std::uint32_t tet, const double* const
   double intensity = ambient + (1 - ambient) * std::max(0.0, lambert);
   intensity = std::clamp(intensity, 0.0, 1.0);
   const std::int32_t region = mesh->region_of(tet);
-  std::uint32_t base = field != nullptr          ? (field->graded ? pack_rgba(255, 255, 255) : field->tet_color[tet])
+  std::uint32_t base = field != nullptr ? (field->graded ? pack_rgba(255, 255, 255) : field->tet_color[tet])
                        : region >= 0 && std::size_t(region) < params.region_colors.size()
                            ? params.region_colors[std::size_t(region)]
                            : region_color(region);
@@ -48,7 +49,8 @@ FaceShade TetRasterizer::Impl::face_shade(std::uint32_t tet, const double* const
   return sh;
 }
 
-inline TetRasterizer::Impl::EdgeLine TetRasterizer::Impl::edge_line(const PolyVertex& a, const PolyVertex& b) {
+inline TetRasterizer::Impl::EdgeLine TetRasterizer::Impl::edge_line(const PolyVertex& a,
+                                                                    const PolyVertex& b) {
   const std::int64_t ex = b.X - a.X, ey = b.Y - a.Y;
   return EdgeLine{-ey * kOne, ex * kOne, ex * (kHalf - a.Y) - ey * (kHalf - a.X),
                   std::sqrt(double(ex) * double(ex) + double(ey) * double(ey))};
@@ -57,7 +59,8 @@ inline TetRasterizer::Impl::EdgeLine TetRasterizer::Impl::edge_line(const PolyVe
 // Whether the line ea x + eb y + ec is below 2^52 in magnitude on the whole image (see
 // FaceSetup::exact_double).
 inline bool TetRasterizer::Impl::exact_in_double(std::int64_t ea, std::int64_t eb, std::int64_t ec) const {
-  return std::abs(double(ea)) * proj.width + std::abs(double(eb)) * proj.height + std::abs(double(ec)) < 0x1p52;
+  return std::abs(double(ea)) * proj.width + std::abs(double(eb)) * proj.height + std::abs(double(ec)) <
+         0x1p52;
 }
 
 // A face of tet `tet` in shade sh.
@@ -74,7 +77,8 @@ inline void TetRasterizer::Impl::set_shade(FaceSetup& fs, std::uint32_t tet, con
 // What repaint_triangle_avx512 reads of setup_face's work for triangle poly (the shade, and the
 // three edge lines in double), false if it does not apply (an edge of no length, or a line not
 // exact in double).
-bool TetRasterizer::Impl::setup_repaint(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly) const {
+bool TetRasterizer::Impl::setup_repaint(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh,
+                                        const PolyVertex* poly) const {
   set_shade(fs, tet, sh);
   fs.lines = 3;
   for (int k = 0; k < 3; ++k) {
@@ -91,13 +95,14 @@ bool TetRasterizer::Impl::setup_repaint(FaceSetup& fs, std::uint32_t tet, const 
 
 // Shading and edge lines of a face; `v` = the face's three corners (camera frame)
 // in outward order, node their nodes; poly = the polygon to draw (positive area), n its size.
-void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3], const std::uint32_t node[3],
-                const PolyVertex* poly, int n) const {
+void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const double* const v[3],
+                                     const std::uint32_t node[3], const PolyVertex* poly, int n) const {
   setup_face(fs, tet, face_shade(tet, v, node), poly, n);
 }
 
 // The same with the shade known.
-void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh, const PolyVertex* poly, int n) const {
+void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh,
+                                     const PolyVertex* poly, int n) const {
   set_shade(fs, tet, sh);
   fs.graded = field != nullptr && field->graded;
   fs.lines = 0;
@@ -115,7 +120,8 @@ void TetRasterizer::Impl::setup_face(FaceSetup& fs, std::uint32_t tet, const Fac
     }
   }
   fs.exact_double = true;
-  for (int k = 0; k < fs.lines; ++k) fs.exact_double = fs.exact_double && exact_in_double(fs.ea[k], fs.eb[k], fs.ec[k]);
+  for (int k = 0; k < fs.lines; ++k)
+    fs.exact_double = fs.exact_double && exact_in_double(fs.ea[k], fs.eb[k], fs.ec[k]);
   for (int k = fs.lines; k < 4; ++k) {  // padding: far from every pixel
     fs.ea[k] = fs.eb[k] = 0;
     fs.ec[k] = std::int64_t(1) << 62;

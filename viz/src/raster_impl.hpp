@@ -100,7 +100,9 @@ inline std::int64_t to_fixed(double p) {
 struct Rows {
   int thread = 0, count = 1;
   int lo = 0, hi = std::numeric_limits<int>::max();
-  bool owns(int y) const { return y >= lo && y <= hi && (count == 1 || ((y >> kBandShift) % count) == thread); }
+  bool owns(int y) const {
+    return y >= lo && y <= hi && (count == 1 || ((y >> kBandShift) % count) == thread);
+  }
   // The first owned row >= y, and the owned row after the owned row y (one division per band).
   int first(int y) const {
     if (count == 1) return y;
@@ -217,13 +219,15 @@ void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, in
 // gets the part at depth >= near, near being near_given or, larger, the tet painter's rule (a point no
 // farther than dmax from the eye then projects within kMaxPixel of the centre). Returns its count,
 // 0 when fewer than 3 remain. Orthographic: a copy.
-inline int clip_near(const Projector& proj, double near_given, const double (*in)[3], int n, double (*out)[3]) {
+inline int clip_near(const Projector& proj, double near_given, const double (*in)[3], int n,
+                     double (*out)[3]) {
   if (!proj.perspective) {
     for (int i = 0; i < n; ++i) std::copy(in[i], in[i] + 3, out[i]);
     return n;
   }
   double dmax = 0;
-  for (int i = 0; i < n; ++i) dmax = std::max(dmax, std::sqrt(in[i][0] * in[i][0] + in[i][1] * in[i][1] + in[i][2] * in[i][2]));
+  for (int i = 0; i < n; ++i)
+    dmax = std::max(dmax, std::sqrt(in[i][0] * in[i][0] + in[i][1] * in[i][1] + in[i][2] * in[i][2]));
   double near = std::max(near_given, dmax * proj.focal / kMaxPixel);
   if (!(near > 0)) near = 1e-300;
   int m = 0;
@@ -335,7 +339,7 @@ struct TetRasterizer::Impl {
   Projector proj;
   RenderParams params;
   double near = 0;
-  double light[3] = {0, 0, -1};  // toward the light, camera frame
+  double light[3] = {0, 0, -1};       // toward the light, camera frame
   const FieldPaint* field = nullptr;  // params.field, if any
   float field_lut[256][3] = {};       // graded: the colour map's entries as floats
   // Edge darkening: a pixel at distance d < edge_width from an edge is scaled by edge_base +
@@ -420,7 +424,7 @@ struct TetRasterizer::Impl {
   // the rows Rows{k, lane_count} owns, see lane_of), so that threads record and restore them
   // independently. A tet's save is filed in each lane whose rows it touches.
   struct Lane {
-    std::vector<Save> saves;                                        // in drawing order
+    std::vector<Save> saves;                                       // in drawing order
     std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;  // y * width + x, colour, id
     std::vector<SaveRegion> regions;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> aliases;  // (request, later request it equals)
@@ -441,7 +445,7 @@ struct TetRasterizer::Impl {
   bool recording = false;
   std::vector<std::uint64_t> shown;
   std::vector<std::uint32_t> slot, before_rgba, before_id;
-  std::vector<std::uint8_t> need_save;  // per batch tet
+  std::vector<std::uint8_t> need_save;     // per batch tet
   std::vector<std::uint16_t> batch_reach;  // per batch tet: its repaint reach (see drawn_reach)
   // Undoable: each drawn tet's pixel box (tet_box, in drawing order, 8 bytes), so that undraw finds
   // the undrawn tets hidden behind farther undrawn ones (most of them) without reading the mesh.
@@ -460,11 +464,11 @@ struct TetRasterizer::Impl {
   // (gather_undrawn, shade_repainted): the walk fetches it a few tets ahead (see undraw_part), so the
   // mesh's scattered arrays are read only for the tets that show, their lookups overlapping.
   struct UndrawTet {
-    std::int32_t X[4], Y[4];         // fixed-point corners
-    std::uint32_t node[4];           // the tet's nodes
-    std::uint8_t repaint = 0;        // bit f: back face f is shared with a kept tet
-    std::uint32_t neighbour[4];      // repaint face f: that tet's face (4 tet + face)
-    FaceShade shade[4];              // repaint face f: that tet's front face's flat colour
+    std::int32_t X[4], Y[4];     // fixed-point corners
+    std::uint32_t node[4];       // the tet's nodes
+    std::uint8_t repaint = 0;    // bit f: back face f is shared with a kept tet
+    std::uint32_t neighbour[4];  // repaint face f: that tet's face (4 tet + face)
+    FaceShade shade[4];          // repaint face f: that tet's front face's flat colour
   };
   PixelRect changed;  // see changed_rect
   // See changed_rects; during an undraw, per band of 16 rows the x-extent of the undrawn tets' boxes.
@@ -529,7 +533,7 @@ struct TetRasterizer::Impl {
   inline std::uint32_t face_color(const FaceSetup& fs, int x, int y) const;
 
   static inline double nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
-                             std::int64_t e3);
+                                    std::int64_t e3);
 
   inline std::uint32_t darkened(const FaceSetup& fs, double d) const;
 
@@ -538,7 +542,8 @@ struct TetRasterizer::Impl {
   std::uint32_t graded_color(const FaceSetup& fs, int x, int y, double d) const;
   void graded_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
   const float* corner_positions(const std::uint32_t* tv) const {
-    return field != nullptr && field->graded ? &field->corner_position[std::size_t(tv - mesh->tet.data())] : nullptr;
+    return field != nullptr && field->graded ? &field->corner_position[std::size_t(tv - mesh->tet.data())]
+                                             : nullptr;
   }
   // Graded: the scale positions the kept tet nb (mesh tet index) gives the nodes tv[0..3] (a cell
   // field averaged per region gives a node a different position in each region); nodes not in nb
@@ -578,32 +583,37 @@ struct TetRasterizer::Impl {
 
   inline void record_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi);
 
-  [[gnu::always_inline]] inline void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
+  [[gnu::always_inline]] inline void shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo,
+                                                int hi) const;
 
   static inline void edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e);
 
   [[gnu::always_inline]] inline void edge_pixels(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                          std::int64_t* e, int from, int to) const;
+                                                 std::int64_t* e, int from, int to) const;
   template <bool kFourLines>
-  [[gnu::always_inline]] inline void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                             std::int64_t* e, int from, int to) const;
+  [[gnu::always_inline]] inline void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id,
+                                                    const FaceSetup& fs, std::int64_t* e, int from,
+                                                    int to) const;
   template <bool kFourLines, class Edge>
-  [[gnu::always_inline]] inline void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                                  Edge* e, const Edge* step, int from, int to) const;
+  [[gnu::always_inline]] inline void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id,
+                                                         const FaceSetup& fs, Edge* e, const Edge* step,
+                                                         int from, int to) const;
 
 #ifdef __SSE2__
   template <bool kFourLines>
-  [[gnu::always_inline]] inline void edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                             const double* e, const double* step, int from, int to) const;
+  [[gnu::always_inline]] inline void edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id,
+                                                    const FaceSetup& fs, const double* e, const double* step,
+                                                    int from, int to) const;
 #endif
 
 #ifdef FOXI_AVX512_REPAINT
   // Whether this CPU (and its OS) runs repaint_triangle_avx512; FOXI_PORTABLE_RASTER=1 in the
   // environment says no, so that tests compare it with the portable path on the same machine.
   static bool avx512_repaint() {
-    static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
-                            !(std::getenv("FOXI_PORTABLE_RASTER") && std::getenv("FOXI_PORTABLE_RASTER")[0] == '1');
+    static const bool yes =
+        __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
+        !(std::getenv("FOXI_PORTABLE_RASTER") && std::getenv("FOXI_PORTABLE_RASTER")[0] == '1');
     return yes;
   }
 
@@ -789,7 +799,8 @@ struct TetRasterizer::Impl {
     std::size_t r = lane.regions.size();
     while (r > 0 && lane.regions[r - 1].first_save > s) --r;
     const SaveRegion& region = lane.regions[r - 1];
-    const std::size_t region_end = r < lane.regions.size() ? lane.regions[r].first_pixel : lane.saved_pixel.size();
+    const std::size_t region_end =
+        r < lane.regions.size() ? lane.regions[r].first_pixel : lane.saved_pixel.size();
     return s > region.first_save ? lane.saves[s - 1].offset : region_end;
   }
 
@@ -801,8 +812,8 @@ struct TetRasterizer::Impl {
 };
 
 // The distance in pixels to the nearest edge line from a pixel whose edge functions are e0..e3.
-inline double TetRasterizer::Impl::nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
-                           std::int64_t e3) {
+inline double TetRasterizer::Impl::nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1,
+                                                std::int64_t e2, std::int64_t e3) {
   return std::min(std::min(double(e0) * fs.inv_len[0], double(e1) * fs.inv_len[1]),
                   std::min(double(e2) * fs.inv_len[2], double(e3) * fs.inv_len[3]));
 }

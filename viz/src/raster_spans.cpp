@@ -9,7 +9,8 @@ inline void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& f
   const std::size_t p = std::size_t(y) * std::size_t(fb.width) + std::size_t(x);
   if (params.depth_buffer) {
     const double ta = fs.da * (x + 0.5 - fs.x0), tb = fs.db * (y + 0.5 - fs.y0);
-    if (!depth_test(fb, p, fs.w0 + ta + tb, fs.da, fs.db, std::abs(fs.w0) + std::abs(ta) + std::abs(tb))) return;
+    if (!depth_test(fb, p, fs.w0 + ta + tb, fs.da, fs.db, std::abs(fs.w0) + std::abs(ta) + std::abs(tb)))
+      return;
   }
   fb.rgba[p] = face_color(fs, x, y);
   fb.id[p] = fs.tet;
@@ -42,7 +43,8 @@ inline std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d
 
 // One row run of a face. Painter mode: only the pixels not yet written (see `written`), then the
 // whole run is marked written.
-[[gnu::always_inline]] inline void TetRasterizer::Impl::shade_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::shade_row(Framebuffer& fb, const FaceSetup& fs, int y,
+                                                                  int lo, int hi) {
   if (params.depth_buffer) {
     for (int x = lo; x <= hi; ++x) shade_pixel(fb, fs, x, y);
     return;
@@ -145,7 +147,8 @@ inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& f
 // pixel, and checked exactly at its ends (the distance to each line is monotone along the row), so
 // every pixel gets exactly face_color's colour whatever the run. Runs of 12 pixels or fewer (most
 // runs of a fine mesh's faces) are not worth solving for: inlined here, each pixel shaded.
-[[gnu::always_inline]] inline void TetRasterizer::Impl::shade_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::shade_span(Framebuffer& fb, const FaceSetup& fs,
+                                                                   int y, int lo, int hi) const {
   if (fs.graded) {
     graded_span(fb, fs, y, lo, hi);
     return;
@@ -183,8 +186,9 @@ inline void TetRasterizer::Impl::edges_at(const FaceSetup& fs, int x, int y, std
 // Pixels [from, to] of a row shaded one by one (rgba, id: the row), e: the edge functions at
 // `from`, stepped on past `to`. The edge functions and colours are held in registers; a face of 3
 // lines or fewer skips the fourth (padding, never the nearest).
-[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                        std::int64_t* e, int from, int to) const {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels(std::uint32_t* rgba, std::uint32_t* id,
+                                                                    const FaceSetup& fs, std::int64_t* e,
+                                                                    int from, int to) const {
   if (fs.lines > 3)
     edge_pixels_of<true>(rgba, id, fs, e, from, to);
   else
@@ -192,8 +196,9 @@ inline void TetRasterizer::Impl::edges_at(const FaceSetup& fs, int x, int y, std
 }
 
 template <bool kFourLines>
-[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                           std::int64_t* e, int from, int to) const {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id,
+                                                                       const FaceSetup& fs, std::int64_t* e,
+                                                                       int from, int to) const {
   if (!fs.exact_double) [[unlikely]] {  // huge coordinates (near-plane cuts)
     edge_pixels_stepped<kFourLines>(rgba, id, fs, e, fs.ea, from, to);
     return;
@@ -208,8 +213,11 @@ template <bool kFourLines>
 // The loop of edge_pixels_of, its edge functions e (at `from`, stepped by `step` per pixel; integers
 // are left past `to`) 64-bit integers or exact doubles.
 template <bool kFourLines, class Edge>
-[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                                Edge* e, const Edge* step, int from, int to) const {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_stepped(std::uint32_t* rgba,
+                                                                            std::uint32_t* id,
+                                                                            const FaceSetup& fs, Edge* e,
+                                                                            const Edge* step, int from,
+                                                                            int to) const {
 #ifdef __SSE2__
   if constexpr (std::is_same_v<Edge, double>) {
     edge_pixels_x4<kFourLines>(rgba, id, fs, e, step, from, to);
@@ -248,8 +256,10 @@ template <bool kFourLines, class Edge>
 // std::max only in the sign of a zero, which max(0, d) and d < w do not see; no FMA in an SSE2
 // build), so every pixel gets the same bits. A last group of fewer than 4 stores only its pixels.
 template <bool kFourLines>
-[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                           const double* e, const double* step, int from, int to) const {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id,
+                                                                       const FaceSetup& fs, const double* e,
+                                                                       const double* step, int from,
+                                                                       int to) const {
   if (to < from) return;
   const __m128d w = _mm_set1_pd(params.edge_width), zero = _mm_setzero_pd();
   const __m128d base = _mm_set1_pd(edge_base), slope = _mm_set1_pd(edge_slope);
@@ -275,12 +285,13 @@ template <bool kFourLines>
       d_lo = _mm_min_pd(d_lo, _mm_mul_pd(lo[2], inv[2]));
       d_hi = _mm_min_pd(d_hi, _mm_mul_pd(hi[2], inv[2]));
     }
-    const __m128 darken = _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(d_lo, w)), _mm_castpd_ps(_mm_cmplt_pd(d_hi, w)),
-                                       _MM_SHUFFLE(2, 0, 2, 0));
+    const __m128 darken = _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(d_lo, w)),
+                                         _mm_castpd_ps(_mm_cmplt_pd(d_hi, w)), _MM_SHUFFLE(2, 0, 2, 0));
     __m128i out = color;
     if (_mm_movemask_ps(darken) != 0) {
-      const __m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_lo, zero)))),
-                                     _mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_hi, zero)))));
+      const __m128 f =
+          _mm_movelh_ps(_mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_lo, zero)))),
+                        _mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_hi, zero)))));
       const __m128i cr = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(r, f), half));
       const __m128i cg = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(g, f), half));
       const __m128i cb = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(b, f), half));
@@ -318,7 +329,8 @@ template <bool kFourLines>
 #endif
 
 // shade_span's long runs (and faces without edge lines).
-[[gnu::noinline]] void TetRasterizer::Impl::shade_long_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
+[[gnu::noinline]] void TetRasterizer::Impl::shade_long_span(Framebuffer& fb, const FaceSetup& fs, int y,
+                                                            int lo, int hi) const {
   std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
   std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
   if (fs.lines == 0) {
@@ -379,8 +391,9 @@ void TetRasterizer::Impl::recolor_row(Framebuffer& fb, const FaceSetup& fs, int 
 // raster_polygon's work; kRecolor: recolor_row in place of shade_row (a template, so that the painter's
 // rows stay as they were, without a test of the mode).
 template <bool kRecolor>
-[[gnu::always_inline]] inline void TetRasterizer::Impl::raster_fan(Framebuffer& fb, const Rows& rows, FaceSetup& fs,
-                                                                   const PolyVertex* poly, int n) {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::raster_fan(Framebuffer& fb, const Rows& rows,
+                                                                   FaceSetup& fs, const PolyVertex* poly,
+                                                                   int n) {
   for (int q = 1; q + 1 < n; ++q) {
     const int i = reverse ? n - 1 - q : q;  // painter mode draws the fan back to front too
     std::int64_t X[3] = {poly[0].X, poly[i].X, poly[i + 1].X}, Y[3] = {poly[0].Y, poly[i].Y, poly[i + 1].Y};
@@ -402,11 +415,14 @@ template <bool kRecolor>
       // bits however the polygon was given: undraw repaints a neighbour's face from the other tet's
       // corners, and must give its pixels the colours drawing it gave.
       const PolyVertex* v[3] = {&poly[0], &poly[i], &poly[i + 1]};
-      auto before = [](const PolyVertex* a, const PolyVertex* b) { return a->Y != b->Y ? a->Y < b->Y : a->X < b->X; };
+      auto before = [](const PolyVertex* a, const PolyVertex* b) {
+        return a->Y != b->Y ? a->Y < b->Y : a->X < b->X;
+      };
       if (before(v[1], v[0])) std::swap(v[0], v[1]);
       if (before(v[2], v[1])) std::swap(v[1], v[2]);
       if (before(v[1], v[0])) std::swap(v[0], v[1]);
-      const std::int64_t area_c = (v[1]->X - v[0]->X) * (v[2]->Y - v[0]->Y) - (v[1]->Y - v[0]->Y) * (v[2]->X - v[0]->X);
+      const std::int64_t area_c =
+          (v[1]->X - v[0]->X) * (v[2]->Y - v[0]->Y) - (v[1]->Y - v[0]->Y) * (v[2]->X - v[0]->X);
       const double inv = double(kOne) * double(kOne) / double(area_c), s = 1.0 / double(kOne);
       const double x1 = double(v[1]->X - v[0]->X) * s, y1 = double(v[1]->Y - v[0]->Y) * s;
       const double x2 = double(v[2]->X - v[0]->X) * s, y2 = double(v[2]->Y - v[0]->Y) * s;
@@ -433,11 +449,13 @@ template <bool kRecolor>
   }
 }
 
-void TetRasterizer::Impl::raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) {
+void TetRasterizer::Impl::raster_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs,
+                                         const PolyVertex* poly, int n) {
   raster_fan<false>(fb, rows, fs, poly, n);
 }
 
-void TetRasterizer::Impl::recolor_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs, const PolyVertex* poly, int n) {
+void TetRasterizer::Impl::recolor_polygon(Framebuffer& fb, const Rows& rows, FaceSetup& fs,
+                                          const PolyVertex* poly, int n) {
   raster_fan<true>(fb, rows, fs, poly, n);
 }
 

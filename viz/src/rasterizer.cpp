@@ -18,7 +18,6 @@ constexpr std::uint32_t kPalette[] = {
 
 }  // namespace
 
-
 std::uint32_t region_color(std::int32_t id) {
   constexpr std::int64_t n = sizeof kPalette / sizeof kPalette[0];
   return kPalette[((std::int64_t(id) % n) + n) % n];
@@ -46,7 +45,8 @@ TetRasterizer::Impl::Impl(const Mesh& m, const Camera& c, int w, int h, const Re
   if (params.undoable) {
     if (params.depth_buffer) throw std::invalid_argument("render: undoable drawing needs the painter");
     if (w > 32767 || h > 32767)
-      throw std::invalid_argument("render: undoable drawing needs an image at most 32767 pixels wide and high");
+      throw std::invalid_argument(
+          "render: undoable drawing needs an image at most 32767 pixels wide and high");
     adjacency = &face_adjacency(m);
     drawn_at.assign(m.tet_count(), 0);
     kept.assign((m.tet_count() + 63) / 64, 0);
@@ -183,13 +183,14 @@ inline void TetRasterizer::Impl::draw_tet(Framebuffer& fb, const Rows& rows, std
 // Draws front face polygon `poly` (n vertices, positive area, from face_polygon) of tet t, whose
 // corners are v (camera frame, outward order; nodes `node`), into the rows of `rows`. test_hidden
 // (a triangle): first test its pixel box against the mask, skipping it if hidden.
-void TetRasterizer::Impl::draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
-               const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden) {
+void TetRasterizer::Impl::draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t,
+                                    const double* const v[3], const std::uint32_t node[3],
+                                    const PolyVertex* poly, int n, bool test_hidden) {
   if (use_mask && test_hidden) {  // hidden behind what this batch drew already?
-    const Box box = pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}),
-                              std::max({poly[0].X, poly[1].X, poly[2].X}),
-                              std::min({poly[0].Y, poly[1].Y, poly[2].Y}),
-                              std::max({poly[0].Y, poly[1].Y, poly[2].Y}), fb.width, fb.height);
+    const Box box =
+        pixel_box(std::min({poly[0].X, poly[1].X, poly[2].X}), std::max({poly[0].X, poly[1].X, poly[2].X}),
+                  std::min({poly[0].Y, poly[1].Y, poly[2].Y}), std::max({poly[0].Y, poly[1].Y, poly[2].Y}),
+                  fb.width, fb.height);
     if (box.x0 > box.x1 || box_written(rows, box, fb.height)) return;
   }
   FaceSetup fs;
@@ -263,8 +264,9 @@ inline void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
     const std::uint32_t p = lane.saved_pixel[i];
     if (slot[p] != i) continue;
     const bool was_shown = (shown[std::size_t(p / std::uint32_t(fb.width)) * std::size_t(mask_words) +
-                                 ((p % std::uint32_t(fb.width)) >> 6)] >>
-                            ((p % std::uint32_t(fb.width)) & 63)) & 1;
+                                  ((p % std::uint32_t(fb.width)) >> 6)] >>
+                            ((p % std::uint32_t(fb.width)) & 63)) &
+                           1;
     lane.saved_rgba[i] = was_shown ? before_rgba[p] : fb.rgba[p];
     lane.saved_id[i] = was_shown ? before_id[p] : fb.id[p];
     slot[p] = kNone;
@@ -283,8 +285,8 @@ inline void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
 // its projected area (as face_polygon does) without building its polygon; k: its corners (finite).
 // reach: t's repaint reach (see drawn_reach). inverted: t has a front face shared with a tet drawn
 // before it (see `tainted`).
-inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach,
-                                                        bool& inverted) const {
+inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const TetCorners& k,
+                                                        std::uint16_t& reach, bool& inverted) const {
   bool unshared = false;
   std::uint32_t least = drawn_at[t];
   const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
@@ -341,12 +343,14 @@ void TetRasterizer::Impl::taint_inverted(std::span<const std::uint32_t> tets) {
         const int n = face_polygon(k, f, false, poly, &clipped);
         bool pixels = false;
         for (int q = 1; q + 1 < n; ++q) {  // its fan triangles, as for_each_run walks them
-          const std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X}, Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
+          const std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X},
+                             Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
           if ((X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]) <= 0) continue;
           raster_triangle(X, Y, proj.width, proj.height, all, [&](int y, int lo, int hi) {
             if (risky.empty()) risky.assign(shown.size(), 0);
             for (int x = lo; x <= hi; ++x)
-              risky[std::size_t(y) * std::size_t(mask_words) + std::size_t(x >> 6)] |= std::uint64_t(1) << (x & 63);
+              risky[std::size_t(y) * std::size_t(mask_words) + std::size_t(x >> 6)] |= std::uint64_t(1)
+                                                                                       << (x & 63);
             pixels = true;
           });
         }
@@ -369,7 +373,7 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
   if (tets.empty()) return;
   // Threads pay for themselves only on long batches. Undoable drawing always uses its lanes'
   // partition (saved pixels are kept per lane), on one thread for short batches.
-  const int count = recording       ? lane_count
+  const int count = recording           ? lane_count
                     : tets.size() < 256 ? 1
                                         : std::min(params.threads, std::max(1, fb.height >> kBandShift));
   const bool spawn = count > 1 && tets.size() >= 256;
@@ -384,7 +388,8 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
       if (i + kAhead < end) prefetch_tet(tets[i + kAhead]);
       if (i + 2 * kAhead < end) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 2 * kAhead])]);
       if (recording) {  // has_unshared_back_face reads the tet's neighbours and their positions
-        if (i + 2 * kAhead < end) __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
+        if (i + 2 * kAhead < end)
+          __builtin_prefetch(&adjacency->neighbour[4 * std::size_t(tets[i + 2 * kAhead])]);
         if (i + kAhead < end) prefetch_neighbours(tets[i + kAhead]);
       }
       TetCorners k;
@@ -393,7 +398,8 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
       if (recording) {
         need_save[i] = false;
         batch_reach[i] = 0;
-        if (boxes[i].x0 <= boxes[i].x1) need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted);
+        if (boxes[i].x0 <= boxes[i].x1)
+          need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted);
       }
     }
   };
@@ -427,7 +433,9 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
     find_boxes(0, tets.size(), inverted[0]);
   } else {
     const std::size_t half = tets.size() / 2;
-    run_parts(2, [&](int k) { k == 0 ? find_boxes(0, half, inverted[0]) : find_boxes(half, tets.size(), inverted[1]); });
+    run_parts(2, [&](int k) {
+      k == 0 ? find_boxes(0, half, inverted[0]) : find_boxes(half, tets.size(), inverted[1]);
+    });
   }
   if (recording && (inverted[0] || inverted[1])) taint_inverted(tets);
   if (recording) {  // the batch is the end of the history

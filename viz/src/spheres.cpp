@@ -125,7 +125,8 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
   std::array<std::uint32_t, 128> spread{};  // bit b of x to bit 3b
   for (std::uint32_t x = 0; x < 128; ++x)
     for (int b = 0; b < 7; ++b) spread[x] |= ((x >> b) & 1u) << (3 * b);
-  constexpr std::int32_t kMax = std::numeric_limits<std::int32_t>::max(), kMin = std::numeric_limits<std::int32_t>::min();
+  constexpr std::int32_t kMax = std::numeric_limits<std::int32_t>::max(),
+                         kMin = std::numeric_limits<std::int32_t>::min();
   const KeyBlock empty = {{kMax, kMax, kMax}, {kMin, kMin, kMin}, kMax, kMin};
   auto merge = [](KeyBlock& into, const KeyBlock& b) {
     for (int c = 0; c < 3; ++c) {
@@ -136,8 +137,10 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
     into.s_hi = std::max(into.s_hi, b.s_hi);
   };
   std::vector<std::uint32_t> codes(m);
-  std::vector<std::uint32_t> slots[2] = {std::vector<std::uint32_t>(cells, 0), std::vector<std::uint32_t>(cells, 0)};
-  std::vector<KeyBlock> cell_box[2] = {std::vector<KeyBlock>(cells, empty), std::vector<KeyBlock>(m < 20000 ? 0 : cells, empty)};
+  std::vector<std::uint32_t> slots[2] = {std::vector<std::uint32_t>(cells, 0),
+                                         std::vector<std::uint32_t>(cells, 0)};
+  std::vector<KeyBlock> cell_box[2] = {std::vector<KeyBlock>(cells, empty),
+                                       std::vector<KeyBlock>(m < 20000 ? 0 : cells, empty)};
   detail::parallel_for(m, 2, [&](std::size_t begin, std::size_t end, int part) {
     std::uint32_t* count = slots[part].data();
     KeyBlock* box = cell_box[part].data();
@@ -166,7 +169,8 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
   const std::size_t block = SphereTable::kKeyBlock, blocks = (m + block - 1) / block;
   t.key_blocks.resize(blocks);
   for (std::size_t b = 0; b < blocks; ++b) {
-    const std::uint32_t first = codes[t.key_order[b * block]], last = codes[t.key_order[std::min(m, (b + 1) * block) - 1]];
+    const std::uint32_t first = codes[t.key_order[b * block]],
+                        last = codes[t.key_order[std::min(m, (b + 1) * block) - 1]];
     KeyBlock box = empty;
     for (std::uint32_t c = first; c <= last; ++c) merge(box, cell_box[0][c]);
     t.key_blocks[b] = box;
@@ -246,11 +250,13 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
       for (int k = 0; k < 3; ++k) num[k] = wb * cd[k] + wc * db[k] + wd * bc[k];
       // Error estimates: a few ulps per operation times the magnitudes that were summed.
       const double det_err = 16 * kEps * nb * nc * nd;
-      const double num_mag = std::abs(wb) * nc * nd + std::abs(wc) * nd * nb + std::abs(wd) * nb * nc +
-                             (W != nullptr ? (lb + lc + ld + 3 * std::abs(w0)) * (nc * nd + nd * nb + nb * nc) : 0);
+      const double num_mag =
+          std::abs(wb) * nc * nd + std::abs(wc) * nd * nb + std::abs(wd) * nb * nc +
+          (W != nullptr ? (lb + lc + ld + 3 * std::abs(w0)) * (nc * nd + nd * nb + nb * nc) : 0);
       const double num_norm = std::sqrt(num[0] * num[0] + num[1] * num[1] + num[2] * num[2]);
       const double num_err = 16 * kEps * num_mag;
-      double rel = std::abs(det) > 0 ? det_err / std::abs(det) + (num_norm > 0 ? num_err / num_norm : 1.0) : 1.0;
+      double rel =
+          std::abs(det) > 0 ? det_err / std::abs(det) + (num_norm > 0 ? num_err / num_norm : 1.0) : 1.0;
       double* cc = t.c.data() + 3 * i;
       double& s = t.s[i];
       if (!(rel <= kRecomputeAbove)) {  // NaN too (a non-finite weight): the exact path calls it flat
@@ -290,7 +296,8 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
                                   (cc[2] - a[2]) * (cc[2] - a[2]));
       const double norg = std::abs(org[0]) + std::abs(org[1]) + std::abs(org[2]);
       const double err_c = 8 * kEps * (na + ncc) + no * rel + (rel == 0 ? 4 * kEps * (ncc + norg) : 0);
-      const double err_s = 32 * kEps * (na * na + 2 * na * no + std::abs(w0) + std::abs(s)) + 2 * na * no * rel +
+      const double err_s = 32 * kEps * (na * na + 2 * na * no + std::abs(w0) + std::abs(s)) +
+                           2 * na * no * rel +
                            (rel == 0 ? 16 * kEps * (std::abs(s) + 2 * (ncc + norg) * norg) : 0);
       t.key_a[i] = static_cast<float>(2 * (err_s + 8 * kEps * std::abs(s)));
       t.key_b[i] = static_cast<float>(2 * (2 * err_c + 16 * kEps * ncc));
@@ -319,7 +326,8 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
         // is at least 4 times the bound of each coordinate's error) are not, with no look at the
         // vertices (scattered over memory; the centres follow the tets).
         const double* cu = t.c.data() + 3 * std::size_t(u);
-        const double apart = std::max({std::abs(cc[0] - cu[0]), std::abs(cc[1] - cu[1]), std::abs(cc[2] - cu[2])});
+        const double apart =
+            std::max({std::abs(cc[0] - cu[0]), std::abs(cc[1] - cu[1]), std::abs(cc[2] - cu[2])});
         if (apart > double(t.key_b[i]) + double(t.key_b[u]) || t.flat[u]) continue;
         const double* a = X + 3 * std::size_t(v[0]);
         const double o[3] = {cc[0] + org[0] - a[0], cc[1] + org[1] - a[1], cc[2] + org[2] - a[2]};
@@ -335,8 +343,9 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
           pw += W[v[0]] - W[qv];
           mag += std::abs(W[v[0]]) + std::abs(W[qv]);
         }
-        double bound = 32 * kEps * mag + 4 * std::sqrt(lqa) * no * double(rel_err[i]) +
-                       8 * std::sqrt(lqa) * kEps * (std::abs(org[0]) + std::abs(org[1]) + std::abs(org[2]) + no);
+        double bound =
+            32 * kEps * mag + 4 * std::sqrt(lqa) * no * double(rel_err[i]) +
+            8 * std::sqrt(lqa) * kEps * (std::abs(org[0]) + std::abs(org[1]) + std::abs(org[2]) + no);
         if (std::abs(pw) > bound) continue;
         double w4[4];
         const double* wv = nullptr;
@@ -346,8 +355,8 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
           wv = w4;
           wq = W[qv];
         }
-        if (exact::in_sphere(a, X + 3 * std::size_t(v[1]), X + 3 * std::size_t(v[2]), X + 3 * std::size_t(v[3]), q,
-                             wv, wq) == 0)
+        if (exact::in_sphere(a, X + 3 * std::size_t(v[1]), X + 3 * std::size_t(v[2]),
+                             X + 3 * std::size_t(v[3]), q, wv, wq) == 0)
           same[4 * i + f] = 1;
       }
     }
@@ -438,8 +447,8 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
           wv = w4;
         }
         double cabs[3], sabs;
-        if (!exact::centre(pa, X + 3 * std::size_t(v[1]), X + 3 * std::size_t(v[2]), X + 3 * std::size_t(v[3]), wv,
-                           cabs, sabs))
+        if (!exact::centre(pa, X + 3 * std::size_t(v[1]), X + 3 * std::size_t(v[2]),
+                           X + 3 * std::size_t(v[3]), wv, cabs, sabs))
           continue;
         ++t.recomputed_exactly;
         double* cc = t.c.data() + 3 * i;
@@ -494,7 +503,7 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
       ft.plane[2] = nn[2];
       ft.plane[3] = nn[0] * p0[0] + nn[1] * p0[1] + nn[2] * p0[2];
       ft.scale = static_cast<float>((std::abs(u[0]) + std::abs(u[1]) + std::abs(u[2])) *
-                                           (std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2])) * (1 + 1e-6));
+                                    (std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2])) * (1 + 1e-6));
       ft.anorm = static_cast<float>((std::abs(p0[0]) + std::abs(p0[1]) + std::abs(p0[2])) * (1 + 1e-6));
       std::uint32_t la = local[t.face_tet[2 * f]], lb = local[t.face_tet[2 * f + 1]];
       ft.local[0] = la < 0xFFFF ? static_cast<std::uint16_t>(la) : 0xFFFF;
@@ -504,12 +513,14 @@ SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
   t.clusters_split = clusters > 0 && t.cluster_tets.size() * SphereTable::kSplitClusters <= n;
   if (t.clusters_split) {
     t.all_items.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
+    for (std::size_t i = 0; i < n; ++i)
+      add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
   } else {
     t.all_items.reserve(n - t.cluster_tets.size() + clusters);
     for (std::size_t i = 0; i < n; ++i)
       if (t.cluster_of[i] == kNone) add_item(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i));
-    for (std::uint32_t k = 0; k < clusters; ++k) add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
+    for (std::uint32_t k = 0; k < clusters; ++k)
+      add_item(k | kClusterBit, t.cluster_tets[t.cluster_begin[k]]);
   }
   make_fixed_keys(t, half);
   if (progress) progress("clusters", 1.0);

@@ -114,8 +114,10 @@ class Pool {
         std::lock_guard<std::mutex> g(mu_);
         idle_.push_back(&s);
       }
-      if (error) done.set_exception(error);
-      else done.set_value();
+      if (error)
+        done.set_exception(error);
+      else
+        done.set_value();
     }
   }
 

@@ -33,7 +33,8 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 bool crosses(const double* c, const std::vector<double>& values) {
   const double lo = std::min({c[0], c[1], c[2], c[3]}), hi = std::max({c[0], c[1], c[2], c[3]});
   if (!(lo < hi)) return false;
-  return std::upper_bound(values.begin(), values.end(), lo) != std::upper_bound(values.begin(), values.end(), hi);
+  return std::upper_bound(values.begin(), values.end(), lo) !=
+         std::upper_bound(values.begin(), values.end(), hi);
 }
 
 std::vector<double> sorted_values(const IsoParams& iso) {
@@ -59,7 +60,8 @@ TranslucentSurfaces translucent_surfaces(const Mesh& mesh, std::span<const std::
                                   std::to_string(r.opacity) + " is not in [0, 1]");
   if (!params.corner.empty() && params.corner.size() != mesh.tet.size())
     throw std::invalid_argument("translucent: " + std::to_string(params.corner.size()) +
-                                " corner values for a mesh of " + std::to_string(n) + " tets (4 per tet expected)");
+                                " corner values for a mesh of " + std::to_string(n) +
+                                " tets (4 per tet expected)");
   TranslucentSurfaces s;
   std::vector<std::uint8_t> member(n, subset.empty() ? 1 : 0);
   for (std::uint32_t t : subset) {
@@ -133,7 +135,7 @@ struct TranslucentPainter::Impl {
   std::uint32_t region_rgb(std::uint32_t t) const {
     const std::int32_t r = mesh->region_of(t);
     return r >= 0 && std::size_t(r) < params.region_colors.size() ? params.region_colors[std::size_t(r)]
-                                                                   : region_color(r);
+                                                                  : region_color(r);
   }
 
   // Blends (or collects) a convex polygon in camera coordinates with colour rgb and opacity alpha.
@@ -144,7 +146,8 @@ struct TranslucentPainter::Impl {
     if (n == 0) return;
     std::int64_t X[kMaxPoly], Y[kMaxPoly];
     double px[kMaxPoly][2], w[kMaxPoly];
-    snap_polygon(proj, n, [&](int i) { return v[i]; }, X, Y, px, w);
+    snap_polygon(
+        proj, n, [&](int i) { return v[i]; }, X, Y, px, w);
     const int width = proj.width;
     for_each_fan_triangle(X, Y, n, [&](const std::int64_t* TX, const std::int64_t* TY, const int* idx) {
       if (collect) {
@@ -154,7 +157,8 @@ struct TranslucentPainter::Impl {
         const double bx = px[idx[2]][0] - x0, by = px[idx[2]][1] - y0;
         const double det = ax * by - ay * bx;
         const double w0 = w[idx[0]], w1 = w[idx[1]], w2 = w[idx[2]];
-        const double wa = ((w1 - w0) * by - (w2 - w0) * ay) / det, wb = ((w2 - w0) * ax - (w1 - w0) * bx) / det;
+        const double wa = ((w1 - w0) * by - (w2 - w0) * ay) / det,
+                     wb = ((w2 - w0) * ax - (w1 - w0) * bx) / det;
         raster_triangle(TX, TY, width, proj.height, rows, [&](int y, int lo, int hi) {
           for (int x = lo; x <= hi; ++x) {
             Fragment f;
@@ -172,7 +176,8 @@ struct TranslucentPainter::Impl {
           const std::size_t row = std::size_t(y) * std::size_t(width);
           float* c = &acc[3 * (row + std::size_t(lo))];
           for (int x = lo; x <= hi; ++x, c += 3) blend_over(c, rgb, alpha);
-          std::fill(front.begin() + std::ptrdiff_t(row) + lo, front.begin() + std::ptrdiff_t(row) + hi + 1, tet);
+          std::fill(front.begin() + std::ptrdiff_t(row) + lo, front.begin() + std::ptrdiff_t(row) + hi + 1,
+                    tet);
           count += std::size_t(hi - lo + 1);
         });
       }
@@ -197,8 +202,8 @@ struct TranslucentPainter::Impl {
     return exact::orientation_at_infinity(a, b, c, back);
   }
 
-  void draw_face(std::uint32_t t, const double (*cam)[3], int f, bool front_face,
-                 bool interface, const Rows& rows, std::size_t& count) {
+  void draw_face(std::uint32_t t, const double (*cam)[3], int f, bool front_face, bool interface,
+                 const Rows& rows, std::size_t& count) {
     std::uint32_t owner = t;  // whose colour the face shows
     float alpha = surf->opacity[t];
     if (interface) {
@@ -206,7 +211,8 @@ struct TranslucentPainter::Impl {
       if (surf->opacity[u] > alpha) owner = u, alpha = surf->opacity[u];
     }
     const double* p[3] = {cam[kFace[f][0]], cam[kFace[f][1]], cam[kFace[f][2]]};
-    const double poly[3][3] = {{p[0][0], p[0][1], p[0][2]}, {p[1][0], p[1][1], p[1][2]}, {p[2][0], p[2][1], p[2][2]}};
+    const double poly[3][3] = {
+        {p[0][0], p[0][1], p[0][2]}, {p[1][0], p[1][1], p[1][2]}, {p[2][0], p[2][1], p[2][2]}};
     // Outward normal in the camera frame: the frame is a mirror of the world, so it is -(b-a)x(c-a).
     const double u[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
     const double w[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
@@ -234,7 +240,8 @@ struct TranslucentPainter::Impl {
     proj.to_camera(p.xyz[0], c0);
     double hot[3];
     to_camera_dir(p.hot, hot);
-    const bool ascending = proj.perspective ? hot[0] * c0[0] + hot[1] * c0[1] + hot[2] * c0[2] < 0 : hot[2] < 0;
+    const bool ascending =
+        proj.perspective ? hot[0] * c0[0] + hot[1] * c0[1] + hot[2] * c0[2] < 0 : hot[2] < 0;
     // The normal toward the eye: the hot direction if the eye sees the hot side (ascending).
     double toward_eye[3];
     for (int k = 0; k < 3; ++k) toward_eye[k] = ascending ? hot[k] : -hot[k];
@@ -251,7 +258,8 @@ struct TranslucentPainter::Impl {
       const std::uint32_t col = params.iso.scale.color(value);
       const float rgb[3] = {float(col & 255u) * float(shade), float((col >> 8) & 255u) * float(shade),
                             float((col >> 16) & 255u) * float(shade)};
-      polygon(v, p.count, t, -1 - int(first - values.begin() + i), rgb, float(params.iso_opacity), rows, count);
+      polygon(v, p.count, t, -1 - int(first - values.begin() + i), rgb, float(params.iso_opacity), rows,
+              count);
     }
   }
 
@@ -278,7 +286,8 @@ struct TranslucentPainter::Impl {
     }
     if (iso) draw_iso(t, rows, count);
     for (int f = 0; f < 4; ++f)
-      if ((m & (0x11u << f)) && face_dir[f] > 0) draw_face(t, cam, f, true, (m & (1u << f)) == 0, rows, count);
+      if ((m & (0x11u << f)) && face_dir[f] > 0)
+        draw_face(t, cam, f, true, (m & (1u << f)) == 0, rows, count);
   }
 };
 
@@ -291,9 +300,11 @@ TranslucentPainter::TranslucentPainter(const Mesh& mesh, const Camera& camera, i
     throw std::invalid_argument("translucent: the surfaces belong to another mesh");
   if (!params.corner.empty() && params.corner.size() != mesh.tet.size())
     throw std::invalid_argument("translucent: corner values of the wrong size");
-  if (!(params.iso.shade_min >= 0 && params.iso.shade_min <= 1) || !(params.iso.cold_side >= 0 && params.iso.cold_side <= 1))
+  if (!(params.iso.shade_min >= 0 && params.iso.shade_min <= 1) ||
+      !(params.iso.cold_side >= 0 && params.iso.cold_side <= 1))
     throw std::invalid_argument("translucent: shade_min and cold_side must be in [0, 1]");
-  if (!(params.ambient >= 0 && params.ambient <= 1)) throw std::invalid_argument("translucent: ambient must be in [0, 1]");
+  if (!(params.ambient >= 0 && params.ambient <= 1))
+    throw std::invalid_argument("translucent: ambient must be in [0, 1]");
   s.surf = &surfaces;
   s.adj = &face_adjacency(mesh);
   s.params = params;
@@ -354,7 +365,8 @@ void TranslucentPainter::resolve(Framebuffer& fb) {
   for (std::size_t p = 0; p < pixels; ++p) {
     if (start[p] == start[p + 1]) continue;
     auto b = by_pixel.begin() + start[p], e = by_pixel.begin() + start[p + 1];
-    std::stable_sort(b, e, [&](std::uint32_t i, std::uint32_t j) { return s.frags[i].depth < s.frags[j].depth; });
+    std::stable_sort(b, e,
+                     [&](std::uint32_t i, std::uint32_t j) { return s.frags[i].depth < s.frags[j].depth; });
     float c[3] = {bg[0], bg[1], bg[2]};
     for (auto it = b; it != e; ++it) blend_over(c, s.frags[*it].rgb, s.frags[*it].alpha);
     fb.rgba[p] = pack_rgba(to8(c[0]), to8(c[1]), to8(c[2]));
@@ -374,7 +386,8 @@ std::size_t TranslucentPainter::fragment_count() const {
 TranslucentReport draw_translucent_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera,
                                            Framebuffer& fb, std::span<const std::uint32_t> subset,
                                            const TranslucentParams& params) {
-  if (fb.width < 1 || fb.height < 1) throw std::invalid_argument("draw_translucent_picture: the framebuffer is empty");
+  if (fb.width < 1 || fb.height < 1)
+    throw std::invalid_argument("draw_translucent_picture: the framebuffer is empty");
   if (table.tet_count() != mesh.tet_count())
     throw std::invalid_argument("draw_translucent_picture: the sphere table belongs to another mesh");
   TranslucentReport report;

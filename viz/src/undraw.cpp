@@ -9,7 +9,8 @@ namespace foxi {
 // Calls fn(y, lo, hi) for the pixel runs of a polygon (positive area) in the rows of `rows`, in a
 // fixed order.
 template <class Fn>
-inline void TetRasterizer::Impl::for_each_run(const PolyVertex* poly, int n, const Rows& rows, Fn&& fn) const {
+inline void TetRasterizer::Impl::for_each_run(const PolyVertex* poly, int n, const Rows& rows,
+                                              Fn&& fn) const {
   for (int q = 1; q + 1 < n; ++q) {
     std::int64_t X[3] = {poly[0].X, poly[q].X, poly[q + 1].X}, Y[3] = {poly[0].Y, poly[q].Y, poly[q + 1].Y};
     std::int64_t area = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
@@ -142,8 +143,8 @@ void TetRasterizer::Impl::undraw(Framebuffer& fb, std::size_t count) {
   changed = all.x0 <= all.x1 ? all : PixelRect{};
   // The changed bands' rectangles (the whole image if the near plane cut a tet), consecutive bands
   // of the same extent as one.
-  if (changed.x0 > changed.x1 || (changed.x0 == 0 && changed.y0 == 0 && changed.x1 == proj.width - 1 &&
-                                  changed.y1 == proj.height - 1)) {
+  if (changed.x0 > changed.x1 ||
+      (changed.x0 == 0 && changed.y0 == 0 && changed.x1 == proj.width - 1 && changed.y1 == proj.height - 1)) {
     changed_is_one_rect();
     return;
   }
@@ -166,10 +167,11 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
     written.assign(std::size_t(mask_words) * std::size_t(fb.height), 0);
     tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
   }
-  FOXI_ASSERT(count > 0 && count <= history.size(), "undraw of " << count << " of " << history.size() << " tets");
+  FOXI_ASSERT(count > 0 && count <= history.size(),
+              "undraw of " << count << " of " << history.size() << " tets");
   FOXI_ASSERT(drawn_box.size() == history.size() && drawn_reach.size() == history.size(),
-              "per-tet undo records: " << drawn_box.size() << " boxes, " << drawn_reach.size() << " reaches for "
-                                       << history.size() << " drawn tets");
+              "per-tet undo records: " << drawn_box.size() << " boxes, " << drawn_reach.size()
+                                       << " reaches for " << history.size() << " drawn tets");
   const std::size_t first = history.size() - count;
   auto first_save = [&](const Lane& lane) {
     return std::size_t(std::lower_bound(lane.saves.begin(), lane.saves.end(), first,
@@ -184,7 +186,8 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
   };
   // The threads' split of the rows (see split_rows) needs only an estimate of each band's work:
   // every 8th box's.
-  std::vector<double> band_work(threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
+  std::vector<double> band_work(
+      threads > 1 ? std::size_t((fb.height + (1 << kBandShift) - 1) >> kBandShift) : 0, 0.0);
   if (threads > 1)
     for (std::size_t i = 0; i < count; i += 8) {
       const Box b = box_of(i);
@@ -202,7 +205,8 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
         unknown = true;
         continue;
       }
-      rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1), std::max(rect.y1, b.y1)};
+      rect = PixelRect{std::min(rect.x0, b.x0), std::min(rect.y0, b.y0), std::max(rect.x1, b.x1),
+                       std::max(rect.y1, b.y1)};
       // The box's first and last band (often the same), then any between: no branch on its height.
       const int band_a = b.y0 >> kBandShift, band_b = b.y1 >> kBandShift;
       band_x0[std::size_t(band_a)] = std::min(band_x0[std::size_t(band_a)], b.x0);
@@ -214,7 +218,9 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
         band_x1[std::size_t(band)] = std::max(band_x1[std::size_t(band)], b.x1);
       }
     }
-    changed = unknown ? PixelRect{0, 0, fb.width - 1, fb.height - 1} : rect.x0 <= rect.x1 ? rect : PixelRect{};
+    changed = unknown              ? PixelRect{0, 0, fb.width - 1, fb.height - 1}
+              : rect.x0 <= rect.x1 ? rect
+                                   : PixelRect{};
   };
   // Thread k takes rows [split[k], split[k + 1]): the lanes' saved pixels in those rows and the
   // undrawn tets' faces there, walked in drawing order.
@@ -367,7 +373,8 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
     work({0, fb.height}, 0);
   } else {
     const std::vector<int> split = split_rows(band_work, threads, fb.height);
-    run_parts(threads, [&](int k) { work(split, k); }, [&] { unkept.store(2, std::memory_order_release); });
+    run_parts(
+        threads, [&](int k) { work(split, k); }, [&] { unkept.store(2, std::memory_order_release); });
   }
   history.resize(first);
   drawn_box.resize(first);
@@ -380,8 +387,10 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
     }
     lane.saved_rgba.resize(lane.saved_pixel.size());
     lane.saved_id.resize(lane.saved_pixel.size());
-    FOXI_ASSERT(lane.saves.empty() || (lane.saves.back().at < first && lane.saves.back().offset <= lane.saved_pixel.size()),
-                "a save of an undrawn tet (position " << lane.saves.back().at << " of " << first << ") or past the saved pixels");
+    FOXI_ASSERT(lane.saves.empty() ||
+                    (lane.saves.back().at < first && lane.saves.back().offset <= lane.saved_pixel.size()),
+                "a save of an undrawn tet (position " << lane.saves.back().at << " of " << first
+                                                      << ") or past the saved pixels");
   }
 }
 
@@ -390,14 +399,16 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
 // split need only be about even).
 inline void TetRasterizer::Impl::add_band_work(std::vector<double>& work, const Box& b) {
   constexpr int kRowCost = 16;  // pixels' worth of per-row setup
-  work[std::size_t(((b.y0 + b.y1) >> 1) >> kBandShift)] += double((b.x1 - b.x0 + 1 + kRowCost) * (b.y1 - b.y0 + 1));
+  work[std::size_t(((b.y0 + b.y1) >> 1) >> kBandShift)] +=
+      double((b.x1 - b.x0 + 1 + kRowCost) * (b.y1 - b.y0 + 1));
 }
 
 // Row ranges for `parts` threads undrawing, from their work per band (add_band_work; a box cut by
 // the near plane, unknown, counts on none): split[k] to split[k + 1] - 1 for thread k, whole bands
 // of 16 rows (a thread's mask tiles are its own), of about equal work. Contiguous ranges, not
 // interleaved bands: a tet is a few bands tall, and each thread whose rows it touches pays its setup.
-inline std::vector<int> TetRasterizer::Impl::split_rows(const std::vector<double>& work, int parts, int height) {
+inline std::vector<int> TetRasterizer::Impl::split_rows(const std::vector<double>& work, int parts,
+                                                        int height) {
   const int bands = int(work.size());
   double total = 0;
   for (double w : work) total += w;
@@ -407,7 +418,8 @@ inline std::vector<int> TetRasterizer::Impl::split_rows(const std::vector<double
   int k = 1;
   for (int band = 0; band < bands && k < parts; ++band) {
     sum += work[std::size_t(band)];
-    while (k < parts && sum >= total * double(k) / double(parts)) split[std::size_t(k++)] = std::min(height, (band + 1) << kBandShift);
+    while (k < parts && sum >= total * double(k) / double(parts))
+      split[std::size_t(k++)] = std::min(height, (band + 1) << kBandShift);
   }
   for (; k < parts; ++k) split[std::size_t(k)] = height;
   return split;
@@ -435,7 +447,8 @@ std::size_t TetRasterizer::Impl::undo_bytes() const {
                        before_id.capacity()) *
                           sizeof(std::uint32_t) +
                       (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t) +
-                      drawn_box.capacity() * sizeof(SmallBox) + drawn_reach.capacity() * sizeof(std::uint16_t);
+                      drawn_box.capacity() * sizeof(SmallBox) +
+                      drawn_reach.capacity() * sizeof(std::uint16_t);
   for (const Lane& lane : lanes)
     bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
                  sizeof(std::uint32_t) +

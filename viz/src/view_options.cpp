@@ -53,7 +53,8 @@ CameraOptions parse_camera_options(std::string_view eye, std::string_view at, st
     const std::string f(fov);
     char* end = nullptr;
     o.fov_deg = std::strtod(f.c_str(), &end);
-    if (*end != 0 || !(o.fov_deg > 0 && o.fov_deg < 180)) throw OptionError("--fov takes degrees in (0, 180)");
+    if (*end != 0 || !(o.fov_deg > 0 && o.fov_deg < 180))
+      throw OptionError("--fov takes degrees in (0, 180)");
   }
   return o;
 }
@@ -70,8 +71,8 @@ ImageSize parse_image_size(std::string_view text) {
   char* e2 = nullptr;
   const std::string w = size.substr(0, x), h = x == std::string::npos ? "" : size.substr(x + 1);
   const long lw = std::strtol(w.c_str(), &e1, 10), lh = std::strtol(h.c_str(), &e2, 10);
-  if (x == std::string::npos || w.empty() || h.empty() || *e1 != 0 || *e2 != 0 || lw < 1 || lh < 1 || lw > 16384 ||
-      lh > 16384)
+  if (x == std::string::npos || w.empty() || h.empty() || *e1 != 0 || *e2 != 0 || lw < 1 || lh < 1 ||
+      lw > 16384 || lh > 16384)
     throw OptionError("--size takes WxH with 1 <= W, H <= 16384, not '" + size + "'");
   return {int(lw), int(lh)};
 }
@@ -84,7 +85,8 @@ double parse_shrink(std::string_view text) {
   return f;
 }
 
-std::vector<std::uint32_t> tets_of_regions(const Mesh& mesh, std::string_view ids_text, std::string_view what) {
+std::vector<std::uint32_t> tets_of_regions(const Mesh& mesh, std::string_view ids_text,
+                                           std::string_view what) {
   const std::vector<double> ids = parse_number_list(ids_text, what);
   std::vector<std::uint32_t> out;
   for (std::size_t t = 0; t < mesh.tet_count(); ++t)
@@ -116,7 +118,8 @@ std::vector<std::uint32_t> parse_subset(const Mesh& mesh, std::string_view spec_
     for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
       double c[3] = {0, 0, 0};
       for (int k = 0; k < 4; ++k)
-        for (int j = 0; j < 3; ++j) c[j] += 0.25 * mesh.xyz[3 * std::size_t(mesh.tet[4 * t + std::size_t(k)]) + std::size_t(j)];
+        for (int j = 0; j < 3; ++j)
+          c[j] += 0.25 * mesh.xyz[3 * std::size_t(mesh.tet[4 * t + std::size_t(k)]) + std::size_t(j)];
       bool in = true;
       for (int j = 0; j < 3; ++j) in = in && c[j] >= b[std::size_t(j)] && c[j] <= b[3 + std::size_t(j)];
       if (in) subset.push_back(static_cast<std::uint32_t>(t));
@@ -133,7 +136,8 @@ double parse_opacity(std::string_view text, std::string_view what) {
   char* end = nullptr;
   const double a = std::strtod(s.c_str(), &end);
   if (s.empty() || end != s.c_str() + s.size() || !(a >= 0 && a <= 1))
-    throw OptionError(std::string(what) + " takes an opacity from 0 (invisible) to 1 (opaque), not '" + s + "'");
+    throw OptionError(std::string(what) + " takes an opacity from 0 (invisible) to 1 (opaque), not '" + s +
+                      "'");
   return a;
 }
 
@@ -147,8 +151,9 @@ std::vector<RegionOpacity> parse_region_opacity(const Mesh& mesh, std::string_vi
     // The last '=' splits, so a region name may hold one.
     const std::size_t eq = part.rfind('=');
     if (eq == std::string::npos || eq == 0)
-      throw OptionError("--region-opacity takes REGION=a,... (a region id or name and an opacity in [0, 1]), not '" +
-                        part + "'");
+      throw OptionError(
+          "--region-opacity takes REGION=a,... (a region id or name and an opacity in [0, 1]), not '" + part +
+          "'");
     const std::string key = part.substr(0, eq);
     const std::optional<std::int32_t> id = region_id_of(mesh, key);
     if (!id) throw OptionError("--region-opacity: the mesh has no region '" + key + "'");
@@ -175,7 +180,8 @@ std::vector<OpacityPoint> parse_opacity_curve(std::string_view text) {
     const std::string part = s.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
     const std::size_t colon = part.find(':');
     OpacityPoint p;
-    if (colon == std::string::npos || !number(part.substr(0, colon), p.value) || !number(part.substr(colon + 1), p.opacity))
+    if (colon == std::string::npos || !number(part.substr(0, colon), p.value) ||
+        !number(part.substr(colon + 1), p.opacity))
       throw OptionError("--opacity-curve takes v0:a0,v1:a1,... (values and opacities), not '" + part + "'");
     if (!(p.opacity >= 0 && p.opacity < 1))
       throw OptionError("--opacity-curve: opacity " + part.substr(colon + 1) + " is not in [0, 1)");

@@ -61,7 +61,8 @@ inline void store_entry(std::uint64_t* at, std::uint64_t value, bool stream) {
 inline void write_line(std::uint64_t* at, const std::uint64_t* line) {
 #if defined(__SSE2__) && defined(__x86_64__)
   for (int k = 0; k < 4; ++k)
-    _mm_stream_si128(reinterpret_cast<__m128i*>(at) + k, _mm_loadu_si128(reinterpret_cast<const __m128i*>(line) + k));
+    _mm_stream_si128(reinterpret_cast<__m128i*>(at) + k,
+                     _mm_loadu_si128(reinterpret_cast<const __m128i*>(line) + k));
 #else
   std::copy(line, line + 8, at);
 #endif
@@ -86,7 +87,8 @@ std::uint32_t rep_tet(const SphereTable& t, std::uint32_t item) {
   return (item & kClusterBit) ? t.cluster_tets[t.cluster_begin[item & ~kClusterBit]] : item;
 }
 
-void exact_key(const Mesh& m, const SphereTable& table, const View& view, std::uint32_t tet, exact::PowerKey& key) {
+void exact_key(const Mesh& m, const SphereTable& table, const View& view, std::uint32_t tet,
+               exact::PowerKey& key) {
   const std::uint32_t* v = m.tet.data() + 4 * std::size_t(tet);
   double w[4];
   const double* wp = nullptr;
@@ -187,9 +189,9 @@ constexpr std::array<FixedPassFn, 16> kFixedPasses = fixed_passes(std::make_inde
 
 // Buffers reused from one view to the next on the same thread (no page faults, no zeroing).
 struct Workspace {
-  PackedBuffer keyed;           // pass 1: the items with their q, in input order (8 bytes per item)
-  PackedBuffer entries;         // the bucketed entries (8 bytes per item)
-  PackedBuffer head[2];         // the head buckets' entries gathered by the key pass (per part)
+  PackedBuffer keyed;    // pass 1: the items with their q, in input order (8 bytes per item)
+  PackedBuffer entries;  // the bucketed entries (8 bytes per item)
+  PackedBuffer head[2];  // the head buckets' entries gathered by the key pass (per part)
 };
 thread_local Workspace t_workspace;
 
@@ -198,9 +200,9 @@ struct ProgressiveOrder::Impl {
   const SphereTable* table = nullptr;
   View view;
   bool front_to_back = false;
-  std::vector<std::uint8_t> in_subset;          // per tet, only when a subset meets clusters
-  PackedBuffer sorted;                          // bucketed; each bucket sorted when handed out
-  std::vector<std::uint32_t> bucket_begin;      // size buckets + 1
+  std::vector<std::uint8_t> in_subset;      // per tet, only when a subset meets clusters
+  PackedBuffer sorted;                      // bucketed; each bucket sorted when handed out
+  std::vector<std::uint32_t> bucket_begin;  // size buckets + 1
   std::size_t next_bucket = 0;
   std::vector<std::uint32_t> batch;
   std::size_t handed = 0, total_tets = 0;
@@ -210,7 +212,7 @@ struct ProgressiveOrder::Impl {
     std::vector<std::uint32_t> local_tets, local_indeg, local_queue;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> local_edges;
     std::vector<std::uint8_t> local_done;
-    std::vector<Packed> tmp;           // the second-level counting sort
+    std::vector<Packed> tmp;  // the second-level counting sort
     std::vector<std::uint32_t> counts;
     std::vector<Entry> run;
     // Split clusters met in a near-tie run (cluster, members in it), and one cluster's local order.
@@ -244,8 +246,8 @@ struct ProgressiveOrder::Impl {
   bool perspective = true;
   double eye2[3] = {0, 0, 0}, dir[3] = {0, 0, 0};
   double sign = -1, ka = 1, np = 0;
-  float bound = 0;                          // the radius of ordinary items (their q)
-  float double_bound = 0;                   // the same for keys recomputed in double (near ties)
+  float bound = 0;         // the radius of ordinary items (their q)
+  float double_bound = 0;  // the same for keys recomputed in double (near ties)
   double lo_of(std::uint32_t tet, float radius) const {
     const double* c = table->c.data() + 3 * std::size_t(tet);
     const double k = perspective ? table->s[tet] - (c[0] * eye2[0] + c[1] * eye2[1] + c[2] * eye2[2])
@@ -255,8 +257,9 @@ struct ProgressiveOrder::Impl {
   float radius_of(std::uint32_t rep) const { return radius_of(rep, bound); }
   float radius_of(std::uint32_t rep, float ordinary) const {
     if (!table->wide[rep]) return ordinary;
-    return std::max(ordinary, static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) *
-                                              (1 + 1e-6)));
+    return std::max(
+        ordinary,
+        static_cast<float>((ka * double(table->key_a[rep]) + double(table->key_b[rep]) * np) * (1 + 1e-6)));
   }
   // q = floor((lo - q_min) q_scale) clamped to 32 bits: monotone in lo (NaN goes to 0).
   double q_min = 0, q_scale = 0;
@@ -276,11 +279,12 @@ struct ProgressiveOrder::Impl {
     const std::uint32_t qa = q_of(a), qb = q_of(b);
     if (std::uint64_t(qb) - qa <= q_window) return true;
     if (zones.empty()) return false;
-    auto z = std::lower_bound(zones.begin(), zones.end(), qa,
-                              [](const std::pair<std::uint32_t, std::uint32_t>& r, std::uint32_t q) { return r.second < q; });
+    auto z = std::lower_bound(
+        zones.begin(), zones.end(), qa,
+        [](const std::pair<std::uint32_t, std::uint32_t>& r, std::uint32_t q) { return r.second < q; });
     return z != zones.end() && z->first <= qa && qb <= z->second;
   }
-  int bucket_shift = 32;                    // first-level bucket of an entry: q >> bucket_shift
+  int bucket_shift = 32;  // first-level bucket of an entry: q >> bucket_shift
   // The entries in input order (pass 1) and what the scatter of them into `sorted` needs.
   PackedBuffer keyed;
   std::vector<std::uint32_t> scatter_start[2];  // per bucket, the next slot of each part
@@ -292,14 +296,14 @@ struct ProgressiveOrder::Impl {
   PackedBuffer head[2];
   std::size_t head_count[2] = {0, 0};
   bool head_fits = false;
-  std::size_t scatter_from = 0;                 // the first bucket the worker's scatter places
+  std::size_t scatter_from = 0;  // the first bucket the worker's scatter places
   bool scattered = false;
-  double key_range_found = 0;                   // set by the scatter, published by add_counts
+  double key_range_found = 0;  // set by the scatter, published by add_counts
   void scatter(std::size_t from, std::size_t to);
 
   // The progressive path sorts ahead on a pooled thread (handed the work by the first next()), so
   // that the caller can draw one batch while the next buckets are being sorted.
-  std::future<void> worker;                 // valid while the sorting ahead runs or has not been waited for
+  std::future<void> worker;  // valid while the sorting ahead runs or has not been waited for
   std::mutex mu;
   std::condition_variable cv;
   std::deque<std::vector<std::uint32_t>> ready;
@@ -327,15 +331,16 @@ struct ProgressiveOrder::Impl {
   // whole-mesh progressive order, which finds only its head now (head_from_blocks) and leaves the
   // other keys to its worker (deferred_key_pass).
   void prepare(std::span<const std::uint32_t> subset, bool progressive);
-  std::size_t item_count = 0;                   // sort items, wide ones included
-  std::size_t ordinary_count = 0;               // the items that are not wide (first in keyed)
-  std::uint32_t q_head = 0;                     // the head's entries have q below this (0: no head)
-  std::size_t head_room = 0;                    // room for head entries per part
-  std::vector<std::uint32_t> hist[2], thist[2]; // per part: entries per bucket, tets beyond each item's first
-  FixedPass fixed_pass;                         // the key pass over fixed-point keys (fixed_run)
+  std::size_t item_count = 0;      // sort items, wide ones included
+  std::size_t ordinary_count = 0;  // the items that are not wide (first in keyed)
+  std::uint32_t q_head = 0;        // the head's entries have q below this (0: no head)
+  std::size_t head_room = 0;       // room for head entries per part
+  std::vector<std::uint32_t> hist[2],
+      thist[2];          // per part: entries per bucket, tets beyond each item's first
+  FixedPass fixed_pass;  // the key pass over fixed-point keys (fixed_run)
   FixedPassFn fixed_run = nullptr;
-  bool keys_deferred = false;                   // keys left to the worker (head_from_blocks)
-  std::size_t head_total = 0;                   // the head's entries found by head_from_blocks
+  bool keys_deferred = false;  // keys left to the worker (head_from_blocks)
+  std::size_t head_total = 0;  // the head's entries found by head_from_blocks
   void place_buckets(std::size_t split, bool gather);
   void head_from_blocks();
   bool deferred_key_pass();
@@ -368,7 +373,7 @@ struct ProgressiveOrder::Impl {
   // writes the items of [begin, end) from o on (around the cache if kStream), returns the end.
   template <bool kStream>
   std::uint32_t* emit_tets(std::size_t begin, std::size_t end, std::uint32_t* o, Scratch& sc);
-  bool t_cluster_free = false;              // no item is a cluster: copy items straight out
+  bool t_cluster_free = false;  // no item is a cluster: copy items straight out
   // A whole-mesh order of a table with clusters_split: every item is a tet (t_cluster_free), and
   // resolve_run draws each cluster whose tets meet in its run as one unit.
   bool split_clusters = false;
@@ -380,7 +385,7 @@ struct ProgressiveOrder::Impl {
     prefetch(table->cluster_begin.data() + k);
   }
   // Prefetches a cluster item's faces and tets ahead of its expansion (nothing for a tet).
-  bool many_clusters = false;               // clusters are a sizeable part of the items
+  bool many_clusters = false;  // clusters are a sizeable part of the items
   void prefetch_cluster(std::uint32_t item) const {
     if (!(item & kClusterBit)) return;
     const SphereTable& t = *table;
@@ -418,8 +423,8 @@ struct ProgressiveOrder::Impl {
   // `direct` is given, written at their places in the whole order (direct + tet_begin[bucket]);
   // returns the next bucket not consumed: a run of joined entries may take in buckets from `last`
   // up to `limit`.
-  std::size_t emit_buckets(std::size_t first, std::size_t last, std::size_t limit, std::vector<std::uint32_t>& out,
-                           Scratch& sc, std::uint32_t* direct = nullptr);
+  std::size_t emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
+                           std::vector<std::uint32_t>& out, Scratch& sc, std::uint32_t* direct = nullptr);
   // Per first-level bucket, the number of tets before it in the order (size buckets + 1): the
   // same as bucket_begin when no item is a cluster.
   std::vector<std::uint32_t> tet_begin;
@@ -495,7 +500,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset, bool
   sign = front_to_back ? 1.0 : -1.0;  // back to front: decreasing key first
   // A whole-mesh order reads the fixed-point keys (their rounding widens the bound a little).
   const bool fixed = subset.empty() && !t.fixed_keys.empty() && t.fixed_keys.size() == m_main;
-  const double bound_a = t.bound_a + (fixed ? t.fixed_a : 0.0), bound_b = t.bound_b + (fixed ? t.fixed_b : 0.0);
+  const double bound_a = t.bound_a + (fixed ? t.fixed_a : 0.0),
+               bound_b = t.bound_b + (fixed ? t.fixed_b : 0.0);
   // Rounded up to float, and a little more for the subtraction that places lo.
   bound = static_cast<float>((ka * bound_a + bound_b * np) * (1 + 1e-6));
   double_bound = static_cast<float>((ka * t.bound_a + t.bound_b * np) * (1 + 1e-6));
@@ -559,8 +565,9 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset, bool
   // The head (progressive orders only): the buckets up to the one of the sample's 0.2% quantile,
   // gathered before the scatter so that they are handed out first. Room for a few times what the
   // sample predicts; more means a skewed sample, and the head is then placed by the scatter.
-  head_buckets =
-      progressive && m >= 50000 ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb) : 0;
+  head_buckets = progressive && m >= 50000
+                     ? std::min<std::size_t>((std::size_t(quantise(head_lo)) >> shift) + 1, nb)
+                     : 0;
   q_head = head_buckets == 0 || head_buckets >= nb ? 0u : static_cast<std::uint32_t>(head_buckets << shift);
   head_room = q_head == 0 ? 0 : m / 128 + 8192;
   for (int part = 0; part < 2; ++part) {
@@ -594,8 +601,10 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset, bool
     std::sort(zones.begin(), zones.end());
     std::size_t k = 0;
     for (std::size_t z = 1; z < zones.size(); ++z) {
-      if (zones[z].first <= zones[k].second) zones[k].second = std::max(zones[k].second, zones[z].second);
-      else zones[++k] = zones[z];
+      if (zones[z].first <= zones[k].second)
+        zones[k].second = std::max(zones[k].second, zones[z].second);
+      else
+        zones[++k] = zones[z];
     }
     zones.resize(k + 1);
   }
@@ -617,49 +626,49 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset, bool
   const std::uint32_t q_head_v = q_head;
   const std::size_t head_room_v = head_room;
   auto key_pass_of = [=, this](auto with_tets) {
-   return [=, this](std::size_t b, std::size_t e, int part) {
-    std::uint32_t* hp = hist[part].data();
-    std::uint32_t* thp = thist[part].data();
-    Packed* head_p = head[part].data();
-    std::size_t heads = 0;
-    // An item's tet: the item itself, or a cluster's first tet (reps[i], read from the cluster
-    // tables instead, which saves a stream of 4 bytes per item when few items are clusters).
-    auto rep_at = [=](std::size_t i) -> std::size_t {
-      if constexpr (decltype(with_tets)::value) {
-        const std::uint32_t item = item_p[i];
-        return (item & kClusterBit) ? cl_tets[cl_begin[item & ~kClusterBit]] : item;
+    return [=, this](std::size_t b, std::size_t e, int part) {
+      std::uint32_t* hp = hist[part].data();
+      std::uint32_t* thp = thist[part].data();
+      Packed* head_p = head[part].data();
+      std::size_t heads = 0;
+      // An item's tet: the item itself, or a cluster's first tet (reps[i], read from the cluster
+      // tables instead, which saves a stream of 4 bytes per item when few items are clusters).
+      auto rep_at = [=](std::size_t i) -> std::size_t {
+        if constexpr (decltype(with_tets)::value) {
+          const std::uint32_t item = item_p[i];
+          return (item & kClusterBit) ? cl_tets[cl_begin[item & ~kClusterBit]] : item;
+        } else {
+          return item_p[i];
+        }
+      };
+      auto put = [=, this, &heads](std::size_t i, double lo, std::uint32_t item) {
+        const double x = (lo - qmin) * qscale;
+        const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
+        const Packed p = (Packed(q) << 32) | item;
+        store_entry(keyed_p + i, p, stream);
+        ++hp[q >> shift];
+        if constexpr (decltype(with_tets)::value)
+          if (item_p[i] & kClusterBit) thp[q >> shift] += tets_of(item_p[i]) - 1;
+        if (q < q_head_v) {
+          if (heads < head_room_v) head_p[heads] = p;
+          ++heads;
+        }
+      };
+      if (persp_view) {
+        for (std::size_t i = b; i < e; ++i) {
+          const std::size_t tet = rep_at(i);
+          const double* c = C + 3 * tet;
+          put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo, item_p[i]);
+        }
       } else {
-        return item_p[i];
+        for (std::size_t i = b; i < e; ++i) {
+          const double* c = C + 3 * rep_at(i);
+          put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo, item_p[i]);
+        }
       }
+      head_count[part] = heads;
+      if (stream) store_fence();
     };
-    auto put = [=, this, &heads](std::size_t i, double lo, std::uint32_t item) {
-      const double x = (lo - qmin) * qscale;
-      const std::uint32_t q = x > 0 ? (x < 4294967295.0 ? static_cast<std::uint32_t>(x) : 0xFFFFFFFFu) : 0u;
-      const Packed p = (Packed(q) << 32) | item;
-      store_entry(keyed_p + i, p, stream);
-      ++hp[q >> shift];
-      if constexpr (decltype(with_tets)::value)
-        if (item_p[i] & kClusterBit) thp[q >> shift] += tets_of(item_p[i]) - 1;
-      if (q < q_head_v) {
-        if (heads < head_room_v) head_p[heads] = p;
-        ++heads;
-      }
-    };
-    if (persp_view) {
-      for (std::size_t i = b; i < e; ++i) {
-        const std::size_t tet = rep_at(i);
-        const double* c = C + 3 * tet;
-        put(i, sgn * (S[tet] - (c[0] * p0 + c[1] * p1 + c[2] * p2)) - shift_lo, item_p[i]);
-      }
-    } else {
-      for (std::size_t i = b; i < e; ++i) {
-        const double* c = C + 3 * rep_at(i);
-        put(i, sgn * (c[0] * p0 + c[1] * p1 + c[2] * p2) - shift_lo, item_p[i]);
-      }
-    }
-    head_count[part] = heads;
-    if (stream) store_fence();
-   };
   };
   head_count[0] = head_count[1] = 0;
   if (fixed) {
@@ -682,7 +691,8 @@ void ProgressiveOrder::Impl::prepare(std::span<const std::uint32_t> subset, bool
     pass.q_scale = q_scale;
     // No clusters and no wide items: all_items lists every tet in order (item i is tet i).
     const bool identity = t_cluster_free && m_main == n;
-    fixed_run = kFixedPasses[(perspective ? 1 : 0) | (identity ? 2 : 0) | (stream ? 4 : 0) | (t_cluster_free ? 0 : 8)];
+    fixed_run = kFixedPasses[(perspective ? 1 : 0) | (identity ? 2 : 0) | (stream ? 4 : 0) |
+                             (t_cluster_free ? 0 : 8)];
     if (q_head > 0 && t.key_order.size() == m_main) {
       // A progressive order: its head now, from the blocks that may hold it; every key later, by the
       // worker, while the caller draws the first batch.
@@ -800,8 +810,10 @@ void ProgressiveOrder::Impl::head_from_blocks() {
       }
     }
   };
-  if (perspective) gather(std::true_type{});
-  else gather(std::false_type{});
+  if (perspective)
+    gather(std::true_type{});
+  else
+    gather(std::false_type{});
   for (std::size_t i = ordinary_count; i < item_count; ++i)
     if (q_of(keyed[i]) < q_head) {
       if (count < head_room) out[count] = keyed[i];
@@ -878,7 +890,8 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
   // (software write-combining): each bucket's line is filled in a buffer that stays in L2 and a full
   // line goes to memory in one non-temporal write, with no read of the destination line first.
   // (Full lines need the buffer 64-byte aligned, which the huge-page allocator gives such sizes.)
-  const bool combine = from == 0 && to == nb && stream_entries(m) && reinterpret_cast<std::uintptr_t>(out) % 64 == 0;
+  const bool combine =
+      from == 0 && to == nb && stream_entries(m) && reinterpret_cast<std::uintptr_t>(out) % 64 == 0;
   auto run_combined = [=, this](std::size_t b, std::size_t e, std::uint32_t* ps) {
     thread_local std::vector<Packed> t_lines;
     thread_local std::vector<std::uint32_t> t_first;
@@ -900,14 +913,16 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
       if ((pos & 7) != 7) continue;
       // The line [pos - 7, pos] is complete; its first slots may belong to the bucket (or part)
       // before, when it is this part's first line of bucket k: then only its own slots are stored.
-      if (pos - 7 >= first[k]) write_line(out + (pos - 7), line);
+      if (pos - 7 >= first[k])
+        write_line(out + (pos - 7), line);
       else
         for (std::uint32_t slot = first[k]; slot <= pos; ++slot) out[slot] = line[slot & 7];
     }
     for (std::size_t k = 0; k < nb; ++k) {  // the partial last lines
       const std::uint32_t end = ps[k];
       if ((end & 7) == 0 || end == first[k]) continue;
-      for (std::uint32_t slot = std::max(end & ~7u, first[k]); slot < end; ++slot) out[slot] = lines[8 * k + (slot & 7)];
+      for (std::uint32_t slot = std::max(end & ~7u, first[k]); slot < end; ++slot)
+        out[slot] = lines[8 * k + (slot & 7)];
     }
     store_fence();
   };
@@ -918,8 +933,10 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
     pool::on_two_cores([&](int part) {
       std::uint32_t* ps = scatter_start[part].data();
       const std::size_t b = part == 0 ? 0 : split, e = part == 0 ? split : m;
-      if (combine) run_combined(b, e, ps);
-      else run(b, e, ps);
+      if (combine)
+        run_combined(b, e, ps);
+      else
+        run(b, e, ps);
     });
   }
   if (to < nb || stop) return;
@@ -944,8 +961,10 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
 // pass that follows mispredicts little; 2n to 4n measured 12% slower: more counters to clear and
 // sum), then the insertion pass.
 void ProgressiveOrder::Impl::sort_bucket(std::size_t begin, std::size_t end, Scratch& sc) {
-  if (prefetch_ties) sort_bucket_of<true>(begin, end, sc);
-  else sort_bucket_of<false>(begin, end, sc);
+  if (prefetch_ties)
+    sort_bucket_of<true>(begin, end, sc);
+  else
+    sort_bucket_of<false>(begin, end, sc);
 }
 
 template <bool kFetch>
@@ -1036,8 +1055,10 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
       const std::uint32_t c = table->cluster_of[item_of(sorted[k])];
       if (c == kNone) continue;
       auto at = cluster_at(c);
-      if (at == clusters.end()) clusters.emplace_back(c, 1);
-      else ++at->second;
+      if (at == clusters.end())
+        clusters.emplace_back(c, 1);
+      else
+        ++at->second;
     }
     for (auto& [c, count] : clusters)
       if (count != table->cluster_begin[c + 1] - table->cluster_begin[c]) count = 0;  // not wholly here
@@ -1057,9 +1078,8 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
     run.push_back({lo_of(rep, r), r, item});
   }
   // By (lo, item): the same order whatever order the run came in.
-  std::sort(run.begin(), run.end(), [](const Entry& x, const Entry& y) {
-    return x.lo < y.lo || (x.lo == y.lo && x.item < y.item);
-  });
+  std::sort(run.begin(), run.end(),
+            [](const Entry& x, const Entry& y) { return x.lo < y.lo || (x.lo == y.lo && x.item < y.item); });
   std::size_t i = 0;
   const std::size_t n = run.size();
   while (i < n) {
@@ -1098,7 +1118,8 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
   }
   // The items in their order; the q values stay where they were (ascending).
   if (clusters.empty()) {
-    for (std::size_t k = begin; k < end; ++k) sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | run[k - begin].item;
+    for (std::size_t k = begin; k < end; ++k)
+      sorted[k] = (sorted[k] & ~Packed(0xFFFFFFFFu)) | run[k - begin].item;
     return;
   }
   std::size_t k = begin;
@@ -1120,10 +1141,13 @@ void ProgressiveOrder::Impl::resolve_run(std::size_t begin, std::size_t end, Scr
 }
 
 template <bool kStream>
-std::uint32_t* ProgressiveOrder::Impl::emit_tets(std::size_t begin, std::size_t end, std::uint32_t* o, Scratch& sc) {
+std::uint32_t* ProgressiveOrder::Impl::emit_tets(std::size_t begin, std::size_t end, std::uint32_t* o,
+                                                 Scratch& sc) {
   auto put = [](std::uint32_t* at, std::uint32_t item) {
-    if constexpr (kStream) store_item(at, item);
-    else *at = item;
+    if constexpr (kStream)
+      store_item(at, item);
+    else
+      *at = item;
   };
   const Packed* a = sorted.data();
   const std::uint64_t w = q_window;
@@ -1165,7 +1189,8 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
     std::fill(pred, pred + size, std::uint64_t(0));
     if (!in_subset.empty())
       for (std::uint32_t i = 0; i < size; ++i)
-        if (!in_subset[t.cluster_tets[cb + i]]) emitted |= std::uint64_t(1) << i;  // not drawn, no constraints
+        if (!in_subset[t.cluster_tets[cb + i]])
+          emitted |= std::uint64_t(1) << i;  // not drawn, no constraints
     const bool persp = view.perspective;
     const double* e = view.eye;
     const double back[3] = {-view.dir[0], -view.dir[1], -view.dir[2]};
@@ -1285,7 +1310,8 @@ ProgressiveOrder::ProgressiveOrder(ProgressiveOrder&&) noexcept = default;
 ProgressiveOrder& ProgressiveOrder::operator=(ProgressiveOrder&&) noexcept = default;
 
 std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t last, std::size_t limit,
-                                                 std::vector<std::uint32_t>& out, Scratch& sc, std::uint32_t* direct) {
+                                                 std::vector<std::uint32_t>& out, Scratch& sc,
+                                                 std::uint32_t* direct) {
   // Sorts bucket k unless this thread has sorted it ahead (a bucket once emitted has its near
   // ties resolved, which a second sort would undo, so each is sorted once).
   auto ensure_sorted = [&](std::size_t k) {
@@ -1355,13 +1381,17 @@ std::size_t ProgressiveOrder::Impl::emit_buckets(std::size_t first, std::size_t 
       if (many_clusters) {
         scan_runs(begin, end, sc, [&](std::uint32_t item) {
           fetch_ahead();
-          if (item & kClusterBit) expand(item, o, sc);
-          else *o++ = item;
+          if (item & kClusterBit)
+            expand(item, o, sc);
+          else
+            *o++ = item;
         });
       } else {
         scan_runs(begin, end, sc, [&](std::uint32_t item) {
-          if (item & kClusterBit) expand(item, o, sc);
-          else *o++ = item;
+          if (item & kClusterBit)
+            expand(item, o, sc);
+          else
+            *o++ = item;
         });
       }
     }
@@ -1510,16 +1540,19 @@ void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, co
   std::size_t split = 0;
   const std::size_t m = d.bucket_begin[nb];
   if (m >= 100000) {
-    split = static_cast<std::size_t>(std::lower_bound(d.bucket_begin.begin(), d.bucket_begin.end(),
-                                                      static_cast<std::uint32_t>(m / 2)) - d.bucket_begin.begin());
+    split = static_cast<std::size_t>(
+        std::lower_bound(d.bucket_begin.begin(), d.bucket_begin.end(), static_cast<std::uint32_t>(m / 2)) -
+        d.bucket_begin.begin());
     if (split >= nb) split = 0;
   }
   bool done = false;
   if (split > 0) {
     ProgressiveOrder::Impl::Scratch other_scratch;
     pool::on_two_cores([&](int part) {
-      if (part == 0) d.emit_buckets(0, split, split, out, d.scratch, direct);
-      else d.emit_buckets(split, nb, nb, out, other_scratch, direct);
+      if (part == 0)
+        d.emit_buckets(0, split, split, out, d.scratch, direct);
+      else
+        d.emit_buckets(split, nb, nb, out, other_scratch, direct);
     });
     // The halves are independent unless the last entry of the first joins the first of the second.
     const std::size_t at = d.bucket_begin[split];

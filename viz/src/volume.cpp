@@ -27,7 +27,8 @@ double volume_extinction(const VolumeParams& params, double v) {
   } else if (v >= c.back().value) {
     a = c.back().opacity;
   } else {
-    const auto hi = std::upper_bound(c.begin(), c.end(), v, [](double x, const OpacityPoint& p) { return x < p.value; });
+    const auto hi =
+        std::upper_bound(c.begin(), c.end(), v, [](double x, const OpacityPoint& p) { return x < p.value; });
     const auto lo = hi - 1;
     const double t = (v - lo->value) / (hi->value - lo->value);
     a = lo->opacity + t * (hi->opacity - lo->opacity);
@@ -106,7 +107,8 @@ struct TableTransfer {
       for (int j = 0; j < 3; ++j) lut_step = std::max(lut_step, std::abs(lut[i][j] - lut[i - 1][j]));
     for (int j = 0; j < 3; ++j) nan_rgb[j] = float((params.scale.nan_color >> (8 * j)) & 255u);
     const ColorScale& sc = params.scale;
-    if (!sc.log && std::isfinite(sc.lo) && std::isfinite(sc.hi) && sc.hi > sc.lo && !params.opacity_curve.empty()) {
+    if (!sc.log && std::isfinite(sc.lo) && std::isfinite(sc.hi) && sc.hi > sc.lo &&
+        !params.opacity_curve.empty()) {
       pre = true;
       g_lo = std::min(sc.lo, lo);
       g_hi = std::max(sc.hi, hi);
@@ -127,7 +129,9 @@ struct TableTransfer {
           acc[0] += t;
           for (int j = 0; j < 3; ++j) acc[j + 1] += t * c[j];
         }
-        for (int j = 0; j < 4; ++j) F[4 * std::size_t(i + 1) + std::size_t(j)] = F[4 * std::size_t(i) + std::size_t(j)] + acc[j] * dv / kSub;
+        for (int j = 0; j < 4; ++j)
+          F[4 * std::size_t(i + 1) + std::size_t(j)] =
+              F[4 * std::size_t(i) + std::size_t(j)] + acc[j] * dv / kSub;
       }
       const double below = g_lo - 1, above = g_hi + 1;
       float cb[3], ca[3];
@@ -193,7 +197,8 @@ double exp_neg_small(double D) {
 
 // One piece in closed form, given the antiderivatives at its ends (a: far, b: near): false where the
 // bound above does not hold.
-bool closed_piece(const TableTransfer& tf, const double a[4], const double b[4], double dv, double length, float c[3]) {
+bool closed_piece(const TableTransfer& tf, const double a[4], const double b[4], double dv, double length,
+                  float c[3]) {
   const double dT = b[0] - a[0];
   const double D = length * dT / dv;
   if (!(D > 0)) return D == 0;  // no extinction anywhere on the piece: nothing to blend
@@ -286,11 +291,13 @@ struct VolumePainter::Impl {
       bool cull = true;
       for (int k = 0; k < 4 && cull; ++k) {
         if (proj.perspective && !(P[k][2] > std::max(params.near, 0.0) && P[k][2] > 0)) cull = false;
-        const double y = proj.perspective ? proj.cy - proj.focal * P[k][1] / P[k][2] : proj.cy - proj.scale * P[k][1];
+        const double y =
+            proj.perspective ? proj.cy - proj.focal * P[k][1] / P[k][2] : proj.cy - proj.scale * P[k][1];
         y_lo = std::min(y_lo, y);
         y_hi = std::max(y_hi, y);
       }
-      if (cull && (y_hi < -1 || y_lo > proj.height + 1 || !rows.any(int(std::floor(y_lo)) - 1, int(std::ceil(y_hi)) + 1)))
+      if (cull && (y_hi < -1 || y_lo > proj.height + 1 ||
+                   !rows.any(int(std::floor(y_lo)) - 1, int(std::ceil(y_hi)) + 1)))
         return;
     }
     // The field's gradient in the camera frame: (P[k] - P[0]) . g = cv[k] - cv[0], by Cramer's rule.
@@ -300,7 +307,8 @@ struct VolumePainter::Impl {
       df[k] = cv[k + 1] - cv[0];
     }
     auto det3 = [](const double a[3], const double b[3], const double c[3]) {
-      return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+      return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+             a[2] * (b[0] * c[1] - b[1] * c[0]);
     };
     const double det = det3(e[0], e[1], e[2]);
     if (!(std::abs(det) > 0)) return;  // flat
@@ -319,7 +327,8 @@ struct VolumePainter::Impl {
       const double* a = P[kFace[f][0]];
       const double* b = P[kFace[f][1]];
       const double* c = P[kFace[f][2]];
-      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                   w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
       n[f][0] = u[1] * w[2] - u[2] * w[1];
       n[f][1] = u[2] * w[0] - u[0] * w[2];
       n[f][2] = u[0] * w[1] - u[1] * w[0];
@@ -333,7 +342,8 @@ struct VolumePainter::Impl {
     // The eye inside the tet (perspective, every plane's inner side): its back faces cover the screen
     // where the rays start inside it.
     const bool inside = front_count == 0;
-    const double near = proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
+    const double near =
+        proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
     for (int f = 0; f < 4; ++f) {
       if (facing[f] == inside) continue;
       double tri[3][3], v[kMaxPolyVolume][3];
@@ -342,7 +352,8 @@ struct VolumePainter::Impl {
       if (m == 0) continue;
       std::int64_t X[kMaxPolyVolume], Y[kMaxPolyVolume];
       double px[kMaxPolyVolume][2], w[kMaxPolyVolume];
-      snap_polygon(proj, m, [&](int i) { return v[i]; }, X, Y, px, w);
+      snap_polygon(
+          proj, m, [&](int i) { return v[i]; }, X, Y, px, w);
       for_each_fan_triangle(X, Y, m, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
         raster_triangle(TX, TY, proj.width, proj.height, rows, [&](int y, int lo, int hi) {
           // Along the row the pixel's ray o + s d (camera frame; perspective: o = 0 and s the depth)
@@ -472,10 +483,11 @@ std::size_t VolumePainter::samples() const {
   return n;
 }
 
-VolumeReport draw_volume_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera, Framebuffer& fb,
-                                 std::span<const std::uint32_t> subset, std::span<const double> corner,
-                                 const VolumeParams& params) {
-  if (fb.width < 1 || fb.height < 1) throw std::invalid_argument("draw_volume_picture: the framebuffer is empty");
+VolumeReport draw_volume_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera,
+                                 Framebuffer& fb, std::span<const std::uint32_t> subset,
+                                 std::span<const double> corner, const VolumeParams& params) {
+  if (fb.width < 1 || fb.height < 1)
+    throw std::invalid_argument("draw_volume_picture: the framebuffer is empty");
   if (table.tet_count() != mesh.tet_count())
     throw std::invalid_argument("draw_volume_picture: the sphere table belongs to another mesh");
   auto ms_since = [](std::chrono::steady_clock::time_point t) {
@@ -487,9 +499,9 @@ VolumeReport draw_volume_picture(const Mesh& mesh, const SphereTable& table, con
   report.certificate_ms = ms_since(t0);
   report.exact_order = report.delaunay;
   t0 = std::chrono::steady_clock::now();
-  const std::vector<std::uint32_t> order = report.delaunay
-                                               ? visibility_order(mesh, table, view_of(camera), subset)
-                                               : mpvo_order(mesh, table, view_of(camera), subset, &report.cycles_broken);
+  const std::vector<std::uint32_t> order =
+      report.delaunay ? visibility_order(mesh, table, view_of(camera), subset)
+                      : mpvo_order(mesh, table, view_of(camera), subset, &report.cycles_broken);
   report.order_ms = ms_since(t0);
   report.tets = order.size();
   t0 = std::chrono::steady_clock::now();

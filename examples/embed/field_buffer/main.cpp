@@ -53,7 +53,8 @@ int run(const char* out) {
   for (int k = 0; k <= nz; ++k)
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i) xyz.insert(xyz.end(), {double(i) / nx, double(j) / ny, 0.5 * k / nz});
-  const int perms[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {1, 0, 2}, {2, 1, 0}};  // even, then odd
+  const int perms[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1},
+                           {0, 2, 1}, {1, 0, 2}, {2, 1, 0}};  // even, then odd
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)
@@ -135,9 +136,10 @@ int run(const char* out) {
       colours.insert(px);
       wrong += px != scale.color(tet_value[t]);  // the colour of the host's value, on the host's scale
     }
-  std::printf("field_buffer: %zu tets, values %.3g..%.3g, %zu pixels covered, %zu colours shown, %zu wrong "
-              "pixels, %zu padding pixels changed\n",
-              mesh.tet_count(), scale.lo, scale.hi, covered, colours.size(), wrong, padding_changed);
+  std::printf(
+      "field_buffer: %zu tets, values %.3g..%.3g, %zu pixels covered, %zu colours shown, %zu wrong "
+      "pixels, %zu padding pixels changed\n",
+      mesh.tet_count(), scale.lo, scale.hi, covered, colours.size(), wrong, padding_changed);
 
   if (out != nullptr) {  // the host's own writer: binary PPM of its buffer, alpha dropped
     std::ofstream f(out, std::ios::binary);
@@ -150,7 +152,8 @@ int run(const char* out) {
       }
     if (!f.flush()) throw std::runtime_error(std::string("cannot write ") + out);
   }
-  return wrong == 0 && padding_changed == 0 && colours.size() > 50 && covered > std::size_t(image.width) * image.height / 10
+  return wrong == 0 && padding_changed == 0 && colours.size() > 50 &&
+                 covered > std::size_t(image.width) * image.height / 10
              ? 0
              : 1;
 }

@@ -29,9 +29,9 @@ namespace {
 
 // The host's own mesh: plain arrays, as a host's solver would keep them.
 struct HostMesh {
-  std::vector<double> xyz;              // 3 per node
-  std::vector<std::uint32_t> tet;       // 4 per tet
-  std::vector<std::int32_t> region;     // 1 per tet
+  std::vector<double> xyz;           // 3 per node
+  std::vector<std::uint32_t> tet;    // 4 per tet
+  std::vector<std::int32_t> region;  // 1 per tet
 };
 
 // An n^3 grid of unit cubes scaled to [0, 1]^3; each cube cut into the 6 tets of the Kuhn (Freudenthal)
@@ -39,7 +39,9 @@ struct HostMesh {
 // share their face diagonals and the mesh is conforming. Region 1 below z = 1/2, region 2 above.
 HostMesh kuhn_grid(int n) {
   HostMesh m;
-  const auto node = [n](int i, int j, int k) { return static_cast<std::uint32_t>((k * (n + 1) + j) * (n + 1) + i); };
+  const auto node = [n](int i, int j, int k) {
+    return static_cast<std::uint32_t>((k * (n + 1) + j) * (n + 1) + i);
+  };
   for (int k = 0; k <= n; ++k)
     for (int j = 0; j <= n; ++j)
       for (int i = 0; i <= n; ++i) m.xyz.insert(m.xyz.end(), {double(i) / n, double(j) / n, double(k) / n});
@@ -76,13 +78,15 @@ int run(const std::string& out, int n) {
 
   const foxi::ValidationReport check = foxi::validate(mesh);
   if (!check.ok()) {
-    for (const std::string& line : foxi::describe(check)) std::fprintf(stderr, "grid_png: %s\n", line.c_str());
+    for (const std::string& line : foxi::describe(check))
+      std::fprintf(stderr, "grid_png: %s\n", line.c_str());
     return 1;
   }
   // The painter's order is a visibility order only for a Delaunay mesh: certify before trusting it.
   const foxi::DelaunayCertificate& cert = foxi::delaunay_certificate(mesh);
   if (!cert.delaunay) {
-    std::fprintf(stderr, "grid_png: the mesh is not Delaunay (%zu violating tets)\n", cert.violating_tet_count);
+    std::fprintf(stderr, "grid_png: the mesh is not Delaunay (%zu violating tets)\n",
+                 cert.violating_tet_count);
     return 1;
   }
 
@@ -128,10 +132,11 @@ int run(const std::string& out, int n) {
       ++covered;
       regions_seen.insert(mesh.region_of(fb.id[p]));
     }
-  std::printf("grid_png: %zu tets (Delaunay, %zu checked), %zu drawn, %zu face pairs in order, %zu pixels "
-              "covered, %zu regions seen -> %s\n",
-              mesh.tet_count(), cert.tets_checked, order.size(), violations.pairs_checked, covered,
-              regions_seen.size(), out.c_str());
+  std::printf(
+      "grid_png: %zu tets (Delaunay, %zu checked), %zu drawn, %zu face pairs in order, %zu pixels "
+      "covered, %zu regions seen -> %s\n",
+      mesh.tet_count(), cert.tets_checked, order.size(), violations.pairs_checked, covered,
+      regions_seen.size(), out.c_str());
   return regions_seen.size() == 2 && covered > std::size_t(width) * height / 10 ? 0 : 1;
 }
 

@@ -7,11 +7,12 @@
 //   mesh_plc_cgal(plc, params)                 CGAL Mesh_3's mesh of a PLC (cgal_mesher.hpp)
 //   MeshParams, MesherError, MesherCancelled   parameters, and why meshing failed (mesher.hpp)
 //   estimate_tet_count(plc, params)            tets a mesh will have, before meshing (tet_estimate.hpp)
-//   mesh_params_from_model(model, plc)         a model's [mesh] controls as parameters (model_mesh_params.hpp)
-//   box_size_field, size_field_from_error      size control: boxes, per region, from an error (size_field.hpp)
-//   zz_error_indicator(mesh, field)            Zienkiewicz-Zhu error estimate of a field (size_field.hpp)
-//   find_thin_layers(plc)                      thin layers a radius-edge bound cannot hold (thin_layers.hpp)
-//   mesh_quality_report(mesh, report)          shape and size quality of a mesh (quality_report.hpp)
+//   mesh_params_from_model(model, plc)         a model's [mesh] controls as parameters
+//   (model_mesh_params.hpp) box_size_field, size_field_from_error      size control: boxes, per region, from
+//   an error (size_field.hpp) zz_error_indicator(mesh, field)            Zienkiewicz-Zhu error estimate of a
+//   field (size_field.hpp) find_thin_layers(plc)                      thin layers a radius-edge bound cannot
+//   hold (thin_layers.hpp) mesh_quality_report(mesh, report)          shape and size quality of a mesh
+//   (quality_report.hpp)
 #pragma once
 
 #include "foxi/mesher/cgal_mesher.hpp"

@@ -14,11 +14,11 @@
 //   read_mesh(path), write_mesh(mesh, path)    any format, chosen from the file name (mesh_io.hpp)
 //   read_/parse_/write_gmsh, _vtu, _vtk_legacy, _tetgen, _medit   one format each (io_*.hpp)
 //   Cancelled                                  what a cancelled mesher, solver or movie throws (progress.hpp)
-//   IoError                                    a reader's or writer's error: file, place, reason (io_error.hpp)
-//   DurableFile, check_output_path             files that appear whole or not at all (durable_file.hpp)
-//   cleanup::track, cleanup::interrupt         what an interrupted run must remove (cleanup.hpp)
-//   Plc, read_poly, parse_poly, write_poly     the piecewise linear complex for the mesher (plc.hpp)
-//   ProgressFn                                 progress and cancel callback (progress.hpp)
+//   IoError                                    a reader's or writer's error: file, place, reason
+//   (io_error.hpp) DurableFile, check_output_path             files that appear whole or not at all
+//   (durable_file.hpp) cleanup::track, cleanup::interrupt         what an interrupted run must remove
+//   (cleanup.hpp) Plc, read_poly, parse_poly, write_poly     the piecewise linear complex for the mesher
+//   (plc.hpp) ProgressFn                                 progress and cancel callback (progress.hpp)
 //
 // The structure modelling (model files, parts, conditions) is foxi::structure: foxi/structure.hpp.
 #pragma once

@@ -37,8 +37,9 @@ FieldSource read_pvd_source(const std::filesystem::path& path) {
   const std::string bytes = io::read_file(path);
   pugi::xml_document doc;
   const pugi::xml_parse_result ok = doc.load_buffer(bytes.data(), bytes.size());
-  if (!ok) io::fail_text(name, bytes, static_cast<std::size_t>(std::max<std::ptrdiff_t>(ok.offset, 0)),
-                         std::string("not XML: ") + ok.description());
+  if (!ok)
+    io::fail_text(name, bytes, static_cast<std::size_t>(std::max<std::ptrdiff_t>(ok.offset, 0)),
+                  std::string("not XML: ") + ok.description());
   const pugi::xml_node root = doc.child("VTKFile");
   if (!root || std::string(root.attribute("type").as_string()) != "Collection")
     throw IoError(name, 0, IoError::kNoOffset, "not a ParaView collection (<VTKFile type=\"Collection\">)");
@@ -57,8 +58,8 @@ FieldSource read_pvd_source(const std::filesystem::path& path) {
       auto [p, ec] = std::from_chars(ts.data(), ts.data() + ts.size(), t);
       if (ec != std::errc() || p != ts.data() + ts.size()) fail("timestep '" + ts + "' is not a number");
     }
-    const std::filesystem::path fp = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file)
-                                                                               : path.parent_path() / file;
+    const std::filesystem::path fp =
+        std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
     Mesh m = read_mesh(fp);  // an IoError names that file
     if (sets == 0) {
       src.mesh = std::move(m);
@@ -66,12 +67,14 @@ FieldSource read_pvd_source(const std::filesystem::path& path) {
         if (f.step_count() == 1) f.step_values = {t};
     } else {
       if (m.node_count() != src.mesh.node_count() || m.tet != src.mesh.tet || m.xyz != src.mesh.xyz)
-        fail(fp.string() + " has other nodes or tets than the first data set: a series over one mesh is read");
+        fail(fp.string() +
+             " has other nodes or tets than the first data set: a series over one mesh is read");
       for (Field& f : src.mesh.fields) {
         const Field* g = m.find_field(f.name);
         if (!g) fail(fp.string() + " lacks the field " + f.name + " of the first data set");
         if (g->location != f.location || g->components != f.components)
-          fail(fp.string() + ": field " + f.name + " has another location or component count than in the first data set");
+          fail(fp.string() + ": field " + f.name +
+               " has another location or component count than in the first data set");
         if (g->step_count() == 1) {
           f.step_values.push_back(t);
         } else {

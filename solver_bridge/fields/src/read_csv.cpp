@@ -116,16 +116,17 @@ FieldSource parse_csv_source(std::string_view text, const std::string& name) {
       line = text.substr(pos, e - pos);
       pos = e + 1;
       ++line_no;
-      if (!trim(line).empty() && trim(line).front() != '#') return true;  // blank lines and # comments skipped
+      if (!trim(line).empty() && trim(line).front() != '#')
+        return true;  // blank lines and # comments skipped
     }
     return false;
   };
   auto fail = [&](const std::string& why) { throw IoError(name, line_no, IoError::kNoOffset, why); };
   if (text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF") pos = 3;  // a spreadsheet's byte order mark
   if (!next_line()) fail("no header row");
-  const char sep = line.find('\t') != std::string_view::npos   ? '\t'
+  const char sep = line.find('\t') != std::string_view::npos  ? '\t'
                    : line.find(';') != std::string_view::npos ? ';'
-                                                               : ',';
+                                                              : ',';
   std::vector<std::string_view> cells;
   split(line, sep, cells);
   SourceKey key = SourceKey::position;
@@ -136,8 +137,9 @@ FieldSource parse_csv_source(std::string_view text, const std::string& name) {
     SourceKey k = key;
     Column c = classify(cells[i], k);
     if (c.role == Column::key) {
-      if (key_col >= 0) fail("two key columns ('" + std::string(trim(cells[key_col])) + "' and '" +
-                             std::string(trim(cells[i])) + "')");
+      if (key_col >= 0)
+        fail("two key columns ('" + std::string(trim(cells[key_col])) + "' and '" +
+             std::string(trim(cells[i])) + "')");
       key_col = static_cast<int>(i);
       key = k;
     } else if (c.role != Column::value) {
@@ -169,7 +171,8 @@ FieldSource parse_csv_source(std::string_view text, const std::string& name) {
     if (fresh) order.push_back(c.field);
     it->second.first = std::max(it->second.first, c.component + 1);
     if (!c.unit.empty() && !it->second.second.empty() && c.unit != it->second.second)
-      fail("the components of " + c.field + " have different units ('" + it->second.second + "', '" + c.unit + "')");
+      fail("the components of " + c.field + " have different units ('" + it->second.second + "', '" + c.unit +
+           "')");
     if (!c.unit.empty()) it->second.second = c.unit;
   }
   if (order.empty()) fail("no field columns: the header names only the key");
@@ -178,8 +181,9 @@ FieldSource parse_csv_source(std::string_view text, const std::string& name) {
     for (const Column& c : cols)
       if (c.role == Column::value && c.field == f) have[c.component] = true;
     for (std::size_t k = 0; k < have.size(); ++k)
-      if (!have[k]) fail("field " + f + " lacks its component " + std::to_string(k) + " (column " + f + ":" +
-                         std::to_string(k) + ")");
+      if (!have[k])
+        fail("field " + f + " lacks its component " + std::to_string(k) + " (column " + f + ":" +
+             std::to_string(k) + ")");
   }
   std::vector<int> field_of(cols.size(), -1);
   for (std::size_t i = 0; i < cols.size(); ++i)
@@ -195,14 +199,16 @@ FieldSource parse_csv_source(std::string_view text, const std::string& name) {
     split(line, sep, cells);
     if (cells.size() != cols.size())
       fail(std::to_string(cells.size()) + " cells where the header has " + std::to_string(cols.size()));
-    for (std::size_t f = 0; f < order.size(); ++f) values[f].resize(values[f].size() + comps[order[f]].first, kNaN);
+    for (std::size_t f = 0; f < order.size(); ++f)
+      values[f].resize(values[f].size() + comps[order[f]].first, kNaN);
     for (std::size_t i = 0; i < cols.size(); ++i) {
       std::string_view s = trim(cells[i]);
       if (cols[i].role == Column::key) {
         std::uint64_t id = 0;
         auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), id);
         if (s.empty() || ec != std::errc() || p != s.data() + s.size() || id == 0)
-          fail("column " + std::to_string(i + 1) + ": '" + std::string(s) + "' is not an id (a positive integer)");
+          fail("column " + std::to_string(i + 1) + ": '" + std::string(s) +
+               "' is not an id (a positive integer)");
         if (!seen_ids.insert(id).second) fail("id " + std::to_string(id) + " appears twice");
         ids.push_back(id);
         continue;
@@ -240,8 +246,12 @@ FieldSource parse_csv_source(std::string_view text, const std::string& name) {
   if (key == SourceKey::node_id) src.node_id = std::move(ids);
   if (key == SourceKey::cell_id) src.cell_id = std::move(ids);
   for (std::size_t f = 0; f < order.size(); ++f)
-    src.mesh.fields.push_back(Field{order[f], loc, static_cast<std::uint32_t>(comps[order[f]].first),
-                                    comps[order[f]].second, {}, std::move(values[f])});
+    src.mesh.fields.push_back(Field{order[f],
+                                    loc,
+                                    static_cast<std::uint32_t>(comps[order[f]].first),
+                                    comps[order[f]].second,
+                                    {},
+                                    std::move(values[f])});
   return src;
 }
 

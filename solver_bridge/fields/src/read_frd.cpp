@@ -87,7 +87,8 @@ class FrdParser {
     if (pos_ >= text_.size()) return false;
     const char* start = text_.data() + pos_;
     const void* nl = std::memchr(start, '\n', text_.size() - pos_);
-    std::size_t end = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text_.data()) : text_.size();
+    std::size_t end =
+        nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - text_.data()) : text_.size();
     line_ = text_.substr(pos_, end - pos_);
     line_start_ = pos_;
     while (!line_.empty() && (line_.back() == '\r' || line_.back() == ' ')) line_.remove_suffix(1);
@@ -131,8 +132,8 @@ class FrdParser {
       double v = 0;
       auto [q, ec] = std::from_chars(b, e, v);
       if (b == e || (ec != std::errc() && ec != std::errc::result_out_of_range) || q != e)
-        fail("expected a number in columns " + std::to_string(p + 1) + "-" + std::to_string(p + 12) + ", found '" +
-             std::string(line_.substr(p, 12)) + "'");
+        fail("expected a number in columns " + std::to_string(p + 1) + "-" + std::to_string(p + 12) +
+             ", found '" + std::string(line_.substr(p, 12)) + "'");
       out[n++] = v;
     }
     return n;
@@ -175,13 +176,13 @@ class FrdParser {
   std::size_t line_start_ = 0;  // byte offset of line_
   bool binary_seen_ = false;
   FieldSource src_;
-  std::vector<std::uint32_t> dense_;                       // node id -> index (ids up to a few times the count)
+  std::vector<std::uint32_t> dense_;  // node id -> index (ids up to a few times the count)
   std::unordered_map<std::uint64_t, std::uint32_t> sparse_;  // the others
   double step_value_ = 0;
   bool have_step_ = false;
-  int format_ = 1;                                         // of the current result block
-  std::int64_t step_nodes_ = 0;                            // the 100C header's node count (binary records)
-  std::map<std::string, std::size_t> field_of_;            // block name -> index in src_.mesh.fields
+  int format_ = 1;                               // of the current result block
+  std::int64_t step_nodes_ = 0;                  // the 100C header's node count (binary records)
+  std::map<std::string, std::size_t> field_of_;  // block name -> index in src_.mesh.fields
 };
 
 void FrdParser::read_nodes() {
@@ -230,7 +231,8 @@ void FrdParser::read_nodes() {
 
 void FrdParser::index_nodes() {
   // Ids to indices: a table where the ids are dense enough, a hash map for the rest.
-  const std::uint64_t max_id = src_.node_id.empty() ? 0 : *std::max_element(src_.node_id.begin(), src_.node_id.end());
+  const std::uint64_t max_id =
+      src_.node_id.empty() ? 0 : *std::max_element(src_.node_id.begin(), src_.node_id.end());
   const bool dense = max_id <= 4 * src_.node_id.size() + 1024;
   if (dense) dense_.assign(max_id + 1, kNone);
   for (std::size_t i = 0; i < src_.node_id.size(); ++i) {
@@ -310,7 +312,8 @@ void FrdParser::read_results() {
   std::vector<std::string> comp_names;
   std::size_t comps = 0;
   for (std::int64_t c = 0; c < declared; ++c) {
-    if (!next_line() || !starts(" -5")) fail("expected " + std::to_string(declared) + " component lines (' -5')");
+    if (!next_line() || !starts(" -5"))
+      fail("expected " + std::to_string(declared) + " component lines (' -5')");
     const std::int64_t iexist = line_.size() >= 38 ? int_at(33, 5, "component flag") : 0;
     if (iexist != 1) ++comps;
   }
@@ -325,7 +328,8 @@ void FrdParser::read_results() {
   Field* f;
   if (it == field_of_.end()) {
     field_of_.emplace(name, src_.mesh.fields.size());
-    src_.mesh.fields.push_back(Field{name, FieldLocation::node, static_cast<std::uint32_t>(comps), "", {}, {}});
+    src_.mesh.fields.push_back(
+        Field{name, FieldLocation::node, static_cast<std::uint32_t>(comps), "", {}, {}});
     f = &src_.mesh.fields.back();
   } else {
     f = &src_.mesh.fields[it->second];
@@ -378,8 +382,9 @@ void FrdParser::read_results() {
     std::size_t got = values_from(3 + w, out, comps);
     // Values beyond one line continue on " -2" records (6 per line).
     while (got < comps) {
-      if (!next_line() || !starts(" -2")) fail("node " + std::to_string(src_.node_id[i]) + " of block " + name +
-                                              " has " + std::to_string(got) + " values, not " + std::to_string(comps));
+      if (!next_line() || !starts(" -2"))
+        fail("node " + std::to_string(src_.node_id[i]) + " of block " + name + " has " + std::to_string(got) +
+             " values, not " + std::to_string(comps));
       got += values_from(3 + w, out + got, comps - got);
     }
   }
@@ -403,7 +408,8 @@ FieldSource FrdParser::parse() {
       std::string_view f = line_.size() >= 24 ? line_.substr(12, 12) : std::string_view{};
       while (!f.empty() && f.front() == ' ') f.remove_prefix(1);
       auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
-      if (f.empty() || ec != std::errc() || p != f.data() + f.size()) fail("expected the step value in columns 13-24");
+      if (f.empty() || ec != std::errc() || p != f.data() + f.size())
+        fail("expected the step value in columns 13-24");
       step_value_ = v;
       have_step_ = true;
     } else if (starts(" -4")) {

@@ -200,13 +200,16 @@ class PointGrid {
       for (std::int64_t z = c[2] - r; z <= c[2] + r; ++z)
         for (std::int64_t y = c[1] - r; y <= c[1] + r; ++y)
           for (std::int64_t x = c[0] - r; x <= c[0] + r; ++x) {
-            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r) continue;  // the shell only
-            if (x < 0 || y < 0 || z < 0 || x >= frame_.dim[0] || y >= frame_.dim[1] || z >= frame_.dim[2]) continue;
+            if (std::max({std::abs(x - c[0]), std::abs(y - c[1]), std::abs(z - c[2])}) != r)
+              continue;  // the shell only
+            if (x < 0 || y < 0 || z < 0 || x >= frame_.dim[0] || y >= frame_.dim[1] || z >= frame_.dim[2])
+              continue;
             const std::size_t cell = frame_.index(x, y, z);
             for (std::uint32_t i = cells_.start[cell]; i < cells_.start[cell + 1]; ++i) {
               const std::uint32_t s = cells_.items[i];
               double d2 = 0;
-              for (int k = 0; k < 3; ++k) d2 += (xyz_[3 * std::size_t(s) + k] - p[k]) * (xyz_[3 * std::size_t(s) + k] - p[k]);
+              for (int k = 0; k < 3; ++k)
+                d2 += (xyz_[3 * std::size_t(s) + k] - p[k]) * (xyz_[3 * std::size_t(s) + k] - p[k]);
               if (d2 < best_d2 && ok(s)) {
                 best_d2 = d2;
                 best = s;

@@ -32,7 +32,8 @@ double bbox_diagonal(const std::vector<double>& xyz) {
 }
 
 // The source fields asked for, checked against the target.
-std::vector<const Field*> chosen_fields(const FieldSource& src, const Mesh& target, const TransferParams& params) {
+std::vector<const Field*> chosen_fields(const FieldSource& src, const Mesh& target,
+                                        const TransferParams& params) {
   std::vector<const Field*> out;
   if (params.names.empty()) {
     for (const Field& f : src.mesh.fields) out.push_back(&f);
@@ -42,7 +43,8 @@ std::vector<const Field*> chosen_fields(const FieldSource& src, const Mesh& targ
       if (!f) {
         std::string have;
         for (const Field& g : src.mesh.fields) have += (have.empty() ? "" : ", ") + g.name;
-        throw FieldError(src.path + " has no field '" + n + "' (it has: " + (have.empty() ? "none" : have) + ")");
+        throw FieldError(src.path + " has no field '" + n + "' (it has: " + (have.empty() ? "none" : have) +
+                         ")");
       }
       out.push_back(f);
     }
@@ -69,7 +71,8 @@ Field empty_like(const Field& f, std::size_t entities) {
 }
 
 // Copies entity `from` of `f` (all steps) to entity `to` of `g`.
-void copy_entity(const Field& f, std::size_t from, std::size_t n_from, Field& g, std::size_t to, std::size_t n_to) {
+void copy_entity(const Field& f, std::size_t from, std::size_t n_from, Field& g, std::size_t to,
+                 std::size_t n_to) {
   const std::size_t c = f.components;
   for (std::size_t s = 0; s < f.step_count(); ++s)
     std::copy_n(f.values.data() + (s * n_from + from) * c, c, g.values.data() + (s * n_to + to) * c);
@@ -113,8 +116,9 @@ void transfer_by_id(const FieldSource& src, const Mesh& target, const std::vecto
     std::vector<std::uint32_t> map(ids.size());
     for (std::size_t i = 0; i < ids.size(); ++i) {
       if (ids[i] == 0 || ids[i] > count)
-        throw FieldError(src.path + ": " + what + " id " + std::to_string(ids[i]) + " does not exist in the target (" +
-                         std::to_string(count) + " " + what + "s, ids 1.." + std::to_string(count) + ")");
+        throw FieldError(src.path + ": " + what + " id " + std::to_string(ids[i]) +
+                         " does not exist in the target (" + std::to_string(count) + " " + what +
+                         "s, ids 1.." + std::to_string(count) + ")");
       map[i] = static_cast<std::uint32_t>(ids[i] - 1);
     }
     return map;
@@ -123,13 +127,16 @@ void transfer_by_id(const FieldSource& src, const Mesh& target, const std::vecto
     case SourceKey::position: {
       if (src.mesh.node_count() != nn || src.mesh.tet_count() != nt)
         throw FieldError(src.path + " has " + count_text(src.mesh.node_count(), "nodes") + " and " +
-                         count_text(src.mesh.tet_count(), "tets") + ", the target " + count_text(nn, "nodes") +
-                         " and " + count_text(nt, "tets") + ": a field over a different mesh (use --by location)");
+                         count_text(src.mesh.tet_count(), "tets") + ", the target " +
+                         count_text(nn, "nodes") + " and " + count_text(nt, "tets") +
+                         ": a field over a different mesh (use --by location)");
       node_of.resize(nn);
       std::iota(node_of.begin(), node_of.end(), 0u);
       check_coordinates(src, target, node_of, params);
       if (!same_tets(src.mesh, target))
-        throw FieldError(src.path + " has the target's nodes but other tets: a field over a different mesh (use --by location)");
+        throw FieldError(
+            src.path +
+            " has the target's nodes but other tets: a field over a different mesh (use --by location)");
       cell_of = node_of;
       cell_of.resize(nt);
       std::iota(cell_of.begin(), cell_of.end(), 0u);
@@ -153,9 +160,10 @@ void transfer_by_id(const FieldSource& src, const Mesh& target, const std::vecto
         double d = 0;
         for (int k = 0; k < 3; ++k) d = std::max(d, std::abs(target.xyz[3 * std::size_t(t) + k] - p[k]));
         if (!(d <= tol))
-          throw FieldError(src.path + ": row " + std::to_string(i + 1) + " (" + std::to_string(p[0]) + ", " +
-                           std::to_string(p[1]) + ", " + std::to_string(p[2]) +
-                           ") is at no node of the target: values over other points (use --by location with a mesh)");
+          throw FieldError(
+              src.path + ": row " + std::to_string(i + 1) + " (" + std::to_string(p[0]) + ", " +
+              std::to_string(p[1]) + ", " + std::to_string(p[2]) +
+              ") is at no node of the target: values over other points (use --by location with a mesh)");
         node_of[i] = t;
       }
       break;
@@ -163,7 +171,8 @@ void transfer_by_id(const FieldSource& src, const Mesh& target, const std::vecto
   }
   std::vector<char> node_hit(nn, 0), cell_hit(nt, 0);
   for (std::uint32_t t : node_of) {
-    if (node_hit[t]) throw FieldError(src.path + ": two source rows give target node " + std::to_string(t + 1));
+    if (node_hit[t])
+      throw FieldError(src.path + ": two source rows give target node " + std::to_string(t + 1));
     node_hit[t] = 1;
   }
   for (std::uint32_t t : cell_of) cell_hit[t] = 1;
@@ -190,7 +199,9 @@ void transfer_by_id(const FieldSource& src, const Mesh& target, const std::vecto
 struct NodeRegions {
   std::vector<std::uint32_t> start;
   std::vector<std::int32_t> ids;
-  std::span<const std::int32_t> of(std::size_t v) const { return {ids.data() + start[v], ids.data() + start[v + 1]}; }
+  std::span<const std::int32_t> of(std::size_t v) const {
+    return {ids.data() + start[v], ids.data() + start[v + 1]};
+  }
 };
 NodeRegions node_regions(const Mesh& m) {
   NodeRegions r;
@@ -203,13 +214,16 @@ NodeRegions node_regions(const Mesh& m) {
       if (std::find(l.begin(), l.end(), id) == l.end()) l.push_back(id);
     }
   r.start.resize(nn + 1, 0);
-  for (std::size_t v = 0; v < nn; ++v) r.start[v + 1] = r.start[v] + static_cast<std::uint32_t>(lists[v].size());
+  for (std::size_t v = 0; v < nn; ++v)
+    r.start[v + 1] = r.start[v] + static_cast<std::uint32_t>(lists[v].size());
   r.ids.reserve(r.start[nn]);
   for (auto& l : lists) r.ids.insert(r.ids.end(), l.begin(), l.end());
   return r;
 }
 
-bool contains(std::span<const std::int32_t> set, std::int32_t id) { return std::find(set.begin(), set.end(), id) != set.end(); }
+bool contains(std::span<const std::int32_t> set, std::int32_t id) {
+  return std::find(set.begin(), set.end(), id) != set.end();
+}
 
 void transfer_by_location(const FieldSource& src, const Mesh& target, const std::vector<const Field*>& fields,
                           const TransferParams& params, TransferReport& rep) {
@@ -218,7 +232,8 @@ void transfer_by_location(const FieldSource& src, const Mesh& target, const std:
     throw FieldError(src.path + " has no mesh (a table keyed by " +
                      std::string(src.key == SourceKey::cell_id ? "cell ids" : "coordinates") +
                      "): match it with --by id");
-  if (sm.tet_count() == 0) throw FieldError(src.path + " has no tets to locate points in: match it with --by id");
+  if (sm.tet_count() == 0)
+    throw FieldError(src.path + " has no tets to locate points in: match it with --by id");
   for (const Field* f : fields)
     if (src.entity_count(*f) != (f->location == FieldLocation::node ? sm.node_count() : sm.tet_count()))
       throw FieldError(src.path + ": field " + f->name + " does not cover the file's mesh");
@@ -244,18 +259,23 @@ void transfer_by_location(const FieldSource& src, const Mesh& target, const std:
   std::vector<double> node_bary;
   if (any_node) {
     const NodeRegions allowed = regions ? node_regions(target) : NodeRegions{};
-    const NodeRegions source_regions = regions && params.outside == Outside::nearest ? node_regions(sm) : NodeRegions{};
+    const NodeRegions source_regions =
+        regions && params.outside == Outside::nearest ? node_regions(sm) : NodeRegions{};
     node_tet.assign(nn, kNone);
     node_bary.assign(4 * nn, 0);
-    detail::parallel_for(nn, threads, [&](std::size_t b, std::size_t e, unsigned) {
-      for (std::size_t v = b; v < e; ++v) {
-        // A node of no target tet has no region to keep to.
-        auto ok = [&](std::uint32_t t) {
-          return !regions || allowed.of(v).empty() || contains(allowed.of(v), sm.tet_region[t]);
-        };
-        node_tet[v] = grid.locate(&target.xyz[3 * v], params.barycentric_tolerance, ok, &node_bary[4 * v]);
-      }
-    }, 2048);
+    detail::parallel_for(
+        nn, threads,
+        [&](std::size_t b, std::size_t e, unsigned) {
+          for (std::size_t v = b; v < e; ++v) {
+            // A node of no target tet has no region to keep to.
+            auto ok = [&](std::uint32_t t) {
+              return !regions || allowed.of(v).empty() || contains(allowed.of(v), sm.tet_region[t]);
+            };
+            node_tet[v] =
+                grid.locate(&target.xyz[3 * v], params.barycentric_tolerance, ok, &node_bary[4 * v]);
+          }
+        },
+        2048);
     rep.nodes_outside = static_cast<std::size_t>(std::count(node_tet.begin(), node_tet.end(), kNone));
     if (params.outside == Outside::nearest && rep.nodes_outside > 0) {
       const PointGrid pts(sm.xyz);
@@ -282,13 +302,16 @@ void transfer_by_location(const FieldSource& src, const Mesh& target, const std:
         centroid[3 * t + k] = s / 4;
       }
     cell_tet.assign(nt, kNone);
-    detail::parallel_for(nt, threads, [&](std::size_t b, std::size_t e, unsigned) {
-      double bary[4];
-      for (std::size_t t = b; t < e; ++t) {
-        auto ok = [&](std::uint32_t s) { return !regions || sm.tet_region[s] == target.tet_region[t]; };
-        cell_tet[t] = grid.locate(&centroid[3 * t], params.barycentric_tolerance, ok, bary);
-      }
-    }, 2048);
+    detail::parallel_for(
+        nt, threads,
+        [&](std::size_t b, std::size_t e, unsigned) {
+          double bary[4];
+          for (std::size_t t = b; t < e; ++t) {
+            auto ok = [&](std::uint32_t s) { return !regions || sm.tet_region[s] == target.tet_region[t]; };
+            cell_tet[t] = grid.locate(&centroid[3 * t], params.barycentric_tolerance, ok, bary);
+          }
+        },
+        2048);
     rep.cells_outside = static_cast<std::size_t>(std::count(cell_tet.begin(), cell_tet.end(), kNone));
     if (params.outside == Outside::nearest && rep.cells_outside > 0) {
       std::vector<double> source_centroid(3 * sm.tet_count());
@@ -321,7 +344,8 @@ void transfer_by_location(const FieldSource& src, const Mesh& target, const std:
               const double* w = &node_bary[4 * v];
               for (std::size_t k = 0; k < c; ++k) {
                 double sum = 0;
-                for (int j = 0; j < 4; ++j) sum += w[j] * in[std::size_t(sm.tet[4 * std::size_t(t) + j]) * c + k];
+                for (int j = 0; j < 4; ++j)
+                  sum += w[j] * in[std::size_t(sm.tet[4 * std::size_t(t) + j]) * c + k];
                 out[v * c + k] = sum;
               }
             } else if (!node_near.empty() && node_near[v] != kNone) {
@@ -354,7 +378,8 @@ TransferReport transfer_fields(const FieldSource& source, const Mesh& target, co
     transfer_by_location(source, target, fields, params, rep);
   }
   for (const Field& f : rep.fields)
-    rep.nan_values += static_cast<std::size_t>(std::count_if(f.values.begin(), f.values.end(), [](double v) { return std::isnan(v); }));
+    rep.nan_values += static_cast<std::size_t>(
+        std::count_if(f.values.begin(), f.values.end(), [](double v) { return std::isnan(v); }));
   return rep;
 }
 
@@ -365,10 +390,14 @@ PointLocation locate_points(const Mesh& mesh, const std::vector<double>& xyz, do
   r.bary.assign(4 * n, 0);
   if (mesh.tet_count() == 0) return r;
   const TetGrid grid(mesh);
-  detail::parallel_for(n, 0, [&](std::size_t b, std::size_t e, unsigned) {
-    for (std::size_t i = b; i < e; ++i)
-      r.tet[i] = grid.locate(&xyz[3 * i], barycentric_tolerance, [](std::uint32_t) { return true; }, &r.bary[4 * i]);
-  }, 2048);
+  detail::parallel_for(
+      n, 0,
+      [&](std::size_t b, std::size_t e, unsigned) {
+        for (std::size_t i = b; i < e; ++i)
+          r.tet[i] = grid.locate(
+              &xyz[3 * i], barycentric_tolerance, [](std::uint32_t) { return true; }, &r.bary[4 * i]);
+      },
+      2048);
   return r;
 }
 

@@ -8,10 +8,10 @@
 // faceted cylinder keeps its facets, and each region's volume is the PLC's (checked: see
 // CgalMeshReport::volumes_match). Only coplanar facets of one marker and pair of cells that share an
 // edge no other facet meets are one patch (the triangle soup a corefined structure gives, e.g. the ball
-// grid array): the edges between them are no feature of the geometry. With `resample`, facets of one marker and pair of cells form one patch
-// and only the patch borders and the edges where the facets turn by more than `feature_angle` are
-// protected: a faceted cylinder's wall is then one smooth patch, resampled within facet_distance, and
-// the region volumes change (reported per region).
+// grid array): the edges between them are no feature of the geometry. With `resample`, facets of one marker
+// and pair of cells form one patch and only the patch borders and the edges where the facets turn by more
+// than `feature_angle` are protected: a faceted cylinder's wall is then one smooth patch, resampled within
+// facet_distance, and the region volumes change (reported per region).
 //
 // The result is a subset of a regular (weighted Delaunay) triangulation: the tets inside the domain.
 // Every node gets its weight in Mesh::weight (the regular triangulation's point weight, a squared
@@ -21,9 +21,9 @@
 //
 // Regions: each cell of the PLC (component of space minus the facets) takes the id of the first region
 // seed inside it, and each tet the region of the PLC cell its centroid lies in (Mesh_3's own label, by
-// circumcentre, puts flat tets of a thin layer in the next part); enclosed cells with no seed are region 0; the unbounded cell and cells holding a
-// volume hole point are not meshed. Boundary triangles carry their facet's marker. Facets with the same
-// cell on both sides (a membrane inside one region) are not kept.
+// circumcentre, puts flat tets of a thin layer in the next part); enclosed cells with no seed are region 0;
+// the unbounded cell and cells holding a volume hole point are not meshed. Boundary triangles carry their
+// facet's marker. Facets with the same cell on both sides (a membrane inside one region) are not kept.
 #pragma once
 
 #include <cstddef>
@@ -42,24 +42,25 @@ struct CgalMeshParams {
   // Largest tet circumradius (PLC units); 0: a twentieth of the bounding box diagonal. A region seed's
   // max_volume lowers it inside that region (the circumradius of a regular tet of that volume).
   double max_size = 0;
-  double facet_size = 0;       // largest surface Delaunay ball radius; 0: max_size
-  double edge_size = 0;        // largest protecting ball along facet edges; 0: facet_size
+  double facet_size = 0;  // largest surface Delaunay ball radius; 0: max_size
+  double edge_size = 0;   // largest protecting ball along facet edges; 0: facet_size
   // Largest distance of a boundary triangle's circumcentre from the PLC surface: with `resample` it
   // bounds how far a curved-looking surface (a faceted cylinder) is cut inside; 0: facet_size / 20.
   double facet_distance = 0;
   // false (default): every PLC facet edge is protected and region volumes are the PLC's. true: facets
   // are resampled, only patch borders and edges turning by more than feature_angle are protected.
   bool resample = false;
-  double feature_angle = 60;   // degrees between facet normals; used with `resample` only
-  double facet_angle = 25;     // lower bound of boundary triangle angles (degrees, at most 30)
-  double radius_edge = 2;      // circumradius / shortest edge bound of tets (>= 2 guarantees termination)
-  bool exude = true;           // sliver exudation (weight pumping: keeps the triangulation regular)
-  bool perturb = false;        // sliver perturbation before exudation (moves vertices)
+  double feature_angle = 60;  // degrees between facet normals; used with `resample` only
+  double facet_angle = 25;    // lower bound of boundary triangle angles (degrees, at most 30)
+  double radius_edge = 2;     // circumradius / shortest edge bound of tets (>= 2 guarantees termination)
+  bool exude = true;          // sliver exudation (weight pumping: keeps the triangulation regular)
+  bool perturb = false;       // sliver perturbation before exudation (moves vertices)
   // Perturbation and exudation work on tets whose smallest dihedral angle is below this (degrees); 0
   // (CGAL's default) has them improve the worst tet for as long as they can, which on some PLCs (the
   // via example) does not end in minutes.
   double sliver_bound = 12;
-  double optimiser_seconds = 60;  // time limit of each of perturb / exude; 0: none (both also end by time_limit)
+  double optimiser_seconds =
+      60;  // time limit of each of perturb / exude; 0: none (both also end by time_limit)
   // Wall-clock limit of the whole run in seconds; 0: none. Mesh_3 has no bound on its refinement (a
   // thin layer under a wide part asks for millions of tets): past the limit its child process is
   // killed and MesherFailure::time_limit is thrown.
@@ -84,12 +85,14 @@ struct CgalMeshReport {
   std::size_t facet_triangles = 0;  // triangles of the PLC's facets handed to CGAL
   std::size_t patches = 0;          // surface patches of the domain (input polyhedra)
   std::size_t cells = 0;            // meshed cells (regions of space) of the PLC
-  std::size_t coordinates_snapped = 0;  // coordinates made equal to others they differ from by rounding (1e-12 of the extent)
-  std::size_t points_welded = 0;        // points merged into one they coincide with to 1e-12 of the extent
-  std::size_t facets_joined = 0;    // PLC facets in the patch of a coplanar neighbour (see above)
-  std::size_t facets_without_area = 0;  // facets of only segments or points (or collinear): they bound nothing, left out
-  bool resampled = false;           // CgalMeshParams::resample was set
-  double max_size = 0;              // the size bounds used
+  std::size_t coordinates_snapped =
+      0;  // coordinates made equal to others they differ from by rounding (1e-12 of the extent)
+  std::size_t points_welded = 0;  // points merged into one they coincide with to 1e-12 of the extent
+  std::size_t facets_joined = 0;  // PLC facets in the patch of a coplanar neighbour (see above)
+  std::size_t facets_without_area =
+      0;                   // facets of only segments or points (or collinear): they bound nothing, left out
+  bool resampled = false;  // CgalMeshParams::resample was set
+  double max_size = 0;     // the size bounds used
   double facet_size = 0, edge_size = 0, facet_distance = 0;
   // Tets labelled by their centroid's part where Mesh_3's label (its circumcentre's part) differs
   // (see "Regions" above).
@@ -112,6 +115,7 @@ struct CgalMeshReport {
 // Throws MesherError: MesherFailure::bad_input for a PLC or parameters it cannot use (the message names
 // the facet, seed or value), time_limit past params.time_limit, cancelled when params.progress says stop,
 // internal_error for a CGAL failure (the message says which).
-FOXI_API Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params = {}, CgalMeshReport* report = nullptr);
+FOXI_API Mesh mesh_plc_cgal(const Plc& plc, const CgalMeshParams& params = {},
+                            CgalMeshReport* report = nullptr);
 
 }  // namespace foxi

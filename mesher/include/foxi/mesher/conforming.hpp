@@ -31,7 +31,7 @@
 namespace foxi {
 
 struct ConformingParams {
-  std::size_t max_iterations = 12;  // TetGen runs after the first
+  std::size_t max_iterations = 12;        // TetGen runs after the first
   std::size_t max_layer_iterations = 60;  // with thin layers: refinement rounds (one TetGen run each)
   // Surface rounds: when the first mesh is not certified, refine from it by splitting its own surface
   // triangles, TetGen recovering them without refinement of its own (see remesh_plc_first). Certifies
@@ -53,37 +53,37 @@ struct ConformingParams {
   // ... and whose area is at least this many thicknesses squared (thin_layers.hpp: below it TetGen's
   // own refinement meshes the layer at an affordable cost, and the quality bounds hold everywhere).
   double thin_layer_min_area = kThinLayerMinArea;
-  double max_added_fraction = 0.15; // stop once the points added exceed this fraction of the
-                                    // first (-O0) mesh's point count ...
-  std::size_t min_added_budget = 100; // ... or this many, whichever is more (small meshes)
+  double max_added_fraction = 0.15;    // stop once the points added exceed this fraction of the
+                                       // first (-O0) mesh's point count ...
+  std::size_t min_added_budget = 100;  // ... or this many, whichever is more (small meshes)
 };
 
 struct ConformingReport {
-  MeshReport tetgen;                       // the last TetGen run
-  std::size_t first_mesh_points = 0;       // points of the first -O0 mesh
-  std::size_t first_mesh_violations = 0;   // its non-Delaunay tets
-  std::size_t added_points = 0;            // Steiner points added to the PLC for conformity
-  std::size_t iterations = 0;              // TetGen re-runs after the first
-  std::vector<std::size_t> violations;     // non-Delaunay tets after each TetGen run
-  bool delaunay = false;                   // the final mesh passed the exact certificate
+  MeshReport tetgen;                      // the last TetGen run
+  std::size_t first_mesh_points = 0;      // points of the first -O0 mesh
+  std::size_t first_mesh_violations = 0;  // its non-Delaunay tets
+  std::size_t added_points = 0;           // Steiner points added to the PLC for conformity
+  std::size_t iterations = 0;             // TetGen re-runs after the first
+  std::vector<std::size_t> violations;    // non-Delaunay tets after each TetGen run
+  bool delaunay = false;                  // the final mesh passed the exact certificate
   // TetGen 1.5.0 failed on a refined PLC (its segment recovery asserts on some inputs), or its mesh
   // of it lost a region (a region's volume changed): the last good mesh is returned, with that
   // mesh's certificate, and refinement stops.
   bool tetgen_failed = false;
-  double seconds = 0;                      // all TetGen runs, certificates and splits
+  double seconds = 0;  // all TetGen runs, certificates and splits
   // Thin layers (thin_layers.hpp; ConformingParams::thin_layer_aspect): when the PLC has any, TetGen runs
   // without its own refinement (which would fill them with tets as wide as they are thick) and foxi
   // refines for quality and size itself, outside the layers.
   std::vector<ThinLayer> thin_layers;
-  std::size_t thin_layer_tets = 0;         // tets lying in them (exempt from the quality bounds)
-  std::size_t quality_points = 0;          // points foxi added for quality and size
-  std::size_t quality_unmet = 0;           // tets outside the layers still over a bound at the end
+  std::size_t thin_layer_tets = 0;  // tets lying in them (exempt from the quality bounds)
+  std::size_t quality_points = 0;   // points foxi added for quality and size
+  std::size_t quality_unmet = 0;    // tets outside the layers still over a bound at the end
   // Without thin layers: the radius-edge bound (0: none) and the tets of the final mesh over it.
   // TetGen's refinement leaves some near small input angles, and the conformity rounds (surface
   // rounds above all) some next to the boundary points they add.
   double radius_edge_bound = 0;
   std::size_t over_radius_edge = 0;
-  double certificate_seconds = 0;          // of which the certificates
+  double certificate_seconds = 0;  // of which the certificates
   // Rounds that refined the mesh's own surface triangles after TetGen failed on a refined PLC or the
   // conforming rounds ran out (0: none were needed).
   std::size_t surface_rounds = 0;
@@ -95,13 +95,14 @@ struct ConformingReport {
 // "conforming refinement" between runs, fraction = iteration / max_iterations). `refined_plc`, if
 // given, receives the PLC with the added points (after surface rounds: the mesh's surface triangles
 // as facets and all its vertices, TetGen's Steiner points among them).
-FOXI_API Mesh mesh_conforming(const Plc& plc, const MeshParams& params = {}, const ConformingParams& conforming = {},
-                     ConformingReport* report = nullptr, Plc* refined_plc = nullptr);
+FOXI_API Mesh mesh_conforming(const Plc& plc, const MeshParams& params = {},
+                              const ConformingParams& conforming = {}, ConformingReport* report = nullptr,
+                              Plc* refined_plc = nullptr);
 
 // The split points for one mesh of `plc`: for every tet in `violating_tets`, every constraint
 // triangle (mesh.bface) encroached by a vertex inside that tet's circumsphere is split; `plc` gets
 // the points. Returns the number of points added (0: nothing found to split). Exposed for tests.
-FOXI_API std::size_t split_encroached_constraints(const Mesh& mesh, const std::vector<std::uint32_t>& violating_tets,
-                                         Plc& plc);
+FOXI_API std::size_t split_encroached_constraints(const Mesh& mesh,
+                                                  const std::vector<std::uint32_t>& violating_tets, Plc& plc);
 
 }  // namespace foxi

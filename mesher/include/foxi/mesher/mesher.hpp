@@ -14,29 +14,38 @@
 namespace foxi {
 
 enum class MesherFailure : int {
-  cancelled = -1,          // the caller's progress function said stop
-  out_of_memory = 1,       // also: no pipe or process could be made
-  internal_error = 2,      // the mesher failed in a way it does not explain (or its child died)
-  self_intersection = 3,   // the PLC's facets cross
-  feature_too_small = 4,   // a PLC feature below the mesher's tolerance
-  facets_too_close = 5,    // two facets closer than the mesher can separate
-  bad_input = 10,          // a PLC or parameter the mesher refuses; the message names the facet, seed or value
-  time_limit = 20,         // stopped at its time limit (the message states the limit)
-  crashed = 21,            // the mesher's child process died on a signal
+  cancelled = -1,         // the caller's progress function said stop
+  out_of_memory = 1,      // also: no pipe or process could be made
+  internal_error = 2,     // the mesher failed in a way it does not explain (or its child died)
+  self_intersection = 3,  // the PLC's facets cross
+  feature_too_small = 4,  // a PLC feature below the mesher's tolerance
+  facets_too_close = 5,   // two facets closer than the mesher can separate
+  bad_input = 10,         // a PLC or parameter the mesher refuses; the message names the facet, seed or value
+  time_limit = 20,        // stopped at its time limit (the message states the limit)
+  crashed = 21,           // the mesher's child process died on a signal
 };
 
 // A short name of the failure ("bad input", "time limit", ...) for messages.
 inline const char* failure_name(MesherFailure f) {
   switch (f) {
-    case MesherFailure::cancelled: return "cancelled";
-    case MesherFailure::out_of_memory: return "out of memory";
-    case MesherFailure::internal_error: return "internal error";
-    case MesherFailure::self_intersection: return "self-intersecting facets";
-    case MesherFailure::feature_too_small: return "feature too small";
-    case MesherFailure::facets_too_close: return "facets too close";
-    case MesherFailure::bad_input: return "bad input";
-    case MesherFailure::time_limit: return "time limit";
-    case MesherFailure::crashed: return "crashed";
+    case MesherFailure::cancelled:
+      return "cancelled";
+    case MesherFailure::out_of_memory:
+      return "out of memory";
+    case MesherFailure::internal_error:
+      return "internal error";
+    case MesherFailure::self_intersection:
+      return "self-intersecting facets";
+    case MesherFailure::feature_too_small:
+      return "feature too small";
+    case MesherFailure::facets_too_close:
+      return "facets too close";
+    case MesherFailure::bad_input:
+      return "bad input";
+    case MesherFailure::time_limit:
+      return "time limit";
+    case MesherFailure::crashed:
+      return "crashed";
   }
   return "internal error";
 }
@@ -47,11 +56,20 @@ class FOXI_API MesherError : public std::runtime_error {
   MesherError(MesherFailure failure, const std::string& message)
       : std::runtime_error(message), code_(static_cast<int>(failure)) {}
   // A TetGen return code (or another MesherFailure value as an integer).
-  MesherError(int tetgen_code, const std::string& message) : std::runtime_error(message), code_(tetgen_code) {}
+  MesherError(int tetgen_code, const std::string& message)
+      : std::runtime_error(message), code_(tetgen_code) {}
   int tetgen_code() const { return code_; }
   MesherFailure failure() const {
     switch (code_) {
-      case -1: case 1: case 2: case 3: case 4: case 5: case 10: case 20: case 21:
+      case -1:
+      case 1:
+      case 2:
+      case 3:
+      case 4:
+      case 5:
+      case 10:
+      case 20:
+      case 21:
         return static_cast<MesherFailure>(code_);
       default:
         return MesherFailure::internal_error;  // a TetGen code foxi does not know

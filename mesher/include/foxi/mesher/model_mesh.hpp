@@ -70,7 +70,8 @@ FOXI_API void check_tet_estimate(const std::string& file, const Plc& plc, const 
 // The model file `file` with `overrides` to a certified mesh (see the top of this file). Errors:
 // IoError from the model (TetLimitError past the limit), MesherError from the mesher
 // (MesherCancelled when progress says stop).
-FOXI_API MeshedModel mesh_model(const std::filesystem::path& file, std::span<const ParameterOverride> overrides = {},
+FOXI_API MeshedModel mesh_model(const std::filesystem::path& file,
+                                std::span<const ParameterOverride> overrides = {},
                                 const ModelMeshOptions& options = {});
 
 }  // namespace foxi

@@ -12,8 +12,8 @@
 namespace foxi {
 
 // MeshParams with max_volume from model.mesh.max_size (or `default_size` when the model gives none;
-// 0: no limit), radius_edge from model.mesh.quality (when given) and min_dihedral; the region seeds in `plc` of
-// parts with their own size get that part's volume bound. Refinement boxes are not applied here (TetGen
+// 0: no limit), radius_edge from model.mesh.quality (when given) and min_dihedral; the region seeds in `plc`
+// of parts with their own size get that part's volume bound. Refinement boxes are not applied here (TetGen
 // has no box sizes); the result's count of ignored boxes is `ignored_refine_boxes`.
 struct ModelMeshParams {
   MeshParams params;

@@ -45,19 +45,19 @@ struct MeshQualityReport {
   // Thin layers (thin_layers.hpp), exempt from the quality bounds; the shape outside them.
   std::size_t thin_layers = 0, thin_layer_tets = 0;
   double max_radius_edge_outside_layers = 0;
-  std::size_t quality_points = 0;         // added by foxi's own refinement (thin-layer meshes)
-  std::size_t quality_unmet = 0;          // tets outside the layers still over a bound
-  double radius_edge_bound = 0;           // without layers (ConformingReport): the bound, 0: none,
-  std::size_t over_radius_edge = 0;       // and the tets over it
+  std::size_t quality_points = 0;    // added by foxi's own refinement (thin-layer meshes)
+  std::size_t quality_unmet = 0;     // tets outside the layers still over a bound
+  double radius_edge_bound = 0;      // without layers (ConformingReport): the bound, 0: none,
+  std::size_t over_radius_edge = 0;  // and the tets over it
   std::size_t first_mesh_violations = 0;
-  bool delaunay = false;                  // the exact certificate of the final mesh
-  bool tetgen_failed = false;             // refinement stopped where TetGen failed (conforming.hpp)
+  bool delaunay = false;       // the exact certificate of the final mesh
+  bool tetgen_failed = false;  // refinement stopped where TetGen failed (conforming.hpp)
   std::size_t violating_tets = 0;
   double mesh_seconds = 0, certificate_seconds = 0;
 };
 
 FOXI_API MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& conforming,
-                                      const QualityReportParams& params = {});
+                                               const QualityReportParams& params = {});
 
 // Several lines of text, no trailing newline.
 FOXI_API std::string format_quality_report(const MeshQualityReport& report);

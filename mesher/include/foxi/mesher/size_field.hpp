@@ -20,22 +20,22 @@ namespace foxi {
 
 // A sizing function: target edge length (m) at the nodes of a tet mesh, linear inside each tet.
 struct SizeField {
-  std::vector<double> xyz;          // 3 per node
-  std::vector<std::uint32_t> tet;   // 4 per tet
-  std::vector<double> size;         // 1 per node, > 0
+  std::vector<double> xyz;         // 3 per node
+  std::vector<std::uint32_t> tet;  // 4 per tet
+  std::vector<double> size;        // 1 per node, > 0
   bool empty() const { return size.empty(); }
 };
 
 struct RefinementBox {
   double lo[3] = {0, 0, 0};
   double hi[3] = {0, 0, 0};
-  double size = 0;                  // target edge length inside (m)
+  double size = 0;  // target edge length inside (m)
 };
 
 struct SizeControls {
-  double max_size = 0;                        // global target edge length (m); 0: none
-  std::vector<std::int32_t> region_ids;       // per-region target edge lengths: region_ids[i] gets
-  std::vector<double> region_sizes;           //   region_sizes[i] (m)
+  double max_size = 0;                   // global target edge length (m); 0: none
+  std::vector<std::int32_t> region_ids;  // per-region target edge lengths: region_ids[i] gets
+  std::vector<double> region_sizes;      //   region_sizes[i] (m)
   std::vector<RefinementBox> boxes;
 };
 
@@ -59,7 +59,8 @@ struct MeshParams;
 // The boxes (and the global size) as a sizing function over the PLC's domain: meshes `plc` with
 // `params` (no size field), samples the sizes at its nodes, and repeats with that field `passes - 1`
 // more times, so that boxes smaller than the first mesh's tets still get nodes inside.
-FOXI_API SizeField box_size_field(const Plc& plc, const MeshParams& params, const SizeControls& controls, int passes = 2);
+FOXI_API SizeField box_size_field(const Plc& plc, const MeshParams& params, const SizeControls& controls,
+                                  int passes = 2);
 
 // A Zienkiewicz-Zhu error indicator of a P1 node field (scalar, first component, step 0): the
 // recovered gradient at each node is the volume-weighted mean of the gradients of the tets around it;
@@ -68,9 +69,9 @@ FOXI_API SizeField box_size_field(const Plc& plc, const MeshParams& params, cons
 // A tet with a node of no value (NaN, e.g. an imported field outside its source mesh) is left out
 // of the recovery and the norms; its error is NaN, and counted.
 struct ErrorIndicator {
-  std::vector<double> tet_error;   // 1 per tet (NaN: no value)
-  double total_error = 0;          // sqrt of the sum of squares
-  double gradient_norm = 0;        // || grad u ||_L2 over the mesh
+  std::vector<double> tet_error;  // 1 per tet (NaN: no value)
+  double total_error = 0;         // sqrt of the sum of squares
+  double gradient_norm = 0;       // || grad u ||_L2 over the mesh
   std::size_t tets_without_value = 0;
   double relative_error() const { return gradient_norm > 0 ? total_error / gradient_norm : 0; }
 };
@@ -83,7 +84,7 @@ FOXI_API ErrorIndicator zz_error_indicator(const Mesh& mesh, const Field& field)
 // node takes the smallest size among its tets. The mesh itself is the background mesh. Throws
 // MesherError(10) if the field is not a node field of this mesh, has no value on any tet, or
 // target_error <= 0.
-FOXI_API SizeField size_field_from_error(const Mesh& mesh, const Field& field, double target_error, double min_size = 0,
-                                double max_size = 0);
+FOXI_API SizeField size_field_from_error(const Mesh& mesh, const Field& field, double target_error,
+                                         double min_size = 0, double max_size = 0);
 
 }  // namespace foxi

@@ -24,6 +24,7 @@ inline constexpr double kDefaultMaxTets = 4e6;
 // The estimated tet count of meshing `plc` with `params` (its max_volume, the seeds' max_volume and its
 // size_field). `region_volume[r - 1]` is the volume (m^3) of region id r where known (a model's part
 // volumes); empty: the PLC's bounding box stands for the whole domain, under the global bound.
-FOXI_API double estimate_tet_count(const Plc& plc, const MeshParams& params, std::span<const double> region_volume = {});
+FOXI_API double estimate_tet_count(const Plc& plc, const MeshParams& params,
+                                   std::span<const double> region_volume = {});
 
 }  // namespace foxi

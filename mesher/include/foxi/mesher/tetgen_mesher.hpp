@@ -24,11 +24,11 @@ namespace foxi {
 inline constexpr double kMinRadiusEdgeBound = 1.414;
 
 struct MeshParams {
-  double max_volume = 0;      // global maximum tet volume (m^3); 0: none
-  double radius_edge = 1.414; // radius-edge bound for quality refinement; 0: no quality refinement
-  double min_dihedral = 0;    // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
-  bool optimize = false;      // TetGen's flips and smoothing (breaks the Delaunay property)
-  bool regions = true;        // region seeds give tet regions (TetGen -A)
+  double max_volume = 0;       // global maximum tet volume (m^3); 0: none
+  double radius_edge = 1.414;  // radius-edge bound for quality refinement; 0: no quality refinement
+  double min_dihedral = 0;     // minimum dihedral angle bound (degrees, TetGen's -q/<angle>); 0: TetGen's
+  bool optimize = false;       // TetGen's flips and smoothing (breaks the Delaunay property)
+  bool regions = true;         // region seeds give tet regions (TetGen -A)
   // A sizing function (TetGen -m with a background mesh, size_field.hpp); null or empty: none. It must
   // outlive the call.
   const SizeField* size_field = nullptr;
@@ -42,9 +42,9 @@ struct MeshParams {
 };
 
 struct MeshReport {
-  std::string switches;           // the TetGen switches used
+  std::string switches;  // the TetGen switches used
   std::size_t input_points = 0;
-  std::size_t steiner_points = 0; // points TetGen added
+  std::size_t steiner_points = 0;  // points TetGen added
   double seconds = 0;
 };
 

@@ -26,7 +26,7 @@ struct FOXI_API ThinLayer {
   double lo = 0, hi = 0;           // the slab: lo <= normal . p <= hi
   double u_lo = 0, u_hi = 0;       // the overlap rectangle, in u . p and v . p
   double v_lo = 0, v_hi = 0;
-  double tolerance = 0;            // slack on every bound (metres)
+  double tolerance = 0;  // slack on every bound (metres)
 
   bool contains(const double* p) const;
 };
@@ -47,7 +47,7 @@ inline constexpr double kThinLayerMinArea = 1e5;
 // least `min_area` times the thickness squared. A layer that lies inside a larger one is dropped.
 // Facets whose polygons are degenerate are ignored. O(facets^2).
 FOXI_API std::vector<ThinLayer> find_thin_layers(const Plc& plc, double min_aspect = kThinLayerAspect,
-                                        double min_area = kThinLayerMinArea);
+                                                 double min_area = kThinLayerMinArea);
 
 // Whether all four vertices of tet t lie in one of the layers.
 FOXI_API bool tet_in_thin_layer(const Mesh& mesh, std::size_t t, const std::vector<ThinLayer>& layers);

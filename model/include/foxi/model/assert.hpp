@@ -26,8 +26,8 @@ namespace foxi::detail {
 
 [[noreturn]] inline void assertion_failed(const char* condition, const char* file, int line,
                                           const std::string& message) {
-  std::fprintf(stderr, "foxi: internal invariant broken: %s (%s) at %s:%d\n", message.c_str(), condition, file,
-               line);
+  std::fprintf(stderr, "foxi: internal invariant broken: %s (%s) at %s:%d\n", message.c_str(), condition,
+               file, line);
   std::fflush(stderr);
   std::abort();
 }
@@ -35,13 +35,13 @@ namespace foxi::detail {
 }  // namespace foxi::detail
 
 #ifdef FOXI_ASSERT_ACTIVE
-#define FOXI_ASSERT(condition, message)                                                          \
-  do {                                                                                           \
-    if (!(condition)) {                                                                          \
-      std::ostringstream foxi_assert_message_;                                                   \
-      foxi_assert_message_ << message;                                                           \
+#define FOXI_ASSERT(condition, message)                                                             \
+  do {                                                                                              \
+    if (!(condition)) {                                                                             \
+      std::ostringstream foxi_assert_message_;                                                      \
+      foxi_assert_message_ << message;                                                              \
       ::foxi::detail::assertion_failed(#condition, __FILE__, __LINE__, foxi_assert_message_.str()); \
-    }                                                                                            \
+    }                                                                                               \
   } while (0)
 #else
 // Not evaluated; sizeof keeps the names it uses "used" (no unused-variable warnings in Release).

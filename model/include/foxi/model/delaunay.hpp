@@ -19,25 +19,26 @@
 namespace foxi {
 
 struct DelaunayCertificate {
-  bool delaunay = false;                   // true when no tet is violated and none is degenerate
-  bool weighted = false;                   // orthospheres were used
-  std::size_t tets_checked = 0;            // tet_count, fewer when cancelled
-  std::size_t violating_tet_count = 0;     // tets with a vertex strictly inside
+  bool delaunay = false;                      // true when no tet is violated and none is degenerate
+  bool weighted = false;                      // orthospheres were used
+  std::size_t tets_checked = 0;               // tet_count, fewer when cancelled
+  std::size_t violating_tet_count = 0;        // tets with a vertex strictly inside
   std::vector<std::uint32_t> violating_tets;  // their indices, ascending (at most max_listed)
-  std::size_t degenerate_tet_count = 0;    // zero-volume tets (exact predicate), and tets with an index
-                                           // out of range or a non-finite coordinate/weight: no sphere;
-                                           // they make `delaunay` false but are not in violating_*
-  double max_relative_depth = 0;           // max over violations of (r - |q - c|) / r (unweighted)
+  std::size_t degenerate_tet_count = 0;       // zero-volume tets (exact predicate), and tets with an index
+                                              // out of range or a non-finite coordinate/weight: no sphere;
+                                              // they make `delaunay` false but are not in violating_*
+  double max_relative_depth = 0;              // max over violations of (r - |q - c|) / r (unweighted)
   bool cancelled = false;
 };
 
 struct CertificateOptions {
   std::size_t max_listed = 1000;
-  ProgressFn progress;                     // may be empty; returning false cancels. Called on the
-                                           // calling thread only, stage "delaunay certificate"
+  ProgressFn progress;  // may be empty; returning false cancels. Called on the
+                        // calling thread only, stage "delaunay certificate"
 };
 
-FOXI_API DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const CertificateOptions& options = {});
+FOXI_API DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh,
+                                                          const CertificateOptions& options = {});
 // Cached on the mesh (computed with default options).
 FOXI_API const DelaunayCertificate& delaunay_certificate(const Mesh& mesh);
 

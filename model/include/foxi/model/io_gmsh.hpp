@@ -30,13 +30,14 @@
 namespace foxi {
 
 struct GmshWriteOptions {
-  int version = 41;    // 22 or 41
+  int version = 41;  // 22 or 41
   bool binary = true;
 };
 
 FOXI_API Mesh read_gmsh(const std::filesystem::path& path);
 // Parses a whole file held in memory; `name` is used in error messages.
 FOXI_API Mesh parse_gmsh(std::string_view bytes, const std::string& name);
-FOXI_API void write_gmsh(const Mesh& mesh, const std::filesystem::path& path, const GmshWriteOptions& options = {});
+FOXI_API void write_gmsh(const Mesh& mesh, const std::filesystem::path& path,
+                         const GmshWriteOptions& options = {});
 
 }  // namespace foxi

@@ -40,7 +40,7 @@ namespace foxi {
 FOXI_API Mesh read_tetgen(const std::filesystem::path& base);
 // In-memory: the .node and .ele texts are required, .face may be empty; names are for messages.
 FOXI_API Mesh parse_tetgen(std::string_view node_text, std::string_view ele_text, std::string_view face_text,
-                  const std::string& base_name);
+                           const std::string& base_name);
 FOXI_API void write_tetgen(const Mesh& mesh, const std::filesystem::path& base);
 
 }  // namespace foxi

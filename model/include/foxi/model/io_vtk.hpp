@@ -41,7 +41,7 @@ namespace foxi {
 FOXI_API Mesh read_vtu(const std::filesystem::path& path);
 FOXI_API Mesh parse_vtu(std::string_view bytes, const std::string& name);
 FOXI_API void write_vtu(const Mesh& mesh, const std::filesystem::path& path,
-               VtuEncoding encoding = VtuEncoding::appended_raw);
+                        VtuEncoding encoding = VtuEncoding::appended_raw);
 
 FOXI_API Mesh read_vtk_legacy(const std::filesystem::path& path);
 FOXI_API Mesh parse_vtk_legacy(std::string_view bytes, const std::string& name);

@@ -31,27 +31,27 @@ inline constexpr std::uint32_t kNone = 0xffffffffu;
 struct Material {
   static constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
   std::string name;
-  double thermal_conductivity = kUnset;    // W/(m K)
-  double electrical_conductivity = kUnset; // S/m
-  double relative_permittivity = kUnset;   // 1
-  double youngs_modulus = kUnset;          // Pa
-  double poisson_ratio = kUnset;           // 1
-  double thermal_expansion = kUnset;       // 1/K
-  double density = kUnset;                 // kg/m^3 (transient heat: rho c dT/dt)
-  double specific_heat = kUnset;           // J/(kg K), at constant pressure
+  double thermal_conductivity = kUnset;     // W/(m K)
+  double electrical_conductivity = kUnset;  // S/m
+  double relative_permittivity = kUnset;    // 1
+  double youngs_modulus = kUnset;           // Pa
+  double poisson_ratio = kUnset;            // 1
+  double thermal_expansion = kUnset;        // 1/K
+  double density = kUnset;                  // kg/m^3 (transient heat: rho c dT/dt)
+  double specific_heat = kUnset;            // J/(kg K), at constant pressure
 };
 
 // A region (a part, a physical volume group): tets whose tet_region equals `id`.
 struct Region {
   std::int32_t id = 0;
-  std::string name;                   // may be empty
-  std::uint32_t material = kNone;     // index into Mesh::materials, or kNone
+  std::string name;                // may be empty
+  std::uint32_t material = kNone;  // index into Mesh::materials, or kNone
 };
 
 // A named boundary: boundary triangles whose bface_tag equals `tag`.
 struct Boundary {
   std::int32_t tag = 0;
-  std::string name;                   // may be empty
+  std::string name;  // may be empty
 };
 
 enum class FieldLocation : std::uint8_t { node, cell };
@@ -64,15 +64,14 @@ struct Field {
   std::string name;
   FieldLocation location = FieldLocation::node;
   std::uint32_t components = 1;
-  std::string unit;                   // SI unit symbol, may be empty
-  std::vector<double> step_values;    // time or load value of each step; size = step count (>= 1)
+  std::string unit;                 // SI unit symbol, may be empty
+  std::vector<double> step_values;  // time or load value of each step; size = step count (>= 1)
   std::vector<double> values;
 
   std::size_t step_count() const { return step_values.empty() ? 1 : step_values.size(); }
   // Values of one step: entity_count * components doubles.
   std::span<const double> step(std::size_t s, std::size_t entity_count) const {
-    return std::span<const double>(values).subspan(s * entity_count * components,
-                                                   entity_count * components);
+    return std::span<const double>(values).subspan(s * entity_count * components, entity_count * components);
   }
 };
 
@@ -83,28 +82,31 @@ class FOXI_API DerivedCache {
  public:
   DerivedCache() = default;
   DerivedCache(const DerivedCache&) {}
-  DerivedCache& operator=(const DerivedCache&) { data_.reset(); return *this; }
+  DerivedCache& operator=(const DerivedCache&) {
+    data_.reset();
+    return *this;
+  }
   DerivedCache(DerivedCache&&) noexcept = default;
   DerivedCache& operator=(DerivedCache&&) noexcept = default;
   ~DerivedCache();
   void clear() { data_.reset(); }
-  DerivedData& get() const;           // creates the (empty) data on first use
+  DerivedData& get() const;  // creates the (empty) data on first use
  private:
   mutable std::shared_ptr<DerivedData> data_;
 };
 
 struct FOXI_API Mesh {
-  std::vector<double> xyz;                 // 3 per node
-  std::vector<std::uint32_t> tet;          // 4 per tet, positively oriented (see validate.hpp)
-  std::vector<std::int32_t> tet_region;    // 1 per tet (region id), or empty = all region 0
-  std::vector<Region> regions;             // id -> name and material
+  std::vector<double> xyz;               // 3 per node
+  std::vector<std::uint32_t> tet;        // 4 per tet, positively oriented (see validate.hpp)
+  std::vector<std::int32_t> tet_region;  // 1 per tet (region id), or empty = all region 0
+  std::vector<Region> regions;           // id -> name and material
   std::vector<Material> materials;
-  std::vector<std::uint32_t> bface;        // 3 per boundary triangle
-  std::vector<std::int32_t> bface_tag;     // 1 per boundary triangle (boundary tag)
-  std::vector<Boundary> boundaries;        // tag -> name
-  std::vector<double> weight;              // 1 per node (regular triangulation), or empty
+  std::vector<std::uint32_t> bface;     // 3 per boundary triangle
+  std::vector<std::int32_t> bface_tag;  // 1 per boundary triangle (boundary tag)
+  std::vector<Boundary> boundaries;     // tag -> name
+  std::vector<double> weight;           // 1 per node (regular triangulation), or empty
   std::vector<Field> fields;
-  DerivedCache derived;                    // see invalidate_derived()
+  DerivedCache derived;  // see invalidate_derived()
 
   std::size_t node_count() const { return xyz.size() / 3; }
   std::size_t tet_count() const { return tet.size() / 4; }

@@ -24,8 +24,8 @@ enum class MeshFormat { gmsh, vtu, vtk_legacy, tetgen, medit };
 enum class VtuEncoding { ascii, base64, appended_raw, zlib };
 
 struct WriteOptions {
-  bool binary = true;                              // .msh and legacy .vtk
-  int gmsh_version = 41;                           // 22 or 41
+  bool binary = true;     // .msh and legacy .vtk
+  int gmsh_version = 41;  // 22 or 41
   VtuEncoding vtu_encoding = VtuEncoding::appended_raw;
 };
 
@@ -34,6 +34,7 @@ FOXI_API MeshFormat format_from_path(const std::filesystem::path& path);
 FOXI_API const char* format_name(MeshFormat format);
 
 FOXI_API Mesh read_mesh(const std::filesystem::path& path);
-FOXI_API void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
+FOXI_API void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
+                         const WriteOptions& options = {});
 
 }  // namespace foxi

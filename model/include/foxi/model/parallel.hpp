@@ -49,7 +49,8 @@ void parallel_for_balanced(std::size_t n, F f) {
   const std::size_t chunk = std::max<std::size_t>(4096, n / 256);
   std::atomic<std::size_t> next{0};
   auto work = [&](int part) {
-    for (std::size_t b = next.fetch_add(chunk); b < n; b = next.fetch_add(chunk)) f(b, std::min(n, b + chunk), part);
+    for (std::size_t b = next.fetch_add(chunk); b < n; b = next.fetch_add(chunk))
+      f(b, std::min(n, b + chunk), part);
   };
   std::thread other([&] { work(1); });
   work(0);

@@ -21,16 +21,16 @@ struct RegionSeed {
 };
 
 struct FOXI_API Plc {
-  std::vector<double> points;                    // 3 per point
+  std::vector<double> points;  // 3 per point
   // Facets: facet f owns polygons [facet_polygon_begin[f], facet_polygon_begin[f+1]); polygon p owns
   // polygon_vertices[polygon_vertex_begin[p] .. polygon_vertex_begin[p+1]) (0-based point indices).
   std::vector<std::uint32_t> facet_polygon_begin = {0};
   std::vector<std::uint32_t> polygon_vertex_begin = {0};
   std::vector<std::uint32_t> polygon_vertices;
-  std::vector<std::int32_t> facet_marker;        // 1 per facet (0 = unmarked)
+  std::vector<std::int32_t> facet_marker;             // 1 per facet (0 = unmarked)
   std::vector<std::uint32_t> facet_hole_begin = {0};  // hole points inside facets, 3 doubles each
   std::vector<double> facet_holes;
-  std::vector<double> holes;                     // volume hole points, 3 each
+  std::vector<double> holes;  // volume hole points, 3 each
   std::vector<RegionSeed> regions;
 
   std::size_t point_count() const { return points.size() / 3; }

@@ -25,9 +25,9 @@ struct Stat {
 
 struct QualitySummary {
   std::size_t tets = 0;
-  double total_volume = 0;      // sum of |volume|
+  double total_volume = 0;  // sum of |volume|
   Stat volume, radius_edge, min_dihedral_deg;
-  std::size_t slivers = 0;      // min dihedral below 5 degrees
+  std::size_t slivers = 0;  // min dihedral below 5 degrees
 };
 
 // Over every tet whose indices are in range (others skipped; see validate()). Volume statistics are

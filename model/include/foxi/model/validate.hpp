@@ -27,13 +27,13 @@ struct ValidationReport {
   // less than 1e-12 across (the visibility order's error bounds are floats). Volumes, gradients,
   // circumspheres and visibility keys of such tets would be inf, 0, NaN or wrongly bounded.
   std::size_t out_of_range = 0;
-  std::size_t unused_nodes = 0;        // nodes no tet uses
+  std::size_t unused_nodes = 0;  // nodes no tet uses
   // Tets that cover the same space (checked only when nothing above is wrong): faces shared by three
   // or more tets, faces whose two tets lie on the same side (folds), boundary faces that cross, and
   // points covered by two tets (a mesh nested inside another). Such a mesh is not a mesh: the
   // visibility order, the painter and the solvers' assembly all assume each point is in one tet.
   std::size_t overlapping = 0;
-  std::vector<std::string> messages;   // first few problems, human-readable, with element numbers
+  std::vector<std::string> messages;  // first few problems, human-readable, with element numbers
 
   // No error that makes the mesh unusable (unused nodes and inverted tets, which every command
   // re-orients, are only warnings).

@@ -25,7 +25,8 @@ namespace foxi {
 // C3D4 needs). Throws SolverError for the problems solve_thermal rejects (missing conductivity,
 // unknown tags and regions, a boundary triangle that is no tet face) and IoError when the file
 // cannot be written.
-FOXI_API void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params, const std::filesystem::path& inp);
+FOXI_API void write_calculix_thermal(const Mesh& mesh, const ThermalParams& params,
+                                     const std::filesystem::path& inp);
 
 // Writes `mesh` and `params` as a CalculiX linear static thermal-stress deck (SI units): *NODE, C3D4
 // elements per region, *ELASTIC and *EXPANSION per region (params first, then the material), the
@@ -39,7 +40,7 @@ FOXI_API void write_calculix_thermal(const Mesh& mesh, const ThermalParams& para
 // rigid-body check) and for a non-zero displacement along a direction that is no coordinate axis;
 // IoError when the file cannot be written.
 FOXI_API void write_calculix_thermoelastic(const Mesh& mesh, const ThermoelasticParams& params,
-                                  const std::filesystem::path& inp);
+                                           const std::filesystem::path& inp);
 
 // One nodal result block of a CalculiX .frd file ("NDTEMP", "DISP", ...).
 struct FrdBlock {

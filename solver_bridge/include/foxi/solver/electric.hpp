@@ -157,8 +157,9 @@ FOXI_API CurrentReport solve_current(Mesh& mesh, const CurrentParams& params);
 // above): "Kirchhoff" (columns sum to 0 relative to their largest entry; with more than one
 // electrode), "Maxwell signs" and "residual" (the given figure), each against `tolerance`. `flow`
 // names what M carries ("the currents") in the checks' text.
-FOXI_API std::vector<BalanceCheck> maxwell_matrix_checks(const std::vector<std::vector<double>>& m, double residual,
-                                                double tolerance, const std::string& flow);
+FOXI_API std::vector<BalanceCheck> maxwell_matrix_checks(const std::vector<std::vector<double>>& m,
+                                                         double residual, double tolerance,
+                                                         const std::string& flow);
 
 // The Joule heat of each region as total heat sources of a thermal run.
 FOXI_API std::vector<HeatSource> joule_heat_sources(const CurrentReport& report);

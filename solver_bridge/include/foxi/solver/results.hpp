@@ -113,7 +113,7 @@ struct ConvergenceRow {
 };
 // `h`: one size per level (m). Throws std::invalid_argument if sizes and levels differ in number.
 FOXI_API std::vector<ConvergenceRow> convergence_table(const std::vector<RunResults>& levels,
-                                              const std::vector<double>& h);
+                                                       const std::vector<double>& h);
 
 // The observed order p of three values at sizes h0 > h1 > h2: p solves (f2 - f1) / (f1 - f0) =
 // (h2^p - h1^p) / (h1^p - h0^p) (bisection on [0.05, 8]); NaN when there is none.

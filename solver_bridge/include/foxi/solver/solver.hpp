@@ -70,9 +70,9 @@ struct LinearSolverOptions {
   // residual in units of the unknown, so that a row of FR-4 counts as much as a row of copper at a
   // contrast of 1e20; W = I for elasticity.
   double relative_tolerance = 1e-10;
-  std::size_t max_iterations = 0;     // 0: 10 * unknowns + 100
-  unsigned threads = 0;               // 0: std::thread::hardware_concurrency()
-  ProgressFn progress;                // stages "assemble", "factorize", "solve"; false cancels
+  std::size_t max_iterations = 0;  // 0: 10 * unknowns + 100
+  unsigned threads = 0;            // 0: std::thread::hardware_concurrency()
+  ProgressFn progress;             // stages "assemble", "factorize", "solve"; false cancels
 };
 
 }  // namespace foxi

@@ -86,9 +86,9 @@ struct ThermalParams {
 // flux tags q * area, for convection tags the integral of h (T_inf - T).
 struct BoundaryHeat {
   std::int32_t tag = 0;
-  std::string kind;    // "fixed", "flux", "convection"
-  double area = 0;     // m^2
-  double heat_in = 0;  // W
+  std::string kind;             // "fixed", "flux", "convection"
+  double area = 0;              // m^2
+  double heat_in = 0;           // W
   double mean_temperature = 0;  // K, area mean of the surface temperature (a case temperature)
 };
 
@@ -123,9 +123,9 @@ struct ThermalReport {
   std::vector<RegionTemperature> regions;  // one per region with tets, by id
   double max_temperature = 0;              // K
   std::uint32_t max_node = kNone;
-  double total_power = 0;        // W from the sources
-  double imbalance = 0;          // W, sources + heat in through all boundaries (~0)
-  double heat_flow = 0;          // W through the body: the larger of what enters and what leaves
+  double total_power = 0;  // W from the sources
+  double imbalance = 0;    // W, sources + heat in through all boundaries (~0)
+  double heat_flow = 0;    // W through the body: the larger of what enters and what leaves
   // "energy": |imbalance| / heat_flow (or / 1e-9 of the fixed nodes' sum |K_vv T_v| where that is
   // larger: with nothing flowing, the reactions are round-off of those terms)
   std::vector<BalanceCheck> checks;
@@ -153,7 +153,7 @@ FOXI_API ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params);
 // tolerance takes in the imbalance that rounding can make. The solver figures stay 0, `solver` is "given".
 // Throws SolverError as solve_thermal does for `params`, and when `temperature` has the wrong size or no
 // finite value at a node of a tet.
-FOXI_API ThermalReport thermal_report(Mesh& mesh, const ThermalParams& params, std::vector<double> temperature,
-                                      double precision = 0);
+FOXI_API ThermalReport thermal_report(Mesh& mesh, const ThermalParams& params,
+                                      std::vector<double> temperature, double precision = 0);
 
 }  // namespace foxi

@@ -54,7 +54,7 @@ struct PowerWaveform {
             // before the first and after the last point
   };
   Kind kind = Kind::step;
-  double power = 0;  // W
+  double power = 0;              // W
   double width = 0, period = 0;  // s
   std::size_t count = 0;
   std::vector<std::pair<double, double>> table;
@@ -89,8 +89,8 @@ struct TransientParams {
   std::vector<TransientPower> power;
   // Overrides the region's material's density * specific_heat; every region needs one of the two.
   std::vector<RegionHeatCapacity> heat_capacity;
-  double end_time = 0;   // s, > 0
-  std::size_t steps = 0; // dt = end_time / steps
+  double end_time = 0;    // s, > 0
+  std::size_t steps = 0;  // dt = end_time / steps
   TimeScheme scheme = TimeScheme::bdf2;
   // Initial temperature: NaN takes the steady solution with the constant sources only (the device
   // off, in equilibrium with its boundaries: the reference of a JEDEC Zth measurement); a number is a
@@ -117,13 +117,13 @@ struct TransientReport {
   // from it by half the difference of the last and the first steps' energy increments (BDF2's
   // three-level "stored energy" is not sum m T), an O(dt) amount where the temperature still moves.
   double heat_in = 0;
-  double heat_flow = 0;       // J, sum over steps of dt * max(what entered, what left): the check's scale
+  double heat_flow = 0;  // J, sum over steps of dt * max(what entered, what left): the check's scale
   std::vector<BalanceCheck> checks;
-  ThermalReport final;        // the steady solver's report of the last state (regions, boundaries)
+  ThermalReport final;  // the steady solver's report of the last state (regions, boundaries)
   std::string solver;
   std::size_t unknowns = 0;
-  std::size_t iterations = 0;       // CG iterations over all steps
-  double relative_residual = 0;     // largest over the steps, each against its step's whole right-hand side
+  std::size_t iterations = 0;    // CG iterations over all steps
+  double relative_residual = 0;  // largest over the steps, each against its step's whole right-hand side
   double setup_seconds = 0, solve_seconds = 0;
 };
 

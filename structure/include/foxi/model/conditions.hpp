@@ -101,8 +101,8 @@ struct RefineBox {
 };
 
 struct ModelMeshControls {
-  double max_size = 0;   // m, edge length; 0: none
-  double quality = -1;   // radius-edge bound; negative: the mesher's default
+  double max_size = 0;      // m, edge length; 0: none
+  double quality = -1;      // radius-edge bound; negative: the mesher's default
   double min_dihedral = 0;  // degrees; 0: the mesher's default
   std::vector<PartSize> part_sizes;
   std::vector<RefineBox> refine;

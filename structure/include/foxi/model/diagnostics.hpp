@@ -67,7 +67,7 @@ struct DiagnosticsParams {
 // conductivity, permittivity, electrical conductivity; Young's modulus): a part that does not is left
 // out of that physics' groups and joins nothing.
 FOXI_API ModelDiagnostics diagnose_model(const Model& model, const Structure& structure,
-                                const DiagnosticsParams& params = {});
+                                         const DiagnosticsParams& params = {});
 
 // The warnings of `d` that concern `physics`: isolated and overhang, and no_fixed_value of `physics`.
 FOXI_API std::vector<ModelWarning> warnings_for(const ModelDiagnostics& d, Physics physics);

@@ -43,14 +43,14 @@ namespace foxi {
 // TOML parser, CGAL or GMP (stack depth, overflow, degenerate geometry) and from hanging the structure
 // builder or the mesher (counts).
 namespace model_limits {
-inline constexpr std::uintmax_t kFileBytes = 4u << 20;  // a model or materials library file
-inline constexpr std::uintmax_t kStlBytes = 64u << 20;  // an STL file
-inline constexpr std::size_t kLineBytes = 64u << 10;  // a line of a model or library file
-inline constexpr int kTomlDepth = 32;             // nested arrays, inline tables and dotted key parts
-inline constexpr std::size_t kParameterChain = 64;  // parameters whose values need each other, in a row
-inline constexpr std::size_t kParts = 1000;         // parts (each layer of a stack counts)
-inline constexpr long kArrayItems = 10000;          // nx * ny of one array
-inline constexpr long kSegments = 1000;             // of a cylinder
+inline constexpr std::uintmax_t kFileBytes = 4u << 20;    // a model or materials library file
+inline constexpr std::uintmax_t kStlBytes = 64u << 20;    // an STL file
+inline constexpr std::size_t kLineBytes = 64u << 10;      // a line of a model or library file
+inline constexpr int kTomlDepth = 32;                     // nested arrays, inline tables and dotted key parts
+inline constexpr std::size_t kParameterChain = 64;        // parameters whose values need each other, in a row
+inline constexpr std::size_t kParts = 1000;               // parts (each layer of a stack counts)
+inline constexpr long kArrayItems = 10000;                // nx * ny of one array
+inline constexpr long kSegments = 1000;                   // of a cylinder
 inline constexpr std::size_t kOutlinePoints = 2000;       // of an extrusion
 inline constexpr std::size_t kOutlineVertices = 100000;   // of all prisms (array items included)
 inline constexpr std::size_t kSurfaceTriangles = 200000;  // of all balls and STL surfaces
@@ -60,8 +60,8 @@ inline constexpr double kMinExtent = 1e-9;      // m: the model's extent (larges
 inline constexpr double kMinFeature = 1e-6;     // times the extent: every edge, height and ball radius
 }  // namespace model_limits
 
-// A vertical prism: a simple (convex or not) counter-clockwise polygon in xy (2 doubles per vertex, metres) extruded
-// over z in [z0, z1].
+// A vertical prism: a simple (convex or not) counter-clockwise polygon in xy (2 doubles per vertex, metres)
+// extruded over z in [z0, z1].
 struct FOXI_API Prism {
   std::vector<double> xy;
   double z0 = 0, z1 = 0;
@@ -88,14 +88,14 @@ struct Parameter {
 struct Model {
   std::string file;
   std::string length_unit = "m";
-  double length_scale = 1;            // metres per length unit
-  std::vector<Parameter> parameters;  // sorted by name
-  std::vector<Material> materials;    // those the parts use, in order of first use
-  std::vector<Part> parts;            // layer stacks expanded; region id of parts[i] = i + 1
-  std::vector<SurfaceSelector> surfaces;       // [surfaces], in name order
-  std::vector<BoundaryCondition> conditions;   // [[conditions]], in file order
-  std::vector<Load> loads;                     // [[loads]], in file order
-  ModelMeshControls mesh;                      // [mesh]
+  double length_scale = 1;                    // metres per length unit
+  std::vector<Parameter> parameters;          // sorted by name
+  std::vector<Material> materials;            // those the parts use, in order of first use
+  std::vector<Part> parts;                    // layer stacks expanded; region id of parts[i] = i + 1
+  std::vector<SurfaceSelector> surfaces;      // [surfaces], in name order
+  std::vector<BoundaryCondition> conditions;  // [[conditions]], in file order
+  std::vector<Load> loads;                    // [[loads]], in file order
+  ModelMeshControls mesh;                     // [mesh]
 };
 
 // A parameter replaced from outside the model file (a host's input, a command-line option): the
@@ -107,14 +107,14 @@ struct ParameterOverride {
 };
 
 // Loads a model file. `overrides` replace the parameters of their names; `origin` names where they
-// came from in messages ("parameter 'w' (from ORIGIN): ...", "ORIGIN: unknown parameter 'w'"). Throws IoError (file, line when known, and a reason naming the entity: parameter, part,
-// material) for TOML syntax errors, unknown parameters, unit mismatches, circular expressions,
-// sizes that are not positive, unknown materials, and unknown shapes or keys; for conditions and
-// loads: unknown types, units that do not fit the type, surfaces that name no part face, interface or
-// [surfaces] entry, unknown parts; for numbers that are not finite, and models past model_limits
-// (degenerate geometry included: a feature below kMinFeature of the model's extent). Referenced files
-// (library, STL) are named relative to the model's folder, must be regular files of the expected kind,
-// and their content is never quoted in an error.
+// came from in messages ("parameter 'w' (from ORIGIN): ...", "ORIGIN: unknown parameter 'w'"). Throws IoError
+// (file, line when known, and a reason naming the entity: parameter, part, material) for TOML syntax errors,
+// unknown parameters, unit mismatches, circular expressions, sizes that are not positive, unknown materials,
+// and unknown shapes or keys; for conditions and loads: unknown types, units that do not fit the type,
+// surfaces that name no part face, interface or [surfaces] entry, unknown parts; for numbers that are not
+// finite, and models past model_limits (degenerate geometry included: a feature below kMinFeature of the
+// model's extent). Referenced files (library, STL) are named relative to the model's folder, must be regular
+// files of the expected kind, and their content is never quoted in an error.
 FOXI_API Model load_model(const std::filesystem::path& path, std::span<const ParameterOverride> overrides,
                           std::string_view origin = "an override");
 // The same with the overrides written "name=expression" (IoError, line 0, for one without a name

@@ -50,7 +50,7 @@ constexpr int kMaxExpressionDepth = 64;
 // parameter 'x'") unit mismatches ("unit mismatch: m + K")
 // and expressions past the limits above; `lookup` may throw its own errors.
 FOXI_API Quantity evaluate_expression(std::string_view text,
-                             const std::function<std::optional<Quantity>(std::string_view)>& lookup);
+                                      const std::function<std::optional<Quantity>(std::string_view)>& lookup);
 
 // `text` (an expression with units, no parameters) in SI, checked to have the dimension of `unit`
 // (itself an expression: "W", "W/(m*K)", "V", "1/K"); a bare number is taken as SI. E.g. "3 W",
@@ -66,7 +66,8 @@ enum class TemperatureKind : std::uint8_t { absolute, difference };
 // or an expression followed by degC or °C ("25 degC", "25degC", "25 °C"). Throws
 // ExpressionError on other units (naming K and degC), on degC inside an expression, and (absolute)
 // on a value not above absolute zero.
-FOXI_API double evaluate_temperature(std::string_view text, TemperatureKind kind,
-                            const std::function<std::optional<Quantity>(std::string_view)>& lookup = {});
+FOXI_API double evaluate_temperature(
+    std::string_view text, TemperatureKind kind,
+    const std::function<std::optional<Quantity>(std::string_view)>& lookup = {});
 
 }  // namespace foxi

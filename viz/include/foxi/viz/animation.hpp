@@ -34,8 +34,10 @@ class FOXI_API AnimationWriter {
 };
 
 // APNG (.apng or .png; readers without APNG support show the first frame).
-FOXI_API std::unique_ptr<AnimationWriter> open_apng(const std::filesystem::path& path, const AnimationParams& params);
+FOXI_API std::unique_ptr<AnimationWriter> open_apng(const std::filesystem::path& path,
+                                                    const AnimationParams& params);
 // GIF89a with a NETSCAPE2.0 loop extension.
-FOXI_API std::unique_ptr<AnimationWriter> open_gif(const std::filesystem::path& path, const AnimationParams& params);
+FOXI_API std::unique_ptr<AnimationWriter> open_gif(const std::filesystem::path& path,
+                                                   const AnimationParams& params);
 
 }  // namespace foxi

@@ -29,7 +29,8 @@ struct Camera {
 FOXI_API void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
 // Axis-aligned bounds of the corners of the tets in `subset` (tet indices < tet_count); an empty
 // subset: mesh_bounds. What a camera is fitted to when only part of a mesh is drawn.
-FOXI_API void tets_bounds(const Mesh& mesh, std::span<const std::uint32_t> subset, double lo[3], double hi[3]);
+FOXI_API void tets_bounds(const Mesh& mesh, std::span<const std::uint32_t> subset, double lo[3],
+                          double hi[3]);
 
 // A camera looking along `dir` (from the eye into the scene) at the centre of the box [lo, hi], far
 // enough that the box's 8 corners project within `fill` (0..1] of the half-width and half-height of
@@ -37,7 +38,8 @@ FOXI_API void tets_bounds(const Mesh& mesh, std::span<const std::uint32_t> subse
 // Perspective with vertical field of view `fov_deg`, or orthographic. `up` is used as given when not parallel
 // to dir, else another axis is chosen.
 FOXI_API Camera fit_camera(const double lo[3], const double hi[3], const double dir[3], const double up[3],
-                  bool perspective = true, double fov_deg = 30, double aspect = 1, double fill = 0.95);
+                           bool perspective = true, double fov_deg = 30, double aspect = 1,
+                           double fill = 0.95);
 
 // The camera the front ends (foxi render, foxi-view) build from partly given options, so that they
 // agree: any of eye, at, up, dir may be null (not given); fov_deg <= 0 means 30 degrees; up defaults
@@ -45,7 +47,7 @@ FOXI_API Camera fit_camera(const double lo[3], const double hi[3], const double 
 // from an oblique direction (front-right, above); `at` replaces the target and `eye` the eye; with
 // `at` but no `eye` the fitted eye's offset from the box centre is kept.
 FOXI_API Camera camera_from_options(const double lo[3], const double hi[3], double aspect, const double* eye,
-                           const double* at, const double* up, double fov_deg, const double* dir);
+                                    const double* at, const double* up, double fov_deg, const double* dir);
 
 // Turns the eye about `at`: by yaw_deg about the up axis, then by pitch_deg about the right axis.
 // Up is kept (re-orthogonalised). Distance to `at` is unchanged.
@@ -82,8 +84,8 @@ struct FOXI_API Projector {
 // coordinates in the tet's node order, the point the pixel shows of that tet (unshrunk). The ray is
 // clamped to the tet where it passes just outside it (a pixel centre past an edge the tet was
 // rasterized on). False if the camera is degenerate or the ray runs the other way.
-FOXI_API bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height, std::uint32_t t,
-                                 int x, int y, double bary[4]);
+FOXI_API bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height,
+                                 std::uint32_t t, int x, int y, double bary[4]);
 
 // The ordering viewpoint of a camera: perspective -> View::at(eye), orthographic -> View::along(at - eye).
 FOXI_API View view_of(const Camera& camera);

@@ -33,7 +33,7 @@ struct ChartAxis {
 };
 
 struct ChartSeries {
-  std::string name;  // in the legend; a chart whose series are all unnamed has no legend
+  std::string name;          // in the legend; a chart whose series are all unnamed has no legend
   std::vector<double> x, y;  // the same length
   std::uint32_t color = 0;   // 0: the palette's colour for the series' index (chart_color)
   bool line = true;          // join consecutive points
@@ -59,7 +59,7 @@ struct ChartParams {
 
 // What draw_chart drew, and its axis mapping (for tests, and for hosts that pick points).
 struct ChartReport {
-  PixelRect plot;                   // the frame's inside: the data's pixels
+  PixelRect plot;                                 // the frame's inside: the data's pixels
   double x_lo = 0, x_hi = 1, y_lo = 0, y_hi = 1;  // the axes' ranges (data units)
   bool x_log = false, y_log = false;
   std::vector<double> x_ticks, y_ticks;  // ascending

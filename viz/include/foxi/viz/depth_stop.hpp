@@ -20,7 +20,7 @@ FOXI_API double tet_depth(const SphereTable& table, const Camera& camera, std::u
 
 // How many tets of a back-to-front order come before the first one whose depth is below d: drawing
 // that many stops at depth d. The whole order if none is.
-FOXI_API std::size_t count_deeper(const SphereTable& table, const Camera& camera, std::span<const std::uint32_t> order,
-                         double d);
+FOXI_API std::size_t count_deeper(const SphereTable& table, const Camera& camera,
+                                  std::span<const std::uint32_t> order, double d);
 
 }  // namespace foxi

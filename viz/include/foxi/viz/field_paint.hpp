@@ -28,7 +28,8 @@ struct FOXI_API FieldSelectError : std::invalid_argument {
 // Which scalar of a field: a component index, or a derived quantity.
 struct FieldScalar {
   enum class Kind : std::uint8_t { component, magnitude, von_mises, principal } kind = Kind::component;
-  std::uint32_t component = 0;  // Kind::component: the index; Kind::principal: 0 largest, 1 middle, 2 smallest
+  std::uint32_t component =
+      0;  // Kind::component: the index; Kind::principal: 0 largest, 1 middle, 2 smallest
 };
 
 // "NAME" or "NAME:COMPONENT" against the field's component count. COMPONENT: an index 0..n-1;
@@ -45,23 +46,26 @@ FOXI_API FieldChoice choose_field(const Mesh& mesh, std::string_view spec);
 
 // The scalar at each of the field's entities (nodes or tets) in step `step` (FieldSelectError if
 // out of range): SI, NaN where the field has NaN.
-FOXI_API std::vector<double> field_scalar_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+FOXI_API std::vector<double> field_scalar_values(const Mesh& mesh, const FieldChoice& choice,
+                                                 std::size_t step = 0);
 
 // The scalar at each tet's centroid: a node field's components interpolated linearly (the mean of
 // the 4 corners) before taking the scalar; a cell field's own value.
-FOXI_API std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+FOXI_API std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& choice,
+                                                 std::size_t step = 0);
 
 // The scalar at each tet's 4 corners (4 per tet, in the tet's node order): a node field's value at
 // the node; a cell field averaged to the node over the tets of the SAME region only (volume-weighted
 // components, then the scalar), so values never blend across a material interface.
-FOXI_API std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step = 0);
+FOXI_API std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice,
+                                               std::size_t step = 0);
 
 // The scalar at one point of tet `t` with barycentric coordinates bary[0..4) (its corners in the
 // tet's node order; foxi::locate_points gives them): a node field's components interpolated linearly
 // before taking the scalar (exact for a component of a field linear over the tet), a cell field the
 // tet's own value. NaN where a value it uses is NaN. For probes and line plots.
-FOXI_API double field_value_in_tet(const Mesh& mesh, const FieldChoice& choice, std::size_t t, const double bary[4],
-                                   std::size_t step = 0);
+FOXI_API double field_value_in_tet(const Mesh& mesh, const FieldChoice& choice, std::size_t t,
+                                   const double bary[4], std::size_t step = 0);
 
 // The deformed shape: moves each node of `mesh` by scale x the 3-component node field `name` (a
 // displacement) in step `step` (-1: the last), and drops the mesh's derived data, its certificate

@@ -30,8 +30,8 @@ FOXI_API std::vector<std::uint32_t> threshold_tets(std::span<const double> tet_v
 
 // Crinkle clip: the tets whose centroid lies on the side the normal points away from (n . (c - p) <= 0;
 // the normal points to the part cut away, as ParaView's clip keeps the inside), whole, ascending. With
-// a subset, only its tets are considered (the clip of a threshold, ...), in its order. Throws std::invalid_argument
-// for a zero or non-finite normal.
+// a subset, only its tets are considered (the clip of a threshold, ...), in its order. Throws
+// std::invalid_argument for a zero or non-finite normal.
 FOXI_API std::vector<std::uint32_t> clip_tets(const Mesh& mesh, const Plane& plane,
                                               std::span<const std::uint32_t> subset = {});
 

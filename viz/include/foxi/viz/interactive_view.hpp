@@ -37,7 +37,8 @@ class FOXI_API InteractiveView {
   // The mesh is lent and must outlive the viewer. Computes the Delaunay certificate and the sphere
   // table once; nothing is drawn until restart(). params.undoable: the painter records what undraw
   // needs (false: cheaper drawing, and set_undrawing refuses).
-  InteractiveView(const Mesh& mesh, const Camera& camera, int width, int height, const RenderParams& params = {});
+  InteractiveView(const Mesh& mesh, const Camera& camera, int width, int height,
+                  const RenderParams& params = {});
   ~InteractiveView();
   InteractiveView(const InteractiveView&) = delete;
   InteractiveView& operator=(const InteractiveView&) = delete;
@@ -143,8 +144,8 @@ class FOXI_API InteractiveView {
   std::vector<PixelRect> damage_;  // see take_damage: per band of 16 rows (x0 > x1: none)
   void add_damage(std::span<const PixelRect> rects);
   void damage_all();
-  std::vector<std::uint32_t> drawn_;    // the prefix of handed_ on the screen
-  std::vector<std::uint32_t> handed_;   // the order as far as it has been handed out
+  std::vector<std::uint32_t> drawn_;   // the prefix of handed_ on the screen
+  std::vector<std::uint32_t> handed_;  // the order as far as it has been handed out
   bool done_ = true, running_ = true, started_ = false, undrawing_ = false;
   double frame_ms_ = 0, step_ms_ = 0;
   std::size_t generation_ = 0;

@@ -32,8 +32,8 @@ namespace foxi {
 struct IsoPolygon {
   int count = 0;
   double xyz[4][3] = {};
-  double attr[4] = {};    // an attribute interpolated the same way (iso_polygon's attr), else 0
-  double hot[3] = {};     // unit normal of the polygon's plane, toward increasing value (0 if degenerate)
+  double attr[4] = {};  // an attribute interpolated the same way (iso_polygon's attr), else 0
+  double hot[3] = {};   // unit normal of the polygon's plane, toward increasing value (0 if degenerate)
 };
 
 // corner: the tet's 4 corner values (in the tet's node order); attr: 4 more values to interpolate at the
@@ -71,8 +71,8 @@ class FOXI_API TetIntervals {
   };
   std::size_t tet_count_ = 0;
   std::vector<Node> nodes_;
-  std::vector<Entry> by_min_;  // per node: its intervals by increasing min
-  std::vector<Entry> by_max_;  // per node: the same intervals by decreasing max
+  std::vector<Entry> by_min_;      // per node: its intervals by increasing min
+  std::vector<Entry> by_max_;      // per node: the same intervals by decreasing max
   std::vector<Entry> max_sorted_;  // all finite tets by increasing max (reaching())
 };
 
@@ -102,12 +102,12 @@ struct IsoParams {
 // its tet's place, so the picture is right without a depth buffer, and the order may be handed over in
 // batches (progressive; stop at any batch). The polygons of one tet are drawn far to near. RenderParams:
 // depth_buffer switches to the depth-buffer mode (the test oracle: nearest wins; fb needs a depth
-// buffer); the rest is for the whole tets of cap mode. Polygons are drawn on the calling thread. Polygons are clipped at the near plane. Each
-// pixel's id is the tet whose polygon it shows. Undoable (RenderParams::undoable, painter mode only):
-// undraw(fb, k) takes back the last k tets handed to draw(), leaving fb pixel for pixel as it was before
-// they were drawn (fb must not be changed in between); each tet drawn here keeps the pixels its
-// polygons overwrote (12 bytes a pixel write), the whole tets of cap mode are undrawn by the tet
-// painter's own undo. The mesh and the value spans are lent and must outlive it.
+// buffer); the rest is for the whole tets of cap mode. Polygons are drawn on the calling thread. Polygons are
+// clipped at the near plane. Each pixel's id is the tet whose polygon it shows. Undoable
+// (RenderParams::undoable, painter mode only): undraw(fb, k) takes back the last k tets handed to draw(),
+// leaving fb pixel for pixel as it was before they were drawn (fb must not be changed in between); each tet
+// drawn here keeps the pixels its polygons overwrote (12 bytes a pixel write), the whole tets of cap mode are
+// undrawn by the tet painter's own undo. The mesh and the value spans are lent and must outlive it.
 class FOXI_API IsoPainter {
  public:
   // corner: 4 values per tet of the field the isovalues apply to; attr: 4 per tet colouring the

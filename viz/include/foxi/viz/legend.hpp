@@ -45,12 +45,13 @@ struct LegendReport {
 FOXI_API int legend_min_height(const LegendParams& params = {});
 
 // The width a legend needs (pixels) at these parameters.
-FOXI_API int legend_width(const TextRenderer& text, const ColorLegend& legend, const LegendParams& params = {});
+FOXI_API int legend_width(const TextRenderer& text, const ColorLegend& legend,
+                          const LegendParams& params = {});
 
 // Draws the legend into `area` of fb (filled with the background first; area inside the image and at
 // least legend_width wide). Throws std::invalid_argument if the area is too small for a bar.
 FOXI_API LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& legend,
-                               PixelRect area, const LegendParams& params = {});
+                                        PixelRect area, const LegendParams& params = {});
 
 // A tick label: the value with as many decimals as the step between ticks needs (%g beyond 1e6 or
 // below 1e-3 in magnitude).

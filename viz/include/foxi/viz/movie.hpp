@@ -21,18 +21,18 @@
 namespace foxi {
 
 struct MovieParams {
-  bool rotate = false;  // false: back-and-forth; true: rotating view
-  int frames = 48;      // frames per cycle (>= 2); back-and-forth: half drawing, half undrawing
-  int cycles = 1;       // cycles (>= 1)
-  double from = 0;      // back-and-forth: fraction of the order drawn at the low turning point
-  double to = 1;        // fraction drawn at the high turning point (rotate: drawn in every frame)
+  bool rotate = false;    // false: back-and-forth; true: rotating view
+  int frames = 48;        // frames per cycle (>= 2); back-and-forth: half drawing, half undrawing
+  int cycles = 1;         // cycles (>= 1)
+  double from = 0;        // back-and-forth: fraction of the order drawn at the low turning point
+  double to = 1;          // fraction drawn at the high turning point (rotate: drawn in every frame)
   double turn_deg = 360;  // rotate: total yaw over one cycle
   RenderParams render;    // painter settings (undoable is set for back-and-forth)
 };
 
 struct MovieStats {
   std::size_t frames = 0;
-  std::size_t tets_drawn = 0;    // tets drawn over the whole movie (redraws counted again)
+  std::size_t tets_drawn = 0;  // tets drawn over the whole movie (redraws counted again)
   std::size_t tets_undrawn = 0;
   std::size_t max_undo_bytes = 0;  // largest memory held for undraw
 };
@@ -47,7 +47,8 @@ struct FOXI_API MovieCancelled : std::runtime_error, Cancelled {
 // with the depth buffer instead).
 struct FOXI_API UncertifiedMeshError : std::invalid_argument {
   UncertifiedMeshError()
-      : std::invalid_argument("the mesh fails the Delaunay certificate: it has no visibility order to make a movie with") {}
+      : std::invalid_argument(
+            "the mesh fails the Delaunay certificate: it has no visibility order to make a movie with") {}
 };
 
 // Calls frame(fb) for each frame, in order. Back-and-forth frame k of a cycle of F frames shows the
@@ -57,8 +58,9 @@ struct FOXI_API UncertifiedMeshError : std::invalid_argument {
 // turn_deg k / F. subset: tets to show (empty = all). Throws UncertifiedMeshError before any frame for a mesh
 // without the visibility-order guarantee (delaunay.hpp's cached certificate), std::invalid_argument
 // for bad parameters, MovieCancelled when progress returns false.
-FOXI_API MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& camera, int width, int height,
-                      std::span<const std::uint32_t> subset, const MovieParams& params,
-                      const std::function<void(const Framebuffer&)>& frame, const ProgressFn& progress = {});
+FOXI_API MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const Camera& camera, int width,
+                               int height, std::span<const std::uint32_t> subset, const MovieParams& params,
+                               const std::function<void(const Framebuffer&)>& frame,
+                               const ProgressFn& progress = {});
 
 }  // namespace foxi

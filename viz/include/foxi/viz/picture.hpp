@@ -62,13 +62,13 @@ struct PictureParams {
 struct PictureReport {
   bool delaunay = false;  // the mesh passed the certificate
   OrderMethod method = OrderMethod::power;
-  bool depth_buffer = false;       // drawn with the depth buffer (uncertified, or asked for)
-  std::size_t tets_ordered = 0;    // the tets selected (the subset, or all)
-  std::size_t tets_drawn = 0;      // the prefix of the order drawn (after the stops)
-  std::size_t cycles_broken = 0;   // MPVO only
+  bool depth_buffer = false;         // drawn with the depth buffer (uncertified, or asked for)
+  std::size_t tets_ordered = 0;      // the tets selected (the subset, or all)
+  std::size_t tets_drawn = 0;        // the prefix of the order drawn (after the stops)
+  std::size_t cycles_broken = 0;     // MPVO only
   std::uint32_t last_drawn = kNone;  // the last tet drawn (the nearest), kNone if none
-  RasterStats raster;              // tets behind the eye, faces clipped
-  double certificate_ms = 0;       // 0 when the mesh's certificate was already cached
+  RasterStats raster;                // tets behind the eye, faces clipped
+  double certificate_ms = 0;         // 0 when the mesh's certificate was already cached
   double order_ms = 0, draw_ms = 0;
 };
 
@@ -76,7 +76,7 @@ struct PictureReport {
 // depth buffer exactly when the depth buffer is used. Throws std::invalid_argument for a stop
 // fraction outside [0, 1], a NaN stop depth, an empty framebuffer, a table of another mesh, and what
 // TetRasterizer throws (degenerate camera).
-FOXI_API PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera, Framebuffer& fb,
-                                    const PictureParams& params = {});
+FOXI_API PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera,
+                                    Framebuffer& fb, const PictureParams& params = {});
 
 }  // namespace foxi

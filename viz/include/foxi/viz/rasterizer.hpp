@@ -43,7 +43,7 @@ struct RenderParams {
   // Colour of region id r (opaque RGBA, pack_rgba) at region_colors[r] where r is in range; other
   // regions take region_color(r).
   std::vector<std::uint32_t> region_colors;
-  bool undoable = false;        // painter only: record what undraw() needs (see TetRasterizer::undraw)
+  bool undoable = false;  // painter only: record what undraw() needs (see TetRasterizer::undraw)
   // Colour by a field instead of by region (field_paint.hpp; shared, not copied: a graded paint of 1M
   // tets is 16 MB): flat, each tet's colour; graded, each face's colour interpolated per pixel from
   // its corners' positions on the scale. Lambert shading then scales the colour within
@@ -102,8 +102,8 @@ class FOXI_API TetRasterizer {
   std::span<const std::uint32_t> drawn_tets() const;  // undoable: the tets drawn, in order
   std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
   std::size_t undo_bytes() const;  // undoable: memory held for undraw (bytes; saved pixels 12 each,
-                                   // 14 per drawn tet (its index, pixel box and repaint reach), 4 and a bit per mesh
-                                   // tet, per-image buffers of 12 bytes and 2 bits a pixel)
+                                   // 14 per drawn tet (its index, pixel box and repaint reach), 4 and a bit
+                                   // per mesh tet, per-image buffers of 12 bytes and 2 bits a pixel)
   // Holds every pixel the last draw() or undraw() call changed (a display need present only these;
   // empty before the first call and after an empty one): the union of the pixel boxes of the tets it
   // drew or undrew, the whole image if the near plane cuts one of them.
@@ -137,12 +137,12 @@ class FOXI_API TetRasterizer {
 
 // A convenience: a fresh framebuffer (background white) with `tets` drawn in order.
 FOXI_API Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
-                        std::span<const std::uint32_t> tets, const RenderParams& params = {});
+                                 std::span<const std::uint32_t> tets, const RenderParams& params = {});
 
 // The pixels covered by one triangle under the rasterizer's fill rule (for tests): vertices in
 // fixed point (pixel coordinate * 256, rounded), either winding; returns y * width + x of every
 // covered pixel of the width x height image, in row order. A zero-area triangle covers nothing.
-FOXI_API std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3], int width,
-                                             int height);
+FOXI_API std::vector<std::uint32_t> triangle_coverage(const std::int64_t x[3], const std::int64_t y[3],
+                                                      int width, int height);
 
 }  // namespace foxi

@@ -28,10 +28,10 @@ struct SphereTable {
   // s = |c - origin|^2 - r^2, so that keys of a mesh far from the coordinate origin keep their
   // precision. A view's eye point is taken relative to the same origin.
   double origin[3] = {0, 0, 0};
-  std::vector<double> c;              // 3 per tet: circumcentre (orthocentre if weighted) - origin
-  std::vector<double> s;              // 1 per tet: |c|^2 - r^2 (|c|^2 - R^2 if weighted), local frame
-  std::vector<std::uint8_t> flat;     // 1 per tet: 1 = zero volume, no sphere (a point sphere at
-                                      // its centroid stands in, so it still gets a place)
+  std::vector<double> c;           // 3 per tet: circumcentre (orthocentre if weighted) - origin
+  std::vector<double> s;           // 1 per tet: |c|^2 - r^2 (|c|^2 - R^2 if weighted), local frame
+  std::vector<std::uint8_t> flat;  // 1 per tet: 1 = zero volume, no sphere (a point sphere at
+                                   // its centroid stands in, so it still gets a place)
   bool weighted = false;
   // Conditioning: a centre computed in double whose estimated relative error exceeds 2^-40 is
   // recomputed with exact rational arithmetic and rounded.
@@ -43,13 +43,13 @@ struct SphereTable {
   // circumspheres of slivers near the hull, badly conditioned centres) are "wide" items, sorted with
   // their own bound (wide_a, wide_b) so that they do not widen everyone's near-tie window.
   double bound_a = 0, bound_b = 0;
-  std::vector<std::uint8_t> wide;     // 1 per tet: 1 = a wide item (see above)
+  std::vector<std::uint8_t> wide;         // 1 per tet: 1 = a wide item (see above)
   std::vector<std::uint32_t> wide_items;  // the wide items of the whole mesh (tet or cluster|bit)
   std::vector<float> wide_a, wide_b;      // their bounds (same order)
 
   // Cospherical clusters (only those with 2 or more tets). cluster_of[t] = cluster id or kNone.
   std::vector<std::uint32_t> cluster_of;
-  std::vector<std::uint32_t> cluster_begin;   // CSR over cluster_tets, size = clusters + 1
+  std::vector<std::uint32_t> cluster_begin;  // CSR over cluster_tets, size = clusters + 1
   std::vector<std::uint32_t> cluster_tets;
   // The faces inside each cluster, CSR by cluster: face_tet[2k], face_tet[2k+1] are the two tets
   // (the first on the positive side of the triangle), face_vertex[3k..3k+2] the triangle's nodes.
@@ -59,16 +59,16 @@ struct SphereTable {
   // Per cluster face, for a fast side test, in one record so that a cluster's faces lie together
   // in memory (clusters are expanded in key order, i.e. at scattered places).
   struct ClusterFace {
-    double plane[4];          // n.x = d, n = (v1 - v0) x (v2 - v0), positive on the first tet's side
-    float scale, anorm;       // for the rounding bound: |v1 - v0|_1 |v2 - v0|_1 and |v0|_1
-    std::uint16_t local[2];   // its two tets' indices within the cluster; 0xFFFF if it is too large
+    double plane[4];         // n.x = d, n = (v1 - v0) x (v2 - v0), positive on the first tet's side
+    float scale, anorm;      // for the rounding bound: |v1 - v0|_1 |v2 - v0|_1 and |v0|_1
+    std::uint16_t local[2];  // its two tets' indices within the cluster; 0xFFFF if it is too large
   };
   std::vector<ClusterFace> face_test;
   // The sort items of the whole mesh that are not wide, built once: each tet not in a cluster, and
   // each cluster as (cluster | kClusterBit), unless clusters_split (below). A cluster's key is the
   // key of its first tet.
   std::vector<std::uint32_t> all_items;
-  std::vector<std::uint32_t> all_rep;     // the tet whose key each item takes (same order)
+  std::vector<std::uint32_t> all_rep;  // the tet whose key each item takes (same order)
   // A mesh with few cluster tets (at most 1 in kSplitClusters) has its clusters split instead:
   // all_items (and wide_items, fixed_keys) list every tet as itself, in tet order, cluster
   // members too, so that a whole-mesh order takes the cluster-free paths (one tet an item, no

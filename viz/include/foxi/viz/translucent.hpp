@@ -77,11 +77,11 @@ struct TranslucentSurfaces {
   // every view); bit 4 + f: face f lies between this drawn tet and a drawn tet of different opacity
   // (drawn by whichever of the two is behind it in the view: this one where it faces the eye).
   std::vector<std::uint8_t> mask;
-  std::vector<float> opacity;           // per tet: its region's opacity (0 outside the drawn set)
-  std::vector<std::uint32_t> tets;      // the tets with a face or an iso polygon to draw: the ones to order
-  std::size_t boundary_faces = 0;       // faces on the outer boundary of the drawn set
-  std::size_t interface_faces = 0;      // faces between drawn regions of different opacity
-  std::size_t iso_tets = 0;             // tets some isovalue crosses
+  std::vector<float> opacity;       // per tet: its region's opacity (0 outside the drawn set)
+  std::vector<std::uint32_t> tets;  // the tets with a face or an iso polygon to draw: the ones to order
+  std::size_t boundary_faces = 0;   // faces on the outer boundary of the drawn set
+  std::size_t interface_faces = 0;  // faces between drawn regions of different opacity
+  std::size_t iso_tets = 0;         // tets some isovalue crosses
 };
 
 // subset: the tets that may be drawn (empty: all). Throws std::invalid_argument for an opacity
@@ -93,8 +93,8 @@ FOXI_API TranslucentSurfaces translucent_surfaces(const Mesh& mesh, std::span<co
 struct Fragment {
   std::uint32_t pixel = 0;  // y * width + x
   std::uint32_t tet = 0;
-  std::int8_t face = 0;     // the tet's face 0..3, or -1 - k for the k-th isovalue (ascending)
-  float depth = 0;          // nearness interpolated on the screen (1/z perspective, -z orthographic): larger = nearer
+  std::int8_t face = 0;  // the tet's face 0..3, or -1 - k for the k-th isovalue (ascending)
+  float depth = 0;  // nearness interpolated on the screen (1/z perspective, -z orthographic): larger = nearer
   float rgb[3] = {0, 0, 0};
   float alpha = 0;
 };
@@ -110,7 +110,8 @@ class FOXI_API TranslucentPainter {
   // fragments (fragments()) instead of blending them (one thread). Throws std::invalid_argument for
   // a degenerate camera, surfaces of another mesh.
   TranslucentPainter(const Mesh& mesh, const Camera& camera, int width, int height,
-                     const TranslucentSurfaces& surfaces, const TranslucentParams& params, bool collect = false);
+                     const TranslucentSurfaces& surfaces, const TranslucentParams& params,
+                     bool collect = false);
   ~TranslucentPainter();
   TranslucentPainter(TranslucentPainter&&) noexcept;
   TranslucentPainter& operator=(TranslucentPainter&&) noexcept;
@@ -133,16 +134,17 @@ class FOXI_API TranslucentPainter {
 
 struct TranslucentReport {
   bool delaunay = false;
-  bool exact_order = false;        // composited in the power order (else fragments sorted per pixel)
-  std::size_t tets_ordered = 0;    // surfaces.tets
+  bool exact_order = false;      // composited in the power order (else fragments sorted per pixel)
+  std::size_t tets_ordered = 0;  // surfaces.tets
   std::size_t fragments = 0;
   double certificate_ms = 0, surfaces_ms = 0, order_ms = 0, draw_ms = 0;
 };
 
 // The safe translucent picture: a mesh with the Delaunay certificate composited in the power order of
 // the surface tets; any other mesh by per-pixel sorting of its fragments (see above). fb keeps its size.
-FOXI_API TranslucentReport draw_translucent_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera,
-                                                    Framebuffer& fb, std::span<const std::uint32_t> subset,
+FOXI_API TranslucentReport draw_translucent_picture(const Mesh& mesh, const SphereTable& table,
+                                                    const Camera& camera, Framebuffer& fb,
+                                                    std::span<const std::uint32_t> subset,
                                                     const TranslucentParams& params);
 
 }  // namespace foxi

@@ -41,7 +41,8 @@ FOXI_API CameraOptions parse_camera_options(std::string_view eye, std::string_vi
 
 // The camera of these options fitted to the box [lo, hi] for an image of width/height `aspect`
 // (camera_from_options: what is not given is fitted).
-FOXI_API Camera camera_for(const CameraOptions& options, const double lo[3], const double hi[3], double aspect);
+FOXI_API Camera camera_for(const CameraOptions& options, const double lo[3], const double hi[3],
+                           double aspect);
 
 // "WxH" with 1 <= W, H <= 16384 (--size).
 struct ImageSize {
@@ -54,7 +55,8 @@ FOXI_API double parse_shrink(std::string_view text);
 
 // The tets of the listed region ids, in index order (each once); `what` names the option in the
 // error for a list that is not numbers.
-FOXI_API std::vector<std::uint32_t> tets_of_regions(const Mesh& mesh, std::string_view ids, std::string_view what);
+FOXI_API std::vector<std::uint32_t> tets_of_regions(const Mesh& mesh, std::string_view ids,
+                                                    std::string_view what);
 
 // A subset of tets from "regions:1,3" (those region ids), "random:F" (each tet with probability F,
 // drawn with std::mt19937(seed)) or "box:x0,y0,z0,x1,y1,z1" (tets whose centroid lies in the box),

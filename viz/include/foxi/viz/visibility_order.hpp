@@ -29,14 +29,14 @@
 namespace foxi {
 
 struct OrderStats {
-  std::size_t items = 0;               // sort items: singleton tets + clusters
+  std::size_t items = 0;  // sort items: singleton tets + clusters
   std::size_t buckets = 0;
-  std::size_t near_tie_runs = 0;       // runs re-sorted exactly
+  std::size_t near_tie_runs = 0;  // runs re-sorted exactly
   std::size_t near_tie_items = 0;
-  std::size_t cluster_cycles = 0;      // cycles broken inside clusters (0 for a Delaunay mesh)
-  double key_bound = 0;                // the rounding bound of ordinary items (key units)
-  double key_range = 0;                // largest minus smallest key
-  std::size_t wide_items = 0;          // items sorted with their own, wider bound
+  std::size_t cluster_cycles = 0;  // cycles broken inside clusters (0 for a Delaunay mesh)
+  double key_bound = 0;            // the rounding bound of ordinary items (key units)
+  double key_range = 0;            // largest minus smallest key
+  std::size_t wide_items = 0;      // items sorted with their own, wider bound
   // Wall time of the phases of visibility_order_into (seconds): keys with the first-level histogram,
   // the scatter into first-level buckets, and the per-bucket sorts with near-tie fix-up and cluster
   // expansion (both cores in each).
@@ -65,8 +65,8 @@ class FOXI_API ProgressiveOrder {
 
   // The next batch (a view into internal storage, valid until the next call); empty when done.
   std::span<const std::uint32_t> next();
-  std::size_t handed_out() const;      // tets handed out so far
-  std::size_t total() const;           // tets in the order
+  std::size_t handed_out() const;  // tets handed out so far
+  std::size_t total() const;       // tets in the order
   const OrderStats& stats() const;
 
  private:
@@ -77,36 +77,39 @@ class FOXI_API ProgressiveOrder {
 };
 
 // The whole order at once (both cores).
-FOXI_API std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
-                                            std::span<const std::uint32_t> subset = {},
-                                            bool front_to_back = false, OrderStats* stats = nullptr);
+FOXI_API std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table,
+                                                     const View& view,
+                                                     std::span<const std::uint32_t> subset = {},
+                                                     bool front_to_back = false, OrderStats* stats = nullptr);
 
 // The same into `out`, resized to the order's size: a caller that orders view after view and keeps
 // `out` allocates nothing per view (the internal buffers are kept per thread as well).
-FOXI_API void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
-                           const View& view, std::span<const std::uint32_t> subset = {},
-                           bool front_to_back = false, OrderStats* stats = nullptr);
+FOXI_API void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh,
+                                    const SphereTable& table, const View& view,
+                                    std::span<const std::uint32_t> subset = {}, bool front_to_back = false,
+                                    OrderStats* stats = nullptr);
 
 // MPVO for meshes without a visibility order guarantee: a topological sort of the view-directed
 // face-adjacency graph of the subset, ready tets taken in decreasing power key; cycles are broken at
 // the tet of largest key and counted in `cycles_broken`.
 FOXI_API std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,
-                                      std::span<const std::uint32_t> subset = {},
-                                      std::size_t* cycles_broken = nullptr);
+                                               std::span<const std::uint32_t> subset = {},
+                                               std::size_t* cycles_broken = nullptr);
 
 // A centroid-depth order (what VTK's vtkCellCenterDepthSort does): the baseline that power order
 // beats. Back to front by decreasing distance from the eye (or along dir) of each tet's centroid.
 FOXI_API std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view,
-                                          std::span<const std::uint32_t> subset = {});
+                                                   std::span<const std::uint32_t> subset = {});
 
 struct ViolationReport {
-  std::size_t pairs_checked = 0;       // face-adjacent pairs both in the order, eye not on their face
-  std::size_t violations = 0;          // pairs drawn in the wrong order for this view
+  std::size_t pairs_checked = 0;  // face-adjacent pairs both in the order, eye not on their face
+  std::size_t violations = 0;     // pairs drawn in the wrong order for this view
 };
 
 // Counts face-adjacent pairs drawn in the wrong order (back-to-front order expected): for each
 // interior face shared by two ordered tets, the tet on the eye's side of the face (exact
 // orientation test) must come later. Pairs whose face plane contains the eye are not compared.
-FOXI_API ViolationReport count_violations(const Mesh& mesh, const View& view, std::span<const std::uint32_t> order);
+FOXI_API ViolationReport count_violations(const Mesh& mesh, const View& view,
+                                          std::span<const std::uint32_t> order);
 
 }  // namespace foxi

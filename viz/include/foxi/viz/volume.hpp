@@ -41,10 +41,10 @@ struct OpacityPoint {
 };
 
 struct VolumeParams {
-  ColorScale scale;                          // the colour of value v: scale.color(v)
-  std::vector<OpacityPoint> opacity_curve;   // ascending values, linear between, constant beyond the ends
-  double unit_length = 1;                    // world length over which opacity a(v) accumulates (> 0)
-  double near = 0;                           // perspective near plane (world); 0 = automatic (tiny)
+  ColorScale scale;                         // the colour of value v: scale.color(v)
+  std::vector<OpacityPoint> opacity_curve;  // ascending values, linear between, constant beyond the ends
+  double unit_length = 1;                   // world length over which opacity a(v) accumulates (> 0)
+  double near = 0;                          // perspective near plane (world); 0 = automatic (tiny)
   int threads = 2;
   std::uint32_t background = pack_rgba(255, 255, 255);
 };
@@ -55,7 +55,8 @@ FOXI_API double volume_extinction(const VolumeParams& params, double v);
 // The emission-absorption integral over one segment of a ray, back end first: the field goes linearly
 // from v_far to v_near over `length` world units; blends it over c (3 floats, 0..255) with the steps
 // described above. What the painter does per pixel and tet.
-FOXI_API void integrate_segment(const VolumeParams& params, double v_far, double v_near, double length, float c[3]);
+FOXI_API void integrate_segment(const VolumeParams& params, double v_far, double v_near, double length,
+                                float c[3]);
 
 class FOXI_API VolumePainter {
  public:

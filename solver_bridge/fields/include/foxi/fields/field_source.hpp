@@ -55,7 +55,7 @@ enum class SourceKey : std::uint8_t {
 
 struct FieldSource {
   std::string path;
-  std::string format;               // "vtu", "vtk", "msh", "pvd", "frd", "csv"
+  std::string format;  // "vtu", "vtk", "msh", "pvd", "frd", "csv"
   SourceKey key = SourceKey::position;
   // The source's nodes and tets where the file has them (xyz is empty for a CSV keyed by id alone),
   // its regions (tet_region empty where the file has none) and its fields (mesh.fields). A field
@@ -66,7 +66,8 @@ struct FieldSource {
 
   // The entities a field of this source has values for.
   std::size_t entity_count(const Field& f) const {
-    if (f.location == FieldLocation::node) return key == SourceKey::node_id ? node_id.size() : mesh.node_count();
+    if (f.location == FieldLocation::node)
+      return key == SourceKey::node_id ? node_id.size() : mesh.node_count();
     return key == SourceKey::cell_id ? cell_id.size() : mesh.tet_count();
   }
 };
@@ -86,7 +87,8 @@ struct FrdLimits {
   std::size_t values_per_byte = 16;
 };
 FOXI_API FieldSource read_frd_source(const std::filesystem::path& path, const FrdLimits& limits = {});
-FOXI_API FieldSource parse_frd_source(std::string_view bytes, const std::string& name, const FrdLimits& limits = {});
+FOXI_API FieldSource parse_frd_source(std::string_view bytes, const std::string& name,
+                                      const FrdLimits& limits = {});
 FOXI_API FieldSource read_csv_source(const std::filesystem::path& path);
 FOXI_API FieldSource parse_csv_source(std::string_view bytes, const std::string& name);
 FOXI_API FieldSource read_pvd_source(const std::filesystem::path& path);

@@ -36,7 +36,7 @@ enum class Outside : std::uint8_t { nan, nearest };
 struct TransferParams {
   MatchBy by = MatchBy::location;
   Outside outside = Outside::nan;
-  std::vector<std::string> names;     // the fields to carry; empty = all of the source's
+  std::vector<std::string> names;  // the fields to carry; empty = all of the source's
   // By id: coordinates agree when they differ by at most this times the target's bounding-box
   // diagonal (a .frd prints 6 significant digits).
   double coordinate_tolerance = 1e-5;
@@ -46,17 +46,17 @@ struct TransferParams {
   // By location: keep values inside their region where both meshes have regions (a target region
   // id the source lacks is then an error); false ignores regions.
   bool match_regions = true;
-  unsigned threads = 0;               // 0: all the hardware has
+  unsigned threads = 0;  // 0: all the hardware has
 };
 
 struct TransferReport {
-  std::vector<Field> fields;          // over the target's nodes or tets, the source's steps
+  std::vector<Field> fields;  // over the target's nodes or tets, the source's steps
   std::size_t target_nodes = 0, target_cells = 0;
-  std::size_t nodes_outside = 0;      // target nodes located in no source tet (by location)
-  std::size_t cells_outside = 0;      // target centroids located in no source tet (by location)
-  std::size_t nodes_missing = 0;      // target nodes the source gave no value (by id)
+  std::size_t nodes_outside = 0;  // target nodes located in no source tet (by location)
+  std::size_t cells_outside = 0;  // target centroids located in no source tet (by location)
+  std::size_t nodes_missing = 0;  // target nodes the source gave no value (by id)
   std::size_t cells_missing = 0;
-  std::size_t nan_values = 0;         // NaN values in `fields`, over all components and steps
+  std::size_t nan_values = 0;  // NaN values in `fields`, over all components and steps
 };
 
 // The fields of `source` (all, or params.names) over `target`. Throws FieldError.
@@ -67,7 +67,7 @@ FOXI_API TransferReport transfer_fields(const FieldSource& source, const Mesh& t
 // tet index and barycentric coordinates, kNone where it lies in no tet. For tests and benchmarks.
 struct PointLocation {
   std::vector<std::uint32_t> tet;
-  std::vector<double> bary;           // 4 per point
+  std::vector<double> bary;  // 4 per point
 };
 FOXI_API PointLocation locate_points(const Mesh& mesh, const std::vector<double>& xyz,
                                      double barycentric_tolerance = 1e-9);
