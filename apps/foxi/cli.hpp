@@ -48,8 +48,6 @@ class Args {
 // Comma-separated finite numbers ("1,2.5,-3"); UsageError naming the option `what` otherwise.
 std::vector<double> parse_numbers(const std::string& s, const char* what);
 
-// A JSON string literal for `s` (quotes and escapes added).
-std::string json_string(std::string_view s);
 // A JSON number for `v` (null for NaN and infinities, which JSON lacks).
 std::string json_number(double v);
 

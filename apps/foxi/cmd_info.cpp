@@ -15,6 +15,7 @@
 #include "foxi/model/quality.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/viz/field_paint.hpp"
+#include "foxi/solver/results.hpp"  // json_quoted
 
 namespace foxi::cli {
 
@@ -166,8 +167,8 @@ int cmd_info(Args args) {
 
   if (json) {
     std::string o = "{\n";
-    o += "  \"file\": " + json_string(path) + ",\n";
-    o += "  \"format\": " + json_string(format_name(format)) + ",\n";
+    o += "  \"file\": " + json_quoted(path) + ",\n";
+    o += "  \"format\": " + json_quoted(format_name(format)) + ",\n";
     o += "  \"read_seconds\": " + json_number(read_s) + ",\n";
     o += "  \"nodes\": " + std::to_string(mesh.node_count()) + ",\n";
     o += "  \"tets\": " + std::to_string(mesh.tet_count()) + ",\n";
@@ -182,8 +183,8 @@ int cmd_info(Args args) {
     for (auto& [id, s] : regions) {
       o += first ? "\n" : ",\n";
       first = false;
-      o += "    {\"id\": " + std::to_string(id) + ", \"name\": " + json_string(region_name(id)) +
-           ", \"material\": " + json_string(material_name(id)) + ", \"tets\": " + std::to_string(s.tets) +
+      o += "    {\"id\": " + std::to_string(id) + ", \"name\": " + json_quoted(region_name(id)) +
+           ", \"material\": " + json_quoted(material_name(id)) + ", \"tets\": " + std::to_string(s.tets) +
            ", \"volume\": " + json_number(s.volume) + "}";
     }
     o += first ? "],\n" : "\n  ],\n";
@@ -192,7 +193,7 @@ int cmd_info(Args args) {
     for (auto& [tag, n] : boundaries) {
       o += first ? "\n" : ",\n";
       first = false;
-      o += "    {\"tag\": " + std::to_string(tag) + ", \"name\": " + json_string(boundary_name(tag)) +
+      o += "    {\"tag\": " + std::to_string(tag) + ", \"name\": " + json_quoted(boundary_name(tag)) +
            ", \"triangles\": " + std::to_string(n) + "}";
     }
     o += first ? "],\n" : "\n  ],\n";
@@ -202,11 +203,11 @@ int cmd_info(Args args) {
       o += first ? "\n" : ",\n";
       first = false;
       const FieldRange range = field_range(mesh, f);
-      o += "    {\"name\": " + json_string(f.name) +
-           ", \"location\": " + json_string(location_name(f.location)) +
+      o += "    {\"name\": " + json_quoted(f.name) +
+           ", \"location\": " + json_quoted(location_name(f.location)) +
            ", \"components\": " + std::to_string(f.components) +
-           ", \"steps\": " + std::to_string(f.step_count()) + ", \"unit\": " + json_string(f.unit) +
-           ", \"scalar\": " + json_string(range.scalar) + ", \"min\": " + json_number(range.lo) +
+           ", \"steps\": " + std::to_string(f.step_count()) + ", \"unit\": " + json_quoted(f.unit) +
+           ", \"scalar\": " + json_quoted(range.scalar) + ", \"min\": " + json_number(range.lo) +
            ", \"max\": " + json_number(range.hi) + ", \"nan_values\": " + std::to_string(range.nan) + "}";
     }
     o += first ? "],\n" : "\n  ],\n";
@@ -232,7 +233,7 @@ int cmd_info(Args args) {
            ", \"max_relative_depth\": " + json_number(cert.max_relative_depth) + "},\n";
     }
     o += "  \"validation\": {\"ok\": " + std::string(report.ok() ? "true" : "false") +
-         ", \"size_problem\": " + json_string(report.size_problem) +
+         ", \"size_problem\": " + json_quoted(report.size_problem) +
          ", \"index_out_of_range\": " + std::to_string(report.index_out_of_range) +
          ", \"repeated_vertex\": " + std::to_string(report.repeated_vertex) +
          ", \"nonfinite_nodes\": " + std::to_string(report.nonfinite_nodes) +
@@ -245,7 +246,7 @@ int cmd_info(Args args) {
          ", \"no_tets\": " + std::string(report.no_tets ? "true" : "false") +
          ", \"unused_nodes\": " + std::to_string(report.unused_nodes) + ", \"messages\": [";
     for (std::size_t i = 0; i < report.messages.size(); ++i)
-      o += (i ? ", " : "") + json_string(report.messages[i]);
+      o += (i ? ", " : "") + json_quoted(report.messages[i]);
     o += "]}\n}\n";
     std::fputs(o.c_str(), stdout);
     return report.ok() ? kExitOk : kExitBadInput;

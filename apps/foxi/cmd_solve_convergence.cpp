@@ -96,8 +96,8 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
     o += "],\n \"rows\": [";
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const ConvergenceRow& row = rows[i];
-      o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_string(row.name) +
-           ", \"unit\": " + json_string(row.unit) + ", \"values\": [";
+      o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_quoted(row.name) +
+           ", \"unit\": " + json_quoted(row.unit) + ", \"values\": [";
       for (std::size_t k = 0; k < row.level_values.size(); ++k)
         o += (k ? ", " : "") + json_number(row.level_values[k]);
       o += "], \"order\": " + json_number(row.order) +

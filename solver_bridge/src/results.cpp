@@ -220,9 +220,7 @@ RunResults thermoelastic_results(const Mesh& mesh, const ThermoelasticReport& r)
 
 // ---- JSON ----
 
-namespace {
-
-std::string jstr(std::string_view s) {
+std::string json_quoted(std::string_view s) {
   std::string out = "\"";
   for (char c : s) {
     switch (c) {
@@ -254,6 +252,8 @@ std::string jstr(std::string_view s) {
   return out + "\"";
 }
 
+namespace {
+
 // Shortest text that reads back to the same double (std::to_chars); null for NaN and infinities.
 std::string jnum(double v) {
   if (!std::isfinite(v)) return "null";
@@ -268,36 +268,37 @@ const char* jbool(bool b) { return b ? "true" : "false"; }
 
 std::string results_json(const RunResults& r) {
   std::string o = "{\"foxi_results\": 1,\n";
-  o += " \"model\": " + jstr(r.model) + ",\n";
-  o += " \"physics\": " + jstr(r.physics) + ",\n";
+  o += " \"model\": " + json_quoted(r.model) + ",\n";
+  o += " \"physics\": " + json_quoted(r.physics) + ",\n";
   o += " \"parameters\": [";
   for (std::size_t i = 0; i < r.parameters.size(); ++i)
-    o += std::string(i ? ", " : "") + "{\"name\": " + jstr(r.parameters[i].name) +
-         ", \"text\": " + jstr(r.parameters[i].text) + "}";
+    o += std::string(i ? ", " : "") + "{\"name\": " + json_quoted(r.parameters[i].name) +
+         ", \"text\": " + json_quoted(r.parameters[i].text) + "}";
   o += "],\n";
-  o += " \"status\": " + jstr(run_status_name(r.status)) + ",\n";
-  o += " \"error\": " + jstr(r.error) + ",\n";
+  o += " \"status\": " + json_quoted(run_status_name(r.status)) + ",\n";
+  o += " \"error\": " + json_quoted(r.error) + ",\n";
   o += " \"nodes\": " + std::to_string(r.nodes) + ", \"tets\": " + std::to_string(r.tets) + ",\n";
   o += " \"mesh_seconds\": " + jnum(r.mesh_seconds) + ", \"solve_seconds\": " + jnum(r.solve_seconds) +
        ", \"wall_seconds\": " + jnum(r.wall_seconds) + ",\n";
   o += " \"error_indicator\": " + jnum(r.error_indicator) + ",\n";
-  o += " \"solver\": " + jstr(r.solver) + ",\n";
+  o += " \"solver\": " + json_quoted(r.solver) + ",\n";
   o += " \"values\": [";
   for (std::size_t i = 0; i < r.values.size(); ++i) {
     const ResultValue& v = r.values[i];
-    o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + jstr(v.name) + ", \"unit\": " + jstr(v.unit) +
-         ", \"value\": " + jnum(v.value) + ", \"key\": " + jbool(v.key) + "}";
+    o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_quoted(v.name) +
+         ", \"unit\": " + json_quoted(v.unit) + ", \"value\": " + jnum(v.value) +
+         ", \"key\": " + jbool(v.key) + "}";
   }
   o += "],\n \"texts\": [";
   for (std::size_t i = 0; i < r.texts.size(); ++i)
-    o += std::string(i ? ", " : "") + "{\"name\": " + jstr(r.texts[i].name) +
-         ", \"text\": " + jstr(r.texts[i].text) + "}";
+    o += std::string(i ? ", " : "") + "{\"name\": " + json_quoted(r.texts[i].name) +
+         ", \"text\": " + json_quoted(r.texts[i].text) + "}";
   o += "],\n \"checks\": [";
   for (std::size_t i = 0; i < r.checks.size(); ++i) {
     const BalanceCheck& c = r.checks[i];
-    o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + jstr(c.name) + ", \"what\": " + jstr(c.what) +
-         ", \"figure\": " + jnum(c.figure) + ", \"tolerance\": " + jnum(c.tolerance) +
-         ", \"passed\": " + jbool(c.passed) + "}";
+    o += std::string(i ? ",\n  " : "\n  ") + "{\"name\": " + json_quoted(c.name) +
+         ", \"what\": " + json_quoted(c.what) + ", \"figure\": " + jnum(c.figure) +
+         ", \"tolerance\": " + jnum(c.tolerance) + ", \"passed\": " + jbool(c.passed) + "}";
   }
   o += "]}\n";
   return o;

@@ -91,6 +91,9 @@ FOXI_API RunResults thermoelastic_results(const Mesh& mesh, const ThermoelasticR
 //    "solver", "values": [{"name", "unit", "value", "key"}], "texts": [{"name", "text"}],
 //    "checks": [{"name", "what", "figure", "tolerance", "passed"}]}
 FOXI_API std::string results_json(const RunResults& results);
+// `s` as a JSON string literal, quotes included (\" \\ \n \r \t, other control characters as \u00XX):
+// what results_json writes names with, and what the CLI's --json records use.
+FOXI_API std::string json_quoted(std::string_view s);
 
 // Reads what results_json wrote (null as NaN; members it does not know are skipped). Throws
 // std::runtime_error naming the byte offset on text that is not such an object.
