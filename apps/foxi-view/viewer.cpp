@@ -129,18 +129,15 @@ void apply_field(Viewer& viewer, ViewField& f) {
   f.step = f.choice.field->step_count() - 1;
   const std::vector<double> values =
       f.graded ? tet_corner_values(mesh, f.choice, f.step) : tet_centroid_values(mesh, f.choice, f.step);
-  auto [lo, hi] = finite_range(values, false);
-  if (std::isnan(lo)) lo = 0, hi = 1;  // no finite value: all drawn in the no-value grey
-  if (!(lo < hi)) {                    // a constant shows mid-map
-    const double d = lo != 0 ? std::abs(lo) * 0.01 : 1;
-    lo -= d;
-    hi += d;
-  }
+  // foxi render's automatic range (a constant widened, coolwarm centred on 0); no finite value: all
+  // drawn in the no-value grey over [0, 1].
+  const std::optional<AutoScale> automatic = automatic_scale(values, f.map);
   f.scale = ColorScale{};
   f.scale.map = f.map;
-  f.scale.lo = lo;
-  f.scale.hi = hi;
-  f.unit = default_display_unit(f.choice.field->unit, std::max(std::abs(lo), std::abs(hi)));
+  f.scale.lo = 0;
+  f.scale.hi = 1;
+  if (automatic) f.scale = automatic->scale;
+  f.unit = default_display_unit(f.choice.field->unit, std::max(std::abs(f.scale.lo), std::abs(f.scale.hi)));
   viewer.set_field(std::make_shared<const FieldPaint>(f.graded ? graded_field_paint(values, f.scale)
                                                                : flat_field_paint(values, f.scale)));
   if (f.legend) fit_legend(viewer, f);  // another field's labels may need another width
