@@ -30,6 +30,7 @@
 class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
+class QHBoxLayout;
 class QLabel;
 class QListWidget;
 class QProgressBar;
@@ -154,7 +155,14 @@ class Workbench : public QMainWindow {
   void closeEvent(QCloseEvent* event) override;
 
  private:
-  void build_ui();
+  void build_ui();  // workbench.cpp: the panels put together, the status bar, the keys
+  // The panels, each built in its own file.
+  QPushButton* build_view_panel();   // view_panel.cpp: the view and its tools; its Save picture button
+  QPushButton* build_model_panel();  // model_panel.cpp: its Open model button
+  QHBoxLayout* build_project_row();  // project.cpp: save, open, recent projects
+  void build_mesh_panel();           // mesh_panel.cpp
+  void build_results_panel();        // solve_panel.cpp
+  void build_history_panel();        // history.cpp
   void refresh_model_panel();
   void on_parameter_edited(int row, int column);
   bool start_job(bool mesh, bool solve);

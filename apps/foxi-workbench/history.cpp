@@ -1,0 +1,72 @@
+// foxi-workbench's run history: one row per model state meshed (and solved).
+#include "workbench.hpp"
+#include "workbench_parts.hpp"
+
+#include <QDockWidget>
+#include <QHeaderView>
+#include <QTableWidget>
+
+namespace foxi::workbench {
+
+void Workbench::build_history_panel() {
+  history_table_ = new QTableWidget(0, 5);
+  history_table_->setHorizontalHeaderLabels(
+      {tr("run"), tr("parameters"), tr("tets"), tr("key results"), tr("time")});
+  history_table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  history_table_->horizontalHeader()->setSectionResizeMode(3, QHeaderView::Stretch);
+  history_table_->verticalHeader()->hide();
+  history_table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  auto* history_dock = new QDockWidget(tr("Run history"));
+  history_dock->setObjectName("history");
+  history_dock->setWidget(history_table_);
+  addDockWidget(Qt::BottomDockWidgetArea, history_dock);
+}
+
+void Workbench::add_history(double seconds) {
+  HistoryRow row;
+  row.parameters = meshed_overrides_;
+  row.mesh = mesh_serial_;
+  row.tets = mesh_ ? mesh_->tet_count() : 0;
+  if (has_results_)
+    row.results = results_;
+  else
+    row.results.status = RunStatus::failed, row.results.error = "meshed only";
+  row.seconds = seconds;
+  // A solve of the mesh the last row made completes that row (one row per model state).
+  const bool complete = has_results_ && !history_.empty() && history_.back().results.values.empty() &&
+                        history_.back().mesh == row.mesh;
+  int i = history_table_->rowCount();
+  if (complete) {
+    history_.back() = row;
+    --i;
+  } else {
+    history_.push_back(row);
+    history_table_->insertRow(i);
+  }
+  fill_history_row(i, row);
+}
+
+void Workbench::fill_history_row(int i, const HistoryRow& row) {
+  QString params;
+  for (const ParameterOverride& o : row.parameters)
+    params += QString::fromStdString(o.name + "=" + o.expression + " ");
+  QString key;
+  for (const ResultValue& v : row.results.values)
+    if (v.key)
+      key += QString("%1 %2 %3; ")
+                 .arg(QString::fromStdString(v.name))
+                 .arg(v.value, 0, 'g', 5)
+                 .arg(QString::fromStdString(v.unit));
+  history_table_->setItem(i, 0, new QTableWidgetItem(QString::number(i + 1)));
+  history_table_->setItem(i, 1, new QTableWidgetItem(params.isEmpty() ? tr("(as in the file)") : params));
+  history_table_->setItem(i, 2, new QTableWidgetItem(QString::number(row.tets)));
+  history_table_->setItem(i, 3, new QTableWidgetItem(row.results.values.empty() ? tr("meshed only") : key));
+  history_table_->setItem(i, 4, new QTableWidgetItem(QString("%1 s").arg(row.seconds, 0, 'f', 2)));
+}
+
+void Workbench::refresh_history() {
+  history_table_->setRowCount(int(history_.size()));
+  for (std::size_t i = 0; i < history_.size(); ++i) fill_history_row(int(i), history_[i]);
+}
+
+}  // namespace foxi::workbench

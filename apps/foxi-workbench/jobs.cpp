@@ -1,0 +1,282 @@
+// foxi-workbench's jobs: meshing and solving on a worker with progress and Cancel; a job's outcome shown.
+#include "workbench.hpp"
+#include "workbench_parts.hpp"
+
+#include <QDoubleSpinBox>
+#include <QLabel>
+#include <QPlainTextEdit>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QTimer>
+#include <QtConcurrent/QtConcurrentRun>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iterator>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include "foxi/mesher/mesher.hpp"
+#include "foxi/mesher/model_mesh.hpp"
+#include "foxi/model/io_error.hpp"
+#include "foxi/model/physics.hpp"
+#include "foxi/model/progress.hpp"
+#include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/thermal.hpp"
+
+namespace foxi::workbench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The stages the libraries report (progress.hpp's ProgressFn), numbered for the progress value the
+// worker stores in one atomic: stage * 10000 + fraction in permille. 0: unknown.
+const char* const kStages[] = {"", "meshing", "conforming refinement", "assemble", "factorize", "solve"};
+int stage_index(std::string_view name) {
+  for (int i = 1; i < int(std::size(kStages)); ++i)
+    if (name == kStages[i]) return i;
+  return 0;
+}
+
+bool same_overrides(const std::vector<ParameterOverride>& a, const std::vector<ParameterOverride>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const ParameterOverride& x, const ParameterOverride& y) {
+                      return x.name == y.name && x.expression == y.expression;
+                    });
+}
+
+}  // namespace
+
+const char* progress_stage(int index) {
+  return index > 0 && index < int(std::size(kStages)) ? kStages[index] : "";
+}
+
+void Workbench::launch(std::function<std::shared_ptr<Outcome>()> work, const QString& what,
+                       std::shared_ptr<std::atomic<bool>> cancel,
+                       std::shared_ptr<std::atomic<int>> permille) {
+  job_ = std::make_unique<Job>();
+  job_->what = what;
+  job_->cancel = std::move(cancel);
+  job_->permille = std::move(permille);
+  connect(&job_->watcher, &QFutureWatcher<std::shared_ptr<Outcome>>::finished, this, &Workbench::on_job_done);
+  job_->watcher.setFuture(QtConcurrent::run([work = std::move(work)] {
+    // The worker (and the threads it starts: TetGen, the solver's, which inherit it) niced, so
+    // that on a machine with few cores the GUI thread still gets the CPU when it needs it.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);
+    return work();
+  }));
+  mesh_button_->setEnabled(false);
+  solve_button_->setEnabled(false);
+  cancel_button_->setEnabled(true);
+  progress_->setValue(0);
+  progress_->setFormat(what + " %p%");
+  poll_->start();
+}
+
+// What a mesh or solve job needs, copied from the GUI thread's state when it starts.
+struct JobInput {
+  std::string path;
+  std::vector<ParameterOverride> overrides;
+  bool mesh = true, solve = false;
+  std::shared_ptr<const Mesh> old_mesh;    // solve only: the mesh to solve on
+  std::shared_ptr<const Model> old_model;  // and the model it came from
+  int width = 1, height = 1;
+  std::optional<Camera> camera;  // the view's camera stays across a remesh (compare before and after)
+  Colouring colouring;
+  double shrink = 1;
+  std::shared_ptr<std::atomic<bool>> cancel;
+  std::shared_ptr<std::atomic<int>> permille;
+};
+
+namespace {
+
+// The worker's part: mesh (mesh_model) and/or solve (thermal) and the new picture's view.
+std::shared_ptr<Outcome> run_job(const JobInput& in) {
+  auto out = std::make_shared<Outcome>();
+  const auto t0 = Clock::now();
+  auto progress = [cancel = in.cancel, permille = in.permille](std::string_view stage, double f) {
+    permille->store(stage_index(stage) * 10000 + int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
+    return !cancel->load();
+  };
+  // Cancel pressed after the last progress call (a direct solve may not call it at all) still
+  // discards the result: the previous state stays.
+  auto cancelled = [&] {
+    if (!in.cancel->load()) return false;
+    out->cancelled = true;
+    out->error = "cancelled";
+    return true;
+  };
+  try {
+    std::shared_ptr<Mesh> mesh;
+    std::shared_ptr<const Model> model = in.old_model;
+    if (in.mesh) {
+      ModelMeshOptions options;
+      options.override_origin = "the parameter table";
+      options.progress = progress;
+      // A solve to follow: the model's conditions and materials checked before meshing, as foxi solve does.
+      if (in.solve) options.physics = Physics::thermal;
+      MeshedModel mm = mesh_model(in.path, in.overrides, options);
+      if (cancelled()) return out;
+      mesh = std::make_shared<Mesh>(std::move(mm.mesh));
+      out->quality = mesh_quality_report(*mesh, mm.conforming);
+      model = std::make_shared<const Model>(std::move(mm.model));
+      out->meshed = true;
+      out->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    } else {
+      // The shown mesh stays as it is: the solve writes its fields into a copy.
+      mesh = std::make_shared<Mesh>(*in.old_mesh);
+    }
+    const auto t1 = Clock::now();
+    if (in.solve) {
+      if (!in.mesh) check_physics(*model, Physics::thermal);
+      ThermalParams params = thermal_params_from_model(*model, *mesh);
+      params.solver.progress = progress;
+      const ThermalReport report = solve_thermal(*mesh, params);
+      if (cancelled()) return out;
+      out->results = thermal_results(*mesh, report);
+      out->results.model = in.path;
+      out->results.physics = "thermal";
+      for (const ParameterOverride& o : in.overrides)
+        out->results.parameters.push_back({o.name, o.expression});
+      out->solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
+      out->solved = true;
+    }
+    build_display(*out, *mesh, in.solve ? "temperature" : "", in.colouring, in.shrink, in.width, in.height,
+                  in.camera ? &*in.camera : nullptr);
+    out->mesh = std::move(mesh);
+    out->model = std::move(model);
+    out->overrides = in.overrides;
+    out->ok = true;
+  } catch (const Cancelled&) {
+    out->cancelled = true;
+    out->error = "cancelled";
+  } catch (const IoError& e) {
+    out->bad_input = true;
+    out->error = what_of(e);
+  } catch (const std::exception& e) {
+    out->error = what_of(e);
+  }
+  return out;
+}
+
+}  // namespace
+
+bool Workbench::start_job(bool mesh, bool solve) {
+  if (busy() || model_path_.isEmpty()) return false;
+  JobInput in;
+  in.path = model_path_.toStdString();
+  in.overrides = overrides();
+  // Only what changed reruns: a solve remeshes first when the parameters changed since the mesh.
+  const bool stale = !mesh_ || !meshed_model_ || !same_overrides(in.overrides, meshed_overrides_);
+  in.mesh = mesh || stale;
+  in.solve = solve;
+  in.old_mesh = mesh_;
+  in.old_model = meshed_model_;
+  in.width = view_->width();
+  in.height = view_->height();
+  if (view_->camera()) in.camera = *view_->camera();
+  in.colouring = colouring();
+  in.shrink = shrink_;
+  in.cancel = std::make_shared<std::atomic<bool>>(false);
+  in.permille = std::make_shared<std::atomic<int>>(0);
+  const QString what = in.mesh && in.solve ? tr("meshing and solving")
+                       : in.mesh           ? tr("meshing")
+                                           : tr("solving");
+  auto cancel = in.cancel;
+  auto permille = in.permille;
+  launch([in = std::move(in)] { return run_job(in); }, what, cancel, permille);
+  return true;
+}
+
+bool Workbench::start_mesh() { return start_job(true, false); }
+bool Workbench::start_solve() { return start_job(false, true); }
+
+void Workbench::cancel() {
+  if (job_) job_->cancel->store(true);
+}
+
+void Workbench::on_job_done() {
+  std::shared_ptr<Outcome> out = job_->watcher.result();
+  const QString what = job_->what;
+  job_.reset();
+  poll_->stop();
+  mesh_button_->setEnabled(true);
+  solve_button_->setEnabled(true);
+  cancel_button_->setEnabled(false);
+  progress_->setValue(out && out->ok ? 1000 : 0);
+  if (!out || !out->ok) {
+    const QString why = out ? out->error : tr("no result");
+    last_error_ = why;
+    last_error_bad_input_ = out && out->bad_input;
+    progress_->setFormat(what + ": " + why);
+    if (!out || !out->cancelled) param_error_->setText(why);
+    emit finished(false);
+    return;
+  }
+  last_error_.clear();
+  last_error_bad_input_ = false;
+  progress_->setFormat(what + tr(": done in %1 s").arg(out->seconds + out->solve_seconds, 0, 'f', 2));
+  if (out->meshed) {
+    mesh_ = out->mesh;
+    meshed_model_ = out->model;
+    meshed_overrides_ = out->overrides;
+    mesh_seconds_ = out->seconds;
+    ++mesh_serial_;
+    if (out->quality) {
+      quality_text_->setPlainText(QString::fromStdString(format_quality_report(*out->quality)));
+      histogram_->setPixmap(histogram_pixmap(*out->quality));
+    }
+    has_results_ = false;
+    field_.clear();
+  }
+  if (out->solved) {
+    mesh_ = out->mesh;
+    results_ = out->results;
+    results_.mesh_seconds = mesh_seconds_;
+    results_.solve_seconds = out->solve_seconds;
+    has_results_ = true;
+    field_ = "temperature";
+  }
+  if (!out->meshed && !out->solved) mesh_ = out->mesh;
+  view_->set_view(out->mesh, std::move(out->view));
+  view_->set_probe_values(std::move(out->probe), out->probe_unit);
+  mesh_bounds(*out->mesh, bounds_lo_, bounds_hi_);
+  view_->set_base(std::move(out->base));
+  if (out->has_scale && out->choice) {
+    view_->set_field_source(*out->choice, out->step, out->scale, out->iso_cache);
+    if (!range_) {  // the range boxes start from the automatic range
+      const QSignalBlocker q1(range_lo_), q2(range_hi_);
+      range_lo_->setValue(out->unit.to_display(out->scale.lo));
+      range_hi_->setValue(out->unit.to_display(out->scale.hi));
+    }
+    unit_ = out->unit;
+    field_lo_ = out->corner_lo;
+    field_hi_ = out->corner_hi;
+    // The same field (a new colour map, shrink or solve): its tools stay; another field: they go.
+    if (selection_field_ != field_) selection_ = {};
+    selection_field_ = field_;
+    QString why;
+    if (selection_.any() && !view_->set_selection(selection_, &why)) selection_ = {};
+  } else {
+    selection_ = {};
+    selection_field_.clear();
+  }
+  show_selection();
+  if (out->has_scale)
+    legend_->setPixmap(legend_pixmap(out->scale, out->unit, out->field_label, view_->height()));
+  else
+    legend_->clear();
+  refresh_fields();
+  if (out->meshed && !out->solved) add_history(out->seconds);
+  if (out->solved) {
+    show_results();
+    add_history(mesh_seconds_ + out->solve_seconds);  // the mesh's row gets the results
+  }
+  changed();
+  emit finished(true);
+}
+
+}  // namespace foxi::workbench

@@ -1,0 +1,346 @@
+// foxi-workbench's projects: save and reopen the whole state as a folder, recent projects, autosave.
+#include "workbench.hpp"
+#include "workbench_parts.hpp"
+
+#include <QCheckBox>
+#include <QDoubleSpinBox>
+#include <QFile>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QHBoxLayout>
+#include <QJsonArray>
+#include <QJsonDocument>
+#include <QJsonObject>
+#include <QMenu>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSettings>
+#include <QSignalBlocker>
+#include <QTimer>
+#include <QtConcurrent/QtConcurrentRun>
+#include <filesystem>
+
+#include "foxi/model/durable_file.hpp"
+#include "foxi/model/mesh_io.hpp"
+
+namespace foxi::workbench {
+
+QHBoxLayout* Workbench::build_project_row() {
+  // Projects: save and reopen the whole state; the folder is then autosaved; the recent ones listed.
+  auto* projects = new QHBoxLayout;
+  auto* save_p = new QPushButton(tr("Save project..."));
+  auto* open_p = new QPushButton(tr("Open project..."));
+  auto* recent = new QPushButton(tr("Recent"));
+  auto* recent_menu = new QMenu(recent);
+  recent->setMenu(recent_menu);
+  // After a save or an open of `folder`: it heads the recent list (QSettings) and is autosaved.
+  auto adopt = [this](bool ok, const QString& folder, const QString& why) {
+    if (!ok) {
+      show_error(why);
+      return;
+    }
+    QSettings settings;
+    QStringList list = settings.value("recent_projects").toStringList();
+    list.removeAll(folder);
+    list.prepend(folder);
+    while (list.size() > 8) list.removeLast();
+    settings.setValue("recent_projects", list);
+    set_autosave_folder(folder);
+  };
+  auto open_folder = [this, adopt](const QString& folder) {
+    QString why;
+    adopt(open_project(folder, &why), folder, why);
+  };
+  connect(save_p, &QPushButton::clicked, this, [this, adopt] {
+    const QString f = QFileDialog::getExistingDirectory(this, tr("Save the project into a folder"));
+    if (f.isEmpty()) return;
+    QString why;
+    adopt(save_project(f, &why), f, why);
+  });
+  connect(open_p, &QPushButton::clicked, this, [this, open_folder] {
+    const QString f = QFileDialog::getExistingDirectory(this, tr("Open a project folder"));
+    if (!f.isEmpty()) open_folder(f);
+  });
+  connect(recent_menu, &QMenu::aboutToShow, this, [recent_menu, open_folder] {
+    recent_menu->clear();
+    for (const QString& f : QSettings().value("recent_projects").toStringList())
+      recent_menu->addAction(f, [open_folder, f] { open_folder(f); });
+  });
+  projects->addWidget(save_p);
+  projects->addWidget(open_p);
+  projects->addWidget(recent);
+  return projects;
+}
+
+namespace {
+
+QJsonArray numbers(const double* v, int n) {
+  QJsonArray a;
+  for (int i = 0; i < n; ++i) a.append(v[i]);
+  return a;
+}
+
+void read_numbers(const QJsonValue& v, double* out, int n) {
+  const QJsonArray a = v.toArray();
+  if (a.size() != n)
+    throw std::runtime_error("a camera vector of " + std::to_string(n) + " numbers expected");
+  for (int i = 0; i < n; ++i) out[i] = a[i].toDouble();
+}
+
+QJsonArray overrides_json(const std::vector<ParameterOverride>& ov) {
+  QJsonArray a;
+  for (const ParameterOverride& o : ov)
+    a.append(QJsonArray{QString::fromStdString(o.name), QString::fromStdString(o.expression)});
+  return a;
+}
+
+std::vector<ParameterOverride> overrides_of(const QJsonValue& v) {
+  std::vector<ParameterOverride> ov;
+  for (const QJsonValue& e : v.toArray())
+    ov.push_back({e.toArray().at(0).toString().toStdString(), e.toArray().at(1).toString().toStdString()});
+  return ov;
+}
+
+}  // namespace
+
+// What a save writes, taken on the GUI thread (the state may change meanwhile) and written on any thread.
+struct ProjectSnapshot {
+  std::filesystem::path dir;
+  QJsonObject json;
+  std::shared_ptr<const Mesh> mesh;
+};
+
+namespace {
+
+// Writes the mesh under a new name, then project.json naming it (both DurableFile: each whole or
+// not at all), then removes the mesh file the previous project.json named.
+void write_project(ProjectSnapshot snap) {
+  const std::filesystem::path& dir = snap.dir;
+  std::filesystem::create_directories(dir);
+  std::filesystem::path old_mesh;
+  if (std::filesystem::exists(dir / "project.json")) {
+    QFile f(QString::fromStdString((dir / "project.json").string()));
+    if (f.open(QIODevice::ReadOnly)) {
+      const QString m = QJsonDocument::fromJson(f.readAll()).object()["mesh"].toString();
+      if (!m.isEmpty()) old_mesh = dir / m.toStdString();
+    }
+  }
+  if (snap.mesh) {
+    // A new name each save: the previous project.json names a whole mesh until the new one is in.
+    std::string name;
+    for (int i = 1;; ++i) {
+      name = "mesh-" + std::to_string(i) + ".vtu";
+      if (!std::filesystem::exists(dir / name) && dir / name != old_mesh) break;
+    }
+    write_mesh(*snap.mesh, dir / name);
+    snap.json["mesh"] = QString::fromStdString(name);
+  }
+  DurableFile out(dir / "project.json");
+  out.write(QJsonDocument(snap.json).toJson().toStdString());
+  out.commit();
+  if (!old_mesh.empty() && old_mesh.filename().string() != snap.json["mesh"].toString().toStdString() &&
+      old_mesh.filename().string().rfind("mesh-", 0) == 0)
+    std::filesystem::remove(old_mesh);
+}
+
+}  // namespace
+
+ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
+  if (model_path_.isEmpty()) throw std::runtime_error("no model to save");
+  ProjectSnapshot snap;
+  snap.dir = folder.toStdString();
+  snap.mesh = mesh_;
+  QJsonObject& p = snap.json;
+  p["format"] = "foxi-workbench project 1";
+  p["model"] = QFileInfo(model_path_).absoluteFilePath();
+  p["overrides"] = overrides_json(overrides());
+  p["field"] = field_;
+  p["color_map"] = color_map_;
+  p["graded"] = graded_;
+  if (range_) p["range"] = QJsonArray{range_->first, range_->second};
+  QJsonArray hidden;
+  for (std::int32_t r : hidden_) hidden.append(r);
+  p["hidden_regions"] = hidden;
+  p["shrink"] = shrink_;
+  if (const Camera* c = view_->camera()) {
+    QJsonObject cam;
+    cam["perspective"] = c->perspective;
+    cam["eye"] = numbers(c->eye, 3);
+    cam["at"] = numbers(c->at, 3);
+    cam["up"] = numbers(c->up, 3);
+    cam["fov_deg"] = c->fov_deg;
+    cam["ortho_height"] = c->ortho_height;
+    p["camera"] = cam;
+  }
+  QJsonArray history;
+  for (const HistoryRow& h : history_) {
+    QJsonObject row;
+    row["parameters"] = overrides_json(h.parameters);
+    row["mesh"] = double(h.mesh);
+    row["tets"] = double(h.tets);
+    row["seconds"] = h.seconds;
+    row["results"] = QString::fromStdString(results_json(h.results));
+    history.append(row);
+  }
+  p["history"] = history;
+  if (has_results_) p["results"] = QString::fromStdString(results_json(results_));
+  p["mesh_overrides"] = overrides_json(meshed_overrides_);
+  if (selection_.any()) {
+    QJsonObject sel;
+    QJsonArray iso;
+    for (double v : selection_.iso) iso.append(v);
+    sel["iso"] = iso;
+    sel["iso_only"] = selection_.iso_only;
+    if (selection_.threshold)
+      sel["threshold"] = QJsonArray{selection_.threshold->first, selection_.threshold->second};
+    if (selection_.clip) {
+      QJsonArray c = numbers(selection_.clip->p, 3);
+      for (int k = 0; k < 3; ++k) c.append(selection_.clip->n[k]);
+      sel["clip"] = c;
+    }
+    p["selection"] = sel;
+  }
+  return snap;
+}
+
+bool Workbench::save_project(const QString& folder, QString* error) {
+  try {
+    if (busy()) throw std::runtime_error("a job is running: save when it ends");
+    if (autosaving_.isRunning()) autosaving_.waitForFinished();
+    write_project(project_snapshot(folder));
+    return true;
+  } catch (const std::exception& e) {
+    if (error) *error = QString::fromStdString(e.what());
+    return false;
+  }
+}
+
+void Workbench::set_autosave_folder(const QString& folder) {
+  autosave_folder_ = folder;
+  if (folder.isEmpty()) autosave_timer_->stop();
+}
+
+void Workbench::changed() {
+  if (!autosave_folder_.isEmpty() && !model_path_.isEmpty() && !autosave_timer_->isActive())
+    autosave_timer_->start();
+}
+
+void Workbench::autosave() {
+  // Not while a job runs (its result is the next change) or the previous autosave still writes.
+  if (busy() || autosaving_.isRunning()) {
+    autosave_timer_->start();
+    return;
+  }
+  try {
+    ProjectSnapshot snap = project_snapshot(autosave_folder_);
+    autosaving_ = QtConcurrent::run([snap = std::move(snap)]() -> QString {
+      try {
+        write_project(snap);
+        return {};
+      } catch (const std::exception& e) {
+        return QString::fromStdString(e.what());
+      }
+    });
+    ++autosaves_;
+  } catch (const std::exception& e) {
+    progress_->setFormat(tr("autosave: %1").arg(QString::fromStdString(e.what())));
+  }
+}
+
+void Workbench::wait_autosave() {
+  if (autosaving_.isRunning()) autosaving_.waitForFinished();
+}
+
+bool Workbench::open_project(const QString& folder, QString* error) {
+  try {
+    if (busy()) throw std::runtime_error("a job is running");
+    const std::filesystem::path dir = folder.toStdString();
+    QFile f(QString::fromStdString((dir / "project.json").string()));
+    if (!f.open(QIODevice::ReadOnly))
+      throw std::runtime_error((dir / "project.json").string() + ": cannot read");
+    QJsonParseError perr;
+    const QJsonDocument doc = QJsonDocument::fromJson(f.readAll(), &perr);
+    if (doc.isNull())
+      throw std::runtime_error((dir / "project.json").string() + ": " + perr.errorString().toStdString());
+    const QJsonObject p = doc.object();
+    if (p["format"].toString() != "foxi-workbench project 1")
+      throw std::runtime_error((dir / "project.json").string() + ": not a foxi-workbench project");
+    QString why;
+    if (!open_model(p["model"].toString(), &why)) throw std::runtime_error(why.toStdString());
+    std::map<std::string, std::string> trial;
+    for (const ParameterOverride& o : overrides_of(p["overrides"])) trial[o.name] = o.expression;
+    if (!apply_overrides(trial, &why)) throw std::runtime_error(why.toStdString());
+    field_ = p["field"].toString();
+    color_map_ = p["color_map"].toString("viridis");
+    graded_ = p["graded"].toBool();
+    range_.reset();
+    if (p.contains("range"))
+      range_ = std::pair(p["range"].toArray().at(0).toDouble(), p["range"].toArray().at(1).toDouble());
+    hidden_.clear();
+    for (const QJsonValue& v : p["hidden_regions"].toArray()) hidden_.push_back(v.toInt());
+    shrink_ = p["shrink"].toDouble(1);
+    history_.clear();
+    for (const QJsonValue& v : p["history"].toArray()) {
+      const QJsonObject o = v.toObject();
+      HistoryRow h;
+      h.parameters = overrides_of(o["parameters"]);
+      h.mesh = std::size_t(o["mesh"].toDouble());
+      h.tets = std::size_t(o["tets"].toDouble());
+      h.seconds = o["seconds"].toDouble();
+      h.results = parse_results_json(o["results"].toString().toStdString());
+      history_.push_back(std::move(h));
+    }
+    has_results_ = p.contains("results");
+    if (has_results_) results_ = parse_results_json(p["results"].toString().toStdString());
+    if (!p["mesh"].toString().isEmpty()) {
+      mesh_ = std::make_shared<const Mesh>(read_mesh(dir / p["mesh"].toString().toStdString()));
+      meshed_model_ = model_;
+      meshed_overrides_ = overrides_of(p["mesh_overrides"]);
+      mesh_serial_ = history_.empty() ? 1 : history_.back().mesh;
+    }
+    if (p.contains("camera")) {
+      const QJsonObject c = p["camera"].toObject();
+      Camera cam;
+      cam.perspective = c["perspective"].toBool(true);
+      read_numbers(c["eye"], cam.eye, 3);
+      read_numbers(c["at"], cam.at, 3);
+      read_numbers(c["up"], cam.up, 3);
+      cam.fov_deg = c["fov_deg"].toDouble(30);
+      cam.ortho_height = c["ortho_height"].toDouble(1);
+      pending_camera_ = cam;
+    }
+    selection_ = {};
+    if (p.contains("selection")) {
+      const QJsonObject sel = p["selection"].toObject();
+      for (const QJsonValue& v : sel["iso"].toArray()) selection_.iso.push_back(v.toDouble());
+      selection_.iso_only = sel["iso_only"].toBool();
+      if (sel.contains("threshold"))
+        selection_.threshold = std::pair(sel["threshold"].toArray().at(0).toDouble(),
+                                         sel["threshold"].toArray().at(1).toDouble());
+      if (sel.contains("clip")) {
+        double c[6];
+        read_numbers(sel["clip"], c, 6);
+        Plane pl;
+        for (int k = 0; k < 3; ++k) pl.p[k] = c[k], pl.n[k] = c[k + 3];
+        selection_.clip = pl;
+      }
+    }
+    selection_field_ = field_;  // the display that follows applies it
+    {
+      const QSignalBlocker q1(graded_box_), q2(range_on_), q3(range_lo_), q4(range_hi_), q5(shrink_box_);
+      graded_box_->setChecked(graded_);
+      range_on_->setChecked(range_.has_value());
+      if (range_) range_lo_->setValue(range_->first), range_hi_->setValue(range_->second);
+      shrink_box_->setValue(shrink_);
+    }
+    if (has_results_) show_results();
+    refresh_history();
+    if (mesh_) set_field(field_, color_map_);
+    return true;
+  } catch (const std::exception& e) {
+    if (error) *error = QString::fromStdString(e.what());
+    return false;
+  }
+}
+
+}  // namespace foxi::workbench

@@ -1,0 +1,436 @@
+// foxi-workbench's view panel: the view, its draw controls, the field, colouring and field tools.
+#include "workbench.hpp"
+#include "workbench_parts.hpp"
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QHBoxLayout>
+#include <QImage>
+#include <QLabel>
+#include <QListWidget>
+#include <QPainter>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSlider>
+#include <QVBoxLayout>
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <tuple>
+
+#include "foxi/viz/field_paint.hpp"
+#include "foxi/viz/legend.hpp"
+#include "foxi/viz/rasterizer.hpp"
+
+namespace foxi::workbench {
+
+void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const Colouring& colouring,
+                   double shrink, int w, int h, const Camera* camera) {
+  // The regions shown: the tets of the others left out (foxi render --regions); the automatic colour
+  // range is that of the tets shown, as there.
+  if (!colouring.hidden.empty()) {
+    for (std::size_t t = 0; t < mesh.tet_count(); ++t)
+      if (std::find(colouring.hidden.begin(), colouring.hidden.end(), mesh.region_of(t)) ==
+          colouring.hidden.end())
+        out.base.push_back(std::uint32_t(t));
+    if (out.base.empty()) throw std::runtime_error("every region is hidden: nothing to show");
+  }
+  RenderParams params;
+  params.undoable = true;  // the workbench undraws
+  params.shrink = shrink;
+  if (!field.empty()) {
+    const FieldChoice choice = choose_field(mesh, field);
+    const std::size_t step = choice.field->step_count() - 1;
+    const std::vector<double> values = tet_centroid_values(mesh, choice, step);
+    out.iso_cache = std::make_shared<IsoCache>(make_iso_cache(mesh, choice, step));
+    // The values drawn: per tet, or per tet corner (graded); the unit and automatic range are theirs.
+    const std::vector<double>& all = colouring.graded ? *out.iso_cache->corner : values;
+    std::vector<double> shown;
+    const std::size_t per = colouring.graded ? 4 : 1;
+    for (std::uint32_t t : out.base)
+      shown.insert(shown.end(), all.begin() + std::ptrdiff_t(per * t),
+                   all.begin() + std::ptrdiff_t(per * (t + 1)));
+    const std::vector<double>& drawn = out.base.empty() ? all : shown;
+    const ColorMapId map = parse_color_map(colouring.cmap).value_or(ColorMapId::viridis);
+    const auto [lo, hi] = finite_range(drawn);
+    out.unit = default_display_unit(choice.field->unit,
+                                    std::isfinite(lo) ? std::max(std::abs(lo), std::abs(hi)) : 0);
+    ColorScale scale;
+    if (colouring.range) {
+      scale.map = map;
+      scale.lo = out.unit.to_si(colouring.range->first);
+      scale.hi = out.unit.to_si(colouring.range->second);
+      if (scale.lo > scale.hi) std::swap(scale.lo, scale.hi);
+    } else {
+      const std::optional<AutoScale> a = automatic_scale(drawn, map);
+      if (!a) throw FieldSelectError("field '" + field + "' has no finite value");
+      scale = a->scale;
+    }
+    params.field = std::make_shared<const FieldPaint>(colouring.graded ? graded_field_paint(all, scale)
+                                                                       : flat_field_paint(all, scale));
+    out.scale = scale;
+    out.has_scale = true;
+    out.probe.resize(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) out.probe[i] = out.unit.to_display(values[i]);
+    out.probe_unit = QString::fromStdString(out.unit.symbol);
+    out.field_label = QString::fromStdString(choice.label);
+    out.choice = choice;
+    out.step = step;
+    std::tie(out.corner_lo, out.corner_hi) = finite_range(*out.iso_cache->corner);
+  }
+  out.view = foxi::qt::make_view(mesh, params, w, h, camera);
+}
+
+// A colour bar with ticks (colormap.hpp's entries and nice_ticks), in the field's display unit.
+QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QString& label, int height) {
+  const int w = 150, bar = 18, top = 24, bottom = 10, h = std::max(height, 120);
+  QImage img(w, h, QImage::Format_RGB32);
+  img.fill(Qt::white);
+  QPainter p(&img);
+  const int span = h - top - bottom;
+  for (int y = 0; y < span; ++y) {
+    const std::uint32_t c = s.color_at(1.0 - (y + 0.5) / span);
+    p.setPen(QColor(int(c & 255), int(c >> 8 & 255), int(c >> 16 & 255)));
+    p.drawLine(8, top + y, 8 + bar, top + y);
+  }
+  p.setPen(Qt::black);
+  p.drawRect(8, top, bar, span);
+  p.drawText(4, 16, label + " [" + QString::fromStdString(unit.symbol) + "]");
+  const double lo = unit.to_display(s.lo), hi = unit.to_display(s.hi);
+  const std::vector<double> ticks = nice_ticks(std::min(lo, hi), std::max(lo, hi), 6);
+  const double step = ticks.size() > 1 ? ticks[1] - ticks[0] : 1;
+  for (double t : ticks) {
+    const double pos = s.position(unit.to_si(t));
+    const int y = top + int(std::lround((1 - pos) * span));
+    p.drawLine(8 + bar, y, 8 + bar + 4, y);
+    p.drawText(8 + bar + 8, y + 5, QString::fromStdString(tick_label(t, step)));
+  }
+  return QPixmap::fromImage(img);
+}
+
+QPushButton* Workbench::build_view_panel() {
+  view_ = new foxi::qt::ViewWidget;
+  view_->setMinimumSize(480, 360);
+
+  // The view and its controls.
+  auto* centre = new QWidget;
+  auto* cv = new QVBoxLayout(centre);
+  auto* bar = new QHBoxLayout;
+  auto button = [&](const QString& text, auto slot) {
+    auto* b = new QPushButton(text);
+    connect(b, &QPushButton::clicked, view_, slot);
+    bar->addWidget(b);
+    return b;
+  };
+  button(tr("Draw"), &foxi::qt::ViewWidget::draw);
+  button(tr("Stop"), &foxi::qt::ViewWidget::stop);
+  button(tr("Go on"), &foxi::qt::ViewWidget::resume);
+  button(tr("Step"), &foxi::qt::ViewWidget::step_once);
+  button(tr("Undraw"), &foxi::qt::ViewWidget::undraw);
+  button(tr("Region"), &foxi::qt::ViewWidget::push_region);
+  button(tr("Back"), &foxi::qt::ViewWidget::pop_region);
+  auto* save = new QPushButton(tr("Save picture..."));
+  connect(save, &QPushButton::clicked, this, [this] {
+    const QString f =
+        QFileDialog::getSaveFileName(this, tr("Save the view's picture"), QString(), tr("PNG (*.png)"));
+    QString error;
+    if (!f.isEmpty() && !view_->save_picture(f, &error)) param_error_->setText(error);
+  });
+  bar->addWidget(save);
+  fraction_ = new QSlider(Qt::Horizontal);
+  fraction_->setRange(0, 1000);
+  fraction_->setValue(1000);
+  fraction_->setToolTip(tr("fraction of the displayed set drawn: drawing or undrawing follows it"));
+  connect(fraction_, &QSlider::sliderMoved, this, [this](int v) { view_->set_fraction(v / 1000.0); });
+  cv->addLayout(bar);
+  auto* slider_row = new QHBoxLayout;
+  slider_row->addWidget(new QLabel(tr("fraction drawn")));
+  slider_row->addWidget(fraction_, 1);
+  cv->addLayout(slider_row);
+  auto* fields = new QHBoxLayout;
+  field_box_ = new QComboBox;
+  field_box_->setMinimumContentsLength(12);
+  field_box_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+  cmap_box_ = new QComboBox;
+  for (const char* m : {"viridis", "cividis", "coolwarm", "rainbow"}) cmap_box_->addItem(m);
+  fields->addWidget(new QLabel(tr("field")));
+  fields->addWidget(field_box_, 1);
+  fields->addWidget(new QLabel(tr("colour map")));
+  fields->addWidget(cmap_box_);
+  shrink_box_ = new QDoubleSpinBox;
+  shrink_box_->setRange(0.1, 1.0);
+  shrink_box_->setSingleStep(0.05);
+  shrink_box_->setValue(1.0);
+  shrink_box_->setToolTip(tr("each tet scaled about its centroid: see between them"));
+  connect(shrink_box_, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
+          [this](double v) { set_shrink(v); });
+  // A value in the field's display unit (a range's end), taken when typed in full.
+  auto value_box = [] {
+    auto* b = new QDoubleSpinBox;
+    b->setDecimals(3);
+    b->setRange(-1e12, 1e12);
+    b->setKeyboardTracking(false);
+    b->setMaximumWidth(110);
+    return b;
+  };
+  graded_box_ = new QCheckBox(tr("graded"));
+  graded_box_->setToolTip(tr("each face's colour interpolated from its corners (foxi render --graded)"));
+  range_on_ = new QCheckBox(tr("range"));
+  range_on_->setToolTip(tr("the colour range in the legend's unit (otherwise the values' own range)"));
+  range_lo_ = value_box();
+  range_hi_ = value_box();
+  range_hi_->setValue(1);
+  auto recolour = [this] {
+    std::optional<std::pair<double, double>> r;
+    if (range_on_->isChecked()) r = std::pair(range_lo_->value(), range_hi_->value());
+    if (!set_colouring(graded_box_->isChecked(), r)) param_error_->setText(tr("the range needs low < high"));
+  };
+  connect(graded_box_, &QCheckBox::toggled, this, recolour);
+  connect(range_on_, &QCheckBox::toggled, this, recolour);
+  connect(range_lo_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, recolour);
+  connect(range_hi_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, recolour);
+  fields->addWidget(graded_box_);
+  fields->addWidget(range_on_);
+  fields->addWidget(range_lo_);
+  fields->addWidget(range_hi_);
+  fields->addWidget(new QLabel(tr("shrink")));
+  fields->addWidget(shrink_box_);
+  cv->addLayout(fields);
+  // The field tools: isosurface, threshold, clip (by the field shown; disabled without one).
+  auto* tools = new QHBoxLayout;
+  iso_on_ = new QCheckBox(tr("isosurface"));
+  iso_on_->setToolTip(tr("the solid where the field is at least the isovalue, cut at the isosurface"));
+  iso_slider_ = new QSlider(Qt::Horizontal);
+  iso_slider_->setRange(0, 1000);
+  iso_slider_->setValue(500);
+  iso_value_ = new QLabel;
+  iso_value_->setMinimumWidth(80);
+  iso_only_ = new QCheckBox(tr("surface only"));
+  threshold_on_ = new QCheckBox(tr("threshold"));
+  threshold_on_->setToolTip(tr("only the tets whose value (at the centroid) lies in the range"));
+  threshold_lo_ = value_box();
+  threshold_hi_ = value_box();
+  clip_on_ = new QCheckBox(tr("clip"));
+  clip_on_->setToolTip(
+      tr("only the whole tets behind the plane (its normal, along the axis chosen, points to "
+         "the part cut away)"));
+  clip_axis_ = new QComboBox;
+  for (const char* a : {"+x", "+y", "+z", "-x", "-y", "-z"}) clip_axis_->addItem(a);
+  clip_slider_ = new QSlider(Qt::Horizontal);
+  clip_slider_->setRange(0, 1000);
+  clip_slider_->setValue(500);
+  tools->addWidget(iso_on_);
+  tools->addWidget(iso_slider_, 3);
+  tools->addWidget(iso_value_);
+  tools->addWidget(iso_only_);
+  tools->addWidget(threshold_on_);
+  tools->addWidget(threshold_lo_);
+  tools->addWidget(threshold_hi_);
+  tools->addWidget(clip_on_);
+  tools->addWidget(clip_axis_);
+  tools->addWidget(clip_slider_, 2);
+  cv->addLayout(tools);
+  regions_ = new QListWidget;
+  regions_->setFlow(QListView::LeftToRight);
+  regions_->setMaximumHeight(32);
+  regions_->setToolTip(tr("the regions shown (foxi render --regions)"));
+  connect(regions_, &QListWidget::itemChanged, this, [this] {
+    if (filling_) return;
+    std::vector<std::int32_t> hidden;
+    for (int i = 0; i < regions_->count(); ++i)
+      if (regions_->item(i)->checkState() != Qt::Checked)
+        hidden.push_back(regions_->item(i)->data(Qt::UserRole).toInt());
+    set_hidden_regions(hidden);
+  });
+  auto* region_row = new QHBoxLayout;
+  region_row->addWidget(new QLabel(tr("regions shown")));
+  region_row->addWidget(regions_, 1);
+  cv->addLayout(region_row);
+  for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_})
+    connect(c, &QCheckBox::toggled, this, [this] { apply_field_tools(); });
+  connect(iso_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
+  connect(clip_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
+  connect(clip_axis_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] { apply_field_tools(); });
+  for (QDoubleSpinBox* b : {threshold_lo_, threshold_hi_})
+    connect(b, qOverload<double>(&QDoubleSpinBox::valueChanged), this, [this] { apply_field_tools(); });
+  auto* vrow = new QHBoxLayout;
+  vrow->addWidget(view_, 1);
+  legend_ = new QLabel;
+  legend_->setFixedWidth(150);
+  legend_->setAlignment(Qt::AlignTop);
+  vrow->addWidget(legend_);
+  cv->addLayout(vrow, 1);
+  auto pick_field = [this] {
+    if (filling_) return;
+    const QString f = field_box_->currentIndex() <= 0 ? QString() : field_box_->currentText();
+    set_field(f, cmap_box_->currentText());
+  };
+  connect(field_box_, qOverload<int>(&QComboBox::currentIndexChanged), this, pick_field);
+  connect(cmap_box_, qOverload<int>(&QComboBox::currentIndexChanged), this, pick_field);
+  setCentralWidget(centre);
+  return save;
+}
+
+bool Workbench::set_field(const QString& field, const QString& color_map) {
+  if (busy() || !mesh_) return false;
+  std::shared_ptr<const Mesh> mesh = mesh_;
+  const std::string f = field.toStdString();
+  const double shrink = shrink_;
+  const int w = view_->width(), h = view_->height();
+  std::optional<Camera> cam;
+  if (view_->camera()) cam = *view_->camera();
+  if (pending_camera_) cam = std::exchange(pending_camera_, std::nullopt);
+  field_ = field;
+  color_map_ = color_map;
+  auto work = [mesh, f, c = colouring(), shrink, w, h, cam]() {
+    auto out = std::make_shared<Outcome>();
+    try {
+      build_display(*out, *mesh, f, c, shrink, w, h, cam ? &*cam : nullptr);
+      out->mesh = mesh;
+      out->ok = true;
+    } catch (const std::exception& e) {
+      out->error = what_of(e);
+    }
+    return out;
+  };
+  launch(work, tr("colouring"), std::make_shared<std::atomic<bool>>(false),
+         std::make_shared<std::atomic<int>>(0));
+  return true;
+}
+
+Colouring Workbench::colouring() const {
+  return Colouring{color_map_.toStdString(), graded_, range_, hidden_};
+}
+
+bool Workbench::set_hidden_regions(std::vector<std::int32_t> hidden) {
+  hidden_ = std::move(hidden);
+  return !mesh_ || set_field(field_, color_map_);
+}
+
+bool Workbench::set_colouring(bool graded, std::optional<std::pair<double, double>> range) {
+  if (range && !(range->first < range->second && std::isfinite(range->first) && std::isfinite(range->second)))
+    return false;
+  graded_ = graded;
+  range_ = range;
+  {
+    const QSignalBlocker q1(graded_box_), q2(range_on_), q3(range_lo_), q4(range_hi_);
+    graded_box_->setChecked(graded);
+    range_on_->setChecked(range.has_value());
+    if (range) {
+      range_lo_->setValue(range->first);
+      range_hi_->setValue(range->second);
+    }
+  }
+  return !mesh_ || field_.isEmpty() || set_field(field_, color_map_);
+}
+
+bool Workbench::set_shrink(double shrink) {
+  if (!(shrink > 0 && shrink <= 1)) return false;
+  shrink_ = shrink;
+  if (shrink_box_->value() != shrink) {
+    const QSignalBlocker quiet(shrink_box_);
+    shrink_box_->setValue(shrink);
+  }
+  return !mesh_ || set_field(field_, color_map_);
+}
+
+bool Workbench::set_selection(const FieldSelection& selection, QString* error) {
+  if (!view_->set_selection(selection, error)) return false;
+  changed();
+  selection_ = selection;
+  selection_field_ = field_;
+  show_selection();
+  return true;
+}
+
+void Workbench::show_selection() {
+  filling_ = true;
+  const bool field = !selection_field_.isEmpty() && view_->has_view() && field_hi_ >= field_lo_;
+  for (QWidget* w :
+       std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_only_, threshold_on_, threshold_lo_,
+                                       threshold_hi_, clip_on_, clip_axis_, clip_slider_})
+    w->setEnabled(field);
+  const FieldSelection& s = selection_;
+  const QSignalBlocker b1(iso_on_), b2(iso_slider_), b3(iso_only_), b4(threshold_on_), b5(threshold_lo_),
+      b6(threshold_hi_), b7(clip_on_), b8(clip_axis_), b9(clip_slider_);
+  iso_on_->setChecked(!s.iso.empty());
+  iso_only_->setChecked(s.iso_only);
+  const double span = field_hi_ - field_lo_;
+  if (!s.iso.empty() && span > 0)
+    iso_slider_->setValue(int(std::lround(1000 * (s.iso.front() - field_lo_) / span)));
+  const double iso = s.iso.empty() ? field_lo_ + span * iso_slider_->value() / 1000.0 : s.iso.front();
+  iso_value_->setText(
+      field ? QString("%1 %2").arg(unit_.to_display(iso), 0, 'g', 5).arg(QString::fromStdString(unit_.symbol))
+            : QString());
+  threshold_on_->setChecked(s.threshold.has_value());
+  if (field && !s.threshold) {
+    threshold_lo_->setValue(unit_.to_display(field_lo_));
+    threshold_hi_->setValue(unit_.to_display(field_hi_));
+  } else if (s.threshold) {
+    threshold_lo_->setValue(unit_.to_display(s.threshold->first));
+    threshold_hi_->setValue(unit_.to_display(s.threshold->second));
+  }
+  clip_on_->setChecked(s.clip.has_value());
+  if (s.clip) {
+    // An axis plane of the slider's: its axis, side and position; any other plane leaves the controls.
+    for (int k = 0; k < 3; ++k)
+      if (s.clip->n[k] != 0 && s.clip->n[(k + 1) % 3] == 0 && s.clip->n[(k + 2) % 3] == 0 &&
+          bounds_hi_[k] > bounds_lo_[k]) {
+        clip_axis_->setCurrentIndex(s.clip->n[k] > 0 ? k : k + 3);
+        clip_slider_->setValue(
+            int(std::lround(1000 * (s.clip->p[k] - bounds_lo_[k]) / (bounds_hi_[k] - bounds_lo_[k]))));
+      }
+  }
+  filling_ = false;
+}
+
+void Workbench::apply_field_tools() {
+  if (filling_ || selection_field_.isEmpty()) return;
+  FieldSelection s;
+  const double span = field_hi_ - field_lo_;
+  if (iso_on_->isChecked()) {
+    s.iso = {field_lo_ + span * iso_slider_->value() / 1000.0};
+    s.iso_only = iso_only_->isChecked();
+  }
+  if (threshold_on_->isChecked())
+    s.threshold = {unit_.to_si(threshold_lo_->value()), unit_.to_si(threshold_hi_->value())};
+  if (clip_on_->isChecked()) {
+    Plane p;
+    const int k = clip_axis_->currentIndex() % 3;
+    for (int j = 0; j < 3; ++j) {
+      p.p[j] = 0.5 * (bounds_lo_[j] + bounds_hi_[j]);
+      p.n[j] = j == k ? (clip_axis_->currentIndex() < 3 ? 1 : -1) : 0;
+    }
+    p.p[k] = bounds_lo_[k] + (bounds_hi_[k] - bounds_lo_[k]) * clip_slider_->value() / 1000.0;
+    s.clip = p;
+  }
+  QString why;
+  if (!set_selection(s, &why)) param_error_->setText(why);
+}
+
+void Workbench::refresh_fields() {
+  filling_ = true;
+  field_box_->clear();
+  field_box_->addItem(tr("(regions)"));
+  if (mesh_)
+    for (const Field& f : mesh_->fields) field_box_->addItem(QString::fromStdString(f.name));
+  const int i = field_.isEmpty() ? 0 : field_box_->findText(field_);
+  field_box_->setCurrentIndex(std::max(i, 0));
+  cmap_box_->setCurrentText(color_map_);
+  regions_->clear();
+  if (mesh_)
+    for (const Region& r : mesh_->regions) {
+      auto* item =
+          new QListWidgetItem(r.name.empty() ? QString::number(r.id) : QString::fromStdString(r.name));
+      item->setData(Qt::UserRole, r.id);
+      item->setFlags(item->flags() | Qt::ItemIsUserCheckable);
+      item->setCheckState(std::find(hidden_.begin(), hidden_.end(), r.id) == hidden_.end() ? Qt::Checked
+                                                                                           : Qt::Unchecked);
+      regions_->addItem(item);
+    }
+  filling_ = false;
+}
+
+}  // namespace foxi::workbench

@@ -1,0 +1,76 @@
+// What foxi-workbench's source files share (not installed, not a public header): the outcome a
+// worker hands back, the running job, and the helpers one panel's file defines and another calls.
+// The files: workbench.cpp (the window, its status bar and keys), model_panel.cpp (model and
+// parameters), mesh_panel.cpp (quality report), solve_panel.cpp (results table), view_panel.cpp
+// (the view and its field tools), jobs.cpp (mesh/solve workers, progress, Cancel, results shown),
+// project.cpp (save/open/autosave), history.cpp (run history).
+#pragma once
+
+#include <QFutureWatcher>
+#include <QPixmap>
+#include <QString>
+#include <atomic>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "foxi/mesher/quality_report.hpp"
+#include "foxi/viz/camera.hpp"
+#include "foxi/viz/colormap.hpp"
+#include "foxi/viz/interactive_view.hpp"
+#include "workbench.hpp"
+
+namespace foxi::workbench {
+
+struct Outcome {
+  bool ok = false, cancelled = false;
+  bool bad_input = false;  // the error is the model's (IoError: file, line, reason)
+  QString error;
+  bool meshed = false, solved = false;
+  std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const Model> model;
+  std::vector<ParameterOverride> overrides;
+  std::unique_ptr<InteractiveView> view;
+  std::vector<double> probe;  // per tet, display unit
+  QString probe_unit, field_label;
+  ColorScale scale;
+  DisplayUnit unit;
+  bool has_scale = false;
+  std::vector<std::uint32_t> base;    // the tets of the regions shown (empty: all)
+  std::optional<FieldChoice> choice;  // the field shown, for the field tools
+  std::size_t step = 0;
+  std::shared_ptr<IsoCache> iso_cache;  // built here, on the worker: the tools then only query
+  double corner_lo = 0, corner_hi = 0;  // the corner values' range, SI
+  RunResults results;
+  double seconds = 0;                        // meshing (or the solve when not meshed)
+  double solve_seconds = 0;                  // the solve
+  std::optional<MeshQualityReport> quality;  // a new mesh's
+};
+
+struct Workbench::Job {
+  std::shared_ptr<std::atomic<bool>> cancel;
+  std::shared_ptr<std::atomic<int>> permille;
+  QFutureWatcher<std::shared_ptr<Outcome>> watcher;
+  QString what;
+};
+
+// The stage (1, 2, ...) of a progress value stage * 10000 + permille; "" for 0 (jobs.cpp).
+const char* progress_stage(int index);
+
+// The display of `mesh` on the worker: the field's paint, flat or graded, on the automatic scale or
+// the user's range (as foxi render --field NAME --cmap MAP [--graded] [--range a,b] draws it) and the
+// view, built with `camera` (null: the default) (view_panel.cpp).
+void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const Colouring& colouring,
+                   double shrink, int w, int h, const Camera* camera);
+
+// A colour bar with ticks in the field's display unit (view_panel.cpp).
+QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QString& label, int height);
+
+// The minimum dihedral angle histogram of the quality report as a bar chart (mesh_panel.cpp).
+QPixmap histogram_pixmap(const MeshQualityReport& q);
+
+inline QString what_of(const std::exception& e) { return QString::fromStdString(e.what()); }
+
+}  // namespace foxi::workbench
