@@ -23,8 +23,6 @@
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/physics.hpp"
 #include "foxi/model/progress.hpp"
-#include "foxi/solver/model_problem.hpp"
-#include "foxi/solver/thermal.hpp"
 
 namespace foxi::workbench {
 
@@ -81,6 +79,7 @@ struct JobInput {
   std::string path;
   std::vector<ParameterOverride> overrides;
   bool mesh = true, solve = false;
+  Physics physics = Physics::thermal;      // of the solve
   std::shared_ptr<const Mesh> old_mesh;    // solve only: the mesh to solve on
   std::shared_ptr<const Model> old_model;  // and the model it came from
   int width = 1, height = 1;
@@ -117,7 +116,7 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
       options.override_origin = "the parameter table";
       options.progress = progress;
       // A solve to follow: the model's conditions and materials checked before meshing, as foxi solve does.
-      if (in.solve) options.physics = Physics::thermal;
+      if (in.solve) options.physics = in.physics;
       MeshedModel mm = mesh_model(in.path, in.overrides, options);
       if (cancelled()) return out;
       mesh = std::make_shared<Mesh>(std::move(mm.mesh));
@@ -131,21 +130,17 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
     }
     const auto t1 = Clock::now();
     if (in.solve) {
-      if (!in.mesh) check_physics(*model, Physics::thermal);
-      ThermalParams params = thermal_params_from_model(*model, *mesh);
-      params.solver.progress = progress;
-      const ThermalReport report = solve_thermal(*mesh, params);
+      if (!in.mesh) check_physics(*model, in.physics);
+      out->results = solve_model_physics(in.path, *model, *mesh, in.physics, progress);
       if (cancelled()) return out;
-      out->results = thermal_results(*mesh, report);
       out->results.model = in.path;
-      out->results.physics = "thermal";
       for (const ParameterOverride& o : in.overrides)
         out->results.parameters.push_back({o.name, o.expression});
       out->solve_seconds = std::chrono::duration<double>(Clock::now() - t1).count();
       out->solved = true;
     }
-    build_display(*out, *mesh, in.solve ? "temperature" : "", in.colouring, in.shrink, in.width, in.height,
-                  in.camera ? &*in.camera : nullptr);
+    build_display(*out, *mesh, in.solve ? solved_field(in.physics) : "", in.colouring, in.shrink, in.width,
+                  in.height, in.camera ? &*in.camera : nullptr);
     out->mesh = std::move(mesh);
     out->model = std::move(model);
     out->overrides = in.overrides;
@@ -173,6 +168,7 @@ bool Workbench::start_job(bool mesh, bool solve) {
   const bool stale = !mesh_ || !meshed_model_ || !same_overrides(in.overrides, meshed_overrides_);
   in.mesh = mesh || stale;
   in.solve = solve;
+  in.physics = physics_;
   in.old_mesh = mesh_;
   in.old_model = meshed_model_;
   in.width = view_->width();
@@ -238,7 +234,7 @@ void Workbench::on_job_done() {
     results_.mesh_seconds = mesh_seconds_;
     results_.solve_seconds = out->solve_seconds;
     has_results_ = true;
-    field_ = "temperature";
+    field_ = solved_field(physics_of(out->results.physics).value_or(Physics::thermal));
   }
   if (!out->meshed && !out->solved) mesh_ = out->mesh;
   view_->set_view(out->mesh, std::move(out->view));

@@ -18,12 +18,13 @@
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/view_options.hpp"
 #include "workbench.hpp"
+#include "workbench_parts.hpp"
 
 namespace {
 
 const char* kUsage =
     "foxi-workbench [MODEL.toml]\n"
-    "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics thermal] [--field NAME]\n"
+    "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics NAME] [--field NAME]\n"
     "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
     "               [--regions ID,...] [--graded] [--range a,b] [--iso v [--iso-only]] [--threshold a,b] "
     "[--clip px,py,pz,nx,ny,nz]\n"
@@ -34,7 +35,9 @@ const char* kUsage =
     "  painter (draw, stop, step, undraw, the drawn-fraction slider, regions of interest), colour by a\n"
     "  field with a legend, and compare runs in the history.\n"
     "  --headless runs the loop once without a user: loads MODEL, applies the --set values, meshes,\n"
-    "  solves (--physics thermal), shows --field (default temperature after a solve), draws the view\n"
+    "  solves (--physics thermal|electrostatic|current|thermoelastic: the model's conditions and loads\n"
+    "  of it, as foxi solve MODEL --physics NAME), shows --field (default the solve's temperature,\n"
+    "  potential or von_mises), draws the view\n"
     "  completely and saves the window (--screenshot), the view's own picture (--save-picture: what\n"
     "  foxi render draws for the same mesh, field and camera) and the mesh with its fields\n"
     "  (--save-mesh). Prints the tets, the key results and the camera as foxi render options.\n"
@@ -123,11 +126,12 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     return w.last_error_bad_input() ? kExitBadInput : kExitFailure;
   }
   if (!physics.empty()) {
+    w.set_physics(*foxi::workbench::physics_of(physics));
     if (!w.start_solve() || !wait_job(w)) {
       std::fprintf(stderr, "foxi-workbench: error: solving: %s\n", w.last_error().toUtf8().constData());
       return w.last_error_bad_input() ? kExitBadInput : kExitFailure;
     }
-    if (field.empty()) field = "temperature";
+    if (field.empty()) field = foxi::workbench::solved_field(w.physics());
   }
   if (!field.empty() || cmap != "viridis") {
     if (!w.set_field(QString::fromStdString(field), QString::fromStdString(cmap)) || !wait_job(w)) {
@@ -235,8 +239,9 @@ int main(int argc, char** argv) {
         sets.push_back(value());
       } else if (a == "--physics") {
         physics = value();
-        if (physics != "thermal")
-          throw Usage("--physics: the workbench solves thermal only so far, not '" + physics + "'");
+        if (!foxi::workbench::physics_of(physics))
+          throw Usage("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics +
+                      "'");
       } else if (a == "--field") {
         field = value();
       } else if (a == "--cmap") {

@@ -162,6 +162,7 @@ ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
   for (std::int32_t r : hidden_) hidden.append(r);
   p["hidden_regions"] = hidden;
   p["shrink"] = shrink_;
+  p["physics"] = physics_name(physics_);
   if (const Camera* c = view_->camera()) {
     QJsonObject cam;
     cam["perspective"] = c->perspective;
@@ -279,6 +280,7 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     hidden_.clear();
     for (const QJsonValue& v : p["hidden_regions"].toArray()) hidden_.push_back(v.toInt());
     shrink_ = p["shrink"].toDouble(1);
+    set_physics(physics_of(p["physics"].toString("thermal").toStdString()).value_or(Physics::thermal));
     history_.clear();
     for (const QJsonValue& v : p["history"].toArray()) {
       const QJsonObject o = v.toObject();

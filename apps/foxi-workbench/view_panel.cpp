@@ -9,6 +9,7 @@
 #include <QHBoxLayout>
 #include <QImage>
 #include <QLabel>
+#include <QLineEdit>
 #include <QListWidget>
 #include <QPainter>
 #include <QPushButton>
@@ -207,6 +208,14 @@ QPushButton* Workbench::build_view_panel() {
   iso_slider_->setValue(500);
   iso_value_ = new QLabel;
   iso_value_->setMinimumWidth(80);
+  // Several isosurfaces at once (foxi render --iso a,b,...): the slider's and these.
+  iso_more_ = new QLineEdit;
+  iso_more_->setObjectName("more_isovalues");
+  iso_more_->setPlaceholderText(tr("more isovalues"));
+  iso_more_->setToolTip(
+      tr("more isovalues in the legend's unit, separated by commas: drawn with the slider's (foxi render "
+         "--iso a,b,...)"));
+  iso_more_->setMaximumWidth(140);
   iso_only_ = new QCheckBox(tr("surface only"));
   threshold_on_ = new QCheckBox(tr("threshold"));
   threshold_on_->setToolTip(tr("only the tets whose value (at the centroid) lies in the range"));
@@ -224,6 +233,7 @@ QPushButton* Workbench::build_view_panel() {
   tools->addWidget(iso_on_);
   tools->addWidget(iso_slider_, 3);
   tools->addWidget(iso_value_);
+  tools->addWidget(iso_more_);
   tools->addWidget(iso_only_);
   tools->addWidget(threshold_on_);
   tools->addWidget(threshold_lo_);
@@ -251,6 +261,7 @@ QPushButton* Workbench::build_view_panel() {
   for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_})
     connect(c, &QCheckBox::toggled, this, [this] { apply_field_tools(); });
   connect(iso_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
+  connect(iso_more_, &QLineEdit::editingFinished, this, [this] { apply_field_tools(); });
   connect(clip_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
   connect(clip_axis_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] { apply_field_tools(); });
   for (QDoubleSpinBox* b : {threshold_lo_, threshold_hi_})
@@ -349,12 +360,12 @@ void Workbench::show_selection() {
   filling_ = true;
   const bool field = !selection_field_.isEmpty() && view_->has_view() && field_hi_ >= field_lo_;
   for (QWidget* w :
-       std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_only_, threshold_on_, threshold_lo_,
-                                       threshold_hi_, clip_on_, clip_axis_, clip_slider_})
+       std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_more_, iso_only_, threshold_on_,
+                                       threshold_lo_, threshold_hi_, clip_on_, clip_axis_, clip_slider_})
     w->setEnabled(field);
   const FieldSelection& s = selection_;
-  const QSignalBlocker b1(iso_on_), b2(iso_slider_), b3(iso_only_), b4(threshold_on_), b5(threshold_lo_),
-      b6(threshold_hi_), b7(clip_on_), b8(clip_axis_), b9(clip_slider_);
+  const QSignalBlocker b0(iso_more_), b1(iso_on_), b2(iso_slider_), b3(iso_only_), b4(threshold_on_),
+      b5(threshold_lo_), b6(threshold_hi_), b7(clip_on_), b8(clip_axis_), b9(clip_slider_);
   iso_on_->setChecked(!s.iso.empty());
   iso_only_->setChecked(s.iso_only);
   const double span = field_hi_ - field_lo_;
@@ -364,6 +375,9 @@ void Workbench::show_selection() {
   iso_value_->setText(
       field ? QString("%1 %2").arg(unit_.to_display(iso), 0, 'g', 5).arg(QString::fromStdString(unit_.symbol))
             : QString());
+  QStringList more;
+  for (std::size_t i = 1; i < s.iso.size(); ++i) more << QString::number(unit_.to_display(s.iso[i]), 'g', 6);
+  if (!s.iso.empty() || !field) iso_more_->setText(more.join(", "));
   threshold_on_->setChecked(s.threshold.has_value());
   if (field && !s.threshold) {
     threshold_lo_->setValue(unit_.to_display(field_lo_));
@@ -392,6 +406,16 @@ void Workbench::apply_field_tools() {
   const double span = field_hi_ - field_lo_;
   if (iso_on_->isChecked()) {
     s.iso = {field_lo_ + span * iso_slider_->value() / 1000.0};
+    for (const QString& t : iso_more_->text().split(',', Qt::SkipEmptyParts)) {
+      bool ok = false;
+      const double v = t.trimmed().toDouble(&ok);
+      if (!ok || !std::isfinite(v)) {
+        param_error_->setText(tr("more isovalues: '%1' is not a number (values in %2, separated by commas)")
+                                  .arg(t.trimmed(), QString::fromStdString(unit_.symbol)));
+        return;
+      }
+      s.iso.push_back(unit_.to_si(v));
+    }
     s.iso_only = iso_only_->isChecked();
   }
   if (threshold_on_->isChecked())

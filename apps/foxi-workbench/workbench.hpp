@@ -1,9 +1,10 @@
 // foxi-workbench's main window: a model file's parameters edited with units (checked by the model
-// library's own load_model), the model meshed (mesh_model) and solved (thermal: solve_thermal, its
-// results record and balance checks) on worker threads with a progress bar and Cancel, the result
-// shown on the foxi::qt view with a field, a colour map and a legend, and a history of the runs.
-// Every operation that can take long runs on a worker (QtConcurrent); the GUI thread only presents,
-// and the previous mesh and picture stay shown until a new one is ready.
+// library's own load_model), the model meshed (mesh_model) and solved (thermal, electrostatic, DC
+// current or thermal stress from the model's conditions: the results record and balance checks) on worker
+// threads with a progress bar and Cancel, the result shown on the foxi::qt view with a field, a colour map
+// and a legend, and a history of the runs. Every operation that can take long runs on a worker
+// (QtConcurrent); the GUI thread only presents, and the previous mesh and picture stay shown until a new one
+// is ready.
 #pragma once
 
 #include <QFuture>
@@ -21,6 +22,7 @@
 
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/model_file.hpp"
+#include "foxi/model/physics.hpp"
 #include "foxi/qt/view_widget.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/viz/camera.hpp"
@@ -32,6 +34,7 @@ class QComboBox;
 class QDoubleSpinBox;
 class QHBoxLayout;
 class QLabel;
+class QLineEdit;
 class QListWidget;
 class QProgressBar;
 class QPushButton;
@@ -92,6 +95,12 @@ class Workbench : public QMainWindow {
   // A solve meshes first when the parameters changed since the shown mesh was made.
   bool start_mesh();
   bool start_solve();
+  // The physics Solve runs (foxi solve MODEL --physics NAME): thermal, electrostatic, current or
+  // thermal stress (thermoelastic: the model's temperature_change load), with the model's conditions
+  // and loads of it; the field shown after the solve is its temperature, potential or von Mises
+  // stress. False while a job runs.
+  bool set_physics(Physics physics);
+  Physics physics() const { return physics_; }
   // Asks the running job to stop; the previous mesh and picture stay.
   void cancel();
   bool busy() const { return job_ != nullptr; }
@@ -119,8 +128,11 @@ class Workbench : public QMainWindow {
   const DisplayUnit& display_unit() const { return unit_; }
   double field_lo() const { return field_lo_; }
   double field_hi() const { return field_hi_; }
-  // The isovalue slider (0 .. 1000 over [field_lo, field_hi]): moving it moves the isosurface.
+  // The isovalue slider (0 .. 1000 over [field_lo, field_hi]): moving it moves the isosurface; the
+  // box of more isovalues (display unit, comma-separated) drawn with it (foxi render --iso a,b,...).
   QSlider* iso_slider() const { return iso_slider_; }
+  QLineEdit* more_isovalues() const { return iso_more_; }
+  const FieldSelection& selection() const { return selection_; }
 
   // A project folder: project.json (the model file's absolute path, so its material library and STL
   // references stay valid; the parameter overrides, the colouring, the camera, the history, the
@@ -191,6 +203,7 @@ class Workbench : public QMainWindow {
   std::shared_ptr<const Mesh> mesh_;
   RunResults results_;
   bool has_results_ = false;
+  Physics physics_ = Physics::thermal;
   double mesh_seconds_ = 0;
   std::size_t mesh_serial_ = 0;
   std::vector<HistoryRow> history_;
@@ -226,6 +239,7 @@ class Workbench : public QMainWindow {
   QPushButton *mesh_button_ = nullptr, *solve_button_ = nullptr, *cancel_button_ = nullptr;
   QProgressBar* progress_ = nullptr;
   QTableWidget* results_table_ = nullptr;
+  QComboBox* physics_box_ = nullptr;
   QTableWidget* history_table_ = nullptr;
   QComboBox *field_box_ = nullptr, *cmap_box_ = nullptr;
   QDoubleSpinBox* shrink_box_ = nullptr;
@@ -236,6 +250,7 @@ class Workbench : public QMainWindow {
   QCheckBox *iso_on_ = nullptr, *iso_only_ = nullptr, *threshold_on_ = nullptr, *clip_on_ = nullptr;
   QSlider *iso_slider_ = nullptr, *clip_slider_ = nullptr;
   QLabel* iso_value_ = nullptr;
+  QLineEdit* iso_more_ = nullptr;  // more isovalues (display unit), drawn with the slider's
   QDoubleSpinBox *threshold_lo_ = nullptr, *threshold_hi_ = nullptr;
   QComboBox* clip_axis_ = nullptr;
   QListWidget* regions_ = nullptr;

@@ -17,6 +17,9 @@
 #include <vector>
 
 #include "foxi/mesher/quality_report.hpp"
+#include "foxi/model/physics.hpp"
+#include "foxi/model/progress.hpp"
+#include "foxi/solver/results.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/interactive_view.hpp"
@@ -70,6 +73,16 @@ QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QStrin
 
 // The minimum dihedral angle histogram of the quality report as a bar chart (mesh_panel.cpp).
 QPixmap histogram_pixmap(const MeshQualityReport& q);
+
+// The physics named as foxi solve --physics names it (physics_name), or nullopt (solve_panel.cpp).
+std::optional<Physics> physics_of(const std::string& name);
+// The field a solve of `physics` is shown by: temperature, potential, von_mises (solve_panel.cpp).
+const char* solved_field(Physics physics);
+// Solves `physics` on `mesh` (its fields written there) with the model's conditions and loads, as
+// foxi solve MODEL --physics NAME does; the results record with its checks. Errors: IoError on the
+// model file (`path`) for what the model lacks, SolverError, Cancelled when `progress` says stop.
+RunResults solve_model_physics(const std::string& path, const Model& model, Mesh& mesh, Physics physics,
+                               const ProgressFn& progress);
 
 inline QString what_of(const std::exception& e) { return QString::fromStdString(e.what()); }
 

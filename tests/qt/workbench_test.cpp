@@ -9,6 +9,7 @@
 #include <QApplication>
 #include <QEventLoop>
 #include <QLabel>
+#include <QLineEdit>
 #include <QMouseEvent>
 #include <QTableWidget>
 #include <QTimer>
@@ -24,6 +25,7 @@
 #include <string>
 
 #include "foxi/mesher/model_mesh.hpp"
+#include "foxi/model/physics.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/viz/field_selection.hpp"
 #include "foxi/viz/interactive_view.hpp"
@@ -63,18 +65,22 @@ std::string line_after(const std::string& text, const std::string& key) {
 // The headless loop on a shipped model: the view's saved picture equals foxi render's picture of
 // the mesh the workbench saved, with the camera it printed, pixel for pixel; its key result equals
 // foxi solve's record of the same model and --set values.
-// `tools`: the field tools' options (--iso, --threshold, --clip), given to both programs alike.
+// `tools`: the field tools' options (--iso, --threshold, --clip), given to both programs alike;
+// `physics`: the solve's (foxi solve --physics), whose field the picture shows.
 void check_headless(const std::string& model, const std::string& set, const std::string& result,
-                    const std::string& shrink = "", const std::string& tools = "") {
+                    const std::string& shrink = "", const std::string& tools = "",
+                    const std::string& physics = "thermal") {
+  const std::string field = physics == "thermal"         ? "temperature"
+                            : physics == "thermoelastic" ? "von_mises"
+                                                         : "potential";
   const std::string shrink_option =
       (shrink.empty() ? "" : " --shrink " + shrink) + (tools.empty() ? "" : " " + tools);
   TempDir dir;
   const auto view = dir.path() / "view.png", mesh = dir.path() / "mesh.vtu", shot = dir.path() / "window.png",
              cli = dir.path() / "cli.png", log = dir.path() / "wb.log";
-  const std::string args = "'" + kModels + model + "' --headless --set " + set +
-                           " --physics thermal --view-size 320x240" + shrink_option + " --save-picture '" +
-                           view.string() + "' --screenshot '" + shot.string() + "' --save-mesh '" +
-                           mesh.string() + "'";
+  const std::string args = "'" + kModels + model + "' --headless --set " + set + " --physics " + physics +
+                           " --view-size 320x240" + shrink_option + " --save-picture '" + view.string() +
+                           "' --screenshot '" + shot.string() + "' --save-mesh '" + mesh.string() + "'";
   ASSERT_EQ(foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' " + args, log), 0)
       << foxi::test::read_text(log);
   const std::string out = foxi::test::read_text(log);
@@ -82,7 +88,7 @@ void check_headless(const std::string& model, const std::string& set, const std:
   ASSERT_NE(camera.find("--eye"), std::string::npos) << out;
   EXPECT_TRUE(std::filesystem::file_size(shot) > 0);
   ASSERT_EQ(
-      foxi::test::run_cli("render '" + mesh.string() + "' --field temperature --legend off --size 320x240" +
+      foxi::test::run_cli("render '" + mesh.string() + "' --field " + field + " --legend off --size 320x240" +
                               shrink_option + " " + camera + " -o '" + cli.string() + "'",
                           dir.path() / "render.log"),
       0)
@@ -115,7 +121,7 @@ void check_headless(const std::string& model, const std::string& set, const std:
 
   // The same key result as foxi solve's JSON record of the model with the same --set.
   const auto json = dir.path() / "solve.json";
-  ASSERT_EQ(foxi::test::run_cli("solve '" + kModels + model + "' --physics thermal --set " + set +
+  ASSERT_EQ(foxi::test::run_cli("solve '" + kModels + model + "' --physics " + physics + " --set " + set +
                                     " --json '" + json.string() + "'",
                                 dir.path() / "solve.log"),
             0)
@@ -155,6 +161,9 @@ TEST(WorkbenchHeadless, IsoWithinClipEqualsFoxiRender) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "0.8", "--iso 48 --clip 0.005,0.005,0,0,1,0");
 }
 // Graded colouring and a user's colour range (foxi render --graded --range), alone and under an isotherm.
+TEST(WorkbenchHeadless, SeveralIsovaluesEqualFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--iso 47,50");
+}
 TEST(WorkbenchHeadless, GradedRangePictureEqualsFoxiRender) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--graded --range 46,52");
 }
@@ -168,6 +177,14 @@ TEST(WorkbenchHeadless, RegionsShownEqualFoxiRender) {
 }
 TEST(WorkbenchHeadless, RegionsShownWithIsoEqualFoxiRender) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--regions 1 --iso 49");
+}
+// The other physics: the potential of an electrostatic solve (its capacitance), the von Mises stress
+// of a thermal stress solve (its maximum), as foxi render draws them and foxi solve gives them.
+TEST(WorkbenchHeadless, ElectrostaticPictureAndCapacitanceEqualFoxi) {
+  check_headless("via_in_dielectric.toml", "via_r=0.25mm", "C[via,via]", "", "", "electrostatic");
+}
+TEST(WorkbenchHeadless, ThermalStressPictureAndVonMisesEqualFoxi) {
+  check_headless("die_on_substrate.toml", "die_w=5mm", "von_mises_max", "", "", "thermoelastic");
 }
 
 // Once with a real X server (xvfb-run, Qt's xcb platform): the same view picture as offscreen.
@@ -365,6 +382,81 @@ TEST(Workbench, CancelKeepsThePreviousMeshAndPicture) {
   EXPECT_EQ(w.history()[1].parameters[0].expression, "6 mm");
 }
 
+// Solve with another physics: every value and check of the results table equals foxi solve --json's
+// record of the same model and override (a second program on the same mesh_model mesh); Cancel of
+// a later solve keeps those results, the mesh and the history; a saved project keeps the physics.
+TEST(Workbench, PhysicsResultsEqualFoxiSolveAndCancelKeepsThem) {
+  struct Case {
+    const char* model;
+    const char* name;
+    const char* value;
+    foxi::Physics physics;
+  };
+  for (const Case& c : {Case{"die_on_substrate.toml", "die_w", "7 mm", foxi::Physics::thermal_stress},
+                        Case{"via_in_dielectric.toml", "via_r", "0.25 mm", foxi::Physics::electrostatic}}) {
+    SCOPED_TRACE(c.model);
+    TempDir dir;
+    Workbench w;
+    w.view_widget()->setFixedSize(200, 150);
+    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + c.model)));
+    ASSERT_TRUE(w.set_parameter(c.name, c.value));
+    ASSERT_TRUE(w.set_physics(c.physics));
+    ASSERT_TRUE(w.start_solve());
+    EXPECT_FALSE(w.set_physics(foxi::Physics::thermal)) << "not while a job runs";
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    ASSERT_NE(w.results(), nullptr);
+    const foxi::RunResults got = *w.results();
+    const auto json = dir.path() / "solve.json";
+    ASSERT_EQ(
+        foxi::test::run_cli("solve '" + kModels + c.model + "' --physics " + foxi::physics_name(c.physics) +
+                                " --set '" + c.name + "=" + c.value + "' --json '" + json.string() + "'",
+                            dir.path() / "solve.log"),
+        0)
+        << foxi::test::read_text(dir.path() / "solve.log");
+    const foxi::RunResults cli = foxi::parse_results_json(foxi::test::read_text(json));
+    EXPECT_EQ(got.physics, cli.physics);
+    EXPECT_EQ(got.tets, cli.tets);
+    EXPECT_EQ(got.nodes, cli.nodes);
+    ASSERT_EQ(got.values.size(), cli.values.size());
+    for (std::size_t i = 0; i < cli.values.size(); ++i) {
+      EXPECT_EQ(got.values[i].name, cli.values[i].name);
+      EXPECT_NEAR(got.values[i].value, cli.values[i].value, 1e-9 * std::abs(cli.values[i].value))
+          << cli.values[i].name;
+    }
+    ASSERT_EQ(got.checks.size(), cli.checks.size());
+    for (std::size_t i = 0; i < cli.checks.size(); ++i) {
+      EXPECT_EQ(got.checks[i].name, cli.checks[i].name);
+      EXPECT_EQ(got.checks[i].passed, cli.checks[i].passed) << cli.checks[i].name;
+    }
+    // The picture shows the solve's field.
+    const std::string shown = c.physics == foxi::Physics::thermal_stress ? "von_mises" : "potential";
+    ASSERT_NE(w.mesh()->find_field(shown), nullptr);
+    // A thermal solve started and cancelled: the results, mesh and history stay.
+    const auto mesh = w.mesh();
+    const std::size_t rows = w.history().size();
+    ASSERT_TRUE(w.set_physics(foxi::Physics::thermal));
+    ASSERT_TRUE(w.start_solve());
+    w.cancel();
+    EXPECT_FALSE(wait_job(w));
+    EXPECT_EQ(w.last_error(), "cancelled");
+    ASSERT_NE(w.results(), nullptr);
+    EXPECT_EQ(w.results()->physics, cli.physics);
+    EXPECT_EQ(w.results()->values.size(), got.values.size());
+    EXPECT_EQ(w.mesh(), mesh);
+    EXPECT_EQ(w.history().size(), rows);
+    // A project keeps the physics chosen and the results.
+    const QString folder = QString::fromStdString((dir.path() / "project").string());
+    ASSERT_TRUE(w.set_physics(c.physics));
+    ASSERT_TRUE(w.save_project(folder));
+    Workbench again;
+    ASSERT_TRUE(again.open_project(folder));
+    EXPECT_EQ(again.physics(), c.physics);
+    ASSERT_NE(again.results(), nullptr);
+    EXPECT_EQ(again.results()->physics, cli.physics);
+    wait_job(again);
+  }
+}
+
 // The isovalue slider moves the isotherm both ways: each position draws the solid above its value,
 // which holds the tets with a corner at or above it (counted here from the mesh's node values), and
 // moving back gives the same picture again.
@@ -417,6 +509,17 @@ TEST(Workbench, IsoSliderMovesTheIsovalueBothWays) {
   EXPECT_LT(v->selected_tets(), low_count) << "a hotter isotherm: a smaller solid";
   EXPECT_GT(v->selected_tets(), 0u);
   EXPECT_TRUE(at(200) == low) << "back down: the same picture";
+  // Several isovalues: the box's (display unit, as typed) drawn with the slider's; a word refused.
+  const double extra = lo + 0.8 * (hi - lo);
+  w.more_isovalues()->setText(QString::number(w.display_unit().to_display(extra), 'g', 17));
+  emit w.more_isovalues()->editingFinished();
+  ASSERT_EQ(v->selection().iso.size(), 2u);
+  EXPECT_NEAR(v->selection().iso[0], lo + 0.2 * (hi - lo), 1e-9 * hi);
+  EXPECT_NEAR(v->selection().iso[1], extra, 1e-9 * hi);
+  EXPECT_EQ(w.selection().iso, v->selection().iso);
+  w.more_isovalues()->setText("hot");
+  emit w.more_isovalues()->editingFinished();
+  EXPECT_EQ(v->selection().iso.size(), 2u) << "refused: the selection stays";
   // Off again: all tets.
   ASSERT_TRUE(w.set_selection({}));
   v->finish_now();
