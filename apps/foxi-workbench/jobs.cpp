@@ -175,6 +175,7 @@ bool Workbench::start_job(bool mesh, bool solve) {
   in.height = view_->height();
   if (view_->camera()) in.camera = *view_->camera();
   in.colouring = colouring();
+  in.colouring.deform.reset();  // a new mesh or result: the undeformed shape (deform_ reset when it lands)
   in.shrink = shrink_;
   in.cancel = std::make_shared<std::atomic<bool>>(false);
   in.permille = std::make_shared<std::atomic<int>>(0);
@@ -236,10 +237,12 @@ void Workbench::on_job_done() {
     has_results_ = true;
     field_ = solved_field(physics_of(out->results.physics).value_or(Physics::thermal));
   }
+  if (out->meshed || out->solved) deform_.reset();
   if (!out->meshed && !out->solved) mesh_ = out->mesh;
-  view_->set_view(out->mesh, std::move(out->view));
+  const std::shared_ptr<const Mesh> shown = out->view_mesh ? out->view_mesh : out->mesh;
+  view_->set_view(shown, std::move(out->view));
   view_->set_probe_values(std::move(out->probe), out->probe_unit);
-  mesh_bounds(*out->mesh, bounds_lo_, bounds_hi_);
+  mesh_bounds(*shown, bounds_lo_, bounds_hi_);
   view_->set_base(std::move(out->base));
   if (out->has_scale && out->choice) {
     view_->set_field_source(*out->choice, out->step, out->scale, out->iso_cache);

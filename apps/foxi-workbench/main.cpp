@@ -27,7 +27,7 @@ const char* kUsage =
     "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics NAME] [--field NAME]\n"
     "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
     "               [--regions ID,...] [--graded] [--range a,b] [--iso v [--iso-only]] [--threshold a,b] "
-    "[--clip px,py,pz,nx,ny,nz]\n"
+    "[--clip px,py,pz,nx,ny,nz] [--deform NAME:SCALE]\n"
     "               [--save-project FOLDER] [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh "
     "MESH.vtu]\n"
     "  The window: open a model, edit its parameters (with units, checked as the model file would\n"
@@ -45,6 +45,8 @@ const char* kUsage =
     "  --regions, --graded, --range, --iso, --iso-only, --threshold and --clip set the view's field tools as "
     "foxi render's options\n"
     "  of the same names draw them (values in the field's display unit, as the legend shows it).\n"
+    "  --deform NAME:SCALE draws the deformed shape as foxi render --deform does (the status line says\n"
+    "  the order: MPVO with the depth buffer where the moved mesh is not Delaunay).\n"
     "  Run it with QT_QPA_PLATFORM=offscreen where there is no display.\n"
     "  Exit status: 0 ok, 1 failure, 2 usage, 3 bad model or parameter, 4 a result failed its checks.";
 
@@ -92,7 +94,8 @@ struct ToolOptions {
   bool any() const { return !iso.empty() || !threshold.empty() || !clip.empty(); }
   bool graded = false;
   std::vector<double> range, regions;
-  std::string project;  // --save-project
+  std::string project;                            // --save-project
+  std::optional<foxi::workbench::Deform> deform;  // --deform NAME:SCALE
 };
 
 int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std::string& model,
@@ -147,6 +150,12 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
         hidden.push_back(r.id);
     if (!w.set_hidden_regions(hidden) || !wait_job(w)) {
       std::fprintf(stderr, "foxi-workbench: error: --regions: %s\n", w.last_error().toUtf8().constData());
+      return kExitBadInput;
+    }
+  }
+  if (tools.deform) {
+    if (!w.set_deform(tools.deform) || !wait_job(w)) {
+      std::fprintf(stderr, "foxi-workbench: error: --deform: %s\n", w.last_error().toUtf8().constData());
       return kExitBadInput;
     }
   }
@@ -264,6 +273,15 @@ int main(int argc, char** argv) {
         tools.project = value();
       } else if (a == "--regions") {
         tools.regions = parse_list(value(), "--regions", 0);
+      } else if (a == "--deform") {
+        const std::string d = value();
+        const std::size_t colon = d.rfind(':');
+        char* end = nullptr;
+        const double scale = colon == std::string::npos ? NAN : std::strtod(d.c_str() + colon + 1, &end);
+        if (colon == 0 || !std::isfinite(scale) || (end && *end))
+          throw Usage("--deform takes NAME:SCALE (a displacement field and a finite factor), not '" + d +
+                      "'");
+        tools.deform = foxi::workbench::Deform{d.substr(0, colon), scale};
       } else if (a == "--graded") {
         tools.graded = true;
       } else if (a == "--range") {
@@ -289,9 +307,10 @@ int main(int argc, char** argv) {
     if (is_headless && model.empty()) throw Usage("--headless needs a model file");
     if (tools.iso_only && tools.iso.empty())
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
-    if (!is_headless && (tools.any() || tools.graded || !tools.range.empty() || !tools.regions.empty() ||
-                         !tools.project.empty() || !sets.empty() || !physics.empty() || !field.empty() ||
-                         !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
+    if (!is_headless &&
+        (tools.any() || tools.graded || tools.deform || !tools.range.empty() || !tools.regions.empty() ||
+         !tools.project.empty() || !sets.empty() || !physics.empty() || !field.empty() ||
+         !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
       throw Usage(
           "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")

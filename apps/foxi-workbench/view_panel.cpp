@@ -21,14 +21,29 @@
 #include <initializer_list>
 #include <tuple>
 
+#include "foxi/model/validate.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/legend.hpp"
 #include "foxi/viz/rasterizer.hpp"
 
 namespace foxi::workbench {
 
-void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const Colouring& colouring,
+void build_display(Outcome& out, const Mesh& source, const std::string& field, const Colouring& colouring,
                    double shrink, int w, int h, const Camera* camera) {
+  // The deformed shape: a moved copy (the same fields) drawn, checked as foxi render --deform checks it.
+  if (colouring.deform) {
+    auto moved = std::make_shared<Mesh>(source);
+    deform_by_field(*moved, colouring.deform->field, colouring.deform->scale);
+    const ValidationReport report = validate_and_repair(*moved);
+    if (!report.ok()) {
+      std::string why = "the mesh deformed by " + colouring.deform->field + " x " +
+                        std::to_string(colouring.deform->scale) + " is not usable:";
+      for (const std::string& line : describe(report)) why += " " + line;
+      throw std::runtime_error(why);
+    }
+    out.view_mesh = std::move(moved);
+  }
+  const Mesh& mesh = out.view_mesh ? *out.view_mesh : source;
   // The regions shown: the tets of the others left out (foxi render --regions); the automatic colour
   // range is that of the tets shown, as there.
   if (!colouring.hidden.empty()) {
@@ -198,6 +213,26 @@ QPushButton* Workbench::build_view_panel() {
   fields->addWidget(range_hi_);
   fields->addWidget(new QLabel(tr("shrink")));
   fields->addWidget(shrink_box_);
+  // The deformed shape: the displacement (a thermal stress solve's) times the scale.
+  deform_on_ = new QCheckBox(tr("deformed x"));
+  deform_on_->setToolTip(
+      tr("the mesh moved by the displacement times the scale (foxi render --deform displacement:SCALE); "
+         "not Delaunay in general: drawn in MPVO order, as the status line says"));
+  deform_scale_ = new QDoubleSpinBox;
+  deform_scale_->setRange(0, 1e9);
+  deform_scale_->setDecimals(1);
+  deform_scale_->setValue(100);
+  deform_scale_->setKeyboardTracking(false);
+  auto deform = [this] {
+    if (filling_) return;
+    std::optional<Deform> d;
+    if (deform_on_->isChecked()) d = Deform{"displacement", deform_scale_->value()};
+    if (!set_deform(d)) param_error_->setText(tr("the deformed shape: not while a job runs"));
+  };
+  connect(deform_on_, &QCheckBox::toggled, this, deform);
+  connect(deform_scale_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, deform);
+  fields->addWidget(deform_on_);
+  fields->addWidget(deform_scale_);
   cv->addLayout(fields);
   // The field tools: isosurface, threshold, clip (by the field shown; disabled without one).
   auto* tools = new QHBoxLayout;
@@ -312,7 +347,13 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
 }
 
 Colouring Workbench::colouring() const {
-  return Colouring{color_map_.toStdString(), graded_, range_, hidden_};
+  return Colouring{color_map_.toStdString(), graded_, range_, hidden_, deform_};
+}
+
+bool Workbench::set_deform(std::optional<Deform> deform) {
+  if (busy() || !mesh_ || (deform && !std::isfinite(deform->scale))) return false;
+  deform_ = std::move(deform);
+  return set_field(field_, color_map_);
 }
 
 bool Workbench::set_hidden_regions(std::vector<std::int32_t> hidden) {
@@ -443,6 +484,11 @@ void Workbench::refresh_fields() {
   const int i = field_.isEmpty() ? 0 : field_box_->findText(field_);
   field_box_->setCurrentIndex(std::max(i, 0));
   cmap_box_->setCurrentText(color_map_);
+  const bool displaced = mesh_ && mesh_->find_field("displacement");
+  deform_on_->setEnabled(displaced);
+  deform_scale_->setEnabled(displaced);
+  deform_on_->setChecked(deform_.has_value());
+  if (deform_) deform_scale_->setValue(deform_->scale);
   regions_->clear();
   if (mesh_)
     for (const Region& r : mesh_->regions) {

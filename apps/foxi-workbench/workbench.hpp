@@ -54,12 +54,21 @@ struct HistoryRow {
   double seconds = 0;  // mesh + solve wall time
 };
 
-// How the field is coloured: the map, flat or graded, the automatic range or the user's (display unit).
+// The deformed shape (foxi render --deform NAME:SCALE): each node moved by scale x the node vector
+// field (a thermal stress solve's displacement).
+struct Deform {
+  std::string field = "displacement";
+  double scale = 1;
+};
+
+// How the field is coloured: the map, flat or graded, the automatic range or the user's (display unit);
+// and what is drawn: the regions hidden, the deformed shape.
 struct Colouring {
   std::string cmap = "viridis";
   bool graded = false;
   std::optional<std::pair<double, double>> range;
   std::vector<std::int32_t> hidden;  // regions hidden
+  std::optional<Deform> deform;
 };
 
 // What a worker hands back (mesh, solve or a new field paint).
@@ -114,6 +123,14 @@ class Workbench : public QMainWindow {
   Colouring colouring() const;
   // The regions not shown (by id; foxi render --regions shows the others); redraws on a worker.
   bool set_hidden_regions(std::vector<std::int32_t> hidden);
+
+  // The deformed shape (nullopt: undeformed): the view shows a moved copy of the mesh, checked and
+  // repaired as foxi render --deform does (folded tets re-oriented); in general it is not Delaunay and
+  // is drawn in MPVO order with the depth buffer, which the status line says. A new mesh or solve
+  // shows the undeformed shape again. Redraws on a worker; false while a job runs, without a mesh or
+  // for a scale that is not finite.
+  bool set_deform(std::optional<Deform> deform);
+  const std::optional<Deform>& deform() const { return deform_; }
 
   // Each tet drawn scaled about its centroid by `shrink` in (0, 1] (foxi render --shrink); false
   // for a value outside or while a job runs.
@@ -212,6 +229,7 @@ class Workbench : public QMainWindow {
   bool graded_ = false;
   std::optional<std::pair<double, double>> range_;
   std::vector<std::int32_t> hidden_;
+  std::optional<Deform> deform_;
   std::optional<Camera> pending_camera_;
   QString autosave_folder_;
   QTimer* autosave_timer_ = nullptr;
@@ -243,6 +261,8 @@ class Workbench : public QMainWindow {
   QTableWidget* history_table_ = nullptr;
   QComboBox *field_box_ = nullptr, *cmap_box_ = nullptr;
   QDoubleSpinBox* shrink_box_ = nullptr;
+  QCheckBox* deform_on_ = nullptr;
+  QDoubleSpinBox* deform_scale_ = nullptr;
   QCheckBox *graded_box_ = nullptr, *range_on_ = nullptr;
   QDoubleSpinBox *range_lo_ = nullptr, *range_hi_ = nullptr;
   QLabel* legend_ = nullptr;

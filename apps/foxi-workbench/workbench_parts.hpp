@@ -33,6 +33,7 @@ struct Outcome {
   QString error;
   bool meshed = false, solved = false;
   std::shared_ptr<const Mesh> mesh;
+  std::shared_ptr<const Mesh> view_mesh;  // the deformed copy the view shows (null: `mesh`)
   std::shared_ptr<const Model> model;
   std::vector<ParameterOverride> overrides;
   std::unique_ptr<InteractiveView> view;

@@ -118,6 +118,12 @@ void check_headless(const std::string& model, const std::string& set, const std:
     EXPECT_EQ(m[1].str(), cli_n);
     EXPECT_EQ(m[2].str(), cli_total);
   }
+  if (tools.find("--deform") != std::string::npos) {
+    // The order method as foxi render says it: MPVO for a moved mesh that is no longer Delaunay.
+    const bool cli_mpvo =
+        foxi::test::read_text(dir.path() / "render.log").find("in MPVO order") != std::string::npos;
+    EXPECT_EQ(out.find("MPVO order") != std::string::npos, cli_mpvo) << out;
+  }
 
   // The same key result as foxi solve's JSON record of the model with the same --set.
   const auto json = dir.path() / "solve.json";
@@ -185,6 +191,12 @@ TEST(WorkbenchHeadless, ElectrostaticPictureAndCapacitanceEqualFoxi) {
 }
 TEST(WorkbenchHeadless, ThermalStressPictureAndVonMisesEqualFoxi) {
   check_headless("die_on_substrate.toml", "die_w=5mm", "von_mises_max", "", "", "thermoelastic");
+}
+// The deformed shape (the displacement x 300, no longer Delaunay): foxi render --deform's picture,
+// the same order method said.
+TEST(WorkbenchHeadless, DeformedShapeEqualsFoxiRender) {
+  check_headless("die_on_substrate.toml", "die_w=5mm", "von_mises_max", "", "--deform displacement:300",
+                 "thermoelastic");
 }
 
 // Once with a real X server (xvfb-run, Qt's xcb platform): the same view picture as offscreen.
@@ -431,8 +443,28 @@ TEST(Workbench, PhysicsResultsEqualFoxiSolveAndCancelKeepsThem) {
     // The picture shows the solve's field.
     const std::string shown = c.physics == foxi::Physics::thermal_stress ? "von_mises" : "potential";
     ASSERT_NE(w.mesh()->find_field(shown), nullptr);
-    // A thermal solve started and cancelled: the results, mesh and history stay.
+    // The deformed shape: the view shows a moved copy, the solved mesh stays; off again: the mesh itself.
     const auto mesh = w.mesh();
+    if (c.physics == foxi::Physics::thermal_stress) {
+      ASSERT_TRUE(w.set_deform(foxi::workbench::Deform{"displacement", 100}));
+      ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+      EXPECT_EQ(w.mesh(), mesh);
+      ASSERT_NE(w.view_widget()->mesh(), mesh);
+      EXPECT_EQ(w.view_widget()->mesh()->tet_count(), mesh->tet_count());
+      EXPECT_NE(w.view_widget()->mesh()->xyz, mesh->xyz);
+      ASSERT_TRUE(w.set_deform(std::nullopt));
+      ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+      EXPECT_EQ(w.view_widget()->mesh(), mesh);
+      // A scale that folds tets through each other: refused with the reason, the picture stays.
+      ASSERT_TRUE(w.set_deform(foxi::workbench::Deform{"displacement", 5000}));
+      EXPECT_FALSE(wait_job(w));
+      EXPECT_NE(w.last_error().indexOf("not usable"), -1) << w.last_error().toStdString();
+      EXPECT_EQ(w.view_widget()->mesh(), mesh);
+    } else {
+      EXPECT_FALSE(w.set_deform(foxi::workbench::Deform{"displacement", 300}) && wait_job(w))
+          << "no displacement field: refused";
+    }
+    // A thermal solve started and cancelled: the results, mesh and history stay.
     const std::size_t rows = w.history().size();
     ASSERT_TRUE(w.set_physics(foxi::Physics::thermal));
     ASSERT_TRUE(w.start_solve());
