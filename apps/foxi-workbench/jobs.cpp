@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <utility>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -204,7 +205,12 @@ void Workbench::on_job_done() {
   solve_button_->setEnabled(true);
   cancel_button_->setEnabled(false);
   progress_->setValue(out && out->ok ? 1000 : 0);
+  const auto deform_before = std::exchange(deform_before_, std::nullopt);
   if (!out || !out->ok) {
+    if (deform_before) {  // the deformed shape refused: the one shown stays, and its controls
+      deform_ = *deform_before;
+      refresh_fields();
+    }
     const QString why = out ? out->error : tr("no result");
     last_error_ = why;
     last_error_bad_input_ = out && out->bad_input;

@@ -352,8 +352,14 @@ Colouring Workbench::colouring() const {
 
 bool Workbench::set_deform(std::optional<Deform> deform) {
   if (busy() || !mesh_ || (deform && !std::isfinite(deform->scale))) return false;
+  const std::optional<Deform> before = deform_;
   deform_ = std::move(deform);
-  return set_field(field_, color_map_);
+  if (!set_field(field_, color_map_)) {
+    deform_ = before;
+    return false;
+  }
+  deform_before_ = before;  // back to it if the moved mesh is refused
+  return true;
 }
 
 bool Workbench::set_hidden_regions(std::vector<std::int32_t> hidden) {

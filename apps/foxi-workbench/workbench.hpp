@@ -230,6 +230,7 @@ class Workbench : public QMainWindow {
   std::optional<std::pair<double, double>> range_;
   std::vector<std::int32_t> hidden_;
   std::optional<Deform> deform_;
+  std::optional<std::optional<Deform>> deform_before_;  // set_deform's job running: the shape before it
   std::optional<Camera> pending_camera_;
   QString autosave_folder_;
   QTimer* autosave_timer_ = nullptr;

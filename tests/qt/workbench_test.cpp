@@ -460,6 +460,7 @@ TEST(Workbench, PhysicsResultsEqualFoxiSolveAndCancelKeepsThem) {
       EXPECT_FALSE(wait_job(w));
       EXPECT_NE(w.last_error().indexOf("not usable"), -1) << w.last_error().toStdString();
       EXPECT_EQ(w.view_widget()->mesh(), mesh);
+      EXPECT_FALSE(w.deform().has_value()) << "the shape shown before stays the workbench's";
     } else {
       EXPECT_FALSE(w.set_deform(foxi::workbench::Deform{"displacement", 300}) && wait_job(w))
           << "no displacement field: refused";
