@@ -195,13 +195,17 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
       note(r, "tet " + std::to_string(t) + " " + ids(v, 4) + ": zero volume");
       continue;
     }
+    // One message per tet: a tet both inverted and beyond the range is one line naming both.
+    const std::string inverted_note = o == CGAL::NEGATIVE ? "tet " + std::to_string(t) + " " + ids(v, 4) +
+                                                                ": inverted (negative orientation)"
+                                                          : std::string();
     if (o == CGAL::NEGATIVE) {
       ++r.inverted;
       if (inverted) inverted->push_back(t);
-      note(r, "tet " + std::to_string(t) + " " + ids(v, 4) + ": inverted (negative orientation)");
     }
     if (tiny_mesh) {
       ++r.out_of_range;
+      if (!inverted_note.empty()) note(r, inverted_note);
       continue;
     }
     std::string why;
@@ -212,8 +216,11 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
                            x + 3 * std::size_t(v[pos ? 2 : 3]), x + 3 * std::size_t(v[pos ? 3 : 2]), origin,
                            why)) {
       ++r.out_of_range;
-      note(r, "tet " + std::to_string(t) + " " + ids(v, 4) +
-                  ": geometry beyond the range foxi computes in: " + why + " (rescale the coordinates)");
+      note(r, (inverted_note.empty() ? "tet " + std::to_string(t) + " " + ids(v, 4) + ":"
+                                     : inverted_note + ", and") +
+                  " geometry beyond the range foxi computes in: " + why + " (rescale the coordinates)");
+    } else if (!inverted_note.empty()) {
+      note(r, inverted_note);
     }
   }
   std::sort(keys.begin(), keys.end());

@@ -222,6 +222,24 @@ TEST(Validate, GeometryBeyondDoubleRangeIsRefused) {
   EXPECT_EQ(scaled_volume(1e-300), 0.0);
 }
 
+// A tet both inverted and beyond the range (issue 17 item 7): one message naming both problems, not
+// two lines about the same tet; the counts still count it under each problem.
+TEST(Validate, InvertedTetBeyondTheRangeHasOneMessage) {
+  for (double s : {1e154, 1e-300}) {
+    Mesh m = two_tets();
+    for (double& x : m.xyz) x *= s;
+    std::swap(m.tet[4 * 1 + 0], m.tet[4 * 1 + 1]);  // tet 1 inverted
+    const ValidationReport r = validate(m);
+    EXPECT_EQ(r.inverted, 1u) << s;
+    EXPECT_EQ(r.out_of_range, 2u) << s;
+    std::size_t about_tet1 = 0;
+    for (const std::string& msg : r.messages) about_tet1 += msg.rfind("tet 1 ", 0) == 0;
+    EXPECT_EQ(about_tet1, 1u) << s;
+    EXPECT_TRUE(mentions(r, "inverted")) << s;
+    EXPECT_TRUE(mentions(r, "beyond the range")) << s;
+  }
+}
+
 // Coordinates above 1e60 (issue 22's audit): a mesh moved far from the origin keeps finite, positive
 // volumes, but at 1e60 doubles are 1e44 apart, so no tet there is smaller than that, and its
 // circumsphere reaches past the 1e24 the order's error bounds hold: refused, whatever the offset.
