@@ -58,11 +58,13 @@ const std::string kMovieUsage =
         "                   the tets v_k crosses (or reaches, for the solid) are ordered and drawn, found\n"
         "                   by an interval tree built once, so a frame costs what its isosurface holds\n"
         "    threshold:a,b  a growing threshold: frame k the tets with values in [a, v_k]\n"
-        "                   (foxi render --threshold a,v_k)\n"
+        "                   (foxi render --threshold a,v_k; with --slice, the plane's section through it)\n"
         "    steps          one frame per step of the field (a transient's .pvd, a multi-step .vtu or\n"
         "                   .msh), as foxi render --step k; the range is the union over all steps unless\n"
         "                   --range is given, so colours compare across frames; --iso draws each step's\n"
         "                   isosurfaces\n"
+        "  Each sweep frame says its value at the top left: \"t = 12.5 s\" (the step's time as the file\n"
+        "  gives it; \"step k of N\" when it gives none), \"iso 32 °C\", \"threshold 30 to 50 °C\".\n"
         "  --threshold and --clip select tets in every movie; --iso and --slice only with --sweep.\n") +
     kPictureOptionsHelp + kFieldOptionsHelp + kIsoOptionsHelp + kDeformOptionHelp +
     "  (--size defaults to 640x480; with --field the colour range is the same in every frame)\n"
@@ -294,13 +296,21 @@ int cmd_movie(Args args) {
   } forget_frames{frame_dir, true}, forget_created{created, true};
 
   std::size_t index = 0;
-  // One frame out: the scene, beside the legend of `legend_of` when there is one.
-  auto emit = [&](const Framebuffer& scene, const FieldPicture& legend_of) {
+  // One frame out: the scene with its caption (a sweep's time or value) at the top left, beside the
+  // legend of `legend_of` when there is one.
+  auto emit = [&](const Framebuffer& scene, const FieldPicture& legend_of, const std::string& caption) {
+    Framebuffer captioned;
+    if (!caption.empty()) {
+      if (!text) text = std::make_unique<TextRenderer>(find_font_file());
+      captioned = scene;
+      draw_caption(captioned, *text, caption);
+    }
+    const Framebuffer& shown = caption.empty() ? scene : captioned;
     if (writer) {
-      writer->add(panel > 0 ? with_legend(scene, *text, legend_of, panel) : scene);
+      writer->add(panel > 0 ? with_legend(shown, *text, legend_of, panel) : shown);
     } else {
       frames.emplace_back(frame_name(pattern, index), false);
-      write_png(frames.back(), panel > 0 ? with_legend(scene, *text, legend_of, panel) : scene);
+      write_png(frames.back(), panel > 0 ? with_legend(shown, *text, legend_of, panel) : shown);
     }
     ++index;
   };
@@ -316,7 +326,7 @@ int cmd_movie(Args args) {
   } else {
     try {
       stats = make_movie(mesh, table, picture.camera, options.width, options.height, picture.subset, mp,
-                         [&](const Framebuffer& scene) { emit(scene, field); });
+                         [&](const Framebuffer& scene) { emit(scene, field, std::string()); });
     } catch (const UncertifiedMeshError&) {  // thrown before the first frame: nothing written
       throw InputError(
           path + (deform ? " deformed by " + deform->name : std::string()) +

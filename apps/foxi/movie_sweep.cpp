@@ -53,9 +53,9 @@ void check_sweep_options(const Sweep& sweep, const FieldOptions& field, const Is
     throw UsageError("--sweep iso:a,b gives each frame its isovalue: leave out --iso and --slice");
   if (sweep.kind == K::steps && field.step >= 0)
     throw UsageError("--sweep steps draws every step of the field: leave out --step");
-  if (sweep.kind == K::threshold && (iso.has_threshold || iso.slice))
-    throw UsageError(
-        "--sweep threshold:a,b gives each frame its threshold: leave out --threshold and --slice");
+  // A threshold sweep with --slice: the plane's section through each frame's threshold subset.
+  if (sweep.kind == K::threshold && iso.has_threshold)
+    throw UsageError("--sweep threshold:a,b gives each frame its threshold: leave out --threshold");
 }
 
 double sweep_value(const Sweep& sweep, int k, int n) {
@@ -81,8 +81,27 @@ SweepRange fixed_step_range(const FieldOptions& options, const Mesh& mesh,
   return r;
 }
 
-SweepStats run_sweep(const SweepInputs& in,
-                     const std::function<void(const Framebuffer&, const FieldPicture&)>& frame) {
+std::string sweep_caption(const Sweep& sweep, const SweepStats& st, std::size_t k) {
+  using K = Sweep::Kind;
+  const std::string unit = st.unit.empty() ? "" : " " + st.unit;
+  char b[128];
+  if (sweep.kind == K::steps) {
+    // A field's step values are the times its writer gave (foxi's transient solver: seconds).
+    if (st.step_values.size() == st.frames && k < st.step_values.size())
+      std::snprintf(b, sizeof b, "t = %.6g s", st.step_values[k]);
+    else
+      std::snprintf(b, sizeof b, "step %zu of %zu", k + 1, st.frames);
+  } else if (sweep.kind == K::iso) {
+    std::snprintf(b, sizeof b, "iso %.6g%s", st.values[k], unit.c_str());
+  } else {
+    std::snprintf(b, sizeof b, "threshold %.6g to %.6g%s", sweep.a, st.values[k], unit.c_str());
+  }
+  return b;
+}
+
+SweepStats run_sweep(
+    const SweepInputs& in,
+    const std::function<void(const Framebuffer&, const FieldPicture&, const std::string&)>& frame) {
   using K = Sweep::Kind;
   SweepStats st;
   const bool steps = in.sweep.kind == K::steps;
@@ -90,6 +109,7 @@ SweepStats run_sweep(const SweepInputs& in,
   FieldPicture field = in.field;  // its legend's marks change per frame
   st.unit = field.legend.unit.symbol;
   if (steps) st.step_values = field.choice.field->step_values;
+  st.frames = std::size_t(n);  // for the captions' "step k of n"
   // One unit for every step (resolve_field picks a step's default from its own values): the fixed range's.
   const DisplayUnit unit = field.legend.unit;
   IsoCache cache;  // one field and step for iso and threshold sweeps: the interval tree built once
@@ -135,8 +155,7 @@ SweepStats run_sweep(const SweepInputs& in,
     st.draw_ms += ms_since(t0);
     st.depth_buffer = st.depth_buffer || report.depth_buffer;
     st.drawn.push_back(report.tets_drawn);
-    frame(fb, field);
-    ++st.frames;
+    frame(fb, field, sweep_caption(in.sweep, st, std::size_t(k)));
   }
   return st;
 }

@@ -69,9 +69,15 @@ struct SweepStats {
   std::vector<double> step_values;                 // steps: the field's step times
 };
 
-// Draws the frames in order and hands each, with the field picture its legend shows, to `frame`.
-SweepStats run_sweep(const SweepInputs& in,
-                     const std::function<void(const Framebuffer&, const FieldPicture&)>& frame);
+// Frame k's caption: "t = 12.5 s" (steps with times; "step 3 of 5" without), "iso 32 °C", or
+// "threshold 30 to 50 °C" (display units).
+std::string sweep_caption(const Sweep& sweep, const SweepStats& stats, std::size_t k);
+
+// Draws the frames in order and hands each, with the field picture its legend shows and its caption
+// (sweep_caption), to `frame`.
+SweepStats run_sweep(
+    const SweepInputs& in,
+    const std::function<void(const Framebuffer&, const FieldPicture&, const std::string&)>& frame);
 
 // The sweep's lines of the report.
 void print_sweep(const SweepStats& stats, const Sweep& sweep, const FieldPicture& field);

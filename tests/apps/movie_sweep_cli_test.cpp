@@ -14,6 +14,7 @@
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/isosurface.hpp"
+#include "foxi/viz/legend.hpp"
 #include "foxi/viz/png.hpp"
 #include "test_util.hpp"
 #include "viz/mesh_factory.hpp"
@@ -63,10 +64,31 @@ bool same_rgb(const Framebuffer& a, const Framebuffer& b) {
   return true;
 }
 
-bool blank(const Framebuffer& fb, int width) {  // the mesh part (left of the legend) all white
+// A sweep frame's caption (issue 17 item 1: the step's time or the swept value at the top left), drawn
+// on foxi render's picture of the same choice: what the frame must then equal, pixel for pixel. The
+// expected text comes from the test's own values (the steps' times, the frame's isovalue), so a frame
+// labelled with another step's time or value differs.
+Framebuffer captioned(Framebuffer fb, const std::string& label) {
+  static const TextRenderer text(find_font_file());
+  const PixelRect ink = draw_caption(fb, text, label);
+  if (!label.empty()) EXPECT_LE(ink.x0, ink.x1) << "the caption '" << label << "' draws nothing";
+  return fb;
+}
+
+std::string caption(const char* fmt, double v) {
+  char b[128];
+  std::snprintf(b, sizeof b, fmt, v);
+  return b;
+}
+
+// The mesh part (left of the legend) all white but for the caption.
+bool blank(const Framebuffer& fb, int width, const std::string& label) {
+  Framebuffer white(fb.width, fb.height);
+  std::fill(white.rgba.begin(), white.rgba.end(), pack_rgba(255, 255, 255));
+  const Framebuffer expected = captioned(white, label);
   for (int y = 0; y < fb.height; ++y)
     for (int x = 0; x < width; ++x)
-      if ((fb.rgba[fb.index(x, y)] & 0xFFFFFFu) != 0xFFFFFFu) return false;
+      if ((fb.rgba[fb.index(x, y)] & 0xFFFFFFu) != (expected.rgba[fb.index(x, y)] & 0xFFFFFFu)) return false;
   return true;
 }
 
@@ -92,7 +114,7 @@ TEST_F(MovieSweepCli, IsoSweepFramesEqualRenderAtEachValue) {
       cmax = std::max(cmax, c);
       std::string rlog;
       ASSERT_EQ(foxi("render " + common + " --iso " + exact(v) + " -o " + p("r.png"), &rlog), 0) << rlog;
-      EXPECT_TRUE(same_rgb(frame("iso", k), read_png(dir_ / "r.png")))
+      EXPECT_TRUE(same_rgb(frame("iso", k), captioned(read_png(dir_ / "r.png"), caption("iso %.6g °C", v))))
           << "frame " << k << " at " << v << " °C";
     }
     EXPECT_EQ(cmin, 0u) << "20 °C lies below every node";
@@ -119,10 +141,29 @@ TEST_F(MovieSweepCli, ThresholdSweepFramesEqualRenderOfTheGrowingRange) {
              &out),
         0)
         << out;
-    EXPECT_TRUE(same_rgb(frame("thr", k), read_png(dir_ / "r.png"))) << "frame " << k;
+    EXPECT_TRUE(same_rgb(frame("thr", k), captioned(read_png(dir_ / "r.png"),
+                                                    caption("threshold 30 to %.6g °C", 30 + 20 * k))))
+        << "frame " << k;
   }
-  EXPECT_TRUE(blank(frame("thr", 0), 200)) << "[30, 30] °C holds no tet's value";
-  EXPECT_FALSE(blank(frame("thr", 1), 200));
+  EXPECT_TRUE(blank(frame("thr", 0), 200, "threshold 30 to 30 °C")) << "[30, 30] °C holds no tet's value";
+  EXPECT_FALSE(blank(frame("thr", 1), 200, "threshold 30 to 50 °C"));
+  // With --slice: the plane's section through each frame's threshold subset (issue 17 item 4).
+  const std::string slice = " --slice 4,2,1.5,1,0.3,0.2";
+  ASSERT_EQ(
+      foxi("movie " + common + slice + " --sweep threshold:30,110 --frames 3 -o " + p("ths/f_%d.png"), &out),
+      0)
+      << out;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_EQ(foxi("render " + common + slice + " --threshold 30," + std::to_string(30 + 40 * k) + " -o " +
+                       p("r.png"),
+                   &out),
+              0)
+        << out;
+    EXPECT_TRUE(same_rgb(frame("ths", k), captioned(read_png(dir_ / "r.png"),
+                                                    caption("threshold 30 to %.6g °C", 30 + 40 * k))))
+        << "frame " << k;
+  }
+  EXPECT_FALSE(same_rgb(frame("ths", 1), frame("thr", 2))) << "the slice, not the tets";
 }
 
 TEST_F(MovieSweepCli, StepsSweepKeepsOneRangeOverTheSteps) {
@@ -146,7 +187,9 @@ TEST_F(MovieSweepCli, StepsSweepKeepsOneRangeOverTheSteps) {
                    &out),
               0)
         << out;
-    EXPECT_TRUE(same_rgb(frame("st", k), read_png(dir_ / "r.png"))) << "step " << k;
+    // u's steps are at times 0, 0.5 and 1.
+    EXPECT_TRUE(same_rgb(frame("st", k), captioned(read_png(dir_ / "r.png"), caption("t = %g s", 0.5 * k))))
+        << "step " << k;
   }
   // The fixed range is the point: step 0 alone spans only z, so its own range colours it otherwise.
   ASSERT_EQ(foxi("render " + common + " --step 0 -o " + p("own.png"), &out), 0) << out;
@@ -164,9 +207,10 @@ TEST_F(MovieSweepCli, StepsSweepKeepsOneRangeOverTheSteps) {
                    &out),
               0)
         << out;
-    EXPECT_TRUE(same_rgb(frame("sti", k), read_png(dir_ / "r.png"))) << "step " << k;
+    EXPECT_TRUE(same_rgb(frame("sti", k), captioned(read_png(dir_ / "r.png"), caption("t = %g s", 0.5 * k))))
+        << "step " << k;
   }
-  EXPECT_TRUE(blank(frame("sti", 0), 80)) << "step 0 (u = z / 3 <= 1) never reaches 1.5";
+  EXPECT_TRUE(blank(frame("sti", 0), 80, "t = 0 s")) << "step 0 (u = z / 3 <= 1) never reaches 1.5";
 }
 
 TEST_F(MovieSweepCli, PvdCollectionStepsAreTheFrames) {
@@ -204,8 +248,8 @@ TEST_F(MovieSweepCli, ThresholdInBackAndForthAndDeformInSweeps) {
   std::string out;
   ASSERT_EQ(foxi("movie " + common + " --threshold 40,70 --frames 6 -o " + p("bf/f_%d.png"), &out), 0) << out;
   ASSERT_EQ(foxi("render " + common + " --threshold 40,70 -o " + p("r.png"), &out), 0) << out;
-  EXPECT_TRUE(same_rgb(frame("bf", 3), read_png(dir_ / "r.png")));
-  EXPECT_TRUE(blank(frame("bf", 0), 200));
+  EXPECT_TRUE(same_rgb(frame("bf", 3), read_png(dir_ / "r.png"))) << "no caption out of a sweep";
+  EXPECT_TRUE(blank(frame("bf", 0), 200, ""));
 
   Mesh m = mesh;  // a shear: u = (0.05 z, 0, 0)
   Field d{"displacement", FieldLocation::node, 3, "m", {}, {}};
@@ -222,7 +266,9 @@ TEST_F(MovieSweepCli, ThresholdInBackAndForthAndDeformInSweeps) {
     ASSERT_EQ(foxi("render " + dcommon + " --iso " + std::to_string(40 + 25 * k) + " -o " + p("r.png"), &out),
               0)
         << out;
-    EXPECT_TRUE(same_rgb(frame("dv", k), read_png(dir_ / "r.png"))) << "frame " << k;
+    EXPECT_TRUE(
+        same_rgb(frame("dv", k), captioned(read_png(dir_ / "r.png"), caption("iso %g °C", 40 + 25 * k))))
+        << "frame " << k;
   }
   EXPECT_EQ(foxi("movie " + dcommon + " -o " + p("bfd.gif"), &out), 3) << out;
   EXPECT_NE(out.find("fails the Delaunay certificate"), std::string::npos) << out;
@@ -247,7 +293,9 @@ TEST_F(MovieSweepCli, TransientPvdOutputSteps) {
   for (int k = 0; k < n; ++k) {
     ASSERT_EQ(foxi("render " + common + " --step " + std::to_string(k) + " -o " + p("r.png"), &out), 0)
         << out;
-    EXPECT_TRUE(same_rgb(frame("tr", k), read_png(dir_ / "r.png"))) << "step " << k;
+    // --time 1 --steps 4: the start and four steps of 0.25 s.
+    EXPECT_TRUE(same_rgb(frame("tr", k), captioned(read_png(dir_ / "r.png"), caption("t = %g s", 0.25 * k))))
+        << "step " << k;
   }
   EXPECT_FALSE(same_rgb(frame("tr", 0), frame("tr", n - 1))) << "the die heats up";
 }

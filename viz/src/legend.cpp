@@ -55,6 +55,14 @@ std::vector<double> legend_ticks(const ColorLegend& l, int bar_h, int line_h) {
 
 }  // namespace
 
+PixelRect draw_caption(Framebuffer& fb, const TextRenderer& text, std::string_view caption,
+                       const LegendParams& params) {
+  if (caption.empty()) return {};
+  // The baseline from a fixed string's ascent, so that captions of different text sit on one line.
+  const int ascent = text.measure("Ag", params.font_px).ascent;
+  return text.draw(fb, caption, params.margin, params.margin + ascent, params.font_px, params.text_color);
+}
+
 std::string tick_label(double value, double step) {
   char buf[64];
   const double a = std::abs(value);

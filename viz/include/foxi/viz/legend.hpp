@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "foxi/api.hpp"
@@ -52,6 +53,13 @@ FOXI_API int legend_width(const TextRenderer& text, const ColorLegend& legend,
 // least legend_width wide). Throws std::invalid_argument if the area is too small for a bar.
 FOXI_API LegendReport draw_color_legend(Framebuffer& fb, const TextRenderer& text, const ColorLegend& legend,
                                         PixelRect area, const LegendParams& params = {});
+
+// A one-line caption in a picture's top-left corner (a movie frame's time or swept value: "t = 12.5 s"):
+// `text` drawn with its pen at (params.margin, params.margin + the font's ascent of "Ag"), params.font_px
+// high, in params.text_color, over the pixels there (no background: the mesh is fitted inside margins).
+// Returns the pixels it may have changed. Empty text draws nothing.
+FOXI_API PixelRect draw_caption(Framebuffer& fb, const TextRenderer& text, std::string_view caption,
+                                const LegendParams& params = {});
 
 // A tick label: the value with as many decimals as the step between ticks needs (%g beyond 1e6 or
 // below 1e-3 in magnitude).
