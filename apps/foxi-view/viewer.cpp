@@ -213,7 +213,7 @@ std::string value_under(const Viewer& viewer, const ViewField& f, int x, int y, 
   double b[4];
   char buf[256];
   const std::uint32_t region = mesh.tet_region.empty() ? 0 : mesh.tet_region[t];
-  if (!pixel_point_in_tet(mesh, viewer.camera(), fb.width, fb.height, t, x, y, b)) {
+  if (!pixel_point_in_tet(mesh, viewer.camera(), fb.width, fb.height, t, x, y, b, viewer.shrink())) {
     std::snprintf(buf, sizeof buf, "tet %u, region %u", t, region);
     return buf;
   }

@@ -68,7 +68,8 @@ bool toggle_legend(Viewer& viewer, ViewField& field);
 // marked) when it is on.
 Framebuffer presented(const Viewer& viewer, const ViewField& field);
 // "temperature 53.2 °C at (x, y, z), tet 12, region 3" for pixel (x, y): the tet pick() shows there,
-// the point its front face shows at the pixel's centre (pixel_point_in_tet) and the field's value
+// the point its front face shows at the pixel's centre (pixel_point_in_tet; with --shrink the true
+// point of the tet that the shrunk tet's pixel shows, as foxi probe finds it) and the field's value
 // there (field_value_in_tet); "background" where no tet shows. `digits`: significant digits.
 std::string value_under(const Viewer& viewer, const ViewField& field, int x, int y, int digits = 4);
 // The field, map and range for the status line ("" with region colours).

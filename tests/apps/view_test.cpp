@@ -73,6 +73,38 @@ Mesh two_region_grid() {
   return m;
 }
 
+// Each "probe X,Y: u V at (x, y, z), tet T" line of a foxi-view script's log against foxi probe of
+// `mesh` at that point: the same value (1e-6 relative) and, if `same_tet`, the same tet. Returns the
+// number of such lines.
+int probes_equal_foxi_probe(const std::string& view_log, const std::filesystem::path& mesh,
+                            const std::filesystem::path& dir, bool same_tet) {
+  std::istringstream lines(view_log);
+  std::string line, out;
+  int probed = 0;
+  const std::regex value(
+      "^probe ([0-9]+),([0-9]+): u ([-0-9.e+]+) at \\(([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\), tet "
+      "([0-9]+)");
+  while (std::getline(lines, line)) {
+    std::smatch mm;
+    if (!std::regex_search(line, mm, value)) continue;
+    ++probed;
+    const std::string at = std::string(mm[4]) + "," + std::string(mm[5]) + "," + std::string(mm[6]);
+    EXPECT_EQ(run_logged(q(test::cli_path()) + " probe " + q(mesh) + " --field u --at " + at,
+                         dir / "probe.log", &out),
+              0)
+        << out;
+    std::smatch pm;
+    if (!std::regex_search(out, pm, std::regex("tet ([0-9]+), .*u = ([-0-9.e+]+)"))) {
+      ADD_FAILURE() << out;
+      continue;
+    }
+    if (same_tet)
+      EXPECT_EQ(pm[1], mm[7]) << "the point lies inside the tet the pixel shows\n" << line << "\n" << out;
+    EXPECT_NEAR(std::stod(pm[2]), std::stod(mm[3]), 1e-6 * std::abs(std::stod(mm[3]))) << line << "\n" << out;
+  }
+  return probed;
+}
+
 class ViewTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -151,27 +183,8 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
             0)
       << out;
   EXPECT_EQ(differing_pixels(read_png(dir_ / "fv-001.png"), read_png(dir_ / "fr.png")), 0u);
-  std::istringstream lines(view_log);
-  std::string line;
-  int probed = 0;
-  const std::regex value(
-      "^probe ([0-9]+),([0-9]+): u ([-0-9.e+]+) at \\(([-0-9.e+]+), ([-0-9.e+]+), ([-0-9.e+]+)\\), tet "
-      "([0-9]+)");
-  while (std::getline(lines, line)) {
-    std::smatch mm;
-    if (line.rfind("probe 5,5:", 0) == 0) EXPECT_NE(line.find("background"), std::string::npos) << line;
-    if (!std::regex_search(line, mm, value)) continue;
-    ++probed;
-    const std::string at = std::string(mm[4]) + "," + std::string(mm[5]) + "," + std::string(mm[6]);
-    ASSERT_EQ(run_logged(q(test::cli_path()) + " probe " + q(dir_ / "f.vtu") + " --field u --at " + at,
-                         dir_ / "probe.log", &out),
-              0)
-        << out;
-    std::smatch pm;
-    ASSERT_TRUE(std::regex_search(out, pm, std::regex("tet ([0-9]+), .*u = ([-0-9.e+]+)"))) << out;
-    EXPECT_NEAR(std::stod(pm[2]), std::stod(mm[3]), 1e-6 * std::abs(std::stod(mm[3]))) << line << "\n" << out;
-  }
-  EXPECT_EQ(probed, 5) << view_log;
+  EXPECT_NE(view_log.find("probe 5,5: background"), std::string::npos) << view_log;
+  EXPECT_EQ(probes_equal_foxi_probe(view_log, dir_ / "f.vtu", dir_, false), 5) << view_log;
   // After f: the next field (w, a constant 2).
   EXPECT_NE(view_log.find("probe 160,120: w 2 at"), std::string::npos) << view_log;
 
@@ -215,6 +228,28 @@ TEST_F(ViewTest, FieldColoursAndTheValueUnderTheMouseEqualRenderAndProbe) {
   const Framebuffer lv = read_png(dir_ / "lv-001.png");
   EXPECT_EQ(lv.width, 320);
   EXPECT_EQ(differing_pixels(lv, read_png(dir_ / "lr.png")), 0u);
+}
+
+// With --shrink (issue 17 item 2) the status line's point is the true point the shrunk tet's pixel
+// shows, inside the tet (not on its face, where the pixel's ray enters the unshrunk tet): foxi probe
+// at that point finds the same tet and the same value.
+TEST_F(ViewTest, ValueUnderTheMouseOfShrunkTetsEqualsProbe) {
+  Mesh m = two_region_grid();
+  Field u{"u", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < m.node_count(); ++n)
+    u.values.push_back(1 + m.xyz[3 * n] * m.xyz[3 * n + 1] + std::sin(m.xyz[3 * n + 2]));
+  m.fields = {u};
+  write_mesh(m, dir_ / "f.vtu");
+  std::string script = "d";
+  for (int y = 60; y < 200; y += 23)
+    for (int x = 70; x < 260; x += 31) script += " probe:" + std::to_string(x) + "," + std::to_string(y);
+  std::string out;
+  ASSERT_EQ(run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " " + kSize +
+                           " --shrink 0.5 --field u --graded --script '" + script + "'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  EXPECT_GE(probes_equal_foxi_probe(out, dir_ / "f.vtu", dir_, true), 10) << out;
 }
 
 // Undraw in the viewer's state machine: draw all, undraw 360 of the 720 tets, and the picture (and

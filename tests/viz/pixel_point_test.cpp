@@ -21,6 +21,16 @@ namespace {
 
 double linear(const double p[3]) { return 5 + 2 * p[0] + 3 * p[1] - p[2]; }
 
+// The ray through the centre of pixel (x, y) in world coordinates: origin o, direction d.
+void world_ray(const Projector& proj, int x, int y, double o[3], double d[3]) {
+  double oc[3], dc[3];
+  test::pixel_ray(proj, x, y, oc, dc);
+  for (int k = 0; k < 3; ++k) {
+    o[k] = proj.eye[k] + proj.right[k] * oc[0] + proj.up[k] * oc[1] + proj.forward[k] * oc[2];
+    d[k] = proj.right[k] * dc[0] + proj.up[k] * dc[1] + proj.forward[k] * dc[2];
+  }
+}
+
 TEST(PixelPoint, ThePointAndValueUnderAPixelAreWhereItsRayEntersTheBox) {
   Mesh mesh = test::grid_mesh(4, 3, 2, 1, 1, 1, 6);  // the box [0,4] x [0,3] x [0,2]
   Field t{"t", FieldLocation::node, 1, "", {}, {}};
@@ -42,12 +52,8 @@ TEST(PixelPoint, ThePointAndValueUnderAPixelAreWhereItsRayEntersTheBox) {
         const std::uint32_t tet = fb.id[fb.index(x, y)];
         if (tet == kNone) continue;
         // The oracle: the world ray of the pixel's centre, entering the box at s_in.
-        double oc[3], dc[3], o[3], d[3];
-        test::pixel_ray(proj, x, y, oc, dc);
-        for (int k = 0; k < 3; ++k) {
-          o[k] = proj.eye[k] + proj.right[k] * oc[0] + proj.up[k] * oc[1] + proj.forward[k] * oc[2];
-          d[k] = proj.right[k] * dc[0] + proj.up[k] * dc[1] + proj.forward[k] * dc[2];
-        }
+        double o[3], d[3];
+        world_ray(proj, x, y, o, d);
         double s_in = proj.perspective ? 0 : -std::numeric_limits<double>::infinity();
         double s_out = std::numeric_limits<double>::infinity();
         for (int k = 0; k < 3; ++k) {
@@ -81,6 +87,70 @@ TEST(PixelPoint, ThePointAndValueUnderAPixelAreWhereItsRayEntersTheBox) {
   // Outside the image, a tet the ray runs away from, a bad tet index: no point.
   double b[4];
   EXPECT_FALSE(pixel_point_in_tet(mesh, cams[0], w, h, std::uint32_t(mesh.tet_count()), 0, 0, b));
+}
+
+// With --shrink (issue 17 item 2) a pixel shows a tet scaled about its centroid: the point it shows
+// is where the pixel's ray meets the shrunk tet, and the value its colour shows is the field's at the
+// true point that maps there. Oracle per covered pixel: the reported point p lies in the tet (its
+// barycentric coordinates), p shrunk about the centroid lies on the pixel's ray (test::pixel_ray, to
+// rounding), and the value is the linear field's at p. Without the shrink factor the point is off
+// the ray for most pixels (what the viewer's status line showed).
+TEST(PixelPoint, ShrunkTetsShowTheTruePointUnderAPixel) {
+  Mesh mesh = test::grid_mesh(4, 3, 2, 1, 1, 1, 6);
+  Field t{"t", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < mesh.node_count(); ++n) t.values.push_back(linear(&mesh.xyz[3 * n]));
+  mesh.fields = {t};
+  const FieldChoice choice = choose_field(mesh, "t");
+  const SphereTable table = compute_spheres(mesh);
+  const int w = 120, h = 90;
+  const double f = 0.6;
+  std::size_t checked = 0, off_ray_unshrunk = 0;
+  const std::vector<Camera> cams = test::random_cameras(mesh, 6, 23, double(w) / h);
+  for (std::size_t c = 0; c < cams.size(); ++c) {
+    if (c % 3 == 1) continue;  // eyes inside the box
+    Framebuffer fb(w, h);
+    PictureParams pp;
+    pp.render.shrink = f;
+    draw_picture(mesh, table, cams[c], fb, pp);
+    const Projector proj(cams[c], w, h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::uint32_t tet = fb.id[fb.index(x, y)];
+        if (tet == kNone) continue;
+        double o[3], d[3];
+        world_ray(proj, x, y, o, d);
+        const double dl = std::hypot(d[0], d[1], d[2]);
+        const std::uint32_t* n = &mesh.tet[4 * std::size_t(tet)];
+        auto off_ray = [&](const double b[4], double shrink) {  // distance of the drawn point from the ray
+          double p[3] = {0, 0, 0}, centre[3] = {0, 0, 0};
+          for (int i = 0; i < 4; ++i)
+            for (int k = 0; k < 3; ++k) {
+              p[k] += b[i] * mesh.xyz[3 * std::size_t(n[i]) + std::size_t(k)];
+              centre[k] += 0.25 * mesh.xyz[3 * std::size_t(n[i]) + std::size_t(k)];
+            }
+          double q[3], cr[3];
+          for (int k = 0; k < 3; ++k) q[k] = centre[k] + shrink * (p[k] - centre[k]) - o[k];
+          cr[0] = q[1] * d[2] - q[2] * d[1];
+          cr[1] = q[2] * d[0] - q[0] * d[2];
+          cr[2] = q[0] * d[1] - q[1] * d[0];
+          return std::hypot(cr[0], cr[1], cr[2]) / dl;
+        };
+        double b[4];
+        ASSERT_TRUE(pixel_point_in_tet(mesh, cams[c], w, h, tet, x, y, b, f)) << x << "," << y;
+        double p[3] = {0, 0, 0};
+        for (int i = 0; i < 4; ++i) {
+          EXPECT_GE(b[i], 0.0);
+          for (int k = 0; k < 3; ++k) p[k] += b[i] * mesh.xyz[3 * std::size_t(n[i]) + std::size_t(k)];
+        }
+        EXPECT_LT(off_ray(b, f), 3e-3) << "camera " << c << " pixel " << x << "," << y;
+        EXPECT_NEAR(field_value_in_tet(mesh, choice, tet, b), linear(p), 1e-9);
+        double b1[4];
+        if (pixel_point_in_tet(mesh, cams[c], w, h, tet, x, y, b1)) off_ray_unshrunk += off_ray(b1, f) > 1e-2;
+        ++checked;
+      }
+  }
+  EXPECT_GT(checked, 2000u);
+  EXPECT_GT(off_ray_unshrunk, checked / 2) << "the unshrunk entry is not the point the pixel shows";
 }
 
 }  // namespace

@@ -316,7 +316,7 @@ bool barycentric(const double c[4][3], const double q[3], double b[4]) {
 }  // namespace
 
 bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height, std::uint32_t t, int x,
-                        int y, double bary[4]) {
+                        int y, double bary[4], double shrink) {
   if (t >= mesh.tet_count()) return false;
   Projector p = [&] {
     try {
@@ -342,6 +342,12 @@ bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int h
   for (int i = 0; i < 4; ++i)
     for (int k = 0; k < 3; ++k)
       c[i][k] = mesh.xyz[3 * std::size_t(mesh.tet[4 * std::size_t(t) + std::size_t(i)]) + std::size_t(k)];
+  if (shrink != 1) {  // the tet as drawn: scaled about its centroid, as the rasterizer does
+    for (int k = 0; k < 3; ++k) {
+      const double centre = 0.25 * (c[0][k] + c[1][k] + c[2][k] + c[3][k]);
+      for (int i = 0; i < 4; ++i) c[i][k] = centre + shrink * (c[i][k] - centre);
+    }
+  }
   const double od[3] = {o[0] + d[0], o[1] + d[1], o[2] + d[2]};
   double b0[4], b1[4];
   if (!barycentric(c, o, b0) || !barycentric(c, od, b1)) return false;

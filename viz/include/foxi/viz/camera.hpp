@@ -83,9 +83,12 @@ struct FOXI_API Projector {
 // enters tet `t` of `mesh` (for a perspective eye inside the tet: the eye): its barycentric
 // coordinates in the tet's node order, the point the pixel shows of that tet (unshrunk). The ray is
 // clamped to the tet where it passes just outside it (a pixel centre past an edge the tet was
-// rasterized on). False if the camera is degenerate or the ray runs the other way.
+// rasterized on). False if the camera is degenerate or the ray runs the other way. `shrink`: the
+// tet was drawn scaled about its centroid by it (RenderParams::shrink): the ray then meets the shrunk
+// tet, and bary are that point's coordinates in the shrunk tet, which are those of the true point it
+// shows in the tet itself (the shrink is affine), the point whose value the pixel's colour shows.
 FOXI_API bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height,
-                                 std::uint32_t t, int x, int y, double bary[4]);
+                                 std::uint32_t t, int x, int y, double bary[4], double shrink = 1);
 
 // The ordering viewpoint of a camera: perspective -> View::at(eye), orthographic -> View::along(at - eye).
 FOXI_API View view_of(const Camera& camera);

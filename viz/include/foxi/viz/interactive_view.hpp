@@ -82,6 +82,9 @@ class FOXI_API InteractiveView {
 
   // The tet shown at pixel (x, y) (row 0 at the top), kNone for the background or outside the image.
   std::uint32_t pick(int x, int y) const;
+  // The factor the tets are drawn shrunk by (RenderParams::shrink): pixel_point_in_tet takes it, so
+  // that the point under a pixel is the true point, not where the ray meets the unshrunk tet.
+  double shrink() const { return params_.shrink; }
   // Iso polygons instead of whole tets (isosurface.hpp; the isovalue's surfaces, or in cap mode the
   // solid above it): `drawing` the IsoPainter's inputs (lent with its spans: they must outlive the
   // view or the next set_iso), `tets` the tets it crosses (cap mode: reaches; TetIntervals gives
