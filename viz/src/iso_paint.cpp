@@ -26,6 +26,7 @@ constexpr int kMaxPoly = 10;
 struct Vert {
   double c[3];
   double pos;
+  bool mesh_edge = false;  // the edge from this vertex to the next is (part of) a mesh edge (cap mode)
 };
 
 }  // namespace
@@ -38,6 +39,11 @@ struct IsoPainter::Impl {
   std::vector<double> values;  // ascending
   bool depth = false;
   double near_given = 0;  // RenderParams::near
+  // Cap mode's cut tets darken their faces' mesh edges as the tet painter darkens the whole tets'
+  // (RenderParams edges, edge_width, edge_darkness; raster_field.cpp's rule): a pixel at distance
+  // d < edge_width from a mesh edge's line is scaled by edge_base + edge_slope d.
+  bool edges = false;
+  double edge_width = 1, edge_base = 1, edge_slope = 0;
   double light[3] = {0, 0, -1};
   float lut[256][3] = {};
   std::optional<TetRasterizer> solid;  // cap mode: the whole tets
@@ -97,6 +103,8 @@ struct IsoPainter::Impl {
           for (int k = 0; k < 3; ++k) o.c[k] = a.c[k] + t * (b.c[k] - a.c[k]);
           o.c[2] = near;
           o.pos = a.pos + t * (b.pos - a.pos);
+          // Leaving: the next edge runs along the near plane; entering: it is the rest of a -> b.
+          o.mesh_edge = ina ? false : a.mesh_edge;
         }
       }
       if (m < 3) return;
@@ -108,6 +116,18 @@ struct IsoPainter::Impl {
     snap_polygon(
         proj, n, [&](int i) { return v[i].c; }, X, Y, px, w);
     if (rows.thread == 0) ++polygons;
+    // The mesh edges' lines in pixel coordinates (from the snapped vertices): a point, a unit normal.
+    int lines = 0;
+    double lx[kMaxPoly], ly[kMaxPoly], lnx[kMaxPoly], lny[kMaxPoly];
+    if (edges)
+      for (int i = 0; i < n; ++i) {
+        if (!v[i].mesh_edge) continue;
+        const int j = i + 1 == n ? 0 : i + 1;
+        const double ex = px[j][0] - px[i][0], ey = px[j][1] - px[i][1], len = std::hypot(ex, ey);
+        if (!(len > 0)) continue;
+        lx[lines] = px[i][0], ly[lines] = px[i][1], lnx[lines] = -ey / len, lny[lines] = ex / len;
+        ++lines;
+      }
     for_each_fan_triangle(X, Y, n, [&](const std::int64_t* TX, const std::int64_t* TY, const int* idx) {
       // Affine functions on the screen: nearness, and position x nearness (perspective-correct).
       const double x0 = px[idx[0]][0], y0 = px[idx[0]][1];
@@ -150,8 +170,15 @@ struct IsoPainter::Impl {
               c = lut[int(std::clamp(t * 256, 0.0, 255.0))];
             }
           }
-          fb.rgba[p] = pack_rgba(std::uint32_t(c[0] * factor + 0.5f), std::uint32_t(c[1] * factor + 0.5f),
-                                 std::uint32_t(c[2] * factor + 0.5f));
+          float f = factor;
+          if (lines > 0) {
+            double d = edge_width;
+            for (int k = 0; k < lines; ++k)
+              d = std::min(d, std::abs((x + 0.5 - lx[k]) * lnx[k] + (y + 0.5 - ly[k]) * lny[k]));
+            if (d < edge_width) f *= float(edge_base + edge_slope * d);
+          }
+          fb.rgba[p] = pack_rgba(std::uint32_t(c[0] * f + 0.5f), std::uint32_t(c[1] * f + 0.5f),
+                                 std::uint32_t(c[2] * f + 0.5f));
           fb.id[p] = tet;
         }
       });
@@ -232,13 +259,17 @@ struct IsoPainter::Impl {
       int m = 0;
       for (int i = 0; i < 3; ++i) {
         const int a = kFace[f][i], b = kFace[f][(i + 1) % 3];
+        // Mesh edges: from a corner above v along its face edge (to the next corner or to the
+        // crossing), and from a crossing toward a corner above; not along the cut (crossing to crossing).
         if (c[a] >= v) {
           for (int k = 0; k < 3; ++k) world[m][k] = mesh->xyz[3 * std::size_t(n[a]) + std::size_t(k)];
+          poly[m].mesh_edge = true;
           poly[m++].pos = params.scale.position(c[a]);
         }
         if ((c[a] >= v) != (c[b] >= v)) {
           double dummy;
           iso_detail::edge_point(*mesh, t, c, v, a, b, nullptr, world[m], &dummy);
+          poly[m].mesh_edge = !(c[a] >= v);
           poly[m++].pos = params.scale.position(v);
         }
       }
@@ -305,6 +336,10 @@ IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int he
   // need no per-mesh setup, so a new isovalue or view costs only the tets it crosses: their near plane
   // is chosen per polygon (draw_polygon).
   s.near_given = tet_params.near;
+  s.edges = params.cap && tet_params.edges && tet_params.edge_width > 0;
+  s.edge_width = tet_params.edge_width;
+  s.edge_base = 1 - tet_params.edge_darkness;
+  s.edge_slope = s.edges ? tet_params.edge_darkness / tet_params.edge_width : 0;
   if (params.cap) s.solid.emplace(mesh, camera, width, height, tet_params);
 }
 

@@ -92,8 +92,10 @@ struct IsoParams {
   // Cap mode: draw the threshold subset T >= min(values) as a solid, the tets entirely above it whole
   // (through the tet painter, RenderParams as given to IsoPainter) and the tets it cuts as the part
   // of the tet above it: the cut face (the iso polygon in the isovalue's colour, the field's value
-  // there) and the tet's faces clipped to it, coloured per pixel by the field on `scale`. The higher
-  // isovalues lie inside the solid and are not drawn.
+  // there) and the tet's faces clipped to it, coloured per pixel by the field on `scale`, their parts
+  // of mesh edges darkened as the whole tets' edges are (RenderParams edges, edge_width,
+  // edge_darkness; the cut's own outline is no mesh edge). The higher isovalues lie inside the solid
+  // and are not drawn.
   bool cap = false;
 };
 
