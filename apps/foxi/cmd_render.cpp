@@ -193,6 +193,7 @@ int cmd_render(Args args) {
   if (iso_options.any()) {
     iso = resolve_iso(iso_options, mesh, field, picture.subset);
     field.legend.marks = iso.iso_si;
+    warn_iso_outside(iso, field);
   }
   const std::vector<std::uint32_t>& subset = iso_options.any() ? iso.subset : picture.subset;
   const IsoDrawing iso_drawing = iso.drawing();

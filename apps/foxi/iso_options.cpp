@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
 namespace foxi::cli {
 
@@ -18,8 +20,9 @@ const char* const kIsoOptionsHelp =
     "  --clip px,py,pz,nx,ny,nz  crinkle clip: only the whole tets whose centroid lies behind the plane\n"
     "                  (n points to the part cut away)\n"
     "  --slice px,py,pz,nx,ny,nz the plane's cut through the mesh, coloured by the field (both sides)\n"
-    "  These combine with each other and with --regions (the tets must satisfy all), except --slice,\n"
-    "  which is drawn alone; all need --field.\n";
+    "  These combine with each other and with --regions (the tets must satisfy all): a slice with\n"
+    "  --threshold or --clip is the plane's cut through the tets they keep. --slice and --iso do not\n"
+    "  combine (both are the polygons drawn); all need --field.\n";
 
 namespace {
 
@@ -64,9 +67,46 @@ IsoOptions take_iso_options(Args& args, const FieldOptions& field) {
   if (o.any() && field.spec.empty())
     throw UsageError(
         "--iso, --threshold, --clip and --slice select by a field or draw it: give --field NAME");
-  if (o.slice && (!o.iso.empty() || o.has_threshold || o.clip))
-    throw UsageError("--slice is drawn alone: leave out --iso, --threshold and --clip");
+  if (o.slice && !o.iso.empty())
+    throw UsageError(
+        "--slice and --iso both draw polygons, one kind a picture: give one (a slice combines with "
+        "--threshold and --clip)");
   return o;
+}
+
+std::optional<std::pair<double, double>> iso_values_outside(const IsoPicture& iso,
+                                                            std::vector<double>& outside) {
+  outside.clear();
+  if (iso.iso_si.empty() || !iso.corner) return std::nullopt;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double v : *iso.corner)
+    if (!std::isnan(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  for (double v : iso.iso_si)
+    if (!(v >= lo && v <= hi)) outside.push_back(v);
+  if (!(lo <= hi)) return std::nullopt;
+  return std::pair{lo, hi};
+}
+
+void warn_iso_outside(const IsoPicture& iso, const FieldPicture& field) {
+  std::vector<double> outside;
+  const auto range = iso_values_outside(iso, outside);
+  if (outside.empty()) return;
+  const DisplayUnit& u = field.legend.unit;
+  const std::string unit = u.symbol.empty() ? "" : " " + u.symbol;
+  std::string values;
+  for (double v : outside) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%s%.6g", values.empty() ? "" : ", ", u.to_display(v));
+    values += b;
+  }
+  char r[160];
+  if (range)
+    std::snprintf(r, sizeof r, "the field's values %.6g to %.6g%s", u.to_display(range->first),
+                  u.to_display(range->second), unit.c_str());
+  else
+    std::snprintf(r, sizeof r, "the field, which has no finite value");
+  std::printf("warning     --iso %s%s lies outside %s: no isosurface there\n", values.c_str(), unit.c_str(),
+              r);
 }
 
 IsoPicture resolve_iso(const IsoOptions& options, const Mesh& mesh, const FieldPicture& field,

@@ -9,6 +9,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli.hpp"
@@ -43,5 +44,15 @@ using foxi::IsoCache;
 // `cache`: null, or kept by the caller across calls with the same field choice and step.
 IsoPicture resolve_iso(const IsoOptions& options, const Mesh& mesh, const FieldPicture& field,
                        std::span<const std::uint32_t> base, IsoCache* cache = nullptr);
+
+// The isovalues of `iso` (SI) outside the range of the values its isosurfaces are found in (the tets'
+// corner values: a node field's node values, a cell field's per-region averages), which therefore
+// have no isosurface; returns that range (SI), or nullopt when the field has no finite value.
+std::optional<std::pair<double, double>> iso_values_outside(const IsoPicture& iso,
+                                                            std::vector<double>& outside);
+
+// Prints a warning line naming the isovalues outside the field's range, and the range, in the field's
+// display unit (nothing when all lie inside).
+void warn_iso_outside(const IsoPicture& iso, const FieldPicture& field);
 
 }  // namespace foxi::cli

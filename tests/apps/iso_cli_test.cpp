@@ -5,6 +5,7 @@
 // clip_tets); malformed options exit 2 with the reason.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <regex>
 #include <string>
 
@@ -127,9 +128,53 @@ TEST_F(IsoCli, CountsEqualTheLibrarysSelections) {
   ASSERT_EQ(foxi("--field temperature --clip 3.3,2,1,1,0.5,0.2 --threshold 50,80" + o, &log), 0) << log;
   const std::vector<std::uint32_t> th = threshold_tets(centroid, 323.15, 353.15);
   EXPECT_EQ(drawn(log), clip_tets(mesh, pl, th).size()) << log;
-  // An isovalue outside the data crosses nothing: an empty picture, not the whole mesh.
+  // A slice combines with a threshold and a clip (issue 17 item 4): the plane's cut through the tets
+  // both keep, and the painter's picture is the depth buffer's.
+  Plane pl2;
+  pl2.p[0] = 5, pl2.p[1] = 2, pl2.p[2] = 1.5;
+  pl2.n[0] = 0.3, pl2.n[1] = 1, pl2.n[2] = -0.2;
+  const std::string slice2 = " --size 320x240 --legend off --slice 5,2,1.5,0.3,1,-0.2";
+  const std::vector<std::uint32_t> cut2 = crossing_scan(plane_corner_values(mesh, pl2), 0);
+  const std::vector<std::uint32_t> both = clip_tets(mesh, pl, th);
+  for (const auto& [opts, keep] :
+       {std::pair{std::string(" --threshold 50,80"), th},
+        std::pair{std::string(" --clip 3.3,2,1,1,0.5,0.2"), clip_tets(mesh, pl)},
+        std::pair{std::string(" --clip 3.3,2,1,1,0.5,0.2 --threshold 50,80"), both}}) {
+    SCOPED_TRACE(opts);
+    std::vector<std::uint32_t> expected;
+    std::vector<std::uint32_t> k = keep;
+    std::sort(k.begin(), k.end());
+    for (std::uint32_t t : cut2)
+      if (std::binary_search(k.begin(), k.end(), t)) expected.push_back(t);
+    ASSERT_GT(expected.size(), 5u);
+    ASSERT_LT(expected.size(), cut2.size());
+    const std::string po = " -o '" + (dir_ / "p.png").string() + "'",
+                      zo = " -o '" + (dir_ / "z.png").string() + "'";
+    ASSERT_EQ(foxi("--field temperature --no-edges" + slice2 + opts + po, &log), 0) << log;
+    EXPECT_EQ(drawn(log), expected.size()) << log;
+    EXPECT_NE(log.find(std::to_string(expected.size()) + " tets cut"), std::string::npos) << log;
+    ASSERT_EQ(foxi("--field temperature --no-edges --zbuffer" + slice2 + opts + zo, &log), 0) << log;
+    const Framebuffer a = read_png(dir_ / "p.png"), b = read_png(dir_ / "z.png");
+    ASSERT_EQ(a.rgba.size(), b.rgba.size());
+    std::size_t differ = 0, coloured = 0;
+    for (std::size_t i = 0; i < a.rgba.size(); ++i) {
+      differ += (a.rgba[i] & 0xFFFFFFu) != (b.rgba[i] & 0xFFFFFFu);
+      coloured += (a.rgba[i] & 0xFFFFFFu) != 0xFFFFFFu;
+    }
+    EXPECT_EQ(differ, 0u) << "painter == depth buffer";
+    EXPECT_GT(coloured, 1000u);
+  }
+  // An isovalue outside the data crosses nothing: an empty picture, not the whole mesh, and a warning
+  // with the field's range (300..380 K) says why (issue 17 item 6).
   ASSERT_EQ(foxi("--field temperature --iso 500 --iso-only" + o, &log), 0) << log;
   EXPECT_EQ(drawn(log), 0u) << log;
+  EXPECT_NE(log.find("warning     --iso 500 °C lies outside the field's values 26.85 to 106.85 °C"),
+            std::string::npos)
+      << log;
+  ASSERT_EQ(foxi("--field temperature --iso 20,50,120" + o, &log), 0) << log;
+  EXPECT_NE(log.find("warning     --iso 20, 120 °C lies outside"), std::string::npos) << log;
+  ASSERT_EQ(foxi("--field temperature --iso 50" + o, &log), 0) << log;
+  EXPECT_EQ(log.find("warning"), std::string::npos) << log;
 }
 
 TEST_F(IsoCli, MalformedOptionsExit2WithTheReason) {
@@ -146,7 +191,7 @@ TEST_F(IsoCli, MalformedOptionsExit2WithTheReason) {
   EXPECT_NE(log.find("normal must not be zero"), std::string::npos) << log;
   EXPECT_EQ(foxi("--field temperature --threshold 80,50" + o, &log), 2);
   EXPECT_EQ(foxi("--field temperature --slice 1,2,3,0,0,1 --iso 50" + o, &log), 2);
-  EXPECT_NE(log.find("drawn alone"), std::string::npos) << log;
+  EXPECT_NE(log.find("both draw polygons"), std::string::npos) << log;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "o.png"));
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 namespace foxi {
 
@@ -39,6 +40,9 @@ IsoCache make_iso_cache(const Mesh& mesh, const FieldChoice& choice, std::size_t
 TetSelection select_field_tets(const FieldSelection& options, const Mesh& mesh, const FieldChoice& choice,
                                std::size_t step, const ColorScale& scale, std::span<const std::uint32_t> base,
                                IsoCache* cache) {
+  if (options.slice && !options.iso.empty())
+    throw std::invalid_argument(
+        "field selection: a slice and isovalues are both the polygons drawn: give one");
   TetSelection r;
   IsoCache local;
   IsoCache& c = cache ? *cache : local;

@@ -25,7 +25,9 @@ struct FieldSelection {
   std::vector<double> iso;  // isovalues, SI (empty: none)
   bool iso_only = false;    // the isosurfaces alone, two-sided; otherwise the solid >= the lowest value
   std::optional<std::pair<double, double>> threshold;  // tets whose centroid value lies in [lo, hi], SI
-  std::optional<Plane> clip, slice;                    // slice: drawn alone, without iso/threshold/clip
+  // slice: the plane's cut through the tets the threshold, the clip and the base keep; not with iso
+  // (both are the polygons drawn).
+  std::optional<Plane> clip, slice;
   bool any() const { return !iso.empty() || threshold || clip || slice; }
 };
 
@@ -61,7 +63,8 @@ FOXI_API IsoCache make_iso_cache(const Mesh& mesh, const FieldChoice& choice, st
 
 // The tets of `base` (all when empty) that `selection` selects, and the painter's inputs; `scale`
 // colours the polygons. `cache`: null, or kept by the caller across calls with the same field
-// choice, step and mesh. Throws std::invalid_argument for a clip or slice plane with a zero normal.
+// choice, step and mesh. Throws std::invalid_argument for a clip or slice plane with a zero normal,
+// and for a slice with isovalues.
 FOXI_API TetSelection select_field_tets(const FieldSelection& selection, const Mesh& mesh,
                                         const FieldChoice& choice, std::size_t step, const ColorScale& scale,
                                         std::span<const std::uint32_t> base = {}, IsoCache* cache = nullptr);
