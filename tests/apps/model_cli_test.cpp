@@ -11,6 +11,7 @@
 #include <string>
 
 #include "foxi/model/delaunay.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/viz/png.hpp"
@@ -225,6 +226,16 @@ TEST(ModelCli, DemoShowsIsothermAndStressOnTheDeformedShape) {
   EXPECT_LE(moved, 0.02 * diag * (1 + 1e-5));
   EXPECT_GE(moved, 0.008 * diag);
   EXPECT_NE(out.find("field       von_mises"), std::string::npos) << out;
+  // The von Mises picture is the solid above a quarter of the way up its range (two digits, MPa).
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("iso         ([0-9.e+-]+) MPa: ([0-9]+) tets crossed")))
+      << out;
+  {
+    const std::vector<double> c = foxi::tet_corner_values(te, foxi::choose_field(te, "von_mises"));
+    const auto [vlo, vhi] = std::minmax_element(c.begin(), c.end());
+    const double want = 1e-6 * (*vlo + 0.25 * (*vhi - *vlo));
+    EXPECT_NEAR(std::stod(m[1]), want, 0.051 * want) << out;
+    EXPECT_GT(std::stoul(m[2]), 0u);
+  }
   for (const char* f : {"flip_chip_isotherm.png", "flip_chip_isotherms.gif", "flip_chip_von_mises.png"})
     EXPECT_TRUE(std::filesystem::exists(dir / "d" / f)) << f;
 }
