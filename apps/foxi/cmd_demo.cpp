@@ -222,8 +222,8 @@ int cmd_demo(Args args) {
   {
     const std::vector<double> corner = tet_corner_values(te, choose_field(te, "von_mises"));
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (double v : corner)
-      if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    for (double x : corner)
+      if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
     std::snprintf(level_s, sizeof level_s, "%.2g", 1e-6 * (lo + 0.25 * (hi - lo)));
   }
   std::printf(

@@ -162,7 +162,7 @@ TEST_F(IsoCli, CountsEqualTheLibrarysSelections) {
       coloured += (a.rgba[i] & 0xFFFFFFu) != 0xFFFFFFu;
     }
     EXPECT_EQ(differ, 0u) << "painter == depth buffer";
-    EXPECT_GT(coloured, 1000u);
+    EXPECT_GT(coloured, 300u);
   }
   // An isovalue outside the data crosses nothing: an empty picture, not the whole mesh, and a warning
   // with the field's range (300..380 K) says why (issue 17 item 6).

@@ -71,7 +71,9 @@ bool same_rgb(const Framebuffer& a, const Framebuffer& b) {
 Framebuffer captioned(Framebuffer fb, const std::string& label) {
   static const TextRenderer text(find_font_file());
   const PixelRect ink = draw_caption(fb, text, label);
-  if (!label.empty()) EXPECT_LE(ink.x0, ink.x1) << "the caption '" << label << "' draws nothing";
+  if (!label.empty()) {
+    EXPECT_LE(ink.x0, ink.x1) << "the caption '" << label << "' draws nothing";
+  }
   return fb;
 }
 

@@ -102,7 +102,9 @@ TEST(FieldSelection, SliceCombinesWithThresholdAndClip) {
       for (std::size_t p = 0; p < a.rgba.size(); ++p) {
         differ += a.rgba[p] != b.rgba[p] || a.id[p] != b.id[p];
         pixels += a.id[p] != kNone;
-        if (a.id[p] != kNone) EXPECT_TRUE(std::binary_search(expected.begin(), expected.end(), a.id[p]));
+        if (a.id[p] != kNone) {
+          EXPECT_TRUE(std::binary_search(expected.begin(), expected.end(), a.id[p]));
+        }
       }
       EXPECT_EQ(differ, 0u);
     }
