@@ -224,7 +224,12 @@ int cmd_demo(Args args) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (double x : corner)
       if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x);
-    std::snprintf(level_s, sizeof level_s, "%.2g", 1e-6 * (lo + 0.25 * (hi - lo)));
+    double level = 1e-6 * (lo + 0.25 * (hi - lo));
+    if (level > 0) {  // two significant digits, written out ("140", not "1.4e+02")
+      const double unit = std::pow(10.0, std::floor(std::log10(level)) - 1);
+      level = std::round(level / unit) * unit;
+    }
+    std::snprintf(level_s, sizeof level_s, "%.6g", level);
   }
   std::printf(
       "\n10. von Mises on the deformed shape, the solid above a quarter of its range: foxi render %s --field "
