@@ -27,6 +27,7 @@
 #include <functional>
 #include <future>
 #include <limits>
+#include <queue>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -769,7 +770,7 @@ struct TetRasterizer::Impl {
   inline bool has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach,
                                      bool& inverted) const;
 
-  void taint_inverted(std::span<const std::uint32_t> tets);
+  void taint_inverted(std::span<const std::uint32_t> tets, std::span<const std::uint32_t> inverted_at);
 
   void request_saves(const Framebuffer& fb, const Rows& rows, std::uint32_t t);
 
