@@ -25,7 +25,7 @@
 //                     ratio = graded time / plain time, wall clock (issue 17 target: at most 1.5);
 //                     cpu_ratio the same in process CPU time
 //   field_recolor     (after an untimed draw of all tets with field_flat_draw's paint) recolour the
-//                     picture by another field (flat, coolwarm) through the id buffer
+//                     picture by another field (flat, coolwarm) through the id and shade buffers
 //                     (TetRasterizer::recolor; issue 17 target: at most 10 ms); counters redraw_ms (a
 //                     full painter_draw with the other field's paint, the same view and iteration,
 //                     outside the timing), ratio = recolour / redraw wall clock, shown_tets (the tets

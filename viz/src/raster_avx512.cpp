@@ -43,9 +43,11 @@ TetRasterizer::Impl::repaint_triangle_avx512(Framebuffer& fb, const Rows& rows, 
   const __m512d lane = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0);
   const __m512d width = _mm512_set1_pd(params.edge_width), base = _mm512_set1_pd(edge_base),
                 slope = _mm512_set1_pd(edge_slope);
-  const __m256 r = _mm256_set1_ps(fs.rgb[0]), g = _mm256_set1_ps(fs.rgb[1]), b = _mm256_set1_ps(fs.rgb[2]);
-  const __m256 half = _mm256_set1_ps(0.5f);
-  const __m256i color = _mm256_set1_epi32(int(fs.color)), tet = _mm256_set1_epi32(int(fs.tet));
+  const __m512d level = _mm512_set1_pd(fs.level), half = _mm512_set1_pd(0.5), zero = _mm512_setzero_pd(),
+                top = _mm512_set1_pd(255);
+  const __m256i r = _mm256_set1_epi32(int(fs.base & 255u)), g = _mm256_set1_epi32(int((fs.base >> 8) & 255u)),
+                b = _mm256_set1_epi32(int((fs.base >> 16) & 255u)), round = _mm256_set1_epi32(128);
+  const __m256i tet = _mm256_set1_epi32(int(fs.tet)), face_shade = _mm256_set1_epi32(fs.shade);
   const __m256i alpha = _mm256_set1_epi32(int(0xff000000u));
   const double lo_clamp = bx0 - 1, hi_clamp = bx1 + 1;
   for (int y = rows.first(by0); y <= by1; y = rows.next(y)) {
@@ -67,6 +69,7 @@ TetRasterizer::Impl::repaint_triangle_avx512(Framebuffer& fb, const Rows& rows, 
     if (xa > xb) continue;
     std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
     std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+    std::uint8_t* shade = fb.shade.data() + std::size_t(y) * std::size_t(fb.width);
     std::uint64_t* done = &written[std::size_t(y) * std::size_t(mask_words)];
     const __m512d at0 = _mm512_set1_pd(row_at[0]), at1 = _mm512_set1_pd(row_at[1]),
                   at2 = _mm512_set1_pd(row_at[2]);
@@ -96,18 +99,25 @@ TetRasterizer::Impl::repaint_triangle_avx512(Framebuffer& fb, const Rows& rows, 
       e1 = _mm512_add_pd(e1, a8[1]);
       e2 = _mm512_add_pd(e2, a8[2]);
       // A covered pixel's d is at least +0 (every line's value is), so darkened()'s max(0, d) is
-      // d; the channels are in [0, 255] (edge_darkness in [0, 1], see fast_repaint), so its
-      // saturation changes nothing. Lanes not covered are garbage the stores skip.
+      // d; then shade_of and shade_color as darkened() (the face's shade where d >= width). Lanes not
+      // covered are garbage the stores skip.
       const __mmask8 dark = _mm512_cmp_pd_mask(d, width, _CMP_LT_OQ);
-      const __m256 f = _mm512_cvtpd_ps(_mm512_add_pd(base, _mm512_mul_pd(slope, d)));
-      const __m256i cr = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(r, f), half));
-      const __m256i cg = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(g, f), half));
-      const __m256i cb = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(b, f), half));
-      const __m256i px_dark = _mm256_or_si256(_mm256_or_si256(cr, _mm256_slli_epi32(cg, 8)),
-                                              _mm256_or_si256(_mm256_slli_epi32(cb, 16), alpha));
-      const __m256i out = _mm256_mask_blend_epi32(dark, color, px_dark);
+      const __m512d v =
+          _mm512_add_pd(_mm512_mul_pd(level, _mm512_add_pd(base, _mm512_mul_pd(slope, d))), half);
+      const __m256i s = _mm256_mask_blend_epi32(
+          dark, face_shade, _mm512_cvttpd_epi32(_mm512_min_pd(_mm512_max_pd(v, zero), top)));
+      // shade_color's rounding, per 32-bit lane (a lambda would not take the function's target); both
+      // factors below 256, the 16-bit product is the whole product.
+      __m256i c[3] = {_mm256_mullo_epi16(s, r), _mm256_mullo_epi16(s, g), _mm256_mullo_epi16(s, b)};
+      for (__m256i& t : c) {
+        t = _mm256_add_epi32(t, round);
+        t = _mm256_srli_epi32(_mm256_add_epi32(t, _mm256_srli_epi32(t, 8)), 8);
+      }
+      const __m256i out = _mm256_or_si256(_mm256_or_si256(c[0], _mm256_slli_epi32(c[1], 8)),
+                                          _mm256_or_si256(_mm256_slli_epi32(c[2], 16), alpha));
       _mm256_mask_storeu_epi32(rgba + x, todo, out);
       _mm256_mask_storeu_epi32(id + x, todo, tet);
+      _mm256_mask_cvtepi32_storeu_epi8(shade + x, todo, s);
     }
   }
 }

@@ -41,11 +41,10 @@ FaceShade TetRasterizer::Impl::face_shade(std::uint32_t tet, const double* const
                            ? params.region_colors[std::size_t(region)]
                            : region_color(region);
   FaceShade sh;
-  sh.intensity = float(intensity);
-  sh.r = float((base & 255u) * intensity);
-  sh.g = float(((base >> 8) & 255u) * intensity);
-  sh.b = float(((base >> 16) & 255u) * intensity);
-  sh.color = pack_rgba(std::uint32_t(sh.r + 0.5f), std::uint32_t(sh.g + 0.5f), std::uint32_t(sh.b + 0.5f));
+  sh.base = base;
+  sh.level = intensity * 255;
+  sh.shade = shade_of(sh.level, 1);
+  sh.color = shade_color(base, sh.shade);
   return sh;
 }
 
@@ -66,11 +65,10 @@ inline bool TetRasterizer::Impl::exact_in_double(std::int64_t ea, std::int64_t e
 // A face of tet `tet` in shade sh.
 inline void TetRasterizer::Impl::set_shade(FaceSetup& fs, std::uint32_t tet, const FaceShade& sh) {
   fs.tet = tet;
-  fs.rgb[0] = sh.r;
-  fs.rgb[1] = sh.g;
-  fs.rgb[2] = sh.b;
   fs.color = sh.color;
-  fs.intensity = sh.intensity;
+  fs.base = sh.base;
+  fs.level = sh.level;
+  fs.shade = sh.shade;
 }
 
 #ifdef FOXI_AVX512_REPAINT

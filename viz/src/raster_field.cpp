@@ -18,29 +18,21 @@ void TetRasterizer::Impl::setup_field() {
     throw std::invalid_argument("render: the field paint's shade_min must be in [0, 1]");
   for (int i = 0; i < 256; ++i) {
     const std::uint32_t entry = color_map_entry(field->scale.map, i);
-    for (int k = 0; k < 3; ++k) field_lut[i][k] = float((entry >> (8 * k)) & 255u);
+    field_lut[i] = entry | 0xff000000u;
   }
 }
 
-// The entry of the interpolated scale position (the NaN colour for no value), scaled by the face's
-// Lambert intensity and the edge darkening, each channel rounded.
-std::uint32_t TetRasterizer::Impl::graded_color(const FaceSetup& fs, int x, int y, double d) const {
+// The entry of the interpolated scale position (the NaN colour for no value) in the pixel's shade
+// (the face's Lambert intensity and the edge darkening, see shade_of), s.
+std::uint32_t TetRasterizer::Impl::graded_color(const FaceSetup& fs, int x, int y, double d,
+                                                std::uint8_t& s) const {
   const double dx = x + 0.5 - fs.gx0, dy = y + 0.5 - fs.gy0;
   double t = fs.g0 + fs.ga * dx + fs.gb * dy;
   if (proj.perspective) t /= fs.h0 + fs.ha * dx + fs.hb * dy;
-  float f = fs.intensity;
-  if (d < params.edge_width) f *= float(edge_base + edge_slope * std::max(0.0, d));
-  const float* c;
-  float nan_rgb[3];
-  if (std::isnan(t)) {
-    const std::uint32_t n = field->scale.nan_color;
-    for (int k = 0; k < 3; ++k) nan_rgb[k] = float((n >> (8 * k)) & 255u);
-    c = nan_rgb;
-  } else {
-    c = field_lut[int(std::clamp(t * 256, 0.0, 255.0))];
-  }
-  return pack_rgba(std::uint32_t(c[0] * f + 0.5f), std::uint32_t(c[1] * f + 0.5f),
-                   std::uint32_t(c[2] * f + 0.5f));
+  s = d < params.edge_width ? shade_of(fs.level, edge_base + edge_slope * std::max(0.0, d)) : fs.shade;
+  const std::uint32_t base =
+      std::isnan(t) ? field->scale.nan_color : field_lut[int(std::clamp(t * 256, 0.0, 255.0))];
+  return shade_color(base, s);
 }
 
 void TetRasterizer::Impl::neighbour_positions(std::uint32_t nb, const std::uint32_t* tv, float out[4]) const {
@@ -56,10 +48,11 @@ void TetRasterizer::Impl::neighbour_positions(std::uint32_t nb, const std::uint3
 void TetRasterizer::Impl::graded_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
   std::uint32_t* rgba = &fb.rgba[std::size_t(y) * std::size_t(fb.width)];
   std::uint32_t* id = &fb.id[std::size_t(y) * std::size_t(fb.width)];
+  std::uint8_t* shade = &fb.shade[std::size_t(y) * std::size_t(fb.width)];
   for (int x = lo; x <= hi; ++x) {
     std::int64_t e[4];
     for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
-    rgba[x] = graded_color(fs, x, y, nearest_edge(fs, e[0], e[1], e[2], e[3]));
+    rgba[x] = graded_color(fs, x, y, nearest_edge(fs, e[0], e[1], e[2], e[3]), shade[x]);
     id[x] = fs.tet;
   }
 }

@@ -291,18 +291,40 @@ struct PolyVertex {
   float pos = 0;          // graded field paint: the position on the colour scale (FieldPaint)
 };
 
-// A face's flat colour (before edge darkening): packed, and its channels unrounded.
+// Shading: a pixel's colour is its base colour (region or field colour, opaque) scaled by its shade
+// byte s / 255, each channel rounded (shade_color). The shade is the face's Lambert intensity times the
+// edge darkening at the pixel (1 away from edges), as level = intensity x 255 times that factor,
+// rounded and clamped (shade_of). Every path that colours a pixel (painter, depth buffer, undraw's
+// repaints, scalar or vector) goes through these two, and keeps s in Framebuffer::shade, so that
+// recolouring a flat picture is a table lookup per pixel (recolor.cpp).
+inline std::uint8_t shade_of(double level, double factor) {
+  return std::uint8_t(std::min(std::max(level * factor + 0.5, 0.0), 255.0));
+}
+// round(c s / 255) per channel, exactly (t + t / 256 with t = c s + 128, over 256, for c s <= 255^2).
+inline std::uint32_t shade_color(std::uint32_t base, std::uint32_t s) {
+  std::uint32_t out = 0xff000000u;
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t t = ((base >> (8 * k)) & 255u) * s + 128;
+    out |= ((t + (t >> 8)) >> 8) << (8 * k);
+  }
+  return out;
+}
+
+// A face's flat colour (before edge darkening): packed, its base colour and its shade.
 struct FaceShade {
-  std::uint32_t color = 0;
-  float r = 0, g = 0, b = 0;
-  float intensity = 1;  // the Lambert factor (graded field paint scales each pixel's colour by it)
+  std::uint32_t color = 0;  // shade_color(base, shade)
+  std::uint32_t base = 0;   // the region's or the field's colour (graded: unused)
+  double level = 0;         // the Lambert intensity x 255 (see shade_of)
+  std::uint8_t shade = 0;   // shade_of(level, 1): the face away from its edges
 };
 
 // Everything a face's pixels need.
 struct FaceSetup {
   std::uint32_t tet = 0;
-  std::uint32_t color = 0;
-  alignas(16) float rgb[4] = {0, 0, 0, 0};  // FaceShade's r, g, b (and 0), for darkened
+  std::uint32_t color = 0;  // FaceShade's
+  std::uint32_t base = 0;
+  double level = 0;
+  std::uint8_t shade = 0;
   // Mesh edges (up to 4; unused ones never darken): the edge function of edge k at the centre of
   // pixel (x, y), ea x + eb y + ec, exact in 64 bits (fixed point squared, inside >= 0); times
   // inv_len it is the distance in pixels. Exact integers make the distance the same bits whether a
@@ -327,7 +349,6 @@ struct FaceSetup {
   // nearness and nearness are affine on the screen under perspective (h = 1 orthographic), so the
   // position is interpolated linearly across the face in the world.
   bool graded = false;
-  float intensity = 1;
   double gx0 = 0, gy0 = 0, g0 = 0, ga = 0, gb = 0, h0 = 1, ha = 0, hb = 0;
 };
 
@@ -342,7 +363,7 @@ struct TetRasterizer::Impl {
   double near = 0;
   double light[3] = {0, 0, -1};       // toward the light, camera frame
   const FieldPaint* field = nullptr;  // params.field, if any
-  float field_lut[256][3] = {};       // graded: the colour map's entries as floats
+  std::uint32_t field_lut[256] = {};  // graded: the colour map's entries
   // Edge darkening: a pixel at distance d < edge_width from an edge is scaled by edge_base +
   // edge_slope d (1 - edge_darkness at the edge, 1 at edge_width).
   double edge_base = 1, edge_slope = 0;
@@ -427,6 +448,7 @@ struct TetRasterizer::Impl {
   struct Lane {
     std::vector<Save> saves;                                       // in drawing order
     std::vector<std::uint32_t> saved_pixel, saved_rgba, saved_id;  // y * width + x, colour, id
+    std::vector<std::uint8_t> saved_shade;                         // and shade
     std::vector<SaveRegion> regions;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> aliases;  // (request, later request it equals)
     // A request at a pixel its tet's front faces did not show (the tet holds the eye, so it has no
@@ -446,6 +468,7 @@ struct TetRasterizer::Impl {
   bool recording = false;
   std::vector<std::uint64_t> shown;
   std::vector<std::uint32_t> slot, before_rgba, before_id;
+  std::vector<std::uint8_t> before_shade;
   std::vector<std::uint8_t> need_save;     // per batch tet
   std::vector<std::uint16_t> batch_reach;  // per batch tet: its repaint reach (see drawn_reach)
   // Undoable: each drawn tet's pixel box (tet_box, in drawing order, 8 bytes), so that undraw finds
@@ -531,16 +554,17 @@ struct TetRasterizer::Impl {
 
   inline void shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const;
 
-  inline std::uint32_t face_color(const FaceSetup& fs, int x, int y) const;
+  // The face's colour at pixel (x, y), s its shade.
+  inline std::uint32_t face_color(const FaceSetup& fs, int x, int y, std::uint8_t& s) const;
 
   static inline double nearest_edge(const FaceSetup& fs, std::int64_t e0, std::int64_t e1, std::int64_t e2,
                                     std::int64_t e3);
 
-  inline std::uint32_t darkened(const FaceSetup& fs, double d) const;
+  inline std::uint32_t darkened(const FaceSetup& fs, double d, std::uint8_t& s) const;
 
   // Graded field paint (raster_field.cpp): the colour at pixel (x, y), d pixels from the nearest edge
   // line; a run of a row in painter mode; the scale positions of the tet whose node row is tv.
-  std::uint32_t graded_color(const FaceSetup& fs, int x, int y, double d) const;
+  std::uint32_t graded_color(const FaceSetup& fs, int x, int y, double d, std::uint8_t& s) const;
   void graded_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
   const float* corner_positions(const std::uint32_t* tv) const {
     return field != nullptr && field->graded ? &field->corner_position[std::size_t(tv - mesh->tet.data())]
@@ -589,22 +613,24 @@ struct TetRasterizer::Impl {
 
   static inline void edges_at(const FaceSetup& fs, int x, int y, std::int64_t* e);
 
-  [[gnu::always_inline]] inline void edge_pixels(std::uint32_t* rgba, std::uint32_t* id, const FaceSetup& fs,
-                                                 std::int64_t* e, int from, int to) const;
+  // rgba, id, shade: the row's pixels.
+  [[gnu::always_inline]] inline void edge_pixels(std::uint32_t* rgba, std::uint32_t* id, std::uint8_t* shade,
+                                                 const FaceSetup& fs, std::int64_t* e, int from,
+                                                 int to) const;
   template <bool kFourLines>
   [[gnu::always_inline]] inline void edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id,
-                                                    const FaceSetup& fs, std::int64_t* e, int from,
-                                                    int to) const;
+                                                    std::uint8_t* shade, const FaceSetup& fs, std::int64_t* e,
+                                                    int from, int to) const;
   template <bool kFourLines, class Edge>
   [[gnu::always_inline]] inline void edge_pixels_stepped(std::uint32_t* rgba, std::uint32_t* id,
-                                                         const FaceSetup& fs, Edge* e, const Edge* step,
-                                                         int from, int to) const;
+                                                         std::uint8_t* shade, const FaceSetup& fs, Edge* e,
+                                                         const Edge* step, int from, int to) const;
 
 #ifdef __SSE2__
   template <bool kFourLines>
   [[gnu::always_inline]] inline void edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id,
-                                                    const FaceSetup& fs, const double* e, const double* step,
-                                                    int from, int to) const;
+                                                    std::uint8_t* shade, const FaceSetup& fs, const double* e,
+                                                    const double* step, int from, int to) const;
 #endif
 
 #ifdef FOXI_AVX512_REPAINT
@@ -733,11 +759,17 @@ struct TetRasterizer::Impl {
                  const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden);
 
   void check_framebuffer(const Framebuffer& fb) const;
+  // Gives fb a shade buffer if it has none of its size (a framebuffer put together by hand).
+  static void ensure_shade(Framebuffer& fb) {
+    if (fb.shade.size() != fb.rgba.size()) fb.shade.assign(fb.rgba.size(), 0);
+  }
 
   // Recolouring a drawn picture through its id buffer (recolor.cpp).
   void recolor(Framebuffer& fb, std::shared_ptr<const FieldPaint> paint);
   void recolor_tet(Framebuffer& fb, const Rows& rows, std::uint32_t t);
   void recolor_row(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const;
+  void recolor_by_shade(Framebuffer& fb);
+  bool recolors_by_shade(const FieldPaint* paint) const;
 
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
 

@@ -3,6 +3,8 @@
 #include "raster_impl.hpp"
 #include "depth_tie.hpp"
 
+#include <cstring>
+
 namespace foxi {
 
 inline void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& fs, int x, int y) const {
@@ -12,33 +14,28 @@ inline void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& f
     if (!depth_test(fb, p, fs.w0 + ta + tb, fs.da, fs.db, std::abs(fs.w0) + std::abs(ta) + std::abs(tb)))
       return;
   }
-  fb.rgba[p] = face_color(fs, x, y);
+  fb.rgba[p] = face_color(fs, x, y, fb.shade[p]);
   fb.id[p] = fs.tet;
 }
 
-// The colour of a face at pixel (x, y): flat, darkened near its edges.
-inline std::uint32_t TetRasterizer::Impl::face_color(const FaceSetup& fs, int x, int y) const {
+// The colour of a face at pixel (x, y): flat, darkened near its edges; s its shade.
+inline std::uint32_t TetRasterizer::Impl::face_color(const FaceSetup& fs, int x, int y,
+                                                     std::uint8_t& s) const {
   std::int64_t e[4];
   for (int k = 0; k < 4; ++k) e[k] = fs.ea[k] * x + fs.eb[k] * y + fs.ec[k];
-  if (fs.graded) return graded_color(fs, x, y, nearest_edge(fs, e[0], e[1], e[2], e[3]));
-  return darkened(fs, nearest_edge(fs, e[0], e[1], e[2], e[3]));
+  if (fs.graded) return graded_color(fs, x, y, nearest_edge(fs, e[0], e[1], e[2], e[3]), s);
+  return darkened(fs, nearest_edge(fs, e[0], e[1], e[2], e[3]), s);
 }
 
-// The face's colour at distance d from its nearest edge line: each channel scaled by
-// 1 - darkness (1 - d / width), rounded (the three channels at once where SSE2 is there, with the
-// same float operations).
-inline std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d) const {
-  if (!(d < params.edge_width)) return fs.color;
-  const float f = float(edge_base + edge_slope * std::max(0.0, d));
-#ifdef __SSE2__
-  const __m128 scaled = _mm_add_ps(_mm_mul_ps(_mm_load_ps(fs.rgb), _mm_set1_ps(f)), _mm_set1_ps(0.5f));
-  __m128i channels = _mm_cvttps_epi32(scaled);  // each in [0, 255]
-  channels = _mm_packus_epi16(_mm_packs_epi32(channels, channels), channels);
-  return std::uint32_t(_mm_cvtsi128_si32(channels)) | 0xff000000u;
-#else
-  return pack_rgba(std::uint32_t(fs.rgb[0] * f + 0.5f), std::uint32_t(fs.rgb[1] * f + 0.5f),
-                   std::uint32_t(fs.rgb[2] * f + 0.5f));
-#endif
+// The face's colour at distance d from its nearest edge line: its shade times
+// 1 - darkness (1 - d / width) (see shade_of), s.
+inline std::uint32_t TetRasterizer::Impl::darkened(const FaceSetup& fs, double d, std::uint8_t& s) const {
+  if (!(d < params.edge_width)) {
+    s = fs.shade;
+    return fs.color;
+  }
+  s = shade_of(fs.level, edge_base + edge_slope * std::max(0.0, d));
+  return shade_color(fs.base, s);
 }
 
 // One row run of a face. Painter mode: only the pixels not yet written (see `written`), then the
@@ -115,6 +112,8 @@ inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& f
                   before_rgba.begin() + std::ptrdiff_t(row + std::size_t(x)));
       std::copy_n(fb.id.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
                   before_id.begin() + std::ptrdiff_t(row + std::size_t(x)));
+      std::copy_n(fb.shade.begin() + std::ptrdiff_t(row + std::size_t(x)), e - x + 1,
+                  before_shade.begin() + std::ptrdiff_t(row + std::size_t(x)));
       shade_span(fb, fs, y, x, e);
       shown_row[x >> 6] |= (~std::uint64_t(0) >> (63 - (e - x))) << (x & 63);  // [x, e] in one word
       Lane& lane = lanes[std::size_t(lane_of(y))];
@@ -124,6 +123,7 @@ inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& f
           if (request == kNone) continue;
           lane.saved_rgba[request] = fb.rgba[row + std::size_t(k)];
           lane.saved_id[request] = fb.id[row + std::size_t(k)];
+          lane.saved_shade[request] = fb.shade[row + std::size_t(k)];
           request = kNone;
         }
       }
@@ -132,7 +132,7 @@ inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& f
       for (int k = x; k <= e; ++k) {
         std::uint32_t& request = slot[row + std::size_t(k)];
         if (request == kNone) continue;  // cannot happen: shown and not done means a request
-        lane.saved_rgba[request] = face_color(fs, k, y);
+        lane.saved_rgba[request] = face_color(fs, k, y, lane.saved_shade[request]);
         lane.saved_id[request] = fs.tet;
         request = kNone;
       }
@@ -159,22 +159,23 @@ inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& f
   }
   std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
   std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+  std::uint8_t* shade = fb.shade.data() + std::size_t(y) * std::size_t(fb.width);
   if (fs.exact_double) [[likely]] {  // the edge functions at lo straight in double (no 64-bit products)
     const double dx = double(lo), dy = double(y);
     double d[4];
     for (int k = 0; k < 3; ++k) d[k] = fs.step[k] * dx + (fs.step_y[k] * dy + fs.at0[k]);
     if (fs.lines > 3) {
       d[3] = fs.step[3] * dx + (fs.step_y[3] * dy + fs.at0[3]);
-      edge_pixels_stepped<true>(rgba, id, fs, d, fs.step, lo, hi);
+      edge_pixels_stepped<true>(rgba, id, shade, fs, d, fs.step, lo, hi);
     } else {
       d[3] = 0;
-      edge_pixels_stepped<false>(rgba, id, fs, d, fs.step, lo, hi);
+      edge_pixels_stepped<false>(rgba, id, shade, fs, d, fs.step, lo, hi);
     }
     return;
   }
   std::int64_t e[4];
   edges_at(fs, lo, y, e);
-  edge_pixels(rgba, id, fs, e, lo, hi);
+  edge_pixels(rgba, id, shade, fs, e, lo, hi);
 }
 
 // The edge functions of fs's lines at pixel (x, y) (the padding line's is constant).
@@ -187,25 +188,26 @@ inline void TetRasterizer::Impl::edges_at(const FaceSetup& fs, int x, int y, std
 // `from`, stepped on past `to`. The edge functions and colours are held in registers; a face of 3
 // lines or fewer skips the fourth (padding, never the nearest).
 [[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels(std::uint32_t* rgba, std::uint32_t* id,
-                                                                    const FaceSetup& fs, std::int64_t* e,
-                                                                    int from, int to) const {
+                                                                    std::uint8_t* shade, const FaceSetup& fs,
+                                                                    std::int64_t* e, int from, int to) const {
   if (fs.lines > 3)
-    edge_pixels_of<true>(rgba, id, fs, e, from, to);
+    edge_pixels_of<true>(rgba, id, shade, fs, e, from, to);
   else
-    edge_pixels_of<false>(rgba, id, fs, e, from, to);
+    edge_pixels_of<false>(rgba, id, shade, fs, e, from, to);
 }
 
 template <bool kFourLines>
 [[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_of(std::uint32_t* rgba, std::uint32_t* id,
+                                                                       std::uint8_t* shade,
                                                                        const FaceSetup& fs, std::int64_t* e,
                                                                        int from, int to) const {
   if (!fs.exact_double) [[unlikely]] {  // huge coordinates (near-plane cuts)
-    edge_pixels_stepped<kFourLines>(rgba, id, fs, e, fs.ea, from, to);
+    edge_pixels_stepped<kFourLines>(rgba, id, shade, fs, e, fs.ea, from, to);
     return;
   }
   // Stepped in double (see FaceSetup::exact_double): no conversion per pixel.
   double d[4] = {double(e[0]), double(e[1]), double(e[2]), kFourLines ? double(e[3]) : 0};
-  edge_pixels_stepped<kFourLines>(rgba, id, fs, d, fs.step, from, to);
+  edge_pixels_stepped<kFourLines>(rgba, id, shade, fs, d, fs.step, from, to);
   if (to >= from)
     for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (to - from + 1);
 }
@@ -213,14 +215,12 @@ template <bool kFourLines>
 // The loop of edge_pixels_of, its edge functions e (at `from`, stepped by `step` per pixel; integers
 // are left past `to`) 64-bit integers or exact doubles.
 template <bool kFourLines, class Edge>
-[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_stepped(std::uint32_t* rgba,
-                                                                            std::uint32_t* id,
-                                                                            const FaceSetup& fs, Edge* e,
-                                                                            const Edge* step, int from,
-                                                                            int to) const {
+[[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_stepped(
+    std::uint32_t* rgba, std::uint32_t* id, std::uint8_t* shade, const FaceSetup& fs, Edge* e,
+    const Edge* step, int from, int to) const {
 #ifdef __SSE2__
   if constexpr (std::is_same_v<Edge, double>) {
-    edge_pixels_x4<kFourLines>(rgba, id, fs, e, step, from, to);
+    edge_pixels_x4<kFourLines>(rgba, id, shade, fs, e, step, from, to);
     return;
   }
 #endif
@@ -234,7 +234,12 @@ template <bool kFourLines, class Edge>
     const double d = kFourLines ? std::min(std::min(double(e0) * i0, double(e1) * i1),
                                            std::min(double(e2) * i2, double(e3) * i3))
                                 : std::min(std::min(double(e0) * i0, double(e1) * i1), double(e2) * i2);
-    rgba[x] = d < w ? darkened(fs, d) : color;
+    if (d < w) {
+      rgba[x] = darkened(fs, d, shade[x]);
+    } else {
+      rgba[x] = color;
+      shade[x] = fs.shade;
+    }
     id[x] = tet;
     e0 += s0;
     e1 += s1;
@@ -251,22 +256,32 @@ template <bool kFourLines, class Edge>
 
 #ifdef __SSE2__
 // edge_pixels_stepped's exact-double loop four pixels at a time: each pixel goes through the same
-// IEEE operations in the same order as the one-pixel loop and darkened() (the edge functions are
-// integers, so e + k step is the stepped value exactly; min and max differ from std::min and
-// std::max only in the sign of a zero, which max(0, d) and d < w do not see; no FMA in an SSE2
-// build), so every pixel gets the same bits. A last group of fewer than 4 stores only its pixels.
+// IEEE operations in the same order as the one-pixel loop, darkened() and shade_of (the edge
+// functions are integers, so e + k step is the stepped value exactly; min and max differ from
+// std::min and std::max only in the sign of a zero, which max(0, d), d < w and the clamp do not see;
+// no FMA in an SSE2 build), and shade_color's integer rounding, so every pixel gets the same bits. A
+// last group of fewer than 4 stores only its pixels.
 template <bool kFourLines>
 [[gnu::always_inline]] inline void TetRasterizer::Impl::edge_pixels_x4(std::uint32_t* rgba, std::uint32_t* id,
+                                                                       std::uint8_t* shade,
                                                                        const FaceSetup& fs, const double* e,
                                                                        const double* step, int from,
                                                                        int to) const {
   if (to < from) return;
   const __m128d w = _mm_set1_pd(params.edge_width), zero = _mm_setzero_pd();
   const __m128d base = _mm_set1_pd(edge_base), slope = _mm_set1_pd(edge_slope);
-  const __m128 r = _mm_set1_ps(fs.rgb[0]), g = _mm_set1_ps(fs.rgb[1]), b = _mm_set1_ps(fs.rgb[2]);
-  const __m128 half = _mm_set1_ps(0.5f);
+  const __m128d level = _mm_set1_pd(fs.level), half = _mm_set1_pd(0.5), top = _mm_set1_pd(255);
+  const __m128i r = _mm_set1_epi32(int(fs.base & 255u)), g = _mm_set1_epi32(int((fs.base >> 8) & 255u)),
+                b = _mm_set1_epi32(int((fs.base >> 16) & 255u)), round = _mm_set1_epi32(128);
+  const __m128i face_shade = _mm_set1_epi32(fs.shade);
   const __m128i color = _mm_set1_epi32(int(fs.color)), tet = _mm_set1_epi32(int(fs.tet));
-  const __m128i alpha = _mm_set1_epi32(int(0xff000000u)), none = _mm_setzero_si128();
+  const __m128i alpha = _mm_set1_epi32(int(0xff000000u));
+  const std::uint32_t flat_shades = 0x01010101u * fs.shade;
+  // shade_color of 4 shades (32-bit lanes, each < 256: the 16-bit product is the whole product).
+  auto channel = [&](__m128i s, __m128i c) {
+    const __m128i t = _mm_add_epi32(_mm_mullo_epi16(s, c), round);
+    return _mm_srli_epi32(_mm_add_epi32(t, _mm_srli_epi32(t, 8)), 8);
+  };
   constexpr int kLines = kFourLines ? 4 : 3;
   __m128d lo[kLines], hi[kLines], inv[kLines], step4[kLines];  // pixels (x, x + 1), (x + 2, x + 3)
   for (int k = 0; k < kLines; ++k) {
@@ -288,31 +303,34 @@ template <bool kFourLines>
     const __m128 darken = _mm_shuffle_ps(_mm_castpd_ps(_mm_cmplt_pd(d_lo, w)),
                                          _mm_castpd_ps(_mm_cmplt_pd(d_hi, w)), _MM_SHUFFLE(2, 0, 2, 0));
     __m128i out = color;
+    std::uint32_t shades = flat_shades;  // the 4 pixels' shade bytes
     if (_mm_movemask_ps(darken) != 0) {
-      const __m128 f =
-          _mm_movelh_ps(_mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_lo, zero)))),
-                        _mm_cvtpd_ps(_mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d_hi, zero)))));
-      const __m128i cr = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(r, f), half));
-      const __m128i cg = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(g, f), half));
-      const __m128i cb = _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(b, f), half));
-      // Saturated to bytes as darkened() does: r0..r3 g0..g3 b0..b3, then interleaved per pixel.
-      const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(cr, cg), _mm_packs_epi32(cb, cb));
-      const __m128i rg = _mm_unpacklo_epi8(bytes, _mm_srli_si128(bytes, 4));
-      const __m128i b0 = _mm_unpacklo_epi8(_mm_srli_si128(bytes, 8), none);
-      const __m128i dark = _mm_or_si128(_mm_unpacklo_epi16(rg, b0), alpha);
+      // shade_of(level, base + slope max(0, d)) in each lane, as 32-bit integers.
+      auto shade4 = [&](__m128d d) {
+        const __m128d v =
+            _mm_add_pd(_mm_mul_pd(level, _mm_add_pd(base, _mm_mul_pd(slope, _mm_max_pd(d, zero)))), half);
+        return _mm_cvttpd_epi32(_mm_min_pd(_mm_max_pd(v, zero), top));
+      };
       const __m128i m = _mm_castps_si128(darken);
-      out = _mm_or_si128(_mm_and_si128(m, dark), _mm_andnot_si128(m, color));
+      const __m128i s = _mm_or_si128(_mm_and_si128(m, _mm_unpacklo_epi64(shade4(d_lo), shade4(d_hi))),
+                                     _mm_andnot_si128(m, face_shade));
+      out = _mm_or_si128(_mm_or_si128(channel(s, r), _mm_slli_epi32(channel(s, g), 8)),
+                         _mm_or_si128(_mm_slli_epi32(channel(s, b), 16), alpha));
+      const __m128i packed = _mm_packs_epi32(s, s);
+      shades = std::uint32_t(_mm_cvtsi128_si32(_mm_packus_epi16(packed, packed)));
     }
     const int left = to - x + 1;
     if (left >= 4) {
       _mm_storeu_si128(reinterpret_cast<__m128i*>(rgba + x), out);
       _mm_storeu_si128(reinterpret_cast<__m128i*>(id + x), tet);
+      std::memcpy(shade + x, &shades, 4);
       if (left == 4) return;
     } else {
       if (left >= 2) {
         _mm_storel_epi64(reinterpret_cast<__m128i*>(rgba + x), out);
         _mm_storel_epi64(reinterpret_cast<__m128i*>(id + x), tet);
       }
+      std::memcpy(shade + x, &shades, std::size_t(left));  // little-endian: pixel k is byte k
       if (left != 2) {
         const int last = x + left - 1;
         rgba[last] = std::uint32_t(_mm_cvtsi128_si32(left == 1 ? out : _mm_srli_si128(out, 8)));
@@ -333,9 +351,11 @@ template <bool kFourLines>
                                                             int lo, int hi) const {
   std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
   std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
+  std::uint8_t* shade = fb.shade.data() + std::size_t(y) * std::size_t(fb.width);
   if (fs.lines == 0) {
     std::fill(rgba + lo, rgba + hi + 1, fs.color);
     std::fill(id + lo, id + hi + 1, fs.tet);
+    std::fill(shade + lo, shade + hi + 1, fs.shade);
     return;
   }
   std::int64_t e[4];
@@ -365,14 +385,15 @@ template <bool kFourLines>
       b = a - 1;
   }
   if (a > b) {  // no flat part
-    edge_pixels(rgba, id, fs, e, lo, hi);
+    edge_pixels(rgba, id, shade, fs, e, lo, hi);
     return;
   }
-  edge_pixels(rgba, id, fs, e, lo, a - 1);
+  edge_pixels(rgba, id, shade, fs, e, lo, a - 1);
   std::fill(rgba + a, rgba + b + 1, fs.color);
   std::fill(id + a, id + b + 1, fs.tet);
+  std::fill(shade + a, shade + b + 1, fs.shade);
   for (int k = 0; k < 4; ++k) e[k] += fs.ea[k] * (b + 1 - a);
-  edge_pixels(rgba, id, fs, e, b + 1, hi);
+  edge_pixels(rgba, id, shade, fs, e, b + 1, hi);
 }
 
 // Recolouring (recolor.cpp): the runs of row y in [lo, hi] that show the face's tet are shaded again

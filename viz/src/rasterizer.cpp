@@ -56,6 +56,7 @@ TetRasterizer::Impl::Impl(const Mesh& m, const Camera& c, int w, int h, const Re
     slot.assign(pixels, kNone);
     before_rgba.assign(pixels, 0);
     before_id.assign(pixels, 0);
+    before_shade.assign(pixels, 0);
     lane_count = std::min(params.threads, std::max(1, h >> kBandShift));
     lanes.resize(std::size_t(lane_count));
   }
@@ -209,6 +210,7 @@ void TetRasterizer::Impl::check_framebuffer(const Framebuffer& fb) const {
 
 void TetRasterizer::Impl::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
   check_framebuffer(fb);
+  ensure_shade(fb);
   if (params.depth_buffer) ensure_depth_slopes(fb);
   const std::size_t tc = mesh->tet_count();
   for (std::uint32_t t : tets)
@@ -269,11 +271,13 @@ inline void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
                            1;
     lane.saved_rgba[i] = was_shown ? before_rgba[p] : fb.rgba[p];
     lane.saved_id[i] = was_shown ? before_id[p] : fb.id[p];
+    lane.saved_shade[i] = was_shown ? before_shade[p] : fb.shade[p];
     slot[p] = kNone;
   }
   for (std::size_t i = lane.aliases.size(); i-- > 0;) {
     lane.saved_rgba[lane.aliases[i].first] = lane.saved_rgba[lane.aliases[i].second];
     lane.saved_id[lane.aliases[i].first] = lane.saved_id[lane.aliases[i].second];
+    lane.saved_shade[lane.aliases[i].first] = lane.saved_shade[lane.aliases[i].second];
   }
   lane.aliases.clear();
   lane.unshown_requests = false;
@@ -533,6 +537,9 @@ double TetRasterizer::near_plane() const { return impl_->near; }
 void TetRasterizer::undraw(Framebuffer& fb, std::size_t count) { impl_->undraw(fb, count); }
 void TetRasterizer::recolor(Framebuffer& fb, std::shared_ptr<const FieldPaint> field) {
   impl_->recolor(fb, std::move(field));
+}
+bool TetRasterizer::recolors_by_shade(const FieldPaint* field) const {
+  return impl_->recolors_by_shade(field);
 }
 std::span<const std::uint32_t> TetRasterizer::drawn_tets() const { return impl_->history; }
 std::size_t TetRasterizer::saved_pixels() const { return impl_->saved_pixels(); }

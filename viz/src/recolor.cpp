@@ -1,9 +1,13 @@
 // Recolouring a drawn picture through its id buffer (issue 17: another field or colour map without
-// drawing the mesh again; TetRasterizer::recolor). The id buffer says which tet each pixel shows;
-// rasterizing those tets' front faces again, and writing only the pixels that show them, gives each
-// pixel exactly the colour a fresh draw with the new paint would: the same face setup (shade, edge
-// lines, graded planes) and the same per-pixel colour functions as drawing. Hidden tets, the bulk
-// of a 1M-tet view, are never looked at.
+// drawing the mesh again; TetRasterizer::recolor). Two ways, each giving every pixel exactly the
+// colour a fresh draw with the new paint would:
+// - flat colours (a flat field paint, or region colours) of the same shading band (shade_min, or
+//   ambient for regions) as the picture's: a pixel's colour is shade_color(its tet's base colour, its
+//   shade byte) (see shade_of), so one pass over the pixels, a lookup each (a few ms at 1920x1080);
+// - otherwise (graded facets, another shading band): the id buffer says which tet each pixel shows;
+//   rasterizing those tets' front faces again, and writing only the pixels that show them, with the
+//   same face setup (shade, edge lines, graded planes) and per-pixel colour functions as drawing.
+//   Hidden tets, the bulk of a 1M-tet view, are never looked at.
 #include "raster_impl.hpp"
 
 namespace foxi {
@@ -34,8 +38,58 @@ void TetRasterizer::Impl::recolor_tet(Framebuffer& fb, const Rows& rows, std::ui
   }
 }
 
+// The first way: each pixel showing a tet gets shade_color(that tet's base colour, its shade).
+void TetRasterizer::Impl::recolor_by_shade(Framebuffer& fb) {
+  const std::size_t tc = mesh->tet_count();
+  const std::uint32_t* tet_color = field != nullptr ? field->tet_color.data() : nullptr;
+  auto base_of = [&](std::uint32_t t) {
+    if (tet_color != nullptr) return tet_color[t];
+    const std::int32_t region = mesh->region_of(t);  // as face_shade
+    return region >= 0 && std::size_t(region) < params.region_colors.size()
+               ? params.region_colors[std::size_t(region)]
+               : region_color(region);
+  };
+  // Bands of rows, one per thread (the pixels are independent).
+  const int count = fb.height < 64 ? 1 : std::max(1, params.threads);
+  run_parts(count, [&](int part) {
+    const std::size_t begin =
+        std::size_t(fb.height) * std::size_t(part) / std::size_t(count) * std::size_t(fb.width);
+    const std::size_t end =
+        std::size_t(fb.height) * std::size_t(part + 1) / std::size_t(count) * std::size_t(fb.width);
+    const std::uint32_t* id = fb.id.data();
+    const std::uint8_t* shade = fb.shade.data();
+    std::uint32_t* rgba = fb.rgba.data();
+    std::uint32_t last = kNone, base = 0;  // neighbouring pixels mostly show the same tet
+    for (std::size_t p = begin; p < end; ++p) {
+      const std::uint32_t t = id[p];
+      if (t >= tc) continue;  // background (kNone)
+      if (t != last) {
+        last = t;
+        base = base_of(t);
+      }
+      rgba[p] = shade_color(base, shade[p]);
+    }
+  });
+  // Undoable: the saved pixels too (what undraw restores), each lane on its thread.
+  if (lanes.empty()) return;
+  run_parts(int(lanes.size()), [&](int k) {
+    Lane& lane = lanes[std::size_t(k)];
+    for (std::size_t j = 0; j < lane.saved_id.size(); ++j)
+      if (lane.saved_id[j] < tc)
+        lane.saved_rgba[j] = shade_color(base_of(lane.saved_id[j]), lane.saved_shade[j]);
+  });
+}
+
+bool TetRasterizer::Impl::recolors_by_shade(const FieldPaint* paint) const {
+  const double old_band = field != nullptr ? field->shade_min : params.ambient;
+  const double new_band = paint != nullptr ? paint->shade_min : params.ambient;
+  return new_band == old_band && !(paint != nullptr && paint->graded);
+}
+
 void TetRasterizer::Impl::recolor(Framebuffer& fb, std::shared_ptr<const FieldPaint> paint) {
   check_framebuffer(fb);
+  const bool by_shade = fb.shade.size() == fb.rgba.size() && recolors_by_shade(paint.get());
+  ensure_shade(fb);
   std::shared_ptr<const FieldPaint> old = std::move(params.field);
   params.field = std::move(paint);
   try {
@@ -44,6 +98,13 @@ void TetRasterizer::Impl::recolor(Framebuffer& fb, std::shared_ptr<const FieldPa
     params.field = std::move(old);
     setup_field();
     throw;
+  }
+  // The picture's shades hold for the new colours if the Lambert band is the same (the edges are).
+  if (by_shade) {
+    recolor_by_shade(fb);
+    changed = fb.rgba.empty() ? PixelRect{} : PixelRect{0, 0, fb.width - 1, fb.height - 1};
+    changed_is_one_rect();
+    return;
   }
   // The tets visible, each once (a bit per mesh tet: 125 kB at 1M tets), in the order first seen.
   const std::size_t tc = mesh->tet_count();

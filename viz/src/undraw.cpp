@@ -77,6 +77,7 @@ void TetRasterizer::Impl::request_saves(const Framebuffer& fb, const Rows& rows,
   }
   lane.saved_rgba.resize(saved_pixel.size());
   lane.saved_id.resize(saved_pixel.size());
+  lane.saved_shade.resize(saved_pixel.size());
 }
 
 // Fills u for undrawn tet t, whose drawn box (tet_box) is not empty and not cut by the near plane
@@ -123,6 +124,7 @@ inline void TetRasterizer::Impl::shade_repainted(UndrawTet& u) const {
 void TetRasterizer::Impl::undraw(Framebuffer& fb, std::size_t count) {
   if (!params.undoable) throw std::logic_error("render: undraw needs RenderParams::undoable");
   check_framebuffer(fb);
+  ensure_shade(fb);
   if (count > history.size()) throw std::out_of_range("render: undraw of more tets than are drawn");
   // In parts of at most kUndrawPart tets (the per-tet records of a part stay small; taking back the
   // last a tets, then the b before them, gives the picture of taking back a + b), the changed
@@ -303,6 +305,7 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
           word |= bit;
           fb.rgba[p] = lane.saved_rgba[j];
           fb.id[p] = lane.saved_id[j];
+          fb.shade[p] = lane.saved_shade[j];
         }
       }
       if (!shows) continue;
@@ -387,6 +390,7 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
     }
     lane.saved_rgba.resize(lane.saved_pixel.size());
     lane.saved_id.resize(lane.saved_pixel.size());
+    lane.saved_shade.resize(lane.saved_pixel.size());
     FOXI_ASSERT(lane.saves.empty() ||
                     (lane.saves.back().at < first && lane.saves.back().offset <= lane.saved_pixel.size()),
                 "a save of an undrawn tet (position " << lane.saves.back().at << " of " << first
@@ -448,11 +452,12 @@ std::size_t TetRasterizer::Impl::undo_bytes() const {
                           sizeof(std::uint32_t) +
                       (shown.capacity() + written.capacity() + kept.capacity()) * sizeof(std::uint64_t) +
                       drawn_box.capacity() * sizeof(SmallBox) +
-                      drawn_reach.capacity() * sizeof(std::uint16_t);
+                      drawn_reach.capacity() * sizeof(std::uint16_t) + before_shade.capacity();
   for (const Lane& lane : lanes)
     bytes += (lane.saved_pixel.capacity() + lane.saved_rgba.capacity() + lane.saved_id.capacity()) *
                  sizeof(std::uint32_t) +
-             lane.saves.capacity() * sizeof(Save) + lane.regions.capacity() * sizeof(SaveRegion);
+             lane.saved_shade.capacity() + lane.saves.capacity() * sizeof(Save) +
+             lane.regions.capacity() * sizeof(SaveRegion);
   return bytes;
 }
 

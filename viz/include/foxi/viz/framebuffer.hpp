@@ -41,7 +41,11 @@ struct Framebuffer {
   int width = 0, height = 0;
   std::vector<std::uint32_t> rgba;  // width * height, row-major, row 0 at the top
   std::vector<std::uint32_t> id;    // width * height: tet index, or kNone for background
-  std::vector<double> depth;        // width * height in depth-buffer mode, else empty; larger = nearer
+  // width * height: the painter's shade of each pixel it drew (0-255: Lambert and edge darkening
+  // together), its colour being the base colour (region or field colour) scaled by shade / 255, each
+  // channel rounded; undefined where id is kNone. TetRasterizer::recolor recolours through it.
+  std::vector<std::uint8_t> shade;
+  std::vector<double> depth;  // width * height in depth-buffer mode, else empty; larger = nearer
   // Depth-buffer mode: the nearness slopes (per pixel in x, in y) of the face each pixel shows, 2 a
   // pixel; they decide exact depth ties as the painter's fill rule does (the rasterizer sizes it).
   std::vector<double> depth_slope;
@@ -58,6 +62,7 @@ struct Framebuffer {
     detail::reserve_advised(id, std::size_t(w) * std::size_t(h));
     rgba.assign(std::size_t(w) * std::size_t(h), background);
     id.assign(std::size_t(w) * std::size_t(h), kNone);
+    shade.assign(std::size_t(w) * std::size_t(h), 0);
     if (with_depth) {
       depth.assign(std::size_t(w) * std::size_t(h), -std::numeric_limits<double>::infinity());
       depth_slope.assign(2 * depth.size(), 0.0);

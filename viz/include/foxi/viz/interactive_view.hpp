@@ -94,7 +94,9 @@ class FOXI_API InteractiveView {
   // Whole tets, only `tets` (a threshold or clip: field_selection.hpp; empty: none drawn), narrowed by
   // the region stack; nullopt: all tets again. Ends iso drawing. Redraws from the back.
   void set_subset(std::optional<std::vector<std::uint32_t>> tets);
-  // Colours by `field` (null: by region) from now on: the same camera and regions, redrawn from the back.
+  // Colours by `field` (null: by region) from now on: the same camera and regions, redrawn from the
+  // back; a finished picture of whole tets in flat colours is recoloured instead where that gives the
+  // same pixels (TetRasterizer::recolors_by_shade), generation() unchanged.
   void set_field(std::shared_ptr<const FieldPaint> field);
   const std::shared_ptr<const FieldPaint>& field() const { return params_.field; }
 

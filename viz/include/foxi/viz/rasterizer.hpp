@@ -5,7 +5,9 @@
 // same picture pixel for pixel.
 //
 // Faces are flat-shaded (Lambert + ambient) in a per-region colour; mesh edges are drawn by
-// darkening a face's own pixels near its edges (never outside them). Rasterization is watertight:
+// darkening a face's own pixels near its edges (never outside them). Both come to one shade byte a
+// pixel (kept in Framebuffer::shade), the colour being the base colour scaled by shade / 255, so that a
+// flat picture recolours by a lookup a pixel (recolor). Rasterization is watertight:
 // vertices are snapped to fixed point (8 subpixel bits), pixels are sampled at their centres with a
 // top-left fill rule, so two faces sharing an edge cover each pixel once and a shared face covers the
 // same pixels from either side. No anti-aliasing. Perspective faces are clipped against a near plane
@@ -101,9 +103,9 @@ class FOXI_API TetRasterizer {
   void undraw(Framebuffer& fb, std::size_t count);
   std::span<const std::uint32_t> drawn_tets() const;  // undoable: the tets drawn, in order
   std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
-  std::size_t undo_bytes() const;  // undoable: memory held for undraw (bytes; saved pixels 12 each,
+  std::size_t undo_bytes() const;  // undoable: memory held for undraw (bytes; saved pixels 13 each,
                                    // 14 per drawn tet (its index, pixel box and repaint reach), 4 and a bit
-                                   // per mesh tet, per-image buffers of 12 bytes and 2 bits a pixel)
+                                   // per mesh tet, per-image buffers of 13 bytes and 2 bits a pixel)
   // Holds every pixel the last draw() or undraw() call changed (a display need present only these;
   // empty before the first call and after an empty one): the union of the pixel boxes of the tets it
   // drew or undrew, the whole image if the near plane cuts one of them.
@@ -117,14 +119,20 @@ class FOXI_API TetRasterizer {
   void forget_drawn();
 
   // Recolours the picture in fb by another field paint (null: region colours) without drawing it
-  // again: the tets its id buffer shows are found, and each one's front faces are rasterized anew in
-  // the new colours, writing only the pixels whose id is that tet (shading and edge darkening are
-  // recomputed from the geometry, so nothing beyond the id needs keeping). fb is then pixel for
-  // pixel what drawing the same tets with `field` gives (fb must be this rasterizer's picture, ids
-  // unchanged since). Cost: a pass over the ids plus the shown tets and their pixels, not the mesh.
+  // again. fb is then pixel for pixel what drawing the same tets with `field` gives (fb must be this
+  // rasterizer's picture, ids and shades unchanged since). Two ways (recolors_by_shade says which):
+  // flat colours (a flat paint, or region colours) in the shading band of the current paint (its
+  // shade_min, or params.ambient for region colours) go through the shade buffer (Framebuffer::shade),
+  // one lookup a pixel (~5 ms at 1920x1080); undoable, the pixels saved for undraw are recoloured
+  // too, so undraw then gives the remaining tets in the new colours. Otherwise (graded facets,
+  // another band) the tets the id buffer shows are found, and each one's front faces are rasterized
+  // anew in the new colours, writing only the pixels whose id is that tet: a pass over the ids plus
+  // the shown tets and their pixels, not the mesh; the pixels saved for undraw keep the old colours.
   // Later draw() calls use the new paint. Throws std::invalid_argument for a paint of another mesh
   // (the old paint is kept) or a framebuffer of another size.
   void recolor(Framebuffer& fb, std::shared_ptr<const FieldPaint> field);
+  // Whether recolor(fb, field) takes the shade buffer's way (given fb has a shade buffer).
+  bool recolors_by_shade(const FieldPaint* field) const;
 
   const RasterStats& stats() const;
   const Projector& projector() const;
