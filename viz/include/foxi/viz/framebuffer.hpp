@@ -29,11 +29,12 @@ namespace detail {
 // would cost a TLB miss.
 FOXI_API void advise_large_pages(void* p, std::size_t bytes);
 // Room for n pixels in v, fresh memory so advised, unless v has it already.
-inline void reserve_advised(std::vector<std::uint32_t>& v, std::size_t n) {
+template <class T>
+inline void reserve_advised(std::vector<T>& v, std::size_t n) {
   if (v.capacity() >= n) return;
-  std::vector<std::uint32_t>().swap(v);
+  std::vector<T>().swap(v);
   v.reserve(n);
-  advise_large_pages(v.data(), n * sizeof(std::uint32_t));
+  advise_large_pages(v.data(), n * sizeof(T));
 }
 }  // namespace detail
 
@@ -60,6 +61,7 @@ struct Framebuffer {
     height = h;
     detail::reserve_advised(rgba, std::size_t(w) * std::size_t(h));
     detail::reserve_advised(id, std::size_t(w) * std::size_t(h));
+    detail::reserve_advised(shade, std::size_t(w) * std::size_t(h));
     rgba.assign(std::size_t(w) * std::size_t(h), background);
     id.assign(std::size_t(w) * std::size_t(h), kNone);
     shade.assign(std::size_t(w) * std::size_t(h), 0);
