@@ -5,6 +5,8 @@
 #include "foxi/viz/volume.hpp"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -13,6 +15,10 @@
 #include "foxi/model/delaunay.hpp"
 #include "foxi/viz/visibility_order.hpp"
 #include "raster_impl.hpp"
+#ifdef __x86_64__
+#include <immintrin.h>
+#endif
+#include <cstdlib>
 
 namespace foxi {
 
@@ -253,6 +259,188 @@ bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double
   return true;
 }
 
+// Per pixel the colour so far and the nearest tet blended, side by side (16 bytes): a tet's row of
+// pixels touches one run of cache lines, not two.
+struct Pixel {
+  float c[3];
+  std::uint32_t front;
+};
+
+// One pixel row of a tet's face: along the row the pixel's ray o + s d (camera frame; perspective:
+// o = 0 and s the depth) has o and d linear in x, so each plane's n.d and h - n.o, the field's
+// g.(o - P0) and g.d and the direction's x are linear in x too: A + x B, set up per row.
+struct RowSetup {
+  double ndA[4], ndB[4], numA[4], numB[4];
+  double vA, vB, gdA, gdB, dxA, dxB, dyz, near;
+  // The ray's segment through the tet at pixel x: false where the ray misses it (a snapped edge pixel).
+  bool segment(int x, double& v_far, double& v_near, double& len) const {
+    const double xf = x;
+    double s_in = near, s_out = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 4; ++k) {
+      const double nd = ndA[k] + xf * ndB[k];
+      const double sk = (numA[k] + xf * numB[k]) / nd;
+      if (nd < 0)
+        s_in = std::max(s_in, sk);
+      else if (nd > 0)
+        s_out = std::min(s_out, sk);
+    }
+    if (!(s_out > s_in)) return false;
+    const double v0 = vA + xf * vB, gd = gdA + xf * gdB;
+    const double dx = dxA + xf * dxB;
+    len = (s_out - s_in) * std::sqrt(dx * dx + dyz);
+    v_far = v0 + s_out * gd;
+    v_near = v0 + s_in * gd;
+    return true;
+  }
+};
+
+void composite(const TableTransfer& tf, double v_far, double v_near, double len, float c[3],
+               std::size_t& fast) {
+  if (integrate_fast(tf, v_far, v_near, len, c))
+    ++fast;
+  else
+    integrate(tf, v_far, v_near, len, c);
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define FOXI_VOLUME_AVX512 1
+// Whether this CPU runs volume_row_avx512; FOXI_PORTABLE_RASTER=1 says no (the painter's switch),
+// so that the tests can compare the two paths on one machine.
+bool volume_avx512() {
+  static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512dq") &&
+                          !(std::getenv("FOXI_PORTABLE_RASTER") && std::getenv("FOXI_PORTABLE_RASTER")[0] == '1');
+  return yes;
+}
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own _mm512_undefined_pd in its intrinsics
+#endif
+// The row's pixels lo..hi eight at a time: RowSetup::segment and, for the common segment (the
+// pre-integrated table, at least 2 grid cells, inside the grid, one closed piece), integrate_fast with
+// the same operations in the same order (viz is built with -ffp-contract=off, and the gathers read the
+// same table), so the picture is bit for bit the portable path's; every other segment (thin, thick,
+// outside the grid, NaN, a log scale) goes through composite() one pixel at a time.
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_row_avx512(
+    const RowSetup& r, const TableTransfer& tf, Pixel* row, int lo, int hi, std::uint32_t t,
+    std::size_t& count, std::size_t& fast) {
+  const __m512d lane = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0), zero = _mm512_setzero_pd();
+  const __m512d one = _mm512_set1_pd(1.0), inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512d abs_mask = _mm512_castsi512_pd(_mm512_set1_epi64(0x7fffffffffffffffLL));
+  const __m256i pixel_index = _mm256_set_epi32(28, 24, 20, 16, 12, 8, 4, 0);  // floats, 16 bytes a pixel
+  const __m256i tet = _mm256_set1_epi32(int(t));
+  const __m256i last_cell = _mm256_set1_epi32(TableTransfer::kG - 1);
+  const __m512d g_lo = _mm512_set1_pd(tf.g_lo), g_inv = _mm512_set1_pd(tf.g_inv);
+  const __m512d grid_end = _mm512_set1_pd(double(TableTransfer::kG)), two = _mm512_set1_pd(2.0);
+  const __m512d pos_scale = _mm512_set1_pd(tf.pos_scale), lut_step = _mm512_set1_pd(double(tf.lut_step));
+  const __m512d c255 = _mm512_set1_pd(255.0), c256 = _mm512_set1_pd(256.0);
+  for (int x = lo; x <= hi; x += 8) {
+    const int n = std::min(8, hi - x + 1);
+    __mmask8 live = __mmask8((1u << n) - 1u);
+    const __m512d xf = _mm512_add_pd(_mm512_set1_pd(double(x)), lane);
+    __m512d s_in = _mm512_set1_pd(r.near), s_out = inf;
+    for (int k = 0; k < 4; ++k) {
+      const __m512d nd = _mm512_add_pd(_mm512_set1_pd(r.ndA[k]), _mm512_mul_pd(xf, _mm512_set1_pd(r.ndB[k])));
+      const __m512d num =
+          _mm512_add_pd(_mm512_set1_pd(r.numA[k]), _mm512_mul_pd(xf, _mm512_set1_pd(r.numB[k])));
+      const __m512d sk = _mm512_div_pd(num, nd);
+      // max(sk, s_in) is sk > s_in ? sk : s_in (s_in for a NaN sk), as std::max(s_in, sk).
+      s_in = _mm512_mask_max_pd(s_in, _mm512_cmp_pd_mask(nd, zero, _CMP_LT_OQ), sk, s_in);
+      s_out = _mm512_mask_min_pd(s_out, _mm512_cmp_pd_mask(nd, zero, _CMP_GT_OQ), sk, s_out);
+    }
+    live &= _mm512_cmp_pd_mask(s_out, s_in, _CMP_GT_OQ);
+    if (!live) continue;
+    count += std::size_t(__builtin_popcount(live));
+    _mm256_mask_i32scatter_epi32(&row[x].front, live, pixel_index, tet, 4);
+    const __m512d v0 = _mm512_add_pd(_mm512_set1_pd(r.vA), _mm512_mul_pd(xf, _mm512_set1_pd(r.vB)));
+    const __m512d gd = _mm512_add_pd(_mm512_set1_pd(r.gdA), _mm512_mul_pd(xf, _mm512_set1_pd(r.gdB)));
+    const __m512d dx = _mm512_add_pd(_mm512_set1_pd(r.dxA), _mm512_mul_pd(xf, _mm512_set1_pd(r.dxB)));
+    const __m512d len = _mm512_mul_pd(
+        _mm512_sub_pd(s_out, s_in),
+        _mm512_sqrt_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_set1_pd(r.dyz))));
+    const __m512d v_far = _mm512_add_pd(v0, _mm512_mul_pd(s_out, gd));
+    const __m512d v_near = _mm512_add_pd(v0, _mm512_mul_pd(s_in, gd));
+    __mmask8 done = 0;
+    if (tf.pre) {
+      const __m512d dv = _mm512_sub_pd(v_near, v_far);
+      const __m512d adv = _mm512_and_pd(dv, abs_mask);
+      const __m512d xa = _mm512_mul_pd(_mm512_sub_pd(v_far, g_lo), g_inv);
+      const __m512d xb = _mm512_mul_pd(_mm512_sub_pd(v_near, g_lo), g_inv);
+      __mmask8 m = live & _mm512_cmp_pd_mask(_mm512_mul_pd(adv, g_inv), two, _CMP_GE_OQ);
+      m &= _mm512_cmp_pd_mask(xa, zero, _CMP_GT_OQ);
+      m &= _mm512_cmp_pd_mask(xa, grid_end, _CMP_LT_OQ);
+      m &= _mm512_cmp_pd_mask(xb, zero, _CMP_GT_OQ);
+      m &= _mm512_cmp_pd_mask(xb, grid_end, _CMP_LT_OQ);
+      if (m) {
+        // The antiderivatives at both ends: cell i = min(int(x), kG - 1), f = x - i, 4 doubles a node.
+        const __m256i ia = _mm256_min_epi32(_mm512_cvttpd_epi32(xa), last_cell);
+        const __m256i ib = _mm256_min_epi32(_mm512_cvttpd_epi32(xb), last_cell);
+        const __m512d fa = _mm512_sub_pd(xa, _mm512_cvtepi32_pd(ia));
+        const __m512d fb = _mm512_sub_pd(xb, _mm512_cvtepi32_pd(ib));
+        const __m256i ka = _mm256_slli_epi32(ia, 2), kb = _mm256_slli_epi32(ib, 2);
+        __m512d a[4], b[4];
+        for (int j = 0; j < 4; ++j) {
+          const double* F = tf.F.data() + j;
+          const __m512d a0 = _mm512_mask_i32gather_pd(zero, m, ka, F, 8);
+          const __m512d a1 = _mm512_mask_i32gather_pd(zero, m, ka, F + 4, 8);
+          const __m512d b0 = _mm512_mask_i32gather_pd(zero, m, kb, F, 8);
+          const __m512d b1 = _mm512_mask_i32gather_pd(zero, m, kb, F + 4, 8);
+          a[j] = _mm512_add_pd(a0, _mm512_mul_pd(fa, _mm512_sub_pd(a1, a0)));
+          b[j] = _mm512_add_pd(b0, _mm512_mul_pd(fb, _mm512_sub_pd(b1, b0)));
+        }
+        // closed_piece: D = length dT / dv; D == 0 blends nothing; 0 < D <= 1 with spread D^2 <= 1
+        // in closed form.
+        const __m512d dT = _mm512_sub_pd(b[0], a[0]);
+        const __m512d D = _mm512_div_pd(_mm512_mul_pd(len, dT), dv);
+        const __mmask8 none = __mmask8(m & _mm512_cmp_pd_mask(D, zero, _CMP_EQ_OQ));
+        const __m512d spread = _mm512_min_pd(
+            c255,
+            _mm512_mul_pd(_mm512_add_pd(_mm512_mul_pd(_mm512_mul_pd(adv, pos_scale), c256), one), lut_step));
+        __mmask8 blend = m & _mm512_cmp_pd_mask(D, zero, _CMP_GT_OQ);
+        blend &= _mm512_cmp_pd_mask(D, one, _CMP_LE_OQ);
+        blend &= _mm512_cmp_pd_mask(_mm512_mul_pd(_mm512_mul_pd(spread, D), D), one, _CMP_LE_OQ);
+        if (blend) {
+          // exp_neg_small(D), the same operations.
+          const __m512d xs = _mm512_mul_pd(_mm512_set1_pd(0.125), D), x2 = _mm512_mul_pd(xs, xs);
+          __m512d e = _mm512_add_pd(
+              _mm512_add_pd(_mm512_sub_pd(one, xs),
+                            _mm512_mul_pd(x2, _mm512_sub_pd(_mm512_set1_pd(0.5),
+                                                            _mm512_mul_pd(xs, _mm512_set1_pd(1.0 / 6))))),
+              _mm512_mul_pd(_mm512_mul_pd(x2, x2), _mm512_sub_pd(_mm512_set1_pd(1.0 / 24),
+                                                                 _mm512_mul_pd(xs, _mm512_set1_pd(1.0 / 120)))));
+          e = _mm512_mul_pd(e, e);
+          e = _mm512_mul_pd(e, e);
+          e = _mm512_mul_pd(e, e);
+          const __m512d w = _mm512_div_pd(_mm512_sub_pd(one, e), dT);
+          for (int j = 0; j < 3; ++j) {
+            float* base = &row[x].c[j];
+            const __m512d c =
+                _mm512_cvtps_pd(_mm256_mmask_i32gather_ps(_mm256_setzero_ps(), blend, pixel_index, base, 4));
+            const __m512d out =
+                _mm512_add_pd(_mm512_mul_pd(_mm512_sub_pd(b[j + 1], a[j + 1]), w), _mm512_mul_pd(c, e));
+            _mm256_mask_i32scatter_ps(base, blend, pixel_index, _mm512_cvtpd_ps(out), 4);
+          }
+        }
+        done = __mmask8(blend | none);
+        fast += std::size_t(__builtin_popcount(done));
+      }
+    }
+    if (const __mmask8 rest = __mmask8(live & ~done)) {
+      alignas(64) double vf[8], vn[8], ln[8];
+      _mm512_store_pd(vf, v_far);
+      _mm512_store_pd(vn, v_near);
+      _mm512_store_pd(ln, len);
+      for (int i = 0; i < 8; ++i)
+        if (rest >> i & 1) composite(tf, vf[i], vn[i], ln[i], row[x + i].c, fast);
+    }
+  }
+}
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+#endif
+
 }  // namespace
 
 void integrate_segment(const VolumeParams& params, double v_far, double v_near, double length, float c[3]) {
@@ -265,41 +453,77 @@ struct VolumePainter::Impl {
   std::span<const double> corner;
   VolumeParams params;
   int lanes = 1;
-  // Per pixel the colour so far and the nearest tet blended, side by side (16 bytes): a tet's row of
-  // pixels touches one run of cache lines, not two.
-  struct Pixel {
-    float c[3];
-    std::uint32_t front;
-  };
   std::vector<Pixel> acc;
+  bool vector_rows = false;  // volume_row_avx512 for the pixel rows
   std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
 
   Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
 
-  void draw_tet(std::uint32_t t, const Rows& rows, std::size_t& count, std::size_t& fast) {
+  // Screen tiles of kTileW x kTileH pixels (128 KiB of Pixel, which stays in the core's cache while
+  // the tile's tets are drawn): draw() bins a batch's tets by their screen bounds, in order, and each
+  // thread takes whole tiles, so every pixel still sees its tets in the given order and no two
+  // threads write one pixel.
+  static constexpr int kTileW = 128, kTileH = 64;
+  struct Tile {
+    int x0, x1, y0, y1;
+  };
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<double> node_px;  // per node its pixel (x, y); NaN where it is not in front of the eye
+  std::vector<std::uint32_t> tile_start, tile_tets, cursor;
+  std::vector<std::array<std::uint16_t, 4>> tet_tiles;  // per tet of the batch: tiles x0, x1, y0, y1
+
+  // The tiles tet t's projection can touch (the bounds of its nodes' pixels, a pixel wider: the
+  // rasterized pixels' centres lie in the snapped projection); all of them for a tet with a node not
+  // in front of the eye (its near-plane clip is not inside those bounds); none off screen.
+  std::array<std::uint16_t, 4> tiles_of(std::uint32_t t) const {
+    double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo, y_lo = x_lo, y_hi = -x_lo;
+    const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
+    for (int k = 0; k < 4; ++k) {
+      const double* q = &node_px[2 * std::size_t(node[k])];
+      if (std::isnan(q[0]))
+        return {0, std::uint16_t(tiles_x - 1), 0, std::uint16_t(tiles_y - 1)};
+      x_lo = std::min(x_lo, q[0]);
+      x_hi = std::max(x_hi, q[0]);
+      y_lo = std::min(y_lo, q[1]);
+      y_hi = std::max(y_hi, q[1]);
+    }
+    if (!(x_hi >= -1 && y_hi >= -1 && x_lo <= proj.width + 1 && y_lo <= proj.height + 1)) return {1, 0, 1, 0};
+    auto tile = [](double p, int size, int count) {
+      return std::uint16_t(std::clamp(int(std::floor(std::clamp(p, -2.0, 1e7) / size)), 0, count - 1));
+    };
+    return {tile(x_lo - 1, kTileW, tiles_x), tile(x_hi + 1, kTileW, tiles_x), tile(y_lo - 1, kTileH, tiles_y),
+            tile(y_hi + 1, kTileH, tiles_y)};
+  }
+
+  // The batch's tets into the tiles' lists (tile_start, tile_tets), each list in the batch's order.
+  void bin(std::span<const std::uint32_t> tets) {
+    const std::size_t n_tiles = std::size_t(tiles_x) * std::size_t(tiles_y);
+    tile_start.assign(n_tiles + 1, 0);
+    tet_tiles.resize(tets.size());
+    for (std::size_t i = 0; i < tets.size(); ++i) {
+      const auto b = tet_tiles[i] = tiles_of(tets[i]);
+      for (int ty = b[2]; ty <= b[3]; ++ty)
+        for (int tx = b[0]; tx <= b[1]; ++tx) ++tile_start[std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx) + 1];
+    }
+    for (std::size_t k = 0; k < n_tiles; ++k) tile_start[k + 1] += tile_start[k];
+    tile_tets.resize(tile_start[n_tiles]);
+    cursor.assign(tile_start.begin(), tile_start.end() - 1);
+    for (std::size_t i = 0; i < tets.size(); ++i) {
+      const auto b = tet_tiles[i];
+      for (int ty = b[2]; ty <= b[3]; ++ty)
+        for (int tx = b[0]; tx <= b[1]; ++tx)
+          tile_tets[cursor[std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx)]++] = tets[i];
+    }
+  }
+
+  void draw_tet(std::uint32_t t, const Tile& tile, std::size_t& count, std::size_t& fast) {
+    const Rows rows{0, 1, tile.y0, tile.y1};
     const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
     const double* cv = &corner[4 * std::size_t(t)];
     double P[4][3];
     for (int k = 0; k < 4; ++k) std::copy_n(&cam_xyz[3 * std::size_t(node[k])], 3, P[k]);
-    {
-      // The tet's pixel rows (a bound, one pixel wider): every lane sees every tet, and most fall in
-      // another lane's band, so this is checked before the setup (a tet reaching the near plane is
-      // not culled here).
-      double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
-      bool cull = true;
-      for (int k = 0; k < 4 && cull; ++k) {
-        if (proj.perspective && !(P[k][2] > std::max(params.near, 0.0) && P[k][2] > 0)) cull = false;
-        const double y =
-            proj.perspective ? proj.cy - proj.focal * P[k][1] / P[k][2] : proj.cy - proj.scale * P[k][1];
-        y_lo = std::min(y_lo, y);
-        y_hi = std::max(y_hi, y);
-      }
-      if (cull && (y_hi < -1 || y_lo > proj.height + 1 ||
-                   !rows.any(int(std::floor(y_lo)) - 1, int(std::ceil(y_hi)) + 1)))
-        return;
-    }
     // The field's gradient in the camera frame: (P[k] - P[0]) . g = cv[k] - cv[0], by Cramer's rule.
     double e[3][3], df[3];
     for (int k = 0; k < 3; ++k) {
@@ -356,6 +580,9 @@ struct VolumePainter::Impl {
           proj, m, [&](int i) { return v[i]; }, X, Y, px, w);
       for_each_fan_triangle(X, Y, m, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
         raster_triangle(TX, TY, proj.width, proj.height, rows, [&](int y, int lo, int hi) {
+          lo = std::max(lo, tile.x0);
+          hi = std::min(hi, tile.x1);
+          if (lo > hi) return;
           // Along the row the pixel's ray o + s d (camera frame; perspective: o = 0 and s the depth)
           // has o and d linear in x, so each plane's n.d and h - n.o and the field's g.(o - P0) and
           // g.d are linear in x too: set up per row, evaluated per pixel with a multiply-add each.
@@ -369,40 +596,34 @@ struct VolumePainter::Impl {
             o1[0] = 1 / proj.scale;
             o0[1] = -(y + 0.5 - proj.cy) / proj.scale;
           }
-          double ndA[4], ndB[4], numA[4], numB[4];
+          RowSetup r;
           for (int k = 0; k < 4; ++k) {
-            ndA[k] = n[k][0] * d0[0] + n[k][1] * d0[1] + n[k][2] * d0[2];
-            ndB[k] = n[k][0] * d1[0];
-            numA[k] = h[k] - (n[k][0] * o0[0] + n[k][1] * o0[1]);
-            numB[k] = -n[k][0] * o1[0];
+            r.ndA[k] = n[k][0] * d0[0] + n[k][1] * d0[1] + n[k][2] * d0[2];
+            r.ndB[k] = n[k][0] * d1[0];
+            r.numA[k] = h[k] - (n[k][0] * o0[0] + n[k][1] * o0[1]);
+            r.numB[k] = -n[k][0] * o1[0];
           }
-          const double vA = cv[0] + g[0] * (o0[0] - P[0][0]) + g[1] * (o0[1] - P[0][1]) - g[2] * P[0][2];
-          const double vB = g[0] * o1[0];
-          const double gdA = g[0] * d0[0] + g[1] * d0[1] + g[2] * d0[2], gdB = g[0] * d1[0];
-          const double dyz = d0[1] * d0[1] + d0[2] * d0[2];
+          r.vA = cv[0] + g[0] * (o0[0] - P[0][0]) + g[1] * (o0[1] - P[0][1]) - g[2] * P[0][2];
+          r.vB = g[0] * o1[0];
+          r.gdA = g[0] * d0[0] + g[1] * d0[1] + g[2] * d0[2];
+          r.gdB = g[0] * d1[0];
+          r.dxA = d0[0];
+          r.dxB = d1[0];
+          r.dyz = d0[1] * d0[1] + d0[2] * d0[2];
+          r.near = near;
+          Pixel* row = &acc[std::size_t(y) * std::size_t(proj.width)];
+#ifdef FOXI_VOLUME_AVX512
+          if (vector_rows) {
+            volume_row_avx512(r, *transfer, row, lo, hi, t, count, fast);
+            return;
+          }
+#endif
           for (int x = lo; x <= hi; ++x) {
-            const double xf = x;
-            double s_in = near, s_out = std::numeric_limits<double>::infinity();
-            for (int k = 0; k < 4; ++k) {
-              const double nd = ndA[k] + xf * ndB[k];
-              const double sk = (numA[k] + xf * numB[k]) / nd;
-              if (nd < 0)
-                s_in = std::max(s_in, sk);
-              else if (nd > 0)
-                s_out = std::min(s_out, sk);
-            }
-            if (!(s_out > s_in)) continue;  // a snapped edge pixel the ray misses
-            const double v0 = vA + xf * vB, gd = gdA + xf * gdB;
-            const double dx = d0[0] + xf * d1[0];
-            const double len = (s_out - s_in) * std::sqrt(dx * dx + dyz);
-            const double v_far = v0 + s_out * gd, v_near = v0 + s_in * gd;
-            const std::size_t p = std::size_t(y) * std::size_t(proj.width) + std::size_t(x);
-            Pixel& px = acc[p];
-            if (integrate_fast(*transfer, v_far, v_near, len, px.c))
-              ++fast;
-            else
-              integrate(*transfer, v_far, v_near, len, px.c);
-            px.front = t;
+            double v_far, v_near, len;
+            if (!r.segment(x, v_far, v_near, len)) continue;  // a snapped edge pixel the ray misses
+            Pixel& pix = row[x];
+            composite(*transfer, v_far, v_near, len, pix.c, fast);
+            pix.front = t;
             ++count;
           }
         });
@@ -434,14 +655,29 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   s.cam_xyz.resize(mesh.xyz.size());
   for (std::size_t k = 0; k < mesh.node_count(); ++k) s.proj.to_camera(&mesh.xyz[3 * k], &s.cam_xyz[3 * k]);
   s.transfer = std::make_unique<TableTransfer>(s.params);
-  s.lanes = std::clamp(params.threads, 1, std::max(1, height >> kBandShift));
+#ifdef FOXI_VOLUME_AVX512
+  s.vector_rows = volume_avx512();
+#endif
+  s.tiles_x = (width + Impl::kTileW - 1) / Impl::kTileW;
+  s.tiles_y = (height + Impl::kTileH - 1) / Impl::kTileH;
+  if (s.tiles_x > 65535 || s.tiles_y > 65535) throw std::invalid_argument("volume: the picture is too large");
+  s.node_px.resize(2 * mesh.node_count());
+  for (std::size_t k = 0; k < mesh.node_count(); ++k) {
+    const double* c = &s.cam_xyz[3 * k];
+    double* q = &s.node_px[2 * k];
+    if (s.proj.perspective && !(c[2] > std::max(params.near, 0.0) && c[2] > 0))
+      q[0] = q[1] = std::numeric_limits<double>::quiet_NaN();
+    else
+      s.proj.camera_to_pixel(c, q);
+  }
+  s.lanes = std::clamp(params.threads, 1, s.tiles_x * s.tiles_y);
   s.lane_samples.assign(std::size_t(s.lanes), 0);
   s.lane_fast.assign(std::size_t(s.lanes), 0);
   const std::size_t pixels = std::size_t(width) * std::size_t(height);
   s.acc.resize(pixels);
   const float bg[3] = {float(params.background & 255u), float((params.background >> 8) & 255u),
                        float((params.background >> 16) & 255u)};
-  for (Impl::Pixel& p : s.acc) p = {{bg[0], bg[1], bg[2]}, kNone};
+  for (Pixel& p : s.acc) p = {{bg[0], bg[1], bg[2]}, kNone};
 }
 
 VolumePainter::~VolumePainter() = default;
@@ -452,10 +688,18 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
   Impl& s = *impl_;
   for (std::uint32_t t : tets)
     if (t >= s.mesh->tet_count()) throw std::invalid_argument("volume: tet index out of range");
+  s.bin(tets);
+  std::atomic<int> next{0};
+  const int n_tiles = s.tiles_x * s.tiles_y;
   run_parts(s.lanes, [&](int lane) {
-    const Rows rows{lane, s.lanes};
     std::size_t count = 0, fast = 0;
-    for (std::uint32_t t : tets) s.draw_tet(t, rows, count, fast);
+    for (int k; (k = next.fetch_add(1, std::memory_order_relaxed)) < n_tiles;) {
+      const int tx = k % s.tiles_x, ty = k / s.tiles_x;
+      const Impl::Tile tile{tx * Impl::kTileW, std::min(s.proj.width, (tx + 1) * Impl::kTileW) - 1,
+                            ty * Impl::kTileH, std::min(s.proj.height, (ty + 1) * Impl::kTileH) - 1};
+      for (std::uint32_t i = s.tile_start[std::size_t(k)]; i < s.tile_start[std::size_t(k) + 1]; ++i)
+        s.draw_tet(s.tile_tets[i], tile, count, fast);
+    }
     s.lane_samples[std::size_t(lane)] += count;
     s.lane_fast[std::size_t(lane)] += fast;
   });
