@@ -266,28 +266,29 @@ struct Pixel {
   std::uint32_t front;
 };
 
-// One pixel row of a tet's face: along the row the pixel's ray o + s d (camera frame; perspective:
-// o = 0 and s the depth) has o and d linear in x, so each plane's n.d and h - n.o, the field's
-// g.(o - P0) and g.d and the direction's x are linear in x too: A + x B, set up per row.
-struct RowSetup {
-  double ndA[4], ndB[4], numA[4], numB[4];
-  double vA, vB, gdA, gdB, dxA, dxB, dyz, near;
-  // The ray's segment through the tet at pixel x: false where the ray misses it (a snapped edge pixel).
-  bool segment(int x, double& v_far, double& v_near, double& len) const {
-    const double xf = x;
+// A tet's pixels: the ray o + s d of pixel (x, y) (camera frame; perspective: o = 0 and s the depth)
+// has o and d linear in x and y, so each plane's n.d and h - n.o, the field's g.(o - P0) and g.d and
+// the direction's x and y are A + x B + y C too: set up once per tet, a few multiply-adds a pixel.
+struct TetSetup {
+  double ndA[4], ndB[4], ndC[4], numA[4], numB[4], numC[4];
+  double vA, vB, vC, gdA, gdB, gdC, dxA, dxB, dyA, dyC, dz2, near;
+  // The ray's segment through the tet at pixel (x, y): false where the ray misses it (a snapped edge
+  // pixel).
+  bool segment(int x, int y, double& v_far, double& v_near, double& len) const {
+    const double xf = x, yf = y;
     double s_in = near, s_out = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 4; ++k) {
-      const double nd = ndA[k] + xf * ndB[k];
-      const double sk = (numA[k] + xf * numB[k]) / nd;
+      const double nd = ndA[k] + xf * ndB[k] + yf * ndC[k];
+      const double sk = (numA[k] + xf * numB[k] + yf * numC[k]) / nd;
       if (nd < 0)
         s_in = std::max(s_in, sk);
       else if (nd > 0)
         s_out = std::min(s_out, sk);
     }
     if (!(s_out > s_in)) return false;
-    const double v0 = vA + xf * vB, gd = gdA + xf * gdB;
-    const double dx = dxA + xf * dxB;
-    len = (s_out - s_in) * std::sqrt(dx * dx + dyz);
+    const double v0 = vA + xf * vB + yf * vC, gd = gdA + xf * gdB + yf * gdC;
+    const double dx = dxA + xf * dxB, dy = dyA + yf * dyC;
+    len = (s_out - s_in) * std::sqrt(dx * dx + dy * dy + dz2);
     v_far = v0 + s_out * gd;
     v_near = v0 + s_in * gd;
     return true;
@@ -317,34 +318,43 @@ bool volume_avx512() {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own _mm512_undefined_pd in its intrinsics
 #endif
-// The row's pixels lo..hi eight at a time: RowSetup::segment and, for the common segment (the
-// pre-integrated table, at least 2 grid cells, inside the grid, one closed piece), integrate_fast with
-// the same operations in the same order (viz is built with -ffp-contract=off, and the gathers read the
-// same table), so the picture is bit for bit the portable path's; every other segment (thin, thick,
-// outside the grid, NaN, a log scale) goes through composite() one pixel at a time.
-__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_row_avx512(
-    const RowSetup& r, const TableTransfer& tf, Pixel* row, int lo, int hi, std::uint32_t t,
-    std::size_t& count, std::size_t& fast) {
-  const __m512d lane = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0), zero = _mm512_setzero_pd();
+// A + x B + y C, in TetSetup::segment's order.
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline __m512d linear_xy(__m512d xf, __m512d yf, double A,
+                                                                                double B, double C) {
+  return _mm512_add_pd(_mm512_add_pd(_mm512_set1_pd(A), _mm512_mul_pd(xf, _mm512_set1_pd(B))),
+                       _mm512_mul_pd(yf, _mm512_set1_pd(C)));
+}
+
+// The pixels (xs[i], ys[i]), i < n, eight at a time: TetSetup::segment and, for the common segment
+// (the pre-integrated table, at least 2 grid cells, inside the grid, one closed piece),
+// integrate_fast with the same operations in the same order (viz is built with -ffp-contract=off, and
+// the gathers read the same table), so the picture is bit for bit the portable path's; every other
+// segment (thin, thick, outside the grid, NaN, a log scale) goes through composite() one pixel at a
+// time.
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx512(
+    const TetSetup& r, const TableTransfer& tf, Pixel* acc, int width, const int* xs, const int* ys, int n_px,
+    std::uint32_t t, std::size_t& count, std::size_t& fast) {
+  const __m512d zero = _mm512_setzero_pd();
   const __m512d one = _mm512_set1_pd(1.0), inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d abs_mask = _mm512_castsi512_pd(_mm512_set1_epi64(0x7fffffffffffffffLL));
-  const __m256i pixel_index = _mm256_set_epi32(28, 24, 20, 16, 12, 8, 4, 0);  // floats, 16 bytes a pixel
-  const __m256i tet = _mm256_set1_epi32(int(t));
+  const __m256i tet = _mm256_set1_epi32(int(t)), w4 = _mm256_set1_epi32(4 * width);
   const __m256i last_cell = _mm256_set1_epi32(TableTransfer::kG - 1);
   const __m512d g_lo = _mm512_set1_pd(tf.g_lo), g_inv = _mm512_set1_pd(tf.g_inv);
   const __m512d grid_end = _mm512_set1_pd(double(TableTransfer::kG)), two = _mm512_set1_pd(2.0);
   const __m512d pos_scale = _mm512_set1_pd(tf.pos_scale), lut_step = _mm512_set1_pd(double(tf.lut_step));
   const __m512d c255 = _mm512_set1_pd(255.0), c256 = _mm512_set1_pd(256.0);
-  for (int x = lo; x <= hi; x += 8) {
-    const int n = std::min(8, hi - x + 1);
+  float* const base_c = &acc[0].c[0];
+  for (int i0 = 0; i0 < n_px; i0 += 8) {
+    const int n = std::min(8, n_px - i0);
     __mmask8 live = __mmask8((1u << n) - 1u);
-    const __m512d xf = _mm512_add_pd(_mm512_set1_pd(double(x)), lane);
+    const __m256i xi = _mm256_maskz_loadu_epi32(live, xs + i0), yi = _mm256_maskz_loadu_epi32(live, ys + i0);
+    // Each pixel's first float in acc (16 bytes, 4 floats a pixel).
+    const __m256i pixel_index = _mm256_add_epi32(_mm256_mullo_epi32(yi, w4), _mm256_slli_epi32(xi, 2));
+    const __m512d xf = _mm512_cvtepi32_pd(xi), yf = _mm512_cvtepi32_pd(yi);
     __m512d s_in = _mm512_set1_pd(r.near), s_out = inf;
     for (int k = 0; k < 4; ++k) {
-      const __m512d nd = _mm512_add_pd(_mm512_set1_pd(r.ndA[k]), _mm512_mul_pd(xf, _mm512_set1_pd(r.ndB[k])));
-      const __m512d num =
-          _mm512_add_pd(_mm512_set1_pd(r.numA[k]), _mm512_mul_pd(xf, _mm512_set1_pd(r.numB[k])));
-      const __m512d sk = _mm512_div_pd(num, nd);
+      const __m512d nd = linear_xy(xf, yf, r.ndA[k], r.ndB[k], r.ndC[k]);
+      const __m512d sk = _mm512_div_pd(linear_xy(xf, yf, r.numA[k], r.numB[k], r.numC[k]), nd);
       // max(sk, s_in) is sk > s_in ? sk : s_in (s_in for a NaN sk), as std::max(s_in, sk).
       s_in = _mm512_mask_max_pd(s_in, _mm512_cmp_pd_mask(nd, zero, _CMP_LT_OQ), sk, s_in);
       s_out = _mm512_mask_min_pd(s_out, _mm512_cmp_pd_mask(nd, zero, _CMP_GT_OQ), sk, s_out);
@@ -352,26 +362,34 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_row_avx512
     live &= _mm512_cmp_pd_mask(s_out, s_in, _CMP_GT_OQ);
     if (!live) continue;
     count += std::size_t(__builtin_popcount(live));
-    _mm256_mask_i32scatter_epi32(&row[x].front, live, pixel_index, tet, 4);
-    const __m512d v0 = _mm512_add_pd(_mm512_set1_pd(r.vA), _mm512_mul_pd(xf, _mm512_set1_pd(r.vB)));
-    const __m512d gd = _mm512_add_pd(_mm512_set1_pd(r.gdA), _mm512_mul_pd(xf, _mm512_set1_pd(r.gdB)));
+    _mm256_mask_i32scatter_epi32(base_c + 3, live, pixel_index, tet, 4);
+    const __m512d v0 = linear_xy(xf, yf, r.vA, r.vB, r.vC), gd = linear_xy(xf, yf, r.gdA, r.gdB, r.gdC);
     const __m512d dx = _mm512_add_pd(_mm512_set1_pd(r.dxA), _mm512_mul_pd(xf, _mm512_set1_pd(r.dxB)));
+    const __m512d dy = _mm512_add_pd(_mm512_set1_pd(r.dyA), _mm512_mul_pd(yf, _mm512_set1_pd(r.dyC)));
     const __m512d len = _mm512_mul_pd(
         _mm512_sub_pd(s_out, s_in),
-        _mm512_sqrt_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_set1_pd(r.dyz))));
+        _mm512_sqrt_pd(_mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                                     _mm512_set1_pd(r.dz2))));
     const __m512d v_far = _mm512_add_pd(v0, _mm512_mul_pd(s_out, gd));
     const __m512d v_near = _mm512_add_pd(v0, _mm512_mul_pd(s_in, gd));
     __mmask8 done = 0;
     if (tf.pre) {
       const __m512d dv = _mm512_sub_pd(v_near, v_far);
       const __m512d adv = _mm512_and_pd(dv, abs_mask);
+      const __m512d cells = _mm512_mul_pd(adv, g_inv);
       const __m512d xa = _mm512_mul_pd(_mm512_sub_pd(v_far, g_lo), g_inv);
       const __m512d xb = _mm512_mul_pd(_mm512_sub_pd(v_near, g_lo), g_inv);
-      __mmask8 m = live & _mm512_cmp_pd_mask(_mm512_mul_pd(adv, g_inv), two, _CMP_GE_OQ);
+      __mmask8 m = live & _mm512_cmp_pd_mask(cells, two, _CMP_GE_OQ);
       m &= _mm512_cmp_pd_mask(xa, zero, _CMP_GT_OQ);
       m &= _mm512_cmp_pd_mask(xa, grid_end, _CMP_LT_OQ);
       m &= _mm512_cmp_pd_mask(xb, zero, _CMP_GT_OQ);
       m &= _mm512_cmp_pd_mask(xb, grid_end, _CMP_LT_OQ);
+      // Under 2 grid cells (not NaN): the midpoint's extinction and colour (integrate_fast's first case).
+      const __mmask8 thin = __mmask8(live & _mm512_cmp_pd_mask(cells, two, _CMP_LT_OQ));
+      // Per lane the segment's optical depth D, the emitted colour's numerators em and its divisor dT
+      // (the pre-integrated piece: K differences over T's; a thin one: the colour over 1).
+      __m512d D = zero, dT = one, em[3] = {zero, zero, zero};
+      __mmask8 blend = 0, none = 0;
       if (m) {
         // The antiderivatives at both ends: cell i = min(int(x), kG - 1), f = x - i, 4 doubles a node.
         const __m256i ia = _mm256_min_epi32(_mm512_cvttpd_epi32(xa), last_cell);
@@ -391,40 +409,66 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_row_avx512
         }
         // closed_piece: D = length dT / dv; D == 0 blends nothing; 0 < D <= 1 with spread D^2 <= 1
         // in closed form.
-        const __m512d dT = _mm512_sub_pd(b[0], a[0]);
-        const __m512d D = _mm512_div_pd(_mm512_mul_pd(len, dT), dv);
-        const __mmask8 none = __mmask8(m & _mm512_cmp_pd_mask(D, zero, _CMP_EQ_OQ));
+        const __m512d dTm = _mm512_sub_pd(b[0], a[0]);
+        const __m512d Dm = _mm512_div_pd(_mm512_mul_pd(len, dTm), dv);
+        none = __mmask8(m & _mm512_cmp_pd_mask(Dm, zero, _CMP_EQ_OQ));
         const __m512d spread = _mm512_min_pd(
             c255,
             _mm512_mul_pd(_mm512_add_pd(_mm512_mul_pd(_mm512_mul_pd(adv, pos_scale), c256), one), lut_step));
-        __mmask8 blend = m & _mm512_cmp_pd_mask(D, zero, _CMP_GT_OQ);
-        blend &= _mm512_cmp_pd_mask(D, one, _CMP_LE_OQ);
-        blend &= _mm512_cmp_pd_mask(_mm512_mul_pd(_mm512_mul_pd(spread, D), D), one, _CMP_LE_OQ);
-        if (blend) {
-          // exp_neg_small(D), the same operations.
-          const __m512d xs = _mm512_mul_pd(_mm512_set1_pd(0.125), D), x2 = _mm512_mul_pd(xs, xs);
-          __m512d e = _mm512_add_pd(
-              _mm512_add_pd(_mm512_sub_pd(one, xs),
-                            _mm512_mul_pd(x2, _mm512_sub_pd(_mm512_set1_pd(0.5),
-                                                            _mm512_mul_pd(xs, _mm512_set1_pd(1.0 / 6))))),
-              _mm512_mul_pd(_mm512_mul_pd(x2, x2), _mm512_sub_pd(_mm512_set1_pd(1.0 / 24),
-                                                                 _mm512_mul_pd(xs, _mm512_set1_pd(1.0 / 120)))));
-          e = _mm512_mul_pd(e, e);
-          e = _mm512_mul_pd(e, e);
-          e = _mm512_mul_pd(e, e);
-          const __m512d w = _mm512_div_pd(_mm512_sub_pd(one, e), dT);
-          for (int j = 0; j < 3; ++j) {
-            float* base = &row[x].c[j];
-            const __m512d c =
-                _mm512_cvtps_pd(_mm256_mmask_i32gather_ps(_mm256_setzero_ps(), blend, pixel_index, base, 4));
-            const __m512d out =
-                _mm512_add_pd(_mm512_mul_pd(_mm512_sub_pd(b[j + 1], a[j + 1]), w), _mm512_mul_pd(c, e));
-            _mm256_mask_i32scatter_ps(base, blend, pixel_index, _mm512_cvtpd_ps(out), 4);
-          }
-        }
-        done = __mmask8(blend | none);
-        fast += std::size_t(__builtin_popcount(done));
+        blend = m & _mm512_cmp_pd_mask(Dm, zero, _CMP_GT_OQ);
+        blend &= _mm512_cmp_pd_mask(Dm, one, _CMP_LE_OQ);
+        blend &= _mm512_cmp_pd_mask(_mm512_mul_pd(_mm512_mul_pd(spread, Dm), Dm), one, _CMP_LE_OQ);
+        D = _mm512_mask_mov_pd(D, blend, Dm);
+        dT = _mm512_mask_mov_pd(dT, blend, dTm);
+        for (int j = 0; j < 3; ++j) em[j] = _mm512_mask_sub_pd(em[j], blend, b[j + 1], a[j + 1]);
       }
+      if (thin) {
+        // tf.tau(vm), tf.rgb(vm) with the same operations: the extinction table interpolated, the
+        // colour map's entry of the scale position.
+        const __m512d vm = _mm512_mul_pd(_mm512_set1_pd(0.5), _mm512_add_pd(v_far, v_near));
+        const __m512d xt = _mm512_min_pd(
+            _mm512_max_pd(_mm512_mul_pd(_mm512_sub_pd(vm, _mm512_set1_pd(tf.lo)), _mm512_set1_pd(tf.inv_step)),
+                          zero),
+            _mm512_set1_pd(double(TableTransfer::kN)));
+        const __m256i it = _mm256_min_epi32(_mm512_cvttpd_epi32(xt), _mm256_set1_epi32(TableTransfer::kN - 1));
+        const __m512d ft = _mm512_sub_pd(xt, _mm512_cvtepi32_pd(it));
+        const __m512d t0 = _mm512_mask_i32gather_pd(zero, thin, it, tf.tau_at.data(), 8);
+        const __m512d t1 = _mm512_mask_i32gather_pd(zero, thin, it, tf.tau_at.data() + 1, 8);
+        const __m512d Dt = _mm512_mul_pd(_mm512_add_pd(t0, _mm512_mul_pd(ft, _mm512_sub_pd(t1, t0))), len);
+        const __mmask8 ok = __mmask8(thin & _mm512_cmp_pd_mask(Dt, one, _CMP_LE_OQ));
+        const __m512d pos = _mm512_div_pd(_mm512_sub_pd(vm, _mm512_set1_pd(tf.p->scale.lo)),
+                                          _mm512_set1_pd(tf.p->scale.hi - tf.p->scale.lo));
+        const __m256i entry = _mm512_cvttpd_epi32(_mm512_min_pd(_mm512_max_pd(_mm512_mul_pd(pos, c256), zero), c255));
+        const __m256i k3 = _mm256_mullo_epi32(entry, _mm256_set1_epi32(3));
+        D = _mm512_mask_mov_pd(D, ok, Dt);
+        for (int j = 0; j < 3; ++j)
+          em[j] = _mm512_mask_mov_pd(
+              em[j], ok, _mm512_cvtps_pd(_mm256_mmask_i32gather_ps(_mm256_setzero_ps(), ok, k3, &tf.lut[0][j], 4)));
+        blend |= ok;
+      }
+      if (blend) {
+        // exp_neg_small(D), the same operations.
+        const __m512d q = _mm512_mul_pd(_mm512_set1_pd(0.125), D), q2 = _mm512_mul_pd(q, q);
+        __m512d e = _mm512_add_pd(
+            _mm512_add_pd(_mm512_sub_pd(one, q),
+                          _mm512_mul_pd(q2, _mm512_sub_pd(_mm512_set1_pd(0.5), _mm512_mul_pd(q, _mm512_set1_pd(1.0 / 6))))),
+            _mm512_mul_pd(_mm512_mul_pd(q2, q2),
+                          _mm512_sub_pd(_mm512_set1_pd(1.0 / 24), _mm512_mul_pd(q, _mm512_set1_pd(1.0 / 120)))));
+        e = _mm512_mul_pd(e, e);
+        e = _mm512_mul_pd(e, e);
+        e = _mm512_mul_pd(e, e);
+        // Pre-integrated: (K_b - K_a) (1 - e) / dT + c e; thin: rgb (1 - e) + c e (dT = 1 exactly).
+        const __m512d w = _mm512_div_pd(_mm512_sub_pd(one, e), dT);
+        for (int j = 0; j < 3; ++j) {
+          float* base = base_c + j;
+          const __m512d c =
+              _mm512_cvtps_pd(_mm256_mmask_i32gather_ps(_mm256_setzero_ps(), blend, pixel_index, base, 4));
+          const __m512d out = _mm512_add_pd(_mm512_mul_pd(em[j], w), _mm512_mul_pd(c, e));
+          _mm256_mask_i32scatter_ps(base, blend, pixel_index, _mm512_cvtpd_ps(out), 4);
+        }
+      }
+      done = __mmask8(blend | none);
+      fast += std::size_t(__builtin_popcount(done));
     }
     if (const __mmask8 rest = __mmask8(live & ~done)) {
       alignas(64) double vf[8], vn[8], ln[8];
@@ -432,7 +476,9 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_row_avx512
       _mm512_store_pd(vn, v_near);
       _mm512_store_pd(ln, len);
       for (int i = 0; i < 8; ++i)
-        if (rest >> i & 1) composite(tf, vf[i], vn[i], ln[i], row[x + i].c, fast);
+        if (rest >> i & 1)
+          composite(tf, vf[i], vn[i], ln[i], acc[std::size_t(ys[i0 + i]) * std::size_t(width) + std::size_t(xs[i0 + i])].c,
+                    fast);
     }
   }
 }
@@ -518,7 +564,14 @@ struct VolumePainter::Impl {
     }
   }
 
-  void draw_tet(std::uint32_t t, const Tile& tile, std::size_t& count, std::size_t& fast) {
+  // A thread's list of the pixels of the tet it draws.
+  struct Scratch {
+    static constexpr int kRun = 256;
+    alignas(64) int xs[kRun];
+    alignas(64) int ys[kRun];
+  };
+
+  void draw_tet(std::uint32_t t, const Tile& tile, Scratch& scratch, std::size_t& count, std::size_t& fast) {
     const Rows rows{0, 1, tile.y0, tile.y1};
     const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
     const double* cv = &corner[4 * std::size_t(t)];
@@ -566,8 +619,102 @@ struct VolumePainter::Impl {
     // The eye inside the tet (perspective, every plane's inner side): its back faces cover the screen
     // where the rays start inside it.
     const bool inside = front_count == 0;
-    const double near =
-        proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
+    TetSetup r;
+    {
+      // o = o0 + x ox + y oy, d = d0 + x dx + y dy (see TetSetup).
+      double o0[3] = {0, 0, 0}, d0[3] = {0, 0, 1}, ox = 0, oy = 0, dx = 0, dy = 0;
+      if (proj.perspective) {
+        d0[0] = (0.5 - proj.cx) / proj.focal;
+        dx = 1 / proj.focal;
+        d0[1] = -(0.5 - proj.cy) / proj.focal;
+        dy = -1 / proj.focal;
+      } else {
+        o0[0] = (0.5 - proj.cx) / proj.scale;
+        ox = 1 / proj.scale;
+        o0[1] = -(0.5 - proj.cy) / proj.scale;
+        oy = -1 / proj.scale;
+      }
+      for (int k = 0; k < 4; ++k) {
+        r.ndA[k] = n[k][0] * d0[0] + n[k][1] * d0[1] + n[k][2] * d0[2];
+        r.ndB[k] = n[k][0] * dx;
+        r.ndC[k] = n[k][1] * dy;
+        r.numA[k] = h[k] - (n[k][0] * o0[0] + n[k][1] * o0[1]);
+        r.numB[k] = -n[k][0] * ox;
+        r.numC[k] = -n[k][1] * oy;
+      }
+      r.vA = cv[0] + g[0] * (o0[0] - P[0][0]) + g[1] * (o0[1] - P[0][1]) - g[2] * P[0][2];
+      r.vB = g[0] * ox;
+      r.vC = g[1] * oy;
+      r.gdA = g[0] * d0[0] + g[1] * d0[1] + g[2] * d0[2];
+      r.gdB = g[0] * dx;
+      r.gdC = g[1] * dy;
+      r.dxA = d0[0];
+      r.dxB = dx;
+      r.dyA = d0[1];
+      r.dyC = dy;
+      r.dz2 = d0[2] * d0[2];
+      r.near = proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
+    }
+    // The tet's pixels (its front faces', which cover its projection once) are listed, then
+    // integrated in runs of kRun: the vector path takes eight pixels of any rows at once.
+    int n_px = 0;
+    auto flush = [&] {
+#ifdef FOXI_VOLUME_AVX512
+      if (vector_rows) {
+        volume_pixels_avx512(r, *transfer, acc.data(), proj.width, scratch.xs, scratch.ys, n_px, t, count, fast);
+        n_px = 0;
+        return;
+      }
+#endif
+      for (int i = 0; i < n_px; ++i) {
+        double v_far, v_near, len;
+        if (!r.segment(scratch.xs[i], scratch.ys[i], v_far, v_near, len)) continue;  // a snapped edge pixel the ray misses
+        Pixel& pix = acc[std::size_t(scratch.ys[i]) * std::size_t(proj.width) + std::size_t(scratch.xs[i])];
+        composite(*transfer, v_far, v_near, len, pix.c, fast);
+        pix.front = t;
+        ++count;
+      }
+      n_px = 0;
+    };
+    auto add_run = [&](int y, int lo, int hi) {
+      lo = std::max(lo, tile.x0);
+      hi = std::min(hi, tile.x1);
+      for (int x = lo; x <= hi; ++x) {
+        if (n_px == Scratch::kRun) flush();
+        scratch.xs[n_px] = x;
+        scratch.ys[n_px++] = y;
+      }
+    };
+    // No node before the near plane clip_near would use for any face (the usual case): the four
+    // corners snapped once, each front face from them (the same corners snap_polygon would give).
+    bool direct = !inside;
+    if (direct && proj.perspective) {
+      double dmax = 0;
+      for (int k = 0; k < 4; ++k)
+        dmax = std::max(dmax, std::sqrt(P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]));
+      double near_clip = std::max(params.near, dmax * proj.focal / kMaxPixel);
+      if (!(near_clip > 0)) near_clip = 1e-300;
+      for (int k = 0; k < 4; ++k) direct = direct && P[k][2] >= near_clip;
+    }
+    if (direct) {
+      std::int64_t X4[4], Y4[4];
+      for (int k = 0; k < 4; ++k) {
+        double q[2];
+        proj.camera_to_pixel(P[k], q);
+        X4[k] = to_fixed(q[0]);
+        Y4[k] = to_fixed(q[1]);
+      }
+      for (int f = 0; f < 4; ++f) {
+        if (!facing[f]) continue;
+        const std::int64_t X[3] = {X4[kFace[f][0]], X4[kFace[f][1]], X4[kFace[f][2]]},
+                           Y[3] = {Y4[kFace[f][0]], Y4[kFace[f][1]], Y4[kFace[f][2]]};
+        for_each_fan_triangle(X, Y, 3, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
+          raster_triangle(TX, TY, proj.width, proj.height, rows, add_run);
+        });
+      }
+      flush();
+      return;
+    }
     for (int f = 0; f < 4; ++f) {
       if (facing[f] == inside) continue;
       double tri[3][3], v[kMaxPolyVolume][3];
@@ -579,56 +726,10 @@ struct VolumePainter::Impl {
       snap_polygon(
           proj, m, [&](int i) { return v[i]; }, X, Y, px, w);
       for_each_fan_triangle(X, Y, m, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
-        raster_triangle(TX, TY, proj.width, proj.height, rows, [&](int y, int lo, int hi) {
-          lo = std::max(lo, tile.x0);
-          hi = std::min(hi, tile.x1);
-          if (lo > hi) return;
-          // Along the row the pixel's ray o + s d (camera frame; perspective: o = 0 and s the depth)
-          // has o and d linear in x, so each plane's n.d and h - n.o and the field's g.(o - P0) and
-          // g.d are linear in x too: set up per row, evaluated per pixel with a multiply-add each.
-          double o0[3] = {0, 0, 0}, o1[3] = {0, 0, 0}, d0[3] = {0, 0, 1}, d1[3] = {0, 0, 0};
-          if (proj.perspective) {
-            d0[0] = (0.5 - proj.cx) / proj.focal;
-            d1[0] = 1 / proj.focal;
-            d0[1] = -(y + 0.5 - proj.cy) / proj.focal;
-          } else {
-            o0[0] = (0.5 - proj.cx) / proj.scale;
-            o1[0] = 1 / proj.scale;
-            o0[1] = -(y + 0.5 - proj.cy) / proj.scale;
-          }
-          RowSetup r;
-          for (int k = 0; k < 4; ++k) {
-            r.ndA[k] = n[k][0] * d0[0] + n[k][1] * d0[1] + n[k][2] * d0[2];
-            r.ndB[k] = n[k][0] * d1[0];
-            r.numA[k] = h[k] - (n[k][0] * o0[0] + n[k][1] * o0[1]);
-            r.numB[k] = -n[k][0] * o1[0];
-          }
-          r.vA = cv[0] + g[0] * (o0[0] - P[0][0]) + g[1] * (o0[1] - P[0][1]) - g[2] * P[0][2];
-          r.vB = g[0] * o1[0];
-          r.gdA = g[0] * d0[0] + g[1] * d0[1] + g[2] * d0[2];
-          r.gdB = g[0] * d1[0];
-          r.dxA = d0[0];
-          r.dxB = d1[0];
-          r.dyz = d0[1] * d0[1] + d0[2] * d0[2];
-          r.near = near;
-          Pixel* row = &acc[std::size_t(y) * std::size_t(proj.width)];
-#ifdef FOXI_VOLUME_AVX512
-          if (vector_rows) {
-            volume_row_avx512(r, *transfer, row, lo, hi, t, count, fast);
-            return;
-          }
-#endif
-          for (int x = lo; x <= hi; ++x) {
-            double v_far, v_near, len;
-            if (!r.segment(x, v_far, v_near, len)) continue;  // a snapped edge pixel the ray misses
-            Pixel& pix = row[x];
-            composite(*transfer, v_far, v_near, len, pix.c, fast);
-            pix.front = t;
-            ++count;
-          }
-        });
+        raster_triangle(TX, TY, proj.width, proj.height, rows, add_run);
       });
     }
+    flush();
   }
   static constexpr int kMaxPolyVolume = 8;
 };
@@ -656,7 +757,8 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   for (std::size_t k = 0; k < mesh.node_count(); ++k) s.proj.to_camera(&mesh.xyz[3 * k], &s.cam_xyz[3 * k]);
   s.transfer = std::make_unique<TableTransfer>(s.params);
 #ifdef FOXI_VOLUME_AVX512
-  s.vector_rows = volume_avx512();
+  // Its pixel offsets are 32-bit (4 floats a pixel).
+  s.vector_rows = volume_avx512() && std::size_t(width) * std::size_t(height) < (std::size_t(1) << 29);
 #endif
   s.tiles_x = (width + Impl::kTileW - 1) / Impl::kTileW;
   s.tiles_y = (height + Impl::kTileH - 1) / Impl::kTileH;
@@ -693,12 +795,13 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
   const int n_tiles = s.tiles_x * s.tiles_y;
   run_parts(s.lanes, [&](int lane) {
     std::size_t count = 0, fast = 0;
+    auto scratch = std::make_unique<Impl::Scratch>();
     for (int k; (k = next.fetch_add(1, std::memory_order_relaxed)) < n_tiles;) {
       const int tx = k % s.tiles_x, ty = k / s.tiles_x;
       const Impl::Tile tile{tx * Impl::kTileW, std::min(s.proj.width, (tx + 1) * Impl::kTileW) - 1,
                             ty * Impl::kTileH, std::min(s.proj.height, (ty + 1) * Impl::kTileH) - 1};
       for (std::uint32_t i = s.tile_start[std::size_t(k)]; i < s.tile_start[std::size_t(k) + 1]; ++i)
-        s.draw_tet(s.tile_tets[i], tile, count, fast);
+        s.draw_tet(s.tile_tets[i], tile, *scratch, count, fast);
     }
     s.lane_samples[std::size_t(lane)] += count;
     s.lane_fast[std::size_t(lane)] += fast;
