@@ -57,21 +57,24 @@ VolumeParams params_for(const Mesh& m, double light = 1) {
   return p;
 }
 
-// The ray caster: the picture of the tets `set` as the volume-rendering integral along each pixel's ray.
+// The ray caster: the picture of the tets `set` as the volume-rendering integral along each pixel's ray
+// (a W x H picture; where `cast` is given, only the pixels it marks, the others white).
 Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint32_t> set,
-                     std::span<const double> corner, const VolumeParams& p) {
-  const Projector proj(cam, kW, kH);
+                     std::span<const double> corner, const VolumeParams& p, int W = kW, int H = kH,
+                     const std::vector<char>* cast = nullptr) {
+  const Projector proj(cam, W, H);
   std::vector<std::array<double, 12>> P(set.size());  // camera coordinates of the corners
   for (std::size_t i = 0; i < set.size(); ++i)
     for (int k = 0; k < 4; ++k)
       proj.to_camera(&m.xyz[3 * std::size_t(m.tet[4 * std::size_t(set[i]) + std::size_t(k)])],
                      &P[i][3 * std::size_t(k)]);
-  Framebuffer fb(kW, kH);
+  Framebuffer fb(W, H);
   struct Seg {
     double s0, s1, v0, v1;
   };
-  for (int y = 0; y < kH; ++y)
-    for (int x = 0; x < kW; ++x) {
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (cast && !(*cast)[fb.index(x, y)]) continue;
       double o[3], d[3];
       test::pixel_ray(proj, x, y, o, d);
       std::vector<Seg> segs;
@@ -149,8 +152,8 @@ Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint
 
 Framebuffer paint(const Mesh& m, const Camera& cam, std::span<const std::uint32_t> order,
                   std::span<const double> corner, const VolumeParams& p, std::size_t* samples = nullptr,
-                  std::size_t* pre_integrated = nullptr) {
-  VolumePainter painter(m, cam, kW, kH, corner, p);
+                  std::size_t* pre_integrated = nullptr, int W = kW, int H = kH) {
+  VolumePainter painter(m, cam, W, H, corner, p);
   const std::size_t half = order.size() / 2;
   painter.draw(order.first(half));  // progressive: two batches
   painter.draw(order.subspan(half));
@@ -237,6 +240,43 @@ TEST(Volume, NonConvexSubsetMatchesTheRayCaster) {
   for (std::uint32_t t = 0; t < m.tet_count(); ++t)
     if (rng() % 2 == 0) subset.push_back(t);
   check(m, subset, 6, 63, "random half");
+}
+
+// A picture of several screen tiles (the painter bins tets to tiles of 128 x 64 pixels, each thread
+// drawing whole tiles): the ray caster at the pixels either side of every tile border and on a grid,
+// and one thread's picture the same as two threads'.
+TEST(Volume, TiledPictureMatchesTheRayCaster) {
+  test::TempDir dir;
+  const Mesh m = test::random_delaunay(dir, 200, 9);
+  const SphereTable table = compute_spheres(m);
+  const std::vector<double> corner = smooth_field(m);
+  VolumeParams p = params_for(m);
+  constexpr int W = 300, H = 150;
+  std::vector<char> cast(std::size_t(W) * H, 0);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      cast[std::size_t(y) * W + std::size_t(x)] =
+          (x % 6 == 0 && y % 6 == 0) || (x + 2) % 128 < 4 || (y + 2) % 64 < 4;
+  std::size_t bad = 0, covered = 0, compared = 0;
+  int worst = 0;
+  for (const Camera& cam : test::random_cameras(m, std::max(2, 3 / kCameraShare), 65, double(W) / H)) {
+    const std::vector<std::uint32_t> order = visibility_order(m, table, view_of(cam));
+    p.threads = 2;
+    Framebuffer got = paint(m, cam, order, corner, p, nullptr, nullptr, W, H);
+    p.threads = 1;
+    EXPECT_EQ(got.rgba, paint(m, cam, order, corner, p, nullptr, nullptr, W, H).rgba);
+    const Framebuffer want = ray_cast(m, cam, order, corner, p, W, H, &cast);
+    for (std::size_t i = 0; i < cast.size(); ++i) {
+      if (!cast[i]) got.rgba[i] = pack_rgba(255, 255, 255);
+      covered += cast[i] && want.rgba[i] != pack_rgba(255, 255, 255);
+      compared += cast[i];
+    }
+    bad += differing(got, want, 2, &worst);
+  }
+  std::printf("tiled: %zu of %zu compared pixels covered, %zu differ by more than 2/255 (worst %d)\n", covered,
+              compared, bad, worst);
+  EXPECT_GT(covered, compared / 4);
+  EXPECT_EQ(bad, 0u);
 }
 
 TEST(Volume, SafePictureSaysWhichOrder) {
