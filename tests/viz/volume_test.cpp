@@ -273,8 +273,8 @@ TEST(Volume, TiledPictureMatchesTheRayCaster) {
     }
     bad += differing(got, want, 2, &worst);
   }
-  std::printf("tiled: %zu of %zu compared pixels covered, %zu differ by more than 2/255 (worst %d)\n", covered,
-              compared, bad, worst);
+  std::printf("tiled: %zu of %zu compared pixels covered, %zu differ by more than 2/255 (worst %d)\n",
+              covered, compared, bad, worst);
   EXPECT_GT(covered, compared / 4);
   EXPECT_EQ(bad, 0u);
 }

@@ -313,9 +313,10 @@ void composite(const TableTransfer& tf, double v_far, double v_near, double len,
 // Whether this CPU runs volume_row_avx512; FOXI_PORTABLE_RASTER=1 says no (the painter's switch),
 // so that the tests can compare the two paths on one machine.
 bool volume_avx512() {
-  static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                          __builtin_cpu_supports("avx512dq") &&
-                          !(std::getenv("FOXI_PORTABLE_RASTER") && std::getenv("FOXI_PORTABLE_RASTER")[0] == '1');
+  static const bool yes =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+      __builtin_cpu_supports("avx512dq") &&
+      !(std::getenv("FOXI_PORTABLE_RASTER") && std::getenv("FOXI_PORTABLE_RASTER")[0] == '1');
   return yes;
 }
 
@@ -324,8 +325,9 @@ bool volume_avx512() {
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12's own _mm512_undefined_pd in its intrinsics
 #endif
 // A + x B + y C, in TetSetup::segment's order.
-__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline __m512d linear_xy(__m512d xf, __m512d yf, double A,
-                                                                                double B, double C) {
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline __m512d linear_xy(__m512d xf, __m512d yf,
+                                                                                   double A, double B,
+                                                                                   double C) {
   return _mm512_add_pd(_mm512_add_pd(_mm512_set1_pd(A), _mm512_mul_pd(xf, _mm512_set1_pd(B))),
                        _mm512_mul_pd(yf, _mm512_set1_pd(C)));
 }
@@ -432,10 +434,11 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
         // colour map's entry of the scale position.
         const __m512d vm = _mm512_mul_pd(_mm512_set1_pd(0.5), _mm512_add_pd(v_far, v_near));
         const __m512d xt = _mm512_min_pd(
-            _mm512_max_pd(_mm512_mul_pd(_mm512_sub_pd(vm, _mm512_set1_pd(tf.lo)), _mm512_set1_pd(tf.inv_step)),
-                          zero),
+            _mm512_max_pd(
+                _mm512_mul_pd(_mm512_sub_pd(vm, _mm512_set1_pd(tf.lo)), _mm512_set1_pd(tf.inv_step)), zero),
             _mm512_set1_pd(double(TableTransfer::kN)));
-        const __m256i it = _mm256_min_epi32(_mm512_cvttpd_epi32(xt), _mm256_set1_epi32(TableTransfer::kN - 1));
+        const __m256i it =
+            _mm256_min_epi32(_mm512_cvttpd_epi32(xt), _mm256_set1_epi32(TableTransfer::kN - 1));
         const __m512d ft = _mm512_sub_pd(xt, _mm512_cvtepi32_pd(it));
         const __m512d t0 = _mm512_mask_i32gather_pd(zero, thin, it, tf.tau_at.data(), 8);
         const __m512d t1 = _mm512_mask_i32gather_pd(zero, thin, it, tf.tau_at.data() + 1, 8);
@@ -443,12 +446,14 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
         const __mmask8 ok = __mmask8(thin & _mm512_cmp_pd_mask(Dt, one, _CMP_LE_OQ));
         const __m512d pos = _mm512_div_pd(_mm512_sub_pd(vm, _mm512_set1_pd(tf.p->scale.lo)),
                                           _mm512_set1_pd(tf.p->scale.hi - tf.p->scale.lo));
-        const __m256i entry = _mm512_cvttpd_epi32(_mm512_min_pd(_mm512_max_pd(_mm512_mul_pd(pos, c256), zero), c255));
+        const __m256i entry =
+            _mm512_cvttpd_epi32(_mm512_min_pd(_mm512_max_pd(_mm512_mul_pd(pos, c256), zero), c255));
         const __m256i k3 = _mm256_mullo_epi32(entry, _mm256_set1_epi32(3));
         D = _mm512_mask_mov_pd(D, ok, Dt);
         for (int j = 0; j < 3; ++j)
           em[j] = _mm512_mask_mov_pd(
-              em[j], ok, _mm512_cvtps_pd(_mm256_mmask_i32gather_ps(_mm256_setzero_ps(), ok, k3, &tf.lut[0][j], 4)));
+              em[j], ok,
+              _mm512_cvtps_pd(_mm256_mmask_i32gather_ps(_mm256_setzero_ps(), ok, k3, &tf.lut[0][j], 4)));
         blend |= ok;
       }
       if (blend) {
@@ -456,9 +461,10 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
         const __m512d q = _mm512_mul_pd(_mm512_set1_pd(0.125), D), q2 = _mm512_mul_pd(q, q);
         __m512d e = _mm512_add_pd(
             _mm512_add_pd(_mm512_sub_pd(one, q),
-                          _mm512_mul_pd(q2, _mm512_sub_pd(_mm512_set1_pd(0.5), _mm512_mul_pd(q, _mm512_set1_pd(1.0 / 6))))),
-            _mm512_mul_pd(_mm512_mul_pd(q2, q2),
-                          _mm512_sub_pd(_mm512_set1_pd(1.0 / 24), _mm512_mul_pd(q, _mm512_set1_pd(1.0 / 120)))));
+                          _mm512_mul_pd(q2, _mm512_sub_pd(_mm512_set1_pd(0.5),
+                                                          _mm512_mul_pd(q, _mm512_set1_pd(1.0 / 6))))),
+            _mm512_mul_pd(_mm512_mul_pd(q2, q2), _mm512_sub_pd(_mm512_set1_pd(1.0 / 24),
+                                                               _mm512_mul_pd(q, _mm512_set1_pd(1.0 / 120)))));
         e = _mm512_mul_pd(e, e);
         e = _mm512_mul_pd(e, e);
         e = _mm512_mul_pd(e, e);
@@ -482,8 +488,8 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
       _mm512_store_pd(ln, len);
       for (int i = 0; i < 8; ++i)
         if (rest >> i & 1)
-          composite(tf, vf[i], vn[i], ln[i], acc[std::size_t(ys[i0 + i]) * std::size_t(width) + std::size_t(xs[i0 + i])].c,
-                    fast);
+          composite(tf, vf[i], vn[i], ln[i],
+                    acc[std::size_t(ys[i0 + i]) * std::size_t(width) + std::size_t(xs[i0 + i])].c, fast);
     }
   }
 }
@@ -505,7 +511,7 @@ struct VolumePainter::Impl {
   VolumeParams params;
   int lanes = 1;
   std::vector<Pixel> acc;
-  bool vector_rows = false;  // volume_row_avx512 for the pixel rows
+  bool vector_rows = false;     // volume_row_avx512 for the pixel rows
   std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
@@ -533,8 +539,7 @@ struct VolumePainter::Impl {
     const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
     for (int k = 0; k < 4; ++k) {
       const double* q = &node_px[2 * std::size_t(node[k])];
-      if (std::isnan(q[0]))
-        return {0, std::uint16_t(tiles_x - 1), 0, std::uint16_t(tiles_y - 1)};
+      if (std::isnan(q[0])) return {0, std::uint16_t(tiles_x - 1), 0, std::uint16_t(tiles_y - 1)};
       x_lo = std::min(x_lo, q[0]);
       x_hi = std::max(x_hi, q[0]);
       y_lo = std::min(y_lo, q[1]);
@@ -556,7 +561,8 @@ struct VolumePainter::Impl {
     for (std::size_t i = 0; i < tets.size(); ++i) {
       const auto b = tet_tiles[i] = tiles_of(tets[i]);
       for (int ty = b[2]; ty <= b[3]; ++ty)
-        for (int tx = b[0]; tx <= b[1]; ++tx) ++tile_start[std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx) + 1];
+        for (int tx = b[0]; tx <= b[1]; ++tx)
+          ++tile_start[std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx) + 1];
     }
     for (std::size_t k = 0; k < n_tiles; ++k) tile_start[k + 1] += tile_start[k];
     tile_tets.resize(tile_start[n_tiles]);
@@ -666,14 +672,16 @@ struct VolumePainter::Impl {
     auto flush = [&] {
 #ifdef FOXI_VOLUME_AVX512
       if (vector_rows) {
-        volume_pixels_avx512(r, *transfer, acc.data(), proj.width, scratch.xs, scratch.ys, n_px, t, count, fast);
+        volume_pixels_avx512(r, *transfer, acc.data(), proj.width, scratch.xs, scratch.ys, n_px, t, count,
+                             fast);
         n_px = 0;
         return;
       }
 #endif
       for (int i = 0; i < n_px; ++i) {
         double v_far, v_near, len;
-        if (!r.segment(scratch.xs[i], scratch.ys[i], v_far, v_near, len)) continue;  // a snapped edge pixel the ray misses
+        if (!r.segment(scratch.xs[i], scratch.ys[i], v_far, v_near, len))
+          continue;  // a snapped edge pixel the ray misses
         Pixel& pix = acc[std::size_t(scratch.ys[i]) * std::size_t(proj.width) + std::size_t(scratch.xs[i])];
         composite(*transfer, v_far, v_near, len, pix.c, fast);
         pix.front = t;
