@@ -16,6 +16,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "foxi/model/delaunay.hpp"
 #include "foxi/viz/visibility_order.hpp"
@@ -553,26 +554,45 @@ struct VolumePainter::Impl {
             tile(y_hi + 1, kTileH, tiles_y)};
   }
 
-  // The batch's tets into the tiles' lists (tile_start, tile_tets), each list in the batch's order.
+  // The batch's tets into the tiles' lists (tile_start, tile_tets), each list in the batch's order:
+  // the batch cut into `lanes` consecutive parts, each part's tets counted per tile and then written
+  // by its own thread after the earlier parts' (so the order holds within each tile).
   void bin(std::span<const std::uint32_t> tets) {
     const std::size_t n_tiles = std::size_t(tiles_x) * std::size_t(tiles_y);
-    tile_start.assign(n_tiles + 1, 0);
+    const std::size_t parts = std::size_t(lanes);
     tet_tiles.resize(tets.size());
-    for (std::size_t i = 0; i < tets.size(); ++i) {
-      const auto b = tet_tiles[i] = tiles_of(tets[i]);
+    cursor.assign(parts * n_tiles, 0);  // per part: its count per tile, then where it writes next
+    auto part_range = [&](std::size_t part) {
+      return std::pair{tets.size() * part / parts, tets.size() * (part + 1) / parts};
+    };
+    auto each_tile = [&](const std::array<std::uint16_t, 4>& b, auto&& fn) {
       for (int ty = b[2]; ty <= b[3]; ++ty)
-        for (int tx = b[0]; tx <= b[1]; ++tx)
-          ++tile_start[std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx) + 1];
+        for (int tx = b[0]; tx <= b[1]; ++tx) fn(std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx));
+    };
+    run_parts(lanes, [&](int lane) {
+      const auto [i0, i1] = part_range(std::size_t(lane));
+      std::uint32_t* count = &cursor[std::size_t(lane) * n_tiles];
+      for (std::size_t i = i0; i < i1; ++i)
+        each_tile(tet_tiles[i] = tiles_of(tets[i]), [&](std::size_t k) { ++count[k]; });
+    });
+    tile_start.assign(n_tiles + 1, 0);
+    std::uint32_t total = 0;
+    for (std::size_t k = 0; k < n_tiles; ++k) {
+      tile_start[k] = total;
+      for (std::size_t part = 0; part < parts; ++part) {
+        const std::uint32_t c = cursor[part * n_tiles + k];
+        cursor[part * n_tiles + k] = total;
+        total += c;
+      }
     }
-    for (std::size_t k = 0; k < n_tiles; ++k) tile_start[k + 1] += tile_start[k];
-    tile_tets.resize(tile_start[n_tiles]);
-    cursor.assign(tile_start.begin(), tile_start.end() - 1);
-    for (std::size_t i = 0; i < tets.size(); ++i) {
-      const auto b = tet_tiles[i];
-      for (int ty = b[2]; ty <= b[3]; ++ty)
-        for (int tx = b[0]; tx <= b[1]; ++tx)
-          tile_tets[cursor[std::size_t(ty) * std::size_t(tiles_x) + std::size_t(tx)]++] = tets[i];
-    }
+    tile_start[n_tiles] = total;
+    tile_tets.resize(total);
+    run_parts(lanes, [&](int lane) {
+      const auto [i0, i1] = part_range(std::size_t(lane));
+      std::uint32_t* next = &cursor[std::size_t(lane) * n_tiles];
+      for (std::size_t i = i0; i < i1; ++i)
+        each_tile(tet_tiles[i], [&](std::size_t k) { tile_tets[next[k]++] = tets[i]; });
+    });
   }
 
   // A thread's list of the pixels of the tet it draws.
