@@ -712,10 +712,17 @@ struct VolumePainter::Impl {
     auto add_run = [&](int y, int lo, int hi) {
       lo = std::max(lo, tile.x0);
       hi = std::min(hi, tile.x1);
-      for (int x = lo; x <= hi; ++x) {
-        if (n_px == Scratch::kRun) flush();
-        scratch.xs[n_px] = x;
-        scratch.ys[n_px++] = y;
+      // Eight entries at a time (a fixed count the compiler writes as vectors), those past hi left
+      // beyond n_px: the list keeps room for eight.
+      for (int x = lo; x <= hi;) {
+        if (n_px > Scratch::kRun - 8) flush();
+        for (int i = 0; i < 8; ++i) {
+          scratch.xs[n_px + i] = x + i;
+          scratch.ys[n_px + i] = y;
+        }
+        const int m = std::min(8, hi - x + 1);
+        n_px += m;
+        x += m;
       }
     };
     // No node before the near plane clip_near would use for any face (the usual case): the four
