@@ -533,18 +533,51 @@ struct VolumePainter::Impl {
   std::vector<std::array<std::uint16_t, 4>> tet_tiles;  // per tet of the batch: tiles x0, x1, y0, y1
 
   // The tiles tet t's projection can touch (the bounds of its nodes' pixels, a pixel wider: the
-  // rasterized pixels' centres lie in the snapped projection); all of them for a tet with a node not
-  // in front of the eye (its near-plane clip is not inside those bounds); none off screen.
+  // rasterized pixels' centres lie in the snapped projection); none off screen. A tet with a node not
+  // in front of the eye: the bounds of its part at depth >= nb, nb the least near plane clip_near
+  // can use for any of its faces (that part holds every face's clipped polygon).
   std::array<std::uint16_t, 4> tiles_of(std::uint32_t t) const {
     double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo, y_lo = x_lo, y_hi = -x_lo;
-    const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
-    for (int k = 0; k < 4; ++k) {
-      const double* q = &node_px[2 * std::size_t(node[k])];
-      if (std::isnan(q[0])) return {0, std::uint16_t(tiles_x - 1), 0, std::uint16_t(tiles_y - 1)};
+    auto add = [&](const double* q) {
       x_lo = std::min(x_lo, q[0]);
       x_hi = std::max(x_hi, q[0]);
       y_lo = std::min(y_lo, q[1]);
       y_hi = std::max(y_hi, q[1]);
+    };
+    const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
+    bool behind = false;
+    for (int k = 0; k < 4; ++k) behind = behind || std::isnan(node_px[2 * std::size_t(node[k])]);
+    if (!behind) {
+      for (int k = 0; k < 4; ++k) add(&node_px[2 * std::size_t(node[k])]);
+    } else {
+      const double* P[4];
+      double dmin = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < 4; ++k) {
+        P[k] = &cam_xyz[3 * std::size_t(node[k])];
+        dmin = std::min(dmin, std::sqrt(P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]));
+      }
+      // clip_near: a face's plane is max(near, dmax * focal / kMaxPixel), dmax over its corners.
+      const double nb = std::max(params.near, dmin * proj.focal / kMaxPixel);
+      if (!(nb > 0)) return {0, std::uint16_t(tiles_x - 1), 0, std::uint16_t(tiles_y - 1)};
+      for (int i = 0; i < 4; ++i) {
+        double q[2];
+        if (P[i][2] >= nb) {
+          proj.camera_to_pixel(P[i], q);
+          add(q);
+        }
+        for (int j = i + 1; j < 4; ++j)
+          if ((P[i][2] < nb) != (P[j][2] < nb)) {
+            const double u = (nb - P[i][2]) / (P[j][2] - P[i][2]);
+            const double c[3] = {P[i][0] + u * (P[j][0] - P[i][0]), P[i][1] + u * (P[j][1] - P[i][1]), nb};
+            proj.camera_to_pixel(c, q);
+            add(q);
+          }
+      }
+      // Snapping and the rounding of the cut points: a few pixels more.
+      x_lo -= 4;
+      y_lo -= 4;
+      x_hi += 4;
+      y_hi += 4;
     }
     if (!(x_hi >= -1 && y_hi >= -1 && x_lo <= proj.width + 1 && y_lo <= proj.height + 1)) return {1, 0, 1, 0};
     auto tile = [](double p, int size, int count) {
