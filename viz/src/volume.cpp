@@ -605,8 +605,15 @@ struct VolumePainter::Impl {
     run_parts(lanes, [&](int lane) {
       const auto [i0, i1] = part_range(std::size_t(lane));
       std::uint32_t* count = &cursor[std::size_t(lane) * n_tiles];
-      for (std::size_t i = i0; i < i1; ++i)
+      for (std::size_t i = i0; i < i1; ++i) {
+        // Fetched ahead as in draw(): the order's tets lie far apart in memory.
+        if (i + 8 < i1) __builtin_prefetch(&mesh->tet[4 * std::size_t(tets[i + 8])]);
+        if (i + 4 < i1) {
+          const std::uint32_t* node = &mesh->tet[4 * std::size_t(tets[i + 4])];
+          for (int j = 0; j < 4; ++j) __builtin_prefetch(&node_px[2 * std::size_t(node[j])]);
+        }
         each_tile(tet_tiles[i] = tiles_of(tets[i]), [&](std::size_t k) { ++count[k]; });
+      }
     });
     tile_start.assign(n_tiles + 1, 0);
     std::uint32_t total = 0;
@@ -873,8 +880,20 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
       const int tx = k % s.tiles_x, ty = k / s.tiles_x;
       const Impl::Tile tile{tx * Impl::kTileW, std::min(s.proj.width, (tx + 1) * Impl::kTileW) - 1,
                             ty * Impl::kTileH, std::min(s.proj.height, (ty + 1) * Impl::kTileH) - 1};
-      for (std::uint32_t i = s.tile_start[std::size_t(k)]; i < s.tile_start[std::size_t(k) + 1]; ++i)
+      const std::uint32_t end = s.tile_start[std::size_t(k) + 1];
+      for (std::uint32_t i = s.tile_start[std::size_t(k)]; i < end; ++i) {
+        // The order visits tets far apart in memory: their nodes and values are fetched ahead (the
+        // node indices 8 tets ahead, the nodes' coordinates 4 ahead), else draw_tet waits on them.
+        if (i + 8 < end) {
+          __builtin_prefetch(&s.mesh->tet[4 * std::size_t(s.tile_tets[i + 8])]);
+          __builtin_prefetch(&s.corner[4 * std::size_t(s.tile_tets[i + 8])]);
+        }
+        if (i + 4 < end) {
+          const std::uint32_t* node = &s.mesh->tet[4 * std::size_t(s.tile_tets[i + 4])];
+          for (int j = 0; j < 4; ++j) __builtin_prefetch(&s.cam_xyz[3 * std::size_t(node[j])]);
+        }
         s.draw_tet(s.tile_tets[i], tile, *scratch, count, fast);
+      }
     }
     s.lane_samples[std::size_t(lane)] += count;
     s.lane_fast[std::size_t(lane)] += fast;
