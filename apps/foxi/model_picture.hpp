@@ -6,16 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "foxi/viz/model_picture.hpp"
 #include "model_run.hpp"
 
 namespace foxi::cli {
-
-enum class ModelView : std::uint8_t {
-  exploded,  // each part lifted in z by its index times a gap: every part shows whole
-  cut,       // only tets with centroids at y >= the middle: the inside shows (jagged at the cut)
-  whole,     // the mesh as it is
-  interior,  // the far 60 % of the visibility order, each tet shrunk to 85 % (the paper's view inside)
-};
 
 struct ModelPictureParams {
   int width = 1280, height = 960;
