@@ -31,6 +31,7 @@ QPushButton* Workbench::build_model_panel() {
     if (!f.isEmpty() && open_model(f)) settings.setValue("last_model", f);
   });
   lv->addWidget(open);
+  lv->addLayout(build_model_file_row());
   lv->addLayout(build_project_row());
   params_ = new QTableWidget(0, 3);
   params_->setObjectName("parameters");
@@ -47,6 +48,7 @@ QPushButton* Workbench::build_model_panel() {
   model_text_ = new QPlainTextEdit;
   model_text_->setReadOnly(true);
   lv->addWidget(model_text_, 1);
+  lv->addWidget(build_parts_picture(), 1);
   auto* jobs = new QHBoxLayout;
   mesh_button_ = new QPushButton(tr("Mesh"));
   solve_button_ = new QPushButton(tr("Solve (thermal)"));
@@ -197,6 +199,7 @@ void Workbench::refresh_model_panel() {
     model_text_->setPlainText(text);
   }
   filling_ = false;
+  refresh_parts_picture();
 }
 
 }  // namespace foxi::workbench

@@ -108,13 +108,18 @@ struct ProjectSnapshot {
   std::filesystem::path dir;
   QJsonObject json;
   std::shared_ptr<const Mesh> mesh;
+  // The mesh file of the folder's project.json that already holds `mesh` (written by the last
+  // autosave of the same mesh object), kept instead of written again; empty: write the mesh.
+  std::string mesh_written;
 };
 
 namespace {
 
 // Writes the mesh under a new name, then project.json naming it (both DurableFile: each whole or
-// not at all), then removes the mesh file the previous project.json named.
-void write_project(ProjectSnapshot snap) {
+// not at all), then removes the mesh file the previous project.json named. A mesh the folder holds
+// already (snap.mesh_written, still named by project.json) is not written again. Returns the mesh
+// file project.json names ("" for none).
+std::string write_project(ProjectSnapshot snap) {
   const std::filesystem::path& dir = snap.dir;
   std::filesystem::create_directories(dir);
   std::filesystem::path old_mesh;
@@ -125,7 +130,10 @@ void write_project(ProjectSnapshot snap) {
       if (!m.isEmpty()) old_mesh = dir / m.toStdString();
     }
   }
-  if (snap.mesh) {
+  if (snap.mesh && !snap.mesh_written.empty() && dir / snap.mesh_written == old_mesh &&
+      std::filesystem::exists(old_mesh)) {
+    snap.json["mesh"] = QString::fromStdString(snap.mesh_written);  // unchanged since it was written
+  } else if (snap.mesh) {
     // A new name each save: the previous project.json names a whole mesh until the new one is in.
     std::string name;
     for (int i = 1;; ++i) {
@@ -141,6 +149,7 @@ void write_project(ProjectSnapshot snap) {
   if (!old_mesh.empty() && old_mesh.filename().string() != snap.json["mesh"].toString().toStdString() &&
       old_mesh.filename().string().rfind("mesh-", 0) == 0)
     std::filesystem::remove(old_mesh);
+  return snap.json["mesh"].toString().toStdString();
 }
 
 }  // namespace
@@ -234,9 +243,19 @@ void Workbench::autosave() {
   }
   try {
     ProjectSnapshot snap = project_snapshot(autosave_folder_);
-    autosaving_ = QtConcurrent::run([snap = std::move(snap)]() -> QString {
+    // The mesh (with its fields: the results) only when it changed since the last autosave wrote it
+    if (const auto written = autosaved_mesh_.lock();
+        written && written == mesh_ && autosaved_folder_ == autosave_folder_)
+      snap.mesh_written = autosaved_mesh_name_;
+    autosaved_mesh_.reset();
+    autosaved_folder_ = autosave_folder_;
+    autosaving_ = QtConcurrent::run([this, snap = std::move(snap)]() -> QString {
       try {
-        write_project(snap);
+        const std::string name = write_project(snap);
+        // read by the GUI thread only after this future finished (autosave() waits for it)
+        autosaved_mesh_name_ = name;
+        autosaved_mesh_ = snap.mesh;
+        if (!snap.mesh_written.empty() && name == snap.mesh_written) ++mesh_writes_saved_;
         return {};
       } catch (const std::exception& e) {
         return QString::fromStdString(e.what());

@@ -75,6 +75,7 @@ void Workbench::build_ui() {
   key(QKeySequence("Ctrl+R"), [this] { start_solve(); });
   key(QKeySequence("Escape"), [this] { cancel(); });
   key(QKeySequence::Save, [save] { save->click(); });
+  key(QKeySequence("Ctrl+Shift+S"), [this] { save_model_file(); });
   key(QKeySequence::Undo, [this] { undo(); });
   key(QKeySequence::Redo, [this] { redo(); });
   resize(1280, 860);

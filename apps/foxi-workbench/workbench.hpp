@@ -8,6 +8,7 @@
 #pragma once
 
 #include <QFuture>
+#include <QImage>
 #include <QMainWindow>
 #include <QString>
 #include <QStringList>
@@ -96,6 +97,20 @@ class Workbench : public QMainWindow {
   // redo (or the model file no longer loads with those values).
   bool undo();
   bool redo();
+  // Writes the open model file with the current parameter values to `path` (empty: over the open
+  // file) by save_model (foxi/model/model_save.hpp: only the values' text changes, references stay
+  // valid, refused unless it loads back equal); the workbench then works on the saved file with no
+  // overrides. False (nothing written) with the reason (file:line: reason) in `error` and shown.
+  bool save_model_file(const QString& path = {}, QString* error = nullptr);
+  // The model panel's exploded parts picture: foxi model show's (the same coarse mesh, drawing and
+  // colours, draw_model_picture) of `model` with `overrides`, width x height. A null image with the
+  // reason in `error` when the model does not mesh. Static: the panel runs it on a worker.
+  static QImage parts_picture(const QString& model, const std::vector<ParameterOverride>& overrides,
+                              int width, int height, QString* error = nullptr);
+  // The picture the panel shows now (null until the worker has drawn it); parts_pictures(): drawn so far.
+  QImage shown_parts_picture() const { return parts_image_; }
+  int parts_pictures() const { return parts_pictures_; }
+
   // The current overrides (name=expression), and the model as loaded with them.
   std::vector<ParameterOverride> overrides() const;
   const Model* model() const { return model_.get(); }
@@ -165,6 +180,8 @@ class Workbench : public QMainWindow {
   // first change of a burst, written on a worker as save_project writes). autosaves(): started so far.
   void set_autosave_folder(const QString& folder);
   int autosaves() const { return autosaves_; }
+  // Autosaves that kept the mesh file already written (the mesh and results unchanged since).
+  int autosaves_without_mesh() const { return mesh_writes_saved_; }
   void wait_autosave();  // the running autosave written (for tests and quitting)
 
   std::shared_ptr<const Mesh> mesh() const { return mesh_; }
@@ -192,6 +209,10 @@ class Workbench : public QMainWindow {
   void build_mesh_panel();           // mesh_panel.cpp
   void build_results_panel();        // solve_panel.cpp
   void build_history_panel();        // history.cpp
+  // model_file.cpp: Save model, Save model as; the exploded parts picture, redrawn on a worker
+  QHBoxLayout* build_model_file_row();
+  QLabel* build_parts_picture();
+  void refresh_parts_picture();
   void refresh_model_panel();
   void on_parameter_edited(int row, int column);
   bool start_job(bool mesh, bool solve);
@@ -235,7 +256,12 @@ class Workbench : public QMainWindow {
   QString autosave_folder_;
   QTimer* autosave_timer_ = nullptr;
   QFuture<QString> autosaving_;
-  int autosaves_ = 0;         // a reopened project's, for the next display
+  int autosaves_ = 0;  // a reopened project's, for the next display
+  // The mesh the last autosave wrote (set on its worker, read after it finished) and its file
+  std::weak_ptr<const Mesh> autosaved_mesh_;
+  std::string autosaved_mesh_name_;
+  QString autosaved_folder_;
+  std::atomic<int> mesh_writes_saved_{0};
   FieldSelection selection_;  // of selection_field_ (SI)
   QString selection_field_;
   DisplayUnit unit_;
@@ -255,6 +281,11 @@ class Workbench : public QMainWindow {
   QPlainTextEdit* model_text_ = nullptr;
   QPlainTextEdit* quality_text_ = nullptr;
   QLabel* histogram_ = nullptr;
+  QLabel* parts_label_ = nullptr;
+  QImage parts_image_;
+  int parts_pictures_ = 0;
+  std::size_t parts_serial_ = 0;  // the latest request: an older worker's picture is dropped
+  QString parts_key_;             // the model and overrides it was requested for
   QPushButton *mesh_button_ = nullptr, *solve_button_ = nullptr, *cancel_button_ = nullptr;
   QProgressBar* progress_ = nullptr;
   QTableWidget* results_table_ = nullptr;

@@ -12,12 +12,14 @@
 #include <QLineEdit>
 #include <QMouseEvent>
 #include <QTableWidget>
+#include <QThread>
 #include <QTimer>
 #include <QWheelEvent>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <regex>
 #include <span>
@@ -273,6 +275,87 @@ TEST(Workbench, ParameterEditingWithUnits) {
   // A die wider than the substrate is a model the library refuses? Not necessarily; a negative size is.
   EXPECT_FALSE(w.set_parameter("die_h", "-1 mm", &error));
   EXPECT_NEAR(value_of("die_d"), 0.003, 1e-15);
+}
+
+// Save model as: the file written holds the edited values (load_model of it gives the parameters
+// and parts of the source with the overrides), the workbench goes on with it and no overrides; a
+// refused save (a folder that does not exist) writes nothing and keeps the state.
+TEST(Workbench, SaveModelAsKeepsTheEditedValues) {
+  TempDir dir;
+  Workbench w;
+  const std::string source = kModels + "die_on_substrate.toml";
+  ASSERT_TRUE(w.open_model(QString::fromStdString(source)));
+  ASSERT_TRUE(w.set_parameter("die_w", "6 mm"));
+  ASSERT_TRUE(w.set_parameter("sub_h", "2 * die_h"));
+  const std::vector<foxi::ParameterOverride> values = w.overrides();
+  const foxi::Model expected = foxi::load_model(source, values);
+  QString error;
+  EXPECT_FALSE(w.save_model_file(QString::fromStdString((dir.path() / "no" / "m.toml").string()), &error));
+  EXPECT_TRUE(error.contains("m.toml")) << error.toStdString();
+  EXPECT_EQ(w.overrides().size(), 2u);
+  const auto target = dir.path() / "m.toml";
+  ASSERT_TRUE(w.save_model_file(QString::fromStdString(target.string()), &error)) << error.toStdString();
+  const foxi::Model saved = foxi::load_model(target, std::span<const foxi::ParameterOverride>{});
+  ASSERT_EQ(saved.parameters.size(), expected.parameters.size());
+  for (std::size_t i = 0; i < saved.parameters.size(); ++i)
+    EXPECT_EQ(saved.parameters[i].value.value, expected.parameters[i].value.value)
+        << saved.parameters[i].name;
+  ASSERT_EQ(saved.parts.size(), expected.parts.size());
+  for (std::size_t i = 0; i < saved.parts.size(); ++i)
+    EXPECT_EQ(saved.parts[i].prisms[0].xy, expected.parts[i].prisms[0].xy);
+  EXPECT_TRUE(w.overrides().empty());
+  ASSERT_TRUE(w.model());
+  EXPECT_EQ(w.model()->file, target.string());
+  // Save over it: the same text (nothing to change)
+  const std::string text = foxi::test::read_text(target);
+  EXPECT_TRUE(w.save_model_file({}, &error)) << error.toStdString();
+  EXPECT_EQ(foxi::test::read_text(target), text);
+}
+
+// The model panel's exploded parts picture equals foxi model show's, pixel for pixel (the CLI as the
+// second program drawing it), and follows a parameter edit.
+TEST(Workbench, PartsPictureEqualsFoxiModelShow) {
+  TempDir dir;
+  const std::string model = kModels + "flip_chip.toml";
+  const auto png = dir.path() / "show.png", log = dir.path() / "show.log";
+  ASSERT_EQ(foxi::test::run_cli(
+                "model show '" + model + "' --set die_w=5mm --size 320x240 -o '" + png.string() + "'", log),
+            0)
+      << foxi::test::read_text(log);
+  const foxi::Framebuffer cli = foxi::read_png(png);
+  QString error;
+  const QImage image =
+      Workbench::parts_picture(QString::fromStdString(model), {{"die_w", "5mm"}}, 320, 240, &error);
+  ASSERT_FALSE(image.isNull()) << error.toStdString();
+  ASSERT_EQ(image.width(), cli.width);
+  ASSERT_EQ(image.height(), cli.height);
+  const QImage rgba = image.convertToFormat(QImage::Format_RGBA8888);
+  std::size_t differ = 0, coloured = 0;
+  for (int y = 0; y < cli.height; ++y)
+    for (int x = 0; x < cli.width; ++x) {
+      std::uint32_t p;
+      std::memcpy(&p, rgba.constScanLine(y) + 4 * x, 4);
+      differ += p != cli.rgba[std::size_t(y) * cli.width + x];
+      coloured += p != foxi::pack_rgba(255, 255, 255);
+    }
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(coloured, 320u * 240u / 10);  // the parts fill a good part of it
+  // the panel: drawn on a worker for the model as opened, again after an edit
+  Workbench w;
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  auto wait_pictures = [&](int n) {
+    for (int i = 0; i < 600 && w.parts_pictures() < n; ++i) {
+      QCoreApplication::processEvents(QEventLoop::AllEvents, 50);
+      QThread::msleep(10);
+    }
+    return w.parts_pictures() >= n;
+  };
+  ASSERT_TRUE(wait_pictures(1));
+  const QImage first = w.shown_parts_picture();
+  ASSERT_FALSE(first.isNull());
+  ASSERT_TRUE(w.set_parameter("die_w", "5mm"));
+  ASSERT_TRUE(wait_pictures(2));
+  EXPECT_NE(w.shown_parts_picture(), first);
 }
 
 // Editing the table's cell as a user does: a refused value's message shows next to the table (the
@@ -672,6 +755,62 @@ TEST(WorkbenchHeadless, KilledSaveLeavesAProjectThatOpens) {
 
 // Autosave: within 5 s of a parameter change the autosave folder holds a project with it (written on
 // a worker), which reopens with that value.
+// Autosave writes the mesh (with the results' fields) only when it changed: a view change rewrites
+// project.json and keeps the mesh file as it was (same name, size and modification time); a remesh
+// writes a new one.
+TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "auto").string());
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w));
+  w.set_autosave_folder(folder);
+  const auto json = dir.path() / "auto" / "project.json";
+  auto autosave_after = [&](int n) {  // waits for autosave number n to be written
+    const auto t0 = std::chrono::steady_clock::now();
+    while (w.autosaves() < n && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(8))
+      QApplication::processEvents(QEventLoop::AllEvents, 50);
+    w.wait_autosave();
+    return w.autosaves() >= n;
+  };
+  auto mesh_file = [&] {
+    const std::string text = foxi::test::read_text(json);
+    return line_after(text, "\"mesh\": \"").substr(0, line_after(text, "\"mesh\": \"").find('"'));
+  };
+  ASSERT_TRUE(w.set_shrink(0.9));
+  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(autosave_after(1));
+  const std::string first = mesh_file();
+  ASSERT_FALSE(first.empty()) << foxi::test::read_text(json);
+  const auto mesh_path = dir.path() / "auto" / first;
+  const auto time0 = std::filesystem::last_write_time(mesh_path);
+  const auto size0 = std::filesystem::file_size(mesh_path);
+  EXPECT_EQ(w.autosaves_without_mesh(), 0);
+  // a view change: project.json again, the mesh file untouched
+  ASSERT_TRUE(w.set_shrink(0.8));
+  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(autosave_after(2));
+  EXPECT_NE(foxi::test::read_text(json).find("0.8"), std::string::npos);
+  EXPECT_EQ(mesh_file(), first);
+  EXPECT_EQ(std::filesystem::last_write_time(mesh_path), time0);
+  EXPECT_EQ(std::filesystem::file_size(mesh_path), size0);
+  EXPECT_EQ(w.autosaves_without_mesh(), 1);
+  // a new mesh: a new file, the old one gone
+  ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(autosave_after(3));
+  EXPECT_NE(mesh_file(), first);
+  EXPECT_FALSE(std::filesystem::exists(mesh_path));
+  EXPECT_EQ(w.autosaves_without_mesh(), 1);
+  Workbench again;
+  QString why;
+  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
+  EXPECT_EQ(again.mesh()->tet_count(), w.mesh()->tet_count());
+}
+
 TEST(Workbench, AutosaveWithinFiveSeconds) {
   TempDir dir;
   const QString folder = QString::fromStdString((dir.path() / "auto").string());
