@@ -1,8 +1,11 @@
 // foxi-workbench's run history: one row per model state meshed (and solved).
 #include "workbench.hpp"
+#include "history_plot.hpp"
 #include "workbench_parts.hpp"
 
 #include <QDockWidget>
+#include <QPushButton>
+#include <QVBoxLayout>
 #include <QHeaderView>
 #include <QTableWidget>
 
@@ -18,7 +21,15 @@ void Workbench::build_history_panel() {
   history_table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   auto* history_dock = new QDockWidget(tr("Run history"));
   history_dock->setObjectName("history");
-  history_dock->setWidget(history_table_);
+  auto* panel = new QWidget;
+  auto* v = new QVBoxLayout(panel);
+  v->setContentsMargins(0, 0, 0, 0);
+  v->addWidget(history_table_, 1);
+  auto* plot = new QPushButton(tr("Plot a result against a parameter..."));
+  plot->setObjectName("history_plot");
+  connect(plot, &QPushButton::clicked, this, [this] { show_history_plot(this, model_path_, history_); });
+  v->addWidget(plot);
+  history_dock->setWidget(panel);
   addDockWidget(Qt::BottomDockWidgetArea, history_dock);
 }
 

@@ -323,9 +323,10 @@ int main(int argc, char** argv) {
         throw Usage(std::string("--view-size: ") + e.what());
       }
     }
-    // High-DPI screens: Qt scales the widgets; the view's framebuffer is drawn at the widget's
-    // logical size and scaled up (sharp pictures there are future work: a framebuffer at device pixels).
+    // High-DPI screens: Qt scales the widgets; the view's framebuffer and the parts picture have the
+    // widgets' device pixels (foxi::qt::ViewWidget), drawn 1:1, not scaled up.
     QApplication::setAttribute(Qt::AA_EnableHighDpiScaling);
+    QApplication::setAttribute(Qt::AA_UseHighDpiPixmaps);
     QApplication app(argc, argv);
     QApplication::setApplicationName("foxi-workbench");
     QApplication::setOrganizationName("foxi");
@@ -336,7 +337,11 @@ int main(int argc, char** argv) {
       return headless(w, tools, model, sets, physics, field, cmap, shrink, screenshot, picture, mesh_out);
     w.restore_settings();
     // Until a project is saved or opened, the session autosaves here (reopen it with Open project).
-    w.set_autosave_folder(QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/autosave");
+    const QString autosave = QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/autosave";
+    // A session's work left there (the program was killed, or closed before a project save): offered
+    // back before this session autosaves over it
+    if (model.empty()) w.restore_autosave(autosave, true);
+    w.set_autosave_folder(autosave);
     if (!model.empty()) w.open_model(QString::fromStdString(model));
     return app.exec();
   } catch (const Usage& e) {

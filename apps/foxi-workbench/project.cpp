@@ -4,6 +4,7 @@
 
 #include <QCheckBox>
 #include <QDoubleSpinBox>
+#include <QDir>
 #include <QFile>
 #include <QFileDialog>
 #include <QFileInfo>
@@ -12,6 +13,7 @@
 #include <QJsonDocument>
 #include <QJsonObject>
 #include <QMenu>
+#include <QMessageBox>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSettings>
@@ -269,6 +271,20 @@ void Workbench::autosave() {
 
 void Workbench::wait_autosave() {
   if (autosaving_.isRunning()) autosaving_.waitForFinished();
+}
+
+bool Workbench::autosave_found(const QString& folder) {
+  return !folder.isEmpty() && QFileInfo(QDir(folder).filePath("project.json")).isFile();
+}
+
+bool Workbench::restore_autosave(const QString& folder, bool ask, QString* error) {
+  if (!autosave_found(folder)) return false;
+  if (ask && QMessageBox::question(
+                 this, tr("Restore unsaved work?"),
+                 tr("The last session left unsaved work (autosaved in %1). Restore it?").arg(folder)) !=
+                 QMessageBox::Yes)
+    return false;
+  return open_project(folder, error);
 }
 
 bool Workbench::open_project(const QString& folder, QString* error) {

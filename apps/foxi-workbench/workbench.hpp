@@ -183,6 +183,12 @@ class Workbench : public QMainWindow {
   // Autosaves that kept the mesh file already written (the mesh and results unchanged since).
   int autosaves_without_mesh() const { return mesh_writes_saved_; }
   void wait_autosave();  // the running autosave written (for tests and quitting)
+  // Whether `folder` holds an autosaved project (its project.json), which a session left.
+  static bool autosave_found(const QString& folder);
+  // On start, before anything is autosaved again: when `folder` holds an autosave, asks "restore
+  // the unsaved work?" (ask; else restores without asking) and opens it (open_project). False when
+  // there is none, the user declined, or it does not open (the reason in `error`).
+  bool restore_autosave(const QString& folder, bool ask, QString* error = nullptr);
 
   std::shared_ptr<const Mesh> mesh() const { return mesh_; }
   const RunResults* results() const { return has_results_ ? &results_ : nullptr; }

@@ -70,6 +70,10 @@ ViewWidget::ViewWidget(QWidget* parent) : QWidget(parent), d_(std::make_unique<I
 
 ViewWidget::~ViewWidget() = default;
 
+int ViewWidget::device(int logical) const {
+  return std::max(1, int(std::lround(logical * devicePixelRatioF())));
+}
+
 std::unique_ptr<InteractiveView> make_view(const Mesh& mesh, const RenderParams& params, int width,
                                            int height, const Camera* camera) {
   const int w = std::max(1, width), h = std::max(1, height);
@@ -79,7 +83,7 @@ std::unique_ptr<InteractiveView> make_view(const Mesh& mesh, const RenderParams&
 void ViewWidget::set_mesh(std::shared_ptr<const Mesh> mesh, const RenderParams& params, bool keep_camera) {
   const bool keep = keep_camera && d_->view;
   const Camera cam = keep ? d_->view->camera() : Camera{};
-  auto view = make_view(*mesh, params, width(), height(), keep ? &cam : nullptr);
+  auto view = make_view(*mesh, params, device(width()), device(height()), keep ? &cam : nullptr);
   if (!keep) d_->camera_default = true;
   set_view(std::move(mesh), std::move(view));
 }
@@ -95,8 +99,9 @@ void ViewWidget::set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<Inte
   d_->mesh = std::move(mesh);
   d_->target.reset();
   d_->probe.clear();
-  if (d_->view && (d_->view->framebuffer().width != width() || d_->view->framebuffer().height != height()))
-    d_->view->resize(std::max(1, width()), std::max(1, height()));
+  if (d_->view && (d_->view->framebuffer().width != device(width()) ||
+                   d_->view->framebuffer().height != device(height())))
+    d_->view->resize(device(width()), device(height()));
   draw();
 }
 
@@ -384,8 +389,11 @@ void ViewWidget::tick() {
 
 void ViewWidget::present() {
   if (!d_->view) return;
-  for (const PixelRect& r : d_->view->take_damage())
-    update(QRect(r.x0, r.y0, r.x1 - r.x0 + 1, r.y1 - r.y0 + 1));
+  const qreal ratio = devicePixelRatioF();
+  for (const PixelRect& r : d_->view->take_damage()) {  // device pixels to the widget's (rounded out)
+    const int x0 = int(std::floor(r.x0 / ratio)), y0 = int(std::floor(r.y0 / ratio));
+    update(QRect(x0, y0, int(std::ceil((r.x1 + 1) / ratio)) - x0, int(std::ceil((r.y1 + 1) / ratio)) - y0));
+  }
   emit status_changed(status_text());
   emit fraction_changed(fraction_drawn());
 }
@@ -401,13 +409,16 @@ void ViewWidget::paintEvent(QPaintEvent* event) {
   const QImage image(reinterpret_cast<const uchar*>(fb.rgba.data()), fb.width, fb.height, fb.width * 4,
                      QImage::Format_RGBA8888);
   p.fillRect(event->rect(), Qt::white);
-  p.drawImage(event->rect(), image, event->rect());
+  // High-DPI: the framebuffer has the widget's device pixels, drawn 1:1 (not a scaled-up picture)
+  const qreal ratio = devicePixelRatioF();
+  const QRect r = event->rect();
+  p.drawImage(QRectF(r), image, QRectF(r.x() * ratio, r.y() * ratio, r.width() * ratio, r.height() * ratio));
 }
 
 void ViewWidget::resizeEvent(QResizeEvent* event) {
   QWidget::resizeEvent(event);
   if (!d_->view) return;
-  const int w = std::max(1, width()), h = std::max(1, height());
+  const int w = device(width()), h = device(height());
   d_->view->resize(w, h);
   if (d_->camera_default) d_->view->set_camera(default_camera(*d_->mesh, w, h));
   draw();
@@ -418,7 +429,8 @@ void ViewWidget::mousePressEvent(QMouseEvent* event) { d_->last = event->pos(); 
 void ViewWidget::mouseMoveEvent(QMouseEvent* event) {
   if (!d_->view) return;
   if (event->buttons() == Qt::NoButton) {
-    emit probe_changed(probe_text(event->pos().x(), event->pos().y()));
+    const qreal ratio = devicePixelRatioF();  // the framebuffer's pixels are device pixels
+    emit probe_changed(probe_text(int(event->pos().x() * ratio), int(event->pos().y() * ratio)));
     return;
   }
   const QPoint delta = event->pos() - d_->last;

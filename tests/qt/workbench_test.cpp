@@ -3,6 +3,7 @@
 // record, parameter editing with units (refused values keep the state), Cancel keeping the previous
 // mesh, and a GUI heartbeat over meshing, solving and drawing (the window never stalls > 100 ms).
 #include "workbench.hpp"
+#include "history_plot.hpp"
 
 #include <gtest/gtest.h>
 
@@ -202,6 +203,28 @@ TEST(WorkbenchHeadless, DeformedShapeEqualsFoxiRender) {
 }
 
 // Once with a real X server (xvfb-run, Qt's xcb platform): the same view picture as offscreen.
+// High-DPI: at a device pixel ratio of 2 (QT_SCALE_FACTOR) a 160 x 120 view draws a 320 x 240
+// framebuffer, the same picture as a 320 x 240 view at ratio 1 (not a 160 x 120 one scaled up).
+TEST(WorkbenchHeadless, HighDpiViewDrawsDevicePixels) {
+  TempDir dir;
+  const std::string common = "'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
+                             "die_on_substrate.toml' --headless --physics thermal --save-picture ";
+  const auto one = dir.path() / "one.png", two = dir.path() / "two.png";
+  ASSERT_EQ(foxi::test::run("QT_SCALE_FACTOR=1 " + common + "'" + one.string() + "' --view-size 320x240",
+                            dir.path() / "one.log"),
+            0)
+      << foxi::test::read_text(dir.path() / "one.log");
+  ASSERT_EQ(foxi::test::run("QT_SCALE_FACTOR=2 " + common + "'" + two.string() + "' --view-size 160x120",
+                            dir.path() / "two.log"),
+            0)
+      << foxi::test::read_text(dir.path() / "two.log");
+  const foxi::Framebuffer a = foxi::read_png(one), b = foxi::read_png(two);
+  ASSERT_EQ(a.width, 320);
+  ASSERT_EQ(b.width, 320);
+  ASSERT_EQ(b.height, 240);
+  EXPECT_TRUE(a.rgba == b.rgba);
+}
+
 TEST(WorkbenchHeadless, UnderXvfbSamePictureAsOffscreen) {
   if (!foxi::test::have_program("xvfb-run")) GTEST_SKIP() << "xvfb-run is not installed (Debian xvfb)";
   TempDir dir;
@@ -413,6 +436,50 @@ TEST(Workbench, UndoRedoOfParameterEdits) {
 
 // Only what changed reruns: Solve after a parameter change remeshes first (the mesh of the new
 // parameters, as mesh_model gives it here), Solve again on the same parameters does not.
+// The history plot: its points are the history's values (x the parameter as the model evaluates the
+// row's overrides, y the row's result), a meshed-only row left out; the chart puts them left to right
+// in x order and higher for larger values.
+TEST(Workbench, HistoryPlotPointsAreTheHistorysValues) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  const std::string model = kModels + "die_on_substrate.toml";
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(w.set_parameter("die_w", "6 mm"));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(w.set_parameter("die_w", "die_d"));  // 3 mm, an expression
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w));  // meshed only: no results, not plotted
+  ASSERT_TRUE(w.set_parameter("die_w", "2 mm"));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_EQ(w.history().size(), 3u);
+  const std::vector<std::string> names = foxi::workbench::history_results(w.history());
+  ASSERT_FALSE(names.empty());
+  for (const std::string& name : names) {
+    const auto points = foxi::workbench::history_points(model, w.history(), "die_w", name);
+    ASSERT_EQ(points.rows, (std::vector<std::size_t>{0, 2})) << name;
+    EXPECT_DOUBLE_EQ(points.x[0], 0.006);
+    EXPECT_DOUBLE_EQ(points.x[1], 0.002);
+    for (std::size_t k = 0; k < 2; ++k)
+      for (const foxi::ResultValue& v : w.history()[points.rows[k]].results.values)
+        if (v.name == name) {
+          EXPECT_EQ(points.y[k], v.value) << name;
+        }
+  }
+  const auto points = foxi::workbench::history_points(model, w.history(), "die_w", names[0]);
+  std::vector<std::pair<int, int>> pixels;
+  const QImage chart = foxi::workbench::history_chart(points, "die_w", names[0], 480, 320, &pixels);
+  ASSERT_FALSE(chart.isNull());
+  ASSERT_EQ(pixels.size(), 2u);
+  EXPECT_GT(pixels[0].first, pixels[1].first);  // 6 mm right of 2 mm
+  if (points.y[0] != points.y[1]) {
+    EXPECT_EQ(points.y[0] > points.y[1], pixels[0].second < pixels[1].second);
+  }
+  const QRgb marker = chart.pixel(pixels[0].first, pixels[0].second);
+  EXPECT_NE(marker, qRgb(255, 255, 255));  // a marker is drawn there
+}
+
 TEST(Workbench, SolveRemeshesWhenParametersChanged) {
   Workbench w;
   w.view_widget()->setFixedSize(200, 150);
@@ -809,6 +876,28 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   QString why;
   ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
   EXPECT_EQ(again.mesh()->tet_count(), w.mesh()->tet_count());
+}
+
+// An autosave a session left is found and restored on start (the window asks first; here without
+// asking): the parameters as they were; no autosave, nothing restored.
+TEST(Workbench, RestoreOfferedForAnAutosave) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "auto").string());
+  EXPECT_FALSE(Workbench::autosave_found(folder));
+  {
+    Workbench w;
+    EXPECT_FALSE(w.restore_autosave(folder, false));
+    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+    ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
+    QString why;
+    ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
+  }
+  EXPECT_TRUE(Workbench::autosave_found(folder));
+  Workbench again;
+  QString why;
+  ASSERT_TRUE(again.restore_autosave(folder, false, &why)) << why.toStdString();
+  ASSERT_EQ(again.overrides().size(), 1u);
+  EXPECT_EQ(again.overrides()[0].expression, "5 mm");
 }
 
 TEST(Workbench, AutosaveWithinFiveSeconds) {

@@ -61,7 +61,8 @@ class FOXI_API ViewWidget : public QWidget {
   // Values per tet shown under the mouse pointer (the tet's value as its colour shows it), with
   // their unit; empty: the region and tet only.
   void set_probe_values(std::vector<double> tet_values, QString unit);
-  // The text for the tet at widget pixel (x, y): "tet 12, region die, 45.2 °C" (empty: background).
+  // The text for the tet at framebuffer pixel (x, y) (device pixels: the widget's pixels times its
+  // devicePixelRatio, 1 but on high-DPI screens): "tet 12, region die, 45.2 °C" (empty: background).
   QString probe_text(int x, int y) const;
 
   // The field tools (isosurface, threshold, clip) select by `choice` at `step`, its isosurfaces
@@ -124,6 +125,9 @@ class FOXI_API ViewWidget : public QWidget {
   void wheelEvent(QWheelEvent* event) override;
 
  private:
+  // A length in the widget's pixels as device pixels (at least 1): the framebuffer is drawn at the
+  // screen's own resolution on high-DPI screens, not scaled up.
+  int device(int logical) const;
   void tick();
   void kick();  // the timer on, if there is work
   void present();
