@@ -4,6 +4,7 @@
 #include "workbench_parts.hpp"
 
 #include <QDockWidget>
+#include <QHBoxLayout>
 #include <QPushButton>
 #include <QVBoxLayout>
 #include <QHeaderView>
@@ -28,7 +29,10 @@ void Workbench::build_history_panel() {
   auto* plot = new QPushButton(tr("Plot a result against a parameter..."));
   plot->setObjectName("history_plot");
   connect(plot, &QPushButton::clicked, this, [this] { show_history_plot(this, model_path_, history_); });
-  v->addWidget(plot);
+  auto* buttons = new QHBoxLayout;
+  buttons->addWidget(plot);
+  buttons->addStretch(1);
+  v->addLayout(buttons);
   history_dock->setWidget(panel);
   addDockWidget(Qt::BottomDockWidgetArea, history_dock);
 }

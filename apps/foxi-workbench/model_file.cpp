@@ -95,7 +95,9 @@ void Workbench::refresh_parts_picture() {
   const std::size_t serial = ++parts_serial_;
   // drawn at device pixels (high-DPI: the label's size times its ratio, not a scaled-up picture)
   const qreal ratio = parts_label_->devicePixelRatioF();
-  const int w = std::max(160, int(parts_label_->width() * ratio)), h = w * 3 / 4;
+  // the label's whole area (a picture taller than the label would be cut off at the bottom)
+  const int w = std::max(160, int(parts_label_->width() * ratio)),
+            h = std::max(120, int(parts_label_->height() * ratio));
   auto* watcher = new QFutureWatcher<QImage>(this);
   connect(watcher, &QFutureWatcher<QImage>::finished, this, [this, watcher, serial, ratio] {
     watcher->deleteLater();

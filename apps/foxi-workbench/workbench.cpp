@@ -4,6 +4,7 @@
 
 #include <QKeySequence>
 #include <QLabel>
+#include <QMessageBox>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSettings>
@@ -60,24 +61,29 @@ void Workbench::build_ui() {
   connect(view_, &foxi::qt::ViewWidget::fraction_changed, this, [this](double f) {
     if (!fraction_->isSliderDown()) fraction_->setValue(int(std::lround(f * 1000)));
   });
-  // Keyboard: the viewer's keys (foxi-view's), and the loop's.
-  auto key = [this](const QKeySequence& k, auto fn) {
+  // Keyboard: the viewer's keys (foxi-view's), and the loop's; F1 lists them.
+  auto keys = std::make_shared<QStringList>();
+  auto key = [this, keys](const QKeySequence& k, const QString& what, auto fn) {
     connect(new QShortcut(k, this), &QShortcut::activated, this, fn);
+    keys->append(k.toString(QKeySequence::NativeText) + "\t" + what);
   };
-  key(QKeySequence("D"), [this] { view_->draw(); });
-  key(QKeySequence("Space"), [this] { view_->busy() ? view_->stop() : view_->resume(); });
-  key(QKeySequence("N"), [this] { view_->step_once(); });
-  key(QKeySequence("U"), [this] { view_->undraw(); });
-  key(QKeySequence("R"), [this] { view_->push_region(); });
-  key(QKeySequence("B"), [this] { view_->pop_region(); });
-  key(QKeySequence::Open, [open] { open->click(); });
-  key(QKeySequence("Ctrl+M"), [this] { start_mesh(); });
-  key(QKeySequence("Ctrl+R"), [this] { start_solve(); });
-  key(QKeySequence("Escape"), [this] { cancel(); });
-  key(QKeySequence::Save, [save] { save->click(); });
-  key(QKeySequence("Ctrl+Shift+S"), [this] { save_model_file(); });
-  key(QKeySequence::Undo, [this] { undo(); });
-  key(QKeySequence::Redo, [this] { redo(); });
+  key(QKeySequence("D"), tr("draw"), [this] { view_->draw(); });
+  key(QKeySequence("Space"), tr("stop / go on"), [this] { view_->busy() ? view_->stop() : view_->resume(); });
+  key(QKeySequence("N"), tr("step"), [this] { view_->step_once(); });
+  key(QKeySequence("U"), tr("undraw"), [this] { view_->undraw(); });
+  key(QKeySequence("R"), tr("region of interest"), [this] { view_->push_region(); });
+  key(QKeySequence("B"), tr("back out of the region"), [this] { view_->pop_region(); });
+  key(QKeySequence::Open, tr("open a model"), [open] { open->click(); });
+  key(QKeySequence("Ctrl+M"), tr("mesh"), [this] { start_mesh(); });
+  key(QKeySequence("Ctrl+R"), tr("solve"), [this] { start_solve(); });
+  key(QKeySequence("Escape"), tr("cancel the running job"), [this] { cancel(); });
+  key(QKeySequence::Save, tr("save the picture"), [save] { save->click(); });
+  key(QKeySequence("Ctrl+Shift+S"), tr("save the model file"), [this] { save_model_file(); });
+  key(QKeySequence::Undo, tr("undo a parameter edit"), [this] { undo(); });
+  key(QKeySequence::Redo, tr("redo a parameter edit"), [this] { redo(); });
+  key(QKeySequence::HelpContents, tr("these keys"),
+      [this, keys] { QMessageBox::information(this, tr("Keyboard shortcuts"), keys->join("\n")); });
+  statusBar()->addPermanentWidget(new QLabel(tr("F1: keys")));
   resize(1280, 860);
 }
 
