@@ -148,10 +148,102 @@ void next_field(Viewer& viewer, ViewField& f) {
     viewer.set_iso(nullptr, {});
     f.iso_on = false;
   }
+  // The view borrows the corner values for translucent isosurfaces and the volume: let go first.
+  if (f.iso_translucent || f.volume) viewer.set_translucent(nullptr);
   f.corner.clear();
   f.tree.reset();
   f.current = (f.current + 1) % f.specs.size();
   apply_field(viewer, f);
+  if (f.xray || f.iso_translucent || f.volume) apply_composite(viewer, f);  // of the new field
+}
+
+std::vector<RegionOpacity> default_xray(const Mesh& mesh) {
+  std::vector<std::pair<std::int32_t, std::size_t>> count;  // region, tets
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const std::int32_t r = mesh.region_of(t);
+    auto it = std::find_if(count.begin(), count.end(), [&](const auto& c) { return c.first == r; });
+    if (it == count.end())
+      count.push_back({r, 1});
+    else
+      ++it->second;
+  }
+  std::vector<RegionOpacity> out;
+  std::size_t smallest = 0;
+  for (std::size_t i = 1; i < count.size(); ++i)
+    if (count[i].second < count[smallest].second) smallest = i;
+  for (std::size_t i = 0; i < count.size(); ++i)
+    if (i != smallest || count.size() == 1) out.push_back({count[i].first, 0.3});
+  std::sort(out.begin(), out.end(),
+            [](const RegionOpacity& a, const RegionOpacity& b) { return a.region < b.region; });
+  return out;
+}
+
+void apply_composite(Viewer& viewer, ViewField& f) {
+  const bool field = !f.specs[f.current].empty();
+  if (!field) f.iso_translucent = f.volume = false;
+  if (f.iso_on) {  // the opaque isosurface gives way
+    f.iso_on = false;
+    viewer.set_iso(nullptr, {});
+  }
+  if ((f.iso_translucent || f.volume) && f.corner.empty()) {
+    f.corner = tet_corner_values(viewer.mesh(), f.choice, f.step);
+    f.tree = std::make_shared<const TetIntervals>(f.corner);
+  }
+  if (f.volume) {
+    VolumeParams vp;
+    vp.scale = f.scale;
+    if (f.curve.empty()) {  // a ramp: the low end nearly clear, the high end dense
+      vp.opacity_curve = {{f.scale.lo, 0.02}, {f.scale.hi, 0.5}};
+    } else {
+      for (const OpacityPoint& p : f.curve) vp.opacity_curve.push_back({f.unit.to_si(p.value), p.opacity});
+    }
+    double lo[3], hi[3];
+    tets_bounds(viewer.mesh(), {}, lo, hi);  // as foxi render: a tenth of the box's diagonal
+    vp.unit_length = 0.1 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    f.volume_params = vp;
+    viewer.set_volume(f.corner, &f.volume_params);
+    return;
+  }
+  if (f.xray || f.iso_translucent) {
+    TranslucentParams tp;
+    tp.regions = f.xray;
+    tp.region_opacity = f.xray_regions.empty() ? default_xray(viewer.mesh()) : f.xray_regions;
+    if (f.iso_translucent) {
+      tp.corner = f.corner;
+      tp.iso.scale = f.scale;
+      for (int k = 1; k <= f.iso_count; ++k)  // inside the range, its ends left out
+        tp.iso.values.push_back(f.scale.lo + (f.scale.hi - f.scale.lo) * k / (f.iso_count + 1));
+      tp.iso_opacity = f.iso_opacity;
+    }
+    f.translucent = tp;
+    viewer.set_translucent(&f.translucent);
+    return;
+  }
+  viewer.set_translucent(nullptr);
+}
+
+bool toggle_xray(Viewer& viewer, ViewField& f) {
+  f.xray = !f.xray;
+  if (f.xray) f.volume = false;
+  apply_composite(viewer, f);
+  return true;
+}
+
+bool toggle_iso_translucent(Viewer& viewer, ViewField& f) {
+  if (f.specs[f.current].empty()) return false;
+  f.iso_translucent = !f.iso_translucent;
+  if (f.iso_translucent) f.volume = false;
+  apply_composite(viewer, f);
+  return true;
+}
+
+bool toggle_volume(Viewer& viewer, ViewField& f) {
+  if (f.specs[f.current].empty()) return false;
+  f.volume = !f.volume;
+  if (f.volume) f.xray = f.iso_translucent = false;
+  apply_composite(viewer, f);
+  return true;
 }
 
 bool set_iso(Viewer& viewer, ViewField& f, double value, bool iso_only) {
@@ -183,6 +275,7 @@ void toggle_iso(Viewer& viewer, ViewField& f) {
     f.iso_on = false;
     return;
   }
+  f.xray = f.iso_translucent = f.volume = false;  // the opaque isosurface ends compositing
   set_iso(viewer, f, f.unit.to_display(0.5 * (f.scale.lo + f.scale.hi)), f.iso_only);
 }
 
@@ -202,7 +295,10 @@ void next_map(Viewer& viewer, ViewField& f) {
   std::size_t i = 0;
   while (i < 4 && maps[i] != f.map) ++i;
   f.map = maps[(i + 1) % 4];
-  if (!f.specs[f.current].empty()) apply_field(viewer, f);
+  if (!f.specs[f.current].empty()) {
+    apply_field(viewer, f);
+    if (f.iso_translucent || f.volume) apply_composite(viewer, f);  // coloured by the new map
+  }
 }
 
 std::string value_under(const Viewer& viewer, const ViewField& f, int x, int y, int digits) {
@@ -234,8 +330,41 @@ std::string value_under(const Viewer& viewer, const ViewField& f, int x, int y, 
   return value + buf;
 }
 
+namespace {
+
+std::string composite_status(const ViewField& f) {
+  std::string s;
+  char buf[128];
+  if (f.xray) {
+    s += "x-ray ";
+    const std::vector<RegionOpacity>& r = f.translucent.region_opacity;
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      std::snprintf(buf, sizeof buf, "%s%d:%.2g", i ? "," : "", r[i].region, r[i].opacity);
+      s += buf;
+    }
+    s += " (others opaque)";
+  }
+  if (f.iso_translucent) {
+    std::snprintf(buf, sizeof buf, "%s%d translucent isosurfaces, opacity %.2g", s.empty() ? "" : "; ",
+                  int(f.translucent.iso.values.size()), f.iso_opacity);
+    s += buf;
+  }
+  if (f.volume) {
+    s += "volume, opacity ";
+    for (std::size_t i = 0; i < f.volume_params.opacity_curve.size(); ++i) {
+      const OpacityPoint& p = f.volume_params.opacity_curve[i];
+      std::snprintf(buf, sizeof buf, "%s%.4g:%.2g", i ? "," : "", f.unit.to_display(p.value), p.opacity);
+      s += buf;
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
 std::string field_status(const ViewField& f) {
-  if (f.specs[f.current].empty()) return "";
+  const std::string composite = composite_status(f);
+  if (f.specs[f.current].empty()) return composite;
   char buf[256];
   std::snprintf(buf, sizeof buf, "%s, %s%s, %.4g to %.4g%s%s", f.choice.label.c_str(), color_map_name(f.map),
                 f.graded ? ", graded" : "", f.unit.to_display(f.scale.lo), f.unit.to_display(f.scale.hi),
@@ -246,6 +375,7 @@ std::string field_status(const ViewField& f) {
                   f.unit.to_display(f.iso_value), f.unit.symbol.empty() ? "" : " ", f.unit.symbol.c_str());
     s += buf;
   }
+  if (!composite.empty()) s += "; " + composite;
   return s;
 }
 
@@ -276,7 +406,9 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       viewer.finish();
     } else if (name == "u") {
       if (!viewer.set_undrawing(true))
-        throw std::invalid_argument("script: 'u' needs the painter (a Delaunay mesh) and no --no-undo");
+        throw std::invalid_argument(
+            "script: 'u' needs the painter (a Delaunay mesh) and no --no-undo (compositing: a Delaunay "
+            "mesh)");
       if (arg.empty()) {
         while (viewer.step()) {
         }
@@ -321,6 +453,15 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
       toggle_iso(viewer, field);
     } else if (cmd == "noiso") {
       if (field.iso_on) toggle_iso(viewer, field);
+    } else if (cmd == "xray") {
+      toggle_xray(viewer, field);
+    } else if (cmd == "isoalpha" || cmd == "volume") {
+      if (!(cmd == "volume" ? toggle_volume(viewer, field) : toggle_iso_translucent(viewer, field)))
+        throw std::invalid_argument("script: '" + cmd + "' needs a field: give --field");
+    } else if (cmd == "status") {
+      std::printf("status %s%s%s\n", viewer.status().c_str(), field_status(field).empty() ? "" : "  |  ",
+                  field_status(field).c_str());
+      std::fflush(stdout);
     } else if (cmd == "field") {
       next_field(viewer, field);
     } else if (cmd == "map") {
@@ -331,7 +472,7 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
     } else {
       throw std::invalid_argument("unknown script command '" + cmd +
                                   "' (d c n f u u:N r b s orbit:Y,P zoom:F pan:X,Y probe:X,Y field map i "
-                                  "iso:V iso-only:V noiso legend)");
+                                  "iso:V iso-only:V noiso legend xray isoalpha volume status)");
     }
   }
 }

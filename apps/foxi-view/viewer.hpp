@@ -14,6 +14,8 @@
 #include "foxi/viz/isosurface.hpp"
 #include "foxi/viz/legend.hpp"
 #include "foxi/viz/text.hpp"
+#include "foxi/viz/translucent.hpp"
+#include "foxi/viz/volume.hpp"
 
 namespace foxi::view {
 
@@ -42,6 +44,17 @@ struct ViewField {
   bool legend = false;
   int panel = 0, full_width = 0;
   std::shared_ptr<const TextRenderer> text;
+  // Compositing (issue 23; keys x, t, v): translucent regions ("x-ray"), translucent nested
+  // isosurfaces of the field, or a volume rendering of the field, composited in the power order.
+  bool xray = false;                        // key x
+  std::vector<RegionOpacity> xray_regions;  // --region-opacity; empty: default_xray's
+  bool iso_translucent = false;             // key t: iso_count isosurfaces across the range
+  int iso_count = 5;
+  double iso_opacity = 0.35;        // --iso-opacity
+  bool volume = false;              // key v (or --volume at the start)
+  std::vector<OpacityPoint> curve;  // --opacity-curve (display units); empty: a ramp
+  TranslucentParams translucent;    // what the view was given (its corner: `corner` above)
+  VolumeParams volume_params;
 };
 
 // The specs of `mesh` ("" and its fields' names), `current` set to `spec` (NAME[:component], added
@@ -72,8 +85,21 @@ Framebuffer presented(const Viewer& viewer, const ViewField& field);
 // point of the tet that the shrunk tet's pixel shows, as foxi probe finds it) and the field's value
 // there (field_value_in_tet); "background" where no tet shows. `digits`: significant digits.
 std::string value_under(const Viewer& viewer, const ViewField& field, int x, int y, int digits = 4);
-// The field, map and range for the status line ("" with region colours).
+// The field, map and range for the status line ("" with region colours), and what is composited.
 std::string field_status(const ViewField& field);
+
+// The x-ray's opacities when --region-opacity gave none: every region 0.3 but the one with the fewest
+// tets (a die or a bump inside a package), which stays opaque; one region: 0.3.
+std::vector<RegionOpacity> default_xray(const Mesh& mesh);
+// Hands the view what field.xray, iso_translucent and volume ask for (translucent regions and
+// isosurfaces together, or the volume, or opaque tets) and restarts it. Translucent isosurfaces and
+// the volume need a field: with region colours they are turned off. Ends the opaque isosurface.
+void apply_composite(Viewer& viewer, ViewField& field);
+// 'x', 't', 'v': x-ray, translucent isosurfaces, volume on or off (x-ray and isosurfaces together,
+// the volume alone); false (nothing changes) for t and v with region colours.
+bool toggle_xray(Viewer& viewer, ViewField& field);
+bool toggle_iso_translucent(Viewer& viewer, ViewField& field);
+bool toggle_volume(Viewer& viewer, ViewField& field);
 
 // Runs a script of whitespace-separated commands on the viewer (the headless mode):
 //   probe:X,Y    print "probe X,Y: " and value_under(X, Y) (9 digits)
@@ -81,6 +107,7 @@ std::string field_status(const ViewField& field);
 //   iso:V        the isosurface at V (display units) as the solid above it; iso-only:V the surface;
 //                noiso whole tets again, i the key i (each restarts without drawing)
 //   legend       the key l; prints "legend on, P pixels at the right" or "legend off"
+//   xray / isoalpha / volume  the keys x, t and v (each restarts without drawing)
 //   d            restart and draw to completion      c      restart without drawing
 //   n            draw one batch                      f      finish the current draw
 //   r / b        push the drawn tets as region / back up   (each restarts without drawing)

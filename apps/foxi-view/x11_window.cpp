@@ -368,6 +368,18 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
               move_iso(viewer, field, sym == XK_bracketright ? 1 : -1);
               viewer.set_running(true);
               break;
+            case XK_x:
+            case XK_t:
+            case XK_v:
+              try {
+                if (sym == XK_x   ? toggle_xray(viewer, field)
+                    : sym == XK_t ? toggle_iso_translucent(viewer, field)
+                                  : toggle_volume(viewer, field))
+                  viewer.set_running(true);
+              } catch (const std::exception& e) {
+                std::fprintf(stderr, "foxi-view: %s\n", e.what());
+              }
+              break;
             case XK_s:
               try {
                 save_next(viewer, save_prefix, false, &field);

@@ -15,9 +15,11 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "composite_options.hpp"
 #include "exit_codes.hpp"
 #include "field_options.hpp"
 #include "iso_options.hpp"
+#include "movie_composite.hpp"
 #include "movie_sweep.hpp"
 #include "mesh_input.hpp"
 #include "foxi/model/cleanup.hpp"
@@ -44,6 +46,8 @@ const std::string kMovieUsage =
         "                [--legend on|off] [--threshold a,b] [--clip px,py,pz,nx,ny,nz]\n"
         "                [--sweep iso:a,b [--iso-only] | --sweep threshold:a,b | --sweep steps [--iso "
         "v,...]]]\n"
+        "                [--region-opacity REGION=a,... [--iso v,... --iso-opacity a] | --volume NAME[:C]\n"
+        "                --opacity-curve v0:a0,... [--opacity-length L]] [--sweep opacity:a,b]\n"
         "                [--deform NAME:SCALE] -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png\n"
         "  A movie of the painter. backforth (the default): the tets drawn back to front in the\n"
         "  visibility order from --from to --to percent of the order (default 0% to 100%), then\n"
@@ -65,8 +69,17 @@ const std::string kMovieUsage =
         "                   isosurfaces\n"
         "  Each sweep frame says its value at the top left: \"t = 12.5 s\" (the step's time as the file\n"
         "  gives it; \"step k of N\" when it gives none), \"iso 32 °C\", \"threshold 30 to 50 °C\".\n"
-        "  --threshold and --clip select tets in every movie; --iso and --slice only with --sweep.\n") +
-    kPictureOptionsHelp + kFieldOptionsHelp + kIsoOptionsHelp + kDeformOptionHelp +
+        "  --threshold and --clip select tets in every movie; --iso and --slice only with --sweep.\n"
+        "  Translucent (--region-opacity, --iso-opacity) and volume (--volume) movies: each frame\n"
+        "  composited exactly as foxi render composites it (options below). rotate: foxi render's\n"
+        "  picture with the turned camera (not with --from, --to). backforth: the far part of the\n"
+        "  power order of the composited tets growing and shrinking; compositing cannot be taken back,\n"
+        "  so a shrinking frame composites the remaining far part again from the back (exactly the\n"
+        "  picture of that far part drawn afresh; needs the Delaunay certificate). In place of --mode:\n"
+        "    opacity:a,b    frame k with every opacity given (--region-opacity's, --iso-opacity, the\n"
+        "                   opacity curve's) multiplied by s_k = a + (b - a) k / (N - 1): foxi render\n"
+        "                   with those opacities (each must stay <= 1, the curve's < 1)\n") +
+    kPictureOptionsHelp + kFieldOptionsHelp + kIsoOptionsHelp + kDeformOptionHelp + kCompositeOptionsHelp +
     "  (--size defaults to 640x480; with --field the colour range is the same in every frame)\n"
     "  --frames N      frames per cycle (default 48), --cycles C cycles (default 1)\n"
     "  --fps F         frames per second of the animated file (default 12)\n"
@@ -140,8 +153,13 @@ int cmd_movie(Args args) {
     std::puts(kMovieUsage.c_str());
     return kExitOk;
   }
-  const Sweep sweep = parse_sweep(args.option("--sweep"));
-  const bool sweeping = sweep.kind != Sweep::Kind::none;
+  // First: --volume NAME is the field to draw (the field options apply to it).
+  const CompositeOptions composite = take_composite_options(args);
+  const bool compositing = composite.translucent() || composite.volume_on();
+  const std::string sweep_s = args.option("--sweep");
+  const std::optional<Sweep> opacity_sweep = parse_opacity_sweep(sweep_s);
+  const Sweep sweep = opacity_sweep ? Sweep{} : parse_sweep(sweep_s);
+  const bool sweeping = sweep.kind != Sweep::Kind::none || opacity_sweep;
   if (sweeping && args.has_option("--mode"))
     throw UsageError("--sweep is a kind of movie in place of --mode: give one");
   // --iso-only belongs to the swept isovalue here, which take_iso_options does not see.
@@ -163,7 +181,11 @@ int cmd_movie(Args args) {
   if (out.empty()) throw UsageError("give the output with -o OUT.gif|OUT.apng|OUT.mp4|DIR/frame_%04d.png");
   if (mode != "backforth" && mode != "rotate" && mode != "sweep")
     throw UsageError("--mode takes backforth or rotate");
-  check_sweep_options(sweep, field_options, iso_options);
+  if (compositing || opacity_sweep)
+    check_composite_movie(composite, opacity_sweep, sweep, field_options, iso_options, options.params.shrink,
+                          mode == "rotate", !from_s.empty() || !to_s.empty());
+  else
+    check_sweep_options(sweep, field_options, iso_options);
   if (sweeping && !(cycles_s.empty() && from_s.empty() && to_s.empty() && turn_s.empty()))
     throw UsageError("--cycles, --from, --to and --turn belong to --mode backforth|rotate, not to --sweep");
   if (sweep.kind == Sweep::Kind::steps && !frames_s.empty())
@@ -238,7 +260,7 @@ int cmd_movie(Args args) {
     }
   }
   // --threshold and --clip narrow the tets of every kind of movie.
-  if (!sweeping && iso_options.any()) {
+  if (!sweeping && !compositing && iso_options.any()) {
     IsoPicture sel = resolve_iso(iso_options, mesh, field, picture.subset);
     if (sel.empty) throw UsageError("--threshold and --clip select no tets of " + path);
     picture.subset = std::move(sel.subset);
@@ -317,7 +339,24 @@ int cmd_movie(Args args) {
   const auto t0 = std::chrono::steady_clock::now();
   MovieStats stats;
   SweepStats sweep_stats;
-  if (sweeping) {
+  const CompositeMovieInputs composite_in{mesh,
+                                          table,
+                                          picture.camera,
+                                          options.width,
+                                          options.height,
+                                          picture.subset,
+                                          composite,
+                                          options.params,
+                                          field,
+                                          iso_options,
+                                          mp,
+                                          opacity_sweep,
+                                          path};
+  CompositeMovieStats composite_stats;
+  if (compositing) {
+    composite_stats = run_composite_movie(composite_in, emit);
+    stats.frames = composite_stats.frames;
+  } else if (sweeping) {
     SweepInputs in{mesh,           table,          picture.camera, options.width, options.height,
                    options.params, picture.subset, field_options,  field,         iso_options,
                    sweep,          sweep_iso_only, mp.frames,      step_count,    path};
@@ -368,7 +407,9 @@ int cmd_movie(Args args) {
   std::printf("movie       %s, %zu frames of %dx%d, %.1f ms per frame (frames written included)\n",
               mode.c_str(), stats.frames, ap.width, options.height,
               ms / double(std::max<std::size_t>(1, stats.frames)));
-  if (sweeping) {
+  if (compositing) {
+    print_composite_movie(composite_stats, composite_in);
+  } else if (sweeping) {
     print_sweep(sweep_stats, sweep, field);
   } else {
     std::printf("painter     %zu tets drawn, %zu undrawn, undraw memory at most %.1f MB\n", stats.tets_drawn,

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "composite_options.hpp"
 #include "exit_codes.hpp"
 #include "field_options.hpp"
 #include "iso_options.hpp"
@@ -55,28 +56,8 @@ const std::string kRenderUsage =
     "  --zbuffer       draw with a depth buffer instead (the oracle; order irrelevant)\n"
     "  Meshes that fail the Delaunay certificate have no guaranteed order: their picture is drawn\n"
     "  with the depth buffer (in MPVO order, so --stop still takes the far part) and a note says so.\n" +
-    kDeformOptionHelp +
-    "  --region-opacity REGION=a,...  translucent regions (an \"x-ray\" view): REGION a region id or\n"
-    "                  name, a its opacity from 0 (left out) to 1 (opaque; regions not listed). Drawn\n"
-    "                  are the faces between regions of different opacity and the outer boundary of\n"
-    "                  what is drawn, one layer each (the picture does not depend on the mesh\n"
-    "                  density), blended back to front in the power order of the tets that own them,\n"
-    "                  which is exact for a Delaunay mesh. A mesh without the certificate has no such\n"
-    "                  order: its fragments are collected and sorted per pixel by depth instead (said\n"
-    "                  so; memory grows with the fragments). With --iso, the isosurfaces translucent\n"
-    "                  inside. Not with --stop, --depth, --zbuffer, --threshold, --clip, --slice,\n"
-    "                  --shrink, --markers; a field colours only the isosurfaces\n"
-    "  --iso-opacity a every isosurface of --iso translucent with opacity a, all nested ones seen at\n"
-    "                  once (with --region-opacity inside the translucent regions, else alone)\n"
-    "  --volume NAME[:C]  a volume rendering of the field (as --field takes it; --cmap, --range,\n"
-    "                  --units, --step, --legend apply): the emission-absorption integral of the\n"
-    "                  field, linear in each tet, along every pixel's ray, tets composited back to\n"
-    "                  front in the power order (exact for a Delaunay mesh; another mesh is\n"
-    "                  composited in MPVO order, not exact, and a note says so). Colour: the colour\n"
-    "                  map; opacity: --opacity-curve v0:a0,... (values in display units, ascending;\n"
-    "                  a in [0, 1): the opacity a ray gains through --opacity-length L world units of\n"
-    "                  that value, L by default a tenth of the drawn box's diagonal), linear between\n"
-    "                  the points, constant beyond. Not with the other drawing options\n"
+    kDeformOptionHelp + kCompositeOptionsHelp +
+    "  (--region-opacity, --iso-opacity and --volume not with --stop, --depth, --zbuffer)\n"
     "  Inverted tets are re-oriented (a note says so); an unusable mesh (see foxi info) is refused\n"
     "  with exit status 3, and no picture is written.";
 
@@ -91,16 +72,8 @@ int cmd_render(Args args) {
     std::puts(kRenderUsage.c_str());
     return kExitOk;
   }
-  // --volume NAME is the field to draw (the field options apply to it).
-  const std::string volume_field = args.option("--volume");
-  if (!volume_field.empty()) {
-    if (args.has_option("--field")) throw UsageError("--volume NAME names the field: leave out --field");
-    std::vector<std::string> rest = args.remaining();
-    rest.insert(rest.end(), {"--field", volume_field});
-    args = Args(std::move(rest));
-  }
-  const std::string curve_s = args.option("--opacity-curve"),
-                    opacity_length_s = args.option("--opacity-length");
+  // First: --volume NAME is the field to draw (the field options apply to it).
+  const CompositeOptions composite = take_composite_options(args);
   const std::string stop_s = args.option("--stop"), depth_s = args.option("--depth");
   std::string out = args.option("-o");
   if (out.empty()) out = args.option("--output");
@@ -109,45 +82,11 @@ int cmd_render(Args args) {
   const FieldOptions field_options = take_field_options(args);
   const IsoOptions iso_options = take_iso_options(args, field_options);
   const std::optional<DeformOption> deform = take_deform_option(args);
-  const std::string region_opacity_s = args.option("--region-opacity"),
-                    iso_opacity_s = args.option("--iso-opacity");
-  const bool translucent = !region_opacity_s.empty() || !iso_opacity_s.empty();
-  double iso_opacity = 0.5;
-  if (!iso_opacity_s.empty()) {
-    iso_opacity = parse_opacity(iso_opacity_s, "--iso-opacity");
-    if (iso_options.iso.empty())
-      throw UsageError("--iso-opacity makes the isosurfaces of --iso translucent: give --iso");
-  }
-  if (translucent &&
-      (!stop_s.empty() || !depth_s.empty() || zbuffer || iso_options.has_threshold || iso_options.clip ||
-       iso_options.slice || options.params.shrink != 1 || field_options.markers))
-    throw UsageError(
-        "--region-opacity and --iso-opacity draw the whole picture translucent: leave out --stop, "
-        "--depth, --zbuffer, --threshold, --clip, --slice, --shrink and --markers");
-  const bool volume = !volume_field.empty();
-  if (volume != !curve_s.empty() || (!opacity_length_s.empty() && !volume))
-    throw UsageError("--volume NAME and --opacity-curve v0:a0,... go together (--opacity-length with them)");
-  std::vector<OpacityPoint> curve;
-  double opacity_length = 0;
-  if (volume) {
-    curve = parse_opacity_curve(curve_s);
-    if (!opacity_length_s.empty()) {
-      char* end = nullptr;
-      opacity_length = std::strtod(opacity_length_s.c_str(), &end);
-      if (*end != 0 || !(opacity_length > 0) || !std::isfinite(opacity_length))
-        throw UsageError("--opacity-length takes a positive length (world units), not '" + opacity_length_s +
-                         "'");
-    }
-    if (translucent || iso_options.any() || !stop_s.empty() || !depth_s.empty() || zbuffer ||
-        options.params.shrink != 1 || field_options.markers)
-      throw UsageError(
-          "--volume draws the field alone: leave out --region-opacity, --iso-opacity, --iso, --threshold, "
-          "--clip, --slice, --stop, --depth, --zbuffer, --shrink and --markers");
-  }
-  if (translucent && !field_options.spec.empty() && iso_options.iso.empty())
-    throw UsageError(
-        "translucent regions are drawn in their regions' colours: --field serves only --iso there "
-        "(give --iso v1,... --iso-opacity a, or leave out --field)");
+  const bool translucent = composite.translucent(), volume = composite.volume_on();
+  if ((translucent || volume) && (!stop_s.empty() || !depth_s.empty() || zbuffer))
+    throw UsageError(std::string(volume ? "--volume" : "--region-opacity and --iso-opacity") +
+                     " composite the whole picture: leave out --stop, --depth and --zbuffer");
+  check_composite_options(composite, field_options, iso_options, options.params.shrink);
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
   check_output_path(out);
@@ -203,16 +142,7 @@ int cmd_render(Args args) {
   const SphereTable table = compute_spheres(mesh);
   const double spheres_ms = ms_since(t0);
   if (volume) {
-    VolumeParams vp;
-    vp.scale = field.legend.scale;
-    for (const OpacityPoint& p : curve)
-      vp.opacity_curve.push_back({field.legend.unit.to_si(p.value), p.opacity});
-    double lo[3], hi[3];
-    tets_bounds(mesh, picture.subset, lo, hi);
-    vp.unit_length = opacity_length > 0 ? opacity_length
-                                        : 0.1 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
-                                                          (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                                          (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    const VolumeParams vp = volume_params(composite, mesh, field, picture.subset);
     const std::vector<double> corner = tet_corner_values(mesh, field.choice, field.step);
     Framebuffer fb(options.width, height);
     const VolumeReport report = draw_volume_picture(mesh, table, camera, fb, picture.subset, corner, vp);
@@ -238,15 +168,7 @@ int cmd_render(Args args) {
     return kExitOk;
   }
   if (translucent) {
-    TranslucentParams tp;
-    if (!region_opacity_s.empty()) tp.region_opacity = parse_region_opacity(mesh, region_opacity_s);
-    tp.regions = !region_opacity_s.empty();
-    tp.region_colors = params.region_colors;
-    if (!iso_options.iso.empty()) {
-      tp.corner = *iso.corner;  // shared: lives as long as iso
-      tp.iso = iso.params;
-      tp.iso_opacity = iso_opacity;
-    }
+    const TranslucentParams tp = translucent_params(composite, mesh, params, iso);
     Framebuffer fb(options.width, height);
     const TranslucentReport report = draw_translucent_picture(mesh, table, camera, fb, picture.subset, tp);
     write_png(out, field.paint && field_options.legend ? with_legend(fb, *text, field, panel) : fb);

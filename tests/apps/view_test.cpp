@@ -254,6 +254,62 @@ TEST_F(ViewTest, ValueUnderTheMouseOfShrunkTetsEqualsProbe) {
 // the tets left) equal foxi render --stop 50% (another program, drawing them afresh); undraw all is
 // blank; drawing on after the undraw gives the whole picture again; a region taken after an undraw
 // is exactly the tets left.
+// Translucency and volume rendering in the viewer (issue 23 item 3): --region-opacity's x-ray and
+// --volume's picture equal foxi render's with the same options pixel for pixel; undrawing part of the
+// x-ray changes the picture and drawing on restores it exactly; the status line says what is
+// composited and that it is exact; the keys x, t, v (script xray, isoalpha, volume) switch.
+TEST_F(ViewTest, XrayAndVolumeEqualRenderAndUndrawExactly) {
+  Mesh m = two_region_grid();
+  Field u{"u", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < m.node_count(); ++n)
+    u.values.push_back(1 + 0.3 * m.xyz[3 * n] + 0.2 * m.xyz[3 * n + 1] * m.xyz[3 * n + 2]);
+  m.fields = {u};
+  write_mesh(m, dir_ / "x.vtu");
+  const std::string view = q(view_path()) + " " + q(dir_ / "x.vtu") + " " + kSize;
+  const std::string render = q(test::cli_path()) + " render " + q(dir_ / "x.vtu") + " " + kSize;
+  std::string out;
+  ASSERT_EQ(run_logged(view + " --region-opacity left=0.3,right=0.6 --save " + q(dir_ / "xv") +
+                           " --script 'd s status u:100 s f s xray d s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("x-ray composited exactly (power order)"), std::string::npos) << out;
+  EXPECT_NE(out.find("x-ray 1:0.3,2:0.6"), std::string::npos) << out;
+  ASSERT_EQ(run_logged(render + " --region-opacity left=0.3,right=0.6 -o " + q(dir_ / "xr.png"),
+                       dir_ / "render.log", &out),
+            0)
+      << out;
+  const Framebuffer xray = read_png(dir_ / "xv-001.png");
+  EXPECT_EQ(differing_pixels(xray, read_png(dir_ / "xr.png")), 0u) << "the x-ray is foxi render's";
+  EXPECT_GT(differing_pixels(xray, read_png(dir_ / "xv-002.png")), 0u) << "undrawn 100 surface tets";
+  EXPECT_EQ(differing_pixels(xray, read_png(dir_ / "xv-003.png")), 0u) << "drawn on again";
+  ASSERT_EQ(run_logged(render + " -o " + q(dir_ / "opaque.png"), dir_ / "render.log", &out), 0) << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "xv-004.png"), read_png(dir_ / "opaque.png")), 0u)
+      << "x: the x-ray off";
+  // The volume, with the viewer's automatic range as foxi render's.
+  const std::string curve = " --opacity-curve 1:0.05,3:0.3,5:0.6";
+  ASSERT_EQ(run_logged(view + " --volume u" + curve + " --save " + q(dir_ / "vv") + " --script 'd s status'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("volume composited exactly (power order)"), std::string::npos) << out;
+  ASSERT_EQ(run_logged(render + " --volume u" + curve + " --legend off -o " + q(dir_ / "vr.png"),
+                       dir_ / "render.log", &out),
+            0)
+      << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "vv-001.png"), read_png(dir_ / "vr.png")), 0u);
+  // Translucent isosurfaces need a field; the volume and --region-opacity do not go together.
+  EXPECT_EQ(run_logged(view + " --script 'isoalpha'", dir_ / "view.log", &out), 1) << out;
+  EXPECT_NE(out.find("needs a field"), std::string::npos) << out;
+  EXPECT_EQ(run_logged(view + " --volume u --region-opacity left=0.5 --script d", dir_ / "view.log", &out),
+            2);
+  ASSERT_EQ(run_logged(view + " --field u --save " + q(dir_ / "iv") + " --script 'isoalpha d status'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("5 translucent isosurfaces, opacity 0.35"), std::string::npos) << out;
+}
+
 TEST_F(ViewTest, UndrawEqualsRenderingFewerTets) {
   std::string out;
   ASSERT_EQ(run_logged(q(view_path()) + " " + q(mesh_path_) + " " + kSize + " --dump-ids --save " +

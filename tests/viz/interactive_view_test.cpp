@@ -11,6 +11,8 @@
 
 #include "bench_meshes.hpp"
 #include "foxi/viz/picture.hpp"
+#include "foxi/viz/translucent.hpp"
+#include "foxi/viz/volume.hpp"
 #include "random_cameras.hpp"
 
 namespace foxi {
@@ -105,6 +107,146 @@ TEST(InteractiveView, EventsDamageUndrawAndPick) {
   ASSERT_FALSE(all.empty());
   EXPECT_EQ(all.front().y0, 0);
   EXPECT_EQ(all.back().y1, 47);
+}
+
+// Translucency and volume rendering in the view (issue 23 item 3): the finished progressive draw equals
+// the one-call picture (draw_translucent_picture, draw_volume_picture: the static power order, not the
+// progressive one); after drawing n tets in batches and undrawing k in steps, the picture equals a
+// fresh painter compositing the remaining n - k from the back, pixel for pixel, and those n - k are the
+// first n - k drawn; drawing on after the undraw reaches the one-call picture again.
+std::vector<double> corner_values(const Mesh& m) {  // a linear field 3x - 2y + z at the corners
+  std::vector<double> c;
+  for (std::uint32_t node : m.tet) {
+    const double* p = &m.xyz[3 * std::size_t(node)];
+    c.push_back(3 * p[0] - 2 * p[1] + p[2]);
+  }
+  return c;
+}
+
+template <class Fresh>
+void check_composite_undraw(InteractiveView& view, const Framebuffer& whole, const Fresh& fresh) {
+  view.restart();
+  ASSERT_GT(view.total(), 64u);
+  view.finish();
+  EXPECT_EQ(view.drawn().size(), view.total());
+  EXPECT_EQ(differing(view.framebuffer(), whole), 0u) << "the progressive draw is the one-call picture";
+  const std::vector<std::uint32_t> all = view.drawn();
+  ASSERT_TRUE(view.set_undrawing(true));
+  const std::size_t n = all.size();
+  // Undraw in a few uneven steps: a third with u:N, then two key steps (1/64 each).
+  EXPECT_EQ(view.undraw(n / 3), n / 3);
+  ASSERT_TRUE(view.step());
+  ASSERT_TRUE(view.step());
+  const std::size_t left = view.drawn().size();
+  ASSERT_LT(left, n - n / 3);
+  EXPECT_TRUE(std::equal(view.drawn().begin(), view.drawn().end(), all.begin())) << "a prefix of the draw";
+  const Framebuffer ref = fresh(std::span<const std::uint32_t>(all).first(left));
+  EXPECT_EQ(differing(view.framebuffer(), ref), 0u) << "undrawn to " << left << " of " << n;
+  EXPECT_GT(differing(ref, whole), 0u) << "the undraw changed the picture";
+  EXPECT_TRUE(view.status().rfind("undrawing", 0) == 0) << view.status();
+  // Draw on: the whole picture again.
+  ASSERT_TRUE(view.set_undrawing(false));
+  view.finish();
+  EXPECT_EQ(differing(view.framebuffer(), whole), 0u);
+  // Everything undrawn: the background.
+  ASSERT_TRUE(view.set_undrawing(true));
+  EXPECT_EQ(view.undraw(n), n);
+  EXPECT_EQ(differing(view.framebuffer(), Framebuffer(kW, kH)), 0u);
+}
+
+TEST(InteractiveView, TranslucentUndrawEqualsAFreshCompositeOfTheRest) {
+  const Mesh m = bench::kuhn_grid_mesh(10, 0.0);  // regions 1 (lower half) and 2
+  const SphereTable table = compute_spheres(m);
+  const std::vector<double> corner = corner_values(m);
+  TranslucentParams tp;
+  tp.region_opacity = {{1, 0.35}, {2, 0.6}};
+  tp.corner = corner;
+  tp.iso.values = {0.5, 2.0, 4.0};
+  tp.iso.scale = ColorScale{ColorMapId::viridis, -2, 6};
+  tp.iso_opacity = 0.4;
+  for (const Camera& cam : test::random_cameras(m, 2, 31, double(kW) / kH)) {
+    InteractiveView view(m, cam, kW, kH);
+    view.set_translucent(&tp);
+    EXPECT_TRUE(view.translucent());
+    EXPECT_NE(view.status().find("x-ray composited exactly"), std::string::npos) << view.status();
+    EXPECT_FALSE(view.push_region()) << "no region of interest from surface tets";
+    Framebuffer whole(kW, kH);
+    const TranslucentReport r = draw_translucent_picture(m, table, cam, whole, {}, tp);
+    ASSERT_TRUE(r.exact_order);
+    const TranslucentSurfaces surfaces = translucent_surfaces(m, {}, tp);
+    check_composite_undraw(view, whole, [&](std::span<const std::uint32_t> tets) {
+      TranslucentPainter painter(m, cam, kW, kH, surfaces, tp);
+      painter.draw(tets);
+      Framebuffer fb(kW, kH);
+      painter.resolve(fb);
+      return fb;
+    });
+    view.set_translucent(nullptr);  // opaque again: the painter's picture
+    view.finish();
+    Framebuffer opaque(kW, kH);
+    draw_picture(m, table, cam, opaque);
+    EXPECT_EQ(differing(view.framebuffer(), opaque), 0u);
+  }
+}
+
+TEST(InteractiveView, VolumeUndrawEqualsAFreshCompositeOfTheRest) {
+  const Mesh m = bench::kuhn_grid_mesh(10, 0.1, 4);
+  const SphereTable table = compute_spheres(m);
+  const std::vector<double> corner = corner_values(m);
+  VolumeParams vp;
+  vp.scale = ColorScale{ColorMapId::coolwarm, -20, 30};
+  vp.opacity_curve = {{-20, 0.05}, {10, 0.3}, {30, 0.6}};
+  vp.unit_length = 2;
+  for (const Camera& cam : test::random_cameras(m, 2, 41, double(kW) / kH)) {
+    InteractiveView view(m, cam, kW, kH);
+    ASSERT_TRUE(view.delaunay());
+    view.set_volume(corner, &vp);
+    EXPECT_TRUE(view.volume());
+    EXPECT_NE(view.status().find("volume composited exactly"), std::string::npos) << view.status();
+    Framebuffer whole(kW, kH);
+    ASSERT_TRUE(draw_volume_picture(m, table, cam, whole, {}, corner, vp).exact_order);
+    check_composite_undraw(view, whole, [&](std::span<const std::uint32_t> tets) {
+      VolumePainter painter(m, cam, kW, kH, corner, vp);
+      painter.draw(tets);
+      Framebuffer fb(kW, kH);
+      painter.resolve(fb);
+      return fb;
+    });
+  }
+  // Bad settings are refused and the previous drawing kept.
+  InteractiveView view(m, test::random_cameras(m, 1, 3, double(kW) / kH)[0], kW, kH);
+  VolumeParams bad = vp;
+  bad.unit_length = 0;
+  EXPECT_THROW(view.set_volume(corner, &bad), std::invalid_argument);
+  EXPECT_FALSE(view.volume());
+  EXPECT_THROW(view.set_volume(std::span<const double>(corner).first(8), &vp), std::invalid_argument);
+}
+
+TEST(InteractiveView, UncertifiedCompositingSaysSoAndDoesNotUndraw) {
+  const Mesh m = bench::kuhn_grid_mesh(8, 0.15, 3);
+  const SphereTable table = compute_spheres(m);
+  const Camera cam = test::random_cameras(m, 1, 9, double(kW) / kH)[0];
+  InteractiveView view(m, cam, kW, kH);
+  ASSERT_FALSE(view.delaunay());
+  TranslucentParams tp;
+  tp.region_opacity = {{1, 0.5}};
+  view.set_translucent(&tp);
+  view.finish();
+  EXPECT_FALSE(view.composite_exact());
+  EXPECT_NE(view.status().find("x-ray NOT Delaunay: fragments sorted per pixel"), std::string::npos)
+      << view.status();
+  EXPECT_FALSE(view.set_undrawing(true));
+  EXPECT_EQ(view.undraw(10), 0u);
+  Framebuffer ref(kW, kH);
+  EXPECT_FALSE(draw_translucent_picture(m, table, cam, ref, {}, tp).exact_order);
+  EXPECT_EQ(differing(view.framebuffer(), ref), 0u) << "the same per-pixel sort as the one-call picture";
+  const std::vector<double> corner = corner_values(m);
+  VolumeParams vp;
+  vp.scale = ColorScale{ColorMapId::viridis, -10, 20};
+  vp.opacity_curve = {{-10, 0.2}, {20, 0.5}};
+  view.set_volume(corner, &vp);
+  EXPECT_NE(view.status().find("volume NOT Delaunay: composited in MPVO order, NOT exact"), std::string::npos)
+      << view.status();
 }
 
 }  // namespace

@@ -86,11 +86,30 @@ std::span<const std::uint32_t> InteractiveView::current_subset() const {
 void InteractiveView::begin_draw() {
   // A degenerate camera (e.g. zoomed through `at`) throws here; the caller keeps the old picture.
   const auto t0 = std::chrono::steady_clock::now();
-  auto raster = std::make_unique<TetRasterizer>(mesh_, camera_, width_, height_, params_);
+  std::unique_ptr<TetRasterizer> raster;
   std::unique_ptr<IsoPainter> iso_painter;
-  if (iso_)
-    iso_painter = std::make_unique<IsoPainter>(mesh_, camera_, width_, height_, iso_->corner, iso_->params,
-                                               params_, iso_->attr);
+  std::unique_ptr<TranslucentSurfaces> surfaces;
+  std::unique_ptr<TranslucentPainter> translucent_painter;
+  std::unique_ptr<VolumePainter> volume_painter;
+  const std::span<const std::uint32_t> region =
+      stack_.empty() ? std::span<const std::uint32_t>() : std::span<const std::uint32_t>(stack_.back());
+  if (translucent_) {
+    // The surfaces do not depend on the view: a camera move reuses them.
+    if (surfaces_stale_ || !surfaces_)
+      surfaces = std::make_unique<TranslucentSurfaces>(translucent_surfaces(mesh_, region, *translucent_));
+    else
+      surfaces = std::move(surfaces_);
+    translucent_painter = std::make_unique<TranslucentPainter>(mesh_, camera_, width_, height_, *surfaces,
+                                                               *translucent_, !delaunay_);
+  } else if (volume_) {
+    volume_painter =
+        std::make_unique<VolumePainter>(mesh_, camera_, width_, height_, volume_corner_, *volume_);
+  } else {
+    raster = std::make_unique<TetRasterizer>(mesh_, camera_, width_, height_, params_);
+    if (iso_)
+      iso_painter = std::make_unique<IsoPainter>(mesh_, camera_, width_, height_, iso_->corner, iso_->params,
+                                                 params_, iso_->attr);
+  }
   if (selecting_) {
     // The iso (or selected) tets within the region of interest.
     iso_subset_.clear();
@@ -102,31 +121,66 @@ void InteractiveView::begin_draw() {
   }
   raster_ = std::move(raster);
   iso_painter_ = std::move(iso_painter);
+  surfaces_ = std::move(surfaces);
+  surfaces_stale_ = false;
+  translucent_painter_ = std::move(translucent_painter);
+  volume_painter_ = std::move(volume_painter);
   order_.reset();
   mpvo_.clear();
   mpvo_pos_ = 0;
   const View v = view_of(camera_);
-  if (selecting_ && iso_subset_.empty()) {
-    // Nothing crosses: an empty subset would mean the whole mesh to the orders.
+  // Translucency orders only the tets that own a surface fragment (translucent.hpp says why that is exact).
+  const std::span<const std::uint32_t> to_order =
+      surfaces_ ? std::span<const std::uint32_t>(surfaces_->tets) : current_subset();
+  // Nothing crosses, or no surface: an empty subset would mean the whole mesh to the orders.
+  const bool nothing = (selecting_ && iso_subset_.empty()) || (surfaces_ && surfaces_->tets.empty());
+  if (nothing) {
   } else if (delaunay_) {
-    order_.emplace(mesh_, table_, v, current_subset());
+    order_.emplace(mesh_, table_, v, to_order);
+  } else if (surfaces_) {
+    mpvo_.assign(to_order.begin(), to_order.end());  // any order: the painter sorts each pixel's fragments
   } else {
     mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
   }
-  fb_.resize(width_, height_, params_.depth_buffer);
+  fb_.resize(width_, height_, params_.depth_buffer && !compositing());
+  if (translucent_painter_) translucent_painter_->resolve(fb_);  // the background
+  if (volume_painter_) volume_painter_->resolve(fb_);
   damage_all();
   drawn_.clear();
   handed_.clear();
-  done_ = selecting_ && iso_subset_.empty();
+  done_ = nothing;
   undrawing_ = false;
   started_ = true;
   ++generation_;
   frame_ms_ = ms_since(t0);  // ordering set-up (MPVO: the whole order) counts
 }
 
+void InteractiveView::composite(std::span<const std::uint32_t> batch) {
+  if (translucent_painter_) {
+    translucent_painter_->draw(batch);
+    translucent_painter_->resolve(fb_);
+  } else {
+    volume_painter_->draw(batch);
+    volume_painter_->resolve(fb_);
+  }
+  damage_all();  // the composite painters keep no changed rectangles
+}
+
+void InteractiveView::recomposite() {
+  if (translucent_painter_)
+    translucent_painter_ = std::make_unique<TranslucentPainter>(mesh_, camera_, width_, height_, *surfaces_,
+                                                                *translucent_, !delaunay_);
+  else
+    volume_painter_ =
+        std::make_unique<VolumePainter>(mesh_, camera_, width_, height_, volume_corner_, *volume_);
+  composite(drawn_);
+}
+
 void InteractiveView::restart() { begin_draw(); }
 
 void InteractiveView::set_iso(const IsoDrawing* drawing, std::vector<std::uint32_t> tets) {
+  translucent_.reset();
+  volume_.reset();
   iso_ = drawing;
   selecting_ = drawing != nullptr;
   iso_tets_ = drawing ? std::move(tets) : std::vector<std::uint32_t>{};
@@ -136,12 +190,53 @@ void InteractiveView::set_iso(const IsoDrawing* drawing, std::vector<std::uint32
 }
 
 void InteractiveView::set_subset(std::optional<std::vector<std::uint32_t>> tets) {
+  translucent_.reset();
+  volume_.reset();
   iso_ = nullptr;
   selecting_ = tets.has_value();
   iso_tets_ = tets ? std::move(*tets) : std::vector<std::uint32_t>{};
   std::sort(iso_tets_.begin(), iso_tets_.end());
   iso_subset_.clear();
   begin_draw();
+}
+
+void InteractiveView::set_translucent(const TranslucentParams* params) {
+  set_composite(params ? std::optional<TranslucentParams>(*params) : std::nullopt, std::nullopt, {});
+}
+
+void InteractiveView::set_volume(std::span<const double> corner, const VolumeParams* params) {
+  set_composite(std::nullopt, params ? std::optional<VolumeParams>(*params) : std::nullopt,
+                params ? corner : std::span<const double>());
+}
+
+void InteractiveView::set_composite(std::optional<TranslucentParams> translucent,
+                                    std::optional<VolumeParams> volume, std::span<const double> corner) {
+  // Bad settings throw from begin_draw's painters: the previous drawing is then restored.
+  auto old_translucent = std::move(translucent_);
+  auto old_volume = std::move(volume_);
+  const std::span<const double> old_corner = volume_corner_;
+  const IsoDrawing* old_iso = iso_;
+  const bool old_selecting = selecting_;
+  translucent_ = std::move(translucent);
+  volume_ = std::move(volume);
+  volume_corner_ = corner;
+  iso_ = nullptr;
+  selecting_ = false;
+  surfaces_stale_ = true;
+  try {
+    begin_draw();
+  } catch (const std::invalid_argument&) {
+    translucent_ = std::move(old_translucent);
+    volume_ = std::move(old_volume);
+    volume_corner_ = old_corner;
+    iso_ = old_iso;
+    selecting_ = old_selecting;
+    surfaces_stale_ = true;
+    begin_draw();
+    throw;
+  }
+  iso_tets_.clear();  // iso or subset drawing ends
+  iso_subset_.clear();
 }
 
 void InteractiveView::set_field(std::shared_ptr<const FieldPaint> field) {
@@ -189,7 +284,9 @@ bool InteractiveView::step() {
     frame_ms_ += step_ms_;
     return false;
   }
-  if (iso_painter_) {
+  if (compositing()) {
+    composite(batch);
+  } else if (iso_painter_) {
     iso_painter_->draw(fb_, batch);
     damage_all();  // the iso painter keeps no changed rectangles
   } else {
@@ -207,12 +304,23 @@ bool InteractiveView::step() {
 }
 
 bool InteractiveView::set_undrawing(bool on) {
-  if (on && !params_.undoable) return false;
+  // Compositing undraws by compositing again (no record needed), but only in the exact order.
+  if (on && !(compositing() ? delaunay_ : params_.undoable)) return false;
   undrawing_ = on;
   return true;
 }
 
 std::size_t InteractiveView::undraw(std::size_t count) {
+  if (compositing()) {
+    // Not invertible: the first drawn_.size() - n tets composited again from the back (exact).
+    if (!delaunay_) return 0;
+    const std::size_t n = std::min(count, drawn_.size());
+    if (n == 0) return 0;
+    drawn_.resize(drawn_.size() - n);
+    recomposite();
+    done_ = false;
+    return n;
+  }
   if (!params_.undoable || !raster_) return 0;
   const std::size_t n = std::min(count, drawn_.size());
   if (iso_painter_) {
@@ -248,16 +356,18 @@ void InteractiveView::finish() {
 }
 
 std::size_t InteractiveView::total() const {
+  if (surfaces_) return surfaces_->tets.size();
   if (selecting_) return iso_subset_.size();
   if (!stack_.empty()) return stack_.back().size();
   return mesh_.tet_count();
 }
 
 bool InteractiveView::push_region() {
-  if (drawn_.empty()) return false;
+  if (drawn_.empty() || translucent_) return false;
   std::vector<std::uint32_t> subset = drawn_;
   std::sort(subset.begin(), subset.end());
   stack_.push_back(std::move(subset));
+  surfaces_stale_ = true;
   begin_draw();
   return true;
 }
@@ -265,6 +375,7 @@ bool InteractiveView::push_region() {
 bool InteractiveView::pop_region() {
   if (stack_.empty()) return false;
   stack_.pop_back();
+  surfaces_stale_ = true;
   begin_draw();
   return true;
 }
@@ -293,14 +404,21 @@ void InteractiveView::resize(int width, int height) {
 }
 
 std::string InteractiveView::status() const {
-  char buf[256];
+  char buf[512];
   const std::size_t n = drawn_.size(), t = total();
   const char* state = undrawing_ ? (n == 0 ? "undrawn" : "undrawing") : done_ ? "drawn" : "drawing";
   std::snprintf(buf, sizeof buf, "%s %zu / %zu tets (%.1f%%), %.1f ms, %.2f ms/frame%s, region %zu%s", state,
                 n, t, t ? 100.0 * double(n) / double(t) : 0.0, frame_ms_, step_ms_,
                 started_ && !running_ && (undrawing_ ? n > 0 : !done_) ? " [stopped]" : "", stack_.size(),
-                delaunay_ ? "" : "  NOT Delaunay: depth-buffer drawing");
-  return buf;
+                !delaunay_ && !compositing() ? "  NOT Delaunay: depth-buffer drawing" : "");
+  std::string s = buf;
+  if (translucent_)
+    s += delaunay_ ? ", x-ray composited exactly (power order)"
+                   : ", x-ray NOT Delaunay: fragments sorted per pixel by depth (no exact order; no undraw)";
+  if (volume_)
+    s += delaunay_ ? ", volume composited exactly (power order)"
+                   : ", volume NOT Delaunay: composited in MPVO order, NOT exact (no undraw)";
+  return s;
 }
 
 std::string InteractiveView::camera_options() const {

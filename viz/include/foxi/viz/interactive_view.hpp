@@ -9,6 +9,16 @@
 // The safe-picture rule (picture.hpp) holds here too: a mesh that passes the Delaunay certificate
 // is drawn by the painter in the progressive power order (and can undraw); any other mesh in MPVO
 // order, in chunks, with the depth buffer.
+//
+// Translucent regions and isosurfaces (translucent.hpp) and volume rendering (volume.hpp) are drawn
+// progressively the same way, composited back to front in the power order (a partial picture is the
+// exact picture of the far part). Undraw there: compositing ("over") cannot be taken back in
+// general (an opaque fragment forgets what lay behind it), so undrawing the front-most k tets of n
+// composites the first n - k again from the back, in the same order: the picture is then exactly a
+// fresh draw of n - k tets, pixel for pixel (the painters' results do not depend on how the order is
+// cut into batches), at the cost of recompositing n - k tets per undraw step. Without the Delaunay
+// certificate translucency sorts each pixel's fragments by depth and volume rendering composites in
+// MPVO order (not exact), and neither undraws; status() says which.
 #pragma once
 
 #include <chrono>
@@ -28,7 +38,9 @@
 #include "foxi/viz/isosurface.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
+#include "foxi/viz/translucent.hpp"
 #include "foxi/viz/visibility_order.hpp"
+#include "foxi/viz/volume.hpp"
 
 namespace foxi {
 
@@ -60,14 +72,16 @@ class FOXI_API InteractiveView {
   void set_running(bool on) { running_ = on; }
   // 'u': undraw (front to back, the seed paper's undraw: each frame equals drawing fewer tets from
   // scratch) or, set to false, draw on again from where the undraw stopped. Returns false (nothing
-  // changes) for meshes drawn with the depth buffer, which cannot undraw, or without undoable.
+  // changes) for meshes drawn with the depth buffer, which cannot undraw, or without undoable
+  // (translucent and volume drawing need not record anything: they undraw on any certified mesh).
   bool set_undrawing(bool on);
   bool undrawing() const { return undrawing_; }
   // Undraws up to `count` tets at once (the script's u:N); returns how many.
   std::size_t undraw(std::size_t count);
 
   // 'r': the tets drawn so far become the displayed set (pushed on the stack), redrawn from the back.
-  // Returns false (nothing changes) when no tet has been drawn.
+  // Returns false (nothing changes) when no tet has been drawn, and with translucent drawing (its
+  // drawn tets are the surfaces' owners, not a part of the volume).
   bool push_region();
   // 'b': back to the previous displayed set; false at the bottom (the whole mesh).
   bool pop_region();
@@ -99,6 +113,20 @@ class FOXI_API InteractiveView {
   // same pixels (TetRasterizer::recolors_by_shade), generation() unchanged.
   void set_field(std::shared_ptr<const FieldPaint> field);
   const std::shared_ptr<const FieldPaint>& field() const { return params_.field; }
+  // Translucent regions and isosurfaces ("x-ray", translucent.hpp) of the region on top of the stack
+  // instead of opaque tets: the params are copied, their corner values lent (they must outlive the
+  // view or the next call). Null: opaque tets again. Ends iso and subset drawing and volume
+  // rendering; redraws from the back. Throws std::invalid_argument (from translucent_surfaces) for
+  // bad opacities, the previous picture kept.
+  void set_translucent(const TranslucentParams* params);
+  // A volume rendering of the field with `corner` values (4 per tet, lent as above) of the region on
+  // top of the stack (volume.hpp). Null params: opaque tets again. Ends iso, subset and translucent
+  // drawing; redraws from the back. Throws std::invalid_argument (from VolumePainter) for bad params.
+  void set_volume(std::span<const double> corner, const VolumeParams* params);
+  bool translucent() const { return translucent_.has_value(); }
+  bool volume() const { return volume_.has_value(); }
+  // Translucent or volume drawing composited in the exact (power) order: false without the certificate.
+  bool composite_exact() const { return delaunay_; }
 
   const Camera& camera() const { return camera_; }
   const Framebuffer& framebuffer() const { return fb_; }
@@ -145,6 +173,19 @@ class FOXI_API InteractiveView {
   std::vector<std::uint32_t> iso_tets_;    // sorted
   std::vector<std::uint32_t> iso_subset_;  // iso_tets_ within the region on top of the stack
   std::unique_ptr<IsoPainter> iso_painter_;
+  // Compositing (set_translucent, set_volume): the settings, the surfaces and the painter of this draw.
+  bool compositing() const { return translucent_ || volume_; }
+  void composite(std::span<const std::uint32_t> batch);
+  void recomposite();  // a fresh painter with drawn_ composited again (undraw)
+  void set_composite(std::optional<TranslucentParams> translucent, std::optional<VolumeParams> volume,
+                     std::span<const double> corner);
+  std::optional<TranslucentParams> translucent_;
+  std::optional<VolumeParams> volume_;
+  std::span<const double> volume_corner_;
+  std::unique_ptr<TranslucentSurfaces> surfaces_;  // lent to the painter: a stable address
+  bool surfaces_stale_ = true;                     // the params or the region changed
+  std::unique_ptr<TranslucentPainter> translucent_painter_;
+  std::unique_ptr<VolumePainter> volume_painter_;
   Framebuffer fb_;
   std::vector<PixelRect> damage_;  // see take_damage: per band of 16 rows (x0 > x1: none)
   void add_damage(std::span<const PixelRect> rects);
