@@ -157,27 +157,6 @@ void next_field(Viewer& viewer, ViewField& f) {
   if (f.xray || f.iso_translucent || f.volume) apply_composite(viewer, f);  // of the new field
 }
 
-std::vector<RegionOpacity> default_xray(const Mesh& mesh) {
-  std::vector<std::pair<std::int32_t, std::size_t>> count;  // region, tets
-  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
-    const std::int32_t r = mesh.region_of(t);
-    auto it = std::find_if(count.begin(), count.end(), [&](const auto& c) { return c.first == r; });
-    if (it == count.end())
-      count.push_back({r, 1});
-    else
-      ++it->second;
-  }
-  std::vector<RegionOpacity> out;
-  std::size_t smallest = 0;
-  for (std::size_t i = 1; i < count.size(); ++i)
-    if (count[i].second < count[smallest].second) smallest = i;
-  for (std::size_t i = 0; i < count.size(); ++i)
-    if (i != smallest || count.size() == 1) out.push_back({count[i].first, 0.3});
-  std::sort(out.begin(), out.end(),
-            [](const RegionOpacity& a, const RegionOpacity& b) { return a.region < b.region; });
-  return out;
-}
-
 void apply_composite(Viewer& viewer, ViewField& f) {
   const bool field = !f.specs[f.current].empty();
   if (!field) f.iso_translucent = f.volume = false;
@@ -190,17 +169,11 @@ void apply_composite(Viewer& viewer, ViewField& f) {
     f.tree = std::make_shared<const TetIntervals>(f.corner);
   }
   if (f.volume) {
-    VolumeParams vp;
-    vp.scale = f.scale;
-    if (f.curve.empty()) {  // a ramp: the low end nearly clear, the high end dense
-      vp.opacity_curve = {{f.scale.lo, 0.02}, {f.scale.hi, 0.5}};
-    } else {
+    VolumeParams vp = default_volume(viewer.mesh(), f.scale);
+    if (!f.curve.empty()) {
+      vp.opacity_curve.clear();
       for (const OpacityPoint& p : f.curve) vp.opacity_curve.push_back({f.unit.to_si(p.value), p.opacity});
     }
-    double lo[3], hi[3];
-    tets_bounds(viewer.mesh(), {}, lo, hi);  // as foxi render: a tenth of the box's diagonal
-    vp.unit_length = 0.1 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
     f.volume_params = vp;
     viewer.set_volume(f.corner, &f.volume_params);
     return;

@@ -47,7 +47,7 @@ struct ViewField {
   // Compositing (issue 23; keys x, t, v): translucent regions ("x-ray"), translucent nested
   // isosurfaces of the field, or a volume rendering of the field, composited in the power order.
   bool xray = false;                        // key x
-  std::vector<RegionOpacity> xray_regions;  // --region-opacity; empty: default_xray's
+  std::vector<RegionOpacity> xray_regions;  // --region-opacity; empty: default_xray (interactive_view.hpp)
   bool iso_translucent = false;             // key t: iso_count isosurfaces across the range
   int iso_count = 5;
   double iso_opacity = 0.35;        // --iso-opacity
@@ -88,9 +88,6 @@ std::string value_under(const Viewer& viewer, const ViewField& field, int x, int
 // The field, map and range for the status line ("" with region colours), and what is composited.
 std::string field_status(const ViewField& field);
 
-// The x-ray's opacities when --region-opacity gave none: every region 0.3 but the one with the fewest
-// tets (a die or a bump inside a package), which stays opaque; one region: 0.3.
-std::vector<RegionOpacity> default_xray(const Mesh& mesh);
 // Hands the view what field.xray, iso_translucent and volume ask for (translucent regions and
 // isosurfaces together, or the volume, or opaque tets) and restarts it. Translucent isosurfaces and
 // the volume need a field: with region colours they are turned off. Ends the opaque isosurface.

@@ -276,6 +276,21 @@ QPushButton* Workbench::build_view_panel() {
   tools->addWidget(clip_on_);
   tools->addWidget(clip_axis_);
   tools->addWidget(clip_slider_, 2);
+  // Translucency and volume rendering (issue 23), composited exactly: ViewWidget::set_xray, set_volume.
+  for (const bool volume : {false, true}) {
+    auto* box = new QCheckBox(volume ? tr("volume") : tr("X-ray"));
+    box->setToolTip(volume ? tr("a volume rendering of the field shown (foxi render --volume)")
+                           : tr("every region translucent but the smallest (foxi render --region-opacity)"));
+    connect(box, &QCheckBox::toggled, this, [this, box, volume](bool on) {
+      QString why;
+      if (!(volume ? view_->set_volume(on, &why) : view_->set_xray(on, &why))) {
+        param_error_->setText(why);
+        const QSignalBlocker block(box);
+        box->setChecked(false);
+      }
+    });
+    tools->addWidget(box);
+  }
   cv->addLayout(tools);
   regions_ = new QListWidget;
   regions_->setFlow(QListView::LeftToRight);

@@ -15,6 +15,7 @@
 
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/view_options.hpp"
@@ -44,6 +45,7 @@ struct ViewWidget::Impl {
   FieldSelection selection;
   std::unique_ptr<TetSelection> picked;
   std::unique_ptr<IsoDrawing> drawing;
+  std::vector<double> volume_corner;  // lent to the view while it draws the volume
 };
 
 namespace {
@@ -211,6 +213,46 @@ void ViewWidget::set_base(std::vector<std::uint32_t> tets) {
 }
 
 const FieldSelection& ViewWidget::selection() const { return d_->selection; }
+
+bool ViewWidget::set_xray(bool on, QString* error) {
+  if (!d_->view) {
+    if (error) *error = tr("no mesh shown");
+    return false;
+  }
+  if (on) {
+    TranslucentParams tp;
+    tp.region_opacity = default_xray(*d_->mesh);
+    d_->view->set_translucent(&tp);
+  } else {
+    d_->view->set_translucent(nullptr);
+  }
+  draw();
+  return true;
+}
+
+bool ViewWidget::set_volume(bool on, QString* error) {
+  auto fail = [&](const QString& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!d_->view) return fail(tr("no mesh shown"));
+  if (!on) {
+    if (d_->view->volume()) d_->view->set_volume({}, nullptr);
+    draw();
+    return true;
+  }
+  if (!d_->source) return fail(tr("colour by a field first: the volume rendering shows it"));
+  std::vector<double> corner = tet_corner_values(*d_->mesh, d_->source->choice, d_->source->step);
+  const VolumeParams vp = default_volume(*d_->mesh, d_->source->scale);
+  try {
+    d_->view->set_volume(corner, &vp);
+  } catch (const std::exception& e) {
+    return fail(QString::fromStdString(e.what()));
+  }
+  d_->volume_corner = std::move(corner);  // the vector's buffer moves with it: the view's span stays valid
+  draw();
+  return true;
+}
 
 std::size_t ViewWidget::selected_tets() const {
   if (d_->picked) return d_->picked->subset.size();

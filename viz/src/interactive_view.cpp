@@ -25,6 +25,38 @@ constexpr std::size_t kMpvoChunk = 4096;
 
 }  // namespace
 
+std::vector<RegionOpacity> default_xray(const Mesh& mesh, double opacity) {
+  std::vector<std::pair<std::int32_t, std::size_t>> count;  // region, tets (ascending ids)
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const std::int32_t r = mesh.region_of(t);
+    auto it = std::lower_bound(
+        count.begin(), count.end(), r,
+        [](const std::pair<std::int32_t, std::size_t>& c, std::int32_t id) { return c.first < id; });
+    if (it == count.end() || it->first != r)
+      count.insert(it, {r, 1});
+    else
+      ++it->second;
+  }
+  std::size_t smallest = 0;
+  for (std::size_t i = 1; i < count.size(); ++i)
+    if (count[i].second < count[smallest].second) smallest = i;
+  std::vector<RegionOpacity> out;
+  for (std::size_t i = 0; i < count.size(); ++i)
+    if (i != smallest || count.size() == 1) out.push_back({count[i].first, opacity});
+  return out;
+}
+
+VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale) {
+  VolumeParams vp;
+  vp.scale = scale;
+  vp.opacity_curve = {{scale.lo, 0.02}, {scale.hi, 0.5}};
+  double lo[3], hi[3];
+  tets_bounds(mesh, {}, lo, hi);
+  vp.unit_length = 0.1 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  return vp;
+}
+
 InteractiveView::InteractiveView(const Mesh& mesh, const Camera& camera, int width, int height,
                                  const RenderParams& params)
     : mesh_(mesh), params_(params), camera_(camera), width_(width), height_(height) {

@@ -82,6 +82,13 @@ class FOXI_API ViewWidget : public QWidget {
   void set_base(std::vector<std::uint32_t> tets);
   // The tets the current selection draws (0 for none), or the whole mesh's count without one.
   std::size_t selected_tets() const;
+  // Translucency and volume rendering (issue 23; InteractiveView::set_translucent, set_volume),
+  // composited exactly in the power order and undoable: the "x-ray" (every region translucent but the
+  // one with the fewest tets: default_xray), or a volume rendering of the field source's field on its
+  // scale (default_volume); off: opaque tets again. A selection or a new view ends them. False
+  // (nothing changes) with the reason in `error`: no view, or for the volume no field source.
+  bool set_xray(bool on, QString* error = nullptr);
+  bool set_volume(bool on, QString* error = nullptr);
 
   // Milliseconds of painter work per timer slice (default 8).
   void set_time_slice(std::chrono::milliseconds slice);

@@ -44,6 +44,15 @@
 
 namespace foxi {
 
+// The x-ray a viewer starts from (foxi-view's key x, the workbench's X-ray): every region at opacity
+// `opacity` but the one with the fewest tets (a die or a bump inside a package), which stays opaque;
+// a mesh of one region: that region at `opacity`. Ascending region ids.
+FOXI_API std::vector<RegionOpacity> default_xray(const Mesh& mesh, double opacity = 0.3);
+// The volume rendering a viewer starts from: colours on `scale`, an opacity ramp from 0.02 at
+// scale.lo to 0.5 at scale.hi (dense where the field is high), accumulated over a tenth of the mesh
+// box's diagonal (foxi render --volume's default unit length).
+FOXI_API VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale);
+
 class FOXI_API InteractiveView {
  public:
   // The mesh is lent and must outlive the viewer. Computes the Delaunay certificate and the sphere
