@@ -77,7 +77,7 @@ TEST_F(MovieTranslucentCli, RotatingFramesEqualRenderWithTheTurnedCamera) {
                     "--iso-opacity 0.4 --units degC"),
         std::string(" --volume temperature --opacity-curve 27:0.1,40:0.6 --cmap coolwarm --legend off")}) {
     SCOPED_TRACE(what);
-    const std::string common = p("pkg.vtu") + " --size 160x120" + what;
+    const std::string common = p("pkg.vtu") + " --size 240x150" + what;
     std::string out;
     ASSERT_EQ(foxi("movie " + common + camera_options(camera) + " --mode rotate --turn 120 --frames 4 -o " +
                        p("rot/f_%d.png"),
@@ -105,7 +105,7 @@ TEST_F(MovieTranslucentCli, OpacitySweepFramesEqualRenderWithScaledOpacities) {
     const double s = k == n - 1 ? b : a + (b - a) * double(k) / double(n - 1);
     return exact(opacity * s);
   };
-  const std::string base = p("pkg.vtu") + " --size 150x110" + camera_options(camera);
+  const std::string base = p("pkg.vtu") + " --size 240x150" + camera_options(camera);
   std::string out;
   // X-ray with translucent isotherms.
   const std::string xray = base + " --field temperature --iso 27,31 --units degC";
