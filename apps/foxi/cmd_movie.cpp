@@ -421,7 +421,10 @@ int cmd_movie(Args args) {
                 field.legend.title.c_str(),
                 sweep.kind == Sweep::Kind::steps ? ("steps 0 to " + std::to_string(step_count - 1)).c_str()
                                                  : ("step " + std::to_string(field.step)).c_str(),
-                field_options.graded ? "graded facets" : "flat per tet",
+                composite.volume_on()  ? "linear in each tet (corner values)"
+                : compositing          ? "on the isosurfaces"
+                : field_options.graded ? "graded facets"
+                                       : "flat per tet",
                 color_map_name(field.legend.scale.map), field.legend.scale.log ? " log" : "",
                 u.to_display(field.legend.scale.lo), u.to_display(field.legend.scale.hi),
                 u.symbol.empty() ? "" : " ", u.symbol.c_str(), panel > 0 ? ", legend at the right" : "");

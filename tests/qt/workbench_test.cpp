@@ -33,6 +33,8 @@
 #include "foxi/viz/field_selection.hpp"
 #include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/png.hpp"
+#include "foxi/viz/spheres.hpp"
+#include "foxi/viz/translucent.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -714,6 +716,45 @@ TEST(Workbench, IsoSliderMovesTheIsovalueBothWays) {
   EXPECT_FALSE(w.set_selection(bad, &why));
   EXPECT_FALSE(why.isEmpty());
   EXPECT_FALSE(v->selection().any());
+}
+
+// The view's X-ray and volume (issue 23 item 3): the x-ray equals draw_translucent_picture with the
+// same default opacities (default_xray) and the same camera, pixel for pixel; undrawing part of it
+// and drawing on gives the same picture again; the volume needs the field shown and says it is exact.
+TEST(Workbench, XrayAndVolumeInTheView) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  foxi::qt::ViewWidget* v = w.view_widget();
+  const foxi::Mesh& mesh = *w.mesh();
+  ASSERT_TRUE(v->set_xray(true));
+  v->finish_now();
+  EXPECT_TRUE(v->view()->translucent());
+  EXPECT_NE(v->view()->status().find("x-ray composited exactly"), std::string::npos) << v->view()->status();
+  const foxi::Framebuffer xray = v->view()->framebuffer();
+  foxi::TranslucentParams tp;
+  tp.region_opacity = foxi::default_xray(mesh);
+  ASSERT_GE(tp.region_opacity.size(), 1u);
+  foxi::Framebuffer ref(xray.width, xray.height);
+  const foxi::SphereTable table = foxi::compute_spheres(mesh);
+  ASSERT_TRUE(foxi::draw_translucent_picture(mesh, table, v->view()->camera(), ref, {}, tp).exact_order);
+  EXPECT_TRUE(ref.rgba == xray.rgba) << "the x-ray is the one-call picture";
+  ASSERT_TRUE(v->view()->set_undrawing(true));
+  const std::size_t n = v->view()->drawn().size();
+  EXPECT_EQ(v->view()->undraw(n / 2), n / 2);
+  EXPECT_FALSE(v->view()->framebuffer().rgba == xray.rgba);
+  v->view()->set_undrawing(false);
+  v->finish_now();
+  EXPECT_TRUE(v->view()->framebuffer().rgba == xray.rgba) << "drawn on again";
+  ASSERT_TRUE(v->set_volume(true));
+  v->finish_now();
+  EXPECT_TRUE(v->view()->volume());
+  EXPECT_NE(v->view()->status().find("volume composited exactly"), std::string::npos) << v->view()->status();
+  ASSERT_TRUE(v->set_volume(false));
+  EXPECT_FALSE(v->view()->volume());
 }
 
 // A project saved and reopened in a new window: the same parameters, mesh (counts, coordinates),
