@@ -563,8 +563,8 @@ exit 0
 // SIGTERM and SIGHUP to the window (a job scheduler, a closed terminal): the viewer stops with exit
 // 143 / 129 and says so, as the foxi commands do, leaving nothing in its save folder.
 // The field keys in the real window: l (legend), i (isosurface at the middle of the range), m (next
-// colour map), s; the saved picture and the window's screenshot equal the headless script's
-// 'legend i map d s'.
+// colour map), x (x-ray, ending the opaque isosurface), t (translucent isosurfaces), s; the saved
+// picture and the window's screenshot equal the headless script's 'legend i map xray isoalpha d s'.
 TEST_F(ViewTest, FieldKeysInTheWindowUnderXvfb) {
   if (!test::have_program("xvfb-run") || !test::have_program("xdotool"))
     GTEST_SKIP() << "xvfb-run or xdotool is missing (scripts/install-deps.sh installs them)";
@@ -588,6 +588,10 @@ xdotool key --window "$wid" i
 wait_for '^done' 3 || exit 5
 xdotool key --window "$wid" m
 wait_for '^done' 4 || exit 5
+xdotool key --window "$wid" x
+wait_for '^done' 5 || exit 5
+xdotool key --window "$wid" t
+wait_for '^done' 6 || exit 5
 xdotool key --window "$wid" s
 wait_for '^saved' 1 || exit 6
 if command -v xwd > /dev/null; then xwd -silent -id "$wid" > "$D/kshot.xwd" || exit 8; fi
@@ -603,7 +607,7 @@ exit 0
   std::string out;
   ASSERT_EQ(
       run_logged(q(view_path()) + " " + q(dir_ / "f.vtu") + " --size 320x240 --field u --graded --save " +
-                     q(dir_ / "h") + " --script 'legend i map d s'",
+                     q(dir_ / "h") + " --script 'legend i map xray isoalpha d s'",
                  dir_ / "view.log", &out),
       0)
       << out;
