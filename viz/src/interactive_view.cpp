@@ -180,6 +180,10 @@ void InteractiveView::begin_draw() {
   damage_all();
   drawn_.clear();
   handed_.clear();
+  shots_.clear();
+  shot_at_.clear();
+  shot_bytes_ = 0;
+  painter_behind_ = false;
   done_ = nothing;
   undrawing_ = false;
   started_ = true;
@@ -291,18 +295,26 @@ void InteractiveView::set_field(std::shared_ptr<const FieldPaint> field) {
 bool InteractiveView::step() {
   const auto t0 = std::chrono::steady_clock::now();
   if (undrawing_) {
-    const std::size_t n = undraw(std::max<std::size_t>(1, total() / 64));
+    std::size_t count = std::max<std::size_t>(1, total() / 64);
+    if (compositing() && !shot_at_.empty() && drawn_.size() <= shot_at_.back()) {
+      // Back to the previous batch's picture (or to nothing before the first).
+      const auto it = std::lower_bound(shot_at_.begin(), shot_at_.end(), drawn_.size());
+      count = drawn_.size() - (it == shot_at_.begin() ? 0 : *(it - 1));
+    }
+    const std::size_t n = undraw(count);
     step_ms_ = ms_since(t0);
     frame_ms_ += step_ms_;
     return n > 0;
   }
   if (done_) return false;
   std::span<const std::uint32_t> batch;
+  bool first_pass = false;  // a batch of the order drawn for the first time (not drawing on)
   if (drawn_.size() < handed_.size()) {  // drawing on after an undraw: the order is known
     const std::size_t n = std::min(handed_.size() - drawn_.size(), std::max<std::size_t>(1, total() / 64));
     batch = std::span<const std::uint32_t>(handed_).subspan(drawn_.size(), n);
   } else if (order_) {
     batch = order_->next();
+    first_pass = true;
     handed_.insert(handed_.end(), batch.begin(), batch.end());
     batch = std::span<const std::uint32_t>(handed_).last(batch.size());
   } else {
@@ -317,6 +329,8 @@ bool InteractiveView::step() {
     return false;
   }
   if (compositing()) {
+    if (painter_behind_) recomposite();  // fb_ showed a shot: the painter catches up first
+    painter_behind_ = false;
     composite(batch);
   } else if (iso_painter_) {
     iso_painter_->draw(fb_, batch);
@@ -326,6 +340,12 @@ bool InteractiveView::step() {
     add_damage(raster_->changed_rects());
   }
   drawn_.insert(drawn_.end(), batch.begin(), batch.end());
+  const std::size_t shot = fb_.rgba.size() * (sizeof(std::uint32_t) + sizeof(std::uint32_t));
+  if (compositing() && delaunay_ && first_pass && shot_bytes_ + shot <= kShotBudget) {
+    shots_.push_back(fb_);
+    shot_at_.push_back(drawn_.size());
+    shot_bytes_ += shot;
+  }
   step_ms_ = ms_since(t0);
   frame_ms_ += step_ms_;
   if (drawn_.size() >= total()) {
@@ -349,7 +369,15 @@ std::size_t InteractiveView::undraw(std::size_t count) {
     const std::size_t n = std::min(count, drawn_.size());
     if (n == 0) return 0;
     drawn_.resize(drawn_.size() - n);
-    recomposite();
+    const auto it = std::lower_bound(shot_at_.begin(), shot_at_.end(), drawn_.size());
+    if (it != shot_at_.end() && *it == drawn_.size()) {
+      fb_ = shots_[std::size_t(it - shot_at_.begin())];  // that prefix's picture, as drawn
+      damage_all();
+      painter_behind_ = true;
+    } else {
+      recomposite();
+      painter_behind_ = false;
+    }
     done_ = false;
     return n;
   }

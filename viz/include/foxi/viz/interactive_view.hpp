@@ -16,7 +16,9 @@
 // general (an opaque fragment forgets what lay behind it), so undrawing the front-most k tets of n
 // composites the first n - k again from the back, in the same order: the picture is then exactly a
 // fresh draw of n - k tets, pixel for pixel (the painters' results do not depend on how the order is
-// cut into batches), at the cost of recompositing n - k tets per undraw step. Without the Delaunay
+// cut into batches). To make the undraw steps cheap the view keeps the resolved picture after each
+// batch of the first pass (within a memory budget): a step back shows the previous batch's picture,
+// and drawing on after it composites the prefix again once. Without the Delaunay
 // certificate translucency sorts each pixel's fragments by depth and volume rendering composites in
 // MPVO order (not exact), and neither undraws; status() says which.
 #pragma once
@@ -195,6 +197,15 @@ class FOXI_API InteractiveView {
   bool surfaces_stale_ = true;                     // the params or the region changed
   std::unique_ptr<TranslucentPainter> translucent_painter_;
   std::unique_ptr<VolumePainter> volume_painter_;
+  // Compositing's undraw, made cheap: the resolved picture after each batch of the first pass (it is
+  // exactly the picture of that prefix, so showing it is an exact undraw), while they fit in
+  // kShotBudget bytes; shot_at_[i] the tets drawn then (ascending). Undraw steps go back batch by
+  // batch to these pictures; other counts, and drawing on after them, composite the prefix again.
+  static constexpr std::size_t kShotBudget = std::size_t(128) << 20;
+  std::vector<Framebuffer> shots_;
+  std::vector<std::size_t> shot_at_;
+  std::size_t shot_bytes_ = 0;
+  bool painter_behind_ = false;  // fb_ shows a shot: the painter holds more than drawn_
   Framebuffer fb_;
   std::vector<PixelRect> damage_;  // see take_damage: per band of 16 rows (x0 > x1: none)
   void add_damage(std::span<const PixelRect> rects);
