@@ -308,7 +308,7 @@ bool InteractiveView::step() {
   }
   if (done_) return false;
   std::span<const std::uint32_t> batch;
-  bool first_pass = false;  // a batch of the order drawn for the first time (not drawing on)
+  bool first_pass = false;               // a batch of the order drawn for the first time (not drawing on)
   if (drawn_.size() < handed_.size()) {  // drawing on after an undraw: the order is known
     const std::size_t n = std::min(handed_.size() - drawn_.size(), std::max<std::size_t>(1, total() / 64));
     batch = std::span<const std::uint32_t>(handed_).subspan(drawn_.size(), n);
