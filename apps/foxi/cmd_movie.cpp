@@ -354,7 +354,10 @@ int cmd_movie(Args args) {
                                           path};
   CompositeMovieStats composite_stats;
   if (compositing) {
-    composite_stats = run_composite_movie(composite_in, emit);
+    // Uncaptioned: each frame is foxi render's picture (the report lists the opacity factors).
+    composite_stats = run_composite_movie(
+        composite_in,
+        [&](const Framebuffer& scene, const FieldPicture& legend_of) { emit(scene, legend_of, {}); });
     stats.frames = composite_stats.frames;
   } else if (sweeping) {
     SweepInputs in{mesh,           table,          picture.camera, options.width, options.height,
