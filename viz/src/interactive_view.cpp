@@ -340,7 +340,7 @@ bool InteractiveView::step() {
     add_damage(raster_->changed_rects());
   }
   drawn_.insert(drawn_.end(), batch.begin(), batch.end());
-  const std::size_t shot = fb_.rgba.size() * (sizeof(std::uint32_t) + sizeof(std::uint32_t));
+  const std::size_t shot = fb_.rgba.size() * 9;  // colour, id and shade per pixel
   if (compositing() && delaunay_ && first_pass && shot_bytes_ + shot <= kShotBudget) {
     shots_.push_back(fb_);
     shot_at_.push_back(drawn_.size());
