@@ -407,7 +407,9 @@ TEST(Workbench, ParameterTableCellEdit) {
   ASSERT_EQ(w.overrides().size(), 1u);
   EXPECT_EQ(w.overrides()[0].expression, "4.5 mm");
   for (int r = 0; r < table->rowCount(); ++r)
-    if (table->item(r, 0)->text() == "die_w") EXPECT_EQ(table->item(r, 2)->text(), "0.0045 m");
+    if (table->item(r, 0)->text() == "die_w") {
+      EXPECT_EQ(table->item(r, 2)->text(), "0.0045 m");
+    }
 }
 
 TEST(Workbench, UndoRedoOfParameterEdits) {
