@@ -65,7 +65,7 @@ struct Counts {
 
 }  // namespace
 
-FaceAdjacency compute_face_adjacency(const Mesh& mesh) {
+FaceAdjacency compute_face_adjacency(const MeshView& mesh) {
   FaceAdjacency adj;
   const std::size_t n = mesh.tet_count();
   if (n >= (std::size_t{1} << 30)) throw std::length_error("face adjacency: more than 2^30 tets");
@@ -200,7 +200,7 @@ FaceAdjacency compute_face_adjacency(const Mesh& mesh) {
   return adj;
 }
 
-const FaceAdjacency& face_adjacency(const Mesh& mesh) {
+const FaceAdjacency& face_adjacency(const MeshView& mesh) {
   DerivedData& d = derived_of(mesh);
   std::lock_guard<std::mutex> g(d.lock);
   if (!d.adjacency) d.adjacency = std::make_unique<FaceAdjacency>(compute_face_adjacency(mesh));

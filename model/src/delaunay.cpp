@@ -105,7 +105,7 @@ void build_kd(PointGrid& g) {
   }
 }
 
-PointGrid build_grid(const Mesh& mesh, bool weighted) {
+PointGrid build_grid(const MeshView& mesh, bool weighted) {
   PointGrid g;
   const std::size_t nv = mesh.node_count();
   std::vector<std::uint8_t> used(nv, 0);
@@ -187,7 +187,7 @@ struct ThreadResult {
 
 class Checker {
  public:
-  Checker(const Mesh& mesh, const PointGrid& grid, bool weighted)
+  Checker(const MeshView& mesh, const PointGrid& grid, bool weighted)
       : mesh_(mesh), grid_(grid), weighted_(weighted) {}
 
   void check_tet(std::size_t t, ThreadResult& out) const {
@@ -372,14 +372,14 @@ class Checker {
   }
 
  private:
-  const Mesh& mesh_;
+  const MeshView mesh_;
   const PointGrid& grid_;
   bool weighted_;
 };
 
 }  // namespace
 
-DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const CertificateOptions& options) {
+DelaunayCertificate compute_delaunay_certificate(const MeshView& mesh, const CertificateOptions& options) {
   DelaunayCertificate cert;
   const bool weighted = !mesh.weight.empty();
   cert.weighted = weighted;
@@ -451,7 +451,7 @@ DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh, const Certifi
   return cert;
 }
 
-const DelaunayCertificate& delaunay_certificate(const Mesh& mesh) {
+const DelaunayCertificate& delaunay_certificate(const MeshView& mesh) {
   DerivedData& d = derived_of(mesh);
   std::lock_guard<std::mutex> g(d.lock);
   if (!d.certificate)

@@ -1,6 +1,7 @@
 #include "foxi/model/mesh.hpp"
 
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
 
 #include "derived.hpp"
@@ -14,16 +15,38 @@ DerivedData& DerivedCache::get() const {
   return *data_;
 }
 
-DerivedData& derived_of(const Mesh& mesh) {
-  DerivedData& d = mesh.derived.get();
+DerivedData& derived_of(const MeshView& mesh) {
+  if (mesh.derived == nullptr)
+    throw std::invalid_argument(
+        "mesh view: no DerivedCache to keep its adjacency and certificate in (MeshView::derived is null)");
+  DerivedData& d = mesh.derived->get();
   std::lock_guard<std::mutex> g(d.lock);
-  if (d.nodes != mesh.node_count() || d.tets != mesh.tet_count()) {
+  if (d.nodes != mesh.node_count() || d.tets != mesh.tet_count() || d.xyz != mesh.xyz.data() ||
+      d.tet != mesh.tet.data()) {
     d.adjacency.reset();
     d.certificate.reset();
     d.nodes = mesh.node_count();
     d.tets = mesh.tet_count();
+    d.xyz = mesh.xyz.data();
+    d.tet = mesh.tet.data();
   }
   return d;
+}
+
+std::string check_sizes(const MeshView& mesh) {
+  if (mesh.xyz.size() % 3 != 0)
+    return "xyz holds " + std::to_string(mesh.xyz.size()) + " values, not a multiple of 3";
+  if (mesh.tet.size() % 4 != 0)
+    return "tet holds " + std::to_string(mesh.tet.size()) + " indices, not a multiple of 4";
+  if (mesh.bface.size() % 3 != 0)
+    return "bface holds " + std::to_string(mesh.bface.size()) + " indices, not a multiple of 3";
+  if (!mesh.tet_region.empty() && mesh.tet_region.size() != mesh.tet_count())
+    return "tet_region has " + std::to_string(mesh.tet_region.size()) + " entries for " +
+           std::to_string(mesh.tet_count()) + " tets";
+  if (!mesh.weight.empty() && mesh.weight.size() != mesh.node_count())
+    return "weight has " + std::to_string(mesh.weight.size()) + " entries for " +
+           std::to_string(mesh.node_count()) + " nodes";
+  return {};
 }
 
 void invalidate_derived(Mesh& mesh) { mesh.derived.clear(); }

@@ -107,9 +107,10 @@ bool geometry_in_range(const double* a, const double* b, const double* c, const 
 }
 
 // Checks everything; collects the inverted tets when `inverted` is not null.
-ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
+// size_problem: check_sizes of the Mesh (all its arrays) or of the view.
+ValidationReport check(const MeshView& mesh, std::string size_problem, std::vector<std::size_t>* inverted) {
   ValidationReport r;
-  r.size_problem = check_sizes(mesh);
+  r.size_problem = std::move(size_problem);
   // size_problem and no_tets are listed by describe(); messages carry only the per-element details,
   // so a caller printing both does not say the same thing twice.
   if (!r.size_problem.empty()) return r;
@@ -281,7 +282,9 @@ ValidationReport check(const Mesh& mesh, std::vector<std::size_t>* inverted) {
 
 }  // namespace
 
-ValidationReport validate(const Mesh& mesh) { return check(mesh, nullptr); }
+ValidationReport validate(const Mesh& mesh) { return check(mesh, check_sizes(mesh), nullptr); }
+
+ValidationReport validate(const MeshView& mesh) { return check(mesh, check_sizes(mesh), nullptr); }
 
 std::vector<std::string> describe(const ValidationReport& r) {
   std::vector<std::string> out;
@@ -307,7 +310,7 @@ std::vector<std::string> describe(const ValidationReport& r) {
 
 ValidationReport validate_and_repair(Mesh& mesh) {
   std::vector<std::size_t> inverted;
-  ValidationReport r = check(mesh, &inverted);
+  ValidationReport r = check(mesh, check_sizes(mesh), &inverted);
   for (std::size_t t : inverted) std::swap(mesh.tet[4 * t + 2], mesh.tet[4 * t + 3]);
   if (!inverted.empty()) invalidate_derived(mesh);
   return r;

@@ -34,11 +34,11 @@ using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, std::uint32_t>;
 
 constexpr int kFaceVertex[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-Point point_of(const Mesh& m, std::uint32_t v) {
+Point point_of(const MeshView& m, std::uint32_t v) {
   return Point(m.xyz[3 * std::size_t(v)], m.xyz[3 * std::size_t(v) + 1], m.xyz[3 * std::size_t(v) + 2]);
 }
 
-std::array<std::uint32_t, 3> face_nodes(const Mesh& m, std::size_t t, int f) {
+std::array<std::uint32_t, 3> face_nodes(const MeshView& m, std::size_t t, int f) {
   const std::uint32_t* v = &m.tet[4 * t];
   return {v[kFaceVertex[f][0]], v[kFaceVertex[f][1]], v[kFaceVertex[f][2]]};
 }
@@ -60,7 +60,7 @@ bool wedges_overlap(const Point& p, Point a, Point b, Point c, Point d) {
 }
 
 // Whether two boundary triangles meet in more than the vertices they share (exact).
-bool triangles_overlap(const Mesh& m, const std::array<std::uint32_t, 3>& a,
+bool triangles_overlap(const MeshView& m, const std::array<std::uint32_t, 3>& a,
                        const std::array<std::uint32_t, 3>& b) {
   int shared = 0, sa[3] = {-1, -1, -1};  // sa[i]: index in b of a[i], or -1
   for (int i = 0; i < 3; ++i)
@@ -101,7 +101,7 @@ bool triangles_overlap(const Mesh& m, const std::array<std::uint32_t, 3>& a,
 }
 
 // Whether p lies in the closed tet t (exact; either orientation).
-bool tet_contains(const Mesh& m, std::size_t t, const Point& p) {
+bool tet_contains(const MeshView& m, std::size_t t, const Point& p) {
   const std::uint32_t* v = &m.tet[4 * t];
   const Point q[4] = {point_of(m, v[0]), point_of(m, v[1]), point_of(m, v[2]), point_of(m, v[3])};
   const CGAL::Orientation o = CGAL::orientation(q[0], q[1], q[2], q[3]);
@@ -121,7 +121,7 @@ std::uint32_t find(std::vector<std::uint32_t>& parent, std::uint32_t i) {
 
 }  // namespace
 
-OverlapReport check_overlap(const Mesh& mesh, std::size_t max_examples) {
+OverlapReport check_overlap(const MeshView& mesh, std::size_t max_examples) {
   OverlapReport r;
   const FaceAdjacency& adj = face_adjacency(mesh);
   r.nonmanifold_faces = adj.nonmanifold_faces;

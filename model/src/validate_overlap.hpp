@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 
 namespace foxi {
 
@@ -26,6 +27,6 @@ struct OverlapReport {
 // Needs a mesh that passes validation's local checks (indices in range, no repeated vertex, finite,
 // no flat tet, in range); the orientation of the tets does not matter. Each check runs only when the
 // ones before it found nothing (a fold makes the boundary cross itself too).
-OverlapReport check_overlap(const Mesh& mesh, std::size_t max_examples);
+OverlapReport check_overlap(const MeshView& mesh, std::size_t max_examples);
 
 }  // namespace foxi

@@ -55,7 +55,7 @@ void rotate(double v[3], const double axis[3], double angle) {
 
 }  // namespace
 
-void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]) {
+void mesh_bounds(const MeshView& mesh, double lo[3], double hi[3]) {
   for (int k = 0; k < 3; ++k) {
     lo[k] = std::numeric_limits<double>::infinity();
     hi[k] = -std::numeric_limits<double>::infinity();
@@ -74,7 +74,7 @@ void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]) {
   }
 }
 
-void tets_bounds(const Mesh& mesh, std::span<const std::uint32_t> subset, double lo[3], double hi[3]) {
+void tets_bounds(const MeshView& mesh, std::span<const std::uint32_t> subset, double lo[3], double hi[3]) {
   if (subset.empty()) {
     mesh_bounds(mesh, lo, hi);
     return;
@@ -315,8 +315,8 @@ bool barycentric(const double c[4][3], const double q[3], double b[4]) {
 
 }  // namespace
 
-bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height, std::uint32_t t, int x,
-                        int y, double bary[4], double shrink) {
+bool pixel_point_in_tet(const MeshView& mesh, const Camera& camera, int width, int height, std::uint32_t t,
+                        int x, int y, double bary[4], double shrink) {
   if (t >= mesh.tet_count()) return false;
   Projector p = [&] {
     try {

@@ -109,7 +109,7 @@ std::span<const double> step_values(const Mesh& mesh, const Field& f, std::size_
   return f.step(step, field_entity_count(mesh, f));
 }
 
-double tet_volume(const Mesh& mesh, std::size_t t) {
+double tet_volume(const MeshView& mesh, std::size_t t) {
   const std::uint32_t* v = &mesh.tet[4 * t];
   const double* p0 = &mesh.xyz[3 * std::size_t(v[0])];
   double a[3][3];
@@ -119,6 +119,51 @@ double tet_volume(const Mesh& mesh, std::size_t t) {
                   a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
                   a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])) /
          6;
+}
+
+// The scalar `pick` of the per-region, volume-weighted mean at each tet corner of a cell field of
+// n components a tet (v: n per tet), so that values never blend across a material interface.
+std::vector<double> cell_to_corners(const MeshView& mesh, std::span<const double> v, std::uint32_t n,
+                                    const FieldScalar& pick) {
+  std::vector<double> out(4 * mesh.tet_count());
+  std::map<std::int32_t, std::uint32_t> region_index;
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) region_index.emplace(mesh.region_of(t), 0);
+  std::uint32_t r = 0;
+  for (auto& [id, index] : region_index) index = r++;
+  // Accumulators per (region, node) pair; a node touches few regions, so index pairs sparsely.
+  std::vector<std::uint32_t> slot_of(4 * mesh.tet_count());
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> slot;
+  std::vector<double> sum, weight;
+  std::vector<std::uint32_t> tet_region_index(mesh.tet_count());
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) tet_region_index[t] = region_index[mesh.region_of(t)];
+  if (region_index.size() == 1) {
+    for (std::size_t i = 0; i < slot_of.size(); ++i) slot_of[i] = mesh.tet[i];
+    sum.assign(mesh.node_count() * n, 0.0);
+    weight.assign(mesh.node_count(), 0.0);
+  } else {
+    for (std::size_t i = 0; i < slot_of.size(); ++i) {
+      auto [it, fresh] =
+          slot.emplace(std::make_pair(tet_region_index[i / 4], mesh.tet[i]), std::uint32_t(weight.size()));
+      if (fresh) weight.push_back(0);
+      slot_of[i] = it->second;
+    }
+    sum.assign(weight.size() * n, 0.0);
+  }
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const double w = tet_volume(mesh, t);
+    for (int k = 0; k < 4; ++k) {
+      const std::uint32_t s = slot_of[4 * t + std::size_t(k)];
+      weight[s] += w;
+      for (std::uint32_t i = 0; i < n; ++i) sum[std::size_t(s) * n + i] += w * v[t * n + i];
+    }
+  }
+  std::vector<double> scalar(weight.size());
+  for (std::size_t s = 0; s < weight.size(); ++s) {
+    for (std::uint32_t i = 0; i < n; ++i) sum[s * n + i] = weight[s] > 0 ? sum[s * n + i] / weight[s] : kNaN;
+    scalar[s] = scalar_of(pick, &sum[s * n], n);
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = scalar[slot_of[i]];
+  return out;
 }
 
 }  // namespace
@@ -264,46 +309,23 @@ std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choic
     return out;
   }
   // Cell field: per region, volume-weighted mean of the components of the region's tets at each node.
-  const std::span<const double> v = step_values(mesh, f, step);
-  const std::uint32_t n = f.components;
-  std::map<std::int32_t, std::uint32_t> region_index;
-  for (std::size_t t = 0; t < mesh.tet_count(); ++t) region_index.emplace(mesh.region_of(t), 0);
-  std::uint32_t r = 0;
-  for (auto& [id, index] : region_index) index = r++;
-  // Accumulators per (region, node) pair; a node touches few regions, so index pairs sparsely.
-  std::vector<std::uint32_t> slot_of(4 * mesh.tet_count());
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> slot;
-  std::vector<double> sum, weight;
-  std::vector<std::uint32_t> tet_region_index(mesh.tet_count());
-  for (std::size_t t = 0; t < mesh.tet_count(); ++t) tet_region_index[t] = region_index[mesh.region_of(t)];
-  if (region_index.size() == 1) {
-    for (std::size_t i = 0; i < slot_of.size(); ++i) slot_of[i] = mesh.tet[i];
-    sum.assign(mesh.node_count() * n, 0.0);
-    weight.assign(mesh.node_count(), 0.0);
-  } else {
-    for (std::size_t i = 0; i < slot_of.size(); ++i) {
-      auto [it, fresh] =
-          slot.emplace(std::make_pair(tet_region_index[i / 4], mesh.tet[i]), std::uint32_t(weight.size()));
-      if (fresh) weight.push_back(0);
-      slot_of[i] = it->second;
-    }
-    sum.assign(weight.size() * n, 0.0);
-  }
-  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
-    const double w = tet_volume(mesh, t);
-    for (int k = 0; k < 4; ++k) {
-      const std::uint32_t s = slot_of[4 * t + std::size_t(k)];
-      weight[s] += w;
-      for (std::uint32_t i = 0; i < n; ++i) sum[std::size_t(s) * n + i] += w * v[t * n + i];
-    }
-  }
-  std::vector<double> scalar(weight.size());
-  for (std::size_t s = 0; s < weight.size(); ++s) {
-    for (std::uint32_t i = 0; i < n; ++i) sum[s * n + i] = weight[s] > 0 ? sum[s * n + i] / weight[s] : kNaN;
-    scalar[s] = scalar_of(choice.scalar, &sum[s * n], n);
-  }
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = scalar[slot_of[i]];
+  return cell_to_corners(mesh, step_values(mesh, f, step), f.components, choice.scalar);
+}
+
+std::vector<double> node_corner_values(const MeshView& mesh, std::span<const double> node_values) {
+  if (node_values.size() != mesh.node_count())
+    throw std::invalid_argument("node_corner_values: " + std::to_string(node_values.size()) +
+                                " values for a mesh of " + std::to_string(mesh.node_count()) + " nodes");
+  std::vector<double> out(mesh.tet.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = node_values[mesh.tet[i]];
   return out;
+}
+
+std::vector<double> cell_corner_values(const MeshView& mesh, std::span<const double> cell_values) {
+  if (cell_values.size() != mesh.tet_count())
+    throw std::invalid_argument("cell_corner_values: " + std::to_string(cell_values.size()) +
+                                " values for a mesh of " + std::to_string(mesh.tet_count()) + " tets");
+  return cell_to_corners(mesh, cell_values, 1, FieldScalar{});
 }
 
 std::optional<DisplayUnit> display_unit(std::string_view si, std::string_view d) {

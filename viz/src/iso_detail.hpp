@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 
 namespace foxi::iso_detail {
 
@@ -11,7 +12,7 @@ namespace foxi::iso_detail {
 // corners i and j of `tet` (one of them >= v, the other not), interpolated from the edge's lower node
 // index to its higher one, so every tet sharing the edge gets the same bits; attr (4 values or null)
 // interpolated the same way into *attr_out.
-void edge_point(const Mesh& mesh, std::uint32_t tet, const double corner[4], double v, int i, int j,
+void edge_point(const MeshView& mesh, std::uint32_t tet, const double corner[4], double v, int i, int j,
                 const double* attr, double xyz[3], double* attr_out);
 
 }  // namespace foxi::iso_detail

@@ -32,7 +32,9 @@ struct Vert {
 }  // namespace
 
 struct IsoPainter::Impl {
-  const Mesh* mesh = nullptr;
+  // The lent view, kept here (a caller's MeshView may be a temporary); `mesh` points at it.
+  MeshView mesh_view;
+  const MeshView* mesh = nullptr;
   Projector proj;
   std::span<const double> corner, attr;
   IsoParams params;
@@ -74,7 +76,7 @@ struct IsoPainter::Impl {
       steps.push_back({true, run.size(), 0});
   }
 
-  Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
+  Impl(const MeshView& m, const Camera& camera, int w, int h) : mesh_view(m), mesh(&mesh_view), proj(camera, w, h) {}
 
   // Draws a convex polygon (camera coordinates, attribute positions when graded): flat colour rgb x
   // factor, or per pixel the scale entry at the interpolated position x factor.
@@ -300,7 +302,7 @@ struct IsoPainter::Impl {
   }
 };
 
-IsoPainter::IsoPainter(const Mesh& mesh, const Camera& camera, int width, int height,
+IsoPainter::IsoPainter(const MeshView& mesh, const Camera& camera, int width, int height,
                        std::span<const double> corner, const IsoParams& params,
                        const RenderParams& tet_params, std::span<const double> attr)
     : impl_(std::make_unique<Impl>(mesh, camera, width, height)) {

@@ -11,7 +11,7 @@ namespace foxi {
 
 namespace iso_detail {
 
-void edge_point(const Mesh& mesh, std::uint32_t tet, const double corner[4], double v, int i, int j,
+void edge_point(const MeshView& mesh, std::uint32_t tet, const double corner[4], double v, int i, int j,
                 const double* attr, double xyz[3], double* attr_out) {
   const std::uint32_t* n = &mesh.tet[4 * std::size_t(tet)];
   if (n[i] > n[j]) std::swap(i, j);  // the same bits from every tet sharing the edge
@@ -24,7 +24,7 @@ void edge_point(const Mesh& mesh, std::uint32_t tet, const double corner[4], dou
 
 }  // namespace iso_detail
 
-IsoPolygon iso_polygon(const Mesh& mesh, std::uint32_t tet, const double corner[4], double v,
+IsoPolygon iso_polygon(const MeshView& mesh, std::uint32_t tet, const double corner[4], double v,
                        const double* attr) {
   IsoPolygon p;
   int hot[4], cold[4], nh = 0, nc = 0;

@@ -15,7 +15,7 @@ namespace foxi {
 
 using namespace order_detail;
 
-std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,
+std::vector<std::uint32_t> mpvo_order(const MeshView& mesh, const SphereTable& table, const View& view,
                                       std::span<const std::uint32_t> subset, std::size_t* cycles_broken) {
   const std::size_t n = mesh.tet_count();
   std::vector<std::uint32_t> tets;

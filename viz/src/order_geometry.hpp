@@ -27,7 +27,7 @@ void parallel_for(std::size_t n, F f) {
   pool::on_two_cores([&](int part) { part == 0 ? f(std::size_t{0}, half, 0) : f(half, n, 1); });
 }
 
-inline const double* node(const Mesh& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
+inline const double* node(const MeshView& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }
 
 // +1: the eye is on the positive side of triangle (a, b, c); -1 negative; 0 on its plane.
 // orient3d(a, b, c, p) in double with Shewchuk's error bound; the exact predicate when in doubt.

@@ -2,9 +2,12 @@
 #include "foxi/viz/picture.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
+#include <string>
 
 #include "foxi/viz/depth_stop.hpp"
 #include "foxi/viz/isosurface.hpp"
@@ -20,7 +23,7 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
-std::vector<std::uint32_t> safe_order(const Mesh& mesh, const SphereTable& table, const View& view,
+std::vector<std::uint32_t> safe_order(const MeshView& mesh, const SphereTable& table, const View& view,
                                       std::span<const std::uint32_t> subset, OrderMethod* method,
                                       std::size_t* cycles) {
   const OrderMethod use = safe_order_method(delaunay_certificate(mesh));
@@ -35,7 +38,7 @@ std::vector<std::uint32_t> safe_order(const Mesh& mesh, const SphereTable& table
   return order;
 }
 
-PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera, Framebuffer& fb,
+PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera, Framebuffer& fb,
                            const PictureParams& params) {
   if (!(params.stop_fraction >= 0 && params.stop_fraction <= 1))
     throw std::invalid_argument("draw_picture: the stop fraction must lie in [0, 1]");
@@ -80,6 +83,42 @@ PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Cam
     report.raster = raster.stats();
   }
   report.draw_ms = ms_since(t0);
+  return report;
+}
+
+void copy_rgba(const Framebuffer& fb, const RgbaImage& image) {
+  if (image.pixels == nullptr) throw std::invalid_argument("copy_rgba: the image has no pixels");
+  if (image.width != fb.width || image.height != fb.height)
+    throw std::invalid_argument("copy_rgba: the image is " + std::to_string(image.width) + " x " +
+                                std::to_string(image.height) + ", the framebuffer " + std::to_string(fb.width) +
+                                " x " + std::to_string(fb.height));
+  if (image.stride < 4 * std::size_t(image.width))
+    throw std::invalid_argument("copy_rgba: a stride of " + std::to_string(image.stride) +
+                                " bytes is below 4 x the width " + std::to_string(image.width));
+  const std::size_t row = std::size_t(fb.width);
+  for (int y = 0; y < fb.height; ++y) {
+    const std::uint32_t* from = fb.rgba.data() + std::size_t(y) * row;
+    std::uint8_t* to = image.pixels + std::size_t(y) * image.stride;
+    if constexpr (std::endian::native == std::endian::little) {
+      std::memcpy(to, from, row * 4);  // pack_rgba's R in the low byte: R, G, B, A in memory
+    } else {
+      for (std::size_t x = 0; x < row; ++x)
+        for (int k = 0; k < 4; ++k) to[4 * x + std::size_t(k)] = std::uint8_t(from[x] >> (8 * k));
+    }
+  }
+}
+
+PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera,
+                           const RgbaImage& image, Framebuffer& scratch, const PictureParams& params) {
+  if (image.pixels == nullptr || image.width < 1 || image.height < 1)
+    throw std::invalid_argument("draw_picture: the image is empty");
+  if (image.stride < 4 * std::size_t(image.width))
+    throw std::invalid_argument("draw_picture: a stride of " + std::to_string(image.stride) +
+                                " bytes is below 4 x the width " + std::to_string(image.width));
+  scratch.width = image.width;  // draw_picture sizes the buffers to these
+  scratch.height = image.height;
+  const PictureReport report = draw_picture(mesh, table, camera, scratch, params);
+  copy_rgba(scratch, image);
   return report;
 }
 

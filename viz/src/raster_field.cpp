@@ -7,7 +7,7 @@ namespace foxi {
 
 void TetRasterizer::Impl::setup_field() {
   if ((field = params.field.get()) == nullptr) return;
-  const Mesh& m = *mesh;
+  const MeshView& m = *mesh;
   if (field->graded ? field->corner_position.size() != m.tet.size()
                     : field->tet_color.size() != m.tet_count())
     throw std::invalid_argument(

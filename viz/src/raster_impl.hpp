@@ -357,7 +357,9 @@ struct FaceSetup {
 using namespace raster_detail;
 
 struct TetRasterizer::Impl {
-  const Mesh* mesh = nullptr;
+  // The lent view, kept here (a caller's MeshView may be a temporary); `mesh` points at it.
+  MeshView mesh_view;
+  const MeshView* mesh = nullptr;
   Projector proj;
   RenderParams params;
   double near = 0;
@@ -503,7 +505,7 @@ struct TetRasterizer::Impl {
     if (changed.x0 <= changed.x1) changed_list.push_back(changed);
   }
 
-  Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p);
+  Impl(const MeshView& m, const Camera& c, int w, int h, const RenderParams& p);
 
   void project_camera(const double* c, std::int64_t& X, std::int64_t& Y, std::uint8_t& st) const {
     if (!(std::isfinite(c[0]) && std::isfinite(c[1]) && std::isfinite(c[2]))) {

@@ -23,8 +23,8 @@ std::uint32_t region_color(std::int32_t id) {
   return kPalette[((std::int64_t(id) % n) + n) % n];
 }
 
-TetRasterizer::Impl::Impl(const Mesh& m, const Camera& c, int w, int h, const RenderParams& p)
-    : mesh(&m), proj(c, w, h), params(p) {
+TetRasterizer::Impl::Impl(const MeshView& m, const Camera& c, int w, int h, const RenderParams& p)
+    : mesh_view(m), mesh(&mesh_view), proj(c, w, h), params(p) {
   if (!(params.shrink > 0 && params.shrink <= 1))
     throw std::invalid_argument("render: shrink must be in (0, 1]");
   if (params.threads < 1) params.threads = 1;
@@ -523,7 +523,7 @@ inline void TetRasterizer::Impl::clear_mask(std::size_t n) {
               shown.begin() + std::ptrdiff_t(std::size_t(y1 + 1) * words), 0);
 }
 
-TetRasterizer::TetRasterizer(const Mesh& mesh, const Camera& camera, int width, int height,
+TetRasterizer::TetRasterizer(const MeshView& mesh, const Camera& camera, int width, int height,
                              const RenderParams& params)
     : impl_(std::make_unique<Impl>(mesh, camera, width, height, params)) {}
 TetRasterizer::~TetRasterizer() = default;
@@ -548,7 +548,7 @@ PixelRect TetRasterizer::changed_rect() const { return impl_->changed; }
 std::span<const PixelRect> TetRasterizer::changed_rects() const { return impl_->changed_list; }
 void TetRasterizer::forget_drawn() { impl_->forget(); }
 
-Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
+Framebuffer render_tets(const MeshView& mesh, const Camera& camera, int width, int height,
                         std::span<const std::uint32_t> tets, const RenderParams& params) {
   Framebuffer fb(width, height, params.depth_buffer);
   TetRasterizer r(mesh, camera, width, height, params);

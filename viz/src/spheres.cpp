@@ -179,7 +179,7 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
 
 }  // namespace
 
-SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress) {
+SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
   SphereTable t;
   const std::size_t n = mesh.tet_count();
   const bool weighted = !mesh.weight.empty();

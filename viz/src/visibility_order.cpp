@@ -87,7 +87,7 @@ std::uint32_t rep_tet(const SphereTable& t, std::uint32_t item) {
   return (item & kClusterBit) ? t.cluster_tets[t.cluster_begin[item & ~kClusterBit]] : item;
 }
 
-void exact_key(const Mesh& m, const SphereTable& table, const View& view, std::uint32_t tet,
+void exact_key(const MeshView& m, const SphereTable& table, const View& view, std::uint32_t tet,
                exact::PowerKey& key) {
   const std::uint32_t* v = m.tet.data() + 4 * std::size_t(tet);
   double w[4];
@@ -196,7 +196,9 @@ struct Workspace {
 thread_local Workspace t_workspace;
 
 struct ProgressiveOrder::Impl {
-  const Mesh* mesh = nullptr;
+  // The lent view, kept here (a caller's MeshView may be a temporary); `mesh` points at it.
+  MeshView mesh_view;
+  const MeshView* mesh = nullptr;
   const SphereTable* table = nullptr;
   View view;
   bool front_to_back = false;
@@ -1295,10 +1297,11 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
   }
 }
 
-ProgressiveOrder::ProgressiveOrder(const Mesh& mesh, const SphereTable& table, const View& view,
+ProgressiveOrder::ProgressiveOrder(const MeshView& mesh, const SphereTable& table, const View& view,
                                    std::span<const std::uint32_t> subset, bool front_to_back)
     : impl_(std::make_unique<Impl>()) {
-  impl_->mesh = &mesh;
+  impl_->mesh_view = mesh;
+  impl_->mesh = &impl_->mesh_view;
   impl_->table = &table;
   impl_->view = view;
   impl_->front_to_back = front_to_back;
@@ -1508,7 +1511,7 @@ std::size_t ProgressiveOrder::handed_out() const { return impl_->handed; }
 std::size_t ProgressiveOrder::total() const { return impl_->total_tets; }
 const OrderStats& ProgressiveOrder::stats() const { return impl_->stats; }
 
-std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table, const View& view,
+std::vector<std::uint32_t> visibility_order(const MeshView& mesh, const SphereTable& table, const View& view,
                                             std::span<const std::uint32_t> subset, bool front_to_back,
                                             OrderStats* stats) {
   std::vector<std::uint32_t> out;
@@ -1516,7 +1519,7 @@ std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable&
   return out;
 }
 
-void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh, const SphereTable& table,
+void visibility_order_into(std::vector<std::uint32_t>& out, const MeshView& mesh, const SphereTable& table,
                            const View& view, std::span<const std::uint32_t> subset, bool front_to_back,
                            OrderStats* stats) {
   using Clock = std::chrono::steady_clock;

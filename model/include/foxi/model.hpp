@@ -2,6 +2,7 @@
 // include. The entry points, one a line (declared in the topic headers below, which say more):
 //
 //   Mesh, Region, Boundary, Material, Field    the mesh database: plain arrays, SI units (mesh.hpp)
+//   MeshView, DerivedCache                     a mesh over the host's own arrays, no copy (mesh_view.hpp)
 //   check_sizes(mesh)                          the array sizes agree with each other (mesh.hpp)
 //   region_id_of, boundary_tag_of              a region or boundary by name or number (mesh.hpp)
 //   invalidate_derived(mesh)                   drop cached adjacency, spheres, certificate (mesh.hpp)
@@ -35,6 +36,7 @@
 #include "foxi/model/io_vtk.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/model/quality.hpp"

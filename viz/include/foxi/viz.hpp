@@ -2,6 +2,7 @@
 // The entry points, one a line (declared in the topic headers below, which say more):
 //
 //   draw_picture(mesh, table, camera, fb)     a safe picture: painter if certified, else MPVO + depth buffer
+//   draw_picture(view, table, camera, image, scratch)  the same into a host's RGBA buffer with its stride
 //   (picture.hpp) safe_order(mesh, table, view, subset)      the back-to-front order draw_picture uses
 //   (picture.hpp) InteractiveView                            camera, regions of interest, progressive
 //   draw/undraw, damage, pick (interactive_view.hpp) material_color, exploded_mesh              colours of
@@ -20,6 +21,7 @@
 //   tets_bounds(mesh, subset, lo, hi)         bounds of a subset, to fit a camera to (camera.hpp)
 //   tet_depth, count_deeper                    the painter's depth stop (depth_stop.hpp)
 //   make_movie(...)                            movies of the painter: APNG, GIF (movie.hpp, animation.hpp)
+//   node_corner_values, cell_corner_values    a host's own node or cell array as corner values (field_paint.hpp)
 //   choose_field, tet_corner_values, FieldPaint colour by a field: flat or graded (field_paint.hpp,
 //   RenderParams::field) ColorScale, color_map_entry, nice_ticks    colour maps, ranges, colour-bar ticks
 //   (colormap.hpp) TextRenderer, find_font_file               text in pictures with FreeType (text.hpp)

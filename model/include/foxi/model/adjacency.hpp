@@ -9,6 +9,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 
 namespace foxi {
 
@@ -25,8 +26,8 @@ struct FaceAdjacency {
 // Computes the adjacency afresh (uses both cores on large meshes: 50k tets and more). Orientation is
 // not checked (two tets on one triangle are paired whatever their orientations). Indices >= node_count
 // are tolerated up to max(node_count, 4 * tet_count); beyond that std::invalid_argument is thrown.
-FOXI_API FaceAdjacency compute_face_adjacency(const Mesh& mesh);
+FOXI_API FaceAdjacency compute_face_adjacency(const MeshView& mesh);
 // Cached on the mesh (see invalidate_derived); the reference lives as long as the mesh's cache.
-FOXI_API const FaceAdjacency& face_adjacency(const Mesh& mesh);
+FOXI_API const FaceAdjacency& face_adjacency(const MeshView& mesh);
 
 }  // namespace foxi

@@ -14,6 +14,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/model/progress.hpp"
 
 namespace foxi {
@@ -37,9 +38,9 @@ struct CertificateOptions {
                         // calling thread only, stage "delaunay certificate"
 };
 
-FOXI_API DelaunayCertificate compute_delaunay_certificate(const Mesh& mesh,
+FOXI_API DelaunayCertificate compute_delaunay_certificate(const MeshView& mesh,
                                                           const CertificateOptions& options = {});
 // Cached on the mesh (computed with default options).
-FOXI_API const DelaunayCertificate& delaunay_certificate(const Mesh& mesh);
+FOXI_API const DelaunayCertificate& delaunay_certificate(const MeshView& mesh);
 
 }  // namespace foxi

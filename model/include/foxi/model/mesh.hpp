@@ -5,11 +5,13 @@
 // certificate) is never stored here twice: it is computed on demand by the functions that own it and
 // cached in `derived`, which a copy of the mesh does not share.
 //
-// Host-owned data: a Mesh owns its arrays, so a host's own coordinates, tets and regions are moved
-// or copied into it once (there is no mesh view over host arrays yet). Everything after that takes
-// the mesh by reference and copies nothing: the certificate and adjacency (cached here), the
-// sphere table (a value the caller keeps), the orders and the painter (which lend the mesh and take
-// subsets and orders as std::span), the solvers (which add their result fields to it).
+// Host-owned data: a Mesh owns its arrays. A host that keeps its own coordinates, tets and regions
+// hands them to the ordering, the painter, the pictures and the checks as a MeshView (mesh_view.hpp:
+// std::span over its arrays, no copy; that header lists which entry points take a view and which
+// take a Mesh); for the rest (readers, writers, mesher, solvers, named fields) it moves or copies
+// them into a Mesh once. Either way nothing is copied after that: the certificate and adjacency are
+// cached (here, or in the host's DerivedCache for a view), the sphere table is a value the caller
+// keeps, orders and subsets go as std::span, the solvers add their result fields to the Mesh.
 #pragma once
 
 #include <cstdint>

@@ -7,6 +7,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 
 namespace foxi {
 
@@ -49,6 +50,8 @@ struct ValidationReport {
 // Checks without changing anything. Positive orientation means det[p1-p0, p2-p0, p3-p0] > 0 (CGAL's
 // orientation(p0,p1,p2,p3) == POSITIVE). At most 20 messages.
 FOXI_API ValidationReport validate(const Mesh& mesh);
+// The same for a host's arrays (mesh_view.hpp): its sizes checked by check_sizes(MeshView).
+FOXI_API ValidationReport validate(const MeshView& mesh);
 // Checks and re-orients inverted tets (swapping their last two vertices); the report counts them
 // (as found before the repair). Calls invalidate_derived(mesh) when it changed anything.
 FOXI_API ValidationReport validate_and_repair(Mesh& mesh);

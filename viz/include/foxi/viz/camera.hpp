@@ -12,6 +12,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/viz/view.hpp"
 
 namespace foxi {
@@ -26,10 +27,10 @@ struct Camera {
 };
 
 // Axis-aligned bounds of the nodes used by tets (all nodes if there are no tets). lo > hi if none.
-FOXI_API void mesh_bounds(const Mesh& mesh, double lo[3], double hi[3]);
+FOXI_API void mesh_bounds(const MeshView& mesh, double lo[3], double hi[3]);
 // Axis-aligned bounds of the corners of the tets in `subset` (tet indices < tet_count); an empty
 // subset: mesh_bounds. What a camera is fitted to when only part of a mesh is drawn.
-FOXI_API void tets_bounds(const Mesh& mesh, std::span<const std::uint32_t> subset, double lo[3],
+FOXI_API void tets_bounds(const MeshView& mesh, std::span<const std::uint32_t> subset, double lo[3],
                           double hi[3]);
 
 // A camera looking along `dir` (from the eye into the scene) at the centre of the box [lo, hi], far
@@ -87,7 +88,7 @@ struct FOXI_API Projector {
 // tet was drawn scaled about its centroid by it (RenderParams::shrink): the ray then meets the shrunk
 // tet, and bary are that point's coordinates in the shrunk tet, which are those of the true point it
 // shows in the tet itself (the shrink is affine), the point whose value the pixel's colour shows.
-FOXI_API bool pixel_point_in_tet(const Mesh& mesh, const Camera& camera, int width, int height,
+FOXI_API bool pixel_point_in_tet(const MeshView& mesh, const Camera& camera, int width, int height,
                                  std::uint32_t t, int x, int y, double bary[4], double shrink = 1);
 
 // The ordering viewpoint of a camera: perspective -> View::at(eye), orthographic -> View::along(at - eye).

@@ -15,6 +15,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/viz/colormap.hpp"
 
 namespace foxi {
@@ -60,6 +61,15 @@ FOXI_API std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldCh
 FOXI_API std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choice,
                                                std::size_t step = 0);
 
+// The same for a host's own scalar field (its solver's arrays, no foxi::Field): corner values, 4 per
+// tet in the tet's node order, for graded_field_paint, TetIntervals and the IsoPainter.
+//   node_corner_values: node_values has 1 value per node; each corner takes its node's value.
+//   cell_corner_values: cell_values has 1 value per tet; each corner takes the volume-weighted mean
+//   of the tets of the SAME region at its node (as tet_corner_values for a cell field).
+// Throws std::invalid_argument when the count does not match the view. (A per-tet colouring needs no
+// helper: flat_field_paint takes the host's cell values as they are.)
+FOXI_API std::vector<double> node_corner_values(const MeshView& mesh, std::span<const double> node_values);
+FOXI_API std::vector<double> cell_corner_values(const MeshView& mesh, std::span<const double> cell_values);
 // The scalar at one point of tet `t` with barycentric coordinates bary[0..4) (its corners in the
 // tet's node order; foxi::locate_points gives them): a node field's components interpolated linearly
 // before taking the scalar (exact for a component of a field linear over the tet), a cell field the

@@ -19,6 +19,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/framebuffer.hpp"
@@ -38,7 +39,7 @@ struct IsoPolygon {
 
 // corner: the tet's 4 corner values (in the tet's node order); attr: 4 more values to interpolate at the
 // polygon's vertices (or null). A tet whose corners are all equal, or with a NaN corner, has none.
-FOXI_API IsoPolygon iso_polygon(const Mesh& mesh, std::uint32_t tet, const double corner[4], double v,
+FOXI_API IsoPolygon iso_polygon(const MeshView& mesh, std::uint32_t tet, const double corner[4], double v,
                                 const double* attr = nullptr);
 
 // Tets a value crosses, answered from a centred interval tree over each tet's (min, max] of its corner
@@ -114,7 +115,7 @@ class FOXI_API IsoPainter {
  public:
   // corner: 4 values per tet of the field the isovalues apply to; attr: 4 per tet colouring the
   // polygons instead (empty: by isovalue). Throws std::invalid_argument for sizes that do not match.
-  IsoPainter(const Mesh& mesh, const Camera& camera, int width, int height, std::span<const double> corner,
+  IsoPainter(const MeshView& mesh, const Camera& camera, int width, int height, std::span<const double> corner,
              const IsoParams& params, const RenderParams& tet_params = {}, std::span<const double> attr = {});
   ~IsoPainter();
   IsoPainter(IsoPainter&&) noexcept;

@@ -14,6 +14,7 @@
 #include "foxi/api.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/framebuffer.hpp"
 #include "foxi/viz/rasterizer.hpp"
@@ -38,7 +39,7 @@ inline OrderMethod safe_order_method(const DelaunayCertificate& cert) {
 
 // The back-to-front order of `subset` (empty: all tets) seen from `view` by the method the mesh's
 // (cached) certificate calls for; the method used and the MPVO cycles broken are stored where asked.
-FOXI_API std::vector<std::uint32_t> safe_order(const Mesh& mesh, const SphereTable& table, const View& view,
+FOXI_API std::vector<std::uint32_t> safe_order(const MeshView& mesh, const SphereTable& table, const View& view,
                                                std::span<const std::uint32_t> subset = {},
                                                OrderMethod* method = nullptr, std::size_t* cycles = nullptr);
 
@@ -76,7 +77,30 @@ struct PictureReport {
 // depth buffer exactly when the depth buffer is used. Throws std::invalid_argument for a stop
 // fraction outside [0, 1], a NaN stop depth, an empty framebuffer, a table of another mesh, and what
 // TetRasterizer throws (degenerate camera).
-FOXI_API PictureReport draw_picture(const Mesh& mesh, const SphereTable& table, const Camera& camera,
+FOXI_API PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera,
                                     Framebuffer& fb, const PictureParams& params = {});
+
+// A host's own RGBA8 image (a window's back buffer, a texture upload buffer): row 0 (the top) at
+// `pixels`, rows `stride` bytes apart (stride >= 4 * width; the bytes past a row's 4 * width are the
+// host's padding and are never written), each pixel 4 bytes R, G, B, A. Lent.
+struct RgbaImage {
+  std::uint8_t* pixels = nullptr;
+  int width = 0, height = 0;
+  std::size_t stride = 0;  // bytes
+};
+
+// Copies fb's colours into `image` (the same width and height), row by row. Throws
+// std::invalid_argument for a null image, other sizes, or a stride below 4 * width.
+FOXI_API void copy_rgba(const Framebuffer& fb, const RgbaImage& image);
+
+// draw_picture into a host's image: the picture is drawn into `scratch` (resized to the image; a
+// framebuffer the host keeps, so that its memory is reused from one picture to the next, and whose id
+// buffer then says which tet each pixel shows, for picking), then its colours are copied into the
+// image (copy_rgba). The painter draws into a framebuffer of its own because it needs the id buffer and
+// contiguous rows for its span writes; the copy is one pass over the pixels (about 0.1 ms a megapixel),
+// far below the drawing. Throws as both.
+FOXI_API PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera,
+                                    const RgbaImage& image, Framebuffer& scratch,
+                                    const PictureParams& params = {});
 
 }  // namespace foxi

@@ -26,6 +26,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/framebuffer.hpp"
 
@@ -73,7 +74,7 @@ struct RasterStats {
 // orthographic camera zoomed in so far that coordinates leave the fixed-point range.
 class FOXI_API TetRasterizer {
  public:
-  TetRasterizer(const Mesh& mesh, const Camera& camera, int width, int height,
+  TetRasterizer(const MeshView& mesh, const Camera& camera, int width, int height,
                 const RenderParams& params = {});
   ~TetRasterizer();
   TetRasterizer(TetRasterizer&&) noexcept;
@@ -144,7 +145,7 @@ class FOXI_API TetRasterizer {
 };
 
 // A convenience: a fresh framebuffer (background white) with `tets` drawn in order.
-FOXI_API Framebuffer render_tets(const Mesh& mesh, const Camera& camera, int width, int height,
+FOXI_API Framebuffer render_tets(const MeshView& mesh, const Camera& camera, int width, int height,
                                  std::span<const std::uint32_t> tets, const RenderParams& params = {});
 
 // The pixels covered by one triangle under the rasterizer's fill rule (for tests): vertices in

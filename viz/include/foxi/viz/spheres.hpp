@@ -16,6 +16,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/model/progress.hpp"
 
 namespace foxi {
@@ -108,6 +109,6 @@ struct SphereTable {
 };
 
 // Builds the table (both cores). Uses the mesh's cached face adjacency.
-FOXI_API SphereTable compute_spheres(const Mesh& mesh, const ProgressFn& progress = {});
+FOXI_API SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress = {});
 
 }  // namespace foxi

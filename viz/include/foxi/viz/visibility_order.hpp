@@ -23,6 +23,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/model/mesh_view.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/view.hpp"
 
@@ -57,7 +58,7 @@ struct OrderStats {
 class FOXI_API ProgressiveOrder {
  public:
   // subset: tet indices to order (each at most once); empty span = all tets.
-  ProgressiveOrder(const Mesh& mesh, const SphereTable& table, const View& view,
+  ProgressiveOrder(const MeshView& mesh, const SphereTable& table, const View& view,
                    std::span<const std::uint32_t> subset = {}, bool front_to_back = false);
   ~ProgressiveOrder();
   ProgressiveOrder(ProgressiveOrder&&) noexcept;
@@ -70,21 +71,21 @@ class FOXI_API ProgressiveOrder {
   const OrderStats& stats() const;
 
  private:
-  friend void visibility_order_into(std::vector<std::uint32_t>&, const Mesh&, const SphereTable&, const View&,
+  friend void visibility_order_into(std::vector<std::uint32_t>&, const MeshView&, const SphereTable&, const View&,
                                     std::span<const std::uint32_t>, bool, OrderStats*);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
 // The whole order at once (both cores).
-FOXI_API std::vector<std::uint32_t> visibility_order(const Mesh& mesh, const SphereTable& table,
+FOXI_API std::vector<std::uint32_t> visibility_order(const MeshView& mesh, const SphereTable& table,
                                                      const View& view,
                                                      std::span<const std::uint32_t> subset = {},
                                                      bool front_to_back = false, OrderStats* stats = nullptr);
 
 // The same into `out`, resized to the order's size: a caller that orders view after view and keeps
 // `out` allocates nothing per view (the internal buffers are kept per thread as well).
-FOXI_API void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh& mesh,
+FOXI_API void visibility_order_into(std::vector<std::uint32_t>& out, const MeshView& mesh,
                                     const SphereTable& table, const View& view,
                                     std::span<const std::uint32_t> subset = {}, bool front_to_back = false,
                                     OrderStats* stats = nullptr);
@@ -92,13 +93,13 @@ FOXI_API void visibility_order_into(std::vector<std::uint32_t>& out, const Mesh&
 // MPVO for meshes without a visibility order guarantee: a topological sort of the view-directed
 // face-adjacency graph of the subset, ready tets taken in decreasing power key; cycles are broken at
 // the tet of largest key and counted in `cycles_broken`.
-FOXI_API std::vector<std::uint32_t> mpvo_order(const Mesh& mesh, const SphereTable& table, const View& view,
+FOXI_API std::vector<std::uint32_t> mpvo_order(const MeshView& mesh, const SphereTable& table, const View& view,
                                                std::span<const std::uint32_t> subset = {},
                                                std::size_t* cycles_broken = nullptr);
 
 // A centroid-depth order (what VTK's vtkCellCenterDepthSort does): the baseline that power order
 // beats. Back to front by decreasing distance from the eye (or along dir) of each tet's centroid.
-FOXI_API std::vector<std::uint32_t> centroid_order(const Mesh& mesh, const View& view,
+FOXI_API std::vector<std::uint32_t> centroid_order(const MeshView& mesh, const View& view,
                                                    std::span<const std::uint32_t> subset = {});
 
 struct ViolationReport {
@@ -109,7 +110,7 @@ struct ViolationReport {
 // Counts face-adjacent pairs drawn in the wrong order (back-to-front order expected): for each
 // interior face shared by two ordered tets, the tet on the eye's side of the face (exact
 // orientation test) must come later. Pairs whose face plane contains the eye are not compared.
-FOXI_API ViolationReport count_violations(const Mesh& mesh, const View& view,
+FOXI_API ViolationReport count_violations(const MeshView& mesh, const View& view,
                                           std::span<const std::uint32_t> order);
 
 }  // namespace foxi
