@@ -1,22 +1,24 @@
-// field_buffer: a host that has its own per-node field and its own pixel buffer, and has foxi draw
-// the field into that buffer.
+// field_buffer: a host that has its own mesh arrays, its own per-node field (as its own solver would
+// leave it) and its own pixel buffer, and has foxi draw the field into that buffer.
 //
 //   field_buffer [OUT.ppm]
 //
-// The host's mesh is a Kuhn-subdivided box, its field an analytic temperature it computes itself
-// (as its own solver would), T(x, y, z) = sin(pi x) sin(pi y) (1 + z) at every node, and its picture
-// buffer has rows `stride` pixels apart (wider than the image, as a window system's would be).
+// The host's mesh is a Kuhn-subdivided box, its field an analytic temperature it computes itself,
+// T(x, y, z) = sin(pi x) sin(pi y) (1 + z) at every node, and its picture buffer has rows `stride`
+// bytes apart (wider than 4 x the width, as a window system's would be).
 //
-// The host hands foxi its per-tet values as a span (foxi::flat_field_paint: no copy into the mesh,
-// no foxi::Field): each tet's value is the mean of its 4 nodal values, and each tet is painted in
-// the colour of that value on a viridis scale over the field's range. Shading and edges are off
-// (shade_min 1), so every pixel is exactly its tet's colour, which the host checks through the
-// framebuffer's id buffer.
+// No copy of the host's arrays: foxi reads them through a foxi::MeshView (std::span over the host's
+// coordinates and tets), and keeps the view's derived data (face adjacency, Delaunay certificate) in a
+// foxi::DerivedCache the host owns; the sphere table is a value the host keeps. The field goes in as
+// spans: per-tet values for a flat colouring (foxi::flat_field_paint), corner values
+// (foxi::node_corner_values) for two isosurfaces. foxi draws into its own framebuffer (the painter
+// needs its id buffer and contiguous rows) and copies the rows into the host's buffer
+// (foxi::draw_picture with a foxi::RgbaImage); the host keeps that framebuffer (`scratch`) to reuse it.
 //
-// Copies: the host's nodes and tets are copied into a foxi::Mesh (foxi::Mesh owns std::vectors;
-// there is no mesh view over host arrays yet), and foxi::Framebuffer owns its pixels, so the
-// picture is copied row by row into the host's buffer (width * height * 4 bytes). The field goes
-// in as a span; the order and the painter read the mesh in place and take the tet order as a span.
+// Checks: (1) flat colouring, shading and edges off: every pixel is exactly the colour of its tet's
+// value on the host's scale (the tet a pixel shows from the scratch framebuffer's id buffer);
+// (2) the isosurfaces drawn from the view into the strided buffer equal, byte for byte, the same drawn
+// from a foxi::Mesh holding copies of the arrays (the CLI's path); the host's padding stays untouched.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -38,11 +40,28 @@
 
 namespace {
 
-// The host's picture buffer: RGBA8 (R first in memory), `stride` pixels per row, padding included.
+// The host's picture buffer: RGBA8 (R first in memory), rows `stride` bytes apart, padding included.
 struct HostImage {
-  int width = 0, height = 0, stride = 0;
-  std::vector<std::uint32_t> pixels;
+  int width = 0, height = 0;
+  std::size_t stride = 0;
+  std::vector<std::uint8_t> bytes;
+  foxi::RgbaImage target() { return {bytes.data(), width, height, stride}; }
+  std::uint32_t pixel(int x, int y) const {
+    std::uint32_t p;
+    std::memcpy(&p, &bytes[std::size_t(y) * stride + 4 * std::size_t(x)], 4);
+    return p;  // little-endian: pack_rgba's layout
+  }
 };
+
+constexpr std::uint8_t kPadding = 0xA5;  // the host's padding must stay untouched
+
+std::size_t padding_changed(const HostImage& image) {
+  std::size_t n = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (std::size_t b = 4 * std::size_t(image.width); b < image.stride; ++b)
+      n += image.bytes[std::size_t(y) * image.stride + b] != kPadding;
+  return n;
+}
 
 int run(const char* out) {
   // The host's mesh: an nx x ny x nz box of cubes, 6 Kuhn tets each, over [0,1] x [0,1] x [0,0.5].
@@ -75,11 +94,25 @@ int run(const char* out) {
     temperature[v] = std::sin(std::numbers::pi * xyz[3 * v]) * std::sin(std::numbers::pi * xyz[3 * v + 1]) *
                      (1 + xyz[3 * v + 2]);
 
-  foxi::Mesh mesh;  // copies of the host's arrays (see the top)
-  mesh.xyz = xyz;
-  mesh.tet = tets;
+  // The view over the host's arrays (no copy) and the cache the host keeps for it.
+  foxi::DerivedCache derived;
+  const foxi::MeshView mesh(xyz, tets, {}, {}, {}, &derived);
+  if (!foxi::validate(mesh).ok()) throw std::runtime_error("the host's mesh is not valid");
+  if (!foxi::delaunay_certificate(mesh).delaunay) throw std::runtime_error("the host's mesh is not Delaunay");
+  const foxi::SphereTable spheres = foxi::compute_spheres(mesh);
 
-  // The host's per-tet values, handed to foxi as a span.
+  HostImage image;
+  image.width = 480;
+  image.height = 360;
+  image.stride = 4 * 512 + 8;
+  image.bytes.assign(image.stride * std::size_t(image.height), kPadding);
+  double lo[3], hi[3];
+  foxi::mesh_bounds(mesh, lo, hi);
+  const double dir[3] = {-0.6, 1, -0.9}, up[3] = {0, 0, 1};
+  const foxi::Camera camera = foxi::fit_camera(lo, hi, dir, up, true, 30, double(image.width) / image.height);
+  foxi::Framebuffer scratch;  // foxi's framebuffer, kept by the host from one picture to the next
+
+  // (1) Flat colouring by the host's per-tet values (the mean of each tet's 4 nodal values).
   std::vector<double> tet_value(mesh.tet_count());
   for (std::size_t t = 0; t < mesh.tet_count(); ++t)
     for (int v = 0; v < 4; ++v) tet_value[t] += temperature[mesh.tet[4 * t + v]] / 4;
@@ -88,74 +121,78 @@ int run(const char* out) {
   std::tie(scale.lo, scale.hi) = foxi::finite_range(tet_value);
   auto paint = std::make_shared<foxi::FieldPaint>(foxi::flat_field_paint(tet_value, scale));
   paint->shade_min = 1;  // no shading: each pixel is its tet's colour exactly
-  foxi::RenderParams params;
-  params.edges = false;
-  params.field = paint;
-
-  if (!foxi::validate(mesh).ok()) throw std::runtime_error("the host's mesh is not valid");
-  if (!foxi::delaunay_certificate(mesh).delaunay) throw std::runtime_error("the host's mesh is not Delaunay");
-
-  HostImage image;
-  image.width = 480;
-  image.height = 360;
-  image.stride = 512;
-  const std::uint32_t kPadding = 0xdeadbeef;  // the host's padding must stay untouched
-  image.pixels.assign(std::size_t(image.stride) * image.height, kPadding);
-
-  double lo[3], hi[3];
-  foxi::mesh_bounds(mesh, lo, hi);
-  const double dir[3] = {-0.6, 1, -0.9}, up[3] = {0, 0, 1};
-  const foxi::Camera camera = foxi::fit_camera(lo, hi, dir, up, true, 30, double(image.width) / image.height);
-  const foxi::SphereTable spheres = foxi::compute_spheres(mesh);
-  const std::vector<std::uint32_t> order = foxi::visibility_order(mesh, spheres, foxi::view_of(camera));
-
-  foxi::Framebuffer fb(image.width, image.height, false, foxi::pack_rgba(0, 0, 0, 0));
-  foxi::TetRasterizer painter(mesh, camera, image.width, image.height, params);
-  painter.draw(fb, order);
-  for (int y = 0; y < image.height; ++y)  // the copy out of foxi's framebuffer (see the top)
-    std::memcpy(&image.pixels[std::size_t(y) * image.stride], &fb.rgba[fb.index(0, y)],
-                std::size_t(image.width) * sizeof(std::uint32_t));
-
-  // Checks: every covered pixel has the map colour of the field at the tet it shows, the background
-  // stays transparent, the padding untouched, and the picture spans the field's range.
-  std::size_t covered = 0, wrong = 0, padding_changed = 0;
+  foxi::PictureParams flat;
+  flat.render.edges = false;
+  flat.render.field = paint;
+  foxi::draw_picture(mesh, spheres, camera, image.target(), scratch, flat);
+  std::size_t covered = 0, wrong = 0;
   std::set<std::uint32_t> colours;
   for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.stride; ++x) {
-      const std::uint32_t px = image.pixels[std::size_t(y) * image.stride + x];
-      if (x >= image.width) {
-        padding_changed += px != kPadding;
-        continue;
-      }
-      const std::uint32_t t = fb.id[fb.index(x, y)];
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint32_t px = image.pixel(x, y), t = scratch.id[scratch.index(x, y)];
       if (t == foxi::kNone) {
-        wrong += px != foxi::pack_rgba(0, 0, 0, 0);
+        wrong += px != foxi::pack_rgba(255, 255, 255);  // draw_picture's white background
         continue;
       }
       ++covered;
       colours.insert(px);
       wrong += px != scale.color(tet_value[t]);  // the colour of the host's value, on the host's scale
     }
-  std::printf(
-      "field_buffer: %zu tets, values %.3g..%.3g, %zu pixels covered, %zu colours shown, %zu wrong "
-      "pixels, %zu padding pixels changed\n",
-      mesh.tet_count(), scale.lo, scale.hi, covered, colours.size(), wrong, padding_changed);
+  const std::size_t flat_padding = padding_changed(image);
 
-  if (out != nullptr) {  // the host's own writer: binary PPM of its buffer, alpha dropped
+  // (2) Two isosurfaces of the host's node field, only the tets they cross ordered and drawn.
+  foxi::IsoDrawing iso;
+  const std::vector<double> corners = foxi::node_corner_values(mesh, temperature);
+  iso.corner = corners;
+  iso.params.values = {0.35, 0.8};
+  iso.params.scale = scale;
+  std::vector<std::uint32_t> crossing;
+  foxi::TetIntervals(corners).crossing_any(iso.params.values, crossing);
+  foxi::PictureParams iso_params;
+  iso_params.iso = &iso;
+  iso_params.subset = crossing;
+  iso_params.subset_exact = true;
+  const foxi::PictureReport report =
+      foxi::draw_picture(mesh, spheres, camera, image.target(), scratch, iso_params);
+
+  // The same through a foxi::Mesh holding copies of the host's arrays.
+  foxi::Mesh copy;
+  copy.xyz = xyz;
+  copy.tet = tets;
+  foxi::Framebuffer fb(image.width, image.height);
+  foxi::draw_picture(copy, foxi::compute_spheres(copy), camera, fb, iso_params);
+  std::size_t iso_wrong = 0, iso_covered = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      iso_wrong += image.pixel(x, y) != fb.rgba[fb.index(x, y)];
+      iso_covered += fb.id[fb.index(x, y)] != foxi::kNone;
+    }
+  const std::size_t iso_padding = padding_changed(image);
+
+  std::printf(
+      "field_buffer: %zu tets (a view of the host's arrays), values %.3g..%.3g\n"
+      "  flat colours: %zu pixels covered, %zu colours shown, %zu wrong pixels, %zu padding bytes changed\n"
+      "  isosurfaces %.3g and %.3g: %zu tets crossed, %s order, %zu pixels covered, %zu pixels unlike the "
+      "Mesh path's, %zu padding bytes changed\n",
+      mesh.tet_count(), scale.lo, scale.hi, covered, colours.size(), wrong, flat_padding,
+      iso.params.values[0], iso.params.values[1], crossing.size(),
+      report.method == foxi::OrderMethod::power ? "power" : "MPVO", iso_covered, iso_wrong, iso_padding);
+
+  if (out != nullptr) {  // the host's own writer: binary PPM of its buffer (the isosurfaces), alpha dropped
     std::ofstream f(out, std::ios::binary);
     f << "P6\n" << image.width << ' ' << image.height << "\n255\n";
     for (int y = 0; y < image.height; ++y)
-      for (int x = 0; x < image.width; ++x) {
-        const std::uint32_t px = image.pixels[std::size_t(y) * image.stride + x];
-        const char rgb[3] = {char(px & 255u), char(px >> 8 & 255u), char(px >> 16 & 255u)};
-        f.write(rgb, 3);
-      }
+      for (int x = 0; x < image.width; ++x)
+        f.write(
+            reinterpret_cast<const char*>(&image.bytes[std::size_t(y) * image.stride + 4 * std::size_t(x)]),
+            3);
     if (!f.flush()) throw std::runtime_error(std::string("cannot write ") + out);
   }
-  return wrong == 0 && padding_changed == 0 && colours.size() > 50 &&
-                 covered > std::size_t(image.width) * image.height / 10
-             ? 0
-             : 1;
+  const bool ok = wrong == 0 && flat_padding == 0 && colours.size() > 50 &&
+                  covered > std::size_t(image.width) * image.height / 10 && iso_wrong == 0 &&
+                  iso_padding == 0 && iso_covered > std::size_t(image.width) * image.height / 20 &&
+                  report.delaunay;
+  return ok ? 0 : 1;
 }
 
 }  // namespace
