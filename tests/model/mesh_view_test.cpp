@@ -90,7 +90,8 @@ TEST(MeshView, SizesAndMissingCacheAreReported) {
   std::vector<std::uint32_t> tet;
   kuhn_grid(1, xyz, tet);
   const std::vector<std::int32_t> region(5, 1);  // 6 tets
-  EXPECT_NE(check_sizes(MeshView{xyz, tet, region}).find("tet_region has 5 entries for 6 tets"), std::string::npos);
+  EXPECT_NE(check_sizes(MeshView{xyz, tet, region}).find("tet_region has 5 entries for 6 tets"),
+            std::string::npos);
   EXPECT_FALSE(validate(MeshView{xyz, tet, region}).ok());
   EXPECT_NE(check_sizes(MeshView{std::span<const double>(xyz).first(7), tet}).find("multiple of 3"),
             std::string::npos);

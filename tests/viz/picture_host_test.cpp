@@ -111,7 +111,8 @@ TEST(MeshView, HostFieldIsosurfaceIntoHostImage) {
   // The host's own solver arrays: a node field and a cell field.
   std::vector<double> node_t(view.node_count()), cell_q(view.tet_count());
   for (std::size_t v = 0; v < node_t.size(); ++v)
-    node_t[v] = std::sin(std::numbers::pi * host.xyz[3 * v]) * (1 + host.xyz[3 * v + 1]) + host.xyz[3 * v + 2];
+    node_t[v] =
+        std::sin(std::numbers::pi * host.xyz[3 * v]) * (1 + host.xyz[3 * v + 1]) + host.xyz[3 * v + 2];
   for (std::size_t t = 0; t < cell_q.size(); ++t) cell_q[t] = 10.0 * view.region_of(t) + 0.01 * double(t % 7);
 
   // The oracle: the same values as foxi::Fields of a foxi::Mesh.
@@ -149,7 +150,8 @@ TEST(MeshView, HostFieldIsosurfaceIntoHostImage) {
   for (const Camera& cam : test::random_cameras(mesh, 4, 3, double(kW) / kH)) {
     Framebuffer fb(kW, kH);
     draw_picture(mesh, mt, cam, fb, params);
-    const PictureReport r = draw_picture(view, vt, cam, RgbaImage{image.data(), kW, kH, kStride}, scratch, params);
+    const PictureReport r =
+        draw_picture(view, vt, cam, RgbaImage{image.data(), kW, kH, kStride}, scratch, params);
     EXPECT_EQ(r.tets_ordered, crossing.size());
     std::size_t wrong = 0, padding = 0;
     compare_image(image, fb, wrong, padding);
@@ -172,7 +174,8 @@ TEST(MeshView, BadHostInputIsRefused) {
   const Camera cam = test::random_cameras(copy_into_mesh(host), 1, 1, 1.0)[0];
   EXPECT_THROW(draw_picture(view, t, cam, RgbaImage{image.data(), kW, kH, 4 * kW - 4}, scratch),
                std::invalid_argument);  // stride below a row
-  EXPECT_THROW(draw_picture(view, t, cam, RgbaImage{nullptr, kW, kH, kStride}, scratch), std::invalid_argument);
+  EXPECT_THROW(draw_picture(view, t, cam, RgbaImage{nullptr, kW, kH, kStride}, scratch),
+               std::invalid_argument);
   Framebuffer other(kW + 1, kH);
   EXPECT_THROW(copy_rgba(other, RgbaImage{image.data(), kW, kH, kStride}), std::invalid_argument);
   for (std::uint8_t b : image) ASSERT_EQ(b, kPad);  // nothing written on refusal

@@ -76,7 +76,8 @@ struct IsoPainter::Impl {
       steps.push_back({true, run.size(), 0});
   }
 
-  Impl(const MeshView& m, const Camera& camera, int w, int h) : mesh_view(m), mesh(&mesh_view), proj(camera, w, h) {}
+  Impl(const MeshView& m, const Camera& camera, int w, int h)
+      : mesh_view(m), mesh(&mesh_view), proj(camera, w, h) {}
 
   // Draws a convex polygon (camera coordinates, attribute positions when graded): flat colour rgb x
   // factor, or per pixel the scale entry at the interpolated position x factor.

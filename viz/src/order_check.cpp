@@ -43,7 +43,8 @@ std::vector<std::uint32_t> centroid_order(const MeshView& mesh, const View& view
   return tets;
 }
 
-ViolationReport count_violations(const MeshView& mesh, const View& view, std::span<const std::uint32_t> order) {
+ViolationReport count_violations(const MeshView& mesh, const View& view,
+                                 std::span<const std::uint32_t> order) {
   const std::size_t n = mesh.tet_count();
   std::vector<std::uint32_t> pos(n, kNone);
   for (std::size_t i = 0; i < order.size(); ++i) pos[order[i]] = static_cast<std::uint32_t>(i);

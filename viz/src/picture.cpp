@@ -38,8 +38,8 @@ std::vector<std::uint32_t> safe_order(const MeshView& mesh, const SphereTable& t
   return order;
 }
 
-PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera, Framebuffer& fb,
-                           const PictureParams& params) {
+PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera,
+                           Framebuffer& fb, const PictureParams& params) {
   if (!(params.stop_fraction >= 0 && params.stop_fraction <= 1))
     throw std::invalid_argument("draw_picture: the stop fraction must lie in [0, 1]");
   if (std::isnan(params.stop_depth)) throw std::invalid_argument("draw_picture: the stop depth is NaN");
@@ -90,8 +90,8 @@ void copy_rgba(const Framebuffer& fb, const RgbaImage& image) {
   if (image.pixels == nullptr) throw std::invalid_argument("copy_rgba: the image has no pixels");
   if (image.width != fb.width || image.height != fb.height)
     throw std::invalid_argument("copy_rgba: the image is " + std::to_string(image.width) + " x " +
-                                std::to_string(image.height) + ", the framebuffer " + std::to_string(fb.width) +
-                                " x " + std::to_string(fb.height));
+                                std::to_string(image.height) + ", the framebuffer " +
+                                std::to_string(fb.width) + " x " + std::to_string(fb.height));
   if (image.stride < 4 * std::size_t(image.width))
     throw std::invalid_argument("copy_rgba: a stride of " + std::to_string(image.stride) +
                                 " bytes is below 4 x the width " + std::to_string(image.width));

@@ -21,12 +21,12 @@
 //   tets_bounds(mesh, subset, lo, hi)         bounds of a subset, to fit a camera to (camera.hpp)
 //   tet_depth, count_deeper                    the painter's depth stop (depth_stop.hpp)
 //   make_movie(...)                            movies of the painter: APNG, GIF (movie.hpp, animation.hpp)
-//   node_corner_values, cell_corner_values    a host's own node or cell array as corner values (field_paint.hpp)
-//   choose_field, tet_corner_values, FieldPaint colour by a field: flat or graded (field_paint.hpp,
-//   RenderParams::field) ColorScale, color_map_entry, nice_ticks    colour maps, ranges, colour-bar ticks
-//   (colormap.hpp) TextRenderer, find_font_file               text in pictures with FreeType (text.hpp)
-//   draw_color_legend, legend_width            a colour-bar legend drawn into a picture (legend.hpp)
-//   draw_chart, Chart, axis_ticks              line charts: series, log axes, legend (chart.hpp)
+//   node_corner_values, cell_corner_values    a host's own node or cell array as corner values
+//   (field_paint.hpp) choose_field, tet_corner_values, FieldPaint colour by a field: flat or graded
+//   (field_paint.hpp, RenderParams::field) ColorScale, color_map_entry, nice_ticks    colour maps, ranges,
+//   colour-bar ticks (colormap.hpp) TextRenderer, find_font_file               text in pictures with FreeType
+//   (text.hpp) draw_color_legend, legend_width            a colour-bar legend drawn into a picture
+//   (legend.hpp) draw_chart, Chart, axis_ticks              line charts: series, log axes, legend (chart.hpp)
 //   draw_translucent_picture, TranslucentPainter translucent regions and isosurfaces, exactly composited
 //   (translucent.hpp) draw_volume_picture, VolumePainter         volume rendering by projected tetrahedra,
 //   power order (volume.hpp)

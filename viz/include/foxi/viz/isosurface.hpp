@@ -115,8 +115,9 @@ class FOXI_API IsoPainter {
  public:
   // corner: 4 values per tet of the field the isovalues apply to; attr: 4 per tet colouring the
   // polygons instead (empty: by isovalue). Throws std::invalid_argument for sizes that do not match.
-  IsoPainter(const MeshView& mesh, const Camera& camera, int width, int height, std::span<const double> corner,
-             const IsoParams& params, const RenderParams& tet_params = {}, std::span<const double> attr = {});
+  IsoPainter(const MeshView& mesh, const Camera& camera, int width, int height,
+             std::span<const double> corner, const IsoParams& params, const RenderParams& tet_params = {},
+             std::span<const double> attr = {});
   ~IsoPainter();
   IsoPainter(IsoPainter&&) noexcept;
   IsoPainter& operator=(IsoPainter&&) noexcept;

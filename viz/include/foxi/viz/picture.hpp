@@ -39,8 +39,8 @@ inline OrderMethod safe_order_method(const DelaunayCertificate& cert) {
 
 // The back-to-front order of `subset` (empty: all tets) seen from `view` by the method the mesh's
 // (cached) certificate calls for; the method used and the MPVO cycles broken are stored where asked.
-FOXI_API std::vector<std::uint32_t> safe_order(const MeshView& mesh, const SphereTable& table, const View& view,
-                                               std::span<const std::uint32_t> subset = {},
+FOXI_API std::vector<std::uint32_t> safe_order(const MeshView& mesh, const SphereTable& table,
+                                               const View& view, std::span<const std::uint32_t> subset = {},
                                                OrderMethod* method = nullptr, std::size_t* cycles = nullptr);
 
 struct PictureParams {

@@ -71,8 +71,8 @@ class FOXI_API ProgressiveOrder {
   const OrderStats& stats() const;
 
  private:
-  friend void visibility_order_into(std::vector<std::uint32_t>&, const MeshView&, const SphereTable&, const View&,
-                                    std::span<const std::uint32_t>, bool, OrderStats*);
+  friend void visibility_order_into(std::vector<std::uint32_t>&, const MeshView&, const SphereTable&,
+                                    const View&, std::span<const std::uint32_t>, bool, OrderStats*);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -93,8 +93,8 @@ FOXI_API void visibility_order_into(std::vector<std::uint32_t>& out, const MeshV
 // MPVO for meshes without a visibility order guarantee: a topological sort of the view-directed
 // face-adjacency graph of the subset, ready tets taken in decreasing power key; cycles are broken at
 // the tet of largest key and counted in `cycles_broken`.
-FOXI_API std::vector<std::uint32_t> mpvo_order(const MeshView& mesh, const SphereTable& table, const View& view,
-                                               std::span<const std::uint32_t> subset = {},
+FOXI_API std::vector<std::uint32_t> mpvo_order(const MeshView& mesh, const SphereTable& table,
+                                               const View& view, std::span<const std::uint32_t> subset = {},
                                                std::size_t* cycles_broken = nullptr);
 
 // A centroid-depth order (what VTK's vtkCellCenterDepthSort does): the baseline that power order
