@@ -6,16 +6,16 @@
 #include <limits>
 #include <numbers>
 
+#include "foxi/model/vec3.hpp"
+
 namespace foxi {
 namespace {
 
-struct V3 {
-  double x, y, z;
-};
-V3 sub(const double* a, const double* b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-double norm(V3 a) { return std::sqrt(dot(a, a)); }
+using V3 = detail::Vec3;  // foxi/model/vec3.hpp
+using detail::cross;
+using detail::dot;
+using detail::norm;
+using detail::sub;
 
 void add(Stat& s, double v, std::size_t i) {
   if (i == 0) s.min = s.max = v;
@@ -43,8 +43,8 @@ TetQuality tet_quality(const double* p0, const double* p1, const double* p2, con
   // Circumcentre relative to p0: x = (|B|^2 C x D + |C|^2 D x B + |D|^2 B x C) / (2 B . C x D).
   const V3 cd = cross(C, D), db = cross(D, B), bc = cross(B, C);
   const double lb = dot(B, B), lc = dot(C, C), ld = dot(D, D);
-  const V3 num = {lb * cd.x + lc * db.x + ld * bc.x, lb * cd.y + lc * db.y + ld * bc.y,
-                  lb * cd.z + lc * db.z + ld * bc.z};
+  const V3 num = {lb * cd[0] + lc * db[0] + ld * bc[0], lb * cd[1] + lc * db[1] + ld * bc[1],
+                  lb * cd[2] + lc * db[2] + ld * bc[2]};
   q.radius_edge = norm(num) / (2 * std::abs(det)) / lmin;
 
   // Outward area normals of the faces (face k is opposite vertex k); the dihedral angle at the edge
@@ -55,7 +55,7 @@ TetQuality tet_quality(const double* p0, const double* p1, const double* p2, con
     const double* b = p[(k + 2) % 4];
     const double* c = p[(k + 3) % 4];
     n[k] = cross(sub(b, a), sub(c, a));
-    if (dot(n[k], sub(p[k], a)) > 0) n[k] = {-n[k].x, -n[k].y, -n[k].z};
+    if (dot(n[k], sub(p[k], a)) > 0) n[k] = {-n[k][0], -n[k][1], -n[k][2]};
   }
   double amin = std::numeric_limits<double>::infinity();
   for (int k = 0; k < 4; ++k)

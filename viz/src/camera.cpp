@@ -6,25 +6,18 @@
 #include <stdexcept>
 #include <string>
 
+#include "foxi/model/vec3.hpp"
+
 namespace foxi {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-void cross(const double a[3], const double b[3], double r[3]) {
-  r[0] = a[1] * b[2] - a[2] * b[1];
-  r[1] = a[2] * b[0] - a[0] * b[2];
-  r[2] = a[0] * b[1] - a[1] * b[0];
-}
-double norm(const double a[3]) { return std::sqrt(dot(a, a)); }
-bool normalize(double a[3]) {
-  double n = norm(a);
-  if (!(n > 0) || !std::isfinite(n)) return false;
-  for (int k = 0; k < 3; ++k) a[k] /= n;
-  return true;
-}
+using detail::cross;  // foxi/model/vec3.hpp, on the camera's double[3]
+using detail::dot;
+using detail::norm;
+using detail::normalize;
 
 // Orthonormal right, up, forward of a camera; false if degenerate.
 bool basis(const Camera& c, double right[3], double up[3], double fwd[3]) {

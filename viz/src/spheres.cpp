@@ -12,6 +12,7 @@
 #include "exact.hpp"
 #include "huge_page_allocator.hpp"
 #include "foxi/model/adjacency.hpp"
+#include "foxi/model/assert.hpp"
 #include "foxi/model/parallel.hpp"
 
 namespace foxi {
@@ -391,6 +392,10 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
     std::vector<std::uint32_t> fill(t.cluster_begin.begin(), t.cluster_begin.end() - 1);
     for (std::size_t i = 0; i < n; ++i)
       if (t.cluster_of[i] != kNone) t.cluster_tets[fill[t.cluster_of[i]]++] = static_cast<std::uint32_t>(i);
+    for (std::uint32_t k = 0; k < clusters; ++k)
+      FOXI_ASSERT(fill[k] == t.cluster_begin[k + 1],
+                  "cluster " << k << " filled " << fill[k] - t.cluster_begin[k] << " of its "
+                             << t.cluster_begin[k + 1] - t.cluster_begin[k] << " tets");
   }
   // Faces inside clusters, oriented so that the first tet lies on the positive side of the triangle.
   static const int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
@@ -417,6 +422,10 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
         t.face_vertex[3 * k + 1] = v[kFace[f][2]];
         t.face_vertex[3 * k + 2] = v[kFace[f][1]];
       }
+    for (std::uint32_t k = 0; k < clusters; ++k)
+      FOXI_ASSERT(fill[k] == t.cluster_face_begin[k + 1],
+                  "cluster " << k << " filled " << fill[k] - t.cluster_face_begin[k] << " of its "
+                             << t.cluster_face_begin[k + 1] - t.cluster_face_begin[k] << " faces");
   }
   // Wide items: bounds far above the typical (256 x the median), so that a few slivers with huge
   // spheres do not widen the near-tie window of everyone else.
