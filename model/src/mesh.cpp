@@ -72,21 +72,11 @@ std::size_t field_entity_count(const Mesh& mesh, const Field& field) {
 }
 
 std::string check_sizes(const Mesh& mesh) {
-  if (mesh.xyz.size() % 3 != 0)
-    return "xyz holds " + std::to_string(mesh.xyz.size()) + " values, not a multiple of 3";
-  if (mesh.tet.size() % 4 != 0)
-    return "tet holds " + std::to_string(mesh.tet.size()) + " indices, not a multiple of 4";
-  if (mesh.bface.size() % 3 != 0)
-    return "bface holds " + std::to_string(mesh.bface.size()) + " indices, not a multiple of 3";
-  if (!mesh.tet_region.empty() && mesh.tet_region.size() != mesh.tet_count())
-    return "tet_region has " + std::to_string(mesh.tet_region.size()) + " entries for " +
-           std::to_string(mesh.tet_count()) + " tets";
+  // The arrays a view shares are checked by the view's rule; then what only a Mesh holds.
+  if (std::string why = check_sizes(MeshView(mesh)); !why.empty()) return why;
   if (mesh.bface_tag.size() != mesh.bface_count())
     return "bface_tag has " + std::to_string(mesh.bface_tag.size()) + " entries for " +
            std::to_string(mesh.bface_count()) + " boundary triangles";
-  if (!mesh.weight.empty() && mesh.weight.size() != mesh.node_count())
-    return "weight has " + std::to_string(mesh.weight.size()) + " entries for " +
-           std::to_string(mesh.node_count()) + " nodes";
   for (const Region& r : mesh.regions)
     if (r.material != kNone && r.material >= mesh.materials.size())
       return "region " + std::to_string(r.id) + " names material " + std::to_string(r.material) + " of " +
