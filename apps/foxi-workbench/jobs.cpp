@@ -84,7 +84,7 @@ struct JobInput {
   std::shared_ptr<const Mesh> old_mesh;    // solve only: the mesh to solve on
   std::shared_ptr<const Model> old_model;  // and the model it came from
   MeshSettings mesh_settings;              // the mesh panel's (mesh_panel.cpp)
-  std::shared_ptr<const Mesh> result;  // the solved mesh to refine from (null: none)
+  std::shared_ptr<const Mesh> result;      // the solved mesh to refine from (null: none)
   std::string shown_field;
   int width = 1, height = 1;
   std::optional<Camera> camera;  // the view's camera stays across a remesh (compare before and after)

@@ -48,6 +48,18 @@ QString length_text(double metres, double scale, const std::string& unit) {
 
 const char* const kBoxColumns[] = {"x0", "y0", "z0", "x1", "y1", "z1", "size"};
 
+// A cell's text, its item kept when it has one: the tables are refilled from inside their own
+// cellChanged, which must not delete the item it reports.
+void set_cell(QTableWidget* table, int row, int column, const QString& text, bool editable = true) {
+  QTableWidgetItem* item = table->item(row, column);
+  if (!item) {
+    item = new QTableWidgetItem;
+    table->setItem(row, column, item);
+  }
+  item->setText(text);
+  item->setFlags(editable ? item->flags() | Qt::ItemIsEditable : item->flags() & ~Qt::ItemIsEditable);
+}
+
 }  // namespace
 
 // The minimum dihedral angle histogram of the quality report as a bar chart (5-degree bins).
@@ -90,12 +102,14 @@ void apply_mesh_settings(ModelMeshOptions& options, const MeshSettings& s, const
 QString mesher_summary(const MeshedModel& m) {
   QString text;
   if (m.mesher == Mesher::cgal) {
-    text = QObject::tr("mesher: CGAL Mesh_3 (regular triangulation, vertex weights) in %1 s; region volumes "
-                       "against the PLC's: worst change %2%")
+    text = QObject::tr(
+               "mesher: CGAL Mesh_3 (regular triangulation, vertex weights) in %1 s; region volumes "
+               "against the PLC's: worst change %2%")
                .arg(m.cgal.seconds, 0, 'f', 2)
                .arg(100 * m.cgal.worst_volume_change, 0, 'g', 3);
     if (m.ignored_refine_boxes > 0)
-      text += QObject::tr("; the model's %1 refinement boxes left out (TetGen's)").arg(m.ignored_refine_boxes);
+      text +=
+          QObject::tr("; the model's %1 refinement boxes left out (TetGen's)").arg(m.ignored_refine_boxes);
   } else {
     text = QObject::tr("mesher: TetGen (switches %1), conforming Delaunay refinement")
                .arg(QString::fromStdString(m.report.switches));
@@ -162,15 +176,17 @@ void Workbench::on_mesh_controls_edited() {
     if (!ui.quality->text().trimmed().isEmpty()) {
       bool ok = false;
       s.quality = ui.quality->text().trimmed().toDouble(&ok);
-      if (!ok) return fail(tr("the quality bound takes a number (a radius-edge ratio), not '%1'")
-                               .arg(ui.quality->text()));
+      if (!ok)
+        return fail(
+            tr("the quality bound takes a number (a radius-edge ratio), not '%1'").arg(ui.quality->text()));
     }
     s.part_sizes.clear();
     for (int r = 0; r < ui.parts->rowCount(); ++r) {
       const QTableWidgetItem* name = ui.parts->item(r, 0);
       const QTableWidgetItem* size = ui.parts->item(r, 1);
       if (!name || !size || size->text().trimmed().isEmpty()) continue;
-      s.part_sizes.push_back({.part = name->text().toStdString(), .max_size = parse_length(size->text(), scale)});
+      s.part_sizes.push_back(
+          {.part = name->text().toStdString(), .max_size = parse_length(size->text(), scale)});
     }
     s.boxes.clear();
     for (int r = 0; r < ui.boxes->rowCount(); ++r) {
@@ -190,10 +206,12 @@ void Workbench::on_mesh_controls_edited() {
       s.boxes.push_back(b);
     }
     s.refine_from_result = ui.refine->isChecked();
-    s.refine_field = ui.refine_field->currentIndex() <= 0 ? std::string() : ui.refine_field->currentText().toStdString();
+    s.refine_field =
+        ui.refine_field->currentIndex() <= 0 ? std::string() : ui.refine_field->currentText().toStdString();
     bool ok = false;
     s.target_error = ui.target_error->text().trimmed().toDouble(&ok);
-    if (!ok) return fail(tr("the target error takes a number (e.g. 0.05), not '%1'").arg(ui.target_error->text()));
+    if (!ok)
+      return fail(tr("the target error takes a number (e.g. 0.05), not '%1'").arg(ui.target_error->text()));
   } catch (const ExpressionError& e) {
     return fail(what_of(e));
   }
@@ -226,25 +244,20 @@ void Workbench::refresh_mesh_controls() {
   ui.parts->setRowCount(model_ ? int(model_->parts.size()) : 0);
   for (int r = 0; model_ && r < int(model_->parts.size()); ++r) {
     const Part& part = model_->parts[std::size_t(r)];
-    auto* name = new QTableWidgetItem(QString::fromStdString(part.name));
-    name->setFlags(name->flags() & ~Qt::ItemIsEditable);
     QString mine, models;
     for (const PartSize& p : s.part_sizes)
       if (p.part == part.name) mine = length_text(p.max_size, scale, unit);
     for (const PartSize& p : model_->mesh.part_sizes)
       if (p.part == part.name) models = length_text(p.max_size, scale, unit);
-    auto* model_size = new QTableWidgetItem(models);
-    model_size->setFlags(model_size->flags() & ~Qt::ItemIsEditable);
-    ui.parts->setItem(r, 0, name);
-    ui.parts->setItem(r, 1, new QTableWidgetItem(mine));
-    ui.parts->setItem(r, 2, model_size);
+    set_cell(ui.parts, r, 0, QString::fromStdString(part.name), false);
+    set_cell(ui.parts, r, 1, mine);
+    set_cell(ui.parts, r, 2, models, false);
   }
   ui.boxes->setRowCount(int(s.boxes.size()));
   for (int r = 0; r < int(s.boxes.size()); ++r) {
     const RefinementBox& b = s.boxes[std::size_t(r)];
     const double v[7] = {b.lo[0], b.lo[1], b.lo[2], b.hi[0], b.hi[1], b.hi[2], b.size};
-    for (int c = 0; c < 7; ++c)
-      ui.boxes->setItem(r, c, new QTableWidgetItem(QString::number(v[c] / scale, 'g', 6)));
+    for (int c = 0; c < 7; ++c) set_cell(ui.boxes, r, c, QString::number(v[c] / scale, 'g', 6));
   }
   ui.refine->setChecked(s.refine_from_result);
   // The current result's node fields (refine_field's choices); the first entry: the field shown.
@@ -253,7 +266,8 @@ void Workbench::refresh_mesh_controls() {
   if (mesh_)
     for (const Field& f : mesh_->fields)
       if (f.location == FieldLocation::node) ui.refine_field->addItem(QString::fromStdString(f.name));
-  const int at = s.refine_field.empty() ? 0 : ui.refine_field->findText(QString::fromStdString(s.refine_field));
+  const int at =
+      s.refine_field.empty() ? 0 : ui.refine_field->findText(QString::fromStdString(s.refine_field));
   if (at < 0) ui.refine_field->addItem(QString::fromStdString(s.refine_field));
   ui.refine_field->setCurrentIndex(at < 0 ? ui.refine_field->count() - 1 : at);
   ui.target_error->setText(QString::number(s.target_error, 'g', 6));
@@ -272,13 +286,15 @@ void Workbench::build_mesh_panel() {
   form->addRow(tr("Mesher"), ui.mesher);
   ui.max_size = new QLineEdit;
   ui.max_size->setObjectName("mesh_size");
-  ui.max_size->setToolTip(tr("target edge length everywhere (\"0.5 mm\"; a bare number is in the model's "
-                             "length unit); empty: the model's [mesh] max_size"));
+  ui.max_size->setToolTip(
+      tr("target edge length everywhere (\"0.5 mm\"; a bare number is in the model's "
+         "length unit); empty: the model's [mesh] max_size"));
   form->addRow(tr("Size"), ui.max_size);
   ui.quality = new QLineEdit;
   ui.quality->setObjectName("mesh_quality");
-  ui.quality->setToolTip(tr("radius-edge bound: TetGen 0 (none) or at least 1.414; CGAL's cell bound "
-                            "(2 or more guarantees termination); empty: the default"));
+  ui.quality->setToolTip(
+      tr("radius-edge bound: TetGen 0 (none) or at least 1.414; CGAL's cell bound "
+         "(2 or more guarantees termination); empty: the default"));
   form->addRow(tr("Quality"), ui.quality);
   mv->addLayout(form);
   ui.parts = new QTableWidget(0, 3);
@@ -310,7 +326,8 @@ void Workbench::build_mesh_panel() {
   auto* refine_row = new QHBoxLayout;
   ui.refine = new QCheckBox(tr("Refine from the result"));
   ui.refine->setObjectName("refine_from_result");
-  ui.refine->setToolTip(tr("the next mesh's sizes from the Zienkiewicz-Zhu error of the result's field (TetGen)"));
+  ui.refine->setToolTip(
+      tr("the next mesh's sizes from the Zienkiewicz-Zhu error of the result's field (TetGen)"));
   ui.refine_field = new QComboBox;
   ui.target_error = new QLineEdit;
   ui.target_error->setObjectName("target_error");
@@ -361,6 +378,7 @@ void Workbench::build_mesh_panel() {
 
   // The mesh's quality report and its dihedral-angle histogram.
   quality_text_ = new QPlainTextEdit;
+  quality_text_->setObjectName("quality_report");
   quality_text_->setReadOnly(true);
   quality_text_->setLineWrapMode(QPlainTextEdit::NoWrap);
   histogram_ = new QLabel;

@@ -272,7 +272,7 @@ class Workbench : public QMainWindow {
   std::vector<ParameterOverride> meshed_overrides_;
   MeshSettings mesh_settings_;    // the mesh panel's
   MeshSettings meshed_settings_;  // those the shown mesh was made with
-  QString mesh_settings_model_;  // the model file they were made for (another one resets them)
+  QString mesh_settings_model_;   // the model file they were made for (another one resets them)
   std::unique_ptr<MeshControls> mesh_ui_;
   std::shared_ptr<const Mesh> mesh_;
   RunResults results_;

@@ -1,9 +1,9 @@
 // What foxi-workbench's source files share (not installed, not a public header): the outcome a
 // worker hands back, the running job, and the helpers one panel's file defines and another calls.
 // The files: workbench.cpp (the window, its status bar and keys), model_panel.cpp (model and
-// parameters), mesh_panel.cpp (mesh settings and quality report), solve_panel.cpp (results table), view_panel.cpp
-// (the view and its field tools), jobs.cpp (mesh/solve workers, progress, Cancel, results shown),
-// project.cpp (save/open/autosave), history.cpp (run history).
+// parameters), mesh_panel.cpp (mesh settings and quality report), solve_panel.cpp (results table),
+// view_panel.cpp (the view and its field tools), jobs.cpp (mesh/solve workers, progress, Cancel, results
+// shown), project.cpp (save/open/autosave), history.cpp (run history).
 #pragma once
 
 #include <QFutureWatcher>

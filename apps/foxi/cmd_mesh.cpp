@@ -243,7 +243,8 @@ int cmd_mesh(Args args) {
   MeshedModel m;
   int status = kExitOk;
   try {
-    m = is_model ? mesh_loaded_model(std::move(model), options) : mesh_plc_with_options(std::move(plc), options, in);
+    m = is_model ? mesh_loaded_model(std::move(model), options)
+                 : mesh_plc_with_options(std::move(plc), options, in);
   } catch (const MesherError& e) {
     if (cgal) {
       std::fprintf(stderr, "%sfoxi mesh: error: %s: %s: %s\n", tty && last_print > 0 ? "\n" : "", in.c_str(),

@@ -114,8 +114,8 @@ int report_cgal_mesh(const std::string& in, const std::string& out, const Meshed
                  "although every facet edge was protected: Mesh_3 did not recover that surface, the mesh "
                  "written to %s "
                  "does not follow its PLC\n",
-                 in.c_str(), report.worst_area_marker, 100 * volume_tolerance,
-                 100 * report.worst_area_change, out.c_str());
+                 in.c_str(), report.worst_area_marker, 100 * volume_tolerance, 100 * report.worst_area_change,
+                 out.c_str());
     status = kExitUnreliable;
   }
   if (!report.resampled && !report.volumes_match) {

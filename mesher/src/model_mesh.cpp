@@ -66,12 +66,14 @@ void check_mesh_options(const ModelMeshOptions& o) {
   }
   if (o.mesher == Mesher::tetgen) {
     if (o.quality && !(*o.quality == 0 || *o.quality >= kMinRadiusEdgeBound))
-      bad_option("the radius-edge bound must be 0 (no quality refinement) or at least 1.414 (TetGen's "
-                 "refinement does not finish below it on thin layers)");
+      bad_option(
+          "the radius-edge bound must be 0 (no quality refinement) or at least 1.414 (TetGen's "
+          "refinement does not finish below it on thin layers)");
     if (o.min_dihedral && !(*o.min_dihedral >= 0 && *o.min_dihedral < 30))
       bad_option("the dihedral bound must be 0 to 30 degrees (larger bounds do not terminate)");
   } else {
-    if (o.quality && !(*o.quality >= 0 && std::isfinite(*o.quality))) bad_option("the radius-edge bound must be >= 0");
+    if (o.quality && !(*o.quality >= 0 && std::isfinite(*o.quality)))
+      bad_option("the radius-edge bound must be >= 0");
     if (!o.sizes.boxes.empty())
       bad_option("refinement boxes need the TetGen mesher (CGAL's cell size takes no boxes)");
     if (o.refine_from.mesh) bad_option("refining from a result needs the TetGen mesher");
@@ -102,7 +104,8 @@ SizeControls merged_controls(const std::string& file, const Plc& plc, const Mode
     if (o.max_size) controls.mesh.max_size = *o.max_size;
     for (const PartSize& ps : o.part_sizes) {
       if (!model) bad_option("part sizes need a model (a PLC's regions take sizes by id)");
-      if (std::none_of(model->parts.begin(), model->parts.end(), [&](const Part& p) { return p.name == ps.part; }))
+      if (std::none_of(model->parts.begin(), model->parts.end(),
+                       [&](const Part& p) { return p.name == ps.part; }))
         throw IoError(file, 0, IoError::kNoOffset, "no part named '" + ps.part + "' for its mesh size");
       auto it = std::find_if(controls.mesh.part_sizes.begin(), controls.mesh.part_sizes.end(),
                              [&](const PartSize& p) { return p.part == ps.part; });
@@ -152,7 +155,8 @@ void mesh_cgal(const std::string& file, Plc plc, std::span<const double> volumes
   cp.progress = o.progress;
   // The circumradius of the regular tet of that volume: CGAL bounds tet sizes by circumradius.
   if (max_volume > 0) cp.max_size = regular_tet_circumradius(max_volume);
-  if (cp.max_size == 0 && sz.max_size > 0) cp.max_size = regular_tet_circumradius(regular_tet_volume(sz.max_size));
+  if (cp.max_size == 0 && sz.max_size > 0)
+    cp.max_size = regular_tet_circumradius(regular_tet_volume(sz.max_size));
   if (o.quality) cp.radius_edge = *o.quality;
   m.ignored_refine_boxes = sz.boxes.size();
   plc = with_region_sizes(plc, sz);
@@ -200,7 +204,8 @@ void mesh_under_options(const std::string& file, Plc plc, const Model* model, st
   if (o.refine_from.mesh && !o.coarse) {
     const RefineFrom& rf = o.refine_from;
     const Field* f = refine_field(*rf.mesh, rf.field);
-    if (!f) bad_option(rf.origin + " has no node field" + (rf.field.empty() ? "" : " named '" + rf.field + "'"));
+    if (!f)
+      bad_option(rf.origin + " has no node field" + (rf.field.empty() ? "" : " named '" + rf.field + "'"));
     const ErrorIndicator e = zz_error_indicator(*rf.mesh, *f);
     field = size_field_from_error(*rf.mesh, *f, rf.target_error, 0, sz.max_size);
     m.refined = RefinedFrom{f->name, e.relative_error(), rf.mesh->tet_count(), e.tets_without_value};

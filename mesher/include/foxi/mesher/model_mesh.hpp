@@ -44,9 +44,9 @@ enum class Mesher {
 // fields (size_field.hpp's zz_error_indicator and size_field_from_error), so that the new mesh's
 // relative gradient error comes near `target_error`. The solved mesh is the background mesh.
 struct RefineFrom {
-  const Mesh* mesh = nullptr;  // null: no refinement from a result; else it must outlive the call
-  std::string field;           // a node field of it (refine_field); empty: its first node field
-  double target_error = 0;     // relative gradient error, > 0 (e.g. 0.05)
+  const Mesh* mesh = nullptr;              // null: no refinement from a result; else it must outlive the call
+  std::string field;                       // a node field of it (refine_field); empty: its first node field
+  double target_error = 0;                 // relative gradient error, > 0 (e.g. 0.05)
   std::string origin = "the solved mesh";  // named in messages (its file, say)
 };
 
