@@ -242,6 +242,9 @@ void Workbench::refresh_mesh_controls() {
                                      : tr("1.414"));
   // One row per part: the size set here (empty: the model's, shown beside it).
   ui.parts->setRowCount(model_ ? int(model_->parts.size()) : 0);
+  // Every part's row in sight (up to 5; the table scrolls past that).
+  ui.parts->setFixedHeight(ui.parts->horizontalHeader()->sizeHint().height() +
+                           20 * std::clamp(ui.parts->rowCount(), 1, 5) + 8);
   for (int r = 0; model_ && r < int(model_->parts.size()); ++r) {
     const Part& part = model_->parts[std::size_t(r)];
     QString mine, models;
@@ -278,11 +281,12 @@ void Workbench::build_mesh_panel() {
   MeshControls& ui = *mesh_ui_;
   auto* mesh_panel = new QWidget;
   auto* mv = new QVBoxLayout(mesh_panel);
+  mv->setSpacing(3);  // the settings above the report, in the window's height
   // The settings: every edit goes to mesh_settings_ (refused values shown in red, the settings kept).
   auto* form = new QFormLayout;
   ui.mesher = new QComboBox;
   ui.mesher->setObjectName("mesher");
-  ui.mesher->addItems({tr("TetGen, conforming Delaunay"), tr("CGAL Mesh_3, regular")});
+  ui.mesher->addItems({tr("TetGen (conforming Delaunay)"), tr("CGAL Mesh_3 (regular)")});
   form->addRow(tr("Mesher"), ui.mesher);
   ui.max_size = new QLineEdit;
   ui.max_size->setObjectName("mesh_size");
@@ -302,11 +306,11 @@ void Workbench::build_mesh_panel() {
   ui.parts->setHorizontalHeaderLabels({tr("part"), tr("size"), tr("model's")});
   ui.parts->horizontalHeader()->setStretchLastSection(true);
   ui.parts->verticalHeader()->hide();
-  ui.parts->setMaximumHeight(110);
+  ui.parts->verticalHeader()->setDefaultSectionSize(20);
   mv->addWidget(new QLabel(tr("Part sizes (empty: the model's)")));
   mv->addWidget(ui.parts);
   auto* box_row = new QHBoxLayout;
-  box_row->addWidget(new QLabel(tr("Refinement boxes (TetGen)")), 1);
+  box_row->addWidget(new QLabel(tr("Refinement boxes")), 1);
   auto* add_box = new QPushButton(tr("Add"));
   auto* remove_box = new QPushButton(tr("Remove"));
   add_box->setObjectName("add_box");
@@ -316,15 +320,19 @@ void Workbench::build_mesh_panel() {
   mv->addLayout(box_row);
   ui.boxes = new QTableWidget(0, 7);
   ui.boxes->setObjectName("refine_boxes");
+  ui.boxes->setToolTip(
+      tr("target edge length `size` inside each box (corners and size in the model's length unit); TetGen "
+         "only"));
   QStringList columns;
   for (const char* c : kBoxColumns) columns << c;
   ui.boxes->setHorizontalHeaderLabels(columns);
   ui.boxes->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
   ui.boxes->verticalHeader()->hide();
-  ui.boxes->setMaximumHeight(90);
+  ui.boxes->verticalHeader()->setDefaultSectionSize(20);
+  ui.boxes->setFixedHeight(ui.boxes->horizontalHeader()->sizeHint().height() + 2 * 20 + 4);
   mv->addWidget(ui.boxes);
   auto* refine_row = new QHBoxLayout;
-  ui.refine = new QCheckBox(tr("Refine from the result"));
+  ui.refine = new QCheckBox(tr("Refine from the result (TetGen)"));
   ui.refine->setObjectName("refine_from_result");
   ui.refine->setToolTip(
       tr("the next mesh's sizes from the Zienkiewicz-Zhu error of the result's field (TetGen)"));
@@ -333,9 +341,10 @@ void Workbench::build_mesh_panel() {
   ui.target_error->setObjectName("target_error");
   ui.target_error->setToolTip(tr("relative gradient error aimed at (e.g. 0.05)"));
   ui.target_error->setMaximumWidth(60);
-  refine_row->addWidget(ui.refine);
+  mv->addWidget(ui.refine);
+  refine_row->addWidget(new QLabel(tr("field")));
   refine_row->addWidget(ui.refine_field, 1);
-  refine_row->addWidget(new QLabel(tr("error")));
+  refine_row->addWidget(new QLabel(tr("target error")));
   refine_row->addWidget(ui.target_error);
   mv->addLayout(refine_row);
   ui.error = new QLabel;
