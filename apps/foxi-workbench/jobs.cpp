@@ -33,7 +33,8 @@ using Clock = std::chrono::steady_clock;
 
 // The stages the libraries report (progress.hpp's ProgressFn), numbered for the progress value the
 // worker stores in one atomic: stage * 10000 + fraction in permille. 0: unknown.
-const char* const kStages[] = {"", "meshing", "conforming refinement", "assemble", "factorize", "solve"};
+const char* const kStages[] = {"",          "meshing", "conforming refinement", "assemble",
+                               "factorize", "solve",   "meshing (CGAL)"};
 int stage_index(std::string_view name) {
   for (int i = 1; i < int(std::size(kStages)); ++i)
     if (name == kStages[i]) return i;

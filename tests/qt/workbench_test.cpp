@@ -15,6 +15,7 @@
 #include <QLineEdit>
 #include <QMouseEvent>
 #include <QPlainTextEdit>
+#include <QPushButton>
 #include <QTableWidget>
 #include <QThread>
 #include <QTimer>
@@ -613,6 +614,40 @@ TEST(Workbench, MeshPanelPartSizeAndCgal) {
   EXPECT_EQ(w.last_error(), "cancelled");
   EXPECT_EQ(w.mesh(), first);
   EXPECT_EQ(w.view_widget()->mesh(), first);
+}
+
+// Refinement box rows: Add puts the shown mesh's bounds with a tenth of its diagonal, a size typed in
+// the model's unit (mm) becomes metres, Remove takes the row away; the mesh made with the box has
+// more tets than without.
+TEST(Workbench, MeshPanelBoxRowsAddAndRemove) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const std::size_t plain = w.mesh()->tet_count();
+  auto* add = w.findChild<QPushButton*>("add_box");
+  auto* remove = w.findChild<QPushButton*>("remove_box");
+  auto* boxes = w.findChild<QTableWidget*>("refine_boxes");
+  ASSERT_TRUE(add && remove && boxes);
+  add->click();
+  ASSERT_EQ(w.mesh_settings().boxes.size(), 1u);
+  ASSERT_EQ(boxes->rowCount(), 1);
+  const foxi::RefinementBox& b = w.mesh_settings().boxes[0];
+  EXPECT_NEAR(b.hi[0] - b.lo[0], 10e-3, 1e-12) << "the substrate's width";
+  EXPECT_NEAR(b.hi[2] - b.lo[2], 1.5e-3, 1e-12) << "substrate and die";
+  boxes->item(0, 3)->setText("2");  // x1 = 2 mm: the box's corner by the substrate's edge
+  boxes->item(0, 6)->setText("0.25");
+  ASSERT_EQ(w.mesh_settings().boxes.size(), 1u);
+  EXPECT_NEAR(w.mesh_settings().boxes[0].hi[0], 2e-3, 1e-15);
+  EXPECT_NEAR(w.mesh_settings().boxes[0].size, 0.25e-3, 1e-15);
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  EXPECT_GT(w.mesh()->tet_count(), plain);
+  boxes->setCurrentCell(0, 0);
+  remove->click();
+  EXPECT_TRUE(w.mesh_settings().boxes.empty());
+  EXPECT_EQ(boxes->rowCount(), 0);
 }
 
 // Refine from the current result: after a solve, the next mesh takes its sizes from the solved
