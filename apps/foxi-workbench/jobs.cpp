@@ -122,9 +122,15 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
       options.progress = progress;
       // A solve to follow: the model's conditions and materials checked before meshing, as foxi solve does.
       if (in.solve) options.physics = in.physics;
-      apply_mesh_settings(options, in.mesh_settings, in.result.get(), in.shown_field);
-      if (in.mesh_settings.refine_from_result && !in.result)
-        throw MesherError(MesherFailure::bad_input, "refine from the result: there is no solved result yet");
+      MeshSettings settings = in.mesh_settings;
+      if (settings.refine_from_result && !in.result) {
+        if (!in.solve)
+          throw MesherError(
+              MesherFailure::bad_input,
+              "refine from the result: there is no solved result of these parameters yet (solve first)");
+        settings.refine_from_result = false;  // a solve's first mesh: the next Mesh refines from its result
+      }
+      apply_mesh_settings(options, settings, in.result.get(), in.shown_field);
       MeshedModel mm = mesh_model(in.path, in.overrides, options);
       if (cancelled()) return out;
       out->mesher_summary = mesher_summary(mm);
@@ -183,7 +189,9 @@ bool Workbench::start_job(bool mesh, bool solve) {
   in.old_mesh = mesh_;
   in.old_model = meshed_model_;
   in.mesh_settings = mesh_settings_;
-  if (has_results_) in.result = mesh_;
+  // Refining from the result takes the solved mesh as its background: only one of these parameters
+  // (a result of other ones covers another shape).
+  if (has_results_ && same_overrides(in.overrides, meshed_overrides_)) in.result = mesh_;
   in.shown_field = field_.toStdString();
   in.width = view_->width();
   in.height = view_->height();

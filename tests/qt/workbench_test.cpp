@@ -652,7 +652,8 @@ TEST(Workbench, MeshPanelBoxRowsAddAndRemove) {
 
 // Refine from the current result: after a solve, the next mesh takes its sizes from the solved
 // temperature's error; it equals mesh_model's with the same solved mesh, field and target, and has
-// more tets than the mesh solved on. Without a result the job fails with the reason.
+// more tets than the mesh solved on. Without a result a Mesh fails with the reason, and a Solve
+// meshes as the model says.
 TEST(Workbench, MeshPanelRefinesFromTheResult) {
   Workbench w;
   w.view_widget()->setFixedSize(200, 150);
@@ -666,11 +667,13 @@ TEST(Workbench, MeshPanelRefinesFromTheResult) {
   EXPECT_FALSE(wait_job(w));
   EXPECT_NE(w.last_error().toStdString().find("no solved result"), std::string::npos)
       << w.last_error().toStdString();
-  s.refine_from_result = false;
-  ASSERT_TRUE(w.set_mesh_settings(s));
+  // A solve with no result to refine from meshes from the model's sizes (its mesh_model mesh).
   ASSERT_TRUE(w.start_solve());
   ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
   const std::shared_ptr<const foxi::Mesh> solved = w.mesh();
+  EXPECT_TRUE(solved->xyz == foxi::mesh_model(model).mesh.xyz);
+  s.refine_from_result = false;
+  ASSERT_TRUE(w.set_mesh_settings(s));
   ASSERT_NE(solved->find_field("temperature"), nullptr);
   auto* refine = w.findChild<QCheckBox*>("refine_from_result");
   ASSERT_NE(refine, nullptr);
