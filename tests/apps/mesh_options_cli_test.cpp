@@ -87,7 +87,8 @@ TEST(MeshOptionsCli, TetGenSizesBoxesAndPartsEqualTheCommandLine) {
   ASSERT_GT(out_n, 100u);
   const double in_mean = in_sum / double(in_n), out_mean = out_sum / double(out_n);
   EXPECT_LT(in_mean, 1.5 * box.size) << "inside the box: edges about its size";
-  EXPECT_LT(in_mean, 0.6 * out_mean) << in_mean << " inside, " << out_mean << " outside";
+  // Measured: 0.38 mm inside, 0.66 mm outside; the same model without the box: 0.57 and 0.51 mm.
+  EXPECT_LT(in_mean, 0.75 * out_mean) << in_mean << " inside, " << out_mean << " outside";
 }
 
 TEST(MeshOptionsCli, CgalThroughMeshModelEqualsFoxiMeshCgal) {
