@@ -33,7 +33,8 @@ using Clock = std::chrono::steady_clock;
 
 // The stages the libraries report (progress.hpp's ProgressFn), numbered for the progress value the
 // worker stores in one atomic: stage * 10000 + fraction in permille. 0: unknown.
-const char* const kStages[] = {"", "meshing", "conforming refinement", "assemble", "factorize", "solve"};
+const char* const kStages[] = {"",          "meshing", "conforming refinement", "assemble",
+                               "factorize", "solve",   "meshing (CGAL)"};
 int stage_index(std::string_view name) {
   for (int i = 1; i < int(std::size(kStages)); ++i)
     if (name == kStages[i]) return i;
@@ -83,6 +84,9 @@ struct JobInput {
   Physics physics = Physics::thermal;      // of the solve
   std::shared_ptr<const Mesh> old_mesh;    // solve only: the mesh to solve on
   std::shared_ptr<const Model> old_model;  // and the model it came from
+  MeshSettings mesh_settings;              // the mesh panel's (mesh_panel.cpp)
+  std::shared_ptr<const Mesh> result;      // the solved mesh to refine from (null: none)
+  std::string shown_field;
   int width = 1, height = 1;
   std::optional<Camera> camera;  // the view's camera stays across a remesh (compare before and after)
   Colouring colouring;
@@ -118,8 +122,19 @@ std::shared_ptr<Outcome> run_job(const JobInput& in) {
       options.progress = progress;
       // A solve to follow: the model's conditions and materials checked before meshing, as foxi solve does.
       if (in.solve) options.physics = in.physics;
+      MeshSettings settings = in.mesh_settings;
+      if (settings.refine_from_result && !in.result) {
+        if (!in.solve)
+          throw MesherError(
+              MesherFailure::bad_input,
+              "refine from the result: there is no solved result of these parameters yet (solve first)");
+        settings.refine_from_result = false;  // a solve's first mesh: the next Mesh refines from its result
+      }
+      apply_mesh_settings(options, settings, in.result.get(), in.shown_field);
       MeshedModel mm = mesh_model(in.path, in.overrides, options);
       if (cancelled()) return out;
+      out->mesher_summary = mesher_summary(mm);
+      out->mesh_settings = in.mesh_settings;
       mesh = std::make_shared<Mesh>(std::move(mm.mesh));
       out->quality = mesh_quality_report(*mesh, mm.conforming);
       model = std::make_shared<const Model>(std::move(mm.model));
@@ -166,12 +181,18 @@ bool Workbench::start_job(bool mesh, bool solve) {
   in.path = model_path_.toStdString();
   in.overrides = overrides();
   // Only what changed reruns: a solve remeshes first when the parameters changed since the mesh.
-  const bool stale = !mesh_ || !meshed_model_ || !same_overrides(in.overrides, meshed_overrides_);
+  const bool stale = !mesh_ || !meshed_model_ || !same_overrides(in.overrides, meshed_overrides_) ||
+                     !same_mesh_settings(mesh_settings_, meshed_settings_);
   in.mesh = mesh || stale;
   in.solve = solve;
   in.physics = physics_;
   in.old_mesh = mesh_;
   in.old_model = meshed_model_;
+  in.mesh_settings = mesh_settings_;
+  // Refining from the result takes the solved mesh as its background: only one of these parameters
+  // (a result of other ones covers another shape).
+  if (has_results_ && same_overrides(in.overrides, meshed_overrides_)) in.result = mesh_;
+  in.shown_field = field_.toStdString();
   in.width = view_->width();
   in.height = view_->height();
   if (view_->camera()) in.camera = *view_->camera();
@@ -226,10 +247,12 @@ void Workbench::on_job_done() {
     mesh_ = out->mesh;
     meshed_model_ = out->model;
     meshed_overrides_ = out->overrides;
+    meshed_settings_ = out->mesh_settings;
     mesh_seconds_ = out->seconds;
     ++mesh_serial_;
     if (out->quality) {
-      quality_text_->setPlainText(QString::fromStdString(format_quality_report(*out->quality)));
+      quality_text_->setPlainText(out->mesher_summary + "\n" +
+                                  QString::fromStdString(format_quality_report(*out->quality)));
       histogram_->setPixmap(histogram_pixmap(*out->quality));
     }
     has_results_ = false;
@@ -280,6 +303,7 @@ void Workbench::on_job_done() {
     show_results();
     add_history(mesh_seconds_ + out->solve_seconds);  // the mesh's row gets the results
   }
+  refresh_mesh_controls();  // the result's fields to refine from
   changed();
   emit finished(true);
 }

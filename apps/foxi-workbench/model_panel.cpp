@@ -200,6 +200,7 @@ void Workbench::refresh_model_panel() {
   }
   filling_ = false;
   refresh_parts_picture();
+  refresh_mesh_controls();  // the parts' sizes (mesh_panel.cpp)
 }
 
 }  // namespace foxi::workbench

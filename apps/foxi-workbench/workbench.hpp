@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "foxi/mesher/model_mesh.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/physics.hpp"
@@ -72,8 +73,25 @@ struct Colouring {
   std::optional<Deform> deform;
 };
 
+// The mesh panel's choices (mesh_panel.cpp), given to mesh_model's options (model_mesh.hpp) by every
+// mesh job. Lengths in metres; unset or empty: the model's [mesh] table.
+struct MeshSettings {
+  Mesher mesher = Mesher::tetgen;
+  std::optional<double> max_size;
+  std::vector<PartSize> part_sizes;  // by part name: replace the model's size of that part
+  std::optional<double> quality;     // radius-edge bound (TetGen: 0 or >= 1.414; CGAL: its cell bound)
+  std::vector<RefinementBox> boxes;  // TetGen only
+  // Refine from the current result: the next mesh's sizes from the Zienkiewicz-Zhu error of the
+  // result's node field `refine_field` (empty: the field shown, else the first), for this relative
+  // gradient error. TetGen only; a mesh job without a solved result then fails with the reason.
+  bool refine_from_result = false;
+  std::string refine_field;
+  double target_error = 0.1;
+};
+
 // What a worker hands back (mesh, solve or a new field paint).
 struct Outcome;
+struct MeshControls;  // the mesh panel's widgets (workbench_parts.hpp)
 struct ProjectSnapshot;
 
 class Workbench : public QMainWindow {
@@ -125,6 +143,12 @@ class Workbench : public QMainWindow {
   // stress. False while a job runs.
   bool set_physics(Physics physics);
   Physics physics() const { return physics_; }
+  // The mesh panel's settings (mesher, sizes, quality bound, boxes, refine from the result), used by
+  // the next mesh job; a solve remeshes first when they changed since the shown mesh. False (nothing
+  // changes) with the reason for values mesh_model refuses (check_mesh_options, an unknown part) or
+  // while a job runs. The panel's controls follow.
+  bool set_mesh_settings(const MeshSettings& settings, QString* error = nullptr);
+  const MeshSettings& mesh_settings() const { return mesh_settings_; }
   // Asks the running job to stop; the previous mesh and picture stay.
   void cancel();
   bool busy() const { return job_ != nullptr; }
@@ -213,6 +237,8 @@ class Workbench : public QMainWindow {
   QPushButton* build_model_panel();  // model_panel.cpp: its Open model button
   QHBoxLayout* build_project_row();  // project.cpp: save, open, recent projects
   void build_mesh_panel();           // mesh_panel.cpp
+  void refresh_mesh_controls();      // mesh_panel.cpp: the controls from mesh_settings_ and the model
+  void on_mesh_controls_edited();    // mesh_panel.cpp: the controls to mesh_settings_
   void build_results_panel();        // solve_panel.cpp
   void build_history_panel();        // history.cpp
   // model_file.cpp: Save model, Save model as; the exploded parts picture, redrawn on a worker
@@ -244,6 +270,10 @@ class Workbench : public QMainWindow {
   std::shared_ptr<const Model> model_;                           // as loaded with the overrides
   std::shared_ptr<const Model> meshed_model_;                    // the model the shown mesh came from
   std::vector<ParameterOverride> meshed_overrides_;
+  MeshSettings mesh_settings_;    // the mesh panel's
+  MeshSettings meshed_settings_;  // those the shown mesh was made with
+  QString mesh_settings_model_;   // the model file they were made for (another one resets them)
+  std::unique_ptr<MeshControls> mesh_ui_;
   std::shared_ptr<const Mesh> mesh_;
   RunResults results_;
   bool has_results_ = false;

@@ -1,9 +1,9 @@
 // What foxi-workbench's source files share (not installed, not a public header): the outcome a
 // worker hands back, the running job, and the helpers one panel's file defines and another calls.
 // The files: workbench.cpp (the window, its status bar and keys), model_panel.cpp (model and
-// parameters), mesh_panel.cpp (quality report), solve_panel.cpp (results table), view_panel.cpp
-// (the view and its field tools), jobs.cpp (mesh/solve workers, progress, Cancel, results shown),
-// project.cpp (save/open/autosave), history.cpp (run history).
+// parameters), mesh_panel.cpp (mesh settings and quality report), solve_panel.cpp (results table),
+// view_panel.cpp (the view and its field tools), jobs.cpp (mesh/solve workers, progress, Cancel, results
+// shown), project.cpp (save/open/autosave), history.cpp (run history).
 #pragma once
 
 #include <QFutureWatcher>
@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "foxi/mesher/model_mesh.hpp"
 #include "foxi/mesher/quality_report.hpp"
 #include "foxi/model/physics.hpp"
 #include "foxi/model/progress.hpp"
@@ -51,6 +52,8 @@ struct Outcome {
   double seconds = 0;                        // meshing (or the solve when not meshed)
   double solve_seconds = 0;                  // the solve
   std::optional<MeshQualityReport> quality;  // a new mesh's
+  QString mesher_summary;                    // and which mesher made it (mesh_panel.cpp)
+  MeshSettings mesh_settings;                // the mesh settings it was made with
 };
 
 struct Workbench::Job {
@@ -74,6 +77,27 @@ QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QStrin
 
 // The minimum dihedral angle histogram of the quality report as a bar chart (mesh_panel.cpp).
 QPixmap histogram_pixmap(const MeshQualityReport& q);
+
+// The mesh panel's widgets (mesh_panel.cpp).
+struct MeshControls {
+  QComboBox* mesher = nullptr;
+  QLineEdit *max_size = nullptr, *quality = nullptr, *target_error = nullptr;
+  QTableWidget *parts = nullptr, *boxes = nullptr;
+  QCheckBox* refine = nullptr;
+  QComboBox* refine_field = nullptr;
+  QLabel* error = nullptr;
+};
+
+// mesh_model's options (model_mesh.hpp) with the mesh panel's settings; `result` is the solved mesh
+// to refine from (null: none; then refine_from_result fails with the reason), `shown_field` the
+// field the view shows (refined from when the settings name none) (mesh_panel.cpp).
+void apply_mesh_settings(ModelMeshOptions& options, const MeshSettings& settings, const Mesh* result,
+                         const std::string& shown_field);
+// The first line of the quality report: which mesher made the mesh, and for CGAL the region volumes
+// against the PLC's (mesh_panel.cpp).
+QString mesher_summary(const MeshedModel& m);
+// The same settings (mesh_panel.cpp): a solve remeshes first when they differ from the shown mesh's.
+bool same_mesh_settings(const MeshSettings& a, const MeshSettings& b);
 
 // The physics named as foxi solve --physics names it (physics_name), or nullopt (solve_panel.cpp).
 std::optional<Physics> physics_of(const std::string& name);

@@ -1,7 +1,10 @@
 // foxi mesh MODEL.toml|PLC.poly -o OUT: a conforming Delaunay tetrahedral mesh of a model or a PLC,
-// through TetGen and the conforming refinement, with size controls and a quality report.
+// through TetGen and the conforming refinement (or CGAL Mesh_3), with size controls and a quality
+// report. A thin user of mesh_model's options (model_mesh.hpp): the options are read here, the
+// meshing is the library's; the CGAL report is printed by cmd_mesh_cgal.cpp.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -11,17 +14,12 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "model_run.hpp"
-#include "foxi/mesher/conforming.hpp"
+#include "foxi/mesher/model_mesh.hpp"
 #include "foxi/mesher/quality_report.hpp"
-#include "foxi/mesher/model_mesh_params.hpp"
-#include "foxi/mesher/size_field.hpp"
-#include "foxi/mesher/tetgen_mesher.hpp"
-#include "foxi/model/delaunay.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/model/model_file.hpp"
 #include "foxi/model/plc.hpp"
-#include "foxi/model/structure.hpp"
 #include "foxi/model/units.hpp"
 
 namespace foxi::cli {
@@ -54,14 +52,16 @@ const char* kMeshUsage =
     "  --no-conform       TetGen's mesh as it is (may not be Delaunay)\n"
     "  --optimize         TetGen's flips and smoothing (implies --no-conform: the mesh stops being "
     "Delaunay)\n"
-    "  --mesher cgal      CGAL Mesh_3 instead of TetGen (a model, with --set and its max_size and part "
-    "sizes,\n"
-    "                     or a PLC.poly): every facet edge of the PLC protected (region volumes are the\n"
-    "                     PLC's, checked to 0.1%), sliver exudation; the mesh is part of a regular\n"
-    "                     triangulation, its vertex weights are written (point data 'weight' in .vtu)\n"
-    "                     and always certified (orthospheres); a mesh failing a check exits 4.\n"
+    "  --mesher cgal      CGAL Mesh_3 instead of TetGen (a model, with --set and its max_size and part\n"
+    "                     sizes, or a PLC.poly): every facet edge of the PLC protected (region volumes\n"
+    "                     are the PLC's, checked to 0.1%), sliver exudation; the mesh is part of a\n"
+    "                     regular triangulation, its vertex weights are written (point data 'weight' in\n"
+    "                     .vtu) and always certified (orthospheres); a mesh failing a check exits 4.\n"
+    "                     --max-size, --region-size act as for TetGen (as circumradius bounds of the\n"
+    "                     regular tet of that edge); refinement boxes are TetGen's (a model's are left\n"
+    "                     out; --refine-box, --refine-from, --no-conform need TetGen).\n"
     "                     --max-volume becomes the circumradius of a regular tet of that volume;\n"
-    "                     --radius-edge defaults to 2; --perturb adds sliver perturbation;\n"
+    "                     --radius-edge (or --quality) defaults to 2; --perturb adds sliver perturbation;\n"
     "                     --resample: only edges turning by more than --feature-angle (default 60)\n"
     "                     and patch borders are protected, a faceted cylinder's wall is resampled\n"
     "                     (each region's volume change is printed); --time-limit S stops CGAL after\n"
@@ -104,7 +104,12 @@ std::pair<std::string, std::string> split_eq(const std::string& s, const char* w
 
 }  // namespace
 
-int mesh_with_cgal(Args& args);  // cmd_mesh_cgal.cpp
+// The CGAL path's report (cmd_mesh_cgal.cpp): prints it and returns the exit status (4 for a mesh
+// that fails its checks).
+int report_cgal_mesh(const std::string& in, const std::string& out, const MeshedModel& m,
+                     double volume_tolerance);
+// The exit status of a mesher failure on the CGAL path (cmd_mesh_cgal.cpp).
+int cgal_exit_code(MesherFailure f);
 
 int cmd_mesh(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
@@ -112,77 +117,87 @@ int cmd_mesh(Args args) {
     return kExitOk;
   }
   const std::string mesher = args.option("--mesher", "tetgen");
-  if (mesher == "cgal") return mesh_with_cgal(args);
-  if (mesher != "tetgen") throw UsageError("--mesher takes tetgen or cgal, not '" + mesher + "'");
+  if (mesher != "tetgen" && mesher != "cgal")
+    throw UsageError("--mesher takes tetgen or cgal, not '" + mesher + "'");
+  const bool cgal = mesher == "cgal";
+  ModelMeshOptions options;
+  options.mesher = cgal ? Mesher::cgal : Mesher::tetgen;
+  // The options of one mesher only: named as the other's (not "unknown option").
+  auto only = [&](const char* name, bool for_cgal) {
+    if (cgal != for_cgal && args.has_option(name))
+      throw UsageError(std::string(name) + " needs --mesher " + (for_cgal ? "cgal" : "tetgen"));
+  };
+  for (const char* o : {"--min-dihedral", "--refine-box", "--refine-from", "--field", "--target-error"})
+    only(o, false);
+  for (const char* o : {"--time-limit", "--feature-angle"}) only(o, true);
+  for (const char* f : {"--no-conform", "--optimize"})
+    if (cgal && std::find(args.remaining().begin(), args.remaining().end(), f) != args.remaining().end())
+      throw UsageError(std::string(f) + " needs --mesher tetgen");
+  for (const char* f : {"--perturb", "--resample"})
+    if (!cgal && std::find(args.remaining().begin(), args.remaining().end(), f) != args.remaining().end())
+      throw UsageError(std::string(f) + " needs --mesher cgal");
   std::vector<std::string> sets, region_sizes, boxes;
   while (args.has_option("--set")) sets.push_back(args.option("--set"));
   while (args.has_option("--region-size")) region_sizes.push_back(args.option("--region-size"));
   while (args.has_option("--refine-box")) boxes.push_back(args.option("--refine-box"));
   const std::string max_size = args.option("--max-size");
-  MeshParams params;
-  params.max_volume = number(args.option("--max-volume", "0"), "--max-volume");
+  options.max_volume = number(args.option("--max-volume", "0"), "--max-volume");
+  // --radius-edge is --quality's other name (CGAL's default 2, TetGen's 1.414 or the model's).
   const std::string quality = args.option("--quality", args.option("--radius-edge", ""));
   const std::string min_dihedral = args.option("--min-dihedral", "");
-  params.radius_edge = quality.empty() ? 1.414 : number(quality, "--quality");
-  params.min_dihedral = min_dihedral.empty() ? 0 : number(min_dihedral, "--min-dihedral");
-  if (!(params.radius_edge == 0 || params.radius_edge >= kMinRadiusEdgeBound))
+  if (!quality.empty()) options.quality = number(quality, "--quality");
+  if (!min_dihedral.empty()) options.min_dihedral = number(min_dihedral, "--min-dihedral");
+  if (!cgal && options.quality && !(*options.quality == 0 || *options.quality >= kMinRadiusEdgeBound))
     throw UsageError(
         "--quality takes 0 (no quality refinement) or a radius-edge bound of at least 1.414, not '" +
         quality + "' (TetGen's refinement does not finish below it on thin layers)");
-  if (!(params.min_dihedral >= 0 && params.min_dihedral < 30))
+  if (options.min_dihedral && !(*options.min_dihedral >= 0 && *options.min_dihedral < 30))
     throw UsageError("--min-dihedral takes 0 to 30 degrees (larger bounds do not terminate), not '" +
                      min_dihedral + "'");
-  params.optimize = args.flag("--optimize");
-  const bool conform = !args.flag("--no-conform") && !params.optimize;
+  options.optimize = args.flag("--optimize");
+  options.conform = !args.flag("--no-conform") && !options.optimize;
+  CgalMeshParams& cp = options.cgal;
+  cp.perturb = args.flag("--perturb");
+  cp.resample = args.flag("--resample");
+  if (args.has_option("--feature-angle")) {
+    cp.feature_angle = number(args.option("--feature-angle"), "--feature-angle");
+    if (cp.feature_angle > 180) throw UsageError("--feature-angle takes degrees in [0, 180]");
+    if (!cp.resample)
+      throw UsageError("--feature-angle needs --resample (without it every facet edge is protected)");
+  }
+  cp.time_limit = number(args.option("--time-limit", "300"), "--time-limit");
+  if (!std::isfinite(cp.time_limit)) throw UsageError("--time-limit takes a number >= 0");
   args.flag("--check-delaunay");  // the certificate is always part of the report now
   const std::string refine_from = args.option("--refine-from");
   const std::string field_name = args.option("--field");
   const std::string target_error = args.option("--target-error");
   const std::string out = args.option("-o");
-  const double max_tets = max_tets_option(args);
+  options.max_tets = max_tets_option(args);
   if (out.empty()) throw UsageError("give the output file with -o OUT\nusage: " + std::string(kMeshUsage));
   const std::string in = args.positional(1, 1, kMeshUsage)[0];
   if (!refine_from.empty() && target_error.empty()) throw UsageError("--refine-from needs --target-error E");
   format_from_path(out);  // an unknown output format or an unwritable path fails before any meshing
   check_output_path(out);
 
-  // The PLC, from a model or a .poly.
+  // A model (its length unit read first: the sizes given bare are in it) or a .poly.
   const bool is_model = is_model_path(in);
   Model model;
-  Structure structure;
   Plc plc;
   double unit_scale = 1;
   if (is_model) {
     model = load_model(in, sets, "--set");
-    structure = build_structure(model);
-    plc = structure.plc;
     unit_scale = model.length_scale;
   } else {
     if (!sets.empty()) throw UsageError("--set needs a model file (.toml), not a .poly");
     plc = read_poly(in);
   }
-
-  // A model's [mesh] table first; the command line overrides its global size and bounds and adds to
-  // its part sizes and boxes.
-  SizeControls controls;
-  if (is_model) {
-    controls = size_controls_from_model(model);
-    if (controls.max_size > 0 && max_size.empty()) {
-      const double v = regular_tet_volume(controls.max_size);
-      params.max_volume = params.max_volume > 0 ? std::min(params.max_volume, v) : v;
-    }
-    if (quality.empty() && model.mesh.quality >= 0) params.radius_edge = model.mesh.quality;
-    if (min_dihedral.empty()) params.min_dihedral = model.mesh.min_dihedral;
-  }
-  if (!max_size.empty()) {
-    controls.max_size = length(max_size, unit_scale, "--max-size");
-    const double v = regular_tet_volume(controls.max_size);
-    params.max_volume = params.max_volume > 0 ? std::min(params.max_volume, v) : v;
-  }
+  // The model's [mesh] table first; the command line replaces its global size and bounds and adds to
+  // its part sizes and boxes (mesh_model's options).
+  if (!max_size.empty()) options.max_size = length(max_size, unit_scale, "--max-size");
   for (const std::string& r : region_sizes) {
     const auto [id, h] = split_eq(r, "--region-size");
-    controls.region_ids.push_back(static_cast<std::int32_t>(number(id, "--region-size")));
-    controls.region_sizes.push_back(length(h, unit_scale, "--region-size"));
+    options.sizes.region_ids.push_back(static_cast<std::int32_t>(number(id, "--region-size")));
+    options.sizes.region_sizes.push_back(length(h, unit_scale, "--region-size"));
   }
   for (const std::string& b : boxes) {
     const auto [corners, h] = split_eq(b, "--refine-box");
@@ -194,7 +209,18 @@ int cmd_mesh(Args args) {
       box.hi[k] = std::max(c[std::size_t(k)], c[std::size_t(k) + 3]) * unit_scale;
     }
     box.size = length(h, unit_scale, "--refine-box");
-    controls.boxes.push_back(box);
+    options.sizes.boxes.push_back(box);
+  }
+  Mesh solved;
+  if (!refine_from.empty()) {
+    solved = read_mesh(refine_from);
+    if (!refine_field(solved, field_name))
+      throw UsageError(refine_from + " has no node field" +
+                       (field_name.empty() ? "" : " named '" + field_name + "'"));
+    options.refine_from = {.mesh = &solved,
+                           .field = field_name,
+                           .target_error = number(target_error, "--target-error"),
+                           .origin = refine_from};
   }
 
   // Progress on stderr for long runs (SIGINT and SIGTERM are handled by signals.hpp: they end the
@@ -202,7 +228,7 @@ int cmd_mesh(Args args) {
   const auto t0 = std::chrono::steady_clock::now();
   double last_print = 0;
   const bool tty = ::isatty(2);
-  params.progress = [&](std::string_view stage, double fraction) {
+  options.progress = [&](std::string_view stage, double fraction) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (tty && s - last_print >= 1) {
       last_print = s;
@@ -214,61 +240,37 @@ int cmd_mesh(Args args) {
     return true;
   };
 
-  Mesh mesh;
-  ConformingReport report;
-  SizeField field;
+  MeshedModel m;
   int status = kExitOk;
   try {
-    plc = with_region_sizes(plc, controls);
-    const std::span<const double> volumes =
-        is_model ? std::span<const double>(structure.part_volume) : std::span<const double>();
-    if (!refine_from.empty()) {
-      const Mesh solved = read_mesh(refine_from);
-      const Field* f = nullptr;
-      for (const Field& cand : solved.fields)
-        if (cand.location == FieldLocation::node && (field_name.empty() ? true : cand.name == field_name)) {
-          f = &cand;
-          break;
-        }
-      if (!f)
-        throw UsageError(refine_from + " has no node field" +
-                         (field_name.empty() ? "" : " named '" + field_name + "'"));
-      const ErrorIndicator e = zz_error_indicator(solved, *f);
-      field = size_field_from_error(solved, *f, number(target_error, "--target-error"), 0, controls.max_size);
-      std::printf("refine from %s: field '%s', relative gradient error %.3g (Zienkiewicz-Zhu), target %s\n",
-                  refine_from.c_str(), f->name.c_str(), e.relative_error(), target_error.c_str());
-      if (e.tets_without_value > 0)
-        std::printf(
-            "  %zu of its %zu tets have a node without a value (NaN): left out of the error, they keep their "
-            "size\n",
-            e.tets_without_value, solved.tet_count());
-    } else if (!controls.boxes.empty()) {
-      check_tet_estimate(in, plc, params, volumes, max_tets);  // box_size_field meshes with params first
-      field = box_size_field(plc, params, controls);
-    }
-    if (!field.empty()) params.size_field = &field;
-    check_tet_estimate(in, plc, params, volumes, max_tets);
-    if (conform) {
-      mesh = mesh_conforming(plc, params, {}, &report);
-    } else {
-      mesh = mesh_plc(plc, params, &report.tetgen);
-      report.first_mesh_points = mesh.node_count();
-      report.seconds = report.tetgen.seconds;
-      const DelaunayCertificate cert = compute_delaunay_certificate(mesh);
-      report.delaunay = cert.delaunay;
-      report.first_mesh_violations = cert.violating_tet_count;
-      report.violations.push_back(cert.violating_tet_count);
-    }
-    if (is_model) name_mesh(model, structure, mesh);
+    m = is_model ? mesh_loaded_model(std::move(model), options)
+                 : mesh_plc_with_options(std::move(plc), options, in);
   } catch (const MesherError& e) {
-    std::fprintf(stderr, "%sfoxi mesh: error: %s: %s\n", tty ? "\n" : "", in.c_str(), e.what());
-    status = kExitFailure;
+    if (cgal) {
+      std::fprintf(stderr, "%sfoxi mesh: error: %s: %s: %s\n", tty && last_print > 0 ? "\n" : "", in.c_str(),
+                   failure_name(e.failure()), e.what());
+      status = cgal_exit_code(e.failure());
+    } else {
+      std::fprintf(stderr, "%sfoxi mesh: error: %s: %s\n", tty ? "\n" : "", in.c_str(), e.what());
+      status = kExitFailure;
+    }
   }
   if (tty && last_print > 0) std::fputc('\n', stderr);
   if (status != 0) return status;
-  write_mesh(mesh, out);
-  std::printf("%s -> %s (TetGen switches %s)\n", in.c_str(), out.c_str(), report.tetgen.switches.c_str());
-  std::printf("%s\n", format_quality_report(mesh_quality_report(mesh, report)).c_str());
+  write_mesh(m.mesh, out);
+  if (cgal) return report_cgal_mesh(in, out, m, cp.volume_tolerance);
+  if (m.refined) {
+    const RefinedFrom& r = *m.refined;
+    std::printf("refine from %s: field '%s', relative gradient error %.3g (Zienkiewicz-Zhu), target %s\n",
+                refine_from.c_str(), r.field.c_str(), r.relative_error, target_error.c_str());
+    if (r.tets_without_value > 0)
+      std::printf(
+          "  %zu of its %zu tets have a node without a value (NaN): left out of the error, they keep their "
+          "size\n",
+          r.tets_without_value, r.tets);
+  }
+  std::printf("%s -> %s (TetGen switches %s)\n", in.c_str(), out.c_str(), m.report.switches.c_str());
+  std::printf("%s\n", format_quality_report(mesh_quality_report(m.mesh, m.conforming)).c_str());
   return kExitOk;
 }
 

@@ -1,36 +1,20 @@
-// foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT: the CGAL Mesh_3 path of `foxi mesh` (options in
-// cmd_mesh.cpp's usage text): meshes, writes, and prints counts, time, dihedral angles, each region's volume
-// against the PLC's and the weighted certificate. A mesh that fails either check is written but refused (exit
-// 4).
+// foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT: the report of the CGAL Mesh_3 path of `foxi mesh`
+// (options in cmd_mesh.cpp, meshing by mesh_model): counts, time, dihedral angles, each region's volume
+// against the PLC's and the weighted certificate. A mesh that fails either check is written but refused
+// (exit 4).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-#include "cli.hpp"
 #include "exit_codes.hpp"
-#include "model_run.hpp"
-#include "foxi/model/durable_file.hpp"
-#include "foxi/mesher/cgal_mesher.hpp"
-#include "foxi/mesher/model_mesh_params.hpp"
-#include "foxi/mesher/size_field.hpp"
+#include "foxi/mesher/model_mesh.hpp"
 #include "foxi/model/delaunay.hpp"
-#include "foxi/model/model_file.hpp"
-#include "foxi/model/structure.hpp"
-#include "foxi/model/mesh_io.hpp"
-#include "foxi/model/plc.hpp"
 #include "foxi/model/quality.hpp"
 
 namespace foxi::cli {
 
 namespace {
-
-double non_negative(const std::string& s, const char* what) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || end != s.c_str() + s.size() || !(v >= 0) || !std::isfinite(v))
-    throw UsageError(std::string(what) + " takes a number >= 0, not '" + s + "'");
-  return v;
-}
 
 // The largest dihedral angle of a tet (degrees), from its face normals.
 double max_dihedral_deg(const Mesh& m, std::size_t t) {
@@ -58,8 +42,10 @@ double max_dihedral_deg(const Mesh& m, std::size_t t) {
   return worst;
 }
 
+}  // namespace
+
 // The exit status of a mesher failure: the input's fault, a stop asked for, or the mesher's.
-int exit_code(MesherFailure f) {
+int cgal_exit_code(MesherFailure f) {
   switch (f) {
     case MesherFailure::bad_input:
     case MesherFailure::self_intersection:
@@ -73,68 +59,10 @@ int exit_code(MesherFailure f) {
   }
 }
 
-}  // namespace
-
-int mesh_with_cgal(Args& args) {
-  CgalMeshParams params;
-  const double max_volume = non_negative(args.option("--max-volume", "0"), "--max-volume");
-  // The circumradius of the regular tet of that volume: CGAL bounds tet sizes by circumradius.
-  if (max_volume > 0) params.max_size = regular_tet_circumradius(max_volume);
-  params.radius_edge = non_negative(args.option("--radius-edge", "2"), "--radius-edge");
-  params.perturb = args.flag("--perturb");
-  params.resample = args.flag("--resample");
-  if (args.has_option("--feature-angle")) {
-    params.feature_angle = non_negative(args.option("--feature-angle"), "--feature-angle");
-    if (params.feature_angle > 180) throw UsageError("--feature-angle takes degrees in [0, 180]");
-    if (!params.resample)
-      throw UsageError("--feature-angle needs --resample (without it every facet edge is protected)");
-  }
-  params.time_limit = non_negative(args.option("--time-limit", "300"), "--time-limit");
-  args.flag("--check-delaunay");  // the CGAL path always certifies
-  const std::string out = args.option("-o");
-  const double max_tets = max_tets_option(args);
-  if (out.empty()) throw UsageError("give the output file with -o OUT (see foxi mesh --help)");
-  std::vector<std::string> sets;
-  while (args.has_option("--set")) sets.push_back(args.option("--set"));
-  const std::string in = args.positional(1, 1, "foxi mesh MODEL.toml|PLC.poly --mesher cgal -o OUT")[0];
-  format_from_path(out);  // an unknown output format fails before any meshing
-  check_output_path(out);
-
-  // A model: its PLC, its [mesh] sizes (global and per part, as region volume bounds) and its names.
-  const bool is_model = is_model_path(in);
-  Model model;
-  Structure structure;
-  Plc plc;
-  if (is_model) {
-    model = load_model(in, sets, "--set");
-    structure = build_structure(model);
-    plc = structure.plc;
-    const ModelMeshParams mp = mesh_params_from_model(model, plc);
-    if (params.max_size == 0 && mp.params.max_volume > 0)
-      params.max_size = regular_tet_circumradius(mp.params.max_volume);
-  } else {
-    if (!sets.empty()) throw UsageError("--set needs a model file (.toml), not a .poly");
-    plc = read_poly(in);
-  }
-  {  // the tet count estimated as for TetGen, at the regular tet of the circumradius bound
-    MeshParams estimate;
-    if (params.max_size > 0) estimate.max_volume = regular_tet_volume(4 * params.max_size / std::sqrt(6.0));
-    check_tet_estimate(in, plc, estimate,
-                       is_model ? std::span<const double>(structure.part_volume) : std::span<const double>(),
-                       max_tets);
-  }
-  // A stop (SIGINT, SIGTERM, SIGHUP) is handled by signals.hpp's thread: it kills the mesher's child
-  // process and exits, so the mesher needs no progress function for it.
-  CgalMeshReport report;
-  Mesh mesh;
-  try {
-    mesh = mesh_plc_cgal(plc, params, &report);
-  } catch (const MesherError& e) {
-    std::fprintf(stderr, "foxi mesh: error: %s: %s: %s\n", in.c_str(), failure_name(e.failure()), e.what());
-    return exit_code(e.failure());
-  }
-  if (is_model) name_mesh(model, structure, mesh);
-  write_mesh(mesh, out);
+int report_cgal_mesh(const std::string& in, const std::string& out, const MeshedModel& m,
+                     double volume_tolerance) {
+  const Mesh& mesh = m.mesh;
+  const CgalMeshReport& report = m.cgal;
   const QualitySummary q = summarize_quality(mesh);
   double max_dihedral = 0;
   for (std::size_t t = 0; t < mesh.tet_count(); ++t)
@@ -165,7 +93,7 @@ int mesh_with_cgal(Args& args) {
   for (const CgalRegionVolume& v : report.volumes)
     std::printf("  region %d%s: PLC %.6g, mesh %.6g, change %+.3g%%\n", v.region,
                 region_name(v.region).c_str(), v.plc, v.mesh, 100 * v.relative_change());
-  const DelaunayCertificate cert = compute_delaunay_certificate(mesh);
+  const DelaunayCertificate& cert = delaunay_certificate(mesh);  // computed by mesh_model, cached
   if (cert.delaunay)
     std::printf("regular (weighted Delaunay): yes, every orthosphere is empty (%zu tets); weights written\n",
                 cert.tets_checked);
@@ -186,8 +114,8 @@ int mesh_with_cgal(Args& args) {
                  "although every facet edge was protected: Mesh_3 did not recover that surface, the mesh "
                  "written to %s "
                  "does not follow its PLC\n",
-                 in.c_str(), report.worst_area_marker, 100 * params.volume_tolerance,
-                 100 * report.worst_area_change, out.c_str());
+                 in.c_str(), report.worst_area_marker, 100 * volume_tolerance, 100 * report.worst_area_change,
+                 out.c_str());
     status = kExitUnreliable;
   }
   if (!report.resampled && !report.volumes_match) {
@@ -195,7 +123,7 @@ int mesh_with_cgal(Args& args) {
                  "foxi mesh: error: %s: a region's volume differs from the PLC's by %.3g%% (more than "
                  "%.3g%%) although every facet "
                  "edge was protected: the mesh written to %s does not cover its PLC\n",
-                 in.c_str(), 100 * report.worst_volume_change, 100 * params.volume_tolerance, out.c_str());
+                 in.c_str(), 100 * report.worst_volume_change, 100 * volume_tolerance, out.c_str());
     status = kExitUnreliable;
   }
   return status;

@@ -8,10 +8,14 @@
 #include <gtest/gtest.h>
 
 #include <QApplication>
+#include <QCheckBox>
+#include <QComboBox>
 #include <QEventLoop>
 #include <QLabel>
 #include <QLineEdit>
 #include <QMouseEvent>
+#include <QPlainTextEdit>
+#include <QPushButton>
 #include <QTableWidget>
 #include <QThread>
 #include <QTimer>
@@ -28,6 +32,7 @@
 #include <string>
 
 #include "foxi/mesher/model_mesh.hpp"
+#include "foxi/model/delaunay.hpp"
 #include "foxi/model/physics.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/viz/field_selection.hpp"
@@ -546,6 +551,144 @@ TEST(Workbench, CancelKeepsThePreviousMeshAndPicture) {
   EXPECT_NE(w.history()[1].results.find("T_max"), nullptr);
   ASSERT_EQ(w.history()[1].parameters.size(), 1u);
   EXPECT_EQ(w.history()[1].parameters[0].expression, "6 mm");
+}
+
+// The mesh panel: a per-part size typed into its table and CGAL chosen in its combo box reach
+// mesh_model's options; the mesh the workbench makes is the one mesh_model makes with those options
+// (the library as the second caller), certified by the weighted certificate computed here, and the
+// quality report says CGAL. Values mesh_model refuses are refused as set, the settings kept.
+TEST(Workbench, MeshPanelPartSizeAndCgal) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  const std::string model = kModels + "die_on_substrate.toml";
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  auto* parts = w.findChild<QTableWidget*>("part_sizes");
+  auto* mesher = w.findChild<QComboBox*>("mesher");
+  ASSERT_TRUE(parts && mesher);
+  int die_row = -1;
+  for (int r = 0; r < parts->rowCount(); ++r)
+    if (parts->item(r, 0)->text() == "die") die_row = r;
+  ASSERT_GE(die_row, 0);
+  EXPECT_EQ(parts->item(die_row, 2)->text(), "0.5 mm") << "the model's own part size shown";
+  parts->item(die_row, 1)->setText("0.4 mm");
+  mesher->setCurrentIndex(1);
+  ASSERT_EQ(w.mesh_settings().mesher, foxi::Mesher::cgal);
+  ASSERT_EQ(w.mesh_settings().part_sizes.size(), 1u);
+  EXPECT_EQ(w.mesh_settings().part_sizes[0].part, "die");
+  EXPECT_NEAR(w.mesh_settings().part_sizes[0].max_size, 0.4e-3, 1e-15);
+  // Boxes with CGAL: refused with mesh_model's reason, the settings unchanged.
+  foxi::workbench::MeshSettings boxed = w.mesh_settings();
+  boxed.boxes.resize(1);
+  boxed.boxes[0].hi[0] = boxed.boxes[0].hi[1] = boxed.boxes[0].hi[2] = 1e-3;
+  boxed.boxes[0].size = 0.2e-3;
+  QString why;
+  EXPECT_FALSE(w.set_mesh_settings(boxed, &why));
+  EXPECT_NE(why.toStdString().find("refinement boxes need the TetGen mesher"), std::string::npos)
+      << why.toStdString();
+  EXPECT_TRUE(w.mesh_settings().boxes.empty());
+
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  foxi::ModelMeshOptions o;
+  o.mesher = foxi::Mesher::cgal;
+  o.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
+  const foxi::MeshedModel direct = foxi::mesh_model(model, {}, o);
+  ASSERT_TRUE(w.mesh());
+  EXPECT_EQ(w.mesh()->tet_count(), direct.mesh.tet_count());
+  EXPECT_TRUE(w.mesh()->xyz == direct.mesh.xyz);
+  EXPECT_TRUE(w.mesh()->weight == direct.mesh.weight);
+  EXPECT_TRUE(foxi::compute_delaunay_certificate(*w.mesh()).delaunay);
+  const std::string report = w.findChild<QPlainTextEdit*>("quality_report")->toPlainText().toStdString();
+  EXPECT_NE(report.find("mesher: CGAL Mesh_3"), std::string::npos) << report;
+  EXPECT_NE(report.find("delaunay: yes"), std::string::npos) << report;
+  EXPECT_NE(report.find("min dihedral histogram"), std::string::npos) << report;
+
+  // Cancel of a CGAL run: the CGAL mesh stays.
+  const auto first = w.mesh();
+  foxi::workbench::MeshSettings fine = w.mesh_settings();
+  fine.max_size = 0.1e-3;
+  ASSERT_TRUE(w.set_mesh_settings(fine));
+  ASSERT_TRUE(w.start_mesh());
+  w.cancel();
+  EXPECT_FALSE(wait_job(w));
+  EXPECT_EQ(w.last_error(), "cancelled");
+  EXPECT_EQ(w.mesh(), first);
+  EXPECT_EQ(w.view_widget()->mesh(), first);
+}
+
+// Refinement box rows: Add puts the shown mesh's bounds with a tenth of its diagonal, a size typed in
+// the model's unit (mm) becomes metres, Remove takes the row away; the mesh made with the box has
+// more tets than without.
+TEST(Workbench, MeshPanelBoxRowsAddAndRemove) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const std::size_t plain = w.mesh()->tet_count();
+  auto* add = w.findChild<QPushButton*>("add_box");
+  auto* remove = w.findChild<QPushButton*>("remove_box");
+  auto* boxes = w.findChild<QTableWidget*>("refine_boxes");
+  ASSERT_TRUE(add && remove && boxes);
+  add->click();
+  ASSERT_EQ(w.mesh_settings().boxes.size(), 1u);
+  ASSERT_EQ(boxes->rowCount(), 1);
+  const foxi::RefinementBox& b = w.mesh_settings().boxes[0];
+  EXPECT_NEAR(b.hi[0] - b.lo[0], 10e-3, 1e-12) << "the substrate's width";
+  EXPECT_NEAR(b.hi[2] - b.lo[2], 1.5e-3, 1e-12) << "substrate and die";
+  boxes->item(0, 3)->setText("2");  // x1 = 2 mm: the box's corner by the substrate's edge
+  boxes->item(0, 6)->setText("0.25");
+  ASSERT_EQ(w.mesh_settings().boxes.size(), 1u);
+  EXPECT_NEAR(w.mesh_settings().boxes[0].hi[0], 2e-3, 1e-15);
+  EXPECT_NEAR(w.mesh_settings().boxes[0].size, 0.25e-3, 1e-15);
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  EXPECT_GT(w.mesh()->tet_count(), plain);
+  boxes->setCurrentCell(0, 0);
+  remove->click();
+  EXPECT_TRUE(w.mesh_settings().boxes.empty());
+  EXPECT_EQ(boxes->rowCount(), 0);
+}
+
+// Refine from the current result: after a solve, the next mesh takes its sizes from the solved
+// temperature's error; it equals mesh_model's with the same solved mesh, field and target, and has
+// more tets than the mesh solved on. Without a result a Mesh fails with the reason, and a Solve
+// meshes as the model says.
+TEST(Workbench, MeshPanelRefinesFromTheResult) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  const std::string model = kModels + "die_on_substrate.toml";
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  foxi::workbench::MeshSettings s = w.mesh_settings();
+  s.refine_from_result = true;
+  s.target_error = 0.3;
+  ASSERT_TRUE(w.set_mesh_settings(s));
+  ASSERT_TRUE(w.start_mesh());
+  EXPECT_FALSE(wait_job(w));
+  EXPECT_NE(w.last_error().toStdString().find("no solved result"), std::string::npos)
+      << w.last_error().toStdString();
+  // A solve with no result to refine from meshes from the model's sizes (its mesh_model mesh).
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const std::shared_ptr<const foxi::Mesh> solved = w.mesh();
+  EXPECT_TRUE(solved->xyz == foxi::mesh_model(model).mesh.xyz);
+  s.refine_from_result = false;
+  ASSERT_TRUE(w.set_mesh_settings(s));
+  ASSERT_NE(solved->find_field("temperature"), nullptr);
+  auto* refine = w.findChild<QCheckBox*>("refine_from_result");
+  ASSERT_NE(refine, nullptr);
+  refine->setChecked(true);  // through the panel's check box
+  ASSERT_TRUE(w.mesh_settings().refine_from_result);
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  foxi::ModelMeshOptions o;
+  o.refine_from = {.mesh = solved.get(), .field = "temperature", .target_error = 0.3};
+  const foxi::MeshedModel direct = foxi::mesh_model(model, {}, o);
+  EXPECT_EQ(w.mesh()->tet_count(), direct.mesh.tet_count());
+  EXPECT_TRUE(w.mesh()->xyz == direct.mesh.xyz);
+  EXPECT_GT(w.mesh()->tet_count(), solved->tet_count());
+  const std::string report = w.findChild<QPlainTextEdit*>("quality_report")->toPlainText().toStdString();
+  EXPECT_NE(report.find("refined from the result's 'temperature'"), std::string::npos) << report;
 }
 
 // Solve with another physics: every value and check of the results table equals foxi solve --json's
