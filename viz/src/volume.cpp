@@ -41,7 +41,7 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   for (std::size_t k = 0; k < mesh.node_count(); ++k) s.proj.to_camera(&mesh.xyz[3 * k], &s.cam_xyz[3 * k]);
   s.transfer = std::make_unique<TableTransfer>(s.params);
 #ifdef FOXI_VOLUME_AVX512
-  // Its pixel offsets are 32-bit (4 floats a pixel).
+  // Its pixel indices are 32-bit.
   s.vector_rows = volume_avx512() && std::size_t(width) * std::size_t(height) < (std::size_t(1) << 29);
 #endif
   s.tiles_x = (width + Impl::kTileW - 1) / Impl::kTileW;

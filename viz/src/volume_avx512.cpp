@@ -38,12 +38,38 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline __m512d linear_
                        _mm512_mul_pd(yf, _mm512_set1_pd(C)));
 }
 
+// The table rows of the cells cell[0..7] (F + 4 cell, 8 doubles each) transposed: out[j] holds
+// element j of every lane's row (j < 4: node cell's T, K; j >= 4: node cell + 1's).
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline void table_rows(const double* F, const int* cell,
+                                                                                 __m512d out[8]) {
+  __m512d r[8];
+  for (int i = 0; i < 8; ++i) r[i] = _mm512_loadu_pd(F + 4 * std::size_t(cell[i]));
+  // Pairs of lanes, then quadruples, then halves: unpack, 2-element and 4-element shuffles.
+  __m512d s[8], u[8];
+  for (int i = 0; i < 8; i += 2) {
+    s[i] = _mm512_unpacklo_pd(r[i], r[i + 1]);      // r_i0 r_{i+1}0 r_i2 r_{i+1}2 ...
+    s[i + 1] = _mm512_unpackhi_pd(r[i], r[i + 1]);  // r_i1 r_{i+1}1 r_i3 r_{i+1}3 ...
+  }
+  for (int i = 0; i < 8; i += 4)
+    for (int k = 0; k < 2; ++k) {
+      // 128-bit blocks: (0, 2) of s[i + k] with (0, 2) of s[i + 2 + k], and (1, 3) with (1, 3).
+      u[i + k] = _mm512_shuffle_f64x2(s[i + k], s[i + 2 + k], 0x88);
+      u[i + 2 + k] = _mm512_shuffle_f64x2(s[i + k], s[i + 2 + k], 0xdd);
+    }
+  const __m512i lo_idx = _mm512_set_epi64(13, 12, 9, 8, 5, 4, 1, 0);
+  const __m512i hi_idx = _mm512_set_epi64(15, 14, 11, 10, 7, 6, 3, 2);
+  for (int k = 0; k < 4; ++k) {
+    out[k] = _mm512_permutex2var_pd(u[k], lo_idx, u[k + 4]);
+    out[k + 4] = _mm512_permutex2var_pd(u[k], hi_idx, u[k + 4]);
+  }
+}
+
 }  // namespace
 
 // The pixels (xs[i], ys[i]), i < n, eight at a time: TetSetup::segment and, for the common segment
 // (the pre-integrated table, at least 2 grid cells, inside the grid, one closed piece),
 // integrate_fast with the same operations in the same order (viz is built with -ffp-contract=off, and
-// the gathers read the same table), so the picture is bit for bit the portable path's; every other
+// the same table entries are read), so the picture is bit for bit the portable path's; every other
 // segment (thin, thick, outside the grid, NaN, a log scale) goes through composite() one pixel at a
 // time.
 __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx512(
@@ -52,19 +78,18 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
   const __m512d zero = _mm512_setzero_pd();
   const __m512d one = _mm512_set1_pd(1.0), inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d abs_mask = _mm512_castsi512_pd(_mm512_set1_epi64(0x7fffffffffffffffLL));
-  const __m256i tet = _mm256_set1_epi32(int(t)), w4 = _mm256_set1_epi32(4 * width);
+  const __m256i tet = _mm256_set1_epi32(int(t)), wv = _mm256_set1_epi32(width);
   const __m256i last_cell = _mm256_set1_epi32(TableTransfer::kG - 1);
   const __m512d g_lo = _mm512_set1_pd(tf.g_lo), g_inv = _mm512_set1_pd(tf.g_inv);
   const __m512d grid_end = _mm512_set1_pd(double(TableTransfer::kG)), two = _mm512_set1_pd(2.0);
   const __m512d pos_scale = _mm512_set1_pd(tf.pos_scale), lut_step = _mm512_set1_pd(double(tf.lut_step));
   const __m512d c255 = _mm512_set1_pd(255.0), c256 = _mm512_set1_pd(256.0);
-  float* const base_c = &acc[0].c[0];
   for (int i0 = 0; i0 < n_px; i0 += 8) {
     const int n = std::min(8, n_px - i0);
     __mmask8 live = __mmask8((1u << n) - 1u);
     const __m256i xi = _mm256_maskz_loadu_epi32(live, xs + i0), yi = _mm256_maskz_loadu_epi32(live, ys + i0);
-    // Each pixel's first float in acc (16 bytes, 4 floats a pixel).
-    const __m256i pixel_index = _mm256_add_epi32(_mm256_mullo_epi32(yi, w4), _mm256_slli_epi32(xi, 2));
+    // Each pixel's index in acc.
+    const __m256i pixel = _mm256_add_epi32(_mm256_mullo_epi32(yi, wv), xi);
     const __m512d xf = _mm512_cvtepi32_pd(xi), yf = _mm512_cvtepi32_pd(yi);
     __m512d s_in = _mm512_set1_pd(r.near), s_out = inf;
     for (int k = 0; k < 4; ++k) {
@@ -77,7 +102,6 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
     live &= _mm512_cmp_pd_mask(s_out, s_in, _CMP_GT_OQ);
     if (!live) continue;
     count += std::size_t(__builtin_popcount(live));
-    _mm256_mask_i32scatter_epi32(base_c + 3, live, pixel_index, tet, 4);
     const __m512d v0 = linear_xy(xf, yf, r.vA, r.vB, r.vC), gd = linear_xy(xf, yf, r.gdA, r.gdB, r.gdC);
     const __m512d dx = _mm512_add_pd(_mm512_set1_pd(r.dxA), _mm512_mul_pd(xf, _mm512_set1_pd(r.dxB)));
     const __m512d dy = _mm512_add_pd(_mm512_set1_pd(r.dyA), _mm512_mul_pd(yf, _mm512_set1_pd(r.dyC)));
@@ -87,7 +111,7 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
                                      _mm512_set1_pd(r.dz2))));
     const __m512d v_far = _mm512_add_pd(v0, _mm512_mul_pd(s_out, gd));
     const __m512d v_near = _mm512_add_pd(v0, _mm512_mul_pd(s_in, gd));
-    __mmask8 done = 0;
+    __mmask8 done = 0, written = 0;  // written: the lanes whose pixel (colour and front) is stored
     if (tf.pre) {
       const __m512d dv = _mm512_sub_pd(v_near, v_far);
       const __m512d adv = _mm512_and_pd(dv, abs_mask);
@@ -111,16 +135,18 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
         const __m256i ib = _mm256_min_epi32(_mm512_cvttpd_epi32(xb), last_cell);
         const __m512d fa = _mm512_sub_pd(xa, _mm512_cvtepi32_pd(ia));
         const __m512d fb = _mm512_sub_pd(xb, _mm512_cvtepi32_pd(ib));
-        const __m256i ka = _mm256_slli_epi32(ia, 2), kb = _mm256_slli_epi32(ib, 2);
+        // A cell's two nodes are 8 consecutive doubles of F (64 bytes): one load a lane and an 8 x 8
+        // transpose in place of 16 gathers (the lanes outside m read cell 0 and are not used).
+        alignas(32) int cell_a[8], cell_b[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(cell_a), _mm256_maskz_mov_epi32(m, ia));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(cell_b), _mm256_maskz_mov_epi32(m, ib));
+        __m512d na[8], nb[8];
+        table_rows(tf.F.data(), cell_a, na);
+        table_rows(tf.F.data(), cell_b, nb);
         __m512d a[4], b[4];
         for (int j = 0; j < 4; ++j) {
-          const double* F = tf.F.data() + j;
-          const __m512d a0 = _mm512_mask_i32gather_pd(zero, m, ka, F, 8);
-          const __m512d a1 = _mm512_mask_i32gather_pd(zero, m, ka, F + 4, 8);
-          const __m512d b0 = _mm512_mask_i32gather_pd(zero, m, kb, F, 8);
-          const __m512d b1 = _mm512_mask_i32gather_pd(zero, m, kb, F + 4, 8);
-          a[j] = _mm512_add_pd(a0, _mm512_mul_pd(fa, _mm512_sub_pd(a1, a0)));
-          b[j] = _mm512_add_pd(b0, _mm512_mul_pd(fb, _mm512_sub_pd(b1, b0)));
+          a[j] = _mm512_add_pd(na[j], _mm512_mul_pd(fa, _mm512_sub_pd(na[j + 4], na[j])));
+          b[j] = _mm512_add_pd(nb[j], _mm512_mul_pd(fb, _mm512_sub_pd(nb[j + 4], nb[j])));
         }
         // closed_piece: D = length dT / dv; D == 0 blends nothing; 0 < D <= 1 with spread D^2 <= 1
         // in closed form.
@@ -178,16 +204,48 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
         e = _mm512_mul_pd(e, e);
         // Pre-integrated: (K_b - K_a) (1 - e) / dT + c e; thin: rgb (1 - e) + c e (dT = 1 exactly).
         const __m512d w = _mm512_div_pd(_mm512_sub_pd(one, e), dT);
+        // The eight pixels (16 bytes each: r, g, b, front) loaded whole and transposed, in place of
+        // three gathers and four scatters; written back with the tet as their front.
+        alignas(32) int at[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(at), pixel);
+        __m512 q0 = _mm512_castps128_ps512(_mm_loadu_ps(acc[at[0]].c));
+        __m512 q1 = _mm512_castps128_ps512(_mm_loadu_ps(acc[at[4]].c));
+        q0 = _mm512_insertf32x4(q0, _mm_loadu_ps(acc[at[1]].c), 1);
+        q1 = _mm512_insertf32x4(q1, _mm_loadu_ps(acc[at[5]].c), 1);
+        q0 = _mm512_insertf32x4(q0, _mm_loadu_ps(acc[at[2]].c), 2);
+        q1 = _mm512_insertf32x4(q1, _mm_loadu_ps(acc[at[6]].c), 2);
+        q0 = _mm512_insertf32x4(q0, _mm_loadu_ps(acc[at[3]].c), 3);
+        q1 = _mm512_insertf32x4(q1, _mm_loadu_ps(acc[at[7]].c), 3);
+        __m256 out[3];
         for (int j = 0; j < 3; ++j) {
-          float* base = base_c + j;
-          const __m512d c =
-              _mm512_cvtps_pd(_mm256_mmask_i32gather_ps(_mm256_setzero_ps(), blend, pixel_index, base, 4));
-          const __m512d out = _mm512_add_pd(_mm512_mul_pd(em[j], w), _mm512_mul_pd(c, e));
-          _mm256_mask_i32scatter_ps(base, blend, pixel_index, _mm512_cvtpd_ps(out), 4);
+          // Channel j of pixel i is float 4 i + j of (q0, q1).
+          const __m512i idx = _mm512_add_epi32(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 28, 24, 20, 16, 12, 8, 4, 0),
+                                               _mm512_set1_epi32(j));
+          const __m512d c = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutex2var_ps(q0, idx, q1)));
+          out[j] = _mm512_cvtpd_ps(_mm512_add_pd(_mm512_mul_pd(em[j], w), _mm512_mul_pd(c, e)));
         }
+        // Back to (r, g, b, front) per pixel: (r | g) and (b | front) as 16 floats, pixel i's four
+        // from floats i, 8 + i of the first and i, 8 + i of the second.
+        const __m512 rg = _mm512_insertf32x8(_mm512_castps256_ps512(out[0]), out[1], 1);
+        const __m512 bt = _mm512_insertf32x8(_mm512_castps256_ps512(out[2]), _mm256_castsi256_ps(tet), 1);
+        const __m512i lo_idx = _mm512_set_epi32(27, 19, 11, 3, 26, 18, 10, 2, 25, 17, 9, 1, 24, 16, 8, 0);
+        const __m512i hi_idx = _mm512_set_epi32(31, 23, 15, 7, 30, 22, 14, 6, 29, 21, 13, 5, 28, 20, 12, 4);
+        alignas(64) float px_out[32];
+        _mm512_store_ps(px_out, _mm512_permutex2var_ps(rg, lo_idx, bt));
+        _mm512_store_ps(px_out + 16, _mm512_permutex2var_ps(rg, hi_idx, bt));
+        for (int i = 0; i < 8; ++i)
+          if (blend >> i & 1) _mm_storeu_ps(acc[at[i]].c, _mm_load_ps(px_out + 4 * i));
+        written = blend;
       }
       done = __mmask8(blend | none);
       fast += std::size_t(__builtin_popcount(done));
+    }
+    // The front of the pixels not written above.
+    if (const __mmask8 front = __mmask8(live & ~written)) {
+      alignas(32) int at[8];
+      _mm256_store_si256(reinterpret_cast<__m256i*>(at), pixel);
+      for (int i = 0; i < 8; ++i)
+        if (front >> i & 1) acc[at[i]].front = t;
     }
     if (const __mmask8 rest = __mmask8(live & ~done)) {
       alignas(64) double vf[8], vn[8], ln[8];
