@@ -154,8 +154,11 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
       X4[k] = to_fixed(q[0]);
       Y4[k] = to_fixed(q[1]);
     }
+    // Three front faces: the one back face covers the same projection (the three meet at the
+    // projection of its opposite corner), one triangle to rasterize in place of three.
+    const bool back_only = front_count == 3;
     for (int f = 0; f < 4; ++f) {
-      if (!facing[f]) continue;
+      if (facing[f] == back_only) continue;
       const std::int64_t X[3] = {X4[kFace[f][0]], X4[kFace[f][1]], X4[kFace[f][2]]},
                          Y[3] = {Y4[kFace[f][0]], Y4[kFace[f][1]], Y4[kFace[f][2]]};
       for_each_fan_triangle(X, Y, 3, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
@@ -172,9 +175,9 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     const int m = clip_near(proj, params.near, tri, 3, v);
     if (m == 0) continue;
     std::int64_t X[kMaxPolyVolume], Y[kMaxPolyVolume];
-    double px[kMaxPolyVolume][2], w[kMaxPolyVolume];
+    double snapped[kMaxPolyVolume][2], w[kMaxPolyVolume];
     snap_polygon(
-        proj, m, [&](int i) { return v[i]; }, X, Y, px, w);
+        proj, m, [&](int i) { return v[i]; }, X, Y, snapped, w);
     for_each_fan_triangle(X, Y, m, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
       raster_triangle(TX, TY, proj.width, proj.height, rows, add_run);
     });
