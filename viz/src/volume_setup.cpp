@@ -122,17 +122,28 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   auto add_run = [&](int y, int lo, int hi) {
     lo = std::max(lo, tile.x0);
     hi = std::min(hi, tile.x1);
-    // Eight entries at a time (a fixed count the compiler writes as vectors), those past hi left
-    // beyond n_px: the list keeps room for eight.
-    for (int x = lo; x <= hi;) {
-      if (n_px > Scratch::kRun - 8) flush();
-      for (int i = 0; i < 8; ++i) {
-        scratch.xs[n_px + i] = x + i;
-        scratch.ys[n_px + i] = y;
+    // Sixteen entries at a time, written whether the run is that long or not (those past hi are left
+    // beyond n_px: the list keeps room for sixteen): a tet's row is rarely longer, so a row is
+    // usually one pass of four vector stores a list.
+    for (int x = lo; x <= hi; x += 16) {
+      if (n_px > Scratch::kRun - 16) flush();
+      int* xs = scratch.xs + n_px;
+      int* ys = scratch.ys + n_px;
+#ifdef __SSE2__
+      __m128i xv = _mm_add_epi32(_mm_set1_epi32(x), _mm_set_epi32(3, 2, 1, 0));
+      const __m128i yv = _mm_set1_epi32(y), four = _mm_set1_epi32(4);
+      for (int k = 0; k < 16; k += 4) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(xs + k), xv);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(ys + k), yv);
+        xv = _mm_add_epi32(xv, four);
       }
-      const int m = std::min(8, hi - x + 1);
-      n_px += m;
-      x += m;
+#else
+      for (int i = 0; i < 16; ++i) {
+        xs[i] = x + i;
+        ys[i] = y;
+      }
+#endif
+      n_px += std::min(16, hi - x + 1);
     }
   };
   // No node before the near plane clip_near would use for any face (the usual case): the four
