@@ -14,14 +14,18 @@
 //                         in closed form), opaque_ms and ratio. The outside anchor, VTK's projected
 //                         tetrahedra on the same mesh and view: bench/peers/volume_vtk.py.
 //                         FOXI_BENCH_BOX_VOLUME=4e-5 (a maximum tet volume): a smaller box, to profile.
-// Figures (2-core Xeon, AVX-512, load 9 to 12 from other builds, 2026-11-27 14:50-14:57, one
-// sitting): volume_frame 8.3 to 8.8 s a frame wall (order 92 to 140 ms), 2.90 to 3.12 s of CPU, 35.0
-// to 37.8 ns a segment (82.6M segments); the code before that day's vol4 changes 3.06 to 3.10 s CPU
-// (37.0 to 37.5 ns) in the same sitting. VTK's projected tetrahedra (volume_vtk.py, 3 frames, Mesa
-// llvmpipe under Xvfb): 38.5, 40.7, 46.6 s a frame (median 40.7 s; first frame 48.2 s): foxi 4.4 to
-// 5.6 times faster in wall time. Far from the 150 ms (about 0.3 s of CPU on 2 cores): perf
-// puts 56% of the painter's time in the pixel kernel (volume_avx512.cpp), 24% in listing the pixels
-// (raster_triangle), 9% in the per-tet set-up, 7% in fetching the tets (tile loop), 2% in binning.
+// Figures (2-core Xeon with AVX-512, shared: load 9 to 12 from other builds; 2026-11-27, "before":
+// the code at the start of that day's vol4 changes, run alternately with "after" from copies of both
+// binaries). 0.97M tets: after 2.4 to 2.9 s of CPU a frame (29 to 35 ns a segment, 82.6M segments),
+// before 2.7 to 3.0 s (33 to 36 ns); wall 4.2 to 7.5 s a frame (order 37 to 106 ms). VTK's projected
+// tetrahedra (volume_vtk.py, Mesa llvmpipe under Xvfb, 3 frames) in the same sitting: 15.7, 20.4,
+// 36.5 s a frame (an earlier sitting under more load: 38.5, 40.7, 46.6 s against foxi's 8.3 to 8.8 s):
+// foxi 3 to 5 times faster in wall time, not the 10. FOXI_BENCH_BOX_VOLUME=4e-5 (0.1M tets,
+// 40M segments), 4 repetitions twice: after 20.7 to 23.5 ns a segment, before 22.9 to 29.3 ns. Far
+// from the 150 ms (about 0.3 s of CPU on 2 cores, 3.6 ns a segment): perf puts 56% of the
+// painter's time in the pixel kernel (volume_avx512.cpp), 24% in listing the pixels (raster_triangle),
+// 9% in the per-tet set-up, 7% in fetching the tets (tile loop), 2% in binning (profiled before the
+// two changes that cut the listing: one triangle for three front faces, sixteen entries at a time).
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
