@@ -40,7 +40,8 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline __m512d linear_
 
 // The table rows of the cells cell[0..7] (F + 4 cell, 8 doubles each) transposed: out[j] holds
 // element j of every lane's row (j < 4: node cell's T, K; j >= 4: node cell + 1's).
-__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline void table_rows(const double* F, const int* cell,
+__attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) inline void table_rows(const double* F,
+                                                                                 const int* cell,
                                                                                  __m512d out[8]) {
   __m512d r[8];
   for (int i = 0; i < 8; ++i) r[i] = _mm512_loadu_pd(F + 4 * std::size_t(cell[i]));
@@ -219,8 +220,8 @@ __attribute__((target("avx512f,avx512vl,avx512dq,avx2"))) void volume_pixels_avx
         __m256 out[3];
         for (int j = 0; j < 3; ++j) {
           // Channel j of pixel i is float 4 i + j of (q0, q1).
-          const __m512i idx = _mm512_add_epi32(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 28, 24, 20, 16, 12, 8, 4, 0),
-                                               _mm512_set1_epi32(j));
+          const __m512i idx = _mm512_add_epi32(
+              _mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 28, 24, 20, 16, 12, 8, 4, 0), _mm512_set1_epi32(j));
           const __m512d c = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutex2var_ps(q0, idx, q1)));
           out[j] = _mm512_cvtpd_ps(_mm512_add_pd(_mm512_mul_pd(em[j], w), _mm512_mul_pd(c, e)));
         }

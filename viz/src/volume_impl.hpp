@@ -28,7 +28,6 @@
 namespace foxi {
 namespace volume_detail {
 
-
 // The integral over one segment with a transfer function tf (tau(v), position(v), rgb(v, out)).
 template <class Transfer>
 void integrate(const Transfer& tf, double v_far, double v_near, double length, float c[3]) {
@@ -126,7 +125,8 @@ inline double exp_neg_small(double D) {
 // apply (the caller steps with integrate()).
 bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double length, float c[3]);
 // integrate_fast where it applies, else integrate(); counts the closed-form ones in fast.
-void composite(const TableTransfer& tf, double v_far, double v_near, double len, float c[3], std::size_t& fast);
+void composite(const TableTransfer& tf, double v_far, double v_near, double len, float c[3],
+               std::size_t& fast);
 
 // Per pixel the colour so far and the nearest tet blended, side by side (16 bytes): a tet's row of
 // pixels touches one run of cache lines, not two.
