@@ -22,10 +22,10 @@
 // 36.5 s a frame (an earlier sitting under more load: 38.5, 40.7, 46.6 s against foxi's 8.3 to 8.8 s):
 // foxi 3 to 5 times faster in wall time, not the 10. FOXI_BENCH_BOX_VOLUME=4e-5 (0.1M tets,
 // 40M segments), 4 repetitions twice: after 20.7 to 23.5 ns a segment, before 22.9 to 29.3 ns. Far
-// from the 150 ms (about 0.3 s of CPU on 2 cores, 3.6 ns a segment): perf puts 56% of the
-// painter's time in the pixel kernel (volume_avx512.cpp), 24% in listing the pixels (raster_triangle),
-// 9% in the per-tet set-up, 7% in fetching the tets (tile loop), 2% in binning (profiled before the
-// two changes that cut the listing: one triangle for three front faces, sixteen entries at a time).
+// from the 150 ms (about 0.3 s of CPU on 2 cores, 3.6 ns a segment). Where the painter's
+// time goes (perf, after): 57% the pixel kernel (volume_avx512.cpp; its hottest spots wait on the
+// division of the optical depth and on the first load of the pixels), 19% listing the pixels
+// (raster_triangle; 24% before), 10% the per-tet set-up, 9% fetching the tets (tile loop), 3% binning.
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
