@@ -299,7 +299,7 @@ TEST(Volume, VectorPathMatchesThePortableBitForBit) {
     std::size_t samples = 0;
     for (double light : {1.0, 8.0, 0.05}) {
       const VolumeParams p = params_for(m, light);
-      for (const Camera& cam : test::random_cameras(m, 3, 66, 300.0 / 150)) {
+      for (const Camera& cam : test::random_cameras(m, 2, 66, 300.0 / 150)) {
         const Framebuffer fb =
             paint(m, cam, visibility_order(m, table, view_of(cam)), corner, p, &samples, nullptr, 300, 150);
         for (std::size_t i = 0; i < fb.rgba.size(); ++i) {
