@@ -8,10 +8,24 @@
 //                         per mesh, outside the timing (surfaces_ms)
 //   volume_frame          the whole mesh ordered and volume-rendered (VolumePainter: a smooth node field,
 //                         the integral along every pixel's ray through every tet), counters order_ms,
-//                         draw_ms, segments (pixel-tet segments integrated), pre_integrated (of those,
-//                         the ones in closed form), opaque_ms and ratio. The outside anchor, VTK's
-//                         projected tetrahedra on the same mesh and view: bench/peers/volume_vtk.py.
+//                         draw_ms, draw_cpu_ms (the painter's CPU time, all threads: what a loaded
+//                         machine does not inflate much), ns_per_segment (draw_cpu_ms per segment),
+//                         segments (pixel-tet segments integrated), pre_integrated (of those, the ones
+//                         in closed form), opaque_ms and ratio. The outside anchor, VTK's projected
+//                         tetrahedra on the same mesh and view: bench/peers/volume_vtk.py.
 //                         FOXI_BENCH_BOX_VOLUME=4e-5 (a maximum tet volume): a smaller box, to profile.
+// Figures (2-core Xeon with AVX-512, shared: load 9 to 12 from other builds; 2026-11-27, "before":
+// the code at the start of that day's vol4 changes, run alternately with "after" from copies of both
+// binaries). 0.97M tets: after 2.4 to 2.9 s of CPU a frame (29 to 35 ns a segment, 82.6M segments),
+// before 2.7 to 3.0 s (33 to 36 ns); wall 4.2 to 7.5 s a frame (order 37 to 106 ms). VTK's projected
+// tetrahedra (volume_vtk.py, Mesa llvmpipe under Xvfb, 3 frames) in the same sitting: 15.7, 20.4,
+// 36.5 s a frame (an earlier sitting under more load: 38.5, 40.7, 46.6 s against foxi's 8.3 to 8.8 s):
+// foxi 3 to 5 times faster in wall time, not the 10. FOXI_BENCH_BOX_VOLUME=4e-5 (0.1M tets,
+// 40M segments), 4 repetitions twice: after 20.7 to 23.5 ns a segment, before 22.9 to 29.3 ns. Far
+// from the 150 ms (about 0.3 s of CPU on 2 cores, 3.6 ns a segment). Where the painter's
+// time goes (perf, after): 57% the pixel kernel (volume_avx512.cpp; its hottest spots wait on the
+// division of the optical depth and on the first load of the pixels), 19% listing the pixels
+// (raster_triangle; 24% before), 10% the per-tet set-up, 9% fetching the tets (tile loop), 3% binning.
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
@@ -22,6 +36,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cmath>
+#include <ctime>
 #include <memory>
 
 #include "bench_meshes.hpp"
@@ -40,6 +55,14 @@ constexpr int kWidth = 1920, kHeight = 1080;
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The process's CPU time (all threads), ms: on a shared machine the wall clock counts the other
+// users' time too, the CPU time only ours.
+double cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
 }
 
 struct Case {
@@ -187,6 +210,7 @@ void BM_volume_frame(benchmark::State& state) {
   std::vector<std::uint32_t> order;
   Timing t, base;
   std::size_t segments = 0, pre_integrated = 0;
+  double draw_cpu_ms = 0;
   int i = 0;
   for (auto _ : state) {
     const Camera cam = orbit(c.camera, 7.0 * i++, 0);
@@ -194,9 +218,11 @@ void BM_volume_frame(benchmark::State& state) {
     visibility_order_into(order, c.mesh[0], c.table, view_of(cam));
     t.order_ms += ms_since(t0);
     t0 = std::chrono::steady_clock::now();
+    const double cpu0 = cpu_ms();
     VolumePainter painter(c.mesh[0], cam, kWidth, kHeight, c.corner, c.volume);
     painter.draw(order);
     painter.resolve(fb);
+    draw_cpu_ms += cpu_ms() - cpu0;
     segments += painter.samples();
     pre_integrated += painter.pre_integrated();
     t.draw_ms += ms_since(t0);
@@ -209,6 +235,8 @@ void BM_volume_frame(benchmark::State& state) {
   state.counters["pre_integrated"] = double(pre_integrated) / iters;
   state.counters["order_ms"] = t.order_ms / iters;
   state.counters["draw_ms"] = t.draw_ms / iters;
+  state.counters["draw_cpu_ms"] = draw_cpu_ms / iters;
+  state.counters["ns_per_segment"] = draw_cpu_ms * 1e6 / double(segments);
   state.counters["opaque_ms"] = base.total() / iters;
   state.counters["ratio"] = t.total() / base.total();
 }

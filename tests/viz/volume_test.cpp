@@ -12,6 +12,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
 #include <random>
 #include <vector>
 
@@ -277,6 +280,61 @@ TEST(Volume, TiledPictureMatchesTheRayCaster) {
               covered, compared, bad, worst);
   EXPECT_GT(covered, compared / 4);
   EXPECT_EQ(bad, 0u);
+}
+
+// The vector path (volume_avx512.cpp) and the portable one must give the same picture bit for bit
+// (colours and front ids): this binary run twice, once with FOXI_PORTABLE_RASTER=1, each drawing
+// random Delaunay pictures over several tiles (a light and a dense transfer function: closed-form,
+// thin and stepped segments) and printing a hash of its pictures, which must agree.
+TEST(Volume, VectorPathMatchesThePortableBitForBit) {
+  if (std::getenv("FOXI_VOLUME_PICTURE_HASH")) {  // the child run: draw and print the hash
+    test::TempDir dir;
+    const Mesh m = test::random_delaunay(dir, 200, 10);
+    const SphereTable table = compute_spheres(m);
+    const std::vector<double> corner = smooth_field(m);
+    std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the colours and ids
+    auto mix = [&](std::uint32_t v) {
+      for (int k = 0; k < 4; ++k) hash = (hash ^ ((v >> (8 * k)) & 255u)) * 1099511628211ull;
+    };
+    std::size_t samples = 0;
+    for (double light : {1.0, 8.0, 0.05}) {
+      const VolumeParams p = params_for(m, light);
+      for (const Camera& cam : test::random_cameras(m, 2, 66, 300.0 / 150)) {
+        const Framebuffer fb =
+            paint(m, cam, visibility_order(m, table, view_of(cam)), corner, p, &samples, nullptr, 300, 150);
+        for (std::size_t i = 0; i < fb.rgba.size(); ++i) {
+          mix(fb.rgba[i]);
+          mix(fb.id[i]);
+        }
+      }
+    }
+    std::printf("picture hash %016llx samples %zu\n", static_cast<unsigned long long>(hash), samples);
+    return;
+  }
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  if (!(__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx512dq")))
+    GTEST_SKIP() << "no AVX-512: the painter takes the portable path only";
+#else
+  GTEST_SKIP() << "no vector path on this platform";
+#endif
+  test::TempDir dir;
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::string hashes[2];
+  for (int portable = 0; portable < 2; ++portable) {
+    const std::filesystem::path log = dir / ("run" + std::to_string(portable));
+    const int rc =
+        test::run("FOXI_VOLUME_PICTURE_HASH=1 FOXI_PORTABLE_RASTER=" + std::to_string(portable) + " '" +
+                      self + "' --gtest_filter=Volume.VectorPathMatchesThePortableBitForBit",
+                  log);
+    const std::string text = test::read_text(log);
+    ASSERT_EQ(rc, 0) << text;
+    const auto at = text.find("picture hash ");
+    ASSERT_NE(at, std::string::npos) << text;
+    hashes[portable] = text.substr(at, text.find('\n', at) - at);
+  }
+  std::printf("vector: %s\nportable: %s\n", hashes[0].c_str(), hashes[1].c_str());
+  EXPECT_EQ(hashes[0], hashes[1]);
 }
 
 TEST(Volume, SafePictureSaysWhichOrder) {

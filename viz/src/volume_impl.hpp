@@ -1,0 +1,231 @@
+// Internal to the volume renderer (volume.hpp): the types its files share. VolumePainter::Impl's
+// members are defined, by concern, in volume.cpp (construction, draw, resolve, draw_volume_picture),
+// volume_tiles.cpp (the screen tiles and the binning of a batch's tets to them), volume_setup.cpp (a
+// tet's set-up, its pixels listed and integrated on the portable path) and volume_avx512.cpp (the
+// same pixels eight at a time); the transfer function, the segment integral and its pre-integrated
+// form are in volume_transfer.cpp.
+//
+// Speed (issue 23): the screen is cut into tiles, a batch's tets binned to the tiles they touch in
+// the batch's order, and each thread takes whole tiles (a tile's pixels stay in its core's cache; no
+// two threads write one pixel; every pixel still sees its tets in order, so a finished batch is the
+// exact picture of the far part); per tet one set-up (its planes, field and rays linear in the
+// pixel's x and y), its pixels listed and integrated eight at a time with AVX-512 where the CPU has
+// it, with the portable path's operations (the same picture bit for bit).
+#pragma once
+
+#include "foxi/viz/volume.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "raster_impl.hpp"
+
+namespace foxi {
+namespace volume_detail {
+
+// The integral over one segment with a transfer function tf (tau(v), position(v), rgb(v, out)).
+template <class Transfer>
+void integrate(const Transfer& tf, double v_far, double v_near, double length, float c[3]) {
+  if (!(length > 0)) return;
+  // Steps of at most 1/64 of the colour scale and of optical depth at most 1/4 (the ends' and the
+  // middle's extinction), at most 256.
+  const double span = std::abs(tf.position(v_near) - tf.position(v_far));
+  const double tau_max = std::max({tf.tau(v_far), tf.tau(v_near), tf.tau(0.5 * (v_far + v_near))});
+  const double want = std::max(std::isfinite(span) ? span * 64 : 1.0, tau_max * length * 4);
+  const int steps = std::clamp(int(std::ceil(std::min(want, 256.0))), 1, 256);
+  const double dl = length / steps;
+  for (int k = 0; k < steps; ++k) {
+    const double v = v_far + (k + 0.5) / steps * (v_near - v_far);
+    const double tau = tf.tau(v);
+    if (!(tau > 0)) continue;
+    const float a = float(-std::expm1(-tau * dl));
+    float rgb[3];
+    tf.rgb(v, rgb);
+    for (int j = 0; j < 3; ++j) c[j] = rgb[j] * a + c[j] * (1 - a);
+  }
+}
+
+// The transfer function as given (each extinction from the curve, each colour from the scale).
+struct ExactTransfer {
+  const VolumeParams& p;
+  double tau(double v) const { return volume_extinction(p, v); }
+  double position(double v) const { return p.scale.position(v); }
+  void rgb(double v, float out[3]) const {
+    const std::uint32_t col = p.scale.color(v);
+    for (int j = 0; j < 3; ++j) out[j] = float((col >> (8 * j)) & 255u);
+  }
+};
+
+// The painter's: the extinction tabulated at 4097 values across the curve (constant beyond its ends)
+// and interpolated linearly, the colour map's 256 entries, so a sample costs no logarithm. With a
+// linear colour scale also the pre-integrated form (integrate_fast): the antiderivatives over the
+// value of the extinction, T(v) = int tau dv, and of the extinction-weighted colour, K(v) = int c tau dv,
+// tabulated on a fine grid.
+struct TableTransfer {
+  static constexpr int kN = 4096;
+  static constexpr int kG = 8192;  // the antiderivatives' grid: 1/32 of a colour map entry or finer
+  const VolumeParams* p = nullptr;
+  double lo = 0, hi = 0, inv_step = 0;
+  std::vector<double> tau_at;
+  float lut[256][3] = {};
+  float nan_rgb[3] = {};
+  // Pre-integration: grid [g_lo, g_hi], 4 doubles per node (T, K red, K green, K blue); the slopes
+  // beyond the grid (tau and the colour are constant there).
+  bool pre = false;
+  double g_lo = 0, g_hi = 0, g_inv = 0, pos_scale = 0;
+  std::vector<double> F;
+  double slope_lo[4] = {}, slope_hi[4] = {};
+  float lut_step = 0;  // the largest difference of two neighbouring colour map entries, one channel
+  explicit TableTransfer(const VolumeParams& params);  // volume_transfer.cpp
+  double tau(double v) const {
+    if (std::isnan(v) || tau_at.empty()) return 0;
+    const double x = std::clamp((v - lo) * inv_step, 0.0, double(kN));
+    const int i = std::min(int(x), kN - 1);
+    const double f = x - i;
+    return tau_at[std::size_t(i)] + f * (tau_at[std::size_t(i) + 1] - tau_at[std::size_t(i)]);
+  }
+  double position(double v) const { return p->scale.position(v); }
+  void rgb(double v, float out[3]) const {
+    const double t = p->scale.position(v);
+    const float* c = std::isnan(t) ? nan_rgb : lut[int(std::clamp(t * 256, 0.0, 255.0))];
+    std::copy(c, c + 3, out);
+  }
+  // The antiderivatives (T, K) at v.
+  void antiderivative(double v, double out[4]) const {
+    const double x = (v - g_lo) * g_inv;
+    if (x <= 0) {
+      for (int j = 0; j < 4; ++j) out[j] = F[std::size_t(j)] + (v - g_lo) * slope_lo[j];
+    } else if (x >= kG) {
+      for (int j = 0; j < 4; ++j) out[j] = F[4 * std::size_t(kG) + std::size_t(j)] + (v - g_hi) * slope_hi[j];
+    } else {
+      const int i = std::min(int(x), kG - 1);
+      const double f = x - i;
+      const double* a = &F[4 * std::size_t(i)];
+      for (int j = 0; j < 4; ++j) out[j] = a[j] + f * (a[j + 4] - a[j]);
+    }
+  }
+};
+
+// e^-D for 0 <= D <= 1 as (e^-x)^8, x = D/8 <= 1/8, e^-x by its Taylor series to x^5 (error under
+// x^6 / 720 < 5e-9, 4e-8 after the squarings), in a short dependency chain: cheaper than exp.
+inline double exp_neg_small(double D) {
+  const double x = 0.125 * D, x2 = x * x;
+  double e = (1 - x) + x2 * (0.5 - x * (1.0 / 6)) + x2 * x2 * (1.0 / 24 - x * (1.0 / 120));
+  e *= e;
+  e *= e;
+  return e * e;
+}
+
+// The segment's integral in closed form (volume_transfer.cpp says when): false where it does not
+// apply (the caller steps with integrate()).
+bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double length, float c[3]);
+// integrate_fast where it applies, else integrate(); counts the closed-form ones in fast.
+void composite(const TableTransfer& tf, double v_far, double v_near, double len, float c[3],
+               std::size_t& fast);
+
+// Per pixel the colour so far and the nearest tet blended, side by side (16 bytes): a tet's row of
+// pixels touches one run of cache lines, not two.
+struct Pixel {
+  float c[3];
+  std::uint32_t front;
+};
+
+// A tet's pixels: the ray o + s d of pixel (x, y) (camera frame; perspective: o = 0 and s the depth)
+// has o and d linear in x and y, so each plane's n.d and h - n.o, the field's g.(o - P0) and g.d and
+// the direction's x and y are A + x B + y C too: set up once per tet, a few multiply-adds a pixel.
+struct TetSetup {
+  double ndA[4], ndB[4], ndC[4], numA[4], numB[4], numC[4];
+  double vA, vB, vC, gdA, gdB, gdC, dxA, dxB, dyA, dyC, dz2, near;
+  // The ray's segment through the tet at pixel (x, y): false where the ray misses it (a snapped edge
+  // pixel).
+  bool segment(int x, int y, double& v_far, double& v_near, double& len) const {
+    const double xf = x, yf = y;
+    double s_in = near, s_out = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 4; ++k) {
+      const double nd = ndA[k] + xf * ndB[k] + yf * ndC[k];
+      const double sk = (numA[k] + xf * numB[k] + yf * numC[k]) / nd;
+      if (nd < 0)
+        s_in = std::max(s_in, sk);
+      else if (nd > 0)
+        s_out = std::min(s_out, sk);
+    }
+    if (!(s_out > s_in)) return false;
+    const double v0 = vA + xf * vB + yf * vC, gd = gdA + xf * gdB + yf * gdC;
+    const double dx = dxA + xf * dxB, dy = dyA + yf * dyC;
+    len = (s_out - s_in) * std::sqrt(dx * dx + dy * dy + dz2);
+    v_far = v0 + s_out * gd;
+    v_near = v0 + s_in * gd;
+    return true;
+  }
+};
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define FOXI_VOLUME_AVX512 1
+// Whether this CPU runs volume_pixels_avx512; FOXI_PORTABLE_RASTER=1 says no (the painter's switch),
+// so that the tests can compare the two paths on one machine.
+bool volume_avx512();
+// The pixels (xs[i], ys[i]), i < n_px, of tet t into acc (a row of `width` pixels), eight at a time,
+// bit for bit as TetSetup::segment and composite() one at a time (volume_avx512.cpp); count: the
+// pixel segments integrated, fast: of those, the ones in closed form.
+void volume_pixels_avx512(const TetSetup& r, const TableTransfer& tf, Pixel* acc, int width, const int* xs,
+                          const int* ys, int n_px, std::uint32_t t, std::size_t& count, std::size_t& fast);
+#endif
+
+}  // namespace volume_detail
+
+using namespace volume_detail;
+
+struct VolumePainter::Impl {
+  const Mesh* mesh = nullptr;
+  Projector proj;
+  std::span<const double> corner;
+  VolumeParams params;
+  int lanes = 1;
+  std::vector<Pixel> acc;
+  bool vector_rows = false;     // volume_row_avx512 for the pixel rows
+  std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
+  std::vector<std::size_t> lane_samples, lane_fast;
+  std::unique_ptr<TableTransfer> transfer;
+
+  Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
+
+  // Screen tiles of kTileW x kTileH pixels (128 KiB of Pixel, which stays in the core's cache while
+  // the tile's tets are drawn): draw() bins a batch's tets by their screen bounds, in order, and each
+  // thread takes whole tiles, so every pixel still sees its tets in the given order and no two
+  // threads write one pixel.
+  static constexpr int kTileW = 128, kTileH = 64;
+  struct Tile {
+    int x0, x1, y0, y1;
+  };
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<double> node_px;  // per node its pixel (x, y); NaN where it is not in front of the eye
+  std::vector<std::uint32_t> tile_start, tile_tets, cursor;
+  std::vector<std::array<std::uint16_t, 4>> tet_tiles;  // per tet of the batch: tiles x0, x1, y0, y1
+
+  // The tiles tet t's projection can touch (the bounds of its nodes' pixels, a pixel wider: the
+  // rasterized pixels' centres lie in the snapped projection); none off screen. A tet with a node not
+  // in front of the eye: the bounds of its part at depth >= nb, nb the least near plane clip_near
+  // can use for any of its faces (that part holds every face's clipped polygon).
+  // The tiles tet t's projection can touch (volume_tiles.cpp): x0, x1, y0, y1; x0 > x1 for none.
+  std::array<std::uint16_t, 4> tiles_of(std::uint32_t t) const;
+  // The batch's tets into the tiles' lists (tile_start, tile_tets), each list in the batch's order.
+  void bin(std::span<const std::uint32_t> tets);
+
+  // A thread's list of the pixels of the tet it draws.
+  struct Scratch {
+    static constexpr int kRun = 256;
+    alignas(64) int xs[kRun];
+    alignas(64) int ys[kRun];
+  };
+
+  // Tet t's segments at its pixels inside `tile` blended into acc (volume_setup.cpp).
+  void draw_tet(std::uint32_t t, const Tile& tile, Scratch& scratch, std::size_t& count, std::size_t& fast);
+  static constexpr int kMaxPolyVolume = 8;
+};
+
+}  // namespace foxi

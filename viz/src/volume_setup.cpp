@@ -1,0 +1,199 @@
+// The volume renderer's per-tet work (volume_impl.hpp): a tet's set-up in the camera frame (its field's
+// gradient, its four outward planes, the ray's planes and field linear in the pixel's x and y), its
+// pixels listed from its front faces with the painter's fixed point and fill rule, and integrated on
+// the portable path (volume_avx512.cpp takes them eight at a time where the CPU can).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "volume_impl.hpp"
+
+namespace foxi {
+
+void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& scratch, std::size_t& count,
+                                   std::size_t& fast) {
+  const Rows rows{0, 1, tile.y0, tile.y1};
+  const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
+  const double* cv = &corner[4 * std::size_t(t)];
+  double P[4][3];
+  for (int k = 0; k < 4; ++k) std::copy_n(&cam_xyz[3 * std::size_t(node[k])], 3, P[k]);
+  // The field's gradient in the camera frame: (P[k] - P[0]) . g = cv[k] - cv[0], by Cramer's rule.
+  double e[3][3], df[3];
+  for (int k = 0; k < 3; ++k) {
+    for (int j = 0; j < 3; ++j) e[k][j] = P[k + 1][j] - P[0][j];
+    df[k] = cv[k + 1] - cv[0];
+  }
+  auto det3 = [](const double a[3], const double b[3], const double c[3]) {
+    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+           a[2] * (b[0] * c[1] - b[1] * c[0]);
+  };
+  const double det = det3(e[0], e[1], e[2]);
+  if (!(std::abs(det) > 0)) return;  // flat
+  double g[3];
+  for (int j = 0; j < 3; ++j) {
+    double m[3][3];
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < 3; ++i) m[k][i] = i == j ? df[k] : e[k][i];
+    g[j] = det3(m[0], m[1], m[2]) / det;
+  }
+  // Outward planes n . x = h of the four faces.
+  double n[4][3], h[4];
+  bool facing[4];
+  int front_count = 0;
+  for (int f = 0; f < 4; ++f) {
+    const double* a = P[kFace[f][0]];
+    const double* b = P[kFace[f][1]];
+    const double* c = P[kFace[f][2]];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[f][0] = u[1] * w[2] - u[2] * w[1];
+    n[f][1] = u[2] * w[0] - u[0] * w[2];
+    n[f][2] = u[0] * w[1] - u[1] * w[0];
+    const double* opp = P[f];
+    if (n[f][0] * (opp[0] - a[0]) + n[f][1] * (opp[1] - a[1]) + n[f][2] * (opp[2] - a[2]) > 0)
+      for (double& x : n[f]) x = -x;
+    h[f] = n[f][0] * a[0] + n[f][1] * a[1] + n[f][2] * a[2];
+    facing[f] = proj.perspective ? h[f] < 0 : n[f][2] < 0;  // the eye on its outer side
+    front_count += facing[f];
+  }
+  // The eye inside the tet (perspective, every plane's inner side): its back faces cover the screen
+  // where the rays start inside it.
+  const bool inside = front_count == 0;
+  TetSetup r;
+  {
+    // o = o0 + x ox + y oy, d = d0 + x dx + y dy (see TetSetup).
+    double o0[3] = {0, 0, 0}, d0[3] = {0, 0, 1}, ox = 0, oy = 0, dx = 0, dy = 0;
+    if (proj.perspective) {
+      d0[0] = (0.5 - proj.cx) / proj.focal;
+      dx = 1 / proj.focal;
+      d0[1] = -(0.5 - proj.cy) / proj.focal;
+      dy = -1 / proj.focal;
+    } else {
+      o0[0] = (0.5 - proj.cx) / proj.scale;
+      ox = 1 / proj.scale;
+      o0[1] = -(0.5 - proj.cy) / proj.scale;
+      oy = -1 / proj.scale;
+    }
+    for (int k = 0; k < 4; ++k) {
+      r.ndA[k] = n[k][0] * d0[0] + n[k][1] * d0[1] + n[k][2] * d0[2];
+      r.ndB[k] = n[k][0] * dx;
+      r.ndC[k] = n[k][1] * dy;
+      r.numA[k] = h[k] - (n[k][0] * o0[0] + n[k][1] * o0[1]);
+      r.numB[k] = -n[k][0] * ox;
+      r.numC[k] = -n[k][1] * oy;
+    }
+    r.vA = cv[0] + g[0] * (o0[0] - P[0][0]) + g[1] * (o0[1] - P[0][1]) - g[2] * P[0][2];
+    r.vB = g[0] * ox;
+    r.vC = g[1] * oy;
+    r.gdA = g[0] * d0[0] + g[1] * d0[1] + g[2] * d0[2];
+    r.gdB = g[0] * dx;
+    r.gdC = g[1] * dy;
+    r.dxA = d0[0];
+    r.dxB = dx;
+    r.dyA = d0[1];
+    r.dyC = dy;
+    r.dz2 = d0[2] * d0[2];
+    r.near = proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
+  }
+  // The tet's pixels (its front faces', which cover its projection once) are listed, then
+  // integrated in runs of kRun: the vector path takes eight pixels of any rows at once.
+  int n_px = 0;
+  auto flush = [&] {
+#ifdef FOXI_VOLUME_AVX512
+    if (vector_rows) {
+      volume_pixels_avx512(r, *transfer, acc.data(), proj.width, scratch.xs, scratch.ys, n_px, t, count,
+                           fast);
+      n_px = 0;
+      return;
+    }
+#endif
+    for (int i = 0; i < n_px; ++i) {
+      double v_far, v_near, len;
+      if (!r.segment(scratch.xs[i], scratch.ys[i], v_far, v_near, len))
+        continue;  // a snapped edge pixel the ray misses
+      Pixel& pix = acc[std::size_t(scratch.ys[i]) * std::size_t(proj.width) + std::size_t(scratch.xs[i])];
+      composite(*transfer, v_far, v_near, len, pix.c, fast);
+      pix.front = t;
+      ++count;
+    }
+    n_px = 0;
+  };
+  auto add_run = [&](int y, int lo, int hi) {
+    lo = std::max(lo, tile.x0);
+    hi = std::min(hi, tile.x1);
+    // Sixteen entries at a time, written whether the run is that long or not (those past hi are left
+    // beyond n_px: the list keeps room for sixteen): a tet's row is rarely longer, so a row is
+    // usually one pass of four vector stores a list.
+    for (int x = lo; x <= hi; x += 16) {
+      if (n_px > Scratch::kRun - 16) flush();
+      int* xs = scratch.xs + n_px;
+      int* ys = scratch.ys + n_px;
+#ifdef __SSE2__
+      __m128i xv = _mm_add_epi32(_mm_set1_epi32(x), _mm_set_epi32(3, 2, 1, 0));
+      const __m128i yv = _mm_set1_epi32(y), four = _mm_set1_epi32(4);
+      for (int k = 0; k < 16; k += 4) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(xs + k), xv);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(ys + k), yv);
+        xv = _mm_add_epi32(xv, four);
+      }
+#else
+      for (int i = 0; i < 16; ++i) {
+        xs[i] = x + i;
+        ys[i] = y;
+      }
+#endif
+      n_px += std::min(16, hi - x + 1);
+    }
+  };
+  // No node before the near plane clip_near would use for any face (the usual case): the four
+  // corners snapped once, each front face from them (the same corners snap_polygon would give).
+  bool direct = !inside;
+  if (direct && proj.perspective) {
+    double dmax = 0;
+    for (int k = 0; k < 4; ++k)
+      dmax = std::max(dmax, std::sqrt(P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]));
+    double near_clip = std::max(params.near, dmax * proj.focal / kMaxPixel);
+    if (!(near_clip > 0)) near_clip = 1e-300;
+    for (int k = 0; k < 4; ++k) direct = direct && P[k][2] >= near_clip;
+  }
+  if (direct) {
+    std::int64_t X4[4], Y4[4];
+    for (int k = 0; k < 4; ++k) {
+      double q[2];
+      proj.camera_to_pixel(P[k], q);
+      X4[k] = to_fixed(q[0]);
+      Y4[k] = to_fixed(q[1]);
+    }
+    // Three front faces: the one back face covers the same projection (the three meet at the
+    // projection of its opposite corner), one triangle to rasterize in place of three.
+    const bool back_only = front_count == 3;
+    for (int f = 0; f < 4; ++f) {
+      if (facing[f] == back_only) continue;
+      const std::int64_t X[3] = {X4[kFace[f][0]], X4[kFace[f][1]], X4[kFace[f][2]]},
+                         Y[3] = {Y4[kFace[f][0]], Y4[kFace[f][1]], Y4[kFace[f][2]]};
+      for_each_fan_triangle(X, Y, 3, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
+        raster_triangle(TX, TY, proj.width, proj.height, rows, add_run);
+      });
+    }
+    flush();
+    return;
+  }
+  for (int f = 0; f < 4; ++f) {
+    if (facing[f] == inside) continue;
+    double tri[3][3], v[kMaxPolyVolume][3];
+    for (int k = 0; k < 3; ++k) std::copy(P[kFace[f][k]], P[kFace[f][k]] + 3, tri[k]);
+    const int m = clip_near(proj, params.near, tri, 3, v);
+    if (m == 0) continue;
+    std::int64_t X[kMaxPolyVolume], Y[kMaxPolyVolume];
+    double snapped[kMaxPolyVolume][2], w[kMaxPolyVolume];
+    snap_polygon(
+        proj, m, [&](int i) { return v[i]; }, X, Y, snapped, w);
+    for_each_fan_triangle(X, Y, m, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
+      raster_triangle(TX, TY, proj.width, proj.height, rows, add_run);
+    });
+  }
+  flush();
+}
+
+}  // namespace foxi
