@@ -8,11 +8,13 @@
 #include <QPixmap>
 #include <QVBoxLayout>
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "foxi/model/units.hpp"
 #include "foxi/viz/chart.hpp"
 #include "foxi/viz/text.hpp"
+#include "workbench_parts.hpp"
 
 namespace foxi::workbench {
 
@@ -78,7 +80,7 @@ QImage history_chart(const HistoryPoints& points, const std::string& parameter, 
       .copy();
 }
 
-void show_history_plot(QWidget* parent, const QString& model, std::vector<HistoryRow> rows) {
+void show_history_plot(QWidget* parent, const QString& model, std::vector<HistoryRow> rows, bool si_units) {
   auto* dialog = new QDialog(parent);
   dialog->setAttribute(Qt::WA_DeleteOnClose);
   dialog->setWindowTitle(QObject::tr("Run history: a result against a parameter"));
@@ -105,7 +107,13 @@ void show_history_plot(QWidget* parent, const QString& model, std::vector<Histor
   auto redraw = [=, rows = std::move(rows)] {
     try {
       const std::string p = parameter->currentText().toStdString(), r = result->currentText().toStdString();
-      const HistoryPoints points = history_points(model.toStdString(), rows, p, r);
+      HistoryPoints points = history_points(model.toStdString(), rows, p, r);
+      // the result in the unit the results table and the legend show it in (°C, MPa, ... or SI)
+      double most = 0;
+      for (double y : points.y) most = std::max(most, std::abs(y));
+      const DisplayUnit unit = unit_for(points.y_unit, most, si_units);
+      for (double& y : points.y) y = unit.to_display(y);
+      points.y_unit = unit.symbol;
       const qreal ratio = chart->devicePixelRatioF();
       QImage image = history_chart(points, p, r, int(480 * ratio), int(320 * ratio));
       why->setText(image.isNull() ? QObject::tr("no run has both") : QString());

@@ -33,7 +33,8 @@ QImage history_chart(const HistoryPoints& points, const std::string& parameter, 
                      int width, int height, std::vector<std::pair<int, int>>* pixels = nullptr);
 
 // A window beside `parent` with a parameter and a result to choose and their chart, for the history
-// `rows` of the model file `model` (whose parameters the choice lists).
-void show_history_plot(QWidget* parent, const QString& model, std::vector<HistoryRow> rows);
+// `rows` of the model file `model` (whose parameters the choice lists); the result in SI units
+// (`si_units`) or the engineer's (°C, MPa, ...), as the results table shows it.
+void show_history_plot(QWidget* parent, const QString& model, std::vector<HistoryRow> rows, bool si_units);
 
 }  // namespace foxi::workbench

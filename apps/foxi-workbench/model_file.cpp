@@ -45,10 +45,23 @@ bool Workbench::save_model_file(const QString& path, QString* error) {
   const QString target = path.isEmpty() ? model_path_ : path;
   try {
     const std::vector<ParameterOverride> values = overrides();
+    // The shown mesh is of these values (the open file with them): it stays the current mesh, of the
+    // saved file with no overrides, so that the next Solve does not remesh the same geometry.
+    const bool current = mesh_ && meshed_path_ == model_path_ && same_overrides(values, meshed_overrides_);
     save_model(model_path_.toStdString(), target.toStdString(), values);
     // The saved file holds the values: the workbench goes on with it and no overrides (the edits
     // before it are the file's now, so they are not undone past the save)
-    if (!open_model(target, error)) return false;
+    if (!open_model(target, error)) {
+      meshed_path_.clear();
+      return false;
+    }
+    if (current) {
+      meshed_path_ = target;
+      meshed_overrides_.clear();
+      meshed_model_ = model_;
+    } else {
+      meshed_path_.clear();  // of other values: the next Solve remeshes
+    }
     changed();
     return true;
   } catch (const std::exception& e) {

@@ -3,6 +3,7 @@
 #include "workbench_parts.hpp"
 
 #include <QCheckBox>
+#include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QDir>
 #include <QFile>
@@ -20,6 +21,8 @@
 #include <QSignalBlocker>
 #include <QTimer>
 #include <QtConcurrent/QtConcurrentRun>
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "foxi/model/durable_file.hpp"
@@ -174,6 +177,10 @@ ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
   p["hidden_regions"] = hidden;
   p["shrink"] = shrink_;
   p["physics"] = physics_name(physics_);
+  p["si_units"] = si_units_;
+  p["solver"] = solver_.calculix ? -1 : int(solver_.linear);
+  if (deform_)
+    p["deform"] = QJsonObject{{"field", QString::fromStdString(deform_->field)}, {"scale", deform_->scale}};
   if (const Camera* c = view_->camera()) {
     QJsonObject cam;
     cam["perspective"] = c->perspective;
@@ -225,6 +232,10 @@ bool Workbench::save_project(const QString& folder, QString* error) {
     if (error) *error = QString::fromStdString(e.what());
     return false;
   }
+}
+
+void Workbench::set_autosave_delay(int milliseconds) {
+  autosave_timer_->setInterval(std::max(0, milliseconds));
 }
 
 void Workbench::set_autosave_folder(const QString& folder) {
@@ -316,6 +327,26 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     for (const QJsonValue& v : p["hidden_regions"].toArray()) hidden_.push_back(v.toInt());
     shrink_ = p["shrink"].toDouble(1);
     set_physics(physics_of(p["physics"].toString("thermal").toStdString()).value_or(Physics::thermal));
+    si_units_ = p["si_units"].toBool(false);
+    {
+      const QSignalBlocker quiet(units_box_);
+      units_box_->setCurrentIndex(si_units_ ? 1 : 0);
+    }
+    SolverChoice solver;
+    const int kind = p["solver"].toInt(0);
+    solver.calculix = kind < 0;
+    if (kind > 0 && kind <= int(LinearSolverKind::cg_amg)) solver.linear = LinearSolverKind(kind);
+    set_solver(solver);
+    // The deformed shape shown, as saved (its display below: refused, it goes and the mesh shows plain).
+    deform_.reset();
+    if (p.contains("deform")) {
+      const QJsonObject d = p["deform"].toObject();
+      const double scale = d["scale"].toDouble(NAN);
+      if (!std::isfinite(scale))
+        throw std::runtime_error((dir / "project.json").string() +
+                                 ": the deformed shape's scale is not a number");
+      deform_ = Deform{d["field"].toString("displacement").toStdString(), scale};
+    }
     history_.clear();
     for (const QJsonValue& v : p["history"].toArray()) {
       const QJsonObject o = v.toObject();
@@ -332,8 +363,10 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     if (!p["mesh"].toString().isEmpty()) {
       mesh_ = std::make_shared<const Mesh>(read_mesh(dir / p["mesh"].toString().toStdString()));
       meshed_model_ = model_;
+      meshed_path_ = model_path_;
       meshed_overrides_ = overrides_of(p["mesh_overrides"]);
-      mesh_serial_ = history_.empty() ? 1 : history_.back().mesh;
+      mesh_serial_ = 1;
+      for (const HistoryRow& h : history_) mesh_serial_ = std::max(mesh_serial_, h.mesh);
     }
     if (p.contains("camera")) {
       const QJsonObject c = p["camera"].toObject();
@@ -372,7 +405,8 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     }
     if (has_results_) show_results();
     refresh_history();
-    if (mesh_) set_field(field_, color_map_);
+    if (mesh_ && set_field(field_, color_map_) && deform_)
+      deform_before_ = std::optional<Deform>{};  // a refused shape: the undeformed one
     return true;
   } catch (const std::exception& e) {
     if (error) *error = QString::fromStdString(e.what());

@@ -5,6 +5,7 @@
 #include "workbench_parts.hpp"
 
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QDockWidget>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -13,8 +14,11 @@
 #include <QSignalBlocker>
 #include <QTableWidget>
 #include <QVBoxLayout>
+#include <chrono>
+#include <cmath>
 
 #include "foxi/model/io_error.hpp"
+#include "foxi/solver/calculix.hpp"
 #include "foxi/solver/electric.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/thermal.hpp"
@@ -49,19 +53,21 @@ const char* solved_field(Physics physics) {
 }
 
 RunResults solve_model_physics(const std::string& path, const Model& model, Mesh& mesh, Physics physics,
-                               const ProgressFn& progress) {
+                               const LinearSolverOptions& solver, bool calculix) {
+  if (calculix && physics != Physics::thermal)
+    throw SolverError(std::string("CalculiX solves the thermal problem here, not ") + physics_name(physics));
   // Each branch takes from the model what foxi solve MODEL --physics NAME takes (cmd_solve.cpp,
   // cmd_solve_thermoelastic.cpp) with no other option, so that the results are the CLI's.
   switch (physics) {
     case Physics::electrostatic: {
       ElectrostaticParams ep;
-      ep.solver.progress = progress;
+      ep.solver = solver;
       ep.conductors = electrostatic_params_from_model(model, mesh).conductors;
       return electrostatic_results(mesh, solve_electrostatic(mesh, ep));
     }
     case Physics::current: {
       CurrentParams cp;
-      cp.solver.progress = progress;
+      cp.solver = solver;
       cp.terminals = current_params_from_model(model, mesh).terminals;
       return current_results(mesh, solve_current(mesh, cp));
     }
@@ -75,20 +81,69 @@ RunResults solve_model_physics(const std::string& path, const Model& model, Mesh
       ThermoelasticParams tp;
       const ThermoelasticParams mp = thermoelastic_params_from_model(model, mesh);
       tp.materials = mp.materials, tp.fixed = mp.fixed, tp.sliding = mp.sliding, tp.delta_t = mp.delta_t;
-      tp.solver.progress = progress;
+      tp.solver = solver;
       return thermoelastic_results(mesh, solve_thermoelastic(mesh, tp));
     }
     case Physics::thermal:
       break;
   }
   ThermalParams params = thermal_params_from_model(model, mesh);
-  params.solver.progress = progress;
+  params.solver = solver;
+  if (calculix) {
+    // foxi solve MODEL --with ccx: ccx's temperatures with foxi's report of them (its checks).
+    CalculixRunOptions ccx;
+    ccx.progress = solver.progress;
+    const auto t0 = std::chrono::steady_clock::now();
+    ThermalReport rep = solve_thermal_calculix(mesh, params, ccx);
+    rep.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return thermal_results(mesh, rep);
+  }
   return thermal_results(mesh, solve_thermal(mesh, params));
+}
+
+DisplayUnit Workbench::shown_unit(const std::string& si_unit, double max_abs) const {
+  return unit_for(si_unit, max_abs, si_units_);
+}
+
+DisplayUnit unit_for(const std::string& si_unit, double max_abs, bool si) {
+  return si ? DisplayUnit{si_unit, 1, 0} : default_display_unit(si_unit, max_abs);
+}
+
+bool Workbench::set_solver(const SolverChoice& choice) {
+  if (busy() || (choice.calculix && physics_ != Physics::thermal)) return false;
+  solver_ = choice;
+  const QSignalBlocker quiet(solver_box_);
+  const int want = choice.calculix ? -1 : int(choice.linear);
+  solver_box_->setCurrentIndex(std::max(0, solver_box_->findData(want)));
+  return true;
+}
+
+bool Workbench::set_si_units(bool si) {
+  if (busy()) return false;
+  // A colour range of the user's is in the unit shown: the same values in the new one.
+  const Field* f = mesh_ && range_ ? mesh_->find_field(field_.toStdString()) : nullptr;
+  if (f && si != si_units_) {
+    const DisplayUnit to = unit_for(f->unit, std::max(std::abs(field_lo_), std::abs(field_hi_)), si);
+    range_ = std::pair(to.to_display(unit_.to_si(range_->first)), to.to_display(unit_.to_si(range_->second)));
+    const QSignalBlocker q1(range_lo_), q2(range_hi_);
+    range_lo_->setValue(range_->first);
+    range_hi_->setValue(range_->second);
+  }
+  si_units_ = si;
+  {
+    const QSignalBlocker quiet(units_box_);
+    units_box_->setCurrentIndex(si ? 1 : 0);
+  }
+  if (has_results_) show_results();
+  refresh_history();
+  changed();
+  return !mesh_ || field_.isEmpty() || set_field(field_, color_map_);
 }
 
 bool Workbench::set_physics(Physics physics) {
   if (busy()) return false;
   physics_ = physics;
+  if (physics != Physics::thermal && solver_.calculix) set_solver({});  // ccx solves the heat problem only
   const QSignalBlocker quiet(physics_box_);
   physics_box_->setCurrentIndex(physics_box_->findData(int(physics)));
   solve_button_->setText(tr("Solve (%1)").arg(physics_name(physics)));
@@ -110,7 +165,41 @@ void Workbench::build_results_panel() {
   row->addWidget(new QLabel(tr("physics")));
   row->addWidget(physics_box_, 1);
   sv->addLayout(row);
+  // The solver: foxi's own (its linear solver as foxi solve --solver names it) or CalculiX.
+  auto* row2 = new QHBoxLayout;
+  solver_box_ = new QComboBox;
+  solver_box_->setObjectName("solver");
+  solver_box_->addItem(tr("built-in (auto)"), int(LinearSolverKind::automatic));
+  solver_box_->addItem(tr("built-in, direct"), int(LinearSolverKind::direct));
+  solver_box_->addItem(tr("built-in, CG + AMG"), int(LinearSolverKind::cg_amg));
+  solver_box_->addItem(tr("built-in, CG + IC"), int(LinearSolverKind::cg_ichol));
+  solver_box_->addItem(tr("CalculiX (ccx)"), -1);
+  solver_box_->setToolTip(
+      tr("foxi's solver (foxi solve --solver) or CalculiX, thermal only (foxi solve "
+         "--with ccx: a ccx child process, killed by Cancel)"));
+  connect(solver_box_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] {
+    const int v = solver_box_->currentData().toInt();
+    SolverChoice c;
+    c.calculix = v < 0;
+    if (v >= 0) c.linear = LinearSolverKind(v);
+    if (!set_solver(c)) {
+      show_error(tr("CalculiX solves the thermal problem only"));
+      set_solver(solver_);
+    }
+  });
+  units_box_ = new QComboBox;
+  units_box_->setObjectName("units");
+  units_box_->addItem(tr("°C, MPa, µm"));
+  units_box_->addItem(tr("SI: K, Pa, m"));
+  units_box_->setToolTip(tr("the unit of the values shown: the legend's, the results' and the history's"));
+  connect(units_box_, qOverload<int>(&QComboBox::currentIndexChanged), this,
+          [this](int i) { set_si_units(i == 1); });
+  row2->addWidget(new QLabel(tr("solver")));
+  row2->addWidget(solver_box_, 1);
+  row2->addWidget(units_box_);
+  sv->addLayout(row2);
   results_table_ = new QTableWidget(0, 3);
+  results_table_->setObjectName("results");
   results_table_->setHorizontalHeaderLabels({tr("result"), tr("value"), tr("unit / check")});
   results_table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   results_table_->setMinimumWidth(330);
@@ -135,9 +224,12 @@ void Workbench::show_results() {
   };
   add(tr("status"), run_status_name(r.status), QString::fromStdString(r.error));
   add(tr("nodes / tets"), QString("%1 / %2").arg(r.nodes).arg(r.tets), {});
-  for (const ResultValue& v : r.values)
-    add(QString::fromStdString(v.name) + (v.key ? " *" : ""), QString::number(v.value, 'g', 6),
-        QString::fromStdString(v.unit));
+  // Values in the unit the legend uses (°C, MPa, ...; or SI): one unit everywhere.
+  for (const ResultValue& v : r.values) {
+    const DisplayUnit u = shown_unit(v.unit, std::abs(v.value));
+    add(QString::fromStdString(v.name) + (v.key ? " *" : ""), QString::number(u.to_display(v.value), 'g', 6),
+        QString::fromStdString(u.symbol));
+  }
   for (const BalanceCheck& c : r.checks)
     add(tr("check ") + QString::fromStdString(c.name), QString::number(c.figure, 'g', 3),
         (c.passed ? tr("ok, tolerance ") : tr("FAILED, tolerance ")) + QString::number(c.tolerance, 'g', 3));

@@ -71,8 +71,8 @@ void build_display(Outcome& out, const Mesh& source, const std::string& field, c
     const std::vector<double>& drawn = out.base.empty() ? all : shown;
     const ColorMapId map = parse_color_map(colouring.cmap).value_or(ColorMapId::viridis);
     const auto [lo, hi] = finite_range(drawn);
-    out.unit = default_display_unit(choice.field->unit,
-                                    std::isfinite(lo) ? std::max(std::abs(lo), std::abs(hi)) : 0);
+    out.unit = unit_for(choice.field->unit, std::isfinite(lo) ? std::max(std::abs(lo), std::abs(hi)) : 0,
+                        colouring.si_units);
     ColorScale scale;
     if (colouring.range) {
       scale.map = map;
@@ -362,7 +362,7 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
 }
 
 Colouring Workbench::colouring() const {
-  return Colouring{color_map_.toStdString(), graded_, range_, hidden_, deform_};
+  return Colouring{color_map_.toStdString(), graded_, range_, hidden_, deform_, si_units_};
 }
 
 bool Workbench::set_deform(std::optional<Deform> deform) {

@@ -31,8 +31,7 @@ Workbench::Workbench(QWidget* parent) : QMainWindow(parent) {
     if (!job_) return;
     const int v = job_->permille->load();
     progress_->setValue(v % 10000);
-    const char* stage = progress_stage(v / 10000);
-    progress_->setFormat(job_->what + (*stage ? QString(" (%1)").arg(stage) : QString()) + " %p%");
+    progress_->setFormat(progress_format(job_->what, v, job_->solve.get()));
   });
 }
 

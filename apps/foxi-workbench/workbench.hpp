@@ -27,6 +27,7 @@
 #include "foxi/model/physics.hpp"
 #include "foxi/qt/view_widget.hpp"
 #include "foxi/solver/results.hpp"
+#include "foxi/solver/solver.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/field_selection.hpp"
@@ -71,6 +72,16 @@ struct Colouring {
   std::optional<std::pair<double, double>> range;
   std::vector<std::int32_t> hidden;  // regions hidden
   std::optional<Deform> deform;
+  // The unit values are shown in, the legend's and the results table's alike: the engineer's (°C,
+  // MPa, µm, mV: default_display_unit) or SI (K, Pa, m, V).
+  bool si_units = false;
+};
+
+// Which solver Solve runs: foxi's own (its linear solver: automatic, direct, CG) or CalculiX (ccx,
+// a child process: thermal only, as foxi solve --with ccx takes it).
+struct SolverChoice {
+  bool calculix = false;
+  LinearSolverKind linear = LinearSolverKind::automatic;
 };
 
 // The mesh panel's choices (mesh_panel.cpp), given to mesh_model's options (model_mesh.hpp) by every
@@ -93,6 +104,7 @@ struct MeshSettings {
 struct Outcome;
 struct MeshControls;  // the mesh panel's widgets (workbench_parts.hpp)
 struct ProjectSnapshot;
+struct SolveProgress;
 
 class Workbench : public QMainWindow {
   Q_OBJECT
@@ -149,6 +161,17 @@ class Workbench : public QMainWindow {
   // while a job runs. The panel's controls follow.
   bool set_mesh_settings(const MeshSettings& settings, QString* error = nullptr);
   const MeshSettings& mesh_settings() const { return mesh_settings_; }
+  // The solver Solve runs (the solve panel's choice); false while a job runs, or CalculiX for a physics
+  // other than thermal. A CalculiX run is a child process (killed by Cancel, its work folder removed),
+  // its temperatures read back as the field and reported with the balance checks as foxi solve --with
+  // ccx reports them.
+  bool set_solver(const SolverChoice& choice);
+  const SolverChoice& solver() const { return solver_; }
+  // The progress bar: the stage, the iterative solver's iteration and residual while it runs.
+  QProgressBar* progress_bar() const { return progress_; }
+  // The iterations the running (or last) iterative solve reported so far, and its relative residual.
+  long solve_iterations() const;
+  double solve_residual() const;
   // Asks the running job to stop; the previous mesh and picture stay.
   void cancel();
   bool busy() const { return job_ != nullptr; }
@@ -174,6 +197,13 @@ class Workbench : public QMainWindow {
   // Each tet drawn scaled about its centroid by `shrink` in (0, 1] (foxi render --shrink); false
   // for a value outside or while a job runs.
   bool set_shrink(double shrink);
+
+  // Values in SI units (K, Pa, m, V) or the engineer's (°C, MPa, µm, mV), in the legend, the probe, the
+  // field tools, the results table and the history alike; redraws on a worker.
+  bool set_si_units(bool si);
+  bool si_units() const { return si_units_; }
+  // The unit a value of SI unit `si_unit` (largest magnitude `max_abs`) is shown in now.
+  DisplayUnit shown_unit(const std::string& si_unit, double max_abs) const;
 
   // The view's field tools (field_selection.hpp, SI values): an isosurface (the solid above it, or the
   // surface only), a threshold on the tets' values and a clip plane, by the field shown. The controls
@@ -203,6 +233,8 @@ class Workbench : public QMainWindow {
   // Autosave into `folder` (a project folder; empty: off) within 5 s of a change (2 s after the
   // first change of a burst, written on a worker as save_project writes). autosaves(): started so far.
   void set_autosave_folder(const QString& folder);
+  // The wait between a change and its autosave (2 s: a burst of edits is one save; tests shorten it).
+  void set_autosave_delay(int milliseconds);
   int autosaves() const { return autosaves_; }
   // Autosaves that kept the mesh file already written (the mesh and results unchanged since).
   int autosaves_without_mesh() const { return mesh_writes_saved_; }
@@ -213,6 +245,17 @@ class Workbench : public QMainWindow {
   // the unsaved work?" (ask; else restores without asking) and opens it (open_project). False when
   // there is none, the user declined, or it does not open (the reason in `error`).
   bool restore_autosave(const QString& folder, bool ask, QString* error = nullptr);
+
+  // A sweep from the history: `parameter` set to each of `values` in turn ("2 mm", ...: expressions as
+  // the parameter table takes them), each point meshed and solved (the physics and solver chosen) on
+  // the worker, one history row per point (a failed point: a row with its error; the sweep goes on);
+  // progress "point k of n"; Cancel stops it, the rows so far stay. The other parameters are the
+  // current ones. False with the reason when busy, no model, no values, or the parameter or a value
+  // does not load. finished() comes after.
+  bool start_sweep(const QString& parameter, const QStringList& values, QString* error = nullptr);
+  // The values of a range: `count` values evenly from `lo` to `hi` in lo's unit ("2 mm", "8 mm", 4 ->
+  // 2mm, 4mm, 6mm, 8mm), as foxi sweep --vary NAME=LO:HI:N writes them; empty with the reason in `error`.
+  static QStringList sweep_values(const QString& lo, const QString& hi, int count, QString* error = nullptr);
 
   std::shared_ptr<const Mesh> mesh() const { return mesh_; }
   const RunResults* results() const { return has_results_ ? &results_ : nullptr; }
@@ -241,6 +284,7 @@ class Workbench : public QMainWindow {
   void on_mesh_controls_edited();    // mesh_panel.cpp: the controls to mesh_settings_
   void build_results_panel();        // solve_panel.cpp
   void build_history_panel();        // history.cpp
+  void run_sweep_dialog();           // history.cpp: the sweep's parameter and values asked
   // model_file.cpp: Save model, Save model as; the exploded parts picture, redrawn on a worker
   QHBoxLayout* build_model_file_row();
   QLabel* build_parts_picture();
@@ -250,8 +294,10 @@ class Workbench : public QMainWindow {
   bool start_job(bool mesh, bool solve);
   bool apply_overrides(std::map<std::string, std::string> trial, QString* error);
   void launch(std::function<std::shared_ptr<Outcome>()> work, const QString& what,
-              std::shared_ptr<std::atomic<bool>> cancel, std::shared_ptr<std::atomic<int>> permille);
+              std::shared_ptr<std::atomic<bool>> cancel, std::shared_ptr<std::atomic<int>> permille,
+              std::shared_ptr<SolveProgress> solve = nullptr);
   void on_job_done();
+  void finish_sweep(Outcome& out, const QString& what);  // jobs.cpp: a sweep's rows into the history
   void show_results();
   void add_history(double seconds);
   void fill_history_row(int i, const HistoryRow& row);
@@ -269,6 +315,7 @@ class Workbench : public QMainWindow {
   std::vector<std::map<std::string, std::string>> undo_, redo_;  // the overrides before each edit
   std::shared_ptr<const Model> model_;                           // as loaded with the overrides
   std::shared_ptr<const Model> meshed_model_;                    // the model the shown mesh came from
+  QString meshed_path_;                                          // its file
   std::vector<ParameterOverride> meshed_overrides_;
   MeshSettings mesh_settings_;    // the mesh panel's
   MeshSettings meshed_settings_;  // those the shown mesh was made with
@@ -278,6 +325,8 @@ class Workbench : public QMainWindow {
   RunResults results_;
   bool has_results_ = false;
   Physics physics_ = Physics::thermal;
+  SolverChoice solver_;
+  bool si_units_ = false;
   double mesh_seconds_ = 0;
   std::size_t mesh_serial_ = 0;
   std::vector<HistoryRow> history_;
@@ -309,6 +358,7 @@ class Workbench : public QMainWindow {
   // The running job: its cancel flag and progress, polled by a timer (no event per progress call).
   struct Job;
   std::unique_ptr<Job> job_;
+  std::shared_ptr<SolveProgress> last_solve_;  // the running or last solve's iterations
   QTimer* poll_ = nullptr;
 
   foxi::qt::ViewWidget* view_ = nullptr;
@@ -326,6 +376,8 @@ class Workbench : public QMainWindow {
   QProgressBar* progress_ = nullptr;
   QTableWidget* results_table_ = nullptr;
   QComboBox* physics_box_ = nullptr;
+  QComboBox* solver_box_ = nullptr;
+  QComboBox* units_box_ = nullptr;
   QTableWidget* history_table_ = nullptr;
   QComboBox *field_box_ = nullptr, *cmap_box_ = nullptr;
   QDoubleSpinBox* shrink_box_ = nullptr;

@@ -21,6 +21,7 @@
 #include "foxi/model/physics.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/solver/results.hpp"
+#include "foxi/solver/solver.hpp"
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/colormap.hpp"
 #include "foxi/viz/interactive_view.hpp"
@@ -33,6 +34,7 @@ struct Outcome {
   bool bad_input = false;  // the error is the model's (IoError: file, line, reason)
   QString error;
   bool meshed = false, solved = false;
+  std::string path;  // the model file (meshed: the mesh's)
   std::shared_ptr<const Mesh> mesh;
   std::shared_ptr<const Mesh> view_mesh;  // the deformed copy the view shows (null: `mesh`)
   std::shared_ptr<const Model> model;
@@ -54,23 +56,44 @@ struct Outcome {
   std::optional<MeshQualityReport> quality;  // a new mesh's
   QString mesher_summary;                    // and which mesher made it (mesh_panel.cpp)
   MeshSettings mesh_settings;                // the mesh settings it was made with
+  bool sweep = false;                        // a sweep's: its points' rows, nothing shown
+  std::vector<HistoryRow> sweep_rows;
+};
+
+// What a worker reports beside the stage: the iterative solve's iteration and relative residual, a
+// sweep's point (1-based) of how many. Written by the worker, read by the GUI thread's poll.
+struct SolveProgress {
+  std::atomic<long> iteration{0};
+  std::atomic<double> residual{0};
+  std::atomic<int> point{0}, points{0};
 };
 
 struct Workbench::Job {
   std::shared_ptr<std::atomic<bool>> cancel;
   std::shared_ptr<std::atomic<int>> permille;
+  std::shared_ptr<SolveProgress> solve;  // null: a job without a solve
   QFutureWatcher<std::shared_ptr<Outcome>> watcher;
   QString what;
 };
 
+// Whether two override lists are the same, name and expression, in order (jobs.cpp).
+bool same_overrides(const std::vector<ParameterOverride>& a, const std::vector<ParameterOverride>& b);
+
 // The stage (1, 2, ...) of a progress value stage * 10000 + permille; "" for 0 (jobs.cpp).
 const char* progress_stage(int index);
+// The progress bar's text for the running job: what, the stage, %p%, the iteration and residual of an
+// iterative solve, a sweep's point k of n (jobs.cpp).
+QString progress_format(const QString& what, int permille, const SolveProgress* solve);
 
 // The display of `mesh` on the worker: the field's paint, flat or graded, on the automatic scale or
 // the user's range (as foxi render --field NAME --cmap MAP [--graded] [--range a,b] draws it) and the
 // view, built with `camera` (null: the default) (view_panel.cpp).
 void build_display(Outcome& out, const Mesh& mesh, const std::string& field, const Colouring& colouring,
                    double shrink, int w, int h, const Camera* camera);
+
+// The unit a value of SI unit `si_unit` is shown in: SI itself (`si`) or the engineer's
+// (default_display_unit, by the largest magnitude shown) (solve_panel.cpp).
+DisplayUnit unit_for(const std::string& si_unit, double max_abs, bool si);
 
 // A colour bar with ticks in the field's display unit (view_panel.cpp).
 QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QString& label, int height);
@@ -104,10 +127,17 @@ std::optional<Physics> physics_of(const std::string& name);
 // The field a solve of `physics` is shown by: temperature, potential, von_mises (solve_panel.cpp).
 const char* solved_field(Physics physics);
 // Solves `physics` on `mesh` (its fields written there) with the model's conditions and loads, as
-// foxi solve MODEL --physics NAME does; the results record with its checks. Errors: IoError on the
-// model file (`path`) for what the model lacks, SolverError, Cancelled when `progress` says stop.
+// foxi solve MODEL --physics NAME does (with `solver.kind` as its --solver); the results record with
+// its checks. With `calculix`: a thermal solve by ccx, as foxi solve MODEL --with ccx does (SolverError
+// for another physics). `solver`'s progress and iterations report and cancel. Errors: IoError on the
+// model file (`path`) for what the model lacks, SolverError, Cancelled when a callback says stop.
 RunResults solve_model_physics(const std::string& path, const Model& model, Mesh& mesh, Physics physics,
-                               const ProgressFn& progress);
+                               const LinearSolverOptions& solver, bool calculix = false);
+// The progress callbacks of a job's solve: the stage and its permille into `permille` (stage * 10000 +
+// permille, never back within a stage), the iterations into `solve`; all false once `cancel` is set.
+LinearSolverOptions job_solver_options(LinearSolverKind kind, std::shared_ptr<std::atomic<bool>> cancel,
+                                       std::shared_ptr<std::atomic<int>> permille,
+                                       std::shared_ptr<SolveProgress> solve);
 
 inline QString what_of(const std::exception& e) { return QString::fromStdString(e.what()); }
 

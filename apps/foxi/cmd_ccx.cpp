@@ -38,10 +38,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The decks ask for binary results (*NODE OUTPUT): the .frd holds float32 values, rounded to half a
-// unit of their 24-bit mantissa, 2^-24 = 6e-8 relative (an ASCII .frd's E12.5 would be 5e-6).
-constexpr double kFrdPrecision = 6e-8;
-
 const char* kExportUsage =
     "foxi export-ccx MODEL.toml [--set NAME=VALUE]... [--physics thermal|thermoelastic] [--order 1|2]\n"
     "                -o DECK.inp\n"

@@ -24,6 +24,7 @@
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/io_error.hpp"
 #include "foxi/model/model_file.hpp"
+#include "foxi/model/sweep_values.hpp"
 #include "foxi/model/units.hpp"
 #include "foxi/viz/chart.hpp"
 #include "foxi/viz/png.hpp"
@@ -66,99 +67,20 @@ const char* kSweepUsage =
     "  A progress line per finished run on stderr. Exit status 0 when every run is ok, 4 when one is\n"
     "  unreliable, 1 when one failed; a stop (Ctrl-C) writes nothing (130/143).";
 
-struct Varied {
+// A varied parameter: its name and values (foxi/model/sweep_values.hpp).
+struct Varied : SweepValues {
   std::string name;
-  std::vector<std::string> texts;  // as given to --set
-  std::vector<double> si;          // their SI values
-  std::string si_unit;             // "m", "W", "" (dimensionless)
-  std::string unit;                // the unit the values are written in ("mm"; the first value's)
-  double unit_si = 1;              // its SI value
 };
-
-// The SI value and unit text of a value with units ("2mm" -> 0.002, "m").
-Quantity quantity(const std::string& text, const std::string& option) {
-  try {
-    return evaluate_expression(text, [](std::string_view) { return std::optional<Quantity>{}; });
-  } catch (const ExpressionError& e) {
-    throw UsageError(option + ": " + e.what());
-  }
-}
-
-// The unit written after the number of `text` ("2mm" -> "mm", "2 mm" -> "mm", "2" -> "").
-std::string unit_suffix(const std::string& text) {
-  std::size_t at = 0;
-  while (at < text.size() && (std::isdigit(static_cast<unsigned char>(text[at])) || text[at] == '.' ||
-                              text[at] == '-' || text[at] == '+' ||
-                              ((text[at] == 'e' || text[at] == 'E') && at + 1 < text.size() &&
-                               (std::isdigit(static_cast<unsigned char>(text[at + 1])) ||
-                                text[at + 1] == '-' || text[at + 1] == '+'))))
-    ++at;
-  while (at < text.size() && text[at] == ' ') ++at;
-  return text.substr(at);
-}
 
 Varied parse_vary(const std::string& spec) {
   const auto [name, range] = split_assignment(spec, "--vary");
   Varied v;
-  v.name = name;
-  const std::string option = "--vary " + name;
-  if (range.find(':') != std::string::npos) {
-    const auto c1 = range.find(':'), c2 = range.find(':', c1 + 1);
-    if (c2 == std::string::npos || range.find(':', c2 + 1) != std::string::npos)
-      throw UsageError("--vary takes NAME=LO:HI:N or NAME=V1,V2,..., not '" + spec + "'");
-    const std::string lo_text = range.substr(0, c1), hi_text = range.substr(c1 + 1, c2 - c1 - 1);
-    std::int32_t n = 0;
-    if (!parse_int(range.substr(c2 + 1), n) || n < 1 || n > 10000)
-      throw UsageError(option + ": the count N must be a whole number from 1 to 10000, not '" +
-                       range.substr(c2 + 1) + "'");
-    const Quantity lo = quantity(lo_text, option), hi = quantity(hi_text, option);
-    if (lo.dims != hi.dims)
-      throw UsageError(option + ": " + lo_text + " and " + hi_text + " are not of one dimension (" +
-                       dims_to_string(lo.dims) + ", " + dims_to_string(hi.dims) + ")");
-    // The values are written in LO's unit ("2.5mm"), as the user would write them.
-    const std::string unit = unit_suffix(lo_text);
-    const double unit_si = unit.empty() ? 1 : quantity("1 " + unit, option).value;
-    if (!(unit_si != 0) || !std::isfinite(unit_si))
-      throw UsageError(option + ": cannot write values in '" + unit + "'");
-    v.unit = unit, v.unit_si = unit_si;
-    for (std::int32_t i = 0; i < n; ++i) {
-      const double si = n == 1 ? lo.value : lo.value + (hi.value - lo.value) * i / (n - 1);
-      char text[64];
-      std::snprintf(text, sizeof text, "%.10g%s", si / unit_si, unit.c_str());
-      v.texts.push_back(text);
-      v.si.push_back(si);
-    }
-    v.si_unit = dims_to_string(lo.dims);
-  } else {
-    Dims dims{};
-    std::size_t at = 0;
-    while (at <= range.size()) {
-      const std::size_t comma = std::min(range.find(',', at), range.size());
-      const std::string item = range.substr(at, comma - at);
-      if (item.empty()) throw UsageError(option + ": empty value in '" + range + "'");
-      const Quantity q = quantity(item, option);
-      if (!v.texts.empty() && q.dims != dims)
-        throw UsageError(option + ": the values are not of one dimension ('" + item + "')");
-      dims = q.dims;
-      v.texts.push_back(item);
-      v.si.push_back(q.value);
-      at = comma + 1;
-    }
-    v.si_unit = dims_to_string(dims);
-    // The chart's unit: the first value's, when it converts (else SI).
-    const std::string unit = unit_suffix(v.texts.front());
-    double unit_si = 1;
-    try {
-      unit_si = unit.empty() ? 1 : quantity("1 " + unit, option).value;
-    } catch (const UsageError&) {
-      unit_si = 0;
-    }
-    if (unit_si != 0 && std::isfinite(unit_si))
-      v.unit = unit, v.unit_si = unit_si;
-    else
-      v.unit = v.si_unit;
+  try {
+    static_cast<SweepValues&>(v) = parse_sweep_values(range);
+  } catch (const ExpressionError& e) {
+    throw UsageError("--vary " + name + ": " + e.what());
   }
-  if (v.si_unit == "1") v.si_unit.clear();
+  v.name = name;
   return v;
 }
 

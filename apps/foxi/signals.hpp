@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "foxi/model/run_program.hpp"
+
 namespace foxi::cli {
 
 // Call first in main, before any thread starts; `program` names the program in the message ("foxi
@@ -20,11 +22,7 @@ namespace foxi::cli {
 // not whatever the stop did to the work.
 void handle_stop_signals(const std::string& program);
 
-// Runs a program (argv[0] looked up in PATH) with stdin from /dev/null as a tracked child (killed
-// on a stop) and waits for it; returns its exit status, or -1 if it could not be run or died on a
-// signal. A non-empty `output` gets the program's stdout and stderr (created or truncated); a
-// non-empty `stdout_to` then takes its stdout alone.
-int run_program(const std::vector<std::string>& argv, const std::string& output = {},
-                const std::string& stdout_to = {});
+// Runs a program as a tracked child (killed on a stop): foxi/model/run_program.hpp's runner.
+using foxi::run_program;
 
 }  // namespace foxi::cli

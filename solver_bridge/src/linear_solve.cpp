@@ -76,10 +76,11 @@ double parallel_sum(std::size_t n, unsigned threads, F&& f) {
 // Preconditioned conjugate gradients from x = 0; precondition(r, z) sets z = M^-1 r. The vector
 // updates run on threads, fused so that each iteration reads every vector as few times as it can.
 // The stopping test is |W r| <= tol_abs, W the row weights (none: the plain norm).
+// `counter`: the iterations of the whole solve so far (IterationReport's count), advanced here.
 template <class Precondition>
 void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double>& x, double bnorm,
          double tol, const std::vector<double>& weight, const LinearSolverOptions& options, unsigned threads,
-         LinearSolveResult& result, Precondition&& precondition) {
+         LinearSolveResult& result, std::size_t& counter, Precondition&& precondition) {
   const std::size_t n = a.rows();
   if (bnorm == 0) return;
   const double* wd = weight.empty() ? nullptr : weight.data();
@@ -93,6 +94,7 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
   const double log_goal = std::log(std::max(1e-300, options.relative_tolerance));
   std::size_t it = 0;
   double rnorm = weighted_norm(b, weight);
+  double shown = 0;  // the fraction reported: CG's residual is not monotone, the progress is
   while (rnorm > tol) {
     if (it == max_it)
       throw SolverError("conjugate gradients did not converge in " + std::to_string(max_it) +
@@ -117,6 +119,9 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
       return wr * wr;
     }));
     ++it;
+    ++counter;
+    if (options.iterations && !options.iterations(IterationReport{counter, rnorm / bnorm}))
+      throw SolverCancelled("solve cancelled at CG iteration " + std::to_string(counter));
     if (rnorm <= tol) break;
     precondition(r, z);
     const double rz_new = parallel_sum(n, threads, [&](std::size_t i) { return rd[i] * zd[i]; });
@@ -128,7 +133,8 @@ void pcg(const SymmetricCsr& a, const std::vector<double>& b, std::vector<double
         },
         kVectorSerialBelow);
     rz = rz_new;
-    if (it % 10 == 0) report(options, "solve", std::clamp(std::log(rnorm / bnorm) / log_goal, 0.0, 1.0));
+    shown = std::max(shown, std::clamp(std::log(rnorm / bnorm) / log_goal, 0.0, 1.0));
+    if (it % 10 == 0) report(options, "solve", shown);
   }
   result.iterations = it;
 }
@@ -194,6 +200,7 @@ struct SpdSolver::Impl {
   std::vector<double> weight;
   std::string name;
   std::size_t levels = 0;
+  std::size_t iterations = 0;  // over every solve with this factorization (IterationReport's count)
   Eigen::SimplicialLDLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt;
   Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::NaturalOrdering<int>> ic;
   std::unique_ptr<AmgPreconditioner> amg;
@@ -307,14 +314,14 @@ LinearSolveResult SpdSolver::solve(const std::vector<double>& b, std::vector<dou
     constexpr int kRefinements = 4;
     const double tol = s.options.relative_tolerance * bnorm;
     LinearSolveResult one;
-    pcg(a, b, x, bnorm, tol, s.weight, s.options, s.threads, one, precondition);
+    pcg(a, b, x, bnorm, tol, s.weight, s.options, s.threads, one, s.iterations, precondition);
     result.iterations += one.iterations;
     std::vector<double> r = residual(a, b, x, s.threads);
     double rnorm = norm(r);
     for (int round = 0; round < kRefinements && rnorm > tol; ++round) {
       std::vector<double> dx(n, 0.0);
       LinearSolveResult more;
-      pcg(a, r, dx, bnorm, tol, s.weight, s.options, s.threads, more, precondition);
+      pcg(a, r, dx, bnorm, tol, s.weight, s.options, s.threads, more, s.iterations, precondition);
       result.iterations += more.iterations;
       for (std::size_t k = 0; k < n; ++k) x[k] += dx[k];
       r = residual(a, b, x, s.threads);

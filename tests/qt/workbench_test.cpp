@@ -4,6 +4,7 @@
 // mesh, and a GUI heartbeat over meshing, solving and drawing (the window never stalls > 100 ms).
 #include "workbench.hpp"
 #include "history_plot.hpp"
+#include "workbench_parts.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,6 +17,7 @@
 #include <QMouseEvent>
 #include <QPlainTextEdit>
 #include <QPushButton>
+#include <QProgressBar>
 #include <QTableWidget>
 #include <QThread>
 #include <QTimer>
@@ -26,13 +28,19 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <dirent.h>
 #include <regex>
+#include <unistd.h>
 #include <span>
 #include <sstream>
 #include <string>
 
 #include "foxi/mesher/model_mesh.hpp"
 #include "foxi/model/delaunay.hpp"
+#include "foxi/model/io_error.hpp"
+#include "foxi/solver/model_problem.hpp"
+#include "foxi/solver/solver.hpp"
+#include "foxi/solver/thermal.hpp"
 #include "foxi/model/physics.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/viz/field_selection.hpp"
@@ -1020,6 +1028,7 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   ASSERT_TRUE(w.start_mesh());
   ASSERT_TRUE(wait_job(w));
   w.set_autosave_folder(folder);
+  w.set_autosave_delay(50);  // the rule tested is what is written, not when: no 2 s waits
   const auto json = dir.path() / "auto" / "project.json";
   auto autosave_after = [&](int n) {  // waits for autosave number n to be written
     const auto t0 = std::chrono::steady_clock::now();
@@ -1112,6 +1121,389 @@ TEST(Workbench, AutosaveWithinFiveSeconds) {
   ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
   ASSERT_EQ(again.overrides().size(), 1u);
   EXPECT_EQ(again.overrides()[0].expression, "4 mm");
+}
+
+// The value and unit the results table shows for `name` (its row "name *" for a key result).
+std::pair<double, std::string> table_value(Workbench& w, const std::string& name) {
+  auto* t = w.findChild<QTableWidget*>("results");
+  if (!t) return {NAN, ""};
+  for (int r = 0; r < t->rowCount(); ++r) {
+    const std::string n = t->item(r, 0)->text().toStdString();
+    if (n == name || n == name + " *")
+      return {t->item(r, 1)->text().toDouble(), t->item(r, 2)->text().toStdString()};
+  }
+  return {NAN, ""};
+}
+
+// One unit everywhere: the results table shows temperatures in the legend's unit (°C by default,
+// the SI value less 273.15), and in K, as the legend then does, when the user picks SI units; the
+// history's key results follow.
+TEST(Workbench, ResultsTableInTheLegendsUnit) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const foxi::ResultValue* t = w.results()->find("T_max");
+  ASSERT_NE(t, nullptr);
+  ASSERT_EQ(t->unit, "K");
+  EXPECT_EQ(w.display_unit().symbol, "°C");
+  auto [shown, unit] = table_value(w, "T_max");
+  EXPECT_EQ(unit, "°C");
+  EXPECT_NEAR(shown, t->value - 273.15, 1e-3);
+  ASSERT_TRUE(w.set_si_units(true));
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  EXPECT_EQ(w.display_unit().symbol, "K");
+  std::tie(shown, unit) = table_value(w, "T_max");
+  EXPECT_EQ(unit, "K");
+  EXPECT_NEAR(shown, t->value, 1e-3 * t->value);
+  ASSERT_TRUE(w.set_si_units(false));
+  ASSERT_TRUE(wait_job(w));
+  EXPECT_EQ(w.display_unit().symbol, "°C");
+}
+
+// After Save model (the edited values written into the file, the overrides gone) the shown mesh is
+// still the model's: the next Solve solves it without remeshing (no new mesh, the mesh's history row
+// completed), and so does a save of the same values again.
+TEST(Workbench, SaveModelThenSolveDoesNotRemesh) {
+  TempDir dir;
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.set_parameter("die_w", "6 mm"));
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const auto meshed = w.mesh();
+  ASSERT_EQ(w.history().size(), 1u);
+  QString error;
+  ASSERT_TRUE(w.save_model_file(QString::fromStdString((dir.path() / "m.toml").string()), &error))
+      << error.toStdString();
+  EXPECT_TRUE(w.overrides().empty());
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_EQ(w.history().size(), 1u) << "the solve completed the mesh's row: no remesh";
+  EXPECT_EQ(w.history()[0].mesh, 1u);
+  EXPECT_NE(w.history()[0].results.find("T_max"), nullptr);
+  EXPECT_TRUE(w.mesh()->xyz == meshed->xyz);
+  // A parameter edited after the mesh and then saved: the file changed, the next Solve remeshes.
+  ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
+  ASSERT_TRUE(w.save_model_file({}, &error)) << error.toStdString();
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_EQ(w.history().size(), 2u);
+  EXPECT_EQ(w.history()[1].mesh, 2u);
+  const std::vector<foxi::ParameterOverride> ov = {{"die_w", "5 mm"}};
+  EXPECT_EQ(w.mesh()->tet_count(), foxi::mesh_model(kModels + "die_on_substrate.toml", ov).mesh.tet_count());
+}
+
+// A project keeps the deformed shape and its scale: reopened, the view shows the same moved mesh.
+TEST(Workbench, ProjectKeepsTheDeformedShape) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "proj").string());
+  std::vector<double> moved;
+  {
+    Workbench w;
+    w.view_widget()->setFixedSize(200, 150);
+    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+    ASSERT_TRUE(w.set_physics(foxi::Physics::thermal_stress));
+    ASSERT_TRUE(w.start_solve());
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    ASSERT_TRUE(w.set_deform(foxi::workbench::Deform{"displacement", 150}));
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    moved = w.view_widget()->mesh()->xyz;
+    ASSERT_NE(moved, w.mesh()->xyz);
+    QString why;
+    ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
+  }
+  Workbench again;
+  again.view_widget()->setFixedSize(200, 150);
+  QString why;
+  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
+  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(again.deform().has_value());
+  EXPECT_EQ(again.deform()->field, "displacement");
+  EXPECT_EQ(again.deform()->scale, 150);
+  ASSERT_NE(again.view_widget()->mesh(), again.mesh());
+  EXPECT_TRUE(again.view_widget()->mesh()->xyz == moved) << "the same moved mesh as saved";
+}
+
+// The solve's iterations: a CG solve's callbacks counted 1, 2, ..., N (N as foxi solve --solver ichol
+// prints it for the same model), the progress never going back within a stage and the stages in
+// order; a Cancel at iteration 5 stops the solve there. The workbench shows the iterations and the
+// residual on its progress bar.
+TEST(Workbench, SolveProgressIterationsAndCancelMidSolve) {
+  const std::string model = kModels + "die_on_substrate.toml";
+  foxi::MeshedModel mm = foxi::mesh_model(model, std::span<const foxi::ParameterOverride>{});
+  auto cancel = std::make_shared<std::atomic<bool>>(false);
+  auto permille = std::make_shared<std::atomic<int>>(0);
+  auto solve = std::make_shared<foxi::workbench::SolveProgress>();
+  foxi::LinearSolverOptions o =
+      foxi::workbench::job_solver_options(foxi::LinearSolverKind::cg_ichol, cancel, permille, solve);
+  std::vector<long> iterations;
+  std::vector<int> shown;
+  const auto inner_it = o.iterations;
+  const auto inner_progress = o.progress;
+  o.iterations = [&](const foxi::IterationReport& r) {
+    const bool go = inner_it(r);
+    iterations.push_back(solve->iteration.load());
+    EXPECT_TRUE(std::isfinite(r.relative_residual));
+    return go;
+  };
+  o.progress = [&](std::string_view stage, double f) {
+    const bool go = inner_progress(stage, f);
+    shown.push_back(permille->load());
+    return go;
+  };
+  foxi::Mesh mesh = mm.mesh;
+  const foxi::RunResults r =
+      foxi::workbench::solve_model_physics(model, mm.model, mesh, foxi::Physics::thermal, o);
+  ASSERT_FALSE(iterations.empty());
+  for (std::size_t i = 0; i < iterations.size(); ++i) EXPECT_EQ(iterations[i], long(i + 1));
+  EXPECT_LE(solve->residual.load(), 1e-10);
+  for (std::size_t i = 1; i < shown.size(); ++i) EXPECT_GE(shown[i], shown[i - 1]) << "report " << i;
+  // foxi solve's count of the same solve
+  TempDir dir;
+  ASSERT_EQ(foxi::test::run_cli("solve '" + model + "' --solver ichol", dir.path() / "solve.log"), 0);
+  std::smatch m;
+  const std::string log = foxi::test::read_text(dir.path() / "solve.log");
+  ASSERT_TRUE(std::regex_search(log, m, std::regex("([0-9]+) iterations"))) << log;
+  EXPECT_EQ(iterations.back(), std::stol(m[1]));
+  // Cancelled at iteration 5: the solve stops there, the mesh gets no field.
+  iterations.clear();
+  o.iterations = [&](const foxi::IterationReport& rep) {
+    if (rep.iteration == 5) cancel->store(true);
+    iterations.push_back(long(rep.iteration));
+    return inner_it(rep);
+  };
+  foxi::Mesh again = mm.mesh;
+  bool stopped = false;
+  try {
+    foxi::workbench::solve_model_physics(model, mm.model, again, foxi::Physics::thermal, o);
+  } catch (const foxi::Cancelled&) {
+    stopped = true;
+  }
+  EXPECT_TRUE(stopped);
+  EXPECT_EQ(iterations.back(), 5);
+  EXPECT_EQ(again.find_field("temperature"), nullptr);
+  // The label: the stage, the iteration and the residual.
+  solve->iteration.store(12);
+  solve->residual.store(3.5e-7);
+  const QString label = foxi::workbench::progress_format("solving", 5 * 10000 + 400, solve.get());
+  EXPECT_TRUE(label.contains("(solve)")) << label.toStdString();
+  EXPECT_TRUE(label.contains("iteration 12, residual 3.5e-07")) << label.toStdString();
+  solve->points.store(3);  // a sweep's point
+  solve->point.store(2);
+  const QString sweep = foxi::workbench::progress_format("sweep of die_w", 1 * 10000 + 300, solve.get());
+  EXPECT_TRUE(sweep.startsWith("sweep of die_w, point 2 of 3 (meshing)")) << sweep.toStdString();
+  EXPECT_FALSE(sweep.contains("iteration")) << "no iteration while meshing";
+  // The workbench with CG: the iterations of its solve as foxi solve counts them, and a Cancel keeps
+  // the previous results.
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(w.set_solver({false, foxi::LinearSolverKind::cg_ichol}));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  EXPECT_EQ(w.solve_iterations(), std::stol(m[1]));
+  EXPECT_EQ(w.results()->solver, "CG+IncompleteCholesky");
+  const double t_max = w.results()->find("T_max")->value;
+  ASSERT_TRUE(w.start_solve());
+  w.cancel();
+  EXPECT_FALSE(wait_job(w));
+  EXPECT_EQ(w.last_error(), "cancelled");
+  ASSERT_NE(w.results(), nullptr);
+  EXPECT_EQ(w.results()->find("T_max")->value, t_max);
+  // Cancel once CG has begun (the GUI thread watching the count): the solve stops, the results stay.
+  ASSERT_TRUE(w.start_solve());
+  const auto t0 = std::chrono::steady_clock::now();
+  while (w.busy() && w.solve_iterations() == 0 &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+    QApplication::processEvents(QEventLoop::AllEvents);
+  w.cancel();
+  // (on a machine that gives this thread no core for the few ms CG takes, the solve ends first)
+  const bool running = w.busy();
+  if (running) {
+    EXPECT_FALSE(wait_job(w));
+    EXPECT_EQ(w.last_error(), "cancelled");
+    EXPECT_GT(w.solve_iterations(), 0);
+    EXPECT_LE(w.solve_iterations(), std::stol(m[1]));
+  }
+  std::printf("Cancel %s, at CG iteration %ld of %ld\n",
+              running ? "while the job ran" : "after the job had ended", w.solve_iterations(),
+              std::stol(m[1]));
+  ASSERT_NE(w.results(), nullptr);
+  EXPECT_EQ(w.results()->find("T_max")->value, t_max);
+}
+
+// The work folders and child processes a CalculiX run leaves (none, when it is done or cancelled).
+std::size_t ccx_folders() {
+  std::size_t n = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::filesystem::temp_directory_path()))
+    n += e.path().filename().string().rfind("foxi-ccx-", 0) == 0;
+  return n;
+}
+std::size_t child_processes() {
+  std::size_t n = 0;
+  const std::string me = std::to_string(::getpid());
+  for (const auto& e : std::filesystem::directory_iterator("/proc")) {
+    const std::string stat = foxi::test::read_text(e.path() / "stat");
+    // pid (comm) state ppid ...
+    const std::size_t close = stat.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream rest(stat.substr(close + 1));
+    std::string state, ppid;
+    rest >> state >> ppid;
+    n += ppid == me;
+  }
+  return n;
+}
+
+// CalculiX from the solve panel: ccx's temperature on the same mesh equals the built-in solver's with
+// ccx's convection rule to ccx's output precision (foxi solve --with ccx --compare's bound, 1e-5 of
+// the largest), and the workbench's own solve (the exact convection integral) within 1e-3
+// (calculix_test's bound across the rules); its balance checks pass; a ccx run cancelled keeps the
+// previous results and leaves no work folder and no child process.
+TEST(Workbench, CalculixTemperatureEqualsBuiltIn) {
+  if (foxi::test::run("command -v ccx > /dev/null") != 0) GTEST_SKIP() << "ccx is not installed";
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const std::vector<double> own = w.mesh()->find_field("temperature")->values;
+  const double own_t_max = w.results()->find("T_max")->value;
+  const std::size_t folders = ccx_folders();
+  ASSERT_TRUE(w.set_physics(foxi::Physics::current));
+  EXPECT_FALSE(w.set_solver({true, foxi::LinearSolverKind::automatic}))
+      << "CalculiX is for the thermal problem";
+  ASSERT_TRUE(w.set_physics(foxi::Physics::thermal));
+  ASSERT_TRUE(w.set_solver({true, foxi::LinearSolverKind::automatic}));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_NE(w.results(), nullptr);
+  EXPECT_EQ(w.results()->solver, "ccx");
+  ASSERT_EQ(w.history().size(), 2u);
+  EXPECT_EQ(w.history()[1].mesh, w.history()[0].mesh) << "the same mesh: solved again, not remeshed";
+  const std::vector<double> ccx = w.mesh()->find_field("temperature")->values;
+  ASSERT_EQ(ccx.size(), own.size());
+  // foxi's solve of the same mesh with ccx's *FILM rule (the convection integral at face centroids)
+  foxi::Mesh same_rule = *w.mesh();
+  foxi::ThermalParams params = foxi::thermal_params_from_model(*w.model(), same_rule);
+  params.convection_centroid_rule = true;
+  const foxi::ThermalReport rep = foxi::solve_thermal(same_rule, params);
+  const std::vector<double>& centroid = same_rule.find_field("temperature")->values;
+  auto largest = [&](const std::vector<double>& a) {
+    double diff = 0, scale = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      diff = std::max(diff, std::abs(ccx[i] - a[i]));
+      scale = std::max(scale, std::abs(ccx[i]));
+    }
+    return diff / scale;
+  };
+  EXPECT_LE(largest(centroid), 1e-5);
+  EXPECT_LE(largest(own), 1e-3);
+  EXPECT_NEAR(w.results()->find("T_max")->value, rep.max_temperature, 1e-5 * rep.max_temperature);
+  EXPECT_NEAR(w.results()->find("T_max")->value, own_t_max, 1e-3 * own_t_max);
+  ASSERT_FALSE(w.results()->checks.empty());
+  for (const foxi::BalanceCheck& c : w.results()->checks) EXPECT_TRUE(c.passed) << c.name;
+  EXPECT_EQ(ccx_folders(), folders) << "the work folder removed";
+  // Cancelled while it runs: the previous results stay, nothing is left behind.
+  const double t_max = w.results()->find("T_max")->value;
+  ASSERT_TRUE(w.start_solve());
+  while (w.busy() && !w.progress_bar()->format().contains("(ccx)"))
+    QApplication::processEvents(QEventLoop::AllEvents, 5);
+  w.cancel();
+  // (on a machine where ccx ends before the progress poll shows it, the solve ends before the Cancel)
+  std::printf("Cancel %s\n", w.busy() ? "while ccx ran" : "after ccx had ended");
+  if (w.busy()) {
+    EXPECT_FALSE(wait_job(w));
+    EXPECT_EQ(w.last_error(), "cancelled");
+  }
+  ASSERT_NE(w.results(), nullptr);
+  EXPECT_EQ(w.results()->find("T_max")->value, t_max);
+  EXPECT_EQ(ccx_folders(), folders);
+  EXPECT_EQ(child_processes(), 0u) << "ccx killed and reaped";
+}
+
+// A sweep started from the history: each point's row equals foxi sweep's CSV row for the same model,
+// parameter and values (tets, every key result); a value the geometry refuses is a failed row with
+// its error and the sweep goes on; a cancelled sweep adds no row.
+TEST(Workbench, SweepFromTheHistoryEqualsFoxiSweep) {
+  TempDir dir;
+  const std::string model = kModels + "die_on_substrate.toml";
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  QString error;
+  const QStringList values = Workbench::sweep_values("2mm", "6mm", 3, &error);
+  ASSERT_EQ(values, (QStringList{"2mm", "4mm", "6mm"})) << error.toStdString();
+  EXPECT_TRUE(Workbench::sweep_values("2mm", "6 W", 3, &error).isEmpty());
+  EXPECT_TRUE(error.contains("dimension")) << error.toStdString();
+  EXPECT_FALSE(w.start_sweep("no_such", values, &error));
+  ASSERT_TRUE(w.start_sweep("die_w", values, &error)) << error.toStdString();
+  EXPECT_FALSE(w.start_solve()) << "one job at a time";
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_EQ(w.history().size(), 3u);
+  EXPECT_EQ(w.mesh(), nullptr) << "a sweep shows nothing new";
+  const auto csv = dir.path() / "sweep.csv";
+  ASSERT_EQ(
+      foxi::test::run_cli("sweep '" + model + "' --vary die_w=2mm:6mm:3 --jobs 1 -o '" + csv.string() + "'",
+                          dir.path() / "sweep.log"),
+      0)
+      << foxi::test::read_text(dir.path() / "sweep.log");
+  std::istringstream lines(foxi::test::read_text(csv));
+  std::string header, line;
+  std::getline(lines, header);
+  auto split = [](const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    for (std::string f; std::getline(ss, f, ',');) out.push_back(f);
+    if (!s.empty() && s.back() == ',') out.emplace_back();  // (getline drops a last empty field)
+    return out;
+  };
+  const std::vector<std::string> names = split(header);
+  for (std::size_t k = 0; k < 3; ++k) {
+    ASSERT_TRUE(std::getline(lines, line));
+    const std::vector<std::string> f = split(line);
+    ASSERT_EQ(f.size(), names.size()) << line;
+    const foxi::workbench::HistoryRow& row = w.history()[k];
+    ASSERT_EQ(row.parameters.size(), 1u);
+    EXPECT_EQ(row.parameters[0].expression, values[int(k)].toStdString());
+    std::size_t compared = 0;
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      if (names[c] == "die_w") {
+        EXPECT_EQ(f[c], values[int(k)].toStdString());
+      }
+      if (names[c] == "tets") {
+        EXPECT_EQ(std::stoul(f[c]), row.tets);
+      }
+      if (names[c] == "status") {
+        EXPECT_EQ(f[c], "ok");
+      }
+      const std::size_t paren = names[c].find(" (");
+      const foxi::ResultValue* v = row.results.find(names[c].substr(0, paren));
+      if (v == nullptr || !v->key || f[c].empty()) continue;
+      EXPECT_NEAR(v->value, std::stod(f[c]), 1e-9 * std::abs(v->value) + 1e-300) << names[c] << " row " << k;
+      ++compared;
+    }
+    EXPECT_GT(compared, 0u) << "the rows share key results";
+  }
+  // A value the geometry refuses is that point's failed row; the sweep goes on.
+  ASSERT_TRUE(w.start_sweep("die_w", {"-1mm", "3mm"}, &error)) << error.toStdString();
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_EQ(w.history().size(), 5u);
+  EXPECT_EQ(w.history()[3].results.status, foxi::RunStatus::failed);
+  EXPECT_FALSE(w.history()[3].results.error.empty());
+  EXPECT_NE(w.history()[4].results.find("T_max"), nullptr);
+  // The plot of a result against the parameter shows the sweep's points.
+  const auto points = foxi::workbench::history_points(model, w.history(), "die_w", "T_max");
+  EXPECT_EQ(points.rows, (std::vector<std::size_t>{0, 1, 2, 4}));
+  // Cancelled: no row added.
+  ASSERT_TRUE(w.start_sweep("die_w", values, &error));
+  w.cancel();
+  EXPECT_FALSE(wait_job(w));
+  EXPECT_EQ(w.last_error(), "cancelled");
+  EXPECT_EQ(w.history().size(), 5u);
 }
 
 // The view follows the fraction slider both ways: drawing on to it and undrawing back to it; a

@@ -144,6 +144,60 @@ TEST_F(ThermalTest, SlabBetweenTwoTemperaturesIsLinearAndExact) {
   }
 }
 
+// The iterative solve reports each CG iteration: counted 1, 2, ..., N with N the report's count (over
+// the restarts on the true residual), the last residual within the tolerance, the "solve" progress
+// never going back; false from the callback at iteration 3 stops the solve there (SolverCancelled,
+// no temperature stored); a direct solve reports none.
+TEST_F(ThermalTest, IterationReportsCountEveryCgIterationAndCancel) {
+  Mesh m = box_mesh(0.0005);
+  ThermalParams p;
+  p.conductivity = {{1, 2.5}};
+  p.fixed = {{1, 300}, {2, 400}};
+  for (LinearSolverKind kind : {LinearSolverKind::cg_ichol, LinearSolverKind::cg_amg}) {
+    Mesh mesh = m;
+    std::vector<IterationReport> seen;
+    std::vector<double> solve_fractions;
+    p.solver.kind = kind;
+    p.solver.iterations = [&](const IterationReport& r) {
+      seen.push_back(r);
+      return true;
+    };
+    p.solver.progress = [&](std::string_view stage, double f) {
+      if (stage == "solve") solve_fractions.push_back(f);
+      return true;
+    };
+    const ThermalReport r = solve_thermal(mesh, p);
+    ASSERT_GT(r.iterations, 0u);
+    ASSERT_EQ(seen.size(), r.iterations);
+    for (std::size_t i = 0; i < seen.size(); ++i) {
+      EXPECT_EQ(seen[i].iteration, i + 1);
+      EXPECT_TRUE(std::isfinite(seen[i].relative_residual));
+    }
+    EXPECT_LE(seen.back().relative_residual, p.solver.relative_tolerance);
+    for (std::size_t i = 1; i < solve_fractions.size(); ++i)
+      EXPECT_GE(solve_fractions[i], solve_fractions[i - 1]);
+    // Stopped at iteration 3 (where there are more: AMG on this small mesh is a direct solve).
+    if (kind == LinearSolverKind::cg_amg) continue;
+    ASSERT_GT(r.iterations, 3u);
+    Mesh stopped = m;
+    seen.clear();
+    p.solver.iterations = [&](const IterationReport& rep) {
+      seen.push_back(rep);
+      return rep.iteration < 3;
+    };
+    EXPECT_THROW(solve_thermal(stopped, p), SolverCancelled);
+    EXPECT_EQ(seen.size(), 3u);
+    EXPECT_EQ(stopped.find_field("temperature"), nullptr);
+  }
+  p.solver.kind = LinearSolverKind::direct;
+  p.solver.progress = nullptr;  // (it refers to the loop's vectors)
+  std::size_t calls = 0;
+  p.solver.iterations = [&](const IterationReport&) { return ++calls, true; };
+  Mesh direct = m;
+  solve_thermal(direct, p);
+  EXPECT_EQ(calls, 0u);
+}
+
 // -k T'' = Q, T(0) = T(L) = 0: T = Q x (L - x) / (2k). L2 error of P1 must fall as h^2.
 TEST_F(ThermalTest, HeatGenerationConvergesAtSecondOrder) {
   const double k = 3, q = 1200;

@@ -55,4 +55,26 @@ struct FrdBlock {
 // the end record). Throws IoError (file and line or byte) on a malformed or truncated file.
 FOXI_API std::vector<FrdBlock> read_frd(const std::filesystem::path& frd);
 
+// The decks ask for binary results (*NODE OUTPUT): the .frd holds float32 values, rounded to half a
+// unit of their 24-bit mantissa, 2^-24 = 6e-8 relative (an ASCII .frd's E12.5 would be 5e-6).
+inline constexpr double kFrdPrecision = 6e-8;
+
+struct CalculixRunOptions {
+  std::string program = "ccx";  // looked up in PATH
+  // Asked about every 50 ms while ccx runs, as progress("ccx", -1): false kills it (SolverCancelled).
+  ProgressFn progress;
+};
+
+// Solves `params` on `mesh` by CalculiX, as foxi solve --with ccx does: the deck (write_calculix_thermal)
+// in a fresh work folder under the temporary directory, `ccx -i heat` run there as a child process
+// (foxi/model/run_program.hpp; OMP_NUM_THREADS 1 unless set), its NDTEMP read back onto the mesh by
+// node number (coordinates checked, every node given a value) and reported by thermal_report at the
+// .frd's precision with the convection centroid rule of ccx's *FILM (the balance checks of ccx's own
+// solution), `solver` "ccx". The temperature and heat flux are stored on the mesh as solve_thermal
+// stores them. The work folder is removed on return, a throw or cleanup::interrupt(). Throws
+// SolverError for what write_calculix_thermal rejects and for a ccx that fails (its last output in
+// the message) or is not installed, SolverCancelled when progress says stop.
+FOXI_API ThermalReport solve_thermal_calculix(Mesh& mesh, ThermalParams params,
+                                              const CalculixRunOptions& options = {});
+
 }  // namespace foxi

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -54,6 +55,16 @@ inline bool all_passed(const std::vector<BalanceCheck>& checks) {
   return true;
 }
 
+// Where an iterative (CG) solve is: the iterations so far, counted over its restarts on the true residual
+// and over the right-hand sides solved with one factorization (so the count only grows), and the relative
+// residual |W r| / |W b| (the stopping test's, W as below) after the last of them.
+struct IterationReport {
+  std::size_t iteration = 0;
+  double relative_residual = 0;
+};
+// Called after each CG iteration; returns false to cancel (SolverCancelled), as ProgressFn does.
+using IterationFn = std::function<bool(const IterationReport&)>;
+
 enum class LinearSolverKind : std::uint8_t {
   automatic,  // direct up to LinearSolverOptions::direct_max_unknowns, else cg_amg
   direct,     // sparse LDL^T (Eigen SimplicialLDLT, AMD ordering)
@@ -73,6 +84,7 @@ struct LinearSolverOptions {
   std::size_t max_iterations = 0;  // 0: 10 * unknowns + 100
   unsigned threads = 0;            // 0: std::thread::hardware_concurrency()
   ProgressFn progress;             // stages "assemble", "factorize", "solve"; false cancels
+  IterationFn iterations;          // CG only (a direct solve has none); false cancels
 };
 
 }  // namespace foxi
