@@ -125,8 +125,8 @@ TEST(MeshOptionsCli, CgalThroughMeshModelEqualsFoxiMeshCgal) {
   EXPECT_TRUE(m.cgal.volumes_match);
 }
 
-// A model's own [[mesh.refine]] box on the CGAL path: its mesh is the one the same box gives as an
-// option (library) and as --refine-box (foxi mesh --mesher cgal), certified with its weights, the part
+// A model's own [[mesh.refine]] box on the CGAL path: its mesh is the one the same box gives as
+// --refine-box (foxi mesh --mesher cgal, through the options), certified with its weights, the part
 // volumes kept; the box's tets are finer than those outside it and than the same place without the
 // box (edges measured here).
 TEST(MeshOptionsCli, CgalTakesTheModelsBoxesAndRefineBoxAsTetGenDoes) {
@@ -139,13 +139,7 @@ TEST(MeshOptionsCli, CgalTakesTheModelsBoxesAndRefineBoxAsTetGenDoes) {
   o.mesher = Mesher::cgal;
   const MeshedModel own = mesh_model(dir / "boxed.toml", {}, o);
   EXPECT_EQ(own.cgal.boxes, 1u);
-  RefinementBox box;
-  box.hi[0] = box.hi[1] = 3e-3;
-  box.hi[2] = 1e-3;
-  box.size = 0.3e-3;
-  ModelMeshOptions with_box = o;
-  with_box.sizes.boxes = {box};
-  expect_same_mesh(mesh_model(kDie, {}, with_box).mesh, own.mesh);
+  // The same box through the options (foxi mesh --refine-box): the same mesh.
   const auto out = dir / "c.vtu";
   ASSERT_EQ(test::run_cli(
                 "mesh '" + kDie + "' --mesher cgal --refine-box 0,0,0,3,3,1=0.3mm -o '" + out.string() + "'",
@@ -157,15 +151,20 @@ TEST(MeshOptionsCli, CgalTakesTheModelsBoxesAndRefineBoxAsTetGenDoes) {
       << test::read_text(dir / "log.txt");
 
   const DelaunayCertificate cert = compute_delaunay_certificate(own.mesh);
+  RefinementBox box;
+  box.hi[0] = box.hi[1] = 3e-3;
+  box.hi[2] = 1e-3;
+  box.size = 0.3e-3;
   EXPECT_TRUE(cert.weighted);
   EXPECT_TRUE(cert.delaunay);
   EXPECT_TRUE(own.cgal.volumes_match) << "worst part volume change " << own.cgal.worst_volume_change;
   const BoxEdges e = box_edges(own.mesh, box), plain = box_edges(mesh_model(kDie, {}, o).mesh, box);
   ASSERT_GT(e.in_n, 100u);
   ASSERT_GT(plain.in_n, 0u);
-  EXPECT_LT(e.in_mean, 1.5 * box.size) << "inside the box: edges about its size";
-  EXPECT_LT(e.in_mean, 0.75 * e.out_mean) << e.in_mean << " inside, " << e.out_mean << " outside";
-  EXPECT_LT(e.in_mean, 0.75 * plain.in_mean) << e.in_mean << " with the box, " << plain.in_mean << " without";
+  // Measured: 0.24 mm inside, 0.49 mm outside; without the box 0.60 mm inside.
+  EXPECT_LT(e.in_mean, box.size) << "inside the box: edges below its size (a circumradius bound)";
+  EXPECT_LT(e.in_mean, 0.6 * e.out_mean) << e.in_mean << " inside, " << e.out_mean << " outside";
+  EXPECT_LT(e.in_mean, 0.6 * plain.in_mean) << e.in_mean << " with the box, " << plain.in_mean << " without";
 }
 
 // A solved field's error as the size field: the library's mesh is the CLI's, and the error it reports
