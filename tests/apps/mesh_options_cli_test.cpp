@@ -128,7 +128,7 @@ TEST(MeshOptionsCli, CgalThroughMeshModelEqualsFoxiMeshCgal) {
 // A model's own [[mesh.refine]] box on the CGAL path: its mesh is the one the same box gives as
 // --refine-box (foxi mesh --mesher cgal, through the options), certified with its weights, the part
 // volumes kept; the box's tets are finer than those outside it and than the same place without the
-// box (edges measured here).
+// box (edges measured here); a box too fine for the tet limit is refused by its estimate.
 TEST(MeshOptionsCli, CgalTakesTheModelsBoxesAndRefineBoxAsTetGenDoes) {
   test::TempDir dir;
   std::filesystem::copy(test::models_dir() + "materials.toml", dir / "materials.toml");
@@ -165,6 +165,19 @@ TEST(MeshOptionsCli, CgalTakesTheModelsBoxesAndRefineBoxAsTetGenDoes) {
   EXPECT_LT(e.in_mean, box.size) << "inside the box: edges below its size (a circumradius bound)";
   EXPECT_LT(e.in_mean, 0.6 * e.out_mean) << e.in_mean << " inside, " << e.out_mean << " outside";
   EXPECT_LT(e.in_mean, 0.6 * plain.in_mean) << e.in_mean << " with the box, " << plain.in_mean << " without";
+
+  // A box too fine for the tet limit is refused before CGAL runs (its estimate counted here: two tets
+  // per regular-tet volume of its edge over its 9 mm^3).
+  box.size = 1e-6;
+  o.sizes.boxes = {box};
+  const double box_tets = 2 * 9e-9 / (std::pow(box.size, 3) / (6 * std::sqrt(2.0)));
+  try {
+    (void)mesh_model(kDie, {}, o);
+    ADD_FAILURE() << "a box of 1 um edges over 9 mm^3 was meshed";
+  } catch (const TetLimitError& limit) {
+    EXPECT_GE(limit.estimate(), box_tets);
+    EXPECT_LT(limit.estimate(), box_tets * 1.001);
+  }
 }
 
 // A solved field's error as the size field: the library's mesh is the CLI's, and the error it reports
