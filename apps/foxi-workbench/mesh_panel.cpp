@@ -107,9 +107,7 @@ QString mesher_summary(const MeshedModel& m) {
                "against the PLC's: worst change %2%")
                .arg(m.cgal.seconds, 0, 'f', 2)
                .arg(100 * m.cgal.worst_volume_change, 0, 'g', 3);
-    if (m.ignored_refine_boxes > 0)
-      text +=
-          QObject::tr("; the model's %1 refinement boxes left out (TetGen's)").arg(m.ignored_refine_boxes);
+    if (m.cgal.boxes > 0) text += QObject::tr("; refinement boxes: %1").arg(m.cgal.boxes);
   } else {
     text = QObject::tr("mesher: TetGen (switches %1), conforming Delaunay refinement")
                .arg(QString::fromStdString(m.report.switches));
@@ -321,8 +319,8 @@ void Workbench::build_mesh_panel() {
   ui.boxes = new QTableWidget(0, 7);
   ui.boxes->setObjectName("refine_boxes");
   ui.boxes->setToolTip(
-      tr("target edge length `size` inside each box (corners and size in the model's length unit); TetGen "
-         "only"));
+      tr("target edge length `size` inside each box (corners and size in the model's length unit); TetGen's "
+         "size field, or CGAL's cell and facet sizes (the regular tet's circumradius)"));
   QStringList columns;
   for (const char* c : kBoxColumns) columns << c;
   ui.boxes->setHorizontalHeaderLabels(columns);

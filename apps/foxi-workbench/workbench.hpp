@@ -91,7 +91,7 @@ struct MeshSettings {
   std::optional<double> max_size;
   std::vector<PartSize> part_sizes;  // by part name: replace the model's size of that part
   std::optional<double> quality;     // radius-edge bound (TetGen: 0 or >= 1.414; CGAL: its cell bound)
-  std::vector<RefinementBox> boxes;  // TetGen only
+  std::vector<RefinementBox> boxes;  // added to the model's [[mesh.refine]] boxes (either mesher)
   // Refine from the current result: the next mesh's sizes from the Zienkiewicz-Zhu error of the
   // result's node field `refine_field` (empty: the field shown, else the first), for this relative
   // gradient error. TetGen only; a mesh job without a solved result then fails with the reason.

@@ -57,9 +57,10 @@ const char* kMeshUsage =
     "                     are the PLC's, checked to 0.1%), sliver exudation; the mesh is part of a\n"
     "                     regular triangulation, its vertex weights are written (point data 'weight' in\n"
     "                     .vtu) and always certified (orthospheres); a mesh failing a check exits 4.\n"
-    "                     --max-size, --region-size act as for TetGen (as circumradius bounds of the\n"
-    "                     regular tet of that edge); refinement boxes are TetGen's (a model's are left\n"
-    "                     out; --refine-box, --refine-from, --no-conform need TetGen).\n"
+    "                     --max-size, --region-size, --refine-box and a model's refinement boxes act\n"
+    "                     as for TetGen (as circumradius bounds of the regular tet of that edge, on\n"
+    "                     the cells, the boundary triangles and the protected edges in a box);\n"
+    "                     --refine-from, --no-conform need TetGen.\n"
     "                     --max-volume becomes the circumradius of a regular tet of that volume;\n"
     "                     --radius-edge (or --quality) defaults to 2; --perturb adds sliver perturbation;\n"
     "                     --resample: only edges turning by more than --feature-angle (default 60)\n"
@@ -127,8 +128,7 @@ int cmd_mesh(Args args) {
     if (cgal != for_cgal && args.has_option(name))
       throw UsageError(std::string(name) + " needs --mesher " + (for_cgal ? "cgal" : "tetgen"));
   };
-  for (const char* o : {"--min-dihedral", "--refine-box", "--refine-from", "--field", "--target-error"})
-    only(o, false);
+  for (const char* o : {"--min-dihedral", "--refine-from", "--field", "--target-error"}) only(o, false);
   for (const char* o : {"--time-limit", "--feature-angle"}) only(o, true);
   for (const char* f : {"--no-conform", "--optimize"})
     if (cgal && std::find(args.remaining().begin(), args.remaining().end(), f) != args.remaining().end())

@@ -71,10 +71,13 @@ int report_cgal_mesh(const std::string& in, const std::string& out, const Meshed
               in.c_str(), out.c_str(), mesh.node_count(), mesh.tet_count(), mesh.bface_count(),
               mesh.regions.size(), report.seconds);
   std::printf(
-      "sizes: cell %.4g, facet %.4g, edge %.4g; radius-edge max %.4g, dihedral min %.3g max %.4g deg, %zu "
+      "sizes: cell %.4g, facet %.4g, edge %.4g%s; radius-edge max %.4g, dihedral min %.3g max %.4g deg, %zu "
       "slivers below 5 deg\n",
-      report.max_size, report.facet_size, report.edge_size, q.radius_edge.max, q.min_dihedral_deg.min,
-      max_dihedral, q.slivers);
+      report.max_size, report.facet_size, report.edge_size,
+      report.boxes > 0
+          ? (" (smaller inside the refinement boxes: " + std::to_string(report.boxes) + ")").c_str()
+          : "",
+      q.radius_edge.max, q.min_dihedral_deg.min, max_dihedral, q.slivers);
   // Each region's volume against the PLC's (the divergence theorem over its facets).
   auto region_name = [&](std::int32_t id) {
     for (const Region& r : mesh.regions)

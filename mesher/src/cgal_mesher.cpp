@@ -52,7 +52,33 @@ using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_ta
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
 
-// Cell size bound: the global one, lowered in subdomains whose region seed sets a max volume.
+// The refinement boxes (CgalMeshParams::boxes) as size bounds: each box's target edge length as the
+// circumradius of the regular tet of that edge, the conversion of the region sizes (TetGen takes the
+// same edge length as its sizing function inside the box).
+struct BoxSizes {
+  struct Box {
+    double lo[3], hi[3];
+    double radius;
+  };
+  std::vector<Box> boxes;
+  explicit BoxSizes(const std::vector<RefinementBox>& in) {
+    for (const RefinementBox& b : in)
+      boxes.push_back({{b.lo[0], b.lo[1], b.lo[2]},
+                       {b.hi[0], b.hi[1], b.hi[2]},
+                       regular_tet_circumradius(regular_tet_volume(b.size))});
+  }
+  // `bound` lowered to the radius of every box that holds p.
+  double at(const K::Point_3& p, double bound) const {
+    for (const Box& b : boxes)
+      if (b.radius < bound && p.x() >= b.lo[0] && p.x() <= b.hi[0] && p.y() >= b.lo[1] && p.y() <= b.hi[1] &&
+          p.z() >= b.lo[2] && p.z() <= b.hi[2])
+        bound = b.radius;
+    return bound;
+  }
+};
+
+// Cell size bound: the global one, lowered in subdomains whose region seed sets a max volume and in
+// the refinement boxes (at the cell's orthocentre, where Mesh_3 asks).
 struct CellSize {
   using FT = K::FT;
   using Point_3 = K::Point_3;
@@ -60,11 +86,23 @@ struct CellSize {
   const Domain* domain = nullptr;
   double global = 0;
   std::vector<double> per_subdomain;  // by subdomain index
-  FT operator()(const Point_3&, int dim, const Index& index) const {
-    if (dim != 3) return global;
+  BoxSizes boxes;
+  FT operator()(const Point_3& p, int dim, const Index& index) const {
+    if (dim != 3) return boxes.at(p, global);
     const auto sd = static_cast<std::size_t>(domain->subdomain_index(index));
-    return sd < per_subdomain.size() ? per_subdomain[sd] : global;
+    return boxes.at(p, sd < per_subdomain.size() ? per_subdomain[sd] : global);
   }
+};
+
+// Surface Delaunay ball radius bound: the global one, lowered in the refinement boxes (at the ball's
+// centre on the surface), so that a box's part of the boundary is as fine as the tets behind it.
+struct FacetSize {
+  using FT = K::FT;
+  using Point_3 = K::Point_3;
+  using Index = Domain::Index;
+  double global = 0;
+  BoxSizes boxes;
+  FT operator()(const Point_3& p, int, const Index&) const { return boxes.at(p, global); }
 };
 
 // The protecting ball radius at corners (dim 0) and along features. Mesh_3 caps a corner's ball at a
@@ -72,17 +110,19 @@ struct CellSize {
 // narrow rectangle whose four corners then get equal balls, four co-planar weighted points on one
 // orthocircle, and so a flat tet (dihedral angle 0) that no optimiser removes (exudation does not
 // pump protecting balls). Here each corner's ball is below that cap by a factor in (0.7, 0.95] drawn
-// from a hash of its coordinates: deterministic, and different at mirror-image corners.
+// from a hash of its coordinates: deterministic, and different at mirror-image corners. Inside a
+// refinement box the bound is at most the box's (features there are sampled as finely as its facets).
 struct EdgeSize {
   using FT = K::FT;
   using Point_3 = K::Point_3;
   using Index = Domain::Index;
   double global = 0;
+  BoxSizes boxes;
   std::map<std::array<double, 3>, double> corner_size;  // by the corner's coordinates
   FT operator()(const Point_3& p, int dim, const Index&) const {
-    if (dim != 0) return global;
+    if (dim != 0) return boxes.at(p, global);
     const auto it = corner_size.find({p.x(), p.y(), p.z()});
-    return it == corner_size.end() ? global : it->second;
+    return it == corner_size.end() ? boxes.at(p, global) : it->second;
   }
 };
 
@@ -99,11 +139,10 @@ double hash01(const std::array<double, 3>& p) {
   return static_cast<double>(h >> 11) * 0x1p-53;
 }
 
-EdgeSize edge_size_field(const Domain& domain, double global) {
+EdgeSize edge_size_field(const Domain& domain, double global, const BoxSizes& boxes) {
   std::vector<std::pair<Domain::Corner_index, K::Point_3>> corners;
   domain.get_corners(std::back_inserter(corners));
-  EdgeSize e;
-  e.global = global;
+  EdgeSize e{global, boxes, {}};
   // The nearest other corner, by sorting along x and scanning while the x gap can still beat the best.
   std::vector<std::array<double, 3>> pts;
   for (const auto& c : corners) pts.push_back({c.second.x(), c.second.y(), c.second.z()});
@@ -117,7 +156,8 @@ EdgeSize edge_size_field(const Domain& domain, double global) {
     for (std::size_t j = i; j-- > 0 && (pts[i][0] - pts[j][0]) * (pts[i][0] - pts[j][0]) < best;)
       best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]),
                                                    K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
-    const double cap = std::min(global, std::isfinite(best) ? std::sqrt(best) / 3 : global);
+    const double here = boxes.at(K::Point_3(pts[i][0], pts[i][1], pts[i][2]), global);
+    const double cap = std::min(here, std::isfinite(best) ? std::sqrt(best) / 3 : here);
     e.corner_size[pts[i]] = cap * (0.7 + 0.25 * (1 - hash01(pts[i])));
   }
   return e;
@@ -366,7 +406,8 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
     domain.detect_borders();
   }
 
-  CellSize cell_size{&domain, sizes.max_size, std::vector<double>(s.cell_count, sizes.max_size)};
+  const BoxSizes boxes(params.boxes);
+  CellSize cell_size{&domain, sizes.max_size, std::vector<double>(s.cell_count, sizes.max_size), boxes};
   for (const RegionSeed& seed : plc.regions)
     if (seed.max_volume > 0)
       for (std::size_t c = 1; c < s.cell_count; ++c)
@@ -376,9 +417,9 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
   // Facets keep their vertices on one patch (or its bounding features): without it a coarse mesh of a thin
   // part takes facets that cut across its corners (the dual edge meets a patch, the facet does not lie in
   // it).
-  const EdgeSize edge_size = edge_size_field(domain, sizes.edge_size);
-  Criteria criteria(P::edge_size = edge_size, P::facet_angle = params.facet_angle,
-                    P::facet_size = sizes.facet_size,
+  const EdgeSize edge_size = edge_size_field(domain, sizes.edge_size, boxes);
+  const FacetSize facet_size{sizes.facet_size, boxes};
+  Criteria criteria(P::edge_size = edge_size, P::facet_angle = params.facet_angle, P::facet_size = facet_size,
                     P::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH_WITH_ADJACENCY_CHECK,
                     P::facet_distance = sizes.facet_distance, P::cell_radius_edge_ratio = params.radius_edge,
                     P::cell_size = cell_size);
@@ -437,6 +478,15 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
                       "CGAL mesh parameters out of range (finite sizes >= 0, facet angle in [0, 30], sliver "
                       "bound in [0, 70), "
                       "feature angle in [0, 180] degrees, time limit >= 0, volume tolerance > 0)");
+  for (std::size_t i = 0; i < params.boxes.size(); ++i) {
+    const RefinementBox& b = params.boxes[i];
+    bool ok = b.size > 0 && std::isfinite(b.size);
+    for (int k = 0; k < 3; ++k)
+      ok = ok && std::isfinite(b.lo[k]) && std::isfinite(b.hi[k]) && b.lo[k] <= b.hi[k];
+    if (!ok)
+      throw MesherError(MesherFailure::bad_input, "refinement box " + std::to_string(i + 1) +
+                                                      " needs finite corners with lo <= hi and a size > 0");
+  }
   CgalMeshReport rep;
   rep.resampled = params.resample;
   // Coordinates that differ by rounding alone made equal, points that coincide to rounding made one (a
@@ -459,6 +509,7 @@ Mesh mesh_plc_cgal(const Plc& input, const CgalMeshParams& params, CgalMeshRepor
   rep.facet_size = params.facet_size > 0 ? params.facet_size : rep.max_size;
   rep.edge_size = params.edge_size > 0 ? params.edge_size : rep.facet_size;
   rep.facet_distance = params.facet_distance > 0 ? params.facet_distance : rep.facet_size / 20;
+  rep.boxes = params.boxes.size();
   rep.input_points = plc.point_count();
   rep.facet_triangles = s.tri_facet.size();
   rep.patches = patches.polyhedra.size();

@@ -74,8 +74,6 @@ void check_mesh_options(const ModelMeshOptions& o) {
   } else {
     if (o.quality && !(*o.quality >= 0 && std::isfinite(*o.quality)))
       bad_option("the radius-edge bound must be >= 0");
-    if (!o.sizes.boxes.empty())
-      bad_option("refinement boxes need the TetGen mesher (CGAL's cell size takes no boxes)");
     if (o.refine_from.mesh) bad_option("refining from a result needs the TetGen mesher");
   }
   if (o.refine_from.mesh && !(o.refine_from.target_error > 0 && std::isfinite(o.refine_from.target_error)))
@@ -146,9 +144,9 @@ SizeControls merged_controls(const std::string& file, const Plc& plc, const Mode
   return sz;
 }
 
-// The CGAL path: the global size as a circumradius bound, part and region sizes on the seeds (the
-// model's boxes left out), the estimate at the regular tet of that bound, and the weighted
-// certificate in m.conforming.
+// The CGAL path: the global size as a circumradius bound, part and region sizes on the seeds, the
+// model's and the options' refinement boxes as CGAL's (cgal_mesher.hpp), the estimate at the regular
+// tet of those bounds, and the weighted certificate in m.conforming.
 void mesh_cgal(const std::string& file, Plc plc, std::span<const double> volumes, const ModelMeshOptions& o,
                const SizeControls& sz, double max_volume, MeshedModel& m) {
   CgalMeshParams cp = o.cgal;
@@ -158,12 +156,14 @@ void mesh_cgal(const std::string& file, Plc plc, std::span<const double> volumes
   if (cp.max_size == 0 && sz.max_size > 0)
     cp.max_size = regular_tet_circumradius(regular_tet_volume(sz.max_size));
   if (o.quality) cp.radius_edge = *o.quality;
-  m.ignored_refine_boxes = sz.boxes.size();
+  cp.boxes.insert(cp.boxes.end(), sz.boxes.begin(), sz.boxes.end());
   plc = with_region_sizes(plc, sz);
   {  // the tet count estimated as for TetGen, at the regular tet of the circumradius bound
     MeshParams estimate;
     if (cp.max_size > 0) estimate.max_volume = regular_tet_volume(4 * cp.max_size / std::sqrt(6.0));
-    check_tet_estimate(file, plc, estimate, volumes, o.max_tets);
+    double est = estimate_tet_count(plc, estimate, volumes);
+    if (!cp.boxes.empty()) est += estimate_box_tet_count(plc, cp.boxes);
+    if (est > o.max_tets) throw TetLimitError(file, est, o.max_tets);
   }
   m.mesh = mesh_plc_cgal(plc, cp, &m.cgal);
   const DelaunayCertificate& cert = delaunay_certificate(m.mesh);

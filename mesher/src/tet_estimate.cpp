@@ -73,4 +73,17 @@ double estimate_tet_count(const Plc& plc, const MeshParams& params, std::span<co
   return std::isfinite(est) ? est : INFINITY;
 }
 
+double estimate_box_tet_count(const Plc& plc, std::span<const RefinementBox> boxes) {
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (std::size_t i = 0; i < plc.points.size(); ++i)
+    lo[i % 3] = std::min(lo[i % 3], plc.points[i]), hi[i % 3] = std::max(hi[i % 3], plc.points[i]);
+  double tets = 0;
+  for (const RefinementBox& b : boxes) {
+    double v = 1;  // the box's part of the bounding box
+    for (int k = 0; k < 3; ++k) v *= std::max(0.0, std::min(hi[k], b.hi[k]) - std::max(lo[k], b.lo[k]));
+    if (v > 0) tets += kTetsPerBoundVolume * v / regular_tet_volume(b.size);
+  }
+  return std::isfinite(tets) ? tets : INFINITY;
+}
+
 }  // namespace foxi

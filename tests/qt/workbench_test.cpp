@@ -584,17 +584,6 @@ TEST(Workbench, MeshPanelPartSizeAndCgal) {
   ASSERT_EQ(w.mesh_settings().part_sizes.size(), 1u);
   EXPECT_EQ(w.mesh_settings().part_sizes[0].part, "die");
   EXPECT_NEAR(w.mesh_settings().part_sizes[0].max_size, 0.4e-3, 1e-15);
-  // Boxes with CGAL: refused with mesh_model's reason, the settings unchanged.
-  foxi::workbench::MeshSettings boxed = w.mesh_settings();
-  boxed.boxes.resize(1);
-  boxed.boxes[0].hi[0] = boxed.boxes[0].hi[1] = boxed.boxes[0].hi[2] = 1e-3;
-  boxed.boxes[0].size = 0.2e-3;
-  QString why;
-  EXPECT_FALSE(w.set_mesh_settings(boxed, &why));
-  EXPECT_NE(why.toStdString().find("refinement boxes need the TetGen mesher"), std::string::npos)
-      << why.toStdString();
-  EXPECT_TRUE(w.mesh_settings().boxes.empty());
-
   ASSERT_TRUE(w.start_mesh());
   ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
   foxi::ModelMeshOptions o;
@@ -610,6 +599,33 @@ TEST(Workbench, MeshPanelPartSizeAndCgal) {
   EXPECT_NE(report.find("mesher: CGAL Mesh_3"), std::string::npos) << report;
   EXPECT_NE(report.find("delaunay: yes"), std::string::npos) << report;
   EXPECT_NE(report.find("min dihedral histogram"), std::string::npos) << report;
+
+  // A box row with CGAL (through the panel's table, in mm): the mesh is mesh_model's with that box,
+  // certified, with more tets than without it.
+  auto* add = w.findChild<QPushButton*>("add_box");
+  auto* boxes = w.findChild<QTableWidget*>("refine_boxes");
+  ASSERT_TRUE(add && boxes);
+  add->click();
+  ASSERT_EQ(boxes->rowCount(), 1);
+  boxes->item(0, 3)->setText("2");  // x1 = 2 mm: the substrate's end, away from the die
+  boxes->item(0, 6)->setText("0.3");
+  ASSERT_EQ(w.mesh_settings().mesher, foxi::Mesher::cgal);
+  ASSERT_EQ(w.mesh_settings().boxes.size(), 1u) << "a box row is taken with CGAL";
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  o.sizes.boxes = w.mesh_settings().boxes;
+  EXPECT_NEAR(o.sizes.boxes[0].hi[0], 2e-3, 1e-15);
+  EXPECT_NEAR(o.sizes.boxes[0].size, 0.3e-3, 1e-15);
+  const foxi::MeshedModel boxed = foxi::mesh_model(model, {}, o);
+  EXPECT_EQ(boxed.cgal.boxes, 1u);
+  ASSERT_TRUE(w.mesh());
+  EXPECT_TRUE(w.mesh()->xyz == boxed.mesh.xyz);
+  EXPECT_TRUE(w.mesh()->tet == boxed.mesh.tet);
+  EXPECT_GT(w.mesh()->tet_count(), direct.mesh.tet_count() + direct.mesh.tet_count() / 2);
+  EXPECT_TRUE(foxi::compute_delaunay_certificate(*w.mesh()).delaunay);
+  const std::string boxed_report =
+      w.findChild<QPlainTextEdit*>("quality_report")->toPlainText().toStdString();
+  EXPECT_NE(boxed_report.find("refinement boxes: 1"), std::string::npos) << boxed_report;
 
   // Cancel of a CGAL run: the CGAL mesh stays.
   const auto first = w.mesh();

@@ -31,7 +31,8 @@
 #include <vector>
 
 #include "foxi/api.hpp"
-#include "foxi/mesher/mesher.hpp"  // MesherError, MesherFailure
+#include "foxi/mesher/mesher.hpp"      // MesherError, MesherFailure
+#include "foxi/mesher/size_field.hpp"  // RefinementBox
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/plc.hpp"
 #include "foxi/model/progress.hpp"
@@ -44,6 +45,11 @@ struct CgalMeshParams {
   double max_size = 0;
   double facet_size = 0;  // largest surface Delaunay ball radius; 0: max_size
   double edge_size = 0;   // largest protecting ball along facet edges; 0: facet_size
+  // Refinement boxes, each with a target edge length h inside (as TetGen's boxes and region sizes):
+  // at a point inside a box the cell size, the facet size and the edge size are at most the
+  // circumradius of the regular tet of edge h (h sqrt6 / 4, the conversion of the region sizes), the
+  // smallest over the boxes that hold the point. A box needs finite corners with lo <= hi and h > 0.
+  std::vector<RefinementBox> boxes;
   // Largest distance of a boundary triangle's circumcentre from the PLC surface: with `resample` it
   // bounds how far a curved-looking surface (a faceted cylinder) is cut inside; 0: facet_size / 20.
   double facet_distance = 0;
@@ -94,6 +100,7 @@ struct CgalMeshReport {
   bool resampled = false;  // CgalMeshParams::resample was set
   double max_size = 0;     // the size bounds used
   double facet_size = 0, edge_size = 0, facet_distance = 0;
+  std::size_t boxes = 0;  // refinement boxes taken (CgalMeshParams::boxes)
   // Tets labelled by their centroid's part where Mesh_3's label (its circumcentre's part) differs
   // (see "Regions" above).
   std::size_t tets_relabelled = 0;

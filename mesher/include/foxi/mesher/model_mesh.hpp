@@ -70,8 +70,6 @@ struct MeshedModel {
   ConformingReport conforming;
   CgalMeshReport cgal;                 // CGAL only
   std::optional<RefinedFrom> refined;  // when options.refine_from gave a mesh
-  // The model's [[mesh.refine]] boxes the CGAL path left out (its cell size takes no boxes).
-  std::size_t ignored_refine_boxes = 0;
 };
 
 struct ModelMeshOptions {
@@ -104,7 +102,8 @@ struct ModelMeshOptions {
   std::vector<PartSize> part_sizes;
   // Added to the model's: region sizes by region id (a model's part i is region i + 1; where a part
   // size gives the same region one too, the smaller wins; an id with no seed in the PLC is a
-  // MesherError) and refinement boxes (TetGen only). sizes.max_size is not read: use max_size.
+  // MesherError) and refinement boxes (TetGen: a size field; CGAL: CgalMeshParams::boxes, as the
+  // model's). sizes.max_size is not read: use max_size.
   SizeControls sizes;
   // The radius-edge bound: TetGen's (0: no quality refinement, else at least kMinRadiusEdgeBound;
   // unset: the model's quality, else 1.414); CGAL's cell radius-edge bound (unset: cgal.radius_edge;
@@ -116,7 +115,8 @@ struct ModelMeshOptions {
   bool conform = true;
   bool optimize = false;  // TetGen's flips and smoothing; implies conform = false
   // The CGAL path's own parameters (perturb, resample, feature_angle, time_limit, radius_edge, ...);
-  // max_size and progress are set from the options above.
+  // max_size and progress are set from the options above, and the boxes of the model and of `sizes`
+  // are added to cgal.boxes.
   CgalMeshParams cgal;
 };
 
@@ -156,7 +156,7 @@ FOXI_API MeshedModel mesh_plc_with_options(Plc plc, const ModelMeshOptions& opti
                                            const std::string& origin = "the PLC");
 
 // The options' values the meshers cannot take (a size not > 0, a box with lo > hi, a quality or
-// dihedral bound out of range, boxes or refine-from with CGAL, a target error not > 0): MesherError
+// dihedral bound out of range, refine-from with CGAL, a target error not > 0): MesherError
 // (MesherFailure::bad_input) with the reason. mesh_model checks them first; a host checks as its user
 // types. Part names are checked against the model when meshing.
 FOXI_API void check_mesh_options(const ModelMeshOptions& options);

@@ -13,6 +13,7 @@
 #include <span>
 
 #include "foxi/api.hpp"
+#include "foxi/mesher/size_field.hpp"  // RefinementBox
 #include "foxi/mesher/tetgen_mesher.hpp"
 #include "foxi/model/plc.hpp"
 
@@ -26,5 +27,11 @@ inline constexpr double kDefaultMaxTets = 4e6;
 // volumes); empty: the PLC's bounding box stands for the whole domain, under the global bound.
 FOXI_API double estimate_tet_count(const Plc& plc, const MeshParams& params,
                                    std::span<const double> region_volume = {});
+
+// The tets refinement boxes add where the mesher takes them as bounds of their own (CGAL's, not a
+// TetGen size field, which estimate_tet_count counts): each box's part of the PLC's bounding box at
+// the count per bound volume, the regular tet of the box's edge length. Overlapping boxes count
+// twice (an upper estimate).
+FOXI_API double estimate_box_tet_count(const Plc& plc, std::span<const RefinementBox> boxes);
 
 }  // namespace foxi
