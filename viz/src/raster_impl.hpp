@@ -16,8 +16,8 @@
 
 #include "foxi/model/adjacency.hpp"
 #include "foxi/viz/field_paint.hpp"
+#include "foxi/model/parallel.hpp"
 #include "huge_page_allocator.hpp"
-#include "thread_pool.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -53,38 +53,8 @@ constexpr double kMaxPixel = 1048576.0;  // |pixel coordinate - centre| bound (2
 // points out of the tet (world frame); face f is opposite vertex f.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-// Runs f(0), ..., f(parts - 1): f(0) on the calling thread, the others on pooled threads (starting a
-// thread per call would cost tens of microseconds each, per frame); returns when all are done,
-// rethrowing the first exception. not_started() is called if f(0) will not run because a part could
-// not be handed to a thread (parts already running may be waiting for f(0): it must let them go).
-template <class F, class G>
-void run_parts(int parts, F&& f, G&& not_started) {
-  std::vector<std::future<void>> others;
-  std::exception_ptr error;
-  bool posted = false;
-  try {
-    for (int k = 1; k < parts; ++k) others.push_back(pool::run_async([&f, k] { f(k); }));
-    posted = true;
-    f(0);
-  } catch (...) {
-    error = std::current_exception();
-    if (!posted) not_started();
-  }
-  for (auto& other : others) {
-    try {
-      pool::finish(other);
-    } catch (...) {
-      if (!error) error = std::current_exception();
-    }
-  }
-  if (error) std::rethrow_exception(error);
-}
-
-// The same when no part waits for another.
-template <class F>
-void run_parts(int parts, F&& f) {
-  run_parts(parts, f, [] {});
-}
+// The painter's parts run on the one pool (foxi/model/parallel.hpp): a frame starts no thread.
+using detail::run_parts;
 
 inline std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
   std::int64_t q = a / b;
