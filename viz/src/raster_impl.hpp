@@ -360,6 +360,11 @@ struct TetRasterizer::Impl {
   };
   std::vector<Box> boxes;
   RasterStats stats;
+  // Where draw() writes the colours: fb.rgba (rows fb.width apart), or a host's image drawn in place
+  // (rows color_stride pixels apart; draw_into). Set by check_framebuffer at every entry.
+  std::uint32_t* colors = nullptr;
+  std::size_t color_stride = 0;
+  std::uint32_t* color_row(int y) const { return colors + std::size_t(y) * color_stride; }
   // Painter mode draws each batch front to back (tets, faces and fan triangles in reverse order)
   // and writes only pixels not yet written in this batch: "first write wins" in reverse order is
   // "last write wins" in the given order, pixel for pixel, and hidden tets cost only a mask test.
@@ -730,10 +735,12 @@ struct TetRasterizer::Impl {
   void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
                  const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden);
 
-  void check_framebuffer(const Framebuffer& fb) const;
+  // Checks fb's sizes and aims the colour writes (`colors`) at fb.rgba, or at `rows` (row_pixels
+  // apart) when given, fb.rgba then being left as it is (it may be empty).
+  void check_framebuffer(Framebuffer& fb, std::uint32_t* rows = nullptr, std::size_t row_pixels = 0);
   // Gives fb a shade buffer if it has none of its size (a framebuffer put together by hand).
   static void ensure_shade(Framebuffer& fb) {
-    if (fb.shade.size() != fb.rgba.size()) fb.shade.assign(fb.rgba.size(), 0);
+    if (fb.shade.size() != fb.id.size()) fb.shade.assign(fb.id.size(), 0);
   }
 
   // Recolouring a drawn picture through its id buffer (recolor.cpp).
@@ -743,7 +750,8 @@ struct TetRasterizer::Impl {
   void recolor_by_shade(Framebuffer& fb);
   bool recolors_by_shade(const FieldPaint* paint) const;
 
-  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
+  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets, std::uint32_t* rows = nullptr,
+            std::size_t row_pixels = 0);
 
   inline void answer_requests(const Framebuffer& fb, int k);
 
