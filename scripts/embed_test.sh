@@ -86,7 +86,7 @@ int main() {
 }
 CPP
 
-for example in grid_png field_buffer all_targets; do
+for example in grid_png field_buffer heat_loop all_targets; do
   dir=$work/$example
   source_dir=examples/embed/$example
   [ -d "$source_dir" ] || source_dir=$work/$example.src
@@ -117,6 +117,8 @@ print(f'  grid.png: {w} x {h}, {len(data)} bytes')
 PY
 "$work/field_buffer/field_buffer" "$work/field.ppm"
 step "field_buffer: run"
+"$work/heat_loop/heat_loop" examples/embed/heat_loop/heatsink.toml "$work/heat_loop.png"
+step "heat_loop: run"
 "$work/all_targets/all_targets"
 
 # The Qt host (examples/qt): a window embedding foxi::qt, where foxi was built with Qt5. Offscreen:

@@ -15,9 +15,9 @@
 #include <map>
 #include <optional>
 #include <pugixml.hpp>
-#include <thread>
 
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/parallel.hpp"
 #include "io_util.hpp"
 #include "io_vtk_codec.hpp"
 #include "io_vtk_internal.hpp"
@@ -222,13 +222,9 @@ ArrayData read_binary_block(ByteSource& src, VType type, std::uint64_t expected)
         got_size[b] = got;
       }
     };
-    if (nblocks >= 16) {
-      std::thread helper(inflate_range, nblocks / 2, nblocks);
-      inflate_range(0, nblocks / 2);
-      helper.join();
-    } else {
-      inflate_range(0, nblocks);
-    }
+    detail::parallel_for(
+        std::size_t(nblocks), 2, [&](std::size_t b0, std::size_t b1, unsigned) { inflate_range(b0, b1); },
+        16);
     for (std::uint64_t b = 0; b < nblocks; ++b) {
       const std::uint64_t want = b + 1 == nblocks ? last_size : block_size;
       const int rc = status[b];

@@ -3,7 +3,8 @@
 // the Mesh path (itself checked against the depth buffer in picture_test): spheres, orders and pictures
 // must agree bit for bit, the host's padding must stay untouched, and the field helpers must give what
 // tet_corner_values gives for the same values as a foxi::Field (and, for a field constant per region,
-// that constant: the analytic answer).
+// that constant: the analytic answer). The tet painter draws in place into an image of whole uint32
+// pixels; other images are drawn into the scratch framebuffer and copied (both checked here).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,6 +20,7 @@
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/isosurface.hpp"
 #include "foxi/viz/picture.hpp"
+#include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/visibility_order.hpp"
 #include "mesh_factory.hpp"
 #include "random_cameras.hpp"
@@ -160,6 +162,76 @@ TEST(MeshView, HostFieldIsosurfaceIntoHostImage) {
     for (std::uint32_t id : fb.id) shown += id != kNone;
   }
   EXPECT_GT(shown, std::size_t(kW) * kH / 10);  // the isosurfaces cover part of every picture
+}
+
+// The tet painter draws straight into a host image whose rows are whole uint32 pixels (no copy pass):
+// a sub-image at an offset inside a larger canvas, its stride not the width, each mode (painter, depth
+// buffer, graded field, a stop) against the Mesh path's framebuffer, and every canvas byte outside the
+// sub-image (padding, rows above and below, columns left and right) untouched. A stride or an address
+// that is not 4-byte aligned takes the copy path: the same picture.
+TEST(MeshView, HostImageDrawnInPlaceIsTheSamePicture) {
+  const HostArrays host = host_grid();
+  DerivedCache derived;
+  const MeshView view{host.xyz, host.tet, host.region, {}, {}, &derived};
+  const Mesh mesh = copy_into_mesh(host);
+  const SphereTable vt = compute_spheres(view), mt = compute_spheres(mesh);
+  std::vector<double> node_t(view.node_count());
+  for (std::size_t v = 0; v < node_t.size(); ++v) node_t[v] = host.xyz[3 * v] + 2 * host.xyz[3 * v + 2];
+  ColorScale scale;
+  scale.lo = 0;
+  scale.hi = 3;
+  const auto graded =
+      std::make_shared<const FieldPaint>(graded_field_paint(node_corner_values(view, node_t), scale));
+
+  struct Layout {
+    std::size_t stride, x0, y0, shift;  // bytes a row; the sub-image's first pixel; extra byte offset
+  };
+  const Layout layouts[] = {{4 * (kW + 9) + 8, 3, 5, 0},  // in place (stride and address 4-aligned)
+                            {4 * kW + 6, 0, 2, 0},        // copy: the stride is not whole pixels
+                            {4 * kW + 8, 1, 1, 1}};       // copy: the address is not 4-aligned
+  const Camera cam = test::random_cameras(mesh, 3, 11, double(kW) / kH)[1];
+  for (int mode = 0; mode < 4; ++mode) {
+    PictureParams params;
+    if (mode == 1) params.render.depth_buffer = true;
+    if (mode == 2) params.render.field = graded;
+    if (mode == 3) params.stop_fraction = 0.5;
+    Framebuffer fb(kW, kH);
+    draw_picture(mesh, mt, cam, fb, params);
+    for (const Layout& l : layouts) {
+      const std::size_t rows = l.y0 + kH + 3;
+      std::vector<std::uint8_t> canvas(l.stride * rows + l.shift, kPad);
+      std::uint8_t* origin = canvas.data() + l.shift + l.y0 * l.stride + 4 * l.x0;
+      Framebuffer scratch;
+      const PictureReport r =
+          draw_picture(view, vt, cam, RgbaImage{origin, kW, kH, l.stride}, scratch, params);
+      EXPECT_EQ(r.depth_buffer, mode == 1);
+      // In place (scratch holds no colours) exactly where the rows are whole uint32 pixels.
+      EXPECT_EQ(scratch.rgba.empty(), l.stride % 4 == 0 && l.shift == 0);
+      EXPECT_EQ(scratch.id, fb.id) << "mode " << mode << " stride " << l.stride;
+      std::size_t wrong = 0, outside = 0;
+      for (std::size_t i = 0; i < canvas.size(); ++i) {
+        const std::ptrdiff_t at = std::ptrdiff_t(i) - (origin - canvas.data());
+        const std::ptrdiff_t y = at >= 0 ? at / std::ptrdiff_t(l.stride) : -1;
+        const std::ptrdiff_t b = at >= 0 ? at % std::ptrdiff_t(l.stride) : 0;
+        if (y < 0 || y >= kH || b >= 4 * kW) {
+          outside += canvas[i] != kPad;
+          continue;
+        }
+        const std::uint32_t px = fb.rgba[fb.index(int(b / 4), int(y))];
+        wrong += canvas[i] != std::uint8_t(px >> (8 * (b % 4)));
+      }
+      EXPECT_EQ(wrong, 0u) << "mode " << mode << " stride " << l.stride;
+      EXPECT_EQ(outside, 0u) << "mode " << mode << " stride " << l.stride;
+    }
+  }
+  // An undoable picture keeps its colours in the framebuffer (undraw reads them back).
+  RenderParams undoable;
+  undoable.undoable = true;
+  TetRasterizer raster(view, cam, kW, kH, undoable);
+  Framebuffer fb(kW, kH);
+  std::vector<std::uint32_t> rows(std::size_t(kW) * kH);
+  const std::vector<std::uint32_t> order = visibility_order(view, vt, view_of(cam));
+  EXPECT_THROW(raster.draw_into(fb, order, rows.data(), kW), std::logic_error);
 }
 
 TEST(MeshView, BadHostInputIsRefused) {

@@ -7,8 +7,8 @@
 #include <limits>
 
 #include "exact.hpp"
+#include "foxi/model/parallel.hpp"
 #include "foxi/viz/visibility_order.hpp"
-#include "thread_pool.hpp"
 
 namespace foxi::order_detail {
 
@@ -17,14 +17,10 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 // Face f of a positively oriented tet, listed so that the tet's own vertex f is on its negative side.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
+// f(begin, end, part) on the two halves of [0, n), one per core (serial below 50000 items).
 template <class F>
 void parallel_for(std::size_t n, F f) {
-  if (n < 50000) {
-    f(std::size_t{0}, n, 0);
-    return;
-  }
-  const std::size_t half = n / 2;
-  pool::on_two_cores([&](int part) { part == 0 ? f(std::size_t{0}, half, 0) : f(half, n, 1); });
+  detail::parallel_for(n, 2, f, 50000);
 }
 
 inline const double* node(const MeshView& m, std::uint32_t v) { return m.xyz.data() + 3 * std::size_t(v); }

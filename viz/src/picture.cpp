@@ -5,6 +5,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -38,8 +39,31 @@ std::vector<std::uint32_t> safe_order(const MeshView& mesh, const SphereTable& t
   return order;
 }
 
-PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera,
-                           Framebuffer& fb, const PictureParams& params) {
+namespace {
+
+// Sizes fb's id, shade (and depth) buffers for a picture whose colours go to a host's image: as
+// Framebuffer::resize, less the colours (fb.rgba is emptied, its memory kept).
+void resize_without_colours(Framebuffer& fb, bool with_depth) {
+  const std::size_t n = std::size_t(fb.width) * std::size_t(fb.height);
+  detail::reserve_advised(fb.id, n);
+  detail::reserve_advised(fb.shade, n);
+  fb.rgba.clear();
+  fb.id.assign(n, kNone);
+  fb.shade.assign(n, 0);
+  if (with_depth) {
+    fb.depth.assign(n, -std::numeric_limits<double>::infinity());
+    fb.depth_slope.assign(2 * n, 0.0);
+  } else {
+    fb.depth.clear();
+    fb.depth_slope.clear();
+  }
+}
+
+// draw_picture into fb, or, with `rows` (row_pixels apart), with the tet painter's colours drawn in
+// place there (the rows cleared to white first; fb then holds no colours).
+PictureReport draw_picture_at(const MeshView& mesh, const SphereTable& table, const Camera& camera,
+                              Framebuffer& fb, const PictureParams& params, std::uint32_t* rows,
+                              std::size_t row_pixels) {
   if (!(params.stop_fraction >= 0 && params.stop_fraction <= 1))
     throw std::invalid_argument("draw_picture: the stop fraction must lie in [0, 1]");
   if (std::isnan(params.stop_depth)) throw std::invalid_argument("draw_picture: the stop depth is NaN");
@@ -72,18 +96,35 @@ PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const
   rp.depth_buffer = params.render.depth_buffer || !report.delaunay;
   report.depth_buffer = rp.depth_buffer;
   t0 = std::chrono::steady_clock::now();
-  fb.resize(fb.width, fb.height, rp.depth_buffer);
+  if (rows != nullptr) {
+    resize_without_colours(fb, rp.depth_buffer);
+    for (int y = 0; y < fb.height; ++y)
+      std::fill_n(rows + std::size_t(y) * row_pixels, fb.width, pack_rgba(255, 255, 255));
+  } else {
+    fb.resize(fb.width, fb.height, rp.depth_buffer);
+  }
   if (params.iso != nullptr) {  // each tet's iso polygons (or slice) at its place in the order
     IsoPainter painter(mesh, camera, fb.width, fb.height, params.iso->corner, params.iso->params, rp,
                        params.iso->attr);
     painter.draw(fb, std::span<const std::uint32_t>(order).first(count));
   } else {
     TetRasterizer raster(mesh, camera, fb.width, fb.height, rp);
-    raster.draw(fb, std::span<const std::uint32_t>(order).first(count));
+    const auto tets = std::span<const std::uint32_t>(order).first(count);
+    if (rows != nullptr)
+      raster.draw_into(fb, tets, rows, row_pixels);
+    else
+      raster.draw(fb, tets);
     report.raster = raster.stats();
   }
   report.draw_ms = ms_since(t0);
   return report;
+}
+
+}  // namespace
+
+PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const Camera& camera,
+                           Framebuffer& fb, const PictureParams& params) {
+  return draw_picture_at(mesh, table, camera, fb, params, nullptr, 0);
 }
 
 void copy_rgba(const Framebuffer& fb, const RgbaImage& image) {
@@ -117,6 +158,14 @@ PictureReport draw_picture(const MeshView& mesh, const SphereTable& table, const
                                 " bytes is below 4 x the width " + std::to_string(image.width));
   scratch.width = image.width;  // draw_picture sizes the buffers to these
   scratch.height = image.height;
+  // In place where a row is whole uint32 pixels in pack_rgba's byte order (little-endian, the image
+  // and its stride 4-byte aligned) and the tet painter draws; else drawn in scratch and copied.
+  const bool in_place = std::endian::native == std::endian::little && params.iso == nullptr &&
+                        image.stride % 4 == 0 &&
+                        reinterpret_cast<std::uintptr_t>(image.pixels) % alignof(std::uint32_t) == 0;
+  if (in_place)
+    return draw_picture_at(mesh, table, camera, scratch, params,
+                           reinterpret_cast<std::uint32_t*>(image.pixels), image.stride / 4);
   const PictureReport report = draw_picture(mesh, table, camera, scratch, params);
   copy_rgba(scratch, image);
   return report;

@@ -46,7 +46,7 @@ void TetRasterizer::Impl::neighbour_positions(std::uint32_t nb, const std::uint3
 }
 
 void TetRasterizer::Impl::graded_span(Framebuffer& fb, const FaceSetup& fs, int y, int lo, int hi) const {
-  std::uint32_t* rgba = &fb.rgba[std::size_t(y) * std::size_t(fb.width)];
+  std::uint32_t* rgba = color_row(y);
   std::uint32_t* id = &fb.id[std::size_t(y) * std::size_t(fb.width)];
   std::uint8_t* shade = &fb.shade[std::size_t(y) * std::size_t(fb.width)];
   for (int x = lo; x <= hi; ++x) {

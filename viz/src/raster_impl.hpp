@@ -16,8 +16,8 @@
 
 #include "foxi/model/adjacency.hpp"
 #include "foxi/viz/field_paint.hpp"
+#include "foxi/model/parallel.hpp"
 #include "huge_page_allocator.hpp"
-#include "thread_pool.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -53,38 +53,8 @@ constexpr double kMaxPixel = 1048576.0;  // |pixel coordinate - centre| bound (2
 // points out of the tet (world frame); face f is opposite vertex f.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-// Runs f(0), ..., f(parts - 1): f(0) on the calling thread, the others on pooled threads (starting a
-// thread per call would cost tens of microseconds each, per frame); returns when all are done,
-// rethrowing the first exception. not_started() is called if f(0) will not run because a part could
-// not be handed to a thread (parts already running may be waiting for f(0): it must let them go).
-template <class F, class G>
-void run_parts(int parts, F&& f, G&& not_started) {
-  std::vector<std::future<void>> others;
-  std::exception_ptr error;
-  bool posted = false;
-  try {
-    for (int k = 1; k < parts; ++k) others.push_back(pool::run_async([&f, k] { f(k); }));
-    posted = true;
-    f(0);
-  } catch (...) {
-    error = std::current_exception();
-    if (!posted) not_started();
-  }
-  for (auto& other : others) {
-    try {
-      pool::finish(other);
-    } catch (...) {
-      if (!error) error = std::current_exception();
-    }
-  }
-  if (error) std::rethrow_exception(error);
-}
-
-// The same when no part waits for another.
-template <class F>
-void run_parts(int parts, F&& f) {
-  run_parts(parts, f, [] {});
-}
+// The painter's parts run on the one pool (foxi/model/parallel.hpp): a frame starts no thread.
+using detail::run_parts;
 
 inline std::int64_t floor_div(std::int64_t a, std::int64_t b) {  // b > 0
   std::int64_t q = a / b;
@@ -390,6 +360,11 @@ struct TetRasterizer::Impl {
   };
   std::vector<Box> boxes;
   RasterStats stats;
+  // Where draw() writes the colours: fb.rgba (rows fb.width apart), or a host's image drawn in place
+  // (rows color_stride pixels apart; draw_into). Set by check_framebuffer at every entry.
+  std::uint32_t* colors = nullptr;
+  std::size_t color_stride = 0;
+  std::uint32_t* color_row(int y) const { return colors + std::size_t(y) * color_stride; }
   // Painter mode draws each batch front to back (tets, faces and fan triangles in reverse order)
   // and writes only pixels not yet written in this batch: "first write wins" in reverse order is
   // "last write wins" in the given order, pixel for pixel, and hidden tets cost only a mask test.
@@ -760,10 +735,12 @@ struct TetRasterizer::Impl {
   void draw_face(Framebuffer& fb, const Rows& rows, std::uint32_t t, const double* const v[3],
                  const std::uint32_t node[3], const PolyVertex* poly, int n, bool test_hidden);
 
-  void check_framebuffer(const Framebuffer& fb) const;
+  // Checks fb's sizes and aims the colour writes (`colors`) at fb.rgba, or at `rows` (row_pixels
+  // apart) when given, fb.rgba then being left as it is (it may be empty).
+  void check_framebuffer(Framebuffer& fb, std::uint32_t* rows = nullptr, std::size_t row_pixels = 0);
   // Gives fb a shade buffer if it has none of its size (a framebuffer put together by hand).
   static void ensure_shade(Framebuffer& fb) {
-    if (fb.shade.size() != fb.rgba.size()) fb.shade.assign(fb.rgba.size(), 0);
+    if (fb.shade.size() != fb.id.size()) fb.shade.assign(fb.id.size(), 0);
   }
 
   // Recolouring a drawn picture through its id buffer (recolor.cpp).
@@ -773,7 +750,8 @@ struct TetRasterizer::Impl {
   void recolor_by_shade(Framebuffer& fb);
   bool recolors_by_shade(const FieldPaint* paint) const;
 
-  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
+  void draw(Framebuffer& fb, std::span<const std::uint32_t> tets, std::uint32_t* rows = nullptr,
+            std::size_t row_pixels = 0);
 
   inline void answer_requests(const Framebuffer& fb, int k);
 

@@ -14,7 +14,7 @@ inline void TetRasterizer::Impl::shade_pixel(Framebuffer& fb, const FaceSetup& f
     if (!depth_test(fb, p, fs.w0 + ta + tb, fs.da, fs.db, std::abs(fs.w0) + std::abs(ta) + std::abs(tb)))
       return;
   }
-  fb.rgba[p] = face_color(fs, x, y, fb.shade[p]);
+  color_row(y)[x] = face_color(fs, x, y, fb.shade[p]);
   fb.id[p] = fs.tet;
 }
 
@@ -157,7 +157,7 @@ inline void TetRasterizer::Impl::record_span(Framebuffer& fb, const FaceSetup& f
     shade_long_span(fb, fs, y, lo, hi);
     return;
   }
-  std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
+  std::uint32_t* rgba = color_row(y);
   std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
   std::uint8_t* shade = fb.shade.data() + std::size_t(y) * std::size_t(fb.width);
   if (fs.exact_double) [[likely]] {  // the edge functions at lo straight in double (no 64-bit products)
@@ -349,7 +349,7 @@ template <bool kFourLines>
 // shade_span's long runs (and faces without edge lines).
 [[gnu::noinline]] void TetRasterizer::Impl::shade_long_span(Framebuffer& fb, const FaceSetup& fs, int y,
                                                             int lo, int hi) const {
-  std::uint32_t* rgba = fb.rgba.data() + std::size_t(y) * std::size_t(fb.width);
+  std::uint32_t* rgba = color_row(y);
   std::uint32_t* id = fb.id.data() + std::size_t(y) * std::size_t(fb.width);
   std::uint8_t* shade = fb.shade.data() + std::size_t(y) * std::size_t(fb.width);
   if (fs.lines == 0) {

@@ -199,17 +199,25 @@ void TetRasterizer::Impl::draw_face(Framebuffer& fb, const Rows& rows, std::uint
   raster_polygon(fb, rows, fs, poly, n);
 }
 
-void TetRasterizer::Impl::check_framebuffer(const Framebuffer& fb) const {
+void TetRasterizer::Impl::check_framebuffer(Framebuffer& fb, std::uint32_t* rows, std::size_t row_pixels) {
   if (fb.width != proj.width || fb.height != proj.height)
     throw std::invalid_argument("render: framebuffer size differs from the rasterizer's");
-  if (fb.rgba.size() != std::size_t(fb.width) * fb.height || fb.id.size() != fb.rgba.size())
+  const std::size_t pixels = std::size_t(fb.width) * std::size_t(fb.height);
+  if ((rows == nullptr && fb.rgba.size() != pixels) || fb.id.size() != pixels)
     throw std::invalid_argument("render: framebuffer buffers have the wrong size");
-  if (params.depth_buffer && fb.depth.size() != fb.rgba.size())
+  if (params.depth_buffer && fb.depth.size() != pixels)
     throw std::invalid_argument("render: depth-buffer mode needs a framebuffer with a depth buffer");
+  if (rows != nullptr && row_pixels < std::size_t(fb.width))
+    throw std::invalid_argument("render: image rows narrower than the framebuffer");
+  colors = rows != nullptr ? rows : fb.rgba.data();
+  color_stride = rows != nullptr ? row_pixels : std::size_t(fb.width);
 }
 
-void TetRasterizer::Impl::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) {
-  check_framebuffer(fb);
+void TetRasterizer::Impl::draw(Framebuffer& fb, std::span<const std::uint32_t> tets, std::uint32_t* rows,
+                               std::size_t row_pixels) {
+  if (rows != nullptr && params.undoable)
+    throw std::logic_error("render: an undoable picture is drawn into its framebuffer (undraw reads it)");
+  check_framebuffer(fb, rows, row_pixels);
   ensure_shade(fb);
   if (params.depth_buffer) ensure_depth_slopes(fb);
   const std::size_t tc = mesh->tet_count();
@@ -531,6 +539,11 @@ TetRasterizer::TetRasterizer(TetRasterizer&&) noexcept = default;
 TetRasterizer& TetRasterizer::operator=(TetRasterizer&&) noexcept = default;
 
 void TetRasterizer::draw(Framebuffer& fb, std::span<const std::uint32_t> tets) { impl_->draw(fb, tets); }
+void TetRasterizer::draw_into(Framebuffer& fb, std::span<const std::uint32_t> tets, std::uint32_t* rows,
+                              std::size_t row_pixels) {
+  if (rows == nullptr) throw std::invalid_argument("render: draw_into needs the image's rows");
+  impl_->draw(fb, tets, rows, row_pixels);
+}
 const RasterStats& TetRasterizer::stats() const { return impl_->stats; }
 const Projector& TetRasterizer::projector() const { return impl_->proj; }
 double TetRasterizer::near_plane() const { return impl_->near; }

@@ -244,7 +244,7 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
     if (threads > 1) {
       if (k == 0) unkept.store(1, std::memory_order_release);
       int state;
-      while ((state = unkept.load(std::memory_order_acquire)) == 0) pool::relax();
+      while ((state = unkept.load(std::memory_order_acquire)) == 0) detail::relax();
       if (state == 2) return;  // thread 0 will not run (a part could not be handed out)
     }
     const Rows rows{0, 1, split[std::size_t(k)], split[std::size_t(k) + 1] - 1};
@@ -368,7 +368,7 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
       });
     }
     // The mask back to zero on the changed rows of these rows (whole bands: their tiles too).
-    while (!extent_found.load(std::memory_order_acquire)) pool::relax();  // long since, as a rule
+    while (!extent_found.load(std::memory_order_acquire)) detail::relax();  // long since, as a rule
     const int y0 = std::max(rows.lo, changed.y0), y1 = std::min(rows.hi, changed.y1);
     if (y0 <= y1) zero_mask(y0, y1);
   };

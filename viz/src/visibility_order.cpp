@@ -26,7 +26,7 @@
 #include "foxi/model/adjacency.hpp"
 #include "huge_page_allocator.hpp"
 #include "order_geometry.hpp"
-#include "thread_pool.hpp"
+#include "foxi/model/parallel.hpp"
 
 namespace foxi {
 
@@ -932,7 +932,7 @@ void ProgressiveOrder::Impl::scatter(std::size_t from, std::size_t to) {
   if (split == m) {
     run(0, m, scatter_start[0].data());
   } else {
-    pool::on_two_cores([&](int part) {
+    detail::run_parts(2, [&](int part) {
       std::uint32_t* ps = scatter_start[part].data();
       const std::size_t b = part == 0 ? 0 : split, e = part == 0 ? split : m;
       if (combine)
@@ -1475,7 +1475,7 @@ std::span<const std::uint32_t> ProgressiveOrder::next() {
     if (!d.worker.valid() && !d.worker_done) {
       // The head buckets here, at once; the rest is placed and sorted ahead by the worker.
       if (d.head_fits) d.hand_out_head();
-      d.worker = pool::run_async([&d] {
+      d.worker = detail::run_async([&d] {
         try {
           d.run_worker();
         } catch (...) {
@@ -1551,7 +1551,7 @@ void visibility_order_into(std::vector<std::uint32_t>& out, const MeshView& mesh
   bool done = false;
   if (split > 0) {
     ProgressiveOrder::Impl::Scratch other_scratch;
-    pool::on_two_cores([&](int part) {
+    detail::run_parts(2, [&](int part) {
       if (part == 0)
         d.emit_buckets(0, split, split, out, d.scratch, direct);
       else

@@ -11,9 +11,9 @@
 // coordinates and tets), and keeps the view's derived data (face adjacency, Delaunay certificate) in a
 // foxi::DerivedCache the host owns; the sphere table is a value the host keeps. The field goes in as
 // spans: per-tet values for a flat colouring (foxi::flat_field_paint), corner values
-// (foxi::node_corner_values) for two isosurfaces. foxi draws into its own framebuffer (the painter
-// needs its id buffer and contiguous rows) and copies the rows into the host's buffer
-// (foxi::draw_picture with a foxi::RgbaImage); the host keeps that framebuffer (`scratch`) to reuse it.
+// (foxi::node_corner_values) for two isosurfaces. foxi::draw_picture with a foxi::RgbaImage draws into
+// the host's buffer: the tet painter in place, the isosurfaces into foxi's own framebuffer whose rows
+// are then copied; that framebuffer (`scratch`, with the id buffer) is the host's to reuse.
 //
 // Checks: (1) flat colouring, shading and edges off: every pixel is exactly the colour of its tet's
 // value on the host's scale (the tet a pixel shows from the scratch framebuffer's id buffer);

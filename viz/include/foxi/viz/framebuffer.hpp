@@ -2,9 +2,9 @@
 // probing and recolouring) and, in depth-buffer mode only, a depth buffer (double: it is the test
 // oracle, and float rounding alone flips grazing layers).
 //
-// The framebuffer owns its pixels, rows `width` apart: the painter draws only into one. A host with
-// its own RGBA buffer (its own row stride) has draw_picture copy the rows into it (picture.hpp,
-// RgbaImage, copy_rgba; examples/embed/field_buffer).
+// The framebuffer owns its pixels, rows `width` apart. A host with its own RGBA buffer (its own row
+// stride) has draw_picture draw the tet painter's colours straight into it, the framebuffer keeping
+// the ids and shades (picture.hpp, RgbaImage, TetRasterizer::draw_into; examples/embed/field_buffer).
 #pragma once
 
 #include <algorithm>

@@ -84,6 +84,13 @@ class FOXI_API TetRasterizer {
   // into fb, which must be width x height (with a depth buffer in depth mode). Can be called again
   // with the next batch of an order (progressive drawing). Tet indices must be < tet_count.
   void draw(Framebuffer& fb, std::span<const std::uint32_t> tets);
+  // draw() with the colours written in place into a host's image instead of fb.rgba: row y of the
+  // image at rows + y row_pixels (row_pixels >= width; the pixels past a row's width are never
+  // written), pixels as pack_rgba makes them. fb keeps the id, shade (and depth) buffers, which must
+  // be width x height, and fb.rgba is left as it is (it may be empty). Not undoable (std::logic_error:
+  // undraw reads the colours back from fb).
+  void draw_into(Framebuffer& fb, std::span<const std::uint32_t> tets, std::uint32_t* rows,
+                 std::size_t row_pixels);
 
   // Undoable mode (RenderParams::undoable; the seed paper's undrawing, section 6.2). draw() keeps the tets
   // drawn so far (each tet at most once, else std::invalid_argument) and saves, for each tet with a back

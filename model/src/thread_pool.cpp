@@ -1,4 +1,5 @@
-#include "thread_pool.hpp"
+// The persistent pool behind foxi/model/parallel.hpp: run_async, relax, finish.
+#include "foxi/model/parallel.hpp"
 
 #include <atomic>
 #include <chrono>
@@ -14,7 +15,7 @@
 #include <immintrin.h>
 #endif
 
-namespace foxi::pool {
+namespace foxi::detail {
 
 namespace {
 
@@ -147,15 +148,4 @@ void finish(std::future<void>& done) {
   done.get();
 }
 
-void on_two_cores(const std::function<void(int)>& f) {
-  std::future<void> other = run_async([&f] { f(1); });
-  try {
-    f(0);
-  } catch (...) {
-    other.wait();
-    throw;
-  }
-  finish(other);
-}
-
-}  // namespace foxi::pool
+}  // namespace foxi::detail
