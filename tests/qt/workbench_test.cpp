@@ -287,7 +287,13 @@ void check_movie(const std::string& tools) {
     ASSERT_EQ(b.width, a.width);
     ASSERT_EQ(b.height, a.height);
     EXPECT_TRUE(a.rgba == b.rgba) << "frame " << k;
-    if (k == 0) first = a.rgba;
+    if (k == 0) {
+      first = a.rgba;
+      const std::size_t coloured = std::size_t(std::count_if(a.rgba.begin(), a.rgba.end(), [](std::uint32_t c) {
+        return c != foxi::pack_rgba(255, 255, 255);
+      }));
+      EXPECT_GT(coloured, a.rgba.size() / 20) << "the frame shows the model";
+    }
     if (k == 1) {
       EXPECT_FALSE(a.rgba == first) << "the camera turned";
     }

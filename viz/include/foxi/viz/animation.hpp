@@ -42,7 +42,7 @@ FOXI_API std::unique_ptr<AnimationWriter> open_apng(const std::filesystem::path&
 FOXI_API std::unique_ptr<AnimationWriter> open_gif(const std::filesystem::path& path,
                                                    const AnimationParams& params);
 
-// Numbered PNG frames: `pattern` a file name with one printf integer conversion (%d or %0Nd, N < 10)
+// Numbered PNG frames: `pattern` a file name with one printf integer conversion (%d or %0Nd, N < 100)
 // and no other '%' (frame_pattern), frame k written as frame_name(pattern, k). The frames appear
 // together at finish() (DurableFile temporaries committed together); the folder must exist.
 FOXI_API std::unique_ptr<AnimationWriter> open_png_frames(const std::string& pattern,
