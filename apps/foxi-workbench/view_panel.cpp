@@ -199,7 +199,7 @@ QPushButton* Workbench::build_view_panel() {
   auto* slider_row = new QHBoxLayout;
   slider_row->addWidget(new QLabel(tr("fraction drawn")));
   slider_row->addWidget(fraction_, 1);
-  cv->addLayout(slider_row);
+  cv->addLayout(slider_row);  // shrink and the deformed shape join this row below
   auto* fields = new QHBoxLayout;
   field_box_ = new QComboBox;
   field_box_->setMinimumContentsLength(12);
@@ -246,8 +246,6 @@ QPushButton* Workbench::build_view_panel() {
   fields->addWidget(range_on_);
   fields->addWidget(range_lo_);
   fields->addWidget(range_hi_);
-  fields->addWidget(new QLabel(tr("shrink")));
-  fields->addWidget(shrink_box_);
   // The deformed shape: the displacement (a thermal stress solve's) times the scale.
   deform_on_ = new QCheckBox(tr("deformed x"));
   deform_on_->setToolTip(
@@ -258,6 +256,7 @@ QPushButton* Workbench::build_view_panel() {
   deform_scale_->setDecimals(1);
   deform_scale_->setValue(100);
   deform_scale_->setKeyboardTracking(false);
+  deform_scale_->setMaximumWidth(90);
   auto deform = [this] {
     if (filling_) return;
     std::optional<Deform> d;
@@ -266,8 +265,6 @@ QPushButton* Workbench::build_view_panel() {
   };
   connect(deform_on_, &QCheckBox::toggled, this, deform);
   connect(deform_scale_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, deform);
-  fields->addWidget(deform_on_);
-  fields->addWidget(deform_scale_);
   cv->addLayout(fields);
   // The field tools: isosurface, threshold, clip (by the field shown; disabled without one).
   auto* tools = new QHBoxLayout;
@@ -315,15 +312,17 @@ QPushButton* Workbench::build_view_panel() {
   tools->addWidget(iso_value_);
   tools->addWidget(iso_more_);
   tools->addWidget(iso_only_);
-  tools->addWidget(threshold_on_);
-  tools->addWidget(threshold_lo_);
-  tools->addWidget(threshold_hi_);
-  tools->addWidget(clip_on_);
-  tools->addWidget(clip_axis_);
-  tools->addWidget(clip_slider_, 2);
-  tools->addWidget(slice_on_);
-  tools->addWidget(slice_axis_);
-  tools->addWidget(slice_slider_, 2);
+  // The subsets and cuts on a row of their own (one row for all made the window ~2000 pixels wide).
+  auto* cuts = new QHBoxLayout;
+  cuts->addWidget(threshold_on_);
+  cuts->addWidget(threshold_lo_);
+  cuts->addWidget(threshold_hi_);
+  cuts->addWidget(clip_on_);
+  cuts->addWidget(clip_axis_);
+  cuts->addWidget(clip_slider_, 2);
+  cuts->addWidget(slice_on_);
+  cuts->addWidget(slice_axis_);
+  cuts->addWidget(slice_slider_, 2);
   // Translucency and volume rendering (issue 23), composited exactly: ViewWidget::set_xray, set_volume.
   // The boxes show what the view draws (composite_changed), not what was last clicked.
   for (const bool volume : {false, true}) {
@@ -347,12 +346,18 @@ QPushButton* Workbench::build_view_panel() {
     xray_box_->setChecked(xray);
     volume_box_->setChecked(volume);
   });
+  tools->addWidget(xray_box_);
+  tools->addWidget(volume_box_);
+  // Shrink and the deformed shape beside the fraction slider: each row of tools stays short enough
+  // that the window fits a 1680-pixel screen with its panels.
+  slider_row->addWidget(new QLabel(tr("shrink")));
+  slider_row->addWidget(shrink_box_);
+  slider_row->addWidget(deform_on_);
+  slider_row->addWidget(deform_scale_);
+  for (QSlider* sl : {iso_slider_, clip_slider_, slice_slider_}) sl->setMinimumWidth(100);
+  iso_more_->setMinimumWidth(90);
   cv->addLayout(tools);
-  auto* composite_row = new QHBoxLayout;
-  composite_row->addWidget(xray_box_);
-  composite_row->addWidget(volume_box_);
-  composite_row->addStretch(1);
-  cv->addLayout(composite_row);
+  cv->addLayout(cuts);
   regions_ = new QListWidget;
   regions_->setFlow(QListView::LeftToRight);
   regions_->setMaximumHeight(32);
