@@ -1124,7 +1124,7 @@ TEST(Workbench, DoneWhenWalkThrough) {
   int shot_number = 0;
   auto shot = [&](const std::string& name) {
     QApplication::processEvents();
-    char prefix[8];
+    char prefix[16];
     std::snprintf(prefix, sizeof prefix, "%02d-", ++shot_number);
     const auto path = dir / (prefix + name + ".png");
     ASSERT_TRUE(w.grab().save(QString::fromStdString(path.string()))) << path;
@@ -1235,6 +1235,59 @@ TEST(Workbench, DoneWhenWalkThrough) {
   const foxi::Framebuffer saved = foxi::read_png(picture);
   EXPECT_TRUE(saved.rgba == v->view()->framebuffer().rgba);
   shot("picture-saved");
+}
+
+// Save movie runs on a worker: the window goes on (the GUI thread is not held), Cancel stops it and no
+// file is left; a name of no known kind, a second movie while one runs and a movie of an isosurface
+// are refused with the reason; an APNG is written whole.
+TEST(Workbench, MovieOnAWorkerCancelsAndRefuses) {
+  TempDir dir;
+  Workbench w;
+  w.view_widget()->setFixedSize(160, 120);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  auto wait_movie = [&](bool* ok, QString* message) {
+    QEventLoop loop;
+    QObject::connect(&w, &Workbench::movie_finished, &loop, [&](bool r, const QString& m) {
+      *ok = r;
+      *message = m;
+      loop.quit();
+    });
+    QTimer::singleShot(120000, &loop, &QEventLoop::quit);
+    loop.exec();
+  };
+  QString why;
+  EXPECT_FALSE(w.save_movie(QString::fromStdString((dir.path() / "m.mp3").string()), 8, &why));
+  EXPECT_NE(why.indexOf(".gif"), -1) << why.toStdString();
+  const auto long_one = dir.path() / "long.apng";
+  ASSERT_TRUE(w.save_movie(QString::fromStdString(long_one.string()), 2000, &why)) << why.toStdString();
+  EXPECT_TRUE(w.movie_running());
+  EXPECT_FALSE(w.save_movie(QString::fromStdString((dir.path() / "b.gif").string()), 8, &why));
+  w.cancel_movie();
+  bool ok = true;
+  QString message;
+  wait_movie(&ok, &message);
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(message, "cancelled");
+  EXPECT_FALSE(w.movie_running());
+  EXPECT_FALSE(std::filesystem::exists(long_one));
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << "no temporary left";
+  const auto apng = dir.path() / "turn.apng";
+  ASSERT_TRUE(w.save_movie(QString::fromStdString(apng.string()), 6, &why)) << why.toStdString();
+  wait_movie(&ok, &message);
+  EXPECT_TRUE(ok) << message.toStdString();
+  ASSERT_TRUE(std::filesystem::exists(apng));
+  const foxi::Framebuffer first = foxi::read_png(apng);  // an APNG's first frame, to a PNG reader
+  EXPECT_EQ(first.width, 160);
+  EXPECT_EQ(first.height, 120);
+  foxi::FieldSelection iso;
+  iso.iso = {0.5 * (w.field_lo() + w.field_hi())};
+  ASSERT_TRUE(w.set_selection(iso));
+  why.clear();
+  EXPECT_FALSE(w.save_movie(QString::fromStdString((dir.path() / "iso.gif").string()), 6, &why));
+  EXPECT_NE(why.indexOf("isosurface"), -1) << why.toStdString();
 }
 
 // A project saved and reopened in a new window: the same parameters, mesh (counts, coordinates),
