@@ -97,8 +97,8 @@ struct ToolOptions {
   bool iso_only = false;
   std::vector<double> threshold, clip, slice;
   bool any() const { return !iso.empty() || !threshold.empty() || !clip.empty() || !slice.empty(); }
-  bool xray = false;   // --xray
-  std::string movie;   // --save-movie
+  bool xray = false;  // --xray
+  std::string movie;  // --save-movie
   int movie_frames = 48;
   bool graded = false;
   std::vector<double> range, regions;
@@ -247,7 +247,8 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     });
     loop.exec();
     if (!ok) {
-      std::fprintf(stderr, "foxi-workbench: error: %s: %s\n", tools.movie.c_str(), message.toUtf8().constData());
+      std::fprintf(stderr, "foxi-workbench: error: %s: %s\n", tools.movie.c_str(),
+                   message.toUtf8().constData());
       return kExitFailure;
     }
     std::printf("wrote %s (%d frames)\n", tools.movie.c_str(), tools.movie_frames);
@@ -366,9 +367,8 @@ int main(int argc, char** argv) {
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
     if (!is_headless &&
         (tools.any() || tools.graded || tools.deform || tools.xray || !tools.movie.empty() ||
-         !tools.range.empty() || !tools.regions.empty() ||
-         !tools.project.empty() || !sets.empty() || !physics.empty() || !field.empty() ||
-         !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
+         !tools.range.empty() || !tools.regions.empty() || !tools.project.empty() || !sets.empty() ||
+         !physics.empty() || !field.empty() || !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
       throw Usage(
           "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")

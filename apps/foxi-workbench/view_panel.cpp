@@ -377,7 +377,8 @@ QPushButton* Workbench::build_view_panel() {
   for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_, slice_on_})
     connect(c, &QCheckBox::toggled, this, [this] { apply_field_tools(); });
   connect(slice_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
-  connect(slice_axis_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] { apply_field_tools(); });
+  connect(slice_axis_, qOverload<int>(&QComboBox::currentIndexChanged), this,
+          [this] { apply_field_tools(); });
   connect(iso_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
   connect(iso_more_, &QLineEdit::editingFinished, this, [this] { apply_field_tools(); });
   connect(clip_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
@@ -489,10 +490,9 @@ bool Workbench::set_selection(const FieldSelection& selection, QString* error) {
 void Workbench::show_selection() {
   filling_ = true;
   const bool field = !selection_field_.isEmpty() && view_->has_view() && field_hi_ >= field_lo_;
-  for (QWidget* w :
-       std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_more_, iso_only_, threshold_on_,
-                                       threshold_lo_, threshold_hi_, clip_on_, clip_axis_, clip_slider_,
-                                       slice_on_, slice_axis_, slice_slider_})
+  for (QWidget* w : std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_more_, iso_only_, threshold_on_,
+                                                    threshold_lo_, threshold_hi_, clip_on_, clip_axis_,
+                                                    clip_slider_, slice_on_, slice_axis_, slice_slider_})
     w->setEnabled(field);
   const FieldSelection& s = selection_;
   const QSignalBlocker b0(iso_more_), b1(iso_on_), b2(iso_slider_), b3(iso_only_), b4(threshold_on_),

@@ -206,8 +206,8 @@ class Workbench : public QMainWindow {
   DisplayUnit shown_unit(const std::string& si_unit, double max_abs) const;
 
   // The view's field tools (field_selection.hpp, SI values): an isosurface (the solid above it, or the
-  // surface only), a threshold on the tets' values, a clip plane and a slice, by the field shown. The controls
-  // follow. False (nothing changes) with the reason: no field shown, a slice with isovalues, a zero
+  // surface only), a threshold on the tets' values, a clip plane and a slice, by the field shown. The
+  // controls follow. False (nothing changes) with the reason: no field shown, a slice with isovalues, a zero
   // clip or slice normal, what the x-ray or the volume does not draw with (ViewWidget::set_selection).
   bool set_selection(const FieldSelection& selection, QString* error = nullptr);
   // The field shown's display unit (the legend's, the probe's) and its corner values' range, SI: the

@@ -449,9 +449,9 @@ bool ViewWidget::push_region(QString* error) {
   if (!d_->view) return false;
   if (d_->xray) {
     if (error)
-      *error = tr(
-          "a region of interest is the far part of the opaque tets drawn: turn the x-ray off, draw (or "
-          "undraw) to the part you want and press Region; the x-ray then shows that region");
+      *error =
+          tr("a region of interest is the far part of the opaque tets drawn: turn the x-ray off, draw (or "
+             "undraw) to the part you want and press Region; the x-ray then shows that region");
     return false;
   }
   const std::vector<std::uint32_t> region = d_->view->drawn();  // what becomes the displayed set

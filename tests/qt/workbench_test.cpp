@@ -118,8 +118,8 @@ void check_headless(const std::string& model, const std::string& set, const std:
     // foxi render's translucent regions take their own colours: the field only for isosurfaces.
     if (tools.find("--iso") == std::string::npos) field_option.clear();
   }
-  ASSERT_EQ(foxi::test::run_cli("render '" + mesh.string() + "'" + field_option + " --size 320x240" + cli_tools +
-                                    " " + camera + " -o '" + cli.string() + "'",
+  ASSERT_EQ(foxi::test::run_cli("render '" + mesh.string() + "'" + field_option + " --size 320x240" +
+                                    cli_tools + " " + camera + " -o '" + cli.string() + "'",
                                 dir.path() / "render.log"),
             0)
       << foxi::test::read_text(dir.path() / "render.log");
@@ -201,7 +201,8 @@ TEST(WorkbenchHeadless, SlicePictureEqualsFoxiRender) {
   check_headless("die_on_substrate.toml", "die_w=5mm", "T_max", "", "--slice 0.005,0.004,0.0004,0,0.3,1");
 }
 TEST(WorkbenchHeadless, SliceWithinClipEqualsFoxiRender) {
-  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--slice 0.005,0.005,0,0,1,0 --clip 0.005,0.005,0,1,0,0");
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "",
+                 "--slice 0.005,0.005,0,0,1,0 --clip 0.005,0.005,0,1,0,0");
 }
 // The x-ray (issue 23) as foxi render --region-opacity draws it from the opacities the workbench
 // prints: of the regions shown (--regions), and with translucent isotherms inside (--iso-opacity 0.5).
@@ -252,13 +253,13 @@ void check_movie(const std::string& tools) {
   const auto mesh = dir.path() / "mesh.vtu", log = dir.path() / "wb.log";
   const bool xray = tools.find("--xray") != std::string::npos;
   const int frames = 4;
-  ASSERT_EQ(foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
-                                "die_on_substrate.toml' --headless --physics thermal --view-size 160x120 " +
-                                tools + " --save-movie '" + (dir.path() / "wb_%02d.png").string() +
-                                "' --movie-frames " + std::to_string(frames) + " --save-mesh '" +
-                                mesh.string() + "'",
-                            log),
-            0)
+  ASSERT_EQ(
+      foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
+                          "die_on_substrate.toml' --headless --physics thermal --view-size 160x120 " + tools +
+                          " --save-movie '" + (dir.path() / "wb_%02d.png").string() + "' --movie-frames " +
+                          std::to_string(frames) + " --save-mesh '" + mesh.string() + "'",
+                      log),
+      0)
       << foxi::test::read_text(log);
   const std::string out = foxi::test::read_text(log);
   const std::string camera = line_after(out, "camera: ");
@@ -289,9 +290,8 @@ void check_movie(const std::string& tools) {
     EXPECT_TRUE(a.rgba == b.rgba) << "frame " << k;
     if (k == 0) {
       first = a.rgba;
-      const std::size_t coloured = std::size_t(std::count_if(a.rgba.begin(), a.rgba.end(), [](std::uint32_t c) {
-        return c != foxi::pack_rgba(255, 255, 255);
-      }));
+      const std::size_t coloured = std::size_t(std::count_if(
+          a.rgba.begin(), a.rgba.end(), [](std::uint32_t c) { return c != foxi::pack_rgba(255, 255, 255); }));
       EXPECT_GT(coloured, a.rgba.size() / 20) << "the frame shows the model";
     }
     if (k == 1) {

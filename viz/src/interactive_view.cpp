@@ -46,7 +46,8 @@ std::vector<RegionOpacity> default_xray(const Mesh& mesh, double opacity) {
   return out;
 }
 
-VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale, std::span<const std::uint32_t> subset) {
+VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale,
+                            std::span<const std::uint32_t> subset) {
   VolumeParams vp;
   vp.scale = scale;
   vp.opacity_curve = {{scale.lo, 0.02}, {scale.hi, 0.5}};
@@ -453,7 +454,8 @@ ViewMovie InteractiveView::movie_input() const {
 }
 
 std::size_t make_view_movie(const Mesh& mesh, const ViewMovie& movie, const MovieParams& params,
-                            const std::function<void(const Framebuffer&)>& frame, const ProgressFn& progress) {
+                            const std::function<void(const Framebuffer&)>& frame,
+                            const ProgressFn& progress) {
   const SphereTable table = compute_spheres(mesh);
   if (movie.translucent || movie.volume) {
     CompositeMovieParams cp;

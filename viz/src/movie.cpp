@@ -130,12 +130,14 @@ CompositeMovieStats make_composite_movie(const Mesh& mesh, const SphereTable& ta
         Framebuffer fb(width, height);
         const Camera cam = orbit(camera, mp.turn_deg * k / mp.frames, 0);
         if (volume) {
-          const VolumeReport r = draw_volume_picture(mesh, table, cam, fb, subset, params.corner, *params.volume);
+          const VolumeReport r =
+              draw_volume_picture(mesh, table, cam, fb, subset, params.corner, *params.volume);
           st.exact = st.exact && r.exact_order;
           st.composited += r.tets;
           st.fragments += r.samples;
         } else {
-          const TranslucentReport r = draw_translucent_picture(mesh, table, cam, fb, subset, *params.translucent);
+          const TranslucentReport r =
+              draw_translucent_picture(mesh, table, cam, fb, subset, *params.translucent);
           st.exact = st.exact && r.exact_order;
           st.composited += r.tets_ordered;
           st.fragments += r.fragments;
