@@ -269,6 +269,7 @@ QPushButton* Workbench::build_view_panel() {
   // The field tools: isosurface, threshold, clip (by the field shown; disabled without one).
   auto* tools = new QHBoxLayout;
   iso_on_ = new QCheckBox(tr("isosurface"));
+  iso_on_->setObjectName("isosurface");
   iso_on_->setToolTip(tr("the solid where the field is at least the isovalue, cut at the isosurface"));
   iso_slider_ = new QSlider(Qt::Horizontal);
   iso_slider_->setRange(0, 1000);
@@ -298,6 +299,7 @@ QPushButton* Workbench::build_view_panel() {
   clip_slider_->setRange(0, 1000);
   clip_slider_->setValue(500);
   slice_on_ = new QCheckBox(tr("slice"));
+  slice_on_->setObjectName("slice");
   slice_on_->setToolTip(
       tr("the plane's cut through the tets shown, coloured by the field (foxi render --slice); not with "
          "isovalues"));

@@ -1237,6 +1237,54 @@ TEST(Workbench, DoneWhenWalkThrough) {
   shot("picture-saved");
 }
 
+// The slice control: ticking it draws the plane across z through the middle of the mesh's box (the
+// slider's middle), the tets it cuts; with the isosurface on it is refused (a slice and isovalues are
+// both the polygons drawn) and the box unticks itself: the controls show what is drawn.
+TEST(Workbench, SliceControlDrawsAndRefusesWithIsovalues) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  auto* slice = w.findChild<QCheckBox*>("slice");
+  ASSERT_NE(slice, nullptr);
+  ASSERT_TRUE(slice->isEnabled());
+  slice->click();
+  foxi::qt::ViewWidget* v = w.view_widget();
+  ASSERT_TRUE(v->selection().slice.has_value());
+  double lo[3], hi[3];
+  foxi::mesh_bounds(*w.mesh(), lo, hi);
+  EXPECT_DOUBLE_EQ(v->selection().slice->p[2], lo[2] + (hi[2] - lo[2]) * 500 / 1000.0);
+  EXPECT_EQ(v->selection().slice->n[2], 1.0);
+  // The tets drawn are those the plane cuts (a corner below it, one on or above it), counted here;
+  // the middle of this box is a layer of nodes, so the rule at a corner on the plane matters.
+  const foxi::Mesh& m = *w.mesh();
+  const double z = v->selection().slice->p[2];
+  std::size_t cut = 0;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    double zlo = INFINITY, zhi = -INFINITY;
+    for (int k = 0; k < 4; ++k) {
+      const double c = m.xyz[3 * std::size_t(m.tet[4 * t + std::size_t(k)]) + 2] - z;
+      zlo = std::min(zlo, c), zhi = std::max(zhi, c);
+    }
+    cut += zlo < 0 && zhi >= 0;  // crossing's half-open rule (isosurface.hpp): min < v <= max
+  }
+  v->finish_now();
+  EXPECT_GT(v->view()->drawn().size(), 0u);
+  EXPECT_EQ(v->view()->drawn().size(), cut);
+  EXPECT_TRUE(v->view()->iso()) << "drawn as polygons";
+  // The isosurface too: refused, the slice stays and the isosurface box unticks.
+  auto* iso = w.findChild<QCheckBox*>("isosurface");
+  ASSERT_NE(iso, nullptr);
+  iso->click();
+  EXPECT_FALSE(iso->isChecked());
+  EXPECT_TRUE(v->selection().iso.empty());
+  EXPECT_TRUE(v->selection().slice.has_value());
+  slice->click();
+  EXPECT_FALSE(v->selection().any());
+}
+
 // Save movie runs on a worker: the window goes on (the GUI thread is not held), Cancel stops it and no
 // file is left; a name of no known kind, a second movie while one runs and a movie of an isosurface
 // are refused with the reason; an APNG is written whole.
