@@ -492,10 +492,10 @@ bool Workbench::set_selection(const FieldSelection& selection, QString* error) {
 void Workbench::show_selection() {
   filling_ = true;
   const bool field = !selection_field_.isEmpty() && view_->has_view() && field_hi_ >= field_lo_;
-  for (QWidget* w : std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_more_, iso_only_, threshold_on_,
-                                                    threshold_lo_, threshold_hi_, clip_on_, clip_axis_,
-                                                    clip_slider_, slice_on_, slice_axis_, slice_slider_})
-    w->setEnabled(field);
+  for (QWidget* w : std::initializer_list<QWidget*>{
+           iso_on_, iso_slider_, iso_more_, iso_only_, threshold_on_, threshold_lo_, threshold_hi_, clip_on_,
+           clip_axis_, clip_slider_, slice_on_, slice_axis_, slice_slider_, volume_box_})
+    w->setEnabled(field);  // the volume renders the field shown (the x-ray needs none)
   const FieldSelection& s = selection_;
   const QSignalBlocker b0(iso_more_), b1(iso_on_), b2(iso_slider_), b3(iso_only_), b4(threshold_on_),
       b5(threshold_lo_), b6(threshold_hi_), b7(clip_on_), b8(clip_axis_), b9(clip_slider_), b10(slice_on_),

@@ -1083,6 +1083,8 @@ TEST(Workbench, XrayVolumeAndSelectionsStayInSync) {
   ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
   EXPECT_FALSE(v->view()->volume());
   in_sync("by region");
+  EXPECT_FALSE(volume_box->isEnabled()) << "no field shown: nothing to render";
+  EXPECT_TRUE(xray_box->isEnabled());
   // A region of interest first, then the x-ray of it.
   v->finish_now();
   v->set_fraction(0.3);
