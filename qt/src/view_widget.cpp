@@ -116,10 +116,13 @@ void ViewWidget::set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<Inte
   if (d_->view && (d_->view->framebuffer().width != device(width()) ||
                    d_->view->framebuffer().height != device(height())))
     d_->view->resize(device(width()), device(height()));
-  if (d_->view && !apply(nullptr)) {
+  // A new view draws all tets opaque already: only the x-ray has to be put on it (each set-up of the
+  // view is a begin_draw on this thread, so none is spent for nothing).
+  if (d_->view && d_->xray && !apply(nullptr)) {
     d_->xray = false;  // default opacities the painter refuses cannot happen; opaque then, said so
     apply(nullptr);
   }
+  say_composite();
   draw();
 }
 
@@ -224,13 +227,18 @@ bool ViewWidget::apply(QString* error) {
     return false;
   }
   if (!(d_->picked && d_->picked->polygons && !d_->xray)) d_->drawing.reset();
-  const bool x = d_->xray && v.translucent(), vol = d_->volume && v.volume();
+  say_composite();
+  return true;
+}
+
+void ViewWidget::say_composite() {
+  const bool x = d_->view && d_->xray && d_->view->translucent();
+  const bool vol = d_->view && d_->volume && d_->view->volume();
   if (x != d_->shown_xray || vol != d_->shown_volume) {
     d_->shown_xray = x;
     d_->shown_volume = vol;
     emit composite_changed(x, vol);
   }
-  return true;
 }
 
 bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) {

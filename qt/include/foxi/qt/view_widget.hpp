@@ -160,6 +160,7 @@ class FOXI_API ViewWidget : public QWidget {
   // Puts the widget's state on the view: the selection, or the x-ray or volume over the base; says a
   // change of the composite state. False with the reason when the painter refuses (state kept).
   bool apply(QString* error);
+  void say_composite();  // composite_changed, when what is drawn differs from what it last said
   struct Impl;
   std::unique_ptr<Impl> d_;
 };
