@@ -27,7 +27,8 @@ const char* kUsage =
     "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics NAME] [--field NAME]\n"
     "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
     "               [--regions ID,...] [--graded] [--range a,b] [--iso v [--iso-only]] [--threshold a,b] "
-    "[--clip px,py,pz,nx,ny,nz] [--deform NAME:SCALE]\n"
+    "[--clip px,py,pz,nx,ny,nz] [--slice px,py,pz,nx,ny,nz] [--deform NAME:SCALE]\n"
+    "               [--xray] [--save-movie OUT.gif|OUT.apng|DIR/frame_%04d.png [--movie-frames N]]\n"
     "               [--save-project FOLDER] [--screenshot WINDOW.png] [--save-picture VIEW.png] [--save-mesh "
     "MESH.vtu]\n"
     "  The window: open a model, edit its parameters (with units, checked as the model file would\n"
@@ -45,6 +46,10 @@ const char* kUsage =
     "  --regions, --graded, --range, --iso, --iso-only, --threshold and --clip set the view's field tools as "
     "foxi render's options\n"
     "  of the same names draw them (values in the field's display unit, as the legend shows it).\n"
+    "  --slice draws the plane's cut as foxi render --slice. --xray: every region translucent but the\n"
+    "  smallest (printed as foxi render's --region-opacity), isotherms of --iso translucent inside\n"
+    "  (--iso-opacity 0.5). --save-movie: the view's camera turned once around in --movie-frames N\n"
+    "  frames (default 48), as foxi movie --mode rotate --frames N draws them.\n"
     "  --deform NAME:SCALE draws the deformed shape as foxi render --deform does (the status line says\n"
     "  the order: MPVO with the depth buffer where the moved mesh is not Delaunay).\n"
     "  Run it with QT_QPA_PLATFORM=offscreen where there is no display.\n"
@@ -90,8 +95,11 @@ std::vector<double> parse_list(const std::string& s, const char* what, std::size
 struct ToolOptions {
   std::vector<double> iso;
   bool iso_only = false;
-  std::vector<double> threshold, clip;
-  bool any() const { return !iso.empty() || !threshold.empty() || !clip.empty(); }
+  std::vector<double> threshold, clip, slice;
+  bool any() const { return !iso.empty() || !threshold.empty() || !clip.empty() || !slice.empty(); }
+  bool xray = false;  // --xray
+  std::string movie;  // --save-movie
+  int movie_frames = 48;
   bool graded = false;
   std::vector<double> range, regions;
   std::string project;                            // --save-project
@@ -171,13 +179,31 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
         p.p[k] = tools.clip[std::size_t(k)], p.n[k] = tools.clip[std::size_t(k) + 3];
       s.clip = p;
     }
+    if (!tools.slice.empty()) {
+      foxi::Plane p;
+      for (int k = 0; k < 3; ++k)
+        p.p[k] = tools.slice[std::size_t(k)], p.n[k] = tools.slice[std::size_t(k) + 3];
+      s.slice = p;
+    }
     if (!w.set_selection(s, &error)) {
-      std::fprintf(stderr, "foxi-workbench: error: --iso/--threshold/--clip: %s\n",
+      std::fprintf(stderr, "foxi-workbench: error: --iso/--threshold/--clip/--slice: %s\n",
                    error.toUtf8().constData());
       return kExitUsage;
     }
   }
   foxi::qt::ViewWidget* view = w.view_widget();
+  if (tools.xray) {
+    if (!view->set_xray(true, &error)) {
+      std::fprintf(stderr, "foxi-workbench: error: --xray: %s\n", error.toUtf8().constData());
+      return kExitUsage;
+    }
+    // The opacities as foxi render's option (region ids), so that a script can draw the same.
+    std::string spec;
+    for (const foxi::RegionOpacity& r : view->xray_params()->region_opacity)
+      spec += (spec.empty() ? "" : ",") + std::to_string(r.region) + "=" + std::to_string(r.opacity);
+    std::printf("x-ray: --region-opacity %s%s\n", spec.c_str(),
+                view->xray_params()->iso.values.empty() ? "" : " --iso-opacity 0.5");
+  }
   view->finish_now();
   QApplication::processEvents();
   std::printf("mesh: %zu tets\n", w.mesh()->tet_count());
@@ -205,6 +231,27 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
       return kExitFailure;
     }
     std::printf("wrote %s\n", screenshot.c_str());
+  }
+  if (!tools.movie.empty()) {
+    if (!w.save_movie(QString::fromStdString(tools.movie), tools.movie_frames, &error)) {
+      std::fprintf(stderr, "foxi-workbench: error: --save-movie: %s\n", error.toUtf8().constData());
+      return kExitUsage;
+    }
+    bool ok = false;
+    QString message;
+    QEventLoop loop;
+    QObject::connect(&w, &foxi::workbench::Workbench::movie_finished, &loop, [&](bool r, const QString& m) {
+      ok = r;
+      message = m;
+      loop.quit();
+    });
+    loop.exec();
+    if (!ok) {
+      std::fprintf(stderr, "foxi-workbench: error: %s: %s\n", tools.movie.c_str(),
+                   message.toUtf8().constData());
+      return kExitFailure;
+    }
+    std::printf("wrote %s (%d frames)\n", tools.movie.c_str(), tools.movie_frames);
   }
   if (!tools.project.empty()) {
     if (!w.save_project(QString::fromStdString(tools.project), &error)) {
@@ -294,6 +341,17 @@ int main(int argc, char** argv) {
         if (!(tools.threshold[0] <= tools.threshold[1])) throw Usage("--threshold takes a,b with a <= b");
       } else if (a == "--clip") {
         tools.clip = parse_list(value(), "--clip", 6);
+      } else if (a == "--slice") {
+        tools.slice = parse_list(value(), "--slice", 6);
+      } else if (a == "--xray") {
+        tools.xray = true;
+      } else if (a == "--save-movie") {
+        tools.movie = value();
+      } else if (a == "--movie-frames") {
+        const std::vector<double> n = parse_list(value(), "--movie-frames", 1);
+        if (!(n[0] >= 2 && n[0] <= 10000 && n[0] == std::floor(n[0])))
+          throw Usage("--movie-frames takes a whole number 2..10000");
+        tools.movie_frames = int(n[0]);
       } else if (a == "--view-size") {
         view_size = value();
       } else if (a.rfind("-", 0) == 0 && a.size() > 1 && a.rfind("-platform", 0) != 0) {
@@ -308,9 +366,9 @@ int main(int argc, char** argv) {
     if (tools.iso_only && tools.iso.empty())
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
     if (!is_headless &&
-        (tools.any() || tools.graded || tools.deform || !tools.range.empty() || !tools.regions.empty() ||
-         !tools.project.empty() || !sets.empty() || !physics.empty() || !field.empty() ||
-         !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
+        (tools.any() || tools.graded || tools.deform || tools.xray || !tools.movie.empty() ||
+         !tools.range.empty() || !tools.regions.empty() || !tools.project.empty() || !sets.empty() ||
+         !physics.empty() || !field.empty() || !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
       throw Usage(
           "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")

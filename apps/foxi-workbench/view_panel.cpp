@@ -6,22 +6,30 @@
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFileDialog>
+#include <QFileInfo>
 #include <QHBoxLayout>
 #include <QImage>
 #include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
 #include <QPainter>
+#include <QProgressBar>
 #include <QPushButton>
 #include <QSignalBlocker>
 #include <QSlider>
+#include <QTimer>
 #include <QVBoxLayout>
+#include <QtConcurrent/QtConcurrentRun>
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
 #include <tuple>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include "foxi/model/validate.hpp"
+#include "foxi/viz/animation.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/legend.hpp"
 #include "foxi/viz/rasterizer.hpp"
@@ -145,7 +153,13 @@ QPushButton* Workbench::build_view_panel() {
   button(tr("Go on"), &foxi::qt::ViewWidget::resume);
   button(tr("Step"), &foxi::qt::ViewWidget::step_once);
   button(tr("Undraw"), &foxi::qt::ViewWidget::undraw);
-  button(tr("Region"), &foxi::qt::ViewWidget::push_region);
+  auto* region = new QPushButton(tr("Region"));
+  region->setToolTip(tr("the tets drawn become the displayed set, the camera framed on them"));
+  connect(region, &QPushButton::clicked, this, [this] {
+    QString why;
+    if (!view_->push_region(&why)) param_error_->setText(why);
+  });
+  bar->addWidget(region);
   button(tr("Back"), &foxi::qt::ViewWidget::pop_region);
   auto* save = new QPushButton(tr("Save picture..."));
   connect(save, &QPushButton::clicked, this, [this] {
@@ -155,6 +169,27 @@ QPushButton* Workbench::build_view_panel() {
     if (!f.isEmpty() && !view_->save_picture(f, &error)) param_error_->setText(error);
   });
   bar->addWidget(save);
+  // The movie: a turning camera (foxi movie --mode rotate), written on a worker; the button cancels it.
+  movie_button_ = new QPushButton(tr("Save movie..."));
+  movie_button_->setToolTip(
+      tr("the camera turned once around, 48 frames, as foxi movie --mode rotate draws them: .gif, .apng or "
+         "numbered PNG frames (frame_%04d.png)"));
+  movie_progress_ = new QProgressBar;
+  movie_progress_->setRange(0, 1000);
+  movie_progress_->setMaximumWidth(120);
+  movie_progress_->setVisible(false);
+  connect(movie_button_, &QPushButton::clicked, this, [this] {
+    if (movie_) {
+      cancel_movie();
+      return;
+    }
+    const QString f = QFileDialog::getSaveFileName(this, tr("Save a movie of the view"), QString(),
+                                                   tr("Movies (*.gif *.apng);;PNG frames (*.png)"));
+    QString error;
+    if (!f.isEmpty() && !save_movie(f, 48, &error)) param_error_->setText(error);
+  });
+  bar->addWidget(movie_button_);
+  bar->addWidget(movie_progress_);
   fraction_ = new QSlider(Qt::Horizontal);
   fraction_->setRange(0, 1000);
   fraction_->setValue(1000);
@@ -164,7 +199,7 @@ QPushButton* Workbench::build_view_panel() {
   auto* slider_row = new QHBoxLayout;
   slider_row->addWidget(new QLabel(tr("fraction drawn")));
   slider_row->addWidget(fraction_, 1);
-  cv->addLayout(slider_row);
+  cv->addLayout(slider_row);  // shrink and the deformed shape join this row below
   auto* fields = new QHBoxLayout;
   field_box_ = new QComboBox;
   field_box_->setMinimumContentsLength(12);
@@ -211,8 +246,6 @@ QPushButton* Workbench::build_view_panel() {
   fields->addWidget(range_on_);
   fields->addWidget(range_lo_);
   fields->addWidget(range_hi_);
-  fields->addWidget(new QLabel(tr("shrink")));
-  fields->addWidget(shrink_box_);
   // The deformed shape: the displacement (a thermal stress solve's) times the scale.
   deform_on_ = new QCheckBox(tr("deformed x"));
   deform_on_->setToolTip(
@@ -223,6 +256,7 @@ QPushButton* Workbench::build_view_panel() {
   deform_scale_->setDecimals(1);
   deform_scale_->setValue(100);
   deform_scale_->setKeyboardTracking(false);
+  deform_scale_->setMaximumWidth(90);
   auto deform = [this] {
     if (filling_) return;
     std::optional<Deform> d;
@@ -231,12 +265,11 @@ QPushButton* Workbench::build_view_panel() {
   };
   connect(deform_on_, &QCheckBox::toggled, this, deform);
   connect(deform_scale_, qOverload<double>(&QDoubleSpinBox::valueChanged), this, deform);
-  fields->addWidget(deform_on_);
-  fields->addWidget(deform_scale_);
   cv->addLayout(fields);
   // The field tools: isosurface, threshold, clip (by the field shown; disabled without one).
   auto* tools = new QHBoxLayout;
   iso_on_ = new QCheckBox(tr("isosurface"));
+  iso_on_->setObjectName("isosurface");
   iso_on_->setToolTip(tr("the solid where the field is at least the isovalue, cut at the isosurface"));
   iso_slider_ = new QSlider(Qt::Horizontal);
   iso_slider_->setRange(0, 1000);
@@ -265,33 +298,68 @@ QPushButton* Workbench::build_view_panel() {
   clip_slider_ = new QSlider(Qt::Horizontal);
   clip_slider_->setRange(0, 1000);
   clip_slider_->setValue(500);
+  slice_on_ = new QCheckBox(tr("slice"));
+  slice_on_->setObjectName("slice");
+  slice_on_->setToolTip(
+      tr("the plane's cut through the tets shown, coloured by the field (foxi render --slice); not with "
+         "isovalues"));
+  slice_axis_ = new QComboBox;
+  for (const char* a : {"x", "y", "z"}) slice_axis_->addItem(a);
+  slice_axis_->setCurrentIndex(2);
+  slice_slider_ = new QSlider(Qt::Horizontal);
+  slice_slider_->setRange(0, 1000);
+  slice_slider_->setValue(500);
   tools->addWidget(iso_on_);
   tools->addWidget(iso_slider_, 3);
   tools->addWidget(iso_value_);
   tools->addWidget(iso_more_);
   tools->addWidget(iso_only_);
-  tools->addWidget(threshold_on_);
-  tools->addWidget(threshold_lo_);
-  tools->addWidget(threshold_hi_);
-  tools->addWidget(clip_on_);
-  tools->addWidget(clip_axis_);
-  tools->addWidget(clip_slider_, 2);
+  // The subsets and cuts on a row of their own (one row for all made the window ~2000 pixels wide).
+  auto* cuts = new QHBoxLayout;
+  cuts->addWidget(threshold_on_);
+  cuts->addWidget(threshold_lo_);
+  cuts->addWidget(threshold_hi_);
+  cuts->addWidget(clip_on_);
+  cuts->addWidget(clip_axis_);
+  cuts->addWidget(clip_slider_, 2);
+  cuts->addWidget(slice_on_);
+  cuts->addWidget(slice_axis_);
+  cuts->addWidget(slice_slider_, 2);
   // Translucency and volume rendering (issue 23), composited exactly: ViewWidget::set_xray, set_volume.
+  // The boxes show what the view draws (composite_changed), not what was last clicked.
   for (const bool volume : {false, true}) {
     auto* box = new QCheckBox(volume ? tr("volume") : tr("X-ray"));
+    box->setObjectName(volume ? "volume" : "xray");
     box->setToolTip(volume ? tr("a volume rendering of the field shown (foxi render --volume)")
-                           : tr("every region translucent but the smallest (foxi render --region-opacity)"));
+                           : tr("every region translucent but the smallest, isosurfaces translucent inside "
+                                "(foxi render --region-opacity, --iso-opacity)"));
     connect(box, &QCheckBox::toggled, this, [this, box, volume](bool on) {
       QString why;
       if (!(volume ? view_->set_volume(on, &why) : view_->set_xray(on, &why))) {
         param_error_->setText(why);
         const QSignalBlocker block(box);
-        box->setChecked(false);
+        box->setChecked(volume ? view_->volume() : view_->xray());
       }
     });
-    tools->addWidget(box);
+    (volume ? volume_box_ : xray_box_) = box;
   }
+  connect(view_, &foxi::qt::ViewWidget::composite_changed, this, [this](bool xray, bool volume) {
+    const QSignalBlocker b1(xray_box_), b2(volume_box_);
+    xray_box_->setChecked(xray);
+    volume_box_->setChecked(volume);
+  });
+  tools->addWidget(xray_box_);
+  tools->addWidget(volume_box_);
+  // Shrink and the deformed shape beside the fraction slider: each row of tools stays short enough
+  // that the window fits a 1680-pixel screen with its panels.
+  slider_row->addWidget(new QLabel(tr("shrink")));
+  slider_row->addWidget(shrink_box_);
+  slider_row->addWidget(deform_on_);
+  slider_row->addWidget(deform_scale_);
+  for (QSlider* sl : {iso_slider_, clip_slider_, slice_slider_}) sl->setMinimumWidth(100);
+  iso_more_->setMinimumWidth(90);
   cv->addLayout(tools);
+  cv->addLayout(cuts);
   regions_ = new QListWidget;
   regions_->setFlow(QListView::LeftToRight);
   regions_->setMaximumHeight(32);
@@ -308,8 +376,11 @@ QPushButton* Workbench::build_view_panel() {
   region_row->addWidget(new QLabel(tr("regions shown")));
   region_row->addWidget(regions_, 1);
   cv->addLayout(region_row);
-  for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_})
+  for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_, slice_on_})
     connect(c, &QCheckBox::toggled, this, [this] { apply_field_tools(); });
+  connect(slice_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
+  connect(slice_axis_, qOverload<int>(&QComboBox::currentIndexChanged), this,
+          [this] { apply_field_tools(); });
   connect(iso_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
   connect(iso_more_, &QLineEdit::editingFinished, this, [this] { apply_field_tools(); });
   connect(clip_slider_, &QSlider::valueChanged, this, [this] { apply_field_tools(); });
@@ -421,13 +492,14 @@ bool Workbench::set_selection(const FieldSelection& selection, QString* error) {
 void Workbench::show_selection() {
   filling_ = true;
   const bool field = !selection_field_.isEmpty() && view_->has_view() && field_hi_ >= field_lo_;
-  for (QWidget* w :
-       std::initializer_list<QWidget*>{iso_on_, iso_slider_, iso_more_, iso_only_, threshold_on_,
-                                       threshold_lo_, threshold_hi_, clip_on_, clip_axis_, clip_slider_})
-    w->setEnabled(field);
+  for (QWidget* w : std::initializer_list<QWidget*>{
+           iso_on_, iso_slider_, iso_more_, iso_only_, threshold_on_, threshold_lo_, threshold_hi_, clip_on_,
+           clip_axis_, clip_slider_, slice_on_, slice_axis_, slice_slider_, volume_box_})
+    w->setEnabled(field);  // the volume renders the field shown (the x-ray needs none)
   const FieldSelection& s = selection_;
   const QSignalBlocker b0(iso_more_), b1(iso_on_), b2(iso_slider_), b3(iso_only_), b4(threshold_on_),
-      b5(threshold_lo_), b6(threshold_hi_), b7(clip_on_), b8(clip_axis_), b9(clip_slider_);
+      b5(threshold_lo_), b6(threshold_hi_), b7(clip_on_), b8(clip_axis_), b9(clip_slider_), b10(slice_on_),
+      b11(slice_axis_), b12(slice_slider_);
   iso_on_->setChecked(!s.iso.empty());
   iso_only_->setChecked(s.iso_only);
   const double span = field_hi_ - field_lo_;
@@ -457,6 +529,16 @@ void Workbench::show_selection() {
         clip_axis_->setCurrentIndex(s.clip->n[k] > 0 ? k : k + 3);
         clip_slider_->setValue(
             int(std::lround(1000 * (s.clip->p[k] - bounds_lo_[k]) / (bounds_hi_[k] - bounds_lo_[k]))));
+      }
+  }
+  slice_on_->setChecked(s.slice.has_value());
+  if (s.slice) {
+    for (int k = 0; k < 3; ++k)
+      if (s.slice->n[k] != 0 && s.slice->n[(k + 1) % 3] == 0 && s.slice->n[(k + 2) % 3] == 0 &&
+          bounds_hi_[k] > bounds_lo_[k]) {
+        slice_axis_->setCurrentIndex(k);
+        slice_slider_->setValue(
+            int(std::lround(1000 * (s.slice->p[k] - bounds_lo_[k]) / (bounds_hi_[k] - bounds_lo_[k]))));
       }
   }
   filling_ = false;
@@ -492,8 +574,21 @@ void Workbench::apply_field_tools() {
     p.p[k] = bounds_lo_[k] + (bounds_hi_[k] - bounds_lo_[k]) * clip_slider_->value() / 1000.0;
     s.clip = p;
   }
+  if (slice_on_->isChecked()) {
+    Plane p;
+    const int k = slice_axis_->currentIndex();
+    for (int j = 0; j < 3; ++j) {
+      p.p[j] = 0.5 * (bounds_lo_[j] + bounds_hi_[j]);
+      p.n[j] = j == k ? 1 : 0;
+    }
+    p.p[k] = bounds_lo_[k] + (bounds_hi_[k] - bounds_lo_[k]) * slice_slider_->value() / 1000.0;
+    s.slice = p;
+  }
   QString why;
-  if (!set_selection(s, &why)) param_error_->setText(why);
+  if (!set_selection(s, &why)) {
+    param_error_->setText(why);
+    show_selection();  // the controls back to what is drawn
+  }
 }
 
 void Workbench::refresh_fields() {
@@ -522,6 +617,92 @@ void Workbench::refresh_fields() {
       regions_->addItem(item);
     }
   filling_ = false;
+}
+
+bool Workbench::save_movie(const QString& path, int frames, QString* error) {
+  auto fail = [&](const QString& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (movie_) return fail(tr("a movie is being written: cancel it or wait"));
+  if (!view_->has_view()) return fail(tr("no picture to make a movie of"));
+  if (frames < 2) return fail(tr("a movie needs at least 2 frames"));
+  const std::string out = path.toStdString();
+  const QString ext = QFileInfo(path).suffix().toLower();
+  enum class Kind { gif, apng, png_frames } kind;
+  if (path.contains('%')) {
+    if (!frame_pattern(out))
+      return fail(tr("%1: a frame name needs one %d or %0Nd and no other %").arg(path));
+    kind = Kind::png_frames;
+  } else if (ext == "gif") {
+    kind = Kind::gif;
+  } else if (ext == "apng") {
+    kind = Kind::apng;
+  } else {
+    return fail(tr("%1: give .gif, .apng or a numbered frame name like frames/frame_%04d.png").arg(path));
+  }
+  ViewMovie input;
+  try {
+    input = view_->view()->movie_input();  // a copy: the view goes on while the worker draws
+  } catch (const std::exception& e) {
+    return fail(what_of(e));
+  }
+  MovieParams mp;
+  mp.rotate = true;
+  mp.frames = frames;
+  std::shared_ptr<const Mesh> mesh = view_->mesh();
+  movie_ = std::make_unique<MovieJob>();
+  auto work = [mesh, input = std::move(input), mp, out, kind, cancel = movie_->cancel,
+               permille = movie_->permille]() -> QString {
+    setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), 10);  // as the jobs' workers
+    try {
+      AnimationParams ap;
+      ap.width = input.width;
+      ap.height = input.height;
+      std::unique_ptr<AnimationWriter> writer = kind == Kind::gif    ? open_gif(out, ap)
+                                                : kind == Kind::apng ? open_apng(out, ap)
+                                                                     : open_png_frames(out, ap);
+      make_view_movie(
+          *mesh, input, mp, [&](const Framebuffer& fb) { writer->add(fb); },
+          [&](std::string_view, double f) {
+            permille->store(int(std::lround(std::clamp(f, 0.0, 1.0) * 1000)));
+            return !cancel->load();
+          });
+      writer->finish();
+      return {};
+    } catch (const MovieCancelled&) {
+      return QStringLiteral("cancelled");
+    } catch (const std::exception& e) {
+      return QString::fromStdString(e.what());
+    }
+  };
+  connect(&movie_->watcher, &QFutureWatcher<QString>::finished, this, [this, path] {
+    const QString why = movie_->watcher.result();
+    // Not deleted inside its own watcher's signal: after it returns.
+    MovieJob* done = movie_.release();
+    QTimer::singleShot(0, this, [done] { delete done; });
+    movie_button_->setText(tr("Save movie..."));
+    movie_progress_->setVisible(false);
+    if (why.isEmpty())
+      progress_->setFormat(tr("movie written: %1").arg(path));
+    else if (why != "cancelled")
+      param_error_->setText(tr("movie: %1").arg(why));
+    emit movie_finished(why.isEmpty(), why.isEmpty() ? path : why);
+  });
+  movie_->poll.setInterval(100);
+  connect(&movie_->poll, &QTimer::timeout, this, [this] {
+    if (movie_) movie_progress_->setValue(movie_->permille->load());
+  });
+  movie_->poll.start();
+  movie_->watcher.setFuture(QtConcurrent::run(std::move(work)));
+  movie_button_->setText(tr("Cancel movie"));
+  movie_progress_->setValue(0);
+  movie_progress_->setVisible(true);
+  return true;
+}
+
+void Workbench::cancel_movie() {
+  if (movie_) movie_->cancel->store(true);
 }
 
 }  // namespace foxi::workbench

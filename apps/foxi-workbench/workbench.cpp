@@ -70,7 +70,10 @@ void Workbench::build_ui() {
   key(QKeySequence("Space"), tr("stop / go on"), [this] { view_->busy() ? view_->stop() : view_->resume(); });
   key(QKeySequence("N"), tr("step"), [this] { view_->step_once(); });
   key(QKeySequence("U"), tr("undraw"), [this] { view_->undraw(); });
-  key(QKeySequence("R"), tr("region of interest"), [this] { view_->push_region(); });
+  key(QKeySequence("R"), tr("region of interest"), [this] {
+    QString why;
+    if (!view_->push_region(&why)) param_error_->setText(why);
+  });
   key(QKeySequence("B"), tr("back out of the region"), [this] { view_->pop_region(); });
   key(QKeySequence::Open, tr("open a model"), [open] { open->click(); });
   key(QKeySequence("Ctrl+M"), tr("mesh"), [this] { start_mesh(); });

@@ -206,8 +206,9 @@ class Workbench : public QMainWindow {
   DisplayUnit shown_unit(const std::string& si_unit, double max_abs) const;
 
   // The view's field tools (field_selection.hpp, SI values): an isosurface (the solid above it, or the
-  // surface only), a threshold on the tets' values and a clip plane, by the field shown. The controls
-  // follow. False (nothing changes) with the reason: no field shown, a slice, a zero clip normal.
+  // surface only), a threshold on the tets' values, a clip plane and a slice, by the field shown. The
+  // controls follow. False (nothing changes) with the reason: no field shown, a slice with isovalues, a zero
+  // clip or slice normal, what the x-ray or the volume does not draw with (ViewWidget::set_selection).
   bool set_selection(const FieldSelection& selection, QString* error = nullptr);
   // The field shown's display unit (the legend's, the probe's) and its corner values' range, SI: the
   // range the isovalue slider spans.
@@ -219,6 +220,16 @@ class Workbench : public QMainWindow {
   QSlider* iso_slider() const { return iso_slider_; }
   QLineEdit* more_isovalues() const { return iso_more_; }
   const FieldSelection& selection() const { return selection_; }
+
+  // A movie of the view: foxi movie --mode rotate --frames N with the view's camera, size and what it
+  // draws (the field's colours, regions shown, threshold or clip, x-ray or volume; not an isosurface
+  // or slice), the camera turned 360 degrees about its up axis, written to `path` (.gif, .apng, or
+  // numbered PNG frames like DIR/frame_%04d.png, the folder existing) on a worker with progress and
+  // Cancel (cancel_movie); movie_finished follows. A file appears whole or not at all. False (nothing
+  // started) with the reason: no view, a movie running, iso drawing, a bad name, frames < 2.
+  bool save_movie(const QString& path, int frames = 48, QString* error = nullptr);
+  void cancel_movie();
+  bool movie_running() const { return movie_ != nullptr; }
 
   // A project folder: project.json (the model file's absolute path, so its material library and STL
   // references stay valid; the parameter overrides, the colouring, the camera, the history, the
@@ -269,6 +280,8 @@ class Workbench : public QMainWindow {
  signals:
   // A job ended: ok false with last_error() (cancelled: "cancelled").
   void finished(bool ok);
+  // A movie ended: ok, or the reason ("cancelled" when cancelled).
+  void movie_finished(bool ok, const QString& message);
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -359,6 +372,10 @@ class Workbench : public QMainWindow {
   struct Job;
   std::unique_ptr<Job> job_;
   std::shared_ptr<SolveProgress> last_solve_;  // the running or last solve's iterations
+  struct MovieJob;  // view_panel.cpp: the movie being written (cancelled and waited for when it goes)
+  std::unique_ptr<MovieJob> movie_;
+  QPushButton* movie_button_ = nullptr;
+  QProgressBar* movie_progress_ = nullptr;
   QTimer* poll_ = nullptr;
 
   foxi::qt::ViewWidget* view_ = nullptr;
@@ -393,6 +410,11 @@ class Workbench : public QMainWindow {
   QLineEdit* iso_more_ = nullptr;  // more isovalues (display unit), drawn with the slider's
   QDoubleSpinBox *threshold_lo_ = nullptr, *threshold_hi_ = nullptr;
   QComboBox* clip_axis_ = nullptr;
+  // The slice (foxi render --slice): an axis plane through the slider's position, coloured by the field.
+  QCheckBox* slice_on_ = nullptr;
+  QComboBox* slice_axis_ = nullptr;
+  QSlider* slice_slider_ = nullptr;
+  QCheckBox *xray_box_ = nullptr, *volume_box_ = nullptr;
   QListWidget* regions_ = nullptr;
   QLabel *status_ = nullptr, *probe_ = nullptr;
   bool filling_ = false;  // the tables being filled by the program, not edited

@@ -9,6 +9,7 @@
 #include <QFutureWatcher>
 #include <QPixmap>
 #include <QString>
+#include <QTimer>
 #include <atomic>
 #include <exception>
 #include <memory>
@@ -78,6 +79,16 @@ struct Workbench::Job {
 
 // Whether two override lists are the same, name and expression, in order (jobs.cpp).
 bool same_overrides(const std::vector<ParameterOverride>& a, const std::vector<ParameterOverride>& b);
+struct Workbench::MovieJob {
+  std::shared_ptr<std::atomic<bool>> cancel = std::make_shared<std::atomic<bool>>(false);
+  std::shared_ptr<std::atomic<int>> permille = std::make_shared<std::atomic<int>>(0);
+  QFutureWatcher<QString> watcher;  // the worker's result: empty when written, else the reason
+  QTimer poll;
+  ~MovieJob() {
+    cancel->store(true);
+    watcher.waitForFinished();
+  }
+};
 
 // The stage (1, 2, ...) of a progress value stage * 10000 + permille; "" for 0 (jobs.cpp).
 const char* progress_stage(int index);

@@ -111,27 +111,6 @@ long whole(const std::string& s, const char* what, long fallback, long lo, long 
   return v;
 }
 
-// True if `pattern` holds exactly one printf integer conversion (%d or %0Nd) and no other '%'.
-bool frame_pattern(const std::string& pattern) {
-  int conversions = 0;
-  for (std::size_t i = 0; i < pattern.size(); ++i) {
-    if (pattern[i] != '%') continue;
-    std::size_t j = i + 1;
-    if (j < pattern.size() && pattern[j] == '0') ++j;
-    while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9') ++j;
-    if (j >= pattern.size() || pattern[j] != 'd' || j - i > 4) return false;
-    ++conversions;
-    i = j;
-  }
-  return conversions == 1;
-}
-
-std::string frame_name(const std::string& pattern, std::size_t k) {
-  char buf[4096];
-  std::snprintf(buf, sizeof buf, pattern.c_str(), int(k));  // checked by frame_pattern
-  return buf;
-}
-
 // Looked up in PATH here rather than by a shell: a child process foxi does not track could outlive a stop.
 bool have_ffmpeg() {
   const char* path = std::getenv("PATH");

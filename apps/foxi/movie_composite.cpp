@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <memory>
 
-#include "foxi/model/delaunay.hpp"
 #include "foxi/viz/field_paint.hpp"
 #include "foxi/viz/translucent.hpp"
 #include "foxi/viz/visibility_order.hpp"
@@ -45,34 +44,6 @@ void check_composite_movie(const CompositeOptions& composite, const std::optiona
     throw UsageError(
         "a translucent or volume rotating movie draws the whole picture: leave out --from and --to");
 }
-
-namespace {
-
-// The first round(n f) of n.
-std::size_t prefix(std::size_t n, double fraction) {
-  return std::min(n, std::size_t(std::llround(std::clamp(fraction, 0.0, 1.0) * double(n))));
-}
-
-// One of the two compositing painters, for the back-and-forth movie.
-struct Compositor {
-  std::unique_ptr<TranslucentPainter> translucent;
-  std::unique_ptr<VolumePainter> volume;
-  void draw(std::span<const std::uint32_t> tets) {
-    if (translucent)
-      translucent->draw(tets);
-    else
-      volume->draw(tets);
-  }
-  void resolve(Framebuffer& fb) {
-    if (translucent)
-      translucent->resolve(fb);
-    else
-      volume->resolve(fb);
-  }
-  std::size_t fragments() const { return translucent ? translucent->fragment_count() : volume->samples(); }
-};
-
-}  // namespace
 
 CompositeMovieStats run_composite_movie(
     const CompositeMovieInputs& in,
@@ -119,69 +90,24 @@ CompositeMovieStats run_composite_movie(
     }
     return st;
   }
-  if (mp.rotate) {
-    for (int c = 0; c < mp.cycles; ++c)
-      for (int k = 0; k < mp.frames; ++k) {
-        Framebuffer fb(in.width, in.height);
-        draw(orbit(in.camera, mp.turn_deg * k / mp.frames, 0), 1, fb);
-        emit(fb);
-      }
-    return st;
+  // Turning and back-and-forth: the library's movie (viz/movie.hpp), from the same parameters.
+  CompositeMovieParams cp;
+  cp.movie = mp;
+  if (volume) {
+    cp.volume = volume_params(in.options, in.mesh, in.field, in.subset);
+    cp.corner = corner;
+  } else {
+    cp.translucent = translucent_params(in.options, in.mesh, in.render, iso);
   }
-  // Back and forth: the far part of the power order of the tets that own something to draw.
-  if (!delaunay_certificate(in.mesh).delaunay)
+  try {
+    static_cast<foxi::CompositeMovieStats&>(st) =
+        make_composite_movie(in.mesh, in.table, in.camera, in.width, in.height, in.subset, cp,
+                             [&](const Framebuffer& fb) { frame(fb, legend); });
+  } catch (const UncertifiedMeshError&) {  // back-and-forth only, before any frame
     throw InputError(in.path +
                      " fails the Delaunay certificate: it has no visibility order to grow the far part of "
                      "(--mode rotate and --sweep opacity composite it without one, as foxi render does)");
-  TranslucentParams tp;
-  VolumeParams vp;
-  TranslucentSurfaces surfaces;
-  std::span<const std::uint32_t> tets = in.subset;
-  if (volume) {
-    vp = volume_params(in.options, in.mesh, in.field, in.subset);
-  } else {
-    tp = translucent_params(in.options, in.mesh, in.render, iso);
-    surfaces = translucent_surfaces(in.mesh, in.subset, tp);
-    tets = surfaces.tets;
   }
-  std::vector<std::uint32_t> order;
-  if (volume || !tets.empty()) order = visibility_order(in.mesh, in.table, view_of(in.camera), tets);
-  const std::span<const std::uint32_t> all(order);
-  auto fresh = [&] {
-    Compositor c;
-    if (volume)
-      c.volume = std::make_unique<VolumePainter>(in.mesh, in.camera, in.width, in.height, corner, vp);
-    else
-      c.translucent =
-          std::make_unique<TranslucentPainter>(in.mesh, in.camera, in.width, in.height, surfaces, tp);
-    return c;
-  };
-  Compositor painter = fresh();
-  std::size_t fragments_before = 0;  // of the painters replaced
-  std::size_t have = prefix(order.size(), mp.from);
-  painter.draw(all.first(have));
-  st.composited += have;
-  const int half = mp.frames / 2;
-  Framebuffer fb(in.width, in.height);
-  for (int c = 0; c < mp.cycles; ++c)
-    for (int k = 0; k < mp.frames; ++k) {
-      const double t = k <= half ? double(k) / half : double(mp.frames - k) / double(mp.frames - half);
-      const std::size_t want = prefix(order.size(), mp.from + (mp.to - mp.from) * t);
-      if (want > have) {
-        painter.draw(all.subspan(have, want - have));
-        st.composited += want - have;
-      } else if (want < have) {
-        fragments_before += painter.fragments();
-        painter = fresh();
-        painter.draw(all.first(want));
-        st.composited += want;
-        st.recomposited += want;
-      }
-      have = want;
-      painter.resolve(fb);
-      emit(fb);
-    }
-  st.fragments = fragments_before + painter.fragments();
   return st;
 }
 

@@ -56,13 +56,9 @@ struct CompositeMovieInputs {
   const std::string& path;
 };
 
-struct CompositeMovieStats {
-  std::size_t frames = 0;
-  bool exact = true;             // every frame composited in the power order
-  std::size_t composited = 0;    // tets composited over the movie (recomposited ones again)
-  std::size_t recomposited = 0;  // of those, composited again to go back (backforth)
-  std::size_t fragments = 0;     // translucent: fragments blended; volume: pixel segments integrated
-  std::vector<double> scales;    // --sweep opacity: each frame's factor
+// The library's counts (viz/movie.hpp), and an opacity sweep's factors.
+struct CompositeMovieStats : foxi::CompositeMovieStats {
+  std::vector<double> scales;  // --sweep opacity: each frame's factor
 };
 
 // Draws the frames in order and hands each, with the field picture its legend shows, to `frame`.

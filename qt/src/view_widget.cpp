@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <exception>
 #include <optional>
+#include <utility>
 
 #include "foxi/model/mesh.hpp"
 #include "foxi/viz/camera.hpp"
@@ -46,6 +47,16 @@ struct ViewWidget::Impl {
   std::unique_ptr<TetSelection> picked;
   std::unique_ptr<IsoDrawing> drawing;
   std::vector<double> volume_corner;  // lent to the view while it draws the volume
+  // What is composited (a host's check boxes show it): at most one of the two.
+  bool xray = false, volume = false;
+  bool volume_pending = false;  // a new view: the volume comes back with the next field source
+  bool shown_xray = false, shown_volume = false;  // as composite_changed last said
+  TranslucentParams xray_params;                  // the x-ray as drawn (its iso corner values lent by picked)
+  void reset_selection() {
+    selection = {};
+    drawing.reset();
+    picked.reset();
+  }
 };
 
 namespace {
@@ -95,15 +106,23 @@ void ViewWidget::set_view(std::shared_ptr<const Mesh> mesh, std::unique_ptr<Inte
   d_->view = std::move(view);
   d_->source.reset();
   d_->base.clear();
-  d_->selection = {};
-  d_->drawing.reset();
-  d_->picked.reset();
+  d_->reset_selection();
   d_->mesh = std::move(mesh);
   d_->target.reset();
   d_->probe.clear();
+  // The x-ray needs nothing but the mesh: it stays. The volume needs the new field source.
+  d_->volume_pending = d_->volume;
+  d_->volume = false;
   if (d_->view && (d_->view->framebuffer().width != device(width()) ||
                    d_->view->framebuffer().height != device(height())))
     d_->view->resize(device(width()), device(height()));
+  // A new view draws all tets opaque already: only the x-ray has to be put on it (each set-up of the
+  // view is a begin_draw on this thread, so none is spent for nothing).
+  if (d_->view && d_->xray && !apply(nullptr)) {
+    d_->xray = false;  // default opacities the painter refuses cannot happen; opaque then, said so
+    apply(nullptr);
+  }
+  say_composite();
   draw();
 }
 
@@ -112,11 +131,14 @@ void ViewWidget::clear() {
   d_->view.reset();
   d_->source.reset();
   d_->base.clear();
-  d_->selection = {};
-  d_->drawing.reset();
-  d_->picked.reset();
+  d_->reset_selection();
   d_->mesh.reset();
   d_->probe.clear();
+  d_->xray = d_->volume = d_->volume_pending = false;
+  if (d_->shown_xray || d_->shown_volume) {
+    d_->shown_xray = d_->shown_volume = false;
+    emit composite_changed(false, false);
+  }
   update();
   emit status_changed(status_text());
 }
@@ -155,14 +177,68 @@ QString ViewWidget::probe_text(int x, int y) const {
 
 void ViewWidget::set_field_source(FieldChoice choice, std::size_t step, ColorScale scale,
                                   std::shared_ptr<IsoCache> cache) {
-  if (d_->view && d_->selection.any()) {
-    d_->view->set_subset(d_->base.empty() ? std::nullopt : std::optional(d_->base));
+  const bool redraw = d_->selection.any() || d_->volume_pending || d_->volume;
+  d_->reset_selection();
+  d_->source = Impl::Source{std::move(choice), step, scale, std::move(cache)};
+  if (d_->volume_pending) d_->volume = true;
+  d_->volume_pending = false;
+  if (d_->view && redraw) {
+    if (!apply(nullptr)) {
+      d_->volume = false;
+      apply(nullptr);
+    }
     draw();
   }
-  d_->selection = {};
-  d_->drawing.reset();
-  d_->picked.reset();
-  d_->source = Impl::Source{std::move(choice), step, scale, std::move(cache)};
+}
+
+bool ViewWidget::apply(QString* error) {
+  InteractiveView& v = *d_->view;
+  const std::optional<std::vector<std::uint32_t>> base =
+      d_->base.empty() ? std::nullopt : std::optional(d_->base);
+  try {
+    if (d_->volume && d_->source) {
+      // foxi render --volume's picture with default_volume's curve: the regions shown, the field alone.
+      v.set_subset(base);
+      std::vector<double> corner = tet_corner_values(*d_->mesh, d_->source->choice, d_->source->step);
+      const VolumeParams vp = default_volume(*d_->mesh, d_->source->scale, d_->base);
+      v.set_volume(corner, &vp);
+      d_->volume_corner = std::move(corner);  // the buffer moves with it: the view's span stays valid
+    } else if (d_->xray) {
+      // foxi render --region-opacity (default_xray's) [--regions] [--iso v,... --iso-opacity 0.5].
+      v.set_subset(base);
+      TranslucentParams tp;
+      tp.region_opacity = default_xray(*d_->mesh);
+      if (d_->picked && d_->picked->polygons && d_->picked->corner) {
+        tp.corner = *d_->picked->corner;  // lent: picked lives until the next selection
+        tp.iso = d_->picked->params;
+        tp.iso_opacity = 0.5;
+      }
+      v.set_translucent(&tp);
+      d_->xray_params = tp;
+    } else if (d_->picked && d_->picked->polygons) {
+      auto drawing = std::make_unique<IsoDrawing>(d_->picked->drawing());
+      v.set_iso(drawing.get(), d_->picked->subset);
+      d_->drawing = std::move(drawing);  // the view now borrows the new drawing: the old one may go
+    } else {
+      v.set_subset(d_->picked ? std::optional(d_->picked->subset) : base);
+    }
+  } catch (const std::exception& e) {
+    if (error) *error = QString::fromStdString(e.what());
+    return false;
+  }
+  if (!(d_->picked && d_->picked->polygons && !d_->xray)) d_->drawing.reset();
+  say_composite();
+  return true;
+}
+
+void ViewWidget::say_composite() {
+  const bool x = d_->view && d_->xray && d_->view->translucent();
+  const bool vol = d_->view && d_->volume && d_->view->volume();
+  if (x != d_->shown_xray || vol != d_->shown_volume) {
+    d_->shown_xray = x;
+    d_->shown_volume = vol;
+    emit composite_changed(x, vol);
+  }
 }
 
 bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) {
@@ -171,36 +247,37 @@ bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) 
     return false;
   };
   if (!d_->view) return fail(tr("no mesh shown"));
-  if (!selection.any()) {
-    d_->view->set_subset(d_->base.empty() ? std::nullopt : std::optional(d_->base));
-    d_->selection = {};
-    d_->drawing.reset();
-    d_->picked.reset();
-    draw();
-    return true;
-  }
-  if (!d_->source)
-    return fail(tr("colour by a field first: the isosurface, threshold and clip select by it"));
-  if (selection.slice) return fail(tr("a slice is not drawn in the view yet (foxi render --slice draws it)"));
   std::unique_ptr<TetSelection> picked;
-  try {
-    const Impl::Source& s = *d_->source;
-    picked = std::make_unique<TetSelection>(
-        select_field_tets(selection, *d_->mesh, s.choice, s.step, s.scale, d_->base, s.cache.get()));
-  } catch (const std::exception& e) {
-    return fail(QString::fromStdString(e.what()));
+  if (selection.any()) {
+    if (!d_->source)
+      return fail(tr("colour by a field first: the isosurface, threshold, clip and slice select by it"));
+    if (d_->volume)
+      return fail(
+          tr("the volume rendering draws the field alone (foxi render --volume takes no --iso, --threshold, "
+             "--clip or --slice): turn the volume off first"));
+    if (d_->xray && (selection.threshold || selection.clip || selection.slice))
+      return fail(
+          tr("the x-ray draws whole regions translucent, with isosurfaces inside (foxi render "
+             "--region-opacity takes --iso, not --threshold, --clip or --slice): turn the x-ray off first"));
+    try {
+      const Impl::Source& s = *d_->source;
+      picked = std::make_unique<TetSelection>(
+          select_field_tets(selection, *d_->mesh, s.choice, s.step, s.scale, d_->base, s.cache.get()));
+    } catch (const std::exception& e) {
+      return fail(QString::fromStdString(e.what()));
+    }
   }
-  std::unique_ptr<IsoDrawing> drawing;
-  if (picked->polygons) {
-    drawing = std::make_unique<IsoDrawing>(picked->drawing());
-    d_->view->set_iso(drawing.get(), picked->subset);
-  } else {
-    d_->view->set_subset(picked->subset);
+  // The old selection lives until the view has let go of it (apply), then goes.
+  std::unique_ptr<TetSelection> old_picked = std::exchange(d_->picked, std::move(picked));
+  std::unique_ptr<IsoDrawing> old_drawing = std::move(d_->drawing);
+  const FieldSelection old_selection = std::exchange(d_->selection, selection);
+  if (!apply(error)) {
+    d_->picked = std::move(old_picked);
+    d_->drawing = std::move(old_drawing);
+    d_->selection = old_selection;
+    apply(nullptr);
+    return false;
   }
-  // The view now borrows the new drawing: the old one may go.
-  d_->drawing = std::move(drawing);
-  d_->picked = std::move(picked);
-  d_->selection = selection;
   draw();
   return true;
 }
@@ -215,16 +292,25 @@ void ViewWidget::set_base(std::vector<std::uint32_t> tets) {
 const FieldSelection& ViewWidget::selection() const { return d_->selection; }
 
 bool ViewWidget::set_xray(bool on, QString* error) {
-  if (!d_->view) {
-    if (error) *error = tr("no mesh shown");
+  auto fail = [&](const QString& why) {
+    if (error) *error = why;
     return false;
-  }
-  if (on) {
-    TranslucentParams tp;
-    tp.region_opacity = default_xray(*d_->mesh);
-    d_->view->set_translucent(&tp);
-  } else {
-    d_->view->set_translucent(nullptr);
+  };
+  if (!d_->view) return fail(tr("no mesh shown"));
+  const FieldSelection& s = d_->selection;
+  if (on && (s.threshold || s.clip || s.slice))
+    return fail(
+        tr("the x-ray draws whole regions translucent (foxi render --region-opacity takes --iso, not "
+           "--threshold, --clip or --slice): turn the threshold, clip and slice off first"));
+  const bool old_xray = d_->xray, old_volume = d_->volume;
+  d_->xray = on;
+  if (on) d_->volume = false;
+  d_->volume_pending = false;
+  if (!apply(error)) {
+    d_->xray = old_xray;
+    d_->volume = old_volume;
+    apply(nullptr);
+    return false;
   }
   draw();
   return true;
@@ -236,22 +322,29 @@ bool ViewWidget::set_volume(bool on, QString* error) {
     return false;
   };
   if (!d_->view) return fail(tr("no mesh shown"));
-  if (!on) {
-    if (d_->view->volume()) d_->view->set_volume({}, nullptr);
-    draw();
-    return true;
+  if (on && !d_->source) return fail(tr("colour by a field first: the volume rendering shows it"));
+  if (on && d_->selection.any())
+    return fail(
+        tr("the volume rendering draws the field alone (foxi render --volume takes no --iso, --threshold, "
+           "--clip or --slice): turn the isosurface, threshold, clip and slice off first"));
+  const bool old_xray = d_->xray, old_volume = d_->volume;
+  d_->volume = on;
+  if (on) d_->xray = false;
+  d_->volume_pending = false;
+  if (!apply(error)) {
+    d_->xray = old_xray;
+    d_->volume = old_volume;
+    apply(nullptr);
+    return false;
   }
-  if (!d_->source) return fail(tr("colour by a field first: the volume rendering shows it"));
-  std::vector<double> corner = tet_corner_values(*d_->mesh, d_->source->choice, d_->source->step);
-  const VolumeParams vp = default_volume(*d_->mesh, d_->source->scale);
-  try {
-    d_->view->set_volume(corner, &vp);
-  } catch (const std::exception& e) {
-    return fail(QString::fromStdString(e.what()));
-  }
-  d_->volume_corner = std::move(corner);  // the vector's buffer moves with it: the view's span stays valid
   draw();
   return true;
+}
+
+bool ViewWidget::xray() const { return d_->shown_xray; }
+bool ViewWidget::volume() const { return d_->shown_volume; }
+const TranslucentParams* ViewWidget::xray_params() const {
+  return d_->shown_xray ? &d_->xray_params : nullptr;
 }
 
 std::size_t ViewWidget::selected_tets() const {
@@ -360,10 +453,20 @@ void ViewWidget::set_fraction(double f) {
   kick();
 }
 
-bool ViewWidget::push_region() {
+bool ViewWidget::push_region(QString* error) {
   if (!d_->view) return false;
+  if (d_->xray) {
+    if (error)
+      *error =
+          tr("a region of interest is the far part of the opaque tets drawn: turn the x-ray off, draw (or "
+             "undraw) to the part you want and press Region; the x-ray then shows that region");
+    return false;
+  }
   const std::vector<std::uint32_t> region = d_->view->drawn();  // what becomes the displayed set
-  if (!d_->view->push_region()) return false;
+  if (!d_->view->push_region()) {
+    if (error) *error = tr("nothing drawn yet: draw the part that is to become the region first");
+    return false;
+  }
   // The camera re-framed on the region: the same direction and up, fitted to the region's bounds.
   double lo[3], hi[3];
   tets_bounds(*d_->mesh, region, lo, hi);

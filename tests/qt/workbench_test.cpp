@@ -93,6 +93,10 @@ void check_headless(const std::string& model, const std::string& set, const std:
                                                          : "potential";
   const std::string shrink_option =
       (shrink.empty() ? "" : " --shrink " + shrink) + (tools.empty() ? "" : " " + tools);
+  // --xray: foxi render draws the same from the opacities the workbench prints (its own options).
+  const bool xray = tools.find("--xray") != std::string::npos;
+  std::string cli_tools = shrink_option;
+  if (xray) cli_tools.erase(cli_tools.find(" --xray"), 7);
   TempDir dir;
   const auto view = dir.path() / "view.png", mesh = dir.path() / "mesh.vtu", shot = dir.path() / "window.png",
              cli = dir.path() / "cli.png", log = dir.path() / "wb.log";
@@ -105,11 +109,19 @@ void check_headless(const std::string& model, const std::string& set, const std:
   const std::string camera = line_after(out, "camera: ");
   ASSERT_NE(camera.find("--eye"), std::string::npos) << out;
   EXPECT_TRUE(std::filesystem::file_size(shot) > 0);
-  ASSERT_EQ(
-      foxi::test::run_cli("render '" + mesh.string() + "' --field " + field + " --legend off --size 320x240" +
-                              shrink_option + " " + camera + " -o '" + cli.string() + "'",
-                          dir.path() / "render.log"),
-      0)
+  std::string field_option = " --field " + field + " --legend off";
+  if (xray) {
+    const std::string opacities = line_after(out, "x-ray: ");
+    ASSERT_NE(opacities.find("--region-opacity"), std::string::npos) << out;
+    EXPECT_NE(out.find("x-ray composited exactly"), std::string::npos) << out;
+    cli_tools += " " + opacities;
+    // foxi render's translucent regions take their own colours: the field only for isosurfaces.
+    if (tools.find("--iso") == std::string::npos) field_option.clear();
+  }
+  ASSERT_EQ(foxi::test::run_cli("render '" + mesh.string() + "'" + field_option + " --size 320x240" +
+                                    cli_tools + " " + camera + " -o '" + cli.string() + "'",
+                                dir.path() / "render.log"),
+            0)
       << foxi::test::read_text(dir.path() / "render.log");
   const foxi::Framebuffer a = foxi::read_png(view), b = foxi::read_png(cli);
   ASSERT_EQ(a.width, 320);
@@ -124,7 +136,7 @@ void check_headless(const std::string& model, const std::string& set, const std:
   EXPECT_EQ(differ, 0u);
   // The tools draw part of the model: a small picture, but not an empty one.
   EXPECT_GT(coloured, a.rgba.size() / (tools.empty() ? 10 : 100)) << "the picture shows the model";
-  if (!tools.empty()) {
+  if (!tools.empty() && !xray) {
     // The same tets drawn as foxi render reports ("drawn N of M tets").
     std::smatch m;
     const std::string render_log = foxi::test::read_text(dir.path() / "render.log");
@@ -184,6 +196,22 @@ TEST(WorkbenchHeadless, ClipPictureEqualsFoxiRender) {
 TEST(WorkbenchHeadless, IsoWithinClipEqualsFoxiRender) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "0.8", "--iso 48 --clip 0.005,0.005,0,0,1,0");
 }
+// The slice (foxi render --slice): the plane's cut coloured by the field, alone and within a clip.
+TEST(WorkbenchHeadless, SlicePictureEqualsFoxiRender) {
+  check_headless("die_on_substrate.toml", "die_w=5mm", "T_max", "", "--slice 0.005,0.004,0.0004,0,0.3,1");
+}
+TEST(WorkbenchHeadless, SliceWithinClipEqualsFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "",
+                 "--slice 0.005,0.005,0,0,1,0 --clip 0.005,0.005,0,1,0,0");
+}
+// The x-ray (issue 23) as foxi render --region-opacity draws it from the opacities the workbench
+// prints: of the regions shown (--regions), and with translucent isotherms inside (--iso-opacity 0.5).
+TEST(WorkbenchHeadless, XrayOfRegionsShownEqualsFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--regions 1,3 --xray");
+}
+TEST(WorkbenchHeadless, XrayWithIsothermsEqualsFoxiRender) {
+  check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--iso 47,50 --xray");
+}
 // Graded colouring and a user's colour range (foxi render --graded --range), alone and under an isotherm.
 TEST(WorkbenchHeadless, SeveralIsovaluesEqualFoxiRender) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--iso 47,50");
@@ -216,6 +244,65 @@ TEST(WorkbenchHeadless, DeformedShapeEqualsFoxiRender) {
   check_headless("die_on_substrate.toml", "die_w=5mm", "von_mises_max", "", "--deform displacement:300",
                  "thermoelastic");
 }
+
+// Save movie: the view's turning camera, frame k equal pixel for pixel to foxi movie --mode rotate's
+// frame k with the camera the workbench printed, the same size and options (the CLI as the second
+// program): the temperature within a threshold, and the x-ray (foxi movie --region-opacity).
+void check_movie(const std::string& tools) {
+  TempDir dir;
+  const auto mesh = dir.path() / "mesh.vtu", log = dir.path() / "wb.log";
+  const bool xray = tools.find("--xray") != std::string::npos;
+  const int frames = 4;
+  ASSERT_EQ(
+      foxi::test::run("'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + kModels +
+                          "die_on_substrate.toml' --headless --physics thermal --view-size 160x120 " + tools +
+                          " --save-movie '" + (dir.path() / "wb_%02d.png").string() + "' --movie-frames " +
+                          std::to_string(frames) + " --save-mesh '" + mesh.string() + "'",
+                      log),
+      0)
+      << foxi::test::read_text(log);
+  const std::string out = foxi::test::read_text(log);
+  const std::string camera = line_after(out, "camera: ");
+  ASSERT_NE(camera.find("--eye"), std::string::npos) << out;
+  std::string cli_tools = tools;
+  std::string field = " --field temperature --legend off";
+  if (xray) {
+    cli_tools.erase(cli_tools.find("--xray"), 6);
+    cli_tools += " " + line_after(out, "x-ray: ");
+    field.clear();
+  }
+  ASSERT_EQ(foxi::test::run_cli("movie '" + mesh.string() + "'" + field + " --mode rotate --frames " +
+                                    std::to_string(frames) + " --size 160x120 " + cli_tools + " " + camera +
+                                    " -o '" + (dir.path() / "cli_%02d.png").string() + "'",
+                                dir.path() / "movie.log"),
+            0)
+      << foxi::test::read_text(dir.path() / "movie.log");
+  std::vector<std::uint32_t> first;
+  for (int k = 0; k < frames; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%02d.png", k);
+    const foxi::Framebuffer a = foxi::read_png(dir.path() / ("wb_" + std::string(name))),
+                            b = foxi::read_png(dir.path() / ("cli_" + std::string(name)));
+    ASSERT_EQ(a.width, 160);
+    ASSERT_EQ(a.height, 120);
+    ASSERT_EQ(b.width, a.width);
+    ASSERT_EQ(b.height, a.height);
+    EXPECT_TRUE(a.rgba == b.rgba) << "frame " << k;
+    if (k == 0) {
+      first = a.rgba;
+      const std::size_t coloured = std::size_t(std::count_if(
+          a.rgba.begin(), a.rgba.end(), [](std::uint32_t c) { return c != foxi::pack_rgba(255, 255, 255); }));
+      EXPECT_GT(coloured, a.rgba.size() / 20) << "the frame shows the model";
+    }
+    if (k == 1) {
+      EXPECT_FALSE(a.rgba == first) << "the camera turned";
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "wb_04.png")) << "exactly the frames asked for";
+}
+
+TEST(WorkbenchHeadless, MovieFramesEqualFoxiMovie) { check_movie("--threshold 30,50"); }
+TEST(WorkbenchHeadless, XrayMovieFramesEqualFoxiMovie) { check_movie("--xray"); }
 
 // Once with a real X server (xvfb-run, Qt's xcb platform): the same view picture as offscreen.
 // High-DPI: at a device pixel ratio of 2 (QT_SCALE_FACTOR) a 160 x 120 view draws a 320 x 240
@@ -878,7 +965,7 @@ TEST(Workbench, IsoSliderMovesTheIsovalueBothWays) {
   ASSERT_TRUE(w.set_selection({}));
   v->finish_now();
   EXPECT_EQ(v->view()->drawn().size(), mesh.tet_count());
-  // Refused: a slice (not in the view yet), a zero clip normal; the selection stays as it was.
+  // Refused: a zero clip normal; the selection stays as it was.
   foxi::FieldSelection bad;
   bad.clip = foxi::Plane{{0, 0, 0}, {0, 0, 0}};
   QString why;
@@ -924,6 +1011,333 @@ TEST(Workbench, XrayAndVolumeInTheView) {
   EXPECT_NE(v->view()->status().find("volume composited exactly"), std::string::npos) << v->view()->status();
   ASSERT_TRUE(v->set_volume(false));
   EXPECT_FALSE(v->view()->volume());
+}
+
+// Translucency and selections together (issue 23): the X-ray and volume check boxes always show what
+// the view draws. An isotherm with the x-ray on stays translucent (the x-ray's isosurfaces); what
+// foxi render does not combine with it (a threshold, clip or slice; any selection with the volume; a
+// region of interest taken from the x-ray's surface tets) is refused with a reason and changes
+// nothing; volume and x-ray exclude each other; a recolour keeps the volume, colouring by regions
+// ends it. A region of interest pushed with the x-ray off is what the x-ray then shows: the one-call
+// picture of that subset (draw_translucent_picture, the same camera), pixel for pixel.
+TEST(Workbench, XrayVolumeAndSelectionsStayInSync) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  foxi::qt::ViewWidget* v = w.view_widget();
+  auto* xray_box = w.findChild<QCheckBox*>("xray");
+  auto* volume_box = w.findChild<QCheckBox*>("volume");
+  ASSERT_NE(xray_box, nullptr);
+  ASSERT_NE(volume_box, nullptr);
+  auto in_sync = [&](const char* when) {
+    EXPECT_EQ(xray_box->isChecked(), v->view()->translucent()) << when;
+    EXPECT_EQ(volume_box->isChecked(), v->view()->volume()) << when;
+    EXPECT_EQ(v->xray(), v->view()->translucent()) << when;
+    EXPECT_EQ(v->volume(), v->view()->volume()) << when;
+  };
+  xray_box->click();
+  EXPECT_TRUE(v->view()->translucent());
+  in_sync("x-ray on");
+  foxi::FieldSelection iso;
+  iso.iso = {0.5 * (w.field_lo() + w.field_hi())};
+  QString why;
+  ASSERT_TRUE(w.set_selection(iso, &why)) << why.toStdString();
+  EXPECT_TRUE(v->view()->translucent()) << "the isotherm drawn translucent inside the x-ray";
+  ASSERT_NE(v->xray_params(), nullptr);
+  EXPECT_EQ(v->xray_params()->iso.values, iso.iso);
+  in_sync("isotherm with the x-ray");
+  foxi::FieldSelection threshold;
+  threshold.threshold = {w.field_lo(), w.field_hi()};
+  why.clear();
+  EXPECT_FALSE(w.set_selection(threshold, &why));
+  EXPECT_NE(why.indexOf("x-ray"), -1) << why.toStdString();
+  EXPECT_EQ(v->selection().iso, iso.iso) << "refused: the isotherm stays";
+  foxi::FieldSelection slice;
+  slice.slice = foxi::Plane{{0.005, 0.004, 0.0004}, {0, 0, 1}};
+  EXPECT_FALSE(w.set_selection(slice));
+  in_sync("threshold and slice refused");
+  v->finish_now();
+  why.clear();
+  EXPECT_FALSE(v->push_region(&why));
+  EXPECT_NE(why.indexOf("x-ray off"), -1) << why.toStdString();
+  EXPECT_EQ(v->view()->region_depth(), 0u);
+  volume_box->click();  // refused: the isotherm is on
+  EXPECT_FALSE(v->view()->volume());
+  in_sync("volume refused with a selection");
+  ASSERT_TRUE(w.set_selection({}));
+  EXPECT_TRUE(v->view()->translucent()) << "the selection off: the x-ray stays";
+  volume_box->click();
+  EXPECT_TRUE(v->view()->volume());
+  EXPECT_FALSE(xray_box->isChecked()) << "one at a time";
+  in_sync("volume replaces the x-ray");
+  EXPECT_FALSE(w.set_selection(iso));
+  in_sync("a selection refused with the volume");
+  ASSERT_TRUE(w.set_field("temperature", "coolwarm"));  // a new view (recolour): the volume follows
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  EXPECT_TRUE(v->view()->volume());
+  in_sync("recoloured");
+  ASSERT_TRUE(w.set_field("", "viridis"));  // coloured by region: no field for the volume
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  EXPECT_FALSE(v->view()->volume());
+  in_sync("by region");
+  EXPECT_FALSE(volume_box->isEnabled()) << "no field shown: nothing to render";
+  EXPECT_TRUE(xray_box->isEnabled());
+  // A region of interest first, then the x-ray of it.
+  v->finish_now();
+  v->set_fraction(0.3);
+  for (int i = 0; i < 100000 && v->busy(); ++i) QApplication::processEvents();
+  std::vector<std::uint32_t> region = v->view()->drawn();
+  ASSERT_FALSE(region.empty());
+  ASSERT_TRUE(v->push_region(&why)) << why.toStdString();
+  xray_box->click();
+  ASSERT_TRUE(v->view()->translucent());
+  v->finish_now();
+  std::sort(region.begin(), region.end());
+  foxi::TranslucentParams tp;
+  tp.region_opacity = foxi::default_xray(*w.mesh());
+  const foxi::Framebuffer& got = v->view()->framebuffer();
+  foxi::Framebuffer ref(got.width, got.height);
+  ASSERT_TRUE(foxi::draw_translucent_picture(*w.mesh(), foxi::compute_spheres(*w.mesh()), *v->camera(), ref,
+                                             region, tp)
+                  .exact_order);
+  EXPECT_TRUE(ref.rgba == got.rgba) << "the x-ray of the region of interest";
+  ASSERT_TRUE(v->pop_region());
+  EXPECT_TRUE(v->view()->translucent()) << "back to all tets: still the x-ray";
+  in_sync("region popped");
+}
+
+// Issue 21's "Done when", step by step as a new user does it, without the command line: open the flip
+// chip, change the die size, remesh, solve the thermal problem, look inside (draw, stop, undraw, a
+// region of interest, an isotherm), compare two runs in the history, save the picture. Each step is
+// asserted on what the window shows, and a screenshot of the whole window is taken after it (into
+// $FOXI_WALKTHROUGH_DIR when set, to look at; else a temporary folder).
+TEST(Workbench, DoneWhenWalkThrough) {
+  TempDir tmp;
+  const char* keep = std::getenv("FOXI_WALKTHROUGH_DIR");
+  const std::filesystem::path dir = keep && *keep ? std::filesystem::path(keep) : tmp.path();
+  std::filesystem::create_directories(dir);
+  Workbench w;
+  w.resize(1280, 860);
+  w.show();
+  QApplication::processEvents();
+  int shot_number = 0;
+  auto shot = [&](const std::string& name) {
+    QApplication::processEvents();
+    char prefix[16];
+    std::snprintf(prefix, sizeof prefix, "%02d-", ++shot_number);
+    const auto path = dir / (prefix + name + ".png");
+    ASSERT_TRUE(w.grab().save(QString::fromStdString(path.string()))) << path;
+    EXPECT_GT(std::filesystem::file_size(path), 1000u) << path;
+  };
+  auto settle = [&](foxi::qt::ViewWidget* v) {
+    for (int i = 0; i < 100000 && v->busy(); ++i) QApplication::processEvents();
+  };
+  auto* params = w.findChild<QTableWidget*>("parameters");
+  ASSERT_NE(params, nullptr);
+  // 1. Open the example: its parameters listed, die_w among them.
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "flip_chip.toml")));
+  bool listed = false;
+  for (int r = 0; r < params->rowCount(); ++r)
+    listed |= params->item(r, 0) && params->item(r, 0)->text() == "die_w";
+  EXPECT_TRUE(listed) << "die_w in the parameter table";
+  shot("opened");
+  // 2. The die size changed (a unit the model checks).
+  ASSERT_TRUE(w.set_parameter("die_w", "7 mm"));
+  ASSERT_EQ(w.overrides().size(), 1u);
+  EXPECT_EQ(w.overrides()[0].expression, "7 mm");
+  shot("die-size-changed");
+  // 3. Remesh: the mesh of those parameters shown.
+  ASSERT_TRUE(w.start_mesh());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(w.mesh());
+  foxi::qt::ViewWidget* v = w.view_widget();
+  EXPECT_EQ(v->mesh(), w.mesh());
+  shot("remeshed");
+  // 4. Solve the thermal problem: results and the temperature shown with its legend.
+  ASSERT_TRUE(w.set_physics(foxi::Physics::thermal));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_NE(w.results(), nullptr);
+  const foxi::ResultValue* t_first = w.results()->find("T_max");
+  ASSERT_NE(t_first, nullptr);
+  const double t_max_first = t_first->value;
+  EXPECT_TRUE(v->view()->field()) << "coloured by the temperature";
+  v->finish_now();
+  EXPECT_EQ(v->view()->drawn().size(), w.mesh()->tet_count());
+  shot("solved");
+  // 5. Draw from the back, stop part way: the far part drawn, nothing more while stopped.
+  v->draw();
+  for (int i = 0; i < 3 && v->busy(); ++i) v->step_once();
+  v->stop();
+  const std::size_t stopped = v->view()->drawn().size();
+  EXPECT_GT(stopped, 0u);
+  EXPECT_LT(stopped, v->view()->total());
+  for (int i = 0; i < 20; ++i) QApplication::processEvents();
+  EXPECT_EQ(v->view()->drawn().size(), stopped) << "stopped: nothing drawn";
+  EXPECT_FALSE(v->busy());
+  v->finish_now();
+  v->set_fraction(0.6);
+  settle(v);
+  shot("drawn-60-percent");
+  // 6. Undraw: front to back, the picture of fewer tets.
+  const std::size_t before = v->view()->drawn().size();
+  v->set_fraction(0.35);
+  settle(v);
+  EXPECT_LT(v->view()->drawn().size(), before);
+  EXPECT_EQ(v->view()->drawn().size(), std::size_t(std::llround(0.35 * double(v->view()->total()))));
+  shot("undrawn-35-percent");
+  // 7. A region of interest: what is drawn becomes the displayed set, the camera framed on it.
+  const std::size_t region = v->view()->drawn().size();
+  QString why;
+  ASSERT_TRUE(v->push_region(&why)) << why.toStdString();
+  EXPECT_EQ(v->view()->total(), region);
+  v->finish_now();
+  EXPECT_EQ(v->view()->drawn().size(), region);
+  shot("region-of-interest");
+  // 8. An isotherm inside it: the solid above the middle temperature, within the region.
+  foxi::FieldSelection iso;
+  iso.iso = {0.5 * (w.field_lo() + w.field_hi())};
+  ASSERT_TRUE(w.set_selection(iso, &why)) << why.toStdString();
+  v->finish_now();
+  EXPECT_GT(v->view()->drawn().size(), 0u);
+  EXPECT_LT(v->view()->drawn().size(), region);
+  EXPECT_EQ(w.iso_slider()->value(), 500);
+  shot("isotherm-in-region");
+  // The x-ray with the isotherm inside, translucent.
+  auto* xray_box = w.findChild<QCheckBox*>("xray");
+  ASSERT_NE(xray_box, nullptr);
+  xray_box->click();
+  EXPECT_TRUE(v->view()->translucent());
+  v->finish_now();
+  shot("xray-isotherm");
+  xray_box->click();
+  EXPECT_FALSE(v->view()->translucent());
+  ASSERT_TRUE(v->pop_region());
+  // 9. A second run: another die size, solved; the history compares them.
+  ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
+  ASSERT_TRUE(w.start_solve());  // remeshes first: the parameters changed
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_EQ(w.history().size(), 2u);
+  const foxi::ResultValue* a = w.history()[0].results.find("T_max");
+  const foxi::ResultValue* b = w.history()[1].results.find("T_max");
+  ASSERT_NE(a, nullptr);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(a->value, t_max_first);
+  EXPECT_NE(a->value, b->value) << "two die sizes, two maximum temperatures";
+  EXPECT_NE(w.history()[0].tets, w.history()[1].tets);
+  EXPECT_EQ(w.selection().iso.size(), 1u) << "the isotherm stays across the re-solve";
+  v->finish_now();
+  shot("second-run-history");
+  // 10. Save the picture: the view's framebuffer as a PNG.
+  const auto picture = dir / "view.png";
+  ASSERT_TRUE(v->save_picture(QString::fromStdString(picture.string()), &why)) << why.toStdString();
+  const foxi::Framebuffer saved = foxi::read_png(picture);
+  EXPECT_TRUE(saved.rgba == v->view()->framebuffer().rgba);
+  shot("picture-saved");
+}
+
+// The slice control: ticking it draws the plane across z through the middle of the mesh's box (the
+// slider's middle), the tets it cuts; with the isosurface on it is refused (a slice and isovalues are
+// both the polygons drawn) and the box unticks itself: the controls show what is drawn.
+TEST(Workbench, SliceControlDrawsAndRefusesWithIsovalues) {
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  auto* slice = w.findChild<QCheckBox*>("slice");
+  ASSERT_NE(slice, nullptr);
+  ASSERT_TRUE(slice->isEnabled());
+  slice->click();
+  foxi::qt::ViewWidget* v = w.view_widget();
+  ASSERT_TRUE(v->selection().slice.has_value());
+  double lo[3], hi[3];
+  foxi::mesh_bounds(*w.mesh(), lo, hi);
+  EXPECT_DOUBLE_EQ(v->selection().slice->p[2], lo[2] + (hi[2] - lo[2]) * 500 / 1000.0);
+  EXPECT_EQ(v->selection().slice->n[2], 1.0);
+  // The tets drawn are those the plane cuts (a corner below it, one on or above it), counted here;
+  // the middle of this box is a layer of nodes, so the rule at a corner on the plane matters.
+  const foxi::Mesh& m = *w.mesh();
+  const double z = v->selection().slice->p[2];
+  std::size_t cut = 0;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    double zlo = INFINITY, zhi = -INFINITY;
+    for (int k = 0; k < 4; ++k) {
+      const double c = m.xyz[3 * std::size_t(m.tet[4 * t + std::size_t(k)]) + 2] - z;
+      zlo = std::min(zlo, c), zhi = std::max(zhi, c);
+    }
+    cut += zlo < 0 && zhi >= 0;  // crossing's half-open rule (isosurface.hpp): min < v <= max
+  }
+  v->finish_now();
+  EXPECT_GT(v->view()->drawn().size(), 0u);
+  EXPECT_EQ(v->view()->drawn().size(), cut);
+  EXPECT_TRUE(v->view()->iso()) << "drawn as polygons";
+  // The isosurface too: refused, the slice stays and the isosurface box unticks.
+  auto* iso = w.findChild<QCheckBox*>("isosurface");
+  ASSERT_NE(iso, nullptr);
+  iso->click();
+  EXPECT_FALSE(iso->isChecked());
+  EXPECT_TRUE(v->selection().iso.empty());
+  EXPECT_TRUE(v->selection().slice.has_value());
+  slice->click();
+  EXPECT_FALSE(v->selection().any());
+}
+
+// Save movie runs on a worker: the window goes on (the GUI thread is not held), Cancel stops it and no
+// file is left; a name of no known kind, a second movie while one runs and a movie of an isosurface
+// are refused with the reason; an APNG is written whole.
+TEST(Workbench, MovieOnAWorkerCancelsAndRefuses) {
+  TempDir dir;
+  Workbench w;
+  w.view_widget()->setFixedSize(160, 120);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  auto wait_movie = [&](bool* ok, QString* message) {
+    QEventLoop loop;
+    QObject::connect(&w, &Workbench::movie_finished, &loop, [&](bool r, const QString& m) {
+      *ok = r;
+      *message = m;
+      loop.quit();
+    });
+    QTimer::singleShot(120000, &loop, &QEventLoop::quit);
+    loop.exec();
+  };
+  QString why;
+  EXPECT_FALSE(w.save_movie(QString::fromStdString((dir.path() / "m.mp3").string()), 8, &why));
+  EXPECT_NE(why.indexOf(".gif"), -1) << why.toStdString();
+  const auto long_one = dir.path() / "long.apng";
+  ASSERT_TRUE(w.save_movie(QString::fromStdString(long_one.string()), 2000, &why)) << why.toStdString();
+  EXPECT_TRUE(w.movie_running());
+  EXPECT_FALSE(w.save_movie(QString::fromStdString((dir.path() / "b.gif").string()), 8, &why));
+  w.cancel_movie();
+  bool ok = true;
+  QString message;
+  wait_movie(&ok, &message);
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(message, "cancelled");
+  EXPECT_FALSE(w.movie_running());
+  EXPECT_FALSE(std::filesystem::exists(long_one));
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << "no temporary left";
+  const auto apng = dir.path() / "turn.apng";
+  ASSERT_TRUE(w.save_movie(QString::fromStdString(apng.string()), 6, &why)) << why.toStdString();
+  wait_movie(&ok, &message);
+  EXPECT_TRUE(ok) << message.toStdString();
+  ASSERT_TRUE(std::filesystem::exists(apng));
+  const foxi::Framebuffer first = foxi::read_png(apng);  // an APNG's first frame, to a PNG reader
+  EXPECT_EQ(first.width, 160);
+  EXPECT_EQ(first.height, 120);
+  foxi::FieldSelection iso;
+  iso.iso = {0.5 * (w.field_lo() + w.field_hi())};
+  ASSERT_TRUE(w.set_selection(iso));
+  why.clear();
+  EXPECT_FALSE(w.save_movie(QString::fromStdString((dir.path() / "iso.gif").string()), 6, &why));
+  EXPECT_NE(why.indexOf("isosurface"), -1) << why.toStdString();
 }
 
 // A project saved and reopened in a new window: the same parameters, mesh (counts, coordinates),

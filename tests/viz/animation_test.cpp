@@ -263,5 +263,37 @@ TEST(Animation, BadUseLeavesNoFile) {
   EXPECT_THROW(open_gif(dir / "no/such/dir/y.gif", p), std::runtime_error);
 }
 
+// Numbered PNG frames: each frame read back by libpng equals the one added, named by the pattern;
+// none in place before finish(); a writer dropped without finish() leaves nothing; bad patterns refused.
+TEST(Animation, PngFramesReadBackExactlyAndAppearTogether) {
+  test::TempDir dir;
+  const int w = 33, h = 21;
+  const auto frames = test_frames(w, h, 4, 5, 3);
+  AnimationParams p;
+  p.width = w;
+  p.height = h;
+  const std::string pattern = (dir / "f_%03d.png").string();
+  auto writer = open_png_frames(pattern, p);
+  for (const Framebuffer& fb : frames) writer->add(fb);
+  EXPECT_EQ(writer->frames(), 4);
+  EXPECT_FALSE(std::filesystem::exists(dir / "f_000.png")) << "nothing in place before finish";
+  writer->finish();
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(frame_name(pattern, i), (dir / ("f_00" + std::to_string(i) + ".png")).string());
+    EXPECT_TRUE(same_rgb(read_png(frame_name(pattern, i)), frames[i])) << "frame " << i;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "f_004.png"));
+  {
+    auto dropped = open_png_frames((dir / "g_%d.png").string(), p);
+    dropped->add(frames[0]);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "g_0.png"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 4) << "no temporaries left";
+  for (const char* bad : {"f.png", "f_%d_%d.png", "f_%s.png", "f_%0123d.png", "50%.png"})
+    EXPECT_FALSE(frame_pattern(bad)) << bad;
+  EXPECT_TRUE(frame_pattern("frame_%04d.png"));
+  EXPECT_THROW(open_png_frames((dir / "f.png").string(), p), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace foxi

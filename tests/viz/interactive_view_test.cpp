@@ -222,6 +222,58 @@ TEST(InteractiveView, VolumeUndrawEqualsAFreshCompositeOfTheRest) {
   EXPECT_THROW(view.set_volume(std::span<const double>(corner).first(8), &vp), std::invalid_argument);
 }
 
+// A whole-tet subset (set_subset: the regions shown, a threshold) stays when translucency or the
+// volume is turned on: the view composites that subset, as the one-call pictures do given it, pixel
+// for pixel; iso drawing ends instead. movie_input copies what the view draws.
+TEST(InteractiveView, CompositingKeepsTheWholeTetSubset) {
+  const Mesh m = bench::kuhn_grid_mesh(10, 0.0);  // regions 1 (lower half) and 2, certified
+  const SphereTable table = compute_spheres(m);
+  const std::vector<double> corner = corner_values(m);
+  std::vector<std::uint32_t> subset;  // a non-convex part: every tet but a slab through the middle
+  for (std::uint32_t t = 0; t < m.tet_count(); ++t)
+    if (t % 7 != 0) subset.push_back(t);
+  TranslucentParams tp;
+  tp.region_opacity = {{1, 0.35}, {2, 0.6}};
+  VolumeParams vp;
+  vp.scale = ColorScale{ColorMapId::coolwarm, -20, 30};
+  vp.opacity_curve = {{-20, 0.05}, {30, 0.6}};
+  vp.unit_length = 2;
+  const Camera cam = test::random_cameras(m, 1, 17, double(kW) / kH)[0];
+  InteractiveView view(m, cam, kW, kH);
+  view.set_subset(subset);
+  view.set_translucent(&tp);
+  view.finish();
+  EXPECT_EQ(view.shown_tets(), subset);
+  Framebuffer ref(kW, kH);
+  ASSERT_TRUE(draw_translucent_picture(m, table, cam, ref, subset, tp).exact_order);
+  EXPECT_EQ(differing(view.framebuffer(), ref), 0u) << "the x-ray of the subset";
+  const ViewMovie movie = view.movie_input();
+  ASSERT_TRUE(movie.translucent.has_value());
+  EXPECT_EQ(movie.subset, subset);
+  EXPECT_FALSE(movie.volume.has_value());
+  view.set_volume(corner, &vp);
+  view.finish();
+  Framebuffer vref(kW, kH);
+  ASSERT_TRUE(draw_volume_picture(m, table, cam, vref, subset, corner, vp).exact_order);
+  EXPECT_EQ(differing(view.framebuffer(), vref), 0u) << "the volume of the subset";
+  EXPECT_EQ(view.movie_input().corner, corner);
+  // Iso drawing does not stay: the x-ray of all tets.
+  IsoParams ip;
+  ip.values = {1.0};
+  ip.scale = vp.scale;
+  IsoDrawing drawing;
+  drawing.corner = corner;
+  drawing.params = ip;
+  view.set_iso(&drawing, subset);
+  EXPECT_THROW((void)view.movie_input(), std::invalid_argument) << "no movie of iso polygons";
+  view.set_translucent(&tp);
+  view.finish();
+  EXPECT_TRUE(view.shown_tets().empty());
+  Framebuffer all(kW, kH);
+  draw_translucent_picture(m, table, cam, all, {}, tp);
+  EXPECT_EQ(differing(view.framebuffer(), all), 0u);
+}
+
 TEST(InteractiveView, UncertifiedCompositingSaysSoAndDoesNotUndraw) {
   const Mesh m = bench::kuhn_grid_mesh(12, 0.15, 3);  // not certified (as above)
   const SphereTable table = compute_spheres(m);

@@ -12,9 +12,11 @@
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "foxi/model/durable_file.hpp"
+#include "foxi/viz/png.hpp"
 
 namespace foxi {
 
@@ -280,7 +282,56 @@ class GifWriter final : public AnimationWriter {
   int delay_cs_ = 8, frames_ = 0;
 };
 
+class PngFramesWriter : public AnimationWriter {
+ public:
+  PngFramesWriter(std::string pattern, const AnimationParams& p) : pattern_(std::move(pattern)), p_(p) {
+    if (!frame_pattern(pattern_))
+      throw std::runtime_error(pattern_ + ": a frame name needs one %d or %0Nd and no other %");
+    check_params(pattern_, p_);
+  }
+  void add(const Framebuffer& fb) override {
+    const std::filesystem::path path = frame_name(pattern_, files_.size());
+    check_frame(path, p_, fb);
+    files_.emplace_back(path, false);
+    write_png(files_.back(), fb);
+  }
+  void finish() override {
+    if (files_.empty()) throw std::runtime_error(pattern_ + ": no frames to write");
+    commit_together(files_);
+  }
+  int frames() const override { return int(files_.size()); }
+
+ private:
+  std::string pattern_;
+  AnimationParams p_;
+  std::vector<DurableFile> files_;  // removed unless committed
+};
+
 }  // namespace
+
+bool frame_pattern(const std::string& pattern) {
+  int conversions = 0;
+  for (std::size_t i = 0; i < pattern.size(); ++i) {
+    if (pattern[i] != '%') continue;
+    std::size_t j = i + 1;
+    if (j < pattern.size() && pattern[j] == '0') ++j;
+    while (j < pattern.size() && pattern[j] >= '0' && pattern[j] <= '9') ++j;
+    if (j >= pattern.size() || pattern[j] != 'd' || j - i > 4) return false;
+    ++conversions;
+    i = j;
+  }
+  return conversions == 1;
+}
+
+std::string frame_name(const std::string& pattern, std::size_t k) {
+  char buf[4096];
+  std::snprintf(buf, sizeof buf, pattern.c_str(), int(k));  // checked by frame_pattern
+  return buf;
+}
+
+std::unique_ptr<AnimationWriter> open_png_frames(const std::string& pattern, const AnimationParams& params) {
+  return std::make_unique<PngFramesWriter>(pattern, params);
+}
 
 std::unique_ptr<AnimationWriter> open_apng(const std::filesystem::path& path, const AnimationParams& params) {
   return std::make_unique<ApngWriter>(path, params);

@@ -46,12 +46,13 @@ std::vector<RegionOpacity> default_xray(const Mesh& mesh, double opacity) {
   return out;
 }
 
-VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale) {
+VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale,
+                            std::span<const std::uint32_t> subset) {
   VolumeParams vp;
   vp.scale = scale;
   vp.opacity_curve = {{scale.lo, 0.02}, {scale.hi, 0.5}};
   double lo[3], hi[3];
-  tets_bounds(mesh, {}, lo, hi);
+  tets_bounds(mesh, subset, lo, hi);
   vp.unit_length = 0.1 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                    (hi[2] - lo[2]) * (hi[2] - lo[2]));
   return vp;
@@ -123,8 +124,17 @@ void InteractiveView::begin_draw() {
   std::unique_ptr<TranslucentSurfaces> surfaces;
   std::unique_ptr<TranslucentPainter> translucent_painter;
   std::unique_ptr<VolumePainter> volume_painter;
-  const std::span<const std::uint32_t> region =
-      stack_.empty() ? std::span<const std::uint32_t>() : std::span<const std::uint32_t>(stack_.back());
+  if (selecting_) {
+    // The iso (or selected) tets within the region of interest.
+    iso_subset_.clear();
+    if (stack_.empty())
+      iso_subset_ = iso_tets_;
+    else
+      std::set_intersection(iso_tets_.begin(), iso_tets_.end(), stack_.back().begin(), stack_.back().end(),
+                            std::back_inserter(iso_subset_));
+  }
+  // What is composited: the whole-tet subset within the region (a subset stays with compositing).
+  const std::span<const std::uint32_t> region = current_subset();
   if (translucent_) {
     // The surfaces do not depend on the view: a camera move reuses them.
     if (surfaces_stale_ || !surfaces_)
@@ -141,15 +151,6 @@ void InteractiveView::begin_draw() {
     if (iso_)
       iso_painter = std::make_unique<IsoPainter>(mesh_, camera_, width_, height_, iso_->corner, iso_->params,
                                                  params_, iso_->attr);
-  }
-  if (selecting_) {
-    // The iso (or selected) tets within the region of interest.
-    iso_subset_.clear();
-    if (stack_.empty())
-      iso_subset_ = iso_tets_;
-    else
-      std::set_intersection(iso_tets_.begin(), iso_tets_.end(), stack_.back().begin(), stack_.back().end(),
-                            std::back_inserter(iso_subset_));
   }
   raster_ = std::move(raster);
   iso_painter_ = std::move(iso_painter);
@@ -256,8 +257,10 @@ void InteractiveView::set_composite(std::optional<TranslucentParams> translucent
   translucent_ = std::move(translucent);
   volume_ = std::move(volume);
   volume_corner_ = corner;
+  // Iso polygons end; a whole-tet subset (no iso drawing) stays: its tets are what is composited.
+  const bool keep_subset = selecting_ && iso_ == nullptr;
   iso_ = nullptr;
-  selecting_ = false;
+  selecting_ = keep_subset;
   surfaces_stale_ = true;
   try {
     begin_draw();
@@ -271,8 +274,10 @@ void InteractiveView::set_composite(std::optional<TranslucentParams> translucent
     begin_draw();
     throw;
   }
-  iso_tets_.clear();  // iso or subset drawing ends
-  iso_subset_.clear();
+  if (!keep_subset) {  // iso drawing ends
+    iso_tets_.clear();
+    iso_subset_.clear();
+  }
 }
 
 void InteractiveView::set_field(std::shared_ptr<const FieldPaint> field) {
@@ -413,6 +418,60 @@ std::uint32_t InteractiveView::pick(int x, int y) const {
 void InteractiveView::finish() {
   while (step()) {
   }
+}
+
+std::vector<std::uint32_t> InteractiveView::shown_tets() const {
+  if (selecting_) {
+    if (stack_.empty()) return iso_tets_;
+    std::vector<std::uint32_t> out;
+    std::set_intersection(iso_tets_.begin(), iso_tets_.end(), stack_.back().begin(), stack_.back().end(),
+                          std::back_inserter(out));
+    return out;
+  }
+  return stack_.empty() ? std::vector<std::uint32_t>() : stack_.back();
+}
+
+ViewMovie InteractiveView::movie_input() const {
+  if (iso_ != nullptr)
+    throw std::invalid_argument(
+        "a movie turns the camera around whole tets, translucency or a volume rendering (as foxi movie "
+        "--mode rotate): turn the isosurface or slice off first (foxi movie --sweep iso makes an "
+        "isosurface movie)");
+  ViewMovie m;
+  m.camera = camera_;
+  m.width = width_;
+  m.height = height_;
+  m.render = params_;
+  m.subset = shown_tets();
+  if (translucent_) {
+    m.translucent = *translucent_;
+    m.corner.assign(translucent_->corner.begin(), translucent_->corner.end());
+  } else if (volume_) {
+    m.volume = *volume_;
+    m.corner.assign(volume_corner_.begin(), volume_corner_.end());
+  }
+  return m;
+}
+
+std::size_t make_view_movie(const Mesh& mesh, const ViewMovie& movie, const MovieParams& params,
+                            const std::function<void(const Framebuffer&)>& frame,
+                            const ProgressFn& progress) {
+  const SphereTable table = compute_spheres(mesh);
+  if (movie.translucent || movie.volume) {
+    CompositeMovieParams cp;
+    cp.movie = params;
+    cp.translucent = movie.translucent;
+    if (cp.translucent && !cp.translucent->corner.empty()) cp.translucent->corner = movie.corner;
+    cp.volume = movie.volume;
+    if (movie.volume) cp.corner = movie.corner;
+    return make_composite_movie(mesh, table, movie.camera, movie.width, movie.height, movie.subset, cp, frame,
+                                progress)
+        .frames;
+  }
+  MovieParams mp = params;
+  mp.render = movie.render;
+  return make_movie(mesh, table, movie.camera, movie.width, movie.height, movie.subset, mp, frame, progress)
+      .frames;
 }
 
 std::size_t InteractiveView::total() const {

@@ -18,6 +18,7 @@
 
 #include "foxi/api.hpp"
 #include "foxi/viz/field_selection.hpp"
+#include "foxi/viz/translucent.hpp"
 
 namespace foxi {
 struct Mesh;
@@ -71,10 +72,13 @@ class FOXI_API ViewWidget : public QWidget {
   void set_field_source(FieldChoice choice, std::size_t step, ColorScale scale,
                         std::shared_ptr<IsoCache> cache);
   // Draws what `selection` selects (field_selection.hpp, the rule of foxi render's --iso, --iso-only,
-  // --threshold and --clip: the same picture for the same camera), redrawn from the back; an empty
-  // selection draws all tets again. Costs the interval tree's query and, for a threshold or clip, a
-  // pass over the tets. False (nothing changes) with the reason in `error`: no view or no field
-  // source, a slice (not drawn here yet), a clip plane with a zero normal.
+  // --threshold, --clip and --slice: the same picture for the same camera), redrawn from the back; an
+  // empty selection draws all tets again. Costs the interval tree's query and, for a threshold, clip
+  // or slice, a pass over the tets. With the x-ray on, isovalues are drawn as translucent
+  // isosurfaces inside the translucent regions (foxi render --region-opacity ... --iso v,...
+  // --iso-opacity 0.5). False (nothing changes) with the reason in `error`: no view or no field
+  // source, a clip or slice plane with a zero normal, a slice with isovalues, what foxi render does
+  // not draw either: a threshold, clip or slice with the x-ray, any selection with the volume.
   bool set_selection(const FieldSelection& selection, QString* error = nullptr);
   const FieldSelection& selection() const;
   // The tets shown without a selection and that a selection narrows: those of the regions shown
@@ -85,10 +89,20 @@ class FOXI_API ViewWidget : public QWidget {
   // Translucency and volume rendering (issue 23; InteractiveView::set_translucent, set_volume),
   // composited exactly in the power order and undoable: the "x-ray" (every region translucent but the
   // one with the fewest tets: default_xray), or a volume rendering of the field source's field on its
-  // scale (default_volume); off: opaque tets again. A selection or a new view ends them. False
-  // (nothing changes) with the reason in `error`: no view, or for the volume no field source.
+  // scale (default_volume); off: opaque tets again. One at a time: turning one on turns the other
+  // off. Both draw the regions shown (set_base) within the region of interest, as foxi render
+  // --regions does with --region-opacity or --volume. The x-ray stays across new views (a recolour,
+  // a remesh); the volume follows the next field source after a new view (set_field_source), and is
+  // off while there is none. composite_changed says each change of what is drawn. False (nothing
+  // changes) with the reason in `error`: no view; for the volume no field source or a selection; for
+  // the x-ray a threshold, clip or slice (foxi render does not combine them either).
   bool set_xray(bool on, QString* error = nullptr);
   bool set_volume(bool on, QString* error = nullptr);
+  bool xray() const;
+  bool volume() const;
+  // The x-ray's parameters as drawn now (default_xray's opacities; the selection's isosurfaces at
+  // opacity 0.5), or null when the x-ray is off: what foxi render --region-opacity draws the same from.
+  const TranslucentParams* xray_params() const;
 
   // Milliseconds of painter work per timer slice (default 8).
   void set_time_slice(std::chrono::milliseconds slice);
@@ -114,7 +128,10 @@ class FOXI_API ViewWidget : public QWidget {
   void finish_now();  // draw all that is left, at once (blocking: for scripts and tests)
   // The picture follows the fraction `f` of the displayed set: draws on or undraws to it.
   void set_fraction(double f);
-  bool push_region();  // the drawn tets become the displayed set, camera re-framed on them
+  // The drawn tets become the displayed set, camera re-framed on them. False (nothing changes) with
+  // the reason in `error`: nothing drawn, or the x-ray on (its drawn tets are the surfaces' owners,
+  // not a part of the volume: push the region with the x-ray off; the x-ray then shows it).
+  bool push_region(QString* error = nullptr);
   bool pop_region();
 
  signals:
@@ -122,6 +139,8 @@ class FOXI_API ViewWidget : public QWidget {
   void probe_changed(const QString& text);
   void fraction_changed(double fraction);
   void draw_finished();
+  // What is drawn changed between opaque, x-ray and volume (a host's check boxes follow it).
+  void composite_changed(bool xray, bool volume);
 
  protected:
   void paintEvent(QPaintEvent* event) override;
@@ -138,6 +157,10 @@ class FOXI_API ViewWidget : public QWidget {
   void tick();
   void kick();  // the timer on, if there is work
   void present();
+  // Puts the widget's state on the view: the selection, or the x-ray or volume over the base; says a
+  // change of the composite state. False with the reason when the painter refuses (state kept).
+  bool apply(QString* error);
+  void say_composite();  // composite_changed, when what is drawn differs from what it last said
   struct Impl;
   std::unique_ptr<Impl> d_;
 };

@@ -8,9 +8,11 @@
 // std::runtime_error naming the file and the reason.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <string>
 
 #include "foxi/api.hpp"
 #include "foxi/viz/framebuffer.hpp"
@@ -39,5 +41,15 @@ FOXI_API std::unique_ptr<AnimationWriter> open_apng(const std::filesystem::path&
 // GIF89a with a NETSCAPE2.0 loop extension.
 FOXI_API std::unique_ptr<AnimationWriter> open_gif(const std::filesystem::path& path,
                                                    const AnimationParams& params);
+
+// Numbered PNG frames: `pattern` a file name with one printf integer conversion (%d or %0Nd, N < 100)
+// and no other '%' (frame_pattern), frame k written as frame_name(pattern, k). The frames appear
+// together at finish() (DurableFile temporaries committed together); the folder must exist.
+FOXI_API std::unique_ptr<AnimationWriter> open_png_frames(const std::string& pattern,
+                                                          const AnimationParams& params);
+// Whether `pattern` holds exactly one %d or %0Nd and no other '%'.
+FOXI_API bool frame_pattern(const std::string& pattern);
+// Frame k's file name (pattern checked by frame_pattern).
+FOXI_API std::string frame_name(const std::string& pattern, std::size_t k);
 
 }  // namespace foxi

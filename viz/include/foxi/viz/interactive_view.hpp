@@ -38,6 +38,7 @@
 #include "foxi/viz/camera.hpp"
 #include "foxi/viz/framebuffer.hpp"
 #include "foxi/viz/isosurface.hpp"
+#include "foxi/viz/movie.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/translucent.hpp"
@@ -51,9 +52,31 @@ namespace foxi {
 // a mesh of one region: that region at `opacity`. Ascending region ids.
 FOXI_API std::vector<RegionOpacity> default_xray(const Mesh& mesh, double opacity = 0.3);
 // The volume rendering a viewer starts from: colours on `scale`, an opacity ramp from 0.02 at
-// scale.lo to 0.5 at scale.hi (dense where the field is high), accumulated over a tenth of the mesh
-// box's diagonal (foxi render --volume's default unit length).
-FOXI_API VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale);
+// scale.lo to 0.5 at scale.hi (dense where the field is high), accumulated over a tenth of the
+// diagonal of the box of `subset` (all tets when empty: foxi render --volume's default unit length).
+FOXI_API VolumeParams default_volume(const Mesh& mesh, const ColorScale& scale,
+                                     std::span<const std::uint32_t> subset = {});
+
+// What a movie of a view draws, copied from it (InteractiveView::movie_input), so that a worker
+// makes the movie while the view goes on: the camera, size and painter settings, the tets shown (the
+// subset within the region of interest; empty: all) and what is composited, with its corner values.
+struct ViewMovie {
+  Camera camera;
+  int width = 1, height = 1;
+  RenderParams render;
+  std::vector<std::uint32_t> subset;
+  std::optional<TranslucentParams> translucent;  // its corner span is re-pointed at `corner`
+  std::optional<VolumeParams> volume;
+  std::vector<double> corner;  // the isosurfaces' (translucent) or the field's (volume), 4 per tet
+};
+
+// The movie of the view `movie` of `mesh` (the view's mesh) that foxi movie makes with the same
+// camera, size and options: opaque tets by make_movie, translucency or a volume by
+// make_composite_movie (`params.render` is taken from the view). Returns the frames written. Throws
+// as those do (UncertifiedMeshError, MovieCancelled, std::invalid_argument).
+FOXI_API std::size_t make_view_movie(const Mesh& mesh, const ViewMovie& movie, const MovieParams& params,
+                                     const std::function<void(const Framebuffer&)>& frame,
+                                     const ProgressFn& progress = {});
 
 class FOXI_API InteractiveView {
  public:
@@ -110,6 +133,15 @@ class FOXI_API InteractiveView {
   // The factor the tets are drawn shrunk by (RenderParams::shrink): pixel_point_in_tet takes it, so
   // that the point under a pixel is the true point, not where the ray meets the unshrunk tet.
   double shrink() const { return params_.shrink; }
+  // The painter's settings (the field paint, colours, shrink): what a movie of this view draws with.
+  const RenderParams& params() const { return params_; }
+  // The tets drawn without the ones a camera hides: the whole-tet subset (set_subset) within the
+  // region on top of the stack, sorted; empty: all tets (a movie's or a one-call picture's subset).
+  // Not meaningful with iso drawing (its polygons are not whole tets).
+  std::vector<std::uint32_t> shown_tets() const;
+  // The view as a movie draws it (see ViewMovie). Throws std::invalid_argument with iso drawing (iso
+  // polygons or a slice: foxi movie turns the camera around whole tets, translucency or a volume).
+  ViewMovie movie_input() const;
   // Iso polygons instead of whole tets (isosurface.hpp; the isovalue's surfaces, or in cap mode the
   // solid above it): `drawing` the IsoPainter's inputs (lent with its spans: they must outlive the
   // view or the next set_iso), `tets` the tets it crosses (cap mode: reaches; TetIntervals gives
@@ -126,13 +158,15 @@ class FOXI_API InteractiveView {
   const std::shared_ptr<const FieldPaint>& field() const { return params_.field; }
   // Translucent regions and isosurfaces ("x-ray", translucent.hpp) of the region on top of the stack
   // instead of opaque tets: the params are copied, their corner values lent (they must outlive the
-  // view or the next call). Null: opaque tets again. Ends iso and subset drawing and volume
-  // rendering; redraws from the back. Throws std::invalid_argument (from translucent_surfaces) for
-  // bad opacities, the previous picture kept.
+  // view or the next call). Null: opaque tets again. A whole-tet subset (set_subset) stays: only its
+  // tets are drawn translucent (foxi render --regions with --region-opacity); iso drawing and volume
+  // rendering end. Redraws from the back. Throws std::invalid_argument (from translucent_surfaces)
+  // for bad opacities, the previous picture kept.
   void set_translucent(const TranslucentParams* params);
   // A volume rendering of the field with `corner` values (4 per tet, lent as above) of the region on
-  // top of the stack (volume.hpp). Null params: opaque tets again. Ends iso, subset and translucent
-  // drawing; redraws from the back. Throws std::invalid_argument (from VolumePainter) for bad params.
+  // top of the stack (volume.hpp), within the whole-tet subset as above. Null params: opaque tets
+  // again. Ends iso and translucent drawing; redraws from the back. Throws std::invalid_argument
+  // (from VolumePainter) for bad params.
   void set_volume(std::span<const double> corner, const VolumeParams* params);
   bool translucent() const { return translucent_.has_value(); }
   bool volume() const { return volume_.has_value(); }

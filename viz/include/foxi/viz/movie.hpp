@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <stdexcept>
 
@@ -17,6 +18,8 @@
 #include "foxi/viz/framebuffer.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
+#include "foxi/viz/translucent.hpp"
+#include "foxi/viz/volume.hpp"
 
 namespace foxi {
 
@@ -62,5 +65,39 @@ FOXI_API MovieStats make_movie(const Mesh& mesh, const SphereTable& table, const
                                int height, std::span<const std::uint32_t> subset, const MovieParams& params,
                                const std::function<void(const Framebuffer&)>& frame,
                                const ProgressFn& progress = {});
+
+// Movies of translucent regions and isosurfaces or of a volume rendering (issue 23): one of
+// `translucent` and `volume` (its corner values lent, 4 per tet), each frame composited as
+// draw_translucent_picture or draw_volume_picture composites it.
+struct CompositeMovieParams {
+  MovieParams movie;  // rotate, frames, cycles, from and to (back-and-forth), turn_deg; render unused
+  std::optional<TranslucentParams> translucent;
+  std::optional<VolumeParams> volume;
+  std::span<const double> corner;  // volume: the field's corner values
+};
+
+struct CompositeMovieStats {
+  std::size_t frames = 0;
+  bool exact = true;             // every frame composited in the power order
+  std::size_t composited = 0;    // tets composited over the movie (recomposited ones again)
+  std::size_t recomposited = 0;  // of those, composited again to go back (back-and-forth)
+  std::size_t fragments = 0;     // translucent: fragments blended; volume: pixel segments integrated
+};
+
+// Calls frame(fb) for each frame, in order, of `subset` (empty: all tets). Rotate: frame k is the
+// one-call picture with the camera turned by turn_deg k / frames (a mesh without the certificate is
+// composited as those functions do it without one, not exactly, and stats.exact says so).
+// Back-and-forth (make_movie's frame counts): the far part of the power order of the tets that own
+// something to draw growing from `from` to `to` and shrinking back; "over" cannot be taken back, so a
+// shrinking frame composites the remaining far part again from the back (exactly the picture of
+// that far part drawn afresh). Throws UncertifiedMeshError for back-and-forth without the
+// certificate, std::invalid_argument for bad parameters (neither or both of translucent and volume),
+// MovieCancelled when progress returns false.
+FOXI_API CompositeMovieStats make_composite_movie(const Mesh& mesh, const SphereTable& table,
+                                                  const Camera& camera, int width, int height,
+                                                  std::span<const std::uint32_t> subset,
+                                                  const CompositeMovieParams& params,
+                                                  const std::function<void(const Framebuffer&)>& frame,
+                                                  const ProgressFn& progress = {});
 
 }  // namespace foxi
