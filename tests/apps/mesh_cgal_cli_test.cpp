@@ -164,7 +164,9 @@ TEST(MeshCgalCli, ViaModelKeepsThePartVolumesModelCheckPrints) {
 // Several dies on one substrate. (The bga, a corefined triangle soup that failed with "facet 488 has no
 // polygon with an area" before, takes 1.5 to 5 minutes: CgalMesherSlow.BgaModelMeshes meshes it through
 // the same library call, so the command's test takes a model of seconds.)
-TEST(MeshCgalCli, MultiChipModelKeepsThePartVolumesModelCheckPrints) { expect_cli_meshes_model("multi_chip"); }
+TEST(MeshCgalCli, MultiChipModelKeepsThePartVolumesModelCheckPrints) {
+  expect_cli_meshes_model("multi_chip");
+}
 
 // die_attach (a 20 um layer under a 10 mm die) ran past 60 s. CgalMesherSlow.DieAttachFinishesOrStops...
 // gives Mesh_3 its 60 s; the command, given 5 s, stops there with exit 1, a message naming the limit
