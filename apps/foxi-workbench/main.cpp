@@ -25,6 +25,7 @@ namespace {
 const char* kUsage =
     "foxi-workbench [MODEL.toml]\n"
     "foxi-workbench MODEL.toml --headless [--set NAME=VALUE]... [--physics NAME] [--field NAME]\n"
+    "               [--solver auto|direct|amg|ichol|ccx] [--units engineering|si]\n"
     "               [--cmap viridis|cividis|coolwarm|rainbow] [--shrink F] [--view-size WxH]\n"
     "               [--regions ID,...] [--graded] [--range a,b] [--iso v [--iso-only]] [--threshold a,b] "
     "[--clip px,py,pz,nx,ny,nz] [--slice px,py,pz,nx,ny,nz] [--deform NAME:SCALE]\n"
@@ -41,8 +42,13 @@ const char* kUsage =
     "  potential or von_mises), draws the view\n"
     "  completely and saves the window (--screenshot), the view's own picture (--save-picture: what\n"
     "  foxi render draws for the same mesh, field and camera) and the mesh with its fields\n"
-    "  (--save-mesh). Prints the tets, the key results and the camera as foxi render options.\n"
+    "  (--save-mesh). Prints the tets, the key results, the solver used and the camera as foxi render\n"
+    "  options.\n"
     "  --save-project writes the project folder (Save project in the window).\n"
+    "  --solver picks the solve panel's solver: foxi's linear solver (auto, direct, amg: CG + AMG,\n"
+    "  ichol: CG + IC, as foxi solve --solver) or ccx, CalculiX (thermal only, as foxi solve --with ccx).\n"
+    "  --units sets the panel's units box: engineering (°C, MPa, µm, mV; the default) or si (K, Pa, m,\n"
+    "  V) for the legend, the results table and the history; the printed results are SI either way.\n"
     "  --regions, --graded, --range, --iso, --iso-only, --threshold and --clip set the view's field tools as "
     "foxi render's options\n"
     "  of the same names draw them (values in the field's display unit, as the legend shows it).\n"
@@ -104,6 +110,8 @@ struct ToolOptions {
   std::vector<double> range, regions;
   std::string project;                            // --save-project
   std::optional<foxi::workbench::Deform> deform;  // --deform NAME:SCALE
+  std::optional<foxi::workbench::SolverChoice> solver;  // --solver (the solve panel's)
+  std::optional<bool> si_units;                         // --units si (true) or engineering
 };
 
 int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std::string& model,
@@ -126,6 +134,7 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     }
   }
   w.set_shrink(shrink);
+  if (tools.si_units) w.set_si_units(*tools.si_units);
   if (tools.graded || !tools.range.empty()) {
     std::optional<std::pair<double, double>> r;
     if (!tools.range.empty()) r = std::pair(tools.range[0], tools.range[1]);
@@ -138,6 +147,8 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
   }
   if (!physics.empty()) {
     w.set_physics(*foxi::workbench::physics_of(physics));
+    // main() refused the choices set_solver refuses (CalculiX for a physics other than thermal)
+    if (tools.solver) w.set_solver(*tools.solver);
     if (!w.start_solve() || !wait_job(w)) {
       std::fprintf(stderr, "foxi-workbench: error: solving: %s\n", w.last_error().toUtf8().constData());
       return w.last_error_bad_input() ? kExitBadInput : kExitFailure;
@@ -215,6 +226,7 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
       std::printf("check %s %s %.3g (tolerance %.3g)\n", c.name.c_str(), c.passed ? "ok" : "FAILED", c.figure,
                   c.tolerance);
     if (r->status != foxi::RunStatus::ok) status = kExitUnreliable;
+    if (!r->solver.empty()) std::printf("solver: %s\n", r->solver.c_str());
   }
   std::printf("view: %s\n", view->status_text().toUtf8().constData());
   std::printf("camera: %s\n", view->camera_options().c_str());
@@ -298,6 +310,16 @@ int main(int argc, char** argv) {
         if (!foxi::workbench::physics_of(physics))
           throw Usage("--physics takes thermal, electrostatic, current or thermoelastic, not '" + physics +
                       "'");
+      } else if (a == "--solver") {
+        const std::string name = value();
+        tools.solver = foxi::workbench::solver_of(name);
+        if (!tools.solver)
+          throw Usage("--solver takes auto, direct, amg, ichol or ccx (CalculiX), not '" + name + "'");
+      } else if (a == "--units") {
+        const std::string units = value();
+        if (units != "si" && units != "engineering")
+          throw Usage("--units takes engineering (°C, MPa, µm, mV) or si (K, Pa, m, V), not '" + units + "'");
+        tools.si_units = units == "si";
       } else if (a == "--field") {
         field = value();
       } else if (a == "--cmap") {
@@ -363,14 +385,19 @@ int main(int argc, char** argv) {
       }
     }
     if (is_headless && model.empty()) throw Usage("--headless needs a model file");
+    if (tools.solver && physics.empty()) throw Usage("--solver picks the solve's solver: give --physics");
+    if (tools.solver && tools.solver->calculix && physics != "thermal")
+      throw Usage("--solver ccx solves the thermal problem only (--physics thermal), not " + physics);
     if (tools.iso_only && tools.iso.empty())
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
     if (!is_headless &&
         (tools.any() || tools.graded || tools.deform || tools.xray || !tools.movie.empty() ||
-         !tools.range.empty() || !tools.regions.empty() || !tools.project.empty() || !sets.empty() ||
-         !physics.empty() || !field.empty() || !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
+         !tools.range.empty() || !tools.regions.empty() || !tools.project.empty() || tools.solver ||
+         tools.si_units || !sets.empty() || !physics.empty() || !field.empty() || !screenshot.empty() ||
+         !picture.empty() || !mesh_out.empty()))
       throw Usage(
-          "--set, --physics, --field, --screenshot, --save-picture and --save-mesh are for --headless");
+          "--set, --physics, --solver, --units, --field, --screenshot, --save-picture and --save-mesh "
+          "are for --headless");
     if (cmap != "viridis" && cmap != "cividis" && cmap != "coolwarm" && cmap != "rainbow")
       throw Usage("--cmap takes viridis, cividis, coolwarm or rainbow, not '" + cmap + "'");
     foxi::ImageSize size{0, 0};

@@ -155,9 +155,12 @@ bool Workbench::set_mesh_settings(const MeshSettings& settings, QString* error) 
     if (!model_ || std::none_of(model_->parts.begin(), model_->parts.end(),
                                 [&](const Part& q) { return q.name == p.part; }))
       return refuse(tr("no part named '%1' in the model").arg(QString::fromStdString(p.part)));
+  // A project keeps the settings: a change of them is autosaved (an edit that changes nothing is not).
+  const bool change = !same_mesh_settings(settings, mesh_settings_);
   mesh_settings_ = settings;
   if (mesh_ui_) mesh_ui_->error->clear();
   refresh_mesh_controls();
+  if (change) changed();
   return true;
 }
 

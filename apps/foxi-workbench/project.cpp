@@ -106,6 +106,91 @@ std::vector<ParameterOverride> overrides_of(const QJsonValue& v) {
   return ov;
 }
 
+// The mesh panel's settings (MeshSettings) as project.json keeps them: lengths in metres, each
+// optional value only when set.
+QJsonObject mesh_settings_json(const MeshSettings& s) {
+  QJsonObject o;
+  o["mesher"] = s.mesher == Mesher::cgal ? "cgal" : "tetgen";
+  if (s.max_size) o["max_size"] = *s.max_size;
+  QJsonArray parts;
+  for (const PartSize& p : s.part_sizes)
+    parts.append(QJsonObject{{"part", QString::fromStdString(p.part)}, {"max_size", p.max_size}});
+  o["part_sizes"] = parts;
+  if (s.quality) o["quality"] = *s.quality;
+  QJsonArray boxes;
+  for (const RefinementBox& b : s.boxes)
+    boxes.append(QJsonObject{{"lo", numbers(b.lo, 3)}, {"hi", numbers(b.hi, 3)}, {"size", b.size}});
+  o["boxes"] = boxes;
+  o["refine_from_result"] = s.refine_from_result;
+  o["refine_field"] = QString::fromStdString(s.refine_field);
+  o["target_error"] = s.target_error;
+  return o;
+}
+
+// The settings back from mesh_settings_json's object; `where` ("FILE: mesh_settings") heads the
+// reason of a malformed entry (a wrong type, an unknown key, a mesher foxi does not have). Entries
+// left out keep their defaults. The values' ranges are set_mesh_settings' to check (mesh_model's
+// own check_mesh_options, the parts of the model).
+MeshSettings mesh_settings_of(const QJsonValue& v, const std::string& where) {
+  auto bad = [&](const std::string& why) { return std::runtime_error(where + ": " + why); };
+  if (!v.isObject()) throw bad("an object expected");
+  const QJsonObject o = v.toObject();
+  static const char* const kKeys[] = {"mesher", "max_size",           "part_sizes",   "quality",
+                                      "boxes",  "refine_from_result", "refine_field", "target_error"};
+  for (const QString& key : o.keys())
+    if (std::none_of(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }))
+      throw bad("unknown entry '" + key.toStdString() + "'");
+  auto number = [&](const QJsonValue& x, const std::string& what) {
+    if (!x.isDouble() || !std::isfinite(x.toDouble())) throw bad(what + " is not a number");
+    return x.toDouble();
+  };
+  auto corner = [&](const QJsonValue& x, double* out, const std::string& what) {
+    const QJsonArray a = x.toArray();
+    if (!x.isArray() || a.size() != 3) throw bad(what + " is not 3 numbers");
+    for (int k = 0; k < 3; ++k) out[k] = number(a[k], what);
+  };
+  MeshSettings s;
+  if (o.contains("mesher")) {
+    const QString m = o["mesher"].toString();
+    if (!o["mesher"].isString()) throw bad("the mesher is not a name (tetgen or cgal)");
+    if (m == "cgal")
+      s.mesher = Mesher::cgal;
+    else if (m != "tetgen")
+      throw bad("the mesher is tetgen or cgal, not '" + m.toStdString() + "'");
+  }
+  if (o.contains("max_size")) s.max_size = number(o["max_size"], "max_size");
+  if (o.contains("quality")) s.quality = number(o["quality"], "quality");
+  if (o.contains("part_sizes") && !o["part_sizes"].isArray()) throw bad("part_sizes is not a list");
+  for (const QJsonValue& e : o["part_sizes"].toArray()) {
+    const std::string what = "part size " + std::to_string(s.part_sizes.size() + 1);
+    const QJsonObject p = e.toObject();
+    if (!e.isObject() || !p["part"].isString() || p["part"].toString().isEmpty())
+      throw bad(what + ": a part name and its max_size expected");
+    s.part_sizes.push_back({.part = p["part"].toString().toStdString(),
+                            .max_size = number(p["max_size"], what + "'s max_size")});
+  }
+  if (o.contains("boxes") && !o["boxes"].isArray()) throw bad("boxes is not a list");
+  for (const QJsonValue& e : o["boxes"].toArray()) {
+    const std::string what = "refinement box " + std::to_string(s.boxes.size() + 1);
+    if (!e.isObject()) throw bad(what + ": lo, hi and size expected");
+    RefinementBox b;
+    corner(e.toObject()["lo"], b.lo, what + "'s lo");
+    corner(e.toObject()["hi"], b.hi, what + "'s hi");
+    b.size = number(e.toObject()["size"], what + "'s size");
+    s.boxes.push_back(b);
+  }
+  if (o.contains("refine_from_result")) {
+    if (!o["refine_from_result"].isBool()) throw bad("refine_from_result is not true or false");
+    s.refine_from_result = o["refine_from_result"].toBool();
+  }
+  if (o.contains("refine_field")) {
+    if (!o["refine_field"].isString()) throw bad("refine_field is not a field name");
+    s.refine_field = o["refine_field"].toString().toStdString();
+  }
+  if (o.contains("target_error")) s.target_error = number(o["target_error"], "target_error");
+  return s;
+}
+
 }  // namespace
 
 // What a save writes, taken on the GUI thread (the state may change meanwhile) and written on any thread.
@@ -179,6 +264,10 @@ ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
   p["physics"] = physics_name(physics_);
   p["si_units"] = si_units_;
   p["solver"] = solver_.calculix ? -1 : int(solver_.linear);
+  // The mesh panel's settings (the next mesh's) and those the shown mesh was made with: reopened,
+  // a Solve remeshes exactly when it would have before the save.
+  p["mesh_settings"] = mesh_settings_json(mesh_settings_);
+  if (mesh_) p["meshed_settings"] = mesh_settings_json(meshed_settings_);
   if (deform_)
     p["deform"] = QJsonObject{{"field", QString::fromStdString(deform_->field)}, {"scale", deform_->scale}};
   if (const Camera* c = view_->camera()) {
@@ -312,11 +401,23 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     const QJsonObject p = doc.object();
     if (p["format"].toString() != "foxi-workbench project 1")
       throw std::runtime_error((dir / "project.json").string() + ": not a foxi-workbench project");
+    // The mesh settings read before anything changes (a malformed entry leaves the window as it was);
+    // a project without them (saved before they were kept) meshes with the defaults.
+    const std::string file = (dir / "project.json").string();
+    const MeshSettings settings = p.contains("mesh_settings")
+                                      ? mesh_settings_of(p["mesh_settings"], file + ": mesh_settings")
+                                      : MeshSettings{};
+    const MeshSettings meshed = p.contains("meshed_settings")
+                                    ? mesh_settings_of(p["meshed_settings"], file + ": meshed_settings")
+                                    : settings;
     QString why;
     if (!open_model(p["model"].toString(), &why)) throw std::runtime_error(why.toStdString());
     std::map<std::string, std::string> trial;
     for (const ParameterOverride& o : overrides_of(p["overrides"])) trial[o.name] = o.expression;
     if (!apply_overrides(trial, &why)) throw std::runtime_error(why.toStdString());
+    // Their values as the panel checks them (mesh_model's check, the model's parts).
+    if (!set_mesh_settings(settings, &why))
+      throw std::runtime_error(file + ": mesh_settings: " + why.toStdString());
     field_ = p["field"].toString();
     color_map_ = p["color_map"].toString("viridis");
     graded_ = p["graded"].toBool();
@@ -365,6 +466,7 @@ bool Workbench::open_project(const QString& folder, QString* error) {
       meshed_model_ = model_;
       meshed_path_ = model_path_;
       meshed_overrides_ = overrides_of(p["mesh_overrides"]);
+      meshed_settings_ = meshed;
       mesh_serial_ = 1;
       for (const HistoryRow& h : history_) mesh_serial_ = std::max(mesh_serial_, h.mesh);
     }
@@ -405,6 +507,7 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     }
     if (has_results_) show_results();
     refresh_history();
+    refresh_mesh_controls();  // the reopened result's fields to refine from
     if (mesh_ && set_field(field_, color_map_) && deform_)
       deform_before_ = std::optional<Deform>{};  // a refused shape: the undeformed one
     return true;

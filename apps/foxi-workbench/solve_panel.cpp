@@ -39,6 +39,15 @@ std::optional<Physics> physics_of(const std::string& name) {
   return std::nullopt;
 }
 
+std::optional<SolverChoice> solver_of(const std::string& name) {
+  if (name == "auto") return SolverChoice{false, LinearSolverKind::automatic};
+  if (name == "direct") return SolverChoice{false, LinearSolverKind::direct};
+  if (name == "amg") return SolverChoice{false, LinearSolverKind::cg_amg};
+  if (name == "ichol") return SolverChoice{false, LinearSolverKind::cg_ichol};
+  if (name == "ccx") return SolverChoice{true, LinearSolverKind::automatic};
+  return std::nullopt;
+}
+
 const char* solved_field(Physics physics) {
   switch (physics) {
     case Physics::electrostatic:

@@ -135,6 +135,9 @@ bool same_mesh_settings(const MeshSettings& a, const MeshSettings& b);
 
 // The physics named as foxi solve --physics names it (physics_name), or nullopt (solve_panel.cpp).
 std::optional<Physics> physics_of(const std::string& name);
+// The solve panel's solver by the name foxi solve --solver gives it (auto, direct, amg, ichol) or
+// ccx for CalculiX (foxi solve --with ccx), or nullopt (solve_panel.cpp).
+std::optional<SolverChoice> solver_of(const std::string& name);
 // The field a solve of `physics` is shown by: temperature, potential, von_mises (solve_panel.cpp).
 const char* solved_field(Physics physics);
 // Solves `physics` on `mesh` (its fields written there) with the model's conditions and loads, as

@@ -12,6 +12,9 @@
 #include <QCheckBox>
 #include <QComboBox>
 #include <QEventLoop>
+#include <QJsonArray>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QLabel>
 #include <QLineEdit>
 #include <QMouseEvent>
@@ -1655,6 +1658,352 @@ TEST(Workbench, ProjectKeepsTheDeformedShape) {
   EXPECT_EQ(again.deform()->scale, 150);
   ASSERT_NE(again.view_widget()->mesh(), again.mesh());
   EXPECT_TRUE(again.view_widget()->mesh()->xyz == moved) << "the same moved mesh as saved";
+}
+
+// The mesh panel's settings, field by field (lengths exactly: the project keeps them in metres).
+void expect_same_settings(const foxi::workbench::MeshSettings& a, const foxi::workbench::MeshSettings& b,
+                          const char* when) {
+  EXPECT_EQ(a.mesher, b.mesher) << when;
+  EXPECT_EQ(a.max_size, b.max_size) << when;
+  EXPECT_EQ(a.quality, b.quality) << when;
+  ASSERT_EQ(a.part_sizes.size(), b.part_sizes.size()) << when;
+  for (std::size_t i = 0; i < a.part_sizes.size(); ++i) {
+    EXPECT_EQ(a.part_sizes[i].part, b.part_sizes[i].part) << when;
+    EXPECT_EQ(a.part_sizes[i].max_size, b.part_sizes[i].max_size) << when;
+  }
+  ASSERT_EQ(a.boxes.size(), b.boxes.size()) << when;
+  for (std::size_t i = 0; i < a.boxes.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(a.boxes[i].lo[k], b.boxes[i].lo[k]) << when;
+      EXPECT_EQ(a.boxes[i].hi[k], b.boxes[i].hi[k]) << when;
+    }
+    EXPECT_EQ(a.boxes[i].size, b.boxes[i].size) << when;
+  }
+  EXPECT_EQ(a.refine_from_result, b.refine_from_result) << when;
+  EXPECT_EQ(a.refine_field, b.refine_field) << when;
+  EXPECT_EQ(a.target_error, b.target_error) << when;
+}
+
+// A refinement box from the origin to (x, y, z) with edge length `size` inside (m).
+foxi::RefinementBox box_from_origin(double x, double y, double z, double size) {
+  foxi::RefinementBox b;
+  b.hi[0] = x, b.hi[1] = y, b.hi[2] = z;
+  b.size = size;
+  return b;
+}
+
+// Waits (serving events) until the workbench has started `n` autosaves and the last is written.
+bool autosaved(Workbench& w, int n) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (w.autosaves() < n && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(8))
+    QApplication::processEvents(QEventLoop::AllEvents, 50);
+  w.wait_autosave();
+  return w.autosaves() >= n;
+}
+
+// A project keeps the mesh panel's settings (TetGen: global and part size, quality bound, a
+// refinement box, refine from the result with its field and target): a change of one is autosaved,
+// and the autosaved project reopened in a new window has them field by field, in the panel's
+// controls too; a Solve there does not remesh (the shown mesh was made with them), and the next Mesh
+// is mesh_model's with those options, refined from the reopened result.
+TEST(Workbench, ProjectKeepsTheMeshSettings) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "auto").string());
+  const std::string model = kModels + "die_on_substrate.toml";
+  foxi::workbench::MeshSettings s;
+  s.max_size = 1.5e-3;
+  s.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
+  s.quality = 1.8;
+  const foxi::RefinementBox box = box_from_origin(2e-3, 10e-3, 1.5e-3, 0.3e-3);
+  s.boxes = {box};
+  s.refine_from_result = true;
+  s.refine_field = "temperature";
+  s.target_error = 0.25;
+  {
+    Workbench w;
+    w.view_widget()->setFixedSize(160, 120);
+    ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+    QString why;
+    ASSERT_TRUE(w.set_mesh_settings(s, &why)) << why.toStdString();
+    ASSERT_TRUE(w.start_solve());  // no result to refine from yet: meshed with the sizes, solved
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    w.set_autosave_folder(folder);
+    w.set_autosave_delay(50);
+    const int before = w.autosaves();
+    s.target_error = 0.3;  // a mesh setting changed: an autosave follows
+    ASSERT_TRUE(w.set_mesh_settings(s, &why)) << why.toStdString();
+    ASSERT_TRUE(autosaved(w, before + 1)) << "no autosave after a mesh setting changed";
+    EXPECT_NE(foxi::test::read_text(dir.path() / "auto" / "project.json").find("\"target_error\": 0.3"),
+              std::string::npos);
+    // The same settings again (the panel's editingFinished without an edit) is no change.
+    ASSERT_TRUE(w.set_mesh_settings(s));
+    for (int i = 0; i < 5; ++i) QApplication::processEvents(QEventLoop::AllEvents, 50);
+    EXPECT_EQ(w.autosaves(), before + 1);
+    // the shown mesh made with these settings again (a Solve reopened must not remesh)
+    s.target_error = 0.25;
+    ASSERT_TRUE(w.set_mesh_settings(s, &why));
+    ASSERT_TRUE(autosaved(w, before + 2));
+  }
+  Workbench again;
+  again.view_widget()->setFixedSize(160, 120);
+  QString why;
+  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
+  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  expect_same_settings(again.mesh_settings(), s, "reopened");
+  // The panel's controls show them (lengths in the model's mm).
+  EXPECT_EQ(again.findChild<QComboBox*>("mesher")->currentIndex(), 0);
+  EXPECT_EQ(again.findChild<QLineEdit*>("mesh_size")->text(), "1.5 mm");
+  EXPECT_EQ(again.findChild<QLineEdit*>("mesh_quality")->text(), "1.8");
+  EXPECT_EQ(again.findChild<QLineEdit*>("target_error")->text(), "0.25");
+  EXPECT_TRUE(again.findChild<QCheckBox*>("refine_from_result")->isChecked());
+  auto* parts = again.findChild<QTableWidget*>("part_sizes");
+  bool die_shown = false;
+  for (int r = 0; r < parts->rowCount(); ++r)
+    if (parts->item(r, 0)->text() == "die") die_shown = parts->item(r, 1)->text() == "0.4 mm";
+  EXPECT_TRUE(die_shown);
+  auto* boxes = again.findChild<QTableWidget*>("refine_boxes");
+  ASSERT_EQ(boxes->rowCount(), 1);
+  EXPECT_EQ(boxes->item(0, 3)->text(), "2");
+  EXPECT_EQ(boxes->item(0, 6)->text(), "0.3");
+  // A Solve on the reopened mesh solves it (made with the settings shown: no remesh).
+  const std::shared_ptr<const foxi::Mesh> solved = again.mesh();
+  ASSERT_TRUE(solved && again.results());
+  ASSERT_FALSE(again.history().empty());
+  const std::size_t mesh_number = again.history().back().mesh;
+  ASSERT_TRUE(again.start_solve());
+  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  EXPECT_EQ(again.history().back().mesh, mesh_number)
+      << "the reopened mesh's settings are the panel's: no remesh";
+  EXPECT_TRUE(again.mesh()->xyz == solved->xyz);
+  // The next Mesh: mesh_model's with the options written out here, refined from the reopened result.
+  const std::shared_ptr<const foxi::Mesh> result = again.mesh();
+  ASSERT_TRUE(again.start_mesh());
+  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  foxi::ModelMeshOptions o;
+  o.max_size = 1.5e-3;
+  o.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
+  o.quality = 1.8;
+  o.sizes.boxes = {box};
+  o.refine_from = {.mesh = result.get(), .field = "temperature", .target_error = 0.25};
+  const foxi::MeshedModel direct = foxi::mesh_model(model, {}, o);
+  EXPECT_EQ(again.mesh()->tet_count(), direct.mesh.tet_count());
+  EXPECT_TRUE(again.mesh()->xyz == direct.mesh.xyz);
+  EXPECT_TRUE(again.mesh()->tet == direct.mesh.tet);
+  EXPECT_GT(again.mesh()->tet_count(), result->tet_count()) << "refined";
+}
+
+// CGAL with a part size, a quality bound and a box, saved in a project (no mesh yet) and reopened in a
+// new window: the same settings, the mesher box on CGAL, and the next mesh mesh_model's with them.
+TEST(Workbench, ProjectKeepsCgalMeshSettings) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "proj").string());
+  const std::string model = kModels + "die_on_substrate.toml";
+  foxi::workbench::MeshSettings s;
+  s.mesher = foxi::Mesher::cgal;
+  s.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
+  s.quality = 2.5;
+  const foxi::RefinementBox box = box_from_origin(2e-3, 10e-3, 1e-3, 0.4e-3);
+  s.boxes = {box};
+  {
+    Workbench w;
+    ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+    QString why;
+    ASSERT_TRUE(w.set_mesh_settings(s, &why)) << why.toStdString();
+    ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
+  }
+  Workbench again;
+  again.view_widget()->setFixedSize(160, 120);
+  QString why;
+  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
+  expect_same_settings(again.mesh_settings(), s, "reopened");
+  EXPECT_EQ(again.findChild<QComboBox*>("mesher")->currentIndex(), 1);
+  EXPECT_EQ(again.findChild<QLineEdit*>("mesh_quality")->text(), "2.5");
+  ASSERT_TRUE(again.start_mesh());
+  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  foxi::ModelMeshOptions o;
+  o.mesher = foxi::Mesher::cgal;
+  o.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
+  o.quality = 2.5;
+  o.sizes.boxes = {box};
+  const foxi::MeshedModel direct = foxi::mesh_model(model, {}, o);
+  EXPECT_EQ(direct.cgal.boxes, 1u);
+  EXPECT_TRUE(again.mesh()->xyz == direct.mesh.xyz);
+  EXPECT_TRUE(again.mesh()->tet == direct.mesh.tet);
+  EXPECT_TRUE(again.mesh()->weight == direct.mesh.weight);
+}
+
+// A project saved before the mesh settings were kept opens with the defaults (also in a window whose
+// settings for the same model were others); a malformed entry is refused naming project.json and
+// the reason, the window's settings as they were.
+TEST(Workbench, ProjectMeshSettingsOldAndMalformed) {
+  TempDir dir;
+  const auto proj = dir.path() / "proj";
+  QJsonObject saved;
+  {
+    Workbench w;
+    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+    QString why;
+    ASSERT_TRUE(w.save_project(QString::fromStdString(proj.string()), &why)) << why.toStdString();
+    saved = QJsonDocument::fromJson(QByteArray::fromStdString(foxi::test::read_text(proj / "project.json")))
+                .object();
+  }
+  ASSERT_TRUE(saved.contains("mesh_settings"));
+  auto write = [&](const QJsonObject& p) {
+    foxi::test::write_text(proj / "project.json", QJsonDocument(p).toJson().toStdString());
+  };
+  // A window on the project's model (the same path) with settings of its own.
+  Workbench x;
+  ASSERT_TRUE(x.open_model(saved["model"].toString()));
+  foxi::workbench::MeshSettings mine;
+  mine.mesher = foxi::Mesher::cgal;
+  mine.max_size = 2e-3;
+  mine.boxes = {foxi::RefinementBox{{0, 0, 0}, {1e-3, 1e-3, 1e-3}, 0.5e-3}};
+  QString why;
+  ASSERT_TRUE(x.set_mesh_settings(mine, &why)) << why.toStdString();
+
+  // Malformed entries: refused with the file and the reason; the settings stay.
+  const std::string file = (proj / "project.json").string();
+  struct Case {
+    const char* key;
+    QJsonValue value;
+    const char* reason;
+  };
+  const QJsonObject settings = saved["mesh_settings"].toObject();
+  auto with = [&](const char* key, const QJsonValue& v) {
+    QJsonObject o = settings;
+    o[key] = v;
+    return o;
+  };
+  const QJsonObject bad_box{{"lo", QJsonArray{0, 0}}, {"hi", QJsonArray{1e-3, 1e-3, 1e-3}}, {"size", 1e-4}};
+  const Case cases[] = {
+      {"mesher", "gmsh", "the mesher is tetgen or cgal, not 'gmsh'"},
+      {"max_size", "1 mm", "max_size is not a number"},
+      {"boxes", QJsonArray{bad_box}, "refinement box 1's lo is not 3 numbers"},
+      {"refine_from_result", 1, "refine_from_result is not true or false"},
+      {"max-size", 1e-3, "unknown entry 'max-size'"},
+  };
+  for (const Case& c : cases) {
+    QJsonObject p = saved;
+    p["mesh_settings"] = with(c.key, c.value);
+    write(p);
+    why.clear();
+    EXPECT_FALSE(x.open_project(QString::fromStdString(proj.string()), &why)) << c.key;
+    EXPECT_NE(why.toStdString().find(file + ": mesh_settings: " + c.reason), std::string::npos)
+        << why.toStdString();
+    expect_same_settings(x.mesh_settings(), mine, c.key);
+  }
+  // Values the panel refuses, with its reason (mesh_model's check, the model's parts).
+  const std::pair<QJsonObject, const char*> refused[] = {
+      {with("part_sizes", QJsonArray{QJsonObject{{"part", "chip"}, {"max_size", 1e-3}}}),
+       "no part named 'chip' in the model"},
+      {with("quality", 1.0), "the radius-edge bound must be 0 (no quality refinement) or at least 1.414"},
+      {with("max_size", -1e-3), "the global mesh size must be > 0"},
+  };
+  for (const auto& [entry, reason] : refused) {
+    QJsonObject p = saved;
+    p["mesh_settings"] = entry;
+    write(p);
+    why.clear();
+    EXPECT_FALSE(x.open_project(QString::fromStdString(proj.string()), &why)) << reason;
+    EXPECT_NE(why.toStdString().find(file + ": mesh_settings: "), std::string::npos) << why.toStdString();
+    EXPECT_NE(why.toStdString().find(reason), std::string::npos) << why.toStdString();
+  }
+
+  // An old project (no entry): the defaults, in the panel too.
+  ASSERT_TRUE(x.set_mesh_settings(mine, &why)) << why.toStdString();
+  QJsonObject old = saved;
+  old.remove("mesh_settings");
+  write(old);
+  ASSERT_TRUE(x.open_project(QString::fromStdString(proj.string()), &why)) << why.toStdString();
+  expect_same_settings(x.mesh_settings(), foxi::workbench::MeshSettings{}, "an old project");
+  EXPECT_EQ(x.findChild<QComboBox*>("mesher")->currentIndex(), 0);
+  EXPECT_EQ(x.findChild<QTableWidget*>("refine_boxes")->rowCount(), 0);
+  EXPECT_TRUE(x.findChild<QLineEdit*>("mesh_size")->text().isEmpty());
+}
+
+// Headless --solver ichol --units si: the printed results and solver are foxi solve --solver ichol
+// --json's and the solve panel's (the same choices set in a window); the saved project has them (the
+// units box on SI: the results table in K). Bad values: exit 2 with the usage.
+TEST(WorkbenchHeadless, SolverAndUnitsAsTheSolvePanel) {
+  TempDir dir;
+  const std::string model = kModels + "die_on_substrate.toml";
+  const auto proj = dir.path() / "proj", log = dir.path() / "wb.log";
+  const std::string wb = "'" + std::string(FOXI_WORKBENCH_PATH) + "' '" + model + "' --headless ";
+  ASSERT_EQ(foxi::test::run(wb +
+                                "--physics thermal --solver ichol --units si --view-size 160x120 "
+                                "--save-project '" +
+                                proj.string() + "'",
+                            log),
+            0)
+      << foxi::test::read_text(log);
+  const std::string out = foxi::test::read_text(log);
+  const auto json = dir.path() / "solve.json";
+  ASSERT_EQ(foxi::test::run_cli("solve '" + model + "' --solver ichol --json '" + json.string() + "'",
+                                dir.path() / "solve.log"),
+            0)
+      << foxi::test::read_text(dir.path() / "solve.log");
+  const foxi::RunResults cli = foxi::parse_results_json(foxi::test::read_text(json));
+  auto line = [](const std::string& text, const std::string& key) {  // the rest of key's line
+    const std::string rest = line_after(text, key);
+    return rest.substr(0, rest.find('\n'));
+  };
+  EXPECT_EQ(line(out, "solver: "), cli.solver) << out;
+  // The window's solve panel with the same choices.
+  Workbench w;
+  w.view_widget()->setFixedSize(160, 120);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(w.set_solver({false, foxi::LinearSolverKind::cg_ichol}));
+  ASSERT_TRUE(w.set_si_units(true));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  EXPECT_EQ(w.results()->solver, cli.solver);
+  std::size_t keys = 0;
+  for (const foxi::ResultValue& v : cli.values) {
+    if (!v.key) continue;
+    ++keys;
+    const std::string shown = line(out, "\n" + v.name + " ");
+    ASSERT_FALSE(shown.empty()) << v.name << "\n" << out;
+    EXPECT_NEAR(std::stod(shown), v.value, 1e-5 * std::abs(v.value)) << v.name;
+    EXPECT_NE(shown.find(" " + v.unit), std::string::npos) << "SI: " << shown;
+    ASSERT_NE(w.results()->find(v.name), nullptr) << v.name;
+    EXPECT_NEAR(w.results()->find(v.name)->value, v.value, 1e-9 * std::abs(v.value)) << v.name;
+  }
+  EXPECT_GE(keys, 1u);
+  // The headless run's project: the solver and the units box as given.
+  Workbench again;
+  again.view_widget()->setFixedSize(160, 120);
+  QString why;
+  ASSERT_TRUE(again.open_project(QString::fromStdString(proj.string()), &why)) << why.toStdString();
+  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  EXPECT_FALSE(again.solver().calculix);
+  EXPECT_EQ(again.solver().linear, foxi::LinearSolverKind::cg_ichol);
+  EXPECT_TRUE(again.si_units());
+  EXPECT_EQ(again.display_unit().symbol, "K");
+  EXPECT_EQ(again.results()->solver, cli.solver);
+  const foxi::ResultValue* t = cli.find("T_max");
+  ASSERT_NE(t, nullptr);
+  const auto [value, unit] = table_value(again, "T_max");
+  EXPECT_EQ(unit, "K");
+  EXPECT_NEAR(value, t->value, 1e-5 * t->value);
+  // Without --units the engineer's units (°C) and the automatic solver: another solver name.
+  ASSERT_EQ(foxi::test::run(wb + "--physics thermal --view-size 160x120", log), 0)
+      << foxi::test::read_text(log);
+  const std::string automatic = line(foxi::test::read_text(log), "solver: ");
+  EXPECT_FALSE(automatic.empty());
+  EXPECT_NE(automatic, cli.solver);
+  // Bad values and combinations: usage (2), naming the option.
+  const std::pair<const char*, const char*> bad[] = {
+      {"--physics thermal --solver gauss", "--solver takes auto, direct, amg, ichol or ccx"},
+      {"--physics thermal --units kelvin", "--units takes engineering"},
+      {"--physics current --solver ccx", "--solver ccx solves the thermal problem only"},
+      {"--solver ichol", "--solver picks the solve's solver: give --physics"},
+  };
+  for (const auto& [args, reason] : bad) {
+    EXPECT_EQ(foxi::test::run(wb + args, log), 2) << args;
+    const std::string text = foxi::test::read_text(log);
+    EXPECT_NE(text.find(reason), std::string::npos) << text;
+    EXPECT_NE(text.find("usage: "), std::string::npos) << text;
+  }
 }
 
 // The solve's iterations: a CG solve's callbacks counted 1, 2, ..., N (N as foxi solve --solver ichol
