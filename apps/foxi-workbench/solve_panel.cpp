@@ -14,7 +14,6 @@
 #include <QSignalBlocker>
 #include <QTableWidget>
 #include <QVBoxLayout>
-#include <chrono>
 #include <cmath>
 
 #include "foxi/model/io_error.hpp"
@@ -32,6 +31,10 @@ constexpr Physics kPhysics[] = {Physics::thermal, Physics::electrostatic, Physic
                                 Physics::thermal_stress};
 
 }  // namespace
+
+bool calculix_solves(Physics physics) {
+  return physics == Physics::thermal || physics == Physics::thermal_stress;
+}
 
 std::optional<Physics> physics_of(const std::string& name) {
   for (Physics p : kPhysics)
@@ -63,8 +66,12 @@ const char* solved_field(Physics physics) {
 
 RunResults solve_model_physics(const std::string& path, const Model& model, Mesh& mesh, Physics physics,
                                const LinearSolverOptions& solver, bool calculix) {
-  if (calculix && physics != Physics::thermal)
-    throw SolverError(std::string("CalculiX solves the thermal problem here, not ") + physics_name(physics));
+  if (calculix && physics != Physics::thermal && physics != Physics::thermal_stress)
+    throw SolverError(std::string("CalculiX solves the thermal and thermal stress problems here, not ") +
+                      physics_name(physics));
+  // foxi solve MODEL --with ccx: ccx's results with foxi's report of them (its checks); Cancel kills ccx.
+  CalculixRunOptions ccx;
+  ccx.progress = solver.progress;
   // Each branch takes from the model what foxi solve MODEL --physics NAME takes (cmd_solve.cpp,
   // cmd_solve_thermoelastic.cpp) with no other option, so that the results are the CLI's.
   switch (physics) {
@@ -91,6 +98,7 @@ RunResults solve_model_physics(const std::string& path, const Model& model, Mesh
       const ThermoelasticParams mp = thermoelastic_params_from_model(model, mesh);
       tp.materials = mp.materials, tp.fixed = mp.fixed, tp.sliding = mp.sliding, tp.delta_t = mp.delta_t;
       tp.solver = solver;
+      if (calculix) return thermoelastic_results(mesh, solve_thermoelastic_calculix(mesh, tp, ccx).report);
       return thermoelastic_results(mesh, solve_thermoelastic(mesh, tp));
     }
     case Physics::thermal:
@@ -98,15 +106,7 @@ RunResults solve_model_physics(const std::string& path, const Model& model, Mesh
   }
   ThermalParams params = thermal_params_from_model(model, mesh);
   params.solver = solver;
-  if (calculix) {
-    // foxi solve MODEL --with ccx: ccx's temperatures with foxi's report of them (its checks).
-    CalculixRunOptions ccx;
-    ccx.progress = solver.progress;
-    const auto t0 = std::chrono::steady_clock::now();
-    ThermalReport rep = solve_thermal_calculix(mesh, params, ccx);
-    rep.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return thermal_results(mesh, rep);
-  }
+  if (calculix) return thermal_results(mesh, solve_thermal_calculix(mesh, params, ccx).report);
   return thermal_results(mesh, solve_thermal(mesh, params));
 }
 
@@ -119,7 +119,7 @@ DisplayUnit unit_for(const std::string& si_unit, double max_abs, bool si) {
 }
 
 bool Workbench::set_solver(const SolverChoice& choice) {
-  if (busy() || (choice.calculix && physics_ != Physics::thermal)) return false;
+  if (busy() || (choice.calculix && !calculix_solves(physics_))) return false;
   solver_ = choice;
   const QSignalBlocker quiet(solver_box_);
   const int want = choice.calculix ? -1 : int(choice.linear);
@@ -152,7 +152,7 @@ bool Workbench::set_si_units(bool si) {
 bool Workbench::set_physics(Physics physics) {
   if (busy()) return false;
   physics_ = physics;
-  if (physics != Physics::thermal && solver_.calculix) set_solver({});  // ccx solves the heat problem only
+  if (!calculix_solves(physics) && solver_.calculix) set_solver({});  // ccx: heat and thermal stress only
   const QSignalBlocker quiet(physics_box_);
   physics_box_->setCurrentIndex(physics_box_->findData(int(physics)));
   solve_button_->setText(tr("Solve (%1)").arg(physics_name(physics)));
@@ -184,7 +184,7 @@ void Workbench::build_results_panel() {
   solver_box_->addItem(tr("built-in, CG + IC"), int(LinearSolverKind::cg_ichol));
   solver_box_->addItem(tr("CalculiX (ccx)"), -1);
   solver_box_->setToolTip(
-      tr("foxi's solver (foxi solve --solver) or CalculiX, thermal only (foxi solve "
+      tr("foxi's solver (foxi solve --solver) or CalculiX, thermal and thermal_stress (foxi solve "
          "--with ccx: a ccx child process, killed by Cancel)"));
   connect(solver_box_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this] {
     const int v = solver_box_->currentData().toInt();
@@ -192,7 +192,7 @@ void Workbench::build_results_panel() {
     c.calculix = v < 0;
     if (v >= 0) c.linear = LinearSolverKind(v);
     if (!set_solver(c)) {
-      show_error(tr("CalculiX solves the thermal problem only"));
+      show_error(tr("CalculiX solves the thermal and thermal stress problems only"));
       set_solver(solver_);
     }
   });

@@ -78,7 +78,8 @@ struct Colouring {
 };
 
 // Which solver Solve runs: foxi's own (its linear solver: automatic, direct, CG) or CalculiX (ccx,
-// a child process: thermal only, as foxi solve --with ccx takes it).
+// a child process: thermal and thermal stress, as foxi solve --physics thermal|thermoelastic --with ccx
+// takes them).
 struct SolverChoice {
   bool calculix = false;
   LinearSolverKind linear = LinearSolverKind::automatic;
@@ -162,9 +163,10 @@ class Workbench : public QMainWindow {
   bool set_mesh_settings(const MeshSettings& settings, QString* error = nullptr);
   const MeshSettings& mesh_settings() const { return mesh_settings_; }
   // The solver Solve runs (the solve panel's choice); false while a job runs, or CalculiX for a physics
-  // other than thermal. A CalculiX run is a child process (killed by Cancel, its work folder removed),
-  // its temperatures read back as the field and reported with the balance checks as foxi solve --with
-  // ccx reports them.
+  // other than thermal and thermal_stress. A CalculiX run is a child process (killed by Cancel, its
+  // work folder removed), its temperatures or displacements read back (with the stress and von Mises
+  // foxi derives from them, ccx's nodal stress as stress_nodal) and reported with the balance checks
+  // as foxi solve --with ccx reports them (solve_thermal_calculix, solve_thermoelastic_calculix).
   bool set_solver(const SolverChoice& choice);
   const SolverChoice& solver() const { return solver_; }
   // The progress bar: the stage, the iterative solver's iteration and residual while it runs.

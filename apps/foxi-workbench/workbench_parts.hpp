@@ -133,6 +133,8 @@ QString mesher_summary(const MeshedModel& m);
 // The same settings (mesh_panel.cpp): a solve remeshes first when they differ from the shown mesh's.
 bool same_mesh_settings(const MeshSettings& a, const MeshSettings& b);
 
+// Whether CalculiX solves `physics` here (thermal, thermal_stress) (solve_panel.cpp).
+bool calculix_solves(Physics physics);
 // The physics named as foxi solve --physics names it (physics_name), or nullopt (solve_panel.cpp).
 std::optional<Physics> physics_of(const std::string& name);
 // The solve panel's solver by the name foxi solve --solver gives it (auto, direct, amg, ichol) or
@@ -142,9 +144,10 @@ std::optional<SolverChoice> solver_of(const std::string& name);
 const char* solved_field(Physics physics);
 // Solves `physics` on `mesh` (its fields written there) with the model's conditions and loads, as
 // foxi solve MODEL --physics NAME does (with `solver.kind` as its --solver); the results record with
-// its checks. With `calculix`: a thermal solve by ccx, as foxi solve MODEL --with ccx does (SolverError
-// for another physics). `solver`'s progress and iterations report and cancel. Errors: IoError on the
-// model file (`path`) for what the model lacks, SolverError, Cancelled when a callback says stop.
+// its checks. With `calculix`: a thermal or thermal stress solve by ccx, as foxi solve MODEL --physics
+// thermal|thermoelastic --with ccx does (SolverError for another physics; Cancel kills ccx). `solver`'s
+// progress and iterations report and cancel. Errors: IoError on the model file (`path`) for what the model
+// lacks, SolverError, Cancelled when a callback says stop.
 RunResults solve_model_physics(const std::string& path, const Model& model, Mesh& mesh, Physics physics,
                                const LinearSolverOptions& solver, bool calculix = false);
 // The progress callbacks of a job's solve: the stage and its permille into `permille` (stage * 10000 +

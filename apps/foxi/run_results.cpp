@@ -8,10 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <random>
 
 #include "foxi/mesher/size_field.hpp"
-#include "foxi/model/cleanup.hpp"
 #include "foxi/model/durable_file.hpp"
 #include "signals.hpp"
 
@@ -164,24 +162,6 @@ RunResults run_solve_child(const std::vector<std::string>& args, const std::file
   r.error = !error.empty() ? error : !last.empty() ? last : "exit status " + std::to_string(rc);
   if (r.error.rfind("error: ", 0) == 0) r.error = r.error.substr(7);
   return r;
-}
-
-ScratchFolder::ScratchFolder(const std::string& stem) {
-  std::random_device rd;
-  const auto base = std::filesystem::temp_directory_path();
-  path_ = base / (stem + "-" + std::to_string(::getpid()) + "-" + std::to_string(rd()));
-  cleanup::with_lock([&] {
-    std::filesystem::create_directories(path_);
-    cleanup::track(path_, true);
-  });
-}
-
-ScratchFolder::~ScratchFolder() {
-  cleanup::with_lock([&] {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-    cleanup::untrack(path_);
-  });
 }
 
 }  // namespace foxi::cli

@@ -3,12 +3,15 @@
 // --convergence.
 #pragma once
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "cli.hpp"
+#include "foxi/model/cleanup.hpp"
 #include "foxi/model/mesh.hpp"
 #include "foxi/model/progress.hpp"
 #include "foxi/solver/results.hpp"
@@ -55,18 +58,15 @@ std::string self_executable();
 RunResults run_solve_child(const std::vector<std::string>& args, const std::filesystem::path& json,
                            const std::filesystem::path& log);
 
-// A folder for child runs' files, removed (with its contents) when the program stops or the
-// returned guard goes.
+// A folder for child runs' files, STEM-PID-XXXXXX under TMPDIR, removed (with its contents) when the
+// program stops or the guard goes (cleanup::TemporaryFolder).
 class ScratchFolder {
  public:
-  explicit ScratchFolder(const std::string& stem);
-  ~ScratchFolder();
-  ScratchFolder(const ScratchFolder&) = delete;
-  ScratchFolder& operator=(const ScratchFolder&) = delete;
-  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+  explicit ScratchFolder(const std::string& stem) : folder_(stem + "-" + std::to_string(::getpid())) {}
+  std::filesystem::path operator/(const std::string& name) const { return folder_.path() / name; }
 
  private:
-  std::filesystem::path path_;
+  cleanup::TemporaryFolder folder_;
 };
 
 }  // namespace foxi::cli

@@ -1,5 +1,7 @@
 #include "foxi/model/cleanup.hpp"
 
+#include <stdlib.h>
+
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -10,6 +12,8 @@
 #include <set>
 #include <string>
 #include <system_error>
+
+#include "foxi/model/io_error.hpp"
 
 namespace foxi::cleanup {
 
@@ -88,6 +92,25 @@ void interrupt() {
   std::error_code ec;
   for (const std::string& f : r.files) std::filesystem::remove(f, ec);
   for (const std::string& d : r.folders) std::filesystem::remove_all(d, ec);
+}
+
+TemporaryFolder::TemporaryFolder(const std::string& prefix) {
+  std::string tmpl = (std::filesystem::temp_directory_path() / (prefix + "-XXXXXX")).string();
+  // Made and recorded under the lock: an interrupt() sees it either not yet made or recorded.
+  with_lock([&] {
+    if (::mkdtemp(tmpl.data()) == nullptr) return;
+    path_ = tmpl;
+    track(path_, true);
+  });
+  if (path_.empty()) throw IoError(tmpl, 0, IoError::kNoOffset, "cannot create the work folder");
+}
+
+TemporaryFolder::~TemporaryFolder() {
+  with_lock([&] {
+    std::error_code ec;
+    if (!keep_) std::filesystem::remove_all(path_, ec);
+    untrack(path_);
+  });
 }
 
 }  // namespace foxi::cleanup

@@ -2137,6 +2137,27 @@ std::size_t child_processes() {
   return n;
 }
 
+// A solve by ccx cancelled while ccx runs: the previous results (their value `key`) stay, no work
+// folder beyond the `folders` there were and no child process is left behind.
+void cancel_while_ccx_runs(Workbench& w, const char* key, std::size_t folders) {
+  ASSERT_NE(w.results(), nullptr);
+  const double before = w.results()->find(key)->value;
+  ASSERT_TRUE(w.start_solve());
+  while (w.busy() && !w.progress_bar()->format().contains("(ccx)"))
+    QApplication::processEvents(QEventLoop::AllEvents, 5);
+  w.cancel();
+  // (on a machine where ccx ends before the progress poll shows it, the solve ends before the Cancel)
+  std::printf("Cancel %s\n", w.busy() ? "while ccx ran" : "after ccx had ended");
+  if (w.busy()) {
+    EXPECT_FALSE(wait_job(w));
+    EXPECT_EQ(w.last_error(), "cancelled");
+  }
+  ASSERT_NE(w.results(), nullptr);
+  EXPECT_EQ(w.results()->find(key)->value, before);
+  EXPECT_EQ(ccx_folders(), folders);
+  EXPECT_EQ(child_processes(), 0u) << "ccx killed and reaped";
+}
+
 // CalculiX from the solve panel: ccx's temperature on the same mesh equals the built-in solver's with
 // ccx's convection rule to ccx's output precision (foxi solve --with ccx --compare's bound, 1e-5 of
 // the largest), and the workbench's own solve (the exact convection integral) within 1e-3
@@ -2186,22 +2207,82 @@ TEST(Workbench, CalculixTemperatureEqualsBuiltIn) {
   ASSERT_FALSE(w.results()->checks.empty());
   for (const foxi::BalanceCheck& c : w.results()->checks) EXPECT_TRUE(c.passed) << c.name;
   EXPECT_EQ(ccx_folders(), folders) << "the work folder removed";
-  // Cancelled while it runs: the previous results stay, nothing is left behind.
-  const double t_max = w.results()->find("T_max")->value;
+  cancel_while_ccx_runs(w, "T_max", folders);
+}
+
+// CalculiX for the thermal stress from the solve panel (solve_thermoelastic_calculix): on the same
+// mesh, ccx's displacement equals the built-in solver's to 1e-5 of the largest (foxi solve --with ccx
+// --compare's bound, ccx_cli's ThermoelasticWithCcxAgreesWithFoxiAndRenders), and the von Mises
+// results, derived by foxi from ccx's displacements, to 1e-6 of the largest von Mises stress (the
+// bound of ccx_cli's record comparison); the per-tet von Mises field to 1e-5 of its largest (the
+// displacement's bound: a derivative of the same float32 rounding). The results show as the
+// built-in ones (the von Mises field, the deformed shape); its checks (the built-in's) pass; ccx's nodal
+// stress comes along as stress_nodal. Cancel while ccx runs keeps the previous results and leaves no work
+// folder and no child process.
+TEST(Workbench, CalculixThermalStressEqualsBuiltIn) {
+  if (foxi::test::run("command -v ccx > /dev/null") != 0) GTEST_SKIP() << "ccx is not installed";
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(w.set_physics(foxi::Physics::thermal_stress));
   ASSERT_TRUE(w.start_solve());
-  while (w.busy() && !w.progress_bar()->format().contains("(ccx)"))
-    QApplication::processEvents(QEventLoop::AllEvents, 5);
-  w.cancel();
-  // (on a machine where ccx ends before the progress poll shows it, the solve ends before the Cancel)
-  std::printf("Cancel %s\n", w.busy() ? "while ccx ran" : "after ccx had ended");
-  if (w.busy()) {
-    EXPECT_FALSE(wait_job(w));
-    EXPECT_EQ(w.last_error(), "cancelled");
-  }
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const std::vector<double> own_u = w.mesh()->find_field("displacement")->values;
+  const std::vector<double> own_vm = w.mesh()->find_field("von_mises")->values;
+  const foxi::RunResults own = *w.results();
+  const std::size_t folders = ccx_folders();
+  ASSERT_TRUE(w.set_solver({true, foxi::LinearSolverKind::automatic}));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
   ASSERT_NE(w.results(), nullptr);
-  EXPECT_EQ(w.results()->find("T_max")->value, t_max);
-  EXPECT_EQ(ccx_folders(), folders);
-  EXPECT_EQ(child_processes(), 0u) << "ccx killed and reaped";
+  EXPECT_EQ(w.results()->solver, "ccx");
+  ASSERT_EQ(w.history().size(), 2u);
+  EXPECT_EQ(w.history()[1].mesh, w.history()[0].mesh) << "the same mesh: solved again, not remeshed";
+  const foxi::Field* u = w.mesh()->find_field("displacement");
+  const foxi::Field* vm = w.mesh()->find_field("von_mises");
+  const foxi::Field* nodal = w.mesh()->find_field("stress_nodal");
+  ASSERT_TRUE(u && vm && nodal);
+  ASSERT_EQ(u->values.size(), own_u.size());
+  ASSERT_EQ(vm->values.size(), own_vm.size());
+  EXPECT_EQ(nodal->components, 6u);
+  auto largest = [](const std::vector<double>& a, const std::vector<double>& b) {
+    double diff = 0, scale = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      diff = std::max(diff, std::abs(a[i] - b[i]));
+      scale = std::max(scale, std::abs(b[i]));
+    }
+    return diff / scale;
+  };
+  const double du = largest(u->values, own_u), dvm = largest(vm->values, own_vm);
+  std::printf("ccx against built-in: displacement %.3g, von Mises field %.3g of the largest\n", du, dvm);
+  EXPECT_GT(*std::max_element(own_u.begin(), own_u.end()), 1e-8) << "the die and substrate do move";
+  EXPECT_LE(du, 1e-5);
+  EXPECT_LE(dvm, 1e-5);
+  const double vm_max = own.find("von_mises_max")->value;
+  EXPECT_GT(vm_max, 1e6);
+  std::size_t compared = 0;
+  for (const foxi::ResultValue& v : own.values) {
+    if (v.unit != "Pa") continue;
+    const foxi::ResultValue* c = w.results()->find(v.name);
+    ASSERT_NE(c, nullptr) << v.name;
+    EXPECT_NEAR(c->value, v.value, 1e-6 * vm_max) << v.name;
+    ++compared;
+  }
+  EXPECT_GE(compared, 4u) << "the maximum, per region and per interface";
+  ASSERT_EQ(w.results()->checks.size(), own.checks.size()) << "the built-in solve's checks";
+  for (const foxi::BalanceCheck& c : w.results()->checks) EXPECT_TRUE(c.passed) << c.name;
+  EXPECT_EQ(ccx_folders(), folders) << "the work folder removed";
+  // The deformed shape of ccx's displacement, as of the built-in one.
+  ASSERT_TRUE(w.set_deform(foxi::workbench::Deform{"displacement", 150}));
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_NE(w.view_widget()->mesh(), nullptr);
+  const std::vector<double>& moved = w.view_widget()->mesh()->xyz;
+  ASSERT_EQ(moved.size(), w.mesh()->xyz.size());
+  double moved_most = 0;
+  for (std::size_t i = 0; i < moved.size(); ++i)
+    moved_most = std::max(moved_most, std::abs(moved[i] - w.mesh()->xyz[i] - 150 * u->values[i]));
+  EXPECT_LE(moved_most, 1e-12) << "each node moved by 150 x ccx's displacement";
+  cancel_while_ccx_runs(w, "von_mises_max", folders);
 }
 
 // A sweep started from the history: each point's row equals foxi sweep's CSV row for the same model,

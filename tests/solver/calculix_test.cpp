@@ -5,7 +5,12 @@
 
 #include <gtest/gtest.h>
 
+#include <stdlib.h>
+
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <sstream>
 #include <string>
 
@@ -13,6 +18,7 @@
 #include "foxi/model/io_tetgen.hpp"
 #include "foxi/model/validate.hpp"
 #include "foxi/solver/thermal.hpp"
+#include "foxi/solver/results.hpp"
 #include "foxi/solver/thermoelastic.hpp"
 #include "layered_box.hpp"
 #include "test_util.hpp"
@@ -248,6 +254,146 @@ TEST_F(CalculixTest, SlidingPlanesOffTheAxesAgreeWithCcx) {
   const auto [qu, qs] = quadratic_difference(dir, m, p);  // the mid-edge nodes' constraints too
   EXPECT_LT(qu, 1e-6);
   EXPECT_LT(qs, 1e-6);
+}
+
+// The files and children in a private TMPDIR of a test (the CalculiX runs' work folders go there).
+class CalculixRunTest : public CalculixTest {
+ protected:
+  void SetUp() override {
+    CalculixTest::SetUp();
+    const char* old = std::getenv("TMPDIR");
+    old_tmpdir_ = old ? old : "";
+    std::filesystem::create_directories(dir_ / "tmp");
+    ::setenv("TMPDIR", (dir_ / "tmp").c_str(), 1);
+  }
+  void TearDown() override {
+    if (old_tmpdir_.empty())
+      ::unsetenv("TMPDIR");
+    else
+      ::setenv("TMPDIR", old_tmpdir_.c_str(), 1);
+  }
+  std::size_t work_folders() const {
+    std::size_t n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir_ / "tmp")) n += e.is_directory();
+    return n;
+  }
+  // A stand-in for ccx at `name` in the test's folder, running `body` (sh).
+  std::string stand_in(const std::string& name, const std::string& body) {
+    const std::filesystem::path p = dir_ / name;
+    test::write_text(p, "#!/bin/sh\n" + body);
+    std::filesystem::permissions(p, std::filesystem::perms::owner_all);
+    return p.string();
+  }
+  test::TempDir dir_;
+  std::string old_tmpdir_;
+};
+
+// One call runs the whole pipeline: ccx's displacements come back on the mesh (the fields foxi's
+// solve stores, ccx's nodal stress too) and equal foxi's own to the .frd's float32 (1e-6, as
+// ThermalStressAgreesWithCcx finds them by hand); with temperature_from its temperatures are ccx's
+// steady ones, equal to foxi's solve with ccx's *FILM rule (1e-6). The work folder goes, or with
+// KeepWorkFolder::always stays with the decks and ccx's results in it.
+TEST_F(CalculixRunTest, ThermoelasticRunEqualsFoxiAndCleansUp) {
+  Mesh m = test::layered_box_mesh(2e-3, 1e-3, {0, 0.4e-3, 1e-3}, 4e-12);
+  ThermoelasticParams p = two_layer_params(m);
+  p.fixed = {{5}};
+  p.sliding = {{1}};
+  Mesh own = m;
+  const ThermoelasticReport mine = solve_thermoelastic(own, p);
+  const CalculixThermoelastic c = solve_thermoelastic_calculix(m, p);
+  EXPECT_EQ(c.report.solver, "ccx");
+  EXPECT_FALSE(c.thermal.has_value());
+  EXPECT_TRUE(c.work_folder.empty());
+  EXPECT_EQ(work_folders(), 0u) << "the work folder removed";
+  for (const char* name : {"displacement", "stress", "von_mises", "principal_stress", "stress_nodal"})
+    EXPECT_NE(m.find_field(name), nullptr) << name;
+  const std::vector<double>& u = m.find_field("displacement")->values;
+  const std::vector<double>& u_own = own.find_field("displacement")->values;
+  double du = 0;
+  for (std::size_t i = 0; i < u.size(); ++i)
+    du = std::max(du, std::abs(u[i] - u_own[i]) / mine.max_displacement);
+  EXPECT_LT(du, 1e-6);
+  EXPECT_NEAR(c.report.max_von_mises, mine.max_von_mises, 1e-6 * mine.max_von_mises);
+  EXPECT_GT(c.max_nodal_von_mises, 0.1 * mine.max_von_mises);  // ccx's averages at the nodes: smoothed
+  EXPECT_LT(c.max_nodal_von_mises, 1.0 * mine.max_von_mises);
+
+  // The temperatures from ccx's thermal run first, in the same (kept) folder.
+  ThermalParams heat;
+  heat.conductivity = {{1, 0.3}, {2, 148}};
+  heat.fixed = {{5, 300}};
+  heat.convection = {{6, 20, 290}};
+  heat.sources = {{2, 0.05, true}};
+  CalculixRunOptions keep;
+  keep.keep = KeepWorkFolder::always;
+  std::vector<std::string> lines;
+  keep.on_output = [&](const std::string& line) { lines.push_back(line); };
+  const CalculixThermoelastic t = solve_thermoelastic_calculix(m, p, keep, &heat);
+  ASSERT_TRUE(t.thermal.has_value());
+  EXPECT_TRUE(all_passed(thermal_results(m, *t.thermal).checks));
+  ASSERT_FALSE(t.work_folder.empty());
+  for (const char* f : {"heat.inp", "heat.frd", "stress.inp", "stress.frd"})
+    EXPECT_TRUE(std::filesystem::exists(t.work_folder / f)) << f;
+  EXPECT_FALSE(lines.empty());
+  EXPECT_EQ(lines.back(), "Job finished") << "ccx's progress lines, the end last";
+  heat.convection_centroid_rule = true;
+  solve_thermal(own, heat);
+  const std::vector<double>& tc = m.find_field("temperature")->values;
+  const std::vector<double>& to = own.find_field("temperature")->values;
+  double dt = 0;
+  for (std::size_t i = 0; i < tc.size(); ++i) dt = std::max(dt, std::abs(tc[i] - to[i]) / to[i]);
+  EXPECT_LT(dt, 1e-6);
+  EXPECT_GT(t.thermal->max_temperature, 301);  // heated
+  std::filesystem::remove_all(t.work_folder);
+}
+
+// A failing ccx (a stand-in) is a CalculixError with its exit status and last output, the folder kept
+// only on request; a missing one is CalculixError::Kind::not_installed; a cancel kills a running one
+// (SolverCancelled at once, not after it ends) and leaves no folder.
+TEST_F(CalculixRunTest, FailingMissingAndCancelledRuns) {
+  Mesh m = test::layered_box_mesh(2e-3, 1e-3, {0, 0.4e-3, 1e-3}, 4e-12);
+  ThermalParams heat;
+  heat.conductivity = {{1, 0.3}, {2, 148}};
+  heat.fixed = {{5, 300}};
+  CalculixRunOptions o;
+  o.program = stand_in("bad-ccx", "echo ' *ERROR reading *NODE: something ccx-specific'\nexit 201\n");
+  for (KeepWorkFolder keep : {KeepWorkFolder::never, KeepWorkFolder::on_failure}) {
+    o.keep = keep;
+    try {
+      solve_thermal_calculix(m, heat, o);
+      ADD_FAILURE() << "no error";
+    } catch (const CalculixError& e) {
+      EXPECT_EQ(e.kind, CalculixError::Kind::failed);
+      EXPECT_EQ(e.exit_status, 201);
+      EXPECT_NE(e.log_tail.find("something ccx-specific"), std::string::npos) << e.log_tail;
+      EXPECT_NE(std::string(e.what()).find("something ccx-specific"), std::string::npos);
+      EXPECT_EQ(e.work_folder.empty(), keep == KeepWorkFolder::never);
+      if (!e.work_folder.empty()) {
+        EXPECT_TRUE(std::filesystem::exists(e.work_folder / "heat.inp"));
+        std::filesystem::remove_all(e.work_folder);
+      }
+    }
+    EXPECT_EQ(work_folders(), 0u);
+  }
+  EXPECT_EQ(m.find_field("temperature"), nullptr) << "nothing stored from a failed run";
+  o.program = (dir_ / "no-such-ccx").string();
+  try {
+    solve_thermal_calculix(m, heat, o);
+    ADD_FAILURE() << "no error";
+  } catch (const CalculixError& e) {
+    EXPECT_EQ(e.kind, CalculixError::Kind::not_installed) << e.what();
+    EXPECT_TRUE(e.work_folder.empty());
+  }
+  EXPECT_EQ(work_folders(), 0u);
+  // A ccx that would run for a minute, cancelled after its first polls.
+  o.program = stand_in("slow-ccx", "sleep 60\n");
+  o.keep = KeepWorkFolder::always;
+  int polls = 0;
+  o.progress = [&](std::string_view stage, double) { return stage == "ccx" && ++polls < 4; };
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_THROW(solve_thermal_calculix(m, heat, o), SolverCancelled);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10);
+  EXPECT_EQ(polls, 4);
+  EXPECT_EQ(work_folders(), 0u) << "removed on cancel, even when asked to keep it";
 }
 
 TEST(FrdReader, RejectsMalformedFiles) {

@@ -14,7 +14,10 @@
 //     electrostatic_, current_, thermoelastic_params_from_model (model_problem.hpp)
 //   SolverError, SolverCancelled, LinearSolverOptions   why a solve failed; the linear solver (solver.hpp)
 //   write_calculix_thermal, read_frd           the same problem as a CalculiX deck, its results
-//   (calculix.hpp) thermal_results(mesh, report), results_json  a run's key values as a record, JSON
+//   (calculix.hpp)
+//   solve_thermal_calculix, solve_thermoelastic_calculix  the problem solved by ccx, its results on the
+//   mesh (calculix.hpp)
+//   thermal_results(mesh, report), results_json  a run's key values as a record, JSON
 //   (results.hpp) convergence_table, observed_order          convergence over refinement levels (results.hpp)
 #pragma once
 

@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <string>
 
 #include "foxi/api.hpp"
 
@@ -39,5 +40,25 @@ FOXI_API void untrack_child(pid_t pid);
 // with the list still locked for good: the caller exits next. Not async-signal-safe: call it from
 // a thread, not from a signal handler.
 FOXI_API void interrupt();
+
+// A fresh folder under the system's temporary folder (TMPDIR), named PREFIX-XXXXXX (mkdtemp), recorded
+// here while it exists, so that interrupt() removes it with its contents. The destructor removes it
+// unless keep() was called (then it is forgotten, and stays for the user to look into). Throws IoError
+// naming the template when it cannot be made.
+class FOXI_API TemporaryFolder {
+ public:
+  explicit TemporaryFolder(const std::string& prefix);
+  ~TemporaryFolder();
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  void keep() { keep_ = true; }
+  bool kept() const { return keep_; }
+
+ private:
+  std::filesystem::path path_;
+  bool keep_ = false;
+};
 
 }  // namespace foxi::cleanup

@@ -5,11 +5,14 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "foxi/api.hpp"
 #include "foxi/model/mesh.hpp"
+#include "foxi/solver/solver.hpp"
 #include "foxi/solver/thermal.hpp"
 #include "foxi/solver/thermoelastic.hpp"
 
@@ -59,22 +62,83 @@ FOXI_API std::vector<FrdBlock> read_frd(const std::filesystem::path& frd);
 // unit of their 24-bit mantissa, 2^-24 = 6e-8 relative (an ASCII .frd's E12.5 would be 5e-6).
 inline constexpr double kFrdPrecision = 6e-8;
 
+// When a CalculiX run's work folder (the deck, ccx's log, .dat and .frd) outlives the call.
+enum class KeepWorkFolder : std::uint8_t {
+  never,       // removed on return, on a throw and on cancel
+  on_failure,  // kept when ccx fails or its results do not fit the mesh (CalculixError::work_folder)
+  always,      // kept whenever the call returns or ccx fails (the result's work_folder); removed on cancel
+};
+
 struct CalculixRunOptions {
   std::string program = "ccx";  // looked up in PATH
   // Asked about every 50 ms while ccx runs, as progress("ccx", -1): false kills it (SolverCancelled).
   ProgressFn progress;
+  // Given, as they appear in ccx's log (polled every 50 ms while it runs, on the calling thread), the
+  // lines that say where it is: its increments, Newton iterations and their convergence, the end.
+  std::function<void(const std::string& line)> on_output;
+  KeepWorkFolder keep = KeepWorkFolder::never;
+  std::size_t log_tail_lines = 15;  // of ccx's output, in a CalculixError
+};
+
+// A CalculiX run that gave no result to use. The work folder is kept when the options asked for it
+// (then work_folder names it; empty when it was removed).
+struct FOXI_API CalculixError : SolverError {
+  enum class Kind : std::uint8_t {
+    not_installed,  // no `program` in PATH (the shell's status 127)
+    failed,         // a non-zero exit status, *ERROR in its output, or no .frd: log_tail says why
+    bad_results,    // the .frd does not fit the mesh (nodes, coordinates) or leaves nodes without a value
+  };
+  CalculixError(Kind k, const std::string& message, int status = 0, std::string tail = {})
+      : SolverError(message), kind(k), exit_status(status), log_tail(std::move(tail)) {}
+  Kind kind;
+  int exit_status;       // ccx's (failed)
+  std::string log_tail;  // ccx's last output lines (failed)
+  std::filesystem::path work_folder;
+};
+
+struct CalculixThermal {
+  // thermal_report of ccx's temperatures; solver "ccx", solve_seconds the deck written, ccx run and
+  // its .frd read.
+  ThermalReport report;
+  std::filesystem::path work_folder;  // kept (KeepWorkFolder::always), else empty
 };
 
 // Solves `params` on `mesh` by CalculiX, as foxi solve --with ccx does: the deck (write_calculix_thermal)
-// in a fresh work folder under the temporary directory, `ccx -i heat` run there as a child process
-// (foxi/model/run_program.hpp; OMP_NUM_THREADS 1 unless set), its NDTEMP read back onto the mesh by
-// node number (coordinates checked, every node given a value) and reported by thermal_report at the
-// .frd's precision with the convection centroid rule of ccx's *FILM (the balance checks of ccx's own
-// solution), `solver` "ccx". The temperature and heat flux are stored on the mesh as solve_thermal
-// stores them. The work folder is removed on return, a throw or cleanup::interrupt(). Throws
-// SolverError for what write_calculix_thermal rejects and for a ccx that fails (its last output in
-// the message) or is not installed, SolverCancelled when progress says stop.
-FOXI_API ThermalReport solve_thermal_calculix(Mesh& mesh, ThermalParams params,
-                                              const CalculixRunOptions& options = {});
+// in a fresh work folder under the temporary directory (cleanup::TemporaryFolder, "foxi-ccx-XXXXXX"),
+// `ccx -i heat` run there as a child process (foxi/model/run_program.hpp; OMP_NUM_THREADS 1 unless
+// set), its NDTEMP read back onto the mesh by node number (coordinates checked, every node given a
+// value) and reported by thermal_report at the .frd's precision with the convection centroid rule of
+// ccx's *FILM (the balance checks of ccx's own solution). The temperature and heat flux are stored on
+// the mesh as solve_thermal stores them. The work folder goes as options.keep says, and always on
+// cleanup::interrupt(). Throws SolverError for what write_calculix_thermal rejects, CalculixError when
+// ccx is not installed, fails or gives results that do not fit, SolverCancelled when progress says
+// stop (ccx killed and reaped first).
+FOXI_API CalculixThermal solve_thermal_calculix(Mesh& mesh, ThermalParams params,
+                                                const CalculixRunOptions& options = {});
+
+struct CalculixThermoelastic {
+  // ccx's steady temperatures of `temperature_from` (as solve_thermal_calculix reports them), when given.
+  std::optional<ThermalReport> thermal;
+  // thermoelastic_report of ccx's displacements (with C3D10 the mid-edge nodes' too); solver "ccx",
+  // solve_seconds the stress deck written, ccx run and its .frd read.
+  ThermoelasticReport report;
+  // The largest von Mises stress of ccx's own nodal stress (its element values averaged at the nodes).
+  double max_nodal_von_mises = 0;     // Pa
+  std::filesystem::path work_folder;  // kept (KeepWorkFolder::always), else empty
+};
+
+// Solves `params` on `mesh` by CalculiX, as foxi solve --physics thermoelastic --with ccx does: the
+// deck (write_calculix_thermoelastic, C3D4 or with params.order 2 C3D10) run by `ccx -i stress` as
+// solve_thermal_calculix runs its deck; DISP read back onto the mesh's nodes (and the C3D10 mid-edge
+// nodes) and reported by thermoelastic_report, which stores "displacement", "stress", "von_mises"
+// and "principal_stress" as solve_thermoelastic does; ccx's nodal STRESS is stored as "stress_nodal"
+// (Pa, node, xx yy zz xy yz xz). With `temperature_from`: its steady heat problem is first solved by
+// ccx in the same work folder (`ccx -i heat`, as solve_thermal_calculix: "temperature" and
+// "heat_flux" stored) and ccx's temperatures are the load (params.temperature, delta_t 0). Throws as
+// solve_thermal_calculix does, and SolverError for what write_calculix_thermoelastic and
+// thermoelastic_report reject.
+FOXI_API CalculixThermoelastic solve_thermoelastic_calculix(Mesh& mesh, ThermoelasticParams params,
+                                                            const CalculixRunOptions& options = {},
+                                                            const ThermalParams* temperature_from = nullptr);
 
 }  // namespace foxi
