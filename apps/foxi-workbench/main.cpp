@@ -108,8 +108,8 @@ struct ToolOptions {
   int movie_frames = 48;
   bool graded = false;
   std::vector<double> range, regions;
-  std::string project;                            // --save-project
-  std::optional<foxi::workbench::Deform> deform;  // --deform NAME:SCALE
+  std::string project;                                  // --save-project
+  std::optional<foxi::workbench::Deform> deform;        // --deform NAME:SCALE
   std::optional<foxi::workbench::SolverChoice> solver;  // --solver (the solve panel's)
   std::optional<bool> si_units;                         // --units si (true) or engineering
 };
@@ -390,11 +390,10 @@ int main(int argc, char** argv) {
       throw Usage("--solver ccx solves the thermal problem only (--physics thermal), not " + physics);
     if (tools.iso_only && tools.iso.empty())
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
-    if (!is_headless &&
-        (tools.any() || tools.graded || tools.deform || tools.xray || !tools.movie.empty() ||
-         !tools.range.empty() || !tools.regions.empty() || !tools.project.empty() || tools.solver ||
-         tools.si_units || !sets.empty() || !physics.empty() || !field.empty() || !screenshot.empty() ||
-         !picture.empty() || !mesh_out.empty()))
+    if (!is_headless && (tools.any() || tools.graded || tools.deform || tools.xray || !tools.movie.empty() ||
+                         !tools.range.empty() || !tools.regions.empty() || !tools.project.empty() ||
+                         tools.solver || tools.si_units || !sets.empty() || !physics.empty() ||
+                         !field.empty() || !screenshot.empty() || !picture.empty() || !mesh_out.empty()))
       throw Usage(
           "--set, --physics, --solver, --units, --field, --screenshot, --save-picture and --save-mesh "
           "are for --headless");
