@@ -81,6 +81,7 @@ ProgressFn terminal_progress(const LinearSolverOptions& options) {
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now(), last{};
     std::size_t reports = 0;
     bool shown = false;
+    std::string line;  // what the shown line says: a stage's name, or "cg" for the iterations
   };
   auto state = std::make_shared<State>();
   const double relative_tolerance = options.relative_tolerance;
@@ -94,12 +95,18 @@ ProgressFn terminal_progress(const LinearSolverOptions& options) {
       state->shown = false;
       return true;
     }
-    // quiet for the first second (a small solve shows nothing) and then at most 5 times a second
-    if (now - state->start < std::chrono::seconds(1) || now - state->last < std::chrono::milliseconds(200))
+    // Quiet for the first second (a small solve shows nothing), then at most 5 times a second; a line
+    // of another kind (a new stage, the first CG iterations) shows at once, so that a stage shorter
+    // than 200 ms still says what it was.
+    const bool iterations = cg && stage == "solve" && state->reports > 0;
+    const std::string line = iterations ? std::string("cg") : std::string(stage);
+    if (now - state->start < std::chrono::seconds(1) ||
+        (line == state->line && now - state->last < std::chrono::milliseconds(200)))
       return true;
     state->last = now;
+    state->line = line;
     const double seconds = std::chrono::duration<double>(now - state->start).count();
-    if (cg && stage == "solve" && state->reports > 0)
+    if (iterations)
       std::fprintf(stderr,
                    "\r\033[Ksolve: about %zu CG iterations, relative residual %.2g (goal %.2g), %.1f s",
                    10 * state->reports, std::pow(relative_tolerance, fraction), relative_tolerance, seconds);

@@ -49,6 +49,27 @@ double tet_gradient(const Mesh& m, std::size_t t, const double* u, double g[3]) 
   return std::abs(det) / 6;
 }
 
+// The distance from p to the box (0 inside it).
+double distance_to_box(const double* p, const RefinementBox& b) {
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double out = std::max({b.lo[k] - p[k], 0.0, p[k] - b.hi[k]});
+    d2 += out * out;
+  }
+  return std::sqrt(d2);
+}
+
+// Whether every box holds at least one node of `mesh`.
+bool every_box_holds_a_node(const Mesh& mesh, const SizeControls& controls) {
+  for (const RefinementBox& b : controls.boxes) {
+    bool held = false;
+    for (std::size_t n = 0; n < mesh.node_count() && !held; ++n)
+      held = distance_to_box(&mesh.xyz[3 * n], b) == 0;
+    if (!held) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 double regular_tet_volume(double edge) { return edge * edge * edge / (6 * std::sqrt(2.0)); }
@@ -85,9 +106,7 @@ SizeField size_field_from_boxes(const Mesh& background, const SizeControls& cont
   for (std::size_t n = 0; n < background.node_count(); ++n) {
     const double* p = &background.xyz[3 * n];
     for (const RefinementBox& b : controls.boxes)
-      if (p[0] >= b.lo[0] && p[0] <= b.hi[0] && p[1] >= b.lo[1] && p[1] <= b.hi[1] && p[2] >= b.lo[2] &&
-          p[2] <= b.hi[2])
-        f.size[n] = std::min(f.size[n], b.size);
+      f.size[n] = std::min(f.size[n], b.size + distance_to_box(p, b));
   }
   return f;
 }
@@ -95,10 +114,15 @@ SizeField size_field_from_boxes(const Mesh& background, const SizeControls& cont
 SizeField box_size_field(const Plc& plc, const MeshParams& params, const SizeControls& controls, int passes) {
   MeshParams p = params;
   p.size_field = nullptr;
-  SizeField field = size_field_from_boxes(mesh_plc(plc, p), controls);
-  for (int i = 1; i < passes; ++i) {
+  Mesh m = mesh_plc(plc, p);
+  SizeField field = size_field_from_boxes(m, controls);
+  // A box narrower than the first mesh's tets may hold none of its nodes: the graded sizes of the
+  // nodes around it refine there, pass by pass, until it holds some (a box outside the domain never
+  // does: the passes end at the bound).
+  constexpr int max_passes = 8;
+  for (int i = 1; i < max_passes && (i < passes || !every_box_holds_a_node(m, controls)); ++i) {
     p.size_field = &field;
-    const Mesh m = mesh_plc(plc, p);
+    m = mesh_plc(plc, p);
     field = size_field_from_boxes(m, controls);
   }
   return field;

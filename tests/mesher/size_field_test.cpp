@@ -101,6 +101,66 @@ TEST(SizeField, RefinementBoxConcentratesElementsInsideIt) {
   EXPECT_GT(in, 10 * out) << "box " << in << " / m^3, far " << out << " / m^3";
 }
 
+// Mean edge length of the tets whose centroid lies in [lo, hi], and how many there are.
+std::pair<double, std::size_t> mean_edge_in(const Mesh& m, const double lo[3], const double hi[3]) {
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    double c[3];
+    centroid(m, t, c);
+    if (c[0] < lo[0] || c[0] > hi[0] || c[1] < lo[1] || c[1] > hi[1] || c[2] < lo[2] || c[2] > hi[2])
+      continue;
+    const std::uint32_t* v = &m.tet[4 * t];
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+          const double e = m.xyz[3 * v[j] + std::size_t(k)] - m.xyz[3 * v[i] + std::size_t(k)];
+          d2 += e * e;
+        }
+        sum += std::sqrt(d2) / 6;
+      }
+    ++n;
+  }
+  return {n > 0 ? sum / double(n) : 0, n};
+}
+
+// A box narrower than the first mesh's tets holds none of its nodes: sampled at those nodes alone it
+// was lost (a trench PLC kept 0.17 edges in a 0.2-wide box asking 0.05). The graded sizes around it
+// refine there until it holds nodes and its size.
+TEST(SizeField, BoxNarrowerThanTheFirstMeshsTetsStillRefines) {
+  Model model;
+  const Structure s = die_on_substrate(model);
+  MeshParams params;
+  params.max_volume = regular_tet_volume(2e-3);
+  SizeControls c;
+  c.max_size = 2e-3;
+  RefinementBox box;
+  const double lo[3] = {7.6e-3, 1.6e-3, 0.3e-3}, hi[3] = {8.0e-3, 2.0e-3, 0.7e-3};
+  for (int k = 0; k < 3; ++k) box.lo[k] = lo[k], box.hi[k] = hi[k];
+  box.size = 0.1e-3;
+  c.boxes = {box};
+  auto nodes_in_box = [&](const Mesh& m) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < m.node_count(); ++i) {
+      const double* p = &m.xyz[3 * i];
+      n += p[0] >= lo[0] && p[0] <= hi[0] && p[1] >= lo[1] && p[1] <= hi[1] && p[2] >= lo[2] && p[2] <= hi[2];
+    }
+    return n;
+  };
+  ASSERT_EQ(nodes_in_box(mesh_plc(s.plc, params)), 0u) << "the first mesh must miss the box for this test";
+  const SizeField f = box_size_field(s.plc, params, c);
+  params.size_field = &f;
+  const Mesh m = mesh_plc(s.plc, params);
+  EXPECT_TRUE(compute_delaunay_certificate(m).delaunay);
+  EXPECT_GT(nodes_in_box(m), 8u);
+  const auto [inside, n_inside] = mean_edge_in(m, lo, hi);
+  ASSERT_GT(n_inside, 0u);
+  EXPECT_LT(inside, 2.5 * box.size) << n_inside << " tets in the box";
+  const double far_lo[3] = {0, 4e-3, 0}, far_hi[3] = {3e-3, 8e-3, 1e-3};
+  EXPECT_GT(mean_edge_in(m, far_lo, far_hi).first, 5 * box.size);  // far from it, the global size
+}
+
 TEST(SizeField, RefinementFromASolvedFieldFollowsTheGradient) {
   Model model;
   const Structure s = die_on_substrate(model);

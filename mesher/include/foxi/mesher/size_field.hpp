@@ -49,16 +49,19 @@ FOXI_API double regular_tet_circumradius(double volume);
 // the control). Throws MesherError(10) naming a region id that has no seed in the PLC.
 FOXI_API Plc with_region_sizes(const Plc& plc, const SizeControls& controls);
 
-// Samples the box sizes (and the global size, where no box holds the node) at the nodes of
-// `background`; nodes in several boxes take the smallest. A node outside every box with no global
-// size gets the background's largest edge length.
+// Samples the box sizes (and the global size) at the nodes of `background`: a node at distance d from
+// a box (0 inside it) takes that box's size + d, and the smallest of those and the global size. So
+// the size grows by one length unit per unit of distance from a box, and the nodes around a box
+// narrower than the background's tets still lower the sizes there. With no global size, the
+// background's largest edge length bounds the sizes.
 FOXI_API SizeField size_field_from_boxes(const Mesh& background, const SizeControls& controls);
 
 struct MeshParams;
 
 // The boxes (and the global size) as a sizing function over the PLC's domain: meshes `plc` with
 // `params` (no size field), samples the sizes at its nodes, and repeats with that field `passes - 1`
-// more times, so that boxes smaller than the first mesh's tets still get nodes inside.
+// more times, and more (8 meshes at most) until every box holds a node of the mesh: a box smaller
+// than the first mesh's tets gets nodes inside, and its size there.
 FOXI_API SizeField box_size_field(const Plc& plc, const MeshParams& params, const SizeControls& controls,
                                   int passes = 2);
 
