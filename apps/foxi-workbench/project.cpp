@@ -3,6 +3,7 @@
 #include "workbench_parts.hpp"
 
 #include <QCheckBox>
+#include <QDateTime>
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QDir>
@@ -27,6 +28,7 @@
 
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/model/model_save.hpp"
 
 namespace foxi::workbench {
 
@@ -201,6 +203,12 @@ struct ProjectSnapshot {
   // The mesh file of the folder's project.json that already holds `mesh` (written by the last
   // autosave of the same mesh object), kept instead of written again; empty: write the mesh.
   std::string mesh_written;
+  // The model: its file and values, saved as a copy (save_model, the referenced files copied beside
+  // it) named `model_name` in the folder, unless `model_written` (the last autosave wrote that copy).
+  std::filesystem::path model_source;
+  std::vector<ParameterOverride> model_values;
+  std::string model_name;
+  bool model_written = false;
 };
 
 namespace {
@@ -212,6 +220,14 @@ namespace {
 std::string write_project(ProjectSnapshot snap) {
   const std::filesystem::path& dir = snap.dir;
   std::filesystem::create_directories(dir);
+  // The model first: the copy project.json names, its material library and STL files beside it, so
+  // the folder needs nothing outside it (moved, or on another machine). A refused copy writes no
+  // project.json.
+  if (!snap.model_written || !std::filesystem::exists(dir / snap.model_name)) {
+    std::filesystem::create_directories((dir / snap.model_name).parent_path());
+    save_model(snap.model_source, dir / snap.model_name, snap.model_values, {.copy_references = true});
+  }
+  snap.json["model"] = QString::fromStdString(snap.model_name);
   std::filesystem::path old_mesh;
   if (std::filesystem::exists(dir / "project.json")) {
     QFile f(QString::fromStdString((dir / "project.json").string()));
@@ -251,7 +267,12 @@ ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
   snap.mesh = mesh_;
   QJsonObject& p = snap.json;
   p["format"] = "foxi-workbench project 1";
-  p["model"] = QFileInfo(model_path_).absoluteFilePath();
+  // the model as a copy in the folder's model/ (write_project), with the values: project.json names it
+  // relatively. The overrides are kept too: reapplied to the copy (the same values), they stay the
+  // edits the history, undo and the shown mesh's parameters compare with.
+  snap.model_source = QFileInfo(model_path_).absoluteFilePath().toStdString();
+  snap.model_values = overrides();
+  snap.model_name = "model/" + QFileInfo(model_path_).fileName().toStdString();
   p["overrides"] = overrides_json(overrides());
   p["field"] = field_;
   p["color_map"] = color_map_;
@@ -349,11 +370,20 @@ void Workbench::autosave() {
     if (const auto written = autosaved_mesh_.lock();
         written && written == mesh_ && autosaved_folder_ == autosave_folder_)
       snap.mesh_written = autosaved_mesh_name_;
+    // The model copy only when the model file (its last change) or the values changed since
+    QString model_key = autosave_folder_ + "\n" + QFileInfo(model_path_).absoluteFilePath() + "\n" +
+                        QFileInfo(model_path_).lastModified().toString(Qt::ISODateWithMs);
+    for (const ParameterOverride& o : snap.model_values)
+      model_key += "\n" + QString::fromStdString(o.name + "=" + o.expression);
+    snap.model_written = model_key == autosaved_model_key_;
+    autosaved_model_key_.clear();  // set again once this one is written
     autosaved_mesh_.reset();
     autosaved_folder_ = autosave_folder_;
-    autosaving_ = QtConcurrent::run([this, snap = std::move(snap)]() -> QString {
+    autosaving_ = QtConcurrent::run([this, snap = std::move(snap), model_key]() -> QString {
       try {
         const std::string name = write_project(snap);
+        autosaved_model_key_ = model_key;  // read by the GUI thread only after this future finished
+        if (snap.model_written) ++model_writes_saved_;
         // read by the GUI thread only after this future finished (autosave() waits for it)
         autosaved_mesh_name_ = name;
         autosaved_mesh_ = snap.mesh;
@@ -410,8 +440,14 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     const MeshSettings meshed = p.contains("meshed_settings")
                                     ? mesh_settings_of(p["meshed_settings"], file + ": meshed_settings")
                                     : settings;
+    // The folder's copy of the model (a project of an earlier version names the model file itself,
+    // absolutely: opened where it is)
     QString why;
-    if (!open_model(p["model"].toString(), &why)) throw std::runtime_error(why.toStdString());
+    const QString model = p["model"].toString();
+    if (model.isEmpty()) throw std::runtime_error(file + ": no model named");
+    const QString model_file =
+        QFileInfo(model).isAbsolute() ? model : QString::fromStdString((dir / model.toStdString()).string());
+    if (!open_model(model_file, &why)) throw std::runtime_error(why.toStdString());
     std::map<std::string, std::string> trial;
     for (const ParameterOverride& o : overrides_of(p["overrides"])) trial[o.name] = o.expression;
     if (!apply_overrides(trial, &why)) throw std::runtime_error(why.toStdString());
