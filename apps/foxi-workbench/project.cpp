@@ -195,6 +195,18 @@ MeshSettings mesh_settings_of(const QJsonValue& v, const std::string& where) {
 
 }  // namespace
 
+namespace {
+
+// What the model copy of an autosave into `folder` is of: the model file, its last change and the values.
+QString model_key(const QString& folder, const QString& model, const std::vector<ParameterOverride>& values) {
+  QString key = folder + "\n" + QFileInfo(model).absoluteFilePath() + "\n" +
+                QFileInfo(model).lastModified().toString(Qt::ISODateWithMs);
+  for (const ParameterOverride& o : values) key += "\n" + QString::fromStdString(o.name + "=" + o.expression);
+  return key;
+}
+
+}  // namespace
+
 // What a save writes, taken on the GUI thread (the state may change meanwhile) and written on any thread.
 struct ProjectSnapshot {
   std::filesystem::path dir;
@@ -371,28 +383,27 @@ void Workbench::autosave() {
         written && written == mesh_ && autosaved_folder_ == autosave_folder_)
       snap.mesh_written = autosaved_mesh_name_;
     // The model copy only when the model file (its last change) or the values changed since
-    QString model_key = autosave_folder_ + "\n" + QFileInfo(model_path_).absoluteFilePath() + "\n" +
-                        QFileInfo(model_path_).lastModified().toString(Qt::ISODateWithMs);
-    for (const ParameterOverride& o : snap.model_values)
-      model_key += "\n" + QString::fromStdString(o.name + "=" + o.expression);
-    snap.model_written = model_key == autosaved_model_key_;
+    snap.model_written = model_key(autosave_folder_, model_path_, snap.model_values) == autosaved_model_key_;
     autosaved_model_key_.clear();  // set again once this one is written
     autosaved_mesh_.reset();
     autosaved_folder_ = autosave_folder_;
-    autosaving_ = QtConcurrent::run([this, snap = std::move(snap), model_key]() -> QString {
-      try {
-        const std::string name = write_project(snap);
-        autosaved_model_key_ = model_key;  // read by the GUI thread only after this future finished
-        if (snap.model_written) ++model_writes_saved_;
-        // read by the GUI thread only after this future finished (autosave() waits for it)
-        autosaved_mesh_name_ = name;
-        autosaved_mesh_ = snap.mesh;
-        if (!snap.mesh_written.empty() && name == snap.mesh_written) ++mesh_writes_saved_;
-        return {};
-      } catch (const std::exception& e) {
-        return QString::fromStdString(e.what());
-      }
-    });
+    autosaving_ = QtConcurrent::run(
+        [this, snap = std::move(snap), folder = autosave_folder_, model = model_path_]() -> QString {
+          try {
+            const std::string name = write_project(snap);
+            // after the write: a reopened project's model is its copy, which the write just changed;
+            // read by the GUI thread only after this future finished
+            autosaved_model_key_ = model_key(folder, model, snap.model_values);
+            if (snap.model_written) ++model_writes_saved_;
+            // read by the GUI thread only after this future finished (autosave() waits for it)
+            autosaved_mesh_name_ = name;
+            autosaved_mesh_ = snap.mesh;
+            if (!snap.mesh_written.empty() && name == snap.mesh_written) ++mesh_writes_saved_;
+            return {};
+          } catch (const std::exception& e) {
+            return QString::fromStdString(e.what());
+          }
+        });
     ++autosaves_;
   } catch (const std::exception& e) {
     progress_->setFormat(tr("autosave: %1").arg(QString::fromStdString(e.what())));

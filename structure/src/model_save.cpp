@@ -180,6 +180,8 @@ void save_model(const std::filesystem::path& source, const std::filesystem::path
   const std::filesystem::path to =
       std::filesystem::weakly_canonical(std::filesystem::absolute(target).parent_path(), ec);
   std::map<std::string, std::filesystem::path> copied;  // copy's name -> the file it copies
+  // the model's own name is taken (a library of that name is copied as "NAME-2.toml")
+  copied[target.filename().string()] = to / target.filename();
   if (from != to || options.copy_references) {
     auto reference = [&](const Value& v, const std::string& what) {
       if (!v.is_string()) return;  // load_model refused it already

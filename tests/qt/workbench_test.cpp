@@ -1706,6 +1706,23 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   QString why;
   ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
   EXPECT_EQ(again.mesh()->tet_count(), w.mesh()->tet_count());
+  if (again.busy()) {
+    ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  }
+  // The reopened project works on its copy, autosaved over itself: written once, then kept
+  w.set_autosave_folder({});
+  again.set_autosave_folder(folder);
+  again.set_autosave_delay(50);
+  for (int n = 1; n <= 2; ++n) {
+    ASSERT_TRUE(again.set_shrink(n == 1 ? 0.7 : 0.6));
+    ASSERT_TRUE(wait_job(again));
+    const auto t0 = std::chrono::steady_clock::now();
+    while (again.autosaves() < n && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(8))
+      QApplication::processEvents(QEventLoop::AllEvents, 50);
+    again.wait_autosave();
+    ASSERT_EQ(again.autosaves(), n);
+  }
+  EXPECT_EQ(again.autosaves_without_model(), 1);
 }
 
 // An autosave a session left is found and restored on start (the window asks first; here without
@@ -2053,9 +2070,10 @@ TEST(Workbench, ProjectMeshSettingsOldAndMalformed) {
   auto write = [&](const QJsonObject& p) {
     foxi::test::write_text(proj / "project.json", QJsonDocument(p).toJson().toStdString());
   };
-  // A window on the project's model (the same path) with settings of its own.
+  // A window on the project's model (the same path: the folder's copy) with settings of its own.
   Workbench x;
-  ASSERT_TRUE(x.open_model(saved["model"].toString()));
+  ASSERT_TRUE(
+      x.open_model(QString::fromStdString((proj / saved["model"].toString().toStdString()).string())));
   foxi::workbench::MeshSettings mine;
   mine.mesher = foxi::Mesher::cgal;
   mine.max_size = 2e-3;
