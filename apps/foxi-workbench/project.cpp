@@ -3,6 +3,7 @@
 #include "workbench_parts.hpp"
 
 #include <QCheckBox>
+#include <QDateTime>
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QDir>
@@ -27,6 +28,7 @@
 
 #include "foxi/model/durable_file.hpp"
 #include "foxi/model/mesh_io.hpp"
+#include "foxi/model/model_save.hpp"
 
 namespace foxi::workbench {
 
@@ -193,6 +195,18 @@ MeshSettings mesh_settings_of(const QJsonValue& v, const std::string& where) {
 
 }  // namespace
 
+namespace {
+
+// What the model copy of an autosave into `folder` is of: the model file, its last change and the values.
+QString model_key(const QString& folder, const QString& model, const std::vector<ParameterOverride>& values) {
+  QString key = folder + "\n" + QFileInfo(model).absoluteFilePath() + "\n" +
+                QFileInfo(model).lastModified().toString(Qt::ISODateWithMs);
+  for (const ParameterOverride& o : values) key += "\n" + QString::fromStdString(o.name + "=" + o.expression);
+  return key;
+}
+
+}  // namespace
+
 // What a save writes, taken on the GUI thread (the state may change meanwhile) and written on any thread.
 struct ProjectSnapshot {
   std::filesystem::path dir;
@@ -201,6 +215,12 @@ struct ProjectSnapshot {
   // The mesh file of the folder's project.json that already holds `mesh` (written by the last
   // autosave of the same mesh object), kept instead of written again; empty: write the mesh.
   std::string mesh_written;
+  // The model: its file and values, saved as a copy (save_model, the referenced files copied beside
+  // it) named `model_name` in the folder, unless `model_written` (the last autosave wrote that copy).
+  std::filesystem::path model_source;
+  std::vector<ParameterOverride> model_values;
+  std::string model_name;
+  bool model_written = false;
 };
 
 namespace {
@@ -212,6 +232,14 @@ namespace {
 std::string write_project(ProjectSnapshot snap) {
   const std::filesystem::path& dir = snap.dir;
   std::filesystem::create_directories(dir);
+  // The model first: the copy project.json names, its material library and STL files beside it, so
+  // the folder needs nothing outside it (moved, or on another machine). A refused copy writes no
+  // project.json.
+  if (!snap.model_written || !std::filesystem::exists(dir / snap.model_name)) {
+    std::filesystem::create_directories((dir / snap.model_name).parent_path());
+    save_model(snap.model_source, dir / snap.model_name, snap.model_values, {.copy_references = true});
+  }
+  snap.json["model"] = QString::fromStdString(snap.model_name);
   std::filesystem::path old_mesh;
   if (std::filesystem::exists(dir / "project.json")) {
     QFile f(QString::fromStdString((dir / "project.json").string()));
@@ -251,7 +279,12 @@ ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
   snap.mesh = mesh_;
   QJsonObject& p = snap.json;
   p["format"] = "foxi-workbench project 1";
-  p["model"] = QFileInfo(model_path_).absoluteFilePath();
+  // the model as a copy in the folder's model/ (write_project), with the values: project.json names it
+  // relatively. The overrides are kept too: reapplied to the copy (the same values), they stay the
+  // edits the history, undo and the shown mesh's parameters compare with.
+  snap.model_source = QFileInfo(model_path_).absoluteFilePath().toStdString();
+  snap.model_values = overrides();
+  snap.model_name = "model/" + QFileInfo(model_path_).fileName().toStdString();
   p["overrides"] = overrides_json(overrides());
   p["field"] = field_;
   p["color_map"] = color_map_;
@@ -349,20 +382,28 @@ void Workbench::autosave() {
     if (const auto written = autosaved_mesh_.lock();
         written && written == mesh_ && autosaved_folder_ == autosave_folder_)
       snap.mesh_written = autosaved_mesh_name_;
+    // The model copy only when the model file (its last change) or the values changed since
+    snap.model_written = model_key(autosave_folder_, model_path_, snap.model_values) == autosaved_model_key_;
+    autosaved_model_key_.clear();  // set again once this one is written
     autosaved_mesh_.reset();
     autosaved_folder_ = autosave_folder_;
-    autosaving_ = QtConcurrent::run([this, snap = std::move(snap)]() -> QString {
-      try {
-        const std::string name = write_project(snap);
-        // read by the GUI thread only after this future finished (autosave() waits for it)
-        autosaved_mesh_name_ = name;
-        autosaved_mesh_ = snap.mesh;
-        if (!snap.mesh_written.empty() && name == snap.mesh_written) ++mesh_writes_saved_;
-        return {};
-      } catch (const std::exception& e) {
-        return QString::fromStdString(e.what());
-      }
-    });
+    autosaving_ = QtConcurrent::run(
+        [this, snap = std::move(snap), folder = autosave_folder_, model = model_path_]() -> QString {
+          try {
+            const std::string name = write_project(snap);
+            // after the write: a reopened project's model is its copy, which the write just changed;
+            // read by the GUI thread only after this future finished
+            autosaved_model_key_ = model_key(folder, model, snap.model_values);
+            if (snap.model_written) ++model_writes_saved_;
+            // read by the GUI thread only after this future finished (autosave() waits for it)
+            autosaved_mesh_name_ = name;
+            autosaved_mesh_ = snap.mesh;
+            if (!snap.mesh_written.empty() && name == snap.mesh_written) ++mesh_writes_saved_;
+            return {};
+          } catch (const std::exception& e) {
+            return QString::fromStdString(e.what());
+          }
+        });
     ++autosaves_;
   } catch (const std::exception& e) {
     progress_->setFormat(tr("autosave: %1").arg(QString::fromStdString(e.what())));
@@ -410,8 +451,14 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     const MeshSettings meshed = p.contains("meshed_settings")
                                     ? mesh_settings_of(p["meshed_settings"], file + ": meshed_settings")
                                     : settings;
+    // The folder's copy of the model (a project of an earlier version names the model file itself,
+    // absolutely: opened where it is)
     QString why;
-    if (!open_model(p["model"].toString(), &why)) throw std::runtime_error(why.toStdString());
+    const QString model = p["model"].toString();
+    if (model.isEmpty()) throw std::runtime_error(file + ": no model named");
+    const QString model_file =
+        QFileInfo(model).isAbsolute() ? model : QString::fromStdString((dir / model.toStdString()).string());
+    if (!open_model(model_file, &why)) throw std::runtime_error(why.toStdString());
     std::map<std::string, std::string> trial;
     for (const ParameterOverride& o : overrides_of(p["overrides"])) trial[o.name] = o.expression;
     if (!apply_overrides(trial, &why)) throw std::runtime_error(why.toStdString());

@@ -372,9 +372,23 @@ QPushButton* Workbench::build_view_panel() {
         hidden.push_back(regions_->item(i)->data(Qt::UserRole).toInt());
     set_hidden_regions(hidden);
   });
+  regions_->setObjectName("regions_shown");
+  // A box per material: its regions shown or hidden at once, through the regions' own path (the
+  // hidden region set, foxi render --regions of the others); partly checked when only some are.
+  materials_ = new QListWidget;
+  materials_->setObjectName("materials_shown");
+  materials_->setFlow(QListView::LeftToRight);
+  materials_->setMaximumHeight(32);
+  materials_->setToolTip(tr("the materials shown: all their regions (foxi render --regions)"));
+  connect(materials_, &QListWidget::itemChanged, this, [this](QListWidgetItem* item) {
+    if (filling_ || item->checkState() == Qt::PartiallyChecked) return;
+    set_material_shown(item->data(Qt::UserRole).toUInt(), item->checkState() == Qt::Checked);
+  });
   auto* region_row = new QHBoxLayout;
   region_row->addWidget(new QLabel(tr("regions shown")));
   region_row->addWidget(regions_, 1);
+  region_row->addWidget(new QLabel(tr("materials")));
+  region_row->addWidget(materials_, 1);
   cv->addLayout(region_row);
   for (QCheckBox* c : {iso_on_, iso_only_, threshold_on_, clip_on_, slice_on_})
     connect(c, &QCheckBox::toggled, this, [this] { apply_field_tools(); });
@@ -450,7 +464,45 @@ bool Workbench::set_deform(std::optional<Deform> deform) {
 
 bool Workbench::set_hidden_regions(std::vector<std::int32_t> hidden) {
   hidden_ = std::move(hidden);
+  show_region_boxes();
   return !mesh_ || set_field(field_, color_map_);
+}
+
+bool Workbench::set_material_shown(std::uint32_t material, bool shown) {
+  if (!mesh_) return false;
+  std::vector<std::int32_t> hidden;
+  bool found = false;
+  for (const Region& r : mesh_->regions) {
+    const bool hide =
+        r.material == material ? !shown : std::find(hidden_.begin(), hidden_.end(), r.id) != hidden_.end();
+    found = found || r.material == material;
+    if (hide) hidden.push_back(r.id);
+  }
+  if (!found) return false;
+  return set_hidden_regions(std::move(hidden));
+}
+
+void Workbench::show_region_boxes() {
+  if (!regions_ || !materials_) return;
+  const bool was_filling = filling_;
+  filling_ = true;
+  auto is_hidden = [this](std::int32_t id) {
+    return std::find(hidden_.begin(), hidden_.end(), id) != hidden_.end();
+  };
+  for (int i = 0; i < regions_->count(); ++i)
+    regions_->item(i)->setCheckState(is_hidden(regions_->item(i)->data(Qt::UserRole).toInt()) ? Qt::Unchecked
+                                                                                              : Qt::Checked);
+  for (int i = 0; i < materials_->count(); ++i) {
+    const std::uint32_t m = materials_->item(i)->data(Qt::UserRole).toUInt();
+    int shown = 0, hidden = 0;
+    if (mesh_)
+      for (const Region& r : mesh_->regions)
+        if (r.material == m) ++(is_hidden(r.id) ? hidden : shown);
+    materials_->item(i)->setCheckState(hidden == 0  ? Qt::Checked
+                                       : shown == 0 ? Qt::Unchecked
+                                                    : Qt::PartiallyChecked);
+  }
+  filling_ = was_filling;
 }
 
 bool Workbench::set_colouring(bool graded, std::optional<std::pair<double, double>> range) {
@@ -616,6 +668,18 @@ void Workbench::refresh_fields() {
                                                                                            : Qt::Unchecked);
       regions_->addItem(item);
     }
+  materials_->clear();
+  if (mesh_)
+    for (std::uint32_t m = 0; m < mesh_->materials.size(); ++m) {
+      if (std::none_of(mesh_->regions.begin(), mesh_->regions.end(),
+                       [m](const Region& r) { return r.material == m; }))
+        continue;
+      auto* item = new QListWidgetItem(QString::fromStdString(mesh_->materials[m].name));
+      item->setData(Qt::UserRole, m);
+      item->setFlags(item->flags() | Qt::ItemIsUserCheckable);
+      materials_->addItem(item);
+    }
+  show_region_boxes();
   filling_ = false;
 }
 

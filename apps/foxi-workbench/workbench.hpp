@@ -187,6 +187,10 @@ class Workbench : public QMainWindow {
   Colouring colouring() const;
   // The regions not shown (by id; foxi render --regions shows the others); redraws on a worker.
   bool set_hidden_regions(std::vector<std::int32_t> hidden);
+  // Every region of material `material` (an index into the mesh's materials) shown or hidden, the
+  // others as they were: set_hidden_regions with that set (the region boxes and the material boxes
+  // follow, both ways). False without a mesh or for a material no region has.
+  bool set_material_shown(std::uint32_t material, bool shown);
 
   // The deformed shape (nullopt: undeformed): the view shows a moved copy of the mesh, checked and
   // repaired as foxi render --deform does (folded tets re-oriented); in general it is not Delaunay and
@@ -251,6 +255,8 @@ class Workbench : public QMainWindow {
   int autosaves() const { return autosaves_; }
   // Autosaves that kept the mesh file already written (the mesh and results unchanged since).
   int autosaves_without_mesh() const { return mesh_writes_saved_; }
+  // Autosaves that kept the model copy already written (the model and its values unchanged since).
+  int autosaves_without_model() const { return model_writes_saved_; }
   void wait_autosave();  // the running autosave written (for tests and quitting)
   // Whether `folder` holds an autosaved project (its project.json), which a session left.
   static bool autosave_found(const QString& folder);
@@ -318,6 +324,7 @@ class Workbench : public QMainWindow {
   void fill_history_row(int i, const HistoryRow& row);
   void refresh_history();
   void refresh_fields();
+  void show_region_boxes();  // the region and material boxes checked as hidden_ says
   void show_error(const QString& text);
   void changed();  // something a project holds changed: autosave soon
   void autosave();
@@ -362,6 +369,9 @@ class Workbench : public QMainWindow {
   std::string autosaved_mesh_name_;
   QString autosaved_folder_;
   std::atomic<int> mesh_writes_saved_{0};
+  // The model copy the last autosave wrote: its source file, last change and values (the key), and name
+  QString autosaved_model_key_;
+  std::atomic<int> model_writes_saved_{0};
   FieldSelection selection_;  // of selection_field_ (SI)
   QString selection_field_;
   DisplayUnit unit_;
@@ -418,6 +428,7 @@ class Workbench : public QMainWindow {
   QSlider* slice_slider_ = nullptr;
   QCheckBox *xray_box_ = nullptr, *volume_box_ = nullptr;
   QListWidget* regions_ = nullptr;
+  QListWidget* materials_ = nullptr;  // a box per material: all its regions shown, none, or some
   QLabel *status_ = nullptr, *probe_ = nullptr;
   bool filling_ = false;  // the tables being filled by the program, not edited
 };

@@ -129,10 +129,38 @@ std::string model_difference(const Model& expected, const Model& saved) {
   return "";
 }
 
+// `name` (relative to `from`) copied into `to` under its own file name (or "NAME-2.EXT", ... when
+// `copied` holds another file of that name); returns the copy's name. A file already there (a model
+// saved over itself) is not copied again.
+std::string copied_reference(const std::filesystem::path& file, std::uint64_t line, const std::string& name,
+                             const std::filesystem::path& from, const std::filesystem::path& to,
+                             std::map<std::string, std::filesystem::path>& copied) {
+  std::error_code ec;
+  const std::filesystem::path src = std::filesystem::weakly_canonical(from / name, ec);
+  if (ec || !std::filesystem::is_regular_file(src))
+    throw IoError(file.string(), line, IoError::kNoOffset,
+                  "the referenced file '" + name + "' cannot be read");
+  const std::string stem = src.stem().string(), ext = src.extension().string();
+  std::string copy = src.filename().string();
+  for (int i = 2; copied.count(copy) && copied[copy] != src; ++i) copy = stem + "-" + std::to_string(i) + ext;
+  if (copied.emplace(copy, src).second && std::filesystem::weakly_canonical(to / copy, ec) != src) {
+    // whole or not at all: a temporary beside it, renamed over it
+    const std::filesystem::path temp = to / (copy + ".part");
+    std::filesystem::copy_file(src, temp, std::filesystem::copy_options::overwrite_existing, ec);
+    if (!ec) std::filesystem::rename(temp, to / copy, ec);
+    if (ec) {
+      std::filesystem::remove(temp);
+      throw IoError((to / copy).string(), 0, IoError::kNoOffset,
+                    "cannot copy the referenced file '" + name + "' here: " + ec.message());
+    }
+  }
+  return copy;
+}
+
 }  // namespace
 
 void save_model(const std::filesystem::path& source, const std::filesystem::path& target,
-                std::span<const ParameterOverride> values) {
+                std::span<const ParameterOverride> values, const SaveModelOptions& options) {
   // The source loads with the values (so it is a model within the limits, safe to parse again)
   const Model expected = load_model(source, values, "the saved values");
   const std::string text = io::read_file(source);
@@ -145,18 +173,24 @@ void save_model(const std::filesystem::path& source, const std::filesystem::path
     if (!v) throw IoError(source.string(), 0, IoError::kNoOffset, "unknown parameter '" + o.name + "'");
     edits.push_back(edit_of(source, *v, "parameter '" + o.name + "'", toml_quoted(o.expression)));
   }
-  // Referenced files, renamed when the model moves to another folder
+  // Referenced files, renamed when the model moves to another folder (or copied there)
   std::error_code ec;
   const std::filesystem::path from =
       std::filesystem::weakly_canonical(std::filesystem::absolute(source).parent_path(), ec);
   const std::filesystem::path to =
       std::filesystem::weakly_canonical(std::filesystem::absolute(target).parent_path(), ec);
-  if (from != to) {
+  std::map<std::string, std::filesystem::path> copied;  // copy's name -> the file it copies
+  // the model's own name is taken (a library of that name is copied as "NAME-2.toml")
+  copied[target.filename().string()] = to / target.filename();
+  if (from != to || options.copy_references) {
     auto reference = [&](const Value& v, const std::string& what) {
       if (!v.is_string()) return;  // load_model refused it already
       const std::string name = v.as_string().str;
-      edits.push_back(edit_of(source, v, what,
-                              toml_quoted(moved_reference(source, v.location().line(), name, from, to))));
+      const std::uint64_t line = v.location().line();
+      const std::string renamed = options.copy_references
+                                      ? copied_reference(source, line, name, from, to, copied)
+                                      : moved_reference(source, line, name, from, to);
+      edits.push_back(edit_of(source, v, what, toml_quoted(renamed)));
     };
     const auto& t = root.as_table();
     if (auto it = t.find("library"); it != t.end()) reference(it->second, "library");

@@ -144,6 +144,57 @@ TEST(ModelSave, ReferencedFilesStayValid) {
   EXPECT_EQ(foxi::test::read_text(src / "m.toml"), expected);
 }
 
+// copy_references: the library and the STL files copied beside the saved model (two STL files of
+// one name: the second as t-2.stl), named by their copies: with the source folder gone, the saved
+// model loads equal to the source's. Saved over itself, nothing is copied again.
+TEST(ModelSave, CopiedReferencesNeedNothingOutside) {
+  TempDir dir;
+  const auto src = dir.path() / "a";
+  std::filesystem::create_directories(src / "s1");
+  std::filesystem::create_directories(src / "s2");
+  auto tetra = [](double z) {
+    std::string t = "solid t\n";
+    const std::string v[4] = {"1 1 " + std::to_string(z), "1 2 " + std::to_string(z),
+                              "2 1 " + std::to_string(z), "1 1 " + std::to_string(z + 1)};
+    const int f[4][3] = {{0, 1, 2}, {0, 2, 3}, {0, 3, 1}, {2, 1, 3}};
+    for (const auto& tri : f)
+      t += " facet normal 0 0 0\n  outer loop\n   vertex " + v[tri[0]] + "\n   vertex " + v[tri[1]] +
+           "\n   vertex " + v[tri[2]] + "\n  endloop\n endfacet\n";
+    return t + "endsolid t\n";
+  };
+  foxi::test::write_text(src / "s1" / "t.stl", tetra(2));
+  foxi::test::write_text(src / "s2" / "t.stl", tetra(4));
+  foxi::test::write_text(dir.path() / "lib.toml", "[materials.a]\nthermal_conductivity = 3\n");
+  foxi::test::write_text(src / "m.toml",
+                         "units.length = \"mm\"\nlibrary = \"../lib.toml\"\n[parameters]\nw = \"3 mm\"\n"
+                         "[[parts]]\nname = \"base\"\nmaterial = \"a\"\nshape = \"box\"\norigin = [0, 0, 0]\n"
+                         "size = [\"w\", 3, 1]\n"
+                         "[[parts]]\nname = \"p\"\nmaterial = \"a\"\nshape = \"stl\"\nfile = \"s1/t.stl\"\n"
+                         "[[parts]]\nname = \"q\"\nmaterial = \"a\"\nshape = \"stl\"\nfile = \"s2/t.stl\"\n"
+                         "[[parts]]\nname = \"r\"\nmaterial = \"a\"\nshape = \"stl\"\nfile = \"s1/t.stl\"\n");
+  const std::vector<ParameterOverride> values = {{"w", "4 mm"}};
+  const foxi::Model expected = foxi::load_model(src / "m.toml", values);
+  const auto target = dir.path() / "b" / "m.toml";
+  std::filesystem::create_directories(target.parent_path());
+  foxi::save_model(src / "m.toml", target, values, {.copy_references = true});
+  const std::string text = foxi::test::read_text(target);
+  EXPECT_NE(text.find("library = \"lib.toml\"\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("file = \"t.stl\"\n[[parts]]\nname = \"q\""), std::string::npos) << text;
+  EXPECT_NE(text.find("file = \"t-2.stl\"\n[[parts]]\nname = \"r\""), std::string::npos) << text;
+  EXPECT_EQ(foxi::test::read_text(target.parent_path() / "t-2.stl"), tetra(4));
+  std::filesystem::remove_all(src);
+  std::filesystem::remove(dir.path() / "lib.toml");
+  expect_same_model(expected, foxi::load_model(target));
+  // over itself: the copies are there already, not written again
+  const auto stl_time = std::filesystem::last_write_time(target.parent_path() / "t.stl");
+  foxi::save_model(target, target, std::vector<ParameterOverride>{{"w", "5 mm"}}, {.copy_references = true});
+  EXPECT_EQ(std::filesystem::last_write_time(target.parent_path() / "t.stl"), stl_time);
+  EXPECT_EQ(foxi::load_model(target).parts[0].prisms[0].xy[2], 5e-3);
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(target.parent_path())) ++files;
+  EXPECT_EQ(files, 4u);  // m.toml, lib.toml, t.stl, t-2.stl
+}
+
 TEST(ModelSave, RefusesWhatItCannotSaveAndWritesNothing) {
   TempDir dir;
   const std::string model =

@@ -17,6 +17,7 @@
 #include <QJsonObject>
 #include <QLabel>
 #include <QLineEdit>
+#include <QListWidget>
 #include <QMouseEvent>
 #include <QPlainTextEdit>
 #include <QPushButton>
@@ -41,6 +42,7 @@
 #include "foxi/mesher/model_mesh.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/io_error.hpp"
+#include "foxi/model/mesh_io.hpp"
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/solver.hpp"
 #include "foxi/solver/thermal.hpp"
@@ -81,6 +83,16 @@ std::string line_after(const std::string& text, const std::string& key) {
   if (at == std::string::npos) return {};
   const std::size_t end = text.find('\n', at);
   return text.substr(at + key.size(), end - at - key.size());
+}
+
+// Pixels of `a` that differ from `b`'s (of the same size), and those not white (the model drawn).
+std::pair<std::size_t, std::size_t> pixel_counts(const foxi::Framebuffer& a, const foxi::Framebuffer& b) {
+  std::size_t differ = 0, coloured = 0;
+  for (std::size_t i = 0; i < a.rgba.size() && i < b.rgba.size(); ++i) {
+    differ += a.rgba[i] != b.rgba[i];
+    coloured += a.rgba[i] != foxi::pack_rgba(255, 255, 255);
+  }
+  return {differ, coloured};
 }
 
 // The headless loop on a shipped model: the view's saved picture equals foxi render's picture of
@@ -131,11 +143,7 @@ void check_headless(const std::string& model, const std::string& set, const std:
   ASSERT_EQ(a.height, 240);
   ASSERT_EQ(b.width, a.width);
   ASSERT_EQ(b.height, a.height);
-  std::size_t differ = 0, coloured = 0;
-  for (std::size_t i = 0; i < a.rgba.size(); ++i) {
-    differ += a.rgba[i] != b.rgba[i];
-    coloured += a.rgba[i] != foxi::pack_rgba(255, 255, 255);
-  }
+  const auto [differ, coloured] = pixel_counts(a, b);
   EXPECT_EQ(differ, 0u);
   // The tools draw part of the model: a small picture, but not an empty one.
   EXPECT_GT(coloured, a.rgba.size() / (tools.empty() ? 10 : 100)) << "the picture shows the model";
@@ -233,6 +241,99 @@ TEST(WorkbenchHeadless, RegionsShownEqualFoxiRender) {
 TEST(WorkbenchHeadless, RegionsShownWithIsoEqualFoxiRender) {
   check_headless("flip_chip.toml", "die_w=7mm", "T_max", "", "--regions 1 --iso 49");
 }
+// A material's box hides all its regions (multi_chip's two silicon dies): the picture equals foxi
+// render --regions of the other regions, pixel for pixel with the same camera, and the region boxes
+// follow; a region box unticked leaves its material's box partly ticked, ticked again all ticked.
+TEST(Workbench, HidingAMaterialEqualsFoxiRenderOfTheOtherRegions) {
+  TempDir dir;
+  Workbench w;
+  w.view_widget()->setFixedSize(200, 150);
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "multi_chip.toml")));
+  ASSERT_TRUE(w.start_solve());
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(w.set_field("temperature"));
+  if (w.busy()) {
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  }
+  auto* materials = w.findChild<QListWidget*>("materials_shown");
+  auto* regions = w.findChild<QListWidget*>("regions_shown");
+  ASSERT_TRUE(materials && regions);
+  const foxi::Mesh& mesh = *w.mesh();
+  ASSERT_EQ(regions->count(), int(mesh.regions.size()));
+  QListWidgetItem* silicon = nullptr;
+  for (int i = 0; i < materials->count(); ++i) {
+    EXPECT_EQ(materials->item(i)->checkState(), Qt::Checked);
+    if (materials->item(i)->text() == "silicon") silicon = materials->item(i);
+  }
+  ASSERT_NE(silicon, nullptr);
+  const std::uint32_t si = silicon->data(Qt::UserRole).toUInt();
+  std::string others;
+  int silicon_regions = 0;
+  for (const foxi::Region& r : mesh.regions)
+    if (r.material == si)
+      ++silicon_regions;
+    else
+      others += (others.empty() ? "" : ",") + std::to_string(r.id);
+  ASSERT_EQ(silicon_regions, 2);
+  silicon->setCheckState(Qt::Unchecked);  // as a click does
+  if (w.busy()) {
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  }
+  // the boxes are filled again after each drawing: found by name
+  auto silicon_box = [&] {
+    const auto found = materials->findItems("silicon", Qt::MatchExactly);
+    return found.size() == 1 ? found[0] : nullptr;
+  };
+  ASSERT_TRUE(silicon_box());
+  EXPECT_EQ(silicon_box()->checkState(), Qt::Unchecked);
+  for (int i = 0; i < regions->count(); ++i) {
+    const std::int32_t id = regions->item(i)->data(Qt::UserRole).toInt();
+    const bool of_silicon = std::any_of(mesh.regions.begin(), mesh.regions.end(), [&](const foxi::Region& r) {
+      return r.id == id && r.material == si;
+    });
+    EXPECT_EQ(regions->item(i)->checkState(), of_silicon ? Qt::Unchecked : Qt::Checked) << "region " << id;
+  }
+  w.view_widget()->finish_now();
+  const auto mesh_file = dir.path() / "mesh.vtu", view = dir.path() / "view.png",
+             cli = dir.path() / "cli.png";
+  foxi::write_mesh(mesh, mesh_file);
+  QString why;
+  ASSERT_TRUE(w.view_widget()->save_picture(QString::fromStdString(view.string()), &why))
+      << why.toStdString();
+  const foxi::Framebuffer a = foxi::read_png(view);
+  ASSERT_EQ(
+      foxi::test::run_cli("render '" + mesh_file.string() + "' --field temperature --legend off --size " +
+                              std::to_string(a.width) + "x" + std::to_string(a.height) + " --regions " +
+                              others + " " + w.view_widget()->camera_options() + " -o '" + cli.string() + "'",
+                          dir.path() / "render.log"),
+      0)
+      << foxi::test::read_text(dir.path() / "render.log");
+  const foxi::Framebuffer b = foxi::read_png(cli);
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  const auto [differ, coloured] = pixel_counts(a, b);
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(coloured, a.rgba.size() / 20) << "the other regions are drawn";
+  // the region boxes back to the material's: one silicon region shown, silicon partly ticked
+  for (int i = 0; i < regions->count(); ++i)
+    if (regions->item(i)->checkState() == Qt::Unchecked) {
+      regions->item(i)->setCheckState(Qt::Checked);
+      break;
+    }
+  if (w.busy()) {
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  }
+  ASSERT_TRUE(silicon_box());
+  EXPECT_EQ(silicon_box()->checkState(), Qt::PartiallyChecked);
+  ASSERT_TRUE(w.set_material_shown(si, true));
+  if (w.busy()) {
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  }
+  EXPECT_EQ(silicon_box()->checkState(), Qt::Checked);
+  for (int i = 0; i < regions->count(); ++i) EXPECT_EQ(regions->item(i)->checkState(), Qt::Checked);
+}
+
 // The other physics: the potential of an electrostatic solve (its capacitance), the von Mises stress
 // of a thermal stress solve (its maximum), as foxi render draws them and foxi solve gives them.
 TEST(WorkbenchHeadless, ElectrostaticPictureAndCapacitanceEqualFoxi) {
@@ -1409,6 +1510,97 @@ TEST(Workbench, ProjectSaveReopenAndKilledSave) {
   reopen("after a killed save");
 }
 
+// The project folder holds its model: a copy with the edited values, the material library (outside
+// the model's folder here) and the STL file copied beside it, named relatively. The folder renamed and
+// the original model's folder and library removed, it reopens: the same parameters, materials and
+// STL surface, the saved mesh, and a remesh (of the copies) equal to the mesh of the original files.
+// A project of the previous version (the model file's absolute path) still opens where it is.
+TEST(Workbench, ProjectFolderHoldsItsModel) {
+  TempDir dir;
+  const auto src = dir.path() / "src";
+  std::filesystem::create_directories(src / "model" / "shapes");
+  std::filesystem::create_directories(src / "lib");
+  std::string stl = "solid t\n";
+  const char* const facets[4][3] = {{"1 1 2", "1 2 2", "2 1 2"},
+                                    {"1 1 2", "2 1 2", "1 1 3"},
+                                    {"1 1 2", "1 1 3", "1 2 2"},
+                                    {"2 1 2", "1 2 2", "1 1 3"}};
+  for (const auto& f : facets)
+    stl += std::string(" facet normal 0 0 0\n  outer loop\n   vertex ") + f[0] + "\n   vertex " + f[1] +
+           "\n   vertex " + f[2] + "\n  endloop\n endfacet\n";
+  foxi::test::write_text(src / "model" / "shapes" / "t.stl", stl + "endsolid t\n");
+  foxi::test::write_text(
+      src / "lib" / "materials.toml",
+      "[materials.a]\nthermal_conductivity = 3\n[materials.b]\nthermal_conductivity = 30\n");
+  const auto model = src / "model" / "m.toml";
+  foxi::test::write_text(
+      model,
+      "units.length = \"mm\"\nlibrary = \"../lib/materials.toml\"\n"
+      "[parameters]\nw = \"3 mm\"\nh = \"1 mm\"\n"
+      "[[parts]]\nname = \"base\"\nmaterial = \"a\"\nshape = \"box\"\n"
+      "origin = [0, 0, 0]\nsize = [\"w\", 3, \"h\"]\n"
+      "[[parts]]\nname = \"tip\"\nmaterial = \"b\"\nshape = \"stl\"\nfile = \"shapes/t.stl\"\n");
+  const auto proj = dir.path() / "proj";
+  foxi::Mesh before;
+  {
+    Workbench w;
+    ASSERT_TRUE(w.open_model(QString::fromStdString(model.string())));
+    ASSERT_TRUE(w.set_parameter("w", "4 mm"));
+    ASSERT_TRUE(w.start_mesh());
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    QString why;
+    ASSERT_TRUE(w.save_project(QString::fromStdString(proj.string()), &why)) << why.toStdString();
+    before = *w.mesh();
+  }
+  const std::string json = foxi::test::read_text(proj / "project.json");
+  EXPECT_NE(json.find("\"model\": \"model/m.toml\""), std::string::npos) << json;
+  const std::string copy = foxi::test::read_text(proj / "model" / "m.toml");
+  EXPECT_NE(copy.find("library = \"materials.toml\""), std::string::npos) << copy;
+  EXPECT_NE(copy.find("file = \"t.stl\""), std::string::npos) << copy;
+  EXPECT_NE(copy.find("w = \"4 mm\""), std::string::npos) << copy;
+  EXPECT_EQ(foxi::test::read_text(proj / "model" / "t.stl"), stl + "endsolid t\n");
+
+  auto check_open = [&](const std::filesystem::path& folder, const std::filesystem::path& model_file) {
+    Workbench w;
+    QString why;
+    ASSERT_TRUE(w.open_project(QString::fromStdString(folder.string()), &why)) << why.toStdString();
+    EXPECT_EQ(std::filesystem::weakly_canonical(w.model()->file),
+              std::filesystem::weakly_canonical(model_file));
+    ASSERT_EQ(w.overrides().size(), 1u);
+    EXPECT_EQ(w.overrides()[0].name, "w");
+    EXPECT_EQ(w.overrides()[0].expression, "4 mm");
+    ASSERT_EQ(w.model()->materials.size(), 2u);
+    EXPECT_EQ(w.model()->materials[1].thermal_conductivity, 30);  // the library's
+    ASSERT_EQ(w.model()->parts.size(), 2u);
+    EXPECT_EQ(w.model()->parts[1].surface.tri.size(), 12u);  // the STL's 4 triangles
+    EXPECT_EQ(w.model()->parts[0].prisms[0].xy[2], 4e-3);    // the base's width, 4 mm
+    ASSERT_TRUE(w.mesh());
+    EXPECT_TRUE(w.mesh()->xyz == before.xyz) << "the saved mesh";
+    if (w.busy()) {  // the reopened view's drawing
+      ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    }
+    ASSERT_TRUE(w.start_mesh());
+    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    EXPECT_TRUE(w.mesh()->xyz == before.xyz) << "the next mesh, of " << model_file;
+    EXPECT_TRUE(w.mesh()->tet_region == before.tet_region);
+    EXPECT_TRUE(w.mesh()->tet == before.tet);
+  };
+  // The previous version's project: project.json naming the original model absolutely
+  const auto old = dir.path() / "old";
+  std::filesystem::create_directories(old);
+  QJsonObject o = QJsonDocument::fromJson(QByteArray::fromStdString(json)).object();
+  o["model"] = QString::fromStdString(model.string());
+  foxi::test::write_text(old / "project.json", QJsonDocument(o).toJson().toStdString());
+  const std::string mesh_name = o["mesh"].toString().toStdString();
+  std::filesystem::copy_file(proj / mesh_name, old / mesh_name);
+  check_open(old, model);
+
+  const auto moved = dir.path() / "moved";
+  std::filesystem::rename(proj, moved);
+  std::filesystem::remove_all(src);
+  check_open(moved, moved / "model" / "m.toml");
+}
+
 // A save killed while it writes (SIGKILL at staggered moments of a headless run that saves a
 // project over an existing one): the folder always opens, as the old project or the new one whole.
 TEST(WorkbenchHeadless, KilledSaveLeavesAProjectThatOpens) {
@@ -1483,6 +1675,10 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   const auto time0 = std::filesystem::last_write_time(mesh_path);
   const auto size0 = std::filesystem::file_size(mesh_path);
   EXPECT_EQ(w.autosaves_without_mesh(), 0);
+  const auto model_copy = dir.path() / "auto" / "model" / "die_on_substrate.toml";
+  ASSERT_TRUE(std::filesystem::exists(model_copy));
+  const auto model_time0 = std::filesystem::last_write_time(model_copy);
+  EXPECT_EQ(w.autosaves_without_model(), 0);
   // a view change: project.json again, the mesh file untouched
   ASSERT_TRUE(w.set_shrink(0.8));
   ASSERT_TRUE(wait_job(w));
@@ -1492,6 +1688,8 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   EXPECT_EQ(std::filesystem::last_write_time(mesh_path), time0);
   EXPECT_EQ(std::filesystem::file_size(mesh_path), size0);
   EXPECT_EQ(w.autosaves_without_mesh(), 1);
+  EXPECT_EQ(std::filesystem::last_write_time(model_copy), model_time0) << "the model copy kept";
+  EXPECT_EQ(w.autosaves_without_model(), 1);
   // a new mesh: a new file, the old one gone
   ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
   ASSERT_TRUE(w.start_mesh());
@@ -1500,10 +1698,31 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   EXPECT_NE(mesh_file(), first);
   EXPECT_FALSE(std::filesystem::exists(mesh_path));
   EXPECT_EQ(w.autosaves_without_mesh(), 1);
+  // and the model copy with the new value
+  EXPECT_EQ(w.autosaves_without_model(), 1);
+  EXPECT_NE(foxi::test::read_text(model_copy).find("die_w = \"5 mm\""), std::string::npos)
+      << foxi::test::read_text(model_copy);
   Workbench again;
   QString why;
   ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
   EXPECT_EQ(again.mesh()->tet_count(), w.mesh()->tet_count());
+  if (again.busy()) {
+    ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  }
+  // The reopened project works on its copy, autosaved over itself: written once, then kept
+  w.set_autosave_folder({});
+  again.set_autosave_folder(folder);
+  again.set_autosave_delay(50);
+  for (int n = 1; n <= 2; ++n) {
+    ASSERT_TRUE(again.set_shrink(n == 1 ? 0.7 : 0.6));
+    ASSERT_TRUE(wait_job(again));
+    const auto t0 = std::chrono::steady_clock::now();
+    while (again.autosaves() < n && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(8))
+      QApplication::processEvents(QEventLoop::AllEvents, 50);
+    again.wait_autosave();
+    ASSERT_EQ(again.autosaves(), n);
+  }
+  EXPECT_EQ(again.autosaves_without_model(), 1);
 }
 
 // An autosave a session left is found and restored on start (the window asks first; here without
@@ -1851,9 +2070,10 @@ TEST(Workbench, ProjectMeshSettingsOldAndMalformed) {
   auto write = [&](const QJsonObject& p) {
     foxi::test::write_text(proj / "project.json", QJsonDocument(p).toJson().toStdString());
   };
-  // A window on the project's model (the same path) with settings of its own.
+  // A window on the project's model (the same path: the folder's copy) with settings of its own.
   Workbench x;
-  ASSERT_TRUE(x.open_model(saved["model"].toString()));
+  ASSERT_TRUE(
+      x.open_model(QString::fromStdString((proj / saved["model"].toString().toStdString()).string())));
   foxi::workbench::MeshSettings mine;
   mine.mesher = foxi::Mesher::cgal;
   mine.max_size = 2e-3;

@@ -21,7 +21,16 @@ namespace foxi {
 // nothing is written. Throws IoError naming the file, the line (when known) and the reason: the
 // source does not load, a value is not written as one line, a referenced file cannot be named
 // relative to the target's folder, or the saved model would load differently.
+struct SaveModelOptions {
+  // Copy the referenced files (material library, STL surfaces) into the target's folder, each under
+  // its own file name (two different files of one name: the second as "NAME-2.EXT"), and name the
+  // copies: the folder then holds a model that needs nothing outside it (a workbench project folder,
+  // moved or sent to another machine). The copies are written before the model file (its load-back
+  // check reads them); a refused model leaves them there. Otherwise the references are renamed to
+  // the same files, relative to the target's folder.
+  bool copy_references = false;
+};
 FOXI_API void save_model(const std::filesystem::path& source, const std::filesystem::path& target,
-                         std::span<const ParameterOverride> values);
+                         std::span<const ParameterOverride> values, const SaveModelOptions& options = {});
 
 }  // namespace foxi
