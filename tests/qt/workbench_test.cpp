@@ -2357,6 +2357,22 @@ std::size_t child_processes() {
   return n;
 }
 
+// The test's own TMPDIR for its lifetime: the CalculiX runs' work folders go there, so that counting
+// them sees no other test's (ctest -j runs the other CalculiX tests beside this one).
+struct PrivateTmpdir {
+  PrivateTmpdir() : old(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "") {
+    ::setenv("TMPDIR", dir.path().c_str(), 1);
+  }
+  ~PrivateTmpdir() {
+    if (old.empty())
+      ::unsetenv("TMPDIR");
+    else
+      ::setenv("TMPDIR", old.c_str(), 1);
+  }
+  foxi::test::TempDir dir;
+  std::string old;
+};
+
 // A solve by ccx cancelled while ccx runs: the previous results (their value `key`) stay, no work
 // folder beyond the `folders` there were and no child process is left behind.
 void cancel_while_ccx_runs(Workbench& w, const char* key, std::size_t folders) {
@@ -2385,6 +2401,7 @@ void cancel_while_ccx_runs(Workbench& w, const char* key, std::size_t folders) {
 // previous results and leaves no work folder and no child process.
 TEST(Workbench, CalculixTemperatureEqualsBuiltIn) {
   if (foxi::test::run("command -v ccx > /dev/null") != 0) GTEST_SKIP() << "ccx is not installed";
+  const PrivateTmpdir tmpdir;
   Workbench w;
   w.view_widget()->setFixedSize(200, 150);
   ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
@@ -2441,6 +2458,7 @@ TEST(Workbench, CalculixTemperatureEqualsBuiltIn) {
 // folder and no child process.
 TEST(Workbench, CalculixThermalStressEqualsBuiltIn) {
   if (foxi::test::run("command -v ccx > /dev/null") != 0) GTEST_SKIP() << "ccx is not installed";
+  const PrivateTmpdir tmpdir;
   Workbench w;
   w.view_widget()->setFixedSize(200, 150);
   ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
