@@ -106,4 +106,21 @@ for t in "${targets[@]}"; do
     "$([ "$findings" -gt 0 ] && echo "$findings in $build/artifacts/$t (log $log)" || echo none)"
   if [ "$status" != 0 ] || [ "$findings" -gt 0 ]; then found=1; fi
 done
+# What was found, in full: the report and each input in hex, so that a finding on another machine (CI
+# keeps no files) can be read and reproduced (xxd -r -p).
+if [ "$found" = 1 ]; then
+  for t in "${targets[@]}"; do
+    log="$build/fuzz-$t.log"
+    read -r status _ < "$log.status"
+    inputs=$(find "$build/artifacts/$t" -type f -newer "$build/fuzz-start")
+    [ "$status" != 0 ] || [ -n "$inputs" ] || continue
+    echo "=== $t (exit status $status): the end of $log"
+    grep -a -v -E '^#[0-9]+|NEW_FUNC|^\s*$' "$log" | tail -60
+    for f in $inputs; do
+      echo "=== $t: $f ($(stat -c %s "$f") bytes), hex:"
+      od -An -v -tx1 "$f" | tr -d ' \n' | fold -w 128
+      echo
+    done
+  done
+fi
 exit $found

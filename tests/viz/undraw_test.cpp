@@ -412,6 +412,30 @@ TEST(Undraw, EyeOnASharedFace) {
   }
 }
 
+// A Kuhn cube with one of its six tets missing, seen orthographically along (0, 5, -3.75) (fuzz
+// finding tests/data/bad/fuzz/mesh_pipeline/undraw_kuhn_cube_missing_tet): all eight corners are
+// cospherical, so every tet has the same sphere and the power order rests on its tie-breaking.
+// Oracle: the painter's fresh drawing of the kept tets.
+TEST(Undraw, KuhnCubeWithATetMissing) {
+  Mesh m;
+  m.xyz = {0, 0, 0, 2, 0, 0, 0, 2, 0, 2, 2, 0, 0, 0, 2, 2, 0, 2, 0, 2, 2, 2, 2, 2, -4, -3, -1};
+  m.tet = {7, 0, 1, 5, 7, 0, 2, 3, 7, 0, 2, 6, 7, 0, 4, 5, 7, 0, 4, 6};
+  ASSERT_TRUE(validate_and_repair(m).ok());
+  double lo[3], hi[3];
+  mesh_bounds(m, lo, hi);
+  const double dir[3] = {0, 5, -3.75};
+  const SphereTable table = compute_spheres(m);
+  View view;
+  view.perspective = false;
+  std::copy(dir, dir + 3, view.dir);
+  const auto order = visibility_order(m, table, view);
+  EXPECT_EQ(table.separating_planes, 6u) << "the pairs of the chain 0-3-4-2-1 that share no face";
+  for (const auto& [w, h] : {std::pair{24, 16}, std::pair{160, 120}, std::pair{97, 61}}) {
+    const Camera cam = camera_from_options(lo, hi, double(w) / h, nullptr, nullptr, nullptr, 30, dir);
+    EXPECT_EQ(undraw_differences(m, cam, w, h, order), 0u) << w << "x" << h;
+  }
+}
+
 TEST(Undraw, BadUseIsRejected) {
   Mesh m = test::grid_mesh(2, 2, 2, 1, 1, 1, 5);
   Camera cam;

@@ -2,6 +2,7 @@
 // orientation of a face as seen from the eye, and the two-core split of a loop.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -49,6 +50,41 @@ inline int eye_side(const View& view, const double* a, const double* b, const do
   if (view.perspective) return fast_orientation(a, b, c, view.eye);
   const double back[3] = {-view.dir[0], -view.dir[1], -view.dir[2]};
   return exact::orientation_at_infinity(a, b, c, back);
+}
+
+// Whether a ray from the eye (orthographic: along the view) meets the interiors of both tets x and
+// y, which have disjoint interiors: not when a plane through the eye (parallel to the view) has x on
+// one side and y on the other. Such a plane, where there is one, can be taken through the eye and
+// two vertices of x and y (the separating planes through the eye form a polyhedral cone whose
+// extreme rays are tight at two vertices). Exact. Used for the few pairs of a cut cluster's tets
+// that share no face (add_separating_planes in spheres.cpp): a separating plane of x and y orders
+// them only where some ray meets both.
+inline bool rays_meet_both(const View& view, const MeshView& m, std::uint32_t x, std::uint32_t y) {
+  const std::uint32_t* tx = m.tet.data() + 4 * std::size_t(x);
+  const std::uint32_t* ty = m.tet.data() + 4 * std::size_t(y);
+  std::uint32_t u[8];
+  int nu = 0;
+  for (int c = 0; c < 4; ++c) u[nu++] = tx[c];
+  for (int c = 0; c < 4; ++c)
+    if (std::find(u, u + nu, ty[c]) == u + nu) u[nu++] = ty[c];
+  auto side = [&](std::uint32_t p, std::uint32_t q, std::uint32_t w) {
+    if (w == p || w == q) return 0;
+    if (view.perspective) return fast_orientation(view.eye, node(m, p), node(m, q), node(m, w));
+    return -exact::orientation_at_infinity(node(m, p), node(m, q), node(m, w), view.dir);
+  };
+  for (int i = 0; i < nu; ++i)
+    for (int j = i + 1; j < nu; ++j) {
+      int lo_x = 1, hi_x = -1, lo_y = 1, hi_y = -1;
+      for (int c = 0; c < 4; ++c) {
+        const int sx = side(u[i], u[j], tx[c]), sy = side(u[i], u[j], ty[c]);
+        lo_x = std::min(lo_x, sx), hi_x = std::max(hi_x, sx);
+        lo_y = std::min(lo_y, sy), hi_y = std::max(hi_y, sy);
+      }
+      if ((lo_x >= 0 && hi_y <= 0 && (hi_x > 0 || lo_y < 0)) ||
+          (hi_x <= 0 && lo_y >= 0 && (lo_x < 0 || hi_y > 0)))
+        return false;
+    }
+  return true;
 }
 
 }  // namespace foxi::order_detail

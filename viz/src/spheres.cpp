@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "exact.hpp"
+#include "order_geometry.hpp"
 #include "huge_page_allocator.hpp"
 #include "foxi/model/adjacency.hpp"
 #include "foxi/model/assert.hpp"
@@ -176,6 +177,124 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
     for (std::uint32_t c = first; c <= last; ++c) merge(box, cell_box[0][c]);
     t.key_blocks[b] = box;
   }
+}
+
+// A cluster the mesh covers only in part: a cospherical cell (whose tets all share one sphere and
+// fill a convex polytope when the whole cell is meshed) cut by the mesh's boundary, say a Kuhn cube
+// with a tet missing. Its faces then no longer order its tets: two tets that share no face may face
+// each other across the missing part (fuzz finding undraw_kuhn_cube_missing_tet). In a Delaunay mesh
+// only a boundary face of the mesh can cut a cell (a face between two cells lies on both cells'
+// hulls), so a cluster without one is convex and left as it is; one with a boundary face beyond
+// which a vertex of the cluster lies gets, for each pair of its tets that share no face, a plane
+// through three of their vertices with one tet on each side, listed with the cluster's faces (the
+// eye's side of it orders the pair as a shared face would; an eye on it sees no ray through both).
+// Clusters of more than 64 tets are left as they are (a limitation: their faces alone order them).
+bool shares_face(const std::vector<std::uint32_t>& neighbour, std::uint32_t x, std::uint32_t y) {
+  for (int f = 0; f < 4; ++f)
+    if (neighbour[4 * std::size_t(x) + f] != kNone && neighbour[4 * std::size_t(x) + f] >> 2 == y)
+      return true;
+  return false;
+}
+
+void add_separating_planes(SphereTable& t, const double* X, const std::uint32_t* T,
+                           const std::vector<std::uint32_t>& neighbour, std::uint32_t clusters) {
+  using order_detail::fast_orientation;
+  auto P = [X](std::uint32_t v) { return X + 3 * std::size_t(v); };
+  struct Extra {
+    std::uint32_t cluster, a, b, v[3];
+  };
+  std::vector<Extra> extra;
+  std::vector<std::uint32_t> verts;
+  for (std::uint32_t k = 0; k < clusters; ++k) {
+    const std::uint32_t cb = t.cluster_begin[k], ce = t.cluster_begin[k + 1];
+    if (ce - cb > 64) continue;
+    bool cut = false;
+    for (std::uint32_t i = cb; i < ce && !cut; ++i)
+      for (int f = 0; f < 4; ++f) cut = cut || neighbour[4 * std::size_t(t.cluster_tets[i]) + f] == kNone;
+    if (!cut) continue;
+    verts.clear();
+    for (std::uint32_t i = cb; i < ce; ++i)
+      for (int c = 0; c < 4; ++c) verts.push_back(T[4 * std::size_t(t.cluster_tets[i]) + c]);
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    bool convex = true;
+    for (std::uint32_t i = cb; i < ce && convex; ++i) {
+      const std::uint32_t* v = T + 4 * std::size_t(t.cluster_tets[i]);
+      for (int f = 0; f < 4 && convex; ++f) {
+        if (neighbour[4 * std::size_t(t.cluster_tets[i]) + f] != kNone) continue;
+        const std::uint32_t a = v[order_detail::kFace[f][0]], b = v[order_detail::kFace[f][1]],
+                            c = v[order_detail::kFace[f][2]];
+        for (std::uint32_t w : verts)  // the tet's own vertex f is on the negative side: inside
+          if (w != a && w != b && w != c && fast_orientation(P(a), P(b), P(c), P(w)) > 0) {
+            convex = false;
+            break;
+          }
+      }
+    }
+    if (convex) continue;
+    for (std::uint32_t i = cb; i < ce; ++i)
+      for (std::uint32_t j = i + 1; j < ce; ++j) {
+        const std::uint32_t x = t.cluster_tets[i], y = t.cluster_tets[j];
+        if (shares_face(neighbour, x, y)) continue;
+        std::uint32_t u[8];
+        int nu = 0;
+        for (int c = 0; c < 4; ++c) u[nu++] = T[4 * std::size_t(x) + c];
+        for (int c = 0; c < 4; ++c)
+          if (std::find(u, u + nu, T[4 * std::size_t(y) + c]) == u + nu) u[nu++] = T[4 * std::size_t(y) + c];
+        // Signs of x's and y's vertices for each plane through three of the vertices: x on one
+        // side (or on it), y on the other (or on it), each with a vertex off the plane.
+        bool found = false;
+        for (int p = 0; p < nu && !found; ++p)
+          for (int q = p + 1; q < nu && !found; ++q)
+            for (int r = q + 1; r < nu && !found; ++r) {
+              int lo_x = 1, hi_x = -1, lo_y = 1, hi_y = -1;
+              for (int c = 0; c < 4; ++c) {
+                const std::uint32_t wx = T[4 * std::size_t(x) + c], wy = T[4 * std::size_t(y) + c];
+                const int sx = (wx == u[p] || wx == u[q] || wx == u[r])
+                                   ? 0
+                                   : fast_orientation(P(u[p]), P(u[q]), P(u[r]), P(wx));
+                const int sy = (wy == u[p] || wy == u[q] || wy == u[r])
+                                   ? 0
+                                   : fast_orientation(P(u[p]), P(u[q]), P(u[r]), P(wy));
+                lo_x = std::min(lo_x, sx), hi_x = std::max(hi_x, sx);
+                lo_y = std::min(lo_y, sy), hi_y = std::max(hi_y, sy);
+              }
+              if (lo_x >= 0 && hi_x > 0 && hi_y <= 0 && lo_y < 0) {
+                extra.push_back({k, x, y, {u[p], u[q], u[r]}});
+                found = true;
+              } else if (hi_x <= 0 && lo_x < 0 && lo_y >= 0 && hi_y > 0) {
+                extra.push_back({k, y, x, {u[p], u[q], u[r]}});
+                found = true;
+              }
+            }
+      }
+  }
+  if (extra.empty()) return;
+  // The cluster faces again, each cluster's separating planes after its shared faces.
+  std::vector<std::uint32_t> begin(clusters + 1, 0), face_tet, face_vertex;
+  for (std::uint32_t k = 0; k < clusters; ++k)
+    begin[k + 1] = t.cluster_face_begin[k + 1] - t.cluster_face_begin[k];
+  for (const Extra& e : extra) ++begin[e.cluster + 1];
+  for (std::uint32_t k = 0; k < clusters; ++k) begin[k + 1] += begin[k];
+  face_tet.reserve(2 * std::size_t(begin[clusters]));
+  face_vertex.reserve(3 * std::size_t(begin[clusters]));
+  std::size_t e = 0;
+  for (std::uint32_t k = 0; k < clusters; ++k) {
+    for (std::uint32_t f = t.cluster_face_begin[k]; f < t.cluster_face_begin[k + 1]; ++f) {
+      face_tet.insert(face_tet.end(), {t.face_tet[2 * std::size_t(f)], t.face_tet[2 * std::size_t(f) + 1]});
+      face_vertex.insert(face_vertex.end(), t.face_vertex.begin() + 3 * std::ptrdiff_t(f),
+                         t.face_vertex.begin() + 3 * std::ptrdiff_t(f) + 3);
+    }
+    for (; e < extra.size() && extra[e].cluster == k; ++e) {
+      face_tet.insert(face_tet.end(), {extra[e].a, extra[e].b});
+      face_vertex.insert(face_vertex.end(), extra[e].v, extra[e].v + 3);
+    }
+  }
+  FOXI_ASSERT(face_tet.size() == 2 * std::size_t(begin[clusters]), "separating planes miscounted");
+  t.cluster_face_begin = std::move(begin);
+  t.face_tet = std::move(face_tet);
+  t.face_vertex = std::move(face_vertex);
+  t.separating_planes = extra.size();
 }
 
 }  // namespace
@@ -364,14 +483,63 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
   });
   if (progress && !progress("clusters", 0.8)) return t;
 
+  // Pieces of one cospherical cell that share no face: a cell the mesh's boundary cuts (a Kuhn cube
+  // with two opposite tets left out) falls apart into tets or clusters with one sphere, which may
+  // face each other across the part left out, so they must be ordered together (one cluster, with
+  // separating planes: add_separating_planes). Every such piece has a face on the mesh's boundary
+  // inside the cell (in a Delaunay mesh a face between two cells lies on both cells' hulls), so
+  // only tets with a boundary face are compared: sorted by their centre's x, neighbours within the
+  // centres' error bounds (key_b), then all four vertices on the sphere, exactly.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> same_sphere;
+  {
+    std::vector<std::pair<double, std::uint32_t>> cut;
+    double widest = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (t.flat[i]) continue;
+      const std::uint32_t* nb = adj.neighbour.data() + 4 * i;
+      if (nb[0] != kNone && nb[1] != kNone && nb[2] != kNone && nb[3] != kNone) continue;
+      cut.emplace_back(t.c[3 * i], static_cast<std::uint32_t>(i));
+      widest = std::max(widest, double(t.key_b[i]));
+    }
+    std::sort(cut.begin(), cut.end());
+    for (std::size_t x = 0; x < cut.size(); ++x) {
+      const std::uint32_t i = cut[x].second;
+      const double* cc = t.c.data() + 3 * std::size_t(i);
+      const std::uint32_t* v = T + 4 * std::size_t(i);
+      for (std::size_t y = x + 1;
+           y < cut.size() && cut[y].first - cut[x].first <= double(t.key_b[i]) + widest; ++y) {
+        const std::uint32_t u = cut[y].second;
+        const double* cu = t.c.data() + 3 * std::size_t(u);
+        const double apart =
+            std::max({std::abs(cc[0] - cu[0]), std::abs(cc[1] - cu[1]), std::abs(cc[2] - cu[2])});
+        if (apart > double(t.key_b[i]) + double(t.key_b[u])) continue;
+        double w4[4];
+        const double* wv = nullptr;
+        if (W != nullptr) {
+          for (int k = 0; k < 4; ++k) w4[k] = W[v[k]];
+          wv = w4;
+        }
+        bool on = true;
+        for (int k = 0; k < 4 && on; ++k) {
+          const std::uint32_t q = T[4 * std::size_t(u) + k];
+          on = exact::in_sphere(X + 3 * std::size_t(v[0]), X + 3 * std::size_t(v[1]),
+                                X + 3 * std::size_t(v[2]), X + 3 * std::size_t(v[3]), X + 3 * std::size_t(q),
+                                wv, W != nullptr ? W[q] : 0.0) == 0;
+        }
+        if (on) same_sphere.emplace_back(i, u);
+      }
+    }
+  }
+
   t.cluster_of.assign(n, kNone);
   std::uint32_t clusters = 0;
   // Most unstructured meshes have no or few cospherical faces: no union-find over all tets then.
-  if (std::find(same.begin(), same.end(), std::uint8_t(1)) != same.end()) {
+  if (!same_sphere.empty() || std::find(same.begin(), same.end(), std::uint8_t(1)) != same.end()) {
     UnionFind uf(n);
     for (std::size_t i = 0; i < n; ++i)
       for (int f = 0; f < 4; ++f)
         if (same[4 * i + f]) uf.unite(static_cast<std::uint32_t>(i), adj.neighbour[4 * i + f] >> 2);
+    for (const auto& [i, u] : same_sphere) uf.unite(i, u);
     // Number the clusters of two or more tets in order of their smallest tet.
     std::vector<std::uint32_t> size(n, 0);
     for (std::size_t i = 0; i < n; ++i) ++size[uf.find(static_cast<std::uint32_t>(i))];
@@ -427,6 +595,7 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
                   "cluster " << k << " filled " << fill[k] - t.cluster_face_begin[k] << " of its "
                              << t.cluster_face_begin[k + 1] - t.cluster_face_begin[k] << " faces");
   }
+  add_separating_planes(t, X, T, adj.neighbour, clusters);
   // Wide items: bounds far above the typical (256 x the median), so that a few slivers with huge
   // spheres do not widen the near-tie window of everyone else.
   t.wide.assign(n, 0);
@@ -493,13 +662,14 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
     }
   };
   // Planes and local indices of the cluster faces.
-  t.face_test.resize(faces);
+  const std::size_t all_faces = t.cluster_face_begin[clusters];  // with the separating planes
+  t.face_test.resize(all_faces);
   {
     std::vector<std::uint32_t> local(n, 0);
     for (std::uint32_t k = 0; k < clusters; ++k)
       for (std::uint32_t i = t.cluster_begin[k]; i < t.cluster_begin[k + 1]; ++i)
         local[t.cluster_tets[i]] = i - t.cluster_begin[k];
-    for (std::size_t f = 0; f < faces; ++f) {
+    for (std::size_t f = 0; f < all_faces; ++f) {
       const double* p0 = X + 3 * std::size_t(t.face_vertex[3 * f]);
       const double* p1 = X + 3 * std::size_t(t.face_vertex[3 * f + 1]);
       const double* p2 = X + 3 * std::size_t(t.face_vertex[3 * f + 2]);
@@ -517,6 +687,9 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
       std::uint32_t la = local[t.face_tet[2 * f]], lb = local[t.face_tet[2 * f + 1]];
       ft.local[0] = la < 0xFFFF ? static_cast<std::uint16_t>(la) : 0xFFFF;
       ft.local[1] = lb < 0xFFFF ? static_cast<std::uint16_t>(lb) : 0xFFFF;
+      // The separating planes come after the cluster's shared faces (add_separating_planes).
+      ft.separating = t.face_tet[2 * f] != t.face_tet[2 * f + 1] &&
+                      !shares_face(adj.neighbour, t.face_tet[2 * f], t.face_tet[2 * f + 1]);
     }
   }
   t.clusters_split = clusters > 0 && t.cluster_tets.size() * SphereTable::kSplitClusters <= n;

@@ -1186,13 +1186,15 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
     // Small cells (a grid cube: 5 or 6 tets): predecessor bit masks, planes tested in double with a
     // rounding bound, exact orientation only when in doubt.
     std::uint64_t pred[64];
-    std::uint64_t emitted = 0;
+    std::uint64_t emitted = 0, hidden = 0;
     const std::uint32_t size = ce - cb;
     std::fill(pred, pred + size, std::uint64_t(0));
+    // Tets outside the subset are not drawn but keep their constraints: the cluster's order holds
+    // through them (a subset of a cluster need not be convex; two of its tets may face each other
+    // across one left out).
     if (!in_subset.empty())
       for (std::uint32_t i = 0; i < size; ++i)
-        if (!in_subset[t.cluster_tets[cb + i]])
-          emitted |= std::uint64_t(1) << i;  // not drawn, no constraints
+        if (!in_subset[t.cluster_tets[cb + i]]) hidden |= std::uint64_t(1) << i;
     const bool persp = view.perspective;
     const double* e = view.eye;
     const double back[3] = {-view.dir[0], -view.dir[1], -view.dir[2]};
@@ -1216,6 +1218,8 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
         side = eye_side(view, node(*mesh, fv[0]), node(*mesh, fv[1]), node(*mesh, fv[2]));
       }
       if (side == 0) continue;
+      if (ft.separating && !rays_meet_both(view, *mesh, t.cluster_tets[cb + a], t.cluster_tets[cb + b]))
+        continue;
       // Tet a lies on the positive side. Eye there: a is in front, so b comes first (back to front).
       std::uint32_t first = side > 0 ? b : a, second = side > 0 ? a : b;
       if (front_to_back) std::swap(first, second);
@@ -1239,17 +1243,13 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
           }
       }
       emitted |= std::uint64_t(1) << pick;
-      *o++ = t.cluster_tets[cb + pick];
+      if (!(hidden >> pick & 1)) *o++ = t.cluster_tets[cb + pick];
     }
     return;
   }
-  local_tets.clear();
-  for (std::uint32_t i = t.cluster_begin[k]; i < t.cluster_begin[k + 1]; ++i)
-    if (tet_in(t.cluster_tets[i])) local_tets.push_back(t.cluster_tets[i]);
-  if (local_tets.size() == 1) {
-    *o++ = local_tets[0];
-    return;
-  }
+  // All the cluster's tets, those outside the subset too (their constraints hold the order, as
+  // above), written out only if in the subset.
+  local_tets.assign(t.cluster_tets.begin() + cb, t.cluster_tets.begin() + ce);
   auto local_index = [&](std::uint32_t tet) -> std::uint32_t {
     for (std::uint32_t i = 0; i < local_tets.size(); ++i)
       if (local_tets[i] == tet) return i;
@@ -1291,7 +1291,7 @@ void ProgressiveOrder::Impl::expand(std::uint32_t item, std::uint32_t*& o, Scrat
     if (done[x]) continue;
     done[x] = 1;
     ++emitted;
-    *o++ = local_tets[x];
+    if (tet_in(local_tets[x])) *o++ = local_tets[x];
     for (auto& e : local_edges)
       if (e.first == x && !done[e.second] && --local_indeg[e.second] == 0) local_queue.push_back(e.second);
   }

@@ -53,7 +53,10 @@ struct SphereTable {
   std::vector<std::uint32_t> cluster_begin;  // CSR over cluster_tets, size = clusters + 1
   std::vector<std::uint32_t> cluster_tets;
   // The faces inside each cluster, CSR by cluster: face_tet[2k], face_tet[2k+1] are the two tets
-  // (the first on the positive side of the triangle), face_vertex[3k..3k+2] the triangle's nodes.
+  // (the first on the positive side of the triangle), face_vertex[3k..3k+2] the triangle's nodes;
+  // after them, in a cluster the mesh's boundary cuts, separating planes (ClusterFace::separating).
+  // A cluster is the tets of one sphere joined by shared faces, and also, where the mesh's boundary
+  // cuts a cell apart, tets of one sphere with a face on the mesh's boundary.
   std::vector<std::uint32_t> cluster_face_begin;
   std::vector<std::uint32_t> face_tet;
   std::vector<std::uint32_t> face_vertex;
@@ -63,8 +66,14 @@ struct SphereTable {
     double plane[4];         // n.x = d, n = (v1 - v0) x (v2 - v0), positive on the first tet's side
     float scale, anorm;      // for the rounding bound: |v1 - v0|_1 |v2 - v0|_1 and |v0|_1
     std::uint16_t local[2];  // its two tets' indices within the cluster; 0xFFFF if it is too large
+    // 1: a separating plane of two tets that share no face (add_separating_planes), which orders
+    // them only where a ray from the eye meets both.
+    std::uint8_t separating = 0;
   };
   std::vector<ClusterFace> face_test;
+  // Of the cluster faces, how many are separating planes of tets of a cluster the mesh's boundary
+  // cuts (spheres.cpp, add_separating_planes): listed like shared faces, after them.
+  std::size_t separating_planes = 0;
   // The sort items of the whole mesh that are not wide, built once: each tet not in a cluster, and
   // each cluster as (cluster | kClusterBit), unless clusters_split (below). A cluster's key is the
   // key of its first tet.
