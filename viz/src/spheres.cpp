@@ -189,6 +189,79 @@ void make_key_blocks(SphereTable& t, const double half[3]) {
 // through three of their vertices with one tet on each side, listed with the cluster's faces (the
 // eye's side of it orders the pair as a shared face would; an eye on it sees no ray through both).
 // Clusters of more than 64 tets are left as they are (a limitation: their faces alone order them).
+// Pairs of tets with a face on the mesh's boundary whose sphere centres agree within their error
+// bounds (compute_spheres: candidates for pieces of one cut cell). The usual ones (bounds at most
+// 256 x the median) are sorted by x and cut where consecutive centres are further apart than twice
+// the largest bound, each part again by y and by z where it is large, and the pairs of each final
+// part compared (a grid's parts are the tets of one cube); the few with wider bounds are compared
+// with the others whose x is close enough.
+std::vector<std::pair<std::uint32_t, std::uint32_t>> sphere_candidates(
+    const SphereTable& t, const std::vector<std::uint32_t>& neighbour) {
+  const std::size_t n = t.flat.size();
+  std::vector<std::uint32_t> cut;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t* nb = neighbour.data() + 4 * i;
+    if (!t.flat[i] && (nb[0] == kNone || nb[1] == kNone || nb[2] == kNone || nb[3] == kNone))
+      cut.push_back(static_cast<std::uint32_t>(i));
+  }
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  if (cut.size() < 2) return pairs;
+  std::vector<float> bounds;
+  for (std::uint32_t i : cut) bounds.push_back(t.key_b[i]);
+  std::nth_element(bounds.begin(), bounds.begin() + std::ptrdiff_t(bounds.size() / 2), bounds.end());
+  const double cap = 256.0 * std::max(double(bounds[bounds.size() / 2]), 1e-300);
+  double widest = 0;
+  std::vector<std::uint32_t> usual, wide;
+  for (std::uint32_t i : cut) {
+    if (double(t.key_b[i]) > cap) {
+      wide.push_back(i);
+    } else {
+      usual.push_back(i);
+      widest = std::max(widest, double(t.key_b[i]));
+    }
+  }
+  auto coord = [&](std::uint32_t i, int a) { return t.c[3 * std::size_t(i) + std::size_t(a)]; };
+  auto close = [&](std::uint32_t i, std::uint32_t u) {
+    return std::max({std::abs(coord(i, 0) - coord(u, 0)), std::abs(coord(i, 1) - coord(u, 1)),
+                     std::abs(coord(i, 2) - coord(u, 2))}) <= double(t.key_b[i]) + double(t.key_b[u]);
+  };
+  const double gap = 2 * widest;
+  // Sorts [b, e) of `usual` by axis a and splits it where neighbours are more than `gap` apart.
+  auto split = [&](std::size_t b, std::size_t e, int a, auto&& self) -> void {
+    std::sort(usual.begin() + std::ptrdiff_t(b), usual.begin() + std::ptrdiff_t(e),
+              [&](std::uint32_t x, std::uint32_t y) { return coord(x, a) < coord(y, a); });
+    for (std::size_t p = b; p < e;) {
+      std::size_t q = p + 1;
+      while (q < e && coord(usual[q], a) - coord(usual[q - 1], a) <= gap) ++q;
+      if (q - p > 8 && a < 2) {
+        self(p, q, a + 1, self);
+      } else {
+        for (std::size_t x = p; x < q; ++x)
+          for (std::size_t y = x + 1; y < q; ++y)
+            if (close(usual[x], usual[y])) pairs.emplace_back(usual[x], usual[y]);
+      }
+      p = q;
+    }
+  };
+  split(0, usual.size(), 0, split);
+  // The wide ones: against the usual ones (sorted by x again) within their reach, and each other.
+  if (!wide.empty()) {
+    std::sort(usual.begin(), usual.end(),
+              [&](std::uint32_t x, std::uint32_t y) { return coord(x, 0) < coord(y, 0); });
+    for (std::size_t k = 0; k < wide.size(); ++k) {
+      const std::uint32_t i = wide[k];
+      const double reach = double(t.key_b[i]) + widest;
+      auto at = std::lower_bound(usual.begin(), usual.end(), coord(i, 0) - reach,
+                                 [&](std::uint32_t x, double v) { return coord(x, 0) < v; });
+      for (; at != usual.end() && coord(*at, 0) <= coord(i, 0) + reach; ++at)
+        if (close(i, *at)) pairs.emplace_back(i, *at);
+      for (std::size_t m = k + 1; m < wide.size(); ++m)
+        if (close(i, wide[m])) pairs.emplace_back(i, wide[m]);
+    }
+  }
+  return pairs;
+}
+
 bool shares_face(const std::vector<std::uint32_t>& neighbour, std::uint32_t x, std::uint32_t y) {
   for (int f = 0; f < 4; ++f)
     if (neighbour[4 * std::size_t(x) + f] != kNone && neighbour[4 * std::size_t(x) + f] >> 2 == y)
@@ -488,49 +561,13 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
   // face each other across the part left out, so they must be ordered together (one cluster, with
   // separating planes: add_separating_planes). Every such piece has a face on the mesh's boundary
   // inside the cell (in a Delaunay mesh a face between two cells lies on both cells' hulls), so
-  // only tets with a boundary face are compared: sorted by their centre's x, neighbours within the
-  // centres' error bounds (key_b), then all four vertices on the sphere, exactly.
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> same_sphere;
-  {
-    std::vector<std::pair<double, std::uint32_t>> cut;
-    double widest = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (t.flat[i]) continue;
-      const std::uint32_t* nb = adj.neighbour.data() + 4 * i;
-      if (nb[0] != kNone && nb[1] != kNone && nb[2] != kNone && nb[3] != kNone) continue;
-      cut.emplace_back(t.c[3 * i], static_cast<std::uint32_t>(i));
-      widest = std::max(widest, double(t.key_b[i]));
-    }
-    std::sort(cut.begin(), cut.end());
-    for (std::size_t x = 0; x < cut.size(); ++x) {
-      const std::uint32_t i = cut[x].second;
-      const double* cc = t.c.data() + 3 * std::size_t(i);
-      const std::uint32_t* v = T + 4 * std::size_t(i);
-      for (std::size_t y = x + 1;
-           y < cut.size() && cut[y].first - cut[x].first <= double(t.key_b[i]) + widest; ++y) {
-        const std::uint32_t u = cut[y].second;
-        const double* cu = t.c.data() + 3 * std::size_t(u);
-        const double apart =
-            std::max({std::abs(cc[0] - cu[0]), std::abs(cc[1] - cu[1]), std::abs(cc[2] - cu[2])});
-        if (apart > double(t.key_b[i]) + double(t.key_b[u])) continue;
-        double w4[4];
-        const double* wv = nullptr;
-        if (W != nullptr) {
-          for (int k = 0; k < 4; ++k) w4[k] = W[v[k]];
-          wv = w4;
-        }
-        bool on = true;
-        for (int k = 0; k < 4 && on; ++k) {
-          const std::uint32_t q = T[4 * std::size_t(u) + k];
-          on = exact::in_sphere(X + 3 * std::size_t(v[0]), X + 3 * std::size_t(v[1]),
-                                X + 3 * std::size_t(v[2]), X + 3 * std::size_t(v[3]), X + 3 * std::size_t(q),
-                                wv, W != nullptr ? W[q] : 0.0) == 0;
-        }
-        if (on) same_sphere.emplace_back(i, u);
-      }
-    }
-  }
+  // only tets with a boundary face are compared: their centres binned in cubes of side w (at least
+  // twice the centres' error bounds, key_b), each against those in the cubes its bound reaches;
+  // pairs not yet joined by faces are then tested exactly (all four vertices on the sphere). The
+  // few tets with bounds far above the typical (a sliver's huge sphere) are compared with all.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> same_sphere = sphere_candidates(t, adj.neighbour);
 
+  t.cluster_of.assign(n, kNone);
   t.cluster_of.assign(n, kNone);
   std::uint32_t clusters = 0;
   // Most unstructured meshes have no or few cospherical faces: no union-find over all tets then.
@@ -539,7 +576,24 @@ SphereTable compute_spheres(const MeshView& mesh, const ProgressFn& progress) {
     for (std::size_t i = 0; i < n; ++i)
       for (int f = 0; f < 4; ++f)
         if (same[4 * i + f]) uf.unite(static_cast<std::uint32_t>(i), adj.neighbour[4 * i + f] >> 2);
-    for (const auto& [i, u] : same_sphere) uf.unite(i, u);
+    for (const auto& [i, u] : same_sphere) {
+      if (uf.find(i) == uf.find(u)) continue;  // joined by faces already
+      const std::uint32_t* v = T + 4 * std::size_t(i);
+      double w4[4];
+      const double* wv = nullptr;
+      if (W != nullptr) {
+        for (int k = 0; k < 4; ++k) w4[k] = W[v[k]];
+        wv = w4;
+      }
+      bool on = true;
+      for (int k = 0; k < 4 && on; ++k) {
+        const std::uint32_t q = T[4 * std::size_t(u) + k];
+        on = exact::in_sphere(X + 3 * std::size_t(v[0]), X + 3 * std::size_t(v[1]), X + 3 * std::size_t(v[2]),
+                              X + 3 * std::size_t(v[3]), X + 3 * std::size_t(q), wv,
+                              W != nullptr ? W[q] : 0.0) == 0;
+      }
+      if (on) uf.unite(i, u);
+    }
     // Number the clusters of two or more tets in order of their smallest tet.
     std::vector<std::uint32_t> size(n, 0);
     for (std::size_t i = 0; i < n; ++i) ++size[uf.find(static_cast<std::uint32_t>(i))];
