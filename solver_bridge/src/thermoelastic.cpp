@@ -291,6 +291,78 @@ BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const E
   return sys;
 }
 
+// Sums of forces and of their moments about `centre` (moments divided by `extent`, so that both are
+// forces), and the sum of the forces' magnitudes.
+struct ForceSums {
+  Vec3 force{0, 0, 0}, moment{0, 0, 0};
+  double magnitude = 0;
+  void add(const double* x, const Vec3& f, const Vec3& centre, double extent) {
+    const Vec3 arm{(x[0] - centre[0]) / extent, (x[1] - centre[1]) / extent, (x[2] - centre[2]) / extent};
+    const Vec3 m = cross(arm, f);
+    for (int i = 0; i < 3; ++i) force[i] += f[i], moment[i] += m[i];
+    magnitude += std::sqrt(dot(f, f));
+  }
+  double net() const { return std::max(std::sqrt(dot(force, force)), std::sqrt(dot(moment, moment))); }
+};
+
+// The nodal forces of the thermal strain, sum_tets int sigma_th grad N_a, sum to zero in force and
+// moment (sum_a grad N_a = 0 at every point; sigma_th = c dT I is symmetric), whatever the mesh and
+// the temperature: what is left is rounding. Summing n terms loses at most about n eps of their sum
+// of magnitudes, 1e-9 at 10^7 nodes (random-sign rounding gives about sqrt(n) eps, 1e-13): a larger
+// figure is an assembly error, not rounding. `load` is in global coordinates (before the rotation).
+BalanceCheck thermal_load_check(const BlockSystem& sys, const Vec3& centre, double extent) {
+  ForceSums s;
+  for (std::size_t v = 0; v < sys.nodes(); ++v)
+    if (sys.used[v])
+      s.add(&sys.xyz[3 * v], {sys.load[3 * v], sys.load[3 * v + 1], sys.load[3 * v + 2]}, centre, extent);
+  return make_check("thermal load",
+                    "|net force and moment of the thermal strain's nodal forces| / their sum of magnitudes",
+                    s.magnitude > 0 ? s.net() / s.magnitude : 0.0, 1e-9);
+}
+
+// Global equilibrium: with no applied forces (the thermal load is self-equilibrated), the reactions at
+// the constrained nodes (K u - f in the constrained directions) must sum to zero in force and moment.
+// Their net is minus the sum of the free rows' residuals (K's rows sum to zero against rigid motions),
+// so it measures how far the solve is from equilibrium as a whole, against the forces in play (the
+// thermal load's and the reactions' magnitudes). A converged CG solve (|r| <= tol |b|) leaves at most
+// sqrt(n) tol |b|, in practice far less: the tolerance is 100 tol as for the heat balance, at least 1e-6
+// (the rounding of a direct solve and of these sums is far below that) and at most 1e-3: a net support
+// force of more than 0.1 % of the forces in the body is no equilibrium, whatever tolerance was asked.
+// `kval` and `load` are in the node frames, `local` the solver nodes' displacements in them.
+BalanceCheck reaction_check(const BlockSystem& sys, const detail::NodeFrames& fr, const std::vector<double>& local,
+                            const Vec3& centre, double extent, double solver_tolerance, unsigned threads) {
+  const std::size_t nn = sys.nodes();
+  const detail::CsrPattern& pat = sys.pat;
+  std::vector<double> reaction(3 * nn, 0.0);  // global coordinates
+  parallel_for(nn, threads, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t v = b; v < e; ++v) {
+      if (!sys.used[v] || fr.m[v] == 0) continue;
+      for (int c = 0; c < fr.m[v]; ++c) {
+        double r = -sys.load[3 * v + static_cast<std::size_t>(c)];
+        for (std::size_t p = pat.row_start[v]; p < pat.row_start[v + 1]; ++p) {
+          const double* blk = &sys.kval[9 * p + 3 * static_cast<std::size_t>(c)];
+          const double* uw = &local[3 * std::size_t{pat.col[p]}];
+          r += blk[0] * uw[0] + blk[1] * uw[1] + blk[2] * uw[2];
+        }
+        for (int i = 0; i < 3; ++i) reaction[3 * v + static_cast<std::size_t>(i)] += r * fr.r[9 * v + 3 * c + i];
+      }
+    }
+  });
+  ForceSums s;
+  double load = 0;
+  for (std::size_t v = 0; v < nn; ++v) {
+    if (!sys.used[v]) continue;
+    const double* f = &sys.load[3 * v];  // a rotation keeps its magnitude
+    load += std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    if (fr.m[v]) s.add(&sys.xyz[3 * v], {reaction[3 * v], reaction[3 * v + 1], reaction[3 * v + 2]}, centre, extent);
+  }
+  const double scale = load + s.magnitude;
+  return make_check("force balance",
+                    "|net force and moment of the reactions at the constrained nodes| / (thermal load + "
+                    "reactions)",
+                    scale > 0 ? s.net() / scale : 0.0, std::min(1e-3, std::max(1e-6, 100 * solver_tolerance)));
+}
+
 // Rotates the constrained nodes' blocks into their frames, eliminates the constrained unknowns, solves
 // the free system (AMG with the rigid-body modes of every solver node as near-null space) and returns
 // the displacement of every solver node in global coordinates (NaN on unused ones).
@@ -301,6 +373,15 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
   const detail::CsrPattern& pat = sys.pat;
   std::vector<double>&kval = sys.kval, &load = sys.load;
   const std::vector<char>& used = sys.used;
+  Vec3 centre{0, 0, 0}, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t v = 0; v < nn; ++v)
+    for (int i = 0; i < 3 && used[v]; ++i) {
+      lo[i] = std::min(lo[i], sys.xyz[3 * v + i]);
+      hi[i] = std::max(hi[i], sys.xyz[3 * v + i]);
+    }
+  for (int i = 0; i < 3; ++i) centre[i] = (lo[i] + hi[i]) / 2;
+  const double extent = std::max(1e-300, std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
+  rep.checks.push_back(thermal_load_check(sys, centre, extent));
   // Rotate the constrained nodes' rows and columns into their frames.
   parallel_for(nn, threads, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t v = b; v < e; ++v) {
@@ -337,14 +418,6 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
   a.start.push_back(0);
   a.col.reserve(9 * pat.col.size());
   a.val.reserve(9 * pat.col.size());
-  Vec3 centre{0, 0, 0}, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (std::size_t v = 0; v < nn; ++v)
-    for (int i = 0; i < 3 && used[v]; ++i) {
-      lo[i] = std::min(lo[i], sys.xyz[3 * v + i]);
-      hi[i] = std::max(hi[i], sys.xyz[3 * v + i]);
-    }
-  for (int i = 0; i < 3; ++i) centre[i] = (lo[i] + hi[i]) / 2;
-  const double extent = std::max(1e-300, std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
   for (std::size_t v = 0; v < nn; ++v) {
     if (!used[v]) continue;
     const int mv = fr.m[v];
@@ -390,19 +463,19 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
   rep.relative_residual = lin.relative_residual;
   rep.amg_levels = lin.levels;
 
-  // Displacements back in global coordinates.
+  // Displacements in the node frames (0 on unused nodes), then back in global coordinates.
+  std::vector<double> local(3 * nn, 0.0);
   std::vector<double> u(3 * nn, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t v = 0; v < nn; ++v) {
     if (!used[v]) continue;
     const int mv = fr.m[v];
-    double local[3];
-    for (int c = 0; c < 3; ++c)
-      local[c] = c < mv ? fr.g[3 * v + c] : x[static_cast<std::size_t>(base[v] + c - mv)];
+    double* l = &local[3 * v];
+    for (int c = 0; c < 3; ++c) l[c] = c < mv ? fr.g[3 * v + c] : x[static_cast<std::size_t>(base[v] + c - mv)];
     for (int i = 0; i < 3; ++i)
       u[3 * v + i] =
-          mv ? fr.r[9 * v + i] * local[0] + fr.r[9 * v + 3 + i] * local[1] + fr.r[9 * v + 6 + i] * local[2]
-             : local[i];
+          mv ? fr.r[9 * v + i] * l[0] + fr.r[9 * v + 3 + i] * l[1] + fr.r[9 * v + 6 + i] * l[2] : l[i];
   }
+  rep.checks.push_back(reaction_check(sys, fr, local, centre, extent, options.relative_tolerance, threads));
   return u;
 }
 

@@ -98,6 +98,11 @@ struct ThermoelasticReport {
   std::size_t amg_levels = 0;    // 0 unless AMG
   double relative_residual = 0;  // |b - A x| / |b| of the free system
   double assembly_seconds = 0, solve_seconds = 0;
+  // "thermal load": the thermal strain's nodal forces sum to zero in force and moment (rounding only);
+  // "force balance": the reactions at the constrained nodes sum to zero in force and moment (no
+  // applied forces), against the thermal load's and the reactions' magnitudes. Empty for
+  // thermoelastic_report (displacements solved elsewhere).
+  std::vector<BalanceCheck> checks;
 };
 
 // Solves linear thermoelasticity on `mesh` (tets positively oriented, see validate.hpp) and stores the
