@@ -171,7 +171,8 @@ TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) 
   // The balance checks printed beside the result: a clamped box passes them; a CG solve stopped at
   // a relative residual of 0.5 fails the force balance, loudly and with exit status 4.
   const std::string clamped = " --E 1=70e9 --nu 1=0.3 --alpha 1=2e-5 --fix 5 --dT 50";
-  ASSERT_EQ(foxi("solve " + box + " --physics thermoelastic" + clamped), 0) << test::read_text(dir_ / "out.log");
+  ASSERT_EQ(foxi("solve " + box + " --physics thermoelastic" + clamped), 0)
+      << test::read_text(dir_ / "out.log");
   log = test::read_text(dir_ / "out.log");
   EXPECT_NE(log.find("check thermal load   ok"), std::string::npos) << log;
   EXPECT_NE(log.find("check force balance  ok"), std::string::npos) << log;

@@ -408,7 +408,8 @@ NodalForces nodal_forces(const Mesh& m, std::int32_t tag, const ThermoelasticPar
     const double vol = j.determinant() / 6;
     const Eigen::Matrix3d inv = j.inverse();  // rows: the gradients of N_1..N_3
     const RegionElasticity& e = p.materials[static_cast<std::size_t>(m.region_of(t) - 1)];
-    const double lambda = e.youngs_modulus * e.poisson_ratio / ((1 + e.poisson_ratio) * (1 - 2 * e.poisson_ratio));
+    const double lambda =
+        e.youngs_modulus * e.poisson_ratio / ((1 + e.poisson_ratio) * (1 - 2 * e.poisson_ratio));
     const double mu = e.youngs_modulus / (2 * (1 + e.poisson_ratio));
     double dt = 0;
     for (int a = 0; a < 4; ++a) dt += 0.25 * (p.temperature[m.tet[4 * t + a]] - p.reference_temperature);
