@@ -150,6 +150,24 @@ TEST_F(ThermoelasticTest, ReportOfGivenDisplacementIsTheAnalyticStress) {
   EXPECT_EQ(r.solver, "given");
   ASSERT_NE(m.find_field("von_mises"), nullptr);
   EXPECT_EQ(m.find_field("displacement")->values, u);
+  // The analytic field is in equilibrium: both checks pass, at rounding. 10 % more lateral expansion
+  // is not: it leaves sigma_xx = sigma_yy = 2 (lambda + mu) 0.1 lateral on the free sides, which only
+  // the symmetry planes x = 0 and y = 0 hold: a net reaction of that stress times a side's area.
+  ASSERT_EQ(r.checks.size(), 2u);
+  EXPECT_TRUE(all_passed(r.checks));
+  EXPECT_LT(r.checks[1].figure, 1e-12);
+  std::vector<double> wrong = u;
+  for (std::size_t i = 0; i < wrong.size(); ++i)
+    if (i % 3 != 2) wrong[i] *= 1.1;
+  const ThermoelasticReport w = thermoelastic_report(m, p, wrong, 6e-8);
+  ASSERT_EQ(w.checks.size(), 2u);
+  EXPECT_TRUE(w.checks[0].passed);  // the load does not depend on the displacement
+  EXPECT_FALSE(w.checks[1].passed) << w.checks[1].figure;
+  EXPECT_GT(w.checks[1].figure, 1e-3);
+  // ccx's rounding of the analytic field (6e-8) stays within the tolerance that takes it in.
+  std::vector<double> rounded = u;
+  for (std::size_t i = 0; i < rounded.size(); ++i) rounded[i] *= 1 + (i % 2 ? 6e-8 : -6e-8);
+  EXPECT_TRUE(all_passed(thermoelastic_report(m, p, rounded, 6e-8).checks));
   EXPECT_THROW(thermoelastic_report(m, p, std::vector<double>(6, 0.0)), SolverError);
   p.order = 2;  // the mid-edge nodes' values are missing
   EXPECT_THROW(thermoelastic_report(m, p, u), SolverError);
