@@ -66,14 +66,17 @@ const char* kSolveCcxUsage =
     "  model's thermal problem):\n"
     "  DISP as 'displacement' (m), ccx's nodal STRESS (its element values averaged at the nodes) as\n"
     "  'stress_nodal' (Pa, xx yy zz xy yz xz); prints the largest |u| and where, the largest nodal von\n"
-    "  Mises stress. --compare also solves with foxi on the same mesh and temperatures (thermal: with\n"
-    "  ccx's centroid rule for *FILM) and prints the largest difference of the temperature or the\n"
-    "  displacement, relative to its largest value (about 5e-8: ccx's binary .frd holds float32; exit 4\n"
-    "  above 1e-5); OUT then also holds foxi's 'temperature_foxi' or 'displacement_foxi'.\n"
+    "  Mises stress and the balance checks (the force balance's tolerance takes in ccx's float32\n"
+    "  output; exit 4 on a failure). --compare also solves with foxi on the same mesh and\n"
+    "  temperatures (thermal: with ccx's centroid rule for *FILM) and prints the largest difference\n"
+    "  of the temperature or the displacement, relative to its largest value (about 5e-8: ccx's\n"
+    "  binary .frd holds float32; exit 4 above 1e-5); OUT then also holds foxi's 'temperature_foxi'\n"
+    "  or 'displacement_foxi'.\n"
     "  On a terminal ccx's increments and Newton iterations show as it runs (stderr). The work\n"
     "  folder is removed after a successful run (--keep keeps it) and kept, with ccx's\n"
     "  output shown, when ccx fails. --solver and --tol are for foxi's solver: a usage error here.\n"
-    "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model or mesh, 4 a failed\n"
+    "  Exit status: 0 ok, 1 ccx failed or is not installed, 2 usage, 3 bad model or mesh, or a .frd\n"
+    "  that cannot be read (its file, line and reason named) or does not fit the mesh, 4 a failed\n"
     "  check or --compare off.";
 
 MeshedModel model_for_ccx(Args& args, const char* usage, const char* command, const std::string& physics) {
@@ -285,7 +288,9 @@ int cmd_solve_with(Args args, const std::string& physics) {
       std::fprintf(stderr, "foxi solve: %s\n", e.what());
     if (!e.work_folder.empty())
       std::fprintf(stderr, "foxi solve: the deck and ccx's files are kept in %s\n", e.work_folder.c_str());
-    return kExitFailure;
+    // A .frd that cannot be read (its file, line and reason named) or does not fit the mesh is a bad
+    // input file, as the same .frd given to foxi fields is; a ccx that failed is a failure.
+    return e.kind == CalculixError::Kind::bad_results ? kExitBadInput : kExitFailure;
   }
   results.model = files[0];
   results.parameters = run_parameters(sets);

@@ -54,8 +54,10 @@ const char* kThermoelasticUsage =
     "  --E, --nu, --alpha   Young's modulus, Poisson ratio, thermal expansion (default: the region's\n"
     "                       material)\n"
     "  Prints the maximum von Mises stress and where, the largest displacement, the maximum per region\n"
-    "  and at each material interface, and the solver's work. OUT gets 'displacement' (m, nodes),\n"
-    "  'stress' (Pa, cells, xx yy zz xy yz xz), 'von_mises' and 'principal_stress' (Pa, cells).";
+    "  and at each material interface, the solver's work and the checks (the thermal load's nodal forces\n"
+    "  sum to zero; the reactions at the constrained nodes balance: exit 4 if not). OUT gets\n"
+    "  'displacement' (m, nodes), 'stress' (Pa, cells, xx yy zz xy yz xz), 'von_mises' and\n"
+    "  'principal_stress' (Pa, cells).";
 
 FixedDisplacement parse_fix(const Mesh& mesh, const std::string& text) {
   FixedDisplacement f;
@@ -247,13 +249,14 @@ int cmd_solve_thermoelastic(Args args) {
   res.mesh_seconds = std::chrono::duration<double>(t_mesh - t0).count();
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // the displacement is a vector field (the indicator takes a scalar): no indicator for the stress
+  const int status = print_checks(r.checks);
   write_json(json, results_json(res));
   if (!out.empty()) {
     write_mesh(mesh, out);
     std::printf("wrote %s (fields displacement [m], stress, von_mises, principal_stress [Pa])\n",
                 out.c_str());
   }
-  return kExitOk;
+  return status;
 }
 
 }  // namespace foxi::cli

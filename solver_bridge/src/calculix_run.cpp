@@ -284,7 +284,7 @@ CalculixThermoelastic solve_thermoelastic_calculix(Mesh& mesh, ThermoelasticPara
     solver_u.insert(solver_u.end(), mid.begin(), mid.end());
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  out.report = thermoelastic_report(mesh, params, std::move(solver_u));
+  out.report = thermoelastic_report(mesh, params, std::move(solver_u), kFrdPrecision);
   out.report.solver = "ccx";
   out.report.solve_seconds = seconds;
   out.max_nodal_von_mises = max_von_mises(sn.values);

@@ -198,7 +198,6 @@ RunResults current_results(const Mesh& mesh, const CurrentReport& r) {
 
 RunResults thermoelastic_results(const Mesh& mesh, const ThermoelasticReport& r) {
   RunResults res = common(mesh, r, "thermoelastic");
-  // (the elastic solve makes no balance checks of its own yet: status ok, no checks)
   Values v{res.values};
   v.key("von_mises_max", "Pa", r.max_von_mises);
   for (const RegionStress& s : r.regions)

@@ -291,6 +291,110 @@ BlockSystem assemble_p2(const Mesh& mesh, const detail::TetEdges& edges, const E
   return sys;
 }
 
+// Sums of forces and of their moments about `centre` (moments divided by `extent`, so that both are
+// forces), and the sum of the forces' magnitudes.
+struct ForceSums {
+  Vec3 force{0, 0, 0}, moment{0, 0, 0};
+  double magnitude = 0;
+  void add(const double* x, const Vec3& f, const Vec3& centre, double extent) {
+    const Vec3 arm{(x[0] - centre[0]) / extent, (x[1] - centre[1]) / extent, (x[2] - centre[2]) / extent};
+    const Vec3 m = cross(arm, f);
+    for (int i = 0; i < 3; ++i) force[i] += f[i], moment[i] += m[i];
+    magnitude += std::sqrt(dot(f, f));
+  }
+  double net() const { return std::max(std::sqrt(dot(force, force)), std::sqrt(dot(moment, moment))); }
+};
+
+// The nodal forces of the thermal strain, sum_tets int sigma_th grad N_a, sum to zero in force and
+// moment (sum_a grad N_a = 0 at every point; sigma_th = c dT I is symmetric), whatever the mesh and
+// the temperature: what is left is rounding. Summing n terms loses at most about n eps of their sum
+// of magnitudes, 1e-9 at 10^7 nodes (random-sign rounding gives about sqrt(n) eps, 1e-13): a larger
+// figure is an assembly error, not rounding. `load` is in global coordinates (before the rotation).
+BalanceCheck thermal_load_check(const BlockSystem& sys, const Vec3& centre, double extent) {
+  ForceSums s;
+  for (std::size_t v = 0; v < sys.nodes(); ++v)
+    if (sys.used[v])
+      s.add(&sys.xyz[3 * v], {sys.load[3 * v], sys.load[3 * v + 1], sys.load[3 * v + 2]}, centre, extent);
+  return make_check("thermal load",
+                    "|net force and moment of the thermal strain's nodal forces| / their sum of magnitudes",
+                    s.magnitude > 0 ? s.net() / s.magnitude : 0.0, 1e-9);
+}
+
+// Global equilibrium: with no applied forces (the thermal load is self-equilibrated), the reactions at
+// the constrained nodes (K u - f in the constrained directions) must sum to zero in force and moment.
+// Their net is minus the sum of the free rows' residuals (K's rows sum to zero against rigid motions),
+// so it measures how far the solve is from equilibrium as a whole, against the forces in play (the
+// thermal load's and the reactions' magnitudes). A converged CG solve (|r| <= tol |b|) leaves at most
+// sqrt(n) tol |b|, in practice far less: the tolerance is 100 tol as for the heat balance, at least 1e-6
+// (the rounding of a direct solve and of these sums is far below that) and at most 1e-3: a net support
+// force of more than 0.1 % of the forces in the body is no equilibrium, whatever tolerance was asked.
+// `in_frames`: `kval`, `load` and `u` are in the node frames (after solve_blocks' rotation), else in
+// global coordinates. `precision` > 0: `u` was given rounded to that relative precision (ccx's .frd),
+// and the tolerance takes in the largest net force that rounding can make, sum |K_vw| precision |u_w|
+// over the constrained rows (rounding's net over all rows is zero: K's columns sum to zero).
+BalanceCheck reaction_check(const BlockSystem& sys, const detail::NodeFrames& fr,
+                            const std::vector<double>& u, bool in_frames, const Vec3& centre, double extent,
+                            double tolerance, double precision, unsigned threads) {
+  const std::size_t nn = sys.nodes();
+  const detail::CsrPattern& pat = sys.pat;
+  std::vector<double> reaction(3 * nn, 0.0), rounding(nn, 0.0);  // global coordinates
+  parallel_for(nn, threads, [&](std::size_t b, std::size_t e, unsigned) {
+    for (std::size_t v = b; v < e; ++v) {
+      if (!sys.used[v] || fr.m[v] == 0) continue;
+      double r[3];  // K u - f at v, in v's frame or global
+      for (std::size_t i = 0; i < 3; ++i) {
+        r[i] = -sys.load[3 * v + i];
+        for (std::size_t p = pat.row_start[v]; p < pat.row_start[v + 1]; ++p) {
+          const double* blk = &sys.kval[9 * p + 3 * i];
+          const double* uw = &u[3 * std::size_t{pat.col[p]}];
+          r[i] += blk[0] * uw[0] + blk[1] * uw[1] + blk[2] * uw[2];
+          if (precision > 0)
+            rounding[v] +=
+                precision * (std::abs(blk[0] * uw[0]) + std::abs(blk[1] * uw[1]) + std::abs(blk[2] * uw[2]));
+        }
+      }
+      for (int c = 0; c < fr.m[v]; ++c) {
+        const double* axis = &fr.r[9 * v + 3 * static_cast<std::size_t>(c)];
+        const double rc = in_frames ? r[c] : axis[0] * r[0] + axis[1] * r[1] + axis[2] * r[2];
+        for (std::size_t i = 0; i < 3; ++i) reaction[3 * v + i] += rc * axis[i];
+      }
+    }
+  });
+  ForceSums s;
+  double load = 0, rounded = 0;
+  for (std::size_t v = 0; v < nn; ++v) {
+    if (!sys.used[v]) continue;
+    const double* f = &sys.load[3 * v];  // a rotation keeps its magnitude
+    load += std::sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    rounded += rounding[v];
+    if (fr.m[v])
+      s.add(&sys.xyz[3 * v], {reaction[3 * v], reaction[3 * v + 1], reaction[3 * v + 2]}, centre, extent);
+  }
+  const double scale = load + s.magnitude;
+  if (scale > 0) tolerance = std::max(tolerance, rounded / scale);
+  return make_check("force balance",
+                    "|net force and moment of the reactions at the constrained nodes| / (thermal load + "
+                    "reactions)",
+                    scale > 0 ? s.net() / scale : 0.0, tolerance);
+}
+
+// The middle of the used nodes' bounding box and its diagonal (the moments' centre and lever scale).
+std::pair<Vec3, double> node_bounds(const BlockSystem& sys) {
+  Vec3 centre{0, 0, 0}, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::size_t v = 0; v < sys.nodes(); ++v)
+    for (std::size_t i = 0; i < 3 && sys.used[v]; ++i) {
+      lo[i] = std::min(lo[i], sys.xyz[3 * v + i]);
+      hi[i] = std::max(hi[i], sys.xyz[3 * v + i]);
+    }
+  for (int i = 0; i < 3; ++i) centre[i] = (lo[i] + hi[i]) / 2;
+  return {centre, std::max(1e-300, std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]))};
+}
+
+// The tolerance of the force balance for a solve to relative residual `solver_tolerance` (above).
+double force_balance_tolerance(double solver_tolerance) {
+  return std::min(1e-3, std::max(1e-6, 100 * solver_tolerance));
+}
+
 // Rotates the constrained nodes' blocks into their frames, eliminates the constrained unknowns, solves
 // the free system (AMG with the rigid-body modes of every solver node as near-null space) and returns
 // the displacement of every solver node in global coordinates (NaN on unused ones).
@@ -301,6 +405,8 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
   const detail::CsrPattern& pat = sys.pat;
   std::vector<double>&kval = sys.kval, &load = sys.load;
   const std::vector<char>& used = sys.used;
+  const auto [centre, extent] = node_bounds(sys);
+  rep.checks.push_back(thermal_load_check(sys, centre, extent));
   // Rotate the constrained nodes' rows and columns into their frames.
   parallel_for(nn, threads, [&](std::size_t b, std::size_t e, unsigned) {
     for (std::size_t v = b; v < e; ++v) {
@@ -337,14 +443,6 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
   a.start.push_back(0);
   a.col.reserve(9 * pat.col.size());
   a.val.reserve(9 * pat.col.size());
-  Vec3 centre{0, 0, 0}, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (std::size_t v = 0; v < nn; ++v)
-    for (int i = 0; i < 3 && used[v]; ++i) {
-      lo[i] = std::min(lo[i], sys.xyz[3 * v + i]);
-      hi[i] = std::max(hi[i], sys.xyz[3 * v + i]);
-    }
-  for (int i = 0; i < 3; ++i) centre[i] = (lo[i] + hi[i]) / 2;
-  const double extent = std::max(1e-300, std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
   for (std::size_t v = 0; v < nn; ++v) {
     if (!used[v]) continue;
     const int mv = fr.m[v];
@@ -390,19 +488,21 @@ std::vector<double> solve_blocks(BlockSystem& sys, const detail::NodeFrames& fr,
   rep.relative_residual = lin.relative_residual;
   rep.amg_levels = lin.levels;
 
-  // Displacements back in global coordinates.
+  // Displacements in the node frames (0 on unused nodes), then back in global coordinates.
+  std::vector<double> local(3 * nn, 0.0);
   std::vector<double> u(3 * nn, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t v = 0; v < nn; ++v) {
     if (!used[v]) continue;
     const int mv = fr.m[v];
-    double local[3];
+    double* l = &local[3 * v];
     for (int c = 0; c < 3; ++c)
-      local[c] = c < mv ? fr.g[3 * v + c] : x[static_cast<std::size_t>(base[v] + c - mv)];
+      l[c] = c < mv ? fr.g[3 * v + c] : x[static_cast<std::size_t>(base[v] + c - mv)];
     for (int i = 0; i < 3; ++i)
       u[3 * v + i] =
-          mv ? fr.r[9 * v + i] * local[0] + fr.r[9 * v + 3 + i] * local[1] + fr.r[9 * v + 6 + i] * local[2]
-             : local[i];
+          mv ? fr.r[9 * v + i] * l[0] + fr.r[9 * v + 3 + i] * l[1] + fr.r[9 * v + 6 + i] * l[2] : l[i];
   }
+  rep.checks.push_back(reaction_check(sys, fr, local, true, centre, extent,
+                                      force_balance_tolerance(options.relative_tolerance), 0, threads));
   return u;
 }
 
@@ -543,6 +643,28 @@ void finish_report(Mesh& mesh, const ThermoelasticParams& params, const detail::
   detail::set_field(mesh, std::move(principal));
 }
 
+// Node-block stiffness with the thermal load; the constraints per solver node (fixed components and
+// sliding normals, orthonormalised into node frames; for P2 from the boundary split through the
+// mid-edge nodes, so a mid-edge node gets the constraints of the tagged triangles it lies on).
+void build_system(const Mesh& mesh, const ThermoelasticParams& params, const ElasticCoefficients& co,
+                  const std::vector<double>& tet_dt, unsigned threads, BlockSystem& sys,
+                  detail::NodeFrames& fr, detail::TetEdges& edges) {
+  const std::size_t nn = mesh.node_count();
+  if (params.order == 1) {
+    sys = assemble_p1(mesh, co, tet_dt, threads);
+    detail::report_progress(params.solver, "assemble", 0.4);
+    fr = detail::displacement_frames(mesh, params, sys.used);
+  } else {
+    edges = detail::tet_edges(mesh);
+    std::vector<double> node_dt(nn, params.delta_t);
+    if (!params.temperature.empty())  // sizes and values on used nodes checked by tet_temperature_change
+      for (std::size_t v = 0; v < nn; ++v) node_dt[v] = params.temperature[v] - params.reference_temperature;
+    sys = assemble_p2(mesh, edges, co, node_dt, params.solver, threads);
+    detail::report_progress(params.solver, "assemble", 0.4);
+    fr = detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, sys.used);
+  }
+}
+
 }  // namespace
 
 ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& params) {
@@ -551,7 +673,6 @@ ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& p
   if (params.order != 1 && params.order != 2)
     throw SolverInputError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
   detail::check_mesh(mesh);
-  const std::size_t nn = mesh.node_count();
   const unsigned threads = detail::thread_count(params.solver.threads);
   detail::report_progress(params.solver, "assemble", 0.0);
 
@@ -566,25 +687,10 @@ ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& p
   }
   const ElasticCoefficients co{lame_lambda, lame_mu, expansion, regions.tet_rix};
 
-  // Node-block stiffness with the thermal load; the constraints per solver node (fixed components and
-  // sliding normals, orthonormalised into node frames; for P2 from the boundary split through the
-  // mid-edge nodes, so a mid-edge node gets the constraints of the tagged triangles it lies on).
   BlockSystem sys;
   detail::NodeFrames fr;
   detail::TetEdges edges;
-  if (params.order == 1) {
-    sys = assemble_p1(mesh, co, tet_dt, threads);
-    detail::report_progress(params.solver, "assemble", 0.4);
-    fr = detail::displacement_frames(mesh, params, sys.used);
-  } else {
-    edges = detail::tet_edges(mesh);
-    std::vector<double> node_dt(nn, params.delta_t);
-    if (!params.temperature.empty())  // sizes and values on used nodes checked by tet_temperature_change
-      for (std::size_t v = 0; v < nn; ++v) node_dt[v] = params.temperature[v] - params.reference_temperature;
-    sys = assemble_p2(mesh, edges, co, node_dt, params.solver, threads);
-    detail::report_progress(params.solver, "assemble", 0.4);
-    fr = detail::displacement_frames(detail::quadratic_boundary(mesh, edges), params, sys.used);
-  }
+  build_system(mesh, params, co, tet_dt, threads, sys, fr, edges);
   check_rigid_modes(mesh, fr, sys.used);  // the mesh's nodes come first among the solver nodes
   ThermoelasticReport rep;
   std::vector<double> u = solve_blocks(sys, fr, params.solver, threads, rep);
@@ -596,7 +702,7 @@ ThermoelasticReport solve_thermoelastic(Mesh& mesh, const ThermoelasticParams& p
 }
 
 ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& params,
-                                         std::vector<double> displacement) {
+                                         std::vector<double> displacement, double precision) {
   if (params.order != 1 && params.order != 2)
     throw SolverInputError("thermoelastic element order must be 1 or 2, not " + std::to_string(params.order));
   detail::check_mesh(mesh);
@@ -608,8 +714,12 @@ ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& 
     std::vector<double> region_volume;
     (void)detail::tet_volumes(mesh, mat.regions, threads, region_volume);  // rejects flat and inverted tets
   }
+  const auto [lame_lambda, lame_mu] = lame_parameters(mat.young, mat.poisson);
+  const ElasticCoefficients co{lame_lambda, lame_mu, mat.expansion, mat.regions.tet_rix};
+  BlockSystem sys;  // for the checks
+  detail::NodeFrames fr;
   detail::TetEdges edges;
-  if (params.order == 2) edges = detail::tet_edges(mesh);
+  build_system(mesh, params, co, tet_dt, threads, sys, fr, edges);
   const std::size_t solver_nodes = nn + edges.size();
   if (displacement.size() != 3 * solver_nodes)
     throw SolverInputError("thermoelastic_report: " + std::to_string(displacement.size()) +
@@ -626,6 +736,11 @@ ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& 
                                  " of a tet has no displacement");
   ThermoelasticReport rep;
   rep.solver = "given";
+  // The checks of solve_thermoelastic; the solve was another program's (a direct one: rounding only).
+  const auto [centre, extent] = node_bounds(sys);
+  rep.checks.push_back(thermal_load_check(sys, centre, extent));
+  rep.checks.push_back(reaction_check(sys, fr, displacement, false, centre, extent,
+                                      force_balance_tolerance(0), precision, threads));
   finish_report(mesh, params, edges, mat, tet_dt, used, std::move(displacement), threads, rep);
   return rep;
 }

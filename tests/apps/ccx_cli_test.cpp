@@ -4,6 +4,7 @@
 // own text and the work folder kept; --solver with --with ccx is a usage error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -275,6 +276,40 @@ TEST_F(CcxCli, ExportWritesTheDeck) {
   EXPECT_NE(frd.find("DISP"), std::string::npos);
   EXPECT_NE(frd.find("STRESS"), std::string::npos);
   EXPECT_EQ(foxi("export-ccx " + model() + " --order 2 -o '" + stress + "'", &log), 2);
+}
+
+// A .frd that cannot be read (a stand-in ccx leaves a truncated or a mutated copy of a real one) is
+// bad input: exit 3, the message naming the file, its line and the reason; the work folder is kept.
+TEST_F(CcxCli, MalformedFrdExitsThreeNamingFileAndLine) {
+  const std::filesystem::path bin = dir_ / "bin";
+  std::filesystem::create_directories(bin);
+  test::write_text(bin / "ccx", "#!/bin/sh\ncp '" + (dir_ / "bad.frd").string() + "' heat.frd\n");
+  std::filesystem::permissions(bin / "ccx", std::filesystem::perms::owner_all);
+  const std::string frd = test::read_text(test::data_dir() + "/fields/ccx_two_steps.frd");
+  // The first node record's x coordinate (columns 14-25) made a word.
+  std::string mutated = frd;
+  const std::size_t node = mutated.find("\n -1", mutated.find("    2C"));
+  ASSERT_NE(node, std::string::npos);
+  mutated.replace(node + 14, 12, "  not-a-num ");
+  const std::size_t mutated_line =
+      static_cast<std::size_t>(std::count(frd.begin(), frd.begin() + node, '\n')) + 2;
+  const std::pair<std::string, std::string> cases[] = {
+      {frd.substr(0, frd.size() / 2), "expected"},  // cut inside a record: the reader says what it expected
+      {mutated, "heat.frd:" + std::to_string(mutated_line) + ":"}};
+  for (const auto& [text, what] : cases) {
+    test::write_text(dir_ / "bad.frd", text);
+    std::string log;
+    EXPECT_EQ(foxi("solve " + model() + " --with ccx", &log, "PATH='" + bin.string() + "':\"$PATH\" "), 3)
+        << log;
+    EXPECT_NE(log.find("ccx's results cannot be read"), std::string::npos) << log;
+    EXPECT_NE(log.find("heat.frd:"), std::string::npos) << log;  // the file and its line
+    EXPECT_NE(log.find(what), std::string::npos) << log;
+    const std::size_t at = log.find("kept in ");
+    ASSERT_NE(at, std::string::npos) << log;
+    const std::string kept = log.substr(at + 8, log.find('\n', at) - at - 8);
+    EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(kept) / "heat.frd")) << kept;
+    std::filesystem::remove_all(kept);
+  }
 }
 
 TEST_F(CcxCli, FailingOrMissingCcxExitsOneWithItsText) {

@@ -150,6 +150,24 @@ TEST_F(ThermoelasticTest, ReportOfGivenDisplacementIsTheAnalyticStress) {
   EXPECT_EQ(r.solver, "given");
   ASSERT_NE(m.find_field("von_mises"), nullptr);
   EXPECT_EQ(m.find_field("displacement")->values, u);
+  // The analytic field is in equilibrium: both checks pass, at rounding. 10 % more lateral expansion
+  // is not: it leaves sigma_xx = sigma_yy = 2 (lambda + mu) 0.1 lateral on the free sides, which only
+  // the symmetry planes x = 0 and y = 0 hold: a net reaction of that stress times a side's area.
+  ASSERT_EQ(r.checks.size(), 2u);
+  EXPECT_TRUE(all_passed(r.checks));
+  EXPECT_LT(r.checks[1].figure, 1e-12);
+  std::vector<double> wrong = u;
+  for (std::size_t i = 0; i < wrong.size(); ++i)
+    if (i % 3 != 2) wrong[i] *= 1.1;
+  const ThermoelasticReport w = thermoelastic_report(m, p, wrong, 6e-8);
+  ASSERT_EQ(w.checks.size(), 2u);
+  EXPECT_TRUE(w.checks[0].passed);  // the load does not depend on the displacement
+  EXPECT_FALSE(w.checks[1].passed) << w.checks[1].figure;
+  EXPECT_GT(w.checks[1].figure, 1e-3);
+  // ccx's rounding of the analytic field (6e-8) stays within the tolerance that takes it in.
+  std::vector<double> rounded = u;
+  for (std::size_t i = 0; i < rounded.size(); ++i) rounded[i] *= 1 + (i % 2 ? 6e-8 : -6e-8);
+  EXPECT_TRUE(all_passed(thermoelastic_report(m, p, rounded, 6e-8).checks));
   EXPECT_THROW(thermoelastic_report(m, p, std::vector<double>(6, 0.0)), SolverError);
   p.order = 2;  // the mid-edge nodes' values are missing
   EXPECT_THROW(thermoelastic_report(m, p, u), SolverError);
@@ -382,6 +400,97 @@ TEST_F(ThermoelasticTest, RigidMotionIsReportedNotSolved) {
       << message();
   p.sliding = {{5}, {1}, {3}};
   EXPECT_EQ(message(), "");
+}
+
+// The net force on the nodes of `tag` and the sum of the nodal forces' magnitudes over all nodes, from
+// the written per-tet stress (P1: nodal force of tet t at its node a = vol_t sigma_t grad N_a), an
+// independent route to the reactions (the solver takes them from its assembled matrix); `thermal`:
+// the thermal stress (3 lambda + 2 mu) alpha dT_t I instead, for the thermal load's nodal forces.
+struct NodalForces {
+  Eigen::Vector3d on_tag = Eigen::Vector3d::Zero();
+  double tag_magnitude = 0, load_magnitude = 0;
+};
+NodalForces nodal_forces(const Mesh& m, std::int32_t tag, const ThermoelasticParams& p) {
+  const Field* stress = m.find_field("stress");
+  EXPECT_NE(stress, nullptr);
+  std::vector<char> on(m.node_count(), 0);
+  for (std::size_t f = 0; f < m.bface_count(); ++f)
+    if (m.bface_tag[f] == tag)
+      for (int k = 0; k < 3; ++k) on[m.bface[3 * f + k]] = 1;
+  std::vector<Eigen::Vector3d> total(m.node_count(), Eigen::Vector3d::Zero()), load = total;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    Eigen::Vector3d x[4];
+    for (int a = 0; a < 4; ++a) x[a] = Eigen::Vector3d::Map(&m.xyz[3 * std::size_t{m.tet[4 * t + a]}]);
+    Eigen::Matrix3d j;
+    j << x[1] - x[0], x[2] - x[0], x[3] - x[0];
+    const double vol = j.determinant() / 6;
+    const Eigen::Matrix3d inv = j.inverse();  // rows: the gradients of N_1..N_3
+    const RegionElasticity& e = p.materials[static_cast<std::size_t>(m.region_of(t) - 1)];
+    const double lambda =
+        e.youngs_modulus * e.poisson_ratio / ((1 + e.poisson_ratio) * (1 - 2 * e.poisson_ratio));
+    const double mu = e.youngs_modulus / (2 * (1 + e.poisson_ratio));
+    double dt = 0;
+    for (int a = 0; a < 4; ++a) dt += 0.25 * (p.temperature[m.tet[4 * t + a]] - p.reference_temperature);
+    const double* s = &stress->values[6 * t];
+    Eigen::Matrix3d sigma;
+    sigma << s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2];
+    const double th = (3 * lambda + 2 * mu) * e.thermal_expansion * dt;
+    for (int a = 0; a < 4; ++a) {
+      const Eigen::Vector3d g = a == 0 ? Eigen::Vector3d(-inv.colwise().sum().transpose())
+                                       : Eigen::Vector3d(inv.row(a - 1).transpose());
+      total[m.tet[4 * t + a]] += vol * sigma * g;
+      load[m.tet[4 * t + a]] += vol * th * g;
+    }
+  }
+  NodalForces r;
+  for (std::size_t v = 0; v < m.node_count(); ++v) {
+    r.load_magnitude += load[v].norm();
+    if (!on[v]) continue;
+    r.on_tag += total[v];
+    r.tag_magnitude += total[v].norm();
+  }
+  return r;
+}
+
+// The balance checks on a two-material box clamped at its bottom (tag 5) under a temperature field
+// that varies in x and z: a converged solve passes both with figures near rounding, and the net
+// reaction computed from the written stresses (another route than the solver's matrix) is ~0; a CG
+// solve stopped at a relative residual of 0.5 fails the force balance (exit 4 in the CLI), and the
+// stresses confirm a net force on the clamp of the size the check reports.
+TEST_F(ThermoelasticTest, BalanceChecksPassConvergedAndFailUnderConverged) {
+  Mesh m = test::layered_box_mesh(1.0, 0.6, {0, 0.2, 0.4}, 0.002);
+  ThermoelasticParams p;
+  p.materials = {{1, kE, kNu, kAlpha}, {2, 3 * kE, 0.25, kAlpha / 4}};
+  p.fixed = {{5}};
+  p.temperature.resize(m.node_count());
+  for (std::size_t v = 0; v < m.node_count(); ++v)
+    p.temperature[v] = p.reference_temperature + 50 * m.xyz[3 * v] + 100 * m.xyz[3 * v + 2];
+  p.solver.kind = LinearSolverKind::direct;
+  ThermoelasticReport r = solve_thermoelastic(m, p);
+  ASSERT_EQ(r.checks.size(), 2u);
+  EXPECT_EQ(r.checks[0].name, "thermal load");
+  EXPECT_EQ(r.checks[1].name, "force balance");
+  EXPECT_TRUE(all_passed(r.checks));
+  EXPECT_LT(r.checks[0].figure, 1e-13);
+  EXPECT_LT(r.checks[1].figure, 1e-10);
+  NodalForces f = nodal_forces(m, 5, p);
+  EXPECT_GT(f.tag_magnitude, 0.01 * f.load_magnitude);  // the clamp does hold the body back
+  EXPECT_LT(f.on_tag.norm() / (f.load_magnitude + f.tag_magnitude), 1e-9);
+
+  p.solver.kind = LinearSolverKind::cg_ichol;
+  p.solver.relative_tolerance = 0.5;
+  r = solve_thermoelastic(m, p);
+  ASSERT_EQ(r.checks.size(), 2u);
+  EXPECT_TRUE(r.checks[0].passed);  // the load does not depend on the solve
+  EXPECT_FALSE(r.checks[1].passed) << r.checks[1].figure;
+  EXPECT_EQ(r.checks[1].tolerance, 1e-3);  // 100 x 0.5, capped
+  f = nodal_forces(m, 5, p);
+  const double independent = f.on_tag.norm() / (f.load_magnitude + f.tag_magnitude);
+  EXPECT_GT(independent, 1e-3);
+  // The check's figure is the larger of the net force's and net moment's: at least the force's (here
+  // the force's, to rounding).
+  EXPECT_GE(r.checks[1].figure, (1 - 1e-9) * independent);
+  EXPECT_LT(r.checks[1].figure, 10 * independent);
 }
 
 // The progress callback sees the stages in order and can cancel the solve.

@@ -98,6 +98,10 @@ struct ThermoelasticReport {
   std::size_t amg_levels = 0;    // 0 unless AMG
   double relative_residual = 0;  // |b - A x| / |b| of the free system
   double assembly_seconds = 0, solve_seconds = 0;
+  // "thermal load": the thermal strain's nodal forces sum to zero in force and moment (rounding only);
+  // "force balance": the reactions at the constrained nodes sum to zero in force and moment (no
+  // applied forces), against the thermal load's and the reactions' magnitudes.
+  std::vector<BalanceCheck> checks;
 };
 
 // Solves linear thermoelasticity on `mesh` (tets positively oriented, see validate.hpp) and stores the
@@ -112,10 +116,13 @@ FOXI_API ThermoelasticReport solve_thermoelastic(Mesh& mesh, const Thermoelastic
 // The report of solve_thermoelastic for displacements solved elsewhere (CalculiX): the same stress,
 // von Mises and principal stress per tet from `displacement` (3 per node: the mesh's nodes, then for
 // order 2 the mid-edge nodes in the order of the CalculiX deck's C3D10 nodes), the same maxima per
-// region and interface, the same fields stored. The solver figures stay 0, `solver` is "given".
-// Throws SolverError as solve_thermoelastic does for `params`, and when `displacement` has the wrong
-// size or a non-finite value at a node of a tet.
+// region and interface, the same fields stored, and the same checks. The solver figures stay 0,
+// `solver` is "given". `precision` > 0: the displacements are rounded to that relative precision
+// (ccx's binary .frd: float32, 6e-8; an ASCII one: 5e-6), and the force balance's tolerance takes in
+// the net force that rounding can make. Throws SolverError as solve_thermoelastic does for `params`
+// (a body free to move rigidly aside), and when `displacement` has the wrong size or a non-finite
+// value at a node of a tet.
 FOXI_API ThermoelasticReport thermoelastic_report(Mesh& mesh, const ThermoelasticParams& params,
-                                                  std::vector<double> displacement);
+                                                  std::vector<double> displacement, double precision = 0);
 
 }  // namespace foxi
