@@ -103,6 +103,21 @@ testing::AssertionResult open_window(Workbench& w, const std::string& model, QSi
   return testing::AssertionSuccess();
 }
 
+// A saved project opened in window `w` (its view small; shown or not) and its picture made (the job
+// open_project starts); a failure says the workbench's reason.
+testing::AssertionResult reopen(Workbench& w, const QString& folder, QSize view = {200, 150},
+                                Shown shown = Shown::no) {
+  w.view_widget()->setFixedSize(view);
+  if (shown == Shown::yes) w.show();
+  QString why;
+  if (!w.open_project(folder, &why))
+    return testing::AssertionFailure() << folder.toStdString() << " did not open: " << why.toStdString();
+  if (!wait_job(w))
+    return testing::AssertionFailure()
+           << folder.toStdString() << " not shown: " << w.last_error().toStdString();
+  return testing::AssertionSuccess();
+}
+
 // Parameter `name`'s value (SI) in the window's model; -1 when it has none.
 double value_of(const Workbench& w, const std::string& name) {
   for (const foxi::Parameter& p : w.model()->parameters)
@@ -1832,10 +1847,7 @@ TEST(Workbench, ProjectKeepsTheDeformedShape) {
     ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
   }
   Workbench again;
-  again.view_widget()->setFixedSize(200, 150);
-  QString why;
-  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(reopen(again, folder));
   ASSERT_TRUE(again.deform().has_value());
   EXPECT_EQ(again.deform()->field, "displacement");
   EXPECT_EQ(again.deform()->scale, 150);
@@ -1927,10 +1939,7 @@ TEST(Workbench, ProjectKeepsTheMeshSettings) {
     ASSERT_TRUE(autosaved(w, before + 2));
   }
   Workbench again;
-  again.view_widget()->setFixedSize(160, 120);
-  QString why;
-  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(reopen(again, folder, {160, 120}));
   expect_same_settings(again.mesh_settings(), s, "reopened");
   // The panel's controls show them (lengths in the model's mm).
   EXPECT_EQ(again.findChild<QComboBox*>("mesher")->currentIndex(), 0);
@@ -2127,17 +2136,10 @@ TEST(Workbench, ProjectKeepsTheSlicePlane) {
     ASSERT_GT(drawn, 0u);
     ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
   }
-  auto reopen = [&](Workbench& again) {
-    again.view_widget()->setFixedSize(200, 150);
-    again.show();
-    QString why;
-    ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
-    ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
-    again.view_widget()->finish_now();
-  };
   {
     Workbench again;
-    reopen(again);
+    ASSERT_TRUE(reopen(again, folder, {200, 150}, Shown::yes));
+    again.view_widget()->finish_now();
     const foxi::FieldSelection& got = again.view_widget()->selection();
     ASSERT_TRUE(got.slice.has_value());
     ASSERT_TRUE(got.clip.has_value());
@@ -2161,7 +2163,8 @@ TEST(Workbench, ProjectKeepsTheSlicePlane) {
   p["selection"] = sel;
   foxi::test::write_text(file, QJsonDocument(p).toJson().toStdString());
   Workbench old;
-  reopen(old);
+  ASSERT_TRUE(reopen(old, folder, {200, 150}, Shown::yes));
+  old.view_widget()->finish_now();
   EXPECT_FALSE(old.view_widget()->selection().slice.has_value());
   EXPECT_TRUE(old.view_widget()->selection().clip.has_value());
   EXPECT_GT(old.view_widget()->view()->drawn().size(), drawn) << "the clip's half, whole tets";
@@ -2219,9 +2222,7 @@ TEST(Workbench, HistoryRowsKeepTheirMeshSettings) {
   }
   {
     Workbench again;
-    QString why;
-    ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
-    wait_job(again);
+    ASSERT_TRUE(reopen(again, folder, {160, 120}));
     ASSERT_EQ(again.history().size(), 2u);
     ASSERT_TRUE(again.history()[0].mesh_settings.has_value());
     ASSERT_TRUE(again.history()[1].mesh_settings.has_value());
@@ -2247,9 +2248,7 @@ TEST(Workbench, HistoryRowsKeepTheirMeshSettings) {
   with_rows([](int, QJsonObject& row) { row.remove("mesh_settings"); });
   {
     Workbench old;
-    QString why;
-    ASSERT_TRUE(old.open_project(folder, &why)) << why.toStdString();
-    wait_job(old);
+    ASSERT_TRUE(reopen(old, folder, {160, 120}));
     ASSERT_EQ(old.history().size(), 2u);
     EXPECT_FALSE(old.history()[0].mesh_settings.has_value());
     EXPECT_FALSE(old.history()[1].mesh_settings.has_value());
@@ -2368,10 +2367,7 @@ TEST(WorkbenchHeadless, SolverAndUnitsAsTheSolvePanel) {
   EXPECT_GE(keys, 1u);
   // The headless run's project: the solver and the units box as given.
   Workbench again;
-  again.view_widget()->setFixedSize(160, 120);
-  QString why;
-  ASSERT_TRUE(again.open_project(QString::fromStdString(proj.string()), &why)) << why.toStdString();
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(reopen(again, QString::fromStdString(proj.string()), {160, 120}));
   EXPECT_FALSE(again.solver().calculix);
   EXPECT_EQ(again.solver().linear, foxi::LinearSolverKind::cg_ichol);
   EXPECT_TRUE(again.si_units());
