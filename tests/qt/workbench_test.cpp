@@ -2731,6 +2731,9 @@ TEST(Workbench, SweepFromTheHistoryEqualsFoxiSweep) {
     const foxi::workbench::HistoryRow& row = w.history()[k];
     ASSERT_EQ(row.parameters.size(), 1u);
     EXPECT_EQ(row.parameters[0].expression, values[int(k)].toStdString());
+    // The mesh settings of the point's mesh: the panel's defaults, as foxi sweep meshes (same tets below).
+    ASSERT_TRUE(row.mesh_settings.has_value());
+    expect_same_settings(*row.mesh_settings, {}, "sweep row");
     std::size_t compared = 0;
     for (std::size_t c = 0; c < names.size(); ++c) {
       if (names[c] == "die_w") {
