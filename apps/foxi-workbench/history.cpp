@@ -22,6 +22,7 @@ namespace foxi::workbench {
 
 void Workbench::build_history_panel() {
   history_table_ = new QTableWidget(0, 5);
+  history_table_->setObjectName("history_table");
   history_table_->setHorizontalHeaderLabels(
       {tr("run"), tr("parameters"), tr("tets"), tr("key results"), tr("time")});
   history_table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
@@ -89,6 +90,7 @@ void Workbench::add_history(double seconds) {
   else
     row.results.status = RunStatus::failed, row.results.error = "meshed only";
   row.seconds = seconds;
+  row.mesh_settings = meshed_settings_;
   // A solve of the mesh the last row made completes that row (one row per model state).
   // (a sweep's rows have mesh 0: no mesh of theirs is kept)
   const bool complete = has_results_ && !history_.empty() && history_.back().results.values.empty() &&
@@ -124,6 +126,12 @@ void Workbench::fill_history_row(int i, const HistoryRow& row) {
   history_table_->setItem(i, 2, new QTableWidgetItem(QString::number(row.tets)));
   history_table_->setItem(i, 3, new QTableWidgetItem(key.isEmpty() ? tr("meshed only") : key));
   history_table_->setItem(i, 4, new QTableWidgetItem(QString("%1 s").arg(row.seconds, 0, 'f', 2)));
+  // The mesh settings that made the row's mesh, on the whole row (hover any cell).
+  const QString settings =
+      row.mesh_settings ? mesh_settings_text(*row.mesh_settings, model_ ? model_->length_scale : 1,
+                                             model_ ? model_->length_unit : "m")
+                        : tr("mesh settings not recorded (a project saved before history rows kept them)");
+  for (int c = 0; c < history_table_->columnCount(); ++c) history_table_->item(i, c)->setToolTip(settings);
 }
 
 void Workbench::refresh_history() {

@@ -79,6 +79,11 @@ QString progress_format(const QString& what, int permille, const SolveProgress* 
   return text;
 }
 
+QString duration_text(double seconds) {
+  if (seconds >= 0.1) return QObject::tr("%1 s").arg(seconds, 0, 'f', seconds >= 10 ? 1 : 2);
+  return QObject::tr("%1 ms").arg(1000 * seconds, 0, 'g', 3);
+}
+
 LinearSolverOptions job_solver_options(LinearSolverKind kind, std::shared_ptr<std::atomic<bool>> cancel,
                                        std::shared_ptr<std::atomic<int>> permille,
                                        std::shared_ptr<SolveProgress> solve) {
@@ -249,6 +254,7 @@ std::shared_ptr<Outcome> run_sweep(JobInput in, const std::string& parameter,
     }
     HistoryRow row;
     row.parameters = in.overrides;
+    row.mesh_settings = in.mesh_settings;
     row.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     if (point->ok) {
       row.tets = point->mesh->tet_count();
@@ -429,7 +435,7 @@ void Workbench::on_job_done() {
   }
   last_error_.clear();
   last_error_bad_input_ = false;
-  progress_->setFormat(what + tr(": done in %1 s").arg(out->seconds + out->solve_seconds, 0, 'f', 2));
+  progress_->setFormat(what + tr(": done in %1").arg(duration_text(out->seconds + out->solve_seconds)));
   if (out->meshed) {
     mesh_ = out->mesh;
     meshed_model_ = out->model;

@@ -16,6 +16,7 @@
 #include <QPainter>
 #include <QPlainTextEdit>
 #include <QPushButton>
+#include <QScrollArea>
 #include <QSignalBlocker>
 #include <QTableWidget>
 #include <QVBoxLayout>
@@ -58,6 +59,16 @@ void set_cell(QTableWidget* table, int row, int column, const QString& text, boo
   }
   item->setText(text);
   item->setFlags(editable ? item->flags() | Qt::ItemIsEditable : item->flags() & ~Qt::ItemIsEditable);
+}
+
+// A settings table of the panel: `name` for tests, the columns' headers, no row numbers, 20 px rows.
+QTableWidget* settings_table(const char* name, const QStringList& columns) {
+  auto* table = new QTableWidget(0, int(columns.size()));
+  table->setObjectName(name);
+  table->setHorizontalHeaderLabels(columns);
+  table->verticalHeader()->hide();
+  table->verticalHeader()->setDefaultSectionSize(20);
+  return table;
 }
 
 }  // namespace
@@ -132,6 +143,37 @@ bool same_mesh_settings(const MeshSettings& a, const MeshSettings& b) {
          std::equal(a.boxes.begin(), a.boxes.end(), b.boxes.begin(), b.boxes.end(), same_box) &&
          a.refine_from_result == b.refine_from_result && a.refine_field == b.refine_field &&
          a.target_error == b.target_error;
+}
+
+QString mesh_settings_text(const MeshSettings& s, double scale, const std::string& unit) {
+  auto length = [&](double metres) { return length_text(metres, scale, unit); };
+  QStringList lines;
+  lines << QObject::tr("mesher: %1").arg(s.mesher == Mesher::cgal ? "CGAL Mesh_3" : "TetGen");
+  lines << QObject::tr("global size: %1").arg(s.max_size ? length(*s.max_size) : QObject::tr("the model's"));
+  QStringList parts;
+  for (const PartSize& p : s.part_sizes) parts << QString::fromStdString(p.part) + " " + length(p.max_size);
+  lines << QObject::tr("part sizes: %1").arg(parts.isEmpty() ? QObject::tr("the model's") : parts.join(", "));
+  for (std::size_t i = 0; i < s.boxes.size(); ++i) {
+    const RefinementBox& b = s.boxes[i];
+    auto corner = [&](const double* c) {
+      return QString("(%1, %2, %3)")
+          .arg(c[0] / scale, 0, 'g', 6)
+          .arg(c[1] / scale, 0, 'g', 6)
+          .arg(c[2] / scale, 0, 'g', 6);
+    };
+    lines << QObject::tr("refinement box %1: %2 to %3 %4, size %5")
+                 .arg(i + 1)
+                 .arg(corner(b.lo), corner(b.hi), QString::fromStdString(unit), length(b.size));
+  }
+  if (s.boxes.empty()) lines << QObject::tr("refinement boxes: none");
+  lines << QObject::tr("quality bound: %1")
+               .arg(s.quality ? QString::number(*s.quality, 'g', 6) : QObject::tr("the default"));
+  if (s.refine_from_result)
+    lines << QObject::tr("refined from the result's %1, target error %2")
+                 .arg(s.refine_field.empty() ? QObject::tr("field shown")
+                                             : "'" + QString::fromStdString(s.refine_field) + "'")
+                 .arg(s.target_error, 0, 'g', 6);
+  return lines.join('\n');
 }
 
 bool Workbench::set_mesh_settings(const MeshSettings& settings, QString* error) {
@@ -302,12 +344,8 @@ void Workbench::build_mesh_panel() {
          "(2 or more guarantees termination); empty: the default"));
   form->addRow(tr("Quality"), ui.quality);
   mv->addLayout(form);
-  ui.parts = new QTableWidget(0, 3);
-  ui.parts->setObjectName("part_sizes");
-  ui.parts->setHorizontalHeaderLabels({tr("part"), tr("size"), tr("model's")});
+  ui.parts = settings_table("part_sizes", {tr("part"), tr("size"), tr("model's")});
   ui.parts->horizontalHeader()->setStretchLastSection(true);
-  ui.parts->verticalHeader()->hide();
-  ui.parts->verticalHeader()->setDefaultSectionSize(20);
   mv->addWidget(new QLabel(tr("Part sizes (empty: the model's)")));
   mv->addWidget(ui.parts);
   auto* box_row = new QHBoxLayout;
@@ -319,17 +357,13 @@ void Workbench::build_mesh_panel() {
   box_row->addWidget(add_box);
   box_row->addWidget(remove_box);
   mv->addLayout(box_row);
-  ui.boxes = new QTableWidget(0, 7);
-  ui.boxes->setObjectName("refine_boxes");
+  QStringList columns;
+  for (const char* c : kBoxColumns) columns << c;
+  ui.boxes = settings_table("refine_boxes", columns);
   ui.boxes->setToolTip(
       tr("target edge length `size` inside each box (corners and size in the model's length unit); TetGen's "
          "size field, or CGAL's cell and facet sizes (the regular tet's circumradius)"));
-  QStringList columns;
-  for (const char* c : kBoxColumns) columns << c;
-  ui.boxes->setHorizontalHeaderLabels(columns);
   ui.boxes->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
-  ui.boxes->verticalHeader()->hide();
-  ui.boxes->verticalHeader()->setDefaultSectionSize(20);
   ui.boxes->setFixedHeight(ui.boxes->horizontalHeader()->sizeHint().height() + 2 * 20 + 4);
   mv->addWidget(ui.boxes);
   auto* refine_row = new QHBoxLayout;
@@ -395,9 +429,18 @@ void Workbench::build_mesh_panel() {
   mv->addWidget(histogram_);
   mv->addWidget(quality_text_, 1);
   mesh_panel->setMinimumWidth(320);
+  // In a scroll area: the panel's natural height is most of the window's, and the results dock below
+  // it would get what is left (one row of the results table at 860 px). Scrolled, the two share the
+  // height (build_ui splits it; the user moves the line between them).
+  auto* scroll = new QScrollArea;
+  scroll->setObjectName("mesh_scroll");
+  scroll->setWidget(mesh_panel);
+  scroll->setWidgetResizable(true);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
   auto* mesh_dock = new QDockWidget(tr("Mesh"));
   mesh_dock->setObjectName("mesh");
-  mesh_dock->setWidget(mesh_panel);
+  mesh_dock->setWidget(scroll);
   addDockWidget(Qt::RightDockWidgetArea, mesh_dock);
   refresh_mesh_controls();
 }

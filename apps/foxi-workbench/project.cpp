@@ -94,6 +94,21 @@ void read_numbers(const QJsonValue& v, double* out, int n) {
   for (int i = 0; i < n; ++i) out[i] = a[i].toDouble();
 }
 
+// A clip or slice plane: its point, then its normal.
+QJsonArray plane_json(const Plane& plane) {
+  QJsonArray a = numbers(plane.p, 3);
+  for (int k = 0; k < 3; ++k) a.append(plane.n[k]);
+  return a;
+}
+
+Plane read_plane(const QJsonValue& v) {
+  const QJsonArray a = v.toArray();
+  if (a.size() != 6) throw std::runtime_error("a plane of 6 numbers (point, normal) expected");
+  Plane plane;
+  for (int k = 0; k < 3; ++k) plane.p[k] = a[k].toDouble(), plane.n[k] = a[k + 3].toDouble();
+  return plane;
+}
+
 QJsonArray overrides_json(const std::vector<ParameterOverride>& ov) {
   QJsonArray a;
   for (const ParameterOverride& o : ov)
@@ -321,6 +336,7 @@ ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
     row["tets"] = double(h.tets);
     row["seconds"] = h.seconds;
     row["results"] = QString::fromStdString(results_json(h.results));
+    if (h.mesh_settings) row["mesh_settings"] = mesh_settings_json(*h.mesh_settings);
     history.append(row);
   }
   p["history"] = history;
@@ -334,11 +350,8 @@ ProjectSnapshot Workbench::project_snapshot(const QString& folder) const {
     sel["iso_only"] = selection_.iso_only;
     if (selection_.threshold)
       sel["threshold"] = QJsonArray{selection_.threshold->first, selection_.threshold->second};
-    if (selection_.clip) {
-      QJsonArray c = numbers(selection_.clip->p, 3);
-      for (int k = 0; k < 3; ++k) c.append(selection_.clip->n[k]);
-      sel["clip"] = c;
-    }
+    if (selection_.clip) sel["clip"] = plane_json(*selection_.clip);
+    if (selection_.slice) sel["slice"] = plane_json(*selection_.slice);
     p["selection"] = sel;
   }
   return snap;
@@ -451,6 +464,22 @@ bool Workbench::open_project(const QString& folder, QString* error) {
     const MeshSettings meshed = p.contains("meshed_settings")
                                     ? mesh_settings_of(p["meshed_settings"], file + ": meshed_settings")
                                     : settings;
+    // The history too (each row's mesh settings: none in a project saved before rows kept them).
+    std::vector<HistoryRow> history;
+    for (const QJsonValue& v : p["history"].toArray()) {
+      const QJsonObject o = v.toObject();
+      HistoryRow h;
+      h.parameters = overrides_of(o["parameters"]);
+      h.mesh = std::size_t(o["mesh"].toDouble());
+      h.tets = std::size_t(o["tets"].toDouble());
+      h.seconds = o["seconds"].toDouble();
+      h.results = parse_results_json(o["results"].toString().toStdString());
+      if (o.contains("mesh_settings"))
+        h.mesh_settings =
+            mesh_settings_of(o["mesh_settings"], file + ": history row " +
+                                                     std::to_string(history.size() + 1) + ": mesh_settings");
+      history.push_back(std::move(h));
+    }
     // The folder's copy of the model (a project of an earlier version names the model file itself,
     // absolutely: opened where it is)
     QString why;
@@ -495,17 +524,7 @@ bool Workbench::open_project(const QString& folder, QString* error) {
                                  ": the deformed shape's scale is not a number");
       deform_ = Deform{d["field"].toString("displacement").toStdString(), scale};
     }
-    history_.clear();
-    for (const QJsonValue& v : p["history"].toArray()) {
-      const QJsonObject o = v.toObject();
-      HistoryRow h;
-      h.parameters = overrides_of(o["parameters"]);
-      h.mesh = std::size_t(o["mesh"].toDouble());
-      h.tets = std::size_t(o["tets"].toDouble());
-      h.seconds = o["seconds"].toDouble();
-      h.results = parse_results_json(o["results"].toString().toStdString());
-      history_.push_back(std::move(h));
-    }
+    history_ = std::move(history);
     has_results_ = p.contains("results");
     if (has_results_) results_ = parse_results_json(p["results"].toString().toStdString());
     if (!p["mesh"].toString().isEmpty()) {
@@ -536,13 +555,9 @@ bool Workbench::open_project(const QString& folder, QString* error) {
       if (sel.contains("threshold"))
         selection_.threshold = std::pair(sel["threshold"].toArray().at(0).toDouble(),
                                          sel["threshold"].toArray().at(1).toDouble());
-      if (sel.contains("clip")) {
-        double c[6];
-        read_numbers(sel["clip"], c, 6);
-        Plane pl;
-        for (int k = 0; k < 3; ++k) pl.p[k] = c[k], pl.n[k] = c[k + 3];
-        selection_.clip = pl;
-      }
+      // A project saved before the slice was kept has none: the slice off.
+      if (sel.contains("clip")) selection_.clip = read_plane(sel["clip"]);
+      if (sel.contains("slice")) selection_.slice = read_plane(sel["slice"]);
     }
     selection_field_ = field_;  // the display that follows applies it
     {

@@ -21,6 +21,7 @@
 #include <QVBoxLayout>
 #include <QtConcurrent/QtConcurrentRun>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <initializer_list>
 #include <tuple>
@@ -433,7 +434,9 @@ bool Workbench::set_field(const QString& field, const QString& color_map) {
   auto work = [mesh, f, c = colouring(), shrink, w, h, cam]() {
     auto out = std::make_shared<Outcome>();
     try {
+      const auto t0 = std::chrono::steady_clock::now();
       build_display(*out, *mesh, f, c, shrink, w, h, cam ? &*cam : nullptr);
+      out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       out->mesh = mesh;
       out->ok = true;
     } catch (const std::exception& e) {

@@ -2,6 +2,7 @@
 #include "workbench.hpp"
 #include "workbench_parts.hpp"
 
+#include <QDockWidget>
 #include <QKeySequence>
 #include <QLabel>
 #include <QMessageBox>
@@ -50,6 +51,14 @@ void Workbench::build_ui() {
   build_mesh_panel();
   build_results_panel();
   build_history_panel();
+  // The right side's two docks take the window's whole height (the history below the view and the
+  // model panel only) and share it half and half: the mesh panel's settings in sight (its report
+  // scrolls), the results table about 8 rows at the default 860 px (it had one: the mesh panel's
+  // natural height took the side).
+  setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
+  auto* mesh_dock = findChild<QDockWidget*>("mesh");
+  auto* results_dock = findChild<QDockWidget*>("results");
+  if (mesh_dock && results_dock) resizeDocks({mesh_dock, results_dock}, {1, 1}, Qt::Vertical);
 
   status_ = new QLabel;
   probe_ = new QLabel;

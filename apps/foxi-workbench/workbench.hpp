@@ -48,15 +48,6 @@ class QTimer;
 
 namespace foxi::workbench {
 
-// One row of the run history.
-struct HistoryRow {
-  std::vector<ParameterOverride> parameters;  // the overrides of that run
-  std::size_t mesh = 0;  // which mesh (1, 2, ... in the session): a solve completes its mesh's row
-  std::size_t tets = 0;
-  RunResults results;  // status failed with no values: meshed only
-  double seconds = 0;  // mesh + solve wall time
-};
-
 // The deformed shape (foxi render --deform NAME:SCALE): each node moved by scale x the node vector
 // field (a thermal stress solve's displacement).
 struct Deform {
@@ -99,6 +90,17 @@ struct MeshSettings {
   bool refine_from_result = false;
   std::string refine_field;
   double target_error = 0.1;
+};
+
+// One row of the run history.
+struct HistoryRow {
+  std::vector<ParameterOverride> parameters;  // the overrides of that run
+  std::size_t mesh = 0;  // which mesh (1, 2, ... in the session): a solve completes its mesh's row
+  std::size_t tets = 0;
+  RunResults results;  // status failed with no values: meshed only
+  double seconds = 0;  // mesh + solve wall time
+  // The mesh panel's settings that made the row's mesh (none: a project saved before rows kept them).
+  std::optional<MeshSettings> mesh_settings;
 };
 
 // What a worker hands back (mesh, solve or a new field paint).

@@ -52,7 +52,7 @@ struct Outcome {
   std::shared_ptr<IsoCache> iso_cache;  // built here, on the worker: the tools then only query
   double corner_lo = 0, corner_hi = 0;  // the corner values' range, SI
   RunResults results;
-  double seconds = 0;                        // meshing (or the solve when not meshed)
+  double seconds = 0;                        // meshing; a recolour's: building the picture
   double solve_seconds = 0;                  // the solve
   std::optional<MeshQualityReport> quality;  // a new mesh's
   QString mesher_summary;                    // and which mesher made it (mesh_panel.cpp)
@@ -95,6 +95,9 @@ const char* progress_stage(int index);
 // The progress bar's text for the running job: what, the stage, %p%, the iteration and residual of an
 // iterative solve, a sweep's point k of n (jobs.cpp).
 QString progress_format(const QString& what, int permille, const SolveProgress* solve);
+// A job's duration as the progress bar says it: "1.25 s", under 0.1 s in milliseconds ("3.14 ms"), so a
+// quick recolour does not read "0.00 s" (jobs.cpp).
+QString duration_text(double seconds);
 
 // The display of `mesh` on the worker: the field's paint, flat or graded, on the automatic scale or
 // the user's range (as foxi render --field NAME --cmap MAP [--graded] [--range a,b] draws it) and the
@@ -132,6 +135,9 @@ void apply_mesh_settings(ModelMeshOptions& options, const MeshSettings& settings
 QString mesher_summary(const MeshedModel& m);
 // The same settings (mesh_panel.cpp): a solve remeshes first when they differ from the shown mesh's.
 bool same_mesh_settings(const MeshSettings& a, const MeshSettings& b);
+// The settings in words, lengths in the model's unit (`scale` metres, named `unit`): a history row's
+// tooltip, one item a line.
+QString mesh_settings_text(const MeshSettings& s, double scale, const std::string& unit);
 
 // Whether CalculiX solves `physics` here (thermal, thermal_stress) (solve_panel.cpp).
 bool calculix_solves(Physics physics);

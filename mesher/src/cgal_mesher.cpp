@@ -77,32 +77,33 @@ struct BoxSizes {
   }
 };
 
-// Cell size bound: the global one, lowered in subdomains whose region seed sets a max volume and in
-// the refinement boxes (at the cell's orthocentre, where Mesh_3 asks).
-struct CellSize {
+// A size bound: the global one, lowered in the refinement boxes. The cell, facet and edge sizes below
+// are this with their own exceptions (subdomains, corners).
+struct BoxedSize {
   using FT = K::FT;
   using Point_3 = K::Point_3;
   using Index = Domain::Index;
-  const Domain* domain = nullptr;
   double global = 0;
-  std::vector<double> per_subdomain;  // by subdomain index
   BoxSizes boxes;
+  double at(const Point_3& p) const { return boxes.at(p, global); }
+};
+
+// Cell size bound: lowered further in subdomains whose region seed sets a max volume (the boxes at the
+// cell's orthocentre, where Mesh_3 asks).
+struct CellSize : BoxedSize {
+  const Domain* domain = nullptr;
+  std::vector<double> per_subdomain;  // by subdomain index
   FT operator()(const Point_3& p, int dim, const Index& index) const {
-    if (dim != 3) return boxes.at(p, global);
+    if (dim != 3) return at(p);
     const auto sd = static_cast<std::size_t>(domain->subdomain_index(index));
     return boxes.at(p, sd < per_subdomain.size() ? per_subdomain[sd] : global);
   }
 };
 
-// Surface Delaunay ball radius bound: the global one, lowered in the refinement boxes (at the ball's
-// centre on the surface), so that a box's part of the boundary is as fine as the tets behind it.
-struct FacetSize {
-  using FT = K::FT;
-  using Point_3 = K::Point_3;
-  using Index = Domain::Index;
-  double global = 0;
-  BoxSizes boxes;
-  FT operator()(const Point_3& p, int, const Index&) const { return boxes.at(p, global); }
+// Surface Delaunay ball radius bound (the boxes at the ball's centre on the surface), so that a box's
+// part of the boundary is as fine as the tets behind it.
+struct FacetSize : BoxedSize {
+  FT operator()(const Point_3& p, int, const Index&) const { return at(p); }
 };
 
 // The protecting ball radius at corners (dim 0) and along features. Mesh_3 caps a corner's ball at a
@@ -112,17 +113,11 @@ struct FacetSize {
 // pump protecting balls). Here each corner's ball is below that cap by a factor in (0.7, 0.95] drawn
 // from a hash of its coordinates: deterministic, and different at mirror-image corners. Inside a
 // refinement box the bound is at most the box's (features there are sampled as finely as its facets).
-struct EdgeSize {
-  using FT = K::FT;
-  using Point_3 = K::Point_3;
-  using Index = Domain::Index;
-  double global = 0;
-  BoxSizes boxes;
+struct EdgeSize : BoxedSize {
   std::map<std::array<double, 3>, double> corner_size;  // by the corner's coordinates
   FT operator()(const Point_3& p, int dim, const Index&) const {
-    if (dim != 0) return boxes.at(p, global);
-    const auto it = corner_size.find({p.x(), p.y(), p.z()});
-    return it == corner_size.end() ? boxes.at(p, global) : it->second;
+    const auto it = dim == 0 ? corner_size.find({p.x(), p.y(), p.z()}) : corner_size.end();
+    return it == corner_size.end() ? at(p) : it->second;
   }
 };
 
@@ -142,21 +137,21 @@ double hash01(const std::array<double, 3>& p) {
 EdgeSize edge_size_field(const Domain& domain, double global, const BoxSizes& boxes) {
   std::vector<std::pair<Domain::Corner_index, K::Point_3>> corners;
   domain.get_corners(std::back_inserter(corners));
-  EdgeSize e{global, boxes, {}};
+  EdgeSize e{{.global = global, .boxes = boxes}, {}};
   // The nearest other corner, by sorting along x and scanning while the x gap can still beat the best.
   std::vector<std::array<double, 3>> pts;
   for (const auto& c : corners) pts.push_back({c.second.x(), c.second.y(), c.second.z()});
   std::sort(pts.begin(), pts.end());
   for (std::size_t i = 0; i < pts.size(); ++i) {
+    const K::Point_3 p(pts[i][0], pts[i][1], pts[i][2]);
     double best = HUGE_VAL;
-    for (std::size_t j = i + 1; j < pts.size() && (pts[j][0] - pts[i][0]) * (pts[j][0] - pts[i][0]) < best;
-         ++j)
-      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]),
-                                                   K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
-    for (std::size_t j = i; j-- > 0 && (pts[i][0] - pts[j][0]) * (pts[i][0] - pts[j][0]) < best;)
-      best = std::min(best, CGAL::squared_distance(K::Point_3(pts[i][0], pts[i][1], pts[i][2]),
-                                                   K::Point_3(pts[j][0], pts[j][1], pts[j][2])));
-    const double here = boxes.at(K::Point_3(pts[i][0], pts[i][1], pts[i][2]), global);
+    auto dx2 = [&](std::size_t j) { return (pts[j][0] - pts[i][0]) * (pts[j][0] - pts[i][0]); };
+    auto d2 = [&](std::size_t j) {
+      return CGAL::squared_distance(p, K::Point_3(pts[j][0], pts[j][1], pts[j][2]));
+    };
+    for (std::size_t j = i + 1; j < pts.size() && dx2(j) < best; ++j) best = std::min(best, d2(j));
+    for (std::size_t j = i; j-- > 0 && dx2(j) < best;) best = std::min(best, d2(j));
+    const double here = e.at(p);
     const double cap = std::min(here, std::isfinite(best) ? std::sqrt(best) / 3 : here);
     e.corner_size[pts[i]] = cap * (0.7 + 0.25 * (1 - hash01(pts[i])));
   }
@@ -407,7 +402,8 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
   }
 
   const BoxSizes boxes(params.boxes);
-  CellSize cell_size{&domain, sizes.max_size, std::vector<double>(s.cell_count, sizes.max_size), boxes};
+  CellSize cell_size{
+      {.global = sizes.max_size, .boxes = boxes}, &domain, std::vector<double>(s.cell_count, sizes.max_size)};
   for (const RegionSeed& seed : plc.regions)
     if (seed.max_volume > 0)
       for (std::size_t c = 1; c < s.cell_count; ++c)
@@ -418,7 +414,7 @@ std::vector<char> run_mesh_3(const Patches& patches, const detail::PlcSurface& s
   // part takes facets that cut across its corners (the dual edge meets a patch, the facet does not lie in
   // it).
   const EdgeSize edge_size = edge_size_field(domain, sizes.edge_size, boxes);
-  const FacetSize facet_size{sizes.facet_size, boxes};
+  const FacetSize facet_size{{.global = sizes.facet_size, .boxes = boxes}};
   Criteria criteria(P::edge_size = edge_size, P::facet_angle = params.facet_angle, P::facet_size = facet_size,
                     P::facet_topology = CGAL::FACET_VERTICES_ON_SAME_SURFACE_PATCH_WITH_ADJACENCY_CHECK,
                     P::facet_distance = sizes.facet_distance, P::cell_radius_edge_ratio = params.radius_edge,

@@ -61,6 +61,12 @@ struct ViewWidget::Impl {
 
 namespace {
 
+// False, with the reason when the caller asks for it.
+bool refuse(QString* error, const QString& why) {
+  if (error) *error = why;
+  return false;
+}
+
 // foxi render's camera for the mesh's bounds and this aspect (view_options.hpp: the same rule).
 Camera default_camera(const Mesh& mesh, int width, int height) {
   double lo[3], hi[3];
@@ -242,21 +248,20 @@ void ViewWidget::say_composite() {
 }
 
 bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) {
-  auto fail = [&](const QString& why) {
-    if (error) *error = why;
-    return false;
-  };
-  if (!d_->view) return fail(tr("no mesh shown"));
+  if (!d_->view) return refuse(error, tr("no mesh shown"));
   std::unique_ptr<TetSelection> picked;
   if (selection.any()) {
     if (!d_->source)
-      return fail(tr("colour by a field first: the isosurface, threshold, clip and slice select by it"));
+      return refuse(error,
+                    tr("colour by a field first: the isosurface, threshold, clip and slice select by it"));
     if (d_->volume)
-      return fail(
+      return refuse(
+          error,
           tr("the volume rendering draws the field alone (foxi render --volume takes no --iso, --threshold, "
              "--clip or --slice): turn the volume off first"));
     if (d_->xray && (selection.threshold || selection.clip || selection.slice))
-      return fail(
+      return refuse(
+          error,
           tr("the x-ray draws whole regions translucent, with isosurfaces inside (foxi render "
              "--region-opacity takes --iso, not --threshold, --clip or --slice): turn the x-ray off first"));
     try {
@@ -264,7 +269,7 @@ bool ViewWidget::set_selection(const FieldSelection& selection, QString* error) 
       picked = std::make_unique<TetSelection>(
           select_field_tets(selection, *d_->mesh, s.choice, s.step, s.scale, d_->base, s.cache.get()));
     } catch (const std::exception& e) {
-      return fail(QString::fromStdString(e.what()));
+      return refuse(error, QString::fromStdString(e.what()));
     }
   }
   // The old selection lives until the view has let go of it (apply), then goes.
@@ -292,44 +297,30 @@ void ViewWidget::set_base(std::vector<std::uint32_t> tets) {
 const FieldSelection& ViewWidget::selection() const { return d_->selection; }
 
 bool ViewWidget::set_xray(bool on, QString* error) {
-  auto fail = [&](const QString& why) {
-    if (error) *error = why;
-    return false;
-  };
-  if (!d_->view) return fail(tr("no mesh shown"));
+  if (!d_->view) return refuse(error, tr("no mesh shown"));
   const FieldSelection& s = d_->selection;
   if (on && (s.threshold || s.clip || s.slice))
-    return fail(
-        tr("the x-ray draws whole regions translucent (foxi render --region-opacity takes --iso, not "
-           "--threshold, --clip or --slice): turn the threshold, clip and slice off first"));
-  const bool old_xray = d_->xray, old_volume = d_->volume;
-  d_->xray = on;
-  if (on) d_->volume = false;
-  d_->volume_pending = false;
-  if (!apply(error)) {
-    d_->xray = old_xray;
-    d_->volume = old_volume;
-    apply(nullptr);
-    return false;
-  }
-  draw();
-  return true;
+    return refuse(
+        error, tr("the x-ray draws whole regions translucent (foxi render --region-opacity takes --iso, not "
+                  "--threshold, --clip or --slice): turn the threshold, clip and slice off first"));
+  return set_composite(on, on ? false : d_->volume, error);
 }
 
 bool ViewWidget::set_volume(bool on, QString* error) {
-  auto fail = [&](const QString& why) {
-    if (error) *error = why;
-    return false;
-  };
-  if (!d_->view) return fail(tr("no mesh shown"));
-  if (on && !d_->source) return fail(tr("colour by a field first: the volume rendering shows it"));
+  if (!d_->view) return refuse(error, tr("no mesh shown"));
+  if (on && !d_->source) return refuse(error, tr("colour by a field first: the volume rendering shows it"));
   if (on && d_->selection.any())
-    return fail(
+    return refuse(
+        error,
         tr("the volume rendering draws the field alone (foxi render --volume takes no --iso, --threshold, "
            "--clip or --slice): turn the isosurface, threshold, clip and slice off first"));
+  return set_composite(on ? false : d_->xray, on, error);
+}
+
+bool ViewWidget::set_composite(bool xray, bool volume, QString* error) {
   const bool old_xray = d_->xray, old_volume = d_->volume;
-  d_->volume = on;
-  if (on) d_->xray = false;
+  d_->xray = xray;
+  d_->volume = volume;
   d_->volume_pending = false;
   if (!apply(error)) {
     d_->xray = old_xray;

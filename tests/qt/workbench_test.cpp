@@ -78,6 +78,53 @@ bool wait_job(Workbench& w) {
   return ok;
 }
 
+// A mesh or solve job (`started`: start_mesh's or start_solve's answer) run to its end; a failure
+// says which and the workbench's reason.
+testing::AssertionResult job_done(Workbench& w, bool started, const char* what) {
+  if (!started) return testing::AssertionFailure() << "the " << what << " did not start";
+  if (!wait_job(w))
+    return testing::AssertionFailure() << "the " << what << " failed: " << w.last_error().toStdString();
+  return testing::AssertionSuccess();
+}
+testing::AssertionResult meshed(Workbench& w) { return job_done(w, w.start_mesh(), "mesh"); }
+testing::AssertionResult solved(Workbench& w) { return job_done(w, w.start_solve(), "solve"); }
+
+enum class Shown { yes, no };
+
+// The window most tests start from: the view small (quick pictures), the window shown (or not) and
+// the model file opened; a failure says the workbench's reason.
+testing::AssertionResult open_window(Workbench& w, const std::string& model, QSize view = {200, 150},
+                                     Shown shown = Shown::yes) {
+  w.view_widget()->setFixedSize(view);
+  if (shown == Shown::yes) w.show();
+  QString why;
+  if (!w.open_model(QString::fromStdString(model), &why))
+    return testing::AssertionFailure() << model << " did not open: " << why.toStdString();
+  return testing::AssertionSuccess();
+}
+
+// A saved project opened in window `w` (its view small; shown or not) and its picture made (the job
+// open_project starts); a failure says the workbench's reason.
+testing::AssertionResult reopen(Workbench& w, const QString& folder, QSize view = {200, 150},
+                                Shown shown = Shown::no) {
+  w.view_widget()->setFixedSize(view);
+  if (shown == Shown::yes) w.show();
+  QString why;
+  if (!w.open_project(folder, &why))
+    return testing::AssertionFailure() << folder.toStdString() << " did not open: " << why.toStdString();
+  if (!wait_job(w))
+    return testing::AssertionFailure()
+           << folder.toStdString() << " not shown: " << w.last_error().toStdString();
+  return testing::AssertionSuccess();
+}
+
+// Parameter `name`'s value (SI) in the window's model; -1 when it has none.
+double value_of(const Workbench& w, const std::string& name) {
+  for (const foxi::Parameter& p : w.model()->parameters)
+    if (p.name == name) return p.value.value;
+  return -1.0;
+}
+
 std::string line_after(const std::string& text, const std::string& key) {
   const std::size_t at = text.find(key);
   if (at == std::string::npos) return {};
@@ -247,11 +294,8 @@ TEST(WorkbenchHeadless, RegionsShownWithIsoEqualFoxiRender) {
 TEST(Workbench, HidingAMaterialEqualsFoxiRenderOfTheOtherRegions) {
   TempDir dir;
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "multi_chip.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "multi_chip.toml"));
+  ASSERT_TRUE(solved(w));
   ASSERT_TRUE(w.set_field("temperature"));
   if (w.busy()) {
     ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
@@ -478,32 +522,27 @@ TEST(WorkbenchHeadless, BadParameterExitsWithBadInput) {
 TEST(Workbench, ParameterEditingWithUnits) {
   Workbench w;
   ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  auto value_of = [&](const std::string& name) {
-    for (const foxi::Parameter& p : w.model()->parameters)
-      if (p.name == name) return p.value.value;
-    return -1.0;
-  };
-  EXPECT_DOUBLE_EQ(value_of("die_w"), 0.004);
+  EXPECT_DOUBLE_EQ(value_of(w, "die_w"), 0.004);
   QString error;
   // A mass where a length belongs: refused with the model library's message, nothing changes.
   EXPECT_FALSE(w.set_parameter("die_w", "3 kg", &error));
   EXPECT_TRUE(error.contains("die_w")) << error.toStdString();
   EXPECT_TRUE(error.contains("die_on_substrate.toml")) << error.toStdString();
   EXPECT_TRUE(w.overrides().empty());
-  EXPECT_DOUBLE_EQ(value_of("die_w"), 0.004);
+  EXPECT_DOUBLE_EQ(value_of(w, "die_w"), 0.004);
   // An unknown parameter and a malformed expression: refused.
   EXPECT_FALSE(w.set_parameter("die_x", "3 mm", &error));
   EXPECT_TRUE(error.contains("die_x")) << error.toStdString();
   EXPECT_FALSE(w.set_parameter("die_w", "3 mm +", &error));
   // Units converted: 0.6 cm is 6 mm; an expression of other parameters evaluated.
   EXPECT_TRUE(w.set_parameter("die_w", "0.6 cm", &error)) << error.toStdString();
-  EXPECT_NEAR(value_of("die_w"), 0.006, 1e-15);
+  EXPECT_NEAR(value_of(w, "die_w"), 0.006, 1e-15);
   EXPECT_TRUE(w.set_parameter("die_d", "die_w / 2", &error)) << error.toStdString();
-  EXPECT_NEAR(value_of("die_d"), 0.003, 1e-15);
+  EXPECT_NEAR(value_of(w, "die_d"), 0.003, 1e-15);
   ASSERT_EQ(w.overrides().size(), 2u);
   // A die wider than the substrate is a model the library refuses? Not necessarily; a negative size is.
   EXPECT_FALSE(w.set_parameter("die_h", "-1 mm", &error));
-  EXPECT_NEAR(value_of("die_d"), 0.003, 1e-15);
+  EXPECT_NEAR(value_of(w, "die_d"), 0.003, 1e-15);
 }
 
 // Save model as: the file written holds the edited values (load_model of it gives the parameters
@@ -619,27 +658,22 @@ TEST(Workbench, ParameterTableCellEdit) {
 TEST(Workbench, UndoRedoOfParameterEdits) {
   Workbench w;
   ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  auto value_of = [&](const std::string& name) {
-    for (const foxi::Parameter& p : w.model()->parameters)
-      if (p.name == name) return p.value.value;
-    return -1.0;
-  };
   EXPECT_FALSE(w.undo());
   ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
   ASSERT_TRUE(w.set_parameter("die_d", "2 mm"));
   EXPECT_FALSE(w.set_parameter("die_d", "2 K"));  // refused: not an edit to undo
   EXPECT_TRUE(w.undo());
-  EXPECT_NEAR(value_of("die_d"), 0.003, 1e-15);
-  EXPECT_NEAR(value_of("die_w"), 0.005, 1e-15);
+  EXPECT_NEAR(value_of(w, "die_d"), 0.003, 1e-15);
+  EXPECT_NEAR(value_of(w, "die_w"), 0.005, 1e-15);
   EXPECT_TRUE(w.undo());
-  EXPECT_NEAR(value_of("die_w"), 0.004, 1e-15);
+  EXPECT_NEAR(value_of(w, "die_w"), 0.004, 1e-15);
   EXPECT_TRUE(w.overrides().empty());
   EXPECT_FALSE(w.undo());
   EXPECT_TRUE(w.redo());
-  EXPECT_NEAR(value_of("die_w"), 0.005, 1e-15);
+  EXPECT_NEAR(value_of(w, "die_w"), 0.005, 1e-15);
   ASSERT_TRUE(w.set_parameter("sub_h", "2 mm"));  // a new edit: nothing left to redo
   EXPECT_FALSE(w.redo());
-  EXPECT_NEAR(value_of("sub_h"), 0.002, 1e-15);
+  EXPECT_NEAR(value_of(w, "sub_h"), 0.002, 1e-15);
 }
 
 // Only what changed reruns: Solve after a parameter change remeshes first (the mesh of the new
@@ -649,18 +683,14 @@ TEST(Workbench, UndoRedoOfParameterEdits) {
 // in x order and higher for larger values.
 TEST(Workbench, HistoryPlotPointsAreTheHistorysValues) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
   const std::string model = kModels + "die_on_substrate.toml";
-  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(open_window(w, model, {200, 150}, Shown::no));
   ASSERT_TRUE(w.set_parameter("die_w", "6 mm"));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_TRUE(w.set_parameter("die_w", "die_d"));  // 3 mm, an expression
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));  // meshed only: no results, not plotted
+  ASSERT_TRUE(meshed(w));                          // meshed only: no results, not plotted
   ASSERT_TRUE(w.set_parameter("die_w", "2 mm"));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_EQ(w.history().size(), 3u);
   const std::vector<std::string> names = foxi::workbench::history_results(w.history());
   ASSERT_FALSE(names.empty());
@@ -690,15 +720,12 @@ TEST(Workbench, HistoryPlotPointsAreTheHistorysValues) {
 
 TEST(Workbench, SolveRemeshesWhenParametersChanged) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
   const std::string model = kModels + "die_on_substrate.toml";
-  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(open_window(w, model, {200, 150}, Shown::no));
+  ASSERT_TRUE(meshed(w));
   const auto first = w.mesh();
   ASSERT_TRUE(w.set_parameter("die_w", "7 mm"));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   const std::vector<foxi::ParameterOverride> ov = {{"die_w", "7 mm"}};
   const foxi::MeshedModel direct = foxi::mesh_model(model, ov);
   EXPECT_EQ(w.mesh()->tet_count(), direct.mesh.tet_count());
@@ -707,8 +734,7 @@ TEST(Workbench, SolveRemeshesWhenParametersChanged) {
   ASSERT_EQ(w.history().size(), 2u);
   EXPECT_EQ(w.history()[1].tets, direct.mesh.tet_count());
   const auto second = w.mesh();
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(solved(w));
   EXPECT_TRUE(w.mesh()->xyz == second->xyz) << "same parameters: solved on the same mesh";
   EXPECT_EQ(w.history().size(), 3u);  // a solve of an already solved mesh: a row of its own
   (void)first;
@@ -716,10 +742,8 @@ TEST(Workbench, SolveRemeshesWhenParametersChanged) {
 
 TEST(Workbench, CancelKeepsThePreviousMeshAndPicture) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
+  ASSERT_TRUE(meshed(w));
   const std::shared_ptr<const foxi::Mesh> first = w.mesh();
   ASSERT_TRUE(first);
   const std::size_t tets = first->tet_count();
@@ -739,11 +763,9 @@ TEST(Workbench, CancelKeepsThePreviousMeshAndPicture) {
   EXPECT_EQ(w.results(), nullptr);
   EXPECT_EQ(w.mesh(), first);
   // And the next mesh goes through: a wider die, another mesh.
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(meshed(w));
   EXPECT_NE(w.mesh(), first);
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_NE(w.results(), nullptr);
   ASSERT_EQ(w.history().size(), 2u);  // first mesh (meshed only); second mesh with its solve
   EXPECT_TRUE(w.history()[0].results.values.empty());
@@ -758,9 +780,8 @@ TEST(Workbench, CancelKeepsThePreviousMeshAndPicture) {
 // quality report says CGAL. Values mesh_model refuses are refused as set, the settings kept.
 TEST(Workbench, MeshPanelPartSizeAndCgal) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
   const std::string model = kModels + "die_on_substrate.toml";
-  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(open_window(w, model, {200, 150}, Shown::no));
   auto* parts = w.findChild<QTableWidget*>("part_sizes");
   auto* mesher = w.findChild<QComboBox*>("mesher");
   ASSERT_TRUE(parts && mesher);
@@ -775,8 +796,7 @@ TEST(Workbench, MeshPanelPartSizeAndCgal) {
   ASSERT_EQ(w.mesh_settings().part_sizes.size(), 1u);
   EXPECT_EQ(w.mesh_settings().part_sizes[0].part, "die");
   EXPECT_NEAR(w.mesh_settings().part_sizes[0].max_size, 0.4e-3, 1e-15);
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(meshed(w));
   foxi::ModelMeshOptions o;
   o.mesher = foxi::Mesher::cgal;
   o.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
@@ -802,8 +822,7 @@ TEST(Workbench, MeshPanelPartSizeAndCgal) {
   boxes->item(0, 6)->setText("0.3");
   ASSERT_EQ(w.mesh_settings().mesher, foxi::Mesher::cgal);
   ASSERT_EQ(w.mesh_settings().boxes.size(), 1u) << "a box row is taken with CGAL";
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(meshed(w));
   o.sizes.boxes = w.mesh_settings().boxes;
   EXPECT_NEAR(o.sizes.boxes[0].hi[0], 2e-3, 1e-15);
   EXPECT_NEAR(o.sizes.boxes[0].size, 0.3e-3, 1e-15);
@@ -836,10 +855,8 @@ TEST(Workbench, MeshPanelPartSizeAndCgal) {
 // more tets than without.
 TEST(Workbench, MeshPanelBoxRowsAddAndRemove) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
+  ASSERT_TRUE(meshed(w));
   const std::size_t plain = w.mesh()->tet_count();
   auto* add = w.findChild<QPushButton*>("add_box");
   auto* remove = w.findChild<QPushButton*>("remove_box");
@@ -856,8 +873,7 @@ TEST(Workbench, MeshPanelBoxRowsAddAndRemove) {
   ASSERT_EQ(w.mesh_settings().boxes.size(), 1u);
   EXPECT_NEAR(w.mesh_settings().boxes[0].hi[0], 2e-3, 1e-15);
   EXPECT_NEAR(w.mesh_settings().boxes[0].size, 0.25e-3, 1e-15);
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(meshed(w));
   EXPECT_GT(w.mesh()->tet_count(), plain);
   boxes->setCurrentCell(0, 0);
   remove->click();
@@ -871,9 +887,8 @@ TEST(Workbench, MeshPanelBoxRowsAddAndRemove) {
 // meshes as the model says.
 TEST(Workbench, MeshPanelRefinesFromTheResult) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
   const std::string model = kModels + "die_on_substrate.toml";
-  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(open_window(w, model, {200, 150}, Shown::no));
   foxi::workbench::MeshSettings s = w.mesh_settings();
   s.refine_from_result = true;
   s.target_error = 0.3;
@@ -883,8 +898,7 @@ TEST(Workbench, MeshPanelRefinesFromTheResult) {
   EXPECT_NE(w.last_error().toStdString().find("no solved result"), std::string::npos)
       << w.last_error().toStdString();
   // A solve with no result to refine from meshes from the model's sizes (its mesh_model mesh).
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   const std::shared_ptr<const foxi::Mesh> solved = w.mesh();
   EXPECT_TRUE(solved->xyz == foxi::mesh_model(model).mesh.xyz);
   s.refine_from_result = false;
@@ -894,8 +908,7 @@ TEST(Workbench, MeshPanelRefinesFromTheResult) {
   ASSERT_NE(refine, nullptr);
   refine->setChecked(true);  // through the panel's check box
   ASSERT_TRUE(w.mesh_settings().refine_from_result);
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(meshed(w));
   foxi::ModelMeshOptions o;
   o.refine_from = {.mesh = solved.get(), .field = "temperature", .target_error = 0.3};
   const foxi::MeshedModel direct = foxi::mesh_model(model, {}, o);
@@ -921,8 +934,7 @@ TEST(Workbench, PhysicsResultsEqualFoxiSolveAndCancelKeepsThem) {
     SCOPED_TRACE(c.model);
     TempDir dir;
     Workbench w;
-    w.view_widget()->setFixedSize(200, 150);
-    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + c.model)));
+    ASSERT_TRUE(open_window(w, kModels + c.model, {200, 150}, Shown::no));
     ASSERT_TRUE(w.set_parameter(c.name, c.value));
     ASSERT_TRUE(w.set_physics(c.physics));
     ASSERT_TRUE(w.start_solve());
@@ -1007,11 +1019,8 @@ TEST(Workbench, PhysicsResultsEqualFoxiSolveAndCancelKeepsThem) {
 // moving back gives the same picture again.
 TEST(Workbench, IsoSliderMovesTheIsovalueBothWays) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(solved(w));
   ASSERT_TRUE(w.iso_slider()->isEnabled()) << "the temperature is shown: the tools are on";
   const foxi::Mesh& mesh = *w.mesh();
   const foxi::Field* t = nullptr;
@@ -1083,11 +1092,8 @@ TEST(Workbench, IsoSliderMovesTheIsovalueBothWays) {
 // and drawing on gives the same picture again; the volume needs the field shown and says it is exact.
 TEST(Workbench, XrayAndVolumeInTheView) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(solved(w));
   foxi::qt::ViewWidget* v = w.view_widget();
   const foxi::Mesh& mesh = *w.mesh();
   ASSERT_TRUE(v->set_xray(true));
@@ -1126,11 +1132,8 @@ TEST(Workbench, XrayAndVolumeInTheView) {
 // picture of that subset (draw_translucent_picture, the same camera), pixel for pixel.
 TEST(Workbench, XrayVolumeAndSelectionsStayInSync) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(solved(w));
   foxi::qt::ViewWidget* v = w.view_widget();
   auto* xray_box = w.findChild<QCheckBox*>("xray");
   auto* volume_box = w.findChild<QCheckBox*>("volume");
@@ -1254,16 +1257,14 @@ TEST(Workbench, DoneWhenWalkThrough) {
   EXPECT_EQ(w.overrides()[0].expression, "7 mm");
   shot("die-size-changed");
   // 3. Remesh: the mesh of those parameters shown.
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(meshed(w));
   ASSERT_TRUE(w.mesh());
   foxi::qt::ViewWidget* v = w.view_widget();
   EXPECT_EQ(v->mesh(), w.mesh());
   shot("remeshed");
   // 4. Solve the thermal problem: results and the temperature shown with its legend.
   ASSERT_TRUE(w.set_physics(foxi::Physics::thermal));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_NE(w.results(), nullptr);
   const foxi::ResultValue* t_first = w.results()->find("T_max");
   ASSERT_NE(t_first, nullptr);
@@ -1348,11 +1349,8 @@ TEST(Workbench, DoneWhenWalkThrough) {
 // both the polygons drawn) and the box unticks itself: the controls show what is drawn.
 TEST(Workbench, SliceControlDrawsAndRefusesWithIsovalues) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(solved(w));
   auto* slice = w.findChild<QCheckBox*>("slice");
   ASSERT_NE(slice, nullptr);
   ASSERT_TRUE(slice->isEnabled());
@@ -1397,11 +1395,8 @@ TEST(Workbench, SliceControlDrawsAndRefusesWithIsovalues) {
 TEST(Workbench, MovieOnAWorkerCancelsAndRefuses) {
   TempDir dir;
   Workbench w;
-  w.view_widget()->setFixedSize(160, 120);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {160, 120}));
+  ASSERT_TRUE(solved(w));
   auto wait_movie = [&](bool* ok, QString* message) {
     QEventLoop loop;
     QObject::connect(&w, &Workbench::movie_finished, &loop, [&](bool r, const QString& m) {
@@ -1458,12 +1453,9 @@ TEST(Workbench, ProjectSaveReopenAndKilledSave) {
   std::string camera;
   {
     Workbench w;
-    w.view_widget()->setFixedSize(200, 150);
-    w.show();
-    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+    ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
     ASSERT_TRUE(w.set_parameter("die_w", "6 mm"));
-    ASSERT_TRUE(w.start_solve());
-    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    ASSERT_TRUE(solved(w));
     w.view_widget()->view()->orbit(20, 10);  // a camera of the user's, not the default
     foxi::FieldSelection sel;                // and an isotherm in the middle of the range
     sel.iso = {0.5 * (w.field_lo() + w.field_hi())};
@@ -1546,8 +1538,7 @@ TEST(Workbench, ProjectFolderHoldsItsModel) {
     Workbench w;
     ASSERT_TRUE(w.open_model(QString::fromStdString(model.string())));
     ASSERT_TRUE(w.set_parameter("w", "4 mm"));
-    ASSERT_TRUE(w.start_mesh());
-    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    ASSERT_TRUE(meshed(w));
     QString why;
     ASSERT_TRUE(w.save_project(QString::fromStdString(proj.string()), &why)) << why.toStdString();
     before = *w.mesh();
@@ -1579,8 +1570,7 @@ TEST(Workbench, ProjectFolderHoldsItsModel) {
     if (w.busy()) {  // the reopened view's drawing
       ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
     }
-    ASSERT_TRUE(w.start_mesh());
-    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    ASSERT_TRUE(meshed(w));
     EXPECT_TRUE(w.mesh()->xyz == before.xyz) << "the next mesh, of " << model_file;
     EXPECT_TRUE(w.mesh()->tet_region == before.tet_region);
     EXPECT_TRUE(w.mesh()->tet == before.tet);
@@ -1648,10 +1638,8 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   TempDir dir;
   const QString folder = QString::fromStdString((dir.path() / "auto").string());
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
+  ASSERT_TRUE(meshed(w));
   w.set_autosave_folder(folder);
   w.set_autosave_delay(50);  // the rule tested is what is written, not when: no 2 s waits
   const auto json = dir.path() / "auto" / "project.json";
@@ -1692,8 +1680,7 @@ TEST(Workbench, AutosaveWritesOnlyWhatChanged) {
   EXPECT_EQ(w.autosaves_without_model(), 1);
   // a new mesh: a new file, the old one gone
   ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(meshed(w));
   ASSERT_TRUE(autosave_after(3));
   EXPECT_NE(mesh_file(), first);
   EXPECT_FALSE(std::filesystem::exists(mesh_path));
@@ -1792,10 +1779,8 @@ std::pair<double, std::string> table_value(Workbench& w, const std::string& name
 // history's key results follow.
 TEST(Workbench, ResultsTableInTheLegendsUnit) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
+  ASSERT_TRUE(solved(w));
   const foxi::ResultValue* t = w.results()->find("T_max");
   ASSERT_NE(t, nullptr);
   ASSERT_EQ(t->unit, "K");
@@ -1820,19 +1805,16 @@ TEST(Workbench, ResultsTableInTheLegendsUnit) {
 TEST(Workbench, SaveModelThenSolveDoesNotRemesh) {
   TempDir dir;
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
   ASSERT_TRUE(w.set_parameter("die_w", "6 mm"));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(meshed(w));
   const auto meshed = w.mesh();
   ASSERT_EQ(w.history().size(), 1u);
   QString error;
   ASSERT_TRUE(w.save_model_file(QString::fromStdString((dir.path() / "m.toml").string()), &error))
       << error.toStdString();
   EXPECT_TRUE(w.overrides().empty());
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_EQ(w.history().size(), 1u) << "the solve completed the mesh's row: no remesh";
   EXPECT_EQ(w.history()[0].mesh, 1u);
   EXPECT_NE(w.history()[0].results.find("T_max"), nullptr);
@@ -1840,8 +1822,7 @@ TEST(Workbench, SaveModelThenSolveDoesNotRemesh) {
   // A parameter edited after the mesh and then saved: the file changed, the next Solve remeshes.
   ASSERT_TRUE(w.set_parameter("die_w", "5 mm"));
   ASSERT_TRUE(w.save_model_file({}, &error)) << error.toStdString();
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_EQ(w.history().size(), 2u);
   EXPECT_EQ(w.history()[1].mesh, 2u);
   const std::vector<foxi::ParameterOverride> ov = {{"die_w", "5 mm"}};
@@ -1855,11 +1836,9 @@ TEST(Workbench, ProjectKeepsTheDeformedShape) {
   std::vector<double> moved;
   {
     Workbench w;
-    w.view_widget()->setFixedSize(200, 150);
-    ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+    ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
     ASSERT_TRUE(w.set_physics(foxi::Physics::thermal_stress));
-    ASSERT_TRUE(w.start_solve());
-    ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+    ASSERT_TRUE(solved(w));
     ASSERT_TRUE(w.set_deform(foxi::workbench::Deform{"displacement", 150}));
     ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
     moved = w.view_widget()->mesh()->xyz;
@@ -1868,10 +1847,7 @@ TEST(Workbench, ProjectKeepsTheDeformedShape) {
     ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
   }
   Workbench again;
-  again.view_widget()->setFixedSize(200, 150);
-  QString why;
-  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(reopen(again, folder));
   ASSERT_TRUE(again.deform().has_value());
   EXPECT_EQ(again.deform()->field, "displacement");
   EXPECT_EQ(again.deform()->scale, 150);
@@ -1940,8 +1916,7 @@ TEST(Workbench, ProjectKeepsTheMeshSettings) {
   s.target_error = 0.25;
   {
     Workbench w;
-    w.view_widget()->setFixedSize(160, 120);
-    ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+    ASSERT_TRUE(open_window(w, model, {160, 120}, Shown::no));
     QString why;
     ASSERT_TRUE(w.set_mesh_settings(s, &why)) << why.toStdString();
     ASSERT_TRUE(w.start_solve());  // no result to refine from yet: meshed with the sizes, solved
@@ -1964,10 +1939,7 @@ TEST(Workbench, ProjectKeepsTheMeshSettings) {
     ASSERT_TRUE(autosaved(w, before + 2));
   }
   Workbench again;
-  again.view_widget()->setFixedSize(160, 120);
-  QString why;
-  ASSERT_TRUE(again.open_project(folder, &why)) << why.toStdString();
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(reopen(again, folder, {160, 120}));
   expect_same_settings(again.mesh_settings(), s, "reopened");
   // The panel's controls show them (lengths in the model's mm).
   EXPECT_EQ(again.findChild<QComboBox*>("mesher")->currentIndex(), 0);
@@ -1985,19 +1957,17 @@ TEST(Workbench, ProjectKeepsTheMeshSettings) {
   EXPECT_EQ(boxes->item(0, 3)->text(), "2");
   EXPECT_EQ(boxes->item(0, 6)->text(), "0.3");
   // A Solve on the reopened mesh solves it (made with the settings shown: no remesh).
-  const std::shared_ptr<const foxi::Mesh> solved = again.mesh();
-  ASSERT_TRUE(solved && again.results());
+  const std::shared_ptr<const foxi::Mesh> before = again.mesh();
+  ASSERT_TRUE(before && again.results());
   ASSERT_FALSE(again.history().empty());
   const std::size_t mesh_number = again.history().back().mesh;
-  ASSERT_TRUE(again.start_solve());
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(solved(again));
   EXPECT_EQ(again.history().back().mesh, mesh_number)
       << "the reopened mesh's settings are the panel's: no remesh";
-  EXPECT_TRUE(again.mesh()->xyz == solved->xyz);
+  EXPECT_TRUE(again.mesh()->xyz == before->xyz);
   // The next Mesh: mesh_model's with the options written out here, refined from the reopened result.
   const std::shared_ptr<const foxi::Mesh> result = again.mesh();
-  ASSERT_TRUE(again.start_mesh());
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(meshed(again));
   foxi::ModelMeshOptions o;
   o.max_size = 1.5e-3;
   o.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
@@ -2037,8 +2007,7 @@ TEST(Workbench, ProjectKeepsCgalMeshSettings) {
   expect_same_settings(again.mesh_settings(), s, "reopened");
   EXPECT_EQ(again.findChild<QComboBox*>("mesher")->currentIndex(), 1);
   EXPECT_EQ(again.findChild<QLineEdit*>("mesh_quality")->text(), "2.5");
-  ASSERT_TRUE(again.start_mesh());
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(meshed(again));
   foxi::ModelMeshOptions o;
   o.mesher = foxi::Mesher::cgal;
   o.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
@@ -2141,6 +2110,215 @@ TEST(Workbench, ProjectMeshSettingsOldAndMalformed) {
   EXPECT_TRUE(x.findChild<QLineEdit*>("mesh_size")->text().isEmpty());
 }
 
+// The slice plane is kept in a project like the clip plane: reopened, the view draws the same slice
+// within the same clip (the same tets, the same picture with the saved camera) and its check box is
+// ticked; a project saved before the slice was kept (no "slice" in its selection) opens with the
+// clip alone.
+TEST(Workbench, ProjectKeepsTheSlicePlane) {
+  TempDir dir;
+  const QString folder = QString::fromStdString((dir.path() / "proj").string());
+  std::size_t drawn = 0;
+  std::vector<std::uint32_t> ids;
+  foxi::FieldSelection s;
+  {
+    Workbench w;
+    ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+    ASSERT_TRUE(solved(w));
+    double lo[3], hi[3];
+    foxi::mesh_bounds(*w.mesh(), lo, hi);
+    s.clip = foxi::Plane{{0.5 * (lo[0] + hi[0]), 0, 0}, {-1, 0, 0}};
+    s.slice = foxi::Plane{{0, lo[1] + 0.3 * (hi[1] - lo[1]), 0}, {0, 1, 0}};
+    QString why;
+    ASSERT_TRUE(w.set_selection(s, &why)) << why.toStdString();
+    w.view_widget()->finish_now();
+    drawn = w.view_widget()->view()->drawn().size();
+    ids = w.view_widget()->view()->framebuffer().id;
+    ASSERT_GT(drawn, 0u);
+    ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
+  }
+  {
+    Workbench again;
+    ASSERT_TRUE(reopen(again, folder, {200, 150}, Shown::yes));
+    again.view_widget()->finish_now();
+    const foxi::FieldSelection& got = again.view_widget()->selection();
+    ASSERT_TRUE(got.slice.has_value());
+    ASSERT_TRUE(got.clip.has_value());
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(got.slice->p[k], s.slice->p[k]);
+      EXPECT_EQ(got.slice->n[k], s.slice->n[k]);
+      EXPECT_EQ(got.clip->p[k], s.clip->p[k]);
+      EXPECT_EQ(got.clip->n[k], s.clip->n[k]);
+    }
+    EXPECT_EQ(again.view_widget()->view()->drawn().size(), drawn);
+    EXPECT_TRUE(again.view_widget()->view()->framebuffer().id == ids) << "the same picture";
+    auto* slice = again.findChild<QCheckBox*>("slice");
+    ASSERT_NE(slice, nullptr);
+    EXPECT_TRUE(slice->isChecked());
+  }
+  const auto file = dir.path() / "proj" / "project.json";
+  QJsonObject p = QJsonDocument::fromJson(QByteArray::fromStdString(foxi::test::read_text(file))).object();
+  QJsonObject sel = p["selection"].toObject();
+  ASSERT_TRUE(sel.contains("slice"));
+  sel.remove("slice");
+  p["selection"] = sel;
+  foxi::test::write_text(file, QJsonDocument(p).toJson().toStdString());
+  Workbench old;
+  ASSERT_TRUE(reopen(old, folder, {200, 150}, Shown::yes));
+  old.view_widget()->finish_now();
+  EXPECT_FALSE(old.view_widget()->selection().slice.has_value());
+  EXPECT_TRUE(old.view_widget()->selection().clip.has_value());
+  EXPECT_GT(old.view_widget()->view()->drawn().size(), drawn) << "the clip's half, whole tets";
+}
+
+// Each history row keeps the mesh settings that made its mesh: in the row's tooltip (lengths in the
+// model's mm), in a saved project and reopened with it. Row 2's mesh is mesh_model's with those
+// settings (the library as the second caller). A project saved before rows kept them opens, its rows
+// saying so; a malformed row's settings are refused with the file, the row and the reason.
+TEST(Workbench, HistoryRowsKeepTheirMeshSettings) {
+  TempDir dir;
+  const std::string model = kModels + "die_on_substrate.toml";
+  const QString folder = QString::fromStdString((dir.path() / "proj").string());
+  foxi::workbench::MeshSettings second;
+  second.max_size = 1.5e-3;
+  second.part_sizes = {{.part = "die", .max_size = 0.4e-3}};
+  second.quality = 1.6;
+  second.boxes = {box_from_origin(2e-3, 10e-3, 1e-3, 0.5e-3)};
+  const QStringList first_text = {"mesher: TetGen", "global size: the model's", "part sizes: the model's",
+                                  "refinement boxes: none", "quality bound: the default"};
+  const QStringList second_text = {"mesher: TetGen", "global size: 1.5 mm", "part sizes: die 0.4 mm",
+                                   "refinement box 1: (0, 0, 0) to (2, 10, 1) mm, size 0.5 mm",
+                                   "quality bound: 1.6"};
+  auto tooltips = [](Workbench& w, int row, const QStringList& lines) {
+    auto* table = w.findChild<QTableWidget*>("history_table");
+    ASSERT_NE(table, nullptr);
+    ASSERT_LT(row, table->rowCount());
+    for (int c = 0; c < table->columnCount(); ++c) {
+      const QString tip = table->item(row, c)->toolTip();
+      for (const QString& line : lines) EXPECT_TRUE(tip.contains(line)) << tip.toStdString();
+    }
+  };
+  {
+    Workbench w;
+    ASSERT_TRUE(open_window(w, model, {160, 120}, Shown::no));
+    ASSERT_TRUE(meshed(w));
+    QString why;
+    ASSERT_TRUE(w.set_mesh_settings(second, &why)) << why.toStdString();
+    ASSERT_TRUE(solved(w));  // remeshed first: the settings changed
+    ASSERT_EQ(w.history().size(), 2u);
+    ASSERT_TRUE(w.history()[0].mesh_settings.has_value());
+    expect_same_settings(*w.history()[0].mesh_settings, {}, "row 1");
+    ASSERT_TRUE(w.history()[1].mesh_settings.has_value());
+    expect_same_settings(*w.history()[1].mesh_settings, second, "row 2");
+    foxi::ModelMeshOptions o;
+    o.max_size = second.max_size;
+    o.part_sizes = second.part_sizes;
+    o.quality = second.quality;
+    o.sizes.boxes = second.boxes;
+    EXPECT_EQ(w.history()[1].tets, foxi::mesh_model(model, {}, o).mesh.tet_count());
+    EXPECT_NE(w.history()[1].tets, w.history()[0].tets);
+    tooltips(w, 0, first_text);
+    tooltips(w, 1, second_text);
+    ASSERT_TRUE(w.save_project(folder, &why)) << why.toStdString();
+  }
+  {
+    Workbench again;
+    ASSERT_TRUE(reopen(again, folder, {160, 120}));
+    ASSERT_EQ(again.history().size(), 2u);
+    ASSERT_TRUE(again.history()[0].mesh_settings.has_value());
+    ASSERT_TRUE(again.history()[1].mesh_settings.has_value());
+    expect_same_settings(*again.history()[0].mesh_settings, {}, "reopened row 1");
+    expect_same_settings(*again.history()[1].mesh_settings, second, "reopened row 2");
+    tooltips(again, 0, first_text);
+    tooltips(again, 1, second_text);
+  }
+  const auto file = dir.path() / "proj" / "project.json";
+  const QJsonObject saved =
+      QJsonDocument::fromJson(QByteArray::fromStdString(foxi::test::read_text(file))).object();
+  auto with_rows = [&](auto edit) {
+    QJsonObject p = saved;
+    QJsonArray rows = p["history"].toArray();
+    for (int i = 0; i < rows.size(); ++i) {
+      QJsonObject row = rows[i].toObject();
+      edit(i, row);
+      rows[i] = row;
+    }
+    p["history"] = rows;
+    foxi::test::write_text(file, QJsonDocument(p).toJson().toStdString());
+  };
+  with_rows([](int, QJsonObject& row) { row.remove("mesh_settings"); });
+  {
+    Workbench old;
+    ASSERT_TRUE(reopen(old, folder, {160, 120}));
+    ASSERT_EQ(old.history().size(), 2u);
+    EXPECT_FALSE(old.history()[0].mesh_settings.has_value());
+    EXPECT_FALSE(old.history()[1].mesh_settings.has_value());
+    tooltips(old, 1, {"mesh settings not recorded"});
+  }
+  with_rows([](int i, QJsonObject& row) {
+    if (i == 1) row["mesh_settings"] = QJsonObject{{"mesher", "gmsh"}};
+  });
+  Workbench bad;
+  QString why;
+  EXPECT_FALSE(bad.open_project(folder, &why));
+  EXPECT_NE(why.toStdString().find(
+                file.string() + ": history row 2: mesh_settings: the mesher is tetgen or cgal, not 'gmsh'"),
+            std::string::npos)
+      << why.toStdString();
+  EXPECT_EQ(bad.model(), nullptr) << "refused before anything changed";
+}
+
+// A job's duration on the progress bar: seconds, under 0.1 s milliseconds (a recolour's picture takes
+// a few). After a recolour the bar says a duration above zero and at most the wall time measured
+// here around the job (it read "0.00 s": the recolour's time was not taken).
+TEST(Workbench, RecolourSaysItsDuration) {
+  EXPECT_EQ(foxi::workbench::duration_text(1.234), "1.23 s");
+  EXPECT_EQ(foxi::workbench::duration_text(12.34), "12.3 s");
+  EXPECT_EQ(foxi::workbench::duration_text(0.0031415), "3.14 ms");
+  EXPECT_EQ(foxi::workbench::duration_text(0.0000123), "0.0123 ms");
+  Workbench w;
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(solved(w));
+  const std::regex done("^([a-z ]+): done in ([0-9.]+) (s|ms)$");
+  std::smatch m;
+  std::string text = w.progress_bar()->format().toStdString();
+  ASSERT_TRUE(std::regex_match(text, m, done)) << text;
+  EXPECT_EQ(m[1].str(), "meshing and solving");
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(w.set_field("temperature", "coolwarm"));
+  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  text = w.progress_bar()->format().toStdString();
+  ASSERT_TRUE(std::regex_match(text, m, done)) << text;
+  EXPECT_EQ(m[1].str(), "colouring");
+  const double said = std::stod(m[2].str()) * (m[3].str() == "ms" ? 1e-3 : 1);
+  EXPECT_GT(said, 0) << text;
+  EXPECT_LE(said, wall * 1.01) << text;  // 3 digits: rounded up by 0.5% at most
+}
+
+// At the default 860 px height the right side's two panels share the height: the results table shows
+// at least 7 rows (it showed one: the mesh panel took the height, and the window grew to 1019 px),
+// the mesh panel scrolls instead and keeps its part sizes in sight.
+TEST(Workbench, SidePanelsShareTheHeightAt860) {
+  Workbench w;
+  w.show();
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(solved(w));
+  QApplication::processEvents();
+  EXPECT_EQ(w.height(), 860);
+  auto* results = w.findChild<QTableWidget*>("results");
+  ASSERT_NE(results, nullptr);
+  ASSERT_GE(results->rowCount(), 8);
+  EXPECT_GE(results->viewport()->height(), 7 * results->rowHeight(0))
+      << "results viewport " << results->viewport()->height() << " px, rows of " << results->rowHeight(0);
+  auto* parts = w.findChild<QTableWidget*>("part_sizes");
+  auto* scroll = w.findChild<QWidget*>("mesh_scroll");
+  ASSERT_TRUE(parts && scroll);
+  EXPECT_TRUE(parts->isVisible());
+  const QPoint top = parts->mapTo(scroll, QPoint(0, 0));
+  EXPECT_GE(top.y(), 0);
+  EXPECT_LE(top.y() + parts->height(), scroll->height()) << "the part sizes in sight";
+}
+
 // Headless --solver ichol --units si: the printed results and solver are foxi solve --solver ichol
 // --json's and the solve panel's (the same choices set in a window); the saved project has them (the
 // units box on SI: the results table in K). Bad values: exit 2 with the usage.
@@ -2170,12 +2348,10 @@ TEST(WorkbenchHeadless, SolverAndUnitsAsTheSolvePanel) {
   EXPECT_EQ(line(out, "solver: "), cli.solver) << out;
   // The window's solve panel with the same choices.
   Workbench w;
-  w.view_widget()->setFixedSize(160, 120);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(open_window(w, model, {160, 120}, Shown::no));
   ASSERT_TRUE(w.set_solver({false, foxi::LinearSolverKind::cg_ichol}));
   ASSERT_TRUE(w.set_si_units(true));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   EXPECT_EQ(w.results()->solver, cli.solver);
   std::size_t keys = 0;
   for (const foxi::ResultValue& v : cli.values) {
@@ -2191,10 +2367,7 @@ TEST(WorkbenchHeadless, SolverAndUnitsAsTheSolvePanel) {
   EXPECT_GE(keys, 1u);
   // The headless run's project: the solver and the units box as given.
   Workbench again;
-  again.view_widget()->setFixedSize(160, 120);
-  QString why;
-  ASSERT_TRUE(again.open_project(QString::fromStdString(proj.string()), &why)) << why.toStdString();
-  ASSERT_TRUE(wait_job(again)) << again.last_error().toStdString();
+  ASSERT_TRUE(reopen(again, QString::fromStdString(proj.string()), {160, 120}));
   EXPECT_FALSE(again.solver().calculix);
   EXPECT_EQ(again.solver().linear, foxi::LinearSolverKind::cg_ichol);
   EXPECT_TRUE(again.si_units());
@@ -2298,11 +2471,9 @@ TEST(Workbench, SolveProgressIterationsAndCancelMidSolve) {
   // The workbench with CG: the iterations of its solve as foxi solve counts them, and a Cancel keeps
   // the previous results.
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(open_window(w, model, {200, 150}, Shown::no));
   ASSERT_TRUE(w.set_solver({false, foxi::LinearSolverKind::cg_ichol}));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   EXPECT_EQ(w.solve_iterations(), std::stol(m[1]));
   EXPECT_EQ(w.results()->solver, "CG+IncompleteCholesky");
   const double t_max = w.results()->find("T_max")->value;
@@ -2403,10 +2574,8 @@ TEST(Workbench, CalculixTemperatureEqualsBuiltIn) {
   if (foxi::test::run("command -v ccx > /dev/null") != 0) GTEST_SKIP() << "ccx is not installed";
   const PrivateTmpdir tmpdir;
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
+  ASSERT_TRUE(solved(w));
   const std::vector<double> own = w.mesh()->find_field("temperature")->values;
   const double own_t_max = w.results()->find("T_max")->value;
   const std::size_t folders = ccx_folders();
@@ -2415,8 +2584,7 @@ TEST(Workbench, CalculixTemperatureEqualsBuiltIn) {
       << "CalculiX is for the thermal problem";
   ASSERT_TRUE(w.set_physics(foxi::Physics::thermal));
   ASSERT_TRUE(w.set_solver({true, foxi::LinearSolverKind::automatic}));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_NE(w.results(), nullptr);
   EXPECT_EQ(w.results()->solver, "ccx");
   ASSERT_EQ(w.history().size(), 2u);
@@ -2460,18 +2628,15 @@ TEST(Workbench, CalculixThermalStressEqualsBuiltIn) {
   if (foxi::test::run("command -v ccx > /dev/null") != 0) GTEST_SKIP() << "ccx is not installed";
   const PrivateTmpdir tmpdir;
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml", {200, 150}, Shown::no));
   ASSERT_TRUE(w.set_physics(foxi::Physics::thermal_stress));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   const std::vector<double> own_u = w.mesh()->find_field("displacement")->values;
   const std::vector<double> own_vm = w.mesh()->find_field("von_mises")->values;
   const foxi::RunResults own = *w.results();
   const std::size_t folders = ccx_folders();
   ASSERT_TRUE(w.set_solver({true, foxi::LinearSolverKind::automatic}));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w)) << w.last_error().toStdString();
+  ASSERT_TRUE(solved(w));
   ASSERT_NE(w.results(), nullptr);
   EXPECT_EQ(w.results()->solver, "ccx");
   ASSERT_EQ(w.history().size(), 2u);
@@ -2530,8 +2695,7 @@ TEST(Workbench, SweepFromTheHistoryEqualsFoxiSweep) {
   TempDir dir;
   const std::string model = kModels + "die_on_substrate.toml";
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  ASSERT_TRUE(w.open_model(QString::fromStdString(model)));
+  ASSERT_TRUE(open_window(w, model, {200, 150}, Shown::no));
   QString error;
   const QStringList values = Workbench::sweep_values("2mm", "6mm", 3, &error);
   ASSERT_EQ(values, (QStringList{"2mm", "4mm", "6mm"})) << error.toStdString();
@@ -2567,6 +2731,9 @@ TEST(Workbench, SweepFromTheHistoryEqualsFoxiSweep) {
     const foxi::workbench::HistoryRow& row = w.history()[k];
     ASSERT_EQ(row.parameters.size(), 1u);
     EXPECT_EQ(row.parameters[0].expression, values[int(k)].toStdString());
+    // The mesh settings of the point's mesh: the panel's defaults, as foxi sweep meshes (same tets below).
+    ASSERT_TRUE(row.mesh_settings.has_value());
+    expect_same_settings(*row.mesh_settings, {}, "sweep row");
     std::size_t compared = 0;
     for (std::size_t c = 0; c < names.size(); ++c) {
       if (names[c] == "die_w") {
@@ -2608,11 +2775,8 @@ TEST(Workbench, SweepFromTheHistoryEqualsFoxiSweep) {
 // fraction's picture equals a draw of that many tets from scratch (InteractiveView's undraw rule).
 TEST(ViewWidget, FractionDrawsAndUndraws) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(meshed(w));
   foxi::qt::ViewWidget* v = w.view_widget();
   v->finish_now();
   const std::size_t total = v->view()->total();
@@ -2636,11 +2800,8 @@ TEST(ViewWidget, FractionDrawsAndUndraws) {
 // (looking at the centre of their bounds, computed here from their corners); Back restores all.
 TEST(ViewWidget, RegionOfInterestReframes) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(meshed(w));
   foxi::qt::ViewWidget* v = w.view_widget();
   v->finish_now();
   v->set_fraction(0.2);
@@ -2671,11 +2832,8 @@ TEST(ViewWidget, RegionOfInterestReframes) {
 // right-drag up bring the eye closer); each restarts the draw.
 TEST(ViewWidget, MouseOrbitsPansZooms) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(meshed(w));
   foxi::qt::ViewWidget* v = w.view_widget();
   auto dist = [](const foxi::Camera& c) {
     return std::hypot(c.eye[0] - c.at[0], c.eye[1] - c.at[1], c.eye[2] - c.at[2]);
@@ -2721,13 +2879,9 @@ TEST(ViewWidget, MouseOrbitsPansZooms) {
 // colour shows its centroid value); the status names the order method and the certificate.
 TEST(ViewWidget, ValueUnderTheMouseAndStatus) {
   Workbench w;
-  w.view_widget()->setFixedSize(200, 150);
-  w.show();
-  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml")));
-  ASSERT_TRUE(w.start_mesh());
-  ASSERT_TRUE(wait_job(w));
-  ASSERT_TRUE(w.start_solve());
-  ASSERT_TRUE(wait_job(w));
+  ASSERT_TRUE(open_window(w, kModels + "die_on_substrate.toml"));
+  ASSERT_TRUE(meshed(w));
+  ASSERT_TRUE(solved(w));
   foxi::qt::ViewWidget* v = w.view_widget();
   v->finish_now();
   EXPECT_NE(v->status_text().indexOf("power order, Delaunay certified"), -1)

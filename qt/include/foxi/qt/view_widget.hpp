@@ -160,6 +160,9 @@ class FOXI_API ViewWidget : public QWidget {
   // Puts the widget's state on the view: the selection, or the x-ray or volume over the base; says a
   // change of the composite state. False with the reason when the painter refuses (state kept).
   bool apply(QString* error);
+  // The x-ray and volume flags set and applied (set_xray, set_volume: after their own checks); on a
+  // refusal the old flags come back.
+  bool set_composite(bool xray, bool volume, QString* error);
   void say_composite();  // composite_changed, when what is drawn differs from what it last said
   struct Impl;
   std::unique_ptr<Impl> d_;
