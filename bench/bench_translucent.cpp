@@ -43,9 +43,10 @@
 // cross-multiplication and the pre-integration's 2 -> 1 (slower: 18.7 to 20.5 against 18.0 to 18.6
 // ns, 0.1M); two groups of 8 interleaved (0.1M 16.4 to 19.6 against 19.1 to 20.1 ns, 0.97M 32.7 to
 // 33.2 against 28.7 to 32.8); thin segments from the table's cell (no gathers; 0.97M 29.7 to 32.9
-// against 29.9 to 31.2); tiles of 64x64 and 64x32 pixels. The kernel is bound by its instruction
-// count, not by one unit: the 3.6 ns needs its redesign (rows evaluated directly, 16 float
-// lanes, the pixels of a row contiguous), not trims.
+// against 29.9 to 31.2); tiles of 64x64 and 64x32 pixels; a pre-integration table 4 times smaller
+// (kG 2048, 64 KiB: 19.6 to 24.8 against 19.8 to 24.3 ns, 0.1M; the table's misses are not it).
+// The kernel is bound by its instruction count, not by one unit: the 3.6 ns needs its
+// redesign (rows evaluated directly, 16 float lanes, the pixels of a row contiguous), not trims.
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
