@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <random>
@@ -282,20 +283,21 @@ TEST(Volume, TiledPictureMatchesTheRayCaster) {
   EXPECT_EQ(bad, 0u);
 }
 
-// The vector path (volume_avx512.cpp) and the portable one must give the same picture bit for bit
-// (colours and front ids): this binary run twice, once with FOXI_PORTABLE_RASTER=1, each drawing
-// random Delaunay pictures over several tiles (a light and a dense transfer function: closed-form,
-// thin and stepped segments) and printing a hash of its pictures, which must agree.
-TEST(Volume, VectorPathMatchesThePortableBitForBit) {
-  if (std::getenv("FOXI_VOLUME_PICTURE_HASH")) {  // the child run: draw and print the hash
+// The vector path (volume_avx512.cpp: float, sixteen lanes, the thin segments from the table's grid
+// cell) against the portable one (double, TetSetup::segment and composite()): this binary run twice,
+// once with FOXI_PORTABLE_RASTER=1, each drawing random Delaunay pictures over several tiles (a light
+// and a dense transfer function: closed-form, thin and stepped segments) into a file, which must agree
+// within 1/255 per channel (the float path's errors, volume_impl.hpp, are a small fraction of a
+// level; rounding to 8 bits can turn that into one level, not two) with the same front tet on all but
+// a few pixels (a ray that grazes a tet's edge can miss it in one arithmetic and not the other: at most
+// 1 in 2000 pixels).
+TEST(Volume, VectorPathMatchesThePortable) {
+  if (const char* out = std::getenv("FOXI_VOLUME_PICTURE_OUT")) {  // the child run: draw and write
     test::TempDir dir;
     const Mesh m = test::random_delaunay(dir, 200, 10);
     const SphereTable table = compute_spheres(m);
     const std::vector<double> corner = smooth_field(m);
-    std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the colours and ids
-    auto mix = [&](std::uint32_t v) {
-      for (int k = 0; k < 4; ++k) hash = (hash ^ ((v >> (8 * k)) & 255u)) * 1099511628211ull;
-    };
+    std::string bytes;
     std::size_t samples = 0;
     for (double light : {1.0, 8.0, 0.05}) {
       const VolumeParams p = params_for(m, light);
@@ -303,12 +305,13 @@ TEST(Volume, VectorPathMatchesThePortableBitForBit) {
         const Framebuffer fb =
             paint(m, cam, visibility_order(m, table, view_of(cam)), corner, p, &samples, nullptr, 300, 150);
         for (std::size_t i = 0; i < fb.rgba.size(); ++i) {
-          mix(fb.rgba[i]);
-          mix(fb.id[i]);
+          const std::uint32_t v[2] = {fb.rgba[i], fb.id[i]};
+          bytes.append(reinterpret_cast<const char*>(v), sizeof v);
         }
       }
     }
-    std::printf("picture hash %016llx samples %zu\n", static_cast<unsigned long long>(hash), samples);
+    test::write_text(out, bytes);
+    std::printf("samples %zu\n", samples);
     return;
   }
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -320,21 +323,39 @@ TEST(Volume, VectorPathMatchesThePortableBitForBit) {
 #endif
   test::TempDir dir;
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-  std::string hashes[2];
+  std::string pictures[2];
   for (int portable = 0; portable < 2; ++portable) {
-    const std::filesystem::path log = dir / ("run" + std::to_string(portable));
-    const int rc =
-        test::run("FOXI_VOLUME_PICTURE_HASH=1 FOXI_PORTABLE_RASTER=" + std::to_string(portable) + " '" +
-                      self + "' --gtest_filter=Volume.VectorPathMatchesThePortableBitForBit",
-                  log);
-    const std::string text = test::read_text(log);
-    ASSERT_EQ(rc, 0) << text;
-    const auto at = text.find("picture hash ");
-    ASSERT_NE(at, std::string::npos) << text;
-    hashes[portable] = text.substr(at, text.find('\n', at) - at);
+    const std::filesystem::path log = dir / ("run" + std::to_string(portable)),
+                                out = dir / ("picture" + std::to_string(portable));
+    const int rc = test::run("FOXI_VOLUME_PICTURE_OUT='" + out.string() +
+                                 "' FOXI_PORTABLE_RASTER=" + std::to_string(portable) + " '" + self +
+                                 "' --gtest_filter=Volume.VectorPathMatchesThePortable",
+                             log);
+    ASSERT_EQ(rc, 0) << test::read_text(log);
+    pictures[portable] = test::read_text(out);
   }
-  std::printf("vector: %s\nportable: %s\n", hashes[0].c_str(), hashes[1].c_str());
-  EXPECT_EQ(hashes[0], hashes[1]);
+  ASSERT_EQ(pictures[0].size(), pictures[1].size());
+  ASSERT_GT(pictures[0].size(), 0u);
+  const std::size_t n = pictures[0].size() / 8;
+  std::size_t ids_differ = 0, colours_differ = 0, covered = 0;
+  int worst = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t v[2][2];
+    for (int k = 0; k < 2; ++k) std::memcpy(v[k], pictures[k].data() + 8 * i, 8);
+    ids_differ += v[0][1] != v[1][1];
+    covered += v[1][1] != kNone;
+    int d = 0;
+    for (int c = 0; c < 3; ++c)
+      d = std::max(d, std::abs(int((v[0][0] >> (8 * c)) & 255u) - int((v[1][0] >> (8 * c)) & 255u)));
+    worst = std::max(worst, d);
+    colours_differ += d > 0;
+  }
+  std::printf(
+      "vector against portable: %zu pixels, %zu covered, %zu colours differ (worst %d/255), %zu front ids\n",
+      n, covered, colours_differ, worst, ids_differ);
+  EXPECT_GT(covered, n / 4);
+  EXPECT_LE(worst, 1);
+  EXPECT_LE(ids_differ, n / 2000);
 }
 
 TEST(Volume, SafePictureSaysWhichOrder) {

@@ -60,10 +60,8 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   s.lane_samples.assign(std::size_t(s.lanes), 0);
   s.lane_fast.assign(std::size_t(s.lanes), 0);
   const std::size_t pixels = std::size_t(width) * std::size_t(height);
-  s.acc.resize(pixels);
-  const float bg[3] = {float(params.background & 255u), float((params.background >> 8) & 255u),
-                       float((params.background >> 16) & 255u)};
-  for (Pixel& p : s.acc) p = {{bg[0], bg[1], bg[2]}, kNone};
+  for (int j = 0; j < 3; ++j) s.chan[j].assign(pixels, float((params.background >> (8 * j)) & 255u));
+  s.front.assign(pixels, kNone);
 }
 
 VolumePainter::~VolumePainter() = default;
@@ -109,8 +107,8 @@ void VolumePainter::resolve(Framebuffer& fb) const {
   fb.resize(s.proj.width, s.proj.height, false, s.params.background);
   auto to8 = [](float c) { return std::uint32_t(std::clamp(c, 0.0f, 255.0f) + 0.5f); };
   for (std::size_t p = 0; p < fb.rgba.size(); ++p) {
-    fb.rgba[p] = pack_rgba(to8(s.acc[p].c[0]), to8(s.acc[p].c[1]), to8(s.acc[p].c[2]));
-    fb.id[p] = s.acc[p].front;
+    fb.rgba[p] = pack_rgba(to8(s.chan[0][p]), to8(s.chan[1][p]), to8(s.chan[2][p]));
+    fb.id[p] = s.front[p];
   }
 }
 

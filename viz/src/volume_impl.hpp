@@ -79,6 +79,10 @@ struct TableTransfer {
   bool pre = false;
   double g_lo = 0, g_hi = 0, g_inv = 0, pos_scale = 0;
   std::vector<double> F;
+  // F in float for the vector path (a node's 4 values 16 bytes, a cell's two nodes 32): a difference
+  // over 2 cells keeps about 1/4000 of the whole range's T, and a segment's optical depth errs by at
+  // most about 2.4e-4 of its extinction's largest times its length (a tenth of a level at depth 1).
+  std::vector<float> Ff;
   double slope_lo[4] = {}, slope_hi[4] = {};
   float lut_step = 0;  // the largest difference of two neighbouring colour map entries, one channel
   explicit TableTransfer(const VolumeParams& params);  // volume_transfer.cpp
@@ -128,11 +132,12 @@ bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double
 void composite(const TableTransfer& tf, double v_far, double v_near, double len, float c[3],
                std::size_t& fast);
 
-// Per pixel the colour so far and the nearest tet blended, side by side (16 bytes): a tet's row of
-// pixels touches one run of cache lines, not two.
-struct Pixel {
-  float c[3];
-  std::uint32_t front;
+// The picture so far, one plane per channel and one of the nearest tet blended: a row of a tet's
+// pixels is a contiguous run in each, loaded and stored sixteen at a time by the vector path.
+struct VolumeAcc {
+  float* c[3];
+  std::uint32_t* front;
+  int width;
 };
 
 // A tet's pixels: the ray o + s d of pixel (x, y) (camera frame; perspective: o = 0 and s the depth)
@@ -166,14 +171,34 @@ struct TetSetup {
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define FOXI_VOLUME_AVX512 1
-// Whether this CPU runs volume_pixels_avx512; FOXI_PORTABLE_RASTER=1 says no (the painter's switch),
+// Whether this CPU runs volume_row_avx512; FOXI_PORTABLE_RASTER=1 says no (the painter's switch),
 // so that the tests can compare the two paths on one machine.
 bool volume_avx512();
-// The pixels (xs[i], ys[i]), i < n_px, of tet t into acc (a row of `width` pixels), eight at a time,
-// bit for bit as TetSetup::segment and composite() one at a time (volume_avx512.cpp); count: the
-// pixel segments integrated, fast: of those, the ones in closed form.
-void volume_pixels_avx512(const TetSetup& r, const TableTransfer& tf, Pixel* acc, int width, const int* xs,
-                          const int* ys, int n_px, std::uint32_t t, std::size_t& count, std::size_t& fast);
+// TetSetup in float for the vector path, re-centred where float keeps the tet's own precision: x and
+// y counted from the pixel (xr, yr) of the tet's first row, the ray parameter from the depth s_ref of
+// one of its corners (s' = s - s_ref, so an entry and exit a tet apart differ in their leading bits,
+// not in the last ones of the eye's distance), the field at s_ref in place of the eye's. Each
+// quantity Q is Q0 + (x - xr) Qx + (y - yr) Qy.
+struct RowSetup {
+  float nd[4], ndx[4], ndy[4], num[4], numx[4], numy[4];
+  float v, vx, vy, gd, gdx, gdy, dx, dxx, dy, dyy, dz2, near;
+  int xr, yr;
+  RowSetup(const TetSetup& r, double s_ref, int xr, int yr);  // volume_avx512.cpp
+};
+// A run of a tet's pixels: lo..hi of row y.
+struct PixelRun {
+  int y, lo, hi;
+};
+// The runs of tet t, sixteen float lanes at a time (the runs packed into the lanes one after another),
+// blended into acc: the four planes' ray parameters at each lane's pixel, entry the largest of the
+// front faces', exit the least of the back faces', the pre-integrated closed form in float
+// (volume_avx512.cpp); a segment outside its conditions goes through composite() (double) one pixel
+// at a time. Not bit for bit the portable path: float, and its own thin-segment rule (the grid cell's
+// mean extinction and colour); the tests bound the difference. count: the segments integrated, fast:
+// of those, in closed form.
+void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
+                        const PixelRun* runs, int n_runs, std::uint32_t t, std::size_t& count,
+                        std::size_t& fast);
 #endif
 
 }  // namespace volume_detail
@@ -186,9 +211,10 @@ struct VolumePainter::Impl {
   std::span<const double> corner;
   VolumeParams params;
   int lanes = 1;
-  std::vector<Pixel> acc;
-  bool vector_rows = false;     // volume_row_avx512 for the pixel rows
-  std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
+  std::vector<float> chan[3];        // the colour so far, one plane per channel (VolumeAcc)
+  std::vector<std::uint32_t> front;  // the nearest tet blended per pixel
+  bool vector_rows = false;          // volume_row_avx512 for the pixel rows
+  std::vector<double> cam_xyz;       // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
 
@@ -216,11 +242,10 @@ struct VolumePainter::Impl {
   // The batch's tets into the tiles' lists (tile_start, tile_tets), each list in the batch's order.
   void bin(std::span<const std::uint32_t> tets);
 
-  // A thread's list of the pixels of the tet it draws.
+  // A thread's runs of the tet it draws (the vector path).
   struct Scratch {
-    static constexpr int kRun = 256;
-    alignas(64) int xs[kRun];
-    alignas(64) int ys[kRun];
+    static constexpr int kRuns = 256;
+    PixelRun runs[kRuns];
   };
 
   // Tet t's segments at its pixels inside `tile` blended into acc (volume_setup.cpp).

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "volume_impl.hpp"
 
@@ -96,54 +97,42 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     r.dz2 = d0[2] * d0[2];
     r.near = proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
   }
-  // The tet's pixels (its front faces', which cover its projection once) are listed, then
-  // integrated in runs of kRun: the vector path takes eight pixels of any rows at once.
-  int n_px = 0;
+  // The tet's pixels (its front faces', which cover its projection once), row by row: the vector
+  // path takes a row's run sixteen pixels at a time (its float set-up centred on the tet's first
+  // run), the portable one pixel by pixel.
+  const VolumeAcc va{{chan[0].data(), chan[1].data(), chan[2].data()}, front.data(), proj.width};
+  int n_runs = 0;
+#ifdef FOXI_VOLUME_AVX512
+  std::optional<RowSetup> rs;
+#endif
   auto flush = [&] {
 #ifdef FOXI_VOLUME_AVX512
-    if (vector_rows) {
-      volume_pixels_avx512(r, *transfer, acc.data(), proj.width, scratch.xs, scratch.ys, n_px, t, count,
-                           fast);
-      n_px = 0;
-      return;
-    }
+    if (n_runs > 0) volume_runs_avx512(*rs, *transfer, va, scratch.runs, n_runs, t, count, fast);
 #endif
-    for (int i = 0; i < n_px; ++i) {
-      double v_far, v_near, len;
-      if (!r.segment(scratch.xs[i], scratch.ys[i], v_far, v_near, len))
-        continue;  // a snapped edge pixel the ray misses
-      Pixel& pix = acc[std::size_t(scratch.ys[i]) * std::size_t(proj.width) + std::size_t(scratch.xs[i])];
-      composite(*transfer, v_far, v_near, len, pix.c, fast);
-      pix.front = t;
-      ++count;
-    }
-    n_px = 0;
+    n_runs = 0;
   };
   auto add_run = [&](int y, int lo, int hi) {
     lo = std::max(lo, tile.x0);
     hi = std::min(hi, tile.x1);
-    // Sixteen entries at a time, written whether the run is that long or not (those past hi are left
-    // beyond n_px: the list keeps room for sixteen): a tet's row is rarely longer, so a row is
-    // usually one pass of four vector stores a list.
-    for (int x = lo; x <= hi; x += 16) {
-      if (n_px > Scratch::kRun - 16) flush();
-      int* xs = scratch.xs + n_px;
-      int* ys = scratch.ys + n_px;
-#ifdef __SSE2__
-      __m128i xv = _mm_add_epi32(_mm_set1_epi32(x), _mm_set_epi32(3, 2, 1, 0));
-      const __m128i yv = _mm_set1_epi32(y), four = _mm_set1_epi32(4);
-      for (int k = 0; k < 16; k += 4) {
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(xs + k), xv);
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(ys + k), yv);
-        xv = _mm_add_epi32(xv, four);
-      }
-#else
-      for (int i = 0; i < 16; ++i) {
-        xs[i] = x + i;
-        ys[i] = y;
-      }
+    if (lo > hi) return;
+#ifdef FOXI_VOLUME_AVX512
+    if (vector_rows) {
+      if (!rs) rs.emplace(r, P[0][2], lo, y);
+      if (n_runs == Scratch::kRuns) flush();
+      scratch.runs[n_runs++] = {y, lo, hi};
+      return;
+    }
 #endif
-      n_px += std::min(16, hi - x + 1);
+    const std::size_t row = std::size_t(y) * std::size_t(proj.width);
+    for (int x = lo; x <= hi; ++x) {
+      double v_far, v_near, len;
+      if (!r.segment(x, y, v_far, v_near, len)) continue;  // a snapped edge pixel the ray misses
+      const std::size_t p = row + std::size_t(x);
+      float c[3] = {va.c[0][p], va.c[1][p], va.c[2][p]};
+      composite(*transfer, v_far, v_near, len, c, fast);
+      for (int j = 0; j < 3; ++j) va.c[j][p] = c[j];
+      va.front[p] = t;
+      ++count;
     }
   };
   // No node before the near plane clip_near would use for any face (the usual case): the four

@@ -72,6 +72,7 @@ TableTransfer::TableTransfer(const VolumeParams& params) : p(&params) {
         F[4 * std::size_t(i + 1) + std::size_t(j)] =
             F[4 * std::size_t(i) + std::size_t(j)] + acc[j] * dv / kSub;
     }
+    Ff.assign(F.begin(), F.end());
     const double below = g_lo - 1, above = g_hi + 1;
     float cb[3], ca[3];
     rgb(below, cb);
