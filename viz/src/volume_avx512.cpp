@@ -269,6 +269,68 @@ FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, 
   }
   if (k > 0) group(__mmask16((1u << k) - 1u));
 }
+FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
+                                   const double q[4][2], int x0, int x1, int y0, int y1, std::uint32_t t,
+                                   PixelRun* runs, std::size_t& count, std::size_t& fast) {
+  constexpr double kEps = 1e-6;
+  double y_lo = q[0][1], y_hi = q[0][1];
+  for (int k = 1; k < 4; ++k) {
+    y_lo = std::min(y_lo, q[k][1]);
+    y_hi = std::max(y_hi, q[k][1]);
+  }
+  // The rows whose centre y + 0.5 lies in [y_lo, y_hi] (a millionth wider), within the tile.
+  const int ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5 - kEps, -1.0))));
+  const int yb = int(std::min(double(y1), std::floor(std::min(y_hi - 0.5 + kEps, 1e9))));
+  if (ya > yb) return;
+  // The segments between the corners, from the lower y to the higher: y range, x at its start, dx/dy.
+  double e_y0[6], e_y1[6], e_x0[6], e_slope[6];
+  int n_edges = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
+      const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
+      if (!(b[1] > a[1])) continue;  // level: its ends lie on the other segments
+      e_y0[n_edges] = a[1] - kEps;
+      e_y1[n_edges] = b[1] + kEps;
+      e_x0[n_edges] = a[0];
+      e_slope[n_edges++] = (b[0] - a[0]) / (b[1] - a[1]);
+    }
+  const __m512d iota = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0);
+  const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
+  const __m512d x_first = _mm512_set1_pd(double(x0)), x_last = _mm512_set1_pd(double(x1));
+  const __m512d x_before = _mm512_set1_pd(double(x0) - 1), x_after = _mm512_set1_pd(double(x1) + 1);
+  const __m512d half_lo = _mm512_set1_pd(0.5 + kEps), half_hi = _mm512_set1_pd(0.5 - kEps);
+  int n_runs = 0;
+  for (int y = ya; y <= yb; y += 8) {
+    const __m512d yc = _mm512_add_pd(_mm512_set1_pd(y + 0.5), iota);
+    __m512d lo = inf, hi = _mm512_sub_pd(_mm512_setzero_pd(), inf);
+    for (int k = 0; k < n_edges; ++k) {
+      const __mmask8 in = _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y0[k]), _CMP_GE_OQ) &
+                          _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y1[k]), _CMP_LE_OQ);
+      const __m512d x = _mm512_fmadd_pd(_mm512_sub_pd(yc, _mm512_set1_pd(e_y0[k] + kEps)),
+                                        _mm512_set1_pd(e_slope[k]), _mm512_set1_pd(e_x0[k]));
+      lo = _mm512_mask_min_pd(lo, in, lo, x);
+      hi = _mm512_mask_max_pd(hi, in, hi, x);
+    }
+    // The pixels whose centre x + 0.5 lies in [lo, hi], within the tile (an empty row: lo > hi).
+    lo = _mm512_min_pd(_mm512_max_pd(_mm512_sub_pd(lo, half_lo), x_first), x_after);
+    hi = _mm512_max_pd(_mm512_min_pd(_mm512_sub_pd(hi, half_hi), x_last), x_before);
+    alignas(32) int ilo[8], ihi[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(ilo),
+                       _mm512_cvt_roundpd_epi32(lo, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(ihi),
+                       _mm512_cvt_roundpd_epi32(hi, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+    for (int i = 0; i < 8 && y + i <= yb; ++i) {
+      if (ilo[i] > ihi[i]) continue;
+      if (n_runs == kMaxRuns) {
+        volume_runs_avx512(r, tf, acc, runs, n_runs, t, count, fast);
+        n_runs = 0;
+      }
+      runs[n_runs++] = {y + i, ilo[i], ihi[i]};
+    }
+  }
+  if (n_runs > 0) volume_runs_avx512(r, tf, acc, runs, n_runs, t, count, fast);
+}
 #undef FOXI_TARGET
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop

@@ -185,10 +185,11 @@ struct RowSetup {
   int xr, yr;
   RowSetup(const TetSetup& r, double s_ref, int xr, int yr);  // volume_avx512.cpp
 };
-// A run of a tet's pixels: lo..hi of row y.
+// A run of a tet's pixels: lo..hi of row y; a thread's list holds kMaxRuns.
 struct PixelRun {
   int y, lo, hi;
 };
+constexpr int kMaxRuns = 256;
 // The runs of tet t, sixteen float lanes at a time (the runs packed into the lanes one after another),
 // blended into acc: the four planes' ray parameters at each lane's pixel, entry the largest of the
 // front faces', exit the least of the back faces', the pre-integrated closed form in float
@@ -199,6 +200,14 @@ struct PixelRun {
 void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
                         const PixelRun* runs, int n_runs, std::uint32_t t, std::size_t& count,
                         std::size_t& fast);
+// The same for a tet whose four corners q (pixel coordinates) are all in front of the eye, its runs
+// found here: per row the span of pixel centres inside the projection of the corners (the least and
+// largest x where the row's centre line meets the six segments between them, eight rows at a time,
+// a millionth of a pixel wider either side; each pixel is then decided by its ray), within the tile
+// x0..x1, y0..y1. runs: room for kMaxRuns.
+void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc, const double q[4][2],
+                       int x0, int x1, int y0, int y1, std::uint32_t t, PixelRun* runs, std::size_t& count,
+                       std::size_t& fast);
 #endif
 
 }  // namespace volume_detail
@@ -244,8 +253,7 @@ struct VolumePainter::Impl {
 
   // A thread's runs of the tet it draws (the vector path).
   struct Scratch {
-    static constexpr int kRuns = 256;
-    PixelRun runs[kRuns];
+    PixelRun runs[kMaxRuns];
   };
 
   // Tet t's segments at its pixels inside `tile` blended into acc (volume_setup.cpp).

@@ -118,7 +118,7 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
 #ifdef FOXI_VOLUME_AVX512
     if (vector_rows) {
       if (!rs) rs.emplace(r, P[0][2], lo, y);
-      if (n_runs == Scratch::kRuns) flush();
+      if (n_runs == kMaxRuns) flush();
       scratch.runs[n_runs++] = {y, lo, hi};
       return;
     }
@@ -149,45 +149,14 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
 #ifdef FOXI_VOLUME_AVX512
   if (direct && vector_rows) {
     // The vector path decides each pixel by its ray (entry before exit), so it needs no rasterizer:
-    // per row the span of the pixel centres inside the projection of the four corners (the convex
-    // hull's cross-section: the least and largest x where the row's centre line meets the six
-    // segments between the corners), a millionth of a pixel wider either side.
-    constexpr double kEps = 1e-6;
+    // volume_tet_avx512 takes per row the span of pixel centres inside the projection of the four
+    // corners.
     double q[4][2];
-    double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
-    for (int k = 0; k < 4; ++k) {
-      proj.camera_to_pixel(P[k], q[k]);
-      y_lo = std::min(y_lo, q[k][1]);
-      y_hi = std::max(y_hi, q[k][1]);
-    }
-    struct Edge {
-      double y0, y1, x0, slope;
-    } edge[6];
-    int n_edges = 0;
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) {
-        const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
-        const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
-        if (b[1] > a[1]) edge[n_edges++] = {a[1] - kEps, b[1] + kEps, a[0], (b[0] - a[0]) / (b[1] - a[1])};
-      }
-    const int ya = int(std::max(double(tile.y0), std::ceil(std::max(y_lo - 0.5 - kEps, -1.0))));
-    const int yb = int(std::min(double(tile.y1), std::floor(std::min(y_hi - 0.5 + kEps, 1e9))));
-    for (int y = ya; y <= yb; ++y) {
-      const double yc = y + 0.5;
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (int k = 0; k < n_edges; ++k) {
-        const Edge& ed = edge[k];
-        if (yc >= ed.y0 && yc <= ed.y1) {
-          const double x = ed.x0 + (yc - ed.y0 - kEps) * ed.slope;
-          lo = std::min(lo, x);
-          hi = std::max(hi, x);
-        }
-      }
-      if (!(hi >= lo)) continue;
-      add_run(y, int(std::ceil(std::max(lo - 0.5 - kEps, -1.0))),
-              int(std::floor(std::min(hi - 0.5 + kEps, 1e9))));
-    }
-    flush();
+    for (int k = 0; k < 4; ++k) proj.camera_to_pixel(P[k], q[k]);
+    const int xr = int(std::clamp(q[0][0], double(tile.x0), double(tile.x1)));
+    const int yr = int(std::clamp(q[0][1], double(tile.y0), double(tile.y1)));
+    volume_tet_avx512(RowSetup(r, P[0][2], xr, yr), *transfer, va, q, tile.x0, tile.x1, tile.y0, tile.y1, t,
+                      scratch.runs, count, fast);
     return;
   }
 #endif
