@@ -124,6 +124,7 @@ FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, 
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
   const __m512 iota = _mm512_set_ps(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
   const __m512i tet = _mm512_set1_epi32(int(t));
+  constexpr float kSixth = 1.0f / 6, k24th = 1.0f / 24, k120th = 1.0f / 120;
   const bool pre = tf.pre;
   const __m512 g_inv = _mm512_set1_ps(float(tf.g_inv)), g_off = _mm512_set1_ps(float(tf.g_lo * tf.g_inv));
   const __m512 grid_end = _mm512_set1_ps(float(TableTransfer::kG));
@@ -136,7 +137,7 @@ FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, 
   __mmask16 piece[16];
   int n_pieces = 0;
   __m512 xo = zero, yo = zero;
-  auto group = [&](__mmask16 live) FOXI_TARGET {
+  auto group = [&](__mmask16 live) FOXI_TARGET __attribute__((always_inline)) {
     __m512 s_in = _mm512_set1_ps(r.near), s_out = inf;
     for (int k = 0; k < 4; ++k) {
       const __m512 nd = at(xo, yo, r.nd[k], r.ndx[k], r.ndy[k]);
@@ -211,9 +212,9 @@ FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, 
           __m512 e = _mm512_add_ps(
               _mm512_add_ps(
                   _mm512_sub_ps(one, q),
-                  _mm512_mul_ps(q2, _mm512_fnmadd_ps(q, _mm512_set1_ps(1.0f / 6), _mm512_set1_ps(0.5f)))),
+                  _mm512_mul_ps(q2, _mm512_fnmadd_ps(q, _mm512_set1_ps(kSixth), _mm512_set1_ps(0.5f)))),
               _mm512_mul_ps(_mm512_mul_ps(q2, q2),
-                            _mm512_fnmadd_ps(q, _mm512_set1_ps(1.0f / 120), _mm512_set1_ps(1.0f / 24))));
+                            _mm512_fnmadd_ps(q, _mm512_set1_ps(k120th), _mm512_set1_ps(k24th))));
           e = _mm512_mul_ps(e, e);
           e = _mm512_mul_ps(e, e);
           e = _mm512_mul_ps(e, e);
