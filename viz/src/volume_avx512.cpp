@@ -117,9 +117,12 @@ FOXI_TARGET inline __m512 at(__m512 xo, __m512 yo, float q0, float qx, float qy)
 // pixels at 0.1M tets at 1920 x 1080, fewer at 1M, so a lane group per row would run half empty);
 // each piece of a run in a group keeps its lanes and the address of its first lane's pixel less its
 // lane, so its pixels are one masked load and store per plane.
-FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
-                                    const PixelRun* runs, int n_runs, std::uint32_t t, std::size_t& count,
-                                    std::size_t& fast) {
+namespace {
+
+FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup& r, const TableTransfer& tf,
+                                                                 const VolumeAcc& acc, const PixelRun* runs,
+                                                                 int n_runs, std::uint32_t t, std::size_t& count,
+                                                                 std::size_t& fast) {
   const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), two = _mm512_set1_ps(2.0f);
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
   const __m512 iota = _mm512_set_ps(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
@@ -270,6 +273,14 @@ FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, 
   }
   if (k > 0) group(__mmask16((1u << k) - 1u));
 }
+
+}  // namespace
+
+FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
+                                    const PixelRun* runs, int n_runs, std::uint32_t t, std::size_t& count,
+                                    std::size_t& fast) {
+  runs_impl(r, tf, acc, runs, n_runs, t, count, fast);
+}
 FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
                                    const double q[4][2], int x0, int x1, int y0, int y1, std::uint32_t t,
                                    PixelRun* runs, std::size_t& count, std::size_t& fast) {
@@ -324,13 +335,13 @@ FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, c
     for (int i = 0; i < 8 && y + i <= yb; ++i) {
       if (ilo[i] > ihi[i]) continue;
       if (n_runs == kMaxRuns) {
-        volume_runs_avx512(r, tf, acc, runs, n_runs, t, count, fast);
+        runs_impl(r, tf, acc, runs, n_runs, t, count, fast);
         n_runs = 0;
       }
       runs[n_runs++] = {y + i, ilo[i], ihi[i]};
     }
   }
-  if (n_runs > 0) volume_runs_avx512(r, tf, acc, runs, n_runs, t, count, fast);
+  if (n_runs > 0) runs_impl(r, tf, acc, runs, n_runs, t, count, fast);
 }
 #undef FOXI_TARGET
 #if defined(__GNUC__) && !defined(__clang__)
