@@ -47,6 +47,18 @@
 // (kG 2048, 64 KiB: 19.6 to 24.8 against 19.8 to 24.3 ns, 0.1M; the table's misses are not it).
 // The kernel is bound by its instruction count, not by one unit: the 3.6 ns needs its
 // redesign (rows evaluated directly, 16 float lanes, the pixels of a row contiguous), not trims.
+// The redesign (vol6, same day, viz/src/volume_avx512.cpp): no rasterizer on the AVX-512 path (per
+// row the span of pixel centres in the corners' projection, eight rows at a time), the runs packed
+// into groups of 16 float lanes, reciprocals in place of divisions, the table in float, the picture in
+// one plane per channel. Steps, each against the one before alternately (0.97M, least of 3, load 3 to
+// 5): packed float lanes 21.0 against 26.7 ns (a lane group per row instead: 8 of 16 lanes live at
+// 0.1M, 19.7 against 21.8); the spans in place of raster_triangle 19.5-20.2 against 29.8-30.7; the
+// spans vectorized (their scalar ceil and floor were SSE2 emulations) 14.5-16.0 against 17.2; the
+// lane group inlined (GCC had made it a call) 13.0-14.0 against 15.0-15.4. Final, alternately with
+// the code before it (load 4.8 to 5.0): 0.97M 15.7 to 20.9 ns a segment (1.30 to 1.72 s CPU a frame)
+// against 31.8 to 35.8 (2.63 to 2.96 s), 1.7 to 2.1 times; 0.1M 9.6 to 10.3 against 20.5 to 21.6.
+// Profile after (0.97M): about 55% the spans and lane groups, 10% the per-tet set-up, 7% the tile
+// loop. Still about 5 times the 3.6 ns.
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +

@@ -1,16 +1,19 @@
 // Internal to the volume renderer (volume.hpp): the types its files share. VolumePainter::Impl's
 // members are defined, by concern, in volume.cpp (construction, draw, resolve, draw_volume_picture),
 // volume_tiles.cpp (the screen tiles and the binning of a batch's tets to them), volume_setup.cpp (a
-// tet's set-up, its pixels listed and integrated on the portable path) and volume_avx512.cpp (the
-// same pixels eight at a time); the transfer function, the segment integral and its pre-integrated
-// form are in volume_transfer.cpp.
+// tet's set-up, its pixels rasterized and integrated on the portable path) and volume_avx512.cpp (the
+// vector path: a tet's rows found and integrated sixteen pixels at a time in float); the transfer
+// function, the segment integral and its pre-integrated form are in volume_transfer.cpp.
 //
 // Speed (issue 23): the screen is cut into tiles, a batch's tets binned to the tiles they touch in
 // the batch's order, and each thread takes whole tiles (a tile's pixels stay in its core's cache; no
 // two threads write one pixel; every pixel still sees its tets in order, so a finished batch is the
 // exact picture of the far part); per tet one set-up (its planes, field and rays linear in the
-// pixel's x and y), its pixels listed and integrated eight at a time with AVX-512 where the CPU has
-// it, with the portable path's operations (the same picture bit for bit).
+// pixel's x and y). Where the CPU has AVX-512 the tet's pixel rows are the spans of pixel centres in
+// its corners' projection, packed sixteen to a lane group and each pixel decided by its ray, in float
+// re-centred on the tet (RowSetup); elsewhere its front faces are rasterized with the painter's fixed
+// point and each pixel integrated in double. The two pictures differ by at most a level of 255 on a
+// few pixels (volume_test compares them).
 #pragma once
 
 #include "foxi/viz/volume.hpp"

@@ -1,7 +1,7 @@
 // The volume renderer's per-tet work (volume_impl.hpp): a tet's set-up in the camera frame (its field's
 // gradient, its four outward planes, the ray's planes and field linear in the pixel's x and y), its
 // pixels listed from its front faces with the painter's fixed point and fill rule, and integrated on
-// the portable path (volume_avx512.cpp takes them eight at a time where the CPU can).
+// the portable path (where the CPU has AVX-512, volume_avx512.cpp finds and integrates its rows).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
