@@ -121,8 +121,8 @@ namespace {
 
 FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup& r, const TableTransfer& tf,
                                                                  const VolumeAcc& acc, const PixelRun* runs,
-                                                                 int n_runs, std::uint32_t t, std::size_t& count,
-                                                                 std::size_t& fast) {
+                                                                 int n_runs, std::uint32_t t,
+                                                                 std::size_t& count, std::size_t& fast) {
   const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), two = _mm512_set1_ps(2.0f);
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
   const __m512 iota = _mm512_set_ps(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
@@ -284,15 +284,18 @@ FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, 
 FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
                                    const double q[4][2], int x0, int x1, int y0, int y1, std::uint32_t t,
                                    PixelRun* runs, std::size_t& count, std::size_t& fast) {
-  constexpr double kEps = 1e-6;
   double y_lo = q[0][1], y_hi = q[0][1];
   for (int k = 1; k < 4; ++k) {
     y_lo = std::min(y_lo, q[k][1]);
     y_hi = std::max(y_hi, q[k][1]);
   }
-  // The rows whose centre y + 0.5 lies in [y_lo, y_hi] (a millionth wider), within the tile.
-  const int ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5 - kEps, -1.0))));
-  const int yb = int(std::min(double(y1), std::floor(std::min(y_hi - 0.5 + kEps, 1e9))));
+  // The rows whose centre y + 0.5 lies in [y_lo, y_hi), within the tile. Half-open, as x below: a face
+  // seen edge on bounds no ray (its plane is parallel to them), so the spans alone decide a pixel
+  // centre on its projection, and each goes to one of the two tets beside it (the painter's fill
+  // rule, on the unsnapped corners: both tets compute the shared edge from the same two corners in the
+  // same order, so bit for bit the same x).
+  const int ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5, -1.0))));
+  const int yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
   if (ya > yb) return;
   // The segments between the corners, from the lower y to the higher: y range, x at its start, dx/dy.
   double e_y0[6], e_y1[6], e_x0[6], e_slope[6];
@@ -302,16 +305,16 @@ FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, c
       const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
       const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
       if (!(b[1] > a[1])) continue;  // level: its ends lie on the other segments
-      e_y0[n_edges] = a[1] - kEps;
-      e_y1[n_edges] = b[1] + kEps;
+      e_y0[n_edges] = a[1];
+      e_y1[n_edges] = b[1];
       e_x0[n_edges] = a[0];
       e_slope[n_edges++] = (b[0] - a[0]) / (b[1] - a[1]);
     }
   const __m512d iota = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0);
   const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d x_first = _mm512_set1_pd(double(x0)), x_last = _mm512_set1_pd(double(x1));
-  const __m512d x_before = _mm512_set1_pd(double(x0) - 1), x_after = _mm512_set1_pd(double(x1) + 1);
-  const __m512d half_lo = _mm512_set1_pd(0.5 + kEps), half_hi = _mm512_set1_pd(0.5 - kEps);
+  const __m512d x_after = _mm512_set1_pd(double(x1) + 1);
+  const __m512d half = _mm512_set1_pd(0.5), one = _mm512_set1_pd(1.0);
   int n_runs = 0;
   for (int y = ya; y <= yb; y += 8) {
     const __m512d yc = _mm512_add_pd(_mm512_set1_pd(y + 0.5), iota);
@@ -319,19 +322,22 @@ FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, c
     for (int k = 0; k < n_edges; ++k) {
       const __mmask8 in = _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y0[k]), _CMP_GE_OQ) &
                           _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y1[k]), _CMP_LE_OQ);
-      const __m512d x = _mm512_fmadd_pd(_mm512_sub_pd(yc, _mm512_set1_pd(e_y0[k] + kEps)),
+      const __m512d x = _mm512_fmadd_pd(_mm512_sub_pd(yc, _mm512_set1_pd(e_y0[k])),
                                         _mm512_set1_pd(e_slope[k]), _mm512_set1_pd(e_x0[k]));
       lo = _mm512_mask_min_pd(lo, in, lo, x);
       hi = _mm512_mask_max_pd(hi, in, hi, x);
     }
-    // The pixels whose centre x + 0.5 lies in [lo, hi], within the tile (an empty row: lo > hi).
-    lo = _mm512_min_pd(_mm512_max_pd(_mm512_sub_pd(lo, half_lo), x_first), x_after);
-    hi = _mm512_max_pd(_mm512_min_pd(_mm512_sub_pd(hi, half_hi), x_last), x_before);
+    // The pixels whose centre x + 0.5 lies in [lo, hi): from ceil(lo - 0.5) to ceil(hi - 0.5) - 1,
+    // within the tile (an empty row: first > last).
+    lo = _mm512_min_pd(_mm512_max_pd(_mm512_sub_pd(lo, half), x_first), x_after);
+    hi = _mm512_max_pd(_mm512_min_pd(_mm512_sub_pd(hi, half), _mm512_add_pd(x_last, one)), x_first);
     alignas(32) int ilo[8], ihi[8];
     _mm256_store_si256(reinterpret_cast<__m256i*>(ilo),
                        _mm512_cvt_roundpd_epi32(lo, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(ihi),
-                       _mm512_cvt_roundpd_epi32(hi, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+    _mm256_store_si256(
+        reinterpret_cast<__m256i*>(ihi),
+        _mm256_sub_epi32(_mm512_cvt_roundpd_epi32(hi, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC),
+                         _mm256_set1_epi32(1)));
     for (int i = 0; i < 8 && y + i <= yb; ++i) {
       if (ilo[i] > ihi[i]) continue;
       if (n_runs == kMaxRuns) {

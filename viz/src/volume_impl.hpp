@@ -204,10 +204,10 @@ void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, const Volume
                         const PixelRun* runs, int n_runs, std::uint32_t t, std::size_t& count,
                         std::size_t& fast);
 // The same for a tet whose four corners q (pixel coordinates) are all in front of the eye, its runs
-// found here: per row the span of pixel centres inside the projection of the corners (the least and
-// largest x where the row's centre line meets the six segments between them, eight rows at a time,
-// a millionth of a pixel wider either side; each pixel is then decided by its ray), within the tile
-// x0..x1, y0..y1. runs: room for kMaxRuns.
+// found here: per row the pixel centres inside the projection of the corners (between the least and
+// largest x where the row's centre line meets the six segments between them, eight rows at a time),
+// half-open like the painter's fill rule so that a centre on a face seen edge on (which bounds no
+// ray) goes to one of its two tets; within the tile x0..x1, y0..y1. runs: room for kMaxRuns.
 void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc, const double q[4][2],
                        int x0, int x1, int y0, int y1, std::uint32_t t, PixelRun* runs, std::size_t& count,
                        std::size_t& fast);
