@@ -78,6 +78,7 @@
 
 #include "bench_meshes.hpp"
 #include "foxi/viz/camera.hpp"
+#include "foxi/viz/interactive_view.hpp"
 #include "foxi/viz/rasterizer.hpp"
 #include "foxi/viz/spheres.hpp"
 #include "foxi/viz/translucent.hpp"
@@ -298,9 +299,51 @@ void BM_volume_frame(benchmark::State& state) {
   state.counters["ratio"] = t.total() / base.total();
 }
 
+// The same frames in an interactive view (InteractiveView::set_volume, restart, steps of 40 ms as
+// foxi-view and the workbench take them, the picture asked for after each step as they show it):
+// the progressive order's batches, one resolve per shown picture. Counter one_call_ms: the one-call
+// frame (order + VolumePainter over the whole order) of the same views in the same iterations, and
+// ratio (view / one call).
+void BM_volume_view_frame(benchmark::State& state) {
+  Case& c = get_case();
+  InteractiveView view(c.mesh[0], c.camera, kWidth, kHeight);
+  view.set_volume(c.corner, &c.volume);
+  Framebuffer fb(kWidth, kHeight);
+  std::vector<std::uint32_t> order;
+  double one_call_ms = 0, view_ms = 0;
+  std::size_t shown = 0;
+  int i = 0;
+  for (auto _ : state) {
+    const Camera cam = orbit(c.camera, 7.0 * i++, 0);
+    auto t0 = std::chrono::steady_clock::now();
+    view.set_camera(cam);
+    view.set_running(true);
+    while (view.running()) {
+      view.step(std::chrono::milliseconds(40));
+      benchmark::DoNotOptimize(view.framebuffer().rgba.data());
+      ++shown;
+    }
+    view_ms += ms_since(t0);
+    state.PauseTiming();
+    t0 = std::chrono::steady_clock::now();
+    visibility_order_into(order, c.mesh[0], c.table, view_of(cam));
+    VolumePainter painter(c.mesh[0], cam, kWidth, kHeight, c.corner, c.volume);
+    painter.draw(order);
+    painter.resolve(fb);
+    one_call_ms += ms_since(t0);
+    state.ResumeTiming();
+  }
+  const double iters = double(state.iterations());
+  state.counters["shown"] = double(shown) / iters;
+  state.counters["one_call_ms"] = one_call_ms / iters;
+  state.counters["ratio"] = view_ms / one_call_ms;
+  state.SetLabel("volume in an InteractiveView");
+}
+
 BENCHMARK(BM_opaque_frame)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_translucent_frame)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 BENCHMARK(BM_volume_frame)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(BM_volume_view_frame)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 
 }  // namespace
 

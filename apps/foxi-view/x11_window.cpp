@@ -11,6 +11,7 @@
 #include <sys/shm.h>
 
 #include <algorithm>
+#include <chrono>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -399,7 +400,12 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
     }
     if (quit) break;
     if (viewer.running() && mapped) {
-      viewer.step();
+      // Compositing resolves the whole picture when it is shown (interactive_view.hpp): batches for
+      // up to 40 ms between two showings, so a 1M-tet volume is not a resolve per batch.
+      if (viewer.translucent() || viewer.volume())
+        viewer.step(std::chrono::milliseconds(40));
+      else
+        viewer.step();
       changed = true;
     }
     // "done" once per completed draw (again after an undraw and a draw on), "undrawn" once per

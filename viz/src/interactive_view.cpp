@@ -176,8 +176,7 @@ void InteractiveView::begin_draw() {
     mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
   }
   fb_.resize(width_, height_, params_.depth_buffer && !compositing());
-  if (translucent_painter_) translucent_painter_->resolve(fb_);  // the background
-  if (volume_painter_) volume_painter_->resolve(fb_);
+  resolve_pending_ = compositing();  // the background, when asked for
   damage_all();
   drawn_.clear();
   handed_.clear();
@@ -195,12 +194,25 @@ void InteractiveView::begin_draw() {
 void InteractiveView::composite(std::span<const std::uint32_t> batch) {
   if (translucent_painter_) {
     translucent_painter_->draw(batch);
-    translucent_painter_->resolve(fb_);
   } else {
     volume_painter_->draw(batch);
-    volume_painter_->resolve(fb_);
   }
+  resolve_pending_ = true;
   damage_all();  // the composite painters keep no changed rectangles
+}
+
+void InteractiveView::sync() const {
+  if (!resolve_pending_) return;
+  if (translucent_painter_)
+    translucent_painter_->resolve(fb_);
+  else if (volume_painter_)
+    volume_painter_->resolve(fb_);
+  resolve_pending_ = false;
+}
+
+const Framebuffer& InteractiveView::framebuffer() const {
+  sync();
+  return fb_;
 }
 
 void InteractiveView::recomposite() {
@@ -347,6 +359,7 @@ bool InteractiveView::step() {
   drawn_.insert(drawn_.end(), batch.begin(), batch.end());
   const std::size_t shot = fb_.rgba.size() * 9;  // colour, id and shade per pixel
   if (compositing() && delaunay_ && first_pass && shot_bytes_ + shot <= kShotBudget) {
+    sync();
     shots_.push_back(fb_);
     shot_at_.push_back(drawn_.size());
     shot_bytes_ += shot;
@@ -377,6 +390,7 @@ std::size_t InteractiveView::undraw(std::size_t count) {
     const auto it = std::lower_bound(shot_at_.begin(), shot_at_.end(), drawn_.size());
     if (it != shot_at_.end() && *it == drawn_.size()) {
       fb_ = shots_[std::size_t(it - shot_at_.begin())];  // that prefix's picture, as drawn
+      resolve_pending_ = false;  // the painter holds more: not resolved until it catches up
       damage_all();
       painter_behind_ = true;
     } else {
@@ -411,6 +425,7 @@ bool InteractiveView::step(std::chrono::steady_clock::duration budget) {
 }
 
 std::uint32_t InteractiveView::pick(int x, int y) const {
+  sync();
   if (x < 0 || y < 0 || x >= fb_.width || y >= fb_.height) return kNone;
   return fb_.id[fb_.index(x, y)];
 }
@@ -553,6 +568,6 @@ std::string InteractiveView::camera_options() const {
   return buf;
 }
 
-void InteractiveView::save_png(const std::filesystem::path& path) const { write_png(path, fb_); }
+void InteractiveView::save_png(const std::filesystem::path& path) const { write_png(path, framebuffer()); }
 
 }  // namespace foxi

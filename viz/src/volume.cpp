@@ -104,12 +104,26 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
 
 void VolumePainter::resolve(Framebuffer& fb) const {
   const Impl& s = *impl_;
-  fb.resize(s.proj.width, s.proj.height, false, s.params.background);
-  auto to8 = [](float c) { return std::uint32_t(std::clamp(c, 0.0f, 255.0f) + 0.5f); };
-  for (std::size_t p = 0; p < fb.rgba.size(); ++p) {
-    fb.rgba[p] = pack_rgba(to8(s.chan[0][p]), to8(s.chan[1][p]), to8(s.chan[2][p]));
-    fb.id[p] = s.front[p];
+  const std::size_t pixels = std::size_t(s.proj.width) * std::size_t(s.proj.height);
+  // Every pixel is written below: a framebuffer of the right size is not cleared first (an
+  // interactive view resolves once a shown frame, and at 1920x1080 the clearing cost as much).
+  if (fb.width != s.proj.width || fb.height != s.proj.height || fb.rgba.size() != pixels ||
+      fb.id.size() != pixels || fb.shade.size() != pixels) {
+    fb.resize(s.proj.width, s.proj.height, false, s.params.background);
+  } else {
+    fb.depth.clear();
+    fb.depth_slope.clear();
   }
+  auto to8 = [](float c) { return std::uint32_t(int(std::clamp(c, 0.0f, 255.0f) + 0.5f)); };
+  run_parts(s.lanes, [&](int lane) {
+    const std::size_t p0 = pixels * std::size_t(lane) / std::size_t(s.lanes),
+                      p1 = pixels * std::size_t(lane + 1) / std::size_t(s.lanes);
+    for (std::size_t p = p0; p < p1; ++p) {
+      fb.rgba[p] = pack_rgba(to8(s.chan[0][p]), to8(s.chan[1][p]), to8(s.chan[2][p]));
+      fb.id[p] = s.front[p];
+      fb.shade[p] = 0;
+    }
+  });
 }
 
 std::size_t VolumePainter::pre_integrated() const {

@@ -174,7 +174,9 @@ class FOXI_API InteractiveView {
   bool composite_exact() const { return delaunay_; }
 
   const Camera& camera() const { return camera_; }
-  const Framebuffer& framebuffer() const { return fb_; }
+  // The picture so far. Compositing resolves the painter's picture into it here, when it is asked
+  // for (not after every batch: at 1920x1080 a resolve costs more than a batch of a 1M-tet volume).
+  const Framebuffer& framebuffer() const;
   // The parts of the framebuffer changed since the last call, as disjoint rectangles in row order
   // (all of it after a draw restarts or a resize; none if nothing changed): what a display must
   // update. Per band of 16 rows, the box of what the draw and undraw steps changed there.
@@ -240,7 +242,11 @@ class FOXI_API InteractiveView {
   std::vector<std::size_t> shot_at_;
   std::size_t shot_bytes_ = 0;
   bool painter_behind_ = false;  // fb_ shows a shot: the painter holds more than drawn_
-  Framebuffer fb_;
+  // Compositing: the painter holds batches fb_ does not show yet; sync() resolves them into fb_
+  // (framebuffer(), pick(), save_png(), a shot), so a step costs the batch, not a resolve.
+  mutable bool resolve_pending_ = false;
+  void sync() const;
+  mutable Framebuffer fb_;
   std::vector<PixelRect> damage_;  // see take_damage: per band of 16 rows (x0 > x1: none)
   void add_damage(std::span<const PixelRect> rects);
   void damage_all();
