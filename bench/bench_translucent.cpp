@@ -62,6 +62,13 @@
 // 13.2, 14.8 s a frame against 1.76 s (after) and 3.16 s (before) wall a frame: 6.7 to 8.4 times VTK.
 // After the spans were made half-open (the fill rule; a correctness fix), load 3.8 to 4.5: 20.0 and
 // 21.4 ns a segment against 32.7 and 36.2 before the redesign, alternately.
+//   volume_view_frame     the same frames in an InteractiveView, as foxi-view and the workbench draw them
+//                         (steps of 40 ms, the picture asked for after each), against the one-call
+//                         frame of the same views in the same iterations: one_call_ms, ratio, shown
+//                         (pictures shown a frame). Quiet machine, 2026-11-27: before the view resolved
+//                         lazily 3.7 to 5.0 s a frame (ratio 4.4 to 5.7), after 1.28 to 1.57 s (1.4 to
+//                         1.6). The one-call frame the same day, quiet: 0.86 to 1.05 s wall (18.9 to
+//                         24.6 ns a segment); VTK (volume_vtk.py, 3 frames, quiet) 6.0, 6.2, 7.2 s.
 // S = 0: a package: the box translucent (0.3), an opaque block inside and 8 balls at 0.8 (their
 //        surfaces, the box's boundary); S = 1: ten slabs along x with ten opacities (nine jagged
 //        interfaces through the mesh). Counters: surface_tets, fragments, order_ms, draw_ms (blend +
