@@ -283,6 +283,48 @@ TEST(Volume, TiledPictureMatchesTheRayCaster) {
   EXPECT_EQ(bad, 0u);
 }
 
+// A tet with a face seen nearly edge on: its projection a sliver 0.0024 pixels wide at a pixel
+// centre (which lies 0.0008 pixels outside the top face's projection). The ray through that centre runs
+// 13 units through the tet (in at the sliver face, out at the back), as a brute-force ray says, so
+// the picture must show it. Rasterizing the front faces with the painter's snapped corners (1/256
+// pixel) lost it: the sliver snaps flat and the centre falls on the top face's excluded edge (the
+// portable path drew the flip chip's temperature at 1280x960 with a pixel 5 levels too bright so).
+TEST(Volume, NearlyEdgeOnSliverKeepsItsSegment) {
+  constexpr int W = 32, H = 32;
+  Camera cam;
+  cam.perspective = false;
+  cam.eye[0] = 0, cam.eye[1] = 0, cam.eye[2] = 50;
+  cam.up[0] = 0, cam.up[1] = 1, cam.up[2] = 0;
+  cam.ortho_height = H;  // a pixel a world unit
+  const Projector proj(cam, W, H);
+  // Corners given as pixel coordinates and depth (camera z) a, b, c on the top face, d behind.
+  const double px[4][3] = {{4, 16.4992, 0}, {28, 16.4992, 0}, {16, 4, 0}, {12.5, 16.5016, 20}};
+  Mesh m;
+  for (const auto& q : px) {
+    const double x = (q[0] - proj.cx) / proj.scale, y = -(q[1] - proj.cy) / proj.scale;
+    for (int j = 0; j < 3; ++j)
+      m.xyz.push_back(proj.eye[j] + x * proj.right[j] + y * proj.up[j] + (30 + q[2]) * proj.forward[j]);
+  }
+  m.tet = {0, 1, 2, 3};
+  m.tet_region = {1};
+  for (int k = 0; k < 4; ++k) {  // the corners where they were meant to be
+    double got[2];
+    ASSERT_TRUE(proj.project(&m.xyz[3 * std::size_t(k)], got));
+    ASSERT_NEAR(got[0], px[k][0], 1e-9);
+    ASSERT_NEAR(got[1], px[k][1], 1e-9);
+  }
+  const std::vector<double> corner = {0.0, 0.3, 0.6, 1.2};
+  VolumeParams p = params_for(m);
+  p.unit_length = 4;  // 13 units: most of the way opaque
+  const std::vector<std::uint32_t> one = {0};
+  const Framebuffer want = ray_cast(m, cam, one, corner, p, W, H);
+  ASSERT_NE(want.rgba[want.index(12, 16)], pack_rgba(255, 255, 255)) << "the ray should meet the tet";
+  int worst = 0;
+  const Framebuffer got = paint(m, cam, one, corner, p, nullptr, nullptr, W, H);
+  EXPECT_EQ(differing(got, want, 2, &worst), 0u) << "worst " << worst;
+  EXPECT_EQ(got.rgba[got.index(12, 16)], want.rgba[want.index(12, 16)]);
+}
+
 // The vector path (volume_avx512.cpp: float, sixteen lanes, the thin segments from the table's grid
 // cell) against the portable one (double, TetSetup::segment and composite()): this binary run twice,
 // once with FOXI_PORTABLE_RASTER=1, each drawing random Delaunay pictures over several tiles (a light

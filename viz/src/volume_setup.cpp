@@ -1,6 +1,7 @@
 // The volume renderer's per-tet work (volume_impl.hpp): a tet's set-up in the camera frame (its field's
 // gradient, its four outward planes, the ray's planes and field linear in the pixel's x and y), its
-// pixels listed from its front faces with the painter's fixed point and fill rule, and integrated on
+// pixels listed (the rows' spans of its corners' projection; with a corner behind the eye its front
+// faces clipped and rasterized with the painter's fixed point and fill rule), and integrated on
 // the portable path (where the CPU has AVX-512, volume_avx512.cpp finds and integrates its rows).
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,53 @@
 #include "volume_impl.hpp"
 
 namespace foxi {
+namespace {
+
+// The pixel rows of a tet whose four corners q (pixel coordinates) are all in front of the eye, as
+// volume_tet_avx512 finds them, one row at a time: per row y (its centre line y + 0.5 in [least,
+// largest) of the corners' y) the pixel centres x + 0.5 in [lo, hi), lo and hi the least and largest
+// x where the centre line meets the six segments between the corners (half-open: a centre on a face
+// seen edge on, which bounds no ray, goes to one of the two tets beside it); within x0..x1, y0..y1.
+// fn(y, first, last) per row with pixels.
+template <class Fn>
+void tet_row_spans(const double q[4][2], int x0, int x1, int y0, int y1, Fn&& fn) {
+  double y_lo = q[0][1], y_hi = q[0][1];
+  for (int k = 1; k < 4; ++k) {
+    y_lo = std::min(y_lo, q[k][1]);
+    y_hi = std::max(y_hi, q[k][1]);
+  }
+  const int ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5, -1.0))));
+  const int yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
+  double e_y0[6], e_y1[6], e_x0[6], e_slope[6];
+  int n_edges = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
+      const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
+      if (!(b[1] > a[1])) continue;  // level: its ends lie on the other segments
+      e_y0[n_edges] = a[1];
+      e_y1[n_edges] = b[1];
+      e_x0[n_edges] = a[0];
+      e_slope[n_edges++] = (b[0] - a[0]) / (b[1] - a[1]);
+    }
+  for (int y = ya; y <= yb; ++y) {
+    const double yc = y + 0.5;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int k = 0; k < n_edges; ++k)
+      if (yc >= e_y0[k] && yc <= e_y1[k]) {
+        // fma as the vector path's, so both find the same spans.
+        const double x = std::fma(yc - e_y0[k], e_slope[k], e_x0[k]);
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+    lo = std::min(std::max(lo - 0.5, double(x0)), double(x1) + 1);
+    hi = std::max(std::min(hi - 0.5, double(x1) + 1), double(x0));
+    const int first = int(std::ceil(lo)), last = int(std::ceil(hi)) - 1;
+    if (first <= last) fn(y, first, last);
+  }
+}
+
+}  // namespace
 
 void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& scratch, std::size_t& count,
                                    std::size_t& fast) {
@@ -161,24 +209,15 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   }
 #endif
   if (direct) {
-    std::int64_t X4[4], Y4[4];
-    for (int k = 0; k < 4; ++k) {
-      double q[2];
-      proj.camera_to_pixel(P[k], q);
-      X4[k] = to_fixed(q[0]);
-      Y4[k] = to_fixed(q[1]);
-    }
-    // Three front faces: the one back face covers the same projection (the three meet at the
-    // projection of its opposite corner), one triangle to rasterize in place of three.
-    const bool back_only = front_count == 3;
-    for (int f = 0; f < 4; ++f) {
-      if (facing[f] == back_only) continue;
-      const std::int64_t X[3] = {X4[kFace[f][0]], X4[kFace[f][1]], X4[kFace[f][2]]},
-                         Y[3] = {Y4[kFace[f][0]], Y4[kFace[f][1]], Y4[kFace[f][2]]};
-      for_each_fan_triangle(X, Y, 3, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
-        raster_triangle(TX, TY, proj.width, proj.height, rows, add_run);
-      });
-    }
+    // The pixels whose ray may meet the tet: the rows' spans of pixel centres inside the projection
+    // of its four corners, unsnapped, as the vector path finds them; the ray decides each pixel
+    // (segment()). Not its front faces rasterized with the painter's snapped corners: where a face is
+    // seen nearly edge on, a pixel centre a thousandth of a pixel inside the projection can fall
+    // outside the snapped one while its ray runs a long way through the tet (a segment lost: the
+    // flip chip's temperature at 1280x960 had a pixel 5 levels too bright).
+    double q[4][2];
+    for (int k = 0; k < 4; ++k) proj.camera_to_pixel(P[k], q[k]);
+    tet_row_spans(q, tile.x0, tile.x1, tile.y0, tile.y1, add_run);
     flush();
     return;
   }
