@@ -11,8 +11,9 @@
 // exact picture of the far part); per tet one set-up (its planes, field and rays linear in the
 // pixel's x and y). Where the CPU has AVX-512 the tet's pixel rows are the spans of pixel centres in
 // its corners' projection, packed sixteen to a lane group and each pixel decided by its ray, in float
-// re-centred on the tet (RowSetup); elsewhere its front faces are rasterized with the painter's fixed
-// point and each pixel integrated in double. The two pictures differ by at most a level of 255 on a
+// re-centred on the tet (RowSetup); elsewhere the same spans one row at a time and each pixel
+// integrated in double (a tet with a corner behind the eye: its clipped front faces rasterized with
+// the painter's fixed point, on both paths). The two pictures differ by at most a level of 255 on a
 // few pixels (volume_test compares them).
 #pragma once
 
