@@ -322,8 +322,11 @@ FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, c
     for (int k = 0; k < n_edges; ++k) {
       const __mmask8 in = _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y0[k]), _CMP_GE_OQ) &
                           _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y1[k]), _CMP_LE_OQ);
-      const __m512d x = _mm512_fmadd_pd(_mm512_sub_pd(yc, _mm512_set1_pd(e_y0[k])),
-                                        _mm512_set1_pd(e_slope[k]), _mm512_set1_pd(e_x0[k]));
+      // On a grid of 2^-15 pixel (volume_setup.cpp's tet_row_spans says why), rounded to nearest.
+      const __m512d x =
+          _mm512_roundscale_pd(_mm512_fmadd_pd(_mm512_sub_pd(yc, _mm512_set1_pd(e_y0[k])),
+                                               _mm512_set1_pd(e_slope[k]), _mm512_set1_pd(e_x0[k])),
+                               (15 << 4) | _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
       lo = _mm512_mask_min_pd(lo, in, lo, x);
       hi = _mm512_mask_max_pd(hi, in, hi, x);
     }

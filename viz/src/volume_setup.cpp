@@ -46,8 +46,12 @@ void tet_row_spans(const double q[4][2], int x0, int x1, int y0, int y1, Fn&& fn
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (int k = 0; k < n_edges; ++k)
       if (yc >= e_y0[k] && yc <= e_y1[k]) {
-        // fma as the vector path's, so both find the same spans.
-        const double x = std::fma(yc - e_y0[k], e_slope[k], e_x0[k]);
+        // fma as the vector path's, so both find the same spans; then on a grid of 2^-15 pixel
+        // (nearest), as the vector path's roundscale: where a face is seen edge on its three edges
+        // are one line, and their x here differ in the last bits; the tets either side of it take
+        // the least and the largest of them, so with a pixel centre on the line both could take it
+        // (or neither). On the grid they agree, and the half-open rule gives it to one.
+        const double x = std::nearbyint(std::fma(yc - e_y0[k], e_slope[k], e_x0[k]) * 32768.0) / 32768.0;
         lo = std::min(lo, x);
         hi = std::max(hi, x);
       }
@@ -193,6 +197,29 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     double near_clip = std::max(params.near, dmax * proj.focal / kMaxPixel);
     if (!(near_clip > 0)) near_clip = 1e-300;
     for (int k = 0; k < 4; ++k) direct = direct && P[k][2] >= near_clip;
+  }
+  if (direct) {
+    // A face's plane through the eye (perspective) or along the rays (orthographic), to a millionth
+    // of the tet's distance (a structured grid seen from one of its planes, to within rounding):
+    // every ray meets that plane at the eye or lies in it, so it bounds no segment, and which side of
+    // it a pixel's ray is on is which side of its projection, a line, the pixel is on: what the spans
+    // below decide (half-open, so a pixel centre on the line goes to one of the two tets beside it).
+    // Its ray parameter would be a ratio of rounding errors (in float on the vector path), and a
+    // pixel on that line could lose its tet or get it twice. (A face the eye is a millionth off sees
+    // rays cross it at a millionth of a radian: a sliver of projection a thousandth of a pixel wide,
+    // whose pixels would be counted in both tets; so rare, and so thin, that it is left.)
+    double reach2 = 1;  // the squared distance scale: the farthest corner's (perspective)
+    if (proj.perspective) {
+      reach2 = 0;
+      for (int k = 0; k < 4; ++k)
+        reach2 = std::max(reach2, P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]);
+    }
+    for (int k = 0; k < 4; ++k) {
+      const double nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
+      const double off = proj.perspective ? h[k] : n[k][2];  // the eye's offset, or the rays'
+      if (off * off <= 1e-12 * nn * reach2)
+        r.ndA[k] = r.ndB[k] = r.ndC[k] = r.numA[k] = r.numB[k] = r.numC[k] = 0;
+    }
   }
 #ifdef FOXI_VOLUME_AVX512
   if (direct && vector_rows) {
