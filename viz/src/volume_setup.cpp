@@ -27,6 +27,7 @@ void tet_row_spans(const double q[4][2], int x0, int x1, int y0, int y1, Fn&& fn
     y_lo = std::min(y_lo, q[k][1]);
     y_hi = std::max(y_hi, q[k][1]);
   }
+  if (!(y_lo <= y_hi)) return;  // a corner not a number (no pixel; the casts below need numbers)
   const int ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5, -1.0))));
   const int yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
   double e_y0[6], e_y1[6], e_x0[6], e_slope[6];
@@ -55,6 +56,7 @@ void tet_row_spans(const double q[4][2], int x0, int x1, int y0, int y1, Fn&& fn
         lo = std::min(lo, x);
         hi = std::max(hi, x);
       }
+    if (!(lo <= hi)) continue;  // no segment crosses the row's centre line (or not a number)
     lo = std::min(std::max(lo - 0.5, double(x0)), double(x1) + 1);
     hi = std::max(std::min(hi - 0.5, double(x1) + 1), double(x0));
     const int first = int(std::ceil(lo)), last = int(std::ceil(hi)) - 1;
