@@ -62,6 +62,12 @@
 // 13.2, 14.8 s a frame against 1.76 s (after) and 3.16 s (before) wall a frame: 6.7 to 8.4 times VTK.
 // After the spans were made half-open (the fill rule; a correctness fix), load 3.8 to 4.5: 20.0 and
 // 21.4 ns a segment against 32.7 and 36.2 before the redesign, alternately.
+// Where the one-call frame's CPU goes (2026-11-27, 0.97M, quiet; the painter cut short by a switch
+// at each stage, least of 3): about 170 ms the fixed costs (painter, binning, tile loop, resolve),
+// 290 ms the per-tet set-up (draw_tet, double), 240 ms the rows' spans and RowSetup, 1160 ms the lane
+// groups, of about 1860 ms. Tried that day and no faster beyond the noise (so not kept): the
+// pre-integration grid 4 times coarser (kG 2048: 32 KiB in float, in L1), a fixed 3, 4 or 6 pieces a
+// lane group (masked loads and stores with no data-dependent loop).
 //   volume_view_frame     the same frames in an InteractiveView, as foxi-view and the workbench draw them
 //                         (steps of 40 ms, the picture asked for after each), against the one-call
 //                         frame of the same views in the same iterations: one_call_ms, ratio, shown
