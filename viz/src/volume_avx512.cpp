@@ -284,32 +284,10 @@ FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, 
 FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
                                    const double q[4][2], int x0, int x1, int y0, int y1, std::uint32_t t,
                                    PixelRun* runs, std::size_t& count, std::size_t& fast) {
-  double y_lo = q[0][1], y_hi = q[0][1];
-  for (int k = 1; k < 4; ++k) {
-    y_lo = std::min(y_lo, q[k][1]);
-    y_hi = std::max(y_hi, q[k][1]);
-  }
-  // The rows whose centre y + 0.5 lies in [y_lo, y_hi), within the tile. Half-open, as x below: a face
-  // seen edge on bounds no ray (its plane is parallel to them), so the spans alone decide a pixel
-  // centre on its projection, and each goes to one of the two tets beside it (the painter's fill
-  // rule, on the unsnapped corners: both tets compute the shared edge from the same two corners in the
-  // same order, so bit for bit the same x).
-  const int ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5, -1.0))));
-  const int yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
-  if (ya > yb) return;
-  // The segments between the corners, from the lower y to the higher: y range, x at its start, dx/dy.
-  double e_y0[6], e_y1[6], e_x0[6], e_slope[6];
-  int n_edges = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) {
-      const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
-      const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
-      if (!(b[1] > a[1])) continue;  // level: its ends lie on the other segments
-      e_y0[n_edges] = a[1];
-      e_y1[n_edges] = b[1];
-      e_x0[n_edges] = a[0];
-      e_slope[n_edges++] = (b[0] - a[0]) / (b[1] - a[1]);
-    }
+  // The rows and the corners' segments (corner_edges, shared with the portable path's tet_row_spans).
+  CornerEdges e;
+  if (!corner_edges(q, y0, y1, e)) return;
+  const int ya = e.ya, yb = e.yb, n_edges = e.n;
   const __m512d iota = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0);
   const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());
   const __m512d x_first = _mm512_set1_pd(double(x0)), x_last = _mm512_set1_pd(double(x1));
@@ -320,12 +298,12 @@ FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, c
     const __m512d yc = _mm512_add_pd(_mm512_set1_pd(y + 0.5), iota);
     __m512d lo = inf, hi = _mm512_sub_pd(_mm512_setzero_pd(), inf);
     for (int k = 0; k < n_edges; ++k) {
-      const __mmask8 in = _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y0[k]), _CMP_GE_OQ) &
-                          _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e_y1[k]), _CMP_LE_OQ);
+      const __mmask8 in = _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e.y0[k]), _CMP_GE_OQ) &
+                          _mm512_cmp_pd_mask(yc, _mm512_set1_pd(e.y1[k]), _CMP_LE_OQ);
       // On a grid of 2^-15 pixel (volume_setup.cpp's tet_row_spans says why), rounded to nearest.
       const __m512d x =
-          _mm512_roundscale_pd(_mm512_fmadd_pd(_mm512_sub_pd(yc, _mm512_set1_pd(e_y0[k])),
-                                               _mm512_set1_pd(e_slope[k]), _mm512_set1_pd(e_x0[k])),
+          _mm512_roundscale_pd(_mm512_fmadd_pd(_mm512_sub_pd(yc, _mm512_set1_pd(e.y0[k])),
+                                               _mm512_set1_pd(e.slope[k]), _mm512_set1_pd(e.x0[k])),
                                (15 << 4) | _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
       lo = _mm512_mask_min_pd(lo, in, lo, x);
       hi = _mm512_mask_max_pd(hi, in, hi, x);

@@ -173,6 +173,41 @@ struct TetSetup {
   }
 };
 
+// A tet's rows of pixels from its four corners q (pixel coordinates, all in front of the eye), as both
+// paths find them: the rows ya..yb whose centre line y + 0.5 lies in [least, largest) of the corners'
+// y, within y0..y1 (half-open, as x: a face seen edge on bounds no ray, so the spans alone decide a
+// pixel centre on its projection, and each goes to one of the two tets beside it, the painter's fill
+// rule on the unsnapped corners), and the segments between the corners from the lower y to the
+// higher (y range, x at its start, dx/dy; level ones left out: their ends lie on the others). False
+// for no row (or a corner not a number: the casts need numbers).
+struct CornerEdges {
+  int ya = 0, yb = -1, n = 0;
+  double y0[6], y1[6], x0[6], slope[6];
+};
+inline bool corner_edges(const double q[4][2], int y0, int y1, CornerEdges& e) {
+  double y_lo = q[0][1], y_hi = q[0][1];
+  for (int k = 1; k < 4; ++k) {
+    y_lo = std::min(y_lo, q[k][1]);
+    y_hi = std::max(y_hi, q[k][1]);
+  }
+  if (!(y_lo <= y_hi)) return false;
+  e.ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5, -1.0))));
+  e.yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
+  if (e.ya > e.yb) return false;
+  e.n = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
+      const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
+      if (!(b[1] > a[1])) continue;
+      e.y0[e.n] = a[1];
+      e.y1[e.n] = b[1];
+      e.x0[e.n] = a[0];
+      e.slope[e.n++] = (b[0] - a[0]) / (b[1] - a[1]);
+    }
+  return true;
+}
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define FOXI_VOLUME_AVX512 1
 // Whether this CPU runs volume_row_avx512; FOXI_PORTABLE_RASTER=1 says no (the painter's switch),

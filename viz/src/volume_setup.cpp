@@ -22,37 +22,19 @@ namespace {
 // fn(y, first, last) per row with pixels.
 template <class Fn>
 void tet_row_spans(const double q[4][2], int x0, int x1, int y0, int y1, Fn&& fn) {
-  double y_lo = q[0][1], y_hi = q[0][1];
-  for (int k = 1; k < 4; ++k) {
-    y_lo = std::min(y_lo, q[k][1]);
-    y_hi = std::max(y_hi, q[k][1]);
-  }
-  if (!(y_lo <= y_hi)) return;  // a corner not a number (no pixel; the casts below need numbers)
-  const int ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5, -1.0))));
-  const int yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
-  double e_y0[6], e_y1[6], e_x0[6], e_slope[6];
-  int n_edges = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) {
-      const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
-      const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
-      if (!(b[1] > a[1])) continue;  // level: its ends lie on the other segments
-      e_y0[n_edges] = a[1];
-      e_y1[n_edges] = b[1];
-      e_x0[n_edges] = a[0];
-      e_slope[n_edges++] = (b[0] - a[0]) / (b[1] - a[1]);
-    }
-  for (int y = ya; y <= yb; ++y) {
+  CornerEdges e;
+  if (!corner_edges(q, y0, y1, e)) return;
+  for (int y = e.ya; y <= e.yb; ++y) {
     const double yc = y + 0.5;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (int k = 0; k < n_edges; ++k)
-      if (yc >= e_y0[k] && yc <= e_y1[k]) {
+    for (int k = 0; k < e.n; ++k)
+      if (yc >= e.y0[k] && yc <= e.y1[k]) {
         // fma as the vector path's, so both find the same spans; then on a grid of 2^-15 pixel
         // (nearest), as the vector path's roundscale: where a face is seen edge on its three edges
         // are one line, and their x here differ in the last bits; the tets either side of it take
         // the least and the largest of them, so with a pixel centre on the line both could take it
         // (or neither). On the grid they agree, and the half-open rule gives it to one.
-        const double x = std::nearbyint(std::fma(yc - e_y0[k], e_slope[k], e_x0[k]) * 32768.0) / 32768.0;
+        const double x = std::nearbyint(std::fma(yc - e.y0[k], e.slope[k], e.x0[k]) * 32768.0) / 32768.0;
         lo = std::min(lo, x);
         hi = std::max(hi, x);
       }
@@ -192,10 +174,16 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   // No node before the near plane clip_near would use for any face (the usual case): the four
   // corners snapped once, each front face from them (the same corners snap_polygon would give).
   bool direct = !inside;
-  if (direct && proj.perspective) {
-    double dmax = 0;
+  // The farthest corner's squared distance from the eye (perspective; 1 orthographic): the near
+  // plane's scale here and the distance scale below.
+  double reach2 = 1;
+  if (proj.perspective) {
+    reach2 = 0;
     for (int k = 0; k < 4; ++k)
-      dmax = std::max(dmax, std::sqrt(P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]));
+      reach2 = std::max(reach2, P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]);
+  }
+  if (direct && proj.perspective) {
+    const double dmax = std::sqrt(reach2);
     double near_clip = std::max(params.near, dmax * proj.focal / kMaxPixel);
     if (!(near_clip > 0)) near_clip = 1e-300;
     for (int k = 0; k < 4; ++k) direct = direct && P[k][2] >= near_clip;
@@ -210,12 +198,6 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     // pixel on that line could lose its tet or get it twice. (A face the eye is a millionth off sees
     // rays cross it at a millionth of a radian: a sliver of projection a thousandth of a pixel wide,
     // whose pixels would be counted in both tets; so rare, and so thin, that it is left.)
-    double reach2 = 1;  // the squared distance scale: the farthest corner's (perspective)
-    if (proj.perspective) {
-      reach2 = 0;
-      for (int k = 0; k < 4; ++k)
-        reach2 = std::max(reach2, P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]);
-    }
     for (int k = 0; k < 4; ++k) {
       const double nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
       const double off = proj.perspective ? h[k] : n[k][2];  // the eye's offset, or the rays'
