@@ -119,6 +119,85 @@ FOXI_TARGET inline __m512 at(__m512 xo, __m512 yo, float q0, float qx, float qy)
 // lane, so its pixels are one masked load and store per plane.
 namespace {
 
+// A lane group between its two halves (runs_impl): after the first (the rays' entry and exit, the
+// field at both ends, the pre-integration table's cells), before the second (the table's rows, the
+// integral, the picture).
+struct StagedGroup {
+  alignas(64) int cell_a[16];
+  alignas(64) int cell_b[16];
+  alignas(64) float fa[16], fb[16], len[16], dv[16], adv[16], v_far[16], v_near[16];
+  std::ptrdiff_t base[16];
+  __mmask16 piece[16];
+  int n_pieces = 0;
+  __mmask16 live = 0, m = 0, thin = 0;
+};
+
+// A group's second half (runs_impl): the table rows, the integral and the picture.
+FOXI_TARGET __attribute__((always_inline)) inline void second_half(const StagedGroup& s,
+                                                                   const TableTransfer& tf,
+                                                                   const VolumeAcc& acc, std::size_t& fast) {
+  const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+  constexpr float kSixth = 1.0f / 6, k24th = 1.0f / 24, k120th = 1.0f / 120;
+  __mmask16 done = 0;
+  if (const __mmask16 m = s.m) {
+    __m512 na[8], nb[8];
+    table_rows(tf.Ff.data(), s.cell_a, na);
+    table_rows(tf.Ff.data(), s.cell_b, nb);
+    const __m512 fa = _mm512_load_ps(s.fa), fb = _mm512_load_ps(s.fb);
+    __m512 a[4], b[4];
+    for (int j = 0; j < 4; ++j) {
+      a[j] = _mm512_fmadd_ps(fa, _mm512_sub_ps(na[j + 4], na[j]), na[j]);
+      b[j] = _mm512_fmadd_ps(fb, _mm512_sub_ps(nb[j + 4], nb[j]), nb[j]);
+    }
+    // integrate_fast's closed piece: D = length dT / dv; D == 0 blends nothing; 0 < D <= 1 with
+    // spread D^2 <= 1 (a thin segment: D <= 1) in closed form.
+    const __m512 spread_a = _mm512_set1_ps(float(tf.pos_scale * 256 * tf.lut_step)),
+                 spread_b = _mm512_set1_ps(tf.lut_step), c255 = _mm512_set1_ps(255.0f);
+    const __m512 dT = _mm512_sub_ps(b[0], a[0]);
+    const __m512 D = _mm512_mul_ps(_mm512_mul_ps(_mm512_load_ps(s.len), dT), recip(_mm512_load_ps(s.dv)));
+    const __mmask16 none = m & _mm512_cmp_ps_mask(D, zero, _CMP_EQ_OQ);
+    const __m512 spread = _mm512_min_ps(c255, _mm512_fmadd_ps(_mm512_load_ps(s.adv), spread_a, spread_b));
+    __mmask16 blend = m & _mm512_cmp_ps_mask(D, zero, _CMP_GT_OQ);
+    blend &= _mm512_cmp_ps_mask(D, one, _CMP_LE_OQ);
+    blend &=
+        __mmask16(s.thin | _mm512_cmp_ps_mask(_mm512_mul_ps(_mm512_mul_ps(spread, D), D), one, _CMP_LE_OQ));
+    if (blend) {
+      // exp_neg_small(D) in float: (e^-D/8)^8, e^-q by its series to q^5.
+      const __m512 q = _mm512_mul_ps(_mm512_set1_ps(0.125f), D), q2 = _mm512_mul_ps(q, q);
+      __m512 e = _mm512_add_ps(
+          _mm512_add_ps(_mm512_sub_ps(one, q),
+                        _mm512_mul_ps(q2, _mm512_fnmadd_ps(q, _mm512_set1_ps(kSixth), _mm512_set1_ps(0.5f)))),
+          _mm512_mul_ps(_mm512_mul_ps(q2, q2),
+                        _mm512_fnmadd_ps(q, _mm512_set1_ps(k120th), _mm512_set1_ps(k24th))));
+      e = _mm512_mul_ps(e, e);
+      e = _mm512_mul_ps(e, e);
+      e = _mm512_mul_ps(e, e);
+      // (K_b - K_a) (1 - e) / dT + c e.
+      const __m512 w = _mm512_mul_ps(_mm512_sub_ps(one, e), recip(dT));
+      for (int j = 0; j < 3; ++j) {
+        float* plane = acc.c[j];
+        __m512 c = zero;
+        for (int p = 0; p < s.n_pieces; ++p)
+          c = _mm512_mask_loadu_ps(c, blend & s.piece[p], plane + s.base[p]);
+        c = _mm512_fmadd_ps(_mm512_sub_ps(b[j + 1], a[j + 1]), w, _mm512_mul_ps(c, e));
+        for (int p = 0; p < s.n_pieces; ++p) _mm512_mask_storeu_ps(plane + s.base[p], blend & s.piece[p], c);
+      }
+    }
+    done = __mmask16(blend | none);
+    fast += std::size_t(__builtin_popcount(done));
+  }
+  if (const __mmask16 rest = __mmask16(s.live & ~done)) {
+    for (int p = 0; p < s.n_pieces; ++p)
+      for (int i = 0; i < 16; ++i)
+        if ((rest & s.piece[p]) >> i & 1) {
+          const std::ptrdiff_t q = s.base[p] + i;
+          float c[3] = {acc.c[0][q], acc.c[1][q], acc.c[2][q]};
+          composite(tf, s.v_far[i], s.v_near[i], s.len[i], c, fast);
+          for (int j = 0; j < 3; ++j) acc.c[j][q] = c[j];
+        }
+  }
+}
+
 FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup& r, const TableTransfer& tf,
                                                                  const VolumeAcc& acc, const PixelRun* runs,
                                                                  int n_runs, std::uint32_t t,
@@ -127,20 +206,16 @@ FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup&
   const __m512 inf = _mm512_set1_ps(std::numeric_limits<float>::infinity());
   const __m512 iota = _mm512_set_ps(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
   const __m512i tet = _mm512_set1_epi32(int(t));
-  constexpr float kSixth = 1.0f / 6, k24th = 1.0f / 24, k120th = 1.0f / 120;
   const bool pre = tf.pre;
-  const __m512 g_inv = _mm512_set1_ps(float(tf.g_inv)), g_off = _mm512_set1_ps(float(tf.g_lo * tf.g_inv));
-  const __m512 grid_end = _mm512_set1_ps(float(TableTransfer::kG));
-  const __m512i last_cell = _mm512_set1_epi32(TableTransfer::kG - 1);
-  const __m512 cell_w = _mm512_set1_ps(float((tf.g_hi - tf.g_lo) / TableTransfer::kG));
-  const __m512 spread_a = _mm512_set1_ps(float(tf.pos_scale * 256 * tf.lut_step)),
-               spread_b = _mm512_set1_ps(tf.lut_step), c255 = _mm512_set1_ps(255.0f);
-  // The group's pieces: lanes `mask`, pixel index of lane i = base + i.
-  std::ptrdiff_t base[16];
-  __mmask16 piece[16];
-  int n_pieces = 0;
+  // Each group's first half, then the second half of the group before it: the two chains are
+  // independent, so the core overlaps them (one group at a time waited on its table rows and
+  // pixels: the pipelined groups took about 9% less CPU, measured alternately in one process).
+  StagedGroup st[2];
+  int cur = 0;
+  bool have_prev = false;
   __m512 xo = zero, yo = zero;
-  auto group = [&](__mmask16 live) FOXI_TARGET __attribute__((always_inline)) {
+  // The first half of the group in st[cur]: false where no lane's ray meets the tet.
+  auto first = [&](StagedGroup & s, __mmask16 live) FOXI_TARGET __attribute__((always_inline)) {
     __m512 s_in = _mm512_set1_ps(r.near), s_out = inf;
     for (int k = 0; k < 4; ++k) {
       const __m512 nd = at(xo, yo, r.nd[k], r.ndx[k], r.ndy[k]);
@@ -150,10 +225,10 @@ FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup&
       s_out = _mm512_mask_min_ps(s_out, _mm512_cmp_ps_mask(nd, zero, _CMP_GT_OQ), sk, s_out);
     }
     live &= _mm512_cmp_ps_mask(s_out, s_in, _CMP_GT_OQ);
-    if (!live) return;
+    if (!live) return false;
     count += std::size_t(__builtin_popcount(live));
-    for (int p = 0; p < n_pieces; ++p)
-      _mm512_mask_storeu_epi32(acc.front + base[p], __mmask16(live & piece[p]), tet);
+    for (int p = 0; p < s.n_pieces; ++p)
+      _mm512_mask_storeu_epi32(acc.front + s.base[p], __mmask16(live & s.piece[p]), tet);
     const __m512 v0 = at(xo, yo, r.v, r.vx, r.vy), gd = at(xo, yo, r.gd, r.gdx, r.gdy);
     const __m512 dxv = _mm512_fmadd_ps(xo, _mm512_set1_ps(r.dxx), _mm512_set1_ps(r.dx));
     const __m512 dyv = _mm512_fmadd_ps(yo, _mm512_set1_ps(r.dyy), _mm512_set1_ps(r.dy));
@@ -161,8 +236,15 @@ FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup&
         _mm512_sub_ps(s_out, s_in),
         _mm512_sqrt_ps(_mm512_fmadd_ps(dxv, dxv, _mm512_fmadd_ps(dyv, dyv, _mm512_set1_ps(r.dz2)))));
     const __m512 v_far = _mm512_fmadd_ps(s_out, gd, v0), v_near = _mm512_fmadd_ps(s_in, gd, v0);
-    __mmask16 done = 0;
+    _mm512_store_ps(s.len, len);
+    _mm512_store_ps(s.v_far, v_far);
+    _mm512_store_ps(s.v_near, v_near);
+    s.live = live;
+    s.m = 0;
     if (pre) {
+      const __m512 g_inv = _mm512_set1_ps(float(tf.g_inv)), g_off = _mm512_set1_ps(float(tf.g_lo * tf.g_inv));
+      const __m512 grid_end = _mm512_set1_ps(float(TableTransfer::kG));
+      const __m512i last_cell = _mm512_set1_epi32(TableTransfer::kG - 1);
       const __m512 dv = _mm512_sub_ps(v_near, v_far);
       const __m512 adv = _mm512_abs_ps(dv);
       const __m512 cells = _mm512_mul_ps(adv, g_inv);
@@ -174,81 +256,35 @@ FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup&
                                              _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
       xa = _mm512_mask_mov_ps(xa, thin, xm);
       xb = _mm512_mask_add_ps(xb, thin, xm, one);
+      const __m512 cell_w = _mm512_set1_ps(float((tf.g_hi - tf.g_lo) / TableTransfer::kG));
       const __m512 dv_eff = _mm512_mask_mov_ps(dv, thin, cell_w);
       __mmask16 m = live & _mm512_cmp_ps_mask(xa, zero, _CMP_GE_OQ);
       m &= _mm512_cmp_ps_mask(xa, grid_end, _CMP_LT_OQ);
       m &= _mm512_cmp_ps_mask(xb, zero, _CMP_GT_OQ);
       m &= _mm512_cmp_ps_mask(xb, grid_end, _CMP_LE_OQ);
       m &= __mmask16(thin | _mm512_cmp_ps_mask(cells, two, _CMP_GE_OQ));  // not NaN
-      if (m) {
-        const __m512i ia = _mm512_min_epi32(_mm512_cvttps_epi32(xa), last_cell);
-        const __m512i ib = _mm512_min_epi32(_mm512_cvttps_epi32(xb), last_cell);
-        const __m512 fa = _mm512_sub_ps(xa, _mm512_cvtepi32_ps(ia));
-        const __m512 fb = _mm512_sub_ps(xb, _mm512_cvtepi32_ps(ib));
-        // The lanes outside m read cell 0 and are not used.
-        alignas(64) int cell_a[16], cell_b[16];
-        _mm512_store_si512(cell_a, _mm512_maskz_mov_epi32(m, ia));
-        _mm512_store_si512(cell_b, _mm512_maskz_mov_epi32(m, ib));
-        // Read back from memory (one load each), not extracted from the register (three instructions).
-        __asm__ volatile("" : : "r"(cell_a), "r"(cell_b) : "memory");
-        __m512 na[8], nb[8];
-        table_rows(tf.Ff.data(), cell_a, na);
-        table_rows(tf.Ff.data(), cell_b, nb);
-        __m512 a[4], b[4];
-        for (int j = 0; j < 4; ++j) {
-          a[j] = _mm512_fmadd_ps(fa, _mm512_sub_ps(na[j + 4], na[j]), na[j]);
-          b[j] = _mm512_fmadd_ps(fb, _mm512_sub_ps(nb[j + 4], nb[j]), nb[j]);
-        }
-        // integrate_fast's closed piece: D = length dT / dv; D == 0 blends nothing; 0 < D <= 1 with
-        // spread D^2 <= 1 (a thin segment: D <= 1) in closed form.
-        const __m512 dT = _mm512_sub_ps(b[0], a[0]);
-        const __m512 D = _mm512_mul_ps(_mm512_mul_ps(len, dT), recip(dv_eff));
-        const __mmask16 none = m & _mm512_cmp_ps_mask(D, zero, _CMP_EQ_OQ);
-        const __m512 spread = _mm512_min_ps(c255, _mm512_fmadd_ps(adv, spread_a, spread_b));
-        __mmask16 blend = m & _mm512_cmp_ps_mask(D, zero, _CMP_GT_OQ);
-        blend &= _mm512_cmp_ps_mask(D, one, _CMP_LE_OQ);
-        blend &=
-            __mmask16(thin | _mm512_cmp_ps_mask(_mm512_mul_ps(_mm512_mul_ps(spread, D), D), one, _CMP_LE_OQ));
-        if (blend) {
-          // exp_neg_small(D) in float: (e^-D/8)^8, e^-q by its series to q^5.
-          const __m512 q = _mm512_mul_ps(_mm512_set1_ps(0.125f), D), q2 = _mm512_mul_ps(q, q);
-          __m512 e = _mm512_add_ps(
-              _mm512_add_ps(
-                  _mm512_sub_ps(one, q),
-                  _mm512_mul_ps(q2, _mm512_fnmadd_ps(q, _mm512_set1_ps(kSixth), _mm512_set1_ps(0.5f)))),
-              _mm512_mul_ps(_mm512_mul_ps(q2, q2),
-                            _mm512_fnmadd_ps(q, _mm512_set1_ps(k120th), _mm512_set1_ps(k24th))));
-          e = _mm512_mul_ps(e, e);
-          e = _mm512_mul_ps(e, e);
-          e = _mm512_mul_ps(e, e);
-          // (K_b - K_a) (1 - e) / dT + c e.
-          const __m512 w = _mm512_mul_ps(_mm512_sub_ps(one, e), recip(dT));
-          for (int j = 0; j < 3; ++j) {
-            float* plane = acc.c[j];
-            __m512 c = zero;
-            for (int p = 0; p < n_pieces; ++p) c = _mm512_mask_loadu_ps(c, blend & piece[p], plane + base[p]);
-            c = _mm512_fmadd_ps(_mm512_sub_ps(b[j + 1], a[j + 1]), w, _mm512_mul_ps(c, e));
-            for (int p = 0; p < n_pieces; ++p) _mm512_mask_storeu_ps(plane + base[p], blend & piece[p], c);
-          }
-        }
-        done = __mmask16(blend | none);
-        fast += std::size_t(__builtin_popcount(done));
-      }
+      const __m512i ia = _mm512_min_epi32(_mm512_cvttps_epi32(xa), last_cell);
+      const __m512i ib = _mm512_min_epi32(_mm512_cvttps_epi32(xb), last_cell);
+      _mm512_store_ps(s.fa, _mm512_sub_ps(xa, _mm512_cvtepi32_ps(ia)));
+      _mm512_store_ps(s.fb, _mm512_sub_ps(xb, _mm512_cvtepi32_ps(ib)));
+      // The lanes outside m read cell 0 and are not used. The second half reads the cells back from
+      // memory (one load each, not three instructions to extract each from a register).
+      _mm512_store_si512(s.cell_a, _mm512_maskz_mov_epi32(m, ia));
+      _mm512_store_si512(s.cell_b, _mm512_maskz_mov_epi32(m, ib));
+      _mm512_store_ps(s.dv, dv_eff);
+      _mm512_store_ps(s.adv, adv);
+      s.m = m;
+      s.thin = thin;
     }
-    if (const __mmask16 rest = __mmask16(live & ~done)) {
-      alignas(64) float vf[16], vn[16], ln[16];
-      _mm512_store_ps(vf, v_far);
-      _mm512_store_ps(vn, v_near);
-      _mm512_store_ps(ln, len);
-      for (int p = 0; p < n_pieces; ++p)
-        for (int i = 0; i < 16; ++i)
-          if ((rest & piece[p]) >> i & 1) {
-            const std::ptrdiff_t q = base[p] + i;
-            float c[3] = {acc.c[0][q], acc.c[1][q], acc.c[2][q]};
-            composite(tf, vf[i], vn[i], ln[i], c, fast);
-            for (int j = 0; j < 3; ++j) acc.c[j][q] = c[j];
-          }
-    }
+    return true;
+  };
+  // A full (or last) group: its first half, then the second half of the group before it (whose
+  // chain is independent of this one's, so the two overlap in the core).
+  auto group = [&](__mmask16 live) FOXI_TARGET __attribute__((always_inline)) {
+    const bool staged = first(st[cur], live);
+    if (have_prev) second_half(st[cur ^ 1], tf, acc, fast);
+    have_prev = staged;
+    if (staged) cur ^= 1;
   };
   int k = 0;  // lanes filled
   for (int i = 0; i < n_runs; ++i) {
@@ -260,18 +296,20 @@ FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup&
       const __mmask16 lanes = __mmask16(((1u << n) - 1u) << k);
       xo = _mm512_mask_add_ps(xo, lanes, _mm512_set1_ps(float(x - k - r.xr)), iota);
       yo = _mm512_mask_mov_ps(yo, lanes, _mm512_set1_ps(yr));
-      base[n_pieces] = row + x - k;
-      piece[n_pieces++] = lanes;
+      StagedGroup& s = st[cur];
+      s.base[s.n_pieces] = row + x - k;
+      s.piece[s.n_pieces++] = lanes;
       k += n;
       x += n;
       if (k == 16) {
         group(__mmask16(0xffff));
         k = 0;
-        n_pieces = 0;
+        st[cur].n_pieces = 0;
       }
     }
   }
   if (k > 0) group(__mmask16((1u << k) - 1u));
+  if (have_prev) second_half(st[cur ^ 1], tf, acc, fast);
 }
 
 }  // namespace
