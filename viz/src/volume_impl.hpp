@@ -259,10 +259,13 @@ struct VolumePainter::Impl {
   std::span<const double> corner;
   VolumeParams params;
   int lanes = 1;
-  std::vector<float> chan[3];        // the colour so far, one plane per channel (VolumeAcc)
-  std::vector<std::uint32_t> front;  // the nearest tet blended per pixel
-  bool vector_rows = false;          // volume_row_avx512 for the pixel rows
-  std::vector<double> cam_xyz;       // the nodes in the camera frame, once (not per tet and lane)
+  // The colour so far, one plane per channel (VolumeAcc), and the nearest tet blended, per pixel;
+  // a tile's pixels hold these only once it is cleared (tile_ready, clear_tile).
+  std::unique_ptr<float[]> chan[3];
+  std::unique_ptr<std::uint32_t[]> front;
+  std::vector<std::uint8_t> tile_ready;
+  bool vector_rows = false;     // volume_row_avx512 for the pixel rows
+  std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
 
@@ -276,6 +279,8 @@ struct VolumePainter::Impl {
   struct Tile {
     int x0, x1, y0, y1;
   };
+  Tile tile_at(int k) const;          // tile k, row by row (volume.cpp)
+  void clear_tile(const Tile& tile);  // its pixels the background, no tet
   int tiles_x = 0, tiles_y = 0;
   std::vector<double> node_px;  // per node its pixel (x, y); NaN where it is not in front of the eye
   std::vector<std::uint32_t> tile_start, tile_tets, cursor;

@@ -136,7 +136,7 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   // The tet's pixels (its front faces', which cover its projection once), row by row: the vector
   // path takes a row's run sixteen pixels at a time (its float set-up centred on the tet's first
   // run), the portable one pixel by pixel.
-  const VolumeAcc va{{chan[0].data(), chan[1].data(), chan[2].data()}, front.data(), proj.width};
+  const VolumeAcc va{{chan[0].get(), chan[1].get(), chan[2].get()}, front.get(), proj.width};
   int n_runs = 0;
 #ifdef FOXI_VOLUME_AVX512
   std::optional<RowSetup> rs;
