@@ -84,7 +84,7 @@ Framebuffer ray_cast(const Mesh& m, const Camera& cam, std::span<const std::uint
       std::vector<Seg> segs;
       for (std::size_t i = 0; i < set.size(); ++i) {
         const double* c = P[i].data();
-        double s0 = proj.perspective ? 0 : -1e300, s1 = 1e300;
+        double s0 = proj.perspective ? std::max(p.near, 0.0) : -1e300, s1 = 1e300;  // from the near plane
         bool empty = false;
         for (int f = 0; f < 4 && !empty; ++f) {
           // The plane through the three corners other than f; inside is f's side.
@@ -361,6 +361,45 @@ TEST(Volume, NearlyEdgeOnSliverKeepsItsSegment) {
   const std::vector<double> corner = {0.0, 0.3, 0.6, 1.2};
   VolumeParams p = params_for(m);
   p.unit_length = 4;  // 13 units: most of the way opaque
+  const std::vector<std::uint32_t> one = {0};
+  const Framebuffer want = ray_cast(m, cam, one, corner, p, W, H);
+  ASSERT_NE(want.rgba[want.index(12, 16)], pack_rgba(255, 255, 255)) << "the ray should meet the tet";
+  int worst = 0;
+  const Framebuffer got = paint(m, cam, one, corner, p, nullptr, nullptr, W, H);
+  EXPECT_EQ(differing(got, want, 2, &worst), 0u) << "worst " << worst;
+  EXPECT_EQ(got.rgba[got.index(12, 16)], want.rgba[want.index(12, 16)]);
+}
+
+// The same sliver seen in perspective with the near plane cutting the tet (its top face before the
+// plane, the corner behind the sliver beyond it): the rays start inside the tet at the plane. The
+// pixel centre 0.0016 pixels from that corner's projection must keep its 10 units of segment.
+TEST(Volume, NearlyEdgeOnSliverCutByTheNearPlaneKeepsItsSegment) {
+  constexpr int W = 32, H = 32;
+  Camera cam;
+  cam.eye[0] = 0, cam.eye[1] = 0, cam.eye[2] = 0;
+  cam.at[0] = 0, cam.at[1] = 0, cam.at[2] = -1;
+  cam.up[0] = 0, cam.up[1] = 1, cam.up[2] = 0;
+  cam.fov_deg = 40;
+  const Projector proj(cam, W, H);
+  const double px[4][3] = {{4, 16.4992, 30}, {28, 16.4992, 30}, {16, 4, 30}, {12.5, 16.5016, 50}};
+  Mesh m;
+  for (const auto& q : px) {
+    const double x = (q[0] - proj.cx) / proj.focal * q[2], y = -(q[1] - proj.cy) / proj.focal * q[2];
+    for (int j = 0; j < 3; ++j)
+      m.xyz.push_back(proj.eye[j] + x * proj.right[j] + y * proj.up[j] + q[2] * proj.forward[j]);
+  }
+  m.tet = {0, 1, 2, 3};
+  m.tet_region = {1};
+  for (int k = 0; k < 4; ++k) {
+    double got[2];
+    ASSERT_TRUE(proj.project(&m.xyz[3 * std::size_t(k)], got));
+    ASSERT_NEAR(got[0], px[k][0], 1e-9);
+    ASSERT_NEAR(got[1], px[k][1], 1e-9);
+  }
+  const std::vector<double> corner = {0.0, 0.3, 0.6, 1.2};
+  VolumeParams p = params_for(m);
+  p.unit_length = 4;
+  p.near = 40;
   const std::vector<std::uint32_t> one = {0};
   const Framebuffer want = ray_cast(m, cam, one, corner, p, W, H);
   ASSERT_NE(want.rgba[want.index(12, 16)], pack_rgba(255, 255, 255)) << "the ray should meet the tet";

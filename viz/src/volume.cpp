@@ -1,6 +1,6 @@
-// Direct volume rendering by projected tetrahedra (volume.hpp): each tet's front faces rasterized with
-// the painter's fixed point and fill rule, the ray's segment through the tet found per pixel from the
-// tet's four planes, and the emission-absorption integral of the linear field over it blended back to
+// Direct volume rendering by projected tetrahedra (volume.hpp): each tet's pixels the spans of pixel
+// centres in its projection (half-open, a fill rule), the ray's segment through the tet found per pixel from
+// the tet's four planes, and the emission-absorption integral of the linear field over it blended back to
 // front. This file: the painter's construction, a batch's draw over the screen tiles, the resolve and
 // the safe picture; volume_impl.hpp says where the rest lives and how the work is shared.
 #include "foxi/viz/volume.hpp"

@@ -314,17 +314,12 @@ FOXI_TARGET __attribute__((always_inline)) inline void runs_impl(const RowSetup&
 
 }  // namespace
 
-FOXI_TARGET void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
-                                    const PixelRun* runs, int n_runs, std::uint32_t t, std::size_t& count,
-                                    std::size_t& fast) {
-  runs_impl(r, tf, acc, runs, n_runs, t, count, fast);
-}
 FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
-                                   const double q[4][2], int x0, int x1, int y0, int y1, std::uint32_t t,
-                                   PixelRun* runs, std::size_t& count, std::size_t& fast) {
-  // The rows and the corners' segments (corner_edges, shared with the portable path's tet_row_spans).
+                                   const double (*q)[2], int n_q, int x0, int x1, int y0, int y1,
+                                   std::uint32_t t, PixelRun* runs, std::size_t& count, std::size_t& fast) {
+  // The rows and the points' segments (corner_edges, shared with the portable path's tet_row_spans).
   CornerEdges e;
-  if (!corner_edges(q, y0, y1, e)) return;
+  if (!corner_edges(q, n_q, y0, y1, e)) return;
   const int ya = e.ya, yb = e.yb, n_edges = e.n;
   const __m512d iota = _mm512_set_pd(7, 6, 5, 4, 3, 2, 1, 0);
   const __m512d inf = _mm512_set1_pd(std::numeric_limits<double>::infinity());

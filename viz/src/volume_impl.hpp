@@ -1,7 +1,7 @@
 // Internal to the volume renderer (volume.hpp): the types its files share. VolumePainter::Impl's
 // members are defined, by concern, in volume.cpp (construction, draw, resolve, draw_volume_picture),
 // volume_tiles.cpp (the screen tiles and the binning of a batch's tets to them), volume_setup.cpp (a
-// tet's set-up, its pixels rasterized and integrated on the portable path) and volume_avx512.cpp (the
+// tet's set-up, its pixels' spans and their integral on the portable path) and volume_avx512.cpp (the
 // vector path: a tet's rows found and integrated sixteen pixels at a time in float); the transfer
 // function, the segment integral and its pre-integrated form are in volume_transfer.cpp.
 //
@@ -12,9 +12,9 @@
 // pixel's x and y). Where the CPU has AVX-512 the tet's pixel rows are the spans of pixel centres in
 // its corners' projection, packed sixteen to a lane group and each pixel decided by its ray, in float
 // re-centred on the tet (RowSetup); elsewhere the same spans one row at a time and each pixel
-// integrated in double (a tet with a corner behind the eye: its clipped front faces rasterized with
-// the painter's fixed point, on both paths). The two pictures differ by at most a level of 255 on a
-// few pixels (volume_test compares them).
+// integrated in double (a tet the near plane cuts: the spans of its part beyond the plane, on both
+// paths). The two pictures differ by at most a level of 255 on a few pixels (volume_test compares
+// them).
 #pragma once
 
 #include "foxi/viz/volume.hpp"
@@ -150,8 +150,8 @@ struct VolumeAcc {
 struct TetSetup {
   double ndA[4], ndB[4], ndC[4], numA[4], numB[4], numC[4];
   double vA, vB, vC, gdA, gdB, gdC, dxA, dxB, dyA, dyC, dz2, near;
-  // The ray's segment through the tet at pixel (x, y): false where the ray misses it (a snapped edge
-  // pixel).
+  // The ray's segment through the tet at pixel (x, y): false where the ray misses it (a pixel centre
+  // on the projection's edge, or a segment of no length).
   bool segment(int x, int y, double& v_far, double& v_near, double& len) const {
     const double xf = x, yf = y;
     double s_in = near, s_out = std::numeric_limits<double>::infinity();
@@ -173,20 +173,23 @@ struct TetSetup {
   }
 };
 
-// A tet's rows of pixels from its four corners q (pixel coordinates, all in front of the eye), as both
-// paths find them: the rows ya..yb whose centre line y + 0.5 lies in [least, largest) of the corners'
-// y, within y0..y1 (half-open, as x: a face seen edge on bounds no ray, so the spans alone decide a
-// pixel centre on its projection, and each goes to one of the two tets beside it, the painter's fill
-// rule on the unsnapped corners), and the segments between the corners from the lower y to the
-// higher (y range, x at its start, dx/dy; level ones left out: their ends lie on the others). False
-// for no row (or a corner not a number: the casts need numbers).
+// The rows of pixels of the convex hull of n points q (pixel coordinates: a tet's four corners, or
+// the corners of its part beyond the near plane, at most 6), as both paths find them: the rows ya..yb
+// whose centre line y + 0.5 lies in [least, largest) of the points' y, within y0..y1 (half-open, as
+// x: a face seen edge on bounds no ray, so the spans alone decide a pixel centre on its projection,
+// and each goes to one of the two tets beside it, the painter's fill rule on the unsnapped corners),
+// and the segments between the points from the lower y to the higher (y range, x at its start,
+// dx/dy; level ones left out: their ends lie on the others). Every hull edge is one of them and every
+// segment lies in the hull, so a row's least and largest x over them is the hull's span. False for
+// no row (or a point not a number: the casts need numbers).
 struct CornerEdges {
+  static constexpr int kMax = 15;  // the pairs of 6 points
   int ya = 0, yb = -1, n = 0;
-  double y0[6], y1[6], x0[6], slope[6];
+  double y0[kMax], y1[kMax], x0[kMax], slope[kMax];
 };
-inline bool corner_edges(const double q[4][2], int y0, int y1, CornerEdges& e) {
+inline bool corner_edges(const double (*q)[2], int n_q, int y0, int y1, CornerEdges& e) {
   double y_lo = q[0][1], y_hi = q[0][1];
-  for (int k = 1; k < 4; ++k) {
+  for (int k = 1; k < n_q; ++k) {
     y_lo = std::min(y_lo, q[k][1]);
     y_hi = std::max(y_hi, q[k][1]);
   }
@@ -195,8 +198,8 @@ inline bool corner_edges(const double q[4][2], int y0, int y1, CornerEdges& e) {
   e.yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
   if (e.ya > e.yb) return false;
   e.n = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) {
+  for (int i = 0; i < n_q; ++i)
+    for (int j = i + 1; j < n_q; ++j) {
       const double* a = q[i][1] <= q[j][1] ? q[i] : q[j];
       const double* b = q[i][1] <= q[j][1] ? q[j] : q[i];
       if (!(b[1] > a[1])) continue;
@@ -229,24 +232,18 @@ struct PixelRun {
   int y, lo, hi;
 };
 constexpr int kMaxRuns = 256;
-// The runs of tet t, sixteen float lanes at a time (the runs packed into the lanes one after another),
-// blended into acc: the four planes' ray parameters at each lane's pixel, entry the largest of the
-// front faces', exit the least of the back faces', the pre-integrated closed form in float
-// (volume_avx512.cpp); a segment outside its conditions goes through composite() (double) one pixel
-// at a time. Not bit for bit the portable path: float, and its own thin-segment rule (the grid cell's
-// mean extinction and colour); the tests bound the difference. count: the segments integrated, fast:
-// of those, in closed form.
-void volume_runs_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
-                        const PixelRun* runs, int n_runs, std::uint32_t t, std::size_t& count,
-                        std::size_t& fast);
-// The same for a tet whose four corners q (pixel coordinates) are all in front of the eye, its runs
-// found here: per row the pixel centres inside the projection of the corners (between the least and
-// largest x where the row's centre line meets the six segments between them, eight rows at a time),
-// half-open like the painter's fill rule so that a centre on a face seen edge on (which bounds no
-// ray) goes to one of its two tets; within the tile x0..x1, y0..y1. runs: room for kMaxRuns.
-void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc, const double q[4][2],
-                       int x0, int x1, int y0, int y1, std::uint32_t t, PixelRun* runs, std::size_t& count,
-                       std::size_t& fast);
+// Tet t's pixels inside the convex hull of the n_q points q (pixel coordinates: corner_edges) within
+// the tile x0..x1, y0..y1, blended into acc sixteen float lanes at a time (volume_avx512.cpp): per
+// row the span of pixel centres inside the hull (eight rows at a time), the spans packed into the
+// lanes one after another; per lane the four planes' ray parameters at its pixel, entry the largest
+// of the front faces', exit the least of the back faces', and the pre-integrated closed form in
+// float; a segment outside its conditions goes through composite() (double) one pixel at a time.
+// Not bit for bit the portable path: float, and its own thin-segment rule (the grid cell's mean
+// extinction and colour); the tests bound the difference. runs: room for kMaxRuns. count: the
+// segments integrated, fast: of those, in closed form.
+void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc, const double (*q)[2],
+                       int n_q, int x0, int x1, int y0, int y1, std::uint32_t t, PixelRun* runs,
+                       std::size_t& count, std::size_t& fast);
 #endif
 
 }  // namespace volume_detail
@@ -286,10 +283,6 @@ struct VolumePainter::Impl {
   std::vector<std::uint32_t> tile_start, tile_tets, cursor;
   std::vector<std::array<std::uint16_t, 4>> tet_tiles;  // per tet of the batch: tiles x0, x1, y0, y1
 
-  // The tiles tet t's projection can touch (the bounds of its nodes' pixels, a pixel wider: the
-  // rasterized pixels' centres lie in the snapped projection); none off screen. A tet with a node not
-  // in front of the eye: the bounds of its part at depth >= nb, nb the least near plane clip_near
-  // can use for any of its faces (that part holds every face's clipped polygon).
   // The tiles tet t's projection can touch (volume_tiles.cpp): x0, x1, y0, y1; x0 > x1 for none.
   std::array<std::uint16_t, 4> tiles_of(std::uint32_t t) const;
   // The batch's tets into the tiles' lists (tile_start, tile_tets), each list in the batch's order.
@@ -302,7 +295,6 @@ struct VolumePainter::Impl {
 
   // Tet t's segments at its pixels inside `tile` blended into acc (volume_setup.cpp).
   void draw_tet(std::uint32_t t, const Tile& tile, Scratch& scratch, std::size_t& count, std::size_t& fast);
-  static constexpr int kMaxPolyVolume = 8;
 };
 
 }  // namespace foxi

@@ -1,13 +1,12 @@
 // The volume renderer's per-tet work (volume_impl.hpp): a tet's set-up in the camera frame (its field's
 // gradient, its four outward planes, the ray's planes and field linear in the pixel's x and y), its
-// pixels listed (the rows' spans of its corners' projection; with a corner behind the eye its front
-// faces clipped and rasterized with the painter's fixed point and fill rule), and integrated on
-// the portable path (where the CPU has AVX-512, volume_avx512.cpp finds and integrates its rows).
+// pixels listed (the rows' spans of its corners' projection, or of its part beyond the near plane's
+// where the plane cuts it), and integrated on the portable path (where the CPU has AVX-512,
+// volume_avx512.cpp finds and integrates its rows).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <optional>
 
 #include "volume_impl.hpp"
 
@@ -21,9 +20,9 @@ namespace {
 // seen edge on, which bounds no ray, goes to one of the two tets beside it); within x0..x1, y0..y1.
 // fn(y, first, last) per row with pixels.
 template <class Fn>
-void tet_row_spans(const double q[4][2], int x0, int x1, int y0, int y1, Fn&& fn) {
+void tet_row_spans(const double (*q)[2], int n, int x0, int x1, int y0, int y1, Fn&& fn) {
   CornerEdges e;
-  if (!corner_edges(q, y0, y1, e)) return;
+  if (!corner_edges(q, n, y0, y1, e)) return;
   for (int y = e.ya; y <= e.yb; ++y) {
     const double yc = y + 0.5;
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -50,7 +49,6 @@ void tet_row_spans(const double q[4][2], int x0, int x1, int y0, int y1, Fn&& fn
 
 void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& scratch, std::size_t& count,
                                    std::size_t& fast) {
-  const Rows rows{0, 1, tile.y0, tile.y1};
   const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
   const double* cv = &corner[4 * std::size_t(t)];
   double P[4][3];
@@ -133,36 +131,16 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     r.dz2 = d0[2] * d0[2];
     r.near = proj.perspective ? std::max(params.near, 0.0) : -std::numeric_limits<double>::infinity();
   }
-  // The tet's pixels (its front faces', which cover its projection once), row by row: the vector
-  // path takes a row's run sixteen pixels at a time (its float set-up centred on the tet's first
-  // run), the portable one pixel by pixel.
+  // The portable path: a row's pixels one at a time, each integrated in double.
   const VolumeAcc va{{chan[0].get(), chan[1].get(), chan[2].get()}, front.get(), proj.width};
-  int n_runs = 0;
-#ifdef FOXI_VOLUME_AVX512
-  std::optional<RowSetup> rs;
-#endif
-  auto flush = [&] {
-#ifdef FOXI_VOLUME_AVX512
-    if (n_runs > 0) volume_runs_avx512(*rs, *transfer, va, scratch.runs, n_runs, t, count, fast);
-#endif
-    n_runs = 0;
-  };
   auto add_run = [&](int y, int lo, int hi) {
     lo = std::max(lo, tile.x0);
     hi = std::min(hi, tile.x1);
     if (lo > hi) return;
-#ifdef FOXI_VOLUME_AVX512
-    if (vector_rows) {
-      if (!rs) rs.emplace(r, P[0][2], lo, y);
-      if (n_runs == kMaxRuns) flush();
-      scratch.runs[n_runs++] = {y, lo, hi};
-      return;
-    }
-#endif
     const std::size_t row = std::size_t(y) * std::size_t(proj.width);
     for (int x = lo; x <= hi; ++x) {
       double v_far, v_near, len;
-      if (!r.segment(x, y, v_far, v_near, len)) continue;  // a snapped edge pixel the ray misses
+      if (!r.segment(x, y, v_far, v_near, len)) continue;  // the ray misses the tet
       const std::size_t p = row + std::size_t(x);
       float c[3] = {va.c[0][p], va.c[1][p], va.c[2][p]};
       composite(*transfer, v_far, v_near, len, c, fast);
@@ -171,9 +149,6 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
       ++count;
     }
   };
-  // No node before the near plane clip_near would use for any face (the usual case): the four
-  // corners snapped once, each front face from them (the same corners snap_polygon would give).
-  bool direct = !inside;
   // The farthest corner's squared distance from the eye (perspective; 1 orthographic): the near
   // plane's scale here and the distance scale below.
   double reach2 = 1;
@@ -182,77 +157,72 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     for (int k = 0; k < 4; ++k)
       reach2 = std::max(reach2, P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]);
   }
-  if (direct && proj.perspective) {
-    const double dmax = std::sqrt(reach2);
-    double near_clip = std::max(params.near, dmax * proj.focal / kMaxPixel);
-    if (!(near_clip > 0)) near_clip = 1e-300;
-    for (int k = 0; k < 4; ++k) direct = direct && P[k][2] >= near_clip;
+  // The pixels whose ray may meet the tet: the rows' spans of pixel centres inside the projection of
+  // its part beyond the clipping plane (perspective: the near plane, or nearer than a millionth of
+  // the farthest corner's distance in pixels, so that the projection stays within kMaxPixel of the
+  // centre; the rays' parts nearer than that weigh nothing), unsnapped; the ray decides each pixel
+  // (segment(): entry, from the near plane on, before exit). That part is convex, so its projection
+  // is the hull of its corners' projections: the tet's four corners where all lie beyond the plane
+  // (the usual case), else those beyond it and the points where its edges cross it (at most six).
+  // Not faces rasterized with the painter's snapped corners: where a face is seen nearly edge on, a
+  // pixel centre a thousandth of a pixel inside the projection can fall outside the snapped one while
+  // its ray runs a long way through the tet (a segment lost: the flip chip's temperature at 1280x960
+  // had a pixel 5 levels too bright; a tet the near plane cut lost its pixels so, or those where the
+  // rays start inside it at the plane, until its back faces were drawn).
+  double clip = -std::numeric_limits<double>::infinity();
+  if (proj.perspective) {
+    clip = std::max(params.near, std::sqrt(reach2) * proj.focal / kMaxPixel);
+    if (!(clip > 0)) clip = 1e-300;
   }
+  double q[6][2];
+  int n_q = 0, beyond = -1;
+  bool direct = !inside;
+  for (int k = 0; k < 4; ++k) direct = direct && P[k][2] >= clip;
   if (direct) {
-    // A face's plane through the eye (perspective) or along the rays (orthographic), to a millionth
-    // of the tet's distance (a structured grid seen from one of its planes, to within rounding):
-    // every ray meets that plane at the eye or lies in it, so it bounds no segment, and which side of
-    // it a pixel's ray is on is which side of its projection, a line, the pixel is on: what the spans
-    // below decide (half-open, so a pixel centre on the line goes to one of the two tets beside it).
-    // Its ray parameter would be a ratio of rounding errors (in float on the vector path), and a
-    // pixel on that line could lose its tet or get it twice. (A face the eye is a millionth off sees
-    // rays cross it at a millionth of a radian: a sliver of projection a thousandth of a pixel wide,
-    // whose pixels would be counted in both tets; so rare, and so thin, that it is left.)
-    for (int k = 0; k < 4; ++k) {
-      const double nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
-      const double off = proj.perspective ? h[k] : n[k][2];  // the eye's offset, or the rays'
-      if (off * off <= 1e-12 * nn * reach2)
-        r.ndA[k] = r.ndB[k] = r.ndC[k] = r.numA[k] = r.numB[k] = r.numC[k] = 0;
+    for (int k = 0; k < 4; ++k) proj.camera_to_pixel(P[k], q[n_q++]);
+    beyond = 0;
+  } else {
+    for (int i = 0; i < 4; ++i) {
+      if (P[i][2] >= clip) {
+        proj.camera_to_pixel(P[i], q[n_q++]);
+        if (beyond < 0) beyond = i;
+      }
+      for (int j = i + 1; j < 4; ++j)
+        if ((P[i][2] >= clip) != (P[j][2] >= clip)) {
+          const double u = (clip - P[i][2]) / (P[j][2] - P[i][2]);
+          const double c[3] = {P[i][0] + u * (P[j][0] - P[i][0]), P[i][1] + u * (P[j][1] - P[i][1]), clip};
+          proj.camera_to_pixel(c, q[n_q++]);
+        }
     }
+    if (beyond < 0) return;  // wholly nearer than the plane (or not a number)
+  }
+  // A face's plane through the eye (perspective) or along the rays (orthographic), to a millionth
+  // of the tet's distance (a structured grid seen from one of its planes, to within rounding):
+  // every ray meets that plane at the eye or lies in it, so it bounds no segment, and which side of
+  // it a pixel's ray is on is which side of its projection, a line, the pixel is on: what the spans
+  // decide (half-open, so a pixel centre on the line goes to one of the two tets beside it).
+  // Its ray parameter would be a ratio of rounding errors (in float on the vector path), and a
+  // pixel on that line could lose its tet or get it twice. (A face the eye is a millionth off sees
+  // rays cross it at a millionth of a radian: a sliver of projection a thousandth of a pixel wide,
+  // whose pixels would be counted in both tets; so rare, and so thin, that it is left.)
+  for (int k = 0; k < 4; ++k) {
+    const double nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
+    const double off = proj.perspective ? h[k] : n[k][2];  // the eye's offset, or the rays'
+    if (off * off <= 1e-12 * nn * reach2)
+      r.ndA[k] = r.ndB[k] = r.ndC[k] = r.numA[k] = r.numB[k] = r.numC[k] = 0;
   }
 #ifdef FOXI_VOLUME_AVX512
-  if (direct && vector_rows) {
-    // The vector path decides each pixel by its ray (entry before exit), so it needs no rasterizer:
-    // volume_tet_avx512 takes per row the span of pixel centres inside the projection of the four
-    // corners.
-    double q[4][2];
-    for (int k = 0; k < 4; ++k) proj.camera_to_pixel(P[k], q[k]);
+  if (vector_rows) {
+    // The vector path decides each pixel by its ray (entry before exit), sixteen at a time in float
+    // re-centred on the tet (its first point's pixel, a corner beyond the plane's depth).
     const int xr = int(std::clamp(q[0][0], double(tile.x0), double(tile.x1)));
     const int yr = int(std::clamp(q[0][1], double(tile.y0), double(tile.y1)));
-    volume_tet_avx512(RowSetup(r, P[0][2], xr, yr), *transfer, va, q, tile.x0, tile.x1, tile.y0, tile.y1, t,
-                      scratch.runs, count, fast);
+    volume_tet_avx512(RowSetup(r, P[beyond][2], xr, yr), *transfer, va, q, n_q, tile.x0, tile.x1, tile.y0,
+                      tile.y1, t, scratch.runs, count, fast);
     return;
   }
 #endif
-  if (direct) {
-    // The pixels whose ray may meet the tet: the rows' spans of pixel centres inside the projection
-    // of its four corners, unsnapped, as the vector path finds them; the ray decides each pixel
-    // (segment()). Not its front faces rasterized with the painter's snapped corners: where a face is
-    // seen nearly edge on, a pixel centre a thousandth of a pixel inside the projection can fall
-    // outside the snapped one while its ray runs a long way through the tet (a segment lost: the
-    // flip chip's temperature at 1280x960 had a pixel 5 levels too bright).
-    double q[4][2];
-    for (int k = 0; k < 4; ++k) proj.camera_to_pixel(P[k], q[k]);
-    tet_row_spans(q, tile.x0, tile.x1, tile.y0, tile.y1, add_run);
-    flush();
-    return;
-  }
-  // A corner before the near plane (or the eye inside): the tet's part beyond the plane, whose pixels
-  // are those of its back faces clipped there (every ray that meets that part leaves it through one
-  // of them). Not its front faces: where the plane cuts the tet, the cut is a face of that part too,
-  // facing the eye, and the rays that start inside the tet at the plane cross no front face (a tet
-  // with a corner just behind the eye lost them: TetGen's lattice seen from 0.001 off a node, a
-  // triangle of the picture 28 levels too light).
-  for (int f = 0; f < 4; ++f) {
-    if (facing[f]) continue;
-    double tri[3][3], v[kMaxPolyVolume][3];
-    for (int k = 0; k < 3; ++k) std::copy(P[kFace[f][k]], P[kFace[f][k]] + 3, tri[k]);
-    const int m = clip_near(proj, params.near, tri, 3, v);
-    if (m == 0) continue;
-    std::int64_t X[kMaxPolyVolume], Y[kMaxPolyVolume];
-    double snapped[kMaxPolyVolume][2], w[kMaxPolyVolume];
-    snap_polygon(
-        proj, m, [&](int i) { return v[i]; }, X, Y, snapped, w);
-    for_each_fan_triangle(X, Y, m, [&](const std::int64_t* TX, const std::int64_t* TY, const int*) {
-      raster_triangle(TX, TY, proj.width, proj.height, rows, add_run);
-    });
-  }
-  flush();
+  tet_row_spans(q, n_q, tile.x0, tile.x1, tile.y0, tile.y1, add_run);
 }
 
 }  // namespace foxi

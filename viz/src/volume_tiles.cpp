@@ -11,10 +11,9 @@
 
 namespace foxi {
 
-// The tiles tet t's projection can touch (the bounds of its nodes' pixels, a pixel wider: the
-// rasterized pixels' centres lie in the snapped projection); none off screen. A tet with a node not
-// in front of the eye: the bounds of its part at depth >= nb, nb the least near plane clip_near
-// can use for any of its faces (that part holds every face's clipped polygon).
+// The tiles tet t's projection can touch (the bounds of its nodes' pixels, a pixel wider); none off
+// screen. A tet with a node not in front of the eye: the bounds of its part at depth >= nb, nb the
+// least clipping plane draw_tet can use for it (that part holds the part draw_tet's spans cover).
 std::array<std::uint16_t, 4> VolumePainter::Impl::tiles_of(std::uint32_t t) const {
   double x_lo = std::numeric_limits<double>::infinity(), x_hi = -x_lo, y_lo = x_lo, y_hi = -x_lo;
   auto add = [&](const double* q) {

@@ -1,6 +1,7 @@
 // Direct volume rendering of a field by projected tetrahedra, composited in the exact visibility order
 // (issue 23 item 2). Each tet's linear field is integrated along every pixel's ray through it: the
-// tet's front faces are rasterized (they cover its projection once), and per pixel the entry and exit
+// pixels whose centres lie in the tet's projection (unsnapped: the rows' spans of its corners'
+// convex hull), and per pixel the entry and exit
 // of the ray (the tet's four planes, in double), the field at both ends (linear in the tet, so linear
 // along the ray) and the emission-absorption integral over that segment give a colour and an opacity,
 // blended over what the farther tets left. The transfer function is a colour scale (colormap.hpp) and an
@@ -17,7 +18,8 @@
 // order of a Delaunay mesh puts the farther of any two tets one ray meets first (seed paper, Theorem
 // 1), so the segments are composited far to near, which is the volume-rendering integral of the whole
 // ray. Progressive: drawn batch by batch, the picture so far is the exact picture of the far part.
-// An eye inside a tet: that tet's back faces are rasterized instead and its segment starts at the eye.
+// A tet the near plane cuts (an eye inside it or next to it): the spans of its part beyond the plane,
+// each ray's segment starting at the plane.
 #pragma once
 
 #include <cstddef>
