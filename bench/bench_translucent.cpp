@@ -76,9 +76,11 @@
 // wall, the fetches further ahead about 3% (32 and 16 no better). Tried and not kept: the colour
 // planes loaded at a group's start (no faster), the table rows prefetched in the first half (10%
 // slower), the two halves pipelined across tets (within the noise), gathers for the table rows in
-// place of loads and transposes (no faster), |d| by rsqrt14 (2% at best, not kept). Alternately with
-// the code before that day: 17.7 to 18.3 ns a segment against 16.7 to 19.7 (least of 3 draws), wall
-// 0.78 to 0.84 s against 0.74 to 0.89; VTK 5.1, 5.7 and 5.9 s a frame in the same sitting.
+// place of loads and transposes (no faster), |d| by rsqrt14 (2% at best, not kept). Later that day:
+// tiles of 256 x 128 pixels (were 128 x 64; about 10% of the wall, 256 x 256 no better). At the end,
+// alternately with the code from before that day's changes: 14.6 to 16.6 ns a segment against 17.2 to
+// 20.2 (least of 3 draws), frame 0.65 to 0.78 s against 0.75 to 0.94 s wall; VTK 4.9 to 6.3 s a
+// frame (medians 5.1, 5.7, 5.4 s) in the same sitting: 6.6 to 8.7 times.
 //   volume_view_frame     the same frames in an InteractiveView, as foxi-view and the workbench draw them
 //                         (steps of 40 ms, the picture asked for after each), against the one-call
 //                         frame of the same views in the same iterations: one_call_ms, ratio, shown
