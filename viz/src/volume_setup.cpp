@@ -74,8 +74,6 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   }
   // Outward planes n . x = h of the four faces.
   double n[4][3], h[4];
-  bool facing[4];
-  int front_count = 0;
   for (int f = 0; f < 4; ++f) {
     const double* a = P[kFace[f][0]];
     const double* b = P[kFace[f][1]];
@@ -89,12 +87,7 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     if (n[f][0] * (opp[0] - a[0]) + n[f][1] * (opp[1] - a[1]) + n[f][2] * (opp[2] - a[2]) > 0)
       for (double& x : n[f]) x = -x;
     h[f] = n[f][0] * a[0] + n[f][1] * a[1] + n[f][2] * a[2];
-    facing[f] = proj.perspective ? h[f] < 0 : n[f][2] < 0;  // the eye on its outer side
-    front_count += facing[f];
   }
-  // The eye inside the tet (perspective, every plane's inner side): its back faces cover the screen
-  // where the rays start inside it.
-  const bool inside = front_count == 0;
   TetSetup r;
   {
     // o = o0 + x ox + y oy, d = d0 + x dx + y dy (see TetSetup).
@@ -163,7 +156,8 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   // centre; the rays' parts nearer than that weigh nothing), unsnapped; the ray decides each pixel
   // (segment(): entry, from the near plane on, before exit). That part is convex, so its projection
   // is the hull of its corners' projections: the tet's four corners where all lie beyond the plane
-  // (the usual case), else those beyond it and the points where its edges cross it (at most six).
+  // (the usual case), else those beyond it and the points where its edges cross it (at most six; an
+  // eye inside the tet has corners on both sides).
   // Not faces rasterized with the painter's snapped corners: where a face is seen nearly edge on, a
   // pixel centre a thousandth of a pixel inside the projection can fall outside the snapped one while
   // its ray runs a long way through the tet (a segment lost: the flip chip's temperature at 1280x960
@@ -175,27 +169,20 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     if (!(clip > 0)) clip = 1e-300;
   }
   double q[6][2];
-  int n_q = 0, beyond = -1;
-  bool direct = !inside;
-  for (int k = 0; k < 4; ++k) direct = direct && P[k][2] >= clip;
-  if (direct) {
-    for (int k = 0; k < 4; ++k) proj.camera_to_pixel(P[k], q[n_q++]);
-    beyond = 0;
-  } else {
-    for (int i = 0; i < 4; ++i) {
-      if (P[i][2] >= clip) {
-        proj.camera_to_pixel(P[i], q[n_q++]);
-        if (beyond < 0) beyond = i;
-      }
-      for (int j = i + 1; j < 4; ++j)
-        if ((P[i][2] >= clip) != (P[j][2] >= clip)) {
-          const double u = (clip - P[i][2]) / (P[j][2] - P[i][2]);
-          const double c[3] = {P[i][0] + u * (P[j][0] - P[i][0]), P[i][1] + u * (P[j][1] - P[i][1]), clip};
-          proj.camera_to_pixel(c, q[n_q++]);
-        }
+  int n_q = 0, beyond = -1;  // beyond: the first corner beyond the plane
+  for (int i = 0; i < 4; ++i) {
+    if (P[i][2] >= clip) {
+      proj.camera_to_pixel(P[i], q[n_q++]);
+      if (beyond < 0) beyond = i;
     }
-    if (beyond < 0) return;  // wholly nearer than the plane (or not a number)
+    for (int j = i + 1; j < 4; ++j)
+      if ((P[i][2] >= clip) != (P[j][2] >= clip)) {
+        const double u = (clip - P[i][2]) / (P[j][2] - P[i][2]);
+        const double c[3] = {P[i][0] + u * (P[j][0] - P[i][0]), P[i][1] + u * (P[j][1] - P[i][1]), clip};
+        proj.camera_to_pixel(c, q[n_q++]);
+      }
   }
+  if (beyond < 0) return;  // wholly nearer than the plane (or not a number)
   // A face's plane through the eye (perspective) or along the rays (orthographic), to a millionth
   // of the tet's distance (a structured grid seen from one of its planes, to within rounding):
   // every ray meets that plane at the eye or lies in it, so it bounds no segment, and which side of
