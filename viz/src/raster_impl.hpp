@@ -105,6 +105,26 @@ struct Rows {
 // owns the pixels on it if it is a top or left edge.
 inline bool owns_boundary(std::int64_t dx, std::int64_t dy) { return dy < 0 || (dy == 0 && dx > 0); }
 
+// Undraw repaints a back face of a tet as the front face of the tet across it, drawn earlier: what
+// the picture held there just before the tet was drawn, unless a tet drawn in between covers some
+// of the face's pixels. In a visibility order that tet's exact projection can only touch the face's,
+// so after snapping (each corner moved at most 0.71 units) it covers only pixel centres within 1.42
+// units of the face's snapped edges, and only where two edges lie on one line of the screen, the
+// projection of a plane through the eye (or along the view) holding mesh faces (a lattice seen from
+// one of its planes): such a face is seen exactly edge on. Pixel centres that near (|E| <= kNearEdge
+// (|dx| + |dy|) for the edge function E of an edge (dx, dy): at least kNearEdge units) to an edge-on
+// face are risky, and saved rather than repainted (tests/data/bad/fuzz/mesh_pipeline/
+// undraw_eye_in_inner_face_planes).
+constexpr std::int64_t kNearEdge = 2;
+
+// Whether the edge function of the edge from (xa, ya) to (xb, yb) is near zero (see kNearEdge) at
+// (px, py) (fixed point).
+inline bool near_edge(std::int64_t xa, std::int64_t ya, std::int64_t xb, std::int64_t yb, std::int64_t px,
+                      std::int64_t py) {
+  const std::int64_t dx = xb - xa, dy = yb - ya;
+  return std::abs(dx * (py - ya) - dy * (px - xa)) <= kNearEdge * (std::abs(dx) + std::abs(dy));
+}
+
 template <class Fn>
 void raster_triangle(const std::int64_t* X, const std::int64_t* Y, int width, int height, const Rows& rows,
                      Fn&& fn) {
@@ -407,6 +427,36 @@ struct TetRasterizer::Impl {
     return any_tainted && (is_tainted(t) || is_tainted(nb >> 2));
   }
   bool is_tainted(std::uint32_t t) const { return tainted[t >> 6] >> (t & 63) & 1; }
+  // Risky pixels near faces seen edge on (see kNearEdge) are marked in `risky` too, and here one bit
+  // per band of 16 rows and 64 columns that holds one (empty while none is). A tet whose pixel box
+  // holds a risky pixel saves the risky pixels of its shared back faces.
+  std::vector<std::uint64_t> risky_tile;
+  bool box_meets_risky(const Box& b) const {
+    if (risky_tile.empty() || b.x0 > b.x1 || b.y0 < 0) return false;
+    bool tile = false;
+    for (int band = b.y0 >> kBandShift; band <= b.y1 >> kBandShift && !tile; ++band)
+      for (int w = b.x0 >> 6; w <= b.x1 >> 6 && !tile; ++w)
+        tile = risky_tile[std::size_t(band) * std::size_t(mask_words) + std::size_t(w)] != 0;
+    if (!tile) return false;
+    for (int y = b.y0; y <= b.y1; ++y)
+      for (int w = b.x0 >> 6; w <= b.x1 >> 6; ++w) {
+        std::uint64_t bits = risky[std::size_t(y) * std::size_t(mask_words) + std::size_t(w)];
+        if (w == b.x0 >> 6) bits &= ~std::uint64_t(0) << (b.x0 & 63);
+        if (w == b.x1 >> 6 && (b.x1 & 63) != 63) bits &= (std::uint64_t(1) << ((b.x1 & 63) + 1)) - 1;
+        if (bits) return true;
+      }
+    return false;
+  }
+  void mark_risky(int x, int y) {
+    if (risky.empty()) risky.assign(shown.size(), 0);
+    if (risky_tile.empty())
+      risky_tile.assign(std::size_t(mask_words) * std::size_t((proj.height >> kBandShift) + 1), 0);
+    risky[std::size_t(y) * std::size_t(mask_words) + std::size_t(x >> 6)] |= std::uint64_t(1) << (x & 63);
+    risky_tile[std::size_t(y >> kBandShift) * std::size_t(mask_words) + std::size_t(x >> 6)] = 1;
+  }
+  // Marks the risky pixels near the edge from (xa, ya) to (xb, yb) (snapped; see kNearEdge) over its
+  // extent.
+  void mark_near_edge(std::int64_t xa, std::int64_t ya, std::int64_t xb, std::int64_t yb);
   void taint(std::uint32_t t) {
     tainted[t >> 6] |= std::uint64_t(1) << (t & 63);
     any_tainted = true;
@@ -780,9 +830,13 @@ struct TetRasterizer::Impl {
   inline void for_each_back_face(std::uint32_t t, Fn&& fn) const;
 
   inline bool has_unshared_back_face(std::uint32_t t, const TetCorners& k, std::uint16_t& reach,
-                                     bool& inverted) const;
+                                     bool& inverted, unsigned* edge_on = nullptr) const;
 
   void taint_inverted(std::span<const std::uint32_t> tets, std::span<const std::uint32_t> inverted_at);
+
+  // Whether face f of a tet (corners k, none cut by the near plane) is seen exactly edge on, to
+  // rounding (see kNearEdge).
+  bool edge_on_face(const TetCorners& k, int f) const;
 
   void request_saves(const Framebuffer& fb, const Rows& rows, std::uint32_t t);
 

@@ -298,7 +298,8 @@ inline void TetRasterizer::Impl::answer_requests(const Framebuffer& fb, int k) {
 // reach: t's repaint reach (see drawn_reach). inverted: t has a front face shared with a tet drawn
 // before it (see `tainted`).
 inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const TetCorners& k,
-                                                        std::uint16_t& reach, bool& inverted) const {
+                                                        std::uint16_t& reach, bool& inverted,
+                                                        unsigned* edge_on) const {
   bool unshared = false;
   std::uint32_t least = drawn_at[t];
   const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
@@ -306,9 +307,17 @@ inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const T
     bool back, front;
     if (unclipped) {
       const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
-      const std::int64_t area = (k.X[b] - k.X[a]) * (k.Y[d] - k.Y[a]) - (k.Y[b] - k.Y[a]) * (k.X[d] - k.X[a]);
+      const std::int64_t ux = k.X[b] - k.X[a], uy = k.Y[b] - k.Y[a], wx = k.X[d] - k.X[a],
+                         wy = k.Y[d] - k.Y[a];
+      const std::int64_t area = ux * wy - uy * wx;
       back = area > 0;
       front = area < 0;
+      // Seen exactly edge on, a face's snapped area is zero to rounding (each corner moved half a
+      // unit at most); only such faces are looked at again (a line covers no pixel).
+      if (edge_on != nullptr && area != 0 &&
+          std::abs(area) <= std::abs(ux) + std::abs(uy) + std::abs(wx) + std::abs(wy) + 6 &&
+          edge_on_face(k, f))
+        *edge_on |= 1u << f;
     } else {
       PolyVertex poly[4];
       bool clipped = false;
@@ -323,12 +332,56 @@ inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const T
     } else {
       least = std::min(least, drawn_at[nb >> 2]);
       if (saves_risky(t, nb)) unshared = true;  // it files saves (of its risky pixels only)
+      if (!unshared && !risky_tile.empty() && box_meets_risky(tet_box(k, proj.width, proj.height)))
+        unshared = true;  // the same (see kNearEdge)
     }
   }
   reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
   // A tet cut by the near plane (not wholly behind it) saves its front faces too (request_saves).
   const int behind = k.st[0] + k.st[1] + k.st[2] + k.st[3];
   return unshared || (behind > 0 && behind < 4);
+}
+
+bool TetRasterizer::Impl::edge_on_face(const TetCorners& k, int f) const {
+  const int a = kFace[f][0], b = kFace[f][1], d = kFace[f][2];
+  const double *pa = k.c[a], *pb = k.c[b], *pd = k.c[d];
+  const double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]};
+  const double w[3] = {pd[0] - pa[0], pd[1] - pa[1], pd[2] - pa[2]};
+  const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+  const double lu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]),
+               lw = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  // Its plane through the eye (perspective; camera coordinates put the eye at the origin) or along
+  // the view (orthographic), to rounding: a generic face is off by a sine under 1e-9 once in 1e9.
+  const double off = proj.perspective ? std::abs(pa[0] * n[0] + pa[1] * n[1] + pa[2] * n[2]) /
+                                            std::sqrt(pa[0] * pa[0] + pa[1] * pa[1] + pa[2] * pa[2])
+                                      : std::abs(n[2]);
+  return off <= 1e-9 * lu * lw;
+}
+
+void TetRasterizer::Impl::mark_near_edge(std::int64_t xa, std::int64_t ya, std::int64_t xb, std::int64_t yb) {
+  const std::int64_t dx = xb - xa, dy = yb - ya;
+  if (dx == 0 && dy == 0) return;  // the face's other edges hold it
+  // Along the edge's longer extent (rows, or columns), the pixel centres within reach across it.
+  const bool rows_major = std::abs(dy) >= std::abs(dx);
+  const std::int64_t ma = rows_major ? ya : xa, mb = rows_major ? yb : xb;  // major coordinates
+  const std::int64_t na = rows_major ? xa : ya, dn = rows_major ? dx : dy, dm = rows_major ? dy : dx;
+  const int major_size = rows_major ? proj.height : proj.width,
+            minor_size = rows_major ? proj.width : proj.height;
+  const std::int64_t reach =
+      2 * kNearEdge + 1;  // across, in units (kNearEdge (|dx| + |dy|) / |dm| <= 2 kNearEdge)
+  const std::int64_t lo = std::min(ma, mb) - 2 * kNearEdge, hi = std::max(ma, mb) + 2 * kNearEdge;
+  for (std::int64_t m = std::max<std::int64_t>(0, -floor_div(-(lo - kHalf), kOne));
+       m < major_size && m * kOne + kHalf <= hi; ++m) {
+    const double across = double(na) + double(dn) * double(m * kOne + kHalf - ma) / double(dm);
+    const std::int64_t first =
+        std::max<std::int64_t>(0, -floor_div(-(std::int64_t(std::floor(across)) - reach - kHalf), kOne));
+    for (std::int64_t n = first;
+         n < minor_size && n * kOne + kHalf <= std::int64_t(std::ceil(across)) + reach; ++n) {
+      const int x = int(rows_major ? n : m), y = int(rows_major ? m : n);
+      if (near_edge(xa, ya, xb, yb, std::int64_t(x) * kOne + kHalf, std::int64_t(y) * kOne + kHalf))
+        mark_risky(x, y);
+    }
+  }
 }
 
 // Undoable, a batch with inverted pairs (rare: a face seen edge-on): taints the pairs' tets (see
@@ -417,7 +470,10 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
     tile_full.assign(std::size_t(mask_words) * std::size_t((fb.height >> kBandShift) + 1), 0);
   }
   boxes.resize(tets.size());
+  // Per half of the batch: the tets with faces seen edge on (batch position * 16 + their faces).
+  std::vector<std::uint64_t> edge_on[2];
   auto find_boxes = [&](std::size_t begin, std::size_t end, std::vector<std::uint32_t>& inverted_at) {
+    std::vector<std::uint64_t>& edge_on_here = edge_on[begin == 0 ? 0 : 1];
     constexpr std::size_t kAhead = 8;
     for (std::size_t i = begin; i < end; ++i) {
       if (i + kAhead < end) prefetch_tet(tets[i + kAhead]);
@@ -434,8 +490,12 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
         need_save[i] = false;
         batch_reach[i] = 0;
         bool inverted = false;
-        if (boxes[i].x0 <= boxes[i].x1)
-          need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted);
+        if (boxes[i].x0 <= boxes[i].x1) {
+          unsigned faces = 0;
+          need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted,
+                                                params.shrink == 1 ? &faces : nullptr);
+          if (faces != 0) edge_on_here.push_back(std::uint64_t(i) << 4 | faces);
+        }
         if (inverted) inverted_at.push_back(std::uint32_t(i));
       }
     }
@@ -477,6 +537,28 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
   if (recording && !(inverted[0].empty() && inverted[1].empty())) {
     inverted[0].insert(inverted[0].end(), inverted[1].begin(), inverted[1].end());
     taint_inverted(tets, inverted[0]);
+  }
+  if (recording && !(edge_on[0].empty() && edge_on[1].empty())) {
+    // Faces seen edge on: their pixels' neighbourhoods become risky, and the tets of the batch whose
+    // boxes meet them save those pixels of their shared back faces (see kNearEdge).
+    for (const auto& half : edge_on)
+      for (const std::uint64_t entry : half) {
+        TetCorners k;
+        load_corners(tets[std::size_t(entry >> 4)], k);
+        for (int f = 0; f < 4; ++f)
+          if (entry >> f & 1)
+            for (int e = 0; e < 3; ++e) {
+              const int a = kFace[f][e], b = kFace[f][(e + 1) % 3];
+              mark_near_edge(k.X[a], k.Y[a], k.X[b], k.Y[b]);
+            }
+      }
+    for (std::size_t i = 0; i < tets.size(); ++i)
+      if (!need_save[i] && box_meets_risky(boxes[i])) {
+        TetCorners k;
+        load_corners(tets[i], k);
+        bool inverted = false;
+        need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted);
+      }
   }
   if (recording) {  // the batch is the end of the history
     SmallBox* kept_box = drawn_box.data() + (drawn_box.size() - tets.size());

@@ -56,18 +56,25 @@ void TetRasterizer::Impl::request_saves(const Framebuffer& fb, const Rows& rows,
       }
     });
   };
+  TetCorners k;
+  const bool finite = load_corners(t, k);
+  // A tet cut by the near plane saves every pixel of its faces, front and back (undraw repaints
+  // none of them): its clipped back faces need not cover every pixel its clipped front faces drew
+  // (with the eye in the plane of one of its faces, a line of them; found by fuzzing,
+  // tests/data/bad/fuzz/mesh_pipeline/undraw_eye_in_face_plane), and where they cover the near
+  // plane's cut, the rays start beyond its front faces and a tet drawn after the neighbour may
+  // touch that back face, the eye in its plane (see kNearEdge; a lattice with the eye inside). The
+  // cuts of the tets the plane cuts tile the picture at most once.
+  const bool cut = finite && k.st[0] + k.st[1] + k.st[2] + k.st[3] != 0;  // (not wholly behind: need_save)
+  const bool meets_risky = finite && !cut && box_meets_risky(tet_box(k, proj.width, proj.height));
   for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {
     const std::uint32_t nb = earlier_neighbour(t, f);
-    if (nb == kNone)
+    if (nb == kNone || cut)
       request(poly, n, false);
-    else if (saves_risky(t, nb))
+    else if (meets_risky || saves_risky(t, nb))
       request(poly, n, true);
   });
-  // A tet cut by the near plane also saves its front faces' pixels: its clipped back faces need not
-  // cover every pixel its clipped front faces drew (with the eye in the plane of one of its faces,
-  // a line of them; found by fuzzing, tests/data/bad/fuzz/mesh_pipeline/undraw_eye_in_face_plane).
-  TetCorners k;
-  if (load_corners(t, k) && k.st[0] + k.st[1] + k.st[2] + k.st[3] != 0) {  // (not wholly behind: need_save)
+  if (cut) {
     PolyVertex poly[4];
     for (int f = 0; f < 4; ++f) {
       bool clipped = false;
@@ -309,63 +316,41 @@ inline void TetRasterizer::Impl::undraw_part(Framebuffer& fb, std::size_t count)
         }
       }
       if (!shows) continue;
-      if (b.y0 >= 0) {
-        if (!repaints(i)) continue;
-        UndrawTet u;
-        gather_undrawn(t, u);
-        shade_repainted(u);
-        // Each back face shared with a kept tet is repainted as that tet's front face: the same
-        // polygon (face_polygon's back order), in its colour. One shared with an earlier tet of the
-        // batch is already written: that tet, met before t in this walk, wrote every pixel of its
-        // projection in these rows.
-        for (int f = 0; f < 4; ++f) {
-          if (!(u.repaint >> f & 1)) continue;
-          const auto& face = kFace[f];
-          PolyVertex poly[3];
-          for (int j = 0; j < 3; ++j) {
-            poly[j].X = u.X[face[j]];
-            poly[j].Y = u.Y[face[j]];
-          }
-          if (field != nullptr && field->graded) {  // the neighbour's positions, and nearness for perspective
-            float pos[4];
-            neighbour_positions(u.neighbour[f] >> 2, u.node, pos);
-            for (int j = 0; j < 3; ++j) {
-              poly[j].pos = pos[face[j]];
-              poly[j].w = nearness(cam(u.node[face[j]]));
-            }
-          }
-          FaceSetup fs;
-#ifdef FOXI_AVX512_REPAINT
-          if (fast_repaint && setup_repaint(fs, u.neighbour[f] >> 2, u.shade[f], poly)) {
-            repaint_triangle_avx512(fb, rows, fs, poly);
-            continue;
-          }
-#endif
-          setup_face(fs, u.neighbour[f] >> 2, u.shade[f], poly, 3);
-          raster_polygon(fb, rows, fs, poly, 3);  // seldom hidden: not worth the test
+      // A tet cut by the near plane (its box not known) saved every pixel of its faces (request_saves).
+      if (b.y0 < 0 || !repaints(i)) continue;
+      UndrawTet u;
+      gather_undrawn(t, u);
+      shade_repainted(u);
+      // Each back face shared with a kept tet is repainted as that tet's front face: the same
+      // polygon (face_polygon's back order), in its colour. One shared with an earlier tet of the
+      // batch is already written: that tet, met before t in this walk, wrote every pixel of its
+      // projection in these rows.
+      for (int f = 0; f < 4; ++f) {
+        if (!(u.repaint >> f & 1)) continue;
+        const auto& face = kFace[f];
+        PolyVertex poly[3];
+        for (int j = 0; j < 3; ++j) {
+          poly[j].X = u.X[face[j]];
+          poly[j].Y = u.Y[face[j]];
         }
-        continue;
-      }
-      for_each_back_face(t, [&](int f, const PolyVertex* poly, int n) {  // cut by the near plane
-        const std::uint32_t nb = kept_neighbour(t, f);
-        if (nb == kNone) return;
-        const std::uint32_t* nv = &mesh->tet[4 * std::size_t(nb >> 2)];
-        const auto& face = kFace[nb & 3];
-        const std::uint32_t node[3] = {nv[face[0]], nv[face[1]], nv[face[2]]};
-        const double* v[3] = {cam(node[0]), cam(node[1]), cam(node[2])};
-        if (field != nullptr && field->graded) {  // the polygon again, with the neighbour's positions
-          TetCorners corners_t;
-          load_corners(t, corners_t);
+        if (field != nullptr && field->graded) {  // the neighbour's positions, and nearness for perspective
           float pos[4];
-          neighbour_positions(nb >> 2, corners_t.tv, pos);
-          PolyVertex again[4];
-          bool clipped = false;
-          const int m = face_polygon(corners_t, f, true, again, &clipped, pos);
-          if (m > 0) draw_face(fb, rows, nb >> 2, v, node, again, m, false);
-          return;
+          neighbour_positions(u.neighbour[f] >> 2, u.node, pos);
+          for (int j = 0; j < 3; ++j) {
+            poly[j].pos = pos[face[j]];
+            poly[j].w = nearness(cam(u.node[face[j]]));
+          }
         }
-        draw_face(fb, rows, nb >> 2, v, node, poly, n, false);
-      });
+        FaceSetup fs;
+#ifdef FOXI_AVX512_REPAINT
+        if (fast_repaint && setup_repaint(fs, u.neighbour[f] >> 2, u.shade[f], poly)) {
+          repaint_triangle_avx512(fb, rows, fs, poly);
+          continue;
+        }
+#endif
+        setup_face(fs, u.neighbour[f] >> 2, u.shade[f], poly, 3);
+        raster_polygon(fb, rows, fs, poly, 3);  // seldom hidden: not worth the test
+      }
     }
     // The mask back to zero on the changed rows of these rows (whole bands: their tiles too).
     while (!extent_found.load(std::memory_order_acquire)) detail::relax();  // long since, as a rule
@@ -433,6 +418,7 @@ void TetRasterizer::Impl::forget() {
   std::fill(kept.begin(), kept.end(), 0);
   std::fill(tainted.begin(), tainted.end(), 0);
   risky.clear();
+  risky_tile.clear();
   any_tainted = false;
   history.clear();
   drawn_box.clear();

@@ -99,15 +99,16 @@ class FOXI_API TetRasterizer {
   // painter (on its threads, each keeping the saved pixels of its own bands of rows), the saved values being
   // filled in by the farther tets met later in the walk. undraw(fb, k) takes back the last k drawn tets:
   // each tet's back faces are repainted as the earlier neighbour's front face, or restored from its saved
-  // pixels; the k tets are walked back to front writing each pixel once (the farthest undrawn tet over a
-  // pixel decides it), each thread in its own range of rows (batches of 256 tets or more), skipping by
-  // their pixel boxes (kept from drawing) the tets hidden behind farther undrawn ones, and reading the mesh
-  // only for the others, a few tets ahead; more than 2^16 tets go in parts of 2^16 (last first). For a
-  // visibility order, fb (colours and ids) is then pixel for pixel the picture of the remaining tets
-  // drawn from scratch; fb must not be changed in between. Cost is proportional to the undrawn tets and
-  // their pixels, not to the mesh. Throws std::logic_error if not undoable,
-  // std::out_of_range if k exceeds the tets drawn. Undoable images are at most 32767 pixels wide and high
-  // (else the constructor throws std::invalid_argument).
+  // pixels (all of them for a tet the near plane cuts, and those within 2/256 pixel of a face seen
+  // exactly edge on, where a tet drawn between the two can cover the shared face after snapping); the k tets
+  // are walked back to front writing each pixel once (the farthest undrawn tet over a pixel decides it), each
+  // thread in its own range of rows (batches of 256 tets or more), skipping by their pixel boxes (kept from
+  // drawing) the tets hidden behind farther undrawn ones, and reading the mesh only for the others, a few
+  // tets ahead; more than 2^16 tets go in parts of 2^16 (last first). For a visibility order, fb (colours and
+  // ids) is then pixel for pixel the picture of the remaining tets drawn from scratch; fb must not be changed
+  // in between. Cost is proportional to the undrawn tets and their pixels, not to the mesh. Throws
+  // std::logic_error if not undoable, std::out_of_range if k exceeds the tets drawn. Undoable images are at
+  // most 32767 pixels wide and high (else the constructor throws std::invalid_argument).
   void undraw(Framebuffer& fb, std::size_t count);
   std::span<const std::uint32_t> drawn_tets() const;  // undoable: the tets drawn, in order
   std::size_t saved_pixels() const;                   // undoable: pixels held for undraw
