@@ -7,6 +7,7 @@
 //   painter_draw_1thread  painter_draw on one thread (the threading baseline)
 //   painter_draw_undoable painter_draw recording what undraw needs (saved pixels of unshared back
 //                     faces); counter undo_MB = memory held for undraw after the whole mesh is drawn
+//   painter_draw_undoable_lattice  undoable drawing of a Kuhn grid seen from its own planes (below)
 //   undraw_front10    (after an untimed undoable draw of all tets) undraw the front 10% of the order
 //                     in 10 frames of 1%, back to back, each frame presented as a display would (the
 //                     rectangles it changed, changed_rects, copied into the displayed image); counters
@@ -378,6 +379,58 @@ void run_picture(benchmark::State& state) {
                  (in_place ? " in place" : " copied"));
 }
 
+// An unjittered Kuhn grid of 50^3 cubes (750k tets) seen from its own planes, where faces are seen
+// exactly edge on and undoable drawing saves the pixels near them (kNearEdge, raster_impl.hpp):
+// /0 orthographic along z (the edge-on faces' corners snap onto common lines: nothing saved for
+// them), /1 in perspective from an eye in the plane y = z (their snapped corners off those lines).
+// Timed: the undoable draw of the whole order; baseline, the same iteration outside the timing: the
+// plain painter draw of the same view, ratio = undoable / plain (wall); undo_MB as above, saved_px
+// the pixels held for undraw.
+void BM_painter_draw_undoable_lattice(benchmark::State& state) {
+  static const Mesh mesh = [] {
+    Mesh m = bench::kuhn_grid_mesh(50, 0.0);
+    face_adjacency(m);
+    return m;
+  }();
+  static const SphereTable table = compute_spheres(mesh);
+  double lo[3], hi[3];
+  mesh_bounds(mesh, lo, hi);
+  const bool along_z = state.range(0) == 0;
+  const double eye[3] = {2.3, 0.35, 0.35}, dir[3] = {0, 0, -1};
+  const Camera cam = camera_from_options(lo, hi, double(kWidth) / kHeight, along_z ? nullptr : eye, nullptr,
+                                         nullptr, 30, along_z ? dir : nullptr);
+  const auto order = visibility_order(mesh, table, view_of(cam));
+  RenderParams params;
+  params.undoable = true;
+  Framebuffer fb(kWidth, kHeight);
+  double undoable_ms = 0, plain_ms = 0;
+  std::size_t undo_bytes = 0, saved = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    fb.clear();
+    TetRasterizer r(mesh, cam, kWidth, kHeight, params);
+    r.draw(fb, order);
+    benchmark::DoNotOptimize(fb.rgba.data());
+    undoable_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    undo_bytes = r.undo_bytes();
+    saved = r.saved_pixels();
+    state.PauseTiming();
+    const auto t1 = std::chrono::steady_clock::now();
+    fb.clear();
+    TetRasterizer plain(mesh, cam, kWidth, kHeight);
+    plain.draw(fb, order);
+    benchmark::DoNotOptimize(fb.rgba.data());
+    plain_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+    state.ResumeTiming();
+  }
+  state.counters["tets"] = double(mesh.tet_count());
+  state.counters["ratio"] = undoable_ms / std::max(plain_ms, 1e-9);
+  state.counters["plain_ms"] = plain_ms / double(state.iterations());
+  state.counters["undo_MB"] = double(undo_bytes) / 1e6;
+  state.counters["saved_px"] = double(saved);
+  state.SetLabel(along_z ? "kuhn_50 along z" : "kuhn_50 eye in y = z");
+}
+
 void BM_painter_draw(benchmark::State& state) { run(state, false, false, 1); }
 void BM_picture_into_image(benchmark::State& state) { run_picture(state); }
 void BM_field_recolor(benchmark::State& state) { run_recolor(state); }
@@ -418,6 +471,11 @@ BENCHMARK(BM_painter_draw_1thread)
     ->MeasureProcessCPUTime()
     ->UseRealTime();
 BENCHMARK(BM_painter_draw_undoable)
+    ->DenseRange(0, 1)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
+BENCHMARK(BM_painter_draw_undoable_lattice)
     ->DenseRange(0, 1)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
