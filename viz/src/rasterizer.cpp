@@ -303,6 +303,7 @@ inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const T
   bool unshared = false;
   std::uint32_t least = drawn_at[t];
   const bool unclipped = k.st[0] + k.st[1] + k.st[2] + k.st[3] == 0;
+  int meets_risky = -1;  // whether t's box holds a risky pixel (see kNearEdge), found when first asked
   for (int f = 0; f < 4; ++f) {
     bool back, front;
     if (unclipped) {
@@ -332,8 +333,10 @@ inline bool TetRasterizer::Impl::has_unshared_back_face(std::uint32_t t, const T
     } else {
       least = std::min(least, drawn_at[nb >> 2]);
       if (saves_risky(t, nb)) unshared = true;  // it files saves (of its risky pixels only)
-      if (!unshared && !risky_tile.empty() && box_meets_risky(tet_box(k, proj.width, proj.height)))
-        unshared = true;  // the same (see kNearEdge)
+      if (!unshared && !risky_tile.empty()) {   // the same (see kNearEdge)
+        if (meets_risky < 0) meets_risky = box_meets_risky(tet_box(k, proj.width, proj.height));
+        unshared = meets_risky != 0;
+      }
     }
   }
   reach = std::uint16_t(std::min<std::uint32_t>(drawn_at[t] - least, 0xffff));
