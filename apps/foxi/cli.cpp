@@ -1,5 +1,6 @@
 #include "cli.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@ bool Args::flag(std::string_view name) {
   for (auto it = args_.begin(); it != args_.end(); ++it) {
     if (*it == name) {
       args_.erase(it);
+      taken_.emplace_back(name);
       return true;
     }
   }
@@ -29,6 +31,7 @@ bool Args::flag_with_file(std::string_view name, std::string_view suffix, std::s
   file.clear();
   for (auto it = args_.begin(); it != args_.end(); ++it) {
     if (*it != name) continue;
+    taken_.emplace_back(name);
     const auto next = it + 1;
     if (next != args_.end() && next->size() > suffix.size() &&
         next->compare(next->size() - suffix.size(), suffix.size(), suffix) == 0) {
@@ -58,6 +61,7 @@ std::string Args::option(std::string_view name, std::string fallback) {
       if (it + 1 == args_.end()) throw UsageError("option " + std::string(name) + " needs a value");
       std::string value = *(it + 1);
       args_.erase(it, it + 2);
+      taken_.emplace_back(name);
       return value;
     }
   }
@@ -66,8 +70,12 @@ std::string Args::option(std::string_view name, std::string fallback) {
 
 std::vector<std::string> Args::positional(std::size_t min, std::size_t max, std::string_view usage) {
   for (const std::string& a : args_) {
-    if (a.size() > 1 && a[0] == '-' && a[1] == '-')
+    if (a.size() > 1 && a[0] == '-' && a[1] == '-') {
+      // The same option twice would silently lose one of its values: say so, not "unknown".
+      if (std::find(taken_.begin(), taken_.end(), a) != taken_.end())
+        throw UsageError("option " + a + " given twice (give it once)\nusage: " + std::string(usage));
       throw UsageError("unknown option " + a + "\nusage: " + std::string(usage));
+    }
   }
   if (args_.size() < min || args_.size() > max) {
     throw UsageError("expected " +

@@ -33,8 +33,8 @@ class Args {
   // taken (removed) into `file` when it ends with `suffix` (e.g. "--json out.json"), else `file` is
   // cleared ("--json" alone, the model file after it left alone).
   bool flag_with_file(std::string_view name, std::string_view suffix, std::string& file);
-  // The remaining arguments; UsageError if any still starts with "--" (an unknown option) or their
-  // count is not between min and max.
+  // The remaining arguments; UsageError if any still starts with "--" (an unknown option, or one
+  // given again after it was taken: "given twice") or their count is not between min and max.
   std::vector<std::string> positional(std::size_t min, std::size_t max, std::string_view usage);
   // Everything after `marker` ("--"), taken out with it; empty when it is absent.
   std::vector<std::string> take_after(std::string_view marker);
@@ -43,6 +43,7 @@ class Args {
 
  private:
   std::vector<std::string> args_;
+  std::vector<std::string> taken_;  // the options and flags taken out so far
 };
 
 // Comma-separated finite numbers ("1,2.5,-3"); UsageError naming the option `what` otherwise.

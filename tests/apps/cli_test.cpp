@@ -157,6 +157,28 @@ TEST(Cli, BadInputNamesFileAndLineAndLeavesNoOutput) {
   EXPECT_NE(unknown.out.find("unknown mesh format"), std::string::npos) << unknown.out;
 }
 
+// An option given twice was reported as "unknown" (the first was taken, the second left over), and
+// a user who meant the second value was told the option does not exist. Options that may repeat
+// (--set) still take every value.
+TEST(Cli, AnOptionGivenTwiceIsNamedSoAndNothingIsWritten) {
+  test::TempDir dir;
+  const std::string png = (dir / "o.png").string();
+  Result twice = foxi_cli("render nope.vtu --size 320x240 --size 64x48 -o '" + png + "'", dir);
+  EXPECT_EQ(twice.status, 2);
+  EXPECT_NE(twice.out.find("option --size given twice"), std::string::npos) << twice.out;
+  EXPECT_FALSE(std::filesystem::exists(png));
+  Result flag = foxi_cli("info nope.vtu --json --json", dir);
+  EXPECT_EQ(flag.status, 2);
+  EXPECT_NE(flag.out.find("option --json given twice"), std::string::npos) << flag.out;
+  Result unknown = foxi_cli("render nope.vtu --sise 320x240 -o '" + png + "'", dir);
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_NE(unknown.out.find("unknown option --sise"), std::string::npos) << unknown.out;
+  Result sets = foxi_cli(
+      "model check '" + test::models_dir() + "die_on_substrate.toml" + "' --set die_w=5mm --set die_w=6mm",
+      dir);
+  EXPECT_EQ(sets.status, 0) << sets.out;
+}
+
 TEST(Cli, HelpForEveryCommand) {
   test::TempDir dir;
   for (std::string cmd : {"--help", "info --help", "convert --help", "order --help"}) {
