@@ -62,12 +62,15 @@ double error_indicator(const Mesh& mesh, const char* field) {
   const Field* f = mesh.find_field(field);
   if (!f || f->location != FieldLocation::node || mesh.tet_count() == 0) return NAN;
   const ErrorIndicator e = zz_error_indicator(mesh, *f);
+  if (!std::isfinite(e.gradient_norm)) return INFINITY;  // overflowed (an absurd load): no indicator
   return e.gradient_norm > 0 ? e.relative_error() : NAN;
 }
 
 void print_error_indicator(double relative, const char* field) {
   if (std::isnan(relative))
     std::printf("error indicator: none (the %s has no gradient)\n", field);
+  else if (std::isinf(relative))
+    std::printf("error indicator: none (the %s's gradient is not a finite number)\n", field);
   else
     std::printf(
         "error indicator (Zienkiewicz-Zhu, recovered against element gradient of the %s): %.3g relative "

@@ -37,7 +37,7 @@ void write_json(const JsonOutput& json, const std::string& text);
 std::vector<RunParameter> run_parameters(std::span<const std::string> sets);
 
 // The Zienkiewicz-Zhu relative gradient error of the node field `field` (NaN when absent or with no
-// gradient) and its printed line.
+// gradient, infinity where the gradient overflows) and its printed line.
 double error_indicator(const Mesh& mesh, const char* field);
 void print_error_indicator(double relative, const char* field);
 

@@ -91,6 +91,47 @@ TEST(ModelCli, SolveModelUsesItsConditionsAndLoads) {
   EXPECT_NE(test::read_text(dir / "cur.txt").find("resistance"), std::string::npos);
 }
 
+// Two bars in series (copper 10 mm, then a weaker conductor 5 mm, both 1 mm square), 1 A from the
+// top to the grounded bottom: the resistance is L1 / (s1 A) + L2 / (s2 A) exactly (the potential
+// is linear in each bar, which P1 elements hold). A current of 1e300 A overflows the Joule heat:
+// the energy check fails, the run says UNRELIABLE with exit status 4, and the error indicator says
+// the gradient is not a finite number (it said "has no gradient").
+TEST(ModelCli, SeriesBarsResistanceAndAnOverflowingCurrentIsFlagged) {
+  TempDir dir;
+  auto model = [&](const std::string& current) {
+    return "units.length = \"mm\"\n"
+           "[materials.cu]\nthermal_conductivity = 400.0\nelectrical_conductivity = 6e7\n"
+           "[materials.alloy]\nthermal_conductivity = 50.0\nelectrical_conductivity = 8e6\n"
+           "[[parts]]\nname = \"bar\"\nmaterial = \"cu\"\nshape = \"box\"\norigin = [0, 0, 0]\n"
+           "size = [1, 1, 10]\n"
+           "[[parts]]\nname = \"cap\"\nmaterial = \"alloy\"\nshape = \"box\"\norigin = [0, 0, 10]\n"
+           "size = [1, 1, 5]\n"
+           "[[conditions]]\ntype = \"ground\"\nsurface = \"bar.bottom\"\nname = \"gnd\"\n"
+           "[[conditions]]\ntype = \"current\"\nsurface = \"cap.top\"\nname = \"load\"\nvalue = \"" +
+           current + "\"\n[mesh]\nmax_size = \"0.5 mm\"\n";
+  };
+  test::write_text(dir / "bars.toml", model("1 A"));
+  ASSERT_EQ(foxi_cli("solve '" + (dir / "bars.toml").string() + "' --physics current -o '" +
+                         (dir / "bars.vtu").string() + "'",
+                     dir / "bars.txt"),
+            0)
+      << test::read_text(dir / "bars.txt");
+  const std::string out = test::read_text(dir / "bars.txt");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("resistance (\\S+) ohm"))) << out;
+  const double analytic = 0.010 / (6e7 * 1e-6) + 0.005 / (8e6 * 1e-6);
+  EXPECT_NEAR(std::stod(m[1]), analytic, 1e-6 * analytic) << out;
+  test::write_text(dir / "huge.toml", model("1e300 A"));
+  EXPECT_EQ(foxi_cli("solve '" + (dir / "huge.toml").string() + "' --physics current -o '" +
+                         (dir / "huge.vtu").string() + "'",
+                     dir / "huge.txt"),
+            4);
+  const std::string huge = test::read_text(dir / "huge.txt");
+  EXPECT_NE(huge.find("UNRELIABLE"), std::string::npos) << huge;
+  EXPECT_NE(huge.find("gradient is not a finite number"), std::string::npos) << huge;
+  EXPECT_EQ(huge.find("has no gradient"), std::string::npos) << huge;
+}
+
 // A [[mesh.refine]] box in the model: `foxi solve` meshes with it as `foxi mesh` does. The nodes in
 // the box (counted on the solved mesh read back) against the same model without the box.
 TEST(ModelCli, SolveAppliesTheModelsRefinementBoxes) {
