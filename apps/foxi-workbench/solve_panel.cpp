@@ -183,6 +183,9 @@ void Workbench::build_results_panel() {
   solver_box_->addItem(tr("built-in, CG + AMG"), int(LinearSolverKind::cg_amg));
   solver_box_->addItem(tr("built-in, CG + IC"), int(LinearSolverKind::cg_ichol));
   solver_box_->addItem(tr("CalculiX (ccx)"), -1);
+  // Narrower than its longest entry when the window is (a laptop screen): the list shows them whole.
+  solver_box_->setMinimumContentsLength(8);
+  solver_box_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
   solver_box_->setToolTip(
       tr("foxi's solver (foxi solve --solver) or CalculiX, thermal and thermal_stress (foxi solve "
          "--with ccx: a ccx child process, killed by Cancel)"));

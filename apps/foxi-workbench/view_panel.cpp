@@ -15,6 +15,8 @@
 #include <QPainter>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QSignalBlocker>
 #include <QSlider>
 #include <QTimer>
@@ -36,6 +38,36 @@
 #include "foxi/viz/rasterizer.hpp"
 
 namespace foxi::workbench {
+namespace {
+
+// The view's rows of controls, scrolled sideways where the window is narrower than they are (a
+// 1366-pixel laptop screen with the side panels; they need about 800 pixels): exactly as tall as
+// the rows, and the scroll bar only while it shows. Without it the rows set the window's least
+// width (1670 pixels with the panels), wider than such screens.
+class ControlRows : public QScrollArea {
+ public:
+  ControlRows() {
+    setWidgetResizable(true);
+    setFrameShape(QFrame::NoFrame);
+    setVerticalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+    setHorizontalScrollBarPolicy(Qt::ScrollBarAsNeeded);
+    setSizePolicy(QSizePolicy::Expanding, QSizePolicy::Fixed);
+    // The bar comes and goes with the window's width and with the rows' own (a field shown widens
+    // them): the height asked for follows it, so the bar never covers the last row.
+    connect(horizontalScrollBar(), &QScrollBar::rangeChanged, this, [this] { updateGeometry(); });
+  }
+  QSize sizeHint() const override { return {widget() ? widget()->sizeHint().width() : 0, rows_height()}; }
+  QSize minimumSizeHint() const override { return {160, rows_height()}; }
+
+ private:
+  int rows_height() const {
+    if (!widget()) return 0;
+    const bool bar = horizontalScrollBar()->maximum() > 0;
+    return widget()->sizeHint().height() + (bar ? horizontalScrollBar()->sizeHint().height() : 0);
+  }
+};
+
+}  // namespace
 
 void build_display(Outcome& out, const Mesh& source, const std::string& field, const Colouring& colouring,
                    double shrink, int w, int h, const Camera* camera) {
@@ -137,11 +169,14 @@ QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QStrin
 
 QPushButton* Workbench::build_view_panel() {
   view_ = new foxi::qt::ViewWidget;
-  view_->setMinimumSize(480, 360);
+  view_->setMinimumSize(400, 300);  // with the side panels, the window fits a 1366 x 768 screen
 
-  // The view and its controls.
+  // The view and, above it, its rows of controls (ControlRows).
   auto* centre = new QWidget;
-  auto* cv = new QVBoxLayout(centre);
+  auto* outer = new QVBoxLayout(centre);
+  auto* rows = new QWidget;
+  auto* cv = new QVBoxLayout(rows);
+  cv->setContentsMargins(0, 0, 0, 0);
   auto* bar = new QHBoxLayout;
   auto button = [&](const QString& text, auto slot) {
     auto* b = new QPushButton(text);
@@ -408,7 +443,11 @@ QPushButton* Workbench::build_view_panel() {
   legend_->setFixedWidth(150);
   legend_->setAlignment(Qt::AlignTop);
   vrow->addWidget(legend_);
-  cv->addLayout(vrow, 1);
+  auto* controls = new ControlRows;
+  controls->setObjectName("view_controls");
+  controls->setWidget(rows);
+  outer->addWidget(controls);
+  outer->addLayout(vrow, 1);
   auto pick_field = [this] {
     if (filling_) return;
     const QString f = field_box_->currentIndex() <= 0 ? QString() : field_box_->currentText();

@@ -95,7 +95,9 @@ void Workbench::build_ui() {
   key(QKeySequence::HelpContents, tr("these keys"),
       [this, keys] { QMessageBox::information(this, tr("Keyboard shortcuts"), keys->join("\n")); });
   statusBar()->addPermanentWidget(new QLabel(tr("F1: keys")));
-  resize(1280, 860);
+  // The panels' natural widths side by side (the view's control rows unscrolled); a narrower screen
+  // gets a narrower window, the control rows scrolled sideways (ControlRows, view_panel.cpp).
+  resize(1680, 860);
 }
 
 void Workbench::restore_settings() {

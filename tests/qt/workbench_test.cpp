@@ -21,6 +21,8 @@
 #include <QMouseEvent>
 #include <QPlainTextEdit>
 #include <QPushButton>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QProgressBar>
 #include <QTableWidget>
 #include <QThread>
@@ -1214,6 +1216,41 @@ TEST(Workbench, XrayVolumeAndSelectionsStayInSync) {
   ASSERT_TRUE(v->pop_region());
   EXPECT_TRUE(v->view()->translucent()) << "back to all tets: still the x-ray";
   in_sync("region popped");
+}
+
+// A 1366 x 768 laptop screen: the window fits it (the view's rows of controls, about 800 pixels
+// wide, set the window's least width at 1670 pixels with the side panels), the rows scroll sideways,
+// and every one of their buttons can be scrolled into sight. At the default size (1680 wide) the rows
+// need no scrolling. Screenshots into $FOXI_WALKTHROUGH_DIR when set.
+TEST(Workbench, FitsALaptopScreenWithItsControlsScrolled) {
+  Workbench w;
+  w.show();
+  QString why;
+  ASSERT_TRUE(w.open_model(QString::fromStdString(kModels + "die_on_substrate.toml"), &why))
+      << why.toStdString();
+  ASSERT_TRUE(meshed(w));
+  QApplication::processEvents();
+  auto* controls = w.findChild<QScrollArea*>("view_controls");
+  ASSERT_NE(controls, nullptr);
+  EXPECT_EQ(controls->horizontalScrollBar()->maximum(), 0) << "scrolled at the default width " << w.width();
+  w.resize(1366, 740);
+  for (int i = 0; i < 20; ++i) QApplication::processEvents();
+  EXPECT_LE(w.minimumSizeHint().width(), 1366);
+  EXPECT_LE(w.width(), 1366);
+  EXPECT_GT(controls->horizontalScrollBar()->maximum(), 0) << "nothing to scroll at " << w.width();
+  // The rows keep their whole height: the scroll bar below them, not over them.
+  EXPECT_GE(controls->viewport()->height(), controls->widget()->minimumSizeHint().height());
+  const QList<QPushButton*> buttons = controls->widget()->findChildren<QPushButton*>();
+  EXPECT_GE(buttons.size(), 9);
+  for (QPushButton* b : buttons) {
+    if (!b->isVisibleTo(controls->widget())) continue;
+    controls->ensureWidgetVisible(b, 0, 0);
+    QApplication::processEvents();
+    const QRect in_viewport(b->mapTo(controls->viewport(), QPoint(0, 0)), b->size());
+    EXPECT_TRUE(controls->viewport()->rect().contains(in_viewport)) << b->text().toStdString();
+  }
+  if (const char* keep = std::getenv("FOXI_WALKTHROUGH_DIR"); keep && *keep)
+    w.grab().save(QString::fromStdString((std::filesystem::path(keep) / "laptop-1366.png").string()));
 }
 
 // Issue 21's "Done when", step by step as a new user does it, without the command line: open the flip
