@@ -101,15 +101,26 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
   for (std::uint32_t t : tets)
     if (t >= s.mesh->tet_count()) throw std::invalid_argument("volume: tet index out of range");
   s.bin(tets);
-  std::atomic<int> next{0};
+  // The tiles with tets, the most first (their tet count stands for their work): each thread takes
+  // the next, so the last ones taken are short and neither thread waits long for the other at the
+  // end (in screen order a thread could take a crowded tile last). Against screen order, alternately
+  // in one process (2026-11-28, the 0.97M box at 1920x1080, 2 threads, 8 frames each, twice): the
+  // painter's wall time least 501/526 against 534/561 ms, median 540/573 against 569/600 (5-6% less).
   const int n_tiles = s.tiles_x * s.tiles_y;
+  std::vector<int> tiles;
+  for (int k = 0; k < n_tiles; ++k)
+    if (s.tile_start[std::size_t(k)] != s.tile_start[std::size_t(k) + 1]) tiles.push_back(k);
+  auto work = [&](int k) { return s.tile_start[std::size_t(k) + 1] - s.tile_start[std::size_t(k)]; };
+  std::stable_sort(tiles.begin(), tiles.end(), [&](int a, int b) { return work(a) > work(b); });
+  std::atomic<int> next{0};
+  const int n_work = int(tiles.size());
   run_parts(s.lanes, [&](int lane) {
     std::size_t count = 0, fast = 0;
     auto scratch = std::make_unique<Impl::Scratch>();
-    for (int k; (k = next.fetch_add(1, std::memory_order_relaxed)) < n_tiles;) {
+    for (int i; (i = next.fetch_add(1, std::memory_order_relaxed)) < n_work;) {
+      const int k = tiles[std::size_t(i)];
       const Impl::Tile tile = s.tile_at(k);
       const std::uint32_t end = s.tile_start[std::size_t(k) + 1];
-      if (s.tile_start[std::size_t(k)] == end) continue;
       if (!s.tile_ready[std::size_t(k)]) {
         s.clear_tile(tile);
         s.tile_ready[std::size_t(k)] = 1;
