@@ -559,8 +559,8 @@ inline void TetRasterizer::Impl::draw_batch(Framebuffer& fb, std::span<const std
       if (!need_save[i] && box_meets_risky(boxes[i])) {
         TetCorners k;
         load_corners(tets[i], k);
-        bool inverted = false;
-        need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted);
+        bool inverted_pair = false;  // the taint rule above has had its say
+        need_save[i] = has_unshared_back_face(tets[i], k, batch_reach[i], inverted_pair);
       }
   }
   if (recording) {  // the batch is the end of the history
