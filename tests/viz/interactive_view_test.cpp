@@ -222,6 +222,43 @@ TEST(InteractiveView, VolumeUndrawEqualsAFreshCompositeOfTheRest) {
   EXPECT_THROW(view.set_volume(std::span<const double>(corner).first(8), &vp), std::invalid_argument);
 }
 
+// The view resolves only the screen tiles drawn since its last picture (VolumePainter::resolve_drawn):
+// at a size of several tiles (256 x 128 pixels each), the picture asked for after every step equals
+// a fresh composite of the tets drawn so far, pixel for pixel, and so after an undraw (a kept picture
+// shown, then the painter catching up) and drawing on.
+TEST(InteractiveView, VolumePictureAfterEachStepEqualsAFreshCompositeOfThePrefix) {
+  constexpr int kBigW = 700, kBigH = 300;  // 3 x 3 tiles
+  const Mesh m = bench::kuhn_grid_mesh(8, 0.0);
+  const std::vector<double> corner = corner_values(m);
+  VolumeParams vp;
+  vp.scale = ColorScale{ColorMapId::coolwarm, -20, 30};
+  vp.opacity_curve = {{-20, 0.05}, {10, 0.3}, {30, 0.6}};
+  vp.unit_length = 2;
+  const Camera cam = test::random_cameras(m, 1, 23, double(kBigW) / kBigH)[0];
+  auto fresh = [&](std::span<const std::uint32_t> tets) {
+    VolumePainter painter(m, cam, kBigW, kBigH, corner, vp);
+    painter.draw(tets);
+    Framebuffer fb(kBigW, kBigH);
+    painter.resolve(fb);
+    return fb;
+  };
+  InteractiveView view(m, cam, kBigW, kBigH);
+  view.set_volume(corner, &vp);
+  int steps = 0;
+  while (view.step()) {
+    ++steps;
+    EXPECT_EQ(differing(view.framebuffer(), fresh(view.drawn())), 0u) << "after step " << steps;
+  }
+  ASSERT_GT(steps, 8);
+  EXPECT_GT(differing(view.framebuffer(), Framebuffer(kBigW, kBigH)), 1000u) << "something drawn";
+  ASSERT_TRUE(view.set_undrawing(true));
+  view.undraw(view.drawn().size() / 2);
+  EXPECT_EQ(differing(view.framebuffer(), fresh(view.drawn())), 0u) << "undrawn to half";
+  ASSERT_TRUE(view.set_undrawing(false));
+  for (int k = 0; k < 3 && view.step(); ++k)
+    EXPECT_EQ(differing(view.framebuffer(), fresh(view.drawn())), 0u) << "drawing on, step " << k;
+}
+
 // A whole-tet subset (set_subset: the regions shown, a threshold) stays when translucency or the
 // volume is turned on: the view composites that subset, as the one-call pictures do given it, pixel
 // for pixel; iso drawing ends instead. movie_input copies what the view draws.

@@ -176,6 +176,7 @@ void InteractiveView::begin_draw() {
     mpvo_ = mpvo_order(mesh_, table_, v, current_subset());
   }
   fb_.resize(width_, height_, params_.depth_buffer && !compositing());
+  fb_holds_volume_ = false;
   resolve_pending_ = compositing();  // the background, when asked for
   damage_all();
   drawn_.clear();
@@ -206,7 +207,8 @@ void InteractiveView::sync() const {
   if (translucent_painter_)
     translucent_painter_->resolve(fb_);
   else if (volume_painter_)
-    volume_painter_->resolve(fb_);
+    volume_painter_->resolve_drawn(fb_, !fb_holds_volume_);  // the tiles drawn since the last one
+  fb_holds_volume_ = volume_painter_ != nullptr;
   resolve_pending_ = false;
 }
 
@@ -300,6 +302,7 @@ void InteractiveView::set_field(std::shared_ptr<const FieldPaint> field) {
       raster_->recolors_by_shade(field.get())) {
     const auto t0 = std::chrono::steady_clock::now();
     raster_->recolor(fb_, field);  // a paint of another mesh throws here, nothing changed
+    fb_holds_volume_ = false;
     params_.field = std::move(field);
     damage_all();
     step_ms_ = ms_since(t0);
@@ -398,6 +401,7 @@ std::size_t InteractiveView::undraw(std::size_t count) {
     const auto it = std::lower_bound(shot_at_.begin(), shot_at_.end(), drawn_.size());
     if (it != shot_at_.end() && *it == drawn_.size()) {
       fb_ = shots_[std::size_t(it - shot_at_.begin())];  // that prefix's picture, as drawn
+      fb_holds_volume_ = false;
       resolve_pending_ = false;  // the painter holds more: not resolved until it catches up
       damage_all();
       painter_behind_ = true;

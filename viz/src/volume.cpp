@@ -73,6 +73,7 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
   for (auto& c : s.chan) c.reset(new float[pixels]);
   s.front.reset(new std::uint32_t[pixels]);
   s.tile_ready.assign(std::size_t(s.tiles_x) * std::size_t(s.tiles_y), 0);
+  s.tile_drawn.assign(s.tile_ready.size(), 1);
 }
 
 void VolumePainter::Impl::clear_tile(const Tile& tile) {
@@ -112,13 +113,14 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
     if (s.tile_start[std::size_t(k)] != s.tile_start[std::size_t(k) + 1]) tiles.push_back(k);
   auto work = [&](int k) { return s.tile_start[std::size_t(k) + 1] - s.tile_start[std::size_t(k)]; };
   std::stable_sort(tiles.begin(), tiles.end(), [&](int a, int b) { return work(a) > work(b); });
+  for (int k : tiles) s.tile_drawn[std::size_t(k)] = 1;
   std::atomic<int> next{0};
   const int n_work = int(tiles.size());
   run_parts(s.lanes, [&](int lane) {
     std::size_t count = 0, fast = 0;
     auto scratch = std::make_unique<Impl::Scratch>();
-    for (int i; (i = next.fetch_add(1, std::memory_order_relaxed)) < n_work;) {
-      const int k = tiles[std::size_t(i)];
+    for (int w; (w = next.fetch_add(1, std::memory_order_relaxed)) < n_work;) {
+      const int k = tiles[std::size_t(w)];
       const Impl::Tile tile = s.tile_at(k);
       const std::uint32_t end = s.tile_start[std::size_t(k) + 1];
       if (!s.tile_ready[std::size_t(k)]) {
@@ -146,26 +148,18 @@ void VolumePainter::draw(std::span<const std::uint32_t> tets) {
   });
 }
 
-void VolumePainter::resolve(Framebuffer& fb) const {
-  const Impl& s = *impl_;
-  const std::size_t pixels = std::size_t(s.proj.width) * std::size_t(s.proj.height);
-  // Every pixel is written below: a framebuffer of the right size is not cleared first (an
-  // interactive view resolves once a shown frame, and at 1920x1080 the clearing cost as much).
-  if (fb.width != s.proj.width || fb.height != s.proj.height || fb.rgba.size() != pixels ||
-      fb.id.size() != pixels || fb.shade.size() != pixels) {
-    fb.resize(s.proj.width, s.proj.height, false, s.params.background);
-  } else {
-    fb.depth.clear();
-    fb.depth_slope.clear();
-  }
+void VolumePainter::Impl::resolve_tiles(Framebuffer& fb, std::span<const int> tiles) const {
+  const Impl& s = *this;
   auto to8 = [](float c) { return std::uint32_t(int(std::clamp(c, 0.0f, 255.0f) + 0.5f)); };
   const std::uint32_t background =
       pack_rgba((s.params.background >> 0) & 255u, (s.params.background >> 8) & 255u,
                 (s.params.background >> 16) & 255u);
-  const int n_tiles = s.tiles_x * s.tiles_y;
-  run_parts(s.lanes, [&](int lane) {
-    for (int k = n_tiles * lane / s.lanes; k < n_tiles * (lane + 1) / s.lanes; ++k) {
-      const Impl::Tile tile = s.tile_at(k);
+  const int n = int(tiles.size());
+  const int parts = std::min(s.lanes, std::max(n, 1));
+  run_parts(parts, [&](int part) {
+    for (int i = n * part / parts; i < n * (part + 1) / parts; ++i) {
+      const int k = tiles[std::size_t(i)];
+      const Tile tile = s.tile_at(k);
       const bool drawn = s.tile_ready[std::size_t(k)] != 0;  // else never cleared: the background
       for (int y = tile.y0; y <= tile.y1; ++y) {
         const std::size_t row = std::size_t(y) * std::size_t(s.proj.width);
@@ -178,6 +172,45 @@ void VolumePainter::resolve(Framebuffer& fb) const {
       }
     }
   });
+}
+
+bool VolumePainter::Impl::fits(const Framebuffer& fb) const {
+  const std::size_t pixels = std::size_t(proj.width) * std::size_t(proj.height);
+  return fb.width == proj.width && fb.height == proj.height && fb.rgba.size() == pixels &&
+         fb.id.size() == pixels && fb.shade.size() == pixels;
+}
+
+void VolumePainter::resolve(Framebuffer& fb) const {
+  const Impl& s = *impl_;
+  // Every pixel is written below: a framebuffer of the right size is not cleared first (an
+  // interactive view resolves once a shown frame, and at 1920x1080 the clearing cost as much).
+  if (!s.fits(fb)) {
+    fb.resize(s.proj.width, s.proj.height, false, s.params.background);
+  } else {
+    fb.depth.clear();
+    fb.depth_slope.clear();
+  }
+  std::vector<int> all(s.tile_ready.size());
+  for (std::size_t k = 0; k < all.size(); ++k) all[k] = int(k);
+  s.resolve_tiles(fb, all);
+}
+
+void VolumePainter::resolve_drawn(Framebuffer& fb, bool whole) {
+  Impl& s = *impl_;
+  if (whole || !s.fits(fb)) {
+    resolve(fb);
+    std::fill(s.tile_drawn.begin(), s.tile_drawn.end(), std::uint8_t(0));
+    return;
+  }
+  fb.depth.clear();
+  fb.depth_slope.clear();
+  std::vector<int> drawn;
+  for (std::size_t k = 0; k < s.tile_drawn.size(); ++k)
+    if (s.tile_drawn[k]) {
+      drawn.push_back(int(k));
+      s.tile_drawn[k] = 0;
+    }
+  s.resolve_tiles(fb, drawn);
 }
 
 std::size_t VolumePainter::pre_integrated() const {

@@ -261,8 +261,9 @@ struct VolumePainter::Impl {
   std::unique_ptr<float[]> chan[3];
   std::unique_ptr<std::uint32_t[]> front;
   std::vector<std::uint8_t> tile_ready;
-  bool vector_rows = false;     // volume_row_avx512 for the pixel rows
-  std::vector<double> cam_xyz;  // the nodes in the camera frame, once (not per tet and lane)
+  std::vector<std::uint8_t> tile_drawn;  // drawn since the last resolve_drawn (all, at first)
+  bool vector_rows = false;              // volume_row_avx512 for the pixel rows
+  std::vector<double> cam_xyz;           // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
 
@@ -280,6 +281,9 @@ struct VolumePainter::Impl {
   };
   Tile tile_at(int k) const;          // tile k, row by row (volume.cpp)
   void clear_tile(const Tile& tile);  // its pixels the background, no tet
+  // The tiles `tiles` (indices) of the picture into fb, which has the painter's size (fits).
+  void resolve_tiles(Framebuffer& fb, std::span<const int> tiles) const;
+  bool fits(const Framebuffer& fb) const;  // the painter's size and planes
   int tiles_x = 0, tiles_y = 0;
   std::vector<double> node_px;  // per node its pixel (x, y); NaN where it is not in front of the eye
   std::vector<std::uint32_t> tile_start, tile_tets, cursor;

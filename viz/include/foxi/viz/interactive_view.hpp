@@ -245,6 +245,9 @@ class FOXI_API InteractiveView {
   // Compositing: the painter holds batches fb_ does not show yet; sync() resolves them into fb_
   // (framebuffer(), pick(), save_png(), a shot), so a step costs the batch, not a resolve.
   mutable bool resolve_pending_ = false;
+  // fb_ holds the volume painter's last resolve (VolumePainter::resolve_drawn then resolves only the
+  // tiles drawn since); false once anything else writes fb_ (a kept undraw picture, a resize).
+  mutable bool fb_holds_volume_ = false;
   void sync() const;
   mutable Framebuffer fb_;
   std::vector<PixelRect> damage_;  // see take_damage: per band of 16 rows (x0 > x1: none)

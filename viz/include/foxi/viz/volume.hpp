@@ -75,6 +75,10 @@ class FOXI_API VolumePainter {
   // The picture so far into fb (resized, no depth buffer): colours rounded to 8 bits, ids the nearest
   // tet blended at each pixel (kNone where none).
   void resolve(Framebuffer& fb) const;
+  // The same, but only the screen tiles drawn since the last resolve_drawn: fb must hold the picture
+  // that call left (an interactive view's framebuffer, resolved after each step). The first call,
+  // `whole`, or a framebuffer of another size resolves everything.
+  void resolve_drawn(Framebuffer& fb, bool whole = false);
   std::size_t samples() const;         // pixel segments integrated
   std::size_t pre_integrated() const;  // of those, the ones taken in closed form (see volume.cpp)
 
