@@ -246,6 +246,16 @@ TEST(Volume, NonConvexSubsetMatchesTheRayCaster) {
   check(m, subset, 6, 63, "random half");
 }
 
+// Tets listed with either orientation (every other one with two nodes swapped, as a mesh written
+// by another program may have them): the painter takes a tet's face planes outward whichever way its
+// nodes turn, and its field's gradient with the right sign.
+TEST(Volume, TetsOfBothOrientationsMatchTheRayCaster) {
+  test::TempDir dir;
+  Mesh m = test::random_delaunay(dir, 200, 6);
+  for (std::size_t t = 0; t < m.tet_count(); t += 2) std::swap(m.tet[4 * t + 2], m.tet[4 * t + 3]);
+  check(m, {}, 6, 66, "both orientations");
+}
+
 // A picture of several screen tiles (the painter bins tets to tiles of 128 x 64 pixels, each thread
 // drawing whole tiles): the ray caster at the pixels either side of every tile border and on a grid,
 // and one thread's picture the same as two threads'.

@@ -53,27 +53,11 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   const double* cv = &corner[4 * std::size_t(t)];
   double P[4][3];
   for (int k = 0; k < 4; ++k) std::copy_n(&cam_xyz[3 * std::size_t(node[k])], 3, P[k]);
-  // The field's gradient in the camera frame: (P[k] - P[0]) . g = cv[k] - cv[0], by Cramer's rule.
-  double e[3][3], df[3];
-  for (int k = 0; k < 3; ++k) {
-    for (int j = 0; j < 3; ++j) e[k][j] = P[k + 1][j] - P[0][j];
-    df[k] = cv[k + 1] - cv[0];
-  }
-  auto det3 = [](const double a[3], const double b[3], const double c[3]) {
-    return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-           a[2] * (b[0] * c[1] - b[1] * c[0]);
-  };
-  const double det = det3(e[0], e[1], e[2]);
-  if (!(std::abs(det) > 0)) return;  // flat
-  double g[3];
-  for (int j = 0; j < 3; ++j) {
-    double m[3][3];
-    for (int k = 0; k < 3; ++k)
-      for (int i = 0; i < 3; ++i) m[k][i] = i == j ? df[k] : e[k][i];
-    g[j] = det3(m[0], m[1], m[2]) / det;
-  }
-  // Outward planes n . x = h of the four faces.
-  double n[4][3], h[4];
+  double g[3], n[4][3], h[4];
+  // The faces' normals n_f = (b - a) x (c - a) in kFace's winding: all outward where the tet is
+  // positively oriented (det = 6 V > 0), all inward where not. The gradient of barycentric
+  // coordinate i is -n_i / det with those normals (either way), so the field's is
+  // -sum_i (cv[i] - cv[0]) n_i / det (the four gradients sum to zero); then the normals outward.
   for (int f = 0; f < 4; ++f) {
     const double* a = P[kFace[f][0]];
     const double* b = P[kFace[f][1]];
@@ -83,9 +67,17 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
     n[f][0] = u[1] * w[2] - u[2] * w[1];
     n[f][1] = u[2] * w[0] - u[0] * w[2];
     n[f][2] = u[0] * w[1] - u[1] * w[0];
-    const double* opp = P[f];
-    if (n[f][0] * (opp[0] - a[0]) + n[f][1] * (opp[1] - a[1]) + n[f][2] * (opp[2] - a[2]) > 0)
-      for (double& x : n[f]) x = -x;
+  }
+  // det = (P1 - P0) . ((P2 - P0) x (P3 - P0)) = -(P1 - P0) . n_1, n_1 = (P3 - P0) x (P2 - P0).
+  const double det =
+      -(n[1][0] * (P[1][0] - P[0][0]) + n[1][1] * (P[1][1] - P[0][1]) + n[1][2] * (P[1][2] - P[0][2]));
+  if (!(std::abs(det) > 0)) return;  // flat
+  const double df1 = cv[1] - cv[0], df2 = cv[2] - cv[0], df3 = cv[3] - cv[0], inv = -1 / det;
+  for (int j = 0; j < 3; ++j) g[j] = (df1 * n[1][j] + df2 * n[2][j] + df3 * n[3][j]) * inv;
+  const double sign = det > 0 ? 1.0 : -1.0;
+  for (int f = 0; f < 4; ++f) {
+    for (double& x : n[f]) x *= sign;
+    const double* a = P[kFace[f][0]];
     h[f] = n[f][0] * a[0] + n[f][1] * a[1] + n[f][2] * a[2];
   }
   TetSetup r;
@@ -172,7 +164,14 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   int n_q = 0, beyond = -1;  // beyond: the first corner beyond the plane
   for (int i = 0; i < 4; ++i) {
     if (P[i][2] >= clip) {
-      proj.camera_to_pixel(P[i], q[n_q++]);
+      // The node's pixel, found once per frame (NaN only where it lies at the near plane itself).
+      const double* px = &node_px[2 * std::size_t(node[i])];
+      if (!std::isnan(px[0])) {
+        q[n_q][0] = px[0];
+        q[n_q++][1] = px[1];
+      } else {
+        proj.camera_to_pixel(P[i], q[n_q++]);
+      }
       if (beyond < 0) beyond = i;
     }
     for (int j = i + 1; j < 4; ++j)
