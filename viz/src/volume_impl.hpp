@@ -187,7 +187,8 @@ struct CornerEdges {
   int ya = 0, yb = -1, n = 0;
   double y0[kMax], y1[kMax], x0[kMax], slope[kMax];
 };
-inline bool corner_edges(const double (*q)[2], int n_q, int y0, int y1, CornerEdges& e) {
+// Its rows (ya, yb) alone.
+inline bool corner_rows(const double (*q)[2], int n_q, int y0, int y1, CornerEdges& e) {
   double y_lo = q[0][1], y_hi = q[0][1];
   for (int k = 1; k < n_q; ++k) {
     y_lo = std::min(y_lo, q[k][1]);
@@ -196,7 +197,10 @@ inline bool corner_edges(const double (*q)[2], int n_q, int y0, int y1, CornerEd
   if (!(y_lo <= y_hi)) return false;
   e.ya = int(std::max(double(y0), std::ceil(std::max(y_lo - 0.5, -1.0))));
   e.yb = int(std::min(double(y1), std::ceil(std::min(y_hi - 0.5, 1e9)) - 1));
-  if (e.ya > e.yb) return false;
+  return e.ya <= e.yb;
+}
+inline bool corner_edges(const double (*q)[2], int n_q, int y0, int y1, CornerEdges& e) {
+  if (!corner_rows(q, n_q, y0, y1, e)) return false;
   e.n = 0;
   for (int i = 0; i < n_q; ++i)
     for (int j = i + 1; j < n_q; ++j) {
