@@ -175,13 +175,18 @@ FOXI_TARGET __attribute__((always_inline)) inline void second_half(const StagedG
       e = _mm512_mul_ps(e, e);
       // (K_b - K_a) (1 - e) / dT + c e.
       const __m512 w = _mm512_mul_ps(_mm512_sub_ps(one, e), recip(dT));
-      for (int j = 0; j < 3; ++j) {
-        float* plane = acc.c[j];
-        __m512 c = zero;
-        for (int p = 0; p < s.n_pieces; ++p)
-          c = _mm512_mask_loadu_ps(c, blend & s.piece[p], plane + s.base[p]);
-        c = _mm512_fmadd_ps(_mm512_sub_ps(b[j + 1], a[j + 1]), w, _mm512_mul_ps(c, e));
-        for (int p = 0; p < s.n_pieces; ++p) _mm512_mask_storeu_ps(plane + s.base[p], blend & s.piece[p], c);
+      // The three planes in one pass over the pieces to load and one to store (a plane at a time
+      // was six loops whose count depends on the data: 4% more CPU a frame).
+      __m512 c[3] = {zero, zero, zero};
+      for (int p = 0; p < s.n_pieces; ++p) {
+        const __mmask16 lanes = blend & s.piece[p];
+        for (int j = 0; j < 3; ++j) c[j] = _mm512_mask_loadu_ps(c[j], lanes, acc.c[j] + s.base[p]);
+      }
+      for (int j = 0; j < 3; ++j)
+        c[j] = _mm512_fmadd_ps(_mm512_sub_ps(b[j + 1], a[j + 1]), w, _mm512_mul_ps(c[j], e));
+      for (int p = 0; p < s.n_pieces; ++p) {
+        const __mmask16 lanes = blend & s.piece[p];
+        for (int j = 0; j < 3; ++j) _mm512_mask_storeu_ps(acc.c[j] + s.base[p], lanes, c[j]);
       }
     }
     done = __mmask16(blend | none);
