@@ -11,7 +11,6 @@
 
 #ifdef FOXI_VOLUME_AVX512
 #include <immintrin.h>
-extern int foxi_volume_variant;
 
 namespace foxi {
 namespace volume_detail {
@@ -366,6 +365,144 @@ FOXI_TARGET bool corner_edges4(const double (*q)[2], int y0, int y1, CornerEdges
 }
 
 }  // namespace
+
+// Eight tets' set-ups (volume_impl.hpp's TetBatch): draw_tet's arithmetic, lane-wise in double
+// (GCC's vector operators on __m512d), then RowSetup's.
+FOXI_TARGET void tet_batch_avx512(TetBatch& b) {
+  using V = __m512d;
+  // (Lambdas with a capture default: a captureless one's conversion to a function pointer has no
+  // target attribute, and GCC warns of its ABI.)
+  const auto ld = [&](const double* p) FOXI_TARGET __attribute__((always_inline)) {
+    return _mm512_load_pd(p);
+  };
+  const auto all = [&](double x) FOXI_TARGET __attribute__((always_inline)) { return _mm512_set1_pd(x); };
+  const auto sel = [&](__mmask8 m, V yes, V no) FOXI_TARGET __attribute__((always_inline)) {
+    return _mm512_mask_blend_pd(m, no, yes);
+  };
+  V P[4][3];
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 3; ++j) P[k][j] = ld(b.P[k][j]);
+  V n[4][3], h[4];
+  for (int f = 0; f < 4; ++f) {
+    const V* a = P[kFace[f][0]];
+    const V* bb = P[kFace[f][1]];
+    const V* c = P[kFace[f][2]];
+    const V u[3] = {bb[0] - a[0], bb[1] - a[1], bb[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[f][0] = u[1] * w[2] - u[2] * w[1];
+    n[f][1] = u[2] * w[0] - u[0] * w[2];
+    n[f][2] = u[0] * w[1] - u[1] * w[0];
+  }
+  const V det =
+      -(n[1][0] * (P[1][0] - P[0][0]) + n[1][1] * (P[1][1] - P[0][1]) + n[1][2] * (P[1][2] - P[0][2]));
+  __mmask8 ok = _mm512_cmp_pd_mask(_mm512_abs_pd(det), _mm512_setzero_pd(), _CMP_GT_OQ);
+  const V cv0 = ld(b.cv[0]);
+  const V df1 = ld(b.cv[1]) - cv0, df2 = ld(b.cv[2]) - cv0, df3 = ld(b.cv[3]) - cv0, inv = all(-1) / det;
+  V g[3];
+  for (int j = 0; j < 3; ++j) g[j] = (df1 * n[1][j] + df2 * n[2][j] + df3 * n[3][j]) * inv;
+  const V sign = sel(_mm512_cmp_pd_mask(det, _mm512_setzero_pd(), _CMP_GT_OQ), all(1), all(-1));
+  for (int f = 0; f < 4; ++f) {
+    for (V& x : n[f]) x = x * sign;
+    const V* a = P[kFace[f][0]];
+    h[f] = n[f][0] * a[0] + n[f][1] * a[1] + n[f][2] * a[2];
+  }
+  // TetSetup's.
+  const V o00 = all(b.o0[0]), o01 = all(b.o0[1]), d00 = all(b.d0[0]), d01 = all(b.d0[1]), d02 = all(b.d0[2]);
+  const V ox = all(b.ox), oy = all(b.oy), dx = all(b.dx), dy = all(b.dy);
+  V ndA[4], ndB[4], ndC[4], numA[4], numB[4], numC[4];
+  for (int k = 0; k < 4; ++k) {
+    ndA[k] = n[k][0] * d00 + n[k][1] * d01 + n[k][2] * d02;
+    ndB[k] = n[k][0] * dx;
+    ndC[k] = n[k][1] * dy;
+    numA[k] = h[k] - (n[k][0] * o00 + n[k][1] * o01);
+    numB[k] = -n[k][0] * ox;
+    numC[k] = -n[k][1] * oy;
+  }
+  const V vA = cv0 + g[0] * (o00 - P[0][0]) + g[1] * (o01 - P[0][1]) - g[2] * P[0][2];
+  const V vB = g[0] * ox, vC = g[1] * oy;
+  const V gdA = g[0] * d00 + g[1] * d01 + g[2] * d02, gdB = g[0] * dx, gdC = g[1] * dy;
+  // The clipping plane (draw_tet's), all four corners beyond it; the face planes through the eye
+  // (or along the rays) bound nothing.
+  V reach2 = all(1);
+  if (b.perspective) {
+    reach2 = _mm512_setzero_pd();
+    for (int k = 0; k < 4; ++k)
+      reach2 = _mm512_max_pd(reach2, P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]);
+    V clip = _mm512_max_pd(_mm512_sqrt_pd(reach2) * all(b.focal) / all(kMaxPixel), all(b.near));
+    clip = sel(_mm512_cmp_pd_mask(clip, _mm512_setzero_pd(), _CMP_GT_OQ), clip, all(1e-300));
+    for (int k = 0; k < 4; ++k) ok &= _mm512_cmp_pd_mask(P[k][2], clip, _CMP_GE_OQ);
+  }
+  for (int k = 0; k < 4; ++k) {
+    const V nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
+    const V off = b.perspective ? h[k] : n[k][2];
+    const __mmask8 edge_on = _mm512_cmp_pd_mask(off * off, all(1e-12) * nn * reach2, _CMP_LE_OQ);
+    const V zero = _mm512_setzero_pd();
+    ndA[k] = sel(edge_on, zero, ndA[k]);
+    ndB[k] = sel(edge_on, zero, ndB[k]);
+    ndC[k] = sel(edge_on, zero, ndC[k]);
+    numA[k] = sel(edge_on, zero, numA[k]);
+    numB[k] = sel(edge_on, zero, numB[k]);
+    numC[k] = sel(edge_on, zero, numC[k]);
+  }
+  // RowSetup's: re-centred on the first corner's pixel (within the tile) and depth.
+  const V X = _mm512_cvtepi32_pd(
+      _mm512_cvttpd_epi32(_mm512_min_pd(_mm512_max_pd(ld(b.q0[0]), all(b.x0)), all(b.x1))));
+  const V Y = _mm512_cvtepi32_pd(
+      _mm512_cvttpd_epi32(_mm512_min_pd(_mm512_max_pd(ld(b.q0[1]), all(b.y0)), all(b.y1))));
+  const V s_ref = P[0][2];
+  alignas(64) float out[40][8];
+  auto put = [&](int field, V x) FOXI_TARGET __attribute__((always_inline)) {
+    _mm256_store_ps(out[field], _mm512_cvtpd_ps(x));
+  };
+  for (int k = 0; k < 4; ++k) {
+    put(k, ndA[k] + X * ndB[k] + Y * ndC[k]);
+    put(4 + k, ndB[k]);
+    put(8 + k, ndC[k]);
+    const V A = numA[k] - s_ref * ndA[k], B = numB[k] - s_ref * ndB[k], C = numC[k] - s_ref * ndC[k];
+    put(12 + k, A + X * B + Y * C);
+    put(16 + k, B);
+    put(20 + k, C);
+  }
+  const V vA2 = vA + s_ref * gdA, vB2 = vB + s_ref * gdB, vC2 = vC + s_ref * gdC;
+  put(24, vA2 + X * vB2 + Y * vC2);
+  put(25, vB2);
+  put(26, vC2);
+  put(27, gdA + X * gdB + Y * gdC);
+  put(28, gdB);
+  put(29, gdC);
+  put(30, d00 + X * dx);
+  put(31, d01 + Y * dy);
+  put(32, (b.perspective ? all(b.near) : all(-std::numeric_limits<double>::infinity())) - s_ref);
+  alignas(32) int xr[8], yr[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(xr), _mm512_cvtpd_epi32(X));
+  _mm256_store_si256(reinterpret_cast<__m256i*>(yr), _mm512_cvtpd_epi32(Y));
+  const float dxx = float(b.dx), dyy = float(b.dy), dz2 = float(b.d0[2] * b.d0[2]);
+  for (int l = 0; l < TetBatch::kLanes; ++l) {
+    RowSetup& r = b.rs[l];
+    for (int k = 0; k < 4; ++k) {
+      r.nd[k] = out[k][l];
+      r.ndx[k] = out[4 + k][l];
+      r.ndy[k] = out[8 + k][l];
+      r.num[k] = out[12 + k][l];
+      r.numx[k] = out[16 + k][l];
+      r.numy[k] = out[20 + k][l];
+    }
+    r.v = out[24][l];
+    r.vx = out[25][l];
+    r.vy = out[26][l];
+    r.gd = out[27][l];
+    r.gdx = out[28][l];
+    r.gdy = out[29][l];
+    r.dx = out[30][l];
+    r.dxx = dxx;
+    r.dy = out[31][l];
+    r.dyy = dyy;
+    r.dz2 = dz2;
+    r.near = out[32][l];
+    r.xr = xr[l];
+    r.yr = yr[l];
+    b.ok[l] = (ok >> l) & 1;
+  }
+}
 
 FOXI_TARGET void volume_tet_avx512(const RowSetup& r, const TableTransfer& tf, const VolumeAcc& acc,
                                    const double (*q)[2], int n_q, int x0, int x1, int y0, int y1,

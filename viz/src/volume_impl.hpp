@@ -229,8 +229,24 @@ struct RowSetup {
   float nd[4], ndx[4], ndy[4], num[4], numx[4], numy[4];
   float v, vx, vy, gd, gdx, gdy, dx, dxx, dy, dyy, dz2, near;
   int xr, yr;
+  RowSetup() = default;
   RowSetup(const TetSetup& r, double s_ref, int xr, int yr);  // volume_avx512.cpp
 };
+// Eight tets' set-ups at once (tet_batch_avx512), each lane what draw_tet's TetSetup and RowSetup
+// give for a tet whose four corners lie beyond its clipping plane and have pixels (ok; the others,
+// and flat ones, go through draw_tet). In: the corners in the camera frame, the field's values,
+// the first corner's pixel (lane-wise), the frame's rays (VolumePainter::Impl::Rays) and the tile.
+struct TetBatch {
+  static constexpr int kLanes = 8;
+  alignas(64) double P[4][3][kLanes], cv[4][kLanes], q0[2][kLanes];
+  double o0[3], d0[3], ox, oy, dx, dy, near, focal;  // near: the painter's, at least 0
+  bool perspective;
+  int x0, x1, y0, y1;
+  // Out: per lane its RowSetup (s_ref its first corner's depth) and whether it applies.
+  RowSetup rs[kLanes];
+  bool ok[kLanes];
+};
+void tet_batch_avx512(TetBatch& b);
 // A run of a tet's pixels: lo..hi of row y; a thread's list holds kMaxRuns.
 struct PixelRun {
   int y, lo, hi;
@@ -270,6 +286,11 @@ struct VolumePainter::Impl {
   std::vector<double> cam_xyz;           // the nodes in the camera frame, once (not per tet and lane)
   std::vector<std::size_t> lane_samples, lane_fast;
   std::unique_ptr<TableTransfer> transfer;
+  // The pixel's ray o + s d in the camera frame: o = o0 + x ox + y oy, d = d0 + x dx + y dy (see
+  // TetSetup), once per painter.
+  struct Rays {
+    double o0[3] = {0, 0, 0}, d0[3] = {0, 0, 1}, ox = 0, oy = 0, dx = 0, dy = 0;
+  } rays;
 
   Impl(const Mesh& m, const Camera& camera, int w, int h) : mesh(&m), proj(camera, w, h) {}
 
@@ -301,10 +322,17 @@ struct VolumePainter::Impl {
   // A thread's runs of the tet it draws (the vector path).
   struct Scratch {
     PixelRun runs[kMaxRuns];
+#ifdef FOXI_VOLUME_AVX512
+    TetBatch batch;
+#endif
   };
 
   // Tet t's segments at its pixels inside `tile` blended into acc (volume_setup.cpp).
   void draw_tet(std::uint32_t t, const Tile& tile, Scratch& scratch, std::size_t& count, std::size_t& fast);
+  // draw_tet for up to TetBatch::kLanes tets (the vector path): their set-ups eight at a time
+  // (volume_setup.cpp).
+  void draw_tets(const std::uint32_t* tets, int n, const Tile& tile, Scratch& scratch, std::size_t& count,
+                 std::size_t& fast);
 };
 
 }  // namespace foxi

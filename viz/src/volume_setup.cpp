@@ -82,19 +82,8 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   }
   TetSetup r;
   {
-    // o = o0 + x ox + y oy, d = d0 + x dx + y dy (see TetSetup).
-    double o0[3] = {0, 0, 0}, d0[3] = {0, 0, 1}, ox = 0, oy = 0, dx = 0, dy = 0;
-    if (proj.perspective) {
-      d0[0] = (0.5 - proj.cx) / proj.focal;
-      dx = 1 / proj.focal;
-      d0[1] = -(0.5 - proj.cy) / proj.focal;
-      dy = -1 / proj.focal;
-    } else {
-      o0[0] = (0.5 - proj.cx) / proj.scale;
-      ox = 1 / proj.scale;
-      o0[1] = -(0.5 - proj.cy) / proj.scale;
-      oy = -1 / proj.scale;
-    }
+    const double *o0 = rays.o0, *d0 = rays.d0;
+    const double ox = rays.ox, oy = rays.oy, dx = rays.dx, dy = rays.dy;
     for (int k = 0; k < 4; ++k) {
       r.ndA[k] = n[k][0] * d0[0] + n[k][1] * d0[1] + n[k][2] * d0[2];
       r.ndB[k] = n[k][0] * dx;
@@ -210,5 +199,57 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
 #endif
   tet_row_spans(q, n_q, tile.x0, tile.x1, tile.y0, tile.y1, add_run);
 }
+
+#ifdef FOXI_VOLUME_AVX512
+void VolumePainter::Impl::draw_tets(const std::uint32_t* tets, int n, const Tile& tile, Scratch& scratch,
+                                    std::size_t& count, std::size_t& fast) {
+  TetBatch& b = scratch.batch;
+  constexpr int kL = TetBatch::kLanes;
+  // The corners' pixels (AoS, as corner_edges4 reads them); a lane whose corner has none (not in
+  // front of the eye) goes through draw_tet.
+  double q[kL][6][2];
+  bool pixels[kL];
+  for (int l = 0; l < kL; ++l) {
+    const std::uint32_t t = tets[l < n ? l : 0];
+    const std::uint32_t* node = &mesh->tet[4 * std::size_t(t)];
+    const double* cv = &corner[4 * std::size_t(t)];
+    bool all = true;
+    for (int k = 0; k < 4; ++k) {
+      const double* c = &cam_xyz[3 * std::size_t(node[k])];
+      const double* px = &node_px[2 * std::size_t(node[k])];
+      for (int j = 0; j < 3; ++j) b.P[k][j][l] = c[j];
+      b.cv[k][l] = cv[k];
+      q[l][k][0] = px[0];
+      q[l][k][1] = px[1];
+      all = all && !std::isnan(px[0]) && !std::isnan(px[1]);
+    }
+    b.q0[0][l] = q[l][0][0];
+    b.q0[1][l] = q[l][0][1];
+    pixels[l] = all;
+  }
+  std::copy_n(rays.o0, 3, b.o0);
+  std::copy_n(rays.d0, 3, b.d0);
+  b.ox = rays.ox;
+  b.oy = rays.oy;
+  b.dx = rays.dx;
+  b.dy = rays.dy;
+  b.near = std::max(params.near, 0.0);
+  b.focal = proj.focal;
+  b.perspective = proj.perspective;
+  b.x0 = tile.x0;
+  b.x1 = tile.x1;
+  b.y0 = tile.y0;
+  b.y1 = tile.y1;
+  tet_batch_avx512(b);
+  const VolumeAcc va{{chan[0].get(), chan[1].get(), chan[2].get()}, front.get(), proj.width};
+  for (int l = 0; l < n; ++l) {
+    if (b.ok[l] && pixels[l])
+      volume_tet_avx512(b.rs[l], *transfer, va, q[l], 4, tile.x0, tile.x1, tile.y0, tile.y1, tets[l],
+                        scratch.runs, count, fast);
+    else
+      draw_tet(tets[l], tile, scratch, count, fast);
+  }
+}
+#endif
 
 }  // namespace foxi
