@@ -55,23 +55,32 @@ TableTransfer::TableTransfer(const VolumeParams& params) : p(&params) {
     pos_scale = 1 / (sc.hi - sc.lo);
     // Each cell integrated with 32 midpoint samples (tau is linear and the colour constant between
     // breakpoints, so the error is that of a breakpoint inside a sample: 1/32 of a cell).
+    // The cells' sums on the painter's threads, then added up in order; the colour inline (rgb()'s
+    // arithmetic: ColorScale::position of a linear scale, the entry of floor(256 t)): 262k samples
+    // took some 4.5 ms of every painter's construction, on one thread.
     constexpr int kSub = 32;
     F.assign(4 * std::size_t(kG + 1), 0.0);
     const double dv = (g_hi - g_lo) / kG;
-    for (int i = 0; i < kG; ++i) {
-      double acc[4] = {};
-      for (int k = 0; k < kSub; ++k) {
-        const double v = g_lo + (i + (k + 0.5) / kSub) * dv;
-        const double t = tau(v);
-        float c[3];
-        rgb(v, c);
-        acc[0] += t;
-        for (int j = 0; j < 3; ++j) acc[j + 1] += t * c[j];
+    std::vector<double> sums(4 * std::size_t(kG));
+    const int parts = std::clamp(params.threads, 1, 8);
+    run_parts(parts, [&](int part) {
+      for (int i = kG * part / parts; i < kG * (part + 1) / parts; ++i) {
+        double acc[4] = {};
+        for (int k = 0; k < kSub; ++k) {
+          const double v = g_lo + (i + (k + 0.5) / kSub) * dv;
+          const double t = tau(v);
+          const double at = (v - sc.lo) / (sc.hi - sc.lo);
+          const float* c = std::isnan(at) ? nan_rgb : lut[int(std::clamp(at * 256, 0.0, 255.0))];
+          acc[0] += t;
+          for (int j = 0; j < 3; ++j) acc[j + 1] += t * c[j];
+        }
+        std::copy_n(acc, 4, &sums[4 * std::size_t(i)]);
       }
+    });
+    for (int i = 0; i < kG; ++i)
       for (int j = 0; j < 4; ++j)
         F[4 * std::size_t(i + 1) + std::size_t(j)] =
-            F[4 * std::size_t(i) + std::size_t(j)] + acc[j] * dv / kSub;
-    }
+            F[4 * std::size_t(i) + std::size_t(j)] + sums[4 * std::size_t(i) + std::size_t(j)] * dv / kSub;
     Ff.assign(F.begin(), F.end());
     const double below = g_lo - 1, above = g_hi + 1;
     float cb[3], ca[3];
