@@ -54,6 +54,8 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   double P[4][3];
   for (int k = 0; k < 4; ++k) std::copy_n(&cam_xyz[3 * std::size_t(node[k])], 3, P[k]);
   double g[3], n[4][3], h[4];
+  // (volume_avx512.cpp's tet_batch_avx512 does this set-up, to RowSetup, eight tets at a time for
+  // the vector path: a change here is a change there; the tests compare both paths' pictures.)
   // The faces' normals n_f = (b - a) x (c - a) in kFace's winding: all outward where the tet is
   // positively oriented (det = 6 V > 0), all inward where not. The gradient of barycentric
   // coordinate i is -n_i / det with those normals (either way), so the field's is
