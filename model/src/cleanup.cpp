@@ -55,7 +55,14 @@ void untrack(const std::filesystem::path& path) {
 bool is_tracked(const std::filesystem::path& path) {
   Registry& r = registry();
   std::lock_guard lock(r.mutex);
-  return r.files.count(path.string()) > 0 || r.folders.count(path.string()) > 0;
+  if (r.files.count(path.string()) > 0 || r.folders.count(path.string()) > 0) return true;
+  // The same path spelt another way: a folder's listing says ./out.mp4.foxi-tmp-... for the
+  // out.mp4.foxi-tmp-... tracked (a stale-temporary sweep removed a live movie's frames so).
+  const std::filesystem::path want = path.lexically_normal();
+  for (const auto* set : {&r.files, &r.folders})
+    for (const std::string& p : *set)
+      if (std::filesystem::path(p).lexically_normal() == want) return true;
+  return false;
 }
 
 pid_t fork_tracked() {

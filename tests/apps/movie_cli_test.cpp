@@ -86,6 +86,22 @@ TEST_F(MovieCli, FramesApngGifAndMp4AgreeWithRender) {
           dir_ / "probe.txt"),
       0);
   EXPECT_EQ(test::read_text(dir_ / "probe.txt"), "80,60,6\n");
+  // A bare file name (the frames' folder beside it in "."): a sweep of the folder's stale
+  // temporaries once took the live frames for one ("./bare.mp4.foxi-tmp-..." against the tracked
+  // "bare.mp4.foxi-tmp-...") and ffmpeg found none.
+  ASSERT_EQ(test::run("cd " + p("") + " && '" + test::cli_path() +
+                          "' movie grid.vtu --size 80x60 --frames 6 "
+                          "--mode rotate -o bare.mp4",
+                      dir_ / "bare.txt"),
+            0)
+      << test::read_text(dir_ / "bare.txt");
+  ASSERT_EQ(test::run("ffprobe -v error -count_frames -show_entries stream=nb_read_frames -of csv=p=0 " +
+                          p("bare.mp4"),
+                      dir_ / "probe2.txt"),
+            0);
+  EXPECT_EQ(test::read_text(dir_ / "probe2.txt"), "6\n");
+  for (const auto& e : std::filesystem::directory_iterator(dir_.path()))
+    EXPECT_EQ(e.path().filename().string().find(".foxi-tmp-"), std::string::npos) << e.path();
 }
 
 TEST_F(MovieCli, RenderDepthStops) {
