@@ -83,6 +83,21 @@ TEST(ColorScale, ValuesPickTheirEntry) {
   EXPECT_EQ(s.color(-5), s.nan_color);
 }
 
+// A range wider than the largest double (its width overflows to infinity): positions still run 0 to
+// 1 across it (every value was once the lowest colour), and no ticks rather than NaN ones.
+TEST(ColorScale, RangeWiderThanTheLargestDouble) {
+  ColorScale s;
+  s.lo = -1.5e308;
+  s.hi = 1.5e308;
+  EXPECT_DOUBLE_EQ(s.position(0), 0.5);
+  EXPECT_DOUBLE_EQ(s.position(s.hi), 1.0);
+  EXPECT_DOUBLE_EQ(s.position(s.lo), 0.0);
+  EXPECT_DOUBLE_EQ(s.position(0.75e308), 0.75);
+  EXPECT_EQ(s.color(0), color_map_entry(s.map, 128));
+  EXPECT_DOUBLE_EQ(s.value_at(0.75), 0.75e308);
+  for (double t : nice_ticks(s.lo, s.hi, 8)) EXPECT_TRUE(std::isfinite(t));
+}
+
 // Whether v is an integer multiple of step (to rounding).
 bool multiple(double v, double step) { return std::abs(v / step - std::round(v / step)) < 1e-6; }
 

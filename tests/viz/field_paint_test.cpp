@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "mesh_factory.hpp"
@@ -122,6 +123,27 @@ TEST(FieldPaint, CentroidValuesOfALinearFieldAreTheFieldAtTheCentroid) {
     EXPECT_NEAR(t[e], linear(c), 1e-12);
     EXPECT_NEAR(mag[e], std::sqrt(14.0) * std::abs(linear(c)), 1e-11);  // |(1, 2, 3) f|
   }
+}
+
+// An infinite node value is no value (NaN) in the pictures' samples: its corners, and the centroids
+// of the tets that have it (an isosurface through it would sit at the finite end of every edge).
+TEST(FieldPaint, InfiniteValuesAreNoValues) {
+  Mesh m = grid_with_fields();
+  std::vector<double>& t = m.fields[0].values;
+  t[3] = std::numeric_limits<double>::infinity();
+  t[5] = -std::numeric_limits<double>::infinity();
+  const FieldChoice c = choose_field(m, "temperature");
+  const std::vector<double> corner = tet_corner_values(m, c), centre = tet_centroid_values(m, c);
+  for (std::size_t i = 0; i < corner.size(); ++i)
+    EXPECT_EQ(std::isnan(corner[i]), m.tet[i] == 3 || m.tet[i] == 5) << i;
+  for (std::size_t e = 0; e < m.tet_count(); ++e) {
+    bool touches = false;
+    for (int k = 0; k < 4; ++k)
+      touches = touches || m.tet[4 * e + std::size_t(k)] == 3 || m.tet[4 * e + std::size_t(k)] == 5;
+    EXPECT_EQ(std::isnan(centre[e]), touches) << e;
+  }
+  EXPECT_THROW(choose_field(m, "temperature:"), FieldSelectError);
+  EXPECT_THROW(choose_field(m, "displacement:"), FieldSelectError);
 }
 
 TEST(FieldPaint, GradedCellFieldsAverageWithinTheirRegionOnly) {

@@ -56,7 +56,10 @@ double ColorScale::position(double v) const {
     if (!(v > 0)) return std::numeric_limits<double>::quiet_NaN();
     return (std::log(v) - std::log(lo)) / (std::log(hi) - std::log(lo));
   }
-  return (v - lo) / (hi - lo);
+  const double span = hi - lo;
+  if (std::isfinite(span)) return (v - lo) / span;
+  // A range wider than the largest double (-1e308 to 1e308): halved, so the difference is finite.
+  return (0.5 * v - 0.5 * lo) / (0.5 * hi - 0.5 * lo);
 }
 
 std::uint32_t ColorScale::color_at(double t) const {
@@ -65,7 +68,8 @@ std::uint32_t ColorScale::color_at(double t) const {
 }
 
 double ColorScale::value_at(double t) const {
-  return log ? std::exp(std::log(lo) + t * (std::log(hi) - std::log(lo))) : lo + t * (hi - lo);
+  if (log) return std::exp(std::log(lo) + t * (std::log(hi) - std::log(lo)));
+  return std::isfinite(hi - lo) ? lo + t * (hi - lo) : 2 * (0.5 * lo + t * (0.5 * hi - 0.5 * lo));
 }
 
 std::vector<double> nice_ticks(double lo, double hi, int max_ticks, bool log) {
@@ -94,6 +98,7 @@ std::vector<double> nice_ticks(double lo, double hi, int max_ticks, bool log) {
   }
   // The step: the smallest 1/2/5 x 10^k with at most max_ticks multiples in [lo, hi].
   const double raw = (hi - lo) / (max_ticks - 1);
+  if (!std::isfinite(raw) || !(raw > 0)) return ticks;  // a range wider than the largest double: no ticks
   double step = 0;
   for (int k = int(std::floor(std::log10(raw))) - 1; step == 0; ++k) {
     for (const double m : {1.0, 2.0, 5.0}) {

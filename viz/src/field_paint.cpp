@@ -183,6 +183,11 @@ FieldChoice choose_field(const Mesh& mesh, std::string_view spec) {
   const std::uint32_t n = c.field->components;
   c.label = std::string(name);
   if (n == 0) throw FieldSelectError("field '" + c.field->name + "' has no components");
+  if (colon != std::string_view::npos && comp.empty())
+    throw FieldSelectError(
+        "'" + std::string(spec) + "' names no component after the colon: give " + c.field->name +
+        (n == 1 ? std::string(" alone (a scalar)")
+                : " alone or " + c.field->name + ":COMPONENT (" + component_names(n) + ")"));
   if (comp.empty()) {
     if (n == 3) {
       c.scalar.kind = FieldScalar::Kind::magnitude;
@@ -234,9 +239,21 @@ std::vector<double> field_scalar_values(const Mesh& mesh, const FieldChoice& cho
   return out;
 }
 
+namespace {
+
+// An infinite value is no value to colour, cut or integrate (an isosurface through one would sit at
+// the finite end of every edge): NaN, the no-value grey, counted as such.
+std::vector<double> no_infinities(std::vector<double> v) {
+  for (double& x : v)
+    if (std::isinf(x)) x = std::numeric_limits<double>::quiet_NaN();
+  return v;
+}
+
+}  // namespace
+
 std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& choice, std::size_t step) {
   const Field& f = *choice.field;
-  if (f.location == FieldLocation::cell) return field_scalar_values(mesh, choice, step);
+  if (f.location == FieldLocation::cell) return no_infinities(field_scalar_values(mesh, choice, step));
   const std::span<const double> v = step_values(mesh, f, step);
   const std::uint32_t n = f.components;
   std::vector<double> out(mesh.tet_count()), c(n);
@@ -248,7 +265,7 @@ std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& cho
     }
     out[t] = scalar_of(choice.scalar, c.data(), n);
   }
-  return out;
+  return no_infinities(std::move(out));
 }
 
 double field_value_in_tet(const Mesh& mesh, const FieldChoice& choice, std::size_t t, const double bary[4],
@@ -306,10 +323,10 @@ std::vector<double> tet_corner_values(const Mesh& mesh, const FieldChoice& choic
   if (f.location == FieldLocation::node) {
     const std::vector<double> nodal = field_scalar_values(mesh, choice, step);
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = nodal[mesh.tet[i]];
-    return out;
+    return no_infinities(std::move(out));
   }
   // Cell field: per region, volume-weighted mean of the components of the region's tets at each node.
-  return cell_to_corners(mesh, step_values(mesh, f, step), f.components, choice.scalar);
+  return no_infinities(cell_to_corners(mesh, step_values(mesh, f, step), f.components, choice.scalar));
 }
 
 std::vector<double> node_corner_values(const MeshView& mesh, std::span<const double> node_values) {

@@ -35,6 +35,14 @@ VolumePainter::VolumePainter(const Mesh& mesh, const Camera& camera, int width, 
     if (i > 0 && !(p.value > params.opacity_curve[i - 1].value))
       throw std::invalid_argument("volume: the opacity curve's values must increase");
   }
+  // Its table (TableTransfer) steps across the curve: the span and its 4096th must be doubles.
+  if (params.opacity_curve.size() > 1) {
+    const double span = params.opacity_curve.back().value - params.opacity_curve.front().value;
+    if (!std::isfinite(span) || !std::isfinite(4096 / span))
+      throw std::invalid_argument(
+          "volume: the opacity curve's values span " + std::to_string(span) +
+          ": more than a double holds, or too little to step across (at least 1e-290 and at most 1e308)");
+  }
   s.corner = corner;
   s.params = params;
 #ifdef FOXI_VOLUME_AVX512

@@ -92,7 +92,8 @@ struct TableTransfer {
   explicit TableTransfer(const VolumeParams& params);  // volume_transfer.cpp
   double tau(double v) const {
     if (std::isnan(v) || tau_at.empty()) return 0;
-    const double x = std::clamp((v - lo) * inv_step, 0.0, double(kN));
+    double x = (v - lo) * inv_step;  // NaN for an infinite v on a one-point curve (inv_step 0)
+    x = x > 0 ? std::min(x, double(kN)) : 0.0;
     const int i = std::min(int(x), kN - 1);
     const double f = x - i;
     return tau_at[std::size_t(i)] + f * (tau_at[std::size_t(i) + 1] - tau_at[std::size_t(i)]);

@@ -46,8 +46,12 @@ TableTransfer::TableTransfer(const VolumeParams& params) : p(&params) {
     for (int j = 0; j < 3; ++j) lut_step = std::max(lut_step, std::abs(lut[i][j] - lut[i - 1][j]));
   for (int j = 0; j < 3; ++j) nan_rgb[j] = float((params.scale.nan_color >> (8 * j)) & 255u);
   const ColorScale& sc = params.scale;
+  // The pre-integration grid needs its cells' widths and their reciprocals as doubles (a range of
+  // -1e308 to 1e308, or of 1e-310, steps instead).
+  const double g_span = std::max(sc.hi, hi) - std::min(sc.lo, lo);
   if (!sc.log && std::isfinite(sc.lo) && std::isfinite(sc.hi) && sc.hi > sc.lo &&
-      !params.opacity_curve.empty()) {
+      !params.opacity_curve.empty() && std::isfinite(sc.hi - sc.lo) && std::isfinite(1 / (sc.hi - sc.lo)) &&
+      std::isfinite(g_span) && std::isfinite(kG / g_span)) {
     pre = true;
     g_lo = std::min(sc.lo, lo);
     g_hi = std::max(sc.hi, hi);
@@ -125,6 +129,15 @@ bool closed_piece(const TableTransfer& tf, const double a[4], const double b[4],
 
 }  // namespace
 
+namespace {
+
+// integrate_fast, else integrate (the near part of an optically deep segment).
+void composite_near(const TableTransfer& tf, double v_far, double v_near, double length, float c[3]) {
+  if (!integrate_fast(tf, v_far, v_near, length, c)) integrate(tf, v_far, v_near, length, c);
+}
+
+}  // namespace
+
 bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double length, float c[3]) {
   if (!tf.pre) return false;
   const double dv = v_near - v_far;
@@ -135,10 +148,11 @@ bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double
     if (!(cells >= 0)) return false;  // NaN
     const double vm = 0.5 * (v_far + v_near);
     const double D = tf.tau(vm) * length;
-    if (!(D <= 1)) return false;
+    // Optically thick too: the colour is the same along it, and D exact for the table's linear tau.
+    if (!(D >= 0) || std::isinf(D)) return false;
     float rgb[3];
     tf.rgb(vm, rgb);
-    const double e = exp_neg_small(D);
+    const double e = D <= 1 ? exp_neg_small(D) : std::exp(-D);
     for (int j = 0; j < 3; ++j) c[j] = float(rgb[j] * (1 - e) + c[j] * e);
     return true;
   }
@@ -146,6 +160,24 @@ bool integrate_fast(const TableTransfer& tf, double v_far, double v_near, double
   tf.antiderivative(v_far, a);
   tf.antiderivative(v_near, b);
   if (closed_piece(tf, a, b, dv, length, c)) return true;
+  // Optically deeper than kOpaque (a short opacity length): what lies behind the near part of that
+  // depth reaches the eye dimmed by e^-kOpaque (under 1e-10 of a level), so only that part is
+  // integrated, found by bisection on the table (the depth from the near end grows with the part);
+  // stepping the whole took up to 64 x 256 steps a segment (minutes a picture).
+  constexpr double kOpaque = 24;
+  if (const double depth = length * (b[0] - a[0]) / dv; depth > kOpaque && std::isfinite(depth)) {
+    double u_lo = 0, u_hi = 1;  // the near part's fraction: depth under kOpaque at u_lo, not under at u_hi
+    for (int it = 0; it < 64 && u_hi - u_lo > 1e-12; ++it) {
+      const double u = 0.5 * (u_lo + u_hi);
+      double m[4];
+      tf.antiderivative(v_near - u * dv, m);
+      (length * (b[0] - m[0]) / dv < kOpaque ? u_lo : u_hi) = u;
+    }
+    const double e = std::exp(-depth);
+    for (int j = 0; j < 3; ++j) c[j] = float(c[j] * e);
+    if (u_lo > 0) composite_near(tf, v_near - u_lo * dv, v_near, length * u_lo, c);
+    return true;
+  }
   // Too thick or too colourful for one piece: n equal pieces of the value (each at least 2 grid
   // cells), enough that the average piece meets the bound; a piece that still does not is stepped.
   const double D = length * (b[0] - a[0]) / dv;

@@ -51,7 +51,8 @@ FOXI_API std::vector<double> field_scalar_values(const Mesh& mesh, const FieldCh
                                                  std::size_t step = 0);
 
 // The scalar at each tet's centroid: a node field's components interpolated linearly (the mean of
-// the 4 corners) before taking the scalar; a cell field's own value.
+// the 4 corners) before taking the scalar; a cell field's own value. Here and below an infinite
+// value is NaN (no value: grey, no isosurface, nothing integrated).
 FOXI_API std::vector<double> tet_centroid_values(const Mesh& mesh, const FieldChoice& choice,
                                                  std::size_t step = 0);
 
