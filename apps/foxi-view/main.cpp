@@ -1,5 +1,6 @@
 // foxi-view MESH: a plain libX11 window that draws the inside of a tetrahedral mesh back to front in
 // the power-function visibility order, progressively and interruptibly (seed paper, sections 6-7).
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -84,12 +85,20 @@ int main(int argc, char** argv) {
     std::string mesh_path, size = "800x600", eye, at, up, fov, dir, shrink, save = "foxi-view", script;
     std::string field_spec, cmap, region_opacity, iso_opacity, volume, curve;
     bool script_mode = false, dump = false, no_undo = false, graded = false;
+    std::vector<std::string> seen;  // as foxi refuses an option given twice, so does the viewer
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string& a = args[i];
       auto value = [&]() -> std::string {
         if (i + 1 >= args.size()) throw Usage(a + " takes a value");
+        if (args[i + 1].empty()) throw Usage("option " + a + " takes a value, not an empty one");
         return args[++i];
       };
+      if (a.rfind("--", 0) == 0) {
+        const std::string name = a == "--batch" ? "--script" : a;
+        if (std::find(seen.begin(), seen.end(), name) != seen.end())
+          throw Usage("option " + a + " given twice (give it once)");
+        seen.push_back(name);
+      }
       if (a == "--help" || a == "-h") {
         std::puts(kUsage);
         return kExitOk;
@@ -165,12 +174,13 @@ int main(int argc, char** argv) {
                      mesh_path.c_str(), report.inverted, report.inverted == 1 ? "" : "s");
     }
     foxi::Camera camera;
+    foxi::CameraOptions camera_options;
+    double lo[3], hi[3];
     try {
       // The same rules as foxi render (view_options.hpp), so both give the same picture.
-      double lo[3], hi[3];
       foxi::mesh_bounds(mesh, lo, hi);
-      camera =
-          foxi::camera_for(foxi::parse_camera_options(eye, at, up, fov, dir), lo, hi, double(width) / height);
+      camera_options = foxi::parse_camera_options(eye, at, up, fov, dir);
+      camera = foxi::camera_for(camera_options, lo, hi, double(width) / height);
     } catch (const std::invalid_argument& e) {
       throw Usage(e.what());
     }
@@ -183,6 +193,8 @@ int main(int argc, char** argv) {
       throw Usage("--iso-opacity draws translucent isosurfaces of a field: give --field NAME");
     if (!volume.empty() && (!region_opacity.empty() || !iso_opacity.empty()))
       throw Usage("--volume draws the field alone: leave out --region-opacity and --iso-opacity");
+    if (!shrink.empty() && (!volume.empty() || !region_opacity.empty() || !iso_opacity.empty()))
+      throw Usage("--region-opacity, --iso-opacity and --volume draw whole tets: leave out --shrink");
     if (field_spec.empty() && (graded || !cmap.empty()))
       throw Usage("--graded and --cmap colour by a field: give --field NAME");
     foxi::ColorMapId map = foxi::ColorMapId::viridis;
@@ -199,11 +211,19 @@ int main(int argc, char** argv) {
     }
     try {
       if (!region_opacity.empty()) field.xray_regions = foxi::parse_region_opacity(mesh, region_opacity);
-      if (!iso_opacity.empty()) field.iso_opacity = foxi::parse_opacity(iso_opacity, "--iso-opacity");
+      if (!iso_opacity.empty()) {
+        field.iso_opacity = foxi::parse_opacity(iso_opacity, "--iso-opacity");
+        if (!(field.iso_opacity > 0))
+          throw Usage("--iso-opacity 0 draws the isosurfaces invisible: give a > 0");
+      }
       if (!curve.empty()) field.curve = foxi::parse_opacity_curve(curve);
     } catch (const foxi::OptionError& e) {
       throw Usage(mesh_path + ": " + e.what());
     }
+    field.camera_options = camera_options;
+    std::copy_n(lo, 3, field.box_lo);
+    std::copy_n(hi, 3, field.box_hi);
+    field.fitted = camera;
     field.xray = !region_opacity.empty();
     field.iso_translucent = !iso_opacity.empty();
     field.volume = !volume.empty();

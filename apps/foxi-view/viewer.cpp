@@ -68,6 +68,13 @@ ViewField view_field(const Mesh& mesh, const std::string& spec, bool graded, Col
 
 namespace {
 
+bool scaled_by_corners(const ViewField& f) { return f.graded || f.volume || f.iso_translucent; }
+
+// The scale again where the mode changed which values it is of (apply_field).
+void rescale(Viewer& viewer, ViewField& f) {
+  if (!f.specs[f.current].empty() && f.scale_of_corners != scaled_by_corners(f)) apply_field(viewer, f);
+}
+
 ColorLegend legend_of(const ViewField& f) {
   ColorLegend l;
   l.title = f.choice.label;
@@ -88,11 +95,27 @@ void fit_legend(Viewer& viewer, ViewField& f) {
   f.legend = panel > 0;
   if (panel != f.panel || viewer.framebuffer().width != f.full_width - panel) {
     f.panel = panel;
-    viewer.resize(f.full_width - panel, height);
+    resize_view(viewer, f, f.full_width - panel, height);
   }
 }
 
+bool same_camera(const Camera& a, const Camera& b) {
+  for (int k = 0; k < 3; ++k)
+    if (a.eye[k] != b.eye[k] || a.at[k] != b.at[k] || a.up[k] != b.up[k]) return false;
+  return a.perspective == b.perspective && a.fov_deg == b.fov_deg && a.ortho_height == b.ortho_height;
+}
+
 }  // namespace
+
+void resize_view(Viewer& viewer, ViewField& f, int width, int height) {
+  if (f.fitted && same_camera(viewer.camera(), *f.fitted) && width > 0 && height > 0) {
+    f.fitted = camera_for(f.camera_options, f.box_lo, f.box_hi, double(width) / height);
+    viewer.resize(width, height);
+    viewer.set_camera(*f.fitted);
+    return;
+  }
+  viewer.resize(width, height);
+}
 
 bool toggle_legend(Viewer& viewer, ViewField& f) {
   if (f.specs[f.current].empty()) return false;
@@ -129,9 +152,15 @@ void apply_field(Viewer& viewer, ViewField& f) {
   f.step = f.choice.field->step_count() - 1;
   const std::vector<double> values =
       f.graded ? tet_corner_values(mesh, f.choice, f.step) : tet_centroid_values(mesh, f.choice, f.step);
+  f.scale_of_corners = scaled_by_corners(f);
+  const std::vector<double> corner_values =
+      f.scale_of_corners && !f.graded ? tet_corner_values(mesh, f.choice, f.step) : std::vector<double>{};
+  const std::vector<double>& ranged = f.scale_of_corners && !f.graded ? corner_values : values;
+  f.no_value =
+      std::size_t(std::count_if(ranged.begin(), ranged.end(), [](double v) { return std::isnan(v); }));
   // foxi render's automatic range (a constant widened, coolwarm centred on 0); no finite value: all
   // drawn in the no-value grey over [0, 1].
-  const std::optional<AutoScale> automatic = automatic_scale(values, f.map);
+  const std::optional<AutoScale> automatic = automatic_scale(ranged, f.map);
   f.scale = ColorScale{};
   f.scale.map = f.map;
   f.scale.lo = 0;
@@ -164,6 +193,7 @@ void apply_composite(Viewer& viewer, ViewField& f) {
     f.iso_on = false;
     viewer.set_iso(nullptr, {});
   }
+  rescale(viewer, f);
   if ((f.iso_translucent || f.volume) && f.corner.empty()) {
     f.corner = tet_corner_values(viewer.mesh(), f.choice, f.step);
     f.tree = std::make_shared<const TetIntervals>(f.corner);
@@ -183,6 +213,10 @@ void apply_composite(Viewer& viewer, ViewField& f) {
     tp.regions = f.xray;
     tp.region_opacity = f.xray_regions.empty() ? default_xray(viewer.mesh()) : f.xray_regions;
     if (f.iso_translucent) {
+      const auto [lo, hi] = finite_range(f.corner);
+      if (!(lo < hi))
+        std::fprintf(stderr, "foxi-view: note: %s has no two different values: no isosurfaces\n",
+                     f.choice.label.c_str());
       tp.corner = f.corner;
       tp.iso.scale = f.scale;
       for (int k = 1; k <= f.iso_count; ++k)  // inside the range, its ends left out
@@ -196,7 +230,19 @@ void apply_composite(Viewer& viewer, ViewField& f) {
   viewer.set_translucent(nullptr);
 }
 
+namespace {
+
+// Translucency and the volume draw whole tets (as foxi render, which refuses --shrink with them).
+void check_unshrunk(const Viewer& viewer) {
+  if (viewer.shrink() != 1)
+    throw std::invalid_argument(
+        "the x-ray, translucent isosurfaces and the volume draw whole tets: start without --shrink");
+}
+
+}  // namespace
+
 bool toggle_xray(Viewer& viewer, ViewField& f) {
+  if (!f.xray) check_unshrunk(viewer);
   f.xray = !f.xray;
   if (f.xray) f.volume = false;
   apply_composite(viewer, f);
@@ -205,6 +251,7 @@ bool toggle_xray(Viewer& viewer, ViewField& f) {
 
 bool toggle_iso_translucent(Viewer& viewer, ViewField& f) {
   if (f.specs[f.current].empty()) return false;
+  if (!f.iso_translucent) check_unshrunk(viewer);
   f.iso_translucent = !f.iso_translucent;
   if (f.iso_translucent) f.volume = false;
   apply_composite(viewer, f);
@@ -213,6 +260,7 @@ bool toggle_iso_translucent(Viewer& viewer, ViewField& f) {
 
 bool toggle_volume(Viewer& viewer, ViewField& f) {
   if (f.specs[f.current].empty()) return false;
+  if (!f.volume) check_unshrunk(viewer);
   f.volume = !f.volume;
   if (f.volume) f.xray = f.iso_translucent = false;
   apply_composite(viewer, f);
@@ -225,9 +273,17 @@ bool set_iso(Viewer& viewer, ViewField& f, double value, bool iso_only) {
     f.corner = tet_corner_values(viewer.mesh(), f.choice, f.step);
     f.tree = std::make_shared<const TetIntervals>(f.corner);
   }
+  f.xray = f.iso_translucent = f.volume = false;  // the opaque isosurface ends compositing (the view's too)
+  rescale(viewer, f);
   f.iso_on = true;
   f.iso_only = iso_only;
   f.iso_value = f.unit.to_si(value);
+  const auto [lo, hi] = finite_range(f.corner);
+  if (!(f.iso_value >= lo && f.iso_value <= hi))  // as foxi render warns
+    std::fprintf(
+        stderr,
+        "foxi-view: note: isovalue %g %s lies outside the field's values (%g to %g %s): no isosurface\n",
+        value, f.unit.symbol.c_str(), f.unit.to_display(lo), f.unit.to_display(hi), f.unit.symbol.c_str());
   f.drawing = IsoDrawing{};
   f.drawing.corner = f.corner;
   f.drawing.params.values = {f.iso_value};
@@ -249,6 +305,7 @@ void toggle_iso(Viewer& viewer, ViewField& f) {
     return;
   }
   f.xray = f.iso_translucent = f.volume = false;  // the opaque isosurface ends compositing
+  rescale(viewer, f);
   set_iso(viewer, f, f.unit.to_display(0.5 * (f.scale.lo + f.scale.hi)), f.iso_only);
 }
 
@@ -330,6 +387,10 @@ std::string composite_status(const ViewField& f) {
       s += buf;
     }
   }
+  if ((f.volume || f.iso_translucent) && f.no_value > 0) {
+    std::snprintf(buf, sizeof buf, "; %zu corner values NaN: their tets left out", f.no_value);
+    s += buf;
+  }
   return s;
 }
 
@@ -391,6 +452,10 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
         viewer.undraw(std::size_t(k));
       }
     } else if (cmd == "r") {
+      if (viewer.translucent())
+        throw std::invalid_argument(
+            "script: 'r' (a region of interest) is refused while the x-ray or translucent isosurfaces are "
+            "on: turn them off first");
       if (!viewer.push_region()) throw std::invalid_argument("script: 'r' with no tets drawn");
     } else if (cmd == "b") {
       viewer.pop_region();
@@ -413,10 +478,14 @@ void run_script(Viewer& viewer, ViewField& field, const std::string& script, con
         throw std::invalid_argument("script: '" + cmd +
                                     "' draws a field's isosurface: give --field or 'field' first");
     } else if (cmd == "legend") {
+      const bool was = field.legend;
       if (!toggle_legend(viewer, field))
         throw std::invalid_argument("script: 'legend' needs a field: give --field");
       if (field.legend)
         std::printf("legend on, %d pixels at the right\n", field.panel);
+      else if (!was)  // as foxi render refuses a --size that leaves no room for it
+        std::printf("legend off: no room in a %dx%d picture\n", viewer.framebuffer().width,
+                    viewer.framebuffer().height);
       else
         std::printf("legend off\n");
       std::fflush(stdout);

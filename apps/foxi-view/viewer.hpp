@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "foxi/viz/legend.hpp"
 #include "foxi/viz/text.hpp"
 #include "foxi/viz/translucent.hpp"
+#include "foxi/viz/view_options.hpp"
 #include "foxi/viz/volume.hpp"
 
 namespace foxi::view {
@@ -33,6 +35,10 @@ struct ViewField {
   std::size_t step = 0;
   ColorScale scale;
   DisplayUnit unit;
+  // scale is the range of the tets' corner values (graded, and for the volume and translucent
+  // isosurfaces, which show the field between the nodes: foxi render's rule), else of their centroids'.
+  bool scale_of_corners = false;
+  std::size_t no_value = 0;  // of those values, the NaN ones
   // The isosurface (keys i, o, [ and ]): at iso_value (SI), the solid above it or (iso_only) the surface.
   bool iso_on = false, iso_only = false;
   double iso_value = 0;
@@ -55,7 +61,17 @@ struct ViewField {
   std::vector<OpacityPoint> curve;  // --opacity-curve (display units); empty: a ramp
   TranslucentParams translucent;    // what the view was given (its corner: `corner` above)
   VolumeParams volume_params;
+  // The camera as fitted from the options (camera_for) to the mesh box [box_lo, box_hi]: while the
+  // view still has it (not orbited, zoomed or panned), a new width (the legend's panel, a resized
+  // window) fits it again, as foxi render fits its camera to what the legend leaves.
+  CameraOptions camera_options;
+  double box_lo[3] = {0, 0, 0}, box_hi[3] = {0, 0, 0};
+  std::optional<Camera> fitted;
 };
+
+// The view's size changed to width x height: the camera fitted again where the user has not moved
+// it (ViewField::fitted), then the view resized.
+void resize_view(Viewer& viewer, ViewField& field, int width, int height);
 
 // The specs of `mesh` ("" and its fields' names), `current` set to `spec` (NAME[:component], added
 // if it names a component); std::invalid_argument (FieldSelectError) for a field not in the mesh.

@@ -256,7 +256,7 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
             width = w;
             height = h;
             field.full_width = w;
-            viewer.resize(field.legend ? w - field.panel : w, h);
+            resize_view(viewer, field, field.legend ? w - field.panel : w, h);
             viewer.set_running(true);
             changed = exposed = true;
           }
@@ -333,7 +333,12 @@ int run_window(Viewer& viewer, ViewField& field, const std::string& save_prefix)
               viewer.step();
               break;
             case XK_r:
-              if (viewer.push_region()) viewer.set_running(true);
+              if (viewer.push_region())
+                viewer.set_running(true);
+              else if (viewer.translucent())
+                std::fprintf(stderr,
+                             "foxi-view: r (a region of interest) is refused while the x-ray or translucent "
+                             "isosurfaces are on: turn them off first\n");
               break;
             case XK_b:
               if (viewer.pop_region()) viewer.set_running(true);

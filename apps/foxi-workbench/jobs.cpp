@@ -468,7 +468,7 @@ void Workbench::on_job_done() {
   mesh_bounds(*shown, bounds_lo_, bounds_hi_);
   view_->set_base(std::move(out->base));
   if (out->has_scale && out->choice) {
-    view_->set_field_source(*out->choice, out->step, out->scale, out->iso_cache);
+    view_->set_field_source(*out->choice, out->step, out->scale, out->iso_cache, out->volume_scale);
     if (!range_) {  // the range boxes start from the automatic range
       const QSignalBlocker q1(range_lo_), q2(range_hi_);
       range_lo_->setValue(out->unit.to_display(out->scale.lo));
@@ -487,10 +487,13 @@ void Workbench::on_job_done() {
     selection_field_.clear();
   }
   show_selection();
-  if (out->has_scale)
-    legend_->setPixmap(legend_pixmap(out->scale, out->unit, out->field_label, view_->height()));
-  else
+  legend_scale_.reset();
+  if (out->has_scale) {
+    legend_scale_ = LegendScales{out->scale, out->volume_scale, out->unit, out->field_label};
+    show_legend();
+  } else {
     legend_->clear();
+  }
   refresh_fields();
   if (out->meshed && !out->solved) add_history(out->seconds);
   if (out->solved) {

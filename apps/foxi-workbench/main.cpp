@@ -163,6 +163,19 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     }
   }
   if (!tools.regions.empty()) {
+    for (double id : tools.regions) {  // an id no region has would hide everything in silence
+      bool known = false;
+      for (const foxi::Region& r : w.mesh()->regions) known = known || double(r.id) == id;
+      if (!known) {
+        std::string there;
+        for (const foxi::Region& r : w.mesh()->regions)
+          there += (there.empty() ? "" : ", ") + std::to_string(r.id) +
+                   (r.name.empty() ? "" : " (" + r.name + ")");
+        std::fprintf(stderr, "foxi-workbench: error: --regions: the mesh has no region %g (it has %s)\n", id,
+                     there.c_str());
+        return kExitUsage;
+      }
+    }
     std::vector<std::int32_t> hidden;
     for (const foxi::Region& r : w.mesh()->regions)
       if (std::find(tools.regions.begin(), tools.regions.end(), double(r.id)) == tools.regions.end())
@@ -201,6 +214,13 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
                    error.toUtf8().constData());
       return kExitUsage;
     }
+    for (double v : tools.iso)  // as foxi render warns: no isosurface at a value the field never takes
+      if (!(u.to_si(v) >= w.field_lo() && u.to_si(v) <= w.field_hi()))
+        std::fprintf(
+            stderr,
+            "foxi-workbench: warning: --iso %g %s lies outside the field's values (%.6g to %.6g %s): no "
+            "isosurface there\n",
+            v, u.symbol.c_str(), u.to_display(w.field_lo()), u.to_display(w.field_hi()), u.symbol.c_str());
   }
   foxi::qt::ViewWidget* view = w.view_widget();
   if (tools.xray) {
@@ -212,7 +232,10 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
     std::string spec;
     for (const foxi::RegionOpacity& r : view->xray_params()->region_opacity)
       spec += (spec.empty() ? "" : ",") + std::to_string(r.region) + "=" + std::to_string(r.opacity);
-    std::printf("x-ray: --region-opacity %s%s\n", spec.c_str(),
+    // The regions shown (--regions) are foxi render's --regions: the others are not drawn at all.
+    std::string shown;
+    for (double r : tools.regions) shown += (shown.empty() ? "--regions " : ",") + std::to_string(long(r));
+    std::printf("x-ray: %s%s--region-opacity %s%s\n", shown.c_str(), shown.empty() ? "" : " ", spec.c_str(),
                 view->xray_params()->iso.values.empty() ? "" : " --iso-opacity 0.5");
   }
   view->finish_now();
@@ -292,12 +315,19 @@ int main(int argc, char** argv) {
     bool is_headless = false;
     ToolOptions tools;
     double shrink = 1;
+    std::vector<std::string> seen;  // as foxi refuses an option given twice (but --set), so does this
     for (std::size_t i = 0; i < args.size(); ++i) {
       const std::string& a = args[i];
       auto value = [&]() -> std::string {
         if (i + 1 >= args.size()) throw Usage(a + " takes a value");
+        if (args[i + 1].empty()) throw Usage("option " + a + " takes a value, not an empty one");
         return args[++i];
       };
+      if (a.rfind("--", 0) == 0 && a != "--set") {
+        if (std::find(seen.begin(), seen.end(), a) != seen.end())
+          throw Usage("option " + a + " given twice (give it once)");
+        seen.push_back(a);
+      }
       if (a == "--help" || a == "-h") {
         std::puts(kUsage);
         return kExitOk;
@@ -388,6 +418,8 @@ int main(int argc, char** argv) {
     if (tools.solver && physics.empty()) throw Usage("--solver picks the solve's solver: give --physics");
     if (tools.solver && tools.solver->calculix && physics != "thermal")
       throw Usage("--solver ccx solves the thermal problem only (--physics thermal), not " + physics);
+    if (tools.xray && (shrink != 1 || tools.graded))
+      throw Usage("--xray draws whole tets in their regions' colours: leave out --shrink and --graded");
     if (tools.iso_only && tools.iso.empty())
       throw Usage("--iso-only draws the isosurface of --iso: give --iso");
     if (!is_headless && (tools.any() || tools.graded || tools.deform || tools.xray || !tools.movie.empty() ||

@@ -128,6 +128,16 @@ void build_display(Outcome& out, const Mesh& source, const std::string& field, c
     params.field = std::make_shared<const FieldPaint>(colouring.graded ? graded_field_paint(all, scale)
                                                                        : flat_field_paint(all, scale));
     out.scale = scale;
+    out.volume_scale = scale;
+    if (!colouring.range && !colouring.graded) {
+      const std::vector<double>& corner = *out.iso_cache->corner;
+      std::vector<double> corners;
+      for (std::uint32_t t : out.base)
+        corners.insert(corners.end(), corner.begin() + std::ptrdiff_t(4 * t),
+                       corner.begin() + std::ptrdiff_t(4 * t + 4));
+      if (const std::optional<AutoScale> a = automatic_scale(out.base.empty() ? corner : corners, map))
+        out.volume_scale = a->scale;
+    }
     out.has_scale = true;
     out.probe.resize(values.size());
     for (std::size_t i = 0; i < values.size(); ++i) out.probe[i] = out.unit.to_display(values[i]);
@@ -141,6 +151,13 @@ void build_display(Outcome& out, const Mesh& source, const std::string& field, c
 }
 
 // A colour bar with ticks (colormap.hpp's entries and nice_ticks), in the field's display unit.
+void Workbench::show_legend() {
+  if (!legend_scale_) return;
+  const LegendScales& l = *legend_scale_;
+  legend_->setPixmap(
+      legend_pixmap(view_->volume() ? l.volume_scale : l.scale, l.unit, l.label, view_->height()));
+}
+
 QPixmap legend_pixmap(const ColorScale& s, const DisplayUnit& unit, const QString& label, int height) {
   const int w = 150, bar = 18, top = 24, bottom = 10, h = std::max(height, 120);
   QImage img(w, h, QImage::Format_RGB32);
@@ -383,6 +400,7 @@ QPushButton* Workbench::build_view_panel() {
     const QSignalBlocker b1(xray_box_), b2(volume_box_);
     xray_box_->setChecked(xray);
     volume_box_->setChecked(volume);
+    show_legend();  // the volume's scale, or the picture's
   });
   tools->addWidget(xray_box_);
   tools->addWidget(volume_box_);

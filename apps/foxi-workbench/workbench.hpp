@@ -333,6 +333,7 @@ class Workbench : public QMainWindow {
   ProjectSnapshot project_snapshot(const QString& folder) const;
   void apply_field_tools();  // the controls' selection to the view
   void show_selection();     // the controls to the selection
+  void show_legend();        // legend_scale_'s, the volume's scale while the view draws the volume
 
   QString model_path_;
   std::map<std::string, std::string> overrides_;
@@ -417,6 +418,13 @@ class Workbench : public QMainWindow {
   QCheckBox *graded_box_ = nullptr, *range_on_ = nullptr;
   QDoubleSpinBox *range_lo_ = nullptr, *range_hi_ = nullptr;
   QLabel* legend_ = nullptr;
+  // The field shown's scales (the picture's, the volume's), unit and label: the legend's.
+  struct LegendScales {
+    ColorScale scale, volume_scale;
+    DisplayUnit unit;
+    QString label;
+  };
+  std::optional<LegendScales> legend_scale_;
   QSlider* fraction_ = nullptr;
   QCheckBox *iso_on_ = nullptr, *iso_only_ = nullptr, *threshold_on_ = nullptr, *clip_on_ = nullptr;
   QSlider *iso_slider_ = nullptr, *clip_slider_ = nullptr;

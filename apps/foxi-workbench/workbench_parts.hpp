@@ -44,6 +44,9 @@ struct Outcome {
   std::vector<double> probe;  // per tet, display unit
   QString probe_unit, field_label;
   ColorScale scale;
+  // The volume's scale: the automatic range of the corner values (a volume shows the field between
+  // the nodes, foxi render's rule), else `scale`.
+  ColorScale volume_scale;
   DisplayUnit unit;
   bool has_scale = false;
   std::vector<std::uint32_t> base;    // the tets of the regions shown (empty: all)

@@ -60,6 +60,9 @@ std::string Args::option(std::string_view name, std::string fallback) {
     if (*it == name) {
       if (it + 1 == args_.end()) throw UsageError("option " + std::string(name) + " needs a value");
       std::string value = *(it + 1);
+      // An empty value (--opacity-curve '' from a script's unset variable) would read as the option
+      // left out, and its default be used in silence.
+      if (value.empty()) throw UsageError("option " + std::string(name) + " takes a value, not an empty one");
       args_.erase(it, it + 2);
       taken_.emplace_back(name);
       return value;

@@ -26,7 +26,8 @@ class Args {
   explicit Args(std::vector<std::string> args) : args_(std::move(args)) {}
   // True (and removed) if `flag` is present.
   bool flag(std::string_view name);
-  // The value after `name` (removed with it), or `fallback` if absent; UsageError if it has none.
+  // The value after `name` (removed with it), or `fallback` if absent; UsageError if it has none or
+  // an empty one.
   std::string option(std::string_view name, std::string fallback = {});
   bool has_option(std::string_view name) const;
   // A flag that may take a file: true (and removed) if `name` is present; the argument after it is

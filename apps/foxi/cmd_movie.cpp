@@ -153,6 +153,7 @@ int cmd_movie(Args args) {
   if (out.empty()) out = args.option("--output");
   PictureOptions options = take_picture_options(args, "640x480");
   FieldOptions field_options = take_field_options(args);
+  field_options.corner_range = composite.volume_on() || composite.has_iso_opacity;
   if (field_options.markers)
     throw UsageError("--markers marks a picture: foxi render takes it, foxi movie does not");
   const IsoOptions iso_options = take_iso_options(args, field_options);
@@ -411,6 +412,10 @@ int cmd_movie(Args args) {
                 color_map_name(field.legend.scale.map), field.legend.scale.log ? " log" : "",
                 u.to_display(field.legend.scale.lo), u.to_display(field.legend.scale.hi),
                 u.symbol.empty() ? "" : " ", u.symbol.c_str(), panel > 0 ? ", legend at the right" : "");
+    if (compositing && field.no_value > 0)
+      std::printf("warning     %zu corner values are NaN or infinite: %s\n", field.no_value,
+                  composite.volume_on() ? "the tets with one are left out (transparent)"
+                                        : "no isosurface crosses the tets with one");
   }
   std::printf("wrote       %s\n", out.c_str());
   return kExitOk;

@@ -79,7 +79,9 @@ int cmd_render(Args args) {
   if (out.empty()) out = args.option("--output");
   const bool zbuffer = args.flag("--zbuffer");
   PictureOptions options = take_picture_options(args, "1280x960");
-  const FieldOptions field_options = take_field_options(args);
+  FieldOptions field_options = take_field_options(args);
+  // A volume and translucent isosurfaces show the field between the nodes: the range is theirs.
+  field_options.corner_range = composite.volume_on() || composite.has_iso_opacity;
   const IsoOptions iso_options = take_iso_options(args, field_options);
   const std::optional<DeformOption> deform = take_deform_option(args);
   const bool translucent = composite.translucent(), volume = composite.volume_on();
@@ -154,6 +156,10 @@ int cmd_render(Args args) {
                 field.legend.title.c_str(), color_map_name(vp.scale.map),
                 field.legend.unit.to_display(vp.scale.lo), field.legend.unit.to_display(vp.scale.hi),
                 field.legend.unit.symbol.c_str(), vp.unit_length);
+    if (field.no_value > 0)
+      std::printf(
+          "warning     %zu corner values are NaN or infinite: the tets with one are left out (transparent)\n",
+          field.no_value);
     if (report.exact_order)
       std::printf(
           "composited back to front in the power order (exact for this Delaunay mesh), order %.1f ms, "
@@ -184,6 +190,10 @@ int cmd_render(Args args) {
     if (!tp.region_opacity.empty()) std::printf(" (others opaque); ");
     if (!iso_options.iso.empty()) std::printf("isosurfaces opacity %g; ", tp.iso_opacity);
     std::printf("%zu tets own a surface (%.1f ms)\n", report.tets_ordered, report.surfaces_ms);
+    if (!iso_options.iso.empty() && field.no_value > 0)
+      std::printf(
+          "warning     %zu corner values are NaN or infinite: no isosurface crosses the tets with one\n",
+          field.no_value);
     std::printf(
         "composited %s, order %.1f ms, blending %.1f ms: %zu fragments, %dx%d, %.1f%% of pixels covered\n",
         report.exact_order ? "back to front in the power order (exact for this Delaunay mesh)"

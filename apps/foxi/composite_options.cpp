@@ -36,6 +36,8 @@ const char* const kCompositeOptionsHelp =
 CompositeOptions take_composite_options(Args& args) {
   CompositeOptions o;
   o.volume = args.option("--volume");
+  // Args are rebuilt below, which forgets what was taken: a second --volume would read as unknown.
+  if (args.has_option("--volume")) throw UsageError("option --volume given twice (give it once)");
   if (!o.volume.empty()) {
     if (args.has_option("--field")) throw UsageError("--volume NAME names the field: leave out --field");
     std::vector<std::string> rest = args.remaining();
@@ -48,6 +50,7 @@ CompositeOptions take_composite_options(Args& args) {
   if (!iso_opacity.empty()) {
     o.has_iso_opacity = true;
     o.iso_opacity = parse_opacity(iso_opacity, "--iso-opacity");
+    if (!(o.iso_opacity > 0)) throw UsageError("--iso-opacity 0 draws the isosurfaces invisible: give a > 0");
   }
   if (o.volume_on() != !curve.empty() || (!length.empty() && !o.volume_on()))
     throw UsageError("--volume NAME and --opacity-curve v0:a0,... go together (--opacity-length with them)");
@@ -123,6 +126,18 @@ VolumeParams volume_params(const CompositeOptions& o, const Mesh& mesh, const Fi
     if (!(vp.opacity_curve.back().opacity < 1))
       throw UsageError("--opacity-curve: opacity " + number(p.opacity) + " times " + number(scale) + " is " +
                        number(p.opacity * scale) + ", not below 1");
+    const std::size_t n = vp.opacity_curve.size();
+    if (n > 1 && !(vp.opacity_curve[n - 1].value > vp.opacity_curve[n - 2].value))
+      throw UsageError("--opacity-curve: the values " + number(o.curve[n - 2].value) + " and " +
+                       number(p.value) + " " + field.legend.unit.symbol + " are the same in SI (" +
+                       number(vp.opacity_curve[n - 1].value) + " " + field.choice.field->unit +
+                       "): give values further apart");
+  }
+  if (vp.opacity_curve.size() > 1) {  // as the painter needs (volume.hpp)
+    const double span = vp.opacity_curve.back().value - vp.opacity_curve.front().value;
+    if (!std::isfinite(span) || !std::isfinite(4096 / span))
+      throw UsageError("--opacity-curve: its values span " + number(span) + " " + field.choice.field->unit +
+                       " in SI: give a span between 1e-290 and 1e308");
   }
   double lo[3], hi[3];
   tets_bounds(mesh, subset, lo, hi);

@@ -83,13 +83,19 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
   const std::vector<double> all =
       o.graded ? tet_corner_values(mesh, f.choice, f.step) : tet_centroid_values(mesh, f.choice, f.step);
   const std::size_t per = o.graded ? 4 : 1;
+  // The values the range is taken from: those drawn, or the corners' (FieldOptions::corner_range).
+  const bool corners = o.corner_range && !o.graded;
+  const std::vector<double> corner_values =
+      corners ? tet_corner_values(mesh, f.choice, f.step) : std::vector<double>{};
+  const std::vector<double>& ranged = corners ? corner_values : all;
+  const std::size_t ranged_per = corners ? 4 : per;
   std::vector<double> drawn;
   if (subset.empty()) {
-    drawn = all;
+    drawn = ranged;
   } else {
     for (std::uint32_t t : subset)
-      drawn.insert(drawn.end(), all.begin() + std::ptrdiff_t(per * t),
-                   all.begin() + std::ptrdiff_t(per * t + per));
+      drawn.insert(drawn.end(), ranged.begin() + std::ptrdiff_t(ranged_per * t),
+                   ranged.begin() + std::ptrdiff_t(ranged_per * t + ranged_per));
   }
   for (double v : drawn) f.no_value += std::isnan(v);
   // The extremes' places: graded, the corner (node) of the largest / smallest value; flat, the tet.
@@ -144,6 +150,11 @@ FieldPicture resolve_field(const FieldOptions& o, const Mesh& mesh, std::span<co
     s.lo = o.has_si_range ? o.si_range[0] : f.legend.unit.to_si(o.range[0]);
     s.hi = o.has_si_range ? o.si_range[1] : f.legend.unit.to_si(o.range[1]);
     if (s.lo > s.hi) std::swap(s.lo, s.hi);
+    if (!(s.hi >
+          s.lo))  // ends a display unit apart can meet in SI (1e-300 and 2e-300 degC are both 273.15 K)
+      throw UsageError("--range " + std::to_string(o.range[0]) + "," + std::to_string(o.range[1]) + " is " +
+                       std::to_string(s.lo) + " to " + std::to_string(s.hi) + " " + field.unit +
+                       " in SI: no range (give ends further apart)");
     if (o.log && !(s.lo > 0))
       throw UsageError("--log needs a range above 0 in SI (" + field.unit + "), not " + std::to_string(s.lo));
   } else {

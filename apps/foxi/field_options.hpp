@@ -33,6 +33,10 @@ struct FieldOptions {
   // its time steps, is found in SI: converting it to a display unit and back would not round-trip).
   bool has_si_range = false;
   double si_range[2] = {0, 0};
+  // The automatic range (and the NaN count) from the tets' corner values even when flat: set by the
+  // commands for pictures that show the field as it varies inside a tet (a volume rendering,
+  // translucent isosurfaces), whose colours reach the nodes' values, not just the centroids'.
+  bool corner_range = false;
 };
 
 // Takes the options out of args; UsageError for malformed ones.

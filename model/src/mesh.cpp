@@ -1,6 +1,8 @@
 #include "foxi/model/mesh.hpp"
 
+#include <cerrno>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -97,8 +99,13 @@ namespace {
 bool whole_number(std::string_view key, std::int32_t& out) {
   const std::string s(key);
   char* end = nullptr;
+  errno = 0;
   const long v = std::strtol(s.c_str(), &end, 10);
   if (s.empty() || end != s.c_str() + s.size()) return false;
+  // Not one past the ids' range (4294967297 is no region, not region 1 after a cast).
+  if (errno == ERANGE || v < std::numeric_limits<std::int32_t>::min() ||
+      v > std::numeric_limits<std::int32_t>::max())
+    return false;
   out = static_cast<std::int32_t>(v);
   return true;
 }

@@ -40,6 +40,7 @@ struct ViewWidget::Impl {
     std::size_t step = 0;
     ColorScale scale;
     std::shared_ptr<IsoCache> cache;
+    ColorScale volume_scale;
   };
   std::optional<Source> source;
   std::vector<std::uint32_t> base;  // the regions shown (empty: all)
@@ -182,10 +183,10 @@ QString ViewWidget::probe_text(int x, int y) const {
 }
 
 void ViewWidget::set_field_source(FieldChoice choice, std::size_t step, ColorScale scale,
-                                  std::shared_ptr<IsoCache> cache) {
+                                  std::shared_ptr<IsoCache> cache, std::optional<ColorScale> volume_scale) {
   const bool redraw = d_->selection.any() || d_->volume_pending || d_->volume;
   d_->reset_selection();
-  d_->source = Impl::Source{std::move(choice), step, scale, std::move(cache)};
+  d_->source = Impl::Source{std::move(choice), step, scale, std::move(cache), volume_scale.value_or(scale)};
   if (d_->volume_pending) d_->volume = true;
   d_->volume_pending = false;
   if (d_->view && redraw) {
@@ -206,7 +207,7 @@ bool ViewWidget::apply(QString* error) {
       // foxi render --volume's picture with default_volume's curve: the regions shown, the field alone.
       v.set_subset(base);
       std::vector<double> corner = tet_corner_values(*d_->mesh, d_->source->choice, d_->source->step);
-      const VolumeParams vp = default_volume(*d_->mesh, d_->source->scale, d_->base);
+      const VolumeParams vp = default_volume(*d_->mesh, d_->source->volume_scale, d_->base);
       v.set_volume(corner, &vp);
       d_->volume_corner = std::move(corner);  // the buffer moves with it: the view's span stays valid
     } else if (d_->xray) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "foxi/model/mesh_io.hpp"
@@ -166,7 +167,68 @@ TEST_F(TranslucentCli, BadOptionsExitWithUsage) {
   EXPECT_EQ(foxi("--volume temperature --opacity-curve 0:1" + out, &log), 2);
   EXPECT_EQ(foxi("--volume temperature --opacity-curve 0:0.5 --iso 40" + out, &log), 2);
   EXPECT_EQ(foxi("--volume temperature --field temperature --opacity-curve 0:0.5" + out, &log), 2);
+  // Given twice, empty, or naming what is not there: each refused with its reason (a second
+  // --volume once read as an unknown option, an empty value as the option left out, and region
+  // 4294967297 as region 1 after a cast).
+  EXPECT_EQ(foxi("--volume temperature --volume temperature --opacity-curve 0:0.5" + out, &log), 2);
+  EXPECT_NE(log.find("--volume given twice"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--volume '' --opacity-curve 0:0.5" + out, &log), 2);
+  EXPECT_NE(log.find("--volume takes a value, not an empty one"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--volume temperature --opacity-curve ''" + out, &log), 2);
+  EXPECT_NE(log.find("--opacity-curve takes a value"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--volume temperature: --opacity-curve 0:0.5" + out, &log), 2);
+  EXPECT_NE(log.find("no component after the colon"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--region-opacity 4294967297=0.5" + out, &log), 2);
+  EXPECT_NE(log.find("no region '4294967297'"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--region-opacity 7=0.5" + out, &log), 2);
+  EXPECT_NE(log.find("its tets' regions: 1 (mould), 2 (die), 3 (substrate)"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--field temperature --iso 304 --iso-opacity 0" + out, &log), 2);
+  EXPECT_NE(log.find("invisible"), std::string::npos) << log;
+  // Values that meet in SI, or span more than a double: said so, exit 2 (once a crash, exit 139).
+  EXPECT_EQ(foxi("--volume temperature --opacity-curve 30:0,30.00000000000001:0.5" + out, &log), 2);
+  EXPECT_NE(log.find("the same in SI"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--volume temperature --opacity-curve -1e308:0.1,1e308:0.5" + out, &log), 2);
+  EXPECT_NE(log.find("give a span between"), std::string::npos) << log;
+  EXPECT_EQ(foxi("--volume temperature --units K --opacity-curve 0:0,3e-310:0.5" + out, &log), 2);
+  EXPECT_EQ(foxi("--field temperature --range 1e-300,2e-300" + out, &log), 2);
+  EXPECT_NE(log.find("no range"), std::string::npos) << log;
   EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.png"));
+}
+
+// A volume's automatic colour range is its corner values' (what it shows between the nodes), not
+// the tets' centroid values': a single tet with 0, 1, 2 and 3 at its corners is coloured 0 to 3
+// (its centroid's 1.5 was widened to 1.485 to 1.515, a hard split of two colours). Its NaN and
+// infinite corner values are counted and said.
+TEST(VolumeCli, AutomaticRangeIsTheCornersAndNoValuesAreSaid) {
+  test::TempDir dir;
+  Mesh one;
+  one.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  one.tet = {0, 1, 2, 3};
+  one.tet_region = {1};
+  one.fields = {Field{"T", FieldLocation::node, 1, "", {}, {0, 1, 2, 3}}};
+  write_mesh(one, dir / "one.vtu");
+  std::string log;
+  const std::string run = "'" + test::cli_path() + "' render '" + (dir / "one.vtu").string() + "' ";
+  ASSERT_EQ(test::run(run + "--volume T --opacity-curve 0:0.1,3:0.5 -o '" + (dir / "v.png").string() + "'",
+                      dir / "log.txt"),
+            0);
+  log = test::read_text(dir / "log.txt");
+  EXPECT_NE(log.find("colours 0 to 3"), std::string::npos) << log;
+  EXPECT_EQ(log.find("NaN"), std::string::npos) << log;
+  // Translucent isosurfaces too: their colours and the legend reach the corners' values.
+  ASSERT_EQ(test::run(run + "--region-opacity 1=0.2 --field T --iso 0.5,2.5 --iso-opacity 0.5 -o '" +
+                          (dir / "i.png").string() + "'",
+                      dir / "log.txt"),
+            0);
+  Mesh holes = one;
+  holes.fields[0].values = {0, std::nan(""), 2, std::numeric_limits<double>::infinity()};
+  write_mesh(holes, dir / "holes.vtu");
+  ASSERT_EQ(test::run("'" + test::cli_path() + "' render '" + (dir / "holes.vtu").string() +
+                          "' --volume T --opacity-curve 0:0.1,3:0.5 -o '" + (dir / "h.png").string() + "'",
+                      dir / "log.txt"),
+            0);
+  log = test::read_text(dir / "log.txt");
+  EXPECT_NE(log.find("2 corner values are NaN or infinite"), std::string::npos) << log;
 }
 
 }  // namespace

@@ -308,6 +308,68 @@ TEST_F(ViewTest, XrayAndVolumeEqualRenderAndUndrawExactly) {
             0)
       << out;
   EXPECT_NE(out.find("5 translucent isosurfaces, opacity 0.35"), std::string::npos) << out;
+  // Isosurfaces alone are not an x-ray.
+  EXPECT_NE(out.find("translucent isosurfaces composited exactly"), std::string::npos) << out;
+  EXPECT_EQ(out.find("x-ray"), std::string::npos) << out;
+}
+
+// The legend's panel at the start with the camera as fitted: the camera is fitted again to what the
+// panel leaves, as foxi render fits it, so the picture is foxi render's with its legend, pixel for
+// pixel (the viewer once kept the camera of the whole width, cutting off both ends of the mesh). A
+// volume's colours and legend span the corner values (foxi render's range), and an 'iso:V' that ends
+// the volume says so in the status line and gives the opaque picture's range back.
+TEST_F(ViewTest, LegendAtTheStartAndTheVolumesRangeEqualFoxiRender) {
+  Mesh m = two_region_grid();
+  Field u{"u", FieldLocation::node, 1, "", {}, {}};
+  for (std::size_t n = 0; n < m.node_count(); ++n) u.values.push_back(m.xyz[3 * n] + 0.5 * m.xyz[3 * n + 2]);
+  m.fields = {u};
+  write_mesh(m, dir_ / "l.vtu");
+  const std::string view = q(view_path()) + " " + q(dir_ / "l.vtu") + " --size 400x300";
+  const std::string render = q(test::cli_path()) + " render " + q(dir_ / "l.vtu") + " --size 400x300";
+  std::string out;
+  ASSERT_EQ(run_logged(view + " --field u --save " + q(dir_ / "lv") + " --script 'legend d s'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  ASSERT_EQ(run_logged(render + " --field u -o " + q(dir_ / "lr.png"), dir_ / "render.log", &out), 0) << out;
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "lv-001.png"), read_png(dir_ / "lr.png")), 0u);
+  const std::string curve = " --opacity-curve 0:0.05,8:0.4";
+  ASSERT_EQ(run_logged(view + " --volume u" + curve + " --save " + q(dir_ / "vl") +
+                           " --script 'legend d s status iso:3 status'",
+                       dir_ / "view.log", &out),
+            0)
+      << out;
+  const std::string view_log = out;
+  ASSERT_EQ(
+      run_logged(render + " --volume u" + curve + " -o " + q(dir_ / "vr.png"), dir_ / "render.log", &out), 0)
+      << out;
+  EXPECT_NE(out.find("colours 0 to 8"), std::string::npos) << out;  // the corners': x + z / 2 on [0,6]x[0,4]
+  EXPECT_EQ(differing_pixels(read_png(dir_ / "vl-001.png"), read_png(dir_ / "vr.png")), 0u);
+  EXPECT_NE(view_log.find("u, viridis, 0 to 8; volume"), std::string::npos) << view_log;
+  const std::size_t after = view_log.rfind("status ");
+  EXPECT_NE(view_log.find("solid above 3", after), std::string::npos) << view_log;
+  EXPECT_EQ(view_log.find("volume", after), std::string::npos) << view_log;
+}
+
+// As foxi render: an option given twice, or an empty value, is refused; --shrink does not go with
+// what draws whole tets; 'r' under the x-ray says why it is refused.
+TEST_F(ViewTest, RepeatedOptionsAndWholeTetModesAreRefused) {
+  std::string out;
+  const std::string view = q(view_path()) + " " + q(mesh_path_);
+  EXPECT_EQ(run_logged(view + " --size 100x100 --size 200x200 --script d", dir_ / "v.log", &out), 2) << out;
+  EXPECT_NE(out.find("--size given twice"), std::string::npos) << out;
+  EXPECT_EQ(run_logged(view + " --region-opacity left=0.2 --region-opacity right=0.5 --script d",
+                       dir_ / "v.log", &out),
+            2)
+      << out;
+  EXPECT_EQ(run_logged(view + " --region-opacity '' --script d", dir_ / "v.log", &out), 2) << out;
+  EXPECT_NE(out.find("not an empty one"), std::string::npos) << out;
+  EXPECT_EQ(run_logged(view + " --shrink 0.5 --region-opacity left=0.2 --script d", dir_ / "v.log", &out), 2)
+      << out;
+  EXPECT_EQ(run_logged(view + " --shrink 0.5 --script 'xray'", dir_ / "v.log", &out), 1) << out;
+  EXPECT_NE(out.find("without --shrink"), std::string::npos) << out;
+  EXPECT_EQ(run_logged(view + " --script 'xray d r'", dir_ / "v.log", &out), 1) << out;
+  EXPECT_NE(out.find("refused while the x-ray"), std::string::npos) << out;
 }
 
 TEST_F(ViewTest, UndrawEqualsRenderingFewerTets) {

@@ -160,7 +160,14 @@ void check_headless(const std::string& model, const std::string& set, const std:
   // --xray: foxi render draws the same from the opacities the workbench prints (its own options).
   const bool xray = tools.find("--xray") != std::string::npos;
   std::string cli_tools = shrink_option;
-  if (xray) cli_tools.erase(cli_tools.find(" --xray"), 7);
+  if (xray) {
+    cli_tools.erase(cli_tools.find(" --xray"), 7);
+    // The printed x-ray options hold --regions themselves (pasted alone, they draw the same).
+    if (const std::size_t r = cli_tools.find(" --regions "); r != std::string::npos) {
+      const std::size_t end = cli_tools.find(' ', r + 11);
+      cli_tools.erase(r, end == std::string::npos ? std::string::npos : end - r);
+    }
+  }
   TempDir dir;
   const auto view = dir.path() / "view.png", mesh = dir.path() / "mesh.vtu", shot = dir.path() / "window.png",
              cli = dir.path() / "cli.png", log = dir.path() / "wb.log";
@@ -2427,6 +2434,11 @@ TEST(WorkbenchHeadless, SolverAndUnitsAsTheSolvePanel) {
       {"--physics thermal --units kelvin", "--units takes engineering"},
       {"--physics current --solver ccx", "--solver ccx solves the thermal problem only"},
       {"--solver ichol", "--solver picks the solve's solver: give --physics"},
+      // As foxi render: an option given twice is refused (the last one once won in silence), and
+      // the x-ray draws whole tets in their regions' colours.
+      {"--physics thermal --range 0,1 --range 2,3", "--range given twice"},
+      {"--physics thermal --physics current", "--physics given twice"},
+      {"--physics thermal --xray --shrink 0.5", "--xray draws whole tets"},
   };
   for (const auto& [args, reason] : bad) {
     EXPECT_EQ(foxi::test::run(wb + args, log), 2) << args;

@@ -558,9 +558,12 @@ std::string InteractiveView::status() const {
                 started_ && !running_ && (undrawing_ ? n > 0 : !done_) ? " [stopped]" : "", stack_.size(),
                 !delaunay_ && !compositing() ? "  NOT Delaunay: depth-buffer drawing" : "");
   std::string s = buf;
-  if (translucent_)
-    s += delaunay_ ? ", x-ray composited exactly (power order)"
-                   : ", x-ray NOT Delaunay: fragments sorted per pixel by depth (no exact order; no undraw)";
+  if (translucent_) {
+    // Translucent regions are the x-ray; isosurfaces alone are not.
+    s += translucent_->regions ? ", x-ray" : ", translucent isosurfaces";
+    s += delaunay_ ? " composited exactly (power order)"
+                   : " NOT Delaunay: fragments sorted per pixel by depth (no exact order; no undraw)";
+  }
   if (volume_)
     s += delaunay_ ? ", volume composited exactly (power order)"
                    : ", volume NOT Delaunay: composited in MPVO order, NOT exact (no undraw)";

@@ -1,6 +1,7 @@
 // The front ends' picture options read from text (view_options.hpp).
 #include "foxi/viz/view_options.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -156,7 +157,24 @@ std::vector<RegionOpacity> parse_region_opacity(const Mesh& mesh, std::string_vi
           "'");
     const std::string key = part.substr(0, eq);
     const std::optional<std::int32_t> id = region_id_of(mesh, key);
-    if (!id) throw OptionError("--region-opacity: the mesh has no region '" + key + "'");
+    // A number no tet carries would leave the picture opaque in silence.
+    bool present = false;
+    for (std::size_t t = 0; id && t < mesh.tet_count() && !present; ++t) present = mesh.region_of(t) == *id;
+    if (!id || !present) {
+      std::vector<std::int32_t> ids;
+      for (std::size_t t = 0; t < mesh.tet_count(); ++t) ids.push_back(mesh.region_of(t));
+      std::sort(ids.begin(), ids.end());
+      ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+      std::string there;
+      for (std::size_t i = 0; i < ids.size() && i < 20; ++i) {
+        there += (i ? ", " : "") + std::to_string(ids[i]);
+        for (const Region& r : mesh.regions)
+          if (r.id == ids[i] && !r.name.empty()) there += " (" + r.name + ")";
+      }
+      if (ids.size() > 20) there += ", ...";
+      throw OptionError("--region-opacity: the mesh has no region '" + key +
+                        "' (its tets' regions: " + there + ")");
+    }
     for (const RegionOpacity& r : out)
       if (r.region == *id) throw OptionError("--region-opacity: region '" + key + "' given twice");
     out.push_back({*id, parse_opacity(part.substr(eq + 1), "--region-opacity " + key + "=")});

@@ -13,6 +13,7 @@
 #include <QWidget>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,8 +70,10 @@ class FOXI_API ViewWidget : public QWidget {
   // The field tools (isosurface, threshold, clip) select by `choice` at `step`, its isosurfaces
   // coloured on `scale`; `cache` is make_iso_cache's for them (O(n log n): a host builds it on a
   // worker). Lifts the current selection. The view must show the mesh the choice belongs to.
+  // volume_scale: the volume's colours and default opacity curve (default: `scale`).
   void set_field_source(FieldChoice choice, std::size_t step, ColorScale scale,
-                        std::shared_ptr<IsoCache> cache);
+                        std::shared_ptr<IsoCache> cache,
+                        std::optional<ColorScale> volume_scale = std::nullopt);
   // Draws what `selection` selects (field_selection.hpp, the rule of foxi render's --iso, --iso-only,
   // --threshold, --clip and --slice: the same picture for the same camera), redrawn from the back; an
   // empty selection draws all tets again. Costs the interval tree's query and, for a threshold, clip
