@@ -195,6 +195,12 @@ int cmd_movie(Args args) {
     kind = Kind::frames;
   } else if (ext == ".gif") {
     kind = Kind::gif;
+    // A GIF frame's delay is 16 bits of hundredths of a second (at most 655.35 s): slower would be
+    // clamped in silence.
+    if (fps < 100.0 / 65535)
+      throw UsageError("--fps " + fps_s +
+                       ": a GIF shows a frame at most 655.35 s (--fps 0.0016 or more; an .apng "
+                       "holds slower ones)");
   } else if (ext == ".apng") {
     kind = Kind::apng;
   } else if (ext == ".mp4") {

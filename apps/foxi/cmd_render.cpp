@@ -1,8 +1,10 @@
 // foxi render MESH: a picture of the mesh's interior by the software painter (tets back to front in
 // the power-function visibility order, front faces only, no depth buffer), written as a PNG.
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -91,6 +93,14 @@ int cmd_render(Args args) {
   check_composite_options(composite, field_options, iso_options, options.params.shrink);
   const std::string path = args.positional(1, 1, kRenderUsage)[0];
   if (out.empty()) throw UsageError("give the output file with -o OUT.png\nusage: " + kRenderUsage);
+  {
+    // It writes PNG: another image extension would hold PNG bytes under a name that says otherwise.
+    std::string ext = std::filesystem::path(out).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".jpg" || ext == ".jpeg" || ext == ".gif" || ext == ".bmp" || ext == ".tif" ||
+        ext == ".tiff" || ext == ".ppm" || ext == ".webp")
+      throw UsageError("-o " + out + ": foxi render writes PNG pictures: give a .png name");
+  }
   check_output_path(out);
   int width = options.width, height = options.height;
   double stop = 1;

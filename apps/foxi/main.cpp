@@ -57,6 +57,9 @@ const char* kUsage =
 
 int main(int argc, char** argv) {
   using namespace foxi::cli;
+  // Line by line into a file or pipe as on a terminal: a run stopped by a signal (which exits
+  // without flushing) or one that fails keeps the report lines it printed before.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     std::fputs(kUsage, stdout);

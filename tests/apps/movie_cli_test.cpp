@@ -124,6 +124,12 @@ TEST_F(MovieCli, BadOptionsAreUsageErrors) {
   EXPECT_NE(out.find(".gif"), std::string::npos) << out;
   EXPECT_EQ(foxi("movie " + p("grid.vtu") + " -o " + p("f_%s.png"), &out), 2);
   EXPECT_EQ(foxi("movie " + p("grid.vtu") + " --mode spin -o " + p("m.gif"), &out), 2);
+  // A GIF's frame delay holds at most 655.35 s (it was clamped in silence); render writes PNG only.
+  EXPECT_EQ(foxi("movie " + p("grid.vtu") + " --fps 0.001 -o " + p("m.gif"), &out), 2);
+  EXPECT_NE(out.find("655.35 s"), std::string::npos) << out;
+  EXPECT_EQ(foxi("render " + p("grid.vtu") + " -o " + p("r.jpg"), &out), 2);
+  EXPECT_NE(out.find("writes PNG"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "r.jpg"));
   EXPECT_EQ(foxi("movie " + p("grid.vtu") + " --frames 1 -o " + p("m.gif"), &out), 2);
   EXPECT_EQ(foxi("movie " + p("grid.vtu") + " --from 60% --to 40% -o " + p("m.gif"), &out), 2);
   EXPECT_EQ(foxi("movie " + p("missing.vtu") + " -o " + p("m.gif"), &out), 3);

@@ -401,6 +401,24 @@ TEST(Translucent, UncertifiedMeshSortsFragmentsPerPixelAndSaysSo) {
   EXPECT_LE(differing, pixels / 500 + 5);
 }
 
+// Collect mode's memory is bounded: past max_fragments the draw stops with TooManyFragments (a big
+// picture of many isosurfaces once took 17 GB); just at the count it draws.
+TEST(Translucent, UncertifiedFragmentsAreBounded) {
+  Mesh m = bench::kuhn_grid_mesh(4, 0.15, 7);
+  random_regions(m, 4);
+  ASSERT_FALSE(compute_delaunay_certificate(m).delaunay);
+  const SphereTable table = compute_spheres(m);
+  TranslucentParams p = three_opacities();
+  const Camera cam = test::random_cameras(m, 1, 52, double(kW) / kH)[0];
+  Framebuffer fb(kW, kH);
+  const std::size_t all = draw_translucent_picture(m, table, cam, fb, {}, p).fragments;
+  ASSERT_GT(all, 100u);
+  p.max_fragments = all;
+  EXPECT_EQ(draw_translucent_picture(m, table, cam, fb, {}, p).fragments, all);
+  p.max_fragments = all - 1;
+  EXPECT_THROW(draw_translucent_picture(m, table, cam, fb, {}, p), TooManyFragments);
+}
+
 TEST(Translucent, CertifiedPictureIsThePowerOrderComposite) {
   test::TempDir dir;
   Mesh m = test::random_delaunay(dir, 200, 12);

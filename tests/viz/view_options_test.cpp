@@ -100,6 +100,18 @@ TEST(ViewOptions, CameraSizeAndShrink) {
     EXPECT_THROW(parse_image_size(bad), OptionError) << bad;
   EXPECT_EQ(parse_shrink("0.8"), 0.8);
   for (const char* bad : {"0", "1.5", "-1", "a"}) EXPECT_THROW(parse_shrink(bad), OptionError) << bad;
+  // Cameras a projection cannot use, refused as options (they were "degenerate" errors at drawing):
+  // the eye on the point looked at (given, or the box centre --at defaults to), too far to square
+  // its distance, an up along the view.
+  EXPECT_THROW(camera_for(parse_camera_options("1,1,1", "1,1,1", "", "", ""), lo, hi, 1.5), OptionError);
+  EXPECT_THROW(camera_for(parse_camera_options("0.5,1,1.5", "", "", "", ""), lo, hi, 1.5), OptionError);
+  EXPECT_THROW(camera_for(parse_camera_options("1e300,0,0", "", "", "", ""), lo, hi, 1.5), OptionError);
+  EXPECT_THROW(camera_for(parse_camera_options("0,0,5", "0,0,0", "0,0,1", "", ""), lo, hi, 1.5), OptionError);
+  // A direction's length does not matter, however small: the same camera as its unit multiple.
+  const Camera tiny = camera_for(parse_camera_options("", "", "", "", "1e-300,0,1e-300"), lo, hi, 1.5);
+  const Camera unit = camera_for(parse_camera_options("", "", "", "", "1,0,1"), lo, hi, 1.5);
+  for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(tiny.eye[k], unit.eye[k]);
+  EXPECT_DOUBLE_EQ(tiny.ortho_height, unit.ortho_height);
 }
 
 TEST(Palette, ExplodedMeshLiftsEachRegion) {

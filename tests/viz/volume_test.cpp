@@ -266,6 +266,36 @@ TEST(Volume, OpticallyDeepVolumeShowsWhereTheRaysEnter) {
   EXPECT_LE(bad, covered / 300);
 }
 
+// The picture does not depend on the values' scale: a field, its colour range and its opacity curve
+// all times 1e300 (beyond what the vector path's float holds: such a picture takes the portable path)
+// or times 1e-20 give the picture of the unscaled ones (a field of 1e300 once drew nothing).
+TEST(Volume, ValuesScaledBeyondFloatGiveTheSamePicture) {
+  test::TempDir dir;
+  const Mesh m = test::random_delaunay(dir, 200, 9);
+  const SphereTable table = compute_spheres(m);
+  const std::vector<double> corner = smooth_field(m);
+  const VolumeParams p = params_for(m);
+  std::vector<std::uint32_t> all(m.tet_count());
+  for (std::uint32_t t = 0; t < all.size(); ++t) all[t] = t;
+  const Camera cam = test::random_cameras(m, 1, 17, double(kW) / kH)[0];
+  const std::vector<std::uint32_t> order = visibility_order(m, table, view_of(cam), all);
+  const Framebuffer want = paint(m, cam, order, corner, p);
+  std::size_t covered = 0;
+  for (std::uint32_t c : want.rgba) covered += c != pack_rgba(255, 255, 255);
+  EXPECT_GT(covered, std::size_t(kW) * kH / 4);
+  for (const double s : {1e300, 1e-20}) {
+    std::vector<double> scaled = corner;
+    for (double& v : scaled) v *= s;
+    VolumeParams q = p;
+    q.scale.lo *= s;
+    q.scale.hi *= s;
+    for (OpacityPoint& c : q.opacity_curve) c.value *= s;
+    int worst = 0;
+    EXPECT_EQ(differing(paint(m, cam, order, scaled, q), want, 2, &worst), 0u)
+        << "scale " << s << ", worst " << worst;
+  }
+}
+
 TEST(Volume, DegenerateKuhnGridMatchesTheRayCaster) {
   const Mesh m = bench::cube_grid_mesh(5);
   check(m, {}, 6, 62, "Kuhn grid");

@@ -168,6 +168,12 @@ struct TranslucentPainter::Impl {
             f.depth = float(w0 + wa * (x + 0.5 - x0) + wb * (y + 0.5 - y0));
             std::copy(rgb, rgb + 3, f.rgb);
             f.alpha = alpha;
+            if (frags.size() >= params.max_fragments)
+              throw TooManyFragments(
+                  "translucent: more than " + std::to_string(params.max_fragments) + " fragments (" +
+                  std::to_string(params.max_fragments * sizeof(Fragment) >> 20) +
+                  " MiB) to sort per pixel (a mesh without the Delaunay certificate has no order to "
+                  "blend them in): draw a smaller picture, or fewer translucent regions or isosurfaces");
             frags.push_back(f);
           }
         });

@@ -61,8 +61,30 @@ CameraOptions parse_camera_options(std::string_view eye, std::string_view at, st
 }
 
 Camera camera_for(const CameraOptions& o, const double lo[3], const double hi[3], double aspect) {
-  return camera_from_options(lo, hi, aspect, o.has_eye ? o.eye : nullptr, o.has_at ? o.at : nullptr,
-                             o.has_up ? o.up : nullptr, o.fov_deg, o.has_dir ? o.dir : nullptr);
+  // A direction's length does not matter: scaled to a largest component of 1, so that 1e-300,0,1e-300
+  // is a direction (its square underflowed to zero).
+  double dir[3] = {o.dir[0], o.dir[1], o.dir[2]};
+  const double largest = std::max({std::abs(dir[0]), std::abs(dir[1]), std::abs(dir[2])});
+  if (o.has_dir && largest > 0 && std::isfinite(largest))
+    for (double& d : dir) d /= largest;
+  const Camera c = camera_from_options(lo, hi, aspect, o.has_eye ? o.eye : nullptr, o.has_at ? o.at : nullptr,
+                                       o.has_up ? o.up : nullptr, o.fov_deg, o.has_dir ? dir : nullptr);
+  // What a projection refuses later as "degenerate", said here with the options' names.
+  const double d[3] = {c.at[0] - c.eye[0], c.at[1] - c.eye[1], c.at[2] - c.eye[2]};
+  const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  if (!o.has_dir && dd == 0)
+    throw OptionError(o.has_at
+                          ? "--eye is the point --at looks at: give two different points"
+                          : "--eye is the centre of the drawn box, which --at defaults to: give --at (the "
+                            "point to look at)");
+  if (!std::isfinite(dd))
+    throw OptionError("--eye and --at are too far apart (" + std::to_string(std::hypot(d[0], d[1], d[2])) +
+                      ") to project with doubles: bring the eye nearer");
+  const double r[3] = {d[1] * c.up[2] - d[2] * c.up[1], d[2] * c.up[0] - d[0] * c.up[2],
+                       d[0] * c.up[1] - d[1] * c.up[0]};
+  if (o.has_up && !(r[0] * r[0] + r[1] * r[1] + r[2] * r[2] > 0))
+    throw OptionError("--up is parallel to the view direction: give another");
+  return c;
 }
 
 ImageSize parse_image_size(std::string_view text) {

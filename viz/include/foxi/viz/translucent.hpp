@@ -36,6 +36,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <vector>
 
 #include "foxi/api.hpp"
@@ -68,6 +69,14 @@ struct TranslucentParams {
   double near = 0;  // perspective near-plane distance (world); 0 = automatic (tiny)
   int threads = 2;  // threads blending interleaved bands of rows
   std::uint32_t background = pack_rgba(255, 255, 255);
+  // Collect mode (no Delaunay certificate: fragments sorted per pixel) keeps every fragment, 32 bytes
+  // each: at most this many (64M, 2 GiB) before draw throws TooManyFragments.
+  std::size_t max_fragments = std::size_t(1) << 26;
+};
+
+// Collect mode's fragments would exceed TranslucentParams::max_fragments.
+struct FOXI_API TooManyFragments : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 // The view-independent part: which faces of which tets are drawn. Build once per mesh, subset and
@@ -118,7 +127,7 @@ class FOXI_API TranslucentPainter {
 
   // Blends the fragments of `tets`, in the order given (back to front), over what is drawn; may be
   // called batch after batch (a partial picture is the exact picture of the far part). Tets outside
-  // surfaces.tets draw nothing.
+  // surfaces.tets draw nothing. Collect mode: TooManyFragments past params.max_fragments.
   void draw(std::span<const std::uint32_t> tets);
   // The picture so far into fb (resized to the painter's size, no depth buffer): colours rounded to
   // 8 bits, ids the tet of each pixel's nearest fragment (kNone where none). Collect mode: the
