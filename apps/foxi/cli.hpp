@@ -23,7 +23,9 @@ struct InputError : std::runtime_error {
 // The arguments of one subcommand, with flags taken out as they are asked for.
 class Args {
  public:
-  explicit Args(std::vector<std::string> args) : args_(std::move(args)) {}
+  // --name=value is read as --name value (GNU style), up to a bare "--" (what follows it is
+  // another program's, taken whole by take_after).
+  explicit Args(std::vector<std::string> args);
   // True (and removed) if `flag` is present.
   bool flag(std::string_view name);
   // The value after `name` (removed with it), or `fallback` if absent; UsageError if it has none or

@@ -87,8 +87,11 @@ const std::string kMovieUsage =
     "  -o              .gif (giflib, 256 colours per frame), .apng (animated PNG), .mp4 (needs the\n"
     "                  ffmpeg program), or a name with a printf number, e.g. out/frame_%04d.png:\n"
     "                  numbered PNG frames (the folder is created)\n"
-    "  Meshes that fail the Delaunay certificate have no visibility order and are refused (exit\n"
-    "  status 3), as are unusable ones (see foxi info); inverted tets are re-oriented (a note says so).";
+    "  Meshes that fail the Delaunay certificate have no visibility order: backforth and rotate movies\n"
+    "  of opaque tets refuse them (exit status 3); a --sweep draws each frame with the depth buffer, and\n"
+    "  a translucent or volume movie composites each frame as foxi render does without the certificate\n"
+    "  (fragments sorted per pixel, or MPVO order: said, not exact; no backforth). Unusable meshes (see\n"
+    "  foxi info) are refused; inverted tets are re-oriented (a note says so).";
 
 double percent(const std::string& s, const char* what, double fallback) {
   if (s.empty()) return fallback;

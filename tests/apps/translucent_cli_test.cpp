@@ -119,6 +119,15 @@ TEST_F(TranslucentCli, VolumeOfALinearFieldIsHalfItsColourOverWhite) {
       << log;
   EXPECT_NE(log.find("composited back to front in the power order"), std::string::npos) << log;
   const Framebuffer fb = read_png(png);
+  // The GNU spelling --name=value is the same options (it once read as none of them).
+  const auto eq = dir_ / "eq.png";
+  ASSERT_EQ(foxi("--volume=temperature --opacity-curve=0:0.5 --opacity-length=1 --legend=off --dir=0,0,-1 "
+                 "--up=0,1,0 --size=180x120 -o '" +
+                     eq.string() + "'",
+                 &log),
+            0)
+      << log;
+  EXPECT_EQ(read_png(eq).rgba, fb.rgba);
   // Unblended: u = 2 p - 255 must be an entry of viridis (to rounding); the image centre (x = 4.5,
   // 345 K on the data range 300..390 K) entry 128.
   auto distance_to_entry = [](const double u[3], int e) {
