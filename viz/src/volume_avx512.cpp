@@ -434,7 +434,7 @@ FOXI_TARGET void tet_batch_avx512(TetBatch& b) {
   for (int k = 0; k < 4; ++k) {
     const V nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
     const V off = b.perspective ? h[k] : n[k][2];
-    const __mmask8 edge_on = _mm512_cmp_pd_mask(off * off, all(1e-12) * nn * reach2, _CMP_LE_OQ);
+    const __mmask8 edge_on = _mm512_cmp_pd_mask(off * off, all(1e-20) * nn * reach2, _CMP_LE_OQ);
     const V zero = _mm512_setzero_pd();
     ndA[k] = sel(edge_on, zero, ndA[k]);
     ndB[k] = sel(edge_on, zero, ndB[k]);

@@ -173,19 +173,22 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
       }
   }
   if (beyond < 0) return;  // wholly nearer than the plane (or not a number)
-  // A face's plane through the eye (perspective) or along the rays (orthographic), to a millionth
-  // of the tet's distance (a structured grid seen from one of its planes, to within rounding):
+  // A face's plane through the eye (perspective) or along the rays (orthographic), to 1e-10 of the
+  // tet's distance (a structured grid seen from one of its planes, to within rounding):
   // every ray meets that plane at the eye or lies in it, so it bounds no segment, and which side of
   // it a pixel's ray is on is which side of its projection, a line, the pixel is on: what the spans
   // decide (half-open, so a pixel centre on the line goes to one of the two tets beside it).
   // Its ray parameter would be a ratio of rounding errors (in float on the vector path), and a
-  // pixel on that line could lose its tet or get it twice. (A face the eye is a millionth off sees
-  // rays cross it at a millionth of a radian: a sliver of projection a thousandth of a pixel wide,
-  // whose pixels would be counted in both tets; so rare, and so thin, that it is left.)
+  // pixel on that line could lose its tet or get it twice. The bound is far below any offset a
+  // user gives and far above rounding: at a millionth (as it was) the faces through a grid node
+  // 1e-7 from the eye were taken for planes through it, and the rays beside them, crossing them at
+  // a ten-millionth of a radian over many pixels, counted both tets (seams of up to 31/255); those
+  // planes' ray parameters are good to the near plane's distance, which is what decides. (A face
+  // 1e-10 off sees a sliver of projection some 1e-7 of a pixel wide counted in both tets: left.)
   for (int k = 0; k < 4; ++k) {
     const double nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
     const double off = proj.perspective ? h[k] : n[k][2];  // the eye's offset, or the rays'
-    if (off * off <= 1e-12 * nn * reach2)
+    if (off * off <= 1e-20 * nn * reach2)
       r.ndA[k] = r.ndB[k] = r.ndC[k] = r.numA[k] = r.numB[k] = r.numC[k] = 0;
   }
 #ifdef FOXI_VOLUME_AVX512
