@@ -358,6 +358,8 @@ TEST_F(ViewTest, RepeatedOptionsAndWholeTetModesAreRefused) {
   const std::string view = q(view_path()) + " " + q(mesh_path_);
   EXPECT_EQ(run_logged(view + " --size 100x100 --size 200x200 --script d", dir_ / "v.log", &out), 2) << out;
   EXPECT_NE(out.find("--size given twice"), std::string::npos) << out;
+  EXPECT_EQ(run_logged(view + " --size=100x100 --size 200x200 --script d", dir_ / "v.log", &out), 2) << out;
+  EXPECT_NE(out.find("--size given twice"), std::string::npos) << out;  // --name=value is --name value
   EXPECT_EQ(run_logged(view + " --region-opacity left=0.2 --region-opacity right=0.5 --script d",
                        dir_ / "v.log", &out),
             2)
