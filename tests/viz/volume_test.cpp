@@ -294,6 +294,16 @@ TEST(Volume, ValuesScaledBeyondFloatGiveTheSamePicture) {
     EXPECT_EQ(differing(paint(m, cam, order, scaled, q), want, 2, &worst), 0u)
         << "scale " << s << ", worst " << worst;
   }
+  // A few nodes' values 1e300 on the usual scale (those tets alone take the portable path): the
+  // picture of 1e20 there, as far beyond the curve's and the range's ends (the same extinction and
+  // colour but within a ten-billionth of those nodes).
+  std::vector<double> far = corner, beyond = corner;
+  for (std::size_t i = 0; i < corner.size(); ++i)
+    if (m.tet[i] % 7 == 0) far[i] = 1e300, beyond[i] = 1e20;
+  int worst = 0;
+  const Framebuffer near_ones = paint(m, cam, order, beyond, p);
+  EXPECT_EQ(differing(paint(m, cam, order, far, p), near_ones, 2, &worst), 0u) << "worst " << worst;
+  EXPECT_GT(differing(near_ones, want, 2, nullptr), 50u) << "the nodes changed the picture";
 }
 
 TEST(Volume, DegenerateKuhnGridMatchesTheRayCaster) {

@@ -216,6 +216,9 @@ inline bool corner_edges(const double (*q)[2], int n_q, int y0, int y1, CornerEd
   return true;
 }
 
+// The values the vector path's float holds with room to spare (volume.cpp, draw_tet).
+constexpr double kFloatSafe = 1e30;
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define FOXI_VOLUME_AVX512 1
 // Whether this CPU runs volume_row_avx512; FOXI_PORTABLE_RASTER=1 says no (the painter's switch),

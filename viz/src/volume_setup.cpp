@@ -192,7 +192,10 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
       r.ndA[k] = r.ndB[k] = r.ndC[k] = r.numA[k] = r.numB[k] = r.numC[k] = 0;
   }
 #ifdef FOXI_VOLUME_AVX512
-  if (vector_rows) {
+  // Corner values beyond what float holds: this tet on the portable path (volume.cpp).
+  const bool float_values = !(std::abs(cv[0]) > kFloatSafe || std::abs(cv[1]) > kFloatSafe ||
+                              std::abs(cv[2]) > kFloatSafe || std::abs(cv[3]) > kFloatSafe);
+  if (vector_rows && float_values) {
     // The vector path decides each pixel by its ray (entry before exit), sixteen at a time in float
     // re-centred on the tet (its first point's pixel, a corner beyond the plane's depth).
     const int xr = int(std::clamp(q[0][0], double(tile.x0), double(tile.x1)));
@@ -226,7 +229,7 @@ void VolumePainter::Impl::draw_tets(const std::uint32_t* tets, int n, const Tile
       b.cv[k][l] = cv[k];
       q[l][k][0] = px[0];
       q[l][k][1] = px[1];
-      all = all && !std::isnan(px[0]) && !std::isnan(px[1]);
+      all = all && !std::isnan(px[0]) && !std::isnan(px[1]) && !(std::abs(cv[k]) > kFloatSafe);
     }
     b.q0[0][l] = q[l][0][0];
     b.q0[1][l] = q[l][0][1];
