@@ -431,10 +431,22 @@ FOXI_TARGET void tet_batch_avx512(TetBatch& b) {
     clip = sel(_mm512_cmp_pd_mask(clip, _mm512_setzero_pd(), _CMP_GT_OQ), clip, all(1e-300));
     for (int k = 0; k < 4; ++k) ok &= _mm512_cmp_pd_mask(P[k][2], clip, _CMP_GE_OQ);
   }
+  // draw_tet's test of a face plane through the eye: to a millionth of the face's nearest drawn
+  // distance (its nearest corner, or its clipping plane from its own farthest corner).
+  V d2[4];
+  for (int k = 0; k < 4; ++k) d2[k] = P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2];
   for (int k = 0; k < 4; ++k) {
     const V nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
     const V off = b.perspective ? h[k] : n[k][2];
-    const __mmask8 edge_on = _mm512_cmp_pd_mask(off * off, all(1e-20) * nn * reach2, _CMP_LE_OQ);
+    V scale2 = all(1);
+    if (b.perspective) {
+      const int c0 = k == 0 ? 1 : 0, c1 = k <= 1 ? 2 : 1, c2 = k <= 2 ? 3 : 2;  // the face's corners
+      const V lo2 = _mm512_min_pd(_mm512_min_pd(d2[c0], d2[c1]), d2[c2]);
+      const V hi2 = _mm512_max_pd(_mm512_max_pd(d2[c0], d2[c1]), d2[c2]);
+      const V clip_f = _mm512_max_pd(_mm512_sqrt_pd(hi2) * all(b.focal) / all(kMaxPixel), all(b.near));
+      scale2 = _mm512_max_pd(clip_f * clip_f, lo2);
+    }
+    const __mmask8 edge_on = _mm512_cmp_pd_mask(off * off, all(1e-12) * nn * scale2, _CMP_LE_OQ);
     const V zero = _mm512_setzero_pd();
     ndA[k] = sel(edge_on, zero, ndA[k]);
     ndB[k] = sel(edge_on, zero, ndB[k]);

@@ -173,22 +173,31 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
       }
   }
   if (beyond < 0) return;  // wholly nearer than the plane (or not a number)
-  // A face's plane through the eye (perspective) or along the rays (orthographic), to 1e-10 of the
-  // tet's distance (a structured grid seen from one of its planes, to within rounding):
-  // every ray meets that plane at the eye or lies in it, so it bounds no segment, and which side of
-  // it a pixel's ray is on is which side of its projection, a line, the pixel is on: what the spans
-  // decide (half-open, so a pixel centre on the line goes to one of the two tets beside it).
-  // Its ray parameter would be a ratio of rounding errors (in float on the vector path), and a
-  // pixel on that line could lose its tet or get it twice. The bound is far below any offset a
-  // user gives and far above rounding: at a millionth (as it was) the faces through a grid node
-  // 1e-7 from the eye were taken for planes through it, and the rays beside them, crossing them at
-  // a ten-millionth of a radian over many pixels, counted both tets (seams of up to 31/255); those
-  // planes' ray parameters are good to the near plane's distance, which is what decides. (A face
-  // 1e-10 off sees a sliver of projection some 1e-7 of a pixel wide counted in both tets: left.)
+  // A face's plane through the eye (perspective) or along the rays (orthographic, to a millionth of
+  // a radian) bounds no segment: every ray meets it at the eye or lies in it, and which side of it
+  // a pixel's ray is on is which side of its projection, a line, the pixel is on: what the spans
+  // decide (half-open, so a pixel centre on the line goes to one of the two tets beside it). Its ray
+  // parameter would be a ratio of rounding errors (in float on the vector path), and a pixel on
+  // that line could lose its tet or get it twice. Perspective: through the eye to a millionth of the
+  // nearest drawn distance of the face (its nearest corner, or its clipping plane's distance,
+  // computed from the face's own corners so that both tets beside it decide alike): a projection
+  // under a thousandth of a pixel wide. (With the tet's farthest corner for scale, faces through a
+  // grid node 1e-7 from the eye were taken for planes through it, though near the clipping plane
+  // they spread over pixels, and the rays there counted both tets: seams of up to 31/255.)
+  double d2[4];
+  for (int k = 0; k < 4; ++k) d2[k] = P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2];
   for (int k = 0; k < 4; ++k) {
     const double nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
+    double scale2 = 1;  // orthographic: the angle
+    if (proj.perspective) {
+      double lo2 = std::numeric_limits<double>::infinity(), hi2 = 0;
+      for (int c = 0; c < 4; ++c)
+        if (c != k) lo2 = std::min(lo2, d2[c]), hi2 = std::max(hi2, d2[c]);
+      const double clip_f = std::max(params.near, std::sqrt(hi2) * proj.focal / kMaxPixel);
+      scale2 = std::max(clip_f * clip_f, lo2);
+    }
     const double off = proj.perspective ? h[k] : n[k][2];  // the eye's offset, or the rays'
-    if (off * off <= 1e-20 * nn * reach2)
+    if (off * off <= 1e-12 * nn * scale2)
       r.ndA[k] = r.ndB[k] = r.ndC[k] = r.numA[k] = r.numB[k] = r.numC[k] = 0;
   }
 #ifdef FOXI_VOLUME_AVX512
