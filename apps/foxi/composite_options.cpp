@@ -29,7 +29,8 @@ const char* const kCompositeOptionsHelp =
     "                  front in the power order (exact for a Delaunay mesh; another mesh is\n"
     "                  composited in MPVO order, not exact, and a note says so). Colour: the colour\n"
     "                  map; opacity: --opacity-curve v0:a0,... (values in display units, ascending;\n"
-    "                  a in [0, 1): the opacity a ray gains through --opacity-length L world units of\n"
+    "                  a in [0, 0.999999]: the opacity a ray gains through --opacity-length L world units "
+    "of\n"
     "                  that value, L by default a tenth of the drawn box's diagonal), linear between\n"
     "                  the points, constant beyond. Not with the other drawing options\n";
 
@@ -123,9 +124,9 @@ VolumeParams volume_params(const CompositeOptions& o, const Mesh& mesh, const Fi
   vp.scale = field.legend.scale;
   for (const OpacityPoint& p : o.curve) {
     vp.opacity_curve.push_back({field.legend.unit.to_si(p.value), p.opacity * scale});
-    if (!(vp.opacity_curve.back().opacity < 1))
+    if (!(vp.opacity_curve.back().opacity <= 0.999999))  // as parse_opacity_curve
       throw UsageError("--opacity-curve: opacity " + number(p.opacity) + " times " + number(scale) + " is " +
-                       number(p.opacity * scale) + ", not below 1");
+                       number(p.opacity * scale) + ", above 0.999999");
     const std::size_t n = vp.opacity_curve.size();
     if (n > 1 && !(vp.opacity_curve[n - 1].value > vp.opacity_curve[n - 2].value))
       throw UsageError("--opacity-curve: the values " + number(o.curve[n - 2].value) + " and " +

@@ -150,7 +150,7 @@ TEST_F(MovieTranslucentCli, OpacitySweepFramesEqualRenderWithScaledOpacities) {
                      p("bad/f_%d.png"),
                  &out),
             2);
-  EXPECT_NE(out.find("not below 1"), std::string::npos) << out;
+  EXPECT_NE(out.find("above 0.999999"), std::string::npos) << out;
 }
 
 TEST_F(MovieTranslucentCli, BackAndForthComesDownThroughTheSamePictures) {

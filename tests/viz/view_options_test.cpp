@@ -48,6 +48,8 @@ TEST(ViewOptions, OpacityCurve) {
   EXPECT_EQ(c[1].opacity, 0.25);
   EXPECT_THROW(parse_opacity_curve("20"), OptionError);
   EXPECT_THROW(parse_opacity_curve("20:1"), OptionError) << "opacity 1 has no finite extinction";
+  EXPECT_THROW(parse_opacity_curve("20:0.99999999"), OptionError) << "drawn as 0.999999: refused";
+  EXPECT_EQ(parse_opacity_curve("20:0.999999")[0].opacity, 0.999999);
   EXPECT_THROW(parse_opacity_curve("20:0.1,10:0.2"), OptionError);
   EXPECT_THROW(parse_opacity_curve("20:0.1,20:0.2"), OptionError);
   EXPECT_THROW(parse_opacity_curve("a:0.1"), OptionError);

@@ -223,8 +223,12 @@ std::vector<OpacityPoint> parse_opacity_curve(std::string_view text) {
     if (colon == std::string::npos || !number(part.substr(0, colon), p.value) ||
         !number(part.substr(colon + 1), p.opacity))
       throw OptionError("--opacity-curve takes v0:a0,v1:a1,... (values and opacities), not '" + part + "'");
-    if (!(p.opacity >= 0 && p.opacity < 1))
-      throw OptionError("--opacity-curve: opacity " + part.substr(colon + 1) + " is not in [0, 1)");
+    // The painter's extinction holds opacities up to 0.999999 (volume_extinction clamps there): a
+    // nearer 1 would be drawn as that in silence.
+    if (!(p.opacity >= 0 && p.opacity <= 0.999999))
+      throw OptionError("--opacity-curve: opacity " + part.substr(colon + 1) +
+                        " is not in [0, 0.999999] (a ray through the opacity length keeps at least a "
+                        "millionth of the light)");
     if (!out.empty() && !(p.value > out.back().value))
       throw OptionError("--opacity-curve: the values must increase ('" + part + "')");
     out.push_back(p);

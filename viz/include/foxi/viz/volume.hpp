@@ -39,7 +39,7 @@ namespace foxi {
 
 struct OpacityPoint {
   double value = 0;
-  double opacity = 0;  // in [0, 1)
+  double opacity = 0;  // in [0, 1); the painter takes at most 0.999999 (volume_extinction clamps)
 };
 
 struct VolumeParams {
