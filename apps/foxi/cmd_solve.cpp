@@ -210,7 +210,13 @@ LinearSolverOptions parse_solver_options(Args& args) {
     options.kind = LinearSolverKind::cg_ichol;
   else if (solver != "auto")
     throw UsageError("--solver takes auto, direct, amg or ichol, not '" + solver + "'");
-  if (!tol.empty()) options.relative_tolerance = parse_number(tol, "--tol");
+  if (!tol.empty()) {
+    options.relative_tolerance = parse_number(tol, "--tol");
+    // The result checks' tolerances follow it (100 x, at most 1e-3): a looser one would be no check
+    // (--tol 0.9 printed a temperature 54 K off with "check energy ok").
+    if (!(options.relative_tolerance >= 1e-14 && options.relative_tolerance <= 1e-3))
+      throw UsageError("--tol takes a relative residual in [1e-14, 1e-3], not '" + tol + "'");
+  }
   const std::string threads = args.option("--threads", "");
   if (!threads.empty()) {
     std::int32_t n = 0;

@@ -168,18 +168,21 @@ TEST_F(SolveCliTest, ThermoelasticFreeExpansionAndTemperatureFromTheThermalRun) 
   EXPECT_LT(expansion_error(read_mesh(out)), 1e-12);
   EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic --order 3 --dT 50" + material), 2);
 
-  // The balance checks printed beside the result: a clamped box passes them; a CG solve stopped at
-  // a relative residual of 0.5 fails the force balance, loudly and with exit status 4.
+  // The balance checks printed beside the result: a clamped box passes them. (A CG solve stopped at a
+  // relative residual of 0.5 fails the force balance: thermoelastic_test; foxi solve refuses such a
+  // --tol, which once loosened the thermal and DC checks with it: --tol 0.9 passed a temperature
+  // 54 K off.)
   const std::string clamped = " --E 1=70e9 --nu 1=0.3 --alpha 1=2e-5 --fix 5 --dT 50";
   ASSERT_EQ(foxi("solve " + box + " --physics thermoelastic" + clamped), 0)
       << test::read_text(dir_ / "out.log");
   log = test::read_text(dir_ / "out.log");
   EXPECT_NE(log.find("check thermal load   ok"), std::string::npos) << log;
   EXPECT_NE(log.find("check force balance  ok"), std::string::npos) << log;
-  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic" + clamped + " --solver ichol --tol 0.5"), 4);
+  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic" + clamped + " --solver ichol --tol 0.5"), 2);
   log = test::read_text(dir_ / "out.log");
-  EXPECT_NE(log.find("check force balance  FAIL"), std::string::npos) << log;
-  EXPECT_NE(log.find("UNRELIABLE: the force balance check failed"), std::string::npos) << log;
+  EXPECT_NE(log.find("--tol takes a relative residual in [1e-14, 1e-3]"), std::string::npos) << log;
+  EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic" + clamped + " --solver ichol --tol 1e-3"), 0)
+      << test::read_text(dir_ / "out.log");
 
   // Bad input: no load (2), an unknown component (2), a body free to move (3, the modes named).
   EXPECT_EQ(foxi("solve " + box + " --physics thermoelastic" + material), 2);
