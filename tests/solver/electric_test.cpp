@@ -377,6 +377,14 @@ TEST(Current, StraightBarResistanceAndJouleHeat) {
   EXPECT_NEAR(c.terminals[1].charge, 2.0, 1e-9);
   EXPECT_NEAR(c.terminals[0].charge, -2.0, 1e-9);
   EXPECT_NEAR(c.total_power, 4.0 * rr, 1e-9 * 4.0 * rr);
+
+  // Both terminals at one voltage: no current, the bar's resistance still L / (sigma A) (it was
+  // 0 / round-off = -0), and the energy check passes (the round-off power failed it against itself).
+  p.terminals = {electrode("in", {1}, 1.0), electrode("out", {2}, 1.0)};
+  const CurrentReport e = solve_current(m, p);
+  EXPECT_NEAR(e.resistance, rr, 1e-9 * rr);
+  EXPECT_LE(std::abs(e.terminals[0].charge), 1e-9 * i);
+  for (const BalanceCheck& k : e.checks) EXPECT_TRUE(k.passed) << k.name << " " << k.figure;
 }
 
 // The Joule heat feeds a thermal run: with both ends held at 300 K the heat leaving through them is I^2 R,
