@@ -158,6 +158,16 @@ void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std:
   rep.checks.push_back(make_check("energy",
                                   "|sources + boundary heat in| / the heat that flows through the body",
                                   scale > 0 ? std::abs(rep.imbalance) / scale : 0.0, tolerance));
+  // Linear conduction does not bound the temperatures: a power drawn out (negative) past what the
+  // conditions can supply gives temperatures at or below 0 K, which no body has (-8e6 K was printed
+  // with every check passed). The figure: minus the lowest temperature used by a tet, which must be
+  // below 0.
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const std::uint32_t v : mesh.tet) lowest = std::min(lowest, temp[v]);
+  rep.checks.push_back(BalanceCheck{"absolute zero",
+                                    "minus the lowest temperature, K: below 0 (else the powers or conditions "
+                                    "are not physical)",
+                                    -lowest, 0, -lowest < 0});
 }
 
 }  // namespace

@@ -122,11 +122,15 @@ TEST_F(ThermalTest, SlabBetweenTwoTemperaturesIsLinearAndExact) {
     // With no sources the balance is measured against the heat that flows through, not against the
     // (vanishing) net boundary heat.
     EXPECT_NEAR(r.heat_flow, q, 1e-9 * q);
-    ASSERT_EQ(r.checks.size(), 1u);
+    ASSERT_EQ(r.checks.size(), 2u);
     EXPECT_EQ(r.checks[0].name, "energy");
     EXPECT_TRUE(r.checks[0].passed);
     EXPECT_LT(r.checks[0].figure, 1e-9);
     EXPECT_LE(r.checks[0].figure, std::abs(r.imbalance) / q * (1 + 1e-12));
+    // The lowest temperature, the cold face's.
+    EXPECT_EQ(r.checks[1].name, "absolute zero");
+    EXPECT_TRUE(r.checks[1].passed);
+    EXPECT_NEAR(r.checks[1].figure, -t0, 1e-9 * t0);
     const Field* flux = m.find_field("heat_flux");
     ASSERT_NE(flux, nullptr);
     ASSERT_EQ(flux->values.size(), 3 * m.tet_count());
@@ -344,7 +348,8 @@ TEST_F(ThermalTest, ReportOfGivenTemperaturesMatchesTheAnalyticHeat) {
   EXPECT_NEAR(heat_of(r, 1).heat_in, -flux * kArea, 1e-9 * flux * kArea);
   EXPECT_NEAR(r.max_temperature, t0 + flux * kL / k, 1e-9 * tinf);
   EXPECT_NEAR(region_of(r, 1).mean_temperature, t0 + flux * kL / (2 * k), 1e-9 * tinf);
-  ASSERT_EQ(r.checks.size(), 1u);
+  ASSERT_EQ(r.checks.size(), 2u);
+  EXPECT_TRUE(r.checks[1].passed);
   EXPECT_TRUE(r.checks[0].passed);
   EXPECT_LT(r.checks[0].figure, 1e-9);
   EXPECT_EQ(r.solver, "given");
