@@ -170,6 +170,17 @@ int cmd_render(Args args) {
       std::printf(
           "warning     %zu corner values are NaN or infinite: the tets with one are left out (transparent)\n",
           field.no_value);
+    // A curve wholly beside the values (given in another unit, say) is one opacity everywhere.
+    if (!vp.opacity_curve.empty() && std::isfinite(field.data_lo) &&
+        (vp.opacity_curve.back().value < field.data_lo || vp.opacity_curve.front().value > field.data_hi)) {
+      const DisplayUnit& u = field.legend.unit;
+      std::printf(
+          "warning     the opacity curve (%g to %g %s) lies wholly %s the field's values (%g to %g %s): one "
+          "opacity throughout\n",
+          u.to_display(vp.opacity_curve.front().value), u.to_display(vp.opacity_curve.back().value),
+          u.symbol.c_str(), vp.opacity_curve.back().value < field.data_lo ? "below" : "above",
+          u.to_display(field.data_lo), u.to_display(field.data_hi), u.symbol.c_str());
+    }
     if (report.exact_order)
       std::printf(
           "composited back to front in the power order (exact for this Delaunay mesh), order %.1f ms, "

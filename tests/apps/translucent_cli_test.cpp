@@ -224,6 +224,14 @@ TEST(VolumeCli, AutomaticRangeIsTheCornersAndNoValuesAreSaid) {
   log = test::read_text(dir / "log.txt");
   EXPECT_NE(log.find("colours 0 to 3"), std::string::npos) << log;
   EXPECT_EQ(log.find("NaN"), std::string::npos) << log;
+  EXPECT_EQ(log.find("wholly"), std::string::npos) << log;
+  // A curve beside the values (another unit's numbers): said.
+  ASSERT_EQ(
+      test::run(run + "--volume T --opacity-curve 300:0.1,400:0.5 -o '" + (dir / "w.png").string() + "'",
+                dir / "log.txt"),
+      0);
+  log = test::read_text(dir / "log.txt");
+  EXPECT_NE(log.find("lies wholly above the field's values (0 to 3"), std::string::npos) << log;
   // Translucent isosurfaces too: their colours and the legend reach the corners' values.
   ASSERT_EQ(test::run(run + "--region-opacity 1=0.2 --field T --iso 0.5,2.5 --iso-opacity 0.5 -o '" +
                           (dir / "i.png").string() + "'",
