@@ -375,11 +375,18 @@ void print_thermal_report(const Mesh& mesh, const ThermalReport& r) {
       }
       return std::string();
     };
-    std::printf("thermal resistance %s %.6g K -> %s %.6g K: dT %.6g K, P %.6g W, theta %.6g K/W; ",
+    std::printf("thermal resistance %s %.6g K -> %s %.6g K: dT %.6g K, P %.6g W, ",
                 side(t.spec.junction).c_str(), t.junction_temperature, side(t.spec.reference).c_str(),
-                t.reference_temperature, t.delta_t, t.power, t.theta);
+                t.reference_temperature, t.delta_t, t.power);
+    if (std::isnan(t.theta))
+      std::printf("theta undefined (no power); ");
+    else
+      std::printf("theta %.6g K/W; ", t.theta);
     if (std::isnan(t.reference_heat_out))
       std::printf("no boundary heat at a region reference\n");
+    else if (std::isnan(t.path_theta))
+      std::printf("heat out there %.6g W, dT/heat undefined (no heat or no difference there)\n",
+                  t.reference_heat_out);
     else
       std::printf("heat out there %.6g W, dT/heat %.6g K/W\n", t.reference_heat_out, t.path_theta);
   }

@@ -534,6 +534,14 @@ TEST_F(ThermalTest, ThermalResistanceProbesAreChecked) {
   EXPECT_EQ(r.resistances[0].reference_heat_out, 0.0);
   EXPECT_TRUE(std::isnan(r.resistances[0].path_theta));
   EXPECT_GT(r.resistances[0].theta, 0.0);
+  // No power at all, the body held at 300 K: theta and dT/heat are undefined, not a ratio of
+  // round-off (10.3 K/W was printed).
+  ThermalParams still = p;
+  still.flux.clear();
+  still.resistances = {theta_spec(K::region_max, 1, K::boundary_mean, 1)};
+  const ThermalReport s = solve_thermal(m, still);
+  EXPECT_TRUE(std::isnan(s.resistances[0].theta));
+  EXPECT_TRUE(std::isnan(s.resistances[0].path_theta)) << s.resistances[0].path_theta;
 }
 
 TEST_F(ThermalTest, IllPosedAndIncompleteProblemsGiveClearErrors) {
