@@ -70,23 +70,29 @@ bool geometry_in_range(const double* a, const double* b, const double* c, const 
   cross(B, C, BC);
   const double six_v = B[0] * CD[0] + B[1] * CD[1] + B[2] * CD[2];
   if (!std::isfinite(six_v)) {
-    why = "6 x volume overflows double (" + num(six_v) + ")";
-    return false;
-  }
-  if (!(std::abs(six_v) >= kMinSixVolume)) {
-    why = "6 x volume underflows double (" + num(six_v) + ")";
+    why = "6 x volume overflows double (" + num(six_v) + "; rescale the coordinates)";
     return false;
   }
   const double lB = B[0] * B[0] + B[1] * B[1] + B[2] * B[2];
   const double lC = C[0] * C[0] + C[1] * C[1] + C[2] * C[2];
   const double lD = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+  if (!(std::abs(six_v) >= kMinSixVolume)) {
+    // Edges of normal size: the volume cancelled, the four corners coplanar to their last bits (a
+    // mesher's flat sliver), which no rescaling mends.
+    const double edge = std::sqrt(std::max({lB, lC, lD}));
+    why = edge * edge * edge >= 1e30 * kMinSixVolume
+              ? "nearly flat: 6 x volume is " + num(six_v) + " in double against edges of " + num(edge) +
+                    " (its corners coplanar to their last bits; mesh again)"
+              : "6 x volume underflows double (" + num(six_v) + "; rescale the coordinates)";
+    return false;
+  }
   double r2 = 0, o2 = 0;
   for (int k = 0; k < 3; ++k) {
     // Each term on its own: a sum of finite terms may hide an overflowed one only as inf or NaN.
     const double n0 = lB * CD[k], n1 = lC * DB[k], n2 = lD * BC[k];
     const double x = (n0 + n1 + n2) / (2 * six_v);
     if (!(std::isfinite(n0) && std::isfinite(n1) && std::isfinite(n2) && std::isfinite(x))) {
-      why = "the circumcentre overflows double";
+      why = "the circumcentre overflows double (rescale the coordinates)";
       return false;
     }
     r2 += x * x;
@@ -94,13 +100,14 @@ bool geometry_in_range(const double* a, const double* b, const double* c, const 
     o2 += rel * rel;
   }
   if (!std::isfinite(r2)) {
-    why = "the circumradius^2 overflows double (" + num(r2) + ")";
+    why = "the circumradius^2 overflows double (" + num(r2) + "; rescale the coordinates)";
     return false;
   }
   const double reach = std::sqrt(o2) + std::sqrt(r2);
   if (!(reach <= kMaxSphereReach)) {
     why = "the circumsphere reaches " + num(reach) + " from the mesh's centre, beyond the " +
-          num(kMaxSphereReach) + " that the visibility order's float error bounds hold";
+          num(kMaxSphereReach) +
+          " that the visibility order's float error bounds hold (rescale the coordinates)";
     return false;
   }
   return true;
@@ -219,7 +226,7 @@ ValidationReport check(const MeshView& mesh, std::string size_problem, std::vect
       ++r.out_of_range;
       note(r, (inverted_note.empty() ? "tet " + std::to_string(t) + " " + ids(v, 4) + ":"
                                      : inverted_note + ", and") +
-                  " geometry beyond the range foxi computes in: " + why + " (rescale the coordinates)");
+                  " geometry beyond the range foxi computes in: " + why);
     } else if (!inverted_note.empty()) {
       note(r, inverted_note);
     }

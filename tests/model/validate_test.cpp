@@ -222,6 +222,20 @@ TEST(Validate, GeometryBeyondDoubleRangeIsRefused) {
   EXPECT_EQ(scaled_volume(1e-300), 0.0);
 }
 
+// A flat sliver of normal size (a mesher's four nearly coplanar corners: 6V cancels to nothing in
+// double while the exact orientation is positive) is said to be one, to mesh again; rescaling, which
+// the message once advised, cannot mend it.
+TEST(Validate, NearlyFlatTetOfNormalSizeIsSaidToBeOne) {
+  Mesh m;
+  m.xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.3, 0.3, 1e-300};
+  m.tet = {0, 1, 2, 3};
+  const ValidationReport r = validate(m);
+  EXPECT_EQ(r.out_of_range, 1u);
+  EXPECT_EQ(r.zero_volume, 0u);
+  EXPECT_TRUE(mentions(r, "nearly flat")) << describe(r).front();
+  EXPECT_FALSE(mentions(r, "rescale"));
+}
+
 // A tet both inverted and beyond the range (issue 17 item 7): one message naming both problems, not
 // two lines about the same tet; the counts still count it under each problem.
 TEST(Validate, InvertedTetBeyondTheRangeHasOneMessage) {
