@@ -757,6 +757,27 @@ class Loader {
   }
 
   void add_part(Part p) {
+    // A part's name makes its boundaries' names (part.face) and its interfaces' (a/b): a '.' or '/'
+    // in it made names collide (parts p/q and r met p and q/r as one boundary "p/q/r"), control
+    // characters reached the terminal raw, and an empty one made ".top".
+    std::string shown;
+    bool bad = p.name.empty() || p.name.size() > 100;
+    for (const char c : p.name) {
+      const auto u = static_cast<unsigned char>(c);
+      bad = bad || c == '.' || c == '/' || u < 0x20 || u == 0x7f;
+      if (u < 0x20 || u == 0x7f) {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "\\x%02x", u);
+        shown += hex;
+      } else if (shown.size() < 100) {
+        shown += c;
+      }
+    }
+    if (bad)
+      throw Located{p.line,
+                    "part name '" + shown +
+                        "': give a name of 1 to 100 characters without '.', '/' or control characters "
+                        "(it names the part's boundaries, part.face, and its interfaces, a/b)"};
     for (const Part& q : model_.parts)
       if (q.name == p.name) throw Located{p.line, "part '" + p.name + "' is defined twice"};
     if (model_.parts.size() == lim::kParts)

@@ -185,6 +185,22 @@ TEST(ModelLimits, LongParameterChainIsRefused) {
 
 // --- the hangs: values with no upper bound ---
 
+// A part's name makes its boundaries' and interfaces' names (part.face, a/b): '.', '/', control
+// characters, an empty or a very long name are refused at the part's line (parts p/q and r, beside
+// p and q/r, once shared one boundary "p/q/r").
+TEST(ModelLimits, PartNamesThatWouldGarbleBoundaryNamesAreRefused) {
+  const std::string box = "origin = [0, 0, 1]\nsize = [1, 1, 1]";
+  for (const std::string& name : {std::string("p/q"), std::string("die.top"), std::string(""),
+                                  std::string("a\\u001b[31mred"), std::string(300, 'x')}) {
+    const std::string t = header() + part(name, "box", box) + sub();
+    const foxi::IoError e = text_error(t);
+    EXPECT_TRUE(has(e, "without '.', '/' or control characters")) << e.what();
+    EXPECT_GE(e.line(), line_of(t, "[[parts]]")) << e.what();  // the part's own lines
+    EXPECT_LE(e.line(), line_of(t, "[[parts]]") + 4) << e.what();
+    EXPECT_FALSE(has(e, "\x1b")) << "a control character printed raw";
+  }
+}
+
 TEST(ModelLimits, HugeArrayCountIsRefused) {
   const std::string t = header() + sub() +
                         part("pins", "array",
