@@ -81,17 +81,8 @@ int main(int argc, char** argv) {
   // its temporary removed (the durable writers' cleanup list).
   handle_stop_signals("foxi-view");
   try {
-    std::vector<std::string> args;
-    for (int i = 1; i < argc; ++i) {  // --name=value as --name value, as foxi reads it
-      const std::string a = argv[i];
-      const std::size_t eq = a.find('=');
-      if (a.rfind("--", 0) == 0 && eq != std::string::npos && eq > 2) {
-        args.push_back(a.substr(0, eq));
-        args.push_back(a.substr(eq + 1));
-      } else {
-        args.push_back(a);
-      }
-    }
+    // --name=value as --name value, as foxi reads it.
+    const std::vector<std::string> args = foxi::split_option_values({argv + 1, argv + argc});
     std::string mesh_path, size = "800x600", eye, at, up, fov, dir, shrink, save = "foxi-view", script;
     std::string field_spec, cmap, region_opacity, iso_opacity, volume, curve;
     bool script_mode = false, dump = false, no_undo = false, graded = false;

@@ -309,17 +309,8 @@ int headless(foxi::workbench::Workbench& w, const ToolOptions& tools, const std:
 int main(int argc, char** argv) {
   using namespace foxi::cli;
   try {
-    std::vector<std::string> args;
-    for (int i = 1; i < argc; ++i) {  // --name=value as --name value, as foxi reads it
-      const std::string a = argv[i];
-      const std::size_t eq = a.find('=');
-      if (a.rfind("--", 0) == 0 && eq != std::string::npos && eq > 2) {
-        args.push_back(a.substr(0, eq));
-        args.push_back(a.substr(eq + 1));
-      } else {
-        args.push_back(a);
-      }
-    }
+    // --name=value as --name value, as foxi reads it.
+    const std::vector<std::string> args = foxi::split_option_values({argv + 1, argv + argc});
     std::string model, physics, field, cmap = "viridis", screenshot, picture, mesh_out, view_size;
     std::vector<std::string> sets;
     bool is_headless = false;

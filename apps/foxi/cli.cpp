@@ -55,19 +55,7 @@ std::vector<std::string> Args::take_after(std::string_view marker) {
   return {};
 }
 
-Args::Args(std::vector<std::string> args) {
-  bool passing = false;
-  for (std::string& a : args) {
-    const std::size_t eq = a.find('=');
-    if (!passing && a.size() > 2 && a[0] == '-' && a[1] == '-' && eq != std::string::npos && eq > 2) {
-      args_.push_back(a.substr(0, eq));
-      args_.push_back(a.substr(eq + 1));
-    } else {
-      args_.push_back(std::move(a));
-    }
-    passing = passing || args_.back() == "--";
-  }
-}
+Args::Args(std::vector<std::string> args) : args_(split_option_values(std::move(args))) {}
 
 std::string Args::option(std::string_view name, std::string fallback) {
   for (auto it = args_.begin(); it != args_.end(); ++it) {

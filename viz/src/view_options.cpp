@@ -87,6 +87,22 @@ Camera camera_for(const CameraOptions& o, const double lo[3], const double hi[3]
   return c;
 }
 
+std::vector<std::string> split_option_values(std::vector<std::string> args) {
+  std::vector<std::string> out;
+  bool passing = false;
+  for (std::string& a : args) {
+    const std::size_t eq = a.find('=');
+    if (!passing && a.size() > 2 && a[0] == '-' && a[1] == '-' && eq != std::string::npos && eq > 2) {
+      out.push_back(a.substr(0, eq));
+      out.push_back(a.substr(eq + 1));
+    } else {
+      out.push_back(std::move(a));
+    }
+    passing = passing || out.back() == "--";
+  }
+  return out;
+}
+
 ImageSize parse_image_size(std::string_view text) {
   const std::string size(text);
   const std::size_t x = size.find('x');

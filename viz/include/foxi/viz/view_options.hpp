@@ -44,6 +44,10 @@ FOXI_API CameraOptions parse_camera_options(std::string_view eye, std::string_vi
 FOXI_API Camera camera_for(const CameraOptions& options, const double lo[3], const double hi[3],
                            double aspect);
 
+// The arguments with each --name=value as --name value (GNU style), up to a bare "--" (what follows
+// it is another program's): how foxi, foxi-view and the workbench read their options.
+FOXI_API std::vector<std::string> split_option_values(std::vector<std::string> args);
+
 // "WxH" with 1 <= W, H <= 16384 (--size).
 struct ImageSize {
   int width = 0, height = 0;
