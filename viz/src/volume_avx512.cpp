@@ -422,19 +422,16 @@ FOXI_TARGET void tet_batch_avx512(TetBatch& b) {
   const V gdA = g[0] * d00 + g[1] * d01 + g[2] * d02, gdB = g[0] * dx, gdC = g[1] * dy;
   // The clipping plane (draw_tet's), all four corners beyond it; the face planes through the eye
   // (or along the rays) bound nothing.
-  V reach2 = all(1);
+  V d2[4];  // the corners' squared distances from the eye
+  for (int k = 0; k < 4; ++k) d2[k] = P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2];
   if (b.perspective) {
-    reach2 = _mm512_setzero_pd();
-    for (int k = 0; k < 4; ++k)
-      reach2 = _mm512_max_pd(reach2, P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]);
+    const V reach2 = _mm512_max_pd(_mm512_max_pd(d2[0], d2[1]), _mm512_max_pd(d2[2], d2[3]));
     V clip = _mm512_max_pd(_mm512_sqrt_pd(reach2) * all(b.focal) / all(kMaxPixel), all(b.near));
     clip = sel(_mm512_cmp_pd_mask(clip, _mm512_setzero_pd(), _CMP_GT_OQ), clip, all(1e-300));
     for (int k = 0; k < 4; ++k) ok &= _mm512_cmp_pd_mask(P[k][2], clip, _CMP_GE_OQ);
   }
   // draw_tet's test of a face plane through the eye: to a millionth of the face's nearest drawn
   // distance (its nearest corner, or its clipping plane from its own farthest corner).
-  V d2[4];
-  for (int k = 0; k < 4; ++k) d2[k] = P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2];
   for (int k = 0; k < 4; ++k) {
     const V nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
     const V off = b.perspective ? h[k] : n[k][2];

@@ -125,14 +125,11 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
       ++count;
     }
   };
-  // The farthest corner's squared distance from the eye (perspective; 1 orthographic): the near
-  // plane's scale here and the distance scale below.
-  double reach2 = 1;
-  if (proj.perspective) {
-    reach2 = 0;
-    for (int k = 0; k < 4; ++k)
-      reach2 = std::max(reach2, P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2]);
-  }
+  // The corners' squared distances from the eye, and the farthest (perspective; 1 orthographic):
+  // the near plane's scale here, the faces' below.
+  double d2[4], reach2 = 1;
+  for (int k = 0; k < 4; ++k) d2[k] = P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2];
+  if (proj.perspective) reach2 = std::max({d2[0], d2[1], d2[2], d2[3]});
   // The pixels whose ray may meet the tet: the rows' spans of pixel centres inside the projection of
   // its part beyond the clipping plane (perspective: the near plane, or nearer than a millionth of
   // the farthest corner's distance in pixels, so that the projection stays within kMaxPixel of the
@@ -184,8 +181,6 @@ void VolumePainter::Impl::draw_tet(std::uint32_t t, const Tile& tile, Scratch& s
   // under a thousandth of a pixel wide. (With the tet's farthest corner for scale, faces through a
   // grid node 1e-7 from the eye were taken for planes through it, though near the clipping plane
   // they spread over pixels, and the rays there counted both tets: seams of up to 31/255.)
-  double d2[4];
-  for (int k = 0; k < 4; ++k) d2[k] = P[k][0] * P[k][0] + P[k][1] * P[k][1] + P[k][2] * P[k][2];
   for (int k = 0; k < 4; ++k) {
     const double nn = n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2];
     double scale2 = 1;  // orthographic: the angle
