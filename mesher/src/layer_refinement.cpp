@@ -145,8 +145,8 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
   // Near-flat tets outside the layers (dihedral angle under 1 degree; four almost cocircular
   // coplanar points, which symmetric refinement makes) are always split: one would make a solver's
   // matrix singular in all but name.
-  const double min_dihedral = std::max(params.min_dihedral, 1.0);
-  const double cos_min = std::cos(min_dihedral * 3.14159265358979323846 / 180);
+  const double min_dihedral = std::max(params.min_dihedral, conforming.split_dihedral_deg);
+  const double cos_min = min_dihedral > 0 ? std::cos(min_dihedral * 3.14159265358979323846 / 180) : 2.0;
   rep.thin_layers = layers;
   Mesh mesh;
   if (first_mesh) mesh = *first_mesh;
@@ -187,7 +187,7 @@ Mesh refine_with_thin_layers(const MeshParams& params, const ConformingParams& c
       }
       if (!over && !in_layer[t])
         over = (q2 > 0 && b.r2 > q2 * shortest2) ||
-               (cos_min >= -1 && dihedral_below(x[0], x[1], x[2], x[3], cos_min));
+               (cos_min <= 1 && dihedral_below(x[0], x[1], x[2], x[3], cos_min));
       if (over) bad.push_back({b.r2, static_cast<std::uint32_t>(t)});
     }
     rep.quality_unmet = 0;

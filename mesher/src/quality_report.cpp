@@ -59,6 +59,9 @@ MeshQualityReport mesh_quality_report(const Mesh& mesh, const ConformingReport& 
   r.delaunay = conforming.delaunay;
   r.tetgen_failed = conforming.tetgen_failed;
   r.violating_tets = conforming.violations.empty() ? 0 : conforming.violations.back();
+  r.flat_tets_removed = conforming.flat_tets_removed;
+  r.flat_points = conforming.flat_points;
+  r.flat_tets = conforming.flat_tets;
   r.mesh_seconds = conforming.seconds;
   r.certificate_seconds = conforming.certificate_seconds;
   return r;
@@ -114,6 +117,13 @@ std::string format_quality_report(const MeshQualityReport& r) {
   else
     put("delaunay: NO, %zu tets have a vertex inside their circumsphere (the first -O0 mesh had %zu)",
         r.violating_tets, r.first_mesh_violations);
+  if (r.flat_tets_removed > 0)
+    put("flat tets: %zu removed (corners coplanar to round-off; %zu %s added inside them, meshed again)",
+        r.flat_tets_removed, r.flat_points, r.flat_points == 1 ? "point" : "points");
+  if (r.flat_tets > 0)
+    put("flat tets: %zu left (corners coplanar to round-off: solvers may refuse this mesh; mesh again with "
+        "another --max-size)",
+        r.flat_tets);
   if (r.tetgen_failed)
     put("refinement stopped early: TetGen failed on the refined PLC (or lost a region); this is the last "
         "good mesh");

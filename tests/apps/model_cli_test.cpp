@@ -132,6 +132,82 @@ TEST(ModelCli, SeriesBarsResistanceAndAnOverflowingCurrentIsFlagged) {
   EXPECT_EQ(huge.find("has no gradient"), std::string::npos) << huge;
 }
 
+// Square copper bars 0.2 to 1.2 mm wide, 10 mm long, meshed at 0.3, 0.5 and 0.77 mm: TetGen puts
+// Steiner points at the midpoints of the four sides at one height, four of them nearly coplanar
+// and cocircular, and its Delaunay mesh held the flat tet across them (6V 1e-17 of its edges
+// cubed): the solve refused the mesh ("nearly flat"), found the matrix singular, or failed the
+// Kirchhoff check (an outside probe: 0.4 to 0.9 mm at 0.5 mm). The mesher now removes them, and
+// every bar conducts L / (sigma w^2) (the potential is linear along the bar, which P1 holds exactly).
+TEST(ModelCli, BarsWhoseMeshHadFlatTetsConductAsTheFormulaSays) {
+  TempDir dir;
+  const std::pair<const char*, const char*> cases[] = {{"0.5", "0.4"}, {"0.5", "0.5"}, {"0.5", "0.6"},
+                                                       {"0.5", "0.7"}, {"0.5", "0.9"}, {"0.3", "0.2"},
+                                                       {"0.77", "1.2"}};
+  for (const auto& [size, width] : cases) {
+    const std::string name = std::string("bar_") + size + "_" + width;
+    test::write_text(dir / (name + ".toml"),
+                     std::string("units.length = \"mm\"\n[materials.cu]\nelectrical_conductivity = 5.96e7\n"
+                                 "[[parts]]\nname = \"bar\"\nmaterial = \"cu\"\nshape = \"box\"\n"
+                                 "origin = [0, 0, 0]\nsize = [") +
+                         width + ", " + width + ", 10]\n" +
+                         "[[conditions]]\ntype = \"voltage\"\nsurface = \"bar.top\"\nname = \"top\"\n"
+                         "value = \"1 V\"\n[[conditions]]\ntype = \"ground\"\nsurface = \"bar.bottom\"\n"
+                         "name = \"bot\"\n[mesh]\nmax_size = \"" +
+                         size + " mm\"\n");
+    const int rc = foxi_cli("solve '" + (dir / (name + ".toml")).string() + "' --physics current",
+                            dir / (name + ".txt"));
+    const std::string out = test::read_text(dir / (name + ".txt"));
+    ASSERT_EQ(rc, 0) << name << "\n" << out;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(out, m, std::regex("resistance (\\S+) ohm"))) << out;
+    const double w = std::stod(width) * 1e-3, analytic = 0.010 / (5.96e7 * w * w);
+    EXPECT_NEAR(std::stod(m[1]), analytic, 1e-6 * analytic) << name << "\n" << out;
+  }
+}
+
+// A part touching the rest only along an edge or at a corner: no area of contact, nothing passes
+// (foxi model check says so), but the mesh shares nodes there and a solve passed a mesh-dependent
+// heat and current through them (8e-5 ohm through an edge, every check passed; an outside probe).
+// Refused before solving, naming the part's line; the same part moved to share a face solves.
+TEST(ModelCli, ContactAlongAnEdgeOrAtACornerIsRefusedBySolve) {
+  TempDir dir;
+  auto model = [&](const std::string& origin) {
+    return "units.length = \"mm\"\n[materials.cu]\nthermal_conductivity = 400.0\n"
+           "electrical_conductivity = 6e7\n"
+           "[[parts]]\nname = \"a\"\nmaterial = \"cu\"\nshape = \"box\"\norigin = [0, 0, 0]\n"
+           "size = [1, 1, 1]\n"
+           "[[parts]]\nname = \"b\"\nmaterial = \"cu\"\nshape = \"box\"\norigin = [" +
+           origin +
+           "]\nsize = [1, 1, 1]\n"
+           "[[conditions]]\ntype = \"voltage\"\nsurface = \"a.bottom\"\nname = \"t1\"\nvalue = \"1 V\"\n"
+           "[[conditions]]\ntype = \"ground\"\nsurface = \"b.top\"\nname = \"t2\"\n"
+           "[[conditions]]\ntype = \"temperature\"\nsurface = \"a.bottom\"\nvalue = \"300 K\"\n"
+           "[[conditions]]\ntype = \"temperature\"\nsurface = \"b.top\"\nvalue = \"310 K\"\n"
+           "[mesh]\nmax_size = \"0.4 mm\"\n";
+  };
+  for (const char* origin : {"1, 0, 1", "1, 1, 1"}) {
+    test::write_text(dir / "m.toml", model(origin));
+    for (const char* physics : {"current", "thermal"}) {
+      const int rc =
+          foxi_cli("solve '" + (dir / "m.toml").string() + "' --physics " + physics, dir / "out.txt");
+      const std::string out = test::read_text(dir / "out.txt");
+      EXPECT_EQ(rc, kBadInput) << origin << " " << physics << "\n" << out;
+      EXPECT_NE(
+          out.find("m.toml:11: part 'b' touches the rest of the model only along an edge or at a point"),
+          std::string::npos)
+          << out;
+      EXPECT_EQ(out.find("resistance"), std::string::npos) << out;
+    }
+  }
+  test::write_text(dir / "m.toml", model("0, 0, 1"));  // b on a's top face: a 2 mm bar
+  ASSERT_EQ(foxi_cli("solve '" + (dir / "m.toml").string() + "' --physics current", dir / "out.txt"), 0)
+      << test::read_text(dir / "out.txt");
+  const std::string out = test::read_text(dir / "out.txt");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("resistance (\\S+) ohm"))) << out;
+  EXPECT_NEAR(std::stod(m[1]), 0.002 / (6e7 * 1e-6), 1e-6 * 0.002 / (6e7 * 1e-6)) << out;
+}
+
 // A [[mesh.refine]] box in the model: `foxi solve` meshes with it as `foxi mesh` does. The nodes in
 // the box (counted on the solved mesh read back) against the same model without the box.
 TEST(ModelCli, SolveAppliesTheModelsRefinementBoxes) {

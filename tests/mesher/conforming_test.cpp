@@ -125,6 +125,77 @@ TEST(Conforming, SplitPointsLieOnTheEncroachedConstraints) {
   EXPECT_EQ(untouched.point_count(), plc.point_count());
 }
 
+// A box PLC (metres) from the origin to (w, w, l).
+Plc bar_plc(double w, double l) {
+  Plc plc;
+  plc.points = {0, 0, 0, w, 0, 0, w, w, 0, 0, w, 0, 0, 0, l, w, 0, l, w, w, l, 0, w, l};
+  plc.add_facet({0, 1, 2, 3}, 1);
+  plc.add_facet({4, 5, 6, 7}, 2);
+  plc.add_facet({0, 1, 5, 4}, 3);
+  plc.add_facet({1, 2, 6, 5}, 3);
+  plc.add_facet({2, 3, 7, 6}, 3);
+  plc.add_facet({3, 0, 4, 7}, 3);
+  plc.regions.push_back(RegionSeed{{w / 2, w / 2, l / 2}, 1, 0});
+  return plc;
+}
+
+// |6V| / (longest edge)^3 of the flattest tet, computed here.
+double flattest(const Mesh& m) {
+  double least = 1;
+  for (std::size_t t = 0; t < m.tet_count(); ++t) {
+    const double* p[4];
+    for (int k = 0; k < 4; ++k) p[k] = &m.xyz[3 * m.tet[4 * t + std::size_t(k)]];
+    double e[3][3], longest = 0;
+    for (int k = 0; k < 3; ++k)
+      for (int c = 0; c < 3; ++c) e[k][c] = p[k + 1][c] - p[0][c];
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j)
+        longest = std::max(longest, std::hypot(p[i][0] - p[j][0], p[i][1] - p[j][1], p[i][2] - p[j][2]));
+    const double six_v = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                         e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                         e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    least = std::min(least, std::abs(six_v) / (longest * longest * longest));
+  }
+  return least;
+}
+
+// Square bars meshed at sizes that put TetGen's Steiner points at the midpoints of the four sides at
+// one height (an outside probe's copper bar): four nearly coplanar, cocircular points, and a flat tet
+// across them in TetGen's Delaunay mesh (6V 1e-17 of the edges cubed; the solvers' matrix singular).
+// Without the removal (flat_tet_bound 0) such tets are there, so the case is real; with it none is,
+// and the mesh is still certified, valid, and of the bar's volume.
+TEST(Conforming, FlatTetsOfSymmetricSteinerPointsAreRemoved) {
+  const std::pair<double, double> bars[] = {
+      {0.5e-3, 0.4e-3}, {0.5e-3, 0.5e-3}, {0.5e-3, 0.7e-3}, {0.3e-3, 0.2e-3}, {0.77e-3, 1.2e-3}};
+  std::size_t flat_before = 0, removed = 0;
+  for (const auto& [size, w] : bars) {
+    SCOPED_TRACE("size " + std::to_string(size) + " width " + std::to_string(w));
+    const Plc plc = bar_plc(w, 10e-3);
+    MeshParams params;
+    params.max_volume = size * size * size / (6 * std::sqrt(2.0));
+    ConformingParams keep;
+    keep.flat_tet_bound = 0;
+    const Mesh plain = mesh_conforming(plc, params, keep);
+    flat_before += flattest(plain) < 1e-9;
+    ConformingReport report;
+    const Mesh m = mesh_conforming(plc, params, {}, &report);
+    removed += report.flat_tets_removed;
+    EXPECT_GE(flattest(m), 1e-9);
+    EXPECT_EQ(report.flat_tets, 0u);
+    EXPECT_TRUE(compute_delaunay_certificate(m).delaunay);
+    EXPECT_TRUE(validate(m).clean()) << describe(validate(m)).front();
+    double volume = 0;
+    for (std::size_t t = 0; t < m.tet_count(); ++t) {
+      const std::uint32_t* v = &m.tet[4 * t];
+      volume += std::abs(
+          tet_quality(&m.xyz[3 * v[0]], &m.xyz[3 * v[1]], &m.xyz[3 * v[2]], &m.xyz[3 * v[3]]).volume);
+    }
+    EXPECT_NEAR(volume, w * w * 10e-3, 1e-12 * w * w * 10e-3);
+  }
+  EXPECT_GE(flat_before, 3u);  // 4 of the 5 with TetGen 1.5 (Debian)
+  EXPECT_GE(removed, flat_before);
+}
+
 TEST(Conforming, CancelStops) {
   const Plc plc = read_poly(corpus("tilted_facets_q1414.poly"));
   MeshParams params;

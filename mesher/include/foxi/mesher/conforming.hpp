@@ -16,7 +16,9 @@
 // result may hold slivers (four nearly cospherical vertices). They are Delaunay and ordered
 // correctly by the viewer; they are counted in the quality report (quality_report.hpp) and left in
 // place, because flipping or smoothing them away would break the Delaunay property. A sliver-free
-// mesh needs the weighted (regular) path through CGAL with sliver exudation.
+// mesh needs the weighted (regular) path through CGAL with sliver exudation. Flat tets, whose
+// corners are coplanar to round-off (ConformingParams::flat_tet_bound), are the exception: no solver
+// can assemble them, so each gets a point inside and the PLC is meshed again.
 #pragma once
 
 #include <cstddef>
@@ -56,6 +58,14 @@ struct ConformingParams {
   double max_added_fraction = 0.15;    // stop once the points added exceed this fraction of the
                                        // first (-O0) mesh's point count ...
   std::size_t min_added_budget = 100;  // ... or this many, whichever is more (small meshes)
+  // Flat tets: |6V| below this times the longest edge cubed (corners coplanar to round-off; a
+  // regular tet has 0.71, TetGen's slivers 1e-3 and more, the flat ones 1e-17). Each gets a point
+  // inside and the PLC is meshed again, at most max_flat_rounds times; 0: kept.
+  double flat_tet_bound = 1e-9;
+  // foxi's own refinement (thin layers, surface rounds) splits every tet outside the layers with a
+  // dihedral angle under this many degrees (four almost cocircular coplanar points); 0: none.
+  double split_dihedral_deg = 1.0;
+  std::size_t max_flat_rounds = 3;
 };
 
 struct ConformingReport {
@@ -87,6 +97,11 @@ struct ConformingReport {
   // Rounds that refined the mesh's own surface triangles after TetGen failed on a refined PLC or the
   // conforming rounds ran out (0: none were needed).
   std::size_t surface_rounds = 0;
+  // Flat tets (ConformingParams::flat_tet_bound): those left in the final mesh, those the flat rounds
+  // removed, and the points they added (also counted in added_points' rounds, not in added_points).
+  std::size_t flat_tets = 0;
+  std::size_t flat_tets_removed = 0;
+  std::size_t flat_points = 0;
 };
 
 // Meshes `plc` with TetGen (params.optimize is forced off) and refines until the exact Delaunay
@@ -102,6 +117,9 @@ FOXI_API Mesh mesh_conforming(const Plc& plc, const MeshParams& params = {},
 // The split points for one mesh of `plc`: for every tet in `violating_tets`, every constraint
 // triangle (mesh.bface) encroached by a vertex inside that tet's circumsphere is split; `plc` gets
 // the points. Returns the number of points added (0: nothing found to split). Exposed for tests.
+// The tets of `mesh` with |6V| < bound x (longest edge)^3, in order.
+FOXI_API std::vector<std::uint32_t> flat_tets(const Mesh& mesh, double bound);
+
 FOXI_API std::size_t split_encroached_constraints(const Mesh& mesh,
                                                   const std::vector<std::uint32_t>& violating_tets, Plc& plc);
 

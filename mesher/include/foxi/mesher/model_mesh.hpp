@@ -73,7 +73,9 @@ struct MeshedModel {
 };
 
 struct ModelMeshOptions {
-  // Checked before meshing (check_physics): the conditions and materials a solve of it needs.
+  // Checked before meshing (check_physics): the conditions and materials a solve of it needs; after
+  // meshing, parts touching the rest only along an edge or at a point are refused (IoError: the mesh
+  // would join them through nodes).
   std::optional<Physics> physics;
   // A mesh for a picture of the parts: TetGen alone, no sizes, no quality refinement, no conforming
   // rounds (the mesh follows the PLC's points and may not be Delaunay; draw_picture copes).

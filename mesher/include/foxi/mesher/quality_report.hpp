@@ -53,6 +53,8 @@ struct MeshQualityReport {
   bool delaunay = false;       // the exact certificate of the final mesh
   bool tetgen_failed = false;  // refinement stopped where TetGen failed (conforming.hpp)
   std::size_t violating_tets = 0;
+  // Flat tets (ConformingParams::flat_tet_bound): removed by points inside them, and left.
+  std::size_t flat_tets_removed = 0, flat_points = 0, flat_tets = 0;
   double mesh_seconds = 0, certificate_seconds = 0;
 };
 
