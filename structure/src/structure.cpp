@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <numeric>
@@ -337,7 +338,51 @@ class Builder {
       if (!(s_.part_volume[p] > 0))
         throw IoError(m_.file, m_.parts[p].line, IoError::kNoOffset,
                       "part '" + m_.parts[p].name + "' is carved away entirely by later parts");
+    refuse_short_edges();
     return std::move(s_);
+  }
+
+  // Two parts whose edges nearly meet (a box at x = 0.9999999 mm on the corner of one ending at
+  // 1 mm) leave an edge in the PLC far below any part's own features (each at least kMinFeature of
+  // the extent: model_file.cpp), and TetGen's refinement then runs without end at that scale
+  // (foxi mesh and foxi solve ran until killed; an outside probe). Refused, with where and which
+  // boundary holds it. Edges under 1e-12 of the extent are round-off (power_module has one of
+  // 3.5e-15 mm), welded by the mesher.
+  void refuse_short_edges() const {
+    const Plc& plc = s_.plc;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (std::size_t i = 0; i < plc.points.size(); ++i) {
+      lo[i % 3] = std::min(lo[i % 3], plc.points[i]);
+      hi[i % 3] = std::max(hi[i % 3], plc.points[i]);
+    }
+    const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    const double tol = model_limits::kMinFeature * extent;
+    for (std::size_t f = 0; f < plc.facet_count(); ++f)
+      for (std::uint32_t g = plc.facet_polygon_begin[f]; g < plc.facet_polygon_begin[f + 1]; ++g) {
+        const std::uint32_t b = plc.polygon_vertex_begin[g], e = plc.polygon_vertex_begin[g + 1];
+        for (std::uint32_t k = b; e - b >= 2 && k < e; ++k) {
+          const double* p = &plc.points[3 * std::size_t{plc.polygon_vertices[k]}];
+          const double* q = &plc.points[3 * std::size_t{plc.polygon_vertices[k + 1 < e ? k + 1 : b]}];
+          const double len = std::hypot(q[0] - p[0], q[1] - p[1], q[2] - p[2]);
+          // Below 1e-12: round-off of two constructions of one point, welded by the mesher.
+          if (len >= tol || len <= 1e-12 * extent) continue;
+          const double u = m_.length_scale;
+          char where[200];
+          std::snprintf(where, sizeof where, "(%.9g, %.9g, %.9g) %s", p[0] / u, p[1] / u, p[2] / u,
+                        m_.length_unit.c_str());
+          const std::string& name = s_.boundary_names[static_cast<std::size_t>(plc.facet_marker[f] - 1)];
+          char size[64], limit[64];
+          std::snprintf(size, sizeof size, "%.3g", len / u);
+          std::snprintf(limit, sizeof limit, "%.3g", extent / u);
+          throw IoError(
+              m_.file, 0, IoError::kNoOffset,
+              "the parts leave an edge of " + std::string(size) + " " + m_.length_unit + " at " + where +
+                  " on boundary '" + name +
+                  "', below the smallest feature foxi meshes (1e-06 of the model's extent, " + limit + " " +
+                  m_.length_unit +
+                  "): two parts nearly meet there; move one onto the other's edge or face, or apart");
+        }
+      }
   }
 
  private:
