@@ -496,6 +496,12 @@ TEST(ModelCli, MeshRefusesAnEstimatePastMaxTets) {
   EXPECT_LT(tets, estimate * 3) << estimate;
   EXPECT_EQ(foxi_cli("mesh " + die + " --max-tets 0 -o " + out, dir / "log.txt"), 2);
   EXPECT_EQ(foxi_cli("mesh " + die + " --max-tets lots -o " + out, dir / "log.txt"), 2);
+  // A refinement box over the whole model at 0.01 mm (an outside probe: meshed until killed, in the
+  // passes that make the boxes' size field, before their estimate): refused as promptly.
+  o = timed("mesh " + die + " --refine-box -10,-10,-10,10,10,10=0.01mm -o " + out, dir / "log.txt");
+  EXPECT_EQ(o.status, kBadInput) << o.text;
+  EXPECT_LT(o.seconds, 5 * test::kTimeScale);
+  EXPECT_NE(o.text.find("over the limit of 4000000"), std::string::npos) << o.text;
 }
 
 // --refine-from with a small target error shrinks every size by up to 4 (64 times the tets) each
