@@ -221,13 +221,28 @@ class Parser {
     if (p_ >= s_.size()) fail("unexpected end, expected a number or a name");
     const char c = s_[p_];
     if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
-      const char* b = s_.data() + p_;
-      std::string tmp(s_.substr(p_));
-      char* end = nullptr;
-      const double v = std::strtod(tmp.c_str(), &end);
-      if (end == tmp.c_str()) fail("bad number");
-      p_ += static_cast<std::size_t>(end - tmp.c_str());
-      (void)b;
+      // Decimal only: strtod alone also read hexadecimal ("0x10" was 16, "0x1p-3 mm" 0.125 mm), "inf"
+      // and "nan" after a digit never occur here.
+      std::size_t n = p_;
+      auto digits = [&] {
+        const std::size_t at = n;
+        while (n < s_.size() && std::isdigit(static_cast<unsigned char>(s_[n]))) ++n;
+        return n > at;
+      };
+      bool any = digits();
+      if (n < s_.size() && s_[n] == '.') {
+        ++n;
+        any = digits() || any;
+      }
+      if (!any) fail("bad number");
+      if (n < s_.size() && (s_[n] == 'e' || s_[n] == 'E')) {
+        const std::size_t mantissa_end = n++;
+        if (n < s_.size() && (s_[n] == '+' || s_[n] == '-')) ++n;
+        if (!digits()) n = mantissa_end;  // "2e" is 2 and a unit "e" (unknown)
+      }
+      const std::string tmp(s_.substr(p_, n - p_));
+      const double v = std::strtod(tmp.c_str(), nullptr);
+      p_ = n;
       Quantity q{v, kDimensionless};
       if (at_ident()) {  // a unit right after a number: "8 mm", "2um", "150 W"
         const std::size_t at = p_;

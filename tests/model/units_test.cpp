@@ -68,6 +68,14 @@ TEST(Units, MismatchesAndUnknownNamesAreErrors) {
   EXPECT_NE(error_of("1 +").find("unexpected end"), std::string::npos);
   EXPECT_NE(error_of("1 / 0").find("finite"), std::string::npos);
   EXPECT_NE(error_of("").find("unexpected end"), std::string::npos);
+  // Numbers are decimal: hexadecimal was read as such ("0x10" was 16; an outside probe).
+  EXPECT_NE(error_of("0x10").find("unknown unit 'x10'"), std::string::npos);
+  EXPECT_NE(error_of("0x1p-3 mm").find("unknown unit"), std::string::npos);
+  EXPECT_NE(error_of("2e mm").find("unknown unit 'e'"), std::string::npos);
+  EXPECT_DOUBLE_EQ(eval("1e-1 mm").value, 1e-4);
+  EXPECT_DOUBLE_EQ(eval("1E+2").value, 100);
+  EXPECT_DOUBLE_EQ(eval(".5 mm").value, 5e-4);
+  EXPECT_DOUBLE_EQ(eval("5. mm").value, 5e-3);
 }
 
 // Found by fuzzing (tests/data/bad/fuzz/expression/min_max_mismatch): min/max named themselves in a
