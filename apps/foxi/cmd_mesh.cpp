@@ -109,8 +109,8 @@ std::pair<std::string, std::string> split_eq(const std::string& s, const char* w
 // that fails its checks).
 int report_cgal_mesh(const std::string& in, const std::string& out, const MeshedModel& m,
                      double volume_tolerance);
-// The exit status of a mesher failure on the CGAL path (cmd_mesh_cgal.cpp).
-int cgal_exit_code(MesherFailure f);
+// The exit status of a mesher failure, TetGen or CGAL (cmd_mesh_cgal.cpp).
+int mesher_exit_code(MesherFailure f);
 
 int cmd_mesh(Args args) {
   if (args.flag("--help") || args.flag("-h")) {
@@ -249,10 +249,12 @@ int cmd_mesh(Args args) {
     if (cgal) {
       std::fprintf(stderr, "%sfoxi mesh: error: %s: %s: %s\n", tty && last_print > 0 ? "\n" : "", in.c_str(),
                    failure_name(e.failure()), e.what());
-      status = cgal_exit_code(e.failure());
+      status = mesher_exit_code(e.failure());
     } else {
       std::fprintf(stderr, "%sfoxi mesh: error: %s: %s\n", tty ? "\n" : "", in.c_str(), e.what());
-      status = kExitFailure;
+      // The input's fault (a PLC TetGen refuses, a --region-size for no region) is exit 3, as with
+      // CGAL; it was 1, the work's failure.
+      status = mesher_exit_code(e.failure());
     }
   }
   if (tty && last_print > 0) std::fputc('\n', stderr);

@@ -45,7 +45,7 @@ double max_dihedral_deg(const Mesh& m, std::size_t t) {
 }  // namespace
 
 // The exit status of a mesher failure: the input's fault, a stop asked for, or the mesher's.
-int cgal_exit_code(MesherFailure f) {
+int mesher_exit_code(MesherFailure f) {
   switch (f) {
     case MesherFailure::bad_input:
     case MesherFailure::self_intersection:

@@ -496,6 +496,9 @@ TEST(ModelCli, MeshRefusesAnEstimatePastMaxTets) {
   EXPECT_LT(tets, estimate * 3) << estimate;
   EXPECT_EQ(foxi_cli("mesh " + die + " --max-tets 0 -o " + out, dir / "log.txt"), 2);
   EXPECT_EQ(foxi_cli("mesh " + die + " --max-tets lots -o " + out, dir / "log.txt"), 2);
+  // A size for a region the model does not have is the input's fault (it was exit 1, a failure).
+  EXPECT_EQ(foxi_cli("mesh " + die + " --region-size 99=0.1mm -o " + out, dir / "log.txt"), kBadInput);
+  EXPECT_NE(test::read_text(dir / "log.txt").find("no region 99"), std::string::npos);
   // A refinement box over the whole model at 0.01 mm (an outside probe: meshed until killed, in the
   // passes that make the boxes' size field, before their estimate): refused as promptly.
   o = timed("mesh " + die + " --refine-box -10,-10,-10,10,10,10=0.01mm -o " + out, dir / "log.txt");
