@@ -443,8 +443,9 @@ int cmd_solve(Args args) {
   Mesh mesh = from_model ? std::move(model_run.mesh) : read_mesh(files[0]);
   require_usable(mesh, files[0], "solve");
   auto t1 = std::chrono::steady_clock::now();
-  // The record of the run: the error indicator printed, the JSON written; the exit status of the checks.
-  auto finish = [&](RunResults res, const char* field) {
+  // The record of the run: the error indicator printed, the mesh written (-o), then the JSON (a
+  // failed -o, a full disk, leaves no record saying ok); the exit status of the checks.
+  auto finish = [&](RunResults res, const char* field, const char* fields_written) {
     res.model = files[0];
     res.parameters = run_parameters(sets);
     res.mesh_seconds = std::chrono::duration<double>(t1 - t0).count();
@@ -452,6 +453,10 @@ int cmd_solve(Args args) {
     res.error_indicator = error_indicator(mesh, field);
     print_error_indicator(res.error_indicator, field);
     const int status = print_checks(res.checks);
+    if (!out.empty()) {
+      write_mesh(mesh, out);
+      std::printf("wrote %s (fields %s)\n", out.c_str(), fields_written);
+    }
     write_json(json, results_json(res));
     return status;
   };
@@ -500,12 +505,7 @@ int cmd_solve(Args args) {
       std::printf("stored energy %.6e J (1/2 sum Q V), field energy %.6e J\n", r.energy, r.field_energy);
       std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
                   r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
-      const int status = finish(electrostatic_results(mesh, r), "potential");
-      if (!out.empty()) {
-        write_mesh(mesh, out);
-        std::printf("wrote %s (fields potential [V], electric_field [V/m])\n", out.c_str());
-      }
-      return status;
+      return finish(electrostatic_results(mesh, r), "potential", "potential [V], electric_field [V/m]");
     }
     if (!conductor.empty() || !eps.empty())
       throw UsageError("--conductor and --eps are for --physics electrostatic");
@@ -546,13 +546,8 @@ int cmd_solve(Args args) {
     std::printf("total Joule heat %.6e W (sum V I %.6e W)\n", r.total_power, r.terminal_power);
     std::printf("solver %s, %zu iterations, relative residual %.3g; assemble %.3f s, solve %.3f s\n",
                 r.solver.c_str(), r.iterations, r.relative_residual, r.assembly_seconds, r.solve_seconds);
-    const int status = finish(current_results(mesh, r), "potential");
-    if (!out.empty()) {
-      write_mesh(mesh, out);
-      std::printf("wrote %s (fields potential [V], current_density [A/m^2], joule_heat [W/m^3])\n",
-                  out.c_str());
-    }
-    return status;
+    return finish(current_results(mesh, r), "potential",
+                  "potential [V], current_density [A/m^2], joule_heat [W/m^3]");
   }
   if (!conductor.empty() || !eps.empty() || !terminal.empty() || !terminal_current.empty() || !sigma.empty())
     throw UsageError("--conductor/--eps are for --physics electrostatic, --terminal/--sigma for current");
@@ -576,12 +571,7 @@ int cmd_solve(Args args) {
       r.solver.c_str(), r.nonzeros, r.iterations, r.relative_residual,
       std::chrono::duration<double>(t1 - t0).count(), r.assembly_seconds, r.solve_seconds);
   (void)t2;
-  const int status = finish(thermal_results(mesh, r), "temperature");
-  if (!out.empty()) {
-    write_mesh(mesh, out);
-    std::printf("wrote %s (fields temperature [K], heat_flux [W/m^2])\n", out.c_str());
-  }
-  return status;
+  return finish(thermal_results(mesh, r), "temperature", "temperature [K], heat_flux [W/m^2]");
 }
 
 }  // namespace foxi::cli

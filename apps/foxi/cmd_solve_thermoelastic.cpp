@@ -250,12 +250,12 @@ int cmd_solve_thermoelastic(Args args) {
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // the displacement is a vector field (the indicator takes a scalar): no indicator for the stress
   const int status = print_checks(r.checks);
-  write_json(json, results_json(res));
-  if (!out.empty()) {
+  if (!out.empty()) {  // before the JSON: a failed -o leaves no record saying ok
     write_mesh(mesh, out);
     std::printf("wrote %s (fields displacement [m], stress, von_mises, principal_stress [Pa])\n",
                 out.c_str());
   }
+  write_json(json, results_json(res));
   return status;
 }
 
