@@ -2,6 +2,7 @@
 // the power-function visibility order, front faces only, no depth buffer), written as a PNG.
 #include <cctype>
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -31,6 +32,17 @@
 #include "foxi/viz/volume.hpp"
 
 namespace foxi::cli {
+
+namespace {
+
+// Whether every pixel is the background colour: a blank picture is said, not only written (a curve
+// of opacity 0 where the field's values are, every region at opacity 0, a camera that sees no tet;
+// an outside probe found such pictures written without a word).
+bool blank(const Framebuffer& fb, std::uint32_t background) {
+  return std::all_of(fb.rgba.begin(), fb.rgba.end(), [&](std::uint32_t c) { return c == background; });
+}
+
+}  // namespace
 
 namespace {
 
@@ -191,6 +203,10 @@ int cmd_render(Args args) {
           "composited in MPVO order, NOT exact (no visibility order without the certificate; %zu cycles "
           "broken), order %.1f ms, integration %.1f ms: %zu pixel segments, %dx%d\n",
           report.cycles_broken, report.order_ms, report.draw_ms, report.samples, options.width, height);
+    if (blank(fb, vp.background))
+      std::printf(
+          "warning     the picture is blank: no segment left a colour (the opacity curve is 0 where the "
+          "field's values are, or the camera sees no tet)\n");
     std::printf("wrote       %s\n", out.c_str());
     return kExitOk;
   }
@@ -222,6 +238,10 @@ int cmd_render(Args args) {
                              "certificate)",
         report.order_ms, report.draw_ms, report.fragments, options.width, height,
         100.0 * double(covered) / double(fb.id.size()));
+    if (blank(fb, tp.background))
+      std::printf(
+          "warning     the picture is blank: every pixel is the background (every surface drawn has "
+          "opacity 0, or the camera sees no tet)\n");
     std::printf("wrote       %s\n", out.c_str());
     return kExitOk;
   }
@@ -276,6 +296,7 @@ int cmd_render(Args args) {
     std::printf(", stopped at depth %g (last tet drawn at %g)", depth_stop,
                 tet_depth(table, camera, report.last_drawn));
   if (report.raster.tets_behind > 0) std::printf(", %zu tets behind the eye", report.raster.tets_behind);
+  if (covered == 0) std::printf(" (a blank picture: the camera sees no tet of the selection)");
   if (field.paint) {
     const DisplayUnit& u = field.legend.unit;
     const ColorScale& sc = field.legend.scale;

@@ -232,6 +232,15 @@ TEST(VolumeCli, AutomaticRangeIsTheCornersAndNoValuesAreSaid) {
       0);
   log = test::read_text(dir / "log.txt");
   EXPECT_NE(log.find("lies wholly above the field's values (0 to 3"), std::string::npos) << log;
+  EXPECT_EQ(log.find("blank"), std::string::npos) << log;
+  // A curve of opacity 0, every region at opacity 0: blank pictures are said (an outside probe).
+  ASSERT_EQ(test::run(run + "--volume T --opacity-curve 0:0,3:0 -o '" + (dir / "z.png").string() + "'",
+                      dir / "log.txt"),
+            0);
+  EXPECT_NE(test::read_text(dir / "log.txt").find("warning     the picture is blank"), std::string::npos);
+  ASSERT_EQ(test::run(run + "--region-opacity 1=0 -o '" + (dir / "z.png").string() + "'", dir / "log.txt"),
+            0);
+  EXPECT_NE(test::read_text(dir / "log.txt").find("warning     the picture is blank"), std::string::npos);
   // Translucent isosurfaces too: their colours and the legend reach the corners' values.
   ASSERT_EQ(test::run(run + "--region-opacity 1=0.2 --field T --iso 0.5,2.5 --iso-opacity 0.5 -o '" +
                           (dir / "i.png").string() + "'",
