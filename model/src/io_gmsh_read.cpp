@@ -8,6 +8,8 @@
 // - Region id of a tet / tag of a triangle: 2.2: its first element tag (physical group), 0 if it has
 //   none; 4.1: the first physical tag of its entity ($Entities), 0 when the entity has none or the
 //   file has no $Entities section. So "no physical group" is 0 in both versions (as gmsh 2.2 writes).
+//   A triangle of a surface in several physical groups is repeated, once with each tag, as a 2.2 file
+//   repeats it (a boundary condition on any of the groups finds it); a tet keeps the first.
 // - NaN / Inf coordinates are read as they are (validate() reports them); a token that is not a
 //   number is an error.
 // - Binary files must be little-endian with 8-byte size_t / double (what gmsh writes on all current
@@ -416,6 +418,8 @@ class Reader {
           std::uint64_t np = bin_count("physical tags", 4);
           const char* p = need(4 * np, "physical tags");
           if (np > 0) entity_phys_[d][tag] = io::load<std::int32_t>(p);
+          for (std::uint64_t k = 1; d == 2 && k < np; ++k)
+            entity_more_phys_[tag].push_back(io::load<std::int32_t>(p + 4 * k));
           advance(4 * np);
           if (d > 0) {
             std::uint64_t nb = bin_count("bounding entities", 4);
@@ -436,6 +440,7 @@ class Reader {
             std::size_t pat = cur_.pos();
             std::int32_t ph = to_i32(num<std::int64_t>(cur_, "physical tag"), pat, "physical tag");
             if (k == 0) entity_phys_[d][tag] = ph;
+            if (k > 0 && d == 2) entity_more_phys_[tag].push_back(ph);
           }
           if (d > 0) {
             std::uint64_t nb = count("bounding entities", 2);
@@ -695,6 +700,20 @@ class Reader {
     }
   };
 
+  // The last m triangles again for each further physical tag of their surface entity.
+  void repeat_triangles(std::int64_t dim, std::int64_t tag, std::uint64_t m) {
+    if (dim != 2) return;
+    const auto it = entity_more_phys_.find(tag);
+    if (it == entity_more_phys_.end()) return;
+    const std::size_t first = mesh_.bface_tag.size() - m;
+    for (std::int32_t phys : it->second) {
+      for (std::size_t i = first; i < first + m; ++i)
+        mesh_.bface.insert(mesh_.bface.end(), mesh_.bface.begin() + std::ptrdiff_t(3 * i),
+                           mesh_.bface.begin() + std::ptrdiff_t(3 * i + 3));
+      mesh_.bface_tag.insert(mesh_.bface_tag.end(), m, phys);
+    }
+  }
+
   std::int32_t entity_physical(std::int64_t dim, std::int64_t tag) const {
     if (dim < 0 || dim > 3) return 0;
     auto it = entity_phys_[dim].find(tag);
@@ -827,9 +846,11 @@ class Reader {
           break;
         case 2:
           block41<3, 3>(m, phys);
+          repeat_triangles(dim, etag, m);
           break;
         case 9:
           block41<6, 3>(m, phys);
+          repeat_triangles(dim, etag, m);
           break;
         default:
           skip_block41(m, nodes_of_type(type));
@@ -1009,6 +1030,9 @@ class Reader {
   TagMap tet_map_;
   bool tet_map_built_ = false;
   std::unordered_map<std::int64_t, std::int32_t> entity_phys_[4];
+  // A surface entity's physical tags after its first: its triangles are repeated with each, as
+  // gmsh's 2.2 files repeat them (a tet keeps its entity's first: it has one region).
+  std::unordered_map<std::int64_t, std::vector<std::int32_t>> entity_more_phys_;
   std::unordered_map<std::int32_t, std::string> volume_names_, surface_names_;
   std::vector<PendingField> fields_;
   std::uint64_t pending_values_ = 0;

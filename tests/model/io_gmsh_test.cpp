@@ -220,6 +220,36 @@ TEST(GmshRead, ParametricNodesMatchPlainFile) {
   }
 }
 
+// A surface in two physical groups ("bottom", and "outer" with all six sides): gmsh's 4.1 file lists
+// both tags on the surface's entity, and its 2.2 file repeats the triangles once per group. Both read
+// alike: every group holds all its triangles (the 4.1 reader kept the entity's first tag only, and
+// "outer" lost the bottom's 90 of its 540 triangles; an outside probe).
+TEST(GmshRead, SurfaceInTwoPhysicalGroupsIsInBoth) {
+  if (!have_gmsh()) GTEST_SKIP() << "gmsh not available";
+  TempDir dir;
+  test::write_text(dir / "g.geo", R"(SetFactory("OpenCASCADE");
+Box(1) = {0,0,0, 1,1,1};
+Physical Volume("v", 1) = {1};
+Physical Surface("bottom", 10) = {5};
+Physical Surface("outer", 11) = {1, 2, 3, 4, 5, 6};
+Mesh.CharacteristicLengthMax = 0.3;
+)");
+  std::map<std::string, std::map<std::int32_t, std::size_t>> count;  // variant -> tag -> triangles
+  for (const char* variant : {"msh22", "msh41", "msh41 -bin"}) {
+    const std::string file = (dir / "g.msh").string();
+    ASSERT_EQ(
+        test::run("gmsh -3 '" + (dir / "g.geo").string() + "' -format " + variant + " -o '" + file + "'",
+                  dir / "log"),
+        0);
+    const Mesh m = read_gmsh(file);
+    for (std::int32_t tag : m.bface_tag) ++count[variant][tag];
+  }
+  EXPECT_GT(count["msh22"][10], 0u);
+  EXPECT_GT(count["msh22"][11], count["msh22"][10]);
+  EXPECT_EQ(count["msh41"], count["msh22"]);
+  EXPECT_EQ(count["msh41 -bin"], count["msh22"]);
+}
+
 // gmsh's second-order meshes (10-node tets, 6-node triangles) read as their corners: the same tets
 // and triangles as gmsh's first-order mesh of the same geometry, in all four file variants.
 TEST(GmshRead, SecondOrderElementsReadAsCorners) {
