@@ -36,6 +36,11 @@ TEST(Units, LengthsConvertToMetres) {
   EXPECT_DOUBLE_EQ(eval("1 in").value, 0.0254);
   EXPECT_DOUBLE_EQ(eval("10 mil").value, 2.54e-4);
   EXPECT_EQ(eval("1 cm").dims, foxi::kLength);
+  // Times below a second (the README's pulse example, 'pulse:3W,1ms,10ms', was refused: unknown unit)
+  EXPECT_DOUBLE_EQ(eval("10 ms").value, 1e-2);
+  EXPECT_DOUBLE_EQ(eval("5 us").value, 5e-6);
+  EXPECT_DOUBLE_EQ(eval("2 ns").value, 2e-9);
+  EXPECT_EQ(eval("1 ms").dims, (foxi::Dims{0, 0, 1, 0, 0}));
 }
 
 TEST(Units, ArithmeticCarriesDimensions) {
