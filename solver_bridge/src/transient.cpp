@@ -41,6 +41,53 @@ double PowerWaveform::at(double t) const {
   return 0.0;
 }
 
+double PowerWaveform::energy(double t) const {
+  if (!(t > 0)) return 0.0;
+  switch (kind) {
+    case Kind::step:
+      return power * t;
+    case Kind::pulse: {
+      if (!(period > 0)) return 0.0;
+      double k = std::floor(t / period);
+      double e = 0;
+      if (count != 0 && k >= static_cast<double>(count)) {
+        k = static_cast<double>(count);
+      } else {
+        e = power * std::min(t - k * period, width);
+      }
+      return e + power * width * k;
+    }
+    case Kind::table: {
+      if (table.empty()) return 0.0;
+      double e = 0, at = 0;  // the energy up to `at`
+      // held constant before the first point
+      const double first = std::min(t, table.front().first);
+      if (first > 0) {
+        e += table.front().second * first;
+        at = first;
+      }
+      for (std::size_t i = 1; i < table.size() && at < t; ++i) {
+        const auto [t0, p0] = table[i - 1];
+        const auto [t1, p1] = table[i];
+        const double a = std::max(at, t0), b = std::min(t, t1);
+        if (b <= a) continue;
+        const double pa = p0 + (p1 - p0) * (a - t0) / (t1 - t0), pb = p0 + (p1 - p0) * (b - t0) / (t1 - t0);
+        e += 0.5 * (pa + pb) * (b - a);
+        at = b;
+      }
+      if (t > std::max(at, table.back().first))
+        e += table.back().second * (t - std::max(at, table.back().first));
+      return e;
+    }
+  }
+  return 0.0;
+}
+
+double PowerWaveform::mean(double t0, double t1) const {
+  if (!(t1 > t0)) return at(t1);
+  return (energy(t1) - energy(t0)) / (t1 - t0);
+}
+
 namespace {
 
 std::string_view trim(std::string_view s) {
@@ -193,10 +240,16 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
     for (const TransientPower& w : params.power) p += w.power.at(t);
     return p;
   };
-  auto load_at = [&](double t) {
+  // The waveforms' mean power over [t0, t1] (their value at t1 where t0 == t1).
+  auto waveform_mean = [&](double t0, double t1) {
+    double p = 0;
+    for (const TransientPower& w : params.power) p += w.power.mean(t0, t1);
+    return p;
+  };
+  auto load_at = [&](double t0, double t1) {
     std::vector<double> f = sys.load;
     for (std::size_t i = 0; i < params.power.size(); ++i) {
-      const double p = params.power[i].power.at(t);
+      const double p = params.power[i].power.mean(t0, t1);
       if (p != 0)
         for (std::size_t v = 0; v < nn; ++v) f[v] += p * unit_load[i][v];
     }
@@ -285,7 +338,15 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
     }
     const double time = dt * static_cast<double>(n + 1);
     for (std::size_t v = 0; v < nn; ++v) hist[v] = use_bdf2 ? 2 * temp[v] - 0.5 * previous[v] : temp[v];
-    std::vector<double> f = load_at(time);
+    // The power over the step, not its value at the step's end: a pulse shorter than a step, or one
+    // between two step ends, was missed or counted a whole step (an outside probe: 10 pulses of 3 W
+    // for 0.5 ms stored 0.030 J for 0.015 J, the energy check passing). Euler: the mean over the
+    // step, so the energy put in is the waveform's to rounding; BDF2 (second order at t_n+1): the
+    // mean over the step's length centred on its end, the same to O(dt^2) where the power is smooth.
+    // (the first BDF2 step's window starts where Euler's ended; the last ends at the end time).
+    const double t_from = use_bdf2 ? (n == 1 ? dt : time - 0.5 * dt) : time - dt;
+    const double t_to = use_bdf2 ? std::min(time + 0.5 * dt, params.end_time) : time;
+    std::vector<double> f = load_at(t_from, t_to);
     std::vector<double> g = f;
     for (std::size_t v = 0; v < nn; ++v)
       if (mass[v] > 0) g[v] += mass[v] / dt * hist[v];
@@ -310,7 +371,7 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
     // Energy of the step: heat in (sources and boundaries at the new time) against the scheme's change
     // of stored energy.
     detail::boundary_heat(mesh, sys, f, temp, boundaries);
-    const double power = constant_power + waveform_power(time);
+    const double power = constant_power + waveform_mean(t_from, t_to);
     double q = power, in = std::max(0.0, power), outflow = std::max(0.0, -power);
     for (const BoundaryHeat& b : boundaries) {
       q += b.heat_in;
@@ -341,7 +402,7 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
     rep.regions[ri].power += params.power[i].power.at(t_end);
   }
   rep.total_power = constant_power + waveform_power(t_end);
-  detail::boundary_heat(mesh, sys, load_at(t_end), temp, rep.boundaries);
+  detail::boundary_heat(mesh, sys, load_at(t_end, t_end), temp, rep.boundaries);
   Field flux = detail::region_results(mesh, params.thermal, sys, temp, rep);
   rep.solver = out.solver;
   rep.unknowns = out.unknowns;

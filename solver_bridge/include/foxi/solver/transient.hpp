@@ -59,6 +59,10 @@ struct PowerWaveform {
   std::size_t count = 0;
   std::vector<std::pair<double, double>> table;
   FOXI_API double at(double t) const;
+  // The energy from t = 0 to t (J, exact for each kind), and the mean power over [t0, t1] (its value
+  // at t1 where t1 <= t0): what a time step of [t0, t1] puts in.
+  FOXI_API double energy(double t) const;
+  FOXI_API double mean(double t0, double t1) const;
   static PowerWaveform step_of(double watts) {
     PowerWaveform w;
     w.power = watts;
