@@ -185,6 +185,18 @@ int cmd_sweep(Args args) {
   std::vector<std::string> pass;
   const std::vector<std::string> sets = all_options(args, "--set");
   for (const std::string& s : sets) pass.insert(pass.end(), {"--set", s});
+  // A varied parameter also --set (before or after '--') overrode every run's value in silence: the
+  // rows said a=5mm and a=6mm and were both a=7mm (an outside probe).
+  std::vector<std::string> given = pass;
+  given.insert(given.end(), solve_options.begin(), solve_options.end());
+  for (std::size_t i = 0; i + 1 < given.size(); ++i) {
+    if (given[i] != "--set") continue;
+    const std::string name = given[i + 1].substr(0, given[i + 1].find('='));
+    for (const Varied& v : varied)
+      if (v.name == name)
+        throw UsageError("--set " + given[i + 1] + ": " + name +
+                         " is varied by --vary (a run's --set would override it)");
+  }
   const std::vector<std::string> theta = all_options(args, "--theta");
   if (!theta.empty() && physics != "thermal") throw UsageError("--theta is for --physics thermal");
   for (const std::string& s : theta) pass.insert(pass.end(), {"--theta", s});

@@ -884,6 +884,11 @@ std::vector<ParameterOverride> split_overrides(const std::filesystem::path& path
     if (eq == std::string::npos || eq == 0)
       throw IoError(path.string(), 0, IoError::kNoOffset,
                     std::string(origin) + " '" + o + "': expected name=value");
+    for (const ParameterOverride& earlier : out)
+      if (earlier.name == o.substr(0, eq))  // the last one won in silence
+        throw IoError(path.string(), 0, IoError::kNoOffset,
+                      std::string(origin) + " '" + o + "': parameter '" + earlier.name +
+                          "' is set twice (also to '" + earlier.expression + "')");
     out.push_back({o.substr(0, eq), o.substr(eq + 1)});
   }
   return out;

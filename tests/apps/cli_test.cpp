@@ -174,7 +174,7 @@ TEST(Cli, AnOptionGivenTwiceIsNamedSoAndNothingIsWritten) {
   EXPECT_EQ(unknown.status, 2);
   EXPECT_NE(unknown.out.find("unknown option --sise"), std::string::npos) << unknown.out;
   Result sets = foxi_cli(
-      "model check '" + test::models_dir() + "die_on_substrate.toml" + "' --set die_w=5mm --set die_w=6mm",
+      "model check '" + test::models_dir() + "die_on_substrate.toml" + "' --set die_w=5mm --set die_d=4mm",
       dir);
   EXPECT_EQ(sets.status, 0) << sets.out;
 }

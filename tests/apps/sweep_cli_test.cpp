@@ -217,6 +217,21 @@ TEST(SolveJson, UsageErrors) {
             3);
   EXPECT_NE(test::read_text(log).find("die_w"), std::string::npos) << test::read_text(log);
   EXPECT_FALSE(std::filesystem::exists(dir / "s.csv"));
+  // a varied parameter also --set, before or after '--', overrode every row's value in silence (an
+  // outside probe); and foxi solve's --set of one parameter twice kept the last in silence
+  for (const std::string& where : {" --set die_w=7mm -o '" + (dir / "s.csv").string() + "'",
+                                   " -o '" + (dir / "s.csv").string() + "' -- --set die_w=7mm"}) {
+    EXPECT_EQ(
+        test::run_cli("sweep '" + model("die_on_substrate.toml") + "' --vary die_w=2mm,3mm" + where, log), 2);
+    EXPECT_NE(test::read_text(log).find("die_w is varied by --vary"), std::string::npos)
+        << test::read_text(log);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "s.csv"));
+  EXPECT_EQ(
+      test::run_cli("solve '" + model("die_on_substrate.toml") + "' --set die_w=2mm --set die_w=3mm", log),
+      3);
+  EXPECT_NE(test::read_text(log).find("parameter 'die_w' is set twice"), std::string::npos)
+      << test::read_text(log);
 }
 
 TEST(Sweep, ThetaFallsWithDieWidthAndRowsEqualSeparateSolves) {
