@@ -242,6 +242,26 @@ TEST(Transient, PulsesShorterThanAStepPutInTheirEnergy) {
   }
 }
 
+// A power drawn out of a body with adiabatic walls: 300 K - P t / C goes below 0 K with 100 W over 10 s
+// (C = 2 J/K), which the absolute-zero check fails (-1362 K was printed with exit 0; an outside
+// probe), and stays above with 3 W.
+TEST(Transient, TemperaturesBelowAbsoluteZeroFailTheirCheck) {
+  Mesh m = test::layered_box_mesh(0.02, 0.01, {0, 0.005}, 1e-8);
+  for (const double watts : {3.0, 100.0}) {
+    TransientParams p = base(m, 50, 2e6);
+    p.power.push_back({1, PowerWaveform::step_of(-watts)});
+    p.initial_temperature = 300;
+    p.end_time = 10;
+    p.steps = 5;
+    const TransientReport r = solve_transient_thermal(m, p);
+    const auto zero = std::find_if(r.checks.begin(), r.checks.end(),
+                                   [](const BalanceCheck& c) { return c.name == "absolute zero"; });
+    ASSERT_NE(zero, r.checks.end());
+    EXPECT_NEAR(zero->figure, -(300 - watts * 10 / 2.0), 1e-6);
+    EXPECT_EQ(zero->passed, watts < 60);
+  }
+}
+
 TEST(TransientBadInput, PowerTableRowsAreRefusedWithTheirLine) {
   test::TempDir dir;
   test::write_text(dir / "ok.csv", "time_s,power_W\n# comment\n0,1\n0.5, 2\n\n1,0\n");
