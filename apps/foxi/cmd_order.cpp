@@ -9,6 +9,7 @@
 #include "cli.hpp"
 #include "exit_codes.hpp"
 #include "mesh_input.hpp"
+#include "solve_options.hpp"
 #include "foxi/model/delaunay.hpp"
 #include "foxi/model/mesh_io.hpp"
 #include "foxi/viz/picture.hpp"
@@ -47,7 +48,13 @@ int cmd_order(Args args) {
   const std::string eye_s = args.option("--eye"), dir_s = args.option("--dir"),
                     views_s = args.option("--views");
   const std::string subset_s = args.option("--subset"), method = args.option("--method", "auto");
-  const unsigned seed = static_cast<unsigned>(std::stoul(args.option("--seed", "1")));
+  // Whole numbers or a usage error naming the option (std::stoi said "stoi" with exit 1, and read
+  // "1e3" as 1 and "12abc" as 12; an outside probe).
+  std::int32_t seed_value = 0;
+  const std::string seed_s = args.option("--seed", "1");
+  if (!parse_int(seed_s, seed_value) || seed_value < 0)
+    throw UsageError("--seed takes a whole number from 0 to 2147483647, not '" + seed_s + "'");
+  const auto seed = static_cast<unsigned>(seed_value);
   const bool ftb = args.flag("--front-to-back"), check = args.flag("--check");
   const std::string path = args.positional(1, 1, kOrderUsage)[0];
   if (int(!eye_s.empty()) + int(!dir_s.empty()) + int(!views_s.empty()) != 1)
@@ -74,8 +81,9 @@ int cmd_order(Args args) {
       throw UsageError("--dir takes a nonzero x,y,z");
     views.push_back(View::along(d[0], d[1], d[2]));
   } else {
-    int n = std::stoi(views_s);
-    if (n < 1) throw UsageError("--views takes a positive count");
+    std::int32_t n = 0;
+    if (!parse_int(views_s, n) || n < 1 || n > 1000000)
+      throw UsageError("--views takes a whole number from 1 to 1000000, not '" + views_s + "'");
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0, 1);
     std::normal_distribution<double> g(0, 1);

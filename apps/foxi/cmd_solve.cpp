@@ -2,6 +2,7 @@
 // file, results printed and written as fields.
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -108,8 +109,10 @@ std::pair<std::string, std::string> split_assignment(const std::string& text, co
 
 bool parse_int(const std::string& s, std::int32_t& out) {
   char* end = nullptr;
+  errno = 0;
   const long v = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || end != s.c_str() + s.size()) return false;
+  if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || v < INT32_MIN || v > INT32_MAX)
+    return false;  // 99999999999 was cast to a wrong int
   out = static_cast<std::int32_t>(v);
   return true;
 }

@@ -203,6 +203,16 @@ TEST(Cli, OrderReportsZeroViolationsOnDelaunayMesh) {
   // The centroid baseline gets some wrong on the same mesh.
   Result c = foxi_cli("order '" + (dir / "t.1.ele").string() + "' --views 12 --method centroid --check", dir);
   EXPECT_EQ(c.status, 4) << c.out;
+  // Counts and seeds that are not whole numbers are usage errors naming the option (std::stoi said
+  // "stoi" with exit 1, and read 1e3 as 1; an outside probe).
+  for (const char* bad : {"--views abc", "--views 1e3", "--views 99999999999", "--views 12 --seed 1e5"}) {
+    Result u = foxi_cli("order '" + (dir / "t.1.ele").string() + "' " + bad, dir);
+    EXPECT_EQ(u.status, 2) << bad << "\n" << u.out;
+    EXPECT_NE(
+        u.out.find(std::string(bad).find("seed") != std::string::npos ? "--seed takes" : "--views takes"),
+        std::string::npos)
+        << u.out;
+  }
 }
 
 }  // namespace
