@@ -93,6 +93,9 @@ int cmd_convert(Args args) {
       files[0].c_str(), format_name(in_format), files[1].c_str(), format_name(out_format), mesh.node_count(),
       mesh.tet_count(), mesh.bface_count(), mesh.fields.size(),
       std::chrono::duration<double>(t1 - t0).count(), std::chrono::duration<double>(t2 - t1).count());
+  if (!mesh.fields.empty() && (out_format == MeshFormat::medit || out_format == MeshFormat::tetgen))
+    std::printf("warning: the %s format holds no fields: the %zu fields of %s are not in %s\n",
+                format_name(out_format), mesh.fields.size(), files[0].c_str(), files[1].c_str());
   if (report.inverted > 0) {
     std::printf("%zu inverted tets %s\n", report.inverted,
                 keep_orientation ? "kept as they were (--keep-orientation)" : "re-oriented");

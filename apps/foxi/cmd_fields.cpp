@@ -110,7 +110,13 @@ int fields_import(Args& args) {
   const std::string out = args.option("-o");
   const auto files = args.positional(2, 2, kFieldsUsage);
   if (out.empty()) throw UsageError("give the output mesh: -o OUT.vtu");
-  format_from_path(out);  // an unknown extension fails before any reading
+  // an unknown extension fails before any reading, and so does a format that holds no fields (the
+  // import was written without them, exit 0; an outside probe)
+  const MeshFormat out_format = format_from_path(out);
+  if (out_format == MeshFormat::medit || out_format == MeshFormat::tetgen)
+    throw UsageError(std::string("the ") + format_name(out_format) +
+                     " format holds no fields: write the imported fields to .vtu, .vtk or .msh, not '" + out +
+                     "'");
   check_output_path(out);
 
   const auto t0 = std::chrono::steady_clock::now();

@@ -86,6 +86,18 @@ TEST_F(FieldsCli, ImportByLocationIsExactAndRenders) {
   const Mesh t2 = read_mesh(dir_ / "t2.vtu");
   for (std::size_t i = 0; i < t2.node_count(); ++i)
     EXPECT_NEAR(t2.find_field("temperature")->values[i], linear(&t2.xyz[3 * i]), 1e-11);
+  // Formats that hold no fields: the import is refused before any work (it wrote the mesh without
+  // them, exit 0; an outside probe), convert says what it leaves out.
+  for (const char* fieldless : {"out.mesh", "out.node"}) {
+    EXPECT_EQ(foxi("fields import " + p("target.vtu") + " " + p("source.vtu") + " -o " + p(fieldless), &log),
+              2)
+        << log;
+    EXPECT_NE(log.find("format holds no fields"), std::string::npos) << log;
+    EXPECT_FALSE(std::filesystem::exists(dir_ / fieldless));
+  }
+  ASSERT_EQ(foxi("convert " + p("out.vtu") + " " + p("plain.mesh"), &log), 0) << log;
+  EXPECT_NE(log.find("warning: the Medit .mesh format holds no fields: the 1 fields"), std::string::npos)
+      << log;
 }
 
 TEST_F(FieldsCli, CsvAndOutsidePoints) {
