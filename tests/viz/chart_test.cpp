@@ -183,6 +183,23 @@ TEST(Chart, AKnownLineLandsWhereTheAxisMappingSays) {
       }
 }
 
+// Values that differ by round-off alone (a junction at 300 K and 300 K + 1e-13 after a run of 1e-20 s;
+// an outside probe): the axis is a range around them, as for one value, with a few ticks (ticks 1e-14
+// apart were stepped from 3e16, where ++ on a double stops counting, until memory ran out).
+TEST(Chart, ValuesApartByRoundOffGetARangeAroundThem) {
+  const TextRenderer text(find_font_file());
+  Chart c;
+  c.x = {"time", "s"};
+  c.y = {"Tj", "K"};
+  c.series.push_back({"", {0, 1e-20}, {300, 300 + 1e-13}, pack_rgba(255, 0, 0)});
+  Framebuffer fb(640, 420);
+  const ChartReport r = draw_chart(fb, text, c, PixelRect{0, 0, 639, 419});
+  EXPECT_LT(r.y_lo, 300);
+  EXPECT_GT(r.y_hi, 300 + 1e-13);
+  EXPECT_GE(r.y_ticks.size(), 2u);
+  EXPECT_LE(r.y_ticks.size(), 12u);
+}
+
 TEST(Chart, LogAxes) {
   const TextRenderer text(find_font_file());
   const std::uint32_t red = pack_rgba(255, 0, 0);

@@ -50,7 +50,11 @@ std::pair<double, double> data_range(const Chart& c, bool x_axis) {
   }
   if (std::isfinite(a.lo)) lo = a.lo;
   if (std::isfinite(a.hi)) hi = a.hi;
-  if (lo == hi) {  // one value: a range around it
+  // One value, or values that differ by round-off alone (300 K and 300 K + 1e-13: ticks 1e-14 apart
+  // at 3e16 steps from 0, where ++ on a double no longer counts, filled memory until it ran out; an
+  // outside probe): a range around their middle.
+  if (hi - lo <= 1e-9 * std::max(std::abs(lo), std::abs(hi))) {
+    lo = hi = 0.5 * (lo + hi);
     const double d = lo == 0 ? 1 : std::abs(lo) * 0.1;
     if (a.log)
       lo /= 2, hi *= 2;
@@ -97,8 +101,10 @@ AxisTicks ticks_for(double lo, double hi, int n, bool log, bool fixed) {
     }
   const double step = t.step;
   const double first = std::floor(lo / step + 1e-9), last = std::ceil(hi / step - 1e-9);
-  for (double i = first; i <= last + 0.5; ++i) {
-    double v = i * step;
+  // Counted, not stepped: at most n + 1 ticks whatever the doubles do.
+  const int count = last - first >= 0 && last - first <= n ? int(last - first) : std::max(n - 1, 1);
+  for (int j = 0; j <= count; ++j) {
+    double v = (first + j) * step;
     if (std::abs(v) < step * 1e-9) v = 0;
     t.ticks.push_back(v);
   }
