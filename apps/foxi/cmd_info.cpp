@@ -71,6 +71,12 @@ FieldRange field_range(const Mesh& mesh, const Field& f) {
   } catch (const FieldSelectError&) {
     return r;
   }
+  // A cell field named as a node field: the name chose the node one (its range was shown for both;
+  // an outside probe). This field, with the scalar of its component count.
+  if (c.field != &f) {
+    if (c.field->components != f.components) return r;
+    c.field = &f;
+  }
   r.scalar = c.scalar.kind == FieldScalar::Kind::magnitude   ? "magnitude"
              : c.scalar.kind == FieldScalar::Kind::von_mises ? "von Mises"
                                                              : "value";

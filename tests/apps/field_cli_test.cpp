@@ -203,6 +203,16 @@ TEST_F(FieldCli, InfoPrintsEachFieldsRange) {
   EXPECT_NE(log.find("von Mises 1e+06 to 1e+06 Pa (1 to 1 MPa)"), std::string::npos) << log;
   ASSERT_EQ(foxi("info --json '" + mesh_.string() + "'", &log), 0);
   EXPECT_NE(log.find("\"scalar\": \"value\", \"min\": 300, \"max\": 380"), std::string::npos) << log;
+  // A cell field with a node field's name shows its own range (it showed the node field's; an outside
+  // probe).
+  Mesh m = read_mesh(mesh_);
+  Field cell{"temperature", FieldLocation::cell, 1, "K", {}, std::vector<double>(m.tet_count(), 500.0)};
+  cell.values[0] = 450;
+  m.fields.push_back(cell);
+  write_mesh(m, dir_ / "twin.vtu");
+  ASSERT_EQ(foxi("info '" + (dir_ / "twin.vtu").string() + "'", &log), 0);
+  EXPECT_NE(log.find("value 300 to 380 K"), std::string::npos) << log;
+  EXPECT_NE(log.find("value 450 to 500 K"), std::string::npos) << log;
 }
 
 TEST_F(FieldCli, MovieWithAFieldKeepsOneRange) {
