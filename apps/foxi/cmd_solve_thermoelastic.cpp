@@ -205,9 +205,9 @@ int cmd_solve_thermoelastic(Args args) {
     params.delta_t = 0;
     std::printf(
         "thermal solve (the model's thermal conditions and power loads): max temperature %.6g K (%.6g C), "
-        "%zu iterations, %.3f s; stress-free at %s K\n",
+        "%zu iterations, %.3f s; stress-free at %.6g K\n",
         tr.max_temperature, tr.max_temperature - 273.15, tr.iterations, tr.solve_seconds,
-        tref.empty() ? "293.15" : tref.c_str());
+        tref.empty() ? 293.15 : parse_temperature(tref, "--tref", TemperatureKind::absolute));  // "300K K"
   }
   for (const std::string& s : fix) params.fixed.push_back(parse_fix(mesh, s));
   for (const std::string& s : slide) params.sliding.push_back({boundary_tag(mesh, s, "--slide")});
