@@ -156,16 +156,24 @@ void parse_face_file(Scanner& in, Mesh& m, std::int64_t offset) {
   const std::uint64_t nodes = m.node_count();
   m.bface.resize(3 * n);
   m.bface_tag.assign(n, 0);
-  int mid_nodes = -1;  // 0 or 3 (second-order faces, tetgen -o2), decided by the first face
+  // Decided by the first face's columns past its corners and markers: 3 mid-edge nodes (second-order
+  // faces, tetgen -o2), 2 adjacent tets (tetgen -nn, after the markers; it was refused), or both.
+  int mid_nodes = -1, adjacent = 0;
   for (std::uint64_t k = 0; k < n; ++k) {
     in.set_record("face", k + 1);
     if (!in.skip_to_content()) in.fail("unexpected end of file, expected " + std::to_string(n) + " faces");
     (void)in.integer<L>("face number");
-    if (mid_nodes < 0) mid_nodes = in.tokens_left_on_line() == 6 + nmark ? 3 : 0;
+    if (mid_nodes < 0) {
+      const std::uint64_t extra =
+          in.tokens_left_on_line() - std::min<std::uint64_t>(in.tokens_left_on_line(), 3 + nmark);
+      mid_nodes = extra == 3 || extra == 5 ? 3 : 0;
+      adjacent = extra == 2 || extra == 5 ? 2 : 0;
+    }
     for (int c = 0; c < 3; ++c) m.bface[3 * k + c] = in.node_index<L>("node", offset, nodes);
     for (int c = 0; c < mid_nodes; ++c) (void)in.node_index<L>("mid-edge node", offset, nodes);
     if (nmark > 0) m.bface_tag[k] = in.id_value<L>("boundary marker");
     for (std::uint64_t a = 1; a < nmark; ++a) in.skip_number<L>("boundary marker");
+    for (int a = 0; a < adjacent; ++a) in.skip_number<L>("adjacent tet");
     in.end_line("the face's values");
   }
   in.set_record(nullptr, 0);

@@ -242,6 +242,23 @@ TEST(TetgenOracle, SecondOrderTetsKeepTheirCorners) {
   EXPECT_NEAR(area[3], 8.0, 1e-12);
 }
 
+// tetgen -nn writes each face's two adjacent tets after its marker (its documented .face format):
+// the faces read the same as without -nn, also with second-order faces (-o2); -nn was refused
+// ("unexpected '0' after the face's values"; an outside probe).
+TEST(TetgenOracle, AdjacentTetColumnsOfNnAreRead) {
+  if (!have_tools()) GTEST_SKIP() << "tetgen not installed";
+  for (const char* order : {"", "o2"}) {
+    TempDir plain_dir, nn_dir;
+    mesh_box(plain_dir, std::string("-pqAa") + order);
+    mesh_box(nn_dir, std::string("-pqAann") + order);
+    const Mesh plain = read_tetgen(plain_dir / "box.1"), nn = read_tetgen(nn_dir / "box.1");
+    EXPECT_EQ(header_of(nn_dir / "box.1.face").at(0), header_of(plain_dir / "box.1.face").at(0));
+    EXPECT_EQ(nn.bface, plain.bface) << order;
+    EXPECT_EQ(nn.bface_tag, plain.bface_tag) << order;
+    EXPECT_EQ(nn.tet, plain.tet) << order;
+  }
+}
+
 TEST(TetgenOracle, TetgenReadsFoxiFiles) {
   if (!have_tools()) GTEST_SKIP() << "tetgen not installed";
   TempDir dir;
