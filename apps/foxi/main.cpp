@@ -101,6 +101,9 @@ int main(int argc, char** argv) {
   } catch (const foxi::TetLimitError& e) {  // a mesh estimated past --max-tets, refused before meshing
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), tet_limit_message(e).c_str());
     return kExitBadInput;
+  } catch (const foxi::WriteError& e) {  // a full disk, an I/O error: the work failed, not the input
+    std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());
+    return kExitFailure;
   } catch (const foxi::IoError& e) {
     // Files that cannot be read or are not what they claim, model files and their parameters.
     std::fprintf(stderr, "foxi %s: error: %s\n", command.c_str(), e.what());

@@ -24,6 +24,8 @@ constexpr std::string_view kTempTag = ".foxi-tmp-";
 constexpr std::size_t kBufferBytes = std::size_t{1} << 20;
 
 [[noreturn]] void fail(const std::filesystem::path& target, const std::string& what, int err) {
+  if (err == ENOSPC || err == EDQUOT || err == EIO || err == EFBIG)
+    throw WriteError(target.string(), 0, IoError::kNoOffset, what + ": " + std::strerror(err));
   throw IoError(target.string(), 0, IoError::kNoOffset, what + ": " + std::strerror(err));
 }
 

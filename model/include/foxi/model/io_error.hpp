@@ -28,4 +28,11 @@ class FOXI_API IoError : public std::runtime_error {
   std::string reason_;
 };
 
+// A write the system would not take: the disk or quota full, an I/O error (a failure of the work,
+// not of the input: foxi's apps exit 1 for it, 3 for other IoErrors).
+class FOXI_API WriteError : public IoError {
+ public:
+  using IoError::IoError;
+};
+
 }  // namespace foxi
