@@ -705,11 +705,18 @@ class Reader {
     if (dim != 2) return;
     const auto it = entity_more_phys_.find(tag);
     if (it == entity_more_phys_.end()) return;
+    // Bounded memory: a hostile file could name a surface in millions of groups.
+    if (it->second.size() > 255)
+      fail_at(cur_.pos(), "surface entity " + std::to_string(tag) + " is in " +
+                              std::to_string(it->second.size() + 1) + " physical groups, more than 256");
+    if (mesh_.bface_tag.size() + m * it->second.size() >= kNone)
+      fail_at(cur_.pos(), "more than 4294967294 boundary triangles (a surface's triangles once per group)");
     const std::size_t first = mesh_.bface_tag.size() - m;
+    // A copy: inserting a vector's own elements into it may read them after it reallocated.
+    const std::vector<std::uint32_t> block(mesh_.bface.begin() + std::ptrdiff_t(3 * first),
+                                           mesh_.bface.end());
     for (std::int32_t phys : it->second) {
-      for (std::size_t i = first; i < first + m; ++i)
-        mesh_.bface.insert(mesh_.bface.end(), mesh_.bface.begin() + std::ptrdiff_t(3 * i),
-                           mesh_.bface.begin() + std::ptrdiff_t(3 * i + 3));
+      mesh_.bface.insert(mesh_.bface.end(), block.begin(), block.end());
       mesh_.bface_tag.insert(mesh_.bface_tag.end(), m, phys);
     }
   }

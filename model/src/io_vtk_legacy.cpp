@@ -373,17 +373,13 @@ void write_vtk_legacy(const Mesh& mesh, const std::filesystem::path& path, bool 
   out += "# vtk DataFile Version 4.2\nfoxi mesh\n";
   out += binary ? "BINARY\n" : "ASCII\n";
   out += "DATASET UNSTRUCTURED_GRID\n";
-  // ASCII: VTK's reader stops at "nan" or "inf" (and loses every array after it: an outside probe
-  // found ParaView's reader failing on foxi's file), so a non-finite value is refused, naming it.
-  auto doubles = [&](const double* v, std::size_t n, std::size_t per_line, const std::string& what) {
+  // ASCII writes a NaN or infinity as "nan"/"inf", which foxi reads back (an imported field's "no
+  // value") but VTK's reader does not (it stops there and loses every array after it): foxi writes
+  // none of its own (the boundary triangles' rows below), a field's own NaN is the user's to see.
+  auto doubles = [&](const double* v, std::size_t n, std::size_t per_line) {
     if (binary) {
       for (std::size_t i = 0; i < n; ++i) put_be(out, v[i]);
     } else {
-      for (std::size_t i = 0; i < n; ++i)
-        if (!std::isfinite(v[i]))
-          throw IoError(file, 0, IoError::kNoOffset,
-                        "ASCII legacy VTK holds no NaN or infinity (VTK's reader stops at them), and " +
-                            what + " has one: write binary .vtk (without --ascii) or .vtu");
       for (std::size_t i = 0; i < n; ++i) {
         io::append_double(out, v[i]);
         out.push_back((i + 1) % per_line == 0 || i + 1 == n ? '\n' : ' ');
@@ -400,7 +396,7 @@ void write_vtk_legacy(const Mesh& mesh, const std::filesystem::path& path, bool 
     }
   };
   out += "POINTS " + std::to_string(nn) + " double\n";
-  doubles(mesh.xyz.data(), mesh.xyz.size(), 3, "the node coordinates");
+  doubles(mesh.xyz.data(), mesh.xyz.size(), 3);
   out += "CELLS " + std::to_string(ncells) + " " + std::to_string(5 * nt + 4 * nf) + "\n";
   for (std::size_t t = 0; t < nt; ++t) {
     ints(4, false);
@@ -440,7 +436,7 @@ void write_vtk_legacy(const Mesh& mesh, const std::filesystem::path& path, bool 
           tmp.resize(ne_written * f.components, binary ? std::numeric_limits<double>::quiet_NaN() : 0.0);
           d = tmp.data();
         }
-        doubles(d, ne_written * f.components, f.components == 1 ? 6 : f.components, "field '" + name + "'");
+        doubles(d, ne_written * f.components, f.components == 1 ? 6 : f.components);
       }
     }
   };
@@ -459,7 +455,7 @@ void write_vtk_legacy(const Mesh& mesh, const std::filesystem::path& path, bool 
     out += "POINT_DATA " + std::to_string(nn) + "\nFIELD FieldData " + std::to_string(n_point_arrays) + "\n";
     if (!mesh.weight.empty()) {
       out += "weight 1 " + std::to_string(nn) + " double\n";
-      doubles(mesh.weight.data(), nn, 6, "the vertex weights");
+      doubles(mesh.weight.data(), nn, 6);
     }
     field_arrays(FieldLocation::node, nn, nn);
   }
