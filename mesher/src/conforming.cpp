@@ -50,11 +50,10 @@ namespace {
 
 // A point inside each flat tet, for the PLC: the tet's centroid moved within the tet's plane by a
 // fifth of its shortest edge in a direction drawn from the tet's own coordinates and the round
-// (reproducible),
-// so that the new point is strictly inside the tet's circumsphere (which destroys the tet) and does
-// not recreate the symmetric, cospherical arrangement that made it. A tet on a facet of the PLC
-// (its centroid there) gets no point: an isolated point on a facet would not be a PLC. Returns the
-// points added.
+// (reproducible), so that the new point is strictly inside the tet's circumsphere (which destroys
+// the tet) and does not recreate the symmetric, cospherical arrangement that made it. A tet on a
+// facet of the PLC (its centroid there) gets no point: an isolated point on a facet would not be a
+// PLC. Returns the points added.
 std::size_t add_points_in_flat_tets(const Mesh& mesh, const std::vector<std::uint32_t>& flat,
                                     std::size_t round, Plc& plc) {
   EditablePlc edit(plc);
