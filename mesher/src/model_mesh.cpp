@@ -212,15 +212,13 @@ void mesh_under_options(const std::string& file, Plc plc, const Model* model, st
     field = size_field_from_error(*rf.mesh, *f, rf.target_error, 0, sz.max_size);
     m.refined = RefinedFrom{f->name, e.relative_error(), rf.mesh->tet_count(), e.tets_without_value};
   } else {
-    check_tet_estimate(file, plc, params, volumes, o.max_tets);
-    // The refinement boxes as a size field (box_size_field meshes with params first: estimated above;
-    // then with the boxes' sizes, which are estimated here first: a box over the whole 10 mm bar at
-    // 0.01 mm, 85M tets, meshed until killed before the field's own estimate below).
-    if (!sz.boxes.empty()) {
-      const double est = estimate_tet_count(plc, params, volumes) + estimate_box_tet_count(plc, sz.boxes);
-      if (est > o.max_tets) throw TetLimitError(file, est, o.max_tets);
-      field = box_size_field(plc, params, sz);
-    }
+    // The refinement boxes as a size field: box_size_field meshes with params first, then with the
+    // boxes' sizes, so both are estimated before it (a box over the whole 10 mm bar at 0.01 mm, 85M
+    // tets, was meshed until killed before the field's own estimate below).
+    double est = estimate_tet_count(plc, params, volumes);
+    if (!sz.boxes.empty()) est += estimate_box_tet_count(plc, sz.boxes);
+    if (est > o.max_tets) throw TetLimitError(file, est, o.max_tets);
+    if (!sz.boxes.empty()) field = box_size_field(plc, params, sz);
   }
   if (!field.empty()) {
     params.size_field = &field;
