@@ -298,17 +298,26 @@ void scatter(const ReducedSystem& r, const std::vector<double>& x, std::vector<d
 }
 
 std::vector<double> slot_reactions(const P1Stiffness& k, const Dirichlet& d, const std::vector<double>& load,
-                                   const std::vector<double>& u, std::size_t slots) {
+                                   const std::vector<double>& u, const std::vector<double>& row_sum,
+                                   std::size_t slots, std::vector<double>* magnitude) {
   const std::size_t nn = d.fixed.size();
   std::vector<double> out(slots, 0.0);
+  if (magnitude) magnitude->assign(slots, 0.0);
   if (d.shares.empty()) return out;
-  std::vector<double> reaction(nn, 0.0), share_w(nn, 0.0);
+  std::vector<double> reaction(nn, 0.0), terms(magnitude ? nn : 0, 0.0), share_w(nn, 0.0);
   std::vector<std::uint32_t> share_n(nn, 0);
   for (std::size_t v = 0; v < nn; ++v) {
     if (!d.fixed[v]) continue;
-    double s = load.empty() ? 0.0 : -load[v];
-    for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i) s += k.val[i] * u[k.pat.col[i]];
+    // (K u)_v = sum_j K_vj (u_j - u_v) + (sum_j K_vj) u_v, the row's sum taken as it is in exact
+    // arithmetic (row_sum; conduction rows sum to 0): the plain sum is round-off of terms K_vv u_v
+    // where conductivities differ by 1e12 (a boundary's heat was 6.8% off).
+    double s = (load.empty() ? 0.0 : -load[v]) + (row_sum.empty() ? 0.0 : row_sum[v] * u[v]);
+    for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i)
+      s += k.val[i] * (u[k.pat.col[i]] - u[v]);
     reaction[v] = s;
+    if (magnitude)
+      for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i)
+        terms[v] += std::abs(k.val[i] * u[k.pat.col[i]]);
   }
   for (const Dirichlet::Share& s : d.shares) {
     share_w[s.node] += s.area;
@@ -318,6 +327,7 @@ std::vector<double> slot_reactions(const P1Stiffness& k, const Dirichlet& d, con
     if (!d.fixed[s.node]) continue;
     const double w = share_w[s.node] > 0 ? s.area / share_w[s.node] : 1.0 / share_n[s.node];
     out[s.slot] += w * reaction[s.node];
+    if (magnitude) (*magnitude)[s.slot] += w * terms[s.node];
   }
   return out;
 }

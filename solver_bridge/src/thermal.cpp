@@ -125,8 +125,11 @@ ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceS
 // rounded to that relative precision (another program's printout), and the tolerance takes in the
 // largest imbalance that rounding can make (each temperature off by precision |T|: the fixed nodes'
 // reactions by sum |K_vj| precision |T_j|, a convection tag's heat by h A precision |T|).
+// `iterate_error`: an iterative solve's relative residual (its temperatures are that far from the
+// discrete solution, where a direct solve's are round-off), 0 for a direct solve or given temperatures.
 void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std::vector<double>& temp,
-                  double solver_tolerance, double precision, ThermalReport& rep) {
+                  const std::vector<double>& magnitude, double solver_tolerance, double precision,
+                  double iterate_error, ThermalReport& rep) {
   const detail::CsrPattern& pat = sys.stiff.pat;
   const std::vector<double>& kval = sys.stiff.val;
   const std::vector<char>& fixed = sys.dir.fixed;
@@ -139,23 +142,29 @@ void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std:
   rep.heat_flow = std::max(in, out);
   // Where (next to) nothing flows, the reactions are round-off of terms K_vv T_v: measure against
   // 1e-9 of those, so that a body held at one temperature balances.
-  double terms = 0, rounding = 0;
+  double terms = 0;
   for (std::size_t v = 0; v < fixed.size(); ++v)
     if (fixed[v]) {
       const auto n = static_cast<std::uint32_t>(v);
       terms += std::abs(kval[pat.find(n, n)] * temp[v]);
-      if (precision > 0)
-        for (std::size_t e = pat.row_start[n]; e < pat.row_start[n + 1]; ++e)
-          rounding += std::abs(kval[e]) * precision * std::abs(temp[pat.col[e]]);
     }
-  if (precision > 0)
-    for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
-      const auto it = sys.bc.find(mesh.bface_tag[f]);
-      if (it == sys.bc.end() || it->second.kind != detail::BcKind::convection) continue;
-      const std::uint32_t* v = &mesh.bface[3 * f];
-      const double t = std::max({std::abs(temp[v[0]]), std::abs(temp[v[1]]), std::abs(temp[v[2]])});
-      rounding += it->second.a * sys.bface_area[f] * precision * t;
-    }
+  // Each boundary's heat is known to `bound`: a fixed tag's reactions are sums of terms K_vj T_j with
+  // each T_j known to about 4 eps of itself (plus `precision` and `iterate_error`), a convection tag's heat
+  // h A (T_inf - T) likewise. Where conductivities differ by 1e12 the temperatures of the good
+  // conductor cannot carry its heat (6.8% off, with the balance passing): the resolution check.
+  std::vector<double> bound = magnitude;
+  const double delta =
+      4 * std::numeric_limits<double>::epsilon() + std::max(precision, 0.0) + std::max(iterate_error, 0.0);
+  double rounding = 0, worst = 0, resolved_in = std::max(0.0, rep.total_power),
+         resolved_out = std::max(0.0, -rep.total_power);
+  for (std::size_t b = 0; b < bound.size(); ++b) {
+    rounding += precision * bound[b];
+    bound[b] *= delta;
+    worst = std::max(worst, bound[b]);
+    const double q = rep.boundaries[b].heat_in;
+    if (std::abs(q) > bound[b]) (q > 0 ? resolved_in : resolved_out) += std::abs(q);
+  }
+  const double resolved = std::max(resolved_in, resolved_out);
   const double scale = std::max(rep.heat_flow, 1e-9 * terms);
   double tolerance = std::min(1e-3, std::max(1e-6, 100 * solver_tolerance));  // a loose --tol is no check
   if (precision > 0 && scale > 0) tolerance = std::max(tolerance, rounding / scale);
@@ -172,6 +181,15 @@ void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std:
                                     "minus the lowest temperature, K: below 0 (else the powers or conditions "
                                     "are not physical)",
                                     -lowest, 0, -lowest < 0});
+  // The bound adds every term's error with one sign, so it is tens of times the error seen (1e9:1
+  // conductivities: bound 6.5e-4 of the flow, error 1.5e-5): 1% of the flow says the heats are not
+  // known (1e12:1: bound 0.65, error 6.8%; with another program's printout rounded to 6 digits about
+  // 3e-3 is usual).
+  rep.checks.push_back(make_check("resolution",
+                                  "largest round-off bound of a boundary's heat / the heat that flows (the "
+                                  "temperatures' round-off times sum |K_vj T_j|: too large where "
+                                  "conductivities differ by many orders)",
+                                  resolved > 0 ? worst / resolved : 0.0, 1e-2));
 }
 
 }  // namespace
@@ -300,6 +318,7 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
 
   // Boundary triangles: Robin mass, flux and convection loads, fixed values (lumped-area mean).
   sys.bface_area.assign(nf, 0.0);
+  sys.row_sum.assign(nn, 0.0);
   std::vector<double>& bface_area = sys.bface_area;
   for (std::size_t f = 0; f < nf; ++f) {
     auto it = bc.find(mesh.bface_tag[f]);
@@ -318,6 +337,7 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
       case BcKind::convection:
         for (int i = 0; i < 3; ++i) {
           load[v[i]] += t.a * t.b * area / 3;
+          sys.row_sum[v[i]] += t.a * area / 3;
           for (int j = 0; j < 3; ++j) {
             const std::size_t pos = pat.find(v[i], v[j]);
             if (pos == SIZE_MAX)
@@ -353,8 +373,10 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
 }
 
 void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector<double>& load,
-                   const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries) {
-  const std::vector<double> heat = slot_reactions(sys.stiff, sys.dir, load, temp, boundaries.size());
+                   const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries,
+                   std::vector<double>* magnitude) {
+  const std::vector<double> heat =
+      slot_reactions(sys.stiff, sys.dir, load, temp, sys.row_sum, boundaries.size(), magnitude);
   for (std::size_t i = 0; i < heat.size(); ++i) boundaries[i].heat_in = heat[i];
   for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
     auto it = sys.bc.find(mesh.bface_tag[f]);
@@ -366,6 +388,10 @@ void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector
     } else if (t.kind == BcKind::convection) {
       const double mean = (temp[v[0]] + temp[v[1]] + temp[v[2]]) / 3;
       boundaries[t.report].heat_in += t.a * (t.b - mean) * sys.bface_area[f];
+      if (magnitude)
+        (*magnitude)[t.report] +=
+            t.a * sys.bface_area[f] *
+            (std::max({std::abs(temp[v[0]]), std::abs(temp[v[1]]), std::abs(temp[v[2]])}) + std::abs(t.b));
     }
   }
 }
@@ -471,10 +497,12 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   detail::scatter(red, x, temp);
 
   // Heat through the boundaries, cell heat flux and per-region temperatures.
-  detail::boundary_heat(mesh, sys, load, temp, rep.boundaries);
+  std::vector<double> magnitude;
+  detail::boundary_heat(mesh, sys, load, temp, rep.boundaries, &magnitude);
   Field flux_field = detail::region_results(mesh, params, sys, temp, rep);
 
-  energy_check(mesh, sys, temp, params.solver.relative_tolerance, 0, rep);
+  energy_check(mesh, sys, temp, magnitude, params.solver.relative_tolerance, 0,
+               lin.iterations > 0 ? lin.relative_residual : 0, rep);
 
   detail::store_temperature(mesh, std::move(temp), std::move(flux_field));
   rep.assembly_seconds = std::chrono::duration<double>(t_assembled - t_start).count();
@@ -494,9 +522,10 @@ ThermalReport thermal_report(Mesh& mesh, const ThermalParams& params, std::vecto
     if (!std::isfinite(temperature[mesh.tet[t]]))
       throw SolverError("thermal_report: node " + std::to_string(mesh.tet[t]) +
                         " of a tet has no temperature");
-  detail::boundary_heat(mesh, sys, sys.load, temperature, rep.boundaries);
+  std::vector<double> magnitude;
+  detail::boundary_heat(mesh, sys, sys.load, temperature, rep.boundaries, &magnitude);
   Field flux_field = detail::region_results(mesh, params, sys, temperature, rep);
-  energy_check(mesh, sys, temperature, params.solver.relative_tolerance, precision, rep);
+  energy_check(mesh, sys, temperature, magnitude, params.solver.relative_tolerance, precision, 0, rep);
   detail::store_temperature(mesh, std::move(temperature), std::move(flux_field));
   rep.solver = "given";
   rep.assembly_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();

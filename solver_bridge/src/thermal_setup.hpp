@@ -28,6 +28,9 @@ struct ThermalSystem {
   std::vector<double> region_k, region_q;
   std::map<std::int32_t, TagBc> bc;
   P1Stiffness stiff;
+  // Per node, the sum of its row of stiff in exact arithmetic: conduction rows sum to 0, a convection
+  // triangle adds h A / 3 to each of its nodes (the reactions' difference form).
+  std::vector<double> row_sum;
   std::vector<double> load;
   std::vector<double> bface_area;  // per boundary triangle with a condition, else 0
   Dirichlet dir;
@@ -41,9 +44,13 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
                                bool require_anchor = true);
 
 // Sets boundaries[i].heat_in (W) for the nodal temperatures `temp`: reactions (K temp - load) at the
-// fixed nodes, q A on flux tags, h (T_inf - T) A on convection tags.
+// fixed nodes, q A on flux tags, h (T_inf - T) A on convection tags. `magnitude` (per boundary, W/K
+// times K): what each heat's round-off is relative to, the fixed nodes' sum |K_vj temp_j| and a
+// convection tag's h A (|T| + |T_inf|) (a relative error d of the temperatures errs a heat by at
+// most d times it).
 void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector<double>& load,
-                   const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries);
+                   const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries,
+                   std::vector<double>* magnitude = nullptr);
 
 // Per-region mean and max temperatures, the overall max, boundary mean temperatures and the
 // resistances of params.resistances into `rep`; returns the cell field "heat_flux".

@@ -122,7 +122,7 @@ TEST_F(ThermalTest, SlabBetweenTwoTemperaturesIsLinearAndExact) {
     // With no sources the balance is measured against the heat that flows through, not against the
     // (vanishing) net boundary heat.
     EXPECT_NEAR(r.heat_flow, q, 1e-9 * q);
-    ASSERT_EQ(r.checks.size(), 2u);
+    ASSERT_EQ(r.checks.size(), 3u);
     EXPECT_EQ(r.checks[0].name, "energy");
     EXPECT_TRUE(r.checks[0].passed);
     EXPECT_LT(r.checks[0].figure, 1e-9);
@@ -131,6 +131,9 @@ TEST_F(ThermalTest, SlabBetweenTwoTemperaturesIsLinearAndExact) {
     EXPECT_EQ(r.checks[1].name, "absolute zero");
     EXPECT_TRUE(r.checks[1].passed);
     EXPECT_NEAR(r.checks[1].figure, -t0, 1e-9 * t0);
+    EXPECT_EQ(r.checks[2].name, "resolution");
+    EXPECT_TRUE(r.checks[2].passed);
+    EXPECT_LT(r.checks[2].figure, 1e-9);
     const Field* flux = m.find_field("heat_flux");
     ASSERT_NE(flux, nullptr);
     ASSERT_EQ(flux->values.size(), 3 * m.tet_count());
@@ -301,6 +304,51 @@ TEST_F(ThermalTest, TwoMaterialSlabIsASeriesResistance) {
   EXPECT_NEAR(region_of(r, 1).volume, l1 * kArea, 1e-12);
 }
 
+// Conductivities 1e12 apart in series (an outside probe): the heat through the good conductor's fixed
+// face is a difference of terms K_vj T_j some 1e14 times larger and came out 6.8% off, every check
+// passing. Against the series formula: the heats either agree within the printed digits or the
+// resolution check fails; at 1e12:1 it fails, at 1e4:1 the heats are exact and every check passes.
+TEST_F(ThermalTest, ConductivitiesFarApartFailTheResolutionCheckRatherThanMisstateTheHeat) {
+  Mesh m = box_mesh(0.004, 0.5);
+  const double t0 = 300, t1 = 400;
+  for (const double contrast : {1e4, 1e9, 1e12}) {
+    ThermalParams p;
+    p.conductivity = {{1, contrast}, {2, 1.0}};
+    p.fixed = {{1, t0}, {2, t1}};
+    const ThermalReport r = solve_thermal(m, p);
+    const double q = (t1 - t0) / (0.5 / (contrast * kArea) + 0.5 / kArea);
+    const BalanceCheck* resolution = nullptr;
+    for (const BalanceCheck& c : r.checks)
+      if (c.name == "resolution") resolution = &c;
+    ASSERT_NE(resolution, nullptr);
+    const double error = std::abs(heat_of(r, 1).heat_in + q) / q;
+    EXPECT_TRUE(!resolution->passed || error < 1e-5)
+        << contrast << ": " << error << " " << resolution->figure;
+    EXPECT_NEAR(heat_of(r, 2).heat_in, q, 1e-9 * q);
+    if (contrast == 1e4) {
+      EXPECT_LT(error, 1e-9);
+      for (const BalanceCheck& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " " << c.figure;
+    }
+    if (contrast == 1e12) EXPECT_FALSE(resolution->passed) << resolution->figure;
+  }
+}
+
+// A body held at one temperature moves no heat: every boundary's heat is round-off and every check
+// passes, with a direct solve and an iterative one (whose temperatures carry its residual).
+TEST_F(ThermalTest, BodyHeldAtOneTemperaturePassesItsChecks) {
+  Mesh m = box_mesh(0.002);
+  ThermalParams p;
+  p.conductivity = {{1, 400}};
+  p.fixed = {{1, 300}, {2, 300}};
+  for (LinearSolverKind kind : {LinearSolverKind::direct, LinearSolverKind::cg_amg}) {
+    p.solver.kind = kind;
+    const ThermalReport r = solve_thermal(m, p);
+    ASSERT_EQ(r.checks.size(), 3u);
+    for (const BalanceCheck& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " " << c.figure;
+    EXPECT_LT(std::abs(heat_of(r, 1).heat_in), 1e-6);
+  }
+}
+
 // Fixed T0 at x = 0, convection (h, Tinf) at x = L: q = (Tinf - T0) / (L/k + 1/h), linear profile.
 TEST_F(ThermalTest, ConvectionBoundaryMatchesRobinSolution) {
   Mesh m = box_mesh(0.002);
@@ -348,7 +396,8 @@ TEST_F(ThermalTest, ReportOfGivenTemperaturesMatchesTheAnalyticHeat) {
   EXPECT_NEAR(heat_of(r, 1).heat_in, -flux * kArea, 1e-9 * flux * kArea);
   EXPECT_NEAR(r.max_temperature, t0 + flux * kL / k, 1e-9 * tinf);
   EXPECT_NEAR(region_of(r, 1).mean_temperature, t0 + flux * kL / (2 * k), 1e-9 * tinf);
-  ASSERT_EQ(r.checks.size(), 2u);
+  ASSERT_EQ(r.checks.size(), 3u);
+  EXPECT_TRUE(r.checks[2].passed);
   EXPECT_TRUE(r.checks[1].passed);
   EXPECT_TRUE(r.checks[0].passed);
   EXPECT_LT(r.checks[0].figure, 1e-9);
@@ -359,6 +408,9 @@ TEST_F(ThermalTest, ReportOfGivenTemperaturesMatchesTheAnalyticHeat) {
   EXPECT_TRUE(rounded.checks[0].passed) << rounded.checks[0].figure << " " << rounded.checks[0].tolerance;
   EXPECT_GT(rounded.checks[0].tolerance, 1e-6);
   EXPECT_LT(rounded.checks[0].tolerance, 0.1);
+  // Six digits carry these heats (a tet's temperatures differ by some 1e-3 of themselves).
+  EXPECT_TRUE(rounded.checks[2].passed) << rounded.checks[2].figure;
+  EXPECT_GT(rounded.checks[2].figure, 1e-5);
   const ThermalReport wrong = thermal_report(m, p, profile(1.05, false), 5e-6);
   EXPECT_FALSE(wrong.checks[0].passed) << wrong.checks[0].figure << " " << wrong.checks[0].tolerance;
   EXPECT_THROW(thermal_report(m, p, std::vector<double>(3, t0)), SolverError);
