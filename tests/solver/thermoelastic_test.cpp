@@ -153,14 +153,16 @@ TEST_F(ThermoelasticTest, ReportOfGivenDisplacementIsTheAnalyticStress) {
   // The analytic field is in equilibrium: both checks pass, at rounding. 10 % more lateral expansion
   // is not: it leaves sigma_xx = sigma_yy = 2 (lambda + mu) 0.1 lateral on the free sides, which only
   // the symmetry planes x = 0 and y = 0 hold: a net reaction of that stress times a side's area.
-  ASSERT_EQ(r.checks.size(), 2u);
+  ASSERT_EQ(r.checks.size(), 3u);
   EXPECT_TRUE(all_passed(r.checks));
   EXPECT_LT(r.checks[1].figure, 1e-12);
+  EXPECT_EQ(r.checks[2].name, "resolution");
+  EXPECT_LT(r.checks[2].figure, 1e-9);
   std::vector<double> wrong = u;
   for (std::size_t i = 0; i < wrong.size(); ++i)
     if (i % 3 != 2) wrong[i] *= 1.1;
   const ThermoelasticReport w = thermoelastic_report(m, p, wrong, 6e-8);
-  ASSERT_EQ(w.checks.size(), 2u);
+  ASSERT_EQ(w.checks.size(), 3u);
   EXPECT_TRUE(w.checks[0].passed);  // the load does not depend on the displacement
   EXPECT_FALSE(w.checks[1].passed) << w.checks[1].figure;
   EXPECT_GT(w.checks[1].figure, 1e-3);
@@ -174,6 +176,35 @@ TEST_F(ThermoelasticTest, ReportOfGivenDisplacementIsTheAnalyticStress) {
   p.order = 1;
   u[3 * m.tet[0] + 2] = NAN;
   EXPECT_THROW(thermoelastic_report(m, p, u), SolverError);
+}
+
+// Two halves in series along z between sliding planes, nu = 0 (no lateral mismatch): one uniform
+// sigma_zz = -2 alpha dT / (1/E1 + 1/E2), exact for P1. Moduli 1e14 apart (an outside probe: 1128 Pa
+// printed for about 628, the force balance passing) fail the resolution check; 1e4 apart every check
+// passes and the stress is exact; in between the stress is right or the check fails.
+TEST_F(ThermoelasticTest, ModuliFarApartFailTheResolutionCheckRatherThanMisstateTheStress) {
+  Mesh m = test::layered_box_mesh(0.2, 0.2, {0, 0.5, 1.0}, 0.0005);
+  for (const double contrast : {1e4, 1e10, 1e14}) {
+    const double e2 = 1e9, e1 = e2 * contrast;
+    ThermoelasticParams p;
+    p.materials = {{1, e1, 0.0, kAlpha}, {2, e2, 0.0, kAlpha}};
+    p.delta_t = kDt;
+    p.sliding = {{1}, {3}, {5}, {6}};
+    p.solver.kind = LinearSolverKind::direct;
+    const ThermoelasticReport r = solve_thermoelastic(m, p);
+    const double s = 2 * kAlpha * kDt / (1 / e1 + 1 / e2);
+    const double want[6] = {0, 0, -s, 0, 0, 0};
+    const double error = max_stress_error(m, want, s);
+    ASSERT_EQ(r.checks.size(), 3u);
+    EXPECT_EQ(r.checks[2].name, "resolution");
+    EXPECT_TRUE(!r.checks[2].passed || error < 1e-3)
+        << contrast << ": " << error << " " << r.checks[2].figure;
+    if (contrast == 1e4) {
+      EXPECT_LT(error, 1e-8);
+      EXPECT_TRUE(all_passed(r.checks));
+    }
+    if (contrast == 1e14) EXPECT_FALSE(r.checks[2].passed) << r.checks[2].figure;
+  }
 }
 
 // Every face fixed: u = 0, hydrostatic sigma = -E alpha dT / (1 - 2 nu).
@@ -467,7 +498,7 @@ TEST_F(ThermoelasticTest, BalanceChecksPassConvergedAndFailUnderConverged) {
     p.temperature[v] = p.reference_temperature + 50 * m.xyz[3 * v] + 100 * m.xyz[3 * v + 2];
   p.solver.kind = LinearSolverKind::direct;
   ThermoelasticReport r = solve_thermoelastic(m, p);
-  ASSERT_EQ(r.checks.size(), 2u);
+  ASSERT_EQ(r.checks.size(), 3u);
   EXPECT_EQ(r.checks[0].name, "thermal load");
   EXPECT_EQ(r.checks[1].name, "force balance");
   EXPECT_TRUE(all_passed(r.checks));
@@ -480,7 +511,7 @@ TEST_F(ThermoelasticTest, BalanceChecksPassConvergedAndFailUnderConverged) {
   p.solver.kind = LinearSolverKind::cg_ichol;
   p.solver.relative_tolerance = 0.5;
   r = solve_thermoelastic(m, p);
-  ASSERT_EQ(r.checks.size(), 2u);
+  ASSERT_EQ(r.checks.size(), 3u);
   EXPECT_TRUE(r.checks[0].passed);  // the load does not depend on the solve
   EXPECT_FALSE(r.checks[1].passed) << r.checks[1].figure;
   EXPECT_EQ(r.checks[1].tolerance, 1e-3);  // 100 x 0.5, capped
