@@ -63,6 +63,9 @@ struct PowerWaveform {
   // at t1 where t1 <= t0): what a time step of [t0, t1] puts in.
   FOXI_API double energy(double t) const;
   FOXI_API double mean(double t0, double t1) const;
+  // Whether the power jumps at some time in (t0, t1] (a step's or a pulse's edge; tables are
+  // continuous): BDF2 restarts with Euler steps across a jump.
+  FOXI_API bool jumps_in(double t0, double t1) const;
   static PowerWaveform step_of(double watts) {
     PowerWaveform w;
     w.power = watts;
