@@ -2,6 +2,8 @@
 // the temperature of every written step as OUT_NNNN.vtu with the OUT.pvd collection, and the
 // junction temperatures and Zth(t) against time as OUT_junction.csv, drawn as OUT_zth.png, and the
 // structure function (transient_charts.hpp).
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -27,6 +29,70 @@
 namespace foxi::cli {
 
 namespace {
+
+// The frames of a series while it is written: a folder beside OUT.pvd that a stop (cleanup) or a
+// failure (the destructor) removes, and commit(), which puts them in place of the series before.
+class SeriesStaging {
+ public:
+  explicit SeriesStaging(const std::string& out) : out_(out) {
+    remove_stale_temporaries(out_);  // a killed run's folder
+    folder_ = out_.string() + ".foxi-tmp-" + std::to_string(::getpid()) + "-frames";
+    cleanup::with_lock([&] {
+      std::error_code ec;
+      std::filesystem::remove_all(folder_, ec);
+      if (!std::filesystem::create_directory(folder_, ec))
+        throw IoError(folder_.string(), 0, IoError::kNoOffset,
+                      "cannot make the folder for the series' frames: " + ec.message());
+      cleanup::track(folder_, true);
+    });
+  }
+  ~SeriesStaging() {
+    if (folder_.empty()) return;
+    cleanup::with_lock([&] {
+      std::error_code ec;
+      std::filesystem::remove_all(folder_, ec);
+      cleanup::untrack(folder_);
+    });
+  }
+  SeriesStaging(const SeriesStaging&) = delete;
+  SeriesStaging& operator=(const SeriesStaging&) = delete;
+  const std::filesystem::path& folder() const { return folder_; }
+
+  // With the cleanup list locked (a stop waits): the old OUT.pvd goes first (so no .pvd names a
+  // half-replaced series), then the old frames (OUT's stem + _NNNN.vtu, the names foxi gives a
+  // series for this OUT), then the new frames are renamed in. The caller writes the new .pvd last.
+  void commit(const std::vector<std::string>& files) {
+    cleanup::with_lock([&] {
+      std::error_code ec;
+      std::filesystem::remove(out_, ec);
+      const std::string prefix = out_.stem().string() + "_";
+      const std::filesystem::path dir = out_.parent_path().empty() ? "." : out_.parent_path();
+      std::vector<std::filesystem::path> old;
+      for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.size() < prefix.size() + 8 || name.compare(0, prefix.size(), prefix) != 0 ||
+            name.compare(name.size() - 4, 4, ".vtu") != 0)
+          continue;
+        const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 4);
+        if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+          old.push_back(it->path());
+      }
+      for (const auto& p : old) std::filesystem::remove(p, ec);
+      for (const std::string& f : files) {
+        std::filesystem::rename(folder_ / f, dir / f, ec);
+        if (ec)
+          throw WriteError((dir / f).string(), 0, IoError::kNoOffset,
+                           "cannot move the frame into place: " + ec.message());
+      }
+      std::filesystem::remove_all(folder_, ec);
+      cleanup::untrack(folder_);
+      folder_.clear();
+    });
+  }
+
+ private:
+  std::filesystem::path out_, folder_;
+};
 
 const char* kTransientUsage =
     "foxi solve MODEL.toml|MESH --physics transient --time T (--time-step DT | --steps N)\n"
@@ -212,21 +278,23 @@ int cmd_solve_transient(Args args) {
     throw UsageError("no power: give --power REGION=... (or a model with power loads)");
   for (const TransientPower& p : params.power) params.junctions.push_back(p.region);
 
-  // Each written step: OUT_NNNN.vtu, tracked so that a stop removes the whole series (until the
-  // .pvd, written last, names it).
-  std::vector<std::pair<double, std::string>> written;
+  // Each written step goes to a folder beside OUT (OUT.foxi-tmp-PID-frames: removed on a stop or a
+  // failure, swept as a stale temporary after a kill) and replaces the series of the run before only
+  // when this run is done (commit_series): a stop left the old .pvd naming frames it had deleted, and
+  // a shorter rerun left the old frames past its own.
+  SeriesStaging staging(out);
+  std::vector<std::pair<double, std::string>> written;  // time, the frame's name (OUT's stem + _NNNN.vtu)
   Mesh frame = mesh;
   frame.fields.clear();
   params.on_step = [&](std::size_t step, double time, std::span<const double> temperature) {
     if (step % every != 0 && step != steps) return true;
     char name[32];
     std::snprintf(name, sizeof name, "_%04zu.vtu", written.size());
-    const std::string path = stem + name;
+    const std::string file = std::filesystem::path(stem).filename().string() + name;
     Field f{"temperature", FieldLocation::node, 1, "K", {}, {temperature.begin(), temperature.end()}};
     frame.fields = {std::move(f)};
-    write_vtu(frame, path);
-    cleanup::track(path);
-    written.emplace_back(time, path);
+    write_vtu(frame, staging.folder() / file);
+    written.emplace_back(time, file);
     return true;
   };
   const TransientReport r = solve_transient_thermal(mesh, params);
@@ -288,15 +356,14 @@ int cmd_solve_transient(Args args) {
   {
     std::string pvd =
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
-    for (const auto& [time, path] : written)
-      pvd += "    <DataSet timestep=\"" + csv_number(time) + "\" part=\"0\" file=\"" +
-             std::filesystem::path(path).filename().string() + "\"/>\n";
+    for (const auto& [time, file] : written)
+      pvd += "    <DataSet timestep=\"" + csv_number(time) + "\" part=\"0\" file=\"" + file + "\"/>\n";
     pvd += "  </Collection>\n</VTKFile>\n";
     DurableFile f(out);
     f.write(pvd);
-    cleanup::with_lock([&] {
-      for (const auto& w : written) cleanup::untrack(w.second);
-    });
+    std::vector<std::string> files_written;
+    for (const auto& w : written) files_written.push_back(w.second);
+    staging.commit(files_written);
     f.commit();
   }
   std::printf("wrote %s (%zu steps of temperature [K]) and %s_junction.csv\n", out.c_str(), written.size(),

@@ -3,9 +3,13 @@
 // step's field, Zth(t) rising from 0, the energy check in the JSON, and bad input refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "foxi/viz/png.hpp"
 
@@ -165,6 +169,101 @@ TEST(TransientCli, ZthChartAndStructureFunction) {
       << test::read_text(dir / "euler.log");
   EXPECT_TRUE(std::filesystem::exists(dir / "e_structure.csv")) << test::read_text(dir / "euler.log");
   EXPECT_FALSE(std::filesystem::exists(dir / "c_structure.csv"));
+}
+
+// Rerunning into one OUT.pvd (an outside probe): a shorter run left the old frames past its own, and
+// a stopped run had deleted the old frames while their .pvd stayed. The frames are now written beside
+// OUT and replace the old series when the run ends: after a shorter rerun only its own frames are
+// there; a rerun stopped by SIGINT (status 130) leaves the series before it whole and no temporary.
+TEST(TransientCli, RerunReplacesTheSeriesWholeAndAStopKeepsTheOneBefore) {
+  test::TempDir dir;
+  const std::string model = R"TOML(units.length = "mm"
+[parameters]
+size = "2.5 mm"
+[materials.m]
+thermal_conductivity = 100.0
+density = 1000.0
+specific_heat = 1000.0
+[[parts]]
+name = "blk"
+material = "m"
+shape = "box"
+origin = [0, 0, 0]
+size = [10, 10, 10]
+[[conditions]]
+type = "convection"
+surface = ["blk.top", "blk.bottom", "blk.side"]
+h = "100 W/(m^2*K)"
+ambient = "300 K"
+[[loads]]
+type = "power"
+part = "blk"
+value = "0.6 W"
+[mesh]
+max_size = "size"
+)TOML";
+  test::write_text(dir / "cube.toml", model);
+  const std::string out = (dir / "run.pvd").string(), cube = (dir / "cube.toml").string();
+  auto frames = [&] {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+      if (e.path().extension() == ".vtu") names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  auto temporaries = [&] {
+    int n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+      n += e.path().filename().string().find(".foxi-tmp-") != std::string::npos;
+    return n;
+  };
+  auto named = [&] {  // the files the .pvd names, each of which must exist
+    const std::string pvd = test::read_text(dir / "run.pvd");
+    std::vector<std::string> names;
+    for (std::size_t at = pvd.find("file=\""); at != std::string::npos; at = pvd.find("file=\"", at + 1)) {
+      const std::size_t from = at + 6;
+      names.push_back(pvd.substr(from, pvd.find('"', from) - from));
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  ASSERT_EQ(
+      test::run_cli("solve " + cube + " --physics transient --time 100 --steps 20 --write-every 1 -o " + out,
+                    dir / "a.log"),
+      0)
+      << test::read_text(dir / "a.log");
+  EXPECT_EQ(frames().size(), 21u);
+  ASSERT_EQ(
+      test::run_cli("solve " + cube + " --physics transient --time 100 --steps 4 --write-every 1 -o " + out,
+                    dir / "b.log"),
+      0)
+      << test::read_text(dir / "b.log");
+  const std::vector<std::string> four = {"run_0000.vtu", "run_0001.vtu", "run_0002.vtu", "run_0003.vtu",
+                                         "run_0004.vtu"};
+  EXPECT_EQ(frames(), four);
+  EXPECT_EQ(named(), four);
+  // A long rerun on a finer mesh, stopped once its first frames are written.
+  const std::string cmd =
+      "timeout -s KILL 120 '" + test::cli_path() + "' solve '" + cube +
+      "' --set size=0.5mm --physics transient --time 100 --steps 100000 --write-every 1 -o '" + out +
+      "' > '" + (dir / "c.log").string() + "' 2>&1 & echo $! > '" + (dir / "pid").string() +
+      "'; wait $!; echo $? > '" + (dir / "status").string() + "'";
+  std::thread runner([&] { test::run(cmd); });
+  bool writing = false;
+  for (int i = 0; i < 1200 && !writing; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+      if (e.path().filename().string().find(".foxi-tmp-") != std::string::npos && e.is_directory())
+        for (const auto& f : std::filesystem::directory_iterator(e.path()))
+          writing = writing || f.path().filename() == "run_0003.vtu";
+  }
+  EXPECT_TRUE(writing) << test::read_text(dir / "c.log");
+  test::run("kill -INT " + test::read_text(dir / "pid"));
+  runner.join();
+  EXPECT_EQ(std::stoi(test::read_text(dir / "status")), 130) << test::read_text(dir / "c.log");
+  EXPECT_EQ(frames(), four);
+  EXPECT_EQ(named(), four);
+  EXPECT_EQ(temporaries(), 0);
 }
 
 }  // namespace
