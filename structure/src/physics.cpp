@@ -2,10 +2,22 @@
 #include "foxi/model/physics.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "foxi/model/io_error.hpp"
 
 namespace foxi {
+
+namespace {
+
+std::string format_value(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", v);
+  return text;
+}
+
+}  // namespace
 
 const char* physics_name(Physics physics) {
   switch (physics) {
@@ -72,6 +84,24 @@ void check_physics(const Model& model, Physics physics) {
             throw IoError(model.file, part.line, IoError::kNoOffset,
                           "part '" + part.name + "': material '" + m.name + "' has no " + n.property +
                               ", which --physics " + physics_name(physics) + " needs");
+  // The elastic constants' ranges (the solve refused them only after meshing, and model check said
+  // ready): E > 0, -1 < nu < 0.5 (0.5 is incompressible: lambda infinite), alpha finite.
+  if (physics == Physics::thermal_stress)
+    for (const Part& part : model.parts)
+      for (const Material& m : model.materials) {
+        if (m.name != part.material) continue;
+        auto refuse = [&](const char* property, double value, const char* range) {
+          throw IoError(model.file, part.line, IoError::kNoOffset,
+                        "part '" + part.name + "': material '" + m.name + "' has " + property + " " +
+                            format_value(value) + "; --physics thermoelastic needs " + range);
+        };
+        if (!(m.youngs_modulus > 0) || !std::isfinite(m.youngs_modulus))
+          refuse("youngs_modulus", m.youngs_modulus, "it positive and finite");
+        if (!(m.poisson_ratio > -1 && m.poisson_ratio < 0.5))
+          refuse("poisson_ratio", m.poisson_ratio, "it in (-1, 0.5)");
+        if (!std::isfinite(m.thermal_expansion))
+          refuse("thermal_expansion", m.thermal_expansion, "it finite");
+      }
   bool fixes = false;
   for (const BoundaryCondition& c : model.conditions)
     fixes = fixes || (condition_applies(c, physics) && c.kind != ConditionKind::heat_flux &&

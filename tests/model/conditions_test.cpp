@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "foxi/model/io_error.hpp"
@@ -245,6 +246,37 @@ TEST(ModelConditions, PhysicsNeedsItsMaterialProperties) {
     ADD_FAILURE() << "no error";
   } catch (const foxi::IoError& e) {
     EXPECT_NE(e.reason().find("no [[conditions]] fix the current solution"), std::string::npos) << e.what();
+  }
+}
+
+// Thermal stress needs E > 0, -1 < nu < 0.5 and a finite alpha: model check said "ready" with E = 0
+// or nu = 0.5 and the solve refused them only after meshing, without the file (an outside probe).
+TEST(ModelConditions, ElasticConstantsOutOfRangeAreRefusedBeforeMeshing) {
+  TempDir dir;
+  const std::string elastic =
+      replaced(replaced(kModel, "thermal_conductivity = 10.0",
+                        "thermal_conductivity = 10.0\nyoungs_modulus = \"E\"\npoisson_ratio = \"nu\"\n"
+                        "thermal_expansion = 1e-5"),
+               "electrical_conductivity = 1e3",
+               "electrical_conductivity = 1e3\nyoungs_modulus = 1e9\n"
+               "poisson_ratio = 0.3\nthermal_expansion = 1e-5");
+  const std::string with_slide = elastic + "[[conditions]]\ntype = \"sliding\"\nsurface = \"base\"\n";
+  auto with = [&](const std::string& e, const std::string& nu) {
+    return replaced(with_slide, "t_amb = \"25\"", "t_amb = \"25\"\nE = \"" + e + "\"\nnu = \"" + nu + "\"");
+  };
+  EXPECT_NO_THROW(foxi::check_physics(load(dir, with("70 GPa", "0.3")), foxi::Physics::thermal_stress));
+  for (const auto& [e, nu, what] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"0", "0.3", "youngs_modulus 0"},  // (negative values the model loader refuses)
+           {"70 GPa", "0.5", "poisson_ratio 0.5"},
+           {"70 GPa", "0.7", "poisson_ratio 0.7"}}) {
+    try {
+      foxi::check_physics(load(dir, with(e, nu)), foxi::Physics::thermal_stress);
+      ADD_FAILURE() << "no error for E " << e << ", nu " << nu;
+    } catch (const foxi::IoError& ex) {
+      EXPECT_NE(ex.reason().find("material 'b' has " + what), std::string::npos) << ex.what();
+      EXPECT_NE(ex.reason().find("--physics thermoelastic needs"), std::string::npos) << ex.what();
+      EXPECT_GT(ex.line(), 0u);
+    }
   }
 }
 
