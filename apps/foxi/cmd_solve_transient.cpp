@@ -351,6 +351,8 @@ int cmd_solve_transient(Args args) {
                       : w.kind == PowerWaveform::Kind::pulse ? "pulse"
                                                              : "table",
                       w.kind == PowerWaveform::Kind::step ? w.power : 0.0, r.junction_temperature[j]});
+    if (params.power.size() == 1 && w.kind == PowerWaveform::Kind::step && w.power != 0)
+      curves.back().moment = r.capacity_moment / (w.power * w.power);
   }
   write_transient_charts(stem, r.times, curves, text);
   {

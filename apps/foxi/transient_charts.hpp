@@ -4,6 +4,7 @@
 // OUT_structure.png.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -17,13 +18,18 @@ struct JunctionCurve {
   std::string waveform;    // "step", "pulse", "table"
   double step_power = 0;   // W, for a step (else 0)
   std::vector<double> tj;  // K at each time
+  // K s/W: the body's first moment of Zth, TransientReport::capacity_moment / P^2 (NaN: not known)
+  double moment = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Zth is (Tj(t) - Tj(0)) / P for a step of P != 0 only: a junction with another waveform gets no
 // Zth (a line says so) and, when no junction has a step, the picture is OUT_tj.png with Tj(t) alone.
 // The structure function needs exactly one powered junction with a step (several sources heat each
 // other's junctions, so no single path is described; a line says so), and a Foster fit within 1 %
-// of Zth(end) (else a line says it is not written and why: too few steps). Prints what it wrote.
+// of Zth(end) (else a line says it is not written and why: too few steps) whose first moment, sum R
+// tau, is within 10 % of the body's (`moment`, where the run reached the steady state: steps long
+// against the body's time constants make a discrete Zth with other time constants, which the fit
+// follows). Prints what it wrote.
 void write_transient_charts(const std::string& stem, const std::vector<double>& times,
                             const std::vector<JunctionCurve>& junctions, const TextRenderer& text);
 

@@ -436,7 +436,10 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
     progress(static_cast<double>(n + 1) / static_cast<double>(params.steps));
   }
   for (std::size_t v = 0; v < nn; ++v)
-    if (mass[v] > 0) out.stored_energy += mass[v] * (temp[v] - temp0[v]);
+    if (mass[v] > 0) {
+      out.stored_energy += mass[v] * (temp[v] - temp0[v]);
+      out.capacity_moment += mass[v] * (temp[v] - temp0[v]) * (temp[v] - temp0[v]);
+    }
   // flowed also covers the heat only stored (a body heated with adiabatic walls): the sources count.
   out.heat_flow = flowed;
   // The imbalance beyond what the temperatures' own error can make (noise), against the heat that flowed.

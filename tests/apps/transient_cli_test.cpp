@@ -20,6 +20,34 @@ namespace {
 
 constexpr int kUsage = 2, kBadInput = 3;  // apps/foxi/exit_codes.hpp
 
+// A 10 mm cube of rho c 1e6 J/(m^3 K) (C = 1 J/K), k 1e4 (nearly isothermal: Biot 1e-4), 0.6 W,
+// cooled by h = 100 W/(m^2 K) on its six sides to 300 K: R = 1 / (h A) = 16.67 K/W, tau = R C.
+const std::string kCube = R"TOML(units.length = "mm"
+[parameters]
+size = "2.5 mm"
+[materials.m]
+thermal_conductivity = 1e4
+density = 1000.0
+specific_heat = 1000.0
+[[parts]]
+name = "blk"
+material = "m"
+shape = "box"
+origin = [0, 0, 0]
+size = [10, 10, 10]
+[[conditions]]
+type = "convection"
+surface = ["blk.top", "blk.bottom", "blk.side"]
+h = "100 W/(m^2*K)"
+ambient = "300 K"
+[[loads]]
+type = "power"
+part = "blk"
+value = "0.6 W"
+[mesh]
+max_size = "size"
+)TOML";
+
 TEST(TransientCli, DieOnSubstrateSeriesReadsBackInMeshio) {
   if (test::run("/usr/bin/python3 -c 'import meshio' > /dev/null 2>&1") != 0) GTEST_SKIP() << "no meshio";
   test::TempDir dir;
@@ -177,31 +205,7 @@ TEST(TransientCli, ZthChartAndStructureFunction) {
 // there; a rerun stopped by SIGINT (status 130) leaves the series before it whole and no temporary.
 TEST(TransientCli, RerunReplacesTheSeriesWholeAndAStopKeepsTheOneBefore) {
   test::TempDir dir;
-  const std::string model = R"TOML(units.length = "mm"
-[parameters]
-size = "2.5 mm"
-[materials.m]
-thermal_conductivity = 100.0
-density = 1000.0
-specific_heat = 1000.0
-[[parts]]
-name = "blk"
-material = "m"
-shape = "box"
-origin = [0, 0, 0]
-size = [10, 10, 10]
-[[conditions]]
-type = "convection"
-surface = ["blk.top", "blk.bottom", "blk.side"]
-h = "100 W/(m^2*K)"
-ambient = "300 K"
-[[loads]]
-type = "power"
-part = "blk"
-value = "0.6 W"
-[mesh]
-max_size = "size"
-)TOML";
+  const std::string model = kCube;
   test::write_text(dir / "cube.toml", model);
   const std::string out = (dir / "run.pvd").string(), cube = (dir / "cube.toml").string();
   auto frames = [&] {
@@ -264,6 +268,43 @@ max_size = "size"
   EXPECT_EQ(frames(), four);
   EXPECT_EQ(named(), four);
   EXPECT_EQ(temporaries(), 0);
+}
+
+// The structure function of the cube: one stage, C = 1 J/K at the junction, R = 16.67 K/W, when the
+// steps resolve tau = 16.7 s. Over 1e6 s in 100 steps the discrete Zth has the stepping's time
+// constants (1.3e3 s), which the fit followed within 0.07 %: C 92 J/K was printed at the junction of
+// this 1 J/K body (an outside probe). Its first moment, sum R tau, is then 93 times the body's, sum m
+// (dT / P)^2, and the structure function is not written.
+TEST(TransientCli, StructureFunctionOfALumpedBodyAndStepsTooLongForIt) {
+  test::TempDir dir;
+  test::write_text(dir / "cube.toml", kCube);
+  const std::string cube = (dir / "cube.toml").string();
+  ASSERT_EQ(test::run_cli("solve " + cube + " --physics transient --time 200 --steps 400 --scheme euler -o " +
+                              (dir / "fine.pvd").string(),
+                          dir / "fine.log"),
+            0)
+      << test::read_text(dir / "fine.log");
+  std::istringstream rows(test::read_text(dir / "fine_structure.csv"));
+  std::string line;
+  std::getline(rows, line);
+  ASSERT_TRUE(std::getline(rows, line)) << test::read_text(dir / "fine.log");
+  std::istringstream first(line);
+  double v[5];
+  for (double& x : v) {
+    std::string field;
+    std::getline(first, field, ',');
+    x = std::stod(field);
+  }
+  EXPECT_NEAR(v[2], 1.0, 0.03) << line;  // C at the junction, J/K
+  EXPECT_NEAR(v[1], 16.67, 0.03 * 16.67) << line;
+  ASSERT_EQ(test::run_cli("solve " + cube + " --physics transient --time 1e6 --steps 100 -o " +
+                              (dir / "long.pvd").string(),
+                          dir / "long.log"),
+            0)
+      << test::read_text(dir / "long.log");
+  const std::string log = test::read_text(dir / "long.log");
+  EXPECT_NE(log.find("not written: the fit's first moment"), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(dir / "long_structure.csv"));
 }
 
 }  // namespace

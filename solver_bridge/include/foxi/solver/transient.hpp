@@ -119,6 +119,11 @@ struct TransientReport {
   std::vector<std::vector<double>> junction_temperature;
   std::vector<double> power;  // total power (constant sources + waveforms) at times[n], W
   double stored_energy = 0;   // J, sum m_i (T_i(end) - T_i(0))
+  // J K, sum m_i (T_i(end) - T_i(0))^2. For a step of power P from an equilibrium that reaches the
+  // steady state, P^2 times the first moment of the thermal impedance, int_0^inf (Zth(inf) - Zth(t))
+  // dt (for any RC network: r^T M r with r the transfer resistances), which is sum R tau of a
+  // Foster fit of Zth: the structure function's check.
+  double capacity_moment = 0;
   // J, the heat that entered over the run as the scheme integrates it: sum of dt * (sources + boundary
   // heat in) at each step's end. Euler: equals stored_energy (to the solver's tolerance); BDF2: differs
   // from it by half the difference of the last and the first steps' energy increments (BDF2's
