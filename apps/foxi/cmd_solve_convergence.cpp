@@ -55,7 +55,10 @@ int cmd_solve_convergence(Args args, const std::string& physics) {
     if (physics == "transient") a.insert(a.end(), {"-o", (scratch / ("level" + n + ".pvd")).string()});
     if (physics == "transient" && std::find(pass.begin(), pass.end(), "--write-every") == pass.end())
       a.insert(a.end(), {"--write-every", "1000000000"});
-    RunResults r = run_solve_child(a, scratch / ("level" + n + ".json"), scratch / ("level" + n + ".log"));
+    int exit_status = 0;
+    RunResults r =
+        run_solve_child(a, scratch / ("level" + n + ".json"), scratch / ("level" + n + ".log"), &exit_status);
+    if (exit_status == kExitUsage) throw UsageError(r.error);
     if (r.status == RunStatus::failed) {
       std::fprintf(stderr, "foxi solve: error: level %d (size scale %s) failed: %s\n", k, scale,
                    r.error.c_str());

@@ -153,6 +153,11 @@ int cmd_sweep(Args args) {
   }
   // after "--": options for every run's foxi solve as they are (--temperature-from-thermal, --k ...)
   const std::vector<std::string> solve_options = args.take_after("--");
+  for (const std::string& o : solve_options)
+    if (o == "-o" || o == "--output" || o == "--json" || o.rfind("--json=", 0) == 0)
+      throw UsageError("'" + o +
+                       "' after '--': the sweep writes each run's output and record itself (-o "
+                       "SWEEP.csv, --json goes before '--')");
   const std::string physics = args.option("--physics", "thermal");
   if (physics != "thermal" && physics != "electrostatic" && physics != "current" &&
       physics != "thermoelastic" && physics != "transient")
@@ -267,10 +272,13 @@ int cmd_sweep(Args args) {
   };
   std::fprintf(stderr, "foxi sweep: %zu runs of %s --physics %s, %d at a time\n", total, model.c_str(),
                physics.c_str(), std::min<int>(jobs, int(total)));
+  // A run refused for its options (exit 2: --tol 1, an unknown region in --theta, a bad option after
+  // '--') is refused for every value: the sweep stops and says so (each run failed alike, exit 0).
+  std::string usage_error;
   auto worker = [&] {
     for (std::size_t run; (run = [&] {
                             std::lock_guard lock(print);
-                            return order.next(seconds());
+                            return usage_error.empty() ? order.next(seconds()) : total;
                           }()) < total;) {
       std::vector<std::string> a{model, "--physics", physics};
       for (const std::string& s : run_sets(run)) a.insert(a.end(), {"--set", s});
@@ -282,7 +290,14 @@ int cmd_sweep(Args args) {
       if (physics == "transient" && std::find(pass.begin(), pass.end(), "--write-every") == pass.end())
         a.insert(a.end(), {"--write-every", "1000000000"});
       const auto start = std::chrono::steady_clock::now();
-      RunResults r = run_solve_child(a, scratch / ("run" + n + ".json"), scratch / ("run" + n + ".log"));
+      int exit_status = 0;
+      RunResults r =
+          run_solve_child(a, scratch / ("run" + n + ".json"), scratch / ("run" + n + ".log"), &exit_status);
+      if (exit_status == kExitUsage) {
+        std::lock_guard lock(print);
+        if (usage_error.empty()) usage_error = r.error;
+        continue;
+      }
       if (r.status == RunStatus::failed)
         r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       std::string label;
@@ -310,6 +325,7 @@ int cmd_sweep(Args args) {
   std::vector<std::thread> threads;
   for (int i = 0; i < std::min<int>(jobs, int(total)); ++i) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
+  if (!usage_error.empty()) throw UsageError("the runs' foxi solve refused its options: " + usage_error);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // Columns: the key results of every run, in the order first met.

@@ -128,7 +128,7 @@ std::string self_executable() {
 }
 
 RunResults run_solve_child(const std::vector<std::string>& args, const std::filesystem::path& json,
-                           const std::filesystem::path& log) {
+                           const std::filesystem::path& log, int* exit_status) {
   std::vector<std::string> argv{self_executable(), "solve"};
   argv.insert(argv.end(), args.begin(), args.end());
   // The record comes on the child's stdout (its text then goes nowhere, its stderr to the log), into
@@ -136,6 +136,7 @@ RunResults run_solve_child(const std::vector<std::string>& args, const std::file
   // more on a busy disk) that the run's caller does not need.
   argv.push_back("--json");
   const int rc = run_program(argv, log.string(), json.string());
+  if (exit_status) *exit_status = rc;
   std::error_code ec;
   if (std::filesystem::file_size(json, ec) > 0 && !ec) {
     std::string text;

@@ -55,8 +55,9 @@ std::string self_executable();
 // Runs `foxi solve ARGS --json` as a tracked child process (killed on a stop), its stdout (the
 // record) in `json`, its stderr in `log`, and reads the record. A run that wrote none is a record with status
 // failed and the child's error line ("foxi solve: error: ..." or its last line) as the error.
+// `exit_status`: the child's exit status (2, kExitUsage: its options are wrong, as they are for every run).
 RunResults run_solve_child(const std::vector<std::string>& args, const std::filesystem::path& json,
-                           const std::filesystem::path& log);
+                           const std::filesystem::path& log, int* exit_status = nullptr);
 
 // A folder for child runs' files, STEM-PID-XXXXXX under TMPDIR, removed (with its contents) when the
 // program stops or the guard goes (cleanup::TemporaryFolder).

@@ -451,6 +451,28 @@ TEST(Sweep, OptionsAfterDashDashGoToEveryRun) {
   EXPECT_GT(std::abs(with - without), 1.0);  // a 10x better substrate is a different answer
 }
 
+// Options every run refuses (an outside probe: --tol 1, an unknown --theta region, '-- -o') made a
+// CSV of failed rows with status 0. The sweep is a usage error (2), says the run's reason, and
+// writes no CSV; so is a convergence study's.
+TEST(Sweep, OptionsEveryRunRefusesAreAUsageError) {
+  TempDir dir;
+  const auto csv = dir / "u.csv", log = dir / "u.txt";
+  const std::string sweep =
+      "sweep '" + model("die_on_substrate.toml") + "' --vary die_w=3mm:5mm:3 -o '" + csv.string() + "' ";
+  for (const auto& [options, reason] :
+       std::vector<std::pair<std::string, std::string>>{{"--tol 1", "--tol takes a relative residual"},
+                                                        {"--theta nosuch:die", "no region named 'nosuch'"},
+                                                        {"-- -o x.vtu", "'-o' after '--'"},
+                                                        {"-- --bogus 1", "--bogus"}}) {
+    EXPECT_EQ(test::run_cli(sweep + options, log), 2) << options << "\n" << test::read_text(log);
+    EXPECT_NE(test::read_text(log).find(reason), std::string::npos) << options << "\n"
+                                                                    << test::read_text(log);
+    EXPECT_FALSE(std::filesystem::exists(csv)) << options;
+  }
+  EXPECT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --convergence 2 --tol 1", log), 2)
+      << test::read_text(log);
+}
+
 TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {
   if (!test::have_program("/usr/bin/python3")) GTEST_SKIP() << "no python3";
   TempDir dir;
