@@ -101,7 +101,7 @@ print("indicator", d["error_indicator"])
                                 json);
   SCOPED_TRACE(py);
   EXPECT_NE(py.find("status ok"), std::string::npos);
-  EXPECT_NE(py.find("checks 2 True"), std::string::npos);  // energy, absolute zero
+  EXPECT_NE(py.find("checks 3 True"), std::string::npos);  // energy, absolute zero, resolution
   EXPECT_EQ(number_after(py, "tets"), number_after(text, R"(nodes, )"));
   EXPECT_EQ(number_after(py, "nodes"), number_after(text, "-> "));
   // the text prints 6 significant digits
