@@ -280,7 +280,7 @@ int cmd_solve_transient(Args args) {
 
   // Each written step goes to a folder beside OUT (OUT.foxi-tmp-PID-frames: removed on a stop or a
   // failure, swept as a stale temporary after a kill) and replaces the series of the run before only
-  // when this run is done (commit_series): a stop left the old .pvd naming frames it had deleted, and
+  // when this run is done (SeriesStaging::commit): a stop left the old .pvd naming frames it had deleted, and
   // a shorter rerun left the old frames past its own.
   SeriesStaging staging(out);
   std::vector<std::pair<double, std::string>> written;  // time, the frame's name (OUT's stem + _NNNN.vtu)

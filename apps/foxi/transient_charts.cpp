@@ -116,7 +116,7 @@ void write_transient_charts(const std::string& stem, const std::vector<double>& 
   // The fit's first moment against the body's (at the steady state only: before it, the body's is
   // not the moment). A first step long against the body's time constants gives a discrete Zth whose
   // time constants are the stepping's: 1e6 s in 100 steps put C 92 J/K at the junction of a body of
-  // 1 J/K, the fit within 0.07 % (an outside probe); its moment was 80 times the body's.
+  // 1 J/K, the fit within 0.07 % (an outside probe); its moment was 93 times the body's.
   double fit_moment = 0;
   for (const FosterTerm& f : sf.fit.terms) fit_moment += f.r * f.tau;
   if (sf.settled <= 0.01 && std::isfinite(c.moment) && c.moment > 0 &&

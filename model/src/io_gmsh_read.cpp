@@ -398,8 +398,16 @@ class Reader {
       std::int64_t dim = num<std::int64_t>(cur_, "physical dimension");
       std::int32_t tag = to_i32(num<std::int64_t>(cur_, "physical tag"), at, "physical tag");
       std::string nm = quoted();
-      if (dim == 2) surface_names_[tag] = std::move(nm);
-      if (dim == 3) volume_names_[tag] = std::move(nm);
+      // One tag named twice differently: which name was meant is not known (the last won in silence).
+      if (dim == 2 || dim == 3) {
+        auto& names = dim == 2 ? surface_names_ : volume_names_;
+        const auto [it, fresh] = names.emplace(tag, nm);
+        // (at the name: `at` may be the end of the line before)
+        if (!fresh && it->second != nm)
+          cur_.fail_at(cur_.pos() - 1, "physical " + std::string(dim == 2 ? "surface" : "volume") + " " +
+                                           std::to_string(tag) + " is named twice: '" + it->second +
+                                           "' and '" + nm + "'");
+      }
     }
     cur_.expect("$EndPhysicalNames");
   }
@@ -1051,6 +1059,7 @@ Mesh parse_gmsh(std::string_view bytes, const std::string& name) { return Reader
 
 Mesh read_gmsh(const std::filesystem::path& path) {
   std::string data = io::read_file(path);
+  io::strip_byte_order_mark(data);
   return parse_gmsh(data, path.string());
 }
 

@@ -208,6 +208,7 @@ Mesh parse_medit(std::string_view bytes, const std::string& name) {
 
 Mesh read_medit(const std::filesystem::path& path) {
   std::string bytes = io::read_file(path);
+  io::strip_byte_order_mark(bytes);
   return parse_medit(bytes, path.string());
 }
 

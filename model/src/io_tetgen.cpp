@@ -208,11 +208,14 @@ Mesh parse_tetgen(std::string_view node_text, std::string_view ele_text, std::st
 Mesh read_tetgen(const std::filesystem::path& base) {
   std::string node = io::read_file(with_suffix(base, ".node"));
   std::string ele = io::read_file(with_suffix(base, ".ele"));
+  io::strip_byte_order_mark(node);
+  io::strip_byte_order_mark(ele);
   std::string face;
   std::filesystem::path face_path = with_suffix(base, ".face");
   std::error_code ec;
   if (std::filesystem::exists(face_path, ec)) {
     face = io::read_file(face_path);
+    io::strip_byte_order_mark(face);
     if (face.empty())
       throw IoError(face_path.string(), 1, 0, "empty file, expected the header '<faces> <boundary markers>'");
   }

@@ -28,6 +28,10 @@ IoError::IoError(std::string file, std::uint64_t line, std::uint64_t byte_offset
 
 namespace io {
 
+void strip_byte_order_mark(std::string& text) {
+  if (text.size() >= 3 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
+}
+
 std::string read_file(const std::filesystem::path& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {

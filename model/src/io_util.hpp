@@ -26,6 +26,9 @@ namespace foxi::io {
 
 // Reads a whole file into memory. Throws IoError (line 0) if it cannot be opened or read.
 FOXI_API std::string read_file(const std::filesystem::path& path);
+// Removes a UTF-8 byte order mark at the start of a text file (an editor's or a spreadsheet's; the
+// readers of .msh, .vtk, .mesh and .node refused the file for it).
+FOXI_API void strip_byte_order_mark(std::string& text);
 
 // 1-based line number of byte `offset` in `text` (counts '\n'; a lone '\r' also ends a line).
 FOXI_API std::uint64_t line_of(std::string_view text, std::size_t offset);

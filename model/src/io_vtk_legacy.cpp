@@ -343,6 +343,7 @@ Mesh parse_vtk_legacy(std::string_view bytes, const std::string& name) {
 
 Mesh read_vtk_legacy(const std::filesystem::path& path) {
   std::string bytes = io::read_file(path);
+  io::strip_byte_order_mark(bytes);
   return LegacyReader(bytes, path.string()).read();
 }
 
@@ -366,6 +367,12 @@ void write_vtk_legacy(const Mesh& mesh, const std::filesystem::path& path, bool 
     throw IoError(file, 0, IoError::kNoOffset, "cannot write an inconsistent mesh: " + err);
   const std::size_t nn = mesh.node_count(), nt = mesh.tet_count(), nf = mesh.bface_count();
   const std::size_t ncells = nt + nf;
+  // A legacy array's name is a word: an empty one wrote a file no reader takes back (an outside probe).
+  for (std::size_t i = 0; i < mesh.fields.size(); ++i)
+    if (mesh.fields[i].name.empty())
+      throw IoError(file, 0, IoError::kNoOffset,
+                    "field " + std::to_string(i + 1) +
+                        " has no name, which the legacy VTK format needs (write .vtu, or name it)");
   if (5 * nt + 4 * nf > 0x7fffffffu)
     throw IoError(file, 0, IoError::kNoOffset, "mesh too large for the legacy VTK format");
   std::string out;

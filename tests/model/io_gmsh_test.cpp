@@ -561,6 +561,26 @@ $ElementData
 $EndElementData
 )";
 
+// One physical tag named twice, differently (an outside probe: the last name won in silence): refused
+// at the second name's line. The same name twice is read.
+TEST(GmshRead, PhysicalTagNamedTwiceIsRefused) {
+  std::string twice = kSparse22;
+  const std::string names = "1\n3 4 \"solid\"\n";
+  twice.replace(twice.find(names), names.size(), "2\n3 4 \"solid\"\n3 4 \"other\"\n");
+  try {
+    parse_gmsh(twice, "twice.msh");
+    ADD_FAILURE() << "no error";
+  } catch (const IoError& e) {
+    EXPECT_EQ(e.line(), 7u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("physical volume 4 is named twice: 'solid' and 'other'"),
+              std::string::npos)
+        << e.what();
+  }
+  std::string same = kSparse22;
+  same.replace(same.find(names), names.size(), "2\n3 4 \"solid\"\n3 4 \"solid\"\n");
+  EXPECT_EQ(parse_gmsh(same, "same.msh").tet_count(), 2u);
+}
+
 TEST(GmshRead, SparseNodeTags41) {
   const Mesh m = parse_gmsh(kSparse41, "sparse41.msh");
   ASSERT_EQ(m.node_count(), 5u);

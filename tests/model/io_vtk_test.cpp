@@ -457,6 +457,24 @@ TEST(VtkLegacyWrite, RoundTripAsciiAndBinaryBitForBit) {
   }
 }
 
+// A field without a name wrote "SCALARS" lines no reader takes back (an outside probe): the legacy
+// writer refuses it, naming the field, and writes nothing; .vtu keeps it.
+TEST(VtkLegacyWrite, FieldWithoutANameIsRefused) {
+  TempDir dir;
+  Mesh m = rich_mesh();
+  ASSERT_FALSE(m.fields.empty());
+  m.fields[0].name.clear();
+  try {
+    write_vtk_legacy(m, dir / "n.vtk", false);
+    ADD_FAILURE() << "written";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 1 has no name"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "n.vtk"));
+  write_vtu(m, dir / "n.vtu");
+  EXPECT_EQ(read_vtu(dir / "n.vtu").fields.size(), m.fields.size());
+}
+
 // VTK's own legacy reader (python3-vtk9, what ParaView uses) reads foxi's ASCII file whole: the
 // boundary triangles' rows of a cell field were written "nan", at which VTK's ASCII reader stopped
 // and lost every array after it (an outside probe). They are 0 in ASCII now (NaN in binary).

@@ -2,6 +2,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <vector>
+#include <cmath>
 #include <string>
 
 #include <pugixml.hpp>
@@ -44,7 +46,14 @@ FieldSource read_pvd_source(const std::filesystem::path& path) {
   if (!root || std::string(root.attribute("type").as_string()) != "Collection")
     throw IoError(name, 0, IoError::kNoOffset, "not a ParaView collection (<VTKFile type=\"Collection\">)");
   FieldSource src = mesh_source(path, Mesh{}, "pvd");
-  std::size_t sets = 0;
+  // The data sets in the order of their timesteps, as ParaView reads them (a collection may list them
+  // in another order; an outside probe's steps came out in file order), equal ones in file order.
+  struct DataSet {
+    std::string file;
+    double t = 0;
+    std::size_t line = 0;
+  };
+  std::vector<DataSet> list;
   for (const pugi::xml_node ds : root.child("Collection").children("DataSet")) {
     const std::size_t line = io::line_of(bytes, static_cast<std::size_t>(ds.offset_debug()));
     auto fail = [&](const std::string& why) { throw IoError(name, line, IoError::kNoOffset, why); };
@@ -53,11 +62,20 @@ FieldSource read_pvd_source(const std::filesystem::path& path) {
     if (ds.attribute("part") && ds.attribute("part").as_int() != 0)
       fail("a collection of several parts per step: only one part (part=\"0\") is read");
     const std::string ts = ds.attribute("timestep").as_string();
-    double t = static_cast<double>(sets);
+    double t = static_cast<double>(list.size());
     if (!ts.empty()) {
       auto [p, ec] = std::from_chars(ts.data(), ts.data() + ts.size(), t);
-      if (ec != std::errc() || p != ts.data() + ts.size()) fail("timestep '" + ts + "' is not a number");
+      if (ec != std::errc() || p != ts.data() + ts.size() || !std::isfinite(t))
+        fail("timestep '" + ts + "' is not a number");
     }
+    list.push_back({file, t, line});
+  }
+  std::stable_sort(list.begin(), list.end(), [](const DataSet& a, const DataSet& b) { return a.t < b.t; });
+  std::size_t sets = 0;
+  for (const DataSet& ds : list) {
+    auto fail = [&](const std::string& why) { throw IoError(name, ds.line, IoError::kNoOffset, why); };
+    const std::string& file = ds.file;
+    const double t = ds.t;
     const std::filesystem::path fp =
         std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : path.parent_path() / file;
     Mesh m = read_mesh(fp);  // an IoError names that file
