@@ -355,8 +355,11 @@ void print_thermal_report(const Mesh& mesh, const ThermalReport& r) {
   std::printf("%-24s %-10s %12s %14s %12s\n", "boundaries", "condition", "area m^2", "heat in W", "mean T K");
   double boundary_heat = 0;
   for (const BoundaryHeat& b : r.boundaries) {
-    std::printf("  %-22s %-10s %12.4g %14.6g %12.6g\n", boundary_label(mesh, b.tag).c_str(), b.kind.c_str(),
+    std::printf("  %-22s %-10s %12.4g %14.6g %12.6g", boundary_label(mesh, b.tag).c_str(), b.kind.c_str(),
                 b.area, b.heat_in, b.mean_temperature);
+    // A heat whose round-off bound reaches its sixth digit says how far it is known.
+    if (b.heat_bound > 1e-6 * std::abs(b.heat_in)) std::printf("  (+-%.2g W round-off)", b.heat_bound);
+    std::printf("\n");
     boundary_heat += b.heat_in;
   }
   std::printf("energy balance: sources %.6g W + heat in through the boundaries %.6g W = %.3g W",

@@ -299,12 +299,15 @@ void scatter(const ReducedSystem& r, const std::vector<double>& x, std::vector<d
 
 std::vector<double> slot_reactions(const P1Stiffness& k, const Dirichlet& d, const std::vector<double>& load,
                                    const std::vector<double>& u, const std::vector<double>& row_sum,
-                                   std::size_t slots, std::vector<double>* magnitude) {
+                                   std::size_t slots, std::vector<double>* magnitude,
+                                   std::vector<double>* squares) {
   const std::size_t nn = d.fixed.size();
   std::vector<double> out(slots, 0.0);
   if (magnitude) magnitude->assign(slots, 0.0);
+  if (squares) squares->assign(slots, 0.0);
   if (d.shares.empty()) return out;
-  std::vector<double> reaction(nn, 0.0), terms(magnitude ? nn : 0, 0.0), share_w(nn, 0.0);
+  std::vector<double> reaction(nn, 0.0), terms(magnitude ? nn : 0, 0.0), terms2(squares ? nn : 0, 0.0),
+      share_w(nn, 0.0);
   std::vector<std::uint32_t> share_n(nn, 0);
   for (std::size_t v = 0; v < nn; ++v) {
     if (!d.fixed[v]) continue;
@@ -315,9 +318,12 @@ std::vector<double> slot_reactions(const P1Stiffness& k, const Dirichlet& d, con
     for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i)
       s += k.val[i] * (u[k.pat.col[i]] - u[v]);
     reaction[v] = s;
-    if (magnitude)
-      for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i)
-        terms[v] += std::abs(k.val[i] * u[k.pat.col[i]]);
+    if (magnitude || squares)
+      for (std::size_t i = k.pat.row_start[v]; i < k.pat.row_start[v + 1]; ++i) {
+        const double term = k.val[i] * u[k.pat.col[i]];
+        if (magnitude) terms[v] += std::abs(term);
+        if (squares) terms2[v] += term * term;
+      }
   }
   for (const Dirichlet::Share& s : d.shares) {
     share_w[s.node] += s.area;
@@ -328,6 +334,7 @@ std::vector<double> slot_reactions(const P1Stiffness& k, const Dirichlet& d, con
     const double w = share_w[s.node] > 0 ? s.area / share_w[s.node] : 1.0 / share_n[s.node];
     out[s.slot] += w * reaction[s.node];
     if (magnitude) (*magnitude)[s.slot] += w * terms[s.node];
+    if (squares) (*squares)[s.slot] += w * w * terms2[s.node];
   }
   return out;
 }

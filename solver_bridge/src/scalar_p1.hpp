@@ -115,10 +115,12 @@ std::vector<double> reduced_rhs(const P1Stiffness& k, const ReducedSystem& r, co
 void scatter(const ReducedSystem& r, const std::vector<double>& x, std::vector<double>& u);
 // (K u - load) at the fixed nodes (0 elsewhere), summed into the slots by lumped-area shares; in
 // difference form, with row_sum the exact sum of each row of K (per node; empty: every row sums to 0).
-// `magnitude`: per slot, the same shares of sum_j |K_vj u_j| (what round-off of u is relative to).
+// `magnitude`: per slot, the same shares of sum_j |K_vj u_j| (what round-off of u is relative to);
+// `squares`: of sum_j (K_vj u_j)^2, the shares squared (for independent rounding errors of u).
 std::vector<double> slot_reactions(const P1Stiffness& k, const Dirichlet& d, const std::vector<double>& load,
                                    const std::vector<double>& u, const std::vector<double>& row_sum,
-                                   std::size_t slots, std::vector<double>* magnitude = nullptr);
+                                   std::size_t slots, std::vector<double>* magnitude = nullptr,
+                                   std::vector<double>* squares = nullptr);
 
 // Per tet: coefficient * gradient of the P1 field u (3 values), and volume * c |grad u|^2 summed per
 // region into `energy` (twice the energy), on threads.

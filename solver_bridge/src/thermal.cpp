@@ -121,16 +121,18 @@ ThermalResistance evaluate_resistance(const Mesh& mesh, const ThermalResistanceS
 }
 
 // Energy balance against the heat that flows (what enters, or what leaves if more): with no sources
-// the net boundary heat is ~0 and no scale for itself. `precision` > 0: the temperatures were given
-// rounded to that relative precision (another program's printout), and the tolerance takes in the
-// largest imbalance that rounding can make (each temperature off by precision |T|: the fixed nodes'
-// reactions by sum |K_vj| precision |T_j|, a convection tag's heat by h A precision |T|).
-void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std::vector<double>& temp,
-                  const std::vector<double>& magnitude, double solver_tolerance, double precision,
-                  ThermalReport& rep) {
-  const detail::CsrPattern& pat = sys.stiff.pat;
-  const std::vector<double>& kval = sys.stiff.val;
-  const std::vector<char>& fixed = sys.dir.fixed;
+// the net boundary heat is ~0 and no scale for itself. Each boundary's heat is known to its bound
+// (BoundaryHeat::heat_bound): a fixed tag's reaction sums terms K_vj T_j, each T_j known to 4 eps of
+// itself plus the solve's relative residual (`iterate_error`; a direct solve of an ill-conditioned
+// system, a body cooled by convection alone, leaves 2.5e-13 there), a convection tag's heat
+// h A (T_inf - T) likewise; temperatures given rounded to a relative `precision` (another program's
+// printout) add precision |T_j| to each term, independently: 3 times the root of the sum of squares.
+// The balance counts the imbalance beyond the bounds' sum (a body held at one temperature, or at
+// its convective ambient, balances to round-off; the old floor, 1e-9 of sum K_vv T_v, grew with the
+// conductivity and hid an imbalance of 3e-4 of the flow).
+void energy_check(const Mesh& mesh, const std::vector<double>& temp, const std::vector<double>& magnitude,
+                  const std::vector<double>& squares, double solver_tolerance, double precision,
+                  double iterate_error, ThermalReport& rep) {
   double in = std::max(0.0, rep.total_power), out = std::max(0.0, -rep.total_power);
   rep.imbalance = rep.total_power;
   for (const BoundaryHeat& b : rep.boundaries) {
@@ -138,38 +140,35 @@ void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std:
     (b.heat_in > 0 ? in : out) += std::abs(b.heat_in);
   }
   rep.heat_flow = std::max(in, out);
-  // Where (next to) nothing flows, the reactions are round-off of terms K_vv T_v: measure against
-  // 1e-9 of those, so that a body held at one temperature balances.
-  double terms = 0;
-  for (std::size_t v = 0; v < fixed.size(); ++v)
-    if (fixed[v]) {
-      const auto n = static_cast<std::uint32_t>(v);
-      terms += std::abs(kval[pat.find(n, n)] * temp[v]);
-    }
-  // Each boundary's heat is known to `bound`: a fixed tag's reactions are sums of terms K_vj T_j with
-  // each T_j known to about 4 eps of itself (plus `precision`), a convection tag's heat
-  // h A (T_inf - T) likewise. Where conductivities differ by 1e12 the temperatures of the good
-  // conductor cannot carry its heat (6.8% off, with the balance passing): the resolution check.
-  std::vector<double> bound = magnitude;
-  const double delta = 4 * std::numeric_limits<double>::epsilon() + std::max(precision, 0.0);
-  double rounding = 0, worst = 0, resolved_in = std::max(0.0, rep.total_power),
+  const double delta = 4 * std::numeric_limits<double>::epsilon() + std::max(iterate_error, 0.0);
+  double bounds = 0, resolved_in = std::max(0.0, rep.total_power),
          resolved_out = std::max(0.0, -rep.total_power);
-  for (std::size_t b = 0; b < bound.size(); ++b) {
-    rounding += precision * bound[b];
-    bound[b] *= delta;
-    worst = std::max(worst, bound[b]);
-    // A heat counts as flowing when its bound is under 1% of it (the check's tolerance): an iterative
-    // solve's noise (a body held at one temperature: 2.5 times the bound) does not.
-    const double q = rep.boundaries[b].heat_in;
-    if (std::abs(q) > 100 * bound[b]) (q > 0 ? resolved_in : resolved_out) += std::abs(q);
+  for (std::size_t b = 0; b < rep.boundaries.size(); ++b) {
+    BoundaryHeat& h = rep.boundaries[b];
+    h.heat_bound = delta * magnitude[b] + 3 * std::max(precision, 0.0) * std::sqrt(squares[b]);
+    bounds += h.heat_bound;
+    // A heat counts as flowing when its bound is under 1% of it (the resolution check's tolerance).
+    if (std::abs(h.heat_in) > 100 * h.heat_bound)
+      (h.heat_in > 0 ? resolved_in : resolved_out) += std::abs(h.heat_in);
   }
-  const double resolved = std::max(resolved_in, resolved_out);
-  const double scale = std::max(rep.heat_flow, 1e-9 * terms);
-  double tolerance = std::min(1e-3, std::max(1e-6, 100 * solver_tolerance));  // a loose --tol is no check
-  if (precision > 0 && scale > 0) tolerance = std::max(tolerance, rounding / scale);
-  rep.checks.push_back(make_check("energy",
-                                  "|sources + boundary heat in| / the heat that flows through the body",
-                                  scale > 0 ? std::abs(rep.imbalance) / scale : 0.0, tolerance));
+  const double unexplained = std::max(0.0, std::abs(rep.imbalance) - bounds);
+  const double tolerance =
+      std::min(1e-3, std::max(1e-6, 100 * solver_tolerance));  // a loose --tol is no check
+  rep.checks.push_back(
+      make_check("energy",
+                 "(|sources + boundary heat in| less the heats' round-off bounds) / the heat "
+                 "that flows through the body",
+                 unexplained > 0 ? unexplained / rep.heat_flow : 0.0, tolerance));
+  // Resolution: each boundary's heat known to 1% of itself, or to 1e-6 of the heat that flows where it
+  // is a small part of it. Conductivities 1e12 apart in series gave a heat 6.8% off, and 1e10 apart a
+  // small heat of the wrong sign (+1.6e-4 W for -5e-5 W of a 1 W flow), the balance passing.
+  const double flowing = std::max(resolved_in, resolved_out);
+  double resolution = 0;
+  if (flowing > 0)
+    for (const BoundaryHeat& h : rep.boundaries)
+      if (h.heat_bound > 0)
+        resolution = std::max(resolution, h.heat_bound / std::max(std::abs(h.heat_in), 1e-4 * flowing));
+  const double resolution_figure = resolution;
   // Linear conduction does not bound the temperatures: a power drawn out (negative) past what the
   // conditions can supply gives temperatures at or below 0 K, which no body has (-8e6 K was printed
   // with every check passed). The figure: minus the lowest temperature used by a tet, which must be
@@ -181,14 +180,12 @@ void energy_check(const Mesh& mesh, const detail::ThermalSystem& sys, const std:
                                     "are not physical)",
                                     -lowest, 0, -lowest < 0});
   // The bound adds every term's error with one sign, so it is tens of times the error seen (1e9:1
-  // conductivities: bound 6.5e-4 of the flow, error 1.5e-5): 1% of the flow says the heats are not
-  // known (1e12:1: bound 0.65, error 6.8%; with another program's printout rounded to 6 digits about
-  // 3e-3 is usual).
-  rep.checks.push_back(make_check("resolution",
-                                  "largest round-off bound of a boundary's heat / the heat that flows (the "
-                                  "temperatures' round-off times sum |K_vj T_j|: too large where "
-                                  "conductivities differ by many orders)",
-                                  resolved > 0 ? worst / resolved : 0.0, 1e-2));
+  // conductivities: bound 6.5e-4 of the flow, error 1.5e-5).
+  rep.checks.push_back(
+      make_check("resolution",
+                 "largest round-off bound of a boundary's heat / that heat (or 1e-4 of the heat "
+                 "that flows, if more): too large where conductivities differ by many orders",
+                 resolution_figure, 1e-2));
 }
 
 }  // namespace
@@ -373,9 +370,9 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
 
 void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector<double>& load,
                    const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries,
-                   std::vector<double>* magnitude) {
+                   std::vector<double>* magnitude, std::vector<double>* squares) {
   const std::vector<double> heat =
-      slot_reactions(sys.stiff, sys.dir, load, temp, sys.row_sum, boundaries.size(), magnitude);
+      slot_reactions(sys.stiff, sys.dir, load, temp, sys.row_sum, boundaries.size(), magnitude, squares);
   for (std::size_t i = 0; i < heat.size(); ++i) boundaries[i].heat_in = heat[i];
   for (std::size_t f = 0; f < mesh.bface_count(); ++f) {
     auto it = sys.bc.find(mesh.bface_tag[f]);
@@ -387,10 +384,10 @@ void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector
     } else if (t.kind == BcKind::convection) {
       const double mean = (temp[v[0]] + temp[v[1]] + temp[v[2]]) / 3;
       boundaries[t.report].heat_in += t.a * (t.b - mean) * sys.bface_area[f];
-      if (magnitude)
-        (*magnitude)[t.report] +=
-            t.a * sys.bface_area[f] *
-            (std::max({std::abs(temp[v[0]]), std::abs(temp[v[1]]), std::abs(temp[v[2]])}) + std::abs(t.b));
+      const double ha = t.a * sys.bface_area[f],
+                   hot = std::max({std::abs(temp[v[0]]), std::abs(temp[v[1]]), std::abs(temp[v[2]])});
+      if (magnitude) (*magnitude)[t.report] += ha * (hot + std::abs(t.b));
+      if (squares) (*squares)[t.report] += ha * ha * (hot * hot + t.b * t.b);
     }
   }
 }
@@ -496,11 +493,12 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   detail::scatter(red, x, temp);
 
   // Heat through the boundaries, cell heat flux and per-region temperatures.
-  std::vector<double> magnitude;
-  detail::boundary_heat(mesh, sys, load, temp, rep.boundaries, &magnitude);
+  std::vector<double> magnitude, squares;
+  detail::boundary_heat(mesh, sys, load, temp, rep.boundaries, &magnitude, &squares);
   Field flux_field = detail::region_results(mesh, params, sys, temp, rep);
 
-  energy_check(mesh, sys, temp, magnitude, params.solver.relative_tolerance, 0, rep);
+  energy_check(mesh, temp, magnitude, squares, params.solver.relative_tolerance, 0, lin.relative_residual,
+               rep);
 
   detail::store_temperature(mesh, std::move(temp), std::move(flux_field));
   rep.assembly_seconds = std::chrono::duration<double>(t_assembled - t_start).count();
@@ -520,10 +518,10 @@ ThermalReport thermal_report(Mesh& mesh, const ThermalParams& params, std::vecto
     if (!std::isfinite(temperature[mesh.tet[t]]))
       throw SolverError("thermal_report: node " + std::to_string(mesh.tet[t]) +
                         " of a tet has no temperature");
-  std::vector<double> magnitude;
-  detail::boundary_heat(mesh, sys, sys.load, temperature, rep.boundaries, &magnitude);
+  std::vector<double> magnitude, squares;
+  detail::boundary_heat(mesh, sys, sys.load, temperature, rep.boundaries, &magnitude, &squares);
   Field flux_field = detail::region_results(mesh, params, sys, temperature, rep);
-  energy_check(mesh, sys, temperature, magnitude, params.solver.relative_tolerance, precision, rep);
+  energy_check(mesh, temperature, magnitude, squares, params.solver.relative_tolerance, precision, 0, rep);
   detail::store_temperature(mesh, std::move(temperature), std::move(flux_field));
   rep.solver = "given";
   rep.assembly_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();

@@ -48,9 +48,10 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
 // times K): what each heat's round-off is relative to, the fixed nodes' sum |K_vj temp_j| and a
 // convection tag's h A (|T| + |T_inf|) (a relative error d of the temperatures errs a heat by at
 // most d times it).
+// `squares`: the sums of the squares of those terms (independent rounding errors add so).
 void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector<double>& load,
                    const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries,
-                   std::vector<double>* magnitude = nullptr);
+                   std::vector<double>* magnitude = nullptr, std::vector<double>* squares = nullptr);
 
 // Per-region mean and max temperatures, the overall max, boundary mean temperatures and the
 // resistances of params.resistances into `rep`; returns the cell field "heat_flux".

@@ -89,6 +89,7 @@ struct BoundaryHeat {
   std::string kind;             // "fixed", "flux", "convection"
   double area = 0;              // m^2
   double heat_in = 0;           // W
+  double heat_bound = 0;        // W, the round-off bound of heat_in (the resolution check's)
   double mean_temperature = 0;  // K, area mean of the surface temperature (a case temperature)
 };
 
