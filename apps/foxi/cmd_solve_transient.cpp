@@ -2,6 +2,8 @@
 // the temperature of every written step as OUT_NNNN.vtu with the OUT.pvd collection, and the
 // junction temperatures and Zth(t) against time as OUT_junction.csv, drawn as OUT_zth.png, and the
 // structure function (transient_charts.hpp).
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -30,8 +32,10 @@ namespace foxi::cli {
 
 namespace {
 
-// The frames of a series while it is written: a folder beside OUT.pvd that a stop (cleanup) or a
-// failure (the destructor) removes, and commit(), which puts them in place of the series before.
+// The files of a series while they are written (the frames OUT_NNNN.vtu and the companions
+// OUT_junction.csv, OUT_zth.png or OUT_tj.png, OUT_structure.csv and .png): a folder beside OUT.pvd
+// that a stop (cleanup) or a failure (the destructor) removes, and commit(), which puts them and the
+// .pvd in place of the series before.
 class SeriesStaging {
  public:
   explicit SeriesStaging(const std::string& out) : out_(out) {
@@ -42,7 +46,7 @@ class SeriesStaging {
       std::filesystem::remove_all(folder_, ec);
       if (!std::filesystem::create_directory(folder_, ec))
         throw IoError(folder_.string(), 0, IoError::kNoOffset,
-                      "cannot make the folder for the series' frames: " + ec.message());
+                      "cannot make the folder for the series' files: " + ec.message());
       cleanup::track(folder_, true);
     });
   }
@@ -57,42 +61,100 @@ class SeriesStaging {
   SeriesStaging(const SeriesStaging&) = delete;
   SeriesStaging& operator=(const SeriesStaging&) = delete;
   const std::filesystem::path& folder() const { return folder_; }
+  // Where a file of the series is written first: OUT's stem + `suffix` in the folder.
+  std::string staged(const std::string& suffix) const {
+    return (folder_ / (out_.stem().string() + suffix)).string();
+  }
 
-  // With the cleanup list locked (a stop waits): the old OUT.pvd goes first (so no .pvd names a
-  // half-replaced series), then the old frames (OUT's stem + _NNNN.vtu, the names foxi gives a
-  // series for this OUT), then the new frames are renamed in. The caller writes the new .pvd last.
-  void commit(const std::vector<std::string>& files) {
-    cleanup::with_lock([&] {
-      std::error_code ec;
-      std::filesystem::remove(out_, ec);
-      const std::string prefix = out_.stem().string() + "_";
-      const std::filesystem::path dir = out_.parent_path().empty() ? "." : out_.parent_path();
-      std::vector<std::filesystem::path> old;
-      for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
-        const std::string name = it->path().filename().string();
-        if (name.size() < prefix.size() + 8 || name.compare(0, prefix.size(), prefix) != 0 ||
-            name.compare(name.size() - 4, 4, ".vtu") != 0)
-          continue;
-        const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 4);
-        if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-          old.push_back(it->path());
-      }
-      for (const auto& p : old) std::filesystem::remove(p, ec);
-      for (const std::string& f : files) {
-        std::filesystem::rename(folder_ / f, dir / f, ec);
-        if (ec)
-          throw WriteError((dir / f).string(), 0, IoError::kNoOffset,
-                           "cannot move the frame into place: " + ec.message());
-      }
-      std::filesystem::remove_all(folder_, ec);
-      cleanup::untrack(folder_);
-      folder_.clear();
-    });
+  // All with the cleanup list locked (a stop waits for the whole of it, the .pvd included: a stop in
+  // between left neither series) and the folder flock()ed (two runs to one OUT commit one after the
+  // other, not mixed): first each target is checked to be a plain file or absent (a folder in a
+  // frame's place failed half-way); then the old OUT.pvd goes (no .pvd names a half-replaced series),
+  // the old frames (OUT's stem + _NNNN.vtu, the names foxi gives a series for this OUT) and
+  // companions, the new files are renamed in, and the new .pvd is written last.
+  void commit(const std::string& pvd) {
+    const std::string stem = out_.stem().string();
+    const std::filesystem::path dir = out_.parent_path().empty() ? "." : out_.parent_path();
+    const int lock_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (lock_fd >= 0) (void)::flock(lock_fd, LOCK_EX);
+    try {
+      cleanup::with_lock([&] {
+        std::error_code ec;
+        std::vector<std::string> files;
+        for (std::filesystem::directory_iterator it(folder_, ec), end; !ec && it != end; it.increment(ec))
+          files.push_back(it->path().filename().string());
+        for (const std::string& f : files) {
+          const auto st = std::filesystem::symlink_status(dir / f, ec);
+          if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+            throw WriteError((dir / f).string(), 0, IoError::kNoOffset,
+                             "is not a file; the series is not written (the one before is left as it was)");
+        }
+        std::filesystem::remove(out_, ec);
+        const std::string prefix = stem + "_";
+        std::vector<std::filesystem::path> old;
+        for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+          const std::string name = it->path().filename().string();
+          if (name.size() < prefix.size() + 8 || name.compare(0, prefix.size(), prefix) != 0 ||
+              name.compare(name.size() - 4, 4, ".vtu") != 0)
+            continue;
+          const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 4);
+          if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+            old.push_back(it->path());
+        }
+        for (const char* companion :
+             {"_junction.csv", "_zth.png", "_tj.png", "_structure.csv", "_structure.png"})
+          old.push_back(dir / (stem + companion));
+        for (const auto& p : old) std::filesystem::remove(p, ec);
+        for (const std::string& f : files) {
+          std::filesystem::rename(folder_ / f, dir / f, ec);
+          if (ec)
+            throw WriteError((dir / f).string(), 0, IoError::kNoOffset,
+                             "cannot move the series' file into place: " + ec.message());
+        }
+        DurableFile index(out_);
+        index.write(pvd);
+        index.commit();
+        std::filesystem::remove_all(folder_, ec);
+        cleanup::untrack(folder_);
+        folder_.clear();
+      });
+    } catch (...) {
+      if (lock_fd >= 0) ::close(lock_fd);
+      throw;
+    }
+    if (lock_fd >= 0) ::close(lock_fd);
   }
 
  private:
   std::filesystem::path out_, folder_;
 };
+
+// A file name as an XML attribute value (a .pvd's file="..."): & < > " ' escaped.
+std::string xml_attribute(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
 
 const char* kTransientUsage =
     "foxi solve MODEL.toml|MESH --physics transient --time T (--time-step DT | --steps N)\n"
@@ -339,7 +401,7 @@ int cmd_solve_transient(Args args) {
       }
       csv += '\n';
     }
-    DurableFile f(stem + "_junction.csv");
+    DurableFile f(staging.staged("_junction.csv"));
     f.write(csv);
     f.commit();
   }
@@ -354,19 +416,15 @@ int cmd_solve_transient(Args args) {
     if (params.power.size() == 1 && w.kind == PowerWaveform::Kind::step && w.power != 0)
       curves.back().moment = r.capacity_moment / (w.power * w.power);
   }
-  write_transient_charts(stem, r.times, curves, text);
+  write_transient_charts(staging.staged(""), r.times, curves, text, stem);
   {
     std::string pvd =
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
     for (const auto& [time, file] : written)
-      pvd += "    <DataSet timestep=\"" + csv_number(time) + "\" part=\"0\" file=\"" + file + "\"/>\n";
+      pvd += "    <DataSet timestep=\"" + csv_number(time) + "\" part=\"0\" file=\"" + xml_attribute(file) +
+             "\"/>\n";
     pvd += "  </Collection>\n</VTKFile>\n";
-    DurableFile f(out);
-    f.write(pvd);
-    std::vector<std::string> files_written;
-    for (const auto& w : written) files_written.push_back(w.second);
-    staging.commit(files_written);
-    f.commit();
+    staging.commit(pvd);
   }
   std::printf("wrote %s (%zu steps of temperature [K]) and %s_junction.csv\n", out.c_str(), written.size(),
               stem.c_str());

@@ -272,13 +272,16 @@ int cmd_sweep(Args args) {
   };
   std::fprintf(stderr, "foxi sweep: %zu runs of %s --physics %s, %d at a time\n", total, model.c_str(),
                physics.c_str(), std::min<int>(jobs, int(total)));
-  // A run refused for its options (exit 2: --tol 1, an unknown region in --theta, a bad option after
-  // '--') is refused for every value: the sweep stops and says so (each run failed alike, exit 0).
+  // Runs refused for their options (exit 2: --tol 1, an unknown region in --theta, a bad option after
+  // '--'): when every run is, the sweep is a usage error with their reason and no CSV (it made a CSV
+  // of failed rows, exit 0); when only some are (a --theta interface that only some geometry has),
+  // they are failed rows.
+  std::size_t refused = 0;
   std::string usage_error;
   auto worker = [&] {
     for (std::size_t run; (run = [&] {
                             std::lock_guard lock(print);
-                            return usage_error.empty() ? order.next(seconds()) : total;
+                            return order.next(seconds());
                           }()) < total;) {
       std::vector<std::string> a{model, "--physics", physics};
       for (const std::string& s : run_sets(run)) a.insert(a.end(), {"--set", s});
@@ -295,8 +298,7 @@ int cmd_sweep(Args args) {
           run_solve_child(a, scratch / ("run" + n + ".json"), scratch / ("run" + n + ".log"), &exit_status);
       if (exit_status == kExitUsage) {
         std::lock_guard lock(print);
-        if (usage_error.empty()) usage_error = r.error;
-        continue;
+        if (refused++ == 0) usage_error = r.error;
       }
       if (r.status == RunStatus::failed)
         r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -325,7 +327,7 @@ int cmd_sweep(Args args) {
   std::vector<std::thread> threads;
   for (int i = 0; i < std::min<int>(jobs, int(total)); ++i) threads.emplace_back(worker);
   for (std::thread& t : threads) t.join();
-  if (!usage_error.empty()) throw UsageError("the runs' foxi solve refused its options: " + usage_error);
+  if (refused == total) throw UsageError("every run's foxi solve refused its options: " + usage_error);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // Columns: the key results of every run, in the order first met.

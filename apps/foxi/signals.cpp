@@ -41,6 +41,13 @@ extern "C" void wait_for_stop() {
 void handle_stop_signals(const std::string& program) {
   const sigset_t set = stop_signals();
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  // A reader of the output that went away (foxi solve ... | head -1) killed the run by SIGPIPE with
+  // its temporaries left and its -o file lost (an outside probe): blocked, a write to the closed pipe
+  // fails instead (the printed lines are lost, the files are written).
+  sigset_t pipe;
+  sigemptyset(&pipe);
+  sigaddset(&pipe, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe, nullptr);
   std::atexit(wait_for_stop);
   std::thread([program, set] {
     int sig = 0;

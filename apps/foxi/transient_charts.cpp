@@ -27,7 +27,8 @@ std::string number(double v) {
 }  // namespace
 
 void write_transient_charts(const std::string& stem, const std::vector<double>& times,
-                            const std::vector<JunctionCurve>& junctions, const TextRenderer& text) {
+                            const std::vector<JunctionCurve>& junctions, const TextRenderer& text,
+                            const std::string& shown) {
   Chart zth, tj;
   zth.title = "Thermal impedance Zth(t) = (Tj(t) - Tj(0)) / P";
   zth.x = {"time", "s", true};
@@ -64,7 +65,7 @@ void write_transient_charts(const std::string& stem, const std::vector<double>& 
     draw_chart(fb, text, tj, PixelRect{0, top, kChartWidth - 1, top + kChartHeight - 1});
     write_png(picture, fb);
   }
-  std::printf("wrote %s (%s)\n", picture.c_str(),
+  std::printf("wrote %s (%s)\n", (shown + (with_zth ? "_zth.png" : "_tj.png")).c_str(),
               with_zth ? "Zth against log time, Tj against time" : "Tj against time");
 
   if (stepped.empty()) return;
@@ -171,7 +172,7 @@ void write_transient_charts(const std::string& stem, const std::vector<double>& 
         "run longer (--time) for the whole path\n",
         100 * sf.settled);
   std::printf("wrote %s_structure.csv and %s_structure.png (cumulative C against cumulative R)\n",
-              stem.c_str(), stem.c_str());
+              shown.c_str(), shown.c_str());
   return;
 }
 

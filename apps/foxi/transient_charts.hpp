@@ -30,7 +30,10 @@ struct JunctionCurve {
 // tau, is within 10 % of the body's (`moment`, where the run reached the steady state: steps long
 // against the body's time constants make a discrete Zth with other time constants, which the fit
 // follows). Prints what it wrote.
+// `shown`: the stem the printed lines name (the files may be written elsewhere first: a series'
+// staging folder).
 void write_transient_charts(const std::string& stem, const std::vector<double>& times,
-                            const std::vector<JunctionCurve>& junctions, const TextRenderer& text);
+                            const std::vector<JunctionCurve>& junctions, const TextRenderer& text,
+                            const std::string& shown);
 
 }  // namespace foxi::cli

@@ -323,6 +323,18 @@ TEST_F(SignalsCliSlow, MovieFrames) {
          kTrials);
 }
 
+// A reader of foxi's output that goes away (foxi solve ... | head -1): SIGPIPE killed the run, its -o
+// file lost and a transient's temporaries left (an outside probe). The run goes on, its files are
+// written, its status is its own.
+TEST(SignalsCli, ClosedPipeOnStdoutDoesNotStopTheRun) {
+  test::TempDir dir;
+  const std::string cmd = "bash -c \"'" + test::cli_path() + "' solve '" + test::models_dir() +
+                          "die_on_substrate.toml' -o '" + (dir / "t.vtu").string() +
+                          "' | head -c 1 > /dev/null; exit \\${PIPESTATUS[0]}\"";
+  EXPECT_EQ(test::run(cmd, dir / "log"), 0) << test::read_text(dir / "log");
+  EXPECT_TRUE(fs::exists(dir / "t.vtu"));
+}
+
 TEST_F(SignalsCliSlow, MovieMp4) {
   if (!test::have_program("ffmpeg")) GTEST_SKIP() << "ffmpeg is not installed";
   trials({"movie-mp4",

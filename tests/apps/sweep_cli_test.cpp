@@ -471,6 +471,25 @@ TEST(Sweep, OptionsEveryRunRefusesAreAUsageError) {
   }
   EXPECT_EQ(test::run_cli("solve '" + model("die_on_substrate.toml") + "' --convergence 2 --tol 1", log), 2)
       << test::read_text(log);
+  // An option only some points refuse (the die/substrate interface exists only while the die sits
+  // on the substrate): failed rows, the good one kept, exit 1 (the sweep stopped at the first refusal
+  // and threw the good row away).
+  std::string gap = test::read_text(model("die_on_substrate.toml"));
+  gap.replace(gap.find("[parameters]\n"), 13, "[parameters]\ngap = \"0 mm\"\n");
+  gap.replace(gap.find("\"sub_h\"]", gap.find("name = \"die\"")), 8, "\"sub_h + gap\"]");  // the die's origin
+  test::write_text(dir / "gap.toml", gap);
+  test::write_text(dir / "materials.toml", test::read_text(model("materials.toml")));
+  EXPECT_EQ(test::run_cli("sweep '" + (dir / "gap.toml").string() + "' --vary gap=0mm,0.1mm,0.2mm -o '" +
+                              csv.string() + "' --theta die:substrate/die",
+                          log),
+            1)
+      << test::read_text(log);
+  const auto rows = read_csv(csv);
+  ASSERT_EQ(rows.size(), 4u) << test::read_text(log);
+  const std::size_t st = column(rows[0], "status");
+  EXPECT_EQ(rows[1][st], "ok");
+  EXPECT_EQ(rows[2][st], "failed");
+  EXPECT_EQ(rows[3][st], "failed");
 }
 
 TEST(Sweep, FailedRunIsARowAndTheSweepGoesOn) {

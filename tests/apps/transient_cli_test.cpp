@@ -268,6 +268,31 @@ TEST(TransientCli, RerunReplacesTheSeriesWholeAndAStopKeepsTheOneBefore) {
   EXPECT_EQ(frames(), four);
   EXPECT_EQ(named(), four);
   EXPECT_EQ(temporaries(), 0);
+  // The companions go with the series: a pulse's run (no Zth) leaves no Zth chart or structure
+  // function of the run before (they stayed beside the new series).
+  ASSERT_TRUE(std::filesystem::exists(dir / "run_zth.png"));
+  ASSERT_EQ(
+      test::run_cli("solve " + cube + " --physics transient --time 100 --steps 4 --write-every 1 --power " +
+                        "blk=pulse:1W,10,40 -o " + out,
+                    dir / "d.log"),
+      0)
+      << test::read_text(dir / "d.log");
+  EXPECT_TRUE(std::filesystem::exists(dir / "run_tj.png"));
+  for (const char* gone : {"run_zth.png", "run_structure.csv", "run_structure.png"})
+    EXPECT_FALSE(std::filesystem::exists(dir / gone)) << gone;
+  // A folder where a new frame would go: refused before anything is replaced (it failed half-way,
+  // leaving neither series), exit 1; the series before stays whole.
+  std::filesystem::create_directory(dir / "run_0006.vtu");
+  EXPECT_EQ(
+      test::run_cli("solve " + cube + " --physics transient --time 100 --steps 8 --write-every 1 -o " + out,
+                    dir / "e.log"),
+      1)
+      << test::read_text(dir / "e.log");
+  EXPECT_NE(test::read_text(dir / "e.log").find("run_0006.vtu: is not a file"), std::string::npos)
+      << test::read_text(dir / "e.log");
+  EXPECT_EQ(named(), four);
+  EXPECT_TRUE(std::filesystem::exists(dir / "run_tj.png"));
+  EXPECT_EQ(temporaries(), 0);
 }
 
 // The structure function of the cube: one stage, C = 1 J/K at the junction, R = 16.67 K/W, when the
