@@ -22,6 +22,7 @@
 #include "foxi/solver/model_problem.hpp"
 #include "foxi/solver/results.hpp"
 #include "foxi/solver/transient.hpp"
+#include "io_util.hpp"  // model/src: io::xml_escape
 #include "mesh_input.hpp"
 #include "model_run.hpp"
 #include "run_results.hpp"
@@ -128,33 +129,6 @@ class SeriesStaging {
  private:
   std::filesystem::path out_, folder_;
 };
-
-// A file name as an XML attribute value (a .pvd's file="..."): & < > " ' escaped.
-std::string xml_attribute(const std::string& s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 const char* kTransientUsage =
     "foxi solve MODEL.toml|MESH --physics transient --time T (--time-step DT | --steps N)\n"
@@ -421,7 +395,7 @@ int cmd_solve_transient(Args args) {
     std::string pvd =
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n";
     for (const auto& [time, file] : written)
-      pvd += "    <DataSet timestep=\"" + csv_number(time) + "\" part=\"0\" file=\"" + xml_attribute(file) +
+      pvd += "    <DataSet timestep=\"" + csv_number(time) + "\" part=\"0\" file=\"" + io::xml_escape(file) +
              "\"/>\n";
     pvd += "  </Collection>\n</VTKFile>\n";
     staging.commit(pvd);

@@ -26,6 +26,9 @@ namespace foxi::io {
 
 // Reads a whole file into memory. Throws IoError (line 0) if it cannot be opened or read.
 FOXI_API std::string read_file(const std::filesystem::path& path);
+// Text as XML character data or an attribute value: & < > " escaped, and tab, CR and LF as character
+// references (so an attribute keeps them).
+FOXI_API std::string xml_escape(std::string_view s);
 // Removes a UTF-8 byte order mark at the start of a text file (an editor's or a spreadsheet's; the
 // readers of .msh, .vtk, .mesh and .node refused the file for it).
 FOXI_API void strip_byte_order_mark(std::string& text);

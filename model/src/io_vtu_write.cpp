@@ -29,38 +29,6 @@ namespace {
 
 using namespace vtk;
 
-std::string xml_escape(std::string_view s) {
-  std::string out;
-  for (char ch : s) {
-    switch (ch) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\n':
-        out += "&#10;";
-        break;
-      case '\r':
-        out += "&#13;";
-        break;
-      case '\t':
-        out += "&#9;";
-        break;
-      default:
-        out.push_back(ch);
-    }
-  }
-  return out;
-}
-
 std::string names_attribute(const std::vector<std::pair<std::int32_t, std::string>>& items) {
   std::string s;
   for (const auto& [id, name] : items) {
@@ -188,9 +156,9 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
       if (g.material < mesh.materials.size())
         rm.emplace_back(g.id, material_attribute(mesh.materials[g.material]));
     std::string ra = names_attribute(rn), ba = names_attribute(bn), ma = names_attribute(rm);
-    if (!ra.empty()) r.extra += " foxi_region_names=\"" + xml_escape(ra) + "\"";
-    if (!ma.empty()) r.extra += " foxi_region_materials=\"" + xml_escape(ma) + "\"";
-    if (!ba.empty()) r.extra += " foxi_boundary_names=\"" + xml_escape(ba) + "\"";
+    if (!ra.empty()) r.extra += " foxi_region_names=\"" + io::xml_escape(ra) + "\"";
+    if (!ma.empty()) r.extra += " foxi_region_materials=\"" + io::xml_escape(ma) + "\"";
+    if (!ba.empty()) r.extra += " foxi_boundary_names=\"" + io::xml_escape(ba) + "\"";
     cell_arrays.push_back(std::move(r));
   }
   if (!mesh.weight.empty()) point_arrays.push_back({"weight", VType::f64, 1, mesh.weight.data(), nn, ""});
@@ -203,7 +171,7 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
       a.type = VType::f64;
       a.components = f.components;
       std::span<const double> v = f.step(s, ne);
-      if (!f.unit.empty()) a.extra += " foxi_unit=\"" + xml_escape(f.unit) + "\"";
+      if (!f.unit.empty()) a.extra += " foxi_unit=\"" + io::xml_escape(f.unit) + "\"";
       if (!f.step_values.empty()) {
         std::string sv;
         io::append_double(sv, f.step_values[s]);
@@ -268,7 +236,7 @@ void write_vtu_impl(const Mesh& mesh, const std::filesystem::path& path, VtuEnco
     head += indent;
     head += "<DataArray type=\"";
     head += vtk::xml_type_name(a.type);
-    head += "\" Name=\"" + xml_escape(a.name) + "\"";
+    head += "\" Name=\"" + io::xml_escape(a.name) + "\"";
     if (a.components != 1) head += " NumberOfComponents=\"" + std::to_string(a.components) + "\"";
     head += a.extra;
     const std::size_t nbytes = a.count * vtk::type_size(a.type);
