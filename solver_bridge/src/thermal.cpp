@@ -8,6 +8,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <string>
@@ -368,6 +369,32 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
   return sys;
 }
 
+void require_anchored(const ThermalSystem& sys, const std::string& what) {
+  if (std::find(sys.dir.fixed.begin(), sys.dir.fixed.end(), char(1)) != sys.dir.fixed.end()) return;
+  // Held by convection alone, the body's mean temperature is fixed by sum h A against the conduction
+  // rows' round-off (about eps sum_j |K_vj| T per row, independent: their root sum of squares): the
+  // ratio is the mean's relative error (a 10 mm cube of k 1e4: h 1e-6 estimate 0.036, error 3e-4;
+  // h 1e-5 3.6e-3 and 1.4e-4; h 1e-4 3.6e-4 and 5e-5).
+  double rows = 0, held = 0;
+  for (std::size_t v = 0; v + 1 < sys.stiff.pat.row_start.size(); ++v) {
+    double row = 0;
+    for (std::size_t i = sys.stiff.pat.row_start[v]; i < sys.stiff.pat.row_start[v + 1]; ++i)
+      row += std::abs(sys.stiff.val[i]);
+    rows += row * row;
+  }
+  rows = std::sqrt(rows);
+  for (const double h : sys.row_sum) held += h;
+  const double error = 4 * std::numeric_limits<double>::epsilon() * rows / held;
+  if (!(error > 1e-3)) return;
+  char figure[160];
+  std::snprintf(figure, sizeof figure,
+                "its convection, sum h A = %.3g W/K, holds its temperature to %.2g of itself against the "
+                "round-off of its conduction (sum |K| = %.3g W/K)",
+                held, error, rows);
+  throw SolverError(what + ": the body is held too weakly for double precision: " + figure +
+                    "; give a larger h or a fixed temperature");
+}
+
 void boundary_heat(const Mesh& mesh, const ThermalSystem& sys, const std::vector<double>& load,
                    const std::vector<double>& temp, std::vector<BoundaryHeat>& boundaries,
                    std::vector<double>* magnitude, std::vector<double>* squares) {
@@ -467,6 +494,7 @@ ThermalReport solve_thermal(Mesh& mesh, const ThermalParams& params) {
   const auto t_start = clock::now();
   ThermalReport rep;
   const detail::ThermalSystem sys = detail::assemble_thermal(mesh, params, rep);
+  detail::require_anchored(sys, "steady heat conduction");
   auto progress = [&](std::string_view stage, double fraction) {
     detail::report_progress(params.solver, stage, fraction);
   };

@@ -383,6 +383,29 @@ TEST_F(ThermalTest, BodyAtItsConvectiveAmbientPassesItsChecks) {
   EXPECT_LE(std::abs(r.imbalance), heat_of(r, 1).heat_bound);
 }
 
+// A body held by convection alone, so weakly that double precision cannot fix its temperature (an
+// outside probe: h 1e-8 W/(m^2 K) on a conductor of k 1e4 printed 431.9 K for a 300 K ambient, every
+// check passing): refused, naming the convection and the conduction; a usual h solves to the ambient.
+TEST_F(ThermalTest, BodyHeldTooWeaklyForDoublePrecisionIsRefused) {
+  Mesh m = box_mesh(0.002);
+  ThermalParams p;
+  p.conductivity = {{1, 1e4}};
+  p.sources = {{1, 0.0}};
+  p.solver.kind = LinearSolverKind::direct;
+  p.convection = {{1, 1e-8, 300}};
+  try {
+    solve_thermal(m, p);
+    ADD_FAILURE() << "solved";
+  } catch (const SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find("held too weakly for double precision"), std::string::npos)
+        << e.what();
+  }
+  p.convection = {{1, 10, 300}};
+  const ThermalReport r = solve_thermal(m, p);
+  EXPECT_NEAR(r.max_temperature, 300, 1e-6);
+  for (const BalanceCheck& c : r.checks) EXPECT_TRUE(c.passed) << c.name << " " << c.figure;
+}
+
 // A body held at one temperature moves no heat: every boundary's heat is round-off and every check
 // passes, with a direct solve and an iterative one (whose temperatures carry its residual).
 TEST_F(ThermalTest, BodyHeldAtOneTemperaturePassesItsChecks) {

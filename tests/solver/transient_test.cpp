@@ -300,6 +300,28 @@ TEST(Transient, Bdf2DoesNotOvershootAfterAPulse) {
   EXPECT_FALSE(pulse.jumps_in(5.4e-3, 1.0));  // no third pulse
   EXPECT_FALSE(PowerWaveform::step_of(3).jumps_in(0.0, 1.0));
   EXPECT_TRUE(PowerWaveform::step_of(3).jumps_in(-1.0, 0.0));
+
+  // A table that drops from 3 W to 0 within a microsecond at 5 s (15 J) is such a jump too (it stored
+  // 18.9 J over 7 BDF2 steps; an outside probe); a gentle table is not.
+  PowerWaveform drop;
+  drop.kind = PowerWaveform::Kind::table;
+  drop.table = {{0, 3}, {5, 3}, {5.000001, 0}, {100, 0}};
+  EXPECT_TRUE(drop.jumps_in(4, 6));
+  EXPECT_FALSE(drop.jumps_in(6, 10));
+  PowerWaveform gentle;
+  gentle.kind = PowerWaveform::Kind::table;
+  gentle.table = {{0, 3}, {100, 3.1}};
+  EXPECT_FALSE(gentle.jumps_in(-1, 200));
+  for (const std::size_t steps : {3u, 7u}) {
+    TransientParams q = base(m, 50, 2e6);
+    q.power.push_back({1, drop});
+    q.initial_temperature = 300;
+    q.end_time = 25;
+    q.steps = steps;
+    const TransientReport t = solve_transient_thermal(m, q);
+    expect_balanced(t);
+    EXPECT_NEAR(t.stored_energy, 15 + 1.5e-6, 1e-9 * 15) << steps;  // the drop itself holds 1.5 uJ
+  }
 }
 
 // A power drawn out of a body with adiabatic walls: 300 K - P t / C goes below 0 K with 100 W over 10 s
