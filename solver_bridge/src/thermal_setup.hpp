@@ -45,9 +45,9 @@ ThermalSystem assemble_thermal(const Mesh& mesh, const ThermalParams& params, Th
                                bool require_anchor = true);
 
 // Throws SolverError when nothing but convection holds the body and so weakly that double precision
-// cannot fix its temperature to 1e-3 of itself (an estimate tens to hundreds of times the error seen) (h = 1e-8
-// W/(m^2 K) on a cube of k 1e4 printed 431.9 K for its 300 K ambient with every check passing; an outside
-// probe). `what` names the solve.
+// cannot fix its temperature to 1e-3 of itself, an estimate tens to hundreds of times the error seen
+// (h = 1e-8 W/(m^2 K) on a cube of k 1e4 printed 431.9 K for its 300 K ambient with every check
+// passing; an outside probe). `what` names the solve.
 void require_anchored(const ThermalSystem& sys, const std::string& what);
 
 // Sets boundaries[i].heat_in (W) for the nodal temperatures `temp`: reactions (K temp - load) at the
