@@ -117,7 +117,24 @@ bool parse_int(const std::string& s, std::int32_t& out) {
   return true;
 }
 
+// A name that several boundaries (or regions) share names none of them: `--fix face=300K` fixed the
+// first of two Gmsh physical surfaces called "face" (an outside probe).
+template <class Items, class Id>
+void refuse_shared_name(const Items& items, const std::string& key, Id id, const std::string& option,
+                        const char* what) {
+  std::string ids;
+  int count = 0;
+  for (const auto& item : items)
+    if (item.name == key && !key.empty()) {
+      ids += (count++ ? " and " : "") + std::to_string(id(item));
+    }
+  if (count > 1)
+    throw UsageError(option + ": the name '" + key + "' names the " + what + " " + ids + "; give the number");
+}
+
 std::int32_t boundary_tag(const Mesh& mesh, const std::string& key, const std::string& option) {
+  refuse_shared_name(
+      mesh.boundaries, key, [](const Boundary& b) { return b.tag; }, option, "boundaries");
   if (const auto tag = boundary_tag_of(mesh, key)) return *tag;
   std::string names;
   for (const Boundary& b : mesh.boundaries)
@@ -127,6 +144,8 @@ std::int32_t boundary_tag(const Mesh& mesh, const std::string& key, const std::s
 }
 
 std::int32_t region_id(const Mesh& mesh, const std::string& key, const std::string& option) {
+  refuse_shared_name(
+      mesh.regions, key, [](const Region& r) { return r.id; }, option, "regions");
   if (const auto id = region_id_of(mesh, key)) return *id;
   throw UsageError(option + ": no region named '" + key + "'");
 }

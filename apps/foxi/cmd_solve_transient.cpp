@@ -244,6 +244,7 @@ int cmd_solve_transient(Args args) {
     throw UsageError("--physics transient writes a series: give -o OUT.pvd");
   check_output_path(out);
   const std::string stem = out.substr(0, out.size() - 4);
+  check_output_path(stem + "_000000.vtu");  // the frames' names (and their temporaries) fit too
   std::vector<std::pair<std::string, PowerWaveform>> waves;
   for (const std::string& s : power) {
     auto [k, v] = split_assignment(s, "--power");

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
@@ -70,6 +71,14 @@ void check_output_path(const std::filesystem::path& path) {
   if (path.empty()) throw IoError("", 0, IoError::kNoOffset, "empty output file name");
   if (std::filesystem::is_directory(path, ec))
     throw IoError(path.string(), 0, IoError::kNoOffset, "is a folder, not a file to write");
+  // Written through NAME.foxi-tmp-PID-RANDOM: a name a file system takes can still be too long for
+  // that (a 229-character name failed after the work).
+  if (path.filename().string().size() + 32 > NAME_MAX)
+    throw IoError(
+        path.string(), 0, IoError::kNoOffset,
+        "the file name is too long: foxi writes it through a temporary of 32 more characters, and a "
+        "name has at most " +
+            std::to_string(NAME_MAX));
   const std::filesystem::path folder = folder_of(path);
   const auto st = std::filesystem::status(folder, ec);
   if (!std::filesystem::exists(st))

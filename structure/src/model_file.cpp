@@ -459,8 +459,11 @@ class Loader {
                                         "relative_permittivity, youngs_modulus, poisson_ratio, "
                                         "thermal_expansion, density, specific_heat, source, note)"};
         const double x = quantity(v, d, entity, 1).value;
-        if (!(x >= 0) && k != "thermal_expansion")
-          throw Located{line_of(v), entity + " must not be negative"};
+        // Negative: a thermal expansion can be (Invar near 0, some ceramics below), and a Poisson ratio
+        // down to -1 (auxetic foams: --nu took them, the model file refused them).
+        if (k == "poisson_ratio" ? !(x > -1) : (!(x >= 0) && k != "thermal_expansion"))
+          throw Located{line_of(v),
+                        entity + (k == "poisson_ratio" ? " must be above -1" : " must not be negative")};
         *field = x;
       }
       if (from_library && materials_.count(name)) continue;  // the model's own definition wins

@@ -331,6 +331,14 @@ TEST(StructureBadInput, DensityAndSpecificHeatTakeUnits) {
                                    "thermal_conductivity = \"2 W/(m*K)\"\nspecific_heat = -1");
   const foxi::IoError n = load_error(neg);
   EXPECT_NE(n.reason().find("must not be negative"), std::string::npos) << n.what();
+  // A Poisson ratio takes (-1, ...]: auxetic materials are negative (the model file refused -0.3,
+  // which --nu took); -1 and below are refused.
+  const std::string auxetic = replaced(kGood, "thermal_conductivity = \"2 W/(m*K)\"",
+                                       "thermal_conductivity = \"2 W/(m*K)\"\npoisson_ratio = -0.3");
+  foxi::test::write_text(dir / "a.toml", auxetic);
+  EXPECT_NEAR(foxi::load_model(dir / "a.toml").materials[0].poisson_ratio, -0.3, 1e-15);
+  const foxi::IoError q = load_error(replaced(auxetic, "poisson_ratio = -0.3", "poisson_ratio = -1"));
+  EXPECT_NE(q.reason().find("must be above -1"), std::string::npos) << q.what();
 }
 
 TEST(StructureBadInput, UnknownParameterIsNamed) {

@@ -114,6 +114,19 @@ TEST_F(SolveCliTest, BadInputGivesClearErrors) {
   EXPECT_EQ(foxi("solve " + mesh() + " --physics magic --fix 1=300 --k 1=1"), 2);
   EXPECT_EQ(foxi("solve " + mesh() + " --fix 1=300 --k 1=1 --solver nope"), 2);
   EXPECT_EQ(foxi("solve --help"), 0);
+  // A name two boundaries share names neither (--fix fixed the first of two Gmsh surfaces "face";
+  // an outside probe): a usage error naming both tags; the tags themselves work.
+  Mesh m = read_mesh(dir_ / "cube.1.node");
+  m.boundaries = {{1, "face"}, {2, "face"}, {3, "rest"}};
+  m.regions = {{1, "solid", kNone}};
+  write_mesh(m, dir_ / "named.vtu");
+  const std::string named = "'" + (dir_ / "named.vtu").string() + "'";
+  EXPECT_EQ(foxi("solve " + named + " --fix face=300 --k solid=1"), 2);
+  EXPECT_NE(test::read_text(dir_ / "out.log").find("the name 'face' names the boundaries 1 and 2"),
+            std::string::npos)
+      << test::read_text(dir_ / "out.log");
+  EXPECT_EQ(foxi("solve " + named + " --fix 1=300 --fix 2=400 --k solid=1"), 0)
+      << test::read_text(dir_ / "out.log");
 }
 
 // Thermal stress from the command line on a 1 x 0.6 x 0.4 box (tags 1..6: x = 0, x = 1, y = 0,
