@@ -390,6 +390,12 @@ TransientReport solve_transient_thermal(Mesh& mesh, const TransientParams& param
       out.solver = solver->name();
       setup_seconds += std::chrono::duration<double>(clock::now() - t0).count();
     }
+    // Steps of power have no jump after t = 0: Euler's solver (its factor or hierarchy) is not needed
+    // again once BDF2 runs.
+    if (use_bdf2 && solvers[0] &&
+        std::all_of(params.power.begin(), params.power.end(),
+                    [](const TransientPower& w) { return w.power.kind == PowerWaveform::Kind::step; }))
+      solvers[0].reset();
     for (std::size_t v = 0; v < nn; ++v) hist[v] = use_bdf2 ? 2 * temp[v] - 0.5 * previous[v] : temp[v];
     // The power over the step, not its value at the step's end: a pulse shorter than a step, or one
     // between two step ends, was missed or counted a whole step (an outside probe: 10 pulses of 3 W
