@@ -322,6 +322,19 @@ TEST(Transient, Bdf2DoesNotOvershootAfterAPulse) {
     expect_balanced(t);
     EXPECT_NEAR(t.stored_energy, 15 + 1.5e-6, 1e-9 * 15) << steps;  // the drop itself holds 1.5 uJ
   }
+  // A ramp from 0 to 3 W over 2 s, then held: 12 J by 5 s. The BDF2 step after the Euler restart at
+  // the ramp's top centres its power window too (one starting where Euler's ended stored 11.917 J).
+  PowerWaveform ramp;
+  ramp.kind = PowerWaveform::Kind::table;
+  ramp.table = {{0, 0}, {2, 3}, {100, 3}};
+  TransientParams q = base(m, 50, 2e6);
+  q.power.push_back({1, ramp});
+  q.initial_temperature = 300;
+  q.end_time = 5;
+  q.steps = 10;
+  const TransientReport t = solve_transient_thermal(m, q);
+  expect_balanced(t);
+  EXPECT_NEAR(t.stored_energy, 12, 1e-9 * 12);
 }
 
 // A power drawn out of a body with adiabatic walls: 300 K - P t / C goes below 0 K with 100 W over 10 s
