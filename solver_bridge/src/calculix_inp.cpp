@@ -100,15 +100,9 @@ void write_nodes_and_elements(std::FILE* out, const Mesh& mesh, const std::vecto
 void refuse_tets_too_small_for_ccx(const Mesh& mesh) {
   double smallest = std::numeric_limits<double>::infinity();
   std::size_t at = 0;
+  std::array<std::array<double, 3>, 4> g;
   for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
-    const double* p[4];
-    for (int k = 0; k < 4; ++k) p[k] = &mesh.xyz[3 * std::size_t{mesh.tet[4 * t + std::size_t(k)]}];
-    double e[3][3];
-    for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) e[a][c] = p[a + 1][c] - p[0][c];
-    const double six_v = std::abs(e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-                                  e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                                  e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]));
+    const double six_v = std::abs(6 * detail::p1_gradients(mesh, t, g));
     if (six_v < smallest) smallest = six_v, at = t;
   }
   if (smallest < 1e-19) {
